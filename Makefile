@@ -1,0 +1,34 @@
+# rotorguard: the two commands a fresh machine needs are `make demo` and `make test`.
+BUILD_DIR ?= build
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+ROTORGUARD_WARNINGS_AS_ERRORS ?= OFF
+DEMO_SCENARIO ?= configs/scenarios/lemniscate_2ms.yaml
+DEMO_OUT ?= out/demo
+
+.PHONY: all deps configure build demo test bench clean
+
+all: build
+
+deps:
+	@./scripts/install-deps.sh
+
+configure: deps
+	@mkdir -p $(BUILD_DIR)
+	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release \
+	  -DROTORGUARD_WARNINGS_AS_ERRORS=$(ROTORGUARD_WARNINGS_AS_ERRORS) > $(BUILD_DIR)/configure.log 2>&1 \
+	  || (cat $(BUILD_DIR)/configure.log; exit 1)
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+demo: build
+	./$(BUILD_DIR)/bin/rotorguard run $(DEMO_SCENARIO) --out $(DEMO_OUT)
+
+test: build
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+bench: build
+	./$(BUILD_DIR)/bin/rotorguard bench sim --json
+
+clean:
+	rm -rf $(BUILD_DIR)

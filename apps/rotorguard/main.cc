@@ -1,0 +1,223 @@
+// rotorguard: the command-line interface. It parses and validates arguments, calls the libraries
+// and prints; no algorithm lives here. Exit codes (DESIGN.md): 0 success; 1 the run failed;
+// 2 usage or invalid config; 3 an input file is unreadable; 4 an infeasible request.
+#include <unistd.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "rotorguard/bench/runner.h"
+#include "rotorguard/bench/scenario.h"
+#include "rotorguard/bench/sim_bench.h"
+#include "rotorguard/io/config_node.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using rotorguard::bench::Override;
+
+enum ExitCode : int { kOk = 0, kRunFailed = 1, kUsage = 2, kUnreadable = 3, kInfeasible = 4 };
+
+/// A command-line value that is not acceptable: exit 2 with this message.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Strict unsigned integer: digits only, no sign, no exponent, in range.
+std::uint64_t ParseUnsigned(const std::string& option, const std::string& text, std::uint64_t lo,
+                            std::uint64_t hi) {
+  std::uint64_t v = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || v < lo || v > hi) {
+    throw UsageError(fmt::format("{}: '{}' is invalid; expected an integer in [{}, {}]", option, text, lo, hi));
+  }
+  return v;
+}
+
+/// Strict finite double in [lo, hi]; rejects nan, inf, 1e999 (overflow), trailing garbage.
+double ParseFinite(const std::string& option, const std::string& text, double lo, double hi) {
+  double v = 0.0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(v) ||
+      v < lo || v > hi) {
+    throw UsageError(fmt::format("{}: '{}' is invalid; expected a finite number in [{:g}, {:g}]", option,
+                                 text, lo, hi));
+  }
+  return v;
+}
+
+std::vector<Override> ParseOverrides(const std::vector<std::string>& sets) {
+  std::vector<Override> out;
+  for (const std::string& s : sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw UsageError(fmt::format("--set: '{}' is invalid; expected key.path=value", s));
+    }
+    out.emplace_back(s.substr(0, eq), s.substr(eq + 1));
+  }
+  return out;
+}
+
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, double duration_s) : enabled_(enabled), duration_s_(duration_s) {}
+  void operator()(double fraction) {
+    if (!enabled_) return;
+    const int width = 40;
+    const int filled = static_cast<int>(fraction * width + 0.5);
+    std::fprintf(stderr, "\r[%s%s] %3.0f%%  t = %.1f / %.1f s", std::string(filled, '#').c_str(),
+                 std::string(width - filled, ' ').c_str(), 100.0 * fraction, fraction * duration_s_,
+                 duration_s_);
+    if (fraction >= 1.0) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_;
+  double duration_s_;
+};
+
+void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out_dir) {
+  std::string faults;
+  for (const auto& f : s.faults) {
+    faults += fmt::format("{}rotor {} {} at {:.3f} s", faults.empty() ? "" : "; ", f.rotor, f.kind, f.onset_s);
+  }
+  fmt::print("scenario          {}\n", s.scenario);
+  fmt::print("outcome           {}\n", s.success ? "success" : "FAILED: " + s.crash_reason);
+  fmt::print("simulated         {:.2f} s in {:.2f} s wall ({:.0f}x real time)\n", s.sim_time_s, s.wall_time_s,
+             s.realtime_factor);
+  fmt::print("tracking RMSE     {:.3f} m (max error {:.3f} m)\n", s.tracking_rmse_m, s.max_position_error_m);
+  fmt::print("min altitude      {:.3f} m\n", s.min_altitude_m);
+  fmt::print("max spin          {:.2f} rad/s\n", s.max_spin_rad_s);
+  fmt::print("faults            {}\n", faults.empty() ? "none" : faults);
+  fmt::print("seed              {}\n", s.seed);
+  if (!out_dir.empty()) {
+    fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());
+    fmt::print("summary           {}\n", (fs::path(out_dir) / "summary.json").string());
+  }
+}
+
+std::string DefaultBenchScenario() {
+  const std::string rel = "configs/scenarios/lemniscate_2ms.yaml";
+  if (fs::exists(rel)) return rel;
+  return (fs::path(ROTORGUARD_SOURCE_DIR) / rel).string();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rotorguard: multirotor flight stack and simulator that keeps flying after rotor failures.\n"
+               "Exit codes: 0 success; 1 the run failed (crash); 2 usage or invalid config;\n"
+               "3 an input file is unreadable; 4 an infeasible request.",
+               "rotorguard"};
+  app.set_version_flag("--version", std::string(ROTORGUARD_VERSION));
+  app.require_subcommand(1);
+
+  // run
+  std::string scenario_path, out_dir, seed_text;
+  std::vector<std::string> sets;
+  bool quiet = false;
+  CLI::App* run = app.add_subcommand("run", "Fly a scenario; write DIR/log.csv and DIR/summary.json.\n"
+                                            "Exit 0 when the mission succeeds, 1 when it fails (crash).");
+  run->add_option("scenario", scenario_path, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
+  run->add_option("--out", out_dir, "Output folder (default: out/<scenario name>)");
+  run->add_option("--set", sets,
+                  "Override a value: key.path=value (e.g. duration_s=5, faults.0.rotor=2, vehicle.mass_kg=1.2); "
+                  "the key must exist in the file. Repeatable.");
+  run->add_option("--seed", seed_text, "Random seed, an integer in [0, 2^64-1] (overrides the file's seed)");
+  run->add_flag("--quiet,-q", quiet, "No progress bar and no summary table");
+
+  // validate
+  std::string validate_path;
+  CLI::App* validate = app.add_subcommand("validate", "Check a scenario or vehicle file without flying it.\n"
+                                                      "Exit 0 when valid, 2 when invalid, 3 when unreadable.");
+  validate->add_option("file", validate_path, "Scenario or vehicle file (YAML)")->required();
+
+  // bench
+  CLI::App* bench = app.add_subcommand("bench", "Benchmarks; results as a table or JSON.");
+  bench->require_subcommand(1);
+  std::string bench_scenario = "", duration_text = "60", repetitions_text = "5";
+  bool json = false;
+  CLI::App* bench_sim = bench->add_subcommand(
+      "sim", "Closed-loop simulation speed: the 2 m/s lemniscate with all sensors and the nominal "
+             "controller. Reports the median realtime_factor and steps_per_s (target >= 200x real time).");
+  bench_sim->add_option("--scenario", bench_scenario, "Scenario to fly (default: configs/scenarios/lemniscate_2ms.yaml)");
+  bench_sim->add_option("--duration", duration_text, "Simulated seconds per repetition (default 60)");
+  bench_sim->add_option("--repetitions", repetitions_text, "Repetitions; the median is reported (default 5)");
+  bench_sim->add_flag("--json", json, "Print JSON instead of a table");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kUsage;
+  }
+
+  try {
+    if (*run) {
+      std::vector<Override> overrides = ParseOverrides(sets);
+      std::optional<std::uint64_t> seed;
+      if (!seed_text.empty()) seed = ParseUnsigned("--seed", seed_text, 0, UINT64_MAX);
+      rotorguard::bench::Scenario scenario = rotorguard::bench::LoadScenario(scenario_path, overrides);
+      if (seed) scenario.seed = *seed;
+      if (out_dir.empty()) out_dir = (fs::path("out") / scenario.name).string();
+      std::error_code ec;
+      fs::create_directories(out_dir, ec);
+      if (ec || !fs::is_directory(out_dir)) {
+        throw UsageError(fmt::format("--out: cannot create folder '{}'{}", out_dir, ec ? ": " + ec.message() : ""));
+      }
+      ProgressBar bar(!quiet && ::isatty(STDERR_FILENO), scenario.duration_s);
+      rotorguard::bench::RunOptions options;
+      options.out_dir = out_dir;
+      options.progress = [&bar](double f) { bar(f); };
+      const rotorguard::bench::RunSummary summary = rotorguard::bench::RunScenario(scenario, options);
+      if (!quiet) PrintSummary(summary, out_dir);
+      return summary.success ? kOk : kRunFailed;
+    }
+    if (*validate) {
+      const rotorguard::bench::ValidationReport r = rotorguard::bench::ValidateConfigFile(validate_path);
+      fmt::print("{}: valid {} ({})\n", validate_path, r.kind, r.summary);
+      return kOk;
+    }
+    if (*bench_sim) {
+      rotorguard::bench::SimBenchOptions o;
+      o.duration_s = ParseFinite("--duration", duration_text, 1e-3, 1e5);
+      o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", repetitions_text, 1, 1000));
+      const std::string path = bench_scenario.empty() ? DefaultBenchScenario() : bench_scenario;
+      const nlohmann::json result = rotorguard::bench::RunSimBenchmark(rotorguard::bench::LoadScenario(path), o);
+      if (json) {
+        fmt::print("{}\n", result.dump(2));
+      } else {
+        fmt::print("scenario          {}\n", result["scenario"].get<std::string>());
+        fmt::print("realtime_factor   {:.1f}x (median of {})\n", result["realtime_factor"].get<double>(), o.repetitions);
+        fmt::print("steps_per_s       {:.0f}\n", result["steps_per_s"].get<double>());
+        fmt::print("cpu               {}\n", result["host"]["cpu"].get<std::string>());
+      }
+      return result["crashed"].get<bool>() ? kRunFailed : kOk;
+    }
+  } catch (const UsageError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kUsage;
+  } catch (const rotorguard::io::ConfigError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kUsage;
+  } catch (const rotorguard::io::InputFileError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kUnreadable;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kRunFailed;
+  }
+  return kUsage;
+}

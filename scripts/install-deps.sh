@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs every Debian package rotorguard builds, tests and runs with.
+# Idempotent: does nothing (and needs no network or root) when all are present.
+# Works as root or through sudo.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev        # linear algebra (core, vehicle, control)
+  libyaml-cpp-dev      # scenario and vehicle files (io)
+  libcli11-dev         # command-line parsing (apps/rotorguard)
+  nlohmann-json3-dev   # summary.json, bench output (io, bench)
+  libfmt-dev           # formatting in messages and logs
+  libgtest-dev libgmock-dev  # tests
+  libbenchmark-dev     # micro-benchmarks
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+if [ "$(id -u)" -eq 0 ]; then
+  sudo=()
+elif command -v sudo >/dev/null 2>&1; then
+  sudo=(sudo)
+else
+  echo "install-deps: missing packages (${missing[*]}) and neither root nor sudo is available" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -qq
+"${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

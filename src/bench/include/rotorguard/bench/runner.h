@@ -1,0 +1,53 @@
+#pragma once
+/// Flies a scenario: the simulator and the flight stack in closed loop, exchanging only sensor
+/// messages and rotor commands. Writes log.csv and summary.json when given an output folder.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/bench/scenario.h"
+
+namespace rotorguard::bench {
+
+struct FaultRecord {
+  int rotor = 0;
+  std::string kind;
+  double onset_s = 0.0;
+};
+
+/// The outcome of one run; the fields of summary.json (DESIGN.md keys; later features add keys).
+struct RunSummary {
+  std::string scenario;
+  std::uint64_t seed = 0;
+  bool success = false;
+  bool crashed = false;
+  std::string crash_reason;     ///< "" when not crashed
+  double sim_time_s = 0.0;
+  double wall_time_s = 0.0;
+  double realtime_factor = 0.0;
+  double tracking_rmse_m = 0.0;
+  double tracking_rmse_eq37_m = 0.0;  ///< paper 000's eq. (37), for comparison with its figures
+  double max_position_error_m = 0.0;
+  double min_altitude_m = 0.0;  ///< after the first fault onset when there is one, else whole run
+  double max_spin_rad_s = 0.0;  ///< largest |yaw rate| of the body
+  std::vector<FaultRecord> faults;
+  std::uint64_t physics_steps = 0;
+  std::uint64_t control_cycles = 0;
+
+  nlohmann::json ToJson() const;
+};
+
+struct RunOptions {
+  std::string out_dir;  ///< "" writes nothing
+  /// Called about every 1 % of simulated time with the completed fraction in [0, 1].
+  std::function<void(double)> progress;
+};
+
+/// Runs the scenario to its duration or to a crash. Throws std::runtime_error when an output
+/// file cannot be written (nothing half-written is left behind).
+RunSummary RunScenario(const Scenario& scenario, const RunOptions& options = {});
+
+}  // namespace rotorguard::bench

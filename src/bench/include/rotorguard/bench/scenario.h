@@ -1,0 +1,58 @@
+#pragma once
+/// Scenario files: vehicle, world, mission, faults, sensors, stack choice, duration, seed.
+/// Loading is strict (unknown, duplicate, missing and non-finite values are errors with file, line
+/// and key path); see docs/scenarios.md for every key.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rotorguard/core/trajectory.h"
+#include "rotorguard/sim/fault_injector.h"
+#include "rotorguard/sim/simulator.h"
+#include "rotorguard/sim/world.h"
+#include "rotorguard/stack/flight_stack.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::bench {
+
+struct Scenario {
+  std::string name;
+  std::string file;           ///< the scenario file it came from ("" when built in code)
+  std::string vehicle_file;
+  double duration_s = 10.0;
+  std::uint64_t seed = 1;
+  vehicle::VehicleParams vehicle;
+  sim::World world;
+  Vector3 initial_position_m = Vector3::Zero();
+  double initial_yaw_rad = 0.0;
+  std::string mission_type;   ///< hover, takeoff, lemniscate, circle, waypoints
+  std::shared_ptr<const ReferenceTrajectory> reference;
+  std::vector<sim::FaultSpec> faults;
+  sim::SimulatorOptions sim;
+  stack::FlightStackOptions stack;
+  double log_rate_hz = 100.0;       ///< rows per second in log.csv
+  double tracking_start_s = 0.0;    ///< tracking metrics cover [tracking_start_s, end]
+};
+
+/// A `--set key.path=value` override. Paths starting with "vehicle." apply to the vehicle file.
+using Override = std::pair<std::string, std::string>;
+
+/// Loads and validates a scenario file. Throws io::ConfigError (bad content, with file, line and
+/// key path) or io::InputFileError (a file that cannot be read).
+Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides = {});
+
+/// Loads and validates a vehicle file (same error contract).
+vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Override>& overrides = {});
+
+/// What `rotorguard validate` found in a file.
+struct ValidationReport {
+  std::string kind;     ///< "scenario" or "vehicle"
+  std::string summary;  ///< one line describing the content
+};
+/// Validates any config file, recognising its kind from its keys. Same error contract.
+ValidationReport ValidateConfigFile(const std::string& path);
+
+}  // namespace rotorguard::bench

@@ -1,0 +1,203 @@
+#include "rotorguard/bench/runner.h"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "rotorguard/bench/metrics.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/io/files.h"
+#include "rotorguard/sim/simulator.h"
+#include "rotorguard/stack/flight_stack.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace rotorguard::bench {
+
+namespace {
+using vehicle::StateView;
+
+// Fault column codes in log.csv (docs/outputs.md).
+int FaultCode(vehicle::FaultKind kind) { return static_cast<int>(kind); }
+
+std::string LogHeader(int n) {
+  std::string h =
+      "t,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,w_x,w_y,w_z,"
+      "ref_p_x,ref_p_y,ref_p_z,ref_v_x,ref_v_y,ref_v_z,ref_yaw,"
+      "est_p_x,est_p_y,est_p_z,est_q_w,est_q_x,est_q_y,est_q_z,est_v_x,est_v_y,est_v_z,"
+      "est_w_x,est_w_y,est_w_z,wind_x,wind_y,wind_z,landed";
+  for (const char* prefix : {"cmd_", "thrust_", "rpm_", "fault_"}) {
+    for (int i = 0; i < n; ++i) h += fmt::format(",{}{}", prefix, i);
+  }
+  return h + "\n";
+}
+
+void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, std::string* out) {
+  const StateView s(sim.state());
+  const auto v3 = [&](const Vector3& v) { fmt::format_to(std::back_inserter(*out), ",{:.9g},{:.9g},{:.9g}", v.x(), v.y(), v.z()); };
+  const auto q4 = [&](const Quaternion& q) {
+    fmt::format_to(std::back_inserter(*out), ",{:.9g},{:.9g},{:.9g},{:.9g}", q.w(), q.x(), q.y(), q.z());
+  };
+  fmt::format_to(std::back_inserter(*out), "{:.6f}", sim.time_s());
+  v3(s.p_W());
+  q4(s.q_WB());
+  v3(s.v_W());
+  v3(s.w_B());
+  const ReferencePoint& r = st.reference_point();
+  v3(r.p_W);
+  v3(r.v_W);
+  fmt::format_to(std::back_inserter(*out), ",{:.9g}", r.yaw);
+  const StateEstimate& e = st.estimate();
+  v3(e.p_W);
+  q4(e.q_WB);
+  v3(e.v_W);
+  v3(e.w_B);
+  v3(sim.wind());
+  fmt::format_to(std::back_inserter(*out), ",{}", sim.landed() ? 1 : 0);
+  const int n = sim.model().num_rotors();
+  for (int i = 0; i < n; ++i) fmt::format_to(std::back_inserter(*out), ",{:.9g}", sim.applied_command()[i]);
+  for (int i = 0; i < n; ++i) fmt::format_to(std::back_inserter(*out), ",{:.9g}", sim.rotor_thrusts()[i]);
+  for (int i = 0; i < n; ++i) {
+    fmt::format_to(std::back_inserter(*out), ",{:.1f}", vehicle::RadPerSecondToRpm(sim.motor_speeds()[i]));
+  }
+  for (int i = 0; i < n; ++i) fmt::format_to(std::back_inserter(*out), ",{}", FaultCode(sim.faults()[i].kind));
+  out->push_back('\n');
+}
+
+void Deliver(const sim::SensorOutputs& o, stack::FlightStack* st) {
+  if (o.imu) st->OnImu(*o.imu);
+  if (o.esc) st->OnEscTelemetry(*o.esc);
+  if (o.odometry) st->OnOdometry(*o.odometry);
+}
+
+double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
+}  // namespace
+
+nlohmann::json RunSummary::ToJson() const {
+  nlohmann::json j;
+  j["scenario"] = scenario;
+  j["seed"] = seed;
+  j["success"] = success;
+  j["crashed"] = crashed;
+  j["crash_reason"] = crashed ? nlohmann::json(crash_reason) : nlohmann::json(nullptr);
+  j["sim_time_s"] = sim_time_s;
+  j["wall_time_s"] = wall_time_s;
+  j["realtime_factor"] = realtime_factor;
+  j["tracking_rmse_m"] = tracking_rmse_m;
+  j["tracking_rmse_eq37_m"] = tracking_rmse_eq37_m;
+  j["max_position_error_m"] = max_position_error_m;
+  j["min_altitude_m"] = min_altitude_m;
+  j["max_spin_rad_s"] = max_spin_rad_s;
+  j["faults"] = nlohmann::json::array();
+  for (const FaultRecord& f : faults) {
+    j["faults"].push_back({{"rotor", f.rotor}, {"kind", f.kind}, {"onset_s", f.onset_s}});
+  }
+  j["fdd"] = nullptr;  // filled once fault detection exists
+  j["physics_steps"] = physics_steps;
+  j["control_cycles"] = control_cycles;
+  return j;
+}
+
+RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
+  namespace fs = std::filesystem;
+  const auto wall_start = std::chrono::steady_clock::now();
+
+  std::optional<io::AtomicFileWriter> log;
+  if (!options.out_dir.empty()) {
+    std::error_code ec;
+    fs::create_directories(options.out_dir, ec);
+    if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", options.out_dir, ec.message()));
+    // A summary left by an earlier run must not pass for this run's.
+    fs::remove(fs::path(options.out_dir) / "summary.json", ec);
+    log.emplace((fs::path(options.out_dir) / "log.csv").string());
+  }
+
+  const vehicle::MultirotorModel truth_model(sc.vehicle);
+  const RotorVector initial_motors = sc.initial_position_m.z() > 0.0
+                                         ? truth_model.HoverThrusts()
+                                         : RotorVector::Zero(truth_model.num_rotors());
+  sim::Simulator sim(truth_model, sc.world, sc.faults, sc.sim, sc.seed,
+                     truth_model.MakeState(sc.initial_position_m, sc.initial_yaw_rad, initial_motors));
+  // The stack builds its own model from the vehicle parameters: it never holds the simulator.
+  stack::FlightStack st(sc.vehicle, sc.reference, sc.stack);
+  Deliver(sim.outputs(), &st);
+
+  const TimeNs dt_ns = sim.step_ns();
+  const double dt = ToSeconds(dt_ns);
+  const auto steps = static_cast<std::int64_t>(std::llround(sc.duration_s / dt));
+  const TimeNs control_period = st.control_period_ns();
+  const TimeNs log_period = PeriodFromRate(sc.log_rate_hz);
+  const TimeNs tracking_start = FromSeconds(sc.tracking_start_s);
+  TimeNs next_control = 0, next_log = 0;
+  std::int64_t next_progress = 0;
+  const std::int64_t progress_stride = std::max<std::int64_t>(1, steps / 100);
+
+  RunSummary summary;
+  summary.scenario = sc.name;
+  summary.seed = sc.seed;
+  TrackingErrorAccumulator tracking;
+  double min_alt_all = std::numeric_limits<double>::infinity();
+  double min_alt_after_fault = std::numeric_limits<double>::infinity();
+  std::string buffer;
+  if (log) buffer = LogHeader(truth_model.num_rotors());
+  RotorCommand command = st.command();
+
+  for (std::int64_t k = 0; k < steps; ++k) {
+    const TimeNs t = sim.time_ns();
+    if (t >= next_control) {
+      command = st.Update(t);
+      next_control += control_period;
+      ++summary.control_cycles;
+    }
+    const StateView s(sim.state());
+    if (t >= tracking_start) tracking.Add(dt, s.p_W(), sc.reference->Evaluate(ToSeconds(t)).p_W);
+    const double alt = s.p_W().z();
+    min_alt_all = std::min(min_alt_all, alt);
+    if (!sim.fault_events().empty()) min_alt_after_fault = std::min(min_alt_after_fault, alt);
+    summary.max_spin_rad_s = std::max(summary.max_spin_rad_s, std::abs(s.w_B().z()));
+    if (log && t >= next_log) {
+      AppendRow(sim, st, &buffer);
+      next_log += log_period;
+      if (buffer.size() > (1u << 20)) {
+        log->Write(buffer);
+        buffer.clear();
+      }
+    }
+    Deliver(sim.Step(command), &st);
+    ++summary.physics_steps;
+    if (sim.crashed()) break;
+    if (options.progress && k >= next_progress) {
+      options.progress(static_cast<double>(k) / static_cast<double>(steps));
+      next_progress += progress_stride;
+    }
+  }
+  if (log) {
+    AppendRow(sim, st, &buffer);  // the final state (or the crash site)
+    log->Write(buffer);
+    log->Commit();
+  }
+  if (options.progress) options.progress(1.0);
+
+  summary.sim_time_s = sim.time_s();
+  summary.crashed = sim.crashed();
+  summary.crash_reason = sim.crash_reason().value_or("");
+  summary.success = !summary.crashed;
+  summary.tracking_rmse_m = Finite(tracking.rmse());
+  summary.tracking_rmse_eq37_m = Finite(tracking.rmse_eq37());
+  summary.max_position_error_m = Finite(tracking.max_error());
+  summary.min_altitude_m = Finite(sim.fault_events().empty() ? min_alt_all : min_alt_after_fault);
+  for (const sim::FaultEvent& e : sim.fault_events()) {
+    summary.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
+  }
+  summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  summary.realtime_factor = summary.wall_time_s > 0.0 ? summary.sim_time_s / summary.wall_time_s : 0.0;
+  if (!options.out_dir.empty()) {
+    io::WriteFileAtomically((fs::path(options.out_dir) / "summary.json").string(),
+                            summary.ToJson().dump(2) + "\n");
+  }
+  return summary;
+}
+
+}  // namespace rotorguard::bench

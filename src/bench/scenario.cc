@@ -1,0 +1,408 @@
+#include "rotorguard/bench/scenario.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/planning/references.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace rotorguard::bench {
+
+namespace {
+using io::ConfigDocument;
+using io::ConfigNode;
+
+/// Runs a validation and re-raises its error at the offending key of `node`.
+template <typename F>
+void ValidateAt(const ConfigNode& node, F&& validate) {
+  try {
+    validate();
+  } catch (const ValidationError& e) {
+    node.FailAt(e.field(), e.what());
+  } catch (const std::invalid_argument& e) {
+    node.Fail(e.what());
+  }
+}
+
+double OptionalDouble(const ConfigNode& map, std::string_view key, double fallback) {
+  const auto n = map.Optional(key);
+  return n ? n->AsDouble() : fallback;
+}
+Vector3 OptionalVector3(const ConfigNode& map, std::string_view key, const Vector3& fallback) {
+  const auto n = map.Optional(key);
+  return n ? n->AsVector3() : fallback;
+}
+
+// ---------------------------------------------------------------- vehicle
+
+vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
+  vehicle::VehicleParams v;
+  v.name = root.Has("name") ? root.Required("name").AsString() : "vehicle";
+  v.mass_kg = root.Required("mass_kg").AsDouble();
+  const ConfigNode inertia = root.Required("inertia_kg_m2");
+  if (!inertia.IsSequence() || inertia.size() != 3) {
+    inertia.Fail("expected a 3x3 matrix written as three rows of three numbers");
+  }
+  for (std::size_t r = 0; r < 3; ++r) {
+    const std::vector<double> row = inertia.At(r).AsDoubleList(3);
+    for (int c = 0; c < 3; ++c) v.inertia_kg_m2(static_cast<int>(r), c) = row[c];
+  }
+  v.rotor_drag_kg_s = root.Required("rotor_drag_kg_s").AsVector3();
+  v.yaw_damping_n_m_s = root.Required("yaw_damping_n_m_s").AsDouble();
+  const ConfigNode kn = root.Required("thrust_coefficient_n_per_rpm2");
+  v.thrust_coefficient_n_s2 = vehicle::ThrustCoefficientFromRpm(kn.AsDouble());
+  v.motor_time_constant_s = root.Required("motor_time_constant_s").AsDouble();
+  v.motor_stop_time_constant_s = root.Required("motor_stop_time_constant_s").AsDouble();
+  v.unloaded_speed_ratio = root.Required("unloaded_rpm_ratio").AsDouble();
+  v.collision_radius_m = root.Required("collision_radius_m").AsDouble();
+  const ConfigNode rotors = root.Required("rotors");
+  if (!rotors.IsSequence() || rotors.size() == 0) rotors.Fail("expected a non-empty list of rotors");
+  for (std::size_t i = 0; i < rotors.size(); ++i) {
+    const ConfigNode r = rotors.At(i);
+    vehicle::Rotor rotor;
+    rotor.p_B = r.Required("position_m").AsVector3();
+    rotor.direction = r.Required("direction").AsEnum({"ccw", "cw"}) == "cw"
+                          ? vehicle::SpinDirection::kClockwise
+                          : vehicle::SpinDirection::kCounterClockwise;
+    rotor.yaw_coefficient_m = r.Required("yaw_coefficient_m").AsDouble();
+    rotor.max_thrust_n = r.Required("max_thrust_n").AsDouble();
+    r.RejectUnknownKeys();
+    v.rotors.push_back(rotor);
+  }
+  root.RejectUnknownKeys();
+  ValidateAt(root, [&] { v.Validate(); });
+  return v;
+}
+
+void ApplyOverrides(ConfigDocument* doc, const std::vector<Override>& overrides, bool vehicle_part) {
+  for (const auto& [path, value] : overrides) {
+    const bool is_vehicle = path.rfind("vehicle.", 0) == 0;
+    if (is_vehicle != vehicle_part) continue;
+    doc->ApplyOverride(is_vehicle ? path.substr(8) : path, value);
+  }
+}
+
+// ---------------------------------------------------------------- world
+
+sim::World ParseWorld(const ConfigNode& node) {
+  sim::World w;
+  if (const auto boxes = node.Optional("boxes")) {
+    for (std::size_t i = 0; i < boxes->size(); ++i) {
+      const ConfigNode b = boxes->At(i);
+      sim::Box box;
+      box.center_m = b.Required("center_m").AsVector3();
+      box.size_m = b.Required("size_m").AsVector3();
+      if (box.size_m.minCoeff() <= 0.0) b.FailAt("size_m", "box sizes must be > 0 m");
+      box.yaw_rad = OptionalDouble(b, "yaw_rad", 0.0);
+      b.RejectUnknownKeys();
+      w.boxes.push_back(box);
+    }
+  }
+  if (const auto cylinders = node.Optional("cylinders")) {
+    for (std::size_t i = 0; i < cylinders->size(); ++i) {
+      const ConfigNode c = cylinders->At(i);
+      sim::Cylinder cyl;
+      const std::vector<double> xy = c.Required("center_m").AsDoubleList(2);
+      cyl.center_m = Eigen::Vector2d(xy[0], xy[1]);
+      cyl.radius_m = c.Required("radius_m").AsPositive();
+      cyl.height_m = c.Required("height_m").AsPositive();
+      c.RejectUnknownKeys();
+      w.cylinders.push_back(cyl);
+    }
+  }
+  if (const auto moving = node.Optional("moving_boxes")) {
+    for (std::size_t i = 0; i < moving->size(); ++i) {
+      const ConfigNode m = moving->At(i);
+      sim::MovingBox mb;
+      mb.size_m = m.Required("size_m").AsVector3();
+      if (mb.size_m.minCoeff() <= 0.0) m.FailAt("size_m", "box sizes must be > 0 m");
+      const ConfigNode wps = m.Required("waypoints_m");
+      if (!wps.IsSequence() || wps.size() == 0) wps.Fail("expected a non-empty list of [x, y, z] points");
+      for (std::size_t k = 0; k < wps.size(); ++k) mb.waypoints_m.push_back(wps.At(k).AsVector3());
+      mb.speed_m_s = m.Required("speed_m_s").AsNonNegative();
+      if (const auto loop = m.Optional("loop")) mb.loop = loop->AsBool();
+      m.RejectUnknownKeys();
+      w.moving_boxes.push_back(mb);
+    }
+  }
+  node.RejectUnknownKeys();
+  return w;
+}
+
+// ---------------------------------------------------------------- mission
+
+std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, const Scenario& s,
+                                                        std::string* type) {
+  *type = node.Required("type").AsEnum({"hover", "takeoff", "lemniscate", "circle", "waypoints"});
+  std::shared_ptr<const ReferenceTrajectory> ref;
+  const double yaw = OptionalDouble(node, "yaw_rad", s.initial_yaw_rad);
+  try {
+    if (*type == "hover") {
+      planning::HoverOptions o;
+      o.position_m = OptionalVector3(node, "position_m", s.initial_position_m);
+      o.yaw_rad = yaw;
+      ref = std::make_shared<planning::HoverReference>(o);
+    } else if (*type == "takeoff") {
+      planning::TakeoffOptions o;
+      o.start_m = s.initial_position_m;
+      o.altitude_m = node.Required("altitude_m").AsDouble();
+      o.max_speed_m_s = OptionalDouble(node, "max_speed_m_s", o.max_speed_m_s);
+      o.yaw_rad = yaw;
+      ref = std::make_shared<planning::TakeoffReference>(o);
+    } else if (*type == "lemniscate") {
+      planning::LemniscateOptions o;
+      o.center_m = OptionalVector3(node, "center_m", s.initial_position_m);
+      const Vector3 size = OptionalVector3(node, "size_m", Vector3(o.size_x_m, o.size_y_m, o.size_z_m));
+      o.size_x_m = size.x();
+      o.size_y_m = size.y();
+      o.size_z_m = size.z();
+      o.max_speed_m_s = node.Required("max_speed_m_s").AsDouble();
+      o.ramp_s = OptionalDouble(node, "ramp_s", o.ramp_s);
+      o.yaw_rad = yaw;
+      ref = std::make_shared<planning::LemniscateReference>(o);
+    } else if (*type == "circle") {
+      planning::CircleOptions o;
+      o.center_m = node.Required("center_m").AsVector3();
+      o.radius_m = node.Required("radius_m").AsDouble();
+      o.speed_m_s = node.Required("speed_m_s").AsDouble();
+      o.ramp_s = OptionalDouble(node, "ramp_s", o.ramp_s);
+      if (const auto cw = node.Optional("clockwise")) o.clockwise = cw->AsBool();
+      o.yaw_rad = yaw;
+      ref = std::make_shared<planning::CircleReference>(o);
+    } else {
+      planning::WaypointOptions o;
+      o.waypoints_m.push_back(s.initial_position_m);
+      const ConfigNode wps = node.Required("waypoints_m");
+      if (!wps.IsSequence() || wps.size() == 0) wps.Fail("expected a non-empty list of [x, y, z] points");
+      for (std::size_t k = 0; k < wps.size(); ++k) o.waypoints_m.push_back(wps.At(k).AsVector3());
+      o.max_speed_m_s = node.Required("max_speed_m_s").AsDouble();
+      o.max_accel_m_s2 = OptionalDouble(node, "max_accel_m_s2", o.max_accel_m_s2);
+      o.dwell_s = OptionalDouble(node, "dwell_s", o.dwell_s);
+      o.yaw_rad = yaw;
+      ref = std::make_shared<planning::WaypointReference>(o);
+    }
+  } catch (const std::invalid_argument& e) {
+    node.Fail(e.what());
+  }
+  node.RejectUnknownKeys();
+  return ref;
+}
+
+// ---------------------------------------------------------------- faults
+
+sim::FaultSpec ParseFault(const ConfigNode& f) {
+  sim::FaultSpec spec;
+  spec.rotor = static_cast<int>(f.Required("rotor").AsIntIn(0, kMaxRotors - 1));
+  const ConfigNode kind = f.Required("kind");
+  spec.kind = *vehicle::ParseFaultKind(
+      kind.AsEnum({"motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck"}));
+  if (spec.kind == vehicle::FaultKind::kLossOfEffectiveness) {
+    spec.eta = f.Required("eta").AsDouble();
+  } else if (f.Has("eta")) {
+    f.FailAt("eta", "eta applies to kind loss_of_effectiveness only");
+  }
+  const ConfigNode onset = f.Required("onset");
+  const std::vector<std::pair<const char*, sim::FaultOnset::Kind>> kinds = {
+      {"at_time_s", sim::FaultOnset::Kind::kAtTime},
+      {"at_altitude_m", sim::FaultOnset::Kind::kAtAltitude},
+      {"during_takeoff_s", sim::FaultOnset::Kind::kDuringTakeoff}};
+  int found = 0;
+  for (const auto& [key, k] : kinds) {
+    if (onset.Has(key)) {
+      spec.onset.kind = k;
+      spec.onset.value = onset.Required(key).AsDouble();
+      ++found;
+    }
+  }
+  onset.RejectUnknownKeys();
+  if (found != 1) onset.Fail("expected exactly one of at_time_s, at_altitude_m, during_takeoff_s");
+  if (const auto im = f.Optional("intermittent")) {
+    sim::IntermittentPattern p;
+    p.on_s = im->Required("on_s").AsDouble();
+    p.off_s = im->Required("off_s").AsDouble();
+    im->RejectUnknownKeys();
+    spec.intermittent = p;
+  }
+  f.RejectUnknownKeys();
+  return spec;
+}
+
+// ---------------------------------------------------------------- sensors, sim, stack
+
+void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
+  if (const auto imu = node.Optional("imu")) {
+    sim::ImuOptions& i = o->imu;
+    i.rate_hz = OptionalDouble(*imu, "rate_hz", i.rate_hz);
+    i.position_m = OptionalVector3(*imu, "position_m", i.position_m);
+    i.accel_noise_density = OptionalDouble(*imu, "accel_noise_density", i.accel_noise_density);
+    i.gyro_noise_density = OptionalDouble(*imu, "gyro_noise_density", i.gyro_noise_density);
+    i.accel_bias_random_walk = OptionalDouble(*imu, "accel_bias_random_walk", i.accel_bias_random_walk);
+    i.gyro_bias_random_walk = OptionalDouble(*imu, "gyro_bias_random_walk", i.gyro_bias_random_walk);
+    i.accel_bias_initial = OptionalDouble(*imu, "accel_bias_initial", i.accel_bias_initial);
+    i.gyro_bias_initial = OptionalDouble(*imu, "gyro_bias_initial", i.gyro_bias_initial);
+    imu->RejectUnknownKeys();
+    ValidateAt(*imu, [&] { i.Validate(o->physics_rate_hz); });
+  }
+  if (const auto esc = node.Optional("esc")) {
+    sim::EscOptions& e = o->esc;
+    e.rate_hz = OptionalDouble(*esc, "rate_hz", e.rate_hz);
+    e.noise_rpm = OptionalDouble(*esc, "noise_rpm", e.noise_rpm);
+    e.quantization_rpm = OptionalDouble(*esc, "quantization_rpm", e.quantization_rpm);
+    e.delay_s = OptionalDouble(*esc, "delay_s", e.delay_s);
+    esc->RejectUnknownKeys();
+    ValidateAt(*esc, [&] { e.Validate(o->physics_rate_hz); });
+  }
+  if (const auto odom = node.Optional("odometry")) {
+    sim::OdometryOptions& d = o->odometry;
+    d.rate_hz = OptionalDouble(*odom, "rate_hz", d.rate_hz);
+    d.position_noise_m = OptionalDouble(*odom, "position_noise_m", d.position_noise_m);
+    d.velocity_noise_m_s = OptionalDouble(*odom, "velocity_noise_m_s", d.velocity_noise_m_s);
+    d.attitude_noise_rad = OptionalDouble(*odom, "attitude_noise_rad", d.attitude_noise_rad);
+    d.rate_noise_gain = OptionalDouble(*odom, "rate_noise_gain", d.rate_noise_gain);
+    odom->RejectUnknownKeys();
+    ValidateAt(*odom, [&] { d.Validate(o->physics_rate_hz); });
+  }
+  node.RejectUnknownKeys();
+}
+
+void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
+  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal"});
+  o->control_rate_hz = OptionalDouble(node, "control_rate_hz", o->control_rate_hz);
+  if (const auto n = node.Optional("nominal")) {
+    control::NominalControllerOptions& g = o->nominal;
+    g.kp_position = OptionalVector3(*n, "kp_position", g.kp_position);
+    g.kd_velocity = OptionalVector3(*n, "kd_velocity", g.kd_velocity);
+    g.ki_position = OptionalVector3(*n, "ki_position", g.ki_position);
+    g.integral_limit_m_s2 = OptionalDouble(*n, "integral_limit_m_s2", g.integral_limit_m_s2);
+    g.max_tilt_rad = OptionalDouble(*n, "max_tilt_rad", g.max_tilt_rad);
+    g.k_attitude = OptionalVector3(*n, "k_attitude", g.k_attitude);
+    g.k_rate = OptionalVector3(*n, "k_rate", g.k_rate);
+    g.max_rate_rad_s = OptionalDouble(*n, "max_rate_rad_s", g.max_rate_rad_s);
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] { g.Validate(); });
+  }
+  node.RejectUnknownKeys();
+  ValidateAt(node, [&] { o->Validate(); });
+}
+
+std::string ResolveRelative(const std::string& base_file, const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  if (p.is_absolute() || base_file.empty()) return p.lexically_normal().string();
+  return (fs::path(base_file).parent_path() / p).lexically_normal().string();
+}
+
+vehicle::VehicleParams LoadVehicleDocument(ConfigDocument doc, const std::vector<Override>& overrides) {
+  ApplyOverrides(&doc, overrides, /*vehicle_part=*/true);
+  return ParseVehicle(doc.root());
+}
+
+}  // namespace
+
+vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Override>& overrides) {
+  return LoadVehicleDocument(ConfigDocument::LoadFile(path), overrides);
+}
+
+Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides) {
+  ConfigDocument doc = ConfigDocument::LoadFile(path);
+  ApplyOverrides(&doc, overrides, /*vehicle_part=*/false);
+  const ConfigNode root = doc.root();
+  Scenario s;
+  s.file = path;
+  s.name = root.Has("name") ? root.Required("name").AsString()
+                            : std::filesystem::path(path).stem().string();
+  if (root.Has("description")) root.Required("description").AsString();
+  const ConfigNode vehicle_node = root.Required("vehicle");
+  s.vehicle_file = ResolveRelative(path, vehicle_node.AsString());
+  try {
+    s.vehicle = LoadVehicle(s.vehicle_file, overrides);
+  } catch (const io::InputFileError& e) {
+    vehicle_node.Fail(fmt::format("cannot read vehicle file: {}", e.what()));
+  }
+  s.duration_s = root.Required("duration_s").AsDoubleIn(1e-3, 1e6);
+  if (const auto seed = root.Optional("seed")) s.seed = seed->AsUint64();
+
+  if (const auto initial = root.Optional("initial")) {
+    s.initial_position_m = OptionalVector3(*initial, "position_m", s.initial_position_m);
+    s.initial_yaw_rad = OptionalDouble(*initial, "yaw_rad", 0.0);
+    if (s.initial_position_m.z() < 0.0) initial->FailAt("position_m", "the start must be at or above the ground (z >= 0)");
+    initial->RejectUnknownKeys();
+  }
+  if (const auto world = root.Optional("world")) s.world = ParseWorld(*world);
+
+  // Simulation settings first: sensor rates are checked against the physics rate.
+  if (const auto simn = root.Optional("sim")) {
+    s.sim.physics_rate_hz = OptionalDouble(*simn, "physics_rate_hz", s.sim.physics_rate_hz);
+    s.log_rate_hz = OptionalDouble(*simn, "log_rate_hz", s.log_rate_hz);
+    s.sim.crash_speed_m_s = OptionalDouble(*simn, "crash_speed_m_s", s.sim.crash_speed_m_s);
+    s.sim.crash_tilt_rad = OptionalDouble(*simn, "crash_tilt_rad", s.sim.crash_tilt_rad);
+    simn->RejectUnknownKeys();
+    if (s.log_rate_hz <= 0.0 || s.log_rate_hz > s.sim.physics_rate_hz) {
+      simn->FailAt("log_rate_hz", fmt::format("log_rate_hz = {} is invalid; expected a rate in (0, {}] Hz "
+                                              "(the physics rate)", s.log_rate_hz, s.sim.physics_rate_hz));
+    }
+  }
+  if (const auto sensors = root.Optional("sensors")) ParseSensors(*sensors, &s.sim);
+  if (const auto wind = root.Optional("wind")) {
+    s.sim.wind.mean_m_s = OptionalVector3(*wind, "mean_m_s", s.sim.wind.mean_m_s);
+    s.sim.wind.gust_std_m_s = OptionalDouble(*wind, "gust_std_m_s", s.sim.wind.gust_std_m_s);
+    s.sim.wind.gust_time_constant_s = OptionalDouble(*wind, "gust_time_constant_s", s.sim.wind.gust_time_constant_s);
+    wind->RejectUnknownKeys();
+    ValidateAt(*wind, [&] { s.sim.wind.Validate(); });
+  }
+  {
+    const auto simn = root.Optional("sim");
+    const ConfigNode at = simn ? *simn : root;
+    ValidateAt(at, [&] { s.sim.Validate(s.vehicle); });
+  }
+
+  s.reference = ParseMission(root.Required("mission"), s, &s.mission_type);
+
+  if (const auto faults = root.Optional("faults")) {
+    if (!faults->IsSequence() && !faults->IsNull()) faults->Fail("expected a list of faults");
+    for (std::size_t i = 0; faults->IsSequence() && i < faults->size(); ++i) {
+      s.faults.push_back(ParseFault(faults->At(i)));
+    }
+    // Rules that need the vehicle and the duration (rotor index, onset time).
+    ValidateAt(root, [&] {
+      for (std::size_t i = 0; i < s.faults.size(); ++i) {
+        s.faults[i].Validate(static_cast<int>(i), s.vehicle.num_rotors(), s.duration_s);
+      }
+    });
+  }
+  if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
+  if (const auto metrics = root.Optional("metrics")) {
+    s.tracking_start_s = metrics->Optional("tracking_start_s") ? metrics->Required("tracking_start_s").AsDoubleIn(0.0, s.duration_s) : 0.0;
+    metrics->RejectUnknownKeys();
+  }
+  root.RejectUnknownKeys();
+  return s;
+}
+
+ValidationReport ValidateConfigFile(const std::string& path) {
+  ConfigDocument doc = ConfigDocument::LoadFile(path);
+  const ConfigNode root = doc.root();
+  const std::vector<std::string> keys = root.Keys();
+  const auto has = [&](const char* k) { return std::find(keys.begin(), keys.end(), k) != keys.end(); };
+  if (has("rotors") || has("mass_kg")) {
+    const vehicle::VehicleParams v = ParseVehicle(root);
+    return {"vehicle", fmt::format("vehicle '{}': {} rotors, {:g} kg, thrust-to-weight {:.2f}", v.name,
+                                   v.num_rotors(), v.mass_kg, v.total_max_thrust_n() / v.weight_n())};
+  }
+  if (has("mission") || has("vehicle")) {
+    const Scenario s = LoadScenario(path);
+    return {"scenario", fmt::format("scenario '{}': {} mission, {:g} s, {} fault(s), vehicle {}", s.name,
+                                    s.mission_type, s.duration_s, s.faults.size(), s.vehicle_file)};
+  }
+  root.Fail("cannot tell the kind of this file; expected a scenario (with 'mission' and 'vehicle') or "
+            "a vehicle (with 'mass_kg' and 'rotors')");
+}
+
+}  // namespace rotorguard::bench

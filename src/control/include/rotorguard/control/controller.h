@@ -1,0 +1,25 @@
+#pragma once
+/// The interface every controller implements: state estimate and reference in, rotor thrust
+/// commands out.
+#include <string_view>
+
+#include "rotorguard/core/messages.h"
+#include "rotorguard/core/trajectory.h"
+#include "rotorguard/core/types.h"
+
+namespace rotorguard::control {
+
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  virtual std::string_view name() const = 0;
+  /// Thrust command per rotor [N] for the estimate and reference at the estimate's time. `dt` is
+  /// the time since the previous call [s]. Never writes non-finite values: a non-finite input
+  /// yields the hover command.
+  virtual void Compute(const StateEstimate& estimate, const ReferencePoint& reference, double dt,
+                       RotorVector* thrust_command) = 0;
+  /// Clears internal state (integrators, filters).
+  virtual void Reset() = 0;
+};
+
+}  // namespace rotorguard::control

@@ -1,0 +1,31 @@
+#pragma once
+/// Rotation helpers. Quaternions are Hamilton, body-to-world (q_WB), stored w,x,y,z.
+#include "rotorguard/core/types.h"
+
+namespace rotorguard {
+
+/// Skew-symmetric matrix: Skew(a) * b == a.cross(b).
+Matrix3 Skew(const Vector3& a);
+
+/// Time derivative of q_WB for body rates w_B: q_dot = 0.5 * q (x) [0, w_B] (paper 000, eq. 2).
+Eigen::Vector4d QuaternionDerivative(const Quaternion& q_WB, const Vector3& w_B);
+
+/// Yaw angle of the body x axis projected on the world xy plane [rad].
+double YawOf(const Quaternion& q_WB);
+
+/// Angle between the body z axis and the world z axis [rad] (0 when level).
+double TiltOf(const Quaternion& q_WB);
+
+/// Rotation about the world z axis by `yaw` [rad].
+Quaternion QuaternionFromYaw(double yaw);
+
+/// Wraps an angle to (-pi, pi].
+double WrapAngle(double a);
+
+/// True when every coefficient is finite.
+template <typename Derived>
+bool AllFinite(const Eigen::MatrixBase<Derived>& m) {
+  return m.allFinite();
+}
+
+}  // namespace rotorguard

@@ -1,0 +1,27 @@
+#pragma once
+/// The reference interface every trajectory implements (simple references, planned trajectories).
+#include "rotorguard/core/types.h"
+
+namespace rotorguard {
+
+/// Flat outputs and their derivatives at one instant.
+struct ReferencePoint {
+  Vector3 p_W = Vector3::Zero();
+  Vector3 v_W = Vector3::Zero();
+  Vector3 a_W = Vector3::Zero();
+  Vector3 j_W = Vector3::Zero();  ///< jerk
+  double yaw = 0.0;               ///< [rad]
+  double yaw_rate = 0.0;          ///< [rad/s]
+};
+
+/// A reference defined for all t >= 0 (it holds its final point after `duration()`).
+class ReferenceTrajectory {
+ public:
+  virtual ~ReferenceTrajectory() = default;
+  /// Reference at time t [s] since the start of the mission.
+  [[nodiscard]] virtual ReferencePoint Evaluate(double t) const = 0;
+  /// Time after which the reference is constant [s] (infinity for periodic references).
+  [[nodiscard]] virtual double duration() const = 0;
+};
+
+}  // namespace rotorguard

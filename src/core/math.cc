@@ -1,0 +1,42 @@
+#include "rotorguard/core/math.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rotorguard {
+
+Matrix3 Skew(const Vector3& a) {
+  Matrix3 s;
+  s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return s;
+}
+
+Eigen::Vector4d QuaternionDerivative(const Quaternion& q, const Vector3& w) {
+  // 0.5 * q (x) [0, w], written out (Hamilton product), as (w, x, y, z).
+  return 0.5 * Eigen::Vector4d(-q.x() * w.x() - q.y() * w.y() - q.z() * w.z(),
+                               q.w() * w.x() + q.y() * w.z() - q.z() * w.y(),
+                               q.w() * w.y() - q.x() * w.z() + q.z() * w.x(),
+                               q.w() * w.z() + q.x() * w.y() - q.y() * w.x());
+}
+
+double YawOf(const Quaternion& q) {
+  const Vector3 x_W = q * Vector3::UnitX();
+  return std::atan2(x_W.y(), x_W.x());
+}
+
+double TiltOf(const Quaternion& q) {
+  const Vector3 z_W = q * Vector3::UnitZ();
+  return std::acos(std::clamp(z_W.z(), -1.0, 1.0));
+}
+
+Quaternion QuaternionFromYaw(double yaw) {
+  return Quaternion(std::cos(0.5 * yaw), 0.0, 0.0, std::sin(0.5 * yaw));
+}
+
+double WrapAngle(double a) {
+  a = std::remainder(a, 2.0 * std::numbers::pi);
+  return a <= -std::numbers::pi ? a + 2.0 * std::numbers::pi : a;
+}
+
+}  // namespace rotorguard

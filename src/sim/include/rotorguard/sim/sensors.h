@@ -1,0 +1,109 @@
+#pragma once
+/// Sensor models: IMU, ESC telemetry, odometry. Each owns its random stream (derived from the run
+/// seed) so that adding or retuning one sensor does not change the noise of another.
+#include <cstdint>
+#include <vector>
+
+#include "rotorguard/core/messages.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/core/types.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace rotorguard::sim {
+
+struct ImuOptions {
+  double rate_hz = 333.0;                    ///< paper 000, Sec. IV-B; (0, physics rate]
+  Vector3 position_m = Vector3(0.02, 0.0, 0.03);  ///< mounting point relative to the CoG, body frame
+  double accel_noise_density = 2.0e-3;       ///< white noise [m/s^2/sqrt(Hz)], >= 0
+  double gyro_noise_density = 1.7e-4;        ///< white noise [rad/s/sqrt(Hz)], >= 0
+  double accel_bias_random_walk = 3.0e-3;    ///< bias diffusion [m/s^3/sqrt(Hz)], >= 0
+  double gyro_bias_random_walk = 2.0e-5;     ///< bias diffusion [rad/s^2/sqrt(Hz)], >= 0
+  double accel_bias_initial = 0.02;          ///< std of the bias at start [m/s^2], >= 0
+  double gyro_bias_initial = 2.0e-3;         ///< std of the bias at start [rad/s], >= 0
+  void Validate(double physics_rate_hz) const;
+};
+
+struct EscOptions {
+  double rate_hz = 1000.0;      ///< telemetry rate; (0, physics rate]
+  double noise_rpm = 20.0;      ///< white measurement noise [rpm], >= 0
+  double quantization_rpm = 10.0;  ///< reported resolution [rpm], >= 0 (0: none)
+  double delay_s = 0.001;       ///< transport delay, >= 0 and < 0.5 s
+  void Validate(double physics_rate_hz) const;
+};
+
+struct OdometryOptions {
+  double rate_hz = 100.0;              ///< (0, physics rate]
+  double position_noise_m = 0.005;     ///< std at rest [m], >= 0
+  double velocity_noise_m_s = 0.01;    ///< std at rest [m/s], >= 0
+  double attitude_noise_rad = 0.002;   ///< std of each small-angle component at rest [rad], >= 0
+  /// Noise grows with body rate: std = std_at_rest * (1 + rate_noise_gain * |w_B|) [per rad/s].
+  double rate_noise_gain = 0.1;
+  void Validate(double physics_rate_hz) const;
+};
+
+/// What a sensor sees of the truth at one instant.
+struct TruthSample {
+  TimeNs t_ns = 0;
+  const vehicle::StateVector* x = nullptr;
+  vehicle::Accelerations acc;
+  RotorVector motor_speed_rad_s;
+};
+
+class ImuModel {
+ public:
+  ImuModel(const ImuOptions& options, std::uint64_t seed);
+  ImuSample Sample(const TruthSample& truth);
+  const Vector3& accel_bias() const { return accel_bias_; }
+  const Vector3& gyro_bias() const { return gyro_bias_; }
+
+ private:
+  ImuOptions options_;
+  Rng rng_;
+  double dt_;
+  Vector3 accel_bias_, gyro_bias_;
+};
+
+/// ESC telemetry with noise, quantisation and a transport delay (a ring buffer of samples).
+class EscModel {
+ public:
+  EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed);
+  /// Measures now; returns the measurement taken `delay_s` ago, when there is one to deliver.
+  bool Sample(const TruthSample& truth, EscTelemetry* delivered);
+
+ private:
+  EscOptions options_;
+  Rng rng_;
+  int num_rotors_;
+  TimeNs delay_ns_;
+  std::vector<EscTelemetry> ring_;
+  std::size_t head_ = 0, count_ = 0;
+};
+
+class OdometryModel {
+ public:
+  OdometryModel(const OdometryOptions& options, std::uint64_t seed);
+  OdometrySample Sample(const TruthSample& truth);
+
+ private:
+  OdometryOptions options_;
+  Rng rng_;
+};
+
+/// Fires every `period` on an integer-nanosecond grid; polled at physics steps.
+class RateTimer {
+ public:
+  RateTimer() = default;
+  explicit RateTimer(double rate_hz) : period_ns_(PeriodFromRate(rate_hz)) {}
+  /// True (once) when t has reached the next tick; the following tick is one period later.
+  bool Due(TimeNs t) {
+    if (t < next_ns_) return false;
+    while (next_ns_ <= t) next_ns_ += period_ns_;
+    return true;
+  }
+
+ private:
+  TimeNs period_ns_ = 1;
+  TimeNs next_ns_ = 0;
+};
+
+}  // namespace rotorguard::sim

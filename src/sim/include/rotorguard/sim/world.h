@@ -1,0 +1,52 @@
+#pragma once
+/// The world the simulated vehicle flies in: the ground plane z = 0, static boxes and vertical
+/// cylinders (trees), and boxes moving along waypoints. Only the simulator (and benchmarks scoring
+/// a map against the truth) may see it; the flight stack perceives obstacles through sensors.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rotorguard/core/types.h"
+
+namespace rotorguard::sim {
+
+/// Box with its centre, full edge lengths and a rotation about the world z axis.
+struct Box {
+  Vector3 center_m = Vector3::Zero();
+  Vector3 size_m = Vector3::Ones();
+  double yaw_rad = 0.0;
+  /// Euclidean distance from `p` to the box (0 inside).
+  double Distance(const Vector3& p) const;
+};
+
+/// Vertical cylinder standing on the ground (a tree trunk): axis at (x, y), from z = 0 to height.
+struct Cylinder {
+  Eigen::Vector2d center_m = Eigen::Vector2d::Zero();
+  double radius_m = 0.1;
+  double height_m = 5.0;
+  double Distance(const Vector3& p) const;
+};
+
+/// A box moving at constant speed along a polyline of centre positions, looping back to the first
+/// waypoint when `loop` (else stopping at the last one).
+struct MovingBox {
+  Vector3 size_m = Vector3::Ones();
+  std::vector<Vector3> waypoints_m;
+  double speed_m_s = 0.5;
+  bool loop = true;
+  /// The box's pose at time t [s].
+  Box At(double t) const;
+};
+
+class World {
+ public:
+  std::vector<Box> boxes;
+  std::vector<Cylinder> cylinders;
+  std::vector<MovingBox> moving_boxes;
+
+  /// Name of the first obstacle a sphere at `p` of `radius` intersects at time t, if any
+  /// ("box 3", "cylinder 12", "moving box 0"). The ground is handled by the simulator.
+  std::optional<std::string> SphereCollision(const Vector3& p, double radius, double t) const;
+};
+
+}  // namespace rotorguard::sim

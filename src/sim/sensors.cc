@@ -1,0 +1,133 @@
+#include "rotorguard/sim/sensors.h"
+
+#include <cmath>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::sim {
+
+namespace {
+void RequireRate(const char* owner, double rate_hz, double physics_rate_hz) {
+  if (!std::isfinite(rate_hz) || rate_hz <= 0.0 || rate_hz > physics_rate_hz) {
+    ThrowValidation(owner, "rate_hz", rate_hz,
+                    fmt::format("a rate in (0, {}] Hz (the physics rate)", physics_rate_hz));
+  }
+}
+void RequireNonNegative(const char* owner, const char* field, double v) {
+  if (!std::isfinite(v) || v < 0.0) ThrowValidation(owner, field, v, "a finite value >= 0");
+}
+Vector3 NormalVector(Rng& rng, double stddev) {
+  const double x = rng.Normal(), y = rng.Normal(), z = rng.Normal();
+  return stddev * Vector3(x, y, z);
+}
+}  // namespace
+
+void ImuOptions::Validate(double physics_rate_hz) const {
+  RequireRate("ImuOptions", rate_hz, physics_rate_hz);
+  if (!position_m.allFinite()) ThrowValidation("ImuOptions", "position_m", "(non-finite)", "finite numbers");
+  RequireNonNegative("ImuOptions", "accel_noise_density", accel_noise_density);
+  RequireNonNegative("ImuOptions", "gyro_noise_density", gyro_noise_density);
+  RequireNonNegative("ImuOptions", "accel_bias_random_walk", accel_bias_random_walk);
+  RequireNonNegative("ImuOptions", "gyro_bias_random_walk", gyro_bias_random_walk);
+  RequireNonNegative("ImuOptions", "accel_bias_initial", accel_bias_initial);
+  RequireNonNegative("ImuOptions", "gyro_bias_initial", gyro_bias_initial);
+}
+
+void EscOptions::Validate(double physics_rate_hz) const {
+  RequireRate("EscOptions", rate_hz, physics_rate_hz);
+  RequireNonNegative("EscOptions", "noise_rpm", noise_rpm);
+  RequireNonNegative("EscOptions", "quantization_rpm", quantization_rpm);
+  if (!std::isfinite(delay_s) || delay_s < 0.0 || delay_s >= 0.5) {
+    ThrowValidation("EscOptions", "delay_s", delay_s, "a value in [0, 0.5) s");
+  }
+}
+
+void OdometryOptions::Validate(double physics_rate_hz) const {
+  RequireRate("OdometryOptions", rate_hz, physics_rate_hz);
+  RequireNonNegative("OdometryOptions", "position_noise_m", position_noise_m);
+  RequireNonNegative("OdometryOptions", "velocity_noise_m_s", velocity_noise_m_s);
+  RequireNonNegative("OdometryOptions", "attitude_noise_rad", attitude_noise_rad);
+  RequireNonNegative("OdometryOptions", "rate_noise_gain", rate_noise_gain);
+}
+
+ImuModel::ImuModel(const ImuOptions& options, std::uint64_t seed)
+    : options_(options), rng_(seed), dt_(1.0 / options.rate_hz) {
+  accel_bias_ = NormalVector(rng_, options_.accel_bias_initial);
+  gyro_bias_ = NormalVector(rng_, options_.gyro_bias_initial);
+}
+
+ImuSample ImuModel::Sample(const TruthSample& truth) {
+  const vehicle::StateView s(*truth.x);
+  const Vector3 w = s.w_B();
+  const Vector3& r = options_.position_m;
+  // Specific force at the CoG, plus the tangential (alpha x r) and centripetal (w x (w x r))
+  // accelerations of a point r away from it: a spinning vehicle's IMU feels them.
+  const Vector3 f_cog_B = s.q_WB().conjugate() * (truth.acc.a_W + Vector3(0.0, 0.0, kGravity));
+  const Vector3 f_B = f_cog_B + truth.acc.alpha_B.cross(r) + w.cross(w.cross(r));
+  // Discrete white noise std = density / sqrt(dt); bias random walk std = rw * sqrt(dt).
+  accel_bias_ += NormalVector(rng_, options_.accel_bias_random_walk * std::sqrt(dt_));
+  gyro_bias_ += NormalVector(rng_, options_.gyro_bias_random_walk * std::sqrt(dt_));
+  ImuSample out;
+  out.t_ns = truth.t_ns;
+  out.specific_force_B =
+      f_B + accel_bias_ + NormalVector(rng_, options_.accel_noise_density / std::sqrt(dt_));
+  out.w_B = w + gyro_bias_ + NormalVector(rng_, options_.gyro_noise_density / std::sqrt(dt_));
+  return out;
+}
+
+EscModel::EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed)
+    : options_(options), rng_(seed), num_rotors_(num_rotors), delay_ns_(FromSeconds(options.delay_s)) {
+  // Enough slots for every sample in flight during the delay, plus margin.
+  const auto slots = static_cast<std::size_t>(std::ceil(options.delay_s * options.rate_hz)) + 2;
+  ring_.resize(slots);
+  for (auto& m : ring_) m.motor_speed_rad_s.resize(num_rotors);
+}
+
+bool EscModel::Sample(const TruthSample& truth, EscTelemetry* delivered) {
+  if (count_ == ring_.size()) {  // full: drop the oldest (cannot happen with the sizing above)
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+  }
+  EscTelemetry& m = ring_[(head_ + count_) % ring_.size()];
+  m.t_ns = truth.t_ns;
+  for (int i = 0; i < num_rotors_; ++i) {
+    double rpm = vehicle::RadPerSecondToRpm(truth.motor_speed_rad_s[i]) +
+                 options_.noise_rpm * rng_.Normal();
+    if (options_.quantization_rpm > 0.0) {
+      rpm = options_.quantization_rpm * std::round(rpm / options_.quantization_rpm);
+    }
+    m.motor_speed_rad_s[i] = vehicle::RpmToRadPerSecond(std::max(0.0, rpm));
+  }
+  ++count_;
+  // Deliver the newest sample whose delay has elapsed; older ones are superseded.
+  bool found = false;
+  while (count_ > 0 && ring_[head_].t_ns + delay_ns_ <= truth.t_ns) {
+    *delivered = ring_[head_];
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+    found = true;
+  }
+  return found;
+}
+
+OdometryModel::OdometryModel(const OdometryOptions& options, std::uint64_t seed)
+    : options_(options), rng_(seed) {}
+
+OdometrySample OdometryModel::Sample(const TruthSample& truth) {
+  const vehicle::StateView s(*truth.x);
+  const double scale = 1.0 + options_.rate_noise_gain * s.w_B().norm();
+  OdometrySample out;
+  out.t_ns = truth.t_ns;
+  out.p_W = s.p_W() + NormalVector(rng_, options_.position_noise_m * scale);
+  out.v_W = s.v_W() + NormalVector(rng_, options_.velocity_noise_m_s * scale);
+  const Vector3 dtheta = NormalVector(rng_, options_.attitude_noise_rad * scale);
+  const double angle = dtheta.norm();
+  const Quaternion dq = angle > 0.0 ? Quaternion(Eigen::AngleAxisd(angle, dtheta / angle))
+                                    : Quaternion::Identity();
+  out.q_WB = (s.q_WB() * dq).normalized();
+  return out;
+}
+
+}  // namespace rotorguard::sim

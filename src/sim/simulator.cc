@@ -1,0 +1,169 @@
+#include "rotorguard/sim/simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+
+namespace rotorguard::sim {
+
+namespace {
+using vehicle::StateIndex;
+using vehicle::StateView;
+
+// Independent random streams of one run.
+enum Stream : std::uint64_t { kImuStream = 1, kEscStream = 2, kOdometryStream = 3, kWindStream = 4 };
+}  // namespace
+
+void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
+  if (!std::isfinite(physics_rate_hz) || physics_rate_hz <= 0.0 || physics_rate_hz > 1e6) {
+    ThrowValidation("SimulatorOptions", "physics_rate_hz", physics_rate_hz, "a rate in (0, 1e6] Hz");
+  }
+  // RK4 on a first-order lag is stable for dt < 2.78 sigma and accurate for dt well below sigma:
+  // require dt <= sigma / 2 for the fastest motor time constant.
+  const double fastest = std::min(vehicle.motor_time_constant_s, vehicle.motor_stop_time_constant_s);
+  if (1.0 / physics_rate_hz > 0.5 * fastest) {
+    ThrowValidation("SimulatorOptions", "physics_rate_hz", physics_rate_hz,
+                    fmt::format("a rate >= {:g} Hz: the step must be at most half the fastest motor "
+                                "time constant ({:g} s)",
+                                2.0 / fastest, fastest));
+  }
+  imu.Validate(physics_rate_hz);
+  esc.Validate(physics_rate_hz);
+  odometry.Validate(physics_rate_hz);
+  wind.Validate();
+  if (!std::isfinite(crash_speed_m_s) || crash_speed_m_s <= 0.0) {
+    ThrowValidation("SimulatorOptions", "crash_speed_m_s", crash_speed_m_s, "a speed > 0 m/s");
+  }
+  if (!std::isfinite(crash_tilt_rad) || crash_tilt_rad <= 0.0 || crash_tilt_rad > std::numbers::pi) {
+    ThrowValidation("SimulatorOptions", "crash_tilt_rad", crash_tilt_rad, "an angle in (0, pi]");
+  }
+}
+
+Simulator::Simulator(const vehicle::MultirotorModel& model, World world,
+                     std::vector<FaultSpec> faults, const SimulatorOptions& options,
+                     std::uint64_t seed, const vehicle::StateVector& initial)
+    : model_(model),
+      world_(std::move(world)),
+      options_(options),
+      injector_(std::move(faults), model.num_rotors()),
+      integrator_(model),
+      imu_(options.imu, DeriveSeed(seed, kImuStream)),
+      esc_(options.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
+      odometry_(options.odometry, DeriveSeed(seed, kOdometryStream)),
+      wind_(options.wind, DeriveSeed(seed, kWindStream)),
+      imu_timer_(options.imu.rate_hz),
+      esc_timer_(options.esc.rate_hz),
+      odometry_timer_(options.odometry.rate_hz),
+      dt_ns_(PeriodFromRate(options.physics_rate_hz)),
+      x_(initial),
+      faults_(model.num_rotors()) {
+  options_.Validate(model.params());
+  if (initial.size() != model.state_size() || !initial.allFinite()) {
+    throw std::invalid_argument(fmt::format(
+        "Simulator: initial state has size {} or non-finite entries; expected {} finite values",
+        initial.size(), model.state_size()));
+  }
+  x_.segment<4>(StateIndex::kQuaternion).normalize();
+  landed_ = x_[StateIndex::kPosition + 2] <= 0.0;
+  if (landed_) x_[StateIndex::kPosition + 2] = 0.0;
+  command_ = RotorVector::Zero(model.num_rotors());
+  UpdateOutputs();
+  vehicle::Disturbance still_air;
+  still_air.wind_W = wind_.velocity();
+  SampleSensors(still_air);
+}
+
+void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
+  // Sensors sample the state at the current time (the end of a step).
+  const bool imu_due = imu_timer_.Due(t_ns_);
+  const bool esc_due = esc_timer_.Due(t_ns_);
+  const bool odom_due = odometry_timer_.Due(t_ns_);
+  if (!(imu_due || esc_due || odom_due)) return;
+  TruthSample truth;
+  truth.t_ns = t_ns_;
+  truth.x = &x_;
+  if (!landed_) truth.acc = model_.ComputeAccelerations(x_, faults_, disturbance);
+  truth.motor_speed_rad_s = speed_;
+  if (imu_due) outputs_.imu = imu_.Sample(truth);
+  if (esc_due) {
+    EscTelemetry telemetry;
+    if (esc_.Sample(truth, &telemetry)) outputs_.esc = telemetry;
+  }
+  if (odom_due) outputs_.odometry = odometry_.Sample(truth);
+}
+
+void Simulator::UpdateOutputs() {
+  model_.RotorThrusts(x_, faults_, &thrust_);
+  model_.MotorSpeeds(x_, faults_, &speed_);
+}
+
+void Simulator::ResolveGroundContact(const vehicle::StateVector& before) {
+  const StateView s(x_);
+  if (landed_) {
+    // Resting on the ground: lift off only when the net vertical force points up.
+    const double up_force = thrust_.sum() * s.q_WB().toRotationMatrix()(2, 2);
+    if (up_force > model_.params().weight_n()) {
+      landed_ = false;
+      return;
+    }
+    // Stay pinned: keep the attitude and motor states, cancel the rigid-body motion.
+    x_.head<StateIndex::kMotor>() = before.head<StateIndex::kMotor>();
+    x_.segment<3>(StateIndex::kVelocity).setZero();
+    x_.segment<3>(StateIndex::kBodyRate).setZero();
+    return;
+  }
+  if (s.p_W().z() > 0.0) return;
+  const double speed = s.v_W().norm();
+  const double tilt = TiltOf(s.q_WB());
+  if (speed > options_.crash_speed_m_s) {
+    crash_reason_ = fmt::format("ground impact at {:.2f} m/s", speed);
+  } else if (tilt > options_.crash_tilt_rad) {
+    crash_reason_ = fmt::format("ground contact tilted {:.0f} deg", tilt * 180.0 / std::numbers::pi);
+  }
+  // Touchdown (or the crash site): stop on the ground.
+  landed_ = true;
+  x_[StateIndex::kPosition + 2] = 0.0;
+  x_.segment<3>(StateIndex::kVelocity).setZero();
+  x_.segment<3>(StateIndex::kBodyRate).setZero();
+}
+
+const SensorOutputs& Simulator::Step(const RotorCommand& command) {
+  outputs_ = SensorOutputs{};
+  if (crashed()) return outputs_;
+  const double dt = ToSeconds(dt_ns_);
+  // A non-finite command reaches the motors as zero thrust (a real ESC would reject the frame).
+  for (int i = 0; i < model_.num_rotors(); ++i) {
+    const double u = i < command.thrust_n.size() ? command.thrust_n[i] : 0.0;
+    command_[i] = std::isfinite(u) ? std::clamp(u, 0.0, model_.max_thrust()[i]) : 0.0;
+  }
+  injector_.Update(t_ns_, x_[StateIndex::kPosition + 2], !landed_, &faults_);
+  vehicle::Disturbance disturbance;
+  disturbance.wind_W = wind_.Step(dt);
+  x_before_ = x_;
+  integrator_.Step(command_, faults_, disturbance, dt, &x_);
+  t_ns_ += dt_ns_;
+  UpdateOutputs();
+  if (!x_.allFinite()) {
+    crash_reason_ = "state diverged (non-finite)";
+    x_ = x_before_;
+    return outputs_;
+  }
+  ResolveGroundContact(x_before_);
+  UpdateOutputs();
+  if (!crash_reason_ && !landed_) {
+    const StateView s(x_);
+    if (auto hit = world_.SphereCollision(s.p_W(), model_.params().collision_radius_m, time_s())) {
+      crash_reason_ = "collision with " + *hit;
+    }
+  }
+
+  SampleSensors(disturbance);
+  return outputs_;
+}
+
+}  // namespace rotorguard::sim

@@ -1,0 +1,80 @@
+#include "rotorguard/vehicle/vehicle_params.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::vehicle {
+
+namespace {
+constexpr char kOwner[] = "VehicleParams";
+constexpr double kRpmPerRadPerSecond = 60.0 / (2.0 * std::numbers::pi);
+
+void RequirePositive(const std::string& field, double value) {
+  if (!std::isfinite(value) || value <= 0.0) ThrowValidation(kOwner, field, value, "a finite value > 0");
+}
+void RequireNonNegative(const std::string& field, double value) {
+  if (!std::isfinite(value) || value < 0.0) ThrowValidation(kOwner, field, value, "a finite value >= 0");
+}
+}  // namespace
+
+double ThrustCoefficientFromRpm(double k) { return k * kRpmPerRadPerSecond * kRpmPerRadPerSecond; }
+double RadPerSecondToRpm(double w) { return w * kRpmPerRadPerSecond; }
+double RpmToRadPerSecond(double rpm) { return rpm / kRpmPerRadPerSecond; }
+
+double VehicleParams::total_max_thrust_n() const {
+  double sum = 0.0;
+  for (const Rotor& r : rotors) sum += r.max_thrust_n;
+  return sum;
+}
+
+void VehicleParams::Validate() const {
+  RequirePositive("mass_kg", mass_kg);
+  if (!inertia_kg_m2.allFinite() || (inertia_kg_m2 - inertia_kg_m2.transpose()).norm() >
+                                        1e-9 * inertia_kg_m2.norm()) {
+    throw ValidationError("inertia_kg_m2",
+                          fmt::format("{}::inertia_kg_m2 is invalid; expected a finite symmetric "
+                                      "3x3 matrix",
+                                      kOwner));
+  }
+  const double min_eig =
+      Eigen::SelfAdjointEigenSolver<Matrix3>(inertia_kg_m2, Eigen::EigenvaluesOnly)
+          .eigenvalues()
+          .minCoeff();
+  if (min_eig <= 0.0) {
+    ThrowValidation(kOwner, "inertia_kg_m2", fmt::format("(smallest eigenvalue {:g})", min_eig),
+                    "a positive definite matrix");
+  }
+  for (int i = 0; i < 3; ++i) RequireNonNegative(fmt::format("rotor_drag_kg_s.{}", i), rotor_drag_kg_s[i]);
+  RequireNonNegative("yaw_damping_n_m_s", yaw_damping_n_m_s);
+  RequirePositive("thrust_coefficient_n_per_rpm2", thrust_coefficient_n_s2);
+  RequirePositive("motor_time_constant_s", motor_time_constant_s);
+  RequirePositive("motor_stop_time_constant_s", motor_stop_time_constant_s);
+  if (!std::isfinite(unloaded_speed_ratio) || unloaded_speed_ratio < 1.0 || unloaded_speed_ratio > 3.0) {
+    ThrowValidation(kOwner, "unloaded_rpm_ratio", unloaded_speed_ratio, "a value in [1, 3]");
+  }
+  RequirePositive("collision_radius_m", collision_radius_m);
+  if (rotors.empty() || num_rotors() > kMaxRotors) {
+    ThrowValidation(kOwner, "rotors", fmt::format("({} rotors)", rotors.size()),
+                    fmt::format("between 1 and {} rotors", kMaxRotors));
+  }
+  for (int i = 0; i < num_rotors(); ++i) {
+    const Rotor& r = rotors[i];
+    if (!r.p_B.allFinite()) {
+      ThrowValidation(kOwner, fmt::format("rotors.{}.position_m", i), "(non-finite)", "finite numbers");
+    }
+    RequireNonNegative(fmt::format("rotors.{}.yaw_coefficient_m", i), r.yaw_coefficient_m);
+    RequirePositive(fmt::format("rotors.{}.max_thrust_n", i), r.max_thrust_n);
+  }
+  const double twr = total_max_thrust_n() / weight_n();
+  if (twr <= 1.0) {
+    ThrowValidation(kOwner, "rotors", fmt::format("(thrust-to-weight {:.3f})", twr),
+                    "total max_thrust_n above the weight m*g (thrust-to-weight > 1)");
+  }
+}
+
+}  // namespace rotorguard::vehicle

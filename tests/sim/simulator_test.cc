@@ -1,0 +1,137 @@
+#include "rotorguard/sim/simulator.h"
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+#include "vehicle/vehicle_fixture.h"
+
+namespace rotorguard::sim {
+namespace {
+
+using rotorguard::testing::ReferenceQuad;
+using vehicle::FaultKind;
+using vehicle::StateView;
+
+struct Rig {
+  explicit Rig(std::vector<FaultSpec> faults = {}, double z = 2.0, std::uint64_t seed = 1, World world = {})
+      : model(ReferenceQuad()),
+        sim(model, std::move(world), std::move(faults), SimulatorOptions{}, seed,
+            model.MakeState(Vector3(0, 0, z), 0.0, z > 0 ? model.HoverThrusts() : RotorVector::Zero(4))) {
+    hover.thrust_n = model.HoverThrusts();
+  }
+  /// Steps for `seconds` holding `command`, keeping the latest telemetry.
+  void Run(double seconds, const RotorCommand& command) {
+    const auto steps = std::llround(seconds / ToSeconds(sim.step_ns()));
+    for (long long k = 0; k < steps; ++k) {
+      const SensorOutputs& o = sim.Step(command);
+      if (o.esc) esc = *o.esc;
+      if (o.imu) imu = *o.imu;
+    }
+  }
+  vehicle::MultirotorModel model;
+  Simulator sim;
+  RotorCommand hover;
+  EscTelemetry esc;
+  ImuSample imu;
+};
+
+FaultSpec AtTime(int rotor, FaultKind kind, double t) {
+  FaultSpec s;
+  s.rotor = rotor;
+  s.kind = kind;
+  s.onset = {FaultOnset::Kind::kAtTime, t};
+  return s;
+}
+
+TEST(Simulator, SameSeedGivesIdenticalSensorStreamsDifferentSeedsDiffer) {
+  Rig a({}, 2.0, 42), b({}, 2.0, 42), c({}, 2.0, 43);
+  bool any_difference = false;
+  for (int k = 0; k < 2000; ++k) {
+    const SensorOutputs oa = a.sim.Step(a.hover), ob = b.sim.Step(b.hover), oc = c.sim.Step(c.hover);
+    ASSERT_EQ(oa.imu.has_value(), ob.imu.has_value());
+    if (oa.imu) {
+      ASSERT_EQ(oa.imu->specific_force_B, ob.imu->specific_force_B) << "step " << k;
+      ASSERT_EQ(oa.imu->w_B, ob.imu->w_B);
+      any_difference = any_difference || oa.imu->w_B != oc.imu->w_B;
+    }
+    if (oa.odometry) {
+      ASSERT_EQ(oa.odometry->p_W, ob.odometry->p_W);
+    }
+  }
+  EXPECT_EQ(a.sim.state(), b.sim.state());
+  EXPECT_TRUE(any_difference);
+}
+
+TEST(Simulator, PropellerLossKeepsTelemetryHighWithZeroThrust) {
+  Rig rig({AtTime(0, FaultKind::kPropellerLoss, 0.1)});
+  rig.Run(0.3, rig.hover);
+  EXPECT_EQ(rig.sim.rotor_thrusts()[0], 0.0);
+  // Telemetry: the unloaded motor reads ~10 % above the loaded ones (noise 20 rpm, 10 rpm steps).
+  const double ratio = rig.esc.motor_speed_rad_s[0] / rig.esc.motor_speed_rad_s[2];
+  EXPECT_NEAR(ratio, 1.1, 0.01);
+}
+
+TEST(Simulator, MotorStopCollapsesTelemetry) {
+  Rig rig({AtTime(1, FaultKind::kMotorStop, 0.1)});
+  rig.Run(0.14, rig.hover);  // 40 ms after onset, telemetry 1 ms old
+  EXPECT_LT(rig.esc.motor_speed_rad_s[1], 0.2 * rig.esc.motor_speed_rad_s[0]);
+  EXPECT_LT(rig.sim.rotor_thrusts()[1], 0.01 * rig.sim.rotor_thrusts()[0]);
+}
+
+TEST(Simulator, RestsOnTheGroundReadingGravityUntilThrustExceedsWeight) {
+  Rig rig({}, 0.0);
+  RotorCommand idle;
+  idle.thrust_n = RotorVector::Constant(4, 1.0);
+  rig.Run(1.0, idle);
+  EXPECT_TRUE(rig.sim.landed());
+  EXPECT_EQ(StateView(rig.sim.state()).p_W().z(), 0.0);
+  EXPECT_NEAR(rig.imu.specific_force_B.z(), kGravity, 0.3);  // noise and bias
+  RotorCommand climb;
+  climb.thrust_n = RotorVector::Constant(4, 4.0);
+  rig.Run(1.0, climb);
+  EXPECT_FALSE(rig.sim.landed());
+  EXPECT_GT(StateView(rig.sim.state()).p_W().z(), 0.5);
+  EXPECT_FALSE(rig.sim.crashed());
+}
+
+TEST(Simulator, FallingOntoTheGroundIsACrash) {
+  Rig rig({}, 5.0);
+  RotorCommand off;
+  off.thrust_n = RotorVector::Zero(4);
+  rig.Run(3.0, off);
+  ASSERT_TRUE(rig.sim.crashed());
+  EXPECT_NE(rig.sim.crash_reason()->find("ground impact"), std::string::npos);
+  EXPECT_LT(rig.sim.time_s(), 1.2);  // ~1 s to fall 5 m; the simulator stops there
+}
+
+TEST(Simulator, FlyingIntoABoxIsACollision) {
+  World w;
+  w.boxes.push_back(Box{Vector3(0, 0, 3.0), Vector3(2, 2, 0.5), 0.0});
+  Rig rig({}, 2.0, 1, w);
+  RotorCommand up;
+  up.thrust_n = RotorVector::Constant(4, 4.0);
+  rig.Run(2.0, up);
+  ASSERT_TRUE(rig.sim.crashed());
+  EXPECT_EQ(*rig.sim.crash_reason(), "collision with box 0");
+}
+
+TEST(Simulator, NonFiniteCommandsReachTheMotorsAsZero) {
+  Rig rig({}, 2.0);
+  RotorCommand bad = rig.hover;
+  bad.thrust_n[2] = std::nan("");
+  rig.sim.Step(bad);
+  EXPECT_EQ(rig.sim.applied_command()[2], 0.0);
+  EXPECT_TRUE(rig.sim.state().allFinite());
+}
+
+TEST(Simulator, RejectsAStepTooLongForTheMotors) {
+  SimulatorOptions o;
+  o.physics_rate_hz = 100.0;  // 10 ms > half the 5 ms stop time constant
+  const vehicle::MultirotorModel model(ReferenceQuad());
+  const vehicle::StateVector x0 = model.MakeState(Vector3(0, 0, 1), 0, model.HoverThrusts());
+  EXPECT_THROW(Simulator(model, {}, {}, o, 1, x0), rotorguard::ValidationError);
+}
+
+}  // namespace
+}  // namespace rotorguard::sim

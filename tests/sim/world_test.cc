@@ -1,0 +1,52 @@
+#include "rotorguard/sim/world.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace rotorguard::sim {
+namespace {
+
+TEST(World, BoxDistanceMatchesClosedForms) {
+  Box b{Vector3(1, 2, 3), Vector3(2, 4, 6), 0.0};
+  EXPECT_EQ(b.Distance(Vector3(1, 2, 3)), 0.0);               // centre
+  EXPECT_NEAR(b.Distance(Vector3(3, 2, 3)), 1.0, 1e-15);      // beyond the +x face
+  EXPECT_NEAR(b.Distance(Vector3(3, 5, 3)), std::hypot(1.0, 1.0), 1e-15);  // off an edge
+  // Rotated 90 degrees: the 2 m side now lies along y.
+  Box r{Vector3(0, 0, 0), Vector3(2, 4, 1), M_PI / 2};
+  EXPECT_NEAR(r.Distance(Vector3(0, 1.5, 0)), 0.5, 1e-12);
+  EXPECT_NEAR(r.Distance(Vector3(2.5, 0, 0)), 0.5, 1e-12);
+}
+
+TEST(World, CylinderDistanceMatchesClosedForms) {
+  Cylinder c{Eigen::Vector2d(0, 0), 0.5, 4.0};
+  EXPECT_NEAR(c.Distance(Vector3(2, 0, 1)), 1.5, 1e-15);
+  EXPECT_NEAR(c.Distance(Vector3(0, 0, 5)), 1.0, 1e-15);   // above the top
+  EXPECT_NEAR(c.Distance(Vector3(1.5, 0, 6)), std::hypot(1.0, 2.0), 1e-15);
+  EXPECT_EQ(c.Distance(Vector3(0.1, 0.1, 2)), 0.0);
+}
+
+TEST(World, MovingBoxFollowsItsWaypointsAtConstantSpeed) {
+  MovingBox m;
+  m.waypoints_m = {Vector3(0, 0, 1), Vector3(4, 0, 1), Vector3(4, 3, 1)};
+  m.speed_m_s = 2.0;
+  m.loop = true;  // closing leg back to the start is 5 m: the loop is 12 m, 6 s
+  EXPECT_NEAR((m.At(1.0).center_m - Vector3(2, 0, 1)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((m.At(2.5).center_m - Vector3(4, 1, 1)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((m.At(6.0).center_m - Vector3(0, 0, 1)).norm(), 0.0, 1e-12);
+  m.loop = false;
+  EXPECT_NEAR((m.At(100.0).center_m - Vector3(4, 3, 1)).norm(), 0.0, 1e-12);
+}
+
+TEST(World, SphereCollisionNamesTheObstacle) {
+  World w;
+  w.boxes.push_back(Box{Vector3(5, 0, 1), Vector3(1, 1, 2), 0.0});
+  w.cylinders.push_back(Cylinder{Eigen::Vector2d(0, 5), 0.2, 5.0});
+  EXPECT_FALSE(w.SphereCollision(Vector3(0, 0, 1), 0.2, 0.0));
+  EXPECT_EQ(*w.SphereCollision(Vector3(4.4, 0, 1), 0.2, 0.0), "box 0");
+  EXPECT_EQ(*w.SphereCollision(Vector3(0, 4.7, 1), 0.2, 0.0), "cylinder 0");
+  EXPECT_FALSE(w.SphereCollision(Vector3(0, 4.5, 1), 0.2, 0.0));  // 0.3 m from the trunk
+}
+
+}  // namespace
+}  // namespace rotorguard::sim

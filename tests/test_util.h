@@ -1,0 +1,55 @@
+#pragma once
+/// Shared test helpers: matrix comparison with an informative message, expect-throw-with-message,
+/// central finite differences.
+#include <functional>
+#include <sstream>
+#include <string>
+
+#include <Eigen/Core>
+#include <gtest/gtest.h>
+
+namespace rotorguard::testing {
+
+/// Passes when |a - b| <= tol elementwise; prints both matrices otherwise.
+template <typename A, typename B>
+::testing::AssertionResult MatricesNear(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b,
+                                        double tol) {
+  if (a.rows() != b.rows() || a.cols() != b.cols()) {
+    return ::testing::AssertionFailure() << "size " << a.rows() << "x" << a.cols() << " vs "
+                                         << b.rows() << "x" << b.cols();
+  }
+  const double err = (a - b).cwiseAbs().maxCoeff();
+  if (err <= tol) return ::testing::AssertionSuccess();
+  std::ostringstream os;
+  os << "max |a - b| = " << err << " > " << tol << "\na =\n" << a << "\nb =\n" << b;
+  return ::testing::AssertionFailure() << os.str();
+}
+
+/// Central-difference Jacobian of f at x.
+inline Eigen::MatrixXd NumericalJacobian(
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, const Eigen::VectorXd& x,
+    double h = 1e-6) {
+  const Eigen::VectorXd f0 = f(x);
+  Eigen::MatrixXd j(f0.size(), x.size());
+  for (int i = 0; i < x.size(); ++i) {
+    Eigen::VectorXd xp = x, xm = x;
+    xp[i] += h;
+    xm[i] -= h;
+    j.col(i) = (f(xp) - f(xm)) / (2.0 * h);
+  }
+  return j;
+}
+
+}  // namespace rotorguard::testing
+
+/// EXPECT that `statement` throws `exception_type` whose what() contains `substring`.
+#define RG_EXPECT_THROW_WITH(statement, exception_type, substring)                        \
+  do {                                                                                    \
+    try {                                                                                 \
+      statement;                                                                          \
+      ADD_FAILURE() << "expected " #exception_type " from " #statement;                   \
+    } catch (const exception_type& e) {                                                   \
+      EXPECT_NE(std::string(e.what()).find(substring), std::string::npos)                 \
+          << "message \"" << e.what() << "\" lacks \"" << (substring) << "\"";            \
+    }                                                                                     \
+  } while (false)
