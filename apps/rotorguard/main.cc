@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
     if (*run) {
       std::vector<Override> overrides = ParseOverrides(sets);
       std::optional<std::uint64_t> seed;
-      if (!seed_text.empty()) seed = ParseUnsigned("--seed", seed_text, 0, UINT64_MAX);
+      if (run->count("--seed") > 0) seed = ParseUnsigned("--seed", seed_text, 0, UINT64_MAX);
       rotorguard::bench::Scenario scenario = rotorguard::bench::LoadScenario(scenario_path, overrides);
       if (seed) scenario.seed = *seed;
       if (out_dir.empty()) out_dir = (fs::path("out") / scenario.name).string();

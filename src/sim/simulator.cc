@@ -107,7 +107,7 @@ void Simulator::ResolveGroundContact(const vehicle::StateVector& before) {
   if (landed_) {
     // Resting on the ground: lift off only when the net vertical force points up.
     const double up_force = thrust_.sum() * s.q_WB().toRotationMatrix()(2, 2);
-    if (up_force > model_.params().weight_n()) {
+    if (up_force > model_.params().weight_n() && s.p_W().z() >= 0.0) {
       landed_ = false;
       return;
     }

@@ -1,0 +1,310 @@
+// End-to-end tests of the rotorguard command line: exit codes, error messages that name file,
+// line and key path, and outputs that are never half-written.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exit_code = -1;
+  std::string out;  ///< stdout and stderr together
+};
+
+/// Runs the CLI with `args` (already shell-quoted where needed).
+Result Cli(const std::string& args) {
+  const std::string cmd = std::string(ROTORGUARD_CLI) + " " + args + " 2>&1";
+  Result r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string ReadText(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+const std::string kVehicle = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml";
+
+/// A short valid hover scenario; `extra` is appended (YAML) to it.
+std::string Scenario(const std::string& vehicle, const std::string& extra = "") {
+  return "vehicle: " + vehicle +
+         "\n"
+         "duration_s: 1.0\n"
+         "seed: 3\n"
+         "initial:\n"
+         "  position_m: [0.0, 0.0, 1.0]\n"
+         "mission:\n"
+         "  type: hover\n" +
+         extra;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("rotorguard_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  /// A copy of the reference vehicle file with `from` replaced by `to` in its text.
+  std::string VehicleWith(const std::string& from, const std::string& to) {
+    std::string text = ReadText(kVehicle);
+    const auto pos = text.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    if (pos != std::string::npos) text.replace(pos, from.size(), to);
+    return Write("vehicle.yaml", text);
+  }
+  /// Expects exit 2 and a message holding "<file>:<line>" and every needle.
+  void ExpectConfigError(const std::string& args, const std::string& file, int line,
+                         const std::vector<std::string>& needles) {
+    const Result r = Cli(args);
+    EXPECT_EQ(r.exit_code, 2) << r.out;
+    EXPECT_NE(r.out.find(file + ":" + std::to_string(line)), std::string::npos)
+        << "expected " << file << ":" << line << " in: " << r.out;
+    for (const std::string& n : needles) EXPECT_NE(r.out.find(n), std::string::npos) << "'" << n << "' not in: " << r.out;
+  }
+  std::string Out() const { return (dir_ / "out").string(); }
+
+  fs::path dir_;
+};
+
+TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
+  const Result r = Cli("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* s : {"run", "validate", "bench", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  const Result run = Cli("run --help");
+  EXPECT_EQ(run.exit_code, 0);
+  for (const char* s : {"--out", "--set", "--seed", "--quiet"}) EXPECT_NE(run.out.find(s), std::string::npos) << s;
+  EXPECT_EQ(Cli("bench sim --help").exit_code, 0);
+  EXPECT_EQ(Cli("validate --help").exit_code, 0);
+}
+
+TEST_F(CliTest, UsageErrorsExitTwo) {
+  EXPECT_EQ(Cli("").exit_code, 2);
+  EXPECT_EQ(Cli("fly").exit_code, 2);
+  EXPECT_EQ(Cli("run").exit_code, 2);
+  EXPECT_EQ(Cli("run a.yaml --no-such-flag").exit_code, 2);
+}
+
+TEST_F(CliTest, HoverRunSucceedsAndWritesLogAndSummary) {
+  const std::string s = Write("hover.yaml", Scenario(kVehicle));
+  const Result r = Cli("run " + s + " --out " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("success"), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
+  for (const char* key : {"scenario", "seed", "success", "crashed", "crash_reason", "sim_time_s", "wall_time_s",
+                          "realtime_factor", "tracking_rmse_m", "max_position_error_m", "min_altitude_m",
+                          "max_spin_rad_s", "faults", "fdd"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["seed"], 3);
+  EXPECT_EQ(j["success"], true);
+  EXPECT_TRUE(j["fdd"].is_null());
+  EXPECT_NEAR(j["sim_time_s"].get<double>(), 1.0, 1e-9);
+  const std::string log = ReadText(fs::path(Out()) / "log.csv");
+  EXPECT_EQ(log.rfind("t,p_x,p_y,p_z", 0), 0u);
+  // 100 Hz over 1 s plus the header and the final row.
+  EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 102);
+}
+
+TEST_F(CliTest, NominalControllerLosingAMotorCrashesAndExitsOne) {
+  const std::string s = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/hover_motor_stop_nominal.yaml";
+  const Result r = Cli("run " + s + " --quiet --out " + Out());
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
+  EXPECT_EQ(j["crashed"], true);
+  EXPECT_EQ(j["success"], false);
+  EXPECT_NE(j["crash_reason"].get<std::string>().find("ground impact"), std::string::npos);
+  ASSERT_EQ(j["faults"].size(), 1u);
+  EXPECT_EQ(j["faults"][0]["rotor"], 0);
+  EXPECT_EQ(j["faults"][0]["kind"], "motor_stop");
+  EXPECT_NEAR(j["faults"][0]["onset_s"].get<double>(), 2.0, 1e-9);
+}
+
+TEST_F(CliTest, SameSeedGivesAnIdenticalLogDifferentSeedsDiffer) {
+  const std::string s = Write("s.yaml", Scenario(kVehicle, "wind: {gust_std_m_s: 0.5}\n"));
+  ASSERT_EQ(Cli("run " + s + " --quiet --out " + Out() + "/a").exit_code, 0);
+  ASSERT_EQ(Cli("run " + s + " --quiet --out " + Out() + "/b").exit_code, 0);
+  ASSERT_EQ(Cli("run " + s + " --quiet --seed 4 --out " + Out() + "/c").exit_code, 0);
+  const std::string a = ReadText(fs::path(Out()) / "a/log.csv");
+  EXPECT_FALSE(a.empty());
+  EXPECT_EQ(a, ReadText(fs::path(Out()) / "b/log.csv"));
+  EXPECT_NE(a, ReadText(fs::path(Out()) / "c/log.csv"));
+}
+
+TEST_F(CliTest, SetOverridesScenarioAndVehicleValues) {
+  const std::string s = Write("s.yaml", Scenario(kVehicle));
+  const Result r = Cli("run " + s + " --quiet --set duration_s=0.5 --set vehicle.mass_kg=1.3 --out " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
+  EXPECT_NEAR(j["sim_time_s"].get<double>(), 0.5, 1e-9);
+}
+
+TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
+  const std::string v = kVehicle;
+  // Line numbers: 1 vehicle, 2 duration_s, 3 seed, 4 initial, 5 position_m, 6 mission, 7 type, 8+ extra.
+  std::string f = Write("unknown.yaml", Scenario(v, "durations_s: 3\n"));
+  ExpectConfigError("run " + f, f, 8, {"durations_s", "unknown key"});
+  f = Write("dup.yaml", Scenario(v, "duration_s: 2.0\n"));
+  ExpectConfigError("run " + f, f, 8, {"duplicate key", "duration_s"});
+  f = Write("missing.yaml", "vehicle: " + v + "\nmission:\n  type: hover\n");
+  ExpectConfigError("run " + f, f, 1, {"duration_s", "missing"});
+  f = Write("nan.yaml", Scenario(v, "wind: {gust_std_m_s: .nan}\n"));
+  ExpectConfigError("run " + f, f, 8, {"wind.gust_std_m_s", "finite"});
+  f = Write("inf.yaml", Scenario(v, "wind: {gust_std_m_s: .inf}\n"));
+  ExpectConfigError("run " + f, f, 8, {"wind.gust_std_m_s", "finite"});
+  f = Write("unit.yaml", Scenario(v, "sim: {physics_rate_hz: 1kHz}\n"));
+  ExpectConfigError("run " + f, f, 8, {"sim.physics_rate_hz", "1kHz"});
+  f = Write("rotor.yaml", Scenario(v, "faults:\n  - {rotor: 7, kind: motor_stop, onset: {at_time_s: 0.5}}\n"));
+  ExpectConfigError("run " + f, f, 9, {"faults.0.rotor", "[0, 3]"});
+  f = Write("onset.yaml", Scenario(v, "faults:\n  - rotor: 1\n    kind: propeller_loss\n    onset: {at_time_s: 5.0}\n"));
+  ExpectConfigError("run " + f, f, 11, {"faults.0.onset.at_time_s", "duration_s"});
+  f = Write("kind.yaml", Scenario(v, "faults:\n  - {rotor: 1, kind: melted, onset: {at_time_s: 0.5}}\n"));
+  ExpectConfigError("run " + f, f, 9, {"faults.0.kind", "motor_stop"});
+  f = Write("malformed.yaml", "vehicle: " + v + "\nduration_s: [1, 2\nmission: {type: hover}\n");
+  {
+    const Result r = Cli("run " + f);
+    EXPECT_EQ(r.exit_code, 2) << r.out;
+    EXPECT_NE(r.out.find(f + ":"), std::string::npos) << r.out;
+  }
+  f = Write("empty.yaml", "");
+  ExpectConfigError("run " + f, f, 1, {"empty"});
+  f = Write("comments.yaml", "# nothing here\n");
+  ExpectConfigError("run " + f, f, 1, {"empty"});
+}
+
+TEST_F(CliTest, BadVehicleContentExitsTwoNamingTheVehicleFile) {
+  std::string v = VehicleWith("mass_kg: 1.15", "mass_kg: -1.15");
+  std::string s = Write("s.yaml", Scenario(v));
+  ExpectConfigError("run " + s, v, 5, {"mass_kg", "-1.15"});
+  v = VehicleWith("mass_kg: 1.15", "mass_kg: 1.5kg");
+  s = Write("s.yaml", Scenario(v));
+  ExpectConfigError("run " + s, v, 5, {"mass_kg", "1.5kg"});
+  v = VehicleWith("[0.0, 0.0, 8.650e-3]", "[0.0, 0.0, -8.650e-3]");
+  s = Write("s.yaml", Scenario(v));
+  ExpectConfigError("run " + s, v, 7, {"inertia_kg_m2", "positive definite"});
+  v = Write("v.yaml", std::regex_replace(ReadText(kVehicle), std::regex("max_thrust_n: 11.5"), "max_thrust_n: 2.5"));
+  s = Write("s.yaml", Scenario(v));
+  const Result r = Cli("run " + s);
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("thrust-to-weight"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(v + ":"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, SetOnAPathThatDoesNotExistExitsTwo) {
+  const std::string s = Write("s.yaml", Scenario(kVehicle));
+  for (const char* set : {"durationn_s=3", "mission.speed=2", "vehicle.masss_kg=1", "faults.0.rotor=1", "novalue"}) {
+    const Result r = Cli("run " + s + " --set " + set);
+    EXPECT_EQ(r.exit_code, 2) << set << ": " << r.out;
+    EXPECT_NE(r.out.find("--set"), std::string::npos) << set << ": " << r.out;
+  }
+  // An existing path given a bad value is reported against --set.
+  const Result r = Cli("run " + s + " --set duration_s=abc");
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("duration_s"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, NumericOptionsRejectNonFiniteNegativeAndGarbage) {
+  const std::string s = Write("s.yaml", Scenario(kVehicle));
+  const auto expect_usage_error = [&](const std::string& args) {
+    const Result r = Cli(args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find("invalid"), std::string::npos) << args << ": " << r.out;
+  };
+  for (const std::string bad : {"nan", "inf", "1e999", "-1", "abc", ""}) {
+    expect_usage_error("run " + s + " --quiet --seed '" + bad + "' --out " + Out());
+    expect_usage_error("bench sim --scenario " + s + " --duration '" + bad + "'");
+    expect_usage_error("bench sim --scenario " + s + " --repetitions '" + bad + "'");
+  }
+  // Integers only where a count is expected.
+  expect_usage_error("run " + s + " --quiet --seed 1.5 --out " + Out());
+  expect_usage_error("bench sim --scenario " + s + " --repetitions 1.5");
+}
+
+TEST_F(CliTest, UnreadableInputExitsThree) {
+  const Result r = Cli("run " + (dir_ / "no_such_file.yaml").string());
+  EXPECT_EQ(r.exit_code, 3) << r.out;
+  EXPECT_NE(r.out.find("no_such_file.yaml"), std::string::npos);
+  EXPECT_EQ(Cli("validate " + dir_.string()).exit_code, 3);  // a folder is not a file
+  const std::string s = Write("s.yaml", Scenario((dir_ / "missing_vehicle.yaml").string()));
+  const Result v = Cli("run " + s);
+  EXPECT_EQ(v.exit_code, 2) << v.out;  // the scenario's vehicle key points nowhere: a config error
+  EXPECT_NE(v.out.find(s + ":1"), std::string::npos) << v.out;
+}
+
+TEST_F(CliTest, ValidateChecksScenariosAndVehiclesWithoutFlying) {
+  const Result ok = Cli("validate " + std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/lemniscate_2ms.yaml");
+  EXPECT_EQ(ok.exit_code, 0) << ok.out;
+  EXPECT_NE(ok.out.find("valid scenario"), std::string::npos) << ok.out;
+  const Result veh = Cli("validate " + kVehicle);
+  EXPECT_EQ(veh.exit_code, 0) << veh.out;
+  EXPECT_NE(veh.out.find("valid vehicle"), std::string::npos) << veh.out;
+  const std::string bad = VehicleWith("collision_radius_m: 0.2", "collision_radius_m: 0.2\ncolision_radius_m: 0.3");
+  EXPECT_EQ(Cli("validate " + bad).exit_code, 2);
+}
+
+TEST_F(CliTest, EveryShippedConfigValidates) {
+  for (const auto& e : fs::recursive_directory_iterator(std::string(ROTORGUARD_SOURCE_DIR) + "/configs")) {
+    if (e.path().extension() != ".yaml") continue;
+    const Result r = Cli("validate " + e.path().string());
+    EXPECT_EQ(r.exit_code, 0) << e.path() << ": " << r.out;
+  }
+}
+
+TEST_F(CliTest, KilledRunLeavesNoSummaryThatLooksComplete) {
+  const std::string s = Write("s.yaml", Scenario(kVehicle));
+  fs::create_directories(Out());
+  std::ofstream(fs::path(Out()) / "summary.json") << "{\"stale\": true}";
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execl(ROTORGUARD_CLI, ROTORGUARD_CLI, "run", s.c_str(), "--quiet", "--set", "duration_s=100000", "--out",
+            Out().c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Wait until the run has started writing, then kill it without warning.
+  for (int i = 0; i < 200; ++i) {
+    bool started = false;
+    for (const auto& e : fs::directory_iterator(Out())) started |= e.path().filename().string().rfind("log.csv.tmp", 0) == 0;
+    if (started) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  EXPECT_FALSE(fs::exists(fs::path(Out()) / "summary.json")) << "a stale or partial summary survived";
+  EXPECT_FALSE(fs::exists(fs::path(Out()) / "log.csv")) << "a partial log carries the final name";
+}
+
+}  // namespace

@@ -1,0 +1,72 @@
+#include "rotorguard/stack/flight_stack.h"
+
+#include <type_traits>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/planning/references.h"
+#include "test_util.h"
+#include "vehicle/vehicle_fixture.h"
+
+namespace rotorguard::stack {
+namespace {
+
+using rotorguard::testing::ReferenceQuad;
+
+std::shared_ptr<const ReferenceTrajectory> HoverAt(double z) {
+  planning::HoverOptions o;
+  o.position_m = Vector3(0, 0, z);
+  return std::make_shared<planning::HoverReference>(o);
+}
+
+// The stack's inputs are sensor messages and nothing else: pin the signatures.
+static_assert(std::is_same_v<decltype(&FlightStack::OnImu), void (FlightStack::*)(const ImuSample&)>);
+static_assert(std::is_same_v<decltype(&FlightStack::OnEscTelemetry), void (FlightStack::*)(const EscTelemetry&)>);
+static_assert(std::is_same_v<decltype(&FlightStack::OnOdometry), void (FlightStack::*)(const OdometrySample&)>);
+static_assert(std::is_same_v<decltype(&FlightStack::Update), const RotorCommand& (FlightStack::*)(TimeNs)>);
+
+TEST(FlightStack, IdlesUntilItHasSensorData) {
+  FlightStack st(ReferenceQuad(), HoverAt(1.0), {});
+  const RotorCommand& c = st.Update(0);
+  EXPECT_EQ(c.thrust_n.size(), 4);
+  EXPECT_EQ(c.thrust_n.norm(), 0.0);
+  EXPECT_FALSE(st.estimate().valid);
+}
+
+TEST(FlightStack, HoldsHoverThrustAtTheReference) {
+  FlightStack st(ReferenceQuad(), HoverAt(1.0), {});
+  ImuSample imu;
+  imu.specific_force_B = Vector3(0, 0, kGravity);
+  OdometrySample odom;
+  odom.p_W = Vector3(0, 0, 1.0);
+  st.OnImu(imu);
+  st.OnOdometry(odom);
+  const RotorCommand& c = st.Update(0);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(c.thrust_n[i], 1.15 * kGravity / 4.0, 1e-9);
+}
+
+TEST(FlightStack, CorruptSensorDataNeverReachesTheMotorsAsNan) {
+  FlightStack st(ReferenceQuad(), HoverAt(1.0), {});
+  ImuSample imu;
+  OdometrySample odom;
+  odom.p_W = Vector3(0, 0, 1.0);
+  st.OnImu(imu);
+  st.OnOdometry(odom);
+  odom.p_W.x() = std::nan("");
+  imu.w_B.z() = std::numeric_limits<double>::infinity();
+  st.OnOdometry(odom);
+  st.OnImu(imu);
+  const RotorCommand& c = st.Update(5'000'000);
+  EXPECT_TRUE(c.thrust_n.allFinite());
+  EXPECT_TRUE(st.estimate().p_W.allFinite());  // the corrupt sample was dropped
+}
+
+TEST(FlightStack, RejectsUnknownControllerNames) {
+  FlightStackOptions o;
+  o.controller = "magic";
+  RG_EXPECT_THROW_WITH(FlightStack(ReferenceQuad(), HoverAt(1.0), o), ValidationError, "controller = magic");
+}
+
+}  // namespace
+}  // namespace rotorguard::stack
