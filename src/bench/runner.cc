@@ -173,8 +173,13 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       next_progress += progress_stride;
     }
   }
+  {
+    const double alt = StateView(sim.state()).p_W().z();  // the final state (or the crash site)
+    min_alt_all = std::min(min_alt_all, alt);
+    if (!sim.fault_events().empty()) min_alt_after_fault = std::min(min_alt_after_fault, alt);
+  }
   if (log) {
-    AppendRow(sim, st, &buffer);  // the final state (or the crash site)
+    AppendRow(sim, st, &buffer);
     log->Write(buffer);
     log->Commit();
   }
