@@ -92,7 +92,7 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
     faults += fmt::format("{}rotor {} {} at {:.3f} s", faults.empty() ? "" : "; ", f.rotor, f.kind, f.onset_s);
   }
   fmt::print("scenario          {}\n", s.scenario);
-  fmt::print("outcome           {}\n", s.success ? "success" : "FAILED: " + s.crash_reason);
+  fmt::print("outcome           {}\n", s.success ? "success" : "FAILED: " + s.failure_reason);
   fmt::print("simulated         {:.2f} s in {:.2f} s wall ({:.0f}x real time)\n", s.sim_time_s, s.wall_time_s,
              s.realtime_factor);
   fmt::print("tracking RMSE     {:.3f} m (max error {:.3f} m)\n", s.tracking_rmse_m, s.max_position_error_m);
@@ -215,6 +215,10 @@ int main(int argc, char** argv) {
   } catch (const rotorguard::io::InputFileError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kUnreadable;
+  } catch (const std::invalid_argument& e) {
+    // Library validation of values the loaders did not locate (a programming-interface misuse).
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kUsage;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kRunFailed;

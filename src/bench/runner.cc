@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "rotorguard/bench/metrics.h"
+#include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/sim/simulator.h"
@@ -19,7 +20,7 @@ namespace rotorguard::bench {
 namespace {
 using vehicle::StateView;
 
-// Fault column codes in log.csv (docs/outputs.md).
+// Fault column codes in log.csv (docs/scenarios.md, "Outputs").
 int FaultCode(vehicle::FaultKind kind) { return static_cast<int>(kind); }
 
 std::string LogHeader(int n) {
@@ -82,6 +83,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["success"] = success;
   j["crashed"] = crashed;
   j["crash_reason"] = crashed ? nlohmann::json(crash_reason) : nlohmann::json(nullptr);
+  j["failure_reason"] = success ? nlohmann::json(nullptr) : nlohmann::json(failure_reason);
   j["sim_time_s"] = sim_time_s;
   j["wall_time_s"] = wall_time_s;
   j["realtime_factor"] = realtime_factor;
@@ -102,6 +104,10 @@ nlohmann::json RunSummary::ToJson() const {
 
 RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   namespace fs = std::filesystem;
+  if (sc.stack.control_rate_hz > sc.sim.physics_rate_hz) {
+    ThrowInvalidArgument("RunScenario", "stack.control_rate_hz", sc.stack.control_rate_hz,
+                         "at most sim.physics_rate_hz (the runner polls the stack at physics steps)");
+  }
   const auto wall_start = std::chrono::steady_clock::now();
 
   std::optional<io::AtomicFileWriter> log;
@@ -138,6 +144,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   summary.scenario = sc.name;
   summary.seed = sc.seed;
   TrackingErrorAccumulator tracking;
+  // Success (DESIGN.md, SucR): no crash, and the error within success_error_m over the last
+  // success_hold_s of the flight. Remember the last time it was exceeded.
+  std::optional<double> last_violation_s;
+  double last_violation_error = 0.0;
   double min_alt_all = std::numeric_limits<double>::infinity();
   double min_alt_after_fault = std::numeric_limits<double>::infinity();
   std::string buffer;
@@ -152,7 +162,13 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       ++summary.control_cycles;
     }
     const StateView s(sim.state());
-    if (t >= tracking_start) tracking.Add(dt, s.p_W(), sc.reference->Evaluate(ToSeconds(t)).p_W);
+    const Vector3 p_ref = sc.reference->Evaluate(ToSeconds(t)).p_W;
+    if (t >= tracking_start) tracking.Add(dt, s.p_W(), p_ref);
+    const double error = (s.p_W() - p_ref).norm();
+    if (!(error <= sc.success_error_m)) {
+      last_violation_s = ToSeconds(t);
+      last_violation_error = error;
+    }
     const double alt = s.p_W().z();
     min_alt_all = std::min(min_alt_all, alt);
     if (!sim.fault_events().empty()) min_alt_after_fault = std::min(min_alt_after_fault, alt);
@@ -188,7 +204,14 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   summary.sim_time_s = sim.time_s();
   summary.crashed = sim.crashed();
   summary.crash_reason = sim.crash_reason().value_or("");
-  summary.success = !summary.crashed;
+  if (summary.crashed) {
+    summary.failure_reason = "crash: " + summary.crash_reason;
+  } else if (last_violation_s && *last_violation_s >= summary.sim_time_s - sc.success_hold_s) {
+    summary.failure_reason =
+        fmt::format("position error {:.2f} m > {:g} m at t = {:.2f} s, within the last {:g} s", last_violation_error,
+                    sc.success_error_m, *last_violation_s, sc.success_hold_s);
+  }
+  summary.success = summary.failure_reason.empty();
   summary.tracking_rmse_m = Finite(tracking.rmse());
   summary.tracking_rmse_eq37_m = Finite(tracking.rmse_eq37());
   summary.max_position_error_m = Finite(tracking.max_error());

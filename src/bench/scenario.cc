@@ -56,8 +56,8 @@ vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
   }
   v.rotor_drag_kg_s = root.Required("rotor_drag_kg_s").AsVector3();
   v.yaw_damping_n_m_s = root.Required("yaw_damping_n_m_s").AsDouble();
-  const ConfigNode kn = root.Required("thrust_coefficient_n_per_rpm2");
-  v.thrust_coefficient_n_s2 = vehicle::ThrustCoefficientFromRpm(kn.AsDouble());
+  v.thrust_coefficient_n_s2 =
+      vehicle::ThrustCoefficientFromRpm(root.Required("thrust_coefficient_n_per_rpm2").AsPositive());
   v.motor_time_constant_s = root.Required("motor_time_constant_s").AsDouble();
   v.motor_stop_time_constant_s = root.Required("motor_stop_time_constant_s").AsDouble();
   v.unloaded_speed_ratio = root.Required("unloaded_rpm_ratio").AsDouble();
@@ -82,10 +82,21 @@ vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
 }
 
 void ApplyOverrides(ConfigDocument* doc, const std::vector<Override>& overrides, bool vehicle_part) {
+  constexpr std::string_view kVehiclePrefix = "vehicle.";
   for (const auto& [path, value] : overrides) {
-    const bool is_vehicle = path.rfind("vehicle.", 0) == 0;
+    const bool is_vehicle = path.rfind(kVehiclePrefix, 0) == 0;
     if (is_vehicle != vehicle_part) continue;
-    doc->ApplyOverride(is_vehicle ? path.substr(8) : path, value);
+    if (!is_vehicle) {
+      doc->ApplyOverride(path, value);
+      continue;
+    }
+    try {
+      doc->ApplyOverride(path.substr(kVehiclePrefix.size()), value);
+    } catch (const io::ConfigError& e) {
+      // Report the path as the user wrote it, with its prefix.
+      throw io::ConfigError(e.file(), e.line(), e.column(), std::string(kVehiclePrefix) + e.key_path(),
+                            e.message());
+    }
   }
 }
 
@@ -199,7 +210,8 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
 
 sim::FaultSpec ParseFault(const ConfigNode& f) {
   sim::FaultSpec spec;
-  spec.rotor = static_cast<int>(f.Required("rotor").AsIntIn(0, kMaxRotors - 1));
+  // The range is checked against the vehicle's rotor count by FaultSpec::Validate.
+  spec.rotor = static_cast<int>(f.Required("rotor").AsIntIn(-1'000'000, 1'000'000));
   const ConfigNode kind = f.Required("kind");
   spec.kind = *vehicle::ParseFaultKind(
       kind.AsEnum({"motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck"}));
@@ -248,7 +260,6 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
     i.accel_bias_initial = OptionalDouble(*imu, "accel_bias_initial", i.accel_bias_initial);
     i.gyro_bias_initial = OptionalDouble(*imu, "gyro_bias_initial", i.gyro_bias_initial);
     imu->RejectUnknownKeys();
-    ValidateAt(*imu, [&] { i.Validate(o->physics_rate_hz); });
   }
   if (const auto esc = node.Optional("esc")) {
     sim::EscOptions& e = o->esc;
@@ -257,7 +268,6 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
     e.quantization_rpm = OptionalDouble(*esc, "quantization_rpm", e.quantization_rpm);
     e.delay_s = OptionalDouble(*esc, "delay_s", e.delay_s);
     esc->RejectUnknownKeys();
-    ValidateAt(*esc, [&] { e.Validate(o->physics_rate_hz); });
   }
   if (const auto odom = node.Optional("odometry")) {
     sim::OdometryOptions& d = o->odometry;
@@ -267,7 +277,6 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
     d.attitude_noise_rad = OptionalDouble(*odom, "attitude_noise_rad", d.attitude_noise_rad);
     d.rate_noise_gain = OptionalDouble(*odom, "rate_noise_gain", d.rate_noise_gain);
     odom->RejectUnknownKeys();
-    ValidateAt(*odom, [&] { d.Validate(o->physics_rate_hz); });
   }
   node.RejectUnknownKeys();
 }
@@ -290,6 +299,42 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
   }
   node.RejectUnknownKeys();
   ValidateAt(node, [&] { o->Validate(); });
+}
+
+/// Fault rules that need the rest of the scenario: a take-off onset needs a start on the ground,
+/// and intermittent periods must be resolvable by the physics step.
+void CheckFaultsAgainstScenario(const ConfigNode& root, const Scenario& s) {
+  const double dt = 1.0 / s.sim.physics_rate_hz;
+  for (std::size_t i = 0; i < s.faults.size(); ++i) {
+    const sim::FaultSpec& f = s.faults[i];
+    if (f.onset.kind == sim::FaultOnset::Kind::kDuringTakeoff && s.initial_position_m.z() > 0.0) {
+      root.FailAt(fmt::format("faults.{}.onset.during_takeoff_s", i),
+                  fmt::format("a take-off onset needs a start on the ground; initial.position_m has z = {:g} m",
+                              s.initial_position_m.z()));
+    }
+    if (f.intermittent && std::min(f.intermittent->on_s, f.intermittent->off_s) < dt) {
+      root.FailAt(fmt::format("faults.{}.intermittent", i),
+                  fmt::format("intermittent periods must be at least one physics step ({:g} s)", dt));
+    }
+  }
+}
+
+/// The mission must keep the reference above the ground (z >= 0) over the flight: a reference
+/// below ground cannot be flown and is a configuration mistake.
+void CheckReferenceAboveGround(const ConfigNode& mission, const Scenario& s) {
+  // References are smooth on this scale; long runs are sampled more coarsely (at most 1e5 points).
+  const double end = std::min(s.duration_s, s.reference->duration());
+  const double step = std::max(0.01, end / 1e5);
+  const auto samples = static_cast<long>(std::ceil(end / step));
+  for (long k = 0; k <= samples; ++k) {
+    const double t = std::min(static_cast<double>(k) * step, end);
+    const double z = s.reference->Evaluate(t).p_W.z();
+    if (z < -1e-9) {
+      mission.Fail(fmt::format("the {} reference goes below the ground (z = {:.3f} m at t = {:.2f} s); raise "
+                               "its centre or the initial position",
+                               s.mission_type, z, t));
+    }
+  }
 }
 
 std::string ResolveRelative(const std::string& base_file, const std::string& path) {
@@ -324,7 +369,9 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   try {
     s.vehicle = LoadVehicle(s.vehicle_file, overrides);
   } catch (const io::InputFileError& e) {
-    vehicle_node.Fail(fmt::format("cannot read vehicle file: {}", e.what()));
+    // Still an unreadable input (exit 3), with the scenario line that names it.
+    throw io::InputFileError(e.path(), fmt::format("{} (named by 'vehicle' at {})", e.reason(),
+                                                   vehicle_node.Location()));
   }
   s.duration_s = root.Required("duration_s").AsDoubleIn(1e-3, 1e6);
   if (const auto seed = root.Optional("seed")) s.seed = seed->AsUint64();
@@ -355,13 +402,10 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     s.sim.wind.gust_std_m_s = OptionalDouble(*wind, "gust_std_m_s", s.sim.wind.gust_std_m_s);
     s.sim.wind.gust_time_constant_s = OptionalDouble(*wind, "gust_time_constant_s", s.sim.wind.gust_time_constant_s);
     wind->RejectUnknownKeys();
-    ValidateAt(*wind, [&] { s.sim.wind.Validate(); });
   }
-  {
-    const auto simn = root.Optional("sim");
-    const ConfigNode at = simn ? *simn : root;
-    ValidateAt(at, [&] { s.sim.Validate(s.vehicle); });
-  }
+  // Field names are scenario key paths ("sensors.esc.rate_hz"): defaults that clash are reported
+  // at the key they would have, or its nearest existing parent.
+  ValidateAt(root, [&] { s.sim.Validate(s.vehicle); });
 
   s.reference = ParseMission(root.Required("mission"), s, &s.mission_type);
 
@@ -377,12 +421,22 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
       }
     });
   }
+  CheckFaultsAgainstScenario(root, s);
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
+  if (s.stack.control_rate_hz > s.sim.physics_rate_hz) {
+    root.FailAt("stack.control_rate_hz",
+                fmt::format("stack.control_rate_hz = {:g} is invalid; expected at most the physics rate "
+                            "sim.physics_rate_hz = {:g} Hz",
+                            s.stack.control_rate_hz, s.sim.physics_rate_hz));
+  }
   if (const auto metrics = root.Optional("metrics")) {
-    s.tracking_start_s = metrics->Optional("tracking_start_s") ? metrics->Required("tracking_start_s").AsDoubleIn(0.0, s.duration_s) : 0.0;
+    if (const auto t = metrics->Optional("tracking_start_s")) s.tracking_start_s = t->AsDoubleIn(0.0, s.duration_s);
+    if (const auto e = metrics->Optional("success_error_m")) s.success_error_m = e->AsPositive();
+    if (const auto h = metrics->Optional("success_hold_s")) s.success_hold_s = h->AsDoubleIn(0.0, s.duration_s);
     metrics->RejectUnknownKeys();
   }
   root.RejectUnknownKeys();
+  CheckReferenceAboveGround(root.Required("mission"), s);
   return s;
 }
 

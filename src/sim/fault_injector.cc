@@ -60,7 +60,12 @@ FaultInjector::FaultInjector(std::vector<FaultSpec> specs, int num_rotors)
 }
 
 void FaultInjector::Update(TimeNs t, double altitude_m, bool airborne, vehicle::RotorFaults* faults) {
-  if (airborne && !liftoff_ns_) liftoff_ns_ = t;
+  // Lift-off is a landed -> airborne transition: a vehicle that starts in the air never lifts off.
+  if (airborne && previous_airborne_ && !*previous_airborne_ && !liftoff_ns_) liftoff_ns_ = t;
+  previous_airborne_ = airborne;
+  // An altitude onset fires when the vehicle climbs through it, not when it starts above it.
+  const double previous_altitude = previous_altitude_.value_or(altitude_m);
+  previous_altitude_ = altitude_m;
   for (auto& f : *faults) f = vehicle::RotorFaultState{};
   // Later specs override earlier ones on the same rotor.
   for (std::size_t i = 0; i < specs_.size(); ++i) {
@@ -72,7 +77,7 @@ void FaultInjector::Update(TimeNs t, double altitude_m, bool airborne, vehicle::
           triggered = t >= FromSeconds(spec.onset.value);
           break;
         case FaultOnset::Kind::kAtAltitude:
-          triggered = altitude_m >= spec.onset.value;
+          triggered = previous_altitude < spec.onset.value && altitude_m >= spec.onset.value;
           break;
         case FaultOnset::Kind::kDuringTakeoff:
           triggered = liftoff_ns_ && t >= *liftoff_ns_ + FromSeconds(spec.onset.value);

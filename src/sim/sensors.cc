@@ -85,7 +85,7 @@ EscModel::EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed
   for (auto& m : ring_) m.motor_speed_rad_s.resize(num_rotors);
 }
 
-bool EscModel::Sample(const TruthSample& truth, EscTelemetry* delivered) {
+void EscModel::Measure(const TruthSample& truth) {
   if (count_ == ring_.size()) {  // full: drop the oldest (cannot happen with the sizing above)
     head_ = (head_ + 1) % ring_.size();
     --count_;
@@ -101,9 +101,12 @@ bool EscModel::Sample(const TruthSample& truth, EscTelemetry* delivered) {
     m.motor_speed_rad_s[i] = vehicle::RpmToRadPerSecond(std::max(0.0, rpm));
   }
   ++count_;
+}
+
+bool EscModel::Deliver(TimeNs t, EscTelemetry* delivered) {
   // Deliver the newest sample whose delay has elapsed; older ones are superseded.
   bool found = false;
-  while (count_ > 0 && ring_[head_].t_ns + delay_ns_ <= truth.t_ns) {
+  while (count_ > 0 && ring_[head_].t_ns + delay_ns_ <= t) {
     *delivered = ring_[head_];
     head_ = (head_ + 1) % ring_.size();
     --count_;

@@ -19,28 +19,42 @@ using vehicle::StateView;
 enum Stream : std::uint64_t { kImuStream = 1, kEscStream = 2, kOdometryStream = 3, kWindStream = 4 };
 }  // namespace
 
+const SimulatorOptions& Simulator::Validated(const SimulatorOptions& options,
+                                             const vehicle::VehicleParams& vehicle) {
+  options.Validate(vehicle);
+  return options;
+}
+
 void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
   if (!std::isfinite(physics_rate_hz) || physics_rate_hz <= 0.0 || physics_rate_hz > 1e6) {
-    ThrowValidation("SimulatorOptions", "physics_rate_hz", physics_rate_hz, "a rate in (0, 1e6] Hz");
+    ThrowValidation("SimulatorOptions", "sim.physics_rate_hz", physics_rate_hz, "a rate in (0, 1e6] Hz");
   }
   // RK4 on a first-order lag is stable for dt < 2.78 sigma and accurate for dt well below sigma:
   // require dt <= sigma / 2 for the fastest motor time constant.
   const double fastest = std::min(vehicle.motor_time_constant_s, vehicle.motor_stop_time_constant_s);
   if (1.0 / physics_rate_hz > 0.5 * fastest) {
-    ThrowValidation("SimulatorOptions", "physics_rate_hz", physics_rate_hz,
+    ThrowValidation("SimulatorOptions", "sim.physics_rate_hz", physics_rate_hz,
                     fmt::format("a rate >= {:g} Hz: the step must be at most half the fastest motor "
                                 "time constant ({:g} s)",
                                 2.0 / fastest, fastest));
   }
-  imu.Validate(physics_rate_hz);
-  esc.Validate(physics_rate_hz);
-  odometry.Validate(physics_rate_hz);
-  wind.Validate();
+  // Sub-options report their fields under the scenario keys they come from.
+  const auto prefixed = [](const std::string& prefix, const auto& validate) {
+    try {
+      validate();
+    } catch (const ValidationError& e) {
+      throw ValidationError(prefix + e.field(), e.what());
+    }
+  };
+  prefixed("sensors.imu.", [&] { imu.Validate(physics_rate_hz); });
+  prefixed("sensors.esc.", [&] { esc.Validate(physics_rate_hz); });
+  prefixed("sensors.odometry.", [&] { odometry.Validate(physics_rate_hz); });
+  prefixed("wind.", [&] { wind.Validate(); });
   if (!std::isfinite(crash_speed_m_s) || crash_speed_m_s <= 0.0) {
-    ThrowValidation("SimulatorOptions", "crash_speed_m_s", crash_speed_m_s, "a speed > 0 m/s");
+    ThrowValidation("SimulatorOptions", "sim.crash_speed_m_s", crash_speed_m_s, "a speed > 0 m/s");
   }
   if (!std::isfinite(crash_tilt_rad) || crash_tilt_rad <= 0.0 || crash_tilt_rad > std::numbers::pi) {
-    ThrowValidation("SimulatorOptions", "crash_tilt_rad", crash_tilt_rad, "an angle in (0, pi]");
+    ThrowValidation("SimulatorOptions", "sim.crash_tilt_rad", crash_tilt_rad, "an angle in (0, pi]");
   }
 }
 
@@ -49,20 +63,19 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world,
                      std::uint64_t seed, const vehicle::StateVector& initial)
     : model_(model),
       world_(std::move(world)),
-      options_(options),
+      options_(Validated(options, model.params())),
       injector_(std::move(faults), model.num_rotors()),
       integrator_(model),
-      imu_(options.imu, DeriveSeed(seed, kImuStream)),
-      esc_(options.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
-      odometry_(options.odometry, DeriveSeed(seed, kOdometryStream)),
-      wind_(options.wind, DeriveSeed(seed, kWindStream)),
-      imu_timer_(options.imu.rate_hz),
-      esc_timer_(options.esc.rate_hz),
-      odometry_timer_(options.odometry.rate_hz),
-      dt_ns_(PeriodFromRate(options.physics_rate_hz)),
+      imu_(options_.imu, DeriveSeed(seed, kImuStream)),
+      esc_(options_.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
+      odometry_(options_.odometry, DeriveSeed(seed, kOdometryStream)),
+      wind_(options_.wind, DeriveSeed(seed, kWindStream)),
+      imu_timer_(options_.imu.rate_hz),
+      esc_timer_(options_.esc.rate_hz),
+      odometry_timer_(options_.odometry.rate_hz),
+      dt_ns_(PeriodFromRate(options_.physics_rate_hz)),
       x_(initial),
       faults_(model.num_rotors()) {
-  options_.Validate(model.params());
   if (initial.size() != model.state_size() || !initial.allFinite()) {
     throw std::invalid_argument(fmt::format(
         "Simulator: initial state has size {} or non-finite entries; expected {} finite values",
@@ -83,18 +96,24 @@ void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
   const bool imu_due = imu_timer_.Due(t_ns_);
   const bool esc_due = esc_timer_.Due(t_ns_);
   const bool odom_due = odometry_timer_.Due(t_ns_);
-  if (!(imu_due || esc_due || odom_due)) return;
+  if (!(imu_due || esc_due || odom_due)) {
+    DeliverTelemetry();
+    return;
+  }
   TruthSample truth;
   truth.t_ns = t_ns_;
   truth.x = &x_;
   if (!landed_) truth.acc = model_.ComputeAccelerations(x_, faults_, disturbance);
   truth.motor_speed_rad_s = speed_;
   if (imu_due) outputs_.imu = imu_.Sample(truth);
-  if (esc_due) {
-    EscTelemetry telemetry;
-    if (esc_.Sample(truth, &telemetry)) outputs_.esc = telemetry;
-  }
+  if (esc_due) esc_.Measure(truth);
   if (odom_due) outputs_.odometry = odometry_.Sample(truth);
+  DeliverTelemetry();
+}
+
+void Simulator::DeliverTelemetry() {
+  EscTelemetry telemetry;
+  if (esc_.Deliver(t_ns_, &telemetry)) outputs_.esc = telemetry;
 }
 
 void Simulator::UpdateOutputs() {
@@ -125,9 +144,12 @@ void Simulator::ResolveGroundContact(const vehicle::StateVector& before) {
   } else if (tilt > options_.crash_tilt_rad) {
     crash_reason_ = fmt::format("ground contact tilted {:.0f} deg", tilt * 180.0 / std::numbers::pi);
   }
-  // Touchdown (or the crash site): stop on the ground.
+  // Touchdown (or the crash site): stop on the ground, level on its landing gear (yaw kept), so
+  // that repeated hops cannot accumulate a tilt the flat ground would not allow.
   landed_ = true;
   x_[StateIndex::kPosition + 2] = 0.0;
+  const Quaternion level = QuaternionFromYaw(YawOf(s.q_WB()));
+  x_.segment<4>(StateIndex::kQuaternion) << level.w(), level.x(), level.y(), level.z();
   x_.segment<3>(StateIndex::kVelocity).setZero();
   x_.segment<3>(StateIndex::kBodyRate).setZero();
 }

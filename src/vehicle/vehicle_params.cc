@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/vehicle/effectiveness.h"
 
 namespace rotorguard::vehicle {
 
@@ -51,7 +52,9 @@ void VehicleParams::Validate() const {
   }
   for (int i = 0; i < 3; ++i) RequireNonNegative(fmt::format("rotor_drag_kg_s.{}", i), rotor_drag_kg_s[i]);
   RequireNonNegative("yaw_damping_n_m_s", yaw_damping_n_m_s);
-  RequirePositive("thrust_coefficient_n_per_rpm2", thrust_coefficient_n_s2);
+  // Reported in the unit of the config files (per rpm^2), not the internal per (rad/s)^2.
+  RequirePositive("thrust_coefficient_n_per_rpm2",
+                  thrust_coefficient_n_s2 / (kRpmPerRadPerSecond * kRpmPerRadPerSecond));
   RequirePositive("motor_time_constant_s", motor_time_constant_s);
   RequirePositive("motor_stop_time_constant_s", motor_stop_time_constant_s);
   if (!std::isfinite(unloaded_speed_ratio) || unloaded_speed_ratio < 1.0 || unloaded_speed_ratio > 3.0) {
@@ -74,6 +77,26 @@ void VehicleParams::Validate() const {
   if (twr <= 1.0) {
     ThrowValidation(kOwner, "rotors", fmt::format("(thrust-to-weight {:.3f})", twr),
                     "total max_thrust_n above the weight m*g (thrust-to-weight > 1)");
+  }
+  // The rotors must produce independent thrust, roll, pitch and yaw torque, and hold hover within
+  // their limits with the minimum-norm allocation the nominal controller uses.
+  const EffectivenessMatrix m = ComputeEffectivenessMatrix(rotors);
+  AllocationMatrix pinv;
+  try {
+    pinv = PseudoInverse(m);
+  } catch (const std::invalid_argument&) {
+    ThrowValidation(kOwner, "rotors", fmt::format("({} rotors)", rotors.size()),
+                    "a geometry that produces independent thrust, roll, pitch and yaw torques "
+                    "(at least 4 rotors, not all on one line, yaw coefficients not all zero)");
+  }
+  const RotorVector hover = pinv * Eigen::Vector4d(weight_n(), 0.0, 0.0, 0.0);
+  for (int i = 0; i < num_rotors(); ++i) {
+    if (hover[i] < 0.0 || hover[i] > rotors[i].max_thrust_n) {
+      ThrowValidation(kOwner, fmt::format("rotors.{}.max_thrust_n", i), rotors[i].max_thrust_n,
+                      fmt::format("a limit that allows hover: the minimum-norm hover allocation needs "
+                                  "{:.3f} N from rotor {}",
+                                  hover[i], i));
+    }
   }
 }
 

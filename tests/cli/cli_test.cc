@@ -151,6 +151,17 @@ TEST_F(CliTest, NominalControllerLosingAMotorCrashesAndExitsOne) {
   EXPECT_NEAR(j["faults"][0]["onset_s"].get<double>(), 2.0, 1e-9);
 }
 
+TEST_F(CliTest, AFlightThatEndsFarFromItsReferenceFailsWithExitOne) {
+  // A 30 m/s wind blows the vehicle away without a crash: the mission failed all the same.
+  const std::string s = Write("windy.yaml", Scenario(kVehicle, "wind: {mean_m_s: [30.0, 0.0, 0.0]}\n"));
+  const Result r = Cli("run " + s + " --out " + Out());
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
+  EXPECT_EQ(j["success"], false);
+  EXPECT_EQ(j["crashed"], false);
+  EXPECT_NE(j["failure_reason"].get<std::string>().find("position error"), std::string::npos) << j.dump();
+}
+
 TEST_F(CliTest, SameSeedGivesAnIdenticalLogDifferentSeedsDiffer) {
   const std::string s = Write("s.yaml", Scenario(kVehicle, "wind: {gust_std_m_s: 0.5}\n"));
   ASSERT_EQ(Cli("run " + s + " --quiet --out " + Out() + "/a").exit_code, 0);
@@ -191,6 +202,12 @@ TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
   ExpectConfigError("run " + f, f, 11, {"faults.0.onset.at_time_s", "duration_s"});
   f = Write("kind.yaml", Scenario(v, "faults:\n  - {rotor: 1, kind: melted, onset: {at_time_s: 0.5}}\n"));
   ExpectConfigError("run " + f, f, 9, {"faults.0.kind", "motor_stop"});
+  f = Write("below.yaml", Scenario(v, "  position_m: [0, 0, -1]\n"));  // extends the mission map
+  ExpectConfigError("run " + f, f, 7, {"below the ground"});
+  f = Write("takeoff.yaml", Scenario(v, "faults:\n  - {rotor: 1, kind: motor_stop, onset: {during_takeoff_s: 0.1}}\n"));
+  ExpectConfigError("run " + f, f, 9, {"faults.0.onset.during_takeoff_s", "on the ground"});
+  f = Write("rate.yaml", Scenario(v, "stack: {control_rate_hz: 5000}\n"));
+  ExpectConfigError("run " + f, f, 8, {"stack.control_rate_hz", "physics rate"});
   f = Write("malformed.yaml", "vehicle: " + v + "\nduration_s: [1, 2\nmission: {type: hover}\n");
   {
     const Result r = Cli("run " + f);
@@ -219,6 +236,14 @@ TEST_F(CliTest, BadVehicleContentExitsTwoNamingTheVehicleFile) {
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_NE(r.out.find("thrust-to-weight"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(v + ":"), std::string::npos) << r.out;
+  v = Write("v.yaml", std::regex_replace(ReadText(kVehicle), std::regex("yaw_coefficient_m: 0.0107"), "yaw_coefficient_m: 0.0"));
+  s = Write("s.yaml", Scenario(v));
+  const Result rank = Cli("run " + s);
+  EXPECT_EQ(rank.exit_code, 2) << rank.out;
+  EXPECT_NE(rank.out.find("independent thrust"), std::string::npos) << rank.out;
+  // The sensor default clashes with a slow physics rate: reported at the sensors key path.
+  const std::string slow = Write("slow.yaml", Scenario(kVehicle, "sim: {physics_rate_hz: 500}\n"));
+  ExpectConfigError("run " + slow, slow, 1, {"sensors.esc.rate_hz", "(0, 500]"});
 }
 
 TEST_F(CliTest, SetOnAPathThatDoesNotExistExitsTwo) {
@@ -256,9 +281,12 @@ TEST_F(CliTest, UnreadableInputExitsThree) {
   EXPECT_EQ(r.exit_code, 3) << r.out;
   EXPECT_NE(r.out.find("no_such_file.yaml"), std::string::npos);
   EXPECT_EQ(Cli("validate " + dir_.string()).exit_code, 3);  // a folder is not a file
+  // The scenario's vehicle file is missing: still an unreadable input, and the message says which
+  // scenario line names it.
   const std::string s = Write("s.yaml", Scenario((dir_ / "missing_vehicle.yaml").string()));
   const Result v = Cli("run " + s);
-  EXPECT_EQ(v.exit_code, 2) << v.out;  // the scenario's vehicle key points nowhere: a config error
+  EXPECT_EQ(v.exit_code, 3) << v.out;
+  EXPECT_NE(v.out.find("missing_vehicle.yaml"), std::string::npos) << v.out;
   EXPECT_NE(v.out.find(s + ":1"), std::string::npos) << v.out;
 }
 

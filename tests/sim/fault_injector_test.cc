@@ -41,6 +41,21 @@ TEST(FaultInjector, TriggersAtTimeAltitudeAndAfterLiftoff) {
   EXPECT_EQ(f[3].kind, FaultKind::kNone);
 }
 
+TEST(FaultInjector, AltitudeOnsetNeedsAnUpwardCrossingAndTakeoffOnsetALiftoff) {
+  FaultInjector inj({Spec(0, FaultKind::kMotorStop, FaultOnset::Kind::kAtAltitude, 0.5),
+                     Spec(1, FaultKind::kMotorStop, FaultOnset::Kind::kDuringTakeoff, 0.0)},
+                    4);
+  vehicle::RotorFaults f(4);
+  // Starts airborne at 1 m (above the onset altitude), descends to 0.2 m, climbs back to 1 m.
+  for (int k = 0; k <= 300; ++k) {
+    const double z = k < 100 ? 1.0 - 0.008 * k : 0.2 + 0.004 * (k - 100);
+    inj.Update(FromSeconds(0.01 * k), z, true, &f);
+  }
+  ASSERT_EQ(inj.events().size(), 1u);  // never landed: no take-off onset
+  EXPECT_EQ(inj.events()[0].rotor, 0);
+  EXPECT_NEAR(inj.events()[0].onset_s, 1.75, 1e-9);  // 0.2 + 0.004 (k - 100) = 0.5 at k = 175
+}
+
 TEST(FaultInjector, IntermittentFaultsToggleWithTheirPeriods) {
   FaultSpec s = Spec(3, FaultKind::kLossOfEffectiveness, FaultOnset::Kind::kAtTime, 1.0);
   s.eta = 0.5;

@@ -64,8 +64,9 @@ TEST(Imu, WhiteNoiseHasTheConfiguredDensity) {
   EXPECT_NEAR(std::sqrt(sum2 / n), expected, 0.03 * expected);  // ~1 % sampling error at n = 20k
 }
 
-TEST(Esc, DeliversMeasurementsAfterTheDelayQuantised) {
+TEST(Esc, DeliversEachMeasurementExactlyTheDelayLaterQuantised) {
   EscOptions o;
+  o.rate_hz = 200.0;  // a measurement every 5 ms, polled by 1 ms physics steps
   o.noise_rpm = 0.0;
   o.quantization_rpm = 10.0;
   o.delay_s = 0.003;
@@ -74,15 +75,16 @@ TEST(Esc, DeliversMeasurementsAfterTheDelayQuantised) {
   truth.motor_speed_rad_s = RotorVector::Constant(1, vehicle::RpmToRadPerSecond(14143.0));
   EscTelemetry out;
   int delivered = 0;
-  for (TimeNs t = 0; t <= 10'000'000; t += 1'000'000) {
+  for (TimeNs t = 0; t <= 30'000'000; t += 1'000'000) {
     truth.t_ns = t;
-    if (esc.Sample(truth, &out)) {
+    if (t % 5'000'000 == 0) esc.Measure(truth);
+    if (esc.Deliver(t, &out)) {
       ++delivered;
-      EXPECT_EQ(out.t_ns, t - 3'000'000);  // measured 3 ms earlier
+      EXPECT_EQ(out.t_ns, t - 3'000'000);  // measured exactly 3 ms earlier, whatever the ESC rate
       EXPECT_NEAR(vehicle::RadPerSecondToRpm(out.motor_speed_rad_s[0]), 14140.0, 1e-6);
     }
   }
-  EXPECT_EQ(delivered, 8);  // t = 3..10 ms
+  EXPECT_EQ(delivered, 6);  // measured at 0, 5, ..., 25 ms; delivered at 3, 8, ..., 28 ms
 }
 
 TEST(Odometry, NoiseGrowsWithBodyRate) {

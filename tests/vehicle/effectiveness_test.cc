@@ -73,6 +73,13 @@ TEST(VehicleParams, ValidationNamesFieldAndRule) {
     EXPECT_NE(std::string(e.what()).find("thrust-to-weight"), std::string::npos);
   }
   p = ReferenceQuad();
+  for (auto& r : p.rotors) r.yaw_coefficient_m = 0.0;  // no yaw authority: rank 3
+  RG_EXPECT_THROW_WITH(p.Validate(), ValidationError, "independent thrust");
+  p = ReferenceQuad();
+  p.rotors[0].max_thrust_n = p.rotors[1].max_thrust_n = 1.0;  // T/W > 1 but hover needs 2.82 N each
+  p.rotors[2].max_thrust_n = 20.0;
+  RG_EXPECT_THROW_WITH(p.Validate(), ValidationError, "allows hover");
+  p = ReferenceQuad();
   p.rotors[2].max_thrust_n = std::nan("");
   try {
     p.Validate();

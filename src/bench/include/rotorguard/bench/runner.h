@@ -22,9 +22,11 @@ struct FaultRecord {
 struct RunSummary {
   std::string scenario;
   std::uint64_t seed = 0;
-  bool success = false;
+  bool success = false;  ///< no crash and position error held within the scenario's bound at the end
   bool crashed = false;
   std::string crash_reason;     ///< "" when not crashed
+  /// Why the run failed: "crash: ..." or the position error that broke the success rule; "" on success.
+  std::string failure_reason;
   double sim_time_s = 0.0;
   double wall_time_s = 0.0;
   double realtime_factor = 0.0;

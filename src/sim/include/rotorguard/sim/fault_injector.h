@@ -12,11 +12,15 @@ namespace rotorguard::sim {
 struct FaultOnset {
   enum class Kind { kAtTime, kAtAltitude, kDuringTakeoff };
   Kind kind = Kind::kAtTime;
-  /// kAtTime: time [s]; kAtAltitude: altitude above the take-off ground [m], crossed upwards;
-  /// kDuringTakeoff: delay after lift-off [s].
+  /// kAtTime: time [s]; kAtAltitude: altitude above the take-off ground [m], crossed upwards
+  /// (a vehicle starting above it must first descend below it); kDuringTakeoff: delay after
+  /// lift-off [s], where lift-off is the vehicle leaving the ground (a vehicle that starts in the
+  /// air never takes off, so the fault never fires).
   double value = 0.0;
 };
 
+/// While active the fault acts for on_s, then the rotor is healthy for off_s, repeating. A `stuck`
+/// motor freezes again at its value at the start of each on-phase.
 struct IntermittentPattern {
   double on_s = 0.5;   ///< fault active for on_s, > 0
   double off_s = 0.5;  ///< then healthy for off_s, > 0; repeating from the onset
@@ -55,6 +59,8 @@ class FaultInjector {
   std::vector<FaultSpec> specs_;
   std::vector<std::optional<TimeNs>> onset_ns_;  // per spec, once triggered
   std::optional<TimeNs> liftoff_ns_;
+  std::optional<bool> previous_airborne_;
+  std::optional<double> previous_altitude_;
   std::vector<FaultEvent> events_;
 };
 

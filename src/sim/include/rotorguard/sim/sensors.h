@@ -67,8 +67,11 @@ class ImuModel {
 class EscModel {
  public:
   EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed);
-  /// Measures now; returns the measurement taken `delay_s` ago, when there is one to deliver.
-  bool Sample(const TruthSample& truth, EscTelemetry* delivered);
+  /// Takes a measurement now (call at the ESC rate); it is delivered `delay_s` later.
+  void Measure(const TruthSample& truth);
+  /// The newest measurement whose delay has elapsed at time t, if one is waiting (call every
+  /// physics step, so the delay is honoured to the physics step whatever the ESC rate).
+  bool Deliver(TimeNs t, EscTelemetry* delivered);
 
  private:
   EscOptions options_;

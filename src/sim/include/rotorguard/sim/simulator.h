@@ -26,7 +26,8 @@ struct SimulatorOptions {
   double crash_speed_m_s = 1.0;
   /// Touching the ground tilted more than this is a crash [rad], in (0, pi].
   double crash_tilt_rad = 0.6;
-  /// Throws ValidationError naming the field; needs the vehicle for the time-constant rule.
+  /// Throws ValidationError whose field is the scenario key path ("sim.physics_rate_hz",
+  /// "sensors.esc.rate_hz", "wind.gust_std_m_s"); needs the vehicle for the time-constant rule.
   void Validate(const vehicle::VehicleParams& vehicle) const;
 };
 
@@ -71,6 +72,10 @@ class Simulator {
   void ResolveGroundContact(const vehicle::StateVector& before);
   void UpdateOutputs();
   void SampleSensors(const vehicle::Disturbance& disturbance);
+  void DeliverTelemetry();
+  /// Validates before any member is built from the options (throws ValidationError).
+  static const SimulatorOptions& Validated(const SimulatorOptions& options,
+                                           const vehicle::VehicleParams& vehicle);
 
   const vehicle::MultirotorModel& model_;
   World world_;
