@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "rotorguard/bench/qp_bench.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/bench/sim_bench.h"
@@ -155,6 +156,16 @@ int main(int argc, char** argv) {
   bench_sim->add_option("--repetitions", repetitions_text, "Repetitions; the median is reported (default 5)");
   bench_sim->add_flag("--json", json, "Print JSON instead of a table");
 
+  std::string qp_instance, qp_repetitions_text = "3";
+  bool qp_json = false;
+  CLI::App* bench_qp = bench->add_subcommand(
+      "qp", "The NMPC's QP solver (condensing + dual active set) on a reference OCP QP instance:\n"
+            "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
+            "iterations_mean and max_u0_error against the instance's optimal u_0.");
+  bench_qp->add_option("--instance", qp_instance, "Instance file (JSON), e.g. a copy of qp_hover_n20.json")->required();
+  bench_qp->add_option("--repetitions", qp_repetitions_text, "Solves per case; the median time counts (default 3)");
+  bench_qp->add_flag("--json", qp_json, "Print JSON instead of a table");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -205,6 +216,27 @@ int main(int argc, char** argv) {
         fmt::print("cpu               {}\n", result["host"]["cpu"].get<std::string>());
       }
       return result["crashed"].get<bool>() ? kRunFailed : kOk;
+    }
+    if (*bench_qp) {
+      rotorguard::bench::QpBenchOptions o;
+      o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", qp_repetitions_text, 1, 1000));
+      const nlohmann::json r = rotorguard::bench::RunQpBenchmark(qp_instance, o);
+      if (qp_json) {
+        fmt::print("{}\n", r.dump(2));
+      } else {
+        fmt::print("cases             {} stress, {} track\n", r["cases_stress"].get<int>(), r["cases_track"].get<int>());
+        fmt::print("stress            {:.1f} us median, {:.1f} us p99\n", r["stress_us_median"].get<double>(),
+                   r["stress_us_p99"].get<double>());
+        fmt::print("track             {:.1f} us median, {:.1f} us p99\n", r["track_us_median"].get<double>(),
+                   r["track_us_p99"].get<double>());
+        fmt::print("iterations_mean   {:.2f}\n", r["iterations_mean"].get<double>());
+        fmt::print("u0 error          {:.2e} median, {:.2e} p99, {:.2e} max\n", r["u0_error_median"].get<double>(),
+                   r["u0_error_p99"].get<double>(), r["max_u0_error"].get<double>());
+        fmt::print("reference u0      not optimal in {} cases (pinning it raises the objective by up to {:.1e})\n",
+                   r["cases_reference_u0_suboptimal"].get<int>(), r["worst_reference_relative_gap"].get<double>());
+        fmt::print("failures          {}\n", r["failures"].get<int>());
+      }
+      return r["failures"].get<int>() > 0 ? kRunFailed : kOk;
     }
   } catch (const UsageError& e) {
     fmt::print(stderr, "error: {}\n", e.what());

@@ -1,0 +1,284 @@
+#include "rotorguard/control/dense_qp.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::control {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Givens rotation (c, s) with [c s; -s c] (a, b)' = (hypot(a, b), 0)'.
+inline void Givens(double a, double b, double* c, double* s) {
+  const double h = std::hypot(a, b);
+  if (h == 0.0) {
+    *c = 1.0;
+    *s = 0.0;
+  } else {
+    *c = a / h;
+    *s = b / h;
+  }
+}
+}  // namespace
+
+std::string_view ToString(QpStatus status) {
+  switch (status) {
+    case QpStatus::kNotSolved: return "not solved (Solve() was not called)";
+    case QpStatus::kSolved: return "solved";
+    case QpStatus::kMaxIterations: return "max iterations reached";
+    case QpStatus::kInfeasible: return "infeasible";
+    case QpStatus::kNumericalFailure: return "numerical failure";
+  }
+  return "unknown";
+}
+
+std::string DenseQpSummary::BriefReport() const {
+  return fmt::format("QP {}: {} iterations, {} active, objective {:.6g}, max violation {:.2e}, {:.1f} us",
+                     ToString(status), iterations, active_constraints, objective, max_violation,
+                     solve_time_s * 1e6);
+}
+
+void DenseQpOptions::Validate() const {
+  if (!(feasibility_tolerance > 0.0) || !std::isfinite(feasibility_tolerance)) {
+    ThrowValidation("DenseQpOptions", "feasibility_tolerance", feasibility_tolerance, "a finite value > 0");
+  }
+  if (max_iterations < 1) ThrowValidation("DenseQpOptions", "max_iterations", max_iterations, "a count >= 1");
+}
+
+DenseQp::DenseQp(int n, int m)
+    : H(Eigen::MatrixXd::Identity(n, n)),
+      g(Eigen::VectorXd::Zero(n)),
+      lb(Eigen::VectorXd::Constant(n, -kInf)),
+      ub(Eigen::VectorXd::Constant(n, kInf)),
+      C(Eigen::MatrixXd::Zero(m, n)),
+      lc(Eigen::VectorXd::Constant(m, -kInf)),
+      uc(Eigen::VectorXd::Constant(m, kInf)) {}
+
+DenseQpSolver::DenseQpSolver(int n, int m, const DenseQpOptions& options)
+    : n_(n),
+      m_(m),
+      options_(options),
+      chol_(n, n),
+      J_(n, n),
+      R_(Eigen::MatrixXd::Zero(n, n)),
+      z_(n),
+      d_(n),
+      step_(n),
+      r_(n),
+      u_(n),
+      cz_(m),
+      y_bound_(n),
+      y_constraint_(m),
+      is_active_(2 * static_cast<std::size_t>(n + m), 0) {
+  if (n < 1 || m < 0) ThrowInvalidArgument("DenseQpSolver", "n, m", fmt::format("{}, {}", n, m), "n >= 1, m >= 0");
+  options_.Validate();
+  active_.reserve(static_cast<std::size_t>(n));
+}
+
+double DenseQpSolver::Slack(const DenseQp& qp, const Side& c) const {
+  if (c.index < n_) {
+    const double bound = c.sign > 0 ? qp.lb[c.index] : qp.ub[c.index];
+    return c.sign * (z_[c.index] - bound);
+  }
+  const int row = c.index - n_;
+  const double bound = c.sign > 0 ? qp.lc[row] : qp.uc[row];
+  return c.sign * (qp.C.row(row).dot(z_) - bound);
+}
+
+void DenseQpSolver::ComputeD(const DenseQp& qp, const Side& c) {
+  if (c.index < n_) {
+    d_ = c.sign * J_.row(c.index).transpose();  // J' e_i: a bound needs no product
+  } else {
+    d_.noalias() = J_.transpose() * qp.C.row(c.index - n_).transpose();
+    d_ *= c.sign;
+  }
+}
+
+double DenseQpSolver::NormalDotStep(const DenseQp& qp, const Side& c) const {
+  if (c.index < n_) return c.sign * step_[c.index];
+  return c.sign * qp.C.row(c.index - n_).dot(step_);
+}
+
+void DenseQpSolver::AddToActiveSet(const Side& c) {
+  // Rotate d so that only d[0..q] is non-zero; apply the same rotations to the columns of J.
+  for (int j = n_ - 1; j > q_; --j) {
+    double cs, sn;
+    Givens(d_[j - 1], d_[j], &cs, &sn);
+    if (sn == 0.0) continue;
+    d_[j - 1] = cs * d_[j - 1] + sn * d_[j];
+    d_[j] = 0.0;
+    for (int i = 0; i < n_; ++i) {
+      const double a = J_(i, j - 1), b = J_(i, j);
+      J_(i, j - 1) = cs * a + sn * b;
+      J_(i, j) = -sn * a + cs * b;
+    }
+  }
+  R_.col(q_).head(q_ + 1) = d_.head(q_ + 1);
+  active_.push_back(c);
+  is_active_[2 * c.index + (c.sign < 0)] = 1;
+  ++q_;
+}
+
+void DenseQpSolver::DropFromActiveSet(int position) {
+  const Side c = active_[position];
+  is_active_[2 * c.index + (c.sign < 0)] = 0;
+  active_.erase(active_.begin() + position);
+  for (int j = position; j < q_ - 1; ++j) u_[j] = u_[j + 1];
+  // Remove column `position` of R; the upper-Hessenberg rest is made triangular by rotations on
+  // rows (col, col + 1), mirrored on the columns of J.
+  for (int col = position; col < q_ - 1; ++col) R_.col(col).head(q_) = R_.col(col + 1).head(q_);
+  R_.col(q_ - 1).setZero();
+  for (int col = position; col < q_ - 1; ++col) {
+    double cs, sn;
+    Givens(R_(col, col), R_(col + 1, col), &cs, &sn);
+    if (sn == 0.0) continue;
+    for (int k = col; k < q_ - 1; ++k) {
+      const double a = R_(col, k), b = R_(col + 1, k);
+      R_(col, k) = cs * a + sn * b;
+      R_(col + 1, k) = -sn * a + cs * b;
+    }
+    R_(col + 1, col) = 0.0;
+    for (int i = 0; i < n_; ++i) {
+      const double a = J_(i, col), b = J_(i, col + 1);
+      J_(i, col) = cs * a + sn * b;
+      J_(i, col + 1) = -sn * a + cs * b;
+    }
+  }
+  --q_;
+}
+
+const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
+  const auto start = std::chrono::steady_clock::now();
+  summary_ = DenseQpSummary{};
+  const auto finish = [&](QpStatus status) -> const DenseQpSummary& {
+    summary_.status = status;
+    summary_.active_constraints = q_;
+    y_bound_.setZero();
+    y_constraint_.setZero();
+    for (int j = 0; j < q_; ++j) {
+      const Side& c = active_[j];
+      if (c.index < n_) {
+        y_bound_[c.index] += c.sign * u_[j];
+      } else {
+        y_constraint_[c.index - n_] += c.sign * u_[j];
+      }
+    }
+    if (z_.allFinite()) {
+      summary_.objective = 0.5 * z_.dot(qp.H * z_) + qp.g.dot(z_);
+      double violation = ((qp.lb - z_).cwiseMax(z_ - qp.ub)).maxCoeff();
+      if (m_ > 0) {
+        cz_.noalias() = qp.C * z_;
+        violation = std::max(violation, ((qp.lc - cz_).cwiseMax(cz_ - qp.uc)).maxCoeff());
+      }
+      summary_.max_violation = std::max(0.0, violation);
+    }
+    summary_.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary_;
+  };
+
+  q_ = 0;
+  active_.clear();
+  std::fill(is_active_.begin(), is_active_.end(), 0);
+  R_.setZero();
+  if (qp.num_variables() != n_ || qp.num_constraints() != m_ || !qp.H.allFinite() || !qp.g.allFinite() ||
+      (m_ > 0 && !qp.C.allFinite())) {
+    z_.setZero();
+    return finish(QpStatus::kNumericalFailure);
+  }
+  for (int i = 0; i < n_; ++i) {
+    if (qp.lb[i] > qp.ub[i]) return finish(QpStatus::kInfeasible);
+  }
+  for (int i = 0; i < m_; ++i) {
+    if (qp.lc[i] > qp.uc[i]) return finish(QpStatus::kInfeasible);
+  }
+
+  // Unconstrained minimum: H = L L', J = L^-T, z = -J J' g.
+  chol_ = qp.H;
+  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(chol_);
+  if (llt.info() != Eigen::Success) {
+    z_.setZero();
+    return finish(QpStatus::kNumericalFailure);
+  }
+  J_.setIdentity();
+  llt.matrixU().solveInPlace(J_);
+  d_.noalias() = J_.transpose() * qp.g;
+  z_.noalias() = -J_ * d_;
+
+  const double tol = options_.feasibility_tolerance;
+  while (true) {
+    // The most violated constraint side that is not active.
+    Side p{-1, 0.0};
+    double worst = -tol;
+    for (int i = 0; i < n_; ++i) {
+      if (z_[i] - qp.lb[i] < worst && !is_active_[2 * i]) {
+        worst = z_[i] - qp.lb[i];
+        p = {i, 1.0};
+      }
+      if (qp.ub[i] - z_[i] < worst && !is_active_[2 * i + 1]) {
+        worst = qp.ub[i] - z_[i];
+        p = {i, -1.0};
+      }
+    }
+    if (m_ > 0) {
+      cz_.noalias() = qp.C * z_;
+      for (int i = 0; i < m_; ++i) {
+        if (cz_[i] - qp.lc[i] < worst && !is_active_[2 * (n_ + i)]) {
+          worst = cz_[i] - qp.lc[i];
+          p = {n_ + i, 1.0};
+        }
+        if (qp.uc[i] - cz_[i] < worst && !is_active_[2 * (n_ + i) + 1]) {
+          worst = qp.uc[i] - cz_[i];
+          p = {n_ + i, -1.0};
+        }
+      }
+    }
+    if (p.index < 0) return finish(QpStatus::kSolved);
+
+    double slack = worst;
+    double u_p = 0.0;
+    while (true) {
+      if (summary_.iterations >= options_.max_iterations) return finish(QpStatus::kMaxIterations);
+      ComputeD(qp, p);
+      // Primal step direction in the null space of the active constraints, and the dual one.
+      step_.noalias() = J_.rightCols(n_ - q_) * d_.tail(n_ - q_);
+      r_.head(q_) = R_.topLeftCorner(q_, q_).triangularView<Eigen::Upper>().solve(d_.head(q_));
+      double t1 = kInf;
+      int drop = -1;
+      for (int j = 0; j < q_; ++j) {
+        if (r_[j] > 0.0 && u_[j] / r_[j] < t1) {
+          t1 = u_[j] / r_[j];
+          drop = j;
+        }
+      }
+      const double ns = NormalDotStep(qp, p);
+      const bool primal_step = step_.norm() > 1e-14 * (1.0 + d_.norm()) && ns > 0.0;
+      const double t2 = primal_step ? -slack / ns : kInf;
+      const double t = std::min(t1, t2);
+      if (!std::isfinite(t)) return finish(QpStatus::kInfeasible);
+      ++summary_.iterations;
+      u_.head(q_) -= t * r_.head(q_);
+      u_p += t;
+      if (!primal_step) {
+        DropFromActiveSet(drop);  // dual step only: make room for p
+        continue;
+      }
+      z_ += t * step_;
+      if (t2 <= t1) {
+        AddToActiveSet(p);
+        u_[q_ - 1] = u_p;
+        break;
+      }
+      DropFromActiveSet(drop);
+      slack = Slack(qp, p);
+    }
+    if (!z_.allFinite()) return finish(QpStatus::kNumericalFailure);
+  }
+}
+
+}  // namespace rotorguard::control

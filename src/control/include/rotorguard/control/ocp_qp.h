@@ -1,0 +1,83 @@
+#pragma once
+/// The QP of one NMPC iteration, in stage form (what a Gauss-Newton SQP step of paper 000's eq. 8
+/// produces):
+///
+///   minimise   sum_{k=0}^{N} 1/2 x_k' Q_k x_k + q_k' x_k  +  sum_{k=0}^{N-1} 1/2 u_k' R_k u_k + r_k' u_k
+///   subject to x_0 given,  x_{k+1} = A_k x_k + B_k u_k + c_k          (k = 0 .. N-1)
+///              u_lower_k <= u_k <= u_upper_k                            (k = 0 .. N-1)
+///              x_lower_k <= x_k[state_bound_index] <= x_upper_k         (k = 1 .. N)
+///
+/// and its solver by condensing: the states are eliminated (x_k = x_bar_k + sum_j S_kj u_j) with
+/// O(N^2) recursions, and the dense QP in the N*nu inputs is solved by the Goldfarb-Idnani dual
+/// active-set method (DenseQpSolver). docs/control.md explains the choice and its measurements.
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rotorguard/control/dense_qp.h"
+
+namespace rotorguard::control {
+
+struct OcpQpDims {
+  int horizon = 20;  ///< N, >= 1
+  int nx = 17;       ///< state size, >= 1
+  int nu = 4;        ///< input size, >= 1
+  std::vector<int> state_bound_index;  ///< indices of x bounded at stages 1..N, each in [0, nx)
+  void Validate() const;
+};
+
+/// Problem data, allocated once for its dimensions. Bounds default to +-infinity.
+struct OcpQp {
+  explicit OcpQp(const OcpQpDims& dims);
+  OcpQpDims dims;
+  Eigen::VectorXd x0;
+  std::vector<Eigen::MatrixXd> A, B;  ///< N each
+  std::vector<Eigen::VectorXd> c;     ///< N
+  std::vector<Eigen::MatrixXd> Q;     ///< N + 1 (Q_0 only shifts the cost: x_0 is fixed)
+  std::vector<Eigen::VectorXd> q;     ///< N + 1
+  std::vector<Eigen::MatrixXd> R;     ///< N, positive definite
+  std::vector<Eigen::VectorXd> r;     ///< N
+  std::vector<Eigen::VectorXd> u_lower, u_upper;  ///< N
+  std::vector<Eigen::VectorXd> x_lower, x_upper;  ///< N + 1; entry 0 is unused
+  /// The objective of a trajectory (inputs u_0..u_{N-1}, states x_0..x_N).
+  double Objective(const std::vector<Eigen::VectorXd>& x, const std::vector<Eigen::VectorXd>& u) const;
+};
+
+struct OcpQpSummary {
+  QpStatus status = QpStatus::kNotSolved;
+  int iterations = 0;           ///< active-set changes of the dense solver
+  int active_constraints = 0;
+  double objective = 0.0;
+  double max_violation = 0.0;   ///< largest bound violation of the returned trajectory
+  double condense_time_s = 0.0;
+  double dense_solve_time_s = 0.0;
+  double total_time_s = 0.0;
+  bool IsSolutionUsable() const { return status == QpStatus::kSolved; }
+  std::string BriefReport() const;
+};
+
+class CondensingQpSolver {
+ public:
+  explicit CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options = {});
+  /// Solves `qp` (whose dims must equal the solver's). Allocates nothing.
+  const OcpQpSummary& Solve(const OcpQp& qp);
+  const std::vector<Eigen::VectorXd>& u() const { return u_; }  ///< N inputs
+  const std::vector<Eigen::VectorXd>& x() const { return x_; }  ///< N + 1 states
+  const OcpQpSummary& summary() const { return summary_; }
+  /// The condensed problem of the last Solve (for inspection and tests).
+  const DenseQp& condensed() const { return dense_; }
+
+ private:
+  Eigen::MatrixXd& S(int k, int j) { return s_[k * (k - 1) / 2 + j]; }  // dx_k/du_j, 0 <= j < k <= N
+
+  OcpQpDims dims_;
+  std::vector<Eigen::MatrixXd> s_, w_matrix_, y_;
+  std::vector<Eigen::VectorXd> x_bar_, w_vector_, x_, u_;
+  Eigen::MatrixXd tmp_;
+  DenseQp dense_;
+  DenseQpSolver dense_solver_;
+  OcpQpSummary summary_;
+};
+
+}  // namespace rotorguard::control

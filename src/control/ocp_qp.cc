@@ -1,0 +1,150 @@
+#include "rotorguard/control/ocp_qp.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::control {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}  // namespace
+
+void OcpQpDims::Validate() const {
+  if (horizon < 1 || horizon > 1000) ThrowValidation("OcpQpDims", "horizon", horizon, "an integer in [1, 1000]");
+  if (nx < 1) ThrowValidation("OcpQpDims", "nx", nx, "an integer >= 1");
+  if (nu < 1) ThrowValidation("OcpQpDims", "nu", nu, "an integer >= 1");
+  for (int i : state_bound_index) {
+    if (i < 0 || i >= nx) ThrowValidation("OcpQpDims", "state_bound_index", i, fmt::format("an index in [0, {})", nx));
+  }
+}
+
+OcpQp::OcpQp(const OcpQpDims& d) : dims(d) {
+  dims.Validate();
+  const int N = d.horizon, nbx = static_cast<int>(d.state_bound_index.size());
+  x0 = Eigen::VectorXd::Zero(d.nx);
+  A.assign(N, Eigen::MatrixXd::Identity(d.nx, d.nx));
+  B.assign(N, Eigen::MatrixXd::Zero(d.nx, d.nu));
+  c.assign(N, Eigen::VectorXd::Zero(d.nx));
+  Q.assign(N + 1, Eigen::MatrixXd::Zero(d.nx, d.nx));
+  q.assign(N + 1, Eigen::VectorXd::Zero(d.nx));
+  R.assign(N, Eigen::MatrixXd::Identity(d.nu, d.nu));
+  r.assign(N, Eigen::VectorXd::Zero(d.nu));
+  u_lower.assign(N, Eigen::VectorXd::Constant(d.nu, -kInf));
+  u_upper.assign(N, Eigen::VectorXd::Constant(d.nu, kInf));
+  x_lower.assign(N + 1, Eigen::VectorXd::Constant(nbx, -kInf));
+  x_upper.assign(N + 1, Eigen::VectorXd::Constant(nbx, kInf));
+}
+
+double OcpQp::Objective(const std::vector<Eigen::VectorXd>& x, const std::vector<Eigen::VectorXd>& u) const {
+  double f = 0.0;
+  for (int k = 0; k <= dims.horizon; ++k) f += 0.5 * x[k].dot(Q[k] * x[k]) + q[k].dot(x[k]);
+  for (int k = 0; k < dims.horizon; ++k) f += 0.5 * u[k].dot(R[k] * u[k]) + r[k].dot(u[k]);
+  return f;
+}
+
+std::string OcpQpSummary::BriefReport() const {
+  return fmt::format("OCP QP {}: {} iterations, {} active, objective {:.6g}, condense {:.1f} us, solve {:.1f} us",
+                     ToString(status), iterations, active_constraints, objective, condense_time_s * 1e6,
+                     dense_solve_time_s * 1e6);
+}
+
+CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options)
+    : dims_(dims),
+      dense_(dims.horizon * dims.nu, dims.horizon * static_cast<int>(dims.state_bound_index.size())),
+      dense_solver_(dims.horizon * dims.nu, dims.horizon * static_cast<int>(dims.state_bound_index.size()),
+                    options) {
+  dims_.Validate();
+  const int N = dims.horizon, nx = dims.nx, nu = dims.nu;
+  s_.assign(static_cast<std::size_t>(N * (N + 1) / 2), Eigen::MatrixXd::Zero(nx, nu));
+  w_matrix_.assign(N + 1, Eigen::MatrixXd::Zero(nx, nx));
+  y_.assign(N, Eigen::MatrixXd::Zero(nx, nu));
+  x_bar_.assign(N + 1, Eigen::VectorXd::Zero(nx));
+  w_vector_.assign(N + 1, Eigen::VectorXd::Zero(nx));
+  x_.assign(N + 1, Eigen::VectorXd::Zero(nx));
+  u_.assign(N, Eigen::VectorXd::Zero(nu));
+  tmp_.resize(nx, nx);
+}
+
+const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
+  const auto start = std::chrono::steady_clock::now();
+  summary_ = OcpQpSummary{};
+  const int N = dims_.horizon, nu = dims_.nu;
+  const std::vector<int>& idx = dims_.state_bound_index;
+  const int nbx = static_cast<int>(idx.size());
+  if (qp.dims.horizon != N || qp.dims.nx != dims_.nx || qp.dims.nu != nu || qp.dims.state_bound_index != idx) {
+    throw std::invalid_argument("CondensingQpSolver::Solve: the problem's dimensions differ from the solver's");
+  }
+
+  // Free response x_bar (u = 0) and sensitivities S_kj = A_{k-1} ... A_{j+1} B_j.
+  x_bar_[0] = qp.x0;
+  for (int k = 0; k < N; ++k) x_bar_[k + 1].noalias() = qp.A[k] * x_bar_[k] + qp.c[k];
+  for (int k = 1; k <= N; ++k) {
+    S(k, k - 1) = qp.B[k - 1];
+    for (int j = 0; j < k - 1; ++j) S(k, j).noalias() = qp.A[k - 1] * S(k - 1, j);
+  }
+  // Backward: W_m = Q_m + A_m' W_{m+1} A_m, w_m = Q_m x_bar_m + q_m + A_m' w_{m+1}.
+  w_matrix_[N] = qp.Q[N];
+  w_vector_[N].noalias() = qp.Q[N] * x_bar_[N] + qp.q[N];
+  for (int m = N - 1; m >= 1; --m) {
+    tmp_.noalias() = w_matrix_[m + 1] * qp.A[m];
+    w_matrix_[m] = qp.Q[m];
+    w_matrix_[m].noalias() += qp.A[m].transpose() * tmp_;
+    w_vector_[m] = qp.q[m];
+    w_vector_[m].noalias() += qp.Q[m] * x_bar_[m] + qp.A[m].transpose() * w_vector_[m + 1];
+  }
+  // Hessian blocks H_ij = S_{j+1,i}' W_{j+1} B_j (i <= j) plus R_j, gradient g_j = r_j + B_j' w_{j+1}.
+  for (int j = 0; j < N; ++j) {
+    y_[j].noalias() = w_matrix_[j + 1] * qp.B[j];
+    for (int i = 0; i <= j; ++i) {
+      auto block = dense_.H.block(i * nu, j * nu, nu, nu);
+      block.noalias() = S(j + 1, i).transpose() * y_[j];
+      if (i == j) {
+        block += qp.R[j];
+      } else {
+        dense_.H.block(j * nu, i * nu, nu, nu) = block.transpose();
+      }
+    }
+    dense_.g.segment(j * nu, nu) = qp.r[j];
+    dense_.g.segment(j * nu, nu).noalias() += qp.B[j].transpose() * w_vector_[j + 1];
+    dense_.lb.segment(j * nu, nu) = qp.u_lower[j];
+    dense_.ub.segment(j * nu, nu) = qp.u_upper[j];
+  }
+  // State bounds become rows of C: x_k[idx] = x_bar_k[idx] + sum_{j<k} S_kj[idx, :] u_j.
+  if (nbx > 0) {
+    dense_.C.setZero();
+    for (int k = 1; k <= N; ++k) {
+      for (int b = 0; b < nbx; ++b) {
+        const int row = (k - 1) * nbx + b;
+        for (int j = 0; j < k; ++j) dense_.C.block(row, j * nu, 1, nu) = S(k, j).row(idx[b]);
+        dense_.lc[row] = qp.x_lower[k][b] - x_bar_[k][idx[b]];
+        dense_.uc[row] = qp.x_upper[k][b] - x_bar_[k][idx[b]];
+      }
+    }
+  }
+  const auto condensed = std::chrono::steady_clock::now();
+  summary_.condense_time_s = std::chrono::duration<double>(condensed - start).count();
+
+  const DenseQpSummary& ds = dense_solver_.Solve(dense_);
+  summary_.status = ds.status;
+  summary_.iterations = ds.iterations;
+  summary_.active_constraints = ds.active_constraints;
+  summary_.dense_solve_time_s = ds.solve_time_s;
+  // Expand the trajectory by forward simulation of the inputs.
+  const Eigen::VectorXd& z = dense_solver_.z();
+  x_[0] = qp.x0;
+  for (int k = 0; k < N; ++k) {
+    u_[k] = z.segment(k * nu, nu);
+    x_[k + 1].noalias() = qp.A[k] * x_[k] + qp.B[k] * u_[k] + qp.c[k];
+  }
+  summary_.objective = qp.Objective(x_, u_);
+  summary_.max_violation = ds.max_violation;
+  summary_.total_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary_;
+}
+
+}  // namespace rotorguard::control

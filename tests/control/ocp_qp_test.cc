@@ -1,0 +1,180 @@
+#include "rotorguard/control/ocp_qp.h"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include "rotorguard/core/rng.h"
+#include "test_util.h"
+
+namespace rotorguard::control {
+namespace {
+
+using rotorguard::testing::MatricesNear;
+
+Eigen::MatrixXd RandomMatrix(int r, int c, Rng& rng, double scale = 1.0) {
+  Eigen::MatrixXd m(r, c);
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < c; ++j) m(i, j) = scale * rng.Normal();
+  return m;
+}
+
+/// A random time-varying OCP QP with state bounds on `bounded` and input bounds that bind.
+OcpQp RandomOcp(int N, int nx, int nu, std::vector<int> bounded, Rng& rng) {
+  OcpQpDims dims{N, nx, nu, bounded};
+  OcpQp qp(dims);
+  qp.x0 = RandomMatrix(nx, 1, rng, 2.0);
+  for (int k = 0; k < N; ++k) {
+    qp.A[k] = Eigen::MatrixXd::Identity(nx, nx) + RandomMatrix(nx, nx, rng, 0.15);
+    qp.B[k] = RandomMatrix(nx, nu, rng, 0.5);
+    qp.c[k] = RandomMatrix(nx, 1, rng, 0.1);
+    const Eigen::MatrixXd M = RandomMatrix(nu, nu, rng);
+    qp.R[k] = M * M.transpose() + 0.2 * Eigen::MatrixXd::Identity(nu, nu);
+    qp.r[k] = RandomMatrix(nu, 1, rng, 0.3);
+    qp.u_lower[k].setConstant(-0.6);
+    qp.u_upper[k].setConstant(0.6);
+  }
+  for (int k = 0; k <= N; ++k) {
+    const Eigen::MatrixXd M = RandomMatrix(nx, nx, rng);
+    qp.Q[k] = M * M.transpose() + 0.1 * Eigen::MatrixXd::Identity(nx, nx);
+    qp.q[k] = RandomMatrix(nx, 1, rng, 0.3);
+    qp.x_lower[k].setConstant(-1.5);
+    qp.x_upper[k].setConstant(1.5);
+  }
+  return qp;
+}
+
+/// Condensing done the naive way: the prediction matrix built from explicit products, the Hessian
+/// as Gamma' Qbig Gamma + Rbig. An oracle independent of the solver's recursions.
+void NaiveCondense(const OcpQp& qp, Eigen::MatrixXd* H, Eigen::VectorXd* g, Eigen::MatrixXd* C,
+                   Eigen::VectorXd* lc, Eigen::VectorXd* uc) {
+  const int N = qp.dims.horizon, nx = qp.dims.nx, nu = qp.dims.nu;
+  const int nbx = static_cast<int>(qp.dims.state_bound_index.size());
+  Eigen::MatrixXd gamma = Eigen::MatrixXd::Zero(N * nx, N * nu);  // rows: x_1 .. x_N
+  Eigen::VectorXd free = Eigen::VectorXd::Zero(N * nx);
+  Eigen::VectorXd x = qp.x0;
+  for (int k = 0; k < N; ++k) {
+    x = qp.A[k] * x + qp.c[k];
+    free.segment(k * nx, nx) = x;
+    for (int j = 0; j <= k; ++j) {
+      Eigen::MatrixXd phi = Eigen::MatrixXd::Identity(nx, nx);
+      for (int m = j + 1; m <= k; ++m) phi = qp.A[m] * phi;
+      gamma.block(k * nx, j * nu, nx, nu) = phi * qp.B[j];
+    }
+  }
+  Eigen::MatrixXd qbig = Eigen::MatrixXd::Zero(N * nx, N * nx), rbig = Eigen::MatrixXd::Zero(N * nu, N * nu);
+  Eigen::VectorXd qvec(N * nx), rvec(N * nu);
+  for (int k = 0; k < N; ++k) {
+    qbig.block(k * nx, k * nx, nx, nx) = qp.Q[k + 1];
+    qvec.segment(k * nx, nx) = qp.q[k + 1];
+    rbig.block(k * nu, k * nu, nu, nu) = qp.R[k];
+    rvec.segment(k * nu, nu) = qp.r[k];
+  }
+  *H = gamma.transpose() * qbig * gamma + rbig;
+  *g = gamma.transpose() * (qbig * free + qvec) + rvec;
+  C->resize(N * nbx, N * nu);
+  lc->resize(N * nbx);
+  uc->resize(N * nbx);
+  for (int k = 0; k < N; ++k) {
+    for (int b = 0; b < nbx; ++b) {
+      const int i = qp.dims.state_bound_index[b];
+      C->row(k * nbx + b) = gamma.row(k * nx + i);
+      (*lc)[k * nbx + b] = qp.x_lower[k + 1][b] - free[k * nx + i];
+      (*uc)[k * nbx + b] = qp.x_upper[k + 1][b] - free[k * nx + i];
+    }
+  }
+}
+
+TEST(CondensingQp, CondensedProblemEqualsTheNaiveConstruction) {
+  Rng rng(11);
+  const OcpQp qp = RandomOcp(7, 5, 2, {1, 3}, rng);
+  CondensingQpSolver solver(qp.dims);
+  solver.Solve(qp);
+  Eigen::MatrixXd H, C;
+  Eigen::VectorXd g, lc, uc;
+  NaiveCondense(qp, &H, &g, &C, &lc, &uc);
+  EXPECT_TRUE(MatricesNear(solver.condensed().H, H, 1e-9 * H.cwiseAbs().maxCoeff()));
+  EXPECT_TRUE(MatricesNear(solver.condensed().g, g, 1e-9 * g.cwiseAbs().maxCoeff()));
+  EXPECT_TRUE(MatricesNear(solver.condensed().C, C, 1e-12 * C.cwiseAbs().maxCoeff()));
+  EXPECT_TRUE(MatricesNear(solver.condensed().lc, lc, 1e-12));
+  EXPECT_TRUE(MatricesNear(solver.condensed().uc, uc, 1e-12));
+}
+
+TEST(CondensingQp, UnconstrainedSolutionSolvesTheFullSpaceKktSystem) {
+  // Without binding bounds the optimum solves the equality-constrained KKT system in all
+  // variables [u_0..u_{N-1}, x_1..x_N] with the dynamics as constraints: an independent solve.
+  Rng rng(5);
+  const int N = 6, nx = 4, nu = 2;
+  OcpQp qp = RandomOcp(N, nx, nu, {}, rng);
+  for (auto& b : qp.u_lower) b.setConstant(-1e9);
+  for (auto& b : qp.u_upper) b.setConstant(1e9);
+  CondensingQpSolver solver(qp.dims);
+  ASSERT_TRUE(solver.Solve(qp).IsSolutionUsable());
+  const int nv = N * nu + N * nx, ne = N * nx;
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(nv + ne, nv + ne);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nv + ne);
+  const auto ui = [&](int k) { return k * nu; };
+  const auto xi = [&](int k) { return N * nu + (k - 1) * nx; };  // k = 1..N
+  for (int k = 0; k < N; ++k) {
+    K.block(ui(k), ui(k), nu, nu) = qp.R[k];
+    rhs.segment(ui(k), nu) = -qp.r[k];
+    K.block(xi(k + 1), xi(k + 1), nx, nx) = qp.Q[k + 1];
+    rhs.segment(xi(k + 1), nx) = -qp.q[k + 1];
+    // x_{k+1} - A_k x_k - B_k u_k = c_k (x_0 is data).
+    const int row = nv + k * nx;
+    K.block(row, xi(k + 1), nx, nx) = Eigen::MatrixXd::Identity(nx, nx);
+    K.block(row, ui(k), nx, nu) = -qp.B[k];
+    rhs.segment(row, nx) = qp.c[k];
+    if (k == 0) {
+      rhs.segment(row, nx) += qp.A[0] * qp.x0;
+    } else {
+      K.block(row, xi(k), nx, nx) = -qp.A[k];
+    }
+  }
+  K.topRightCorner(nv, ne) = K.bottomLeftCorner(ne, nv).transpose();
+  const Eigen::VectorXd sol = K.fullPivLu().solve(rhs);
+  for (int k = 0; k < N; ++k) {
+    EXPECT_TRUE(MatricesNear(solver.u()[k], sol.segment(ui(k), nu), 1e-8)) << "u_" << k;
+    EXPECT_TRUE(MatricesNear(solver.x()[k + 1], sol.segment(xi(k + 1), nx), 1e-8)) << "x_" << k + 1;
+  }
+}
+
+TEST(CondensingQp, RespectsInputAndStateBoundsWhenTheyBind) {
+  Rng rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    OcpQp qp = RandomOcp(10, 6, 3, {0, 2, 5}, rng);
+    // Feasible by construction (mild dynamics from a small start, where zero input stays inside
+    // the bounds), and a cost that pulls the bounded states to +-4, beyond their +-1.5 bounds.
+    qp.x0 *= 0.1;
+    Eigen::VectorXd target = Eigen::VectorXd::Zero(6);
+    target << 4.0, 0.0, -4.0, 0.0, 0.0, 4.0;
+    for (int k = 0; k < 10; ++k) {
+      qp.A[k] = Eigen::MatrixXd::Identity(6, 6) + 0.02 * (qp.A[k] - Eigen::MatrixXd::Identity(6, 6));
+      qp.c[k].setZero();
+    }
+    for (int k = 0; k <= 10; ++k) qp.q[k] = -qp.Q[k] * target;
+    CondensingQpSolver solver(qp.dims);
+    const OcpQpSummary& s = solver.Solve(qp);
+    ASSERT_TRUE(s.IsSolutionUsable()) << s.BriefReport();
+    EXPECT_GT(s.active_constraints, 0);
+    for (int k = 0; k < 10; ++k) {
+      EXPECT_LE(solver.u()[k].cwiseAbs().maxCoeff(), 0.6 + 1e-9);
+      for (int b : {0, 2, 5}) EXPECT_LE(std::abs(solver.x()[k + 1][b]), 1.5 + 1e-8);
+    }
+    // The dynamics hold exactly along the returned trajectory.
+    for (int k = 0; k < 10; ++k) {
+      EXPECT_TRUE(MatricesNear(solver.x()[k + 1], qp.A[k] * solver.x()[k] + qp.B[k] * solver.u()[k] + qp.c[k], 1e-12));
+    }
+  }
+}
+
+TEST(CondensingQp, RejectsMismatchedDimensionsAndBadDims) {
+  Rng rng(1);
+  const OcpQp qp = RandomOcp(4, 3, 1, {}, rng);
+  CondensingQpSolver solver(OcpQpDims{5, 3, 1, {}});
+  EXPECT_THROW(solver.Solve(qp), std::invalid_argument);
+  EXPECT_THROW(OcpQp(OcpQpDims{0, 3, 1, {}}), std::invalid_argument);
+  EXPECT_THROW(OcpQp(OcpQpDims{4, 3, 1, {3}}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rotorguard::control
