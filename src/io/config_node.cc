@@ -501,10 +501,12 @@ class TreeBuilder final : public YAML::EventHandler {
   std::size_t copied_nodes_ = 0;
 };
 
-/// Ignores every event: used to look for a syntax error only.
-class IgnoreEvents final : public YAML::EventHandler {
+/// Ignores every event but document starts: used to look for a syntax error only.
+class DocumentStarts final : public YAML::EventHandler {
  public:
-  void OnDocumentStart(const YAML::Mark& /*mark*/) override {}
+  const YAML::Mark& last() const { return last_; }
+
+  void OnDocumentStart(const YAML::Mark& mark) override { last_ = mark; }
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& /*mark*/, YAML::anchor_t /*anchor*/) override {}
   void OnAlias(const YAML::Mark& /*mark*/, YAML::anchor_t /*anchor*/) override {}
@@ -516,6 +518,9 @@ class IgnoreEvents final : public YAML::EventHandler {
   void OnMapStart(const YAML::Mark& /*mark*/, const std::string& /*tag*/,
                   YAML::anchor_t /*anchor*/, YAML::EmitterStyle::value /*style*/) override {}
   void OnMapEnd() override {}
+
+ private:
+  YAML::Mark last_;
 };
 
 /// Turns yaml-cpp exceptions into ConfigErrors with yaml-cpp's location made 1-based.
@@ -546,16 +551,33 @@ class ParseContext {
     std::istringstream in(text);
     try {
       YAML::Parser parser(in);
-      IgnoreEvents ignore;
-      while (parser.HandleNextDocument(ignore)) {
+      DocumentStarts starts;
+      int previous_start = -1;
+      // Every real document consumes input, so this bounds the loop even if the check below
+      // missed a way for yaml-cpp to stall.
+      for (std::size_t documents = 0; documents <= text.size() + 1; ++documents) {
+        if (!parser.HandleNextDocument(starts)) return std::nullopt;
+        // yaml-cpp 0.7 never consumes a stray ',' outside a flow collection: it reports an
+        // endless run of empty documents starting there. Call that a syntax error.
+        if (starts.last().pos == previous_start) return Stalled(text, starts.last());
+        previous_start = starts.last().pos;
       }
+      return Stalled(text, starts.last());
     } catch (const YAML::Exception& e) {
       return FromYaml(e);
     }
-    return std::nullopt;
   }
 
  private:
+  ConfigError Stalled(const std::string& text, const YAML::Mark& mark) const {
+    const auto pos = static_cast<std::size_t>(mark.pos);
+    const bool printable = mark.pos >= 0 && pos < text.size() &&
+                           std::isprint(static_cast<unsigned char>(text[pos])) != 0;
+    return At(mark, printable ? fmt::format("malformed YAML: unexpected {}",
+                                            Quote(std::string_view(text).substr(pos, 1)))
+                              : std::string("malformed YAML: unexpected content"));
+  }
+
   std::string source_;
   bool from_override_;
   std::string base_path_;

@@ -182,6 +182,15 @@ TEST(ConfigDocument, MalformedYamlReportsYamlCppsLine) {
                        "t.yaml:1:4: malformed YAML: the referenced anchor is not defined");
 }
 
+TEST(ConfigDocument, StrayCommaIsAnErrorNotAHang) {
+  // yaml-cpp 0.7 reports an endless run of empty documents at a stray top-level ','.
+  RG_EXPECT_THROW_WITH(Load(","), ConfigError, "t.yaml:1:1: malformed YAML: unexpected ','");
+  RG_EXPECT_THROW_WITH(Load("- 1\n,\n"), ConfigError,
+                       "t.yaml:2:1: malformed YAML: unexpected ','");
+  RG_EXPECT_THROW_WITH(Load("a: 1\n...\n,\n"), ConfigError,
+                       "t.yaml:3:1: malformed YAML: unexpected ','");
+}
+
 TEST(ConfigDocument, DeepNestingIsAnErrorNotACrash) {
   RG_EXPECT_THROW_WITH(Load("a: " + std::string(100000, '[')), ConfigError,
                        "malformed YAML: nesting is deeper than");
@@ -702,6 +711,10 @@ TEST(ConfigOverride, MalformedValueIsAnErrorAndChangesNothing) {
                        "--set: vehicle.mass_kg: malformed YAML: end of sequence flow not found");
   RG_EXPECT_THROW_WITH(doc.ApplyOverride("vehicle", "{a: 1, a: 2}"), ConfigError,
                        "--set: vehicle.a: duplicate key 'a'");
+  RG_EXPECT_THROW_WITH(doc.ApplyOverride("vehicle.mass_kg", ","), ConfigError,
+                       "--set: vehicle.mass_kg: malformed YAML: unexpected ','");
+  RG_EXPECT_THROW_WITH(doc.ApplyOverride("vehicle.mass_kg", "1\n---\n2"), ConfigError,
+                       "--set: vehicle.mass_kg: a second YAML document starts here");
   EXPECT_DOUBLE_EQ(doc.root().Required("vehicle").Required("mass_kg").AsDouble(), 1.5);
 }
 

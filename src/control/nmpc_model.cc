@@ -1,0 +1,172 @@
+#include "rotorguard/control/nmpc_model.h"
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/core/types.h"
+#include "rotorguard/vehicle/effectiveness.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace rotorguard::control {
+
+namespace {
+using vehicle::StateIndex;
+
+/// Rotation matrix of a (unit) quaternion as the polynomial in its components, and its partial
+/// derivatives with respect to (w, x, y, z); smooth for the slightly non-unit quaternions that a
+/// prediction integrates.
+Eigen::Matrix3d RotationOf(double w, double x, double y, double z) {
+  Eigen::Matrix3d R;
+  R << 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),  //
+      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),   //
+      2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y);
+  return R;
+}
+
+void RotationDerivatives(double w, double x, double y, double z, Eigen::Matrix3d dR[4]) {
+  dR[0] << 0, -2 * z, 2 * y, 2 * z, 0, -2 * x, -2 * y, 2 * x, 0;
+  dR[1] << 0, 2 * y, 2 * z, 2 * y, -4 * x, -2 * w, 2 * z, 2 * w, -4 * x;
+  dR[2] << -4 * y, 2 * x, 2 * w, 2 * x, 0, 2 * z, -2 * w, 2 * z, -4 * y;
+  dR[3] << -4 * z, -2 * w, 2 * x, 2 * w, -4 * z, 2 * y, 2 * x, 2 * y, 0;
+}
+}  // namespace
+
+NmpcModel::NmpcModel(const vehicle::VehicleParams& params) : params_(params), nu_(params.num_rotors()) {
+  params_.Validate();
+  inertia_ = params_.inertia_kg_m2;
+  inertia_inv_ = inertia_.inverse();
+  torque_map_ = vehicle::ComputeEffectivenessMatrix(params_.rotors).bottomRows<3>();
+}
+
+void NmpcModel::Dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot) const {
+  x_dot->resize(nx());
+  const double qw = x[3], qx = x[4], qy = x[5], qz = x[6];
+  const Eigen::Matrix3d R = RotationOf(qw, qx, qy, qz);
+  const Eigen::Vector3d v = x.segment<3>(StateIndex::kVelocity);
+  const Eigen::Vector3d w = x.segment<3>(StateIndex::kBodyRate);
+  const auto T = x.segment(StateIndex::kMotor, nu_);
+  const Eigen::Vector3d D = params_.rotor_drag_kg_s;
+  x_dot->segment<3>(0) = v;
+  x_dot->segment<4>(3) = QuaternionDerivative(Quaternion(qw, qx, qy, qz), w);
+  x_dot->segment<3>(7) = (R.col(2) * T.sum() - R * D.asDiagonal() * (R.transpose() * v)) / params_.mass_kg -
+                         Eigen::Vector3d(0, 0, kGravity);
+  x_dot->segment<3>(10) = inertia_inv_ * (torque_map_ * T - w.cross(inertia_ * w) -
+                                          Eigen::Vector3d(0, 0, params_.yaw_damping_n_m_s * w.z()));
+  x_dot->segment(StateIndex::kMotor, nu_) = (u - T) / params_.motor_time_constant_s;
+}
+
+void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot,
+                                      Eigen::MatrixXd* fx, Eigen::MatrixXd* fu) const {
+  Dynamics(x, u, x_dot);
+  const int n = nx();
+  fx->setZero(n, n);
+  fu->setZero(n, nu_);
+  const double qw = x[3], qx = x[4], qy = x[5], qz = x[6];
+  const Eigen::Matrix3d R = RotationOf(qw, qx, qy, qz);
+  Eigen::Matrix3d dR[4];
+  RotationDerivatives(qw, qx, qy, qz, dR);
+  const Eigen::Vector3d v = x.segment<3>(7), w = x.segment<3>(10);
+  const double thrust = x.segment(StateIndex::kMotor, nu_).sum();
+  const Eigen::Matrix3d D = params_.rotor_drag_kg_s.asDiagonal();
+  const double inv_m = 1.0 / params_.mass_kg;
+
+  fx->block<3, 3>(0, 7).setIdentity();  // p_dot = v
+  // q_dot = 1/2 Omega(w) q = 1/2 Xi(q) w.
+  Eigen::Matrix4d omega;
+  omega << 0, -w.x(), -w.y(), -w.z(),  //
+      w.x(), 0, w.z(), -w.y(),         //
+      w.y(), -w.z(), 0, w.x(),         //
+      w.z(), w.y(), -w.x(), 0;
+  fx->block<4, 4>(3, 3) = 0.5 * omega;
+  Eigen::Matrix<double, 4, 3> xi;
+  xi << -qx, -qy, -qz,  //
+      qw, -qz, qy,      //
+      qz, qw, -qx,      //
+      -qy, qx, qw;
+  fx->block<4, 3>(3, 10) = 0.5 * xi;
+  // v_dot = (R e3 sum(T) - R D R' v) / m - g e3.
+  const Eigen::Vector3d drag_body = D * (R.transpose() * v);
+  for (int i = 0; i < 4; ++i) {
+    fx->block<3, 1>(7, 3 + i) =
+        inv_m * (dR[i].col(2) * thrust - dR[i] * drag_body - R * D * (dR[i].transpose() * v));
+  }
+  fx->block<3, 3>(7, 7) = -inv_m * R * D * R.transpose();
+  for (int j = 0; j < nu_; ++j) fx->block<3, 1>(7, StateIndex::kMotor + j) = inv_m * R.col(2);
+  // w_dot = I^-1 (M T - w x I w - k_dpsi r e3).
+  const Eigen::Matrix3d gyro = Skew(w) * inertia_ - Skew(inertia_ * w);
+  Eigen::Matrix3d damping = Eigen::Matrix3d::Zero();
+  damping(2, 2) = params_.yaw_damping_n_m_s;
+  fx->block<3, 3>(10, 10) = -inertia_inv_ * (gyro + damping);
+  fx->block(10, StateIndex::kMotor, 3, nu_) = inertia_inv_ * torque_map_;
+  // T_dot = (u - T) / sigma (eq. 6).
+  const double inv_sigma = 1.0 / params_.motor_time_constant_s;
+  fx->block(StateIndex::kMotor, StateIndex::kMotor, nu_, nu_) = -inv_sigma * Eigen::MatrixXd::Identity(nu_, nu_);
+  fu->block(StateIndex::kMotor, 0, nu_, nu_) = inv_sigma * Eigen::MatrixXd::Identity(nu_, nu_);
+}
+
+Rk4Sensitivity::Rk4Sensitivity(const NmpcModel& model, double dt, int substeps)
+    : model_(model), h_(dt / substeps), substeps_(substeps) {
+  if (!(dt > 0.0) || substeps < 1) {
+    ThrowInvalidArgument("Rk4Sensitivity", "dt, substeps", fmt::format("{}, {}", dt, substeps), "dt > 0 and substeps >= 1");
+  }
+  const int nx = model.nx(), nu = model.nu();
+  for (int i = 0; i < 4; ++i) {
+    k_[i].resize(nx);
+    fx_[i].resize(nx, nx);
+    fu_[i].resize(nx, nu);
+    dk_x_[i].resize(nx, nx);
+    dk_u_[i].resize(nx, nu);
+  }
+  xs_.resize(nx);
+  xtmp_.resize(nx);
+  ax_.resize(nx, nx);
+  bx_.resize(nx, nu);
+  atmp_.resize(nx, nx);
+  btmp_.resize(nx, nu);
+}
+
+void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_next,
+                          Eigen::MatrixXd* A, Eigen::MatrixXd* B) {
+  const bool sens = A != nullptr && B != nullptr;
+  xs_ = x;
+  if (sens) {
+    ax_.setIdentity();  // d xs / d x
+    bx_.setZero();      // d xs / d u
+  }
+  static constexpr double kStage[4] = {0.0, 0.5, 0.5, 1.0};
+  static constexpr double kWeight[4] = {1.0 / 6.0, 2.0 / 6.0, 2.0 / 6.0, 1.0 / 6.0};
+  for (int s = 0; s < substeps_; ++s) {
+    for (int i = 0; i < 4; ++i) {
+      xtmp_ = xs_;
+      if (i > 0) xtmp_ += kStage[i] * h_ * k_[i - 1];
+      if (!sens) {
+        model_.Dynamics(xtmp_, u, &k_[i]);
+        continue;
+      }
+      model_.DynamicsWithJacobians(xtmp_, u, &k_[i], &fx_[i], &fu_[i]);
+      // d k_i = f_x (d xs + c h d k_{i-1}) + f_u d u.
+      atmp_ = ax_;
+      btmp_ = bx_;
+      if (i > 0) {
+        atmp_ += kStage[i] * h_ * dk_x_[i - 1];
+        btmp_ += kStage[i] * h_ * dk_u_[i - 1];
+      }
+      dk_x_[i].noalias() = fx_[i] * atmp_;
+      dk_u_[i].noalias() = fx_[i] * btmp_;
+      dk_u_[i] += fu_[i];
+    }
+    for (int i = 0; i < 4; ++i) {
+      xs_ += kWeight[i] * h_ * k_[i];
+      if (sens) {
+        ax_ += kWeight[i] * h_ * dk_x_[i];
+        bx_ += kWeight[i] * h_ * dk_u_[i];
+      }
+    }
+  }
+  *x_next = xs_;
+  if (sens) {
+    *A = ax_;
+    *B = bx_;
+  }
+}
+
+}  // namespace rotorguard::control
