@@ -282,7 +282,7 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
 }
 
 void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
-  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal"});
+  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc"});
   o->control_rate_hz = OptionalDouble(node, "control_rate_hz", o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;
@@ -296,6 +296,36 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     g.max_rate_rad_s = OptionalDouble(*n, "max_rate_rad_s", g.max_rate_rad_s);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { g.Validate(); });
+  }
+  if (const auto n = node.Optional("nmpc")) {
+    control::NmpcOptions& m = o->nmpc;
+    if (const auto v = n->Optional("horizon_steps")) m.horizon_steps = static_cast<int>(v->AsIntIn(1, 200));
+    m.step_s = OptionalDouble(*n, "step_s", m.step_s);
+    if (const auto v = n->Optional("integrator_substeps")) m.integrator_substeps = static_cast<int>(v->AsIntIn(1, 20));
+    m.q_position = OptionalVector3(*n, "q_position", m.q_position);
+    if (const auto v = n->Optional("q_attitude")) {
+      const std::vector<double> qa = v->AsDoubleList(4);
+      m.q_attitude = Eigen::Vector4d(qa[0], qa[1], qa[2], qa[3]);
+    }
+    m.q_velocity = OptionalVector3(*n, "q_velocity", m.q_velocity);
+    m.q_rate = OptionalVector3(*n, "q_rate", m.q_rate);
+    m.q_thrust = OptionalDouble(*n, "q_thrust", m.q_thrust);
+    m.r_input = OptionalDouble(*n, "r_input", m.r_input);
+    m.max_rate_rad_s = OptionalVector3(*n, "max_rate_rad_s", m.max_rate_rad_s);
+    if (const auto v = n->Optional("max_sqp_iterations")) m.max_sqp_iterations = static_cast<int>(v->AsIntIn(1, 1000));
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] { m.Validate(); });
+  }
+  if (const auto kf = node.Optional("known_faults")) {
+    if (!kf->IsSequence()) kf->Fail("expected a list of {rotor, at_time_s}");
+    for (std::size_t i = 0; i < kf->size(); ++i) {
+      const ConfigNode f = kf->At(i);
+      stack::KnownFault k;
+      k.rotor = static_cast<int>(f.Required("rotor").AsIntIn(0, kMaxRotors - 1));
+      k.at_time_s = f.Required("at_time_s").AsNonNegative();
+      f.RejectUnknownKeys();
+      o->known_faults.push_back(k);
+    }
   }
   node.RejectUnknownKeys();
   ValidateAt(node, [&] { o->Validate(); });
@@ -423,6 +453,13 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   }
   CheckFaultsAgainstScenario(root, s);
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
+  for (std::size_t i = 0; i < s.stack.known_faults.size(); ++i) {
+    if (s.stack.known_faults[i].rotor >= s.vehicle.num_rotors()) {
+      root.FailAt(fmt::format("stack.known_faults.{}.rotor", i),
+                  fmt::format("rotor {} does not exist; expected an index in [0, {}]", s.stack.known_faults[i].rotor,
+                              s.vehicle.num_rotors() - 1));
+    }
+  }
   if (s.stack.control_rate_hz > s.sim.physics_rate_hz) {
     root.FailAt("stack.control_rate_hz",
                 fmt::format("stack.control_rate_hz = {:g} is invalid; expected at most the physics rate "

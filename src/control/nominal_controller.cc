@@ -47,8 +47,9 @@ NominalController::NominalController(const vehicle::MultirotorModel& model,
   options_.Validate();
 }
 
-void NominalController::Compute(const StateEstimate& est, const ReferencePoint& ref, double dt,
-                                RotorVector* thrust_command) {
+void NominalController::Compute(const StateEstimate& est, const ReferenceTrajectory& reference, double t,
+                                double dt, RotorVector* thrust_command) {
+  const ReferencePoint ref = reference.Evaluate(t);
   const bool finite_input = est.p_W.allFinite() && est.v_W.allFinite() && est.w_B.allFinite() &&
                             est.q_WB.coeffs().allFinite() && ref.p_W.allFinite() &&
                             ref.v_W.allFinite() && ref.a_W.allFinite() && ref.j_W.allFinite() &&

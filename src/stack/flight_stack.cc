@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "rotorguard/core/error.h"
 
 namespace rotorguard::stack {
@@ -10,28 +12,54 @@ void FlightStackOptions::Validate() const {
   if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > 10000.0) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
   }
-  if (controller != "nominal") {
-    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal");
+  if (controller != "nominal" && controller != "nmpc") {
+    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc");
   }
   nominal.Validate();
+  nmpc.Validate();
+  for (std::size_t i = 0; i < known_faults.size(); ++i) {
+    if (!std::isfinite(known_faults[i].at_time_s) || known_faults[i].at_time_s < 0.0) {
+      ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.at_time_s", i), known_faults[i].at_time_s,
+                      "a time >= 0 s");
+    }
+  }
+  if (!known_faults.empty() && controller != "nmpc") {
+    ThrowValidation("FlightStackOptions", "known_faults", controller,
+                    "controller nmpc (the only controller that reconfigures)");
+  }
 }
 
 FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
                          std::shared_ptr<const ReferenceTrajectory> reference,
                          const FlightStackOptions& options)
-    : model_(vehicle), reference_(std::move(reference)), options_(options) {
+    : model_(vehicle),
+      reference_(std::move(reference)),
+      options_(options),
+      estimator_(model_.params().thrust_coefficient_n_s2) {
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
-  controller_ = std::make_unique<control::NominalController>(model_, options_.nominal);
+  if (options_.controller == "nmpc") {
+    auto nmpc = std::make_unique<control::NmpcController>(model_.params(), options_.nmpc);
+    nmpc_ = nmpc.get();
+    controller_ = std::move(nmpc);
+  } else {
+    controller_ = std::make_unique<control::NominalController>(model_, options_.nominal);
+  }
+  for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
+    const int rotor = options_.known_faults[i].rotor;
+    if (rotor < 0 || rotor >= model_.num_rotors()) {
+      ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.rotor", i), rotor,
+                      fmt::format("a rotor index in [0, {}]", model_.num_rotors() - 1));
+    }
+  }
+  known_fault_applied_.assign(options_.known_faults.size(), false);
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
 }
 
 void FlightStack::OnImu(const ImuSample& imu) { estimator_.OnImu(imu); }
 
-void FlightStack::OnEscTelemetry(const EscTelemetry& /*esc*/) {
-  // Consumed by fault detection once it exists; the nominal stack does not use it.
-}
+void FlightStack::OnEscTelemetry(const EscTelemetry& esc) { estimator_.OnEscTelemetry(esc); }
 
 void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_.OnOdometry(odometry); }
 
@@ -46,7 +74,13 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
     command_.thrust_n.setZero();
     return command_;
   }
-  controller_->Compute(estimate_, reference_point_, dt, &command_.thrust_n);
+  for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
+    if (!known_fault_applied_[i] && ToSeconds(t) >= options_.known_faults[i].at_time_s) {
+      nmpc_->SetRotorFailed(options_.known_faults[i].rotor);
+      known_fault_applied_[i] = true;
+    }
+  }
+  controller_->Compute(estimate_, *reference_, ToSeconds(t), dt, &command_.thrust_n);
   return command_;
 }
 

@@ -58,3 +58,36 @@ TEST(Runner, NominalControllerCrashesAfterAMotorStop) {
 
 }  // namespace
 }  // namespace rotorguard::bench
+
+namespace rotorguard::bench {
+namespace {
+
+// Closed-loop NMPC flights (paper 000, Sec. VI-A/B), the failure handed to the controller.
+
+TEST(NmpcClosedLoop, HoversAndTracksTheNominal2msLemniscate) {
+  const RunSummary hover = RunScenario(LoadScenario(Config("hover.yaml"), {{"stack.controller", "nmpc"}}));
+  EXPECT_TRUE(hover.success) << hover.failure_reason;
+  EXPECT_LT(hover.max_position_error_m, 0.05);
+  const RunSummary lem = RunScenario(
+      LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}, {"duration_s", "20"}}));
+  EXPECT_TRUE(lem.success) << lem.failure_reason;
+  EXPECT_LT(lem.tracking_rmse_m, 0.10);
+}
+
+TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverSpinningNearElevenRadPerSecond) {
+  const Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"));
+  const RunSummary r = RunScenario(s);
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_GT(r.min_altitude_m, 2.0 - 0.2);  // altitude within 0.2 m of the hover height
+  EXPECT_NEAR(r.max_spin_rad_s, 11.0, 1.0);
+}
+
+TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {
+  const RunSummary r = RunScenario(LoadScenario(Config("nmpc_lemniscate_1ms_rotor0_failed.yaml")));
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_LE(r.tracking_rmse_m, 0.15);  // paper 000's hardware: 0.14-0.15 m
+  EXPECT_GT(r.max_spin_rad_s, 9.0);
+}
+
+}  // namespace
+}  // namespace rotorguard::bench

@@ -13,10 +13,10 @@ class Controller {
  public:
   virtual ~Controller() = default;
   virtual std::string_view name() const = 0;
-  /// Thrust command per rotor [N] for the estimate and reference at the estimate's time. `dt` is
-  /// the time since the previous call [s]. Never writes non-finite values: a non-finite input
-  /// yields the hover command.
-  virtual void Compute(const StateEstimate& estimate, const ReferencePoint& reference, double dt,
+  /// Thrust command per rotor [N] at time t [s] for the estimate, tracking `reference` (a
+  /// predictive controller looks ahead along it). `dt` is the time since the previous call [s].
+  /// Never writes non-finite values: a non-finite input yields a safe fallback command.
+  virtual void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
                        RotorVector* thrust_command) = 0;
   /// Clears internal state (integrators, filters).
   virtual void Reset() = 0;

@@ -25,7 +25,7 @@ class NominalController final : public Controller {
  public:
   NominalController(const vehicle::MultirotorModel& model, const NominalControllerOptions& options);
   std::string_view name() const override { return "nominal"; }
-  void Compute(const StateEstimate& estimate, const ReferencePoint& reference, double dt,
+  void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
                RotorVector* thrust_command) override;
   void Reset() override { integral_.setZero(); }
 

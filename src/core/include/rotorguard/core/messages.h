@@ -44,6 +44,9 @@ struct StateEstimate {
   Quaternion q_WB = Quaternion::Identity();
   Vector3 v_W = Vector3::Zero();
   Vector3 w_B = Vector3::Zero();  ///< body rates [rad/s]
+  /// Thrust each motor drives [N], from ESC telemetry through T = k_n w^2 (paper 000, Sec. III-B);
+  /// empty until telemetry arrived.
+  RotorVector motor_thrust_n;
 };
 
 }  // namespace rotorguard

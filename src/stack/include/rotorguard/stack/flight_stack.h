@@ -4,8 +4,10 @@
 /// mission reference.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "rotorguard/control/controller.h"
+#include "rotorguard/control/nmpc.h"
 #include "rotorguard/control/nominal_controller.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/trajectory.h"
@@ -14,10 +16,20 @@
 
 namespace rotorguard::stack {
 
+/// A rotor failure handed to the controller at a time, without detection: the stand-in for fault
+/// detection (and the "known failure" setting of the FTC literature). Scenario key
+/// stack.known_faults.
+struct KnownFault {
+  int rotor = 0;
+  double at_time_s = 0.0;
+};
+
 struct FlightStackOptions {
   double control_rate_hz = 200.0;    ///< controller rate (paper 000: 200 Hz), in (0, 10000]
-  std::string controller = "nominal";  ///< controller name; one of: nominal
+  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc
   control::NominalControllerOptions nominal;
+  control::NmpcOptions nmpc;
+  std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc only)
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -38,6 +50,9 @@ class FlightStack {
   const ReferencePoint& reference_point() const { return reference_point_; }
   const RotorCommand& command() const { return command_; }
   const vehicle::MultirotorModel& model() const { return model_; }
+  const control::Controller& controller() const { return *controller_; }
+  /// The NMPC, when it is the controller (for its solve statistics); else null.
+  const control::NmpcController* nmpc() const { return nmpc_; }
 
  private:
   vehicle::MultirotorModel model_;
@@ -45,6 +60,8 @@ class FlightStack {
   FlightStackOptions options_;
   OdometryPassThroughEstimator estimator_;
   std::unique_ptr<control::Controller> controller_;
+  control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
+  std::vector<bool> known_fault_applied_;
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
   StateEstimate estimate_;

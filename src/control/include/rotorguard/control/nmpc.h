@@ -1,0 +1,122 @@
+#pragma once
+/// Fault-tolerant NMPC of paper 000, Sec. V-A: multiple shooting over N steps of the model with
+/// motor dynamics (eqs. 1-3, 6; RK4), the cost of eq. (8) with y and Q of eqs. (10)-(12) and the
+/// tilt-prioritised reduced-attitude error of Brescianini & D'Andrea, input bounds 0 <= u <= u_bar
+/// and body-rate bounds. Solved by real-time iteration (one Gauss-Newton SQP step per call, split
+/// into preparation and feedback, warm-started from the previous solution shifted by the elapsed
+/// time) or iterated to convergence. A rotor isolated as failed gets u_bar_i = 0 at run time; the
+/// yaw-error weight drops to 0 and the thrust reference switches to the post-failure equilibrium.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "rotorguard/control/controller.h"
+#include "rotorguard/control/nmpc_model.h"
+#include "rotorguard/control/ocp_qp.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::control {
+
+struct NmpcOptions {
+  int horizon_steps = 20;       ///< N (paper: 20), in [1, 200]
+  double step_s = 0.05;         ///< dt between shooting nodes (paper: 50 ms), in (0, 1]
+  int integrator_substeps = 2;  ///< RK4 sub-steps per node (docs/control.md measures), in [1, 20]
+  // Weights of eqs. (10)-(11), paper 000 Sec. VI. All >= 0 (r_input > 0).
+  Eigen::Vector3d q_position = Eigen::Vector3d(100.0, 100.0, 600.0);
+  Eigen::Vector4d q_attitude = Eigen::Vector4d(60.0, 60.0, 60.0, 60.0);  ///< [tilt x, tilt y, tilt^2, yaw]
+  Eigen::Vector3d q_velocity = Eigen::Vector3d(5.0, 5.0, 5.0);
+  Eigen::Vector3d q_rate = Eigen::Vector3d(1.0, 1.0, 1.0);
+  double q_thrust = 1.0;  ///< Q_t on T - t_ref
+  double r_input = 1.0;   ///< R on u - t_ref (the paper's R_N; see docs/control.md)
+  Eigen::Vector3d max_rate_rad_s = Eigen::Vector3d(10.0, 10.0, 20.0);  ///< |w| bounds, > 0
+  /// SQP iterations per call: 1 is the real-time iteration; more iterate towards convergence.
+  int max_sqp_iterations = 1;
+  /// Converge mode stops when the largest step in (x, u) is below this, > 0.
+  double sqp_tolerance = 1e-8;
+  DenseQpOptions qp;
+  void Validate() const;
+};
+
+enum class NmpcStatus {
+  kNotSolved,        ///< Compute() was not called
+  kSolved,           ///< the QP(s) solved; in converge mode, the step fell below tolerance
+  kMaxIterations,    ///< converge mode stopped at max_sqp_iterations
+  kFallback,         ///< the QP failed or produced non-finite values: the shifted previous plan was used
+  kInvalidInput,     ///< non-finite estimate or reference: hover command
+};
+std::string_view ToString(NmpcStatus status);
+
+struct NmpcSummary {
+  NmpcStatus status = NmpcStatus::kNotSolved;
+  int sqp_iterations = 0;
+  int qp_iterations = 0;        ///< active-set changes, summed over SQP iterations
+  double step_norm = 0.0;       ///< largest |dx|, |du| of the last SQP step
+  double dynamics_gap = 0.0;    ///< largest shooting gap before the last step
+  double objective = 0.0;       ///< of the last QP
+  double prepare_time_s = 0.0;  ///< linearisation and condensing
+  double feedback_time_s = 0.0; ///< the QP that needs the current state
+  double solve_time_s = 0.0;    ///< the whole call
+  long fallbacks = 0;           ///< cumulative count since construction
+  bool IsSolutionUsable() const { return status == NmpcStatus::kSolved || status == NmpcStatus::kMaxIterations; }
+  std::string BriefReport() const;
+};
+
+class NmpcController final : public Controller {
+ public:
+  NmpcController(const vehicle::VehicleParams& vehicle, const NmpcOptions& options);
+  std::string_view name() const override { return "nmpc"; }
+  void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
+               RotorVector* thrust_command) override;
+  void Reset() override;
+
+  /// Reconfigures for a failed rotor: u_bar_i = 0, yaw weight 0, post-failure thrust reference
+  /// (the diagonal twin idles, the others share the weight) and reference spin. No rebuild.
+  /// Throws std::invalid_argument for a rotor out of range; a second failure leaves fewer than
+  /// three rotors only on vehicles with more than four.
+  void SetRotorFailed(int rotor);
+  const std::vector<bool>& failed_rotors() const { return failed_; }
+  const NmpcSummary& summary() const { return summary_; }
+  const NmpcOptions& options() const { return options_; }
+  /// The current plan: N + 1 states and N inputs (after the last call).
+  const std::vector<Eigen::VectorXd>& planned_states() const { return x_; }
+  const std::vector<Eigen::VectorXd>& planned_inputs() const { return u_; }
+  /// The thrust reference t_ref in use (hover split, or the post-failure equilibrium).
+  Eigen::VectorXd ThrustReference(double total_thrust) const;
+
+  /// Gauss-Newton cost of one node (for tests): residual y and its Jacobian dy/dx at `x` for the
+  /// reference at time t.
+  void Residual(const Eigen::VectorXd& x, const ReferencePoint& ref, Eigen::VectorXd* y, Eigen::MatrixXd* dy_dx) const;
+
+ private:
+  void Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t);
+  void ShiftBy(double elapsed_s);
+  bool SqpIteration(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t);
+  Eigen::Quaterniond ReferenceAttitude(const ReferencePoint& ref) const;
+  double ReferenceTotalThrust(const ReferencePoint& ref) const;
+  void HoverCommand(RotorVector* thrust_command) const;
+
+  vehicle::VehicleParams vehicle_;
+  NmpcOptions options_;
+  NmpcModel model_;
+  Rk4Sensitivity integrator_;
+  int nx_, nu_, N_;
+  OcpQp qp_;
+  CondensingQpSolver qp_solver_;
+  Eigen::VectorXd weights_;          // diagonal of W for y (nx entries)
+  Eigen::VectorXd u_max_;
+  Eigen::VectorXd hover_split_;  // minimum-norm rotor thrusts per newton of total thrust
+  std::vector<bool> failed_;
+  Eigen::Vector3d spin_reference_ = Eigen::Vector3d::Zero();
+  std::vector<Eigen::VectorXd> x_, u_;  // shooting nodes and inputs
+  std::vector<Eigen::VectorXd> x_shift_, u_shift_;
+  bool initialised_ = false;
+  double last_t_ = 0.0;
+  NmpcSummary summary_;
+  // scratch
+  Eigen::VectorXd x_next_, y_, x0_;
+  Eigen::MatrixXd dy_;
+};
+
+}  // namespace rotorguard::control

@@ -1,0 +1,374 @@
+#include "rotorguard/control/nmpc.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/vehicle/effectiveness.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace rotorguard::control {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+using vehicle::StateIndex;
+
+// Regularises the reduced-attitude decomposition at a 180 degree tilt (where w^2 + z^2 = 0).
+constexpr double kDecompositionEpsilon = 1e-9;
+
+double Seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+void RequireNonNegative(const char* field, const Eigen::VectorXd& v) {
+  if (!v.allFinite() || v.minCoeff() < 0.0) {
+    ThrowValidation("NmpcOptions", field, "(a negative or non-finite entry)", "finite values >= 0");
+  }
+}
+}  // namespace
+
+std::string_view ToString(NmpcStatus status) {
+  switch (status) {
+    case NmpcStatus::kNotSolved: return "not solved (Compute() was not called)";
+    case NmpcStatus::kSolved: return "solved";
+    case NmpcStatus::kMaxIterations: return "max SQP iterations reached";
+    case NmpcStatus::kFallback: return "fallback to the shifted previous plan";
+    case NmpcStatus::kInvalidInput: return "invalid (non-finite) input: hover command";
+  }
+  return "unknown";
+}
+
+std::string NmpcSummary::BriefReport() const {
+  return fmt::format("NMPC {}: {} SQP, {} QP iterations, step {:.2e}, gap {:.2e}, {:.3f} ms ({} fallbacks)",
+                     ToString(status), sqp_iterations, qp_iterations, step_norm, dynamics_gap, solve_time_s * 1e3,
+                     fallbacks);
+}
+
+void NmpcOptions::Validate() const {
+  if (horizon_steps < 1 || horizon_steps > 200) {
+    ThrowValidation("NmpcOptions", "horizon_steps", horizon_steps, "an integer in [1, 200]");
+  }
+  if (!(step_s > 0.0) || step_s > 1.0) ThrowValidation("NmpcOptions", "step_s", step_s, "a step in (0, 1] s");
+  if (integrator_substeps < 1 || integrator_substeps > 20) {
+    ThrowValidation("NmpcOptions", "integrator_substeps", integrator_substeps, "an integer in [1, 20]");
+  }
+  RequireNonNegative("q_position", q_position);
+  RequireNonNegative("q_attitude", q_attitude);
+  RequireNonNegative("q_velocity", q_velocity);
+  RequireNonNegative("q_rate", q_rate);
+  if (!std::isfinite(q_thrust) || q_thrust < 0.0) ThrowValidation("NmpcOptions", "q_thrust", q_thrust, "a value >= 0");
+  if (!std::isfinite(r_input) || r_input <= 0.0) ThrowValidation("NmpcOptions", "r_input", r_input, "a value > 0");
+  if (!max_rate_rad_s.allFinite() || max_rate_rad_s.minCoeff() <= 0.0) {
+    ThrowValidation("NmpcOptions", "max_rate_rad_s", "(a non-positive entry)", "rates > 0");
+  }
+  if (max_sqp_iterations < 1 || max_sqp_iterations > 1000) {
+    ThrowValidation("NmpcOptions", "max_sqp_iterations", max_sqp_iterations, "an integer in [1, 1000]");
+  }
+  if (!(sqp_tolerance > 0.0) || !std::isfinite(sqp_tolerance)) {
+    ThrowValidation("NmpcOptions", "sqp_tolerance", sqp_tolerance, "a value > 0");
+  }
+  qp.Validate();
+}
+
+NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const NmpcOptions& options)
+    : vehicle_(vehicle),
+      options_((options.Validate(), options)),
+      model_(vehicle),
+      integrator_(model_, options.step_s, options.integrator_substeps),
+      nx_(model_.nx()),
+      nu_(model_.nu()),
+      N_(options.horizon_steps),
+      qp_(OcpQpDims{options.horizon_steps, model_.nx(), model_.nu(),
+                    {StateIndex::kBodyRate, StateIndex::kBodyRate + 1, StateIndex::kBodyRate + 2}}),
+      qp_solver_(qp_.dims, options.qp),
+      failed_(static_cast<std::size_t>(model_.nu()), false) {
+  weights_.resize(nx_);
+  weights_ << options_.q_position, options_.q_attitude, options_.q_velocity, options_.q_rate,
+      Eigen::VectorXd::Constant(nu_, options_.q_thrust);
+  u_max_.resize(nu_);
+  for (int i = 0; i < nu_; ++i) u_max_[i] = vehicle_.rotors[i].max_thrust_n;
+  x_.assign(N_ + 1, Eigen::VectorXd::Zero(nx_));
+  u_.assign(N_, Eigen::VectorXd::Zero(nu_));
+  x_shift_ = x_;
+  u_shift_ = u_;
+  x_next_.resize(nx_);
+  y_.resize(nx_);
+  dy_.resize(nx_, nx_);
+  x0_.resize(nx_);
+  for (int k = 0; k < N_; ++k) qp_.R[k] = options_.r_input * Eigen::MatrixXd::Identity(nu_, nu_);
+  // Minimum-norm split of a unit total thrust with zero torque.
+  hover_split_ = vehicle::PseudoInverse(vehicle::ComputeEffectivenessMatrix(vehicle_.rotors)) *
+                 Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+}
+
+void NmpcController::Reset() {
+  initialised_ = false;
+  summary_ = NmpcSummary{};
+}
+
+void NmpcController::SetRotorFailed(int rotor) {
+  if (rotor < 0 || rotor >= nu_) {
+    ThrowInvalidArgument("NmpcController::SetRotorFailed", "rotor", rotor, fmt::format("an index in [0, {})", nu_));
+  }
+  failed_[rotor] = true;
+  u_max_[rotor] = 0.0;  // u_bar_i = 0 (paper 000, Sec. V-A)
+  weights_[StateIndex::kQuaternion + 3] = 0.0;  // yaw is given up
+  // Reference spin: the yaw torque of the post-failure thrust split against the yaw damping.
+  const Eigen::VectorXd t_ref = ThrustReference(vehicle_.weight_n());
+  double yaw_torque = 0.0;
+  for (int i = 0; i < nu_; ++i) yaw_torque += vehicle_.rotors[i].yaw_sign() * vehicle_.rotors[i].yaw_coefficient_m * t_ref[i];
+  spin_reference_ = Eigen::Vector3d(0.0, 0.0, yaw_torque / std::max(vehicle_.yaw_damping_n_m_s, 1e-9));
+}
+
+Eigen::VectorXd NmpcController::ThrustReference(double total) const {
+  Eigen::VectorXd t(nu_);
+  std::vector<bool> idle = failed_;
+  // The diagonal twin of a failed rotor idles so that roll and pitch torques balance: the rotor
+  // whose position is closest to the failed one's mirror image through the centre of gravity.
+  for (int f = 0; f < nu_; ++f) {
+    if (!failed_[f]) continue;
+    int twin = -1;
+    double best = 1e300;
+    for (int j = 0; j < nu_; ++j) {
+      if (j == f || failed_[j]) continue;
+      const double d = (vehicle_.rotors[j].p_B + vehicle_.rotors[f].p_B).norm();
+      if (d < best) {
+        best = d;
+        twin = j;
+      }
+    }
+    if (twin >= 0) idle[twin] = true;
+  }
+  const int active = static_cast<int>(std::count(idle.begin(), idle.end(), false));
+  if (active == nu_) {
+    return total * hover_split_;
+  }
+  for (int i = 0; i < nu_; ++i) t[i] = idle[i] || active == 0 ? 0.0 : total / active;
+  return t;
+}
+
+double NmpcController::ReferenceTotalThrust(const ReferencePoint& ref) const {
+  // Eq. (1) solved for the thrust vector along the reference, with the drag of the reference
+  // velocity (body and world frames taken as aligned for the drag term).
+  const Eigen::Vector3d f = vehicle_.mass_kg * (ref.a_W + Eigen::Vector3d(0.0, 0.0, kGravity)) +
+                            vehicle_.rotor_drag_kg_s.cwiseProduct(ref.v_W);
+  return f.norm();
+}
+
+Eigen::Quaterniond NmpcController::ReferenceAttitude(const ReferencePoint& ref) const {
+  Eigen::Vector3d f = vehicle_.mass_kg * (ref.a_W + Eigen::Vector3d(0.0, 0.0, kGravity)) +
+                      vehicle_.rotor_drag_kg_s.cwiseProduct(ref.v_W);
+  if (f.norm() < 1e-6) f = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d z = f.normalized();
+  const Eigen::Vector3d heading(std::cos(ref.yaw), std::sin(ref.yaw), 0.0);
+  Eigen::Vector3d y = z.cross(heading);
+  if (y.norm() < 1e-6) y = z.cross(Eigen::Vector3d::UnitX());
+  y.normalize();
+  Eigen::Matrix3d R;
+  R << y.cross(z), y, z;
+  return Eigen::Quaterniond(R);
+}
+
+void NmpcController::Residual(const Eigen::VectorXd& x, const ReferencePoint& ref, Eigen::VectorXd* y,
+                              Eigen::MatrixXd* dy) const {
+  y->resize(nx_);
+  dy->setZero(nx_, nx_);
+  y->segment<3>(0) = x.segment<3>(StateIndex::kPosition) - ref.p_W;
+  y->segment<3>(7) = x.segment<3>(StateIndex::kVelocity) - ref.v_W;
+  y->segment<3>(10) = x.segment<3>(StateIndex::kBodyRate) - spin_reference_;
+  y->tail(nu_) = x.tail(nu_) - ThrustReference(ReferenceTotalThrust(ref));
+  dy->block<3, 3>(0, 0).setIdentity();
+  dy->block<3, 3>(7, 7).setIdentity();
+  dy->block<3, 3>(10, 10).setIdentity();
+  dy->bottomRightCorner(nu_, nu_).setIdentity();
+
+  // Attitude error in the body frame, q_e = q^-1 (x) q_ref = M q with M = [q_ref]_right diag(1,-1,-1,-1),
+  // decomposed as q_e = q_red (x) q_yaw (Brescianini & D'Andrea, tilt-prioritised): y_att =
+  // [q_red,x, q_red,y, q_e,x^2 + q_e,y^2, q_yaw,z] (paper 000, eq. 10), with the sign of q_e chosen
+  // so that its scalar part is non-negative.
+  const Eigen::Quaterniond r = ReferenceAttitude(ref);
+  Eigen::Matrix4d right;  // p (x) r = right * p
+  right << r.w(), -r.x(), -r.y(), -r.z(),  //
+      r.x(), r.w(), r.z(), -r.y(),         //
+      r.y(), -r.z(), r.w(), r.x(),         //
+      r.z(), r.y(), -r.x(), r.w();
+  Eigen::Matrix4d M = right;
+  M.rightCols<3>() *= -1.0;  // conjugate of q
+  Eigen::Vector4d qe = M * x.segment<4>(StateIndex::kQuaternion);
+  if (qe[0] < 0.0) {
+    qe = -qe;
+    M = -M;
+  }
+  const double w = qe[0], a = qe[1], b = qe[2], c = qe[3];
+  const double n2 = w * w + c * c + kDecompositionEpsilon, n = std::sqrt(n2);
+  const double ex = (w * a - b * c) / n, ey = (w * b + a * c) / n, tilt2 = a * a + b * b, yaw = c / n;
+  y->segment<4>(3) << ex, ey, tilt2, yaw;
+  Eigen::Matrix4d d;  // d y_att / d q_e, columns (w, x, y, z)
+  d << a / n - ex * w / n2, w / n, -c / n, -b / n - ex * c / n2,  //
+      b / n - ey * w / n2, c / n, w / n, a / n - ey * c / n2,      //
+      0.0, 2.0 * a, 2.0 * b, 0.0,                                  //
+      -yaw * w / n2, 0.0, 0.0, 1.0 / n - yaw * c / n2;
+  dy->block<4, 4>(3, 3) = d * M;
+}
+
+void NmpcController::HoverCommand(RotorVector* thrust_command) const {
+  const Eigen::VectorXd t = ThrustReference(vehicle_.weight_n());
+  *thrust_command = t.cwiseMax(0.0).cwiseMin(u_max_);
+}
+
+void NmpcController::Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t) {
+  for (int k = 0; k <= N_; ++k) x_[k] = x0;
+  for (int k = 0; k < N_; ++k) {
+    u_[k] = ThrustReference(ReferenceTotalThrust(reference.Evaluate(t + k * options_.step_s))).cwiseMin(u_max_);
+  }
+  initialised_ = true;
+}
+
+void NmpcController::ShiftBy(double elapsed) {
+  // Warm start: the previous plan advanced by the elapsed time, interpolated between nodes.
+  if (!(elapsed > 0.0)) return;
+  const double s = elapsed / options_.step_s;
+  x_shift_ = x_;
+  u_shift_ = u_;
+  for (int k = 0; k <= N_; ++k) {
+    const double pos = std::min(static_cast<double>(k) + s, static_cast<double>(N_));
+    const int i = std::min(static_cast<int>(pos), N_ - 1);
+    const double frac = pos - i;
+    x_[k] = (1.0 - frac) * x_shift_[i] + frac * x_shift_[i + 1];
+  }
+  for (int k = 0; k < N_; ++k) {
+    const double pos = std::min(static_cast<double>(k) + s, static_cast<double>(N_ - 1));
+    const int i = std::min(static_cast<int>(pos), std::max(N_ - 2, 0));
+    const double frac = N_ > 1 ? pos - i : 0.0;
+    u_[k] = N_ > 1 ? Eigen::VectorXd((1.0 - frac) * u_shift_[i] + frac * u_shift_[i + 1]) : u_shift_[0];
+  }
+  for (int k = 0; k <= N_; ++k) x_[k].segment<4>(StateIndex::kQuaternion).normalize();
+}
+
+bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t) {
+  const auto start = Clock::now();
+  // Preparation: linearise the dynamics (exact RK4 sensitivities) and the cost (Gauss-Newton).
+  double gap = 0.0;
+  for (int k = 0; k < N_; ++k) {
+    integrator_.Step(x_[k], u_[k], &x_next_, &qp_.A[k], &qp_.B[k]);
+    qp_.c[k] = x_next_ - x_[k + 1];
+    gap = std::max(gap, qp_.c[k].cwiseAbs().maxCoeff());
+  }
+  for (int k = 0; k <= N_; ++k) {
+    const ReferencePoint ref = reference.Evaluate(t + k * options_.step_s);
+    Residual(x_[k], ref, &y_, &dy_);
+    qp_.Q[k].noalias() = dy_.transpose() * weights_.asDiagonal() * dy_;
+    qp_.q[k].noalias() = dy_.transpose() * weights_.cwiseProduct(y_);
+    if (k < N_) {
+      const Eigen::VectorXd u_ref = ThrustReference(ReferenceTotalThrust(ref));
+      qp_.r[k] = options_.r_input * (u_[k] - u_ref);
+      qp_.u_lower[k] = -u_[k];
+      qp_.u_upper[k] = u_max_ - u_[k];
+    }
+    if (k > 0) {
+      const Eigen::Vector3d w = x_[k].segment<3>(StateIndex::kBodyRate);
+      qp_.x_lower[k] = -options_.max_rate_rad_s - w;
+      qp_.x_upper[k] = options_.max_rate_rad_s - w;
+    }
+  }
+  qp_.x0 = x0 - x_[0];
+  const auto prepared = Clock::now();
+  const OcpQpSummary& qs = qp_solver_.Solve(qp_);
+  summary_.prepare_time_s += Seconds(start, prepared) + qs.condense_time_s;
+  summary_.feedback_time_s += qs.dense_solve_time_s;
+  summary_.qp_iterations += qs.iterations;
+  summary_.dynamics_gap = gap;
+  summary_.objective = qs.objective;
+  ++summary_.sqp_iterations;
+  if (!qs.IsSolutionUsable()) return false;
+  double step = 0.0;
+  for (int k = 0; k <= N_; ++k) {
+    if (!qp_solver_.x()[k].allFinite()) return false;
+    step = std::max(step, qp_solver_.x()[k].cwiseAbs().maxCoeff());
+    x_[k] += qp_solver_.x()[k];
+    if (k < N_) {
+      if (!qp_solver_.u()[k].allFinite()) return false;
+      step = std::max(step, qp_solver_.u()[k].cwiseAbs().maxCoeff());
+      u_[k] += qp_solver_.u()[k];
+    }
+  }
+  summary_.step_norm = step;
+  return true;
+}
+
+void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory& reference, double t, double dt,
+                             RotorVector* thrust_command) {
+  (void)dt;
+  const auto start = Clock::now();
+  const long fallbacks = summary_.fallbacks;
+  summary_ = NmpcSummary{};
+  summary_.fallbacks = fallbacks;
+  const ReferencePoint ref_now = reference.Evaluate(t);
+  const bool finite = est.valid && est.p_W.allFinite() && est.v_W.allFinite() && est.w_B.allFinite() &&
+                      est.q_WB.coeffs().allFinite() && est.q_WB.norm() > 0.5 && ref_now.p_W.allFinite() &&
+                      ref_now.v_W.allFinite() && ref_now.a_W.allFinite() && std::isfinite(ref_now.yaw) &&
+                      std::isfinite(t);
+  if (!finite) {
+    summary_.status = NmpcStatus::kInvalidInput;
+    if (initialised_) {
+      *thrust_command = u_[0].cwiseMax(0.0).cwiseMin(u_max_);
+    } else {
+      HoverCommand(thrust_command);
+    }
+    summary_.solve_time_s = Seconds(start, Clock::now());
+    return;
+  }
+  // The measured state: pose and velocity from the estimator, motor thrusts from telemetry when
+  // there is any, else from the plan.
+  x0_.segment<3>(StateIndex::kPosition) = est.p_W;
+  Eigen::Vector4d q(est.q_WB.w(), est.q_WB.x(), est.q_WB.y(), est.q_WB.z());
+  q.normalize();
+  if (initialised_ && q.dot(x_[0].segment<4>(StateIndex::kQuaternion)) < 0.0) q = -q;  // same cover as the plan
+  x0_.segment<4>(StateIndex::kQuaternion) = q;
+  x0_.segment<3>(StateIndex::kVelocity) = est.v_W;
+  x0_.segment<3>(StateIndex::kBodyRate) = est.w_B;
+  if (est.motor_thrust_n.size() == nu_ && est.motor_thrust_n.allFinite()) {
+    x0_.tail(nu_) = est.motor_thrust_n;
+  } else if (initialised_) {
+    x0_.tail(nu_) = x_[0].tail(nu_);
+  } else {
+    x0_.tail(nu_) = ThrustReference(vehicle_.weight_n());
+  }
+
+  int iterations = options_.max_sqp_iterations;
+  if (!initialised_) {
+    Initialise(x0_, reference, t);
+    iterations = std::max(iterations, 10);  // a first plan from scratch needs a few iterations
+  } else {
+    ShiftBy(t - last_t_);
+  }
+  last_t_ = t;
+  x_shift_ = x_;
+  u_shift_ = u_;
+  bool ok = true;
+  summary_.status = NmpcStatus::kMaxIterations;
+  for (int i = 0; i < iterations; ++i) {
+    ok = SqpIteration(x0_, reference, t);
+    if (!ok) break;
+    if (summary_.step_norm < options_.sqp_tolerance || (options_.max_sqp_iterations == 1 && i + 1 >= iterations)) {
+      summary_.status = NmpcStatus::kSolved;
+      break;
+    }
+  }
+  if (!ok) {
+    x_ = x_shift_;
+    u_ = u_shift_;
+    ++summary_.fallbacks;
+    summary_.status = NmpcStatus::kFallback;
+  }
+  *thrust_command = u_[0].cwiseMax(0.0).cwiseMin(u_max_);
+  if (!thrust_command->allFinite()) {
+    HoverCommand(thrust_command);
+    summary_.status = NmpcStatus::kFallback;
+  }
+  summary_.solve_time_s = Seconds(start, Clock::now());
+}
+
+}  // namespace rotorguard::control

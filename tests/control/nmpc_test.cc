@@ -1,0 +1,167 @@
+#include "rotorguard/control/nmpc.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/planning/references.h"
+#include "test_util.h"
+#include "vehicle/vehicle_fixture.h"
+
+namespace rotorguard::control {
+namespace {
+
+using rotorguard::testing::MatricesNear;
+using rotorguard::testing::NumericalJacobian;
+using rotorguard::testing::ReferenceQuad;
+
+planning::HoverReference HoverAt(double z) {
+  planning::HoverOptions o;
+  o.position_m = Vector3(0, 0, z);
+  return planning::HoverReference(o);
+}
+
+StateEstimate HoverEstimate(double z) {
+  StateEstimate e;
+  e.valid = true;
+  e.p_W = Vector3(0, 0, z);
+  e.motor_thrust_n = RotorVector::Constant(4, 1.15 * kGravity / 4.0);
+  return e;
+}
+
+TEST(Nmpc, ResidualJacobianMatchesFiniteDifferences) {
+  NmpcController nmpc(ReferenceQuad(), {});
+  Rng rng(4);
+  ReferencePoint ref;
+  ref.p_W = Vector3(1, 2, 3);
+  ref.v_W = Vector3(0.5, -0.2, 0.1);
+  ref.a_W = Vector3(1.0, 0.5, -0.3);
+  ref.yaw = 0.7;
+  for (int failed = 0; failed < 2; ++failed) {
+    if (failed) nmpc.SetRotorFailed(2);
+    for (int trial = 0; trial < 10; ++trial) {
+      Eigen::VectorXd x(17);
+      x << rng.Normal(), rng.Normal(), rng.Normal(), 1.0, 0.2 * rng.Normal(), 0.2 * rng.Normal(), rng.Normal(),
+          rng.Normal(), rng.Normal(), rng.Normal(), rng.Normal(), rng.Normal(), rng.Normal(), 2.0, 3.0, 1.0, 4.0;
+      x.segment<4>(3).normalize();
+      Eigen::VectorXd y;
+      Eigen::MatrixXd dy;
+      nmpc.Residual(x, ref, &y, &dy);
+      const Eigen::MatrixXd dy_num = NumericalJacobian(
+          [&](const Eigen::VectorXd& xx) {
+            Eigen::VectorXd yy;
+            Eigen::MatrixXd unused;
+            nmpc.Residual(xx, ref, &yy, &unused);
+            return yy;
+          },
+          x);
+      EXPECT_TRUE(MatricesNear(dy, dy_num, 1e-6)) << "trial " << trial;
+    }
+  }
+}
+
+TEST(Nmpc, AttitudeResidualSeparatesTiltFromYaw) {
+  NmpcController nmpc(ReferenceQuad(), {});
+  ReferencePoint ref;  // hover: level, yaw 0
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(17), y;
+  Eigen::MatrixXd dy;
+  const Quaternion yawed = QuaternionFromYaw(0.8);
+  x.segment<4>(3) << yawed.w(), yawed.x(), yawed.y(), yawed.z();
+  nmpc.Residual(x, ref, &y, &dy);
+  // A pure yaw error shows only in the yaw component, as sin(yaw / 2).
+  EXPECT_NEAR(y[3], 0.0, 1e-12);
+  EXPECT_NEAR(y[4], 0.0, 1e-12);
+  EXPECT_NEAR(y[5], 0.0, 1e-12);
+  EXPECT_NEAR(std::abs(y[6]), std::sin(0.4), 1e-8);
+  // A pure tilt of 0.3 rad about x shows in the tilt components, not in yaw.
+  const Quaternion tilted(Eigen::AngleAxisd(0.3, Vector3::UnitX()));
+  x.segment<4>(3) << tilted.w(), tilted.x(), tilted.y(), tilted.z();
+  nmpc.Residual(x, ref, &y, &dy);
+  EXPECT_NEAR(std::abs(y[3]), std::sin(0.15), 1e-8);
+  EXPECT_NEAR(y[4], 0.0, 1e-12);
+  EXPECT_NEAR(y[5], std::pow(std::sin(0.15), 2), 1e-8);
+  EXPECT_NEAR(y[6], 0.0, 1e-12);
+}
+
+TEST(Nmpc, HoldsHoverWithTheHoverSplit) {
+  NmpcController nmpc(ReferenceQuad(), {});
+  const auto ref = HoverAt(1.0);
+  RotorVector cmd;
+  nmpc.Compute(HoverEstimate(1.0), ref, 0.0, 0.0, &cmd);
+  ASSERT_TRUE(nmpc.summary().IsSolutionUsable()) << nmpc.summary().BriefReport();
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(cmd[i], 1.15 * kGravity / 4.0, 1e-6);
+}
+
+TEST(Nmpc, ConvergeModeReachesAFixedPointOfTheSqp) {
+  NmpcOptions o;
+  o.max_sqp_iterations = 50;
+  o.sqp_tolerance = 1e-9;
+  NmpcController nmpc(ReferenceQuad(), o);
+  const auto ref = HoverAt(1.5);  // 0.5 m below the reference, moving sideways, tilted
+  StateEstimate est = HoverEstimate(1.0);
+  est.v_W = Vector3(0.8, -0.4, 0.0);
+  est.q_WB = Quaternion(Eigen::AngleAxisd(0.2, Vector3::UnitY()));
+  RotorVector cmd;
+  nmpc.Compute(est, ref, 0.0, 0.0, &cmd);
+  const NmpcSummary& s = nmpc.summary();
+  EXPECT_EQ(s.status, NmpcStatus::kSolved) << s.BriefReport();
+  EXPECT_LT(s.step_norm, 1e-9);
+  EXPECT_LT(s.dynamics_gap, 1e-8);  // the converged plan is a trajectory of the model
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_GE(cmd[i], 0.0);
+    EXPECT_LE(cmd[i], 11.5);
+  }
+}
+
+TEST(Nmpc, AFailedRotorGetsZeroThrustAndTheTwinIdlesInTheReference) {
+  NmpcController nmpc(ReferenceQuad(), {});
+  nmpc.SetRotorFailed(0);
+  const Eigen::VectorXd t_ref = nmpc.ThrustReference(1.15 * kGravity);
+  EXPECT_EQ(t_ref[0], 0.0);
+  EXPECT_EQ(t_ref[1], 0.0);  // rotor 1 is rotor 0's diagonal twin (paper 000, eq. 5)
+  EXPECT_NEAR(t_ref[2], 0.5 * 1.15 * kGravity, 1e-12);
+  EXPECT_NEAR(t_ref[3], 0.5 * 1.15 * kGravity, 1e-12);
+  const auto ref = HoverAt(1.0);
+  RotorVector cmd;
+  for (int k = 0; k < 20; ++k) nmpc.Compute(HoverEstimate(1.0), ref, 0.005 * k, 0.005, &cmd);
+  EXPECT_EQ(cmd[0], 0.0);
+  EXPECT_TRUE(cmd.allFinite());
+  RG_EXPECT_THROW_WITH(nmpc.SetRotorFailed(4), std::invalid_argument, "rotor = 4");
+}
+
+TEST(Nmpc, NonFiniteStateGivesAFiniteFallbackCommand) {
+  NmpcController nmpc(ReferenceQuad(), {});
+  const auto ref = HoverAt(1.0);
+  StateEstimate est = HoverEstimate(1.0);
+  RotorVector cmd;
+  nmpc.Compute(est, ref, 0.0, 0.0, &cmd);
+  est.p_W.x() = std::nan("");
+  nmpc.Compute(est, ref, 0.005, 0.005, &cmd);
+  EXPECT_EQ(nmpc.summary().status, NmpcStatus::kInvalidInput);
+  EXPECT_TRUE(cmd.allFinite());
+}
+
+TEST(Nmpc, AllRotorsFailedStillCommandsFiniteZeros) {
+  NmpcController nmpc(ReferenceQuad(), {});
+  for (int i = 0; i < 4; ++i) nmpc.SetRotorFailed(i);
+  const auto ref = HoverAt(1.0);
+  RotorVector cmd;
+  nmpc.Compute(HoverEstimate(1.0), ref, 0.0, 0.0, &cmd);
+  EXPECT_TRUE(cmd.allFinite());
+  EXPECT_EQ(cmd.cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Nmpc, OptionsValidationNamesTheField) {
+  NmpcOptions o;
+  o.horizon_steps = 0;
+  RG_EXPECT_THROW_WITH(NmpcController(ReferenceQuad(), o), ValidationError, "horizon_steps = 0");
+  o = NmpcOptions{};
+  o.step_s = std::nan("");
+  RG_EXPECT_THROW_WITH(NmpcController(ReferenceQuad(), o), ValidationError, "step_s");
+}
+
+}  // namespace
+}  // namespace rotorguard::control
