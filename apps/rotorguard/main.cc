@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "rotorguard/bench/nmpc_bench.h"
 #include "rotorguard/bench/qp_bench.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
@@ -166,6 +167,12 @@ int main(int argc, char** argv) {
   bench_qp->add_option("--repetitions", qp_repetitions_text, "Solves per case; the median time counts (default 3)");
   bench_qp->add_flag("--json", qp_json, "Print JSON instead of a table");
 
+  bool nmpc_json = false;
+  CLI::App* bench_nmpc = bench->add_subcommand(
+      "nmpc", "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
+              "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
+  bench_nmpc->add_flag("--json", nmpc_json, "Print JSON instead of a table");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -216,6 +223,24 @@ int main(int argc, char** argv) {
         fmt::print("cpu               {}\n", result["host"]["cpu"].get<std::string>());
       }
       return result["crashed"].get<bool>() ? kRunFailed : kOk;
+    }
+    if (*bench_nmpc) {
+      const std::string dir = fs::path(DefaultBenchScenario()).parent_path().string();
+      const nlohmann::json r = rotorguard::bench::RunNmpcBenchmark(
+          rotorguard::bench::LoadScenario(dir + "/lemniscate_2ms.yaml", {{"stack.controller", "nmpc"}}),
+          rotorguard::bench::LoadScenario(dir + "/nmpc_lemniscate_1ms_rotor0_failed.yaml"));
+      if (nmpc_json) {
+        fmt::print("{}\n", r.dump(2));
+      } else {
+        fmt::print("solve time        {:.3f} ms mean, {:.3f} ms p99, {:.3f} ms max over {} calls\n",
+                   r["solve_ms_mean"].get<double>(), r["solve_ms_p99"].get<double>(), r["solve_ms_max"].get<double>(),
+                   r["calls"].get<int>());
+        fmt::print("qp_iterations     {:.2f} mean\n", r["qp_iterations_mean"].get<double>());
+        fmt::print("fallbacks         {}\n", r["fallbacks"].get<long>());
+        fmt::print("tracking RMSE     {:.3f} m nominal, {:.3f} m with a failed rotor\n",
+                   r["tracking_rmse_m_nominal"].get<double>(), r["tracking_rmse_m_failed"].get<double>());
+      }
+      return r["success_nominal"].get<bool>() && r["success_failed"].get<bool>() ? kOk : kRunFailed;
     }
     if (*bench_qp) {
       rotorguard::bench::QpBenchOptions o;

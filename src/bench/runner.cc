@@ -160,6 +160,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       command = st.Update(t);
       next_control += control_period;
       ++summary.control_cycles;
+      if (options.on_control_cycle) options.on_control_cycle(st);
     }
     const StateView s(sim.state());
     const Vector3 p_ref = sc.reference->Evaluate(ToSeconds(t)).p_W;

@@ -259,7 +259,13 @@ bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTraj
   for (int k = 0; k <= N_; ++k) {
     const ReferencePoint ref = reference.Evaluate(t + k * options_.step_s);
     Residual(x_[k], ref, &y_, &dy_);
-    qp_.Q[k].noalias() = dy_.transpose() * weights_.asDiagonal() * dy_;
+    // Gauss-Newton Hessian dy' W dy: dy is the identity but for the 4x4 attitude block, so only
+    // that block is a product.
+    qp_.Q[k].setZero();
+    qp_.Q[k].diagonal() = weights_;
+    const auto d_att = dy_.block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion);
+    qp_.Q[k].block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion).noalias() =
+        d_att.transpose() * weights_.segment<4>(StateIndex::kQuaternion).asDiagonal() * d_att;
     qp_.q[k].noalias() = dy_.transpose() * weights_.cwiseProduct(y_);
     if (k < N_) {
       const Eigen::VectorXd u_ref = ThrustReference(ReferenceTotalThrust(ref));
@@ -340,7 +346,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   int iterations = options_.max_sqp_iterations;
   if (!initialised_) {
     Initialise(x0_, reference, t);
-    iterations = std::max(iterations, 10);  // a first plan from scratch needs a few iterations
+    iterations = std::max(iterations, 3);  // a first plan from scratch needs a few iterations
   } else {
     ShiftBy(t - last_t_);
   }

@@ -103,6 +103,29 @@ void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::Vec
   fu->block(StateIndex::kMotor, 0, nu_, nu_) = inv_sigma * Eigen::MatrixXd::Identity(nu_, nu_);
 }
 
+void NmpcModel::MultiplyStateJacobian(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M,
+                                      Eigen::MatrixXd* out) const {
+  const int c = static_cast<int>(M.cols());
+  out->resize(nx(), c);
+  const auto Mq = M.middleRows<4>(StateIndex::kQuaternion);
+  const auto Mv = M.middleRows<3>(StateIndex::kVelocity);
+  const auto Mw = M.middleRows<3>(StateIndex::kBodyRate);
+  const auto MT = M.middleRows(StateIndex::kMotor, nu_);
+  out->middleRows<3>(StateIndex::kPosition) = Mv;
+  out->middleRows<4>(StateIndex::kQuaternion).noalias() =
+      fx.block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion).lazyProduct(Mq) +
+      fx.block<4, 3>(StateIndex::kQuaternion, StateIndex::kBodyRate).lazyProduct(Mw);
+  // The thrust columns of v_dot are equal (R e3 / m): a rank-one term.
+  out->middleRows<3>(StateIndex::kVelocity).noalias() =
+      fx.block<3, 4>(StateIndex::kVelocity, StateIndex::kQuaternion).lazyProduct(Mq) +
+      fx.block<3, 3>(StateIndex::kVelocity, StateIndex::kVelocity).lazyProduct(Mv) +
+      fx.block<3, 1>(StateIndex::kVelocity, StateIndex::kMotor) * MT.colwise().sum();
+  out->middleRows<3>(StateIndex::kBodyRate).noalias() =
+      fx.block<3, 3>(StateIndex::kBodyRate, StateIndex::kBodyRate).lazyProduct(Mw) +
+      fx.block(StateIndex::kBodyRate, StateIndex::kMotor, 3, nu_).lazyProduct(MT);
+  out->middleRows(StateIndex::kMotor, nu_) = (-1.0 / params_.motor_time_constant_s) * MT;
+}
+
 Rk4Sensitivity::Rk4Sensitivity(const NmpcModel& model, double dt, int substeps)
     : model_(model), h_(dt / substeps), substeps_(substeps) {
   if (!(dt > 0.0) || substeps < 1) {
@@ -150,8 +173,8 @@ void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Ei
         atmp_ += kStage[i] * h_ * dk_x_[i - 1];
         btmp_ += kStage[i] * h_ * dk_u_[i - 1];
       }
-      dk_x_[i].noalias() = fx_[i] * atmp_;
-      dk_u_[i].noalias() = fx_[i] * btmp_;
+      model_.MultiplyStateJacobian(fx_[i], atmp_, &dk_x_[i]);
+      model_.MultiplyStateJacobian(fx_[i], btmp_, &dk_u_[i]);
       dk_u_[i] += fu_[i];
     }
     for (int i = 0; i < 4; ++i) {

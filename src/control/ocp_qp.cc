@@ -80,29 +80,31 @@ const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
     throw std::invalid_argument("CondensingQpSolver::Solve: the problem's dimensions differ from the solver's");
   }
 
+  // The blocks are small (17 x 17 at most for the NMPC): coefficient-wise lazyProduct beats the
+  // packed GEMM kernels at these sizes (measured: docs/control.md).
   // Free response x_bar (u = 0) and sensitivities S_kj = A_{k-1} ... A_{j+1} B_j.
   x_bar_[0] = qp.x0;
   for (int k = 0; k < N; ++k) x_bar_[k + 1].noalias() = qp.A[k] * x_bar_[k] + qp.c[k];
   for (int k = 1; k <= N; ++k) {
     S(k, k - 1) = qp.B[k - 1];
-    for (int j = 0; j < k - 1; ++j) S(k, j).noalias() = qp.A[k - 1] * S(k - 1, j);
+    for (int j = 0; j < k - 1; ++j) S(k, j).noalias() = qp.A[k - 1].lazyProduct(S(k - 1, j));
   }
   // Backward: W_m = Q_m + A_m' W_{m+1} A_m, w_m = Q_m x_bar_m + q_m + A_m' w_{m+1}.
   w_matrix_[N] = qp.Q[N];
   w_vector_[N].noalias() = qp.Q[N] * x_bar_[N] + qp.q[N];
   for (int m = N - 1; m >= 1; --m) {
-    tmp_.noalias() = w_matrix_[m + 1] * qp.A[m];
+    tmp_.noalias() = w_matrix_[m + 1].lazyProduct(qp.A[m]);
     w_matrix_[m] = qp.Q[m];
-    w_matrix_[m].noalias() += qp.A[m].transpose() * tmp_;
+    w_matrix_[m].noalias() += qp.A[m].transpose().lazyProduct(tmp_);
     w_vector_[m] = qp.q[m];
     w_vector_[m].noalias() += qp.Q[m] * x_bar_[m] + qp.A[m].transpose() * w_vector_[m + 1];
   }
   // Hessian blocks H_ij = S_{j+1,i}' W_{j+1} B_j (i <= j) plus R_j, gradient g_j = r_j + B_j' w_{j+1}.
   for (int j = 0; j < N; ++j) {
-    y_[j].noalias() = w_matrix_[j + 1] * qp.B[j];
+    y_[j].noalias() = w_matrix_[j + 1].lazyProduct(qp.B[j]);
     for (int i = 0; i <= j; ++i) {
       auto block = dense_.H.block(i * nu, j * nu, nu, nu);
-      block.noalias() = S(j + 1, i).transpose() * y_[j];
+      block.noalias() = S(j + 1, i).transpose().lazyProduct(y_[j]);
       if (i == j) {
         block += qp.R[j];
       } else {

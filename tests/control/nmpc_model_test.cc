@@ -133,3 +133,21 @@ TEST(Rk4Sensitivity, ConvergesAtFourthOrderAgainstTheSimulatorIntegrator) {
 
 }  // namespace
 }  // namespace rotorguard::control
+
+namespace rotorguard::control {
+namespace {
+
+TEST(NmpcModel, StructuredJacobianProductEqualsTheDenseProduct) {
+  const NmpcModel model(rotorguard::testing::ReferenceQuad());
+  Rng rng(12);
+  const Eigen::VectorXd x = SomeState(rng), u = SomeInput(rng);
+  Eigen::VectorXd f;
+  Eigen::MatrixXd fx, fu, out;
+  model.DynamicsWithJacobians(x, u, &f, &fx, &fu);
+  const Eigen::MatrixXd M = Eigen::MatrixXd::Random(17, 21);
+  model.MultiplyStateJacobian(fx, M, &out);
+  EXPECT_TRUE(rotorguard::testing::MatricesNear(out, fx * M, 1e-12 * (fx * M).cwiseAbs().maxCoeff()));
+}
+
+}  // namespace
+}  // namespace rotorguard::control

@@ -46,6 +46,8 @@ struct RunOptions {
   std::string out_dir;  ///< "" writes nothing
   /// Called about every 1 % of simulated time with the completed fraction in [0, 1].
   std::function<void(double)> progress;
+  /// Called after every control cycle with the stack (benchmarks read solver statistics).
+  std::function<void(const stack::FlightStack&)> on_control_cycle;
 };
 
 /// Runs the scenario to its duration or to a crash. Throws std::runtime_error when an output

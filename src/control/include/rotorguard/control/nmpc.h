@@ -22,7 +22,7 @@ namespace rotorguard::control {
 struct NmpcOptions {
   int horizon_steps = 20;       ///< N (paper: 20), in [1, 200]
   double step_s = 0.05;         ///< dt between shooting nodes (paper: 50 ms), in (0, 1]
-  int integrator_substeps = 2;  ///< RK4 sub-steps per node (docs/control.md measures), in [1, 20]
+  int integrator_substeps = 1;  ///< RK4 sub-steps per node (1 suffices: docs/control.md), in [1, 20]
   // Weights of eqs. (10)-(11), paper 000 Sec. VI. All >= 0 (r_input > 0).
   Eigen::Vector3d q_position = Eigen::Vector3d(100.0, 100.0, 600.0);
   Eigen::Vector4d q_attitude = Eigen::Vector4d(60.0, 60.0, 60.0, 60.0);  ///< [tilt x, tilt y, tilt^2, yaw]

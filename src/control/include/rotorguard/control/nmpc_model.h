@@ -21,6 +21,10 @@ class NmpcModel {
   /// f and its Jacobians df/dx (nx x nx) and df/du (nx x nu).
   void DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot,
                              Eigen::MatrixXd* fx, Eigen::MatrixXd* fu) const;
+  /// out = fx * M for an fx of DynamicsWithJacobians, using its block sparsity (about a quarter of
+  /// the dense product's work): p_dot depends on v only, q_dot on q and w, v_dot on q, v and T,
+  /// w_dot on w and T, T_dot on T.
+  void MultiplyStateJacobian(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M, Eigen::MatrixXd* out) const;
 
  private:
   vehicle::VehicleParams params_;

@@ -1,0 +1,75 @@
+#include "rotorguard/bench/nmpc_bench.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "rotorguard/bench/runner.h"
+#include "rotorguard/bench/sim_bench.h"
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::bench {
+
+namespace {
+struct Flight {
+  RunSummary summary;
+  std::vector<double> solve_ms;
+  double qp_iterations = 0.0;
+  double prepare_ms = 0.0, feedback_ms = 0.0;
+  long fallbacks = 0;
+};
+
+Flight Fly(const Scenario& s) {
+  if (s.stack.controller != "nmpc") {
+    ThrowInvalidArgument("RunNmpcBenchmark", "stack.controller", s.stack.controller, "nmpc");
+  }
+  Flight f;
+  RunOptions o;
+  o.on_control_cycle = [&f](const stack::FlightStack& st) {
+    const control::NmpcSummary& n = st.nmpc()->summary();
+    if (n.status == control::NmpcStatus::kNotSolved || n.status == control::NmpcStatus::kInvalidInput) return;
+    f.solve_ms.push_back(n.solve_time_s * 1e3);
+    f.qp_iterations += n.qp_iterations;
+    f.prepare_ms += n.prepare_time_s * 1e3;
+    f.feedback_ms += n.feedback_time_s * 1e3;
+    f.fallbacks = n.fallbacks;
+  };
+  f.summary = RunScenario(s, o);
+  return f;
+}
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(i, v.size() - 1)];
+}
+}  // namespace
+
+nlohmann::json RunNmpcBenchmark(const Scenario& nominal, const Scenario& failed) {
+  const Flight a = Fly(nominal), b = Fly(failed);
+  std::vector<double> all = a.solve_ms;
+  all.insert(all.end(), b.solve_ms.begin(), b.solve_ms.end());
+  double sum = 0.0;
+  for (double v : all) sum += v;
+  const double calls = static_cast<double>(all.size());
+  return {{"benchmark", "nmpc"},
+          {"scenarios", {nominal.name, failed.name}},
+          {"calls", all.size()},
+          {"solve_ms_mean", calls > 0 ? sum / calls : 0.0},
+          {"solve_ms_median", Percentile(all, 0.5)},
+          {"solve_ms_p99", Percentile(all, 0.99)},
+          {"solve_ms_max", Percentile(all, 1.0)},
+          {"solve_ms_mean_nominal", a.solve_ms.empty() ? 0.0 : Percentile(a.solve_ms, 0.5)},
+          {"prepare_ms_mean", calls > 0 ? (a.prepare_ms + b.prepare_ms) / calls : 0.0},
+          {"feedback_ms_mean", calls > 0 ? (a.feedback_ms + b.feedback_ms) / calls : 0.0},
+          {"qp_iterations_mean", calls > 0 ? (a.qp_iterations + b.qp_iterations) / calls : 0.0},
+          {"fallbacks", a.fallbacks + b.fallbacks},
+          {"tracking_rmse_m_nominal", a.summary.tracking_rmse_m},
+          {"tracking_rmse_m_failed", b.summary.tracking_rmse_m},
+          {"success_nominal", a.summary.success},
+          {"success_failed", b.summary.success},
+          {"max_spin_rad_s_failed", b.summary.max_spin_rad_s},
+          {"host", HostInfo()}};
+}
+
+}  // namespace rotorguard::bench
