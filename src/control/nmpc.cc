@@ -213,6 +213,21 @@ void NmpcController::Residual(const Eigen::VectorXd& x, const ReferencePoint& re
   dy->block<4, 4>(3, 3) = d * M;
 }
 
+double NmpcController::NodeCost(const Eigen::VectorXd& x, const Eigen::VectorXd* u, const ReferencePoint& ref,
+                                Eigen::VectorXd* grad_x, Eigen::VectorXd* grad_u) const {
+  Eigen::VectorXd y;
+  Eigen::MatrixXd dy;
+  Residual(x, ref, &y, &dy);
+  double cost = 0.5 * y.dot(weights_.cwiseProduct(y));
+  if (grad_x) *grad_x = dy.transpose() * weights_.cwiseProduct(y);
+  if (u) {
+    const Eigen::VectorXd e = *u - ThrustReference(ReferenceTotalThrust(ref));
+    cost += 0.5 * options_.r_input * e.squaredNorm();
+    if (grad_u) *grad_u = options_.r_input * e;
+  }
+  return cost;
+}
+
 void NmpcController::HoverCommand(RotorVector* thrust_command) const {
   const Eigen::VectorXd t = ThrustReference(vehicle_.weight_n());
   *thrust_command = t.cwiseMax(0.0).cwiseMin(u_max_);

@@ -88,6 +88,12 @@ class NmpcController final : public Controller {
   /// Gauss-Newton cost of one node (for tests): residual y and its Jacobian dy/dx at `x` for the
   /// reference at time t.
   void Residual(const Eigen::VectorXd& x, const ReferencePoint& ref, Eigen::VectorXd* y, Eigen::MatrixXd* dy_dx) const;
+  /// The cost of one node of the OCP, 1/2 y' W y (+ 1/2 r |u - t_ref|^2 when `u` is given), and its
+  /// gradients: what an independent NLP solver needs to solve the same discretised problem.
+  double NodeCost(const Eigen::VectorXd& x, const Eigen::VectorXd* u, const ReferencePoint& ref,
+                  Eigen::VectorXd* grad_x, Eigen::VectorXd* grad_u) const;
+  /// Upper input bounds u_bar (zero for failed rotors); the lower bounds are zero.
+  const Eigen::VectorXd& input_upper_bounds() const { return u_max_; }
 
  private:
   void Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t);
