@@ -100,6 +100,7 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
   fmt::print("tracking RMSE     {:.3f} m (max error {:.3f} m)\n", s.tracking_rmse_m, s.max_position_error_m);
   fmt::print("min altitude      {:.3f} m\n", s.min_altitude_m);
   fmt::print("max spin          {:.2f} rad/s\n", s.max_spin_rad_s);
+  if (s.tilt_recovery_s >= 0.0) fmt::print("tilt recovery     {:.2f} s after the first fault\n", s.tilt_recovery_s);
   fmt::print("faults            {}\n", faults.empty() ? "none" : faults);
   fmt::print("seed              {}\n", s.seed);
   if (!out_dir.empty()) {

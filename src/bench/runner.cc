@@ -92,6 +92,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["max_position_error_m"] = max_position_error_m;
   j["min_altitude_m"] = min_altitude_m;
   j["max_spin_rad_s"] = max_spin_rad_s;
+  j["tilt_recovery_s"] = tilt_recovery_s >= 0.0 ? nlohmann::json(tilt_recovery_s) : nlohmann::json(nullptr);
   j["faults"] = nlohmann::json::array();
   for (const FaultRecord& f : faults) {
     j["faults"].push_back({{"rotor", f.rotor}, {"kind", f.kind}, {"onset_s", f.onset_s}});
@@ -147,6 +148,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   // Success (DESIGN.md, SucR): no crash, and the error within success_error_m over the last
   // success_hold_s of the flight. Remember the last time it was exceeded.
   std::optional<double> last_violation_s;
+  std::optional<double> last_tilted_s;  // last time the tilt exceeded recovered_tilt_rad after a fault
   double last_violation_error = 0.0;
   double min_alt_all = std::numeric_limits<double>::infinity();
   double min_alt_after_fault = std::numeric_limits<double>::infinity();
@@ -174,6 +176,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     min_alt_all = std::min(min_alt_all, alt);
     if (!sim.fault_events().empty()) min_alt_after_fault = std::min(min_alt_after_fault, alt);
     summary.max_spin_rad_s = std::max(summary.max_spin_rad_s, std::abs(s.w_B().z()));
+    if (!sim.fault_events().empty() && TiltOf(s.q_WB()) > sc.recovered_tilt_rad) last_tilted_s = ToSeconds(t);
     if (log && t >= next_log) {
       AppendRow(sim, st, &buffer);
       next_log += log_period;
@@ -217,6 +220,12 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   summary.tracking_rmse_eq37_m = Finite(tracking.rmse_eq37());
   summary.max_position_error_m = Finite(tracking.max_error());
   summary.min_altitude_m = Finite(sim.fault_events().empty() ? min_alt_all : min_alt_after_fault);
+  if (!sim.fault_events().empty() && !summary.crashed) {
+    const double onset = sim.fault_events().front().onset_s;
+    const double settle = last_tilted_s ? *last_tilted_s : onset;
+    // Still tilted at the very end: it never settled.
+    summary.tilt_recovery_s = settle >= summary.sim_time_s - 2.0 * dt ? -1.0 : std::max(0.0, settle - onset);
+  }
   for (const sim::FaultEvent& e : sim.fault_events()) {
     summary.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
   }

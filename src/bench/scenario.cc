@@ -470,6 +470,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     if (const auto t = metrics->Optional("tracking_start_s")) s.tracking_start_s = t->AsDoubleIn(0.0, s.duration_s);
     if (const auto e = metrics->Optional("success_error_m")) s.success_error_m = e->AsPositive();
     if (const auto h = metrics->Optional("success_hold_s")) s.success_hold_s = h->AsDoubleIn(0.0, s.duration_s);
+    if (const auto r = metrics->Optional("recovered_tilt_rad")) s.recovered_tilt_rad = r->AsDoubleIn(1e-3, 1.5);
     metrics->RejectUnknownKeys();
   }
   root.RejectUnknownKeys();

@@ -80,6 +80,8 @@ TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverSpinningNearElevenRadPerSe
   EXPECT_TRUE(r.success) << r.failure_reason;
   EXPECT_GT(r.min_altitude_m, 2.0 - 0.2);  // altitude within 0.2 m of the hover height
   EXPECT_NEAR(r.max_spin_rad_s, 11.0, 1.0);
+  EXPECT_GE(r.tilt_recovery_s, 0.0);
+  EXPECT_LE(r.tilt_recovery_s, 3.0);  // roll and pitch recovered within 3 s (paper: about 3 s)
 }
 
 TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {

@@ -35,6 +35,10 @@ struct RunSummary {
   double max_position_error_m = 0.0;
   double min_altitude_m = 0.0;  ///< after the first fault onset when there is one, else whole run
   double max_spin_rad_s = 0.0;  ///< largest |yaw rate| of the body
+  /// Time from the first fault onset until the tilt stays below metrics.recovered_tilt_rad to the
+  /// end (paper 000: roll and pitch recovered in about 3 s); negative when there is no fault or
+  /// the tilt never settles.
+  double tilt_recovery_s = -1.0;
   std::vector<FaultRecord> faults;
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;

@@ -40,6 +40,8 @@ struct Scenario {
   /// 0.5 m and held to the end).
   double success_error_m = 0.5;
   double success_hold_s = 2.0;
+  /// Roll and pitch count as recovered after a fault once the tilt stays below this [rad].
+  double recovered_tilt_rad = 0.0873;  // 5 degrees
 };
 
 /// A `--set key.path=value` override. Paths starting with "vehicle." apply to the vehicle file.

@@ -1,0 +1,117 @@
+// Micro-benchmarks of the NMPC's parts (Google Benchmark): the RK4 step with and without exact
+// sensitivities, the condensing of an N = 20, nx = 17, nu = 4 OCP QP, the dense dual active-set
+// solve, and one real-time iteration in hover and while spinning after a failure.
+// Run: build/bin/nmpc_benchmark
+#include <benchmark/benchmark.h>
+
+#include "rotorguard/bench/scenario.h"
+#include "rotorguard/control/nmpc.h"
+#include "rotorguard/control/nmpc_model.h"
+#include "rotorguard/control/ocp_qp.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/planning/references.h"
+
+namespace {
+
+using namespace rotorguard;
+
+vehicle::VehicleParams ReferenceVehicle() {
+  return bench::LoadVehicle(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml");
+}
+
+Eigen::VectorXd SpinningState() {
+  Eigen::VectorXd x(17);
+  x << 0, 0, 1, 0.99, 0.05, -0.04, 0.1, 0.5, -0.2, 0.1, 0.3, -0.2, 11.0, 0.1, 0.2, 5.6, 5.6;
+  x.segment<4>(3).normalize();
+  return x;
+}
+
+void BM_Rk4Step(benchmark::State& state) {
+  const control::NmpcModel model(ReferenceVehicle());
+  control::Rk4Sensitivity rk4(model, 0.05, 1);
+  const Eigen::VectorXd x = SpinningState(), u = Eigen::VectorXd::Constant(4, 3.0);
+  Eigen::VectorXd next;
+  for (auto _ : state) {
+    rk4.Step(x, u, &next);
+    benchmark::DoNotOptimize(next.data());
+  }
+}
+BENCHMARK(BM_Rk4Step);
+
+void BM_Rk4StepWithSensitivities(benchmark::State& state) {
+  const control::NmpcModel model(ReferenceVehicle());
+  control::Rk4Sensitivity rk4(model, 0.05, 1);
+  const Eigen::VectorXd x = SpinningState(), u = Eigen::VectorXd::Constant(4, 3.0);
+  Eigen::VectorXd next;
+  Eigen::MatrixXd A, B;
+  for (auto _ : state) {
+    rk4.Step(x, u, &next, &A, &B);
+    benchmark::DoNotOptimize(A.data());
+  }
+}
+BENCHMARK(BM_Rk4StepWithSensitivities);
+
+/// An OCP QP of the NMPC's size: the sensitivities along a spinning trajectory, GN weights.
+control::OcpQp NmpcSizedQp() {
+  const control::NmpcModel model(ReferenceVehicle());
+  control::Rk4Sensitivity rk4(model, 0.05, 1);
+  control::OcpQp qp(control::OcpQpDims{20, 17, 4, {10, 11, 12}});
+  Eigen::VectorXd x = SpinningState(), next;
+  const Eigen::VectorXd u = (Eigen::VectorXd(4) << 0.0, 0.3, 5.6, 5.6).finished();
+  Rng rng(1);
+  for (int k = 0; k < 20; ++k) {
+    rk4.Step(x, u, &next, &qp.A[k], &qp.B[k]);
+    x = next;
+    qp.u_lower[k] = -u;
+    qp.u_upper[k] = Eigen::VectorXd::Constant(4, 11.5) - u;
+  }
+  Eigen::VectorXd w(17);
+  w << 100, 100, 600, 60, 60, 60, 60, 5, 5, 5, 1, 1, 1, 1, 1, 1, 1;
+  for (int k = 0; k <= 20; ++k) {
+    qp.Q[k] = w.asDiagonal();
+    qp.q[k] = Eigen::VectorXd::Random(17);
+    qp.x_lower[k].setConstant(-10.0);
+    qp.x_upper[k].setConstant(10.0);
+  }
+  qp.x0 = 0.3 * Eigen::VectorXd::Random(17);
+  return qp;
+}
+
+void BM_CondensingQpSolve(benchmark::State& state) {
+  const control::OcpQp qp = NmpcSizedQp();
+  control::CondensingQpSolver solver(qp.dims);
+  double condense = 0.0, dense = 0.0;
+  for (auto _ : state) {
+    const control::OcpQpSummary& s = solver.Solve(qp);
+    condense += s.condense_time_s;
+    dense += s.dense_solve_time_s;
+  }
+  state.counters["condense_us"] = 1e6 * condense / static_cast<double>(state.iterations());
+  state.counters["dense_us"] = 1e6 * dense / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_CondensingQpSolve);
+
+void BM_NmpcRealTimeIteration(benchmark::State& state) {
+  const bool failed = state.range(0) != 0;
+  control::NmpcController nmpc(ReferenceVehicle(), {});
+  if (failed) nmpc.SetRotorFailed(0);
+  planning::HoverOptions ho;
+  ho.position_m = Vector3(0, 0, 1);
+  const planning::HoverReference ref(ho);
+  StateEstimate est;
+  est.valid = true;
+  est.p_W = Vector3(0.05, -0.02, 1.0);
+  est.motor_thrust_n = RotorVector::Constant(4, 2.82);
+  if (failed) est.w_B = Vector3(0.2, -0.1, 11.0);
+  RotorVector cmd;
+  double t = 0.0;
+  nmpc.Compute(est, ref, t, 0.0, &cmd);
+  for (auto _ : state) {
+    t += 0.005;
+    nmpc.Compute(est, ref, t, 0.005, &cmd);
+    benchmark::DoNotOptimize(cmd.data());
+  }
+}
+BENCHMARK(BM_NmpcRealTimeIteration)->Arg(0)->Arg(1)->ArgName("failed");
+
+}  // namespace
