@@ -70,49 +70,59 @@ CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptio
   tmp_.resize(nx, nx);
 }
 
-const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
-  const auto start = std::chrono::steady_clock::now();
-  summary_ = OcpQpSummary{};
-  const int N = dims_.horizon, nu = dims_.nu;
+template <int NX, int NU>
+void CondensingQpSolver::Condense(const OcpQp& qp) {
+  using MatXX = Eigen::Matrix<double, NX, NX>;
+  using MatXU = Eigen::Matrix<double, NX, NU>;
+  using MatUU = Eigen::Matrix<double, NU, NU>;
+  using VecX = Eigen::Matrix<double, NX, 1>;
+  using VecU = Eigen::Matrix<double, NU, 1>;
+  const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
   const std::vector<int>& idx = dims_.state_bound_index;
   const int nbx = static_cast<int>(idx.size());
-  if (qp.dims.horizon != N || qp.dims.nx != dims_.nx || qp.dims.nu != nu || qp.dims.state_bound_index != idx) {
-    throw std::invalid_argument("CondensingQpSolver::Solve: the problem's dimensions differ from the solver's");
-  }
+  const auto A = [&](int k) { return Eigen::Map<const MatXX>(qp.A[k].data(), nx, nx); };
+  const auto B = [&](int k) { return Eigen::Map<const MatXU>(qp.B[k].data(), nx, nu); };
+  const auto Q = [&](int k) { return Eigen::Map<const MatXX>(qp.Q[k].data(), nx, nx); };
+  const auto Sm = [&](int k, int j) { return Eigen::Map<MatXU>(S(k, j).data(), nx, nu); };
+  const auto W = [&](int k) { return Eigen::Map<MatXX>(w_matrix_[k].data(), nx, nx); };
+  const auto Y = [&](int k) { return Eigen::Map<MatXU>(y_[k].data(), nx, nu); };
+  const auto xb = [&](int k) { return Eigen::Map<VecX>(x_bar_[k].data(), nx); };
+  const auto wv = [&](int k) { return Eigen::Map<VecX>(w_vector_[k].data(), nx); };
+  Eigen::Map<MatXX> tmp(tmp_.data(), nx, nx);
 
-  // The blocks are small (17 x 17 at most for the NMPC): coefficient-wise lazyProduct beats the
-  // packed GEMM kernels at these sizes (measured: docs/control.md).
   // Free response x_bar (u = 0) and sensitivities S_kj = A_{k-1} ... A_{j+1} B_j.
-  x_bar_[0] = qp.x0;
-  for (int k = 0; k < N; ++k) x_bar_[k + 1].noalias() = qp.A[k] * x_bar_[k] + qp.c[k];
+  xb(0) = qp.x0;
+  for (int k = 0; k < N; ++k) xb(k + 1).noalias() = A(k) * xb(k) + Eigen::Map<const VecX>(qp.c[k].data(), nx);
   for (int k = 1; k <= N; ++k) {
-    S(k, k - 1) = qp.B[k - 1];
-    for (int j = 0; j < k - 1; ++j) S(k, j).noalias() = qp.A[k - 1].lazyProduct(S(k - 1, j));
+    Sm(k, k - 1) = B(k - 1);
+    for (int j = 0; j < k - 1; ++j) Sm(k, j).noalias() = A(k - 1) * Sm(k - 1, j);
   }
   // Backward: W_m = Q_m + A_m' W_{m+1} A_m, w_m = Q_m x_bar_m + q_m + A_m' w_{m+1}.
-  w_matrix_[N] = qp.Q[N];
-  w_vector_[N].noalias() = qp.Q[N] * x_bar_[N] + qp.q[N];
+  W(N) = Q(N);
+  wv(N).noalias() = Q(N) * xb(N) + Eigen::Map<const VecX>(qp.q[N].data(), nx);
   for (int m = N - 1; m >= 1; --m) {
-    tmp_.noalias() = w_matrix_[m + 1].lazyProduct(qp.A[m]);
-    w_matrix_[m] = qp.Q[m];
-    w_matrix_[m].noalias() += qp.A[m].transpose().lazyProduct(tmp_);
-    w_vector_[m] = qp.q[m];
-    w_vector_[m].noalias() += qp.Q[m] * x_bar_[m] + qp.A[m].transpose() * w_vector_[m + 1];
+    tmp.noalias() = W(m + 1) * A(m);
+    W(m) = Q(m);
+    W(m).noalias() += A(m).transpose() * tmp;
+    wv(m) = Eigen::Map<const VecX>(qp.q[m].data(), nx);
+    wv(m).noalias() += Q(m) * xb(m) + A(m).transpose() * wv(m + 1);
   }
   // Hessian blocks H_ij = S_{j+1,i}' W_{j+1} B_j (i <= j) plus R_j, gradient g_j = r_j + B_j' w_{j+1}.
   for (int j = 0; j < N; ++j) {
-    y_[j].noalias() = w_matrix_[j + 1].lazyProduct(qp.B[j]);
+    Y(j).noalias() = W(j + 1) * B(j);
     for (int i = 0; i <= j; ++i) {
-      auto block = dense_.H.block(i * nu, j * nu, nu, nu);
-      block.noalias() = S(j + 1, i).transpose().lazyProduct(y_[j]);
+      MatUU block(nu, nu);
+      block.noalias() = Sm(j + 1, i).transpose() * Y(j);
       if (i == j) {
-        block += qp.R[j];
+        dense_.H.block(j * nu, j * nu, nu, nu) = block + Eigen::Map<const MatUU>(qp.R[j].data(), nu, nu);
       } else {
+        dense_.H.block(i * nu, j * nu, nu, nu) = block;
         dense_.H.block(j * nu, i * nu, nu, nu) = block.transpose();
       }
     }
-    dense_.g.segment(j * nu, nu) = qp.r[j];
-    dense_.g.segment(j * nu, nu).noalias() += qp.B[j].transpose() * w_vector_[j + 1];
+    VecU g(nu);
+    g.noalias() = B(j).transpose() * wv(j + 1);
+    dense_.g.segment(j * nu, nu) = g + qp.r[j];
     dense_.lb.segment(j * nu, nu) = qp.u_lower[j];
     dense_.ub.segment(j * nu, nu) = qp.u_upper[j];
   }
@@ -122,11 +132,29 @@ const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
     for (int k = 1; k <= N; ++k) {
       for (int b = 0; b < nbx; ++b) {
         const int row = (k - 1) * nbx + b;
-        for (int j = 0; j < k; ++j) dense_.C.block(row, j * nu, 1, nu) = S(k, j).row(idx[b]);
+        for (int j = 0; j < k; ++j) dense_.C.block(row, j * nu, 1, nu) = Sm(k, j).row(idx[b]);
         dense_.lc[row] = qp.x_lower[k][b] - x_bar_[k][idx[b]];
         dense_.uc[row] = qp.x_upper[k][b] - x_bar_[k][idx[b]];
       }
     }
+  }
+}
+
+const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
+  const auto start = std::chrono::steady_clock::now();
+  summary_ = OcpQpSummary{};
+  const int N = dims_.horizon, nu = dims_.nu;
+  const std::vector<int>& idx = dims_.state_bound_index;
+  if (qp.dims.horizon != N || qp.dims.nx != dims_.nx || qp.dims.nu != nu || qp.dims.state_bound_index != idx) {
+    throw std::invalid_argument("CondensingQpSolver::Solve: the problem's dimensions differ from the solver's");
+  }
+
+  // Sizes known at compile time make Eigen's small products several times faster: the NMPC's
+  // quadrotor (nx = 17, nu = 4) gets its own instantiation (measured: docs/control.md).
+  if (dims_.nx == 17 && dims_.nu == 4) {
+    Condense<17, 4>(qp);
+  } else {
+    Condense<Eigen::Dynamic, Eigen::Dynamic>(qp);
   }
   const auto condensed = std::chrono::steady_clock::now();
   summary_.condense_time_s = std::chrono::duration<double>(condensed - start).count();

@@ -99,6 +99,22 @@ TEST(CondensingQp, CondensedProblemEqualsTheNaiveConstruction) {
   EXPECT_TRUE(MatricesNear(solver.condensed().uc, uc, 1e-12));
 }
 
+TEST(CondensingQp, TheNmpcSizedInstantiationEqualsTheNaiveConstruction) {
+  // nx = 17, nu = 4 takes the compile-time-sized code path.
+  Rng rng(12);
+  const OcpQp qp = RandomOcp(6, 17, 4, {10, 11, 12}, rng);
+  CondensingQpSolver solver(qp.dims);
+  solver.Solve(qp);
+  Eigen::MatrixXd H, C;
+  Eigen::VectorXd g, lc, uc;
+  NaiveCondense(qp, &H, &g, &C, &lc, &uc);
+  EXPECT_TRUE(MatricesNear(solver.condensed().H, H, 1e-9 * H.cwiseAbs().maxCoeff()));
+  EXPECT_TRUE(MatricesNear(solver.condensed().g, g, 1e-9 * g.cwiseAbs().maxCoeff()));
+  EXPECT_TRUE(MatricesNear(solver.condensed().C, C, 1e-12 * C.cwiseAbs().maxCoeff()));
+  EXPECT_TRUE(MatricesNear(solver.condensed().lc, lc, 1e-9));
+  EXPECT_TRUE(MatricesNear(solver.condensed().uc, uc, 1e-9));
+}
+
 TEST(CondensingQp, UnconstrainedSolutionSolvesTheFullSpaceKktSystem) {
   // Without binding bounds the optimum solves the equality-constrained KKT system in all
   // variables [u_0..u_{N-1}, x_1..x_N] with the dynamics as constraints: an independent solve.

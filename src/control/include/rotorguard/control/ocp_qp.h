@@ -70,6 +70,9 @@ class CondensingQpSolver {
 
  private:
   Eigen::MatrixXd& S(int k, int j) { return s_[k * (k - 1) / 2 + j]; }  // dx_k/du_j, 0 <= j < k <= N
+  /// Fills dense_ from qp; NX and NU are the sizes when known at compile time, else Dynamic.
+  template <int NX, int NU>
+  void Condense(const OcpQp& qp);
 
   OcpQpDims dims_;
   std::vector<Eigen::MatrixXd> s_, w_matrix_, y_;
