@@ -91,6 +91,35 @@ void BM_CondensingQpSolve(benchmark::State& state) {
 }
 BENCHMARK(BM_CondensingQpSolve);
 
+// One backward Riccati factorisation of the same QP (compile-time sizes): the work an interior-
+// point method with Riccati recursion (HPIPM's approach) repeats at each of its iterations.
+void BM_RiccatiFactorisation(benchmark::State& state) {
+  const control::OcpQp qp = NmpcSizedQp();
+  using M17 = Eigen::Matrix<double, 17, 17>;
+  using M4x17 = Eigen::Matrix<double, 4, 17>;
+  std::vector<M17> A(20), P(21);
+  std::vector<Eigen::Matrix<double, 17, 4>> B(20);
+  for (int k = 0; k < 20; ++k) {
+    A[k] = qp.A[k];
+    B[k] = qp.B[k];
+  }
+  const M17 Q = qp.Q[0];
+  const Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
+  for (auto _ : state) {
+    P[20] = Q;
+    for (int k = 19; k >= 0; --k) {
+      const M17 PA = P[k + 1] * A[k];
+      const Eigen::Matrix<double, 17, 4> PB = P[k + 1] * B[k];
+      const M4x17 S = B[k].transpose() * PA;
+      const Eigen::Matrix4d Ruu = R + B[k].transpose() * PB;
+      const M4x17 K = Ruu.llt().solve(S);
+      P[k] = Q + A[k].transpose() * PA - S.transpose() * K;
+    }
+    benchmark::DoNotOptimize(P[0].data());
+  }
+}
+BENCHMARK(BM_RiccatiFactorisation);
+
 void BM_NmpcRealTimeIteration(benchmark::State& state) {
   const bool failed = state.range(0) != 0;
   control::NmpcController nmpc(ReferenceVehicle(), {});

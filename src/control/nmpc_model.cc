@@ -103,27 +103,49 @@ void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::Vec
   fu->block(StateIndex::kMotor, 0, nu_, nu_) = inv_sigma * Eigen::MatrixXd::Identity(nu_, nu_);
 }
 
+namespace {
+/// out = fx * M using the block sparsity of fx; NU and C are compile-time sizes when known (the
+/// quadrotor: NU = 4, C = 17 or 4), else Eigen::Dynamic.
+template <int NU, int C>
+void MultiplyBlocks(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M_in, int nu, double sigma,
+                    Eigen::MatrixXd* out_full) {
+  constexpr int NX = NU == Eigen::Dynamic ? Eigen::Dynamic : 13 + NU;
+  const int nx = 13 + nu, c = static_cast<int>(M_in.cols());
+  const Eigen::Map<const Eigen::Matrix<double, NX, NX>> F(fx.data(), nx, nx);
+  const Eigen::Map<const Eigen::Matrix<double, NX, C>> M(M_in.data(), nx, c);
+  Eigen::Map<Eigen::Matrix<double, NX, C>> out(out_full->data(), nx, c);
+  const auto Mq = M.template middleRows<4>(StateIndex::kQuaternion);
+  const auto Mv = M.template middleRows<3>(StateIndex::kVelocity);
+  const auto Mw = M.template middleRows<3>(StateIndex::kBodyRate);
+  const auto MT = M.template bottomRows<NU>(nu);
+  out.template middleRows<3>(StateIndex::kPosition) = Mv;
+  out.template middleRows<4>(StateIndex::kQuaternion).noalias() =
+      F.template block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion) * Mq +
+      F.template block<4, 3>(StateIndex::kQuaternion, StateIndex::kBodyRate) * Mw;
+  // The thrust columns of v_dot are equal (R e3 / m): a rank-one term.
+  out.template middleRows<3>(StateIndex::kVelocity).noalias() =
+      F.template block<3, 4>(StateIndex::kVelocity, StateIndex::kQuaternion) * Mq +
+      F.template block<3, 3>(StateIndex::kVelocity, StateIndex::kVelocity) * Mv;
+  out.template middleRows<3>(StateIndex::kVelocity).noalias() +=
+      F.template block<3, 1>(StateIndex::kVelocity, StateIndex::kMotor) * MT.colwise().sum();
+  out.template middleRows<3>(StateIndex::kBodyRate).noalias() =
+      F.template block<3, 3>(StateIndex::kBodyRate, StateIndex::kBodyRate) * Mw +
+      F.template block<3, NU>(StateIndex::kBodyRate, StateIndex::kMotor, 3, nu) * MT;
+  out.template bottomRows<NU>(nu) = (-1.0 / sigma) * MT;
+}
+}  // namespace
+
 void NmpcModel::MultiplyStateJacobian(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M,
                                       Eigen::MatrixXd* out) const {
-  const int c = static_cast<int>(M.cols());
-  out->resize(nx(), c);
-  const auto Mq = M.middleRows<4>(StateIndex::kQuaternion);
-  const auto Mv = M.middleRows<3>(StateIndex::kVelocity);
-  const auto Mw = M.middleRows<3>(StateIndex::kBodyRate);
-  const auto MT = M.middleRows(StateIndex::kMotor, nu_);
-  out->middleRows<3>(StateIndex::kPosition) = Mv;
-  out->middleRows<4>(StateIndex::kQuaternion).noalias() =
-      fx.block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion).lazyProduct(Mq) +
-      fx.block<4, 3>(StateIndex::kQuaternion, StateIndex::kBodyRate).lazyProduct(Mw);
-  // The thrust columns of v_dot are equal (R e3 / m): a rank-one term.
-  out->middleRows<3>(StateIndex::kVelocity).noalias() =
-      fx.block<3, 4>(StateIndex::kVelocity, StateIndex::kQuaternion).lazyProduct(Mq) +
-      fx.block<3, 3>(StateIndex::kVelocity, StateIndex::kVelocity).lazyProduct(Mv) +
-      fx.block<3, 1>(StateIndex::kVelocity, StateIndex::kMotor) * MT.colwise().sum();
-  out->middleRows<3>(StateIndex::kBodyRate).noalias() =
-      fx.block<3, 3>(StateIndex::kBodyRate, StateIndex::kBodyRate).lazyProduct(Mw) +
-      fx.block(StateIndex::kBodyRate, StateIndex::kMotor, 3, nu_).lazyProduct(MT);
-  out->middleRows(StateIndex::kMotor, nu_) = (-1.0 / params_.motor_time_constant_s) * MT;
+  out->resize(nx(), M.cols());
+  const double sigma = params_.motor_time_constant_s;
+  if (nu_ == 4 && M.cols() == 17) {
+    MultiplyBlocks<4, 17>(fx, M, nu_, sigma, out);
+  } else if (nu_ == 4 && M.cols() == 4) {
+    MultiplyBlocks<4, 4>(fx, M, nu_, sigma, out);
+  } else {
+    MultiplyBlocks<Eigen::Dynamic, Eigen::Dynamic>(fx, M, nu_, sigma, out);
+  }
 }
 
 Rk4Sensitivity::Rk4Sensitivity(const NmpcModel& model, double dt, int substeps)

@@ -144,9 +144,11 @@ TEST(NmpcModel, StructuredJacobianProductEqualsTheDenseProduct) {
   Eigen::VectorXd f;
   Eigen::MatrixXd fx, fu, out;
   model.DynamicsWithJacobians(x, u, &f, &fx, &fu);
-  const Eigen::MatrixXd M = Eigen::MatrixXd::Random(17, 21);
-  model.MultiplyStateJacobian(fx, M, &out);
-  EXPECT_TRUE(rotorguard::testing::MatricesNear(out, fx * M, 1e-12 * (fx * M).cwiseAbs().maxCoeff()));
+  for (int cols : {21, 17, 4}) {  // generic, and the two compile-time-sized paths
+    const Eigen::MatrixXd M = Eigen::MatrixXd::Random(17, cols);
+    model.MultiplyStateJacobian(fx, M, &out);
+    EXPECT_TRUE(rotorguard::testing::MatricesNear(out, fx * M, 1e-12 * (fx * M).cwiseAbs().maxCoeff())) << cols;
+  }
 }
 
 }  // namespace
