@@ -41,9 +41,10 @@ std::string_view ToString(NmpcStatus status) {
 }
 
 std::string NmpcSummary::BriefReport() const {
-  return fmt::format("NMPC {}: {} SQP, {} QP iterations, step {:.2e}, gap {:.2e}, {:.3f} ms ({} fallbacks)",
-                     ToString(status), sqp_iterations, qp_iterations, step_norm, dynamics_gap, solve_time_s * 1e3,
-                     fallbacks);
+  return fmt::format("NMPC {}: {} SQP, {} QP iterations, KKT residual {:.2e} (step {:.2e}, gap {:.2e}), "
+                     "{:.3f} ms ({} fallbacks)",
+                     ToString(status), sqp_iterations, qp_iterations, kkt_residual, step_norm, dynamics_gap,
+                     solve_time_s * 1e3, fallbacks);
 }
 
 void NmpcOptions::Validate() const {
@@ -316,6 +317,7 @@ bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTraj
     }
   }
   summary_.step_norm = step;
+  summary_.kkt_residual = std::max(step, gap);
   return true;
 }
 

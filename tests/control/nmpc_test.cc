@@ -110,6 +110,7 @@ TEST(Nmpc, ConvergeModeReachesAFixedPointOfTheSqp) {
   EXPECT_EQ(s.status, NmpcStatus::kSolved) << s.BriefReport();
   EXPECT_LT(s.step_norm, 1e-9);
   EXPECT_LT(s.dynamics_gap, 1e-8);  // the converged plan is a trajectory of the model
+  EXPECT_LT(s.kkt_residual, 1e-8);
   for (int i = 0; i < 4; ++i) {
     EXPECT_GE(cmd[i], 0.0);
     EXPECT_LE(cmd[i], 11.5);

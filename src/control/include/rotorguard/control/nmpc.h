@@ -54,6 +54,10 @@ struct NmpcSummary {
   int qp_iterations = 0;        ///< active-set changes, summed over SQP iterations
   double step_norm = 0.0;       ///< largest |dx|, |du| of the last SQP step
   double dynamics_gap = 0.0;    ///< largest shooting gap before the last step
+  /// First-order optimality residual of the NLP: max(step_norm, dynamics_gap). A zero Gauss-Newton
+  /// step at a gap-free plan is exactly a KKT point (the QP uses the NLP's exact gradient and
+  /// constraint linearisation), so this vanishes at the solution of the converge mode.
+  double kkt_residual = 0.0;
   double objective = 0.0;       ///< of the last QP
   double prepare_time_s = 0.0;  ///< linearisation and condensing
   double feedback_time_s = 0.0; ///< the QP that needs the current state
