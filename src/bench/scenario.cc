@@ -316,6 +316,24 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { m.Validate(); });
   }
+  if (const auto f = node.Optional("fdd")) o->fdd = f->AsEnum({"none", "composite"});
+  if (const auto c = node.Optional("composite_fdd")) {
+    fdd::CompositeFddOptions& d = o->composite_fdd;
+    d.motor_index_threshold = OptionalDouble(*c, "motor_index_threshold", d.motor_index_threshold);
+    if (const auto v = c->Optional("motor_index_samples")) d.motor_index_samples = static_cast<int>(v->AsIntIn(1, 1000));
+    d.motor_index_min_thrust_n = OptionalDouble(*c, "motor_index_min_thrust_n", d.motor_index_min_thrust_n);
+    d.propeller_index_threshold = OptionalDouble(*c, "propeller_index_threshold", d.propeller_index_threshold);
+    d.propeller_persistence_s = OptionalDouble(*c, "propeller_persistence_s", d.propeller_persistence_s);
+    d.degraded_threshold = OptionalDouble(*c, "degraded_threshold", d.degraded_threshold);
+    d.degraded_persistence_s = OptionalDouble(*c, "degraded_persistence_s", d.degraded_persistence_s);
+    d.filter_cutoff_hz = OptionalDouble(*c, "filter_cutoff_hz", d.filter_cutoff_hz);
+    d.takeoff_max_altitude_m = OptionalDouble(*c, "takeoff_max_altitude_m", d.takeoff_max_altitude_m);
+    d.takeoff_window_s = OptionalDouble(*c, "takeoff_window_s", d.takeoff_window_s);
+    d.takeoff_angular_acceleration_rad_s2 =
+        OptionalDouble(*c, "takeoff_angular_acceleration_rad_s2", d.takeoff_angular_acceleration_rad_s2);
+    d.takeoff_direction_cosine = OptionalDouble(*c, "takeoff_direction_cosine", d.takeoff_direction_cosine);
+    c->RejectUnknownKeys();
+  }
   if (const auto kf = node.Optional("known_faults")) {
     if (!kf->IsSequence()) kf->Fail("expected a list of {rotor, at_time_s}");
     for (std::size_t i = 0; i < kf->size(); ++i) {
@@ -452,6 +470,9 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     });
   }
   CheckFaultsAgainstScenario(root, s);
+  // The fault detector knows its own IMU: the sensor's rate and mounting point (hardware facts).
+  s.stack.composite_fdd.imu_rate_hz = s.sim.imu.rate_hz;
+  s.stack.composite_fdd.imu_position_m = s.sim.imu.position_m;
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
   for (std::size_t i = 0; i < s.stack.known_faults.size(); ++i) {
     if (s.stack.known_faults[i].rotor >= s.vehicle.num_rotors()) {

@@ -23,6 +23,8 @@ void FlightStackOptions::Validate() const {
                       "a time >= 0 s");
     }
   }
+  if (fdd != "none" && fdd != "composite") ThrowValidation("FlightStackOptions", "fdd", fdd, "one of: none, composite");
+  composite_fdd.Validate();
   if (!known_faults.empty() && controller != "nmpc") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,
                     "controller nmpc (the only controller that reconfigures)");
@@ -53,13 +55,20 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     }
   }
   known_fault_applied_.assign(options_.known_faults.size(), false);
+  if (options_.fdd == "composite") fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
 }
 
-void FlightStack::OnImu(const ImuSample& imu) { estimator_.OnImu(imu); }
+void FlightStack::OnImu(const ImuSample& imu) {
+  estimator_.OnImu(imu);
+  if (fdd_) fdd_->OnImu(imu);
+}
 
-void FlightStack::OnEscTelemetry(const EscTelemetry& esc) { estimator_.OnEscTelemetry(esc); }
+void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
+  estimator_.OnEscTelemetry(esc);
+  if (fdd_) fdd_->OnEscTelemetry(esc);
+}
 
 void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_.OnOdometry(odometry); }
 
@@ -80,7 +89,15 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
       known_fault_applied_[i] = true;
     }
   }
+  if (fdd_) {
+    fdd_->SetEstimate(estimate_);
+    // Isolation reconfigures the NMPC: u_bar_i = 0, yaw given up, post-failure thrust reference.
+    for (int rotor : fdd_->TakeNewIsolations()) {
+      if (nmpc_ && !nmpc_->failed_rotors()[rotor]) nmpc_->SetRotorFailed(rotor);
+    }
+  }
   controller_->Compute(estimate_, *reference_, ToSeconds(t), dt, &command_.thrust_n);
+  if (fdd_) fdd_->SetCommand(command_.thrust_n);
   return command_;
 }
 

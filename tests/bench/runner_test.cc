@@ -93,3 +93,49 @@ TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {
 
 }  // namespace
 }  // namespace rotorguard::bench
+
+namespace rotorguard::bench {
+namespace {
+
+// Composite FDD + NMPC in closed loop: the stack discovers the failure from its sensors.
+
+TEST(FddClosedLoop, IsolatesAndSurvivesEachFaultKindInHover) {
+  for (const char* kind : {"propeller_loss", "motor_stop"}) {
+    const RunSummary r = RunScenario(LoadScenario(Config(std::string("fdd_hover_") + kind + ".yaml")));
+    EXPECT_TRUE(r.success) << kind << ": " << r.failure_reason;
+    ASSERT_TRUE(r.fdd.has_value());
+    EXPECT_TRUE(r.fdd->correct) << kind << ": " << r.fdd->kind << " on rotor " << r.fdd->rotor;
+    EXPECT_FALSE(r.fdd->false_alarm);
+    EXPECT_LT(r.fdd->latency_s, std::string(kind) == "motor_stop" ? 0.028 : 0.10) << kind;
+    EXPECT_GT(r.min_altitude_m, 1.8) << kind;
+  }
+}
+
+TEST(FddClosedLoop, NoFalseAlarmOnTheAggressiveNominalLemniscate) {
+  for (std::uint64_t seed : {21u, 22u}) {
+    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}, {"stack.fdd", "composite"}});
+    s.seed = seed;
+    const RunSummary r = RunScenario(s);
+    ASSERT_TRUE(r.fdd.has_value());
+    EXPECT_FALSE(r.fdd->detected) << "seed " << seed << ": " << r.fdd->kind << " on rotor " << r.fdd->rotor
+                                  << " by " << r.fdd->detector << " at " << r.fdd->detection_s;
+  }
+}
+
+TEST(FddClosedLoop, AFaultDuringTakeoffOnEachRotorEndsInAStableHover) {
+  for (int rotor = 0; rotor < 4; ++rotor) {
+    for (const char* kind : {"propeller_loss", "motor_stop"}) {
+      const Scenario s = LoadScenario(Config("fdd_takeoff_propeller_loss.yaml"),
+                                      {{"faults.0.rotor", std::to_string(rotor)}, {"faults.0.kind", kind}});
+      const RunSummary r = RunScenario(s);
+      EXPECT_TRUE(r.success) << "rotor " << rotor << " " << kind << ": " << r.failure_reason;
+      ASSERT_TRUE(r.fdd.has_value());
+      EXPECT_TRUE(r.fdd->correct) << "rotor " << rotor << " " << kind;
+      EXPECT_LT(r.fdd->latency_s, 0.025) << "rotor " << rotor << " " << kind;
+      EXPECT_GE(r.min_altitude_m, 0.0);  // MiniA: no altitude lost at take-off
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rotorguard::bench

@@ -18,6 +18,18 @@ struct FaultRecord {
   double onset_s = 0.0;
 };
 
+/// What fault detection concluded, scored against the injected faults (DESIGN.md, Metrics).
+struct FddRecord {
+  bool detected = false;      ///< some rotor left the ok state
+  int rotor = -1;             ///< the first rotor diagnosed
+  std::string kind;           ///< motor_failed, propeller_failed or degraded
+  std::string detector;       ///< motor_index, thrust_loss_observer or takeoff
+  double detection_s = 0.0;
+  bool correct = false;       ///< right rotor and kind, at or after the first onset
+  bool false_alarm = false;   ///< a diagnosis without a fault, or before the first onset
+  double latency_s = -1.0;    ///< detection - onset when correct, else negative
+};
+
 /// The outcome of one run; the fields of summary.json (DESIGN.md keys; later features add keys).
 struct RunSummary {
   std::string scenario;
@@ -40,6 +52,7 @@ struct RunSummary {
   /// the tilt never settles.
   double tilt_recovery_s = -1.0;
   std::vector<FaultRecord> faults;
+  std::optional<FddRecord> fdd;  ///< present when the stack runs fault detection
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;
 

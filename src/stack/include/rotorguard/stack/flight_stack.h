@@ -11,6 +11,7 @@
 #include "rotorguard/control/nominal_controller.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/trajectory.h"
+#include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/stack/estimator.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -30,6 +31,10 @@ struct FlightStackOptions {
   control::NominalControllerOptions nominal;
   control::NmpcOptions nmpc;
   std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc only)
+  /// Fault detection: "none" or "composite" (paper 000, Sec. V-B). On isolation the NMPC is
+  /// reconfigured (ignored by the nominal controller, which cannot).
+  std::string fdd = "none";
+  fdd::CompositeFddOptions composite_fdd;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -53,6 +58,8 @@ class FlightStack {
   const control::Controller& controller() const { return *controller_; }
   /// The NMPC, when it is the controller (for its solve statistics); else null.
   const control::NmpcController* nmpc() const { return nmpc_; }
+  /// The fault detector, when there is one; else null.
+  const fdd::CompositeFdd* fault_detector() const { return fdd_.get(); }
 
  private:
   vehicle::MultirotorModel model_;
@@ -61,6 +68,7 @@ class FlightStack {
   OdometryPassThroughEstimator estimator_;
   std::unique_ptr<control::Controller> controller_;
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
+  std::unique_ptr<fdd::CompositeFdd> fdd_;
   std::vector<bool> known_fault_applied_;
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;

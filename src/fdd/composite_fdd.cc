@@ -1,0 +1,235 @@
+#include "rotorguard/fdd/composite_fdd.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/vehicle/effectiveness.h"
+
+namespace rotorguard::fdd {
+
+namespace {
+void RequireIn(const char* field, double v, double lo, double hi, const char* rule) {
+  if (!std::isfinite(v) || v < lo || v > hi) ThrowValidation("CompositeFddOptions", field, v, rule);
+}
+}  // namespace
+
+std::string_view ToString(RotorHealth h) {
+  switch (h) {
+    case RotorHealth::kOk: return "ok";
+    case RotorHealth::kMotorFailed: return "motor_failed";
+    case RotorHealth::kPropellerFailed: return "propeller_failed";
+    case RotorHealth::kDegraded: return "degraded";
+  }
+  return "unknown";
+}
+
+void CompositeFddOptions::Validate() const {
+  RequireIn("motor_index_threshold", motor_index_threshold, 1e-6, 1.0 - 1e-6, "a value in (0, 1)");
+  if (motor_index_samples < 1) ThrowValidation("CompositeFddOptions", "motor_index_samples", motor_index_samples, ">= 1");
+  RequireIn("motor_index_min_thrust_n", motor_index_min_thrust_n, 1e-6, 1e6, "a thrust > 0 N");
+  RequireIn("propeller_index_threshold", propeller_index_threshold, 1e-6, 1.0, "a value in (0, 1]");
+  RequireIn("propeller_persistence_s", propeller_persistence_s, 0.0, 10.0, "a time in [0, 10] s");
+  RequireIn("degraded_threshold", degraded_threshold, 1e-6, propeller_index_threshold - 1e-6,
+            "a value in (0, propeller_index_threshold)");
+  RequireIn("degraded_persistence_s", degraded_persistence_s, 1e-3, 100.0, "a time in [0.001, 100] s");
+  RequireIn("imu_rate_hz", imu_rate_hz, 1.0, 1e5, "a rate in [1, 1e5] Hz");
+  RequireIn("filter_cutoff_hz", filter_cutoff_hz, 1e-3, 0.5 * imu_rate_hz - 1e-6, "a cut-off below half imu_rate_hz");
+  RequireIn("takeoff_max_altitude_m", takeoff_max_altitude_m, 1e-3, 100.0, "an altitude > 0 m");
+  RequireIn("takeoff_window_s", takeoff_window_s, 1e-3, 1e3, "a time > 0 s");
+  RequireIn("takeoff_angular_acceleration_rad_s2", takeoff_angular_acceleration_rad_s2, 1e-3, 1e6, "a value > 0");
+  RequireIn("takeoff_direction_cosine", takeoff_direction_cosine, 1e-6, 1.0, "a value in (0, 1]");
+  if (!imu_position_m.allFinite()) ThrowValidation("CompositeFddOptions", "imu_position_m", "(non-finite)", "finite");
+}
+
+CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const CompositeFddOptions& options)
+    : vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
+  vehicle_.Validate();
+  options_.Validate();
+  effectiveness_ = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors);
+  pinv_ = vehicle::PseudoInverse(effectiveness_);
+  rotors_.assign(n_, RotorStatus{});
+  command_ = RotorVector::Zero(n_);
+  expected_thrust_ = RotorVector::Zero(n_);
+  measured_thrust_ = RotorVector::Zero(n_);
+  low_index_count_.assign(n_, 0);
+  above_since_s_.assign(n_, -1.0);
+  degraded_since_s_.assign(n_, -1.0);
+  degraded_sum_.assign(n_, 0.0);
+  degraded_count_.assign(n_, 0);
+  thrust_loss_ = Eigen::VectorXd::Zero(n_);
+  force_filter_ = LowPass2<3>(options_.filter_cutoff_hz, options_.imu_rate_hz);
+  rate_filter_ = LowPass2<3>(options_.filter_cutoff_hz, options_.imu_rate_hz);
+  alpha_filter_ = FilteredDerivative<3>(options_.filter_cutoff_hz, options_.imu_rate_hz);
+  wrench_filter_ = LowPass2<4>(options_.filter_cutoff_hz, options_.imu_rate_hz);
+}
+
+std::vector<int> CompositeFdd::TakeNewIsolations() {
+  std::vector<int> out;
+  out.swap(new_isolations_);
+  return out;
+}
+
+void CompositeFdd::Isolate(int rotor, RotorHealth health, double t, const char* detector) {
+  RotorStatus& r = rotors_[rotor];
+  if (r.health == RotorHealth::kMotorFailed || r.health == RotorHealth::kPropellerFailed) return;
+  r.health = health;
+  r.detected_s = t;
+  r.detector = detector;
+  if (health == RotorHealth::kMotorFailed || health == RotorHealth::kPropellerFailed) {
+    r.eta = 1.0;
+    new_isolations_.push_back(rotor);
+    if (!first_isolated_) first_isolated_ = rotor;
+  }
+}
+
+void CompositeFdd::SetCommand(const RotorVector& thrust_command) {
+  if (thrust_command.size() == n_ && thrust_command.allFinite()) command_ = thrust_command;
+}
+
+void CompositeFdd::SetEstimate(const StateEstimate& estimate) {
+  if (!estimate.valid || !estimate.p_W.allFinite() || !estimate.v_W.allFinite() ||
+      !estimate.q_WB.coeffs().allFinite()) {
+    return;
+  }
+  estimate_ = estimate;
+  have_estimate_ = true;
+}
+
+void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
+  if (esc.motor_speed_rad_s.size() != n_ || !esc.motor_speed_rad_s.allFinite()) return;
+  const double t = ToSeconds(esc.t_ns);
+  // Expected motor state: the commanded thrust through the motor lag of eq. (6).
+  const bool first = !last_esc_ns_;
+  const double dt = first ? 0.0 : ToSeconds(esc.t_ns - *last_esc_ns_);
+  last_esc_ns_ = esc.t_ns;
+  const double blend = dt > 0.0 ? 1.0 - std::exp(-dt / vehicle_.motor_time_constant_s) : 0.0;
+  const double kn = vehicle_.thrust_coefficient_n_s2;
+  for (int i = 0; i < n_; ++i) {
+    measured_thrust_[i] = kn * esc.motor_speed_rad_s[i] * esc.motor_speed_rad_s[i];
+    // The motor model starts where the motors are, then follows the commands.
+    if (first) expected_thrust_[i] = measured_thrust_[i];
+    expected_thrust_[i] += blend * (command_[i] - expected_thrust_[i]);
+    if (expected_thrust_[i] < options_.motor_index_min_thrust_n) {
+      low_index_count_[i] = 0;
+      rotors_[i].motor_index = 1.0;
+      continue;
+    }
+    // eq. (13): M_i = w_measured / w_expected.
+    const double index = esc.motor_speed_rad_s[i] / std::sqrt(expected_thrust_[i] / kn);
+    rotors_[i].motor_index = index;
+    low_index_count_[i] = index <= options_.motor_index_threshold ? low_index_count_[i] + 1 : 0;
+    if (low_index_count_[i] >= options_.motor_index_samples) Isolate(i, RotorHealth::kMotorFailed, t, "motor_index");
+  }
+  have_esc_ = true;
+}
+
+void CompositeFdd::OnImu(const ImuSample& imu) {
+  if (!imu.specific_force_B.allFinite() || !imu.w_B.allFinite()) return;
+  const double dt = last_imu_ns_ ? ToSeconds(imu.t_ns - *last_imu_ns_) : 1.0 / options_.imu_rate_hz;
+  last_imu_ns_ = imu.t_ns;
+  if (!have_esc_) return;
+  force_filter_.Step(imu.specific_force_B);
+  rate_filter_.Step(imu.w_B);
+  alpha_filter_.Step(imu.w_B, dt);
+  Eigen::Vector4d wrench = effectiveness_ * measured_thrust_;
+  wrench_filter_.Step(wrench);
+  filters_ready_ = true;
+  RunObserver(ToSeconds(imu.t_ns));
+}
+
+void CompositeFdd::RunObserver(double t) {
+  // The observer's force balance holds once the ground no longer carries the vehicle: in the air,
+  // or when the rotors (by their measured speeds) lift at least kLiftFraction of the weight. The
+  // latter starts the take-off window at lift-off rather than at some altitude.
+  constexpr double kLiftFraction = 0.9;
+  const bool flying = have_estimate_ && (estimate_.p_W.z() > 0.05 ||
+                                          wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
+  if (flying && !airborne_since_s_) airborne_since_s_ = t;
+  if (!flying) airborne_since_s_.reset();
+  if (!airborne_since_s_) {
+    std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
+    return;
+  }
+  const vehicle::VehicleParams& vp = vehicle_;
+  const Vector3& w = rate_filter_.value();
+  const Vector3& alpha = alpha_filter_.value();
+  const Vector3& r = options_.imu_position_m;
+  // Specific force at the centre of gravity: remove the IMU's lever-arm accelerations.
+  const Vector3 f_cog = force_filter_.value() - alpha.cross(r) - w.cross(w.cross(r));
+  const Eigen::Vector4d& wrench = wrench_filter_.value();
+  const Matrix3 R = estimate_.q_WB.normalized().toRotationMatrix();
+  const Vector3 v_B = R.transpose() * estimate_.v_W;
+  // eq. (14) along the thrust axis (body z): thrust the rotors should give minus what the
+  // accelerometer sees (drag included). Signed, where the paper takes the norm.
+  const double force_loss = wrench[0] - (vp.mass_kg * f_cog.z() + vp.rotor_drag_kg_s.z() * v_B.z());
+  // eq. (15): torque the rotors should give minus what the body's rotation shows.
+  const Matrix3& I = vp.inertia_kg_m2;
+  const Vector3 torque_loss = wrench.tail<3>() - I * alpha - w.cross(I * w) -
+                              Vector3(0.0, 0.0, vp.yaw_damping_n_m_s * w.z());
+  // eq. (16): per-rotor losses.
+  Eigen::Vector4d lost;
+  lost << force_loss, torque_loss;
+  thrust_loss_ = pinv_ * lost;
+
+  // Take-off detector (eq. 18): a strong roll/pitch angular acceleration shortly after lift-off,
+  // pointing like the loss of one rotor's thrust: alpha ~ -I^-1 (r_i x T e3).
+  const bool takeoff = t - *airborne_since_s_ <= options_.takeoff_window_s &&
+                       estimate_.p_W.z() <= options_.takeoff_max_altitude_m;
+  if (takeoff && alpha.head<2>().norm() > options_.takeoff_angular_acceleration_rad_s2) {
+    int best = -1;
+    double best_cos = options_.takeoff_direction_cosine;
+    for (int i = 0; i < n_; ++i) {
+      const Vector3 torque(-vp.rotors[i].p_B.y(), vp.rotors[i].p_B.x(), 0.0);  // losing T e3 at r_i
+      const Eigen::Vector2d signature = (I.inverse() * torque).head<2>();
+      const double c = signature.normalized().dot(alpha.head<2>().normalized());
+      if (c > best_cos) {
+        best_cos = c;
+        best = i;
+      }
+    }
+    if (best >= 0) {
+      // Telemetry tells the kind: a collapsing speed is the motor, a healthy one the propeller.
+      const bool motor = rotors_[best].motor_index < 0.5;
+      Isolate(best, motor ? RotorHealth::kMotorFailed : RotorHealth::kPropellerFailed, t, "takeoff");
+    }
+  }
+
+  // eq. (17): P_i = lost thrust / thrust the rotor should give; persistent -> propeller failure.
+  const double min_thrust = options_.motor_index_min_thrust_n;
+  for (int i = 0; i < n_; ++i) {
+    const double p = measured_thrust_[i] > min_thrust ? thrust_loss_[i] / measured_thrust_[i] : 0.0;
+    rotors_[i].propeller_index = p;
+    if (rotors_[i].health == RotorHealth::kMotorFailed || rotors_[i].health == RotorHealth::kPropellerFailed) continue;
+    if (p > options_.propeller_index_threshold) {
+      if (above_since_s_[i] < 0.0) above_since_s_[i] = t;
+      if (t - above_since_s_[i] >= options_.propeller_persistence_s) {
+        Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer");
+      }
+    } else {
+      above_since_s_[i] = -1.0;
+    }
+    // Partial loss: a persistent intermediate index, reported with its mean as eta.
+    if (p > options_.degraded_threshold && p <= options_.propeller_index_threshold) {
+      if (degraded_since_s_[i] < 0.0) {
+        degraded_since_s_[i] = t;
+        degraded_sum_[i] = 0.0;
+        degraded_count_[i] = 0;
+      }
+      degraded_sum_[i] += p;
+      ++degraded_count_[i];
+      if (t - degraded_since_s_[i] >= options_.degraded_persistence_s && rotors_[i].health == RotorHealth::kOk) {
+        Isolate(i, RotorHealth::kDegraded, t, "thrust_loss_observer");
+        rotors_[i].eta = degraded_sum_[i] / degraded_count_[i];
+      } else if (rotors_[i].health == RotorHealth::kDegraded) {
+        rotors_[i].eta = degraded_sum_[i] / degraded_count_[i];
+      }
+    } else {
+      degraded_since_s_[i] = -1.0;
+    }
+  }
+}
+
+}  // namespace rotorguard::fdd

@@ -1,0 +1,119 @@
+#pragma once
+/// Composite fault detection and diagnosis of paper 000, Sec. V-B: the motor index (eq. 13) from
+/// ESC telemetry, the thrust/torque-loss observer (eqs. 14-17) on filtered IMU data and measured
+/// rotor speeds, and the take-off detector (eq. 18). It sees only sensor messages, the stack's
+/// estimate and its own commands; docs/fdd.md gives the filter design and the measured latencies.
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rotorguard/core/messages.h"
+#include "rotorguard/core/types.h"
+#include "rotorguard/fdd/filters.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::fdd {
+
+struct CompositeFddOptions {
+  /// Motor index M_i = w_measured / w_expected (eq. 13) at or below this isolates a motor failure
+  /// (gamma_M, paper: 0.2), in (0, 1).
+  double motor_index_threshold = 0.2;
+  /// Consecutive telemetry samples the index must stay low (debounce), >= 1.
+  int motor_index_samples = 2;
+  /// The index is evaluated only while the expected thrust exceeds this [N] (w_expected -> 0
+  /// makes the ratio meaningless), > 0.
+  double motor_index_min_thrust_n = 0.3;
+  /// Propeller index P_i = thrust lost / thrust the rotor should give (eq. 17) above this isolates
+  /// a propeller failure (gamma_P, paper: 0.8), in (0, 1].
+  double propeller_index_threshold = 0.8;
+  /// P_i must stay above its threshold this long [s], >= 0.
+  double propeller_persistence_s = 0.015;
+  /// Partial loss: P_i between this and the propeller threshold for degraded_persistence_s is
+  /// reported as degradation with eta = mean P_i, in (0, propeller_index_threshold).
+  double degraded_threshold = 0.15;
+  double degraded_persistence_s = 0.5;  ///< [s], > 0
+  /// Cut-off of the low-pass filters on specific force, body rate, angular acceleration and the
+  /// measured wrench [Hz], > 0 and below the IMU's Nyquist frequency.
+  double filter_cutoff_hz = 20.0;
+  /// Take-off detector (eq. 18): active while the vehicle is airborne below this altitude [m] and
+  /// within takeoff_window_s of lift-off, > 0.
+  double takeoff_max_altitude_m = 0.6;
+  double takeoff_window_s = 3.0;
+  /// Filtered roll/pitch angular acceleration magnitude that fires it [rad/s^2], > 0 ...
+  double takeoff_angular_acceleration_rad_s2 = 12.0;
+  /// ... pointing within this cosine of the signature of losing one rotor, in (0, 1].
+  double takeoff_direction_cosine = 0.9;
+  /// Nominal IMU sample rate [Hz] (filters are designed for it), > 2 * filter_cutoff_hz.
+  double imu_rate_hz = 333.0;
+  /// IMU mounting point relative to the centre of gravity, body frame [m]: its lever-arm
+  /// accelerations are removed before the observer uses the accelerometer.
+  Vector3 imu_position_m = Vector3::Zero();
+  void Validate() const;
+};
+
+enum class RotorHealth { kOk, kMotorFailed, kPropellerFailed, kDegraded };
+std::string_view ToString(RotorHealth health);
+
+struct RotorStatus {
+  RotorHealth health = RotorHealth::kOk;
+  double eta = 0.0;              ///< estimated loss of effectiveness (degraded), in [0, 1]
+  double motor_index = 1.0;      ///< M_i, latest
+  double propeller_index = 0.0;  ///< P_i, latest
+  std::optional<double> detected_s;  ///< when the health left kOk
+  std::string detector;          ///< "motor_index", "thrust_loss_observer", "takeoff"
+};
+
+class CompositeFdd {
+ public:
+  CompositeFdd(const vehicle::VehicleParams& vehicle, const CompositeFddOptions& options);
+
+  void OnImu(const ImuSample& imu);
+  void OnEscTelemetry(const EscTelemetry& esc);
+  /// The commanded thrusts sent to the motors (the motor index's reference) and the stack's
+  /// current estimate (attitude, velocity, altitude).
+  void SetCommand(const RotorVector& thrust_command);
+  void SetEstimate(const StateEstimate& estimate);
+
+  const std::vector<RotorStatus>& rotors() const { return rotors_; }
+  /// Rotors isolated as failed (motor or propeller) since the last call; cleared by the call.
+  std::vector<int> TakeNewIsolations();
+  /// The first isolation (rotor, time), if any.
+  std::optional<int> first_isolated_rotor() const { return first_isolated_; }
+  /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16), for logs.
+  const Eigen::VectorXd& thrust_loss() const { return thrust_loss_; }
+
+ private:
+  void Isolate(int rotor, RotorHealth health, double t, const char* detector);
+  void RunObserver(double t);
+
+  vehicle::VehicleParams vehicle_;
+  CompositeFddOptions options_;
+  int n_;
+  EffectivenessMatrix effectiveness_;
+  AllocationMatrix pinv_;
+  std::vector<RotorStatus> rotors_;
+  std::vector<int> new_isolations_;
+  std::optional<int> first_isolated_;
+  // Motor index.
+  RotorVector command_, expected_thrust_;
+  std::vector<int> low_index_count_;
+  std::optional<TimeNs> last_esc_ns_;
+  RotorVector measured_thrust_;
+  bool have_esc_ = false;
+  // Observer.
+  double imu_rate_hz_ = 0.0;
+  std::optional<TimeNs> last_imu_ns_;
+  LowPass2<3> force_filter_, rate_filter_;
+  FilteredDerivative<3> alpha_filter_;
+  LowPass2<4> wrench_filter_;
+  bool filters_ready_ = false;
+  StateEstimate estimate_;
+  bool have_estimate_ = false;
+  std::optional<double> airborne_since_s_;
+  std::vector<double> above_since_s_, degraded_since_s_, degraded_sum_;
+  std::vector<int> degraded_count_;
+  Eigen::VectorXd thrust_loss_;
+};
+
+}  // namespace rotorguard::fdd
