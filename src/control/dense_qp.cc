@@ -186,8 +186,11 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
   active_.clear();
   std::fill(is_active_.begin(), is_active_.end(), 0);
   R_.setZero();
+  // Bounds may be infinite but never NaN (a NaN bound would be silently ignored by comparisons).
+  const bool nan_bound = qp.lb.array().isNaN().any() || qp.ub.array().isNaN().any() ||
+                         qp.lc.array().isNaN().any() || qp.uc.array().isNaN().any();
   if (qp.num_variables() != n_ || qp.num_constraints() != m_ || !qp.H.allFinite() || !qp.g.allFinite() ||
-      (m_ > 0 && !qp.C.allFinite())) {
+      (m_ > 0 && !qp.C.allFinite()) || nan_bound) {
     z_.setZero();
     return finish(QpStatus::kNumericalFailure);
   }

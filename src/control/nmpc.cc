@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -102,6 +103,7 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
   // Minimum-norm split of a unit total thrust with zero torque.
   hover_split_ = vehicle::PseudoInverse(vehicle::ComputeEffectivenessMatrix(vehicle_.rotors)) *
                  Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+  unit_split_ = hover_split_;
 }
 
 void NmpcController::Reset() {
@@ -115,6 +117,7 @@ void NmpcController::SetRotorFailed(int rotor) {
   }
   failed_[rotor] = true;
   u_max_[rotor] = 0.0;  // u_bar_i = 0 (paper 000, Sec. V-A)
+  UpdateThrustSplit();
   weights_[StateIndex::kQuaternion + 3] = 0.0;  // yaw is given up
   // Reference spin: the yaw torque of the post-failure thrust split against the yaw damping.
   const Eigen::VectorXd t_ref = ThrustReference(vehicle_.weight_n());
@@ -123,31 +126,40 @@ void NmpcController::SetRotorFailed(int rotor) {
   spin_reference_ = Eigen::Vector3d(0.0, 0.0, yaw_torque / std::max(vehicle_.yaw_damping_n_m_s, 1e-9));
 }
 
-Eigen::VectorXd NmpcController::ThrustReference(double total) const {
-  Eigen::VectorXd t(nu_);
+Eigen::VectorXd NmpcController::ThrustReference(double total) const { return total * unit_split_; }
+
+void NmpcController::UpdateThrustSplit() {
+  if (std::none_of(failed_.begin(), failed_.end(), [](bool f) { return f; })) {
+    unit_split_ = hover_split_;
+    return;
+  }
+  // The exact mirror image of a failed rotor through the centre of gravity (its diagonal twin on a
+  // quadrotor) idles, so that roll and pitch torques balance; only a healthy twin counts.
   std::vector<bool> idle = failed_;
-  // The diagonal twin of a failed rotor idles so that roll and pitch torques balance: the rotor
-  // whose position is closest to the failed one's mirror image through the centre of gravity.
   for (int f = 0; f < nu_; ++f) {
     if (!failed_[f]) continue;
-    int twin = -1;
-    double best = 1e300;
+    const Eigen::Vector3d& pf = vehicle_.rotors[f].p_B;
     for (int j = 0; j < nu_; ++j) {
-      if (j == f || failed_[j]) continue;
-      const double d = (vehicle_.rotors[j].p_B + vehicle_.rotors[f].p_B).norm();
-      if (d < best) {
-        best = d;
-        twin = j;
+      if (j != f && !failed_[j] && (vehicle_.rotors[j].p_B.head<2>() + pf.head<2>()).norm() < 0.05 * pf.head<2>().norm()) {
+        idle[j] = true;
       }
     }
-    if (twin >= 0) idle[twin] = true;
   }
-  const int active = static_cast<int>(std::count(idle.begin(), idle.end(), false));
-  if (active == nu_) {
-    return total * hover_split_;
+  // The others carry a unit total thrust with zero roll and pitch torque (least squares when the
+  // torques cannot balance, e.g. two adjacent rotors lost).
+  std::vector<int> active;
+  for (int i = 0; i < nu_; ++i) {
+    if (!idle[i]) active.push_back(i);
   }
-  for (int i = 0; i < nu_; ++i) t[i] = idle[i] || active == 0 ? 0.0 : total / active;
-  return t;
+  unit_split_ = Eigen::VectorXd::Zero(nu_);
+  if (active.empty()) return;
+  Eigen::MatrixXd E(3, static_cast<int>(active.size()));
+  for (int c = 0; c < static_cast<int>(active.size()); ++c) {
+    const Eigen::Vector3d& p = vehicle_.rotors[active[c]].p_B;
+    E.col(c) << 1.0, p.y(), -p.x();
+  }
+  const Eigen::VectorXd t = E.completeOrthogonalDecomposition().solve(Eigen::Vector3d(1.0, 0.0, 0.0));
+  for (int c = 0; c < static_cast<int>(active.size()); ++c) unit_split_[active[c]] = std::max(0.0, t[c]);
 }
 
 double NmpcController::ReferenceTotalThrust(const ReferencePoint& ref) const {
@@ -297,14 +309,29 @@ bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTraj
   }
   qp_.x0 = x0 - x_[0];
   const auto prepared = Clock::now();
-  const OcpQpSummary& qs = qp_solver_.Solve(qp_);
-  summary_.prepare_time_s += Seconds(start, prepared) + qs.condense_time_s;
-  summary_.feedback_time_s += qs.dense_solve_time_s;
-  summary_.qp_iterations += qs.iterations;
+  const OcpQpSummary* qs = &qp_solver_.Solve(qp_);
+  if (qs->status == QpStatus::kInfeasible) {
+    // The body-rate bounds are hard constraints, and the motors can change the rate only so fast:
+    // a measured rate far beyond its bound (a gust, a collision, a late isolation) leaves no
+    // feasible plan. Dropping the rate bounds for this iteration beats falling back to a stale
+    // plan that holds no corrective torque.
+    for (int k = 1; k <= N_; ++k) {
+      qp_.x_lower[k].setConstant(-std::numeric_limits<double>::infinity());
+      qp_.x_upper[k].setConstant(std::numeric_limits<double>::infinity());
+    }
+    ++summary_.rate_bounds_relaxed;
+    summary_.prepare_time_s += qs->condense_time_s;
+    summary_.feedback_time_s += qs->dense_solve_time_s;
+    qs = &qp_solver_.Solve(qp_);
+  }
+  const OcpQpSummary& qs_ref = *qs;
+  summary_.prepare_time_s += Seconds(start, prepared) + qs_ref.condense_time_s;
+  summary_.feedback_time_s += qs_ref.dense_solve_time_s;
+  summary_.qp_iterations += qs_ref.iterations;
   summary_.dynamics_gap = gap;
-  summary_.objective = qs.objective;
+  summary_.objective = qs_ref.objective;
   ++summary_.sqp_iterations;
-  if (!qs.IsSolutionUsable()) return false;
+  if (!qs_ref.IsSolutionUsable()) return false;
   double step = 0.0;
   for (int k = 0; k <= N_; ++k) {
     if (!qp_solver_.x()[k].allFinite()) return false;
@@ -390,6 +417,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   if (!thrust_command->allFinite()) {
     HoverCommand(thrust_command);
     summary_.status = NmpcStatus::kFallback;
+    ++summary_.fallbacks;
   }
   summary_.solve_time_s = Seconds(start, Clock::now());
 }

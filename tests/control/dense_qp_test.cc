@@ -178,6 +178,9 @@ TEST(DenseQp, NonFiniteOrIndefiniteDataIsANumericalFailureNotACrash) {
   qp.g << 0.0, 1.0;
   qp.H << 1.0, 0.0, 0.0, -1.0;
   EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure);
+  qp.H.setIdentity();
+  qp.ub[1] = std::nan("");  // a NaN bound is an error, not a missing bound
+  EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure);
 }
 
 TEST(DenseQp, SummaryExplainsAnUnsolvedSolver) {

@@ -133,6 +133,33 @@ TEST(Nmpc, AFailedRotorGetsZeroThrustAndTheTwinIdlesInTheReference) {
   RG_EXPECT_THROW_WITH(nmpc.SetRotorFailed(4), std::invalid_argument, "rotor = 4");
 }
 
+TEST(Nmpc, LosingADiagonalPairLeavesTheOtherPairSharingTheWeight) {
+  NmpcController nmpc(ReferenceQuad(), {});
+  nmpc.SetRotorFailed(0);
+  nmpc.SetRotorFailed(1);  // rotor 0's twin: rotors 2 and 3 can still balance roll and pitch
+  const Eigen::VectorXd t_ref = nmpc.ThrustReference(10.0);
+  EXPECT_EQ(t_ref[0], 0.0);
+  EXPECT_EQ(t_ref[1], 0.0);
+  EXPECT_NEAR(t_ref[2], 5.0, 1e-12);
+  EXPECT_NEAR(t_ref[3], 5.0, 1e-12);
+}
+
+TEST(Nmpc, ARateBeyondWhatTheBoundsAllowStillGetsACorrectiveCommand) {
+  // Rolling at 16 rad/s: the motors cannot bring it under the 10 rad/s bound within one node, so
+  // the QP with rate bounds is infeasible. The NMPC must still counter the roll, not hover.
+  NmpcController nmpc(ReferenceQuad(), {});
+  const auto ref = HoverAt(1.0);
+  StateEstimate est = HoverEstimate(1.0);
+  RotorVector cmd;
+  nmpc.Compute(est, ref, 0.0, 0.0, &cmd);
+  est.w_B = Vector3(16.0, 0.0, 0.0);
+  nmpc.Compute(est, ref, 0.005, 0.005, &cmd);
+  EXPECT_EQ(nmpc.summary().status, NmpcStatus::kSolved) << nmpc.summary().BriefReport();
+  EXPECT_GE(nmpc.summary().rate_bounds_relaxed, 1);
+  // Negative roll torque: the rotors at y < 0 (0 and 3, paper 000 eq. 5) push harder.
+  EXPECT_GT(cmd[0] + cmd[3], cmd[1] + cmd[2] + 1.0);
+}
+
 TEST(Nmpc, NonFiniteStateGivesAFiniteFallbackCommand) {
   NmpcController nmpc(ReferenceQuad(), {});
   const auto ref = HoverAt(1.0);

@@ -63,6 +63,7 @@ struct NmpcSummary {
   double feedback_time_s = 0.0; ///< the QP that needs the current state
   double solve_time_s = 0.0;    ///< the whole call
   long fallbacks = 0;           ///< cumulative count since construction
+  int rate_bounds_relaxed = 0;  ///< QPs of this call re-solved without rate bounds (infeasible with them)
   bool IsSolutionUsable() const { return status == NmpcStatus::kSolved || status == NmpcStatus::kMaxIterations; }
   std::string BriefReport() const;
 };
@@ -76,9 +77,9 @@ class NmpcController final : public Controller {
   void Reset() override;
 
   /// Reconfigures for a failed rotor: u_bar_i = 0, yaw weight 0, post-failure thrust reference
-  /// (the diagonal twin idles, the others share the weight) and reference spin. No rebuild.
-  /// Throws std::invalid_argument for a rotor out of range; a second failure leaves fewer than
-  /// three rotors only on vehicles with more than four.
+  /// (a healthy diagonal twin idles, the others share the weight with zero roll/pitch torque, in
+  /// the least-squares sense when that is impossible) and reference spin. No rebuild. Throws
+  /// std::invalid_argument for a rotor out of range.
   void SetRotorFailed(int rotor);
   const std::vector<bool>& failed_rotors() const { return failed_; }
   const NmpcSummary& summary() const { return summary_; }
@@ -117,6 +118,8 @@ class NmpcController final : public Controller {
   Eigen::VectorXd weights_;          // diagonal of W for y (nx entries)
   Eigen::VectorXd u_max_;
   Eigen::VectorXd hover_split_;  // minimum-norm rotor thrusts per newton of total thrust
+  Eigen::VectorXd unit_split_;   // the thrust reference per newton: hover_split_ or post-failure
+  void UpdateThrustSplit();
   std::vector<bool> failed_;
   Eigen::Vector3d spin_reference_ = Eigen::Vector3d::Zero();
   std::vector<Eigen::VectorXd> x_, u_;  // shooting nodes and inputs
