@@ -65,6 +65,7 @@ DenseQpSolver::DenseQpSolver(int n, int m, const DenseQpOptions& options)
       m_(m),
       options_(options),
       chol_(n, n),
+      J0_(n, n),
       J_(n, n),
       R_(Eigen::MatrixXd::Zero(n, n)),
       z_(n),
@@ -153,7 +154,36 @@ void DenseQpSolver::DropFromActiveSet(int position) {
   --q_;
 }
 
+bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
+  factorized_ = false;
+  if (H.rows() != n_ || H.cols() != n_ || !H.allFinite()) return false;
+  chol_ = H;
+  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(chol_);
+  if (llt.info() != Eigen::Success) return false;
+  J0_.setIdentity();
+  llt.matrixU().solveInPlace(J0_);  // J0 = L^-T
+  factorized_ = true;
+  return true;
+}
+
 const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
+  const auto start = std::chrono::steady_clock::now();
+  const bool ok = Factorize(qp.H);
+  const double factorize_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!ok) {
+    summary_ = DenseQpSummary{};
+    q_ = 0;
+    z_.setZero();
+    summary_.status = QpStatus::kNumericalFailure;
+    summary_.solve_time_s = factorize_s;
+    return summary_;
+  }
+  SolveFactorized(qp);
+  summary_.solve_time_s += factorize_s;
+  return summary_;
+}
+
+const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
   const auto start = std::chrono::steady_clock::now();
   summary_ = DenseQpSummary{};
   const auto finish = [&](QpStatus status) -> const DenseQpSummary& {
@@ -170,7 +200,8 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
       }
     }
     if (z_.allFinite()) {
-      summary_.objective = 0.5 * z_.dot(qp.H * z_) + qp.g.dot(z_);
+      step_.noalias() = qp.H * z_;
+      summary_.objective = 0.5 * z_.dot(step_) + qp.g.dot(z_);
       double violation = ((qp.lb - z_).cwiseMax(z_ - qp.ub)).maxCoeff();
       if (m_ > 0) {
         cz_.noalias() = qp.C * z_;
@@ -189,7 +220,7 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
   // Bounds may be infinite but never NaN (a NaN bound would be silently ignored by comparisons).
   const bool nan_bound = qp.lb.array().isNaN().any() || qp.ub.array().isNaN().any() ||
                          qp.lc.array().isNaN().any() || qp.uc.array().isNaN().any();
-  if (qp.num_variables() != n_ || qp.num_constraints() != m_ || !qp.H.allFinite() || !qp.g.allFinite() ||
+  if (!factorized_ || qp.num_variables() != n_ || qp.num_constraints() != m_ || !qp.g.allFinite() ||
       (m_ > 0 && !qp.C.allFinite()) || nan_bound) {
     z_.setZero();
     return finish(QpStatus::kNumericalFailure);
@@ -201,15 +232,8 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
     if (qp.lc[i] > qp.uc[i]) return finish(QpStatus::kInfeasible);
   }
 
-  // Unconstrained minimum: H = L L', J = L^-T, z = -J J' g.
-  chol_ = qp.H;
-  Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(chol_);
-  if (llt.info() != Eigen::Success) {
-    z_.setZero();
-    return finish(QpStatus::kNumericalFailure);
-  }
-  J_.setIdentity();
-  llt.matrixU().solveInPlace(J_);
+  // Unconstrained minimum from the factorisation H = L L', J = L^-T: z = -J J' g.
+  J_ = J0_;
   d_.noalias() = J_.transpose() * qp.g;
   z_.noalias() = -J_ * d_;
 

@@ -108,6 +108,7 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
 
 void NmpcController::Reset() {
   initialised_ = false;
+  prepared_for_t_.reset();
   summary_ = NmpcSummary{};
 }
 
@@ -275,9 +276,9 @@ void NmpcController::ShiftBy(double elapsed) {
   for (int k = 0; k <= N_; ++k) x_[k].segment<4>(StateIndex::kQuaternion).normalize();
 }
 
-bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t) {
+bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, double t) {
   const auto start = Clock::now();
-  // Preparation: linearise the dynamics (exact RK4 sensitivities) and the cost (Gauss-Newton).
+  // Linearise the dynamics (exact RK4 sensitivities) and the cost (Gauss-Newton) along the plan.
   double gap = 0.0;
   for (int k = 0; k < N_; ++k) {
     integrator_.Step(x_[k], u_[k], &x_next_, &qp_.A[k], &qp_.B[k]);
@@ -307,9 +308,17 @@ bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTraj
       qp_.x_upper[k] = options_.max_rate_rad_s - w;
     }
   }
-  qp_.x0 = x0 - x_[0];
-  const auto prepared = Clock::now();
-  const OcpQpSummary* qs = &qp_solver_.Solve(qp_);
+  qp_.x0.setZero();  // condensed around the plan's own first node; the measurement comes later
+  gap_ = gap;
+  const OcpQpSummary& qs = qp_solver_.Prepare(qp_);
+  summary_.prepare_time_s += Seconds(start, Clock::now());
+  return qs.status != QpStatus::kNumericalFailure;
+}
+
+bool NmpcController::FeedbackIteration(const Eigen::VectorXd& x0) {
+  auto start = Clock::now();
+  x0_delta_ = x0 - x_[0];
+  const OcpQpSummary* qs = &qp_solver_.Feedback(x0_delta_);
   if (qs->status == QpStatus::kInfeasible) {
     // The body-rate bounds are hard constraints, and the motors can change the rate only so fast:
     // a measured rate far beyond its bound (a gust, a collision, a late isolation) leaves no
@@ -320,37 +329,42 @@ bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTraj
       qp_.x_upper[k].setConstant(std::numeric_limits<double>::infinity());
     }
     ++summary_.rate_bounds_relaxed;
-    summary_.prepare_time_s += qs->condense_time_s;
-    summary_.feedback_time_s += qs->dense_solve_time_s;
-    qs = &qp_solver_.Solve(qp_);
+    summary_.feedback_time_s += Seconds(start, Clock::now());
+    const auto prepare = Clock::now();
+    qp_solver_.Prepare(qp_);
+    summary_.prepare_time_s += Seconds(prepare, Clock::now());
+    start = Clock::now();
+    qs = &qp_solver_.Feedback(x0_delta_);
   }
-  const OcpQpSummary& qs_ref = *qs;
-  summary_.prepare_time_s += Seconds(start, prepared) + qs_ref.condense_time_s;
-  summary_.feedback_time_s += qs_ref.dense_solve_time_s;
-  summary_.qp_iterations += qs_ref.iterations;
-  summary_.dynamics_gap = gap;
-  summary_.objective = qs_ref.objective;
+  const OcpQpSummary& q = *qs;
+  summary_.qp_iterations += q.iterations;
+  summary_.dynamics_gap = gap_;
+  summary_.objective = q.objective;
   ++summary_.sqp_iterations;
-  if (!qs_ref.IsSolutionUsable()) return false;
+  bool ok = q.IsSolutionUsable();
   double step = 0.0;
-  for (int k = 0; k <= N_; ++k) {
-    if (!qp_solver_.x()[k].allFinite()) return false;
+  for (int k = 0; ok && k <= N_; ++k) {
+    ok = qp_solver_.x()[k].allFinite() && (k == N_ || qp_solver_.u()[k].allFinite());
+    if (!ok) break;
     step = std::max(step, qp_solver_.x()[k].cwiseAbs().maxCoeff());
     x_[k] += qp_solver_.x()[k];
     if (k < N_) {
-      if (!qp_solver_.u()[k].allFinite()) return false;
       step = std::max(step, qp_solver_.u()[k].cwiseAbs().maxCoeff());
       u_[k] += qp_solver_.u()[k];
     }
   }
   summary_.step_norm = step;
-  summary_.kkt_residual = std::max(step, gap);
-  return true;
+  summary_.kkt_residual = std::max(step, gap_);
+  summary_.feedback_time_s += Seconds(start, Clock::now());
+  return ok;
+}
+
+bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t) {
+  return PrepareIteration(reference, t) && FeedbackIteration(x0);
 }
 
 void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory& reference, double t, double dt,
                              RotorVector* thrust_command) {
-  (void)dt;
   const auto start = Clock::now();
   const long fallbacks = summary_.fallbacks;
   summary_ = NmpcSummary{};
@@ -388,10 +402,14 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   }
 
   int iterations = options_.max_sqp_iterations;
+  // Real-time iteration: when the previous call prepared the QP for this very time, only the
+  // feedback phase stands between the measurement and the command.
+  const bool prepared = initialised_ && prepared_for_t_ && std::abs(*prepared_for_t_ - t) < 1e-9;
+  prepared_for_t_.reset();
   if (!initialised_) {
     Initialise(x0_, reference, t);
     iterations = std::max(iterations, 3);  // a first plan from scratch needs a few iterations
-  } else {
+  } else if (!prepared) {
     ShiftBy(t - last_t_);
   }
   last_t_ = t;
@@ -400,7 +418,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   bool ok = true;
   summary_.status = NmpcStatus::kMaxIterations;
   for (int i = 0; i < iterations; ++i) {
-    ok = SqpIteration(x0_, reference, t);
+    ok = (i == 0 && prepared) ? FeedbackIteration(x0_) : SqpIteration(x0_, reference, t);
     if (!ok) break;
     if (summary_.step_norm < options_.sqp_tolerance || (options_.max_sqp_iterations == 1 && i + 1 >= iterations)) {
       summary_.status = NmpcStatus::kSolved;
@@ -418,6 +436,13 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     HoverCommand(thrust_command);
     summary_.status = NmpcStatus::kFallback;
     ++summary_.fallbacks;
+  }
+  summary_.command_latency_s = Seconds(start, Clock::now());
+  // Preparation for the next call, after the command is out: shift the plan by this call's period
+  // (the stack's control period) and linearise and condense around it.
+  if (options_.max_sqp_iterations == 1 && dt > 0.0 && std::isfinite(dt) && ok) {
+    ShiftBy(dt);
+    if (PrepareIteration(reference, t + dt)) prepared_for_t_ = t + dt;
   }
   summary_.solve_time_s = Seconds(start, Clock::now());
 }

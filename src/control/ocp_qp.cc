@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -68,6 +69,12 @@ CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptio
   x_.assign(N + 1, Eigen::VectorXd::Zero(nx));
   u_.assign(N, Eigen::VectorXd::Zero(nu));
   tmp_.resize(nx, nx);
+  const int n = N * nu, m = N * static_cast<int>(dims.state_bound_index.size());
+  phi_.assign(N + 1, Eigen::MatrixXd::Zero(nx, nx));
+  g_x0_.resize(n, nx);
+  c_x0_.resize(m, nx);
+  dx0_.resize(nx);
+  cdx_.resize(m);
 }
 
 template <int NX, int NU>
@@ -138,17 +145,31 @@ void CondensingQpSolver::Condense(const OcpQp& qp) {
       }
     }
   }
+  // Sensitivities to the initial state, for the feedback phase: x_bar_k moves by Phi_k0 dx0 with
+  // Phi_k0 = A_{k-1} ... A_0, so g_j moves by B_j' W_{j+1} Phi_{j+1,0} dx0 = Y_j' Phi_{j+1,0} dx0
+  // and the state-bound rows by -Phi_k0[idx, :] dx0.
+  const auto Phi = [&](int k) { return Eigen::Map<MatXX>(phi_[k].data(), nx, nx); };
+  Phi(0).setIdentity();
+  for (int k = 1; k <= N; ++k) Phi(k).noalias() = A(k - 1) * Phi(k - 1);
+  for (int j = 0; j < N; ++j) g_x0_.block(j * nu, 0, nu, nx).noalias() = Y(j).transpose() * Phi(j + 1);
+  for (int k = 1; k <= N; ++k) {
+    for (int b = 0; b < nbx; ++b) c_x0_.row((k - 1) * nbx + b) = Phi(k).row(idx[b]);
+  }
 }
 
 const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
+  Prepare(qp);
+  if (summary_.status == QpStatus::kNumericalFailure) return summary_;
+  return Feedback(qp.x0);
+}
+
+const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp) {
   const auto start = std::chrono::steady_clock::now();
   summary_ = OcpQpSummary{};
-  const int N = dims_.horizon, nu = dims_.nu;
-  const std::vector<int>& idx = dims_.state_bound_index;
-  if (qp.dims.horizon != N || qp.dims.nx != dims_.nx || qp.dims.nu != nu || qp.dims.state_bound_index != idx) {
-    throw std::invalid_argument("CondensingQpSolver::Solve: the problem's dimensions differ from the solver's");
+  if (qp.dims.horizon != dims_.horizon || qp.dims.nx != dims_.nx || qp.dims.nu != dims_.nu ||
+      qp.dims.state_bound_index != dims_.state_bound_index) {
+    throw std::invalid_argument("CondensingQpSolver: the problem's dimensions differ from the solver's");
   }
-
   // Sizes known at compile time make Eigen's small products several times faster: the NMPC's
   // quadrotor (nx = 17, nu = 4) gets its own instantiation (measured: docs/control.md).
   if (dims_.nx == 17 && dims_.nu == 4) {
@@ -156,24 +177,51 @@ const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
   } else {
     Condense<Eigen::Dynamic, Eigen::Dynamic>(qp);
   }
-  const auto condensed = std::chrono::steady_clock::now();
-  summary_.condense_time_s = std::chrono::duration<double>(condensed - start).count();
+  g0_ = dense_.g;
+  lc0_ = dense_.lc;
+  uc0_ = dense_.uc;
+  prepared_x0_ = qp.x0;
+  prepared_ = &qp;
+  if (!dense_solver_.Factorize(dense_.H)) summary_.status = QpStatus::kNumericalFailure;
+  summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary_;
+}
 
-  const DenseQpSummary& ds = dense_solver_.Solve(dense_);
+const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
+  if (prepared_ == nullptr) throw std::logic_error("CondensingQpSolver::Feedback called before Prepare");
+  const auto start = std::chrono::steady_clock::now();
+  const OcpQp& qp = *prepared_;
+  const int N = dims_.horizon, nu = dims_.nu;
+  if (summary_.status == QpStatus::kNumericalFailure || x0.size() != dims_.nx || !x0.allFinite()) {
+    summary_.status = QpStatus::kNumericalFailure;
+    return summary_;
+  }
+  // Only what depends on the measured state: O(n nx) updates, then the active-set iterations.
+  dx0_ = x0 - prepared_x0_;
+  dense_.g = g0_;
+  dense_.g.noalias() += g_x0_ * dx0_;
+  if (dense_.num_constraints() > 0) {
+    cdx_.noalias() = c_x0_ * dx0_;
+    dense_.lc = lc0_ - cdx_;
+    dense_.uc = uc0_ - cdx_;
+  }
+  const DenseQpSummary& ds = dense_solver_.SolveFactorized(dense_);
   summary_.status = ds.status;
   summary_.iterations = ds.iterations;
   summary_.active_constraints = ds.active_constraints;
-  summary_.dense_solve_time_s = ds.solve_time_s;
+  summary_.max_violation = ds.max_violation;
   // Expand the trajectory by forward simulation of the inputs.
   const Eigen::VectorXd& z = dense_solver_.z();
-  x_[0] = qp.x0;
+  x_[0] = x0;
   for (int k = 0; k < N; ++k) {
     u_[k] = z.segment(k * nu, nu);
-    x_[k + 1].noalias() = qp.A[k] * x_[k] + qp.B[k] * u_[k] + qp.c[k];
+    x_[k + 1].noalias() = qp.A[k] * x_[k];
+    x_[k + 1].noalias() += qp.B[k] * u_[k];
+    x_[k + 1] += qp.c[k];
   }
   summary_.objective = qp.Objective(x_, u_);
-  summary_.max_violation = ds.max_violation;
-  summary_.total_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary_.dense_solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary_.total_time_s = summary_.condense_time_s + summary_.dense_solve_time_s;
   return summary_;
 }
 

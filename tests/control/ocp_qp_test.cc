@@ -183,6 +183,26 @@ TEST(CondensingQp, RespectsInputAndStateBoundsWhenTheyBind) {
   }
 }
 
+TEST(CondensingQp, FeedbackOnAPreparedProblemEqualsAFreshSolveAtTheMeasuredState) {
+  // The real-time iteration's split: prepare around a predicted x0, feed back the measured one.
+  Rng rng(21);
+  for (int nx : {6, 17}) {
+    const int nu = nx == 17 ? 4 : 2;
+    OcpQp qp = RandomOcp(8, nx, nu, {0, 3}, rng);
+    qp.x0 *= 0.1;
+    const Eigen::VectorXd measured = qp.x0 + 0.05 * RandomMatrix(nx, 1, rng);
+    CondensingQpSolver split(qp.dims), fresh(qp.dims);
+    split.Prepare(qp);
+    const OcpQpSummary& s = split.Feedback(measured);
+    ASSERT_TRUE(s.IsSolutionUsable()) << s.BriefReport();
+    OcpQp measured_qp = qp;
+    measured_qp.x0 = measured;
+    ASSERT_TRUE(fresh.Solve(measured_qp).IsSolutionUsable());
+    for (int k = 0; k < 8; ++k) EXPECT_TRUE(MatricesNear(split.u()[k], fresh.u()[k], 1e-9)) << "nx " << nx << " u_" << k;
+    EXPECT_TRUE(MatricesNear(split.x()[8], fresh.x()[8], 1e-9));
+  }
+}
+
 TEST(CondensingQp, RejectsMismatchedDimensionsAndBadDims) {
   Rng rng(1);
   const OcpQp qp = RandomOcp(4, 3, 1, {}, rng);

@@ -64,8 +64,14 @@ class DenseQpSolver {
   DenseQpSolver(int n, int m, const DenseQpOptions& options = {});
   /// Solves `qp`; the solution is in z() and the multipliers in bound_multipliers() and
   /// constraint_multipliers() (positive at a lower bound, negative at an upper bound; the KKT
-  /// stationarity reads H z + g = y_b + C' y_c). Does not allocate.
+  /// stationarity reads H z + g = y_b + C' y_c). Equals Factorize(qp.H) then SolveFactorized(qp).
   const DenseQpSummary& Solve(const DenseQp& qp);
+  /// Factorises a Hessian (Cholesky and J = L^-T, O(n^3)) ahead of the data that changes: the
+  /// preparation phase of a real-time iteration. False when H is not finite positive definite.
+  bool Factorize(const Eigen::MatrixXd& H);
+  /// Solves `qp` whose H was given to the last successful Factorize (qp.H serves only the reported
+  /// objective): the feedback phase, O(n^2) per active-set change.
+  const DenseQpSummary& SolveFactorized(const DenseQp& qp);
   const Eigen::VectorXd& z() const { return z_; }
   const Eigen::VectorXd& bound_multipliers() const { return y_bound_; }
   const Eigen::VectorXd& constraint_multipliers() const { return y_constraint_; }
@@ -87,6 +93,8 @@ class DenseQpSolver {
   int n_, m_;
   DenseQpOptions options_;
   Eigen::MatrixXd chol_;   // L with H = L L'
+  Eigen::MatrixXd J0_;     // L^-T of the factorised H
+  bool factorized_ = false;
   Eigen::MatrixXd J_;      // L^-T Q
   Eigen::MatrixXd R_;      // upper triangular, q x q in the top-left corner
   Eigen::VectorXd z_, d_, step_, r_, u_, cz_;

@@ -59,9 +59,10 @@ struct NmpcSummary {
   /// constraint linearisation), so this vanishes at the solution of the converge mode.
   double kkt_residual = 0.0;
   double objective = 0.0;       ///< of the last QP
-  double prepare_time_s = 0.0;  ///< linearisation and condensing
-  double feedback_time_s = 0.0; ///< the QP that needs the current state
-  double solve_time_s = 0.0;    ///< the whole call
+  double prepare_time_s = 0.0;  ///< linearisation, condensing, factorisation (RTI: for the next call)
+  double feedback_time_s = 0.0; ///< the QP that needs the measured state
+  double command_latency_s = 0.0;  ///< from the call to the command (RTI: the feedback phase)
+  double solve_time_s = 0.0;    ///< the whole call, preparation for the next call included
   long fallbacks = 0;           ///< cumulative count since construction
   int rate_bounds_relaxed = 0;  ///< QPs of this call re-solved without rate bounds (infeasible with them)
   bool IsSolutionUsable() const { return status == NmpcStatus::kSolved || status == NmpcStatus::kMaxIterations; }
@@ -104,6 +105,10 @@ class NmpcController final : public Controller {
   void Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t);
   void ShiftBy(double elapsed_s);
   bool SqpIteration(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t);
+  /// Linearisation, condensing and factorisation around the current plan (no measurement needed).
+  bool PrepareIteration(const ReferenceTrajectory& reference, double t);
+  /// The prepared QP for the measured state, and the plan update.
+  bool FeedbackIteration(const Eigen::VectorXd& x0);
   Eigen::Quaterniond ReferenceAttitude(const ReferencePoint& ref) const;
   double ReferenceTotalThrust(const ReferencePoint& ref) const;
   void HoverCommand(RotorVector* thrust_command) const;
@@ -126,6 +131,9 @@ class NmpcController final : public Controller {
   std::vector<Eigen::VectorXd> x_shift_, u_shift_;
   bool initialised_ = false;
   double last_t_ = 0.0;
+  std::optional<double> prepared_for_t_;  // time the prepared QP is for, in RTI mode
+  double gap_ = 0.0;
+  Eigen::VectorXd x0_delta_;
   NmpcSummary summary_;
   // scratch
   Eigen::VectorXd x_next_, y_, x0_;

@@ -50,8 +50,8 @@ struct OcpQpSummary {
   int active_constraints = 0;
   double objective = 0.0;
   double max_violation = 0.0;   ///< largest bound violation of the returned trajectory
-  double condense_time_s = 0.0;
-  double dense_solve_time_s = 0.0;
+  double condense_time_s = 0.0;      ///< preparation: condensing and factorisation
+  double dense_solve_time_s = 0.0;   ///< feedback: gradient and bound updates, active-set solve
   double total_time_s = 0.0;
   bool IsSolutionUsable() const { return status == QpStatus::kSolved; }
   std::string BriefReport() const;
@@ -60,8 +60,15 @@ struct OcpQpSummary {
 class CondensingQpSolver {
  public:
   explicit CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options = {});
-  /// Solves `qp` (whose dims must equal the solver's). Allocates nothing.
+  /// Solves `qp` (whose dims must equal the solver's): Prepare(qp) then Feedback(qp.x0).
   const OcpQpSummary& Solve(const OcpQp& qp);
+  /// Preparation phase of a real-time iteration: condenses `qp` around its x0, the sensitivities
+  /// of the condensed gradient and constraint bounds to x0, and factorises the Hessian. `qp` must
+  /// outlive the following Feedback calls and stay unchanged.
+  const OcpQpSummary& Prepare(const OcpQp& qp);
+  /// Feedback phase: the QP for the measured initial state x0 (only the gradient and bounds move,
+  /// linearly in x0 - prepared x0), solved on the prepared factorisation, and the trajectory.
+  const OcpQpSummary& Feedback(const Eigen::VectorXd& x0);
   const std::vector<Eigen::VectorXd>& u() const { return u_; }  ///< N inputs
   const std::vector<Eigen::VectorXd>& x() const { return x_; }  ///< N + 1 states
   const OcpQpSummary& summary() const { return summary_; }
@@ -78,6 +85,10 @@ class CondensingQpSolver {
   std::vector<Eigen::MatrixXd> s_, w_matrix_, y_;
   std::vector<Eigen::VectorXd> x_bar_, w_vector_, x_, u_;
   Eigen::MatrixXd tmp_;
+  std::vector<Eigen::MatrixXd> phi_;  // Phi_k0 = A_{k-1} ... A_0, k = 0..N
+  Eigen::MatrixXd g_x0_, c_x0_;       // d g / d x0, d (C z bound rows) / d x0
+  Eigen::VectorXd g0_, lc0_, uc0_, prepared_x0_, dx0_, cdx_;
+  const OcpQp* prepared_ = nullptr;
   DenseQp dense_;
   DenseQpSolver dense_solver_;
   OcpQpSummary summary_;
