@@ -99,6 +99,8 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
   y_.resize(nx_);
   dy_.resize(nx_, nx_);
   x0_.resize(nx_);
+  x0_delta_.resize(nx_);
+  weighted_y_.resize(nx_);
   for (int k = 0; k < N_; ++k) qp_.R[k] = options_.r_input * Eigen::MatrixXd::Identity(nu_, nu_);
   // Minimum-norm split of a unit total thrust with zero torque.
   hover_split_ = vehicle::PseudoInverse(vehicle::ComputeEffectivenessMatrix(vehicle_.rotors)) *
@@ -192,7 +194,7 @@ void NmpcController::Residual(const Eigen::VectorXd& x, const ReferencePoint& re
   y->segment<3>(0) = x.segment<3>(StateIndex::kPosition) - ref.p_W;
   y->segment<3>(7) = x.segment<3>(StateIndex::kVelocity) - ref.v_W;
   y->segment<3>(10) = x.segment<3>(StateIndex::kBodyRate) - spin_reference_;
-  y->tail(nu_) = x.tail(nu_) - ThrustReference(ReferenceTotalThrust(ref));
+  y->tail(nu_) = x.tail(nu_) - ReferenceTotalThrust(ref) * unit_split_;
   dy->block<3, 3>(0, 0).setIdentity();
   dy->block<3, 3>(7, 7).setIdentity();
   dy->block<3, 3>(10, 10).setIdentity();
@@ -250,7 +252,7 @@ void NmpcController::HoverCommand(RotorVector* thrust_command) const {
 void NmpcController::Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t) {
   for (int k = 0; k <= N_; ++k) x_[k] = x0;
   for (int k = 0; k < N_; ++k) {
-    u_[k] = ThrustReference(ReferenceTotalThrust(reference.Evaluate(t + k * options_.step_s))).cwiseMin(u_max_);
+    u_[k] = (ReferenceTotalThrust(reference.Evaluate(t + k * options_.step_s)) * unit_split_).cwiseMin(u_max_);
   }
   initialised_ = true;
 }
@@ -271,7 +273,11 @@ void NmpcController::ShiftBy(double elapsed) {
     const double pos = std::min(static_cast<double>(k) + s, static_cast<double>(N_ - 1));
     const int i = std::min(static_cast<int>(pos), std::max(N_ - 2, 0));
     const double frac = N_ > 1 ? pos - i : 0.0;
-    u_[k] = N_ > 1 ? Eigen::VectorXd((1.0 - frac) * u_shift_[i] + frac * u_shift_[i + 1]) : u_shift_[0];
+    if (N_ > 1) {
+      u_[k] = (1.0 - frac) * u_shift_[i] + frac * u_shift_[i + 1];
+    } else {
+      u_[k] = u_shift_[0];
+    }
   }
   for (int k = 0; k <= N_; ++k) x_[k].segment<4>(StateIndex::kQuaternion).normalize();
 }
@@ -295,10 +301,10 @@ bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, doub
     const auto d_att = dy_.block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion);
     qp_.Q[k].block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion).noalias() =
         d_att.transpose() * weights_.segment<4>(StateIndex::kQuaternion).asDiagonal() * d_att;
-    qp_.q[k].noalias() = dy_.transpose() * weights_.cwiseProduct(y_);
+    weighted_y_ = weights_.cwiseProduct(y_);
+    qp_.q[k].noalias() = dy_.transpose() * weighted_y_;
     if (k < N_) {
-      const Eigen::VectorXd u_ref = ThrustReference(ReferenceTotalThrust(ref));
-      qp_.r[k] = options_.r_input * (u_[k] - u_ref);
+      qp_.r[k] = options_.r_input * (u_[k] - ReferenceTotalThrust(ref) * unit_split_);
       qp_.u_lower[k] = -u_[k];
       qp_.u_upper[k] = u_max_ - u_[k];
     }
@@ -398,7 +404,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   } else if (initialised_) {
     x0_.tail(nu_) = x_[0].tail(nu_);
   } else {
-    x0_.tail(nu_) = ThrustReference(vehicle_.weight_n());
+    x0_.tail(nu_) = vehicle_.weight_n() * unit_split_;
   }
 
   int iterations = options_.max_sqp_iterations;

@@ -35,6 +35,7 @@ NmpcModel::NmpcModel(const vehicle::VehicleParams& params) : params_(params), nu
   inertia_ = params_.inertia_kg_m2;
   inertia_inv_ = inertia_.inverse();
   torque_map_ = vehicle::ComputeEffectivenessMatrix(params_.rotors).bottomRows<3>();
+  alpha_map_ = inertia_inv_ * torque_map_;
 }
 
 void NmpcModel::Dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot) const {
@@ -96,7 +97,7 @@ void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::Vec
   Eigen::Matrix3d damping = Eigen::Matrix3d::Zero();
   damping(2, 2) = params_.yaw_damping_n_m_s;
   fx->block<3, 3>(10, 10) = -inertia_inv_ * (gyro + damping);
-  fx->block(10, StateIndex::kMotor, 3, nu_) = inertia_inv_ * torque_map_;
+  fx->block(10, StateIndex::kMotor, 3, nu_) = alpha_map_;
   // T_dot = (u - T) / sigma (eq. 6).
   const double inv_sigma = 1.0 / params_.motor_time_constant_s;
   fx->block(StateIndex::kMotor, StateIndex::kMotor, nu_, nu_) = -inv_sigma * Eigen::MatrixXd::Identity(nu_, nu_);

@@ -75,6 +75,8 @@ CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptio
   c_x0_.resize(m, nx);
   dx0_.resize(nx);
   cdx_.resize(m);
+  qx_.resize(nx);
+  ru_.resize(nu);
 }
 
 template <int NX, int NU>
@@ -219,7 +221,17 @@ const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
     x_[k + 1].noalias() += qp.B[k] * u_[k];
     x_[k + 1] += qp.c[k];
   }
-  summary_.objective = qp.Objective(x_, u_);
+  // The objective of the returned trajectory, with the solver's own scratch vectors.
+  double objective = 0.0;
+  for (int k = 0; k <= N; ++k) {
+    qx_.noalias() = qp.Q[k] * x_[k];
+    objective += 0.5 * x_[k].dot(qx_) + qp.q[k].dot(x_[k]);
+    if (k < N) {
+      ru_.noalias() = qp.R[k] * u_[k];
+      objective += 0.5 * u_[k].dot(ru_) + qp.r[k].dot(u_[k]);
+    }
+  }
+  summary_.objective = objective;
   summary_.dense_solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary_.total_time_s = summary_.condense_time_s + summary_.dense_solve_time_s;
   return summary_;

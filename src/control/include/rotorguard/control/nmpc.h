@@ -136,7 +136,7 @@ class NmpcController final : public Controller {
   Eigen::VectorXd x0_delta_;
   NmpcSummary summary_;
   // scratch
-  Eigen::VectorXd x_next_, y_, x0_;
+  Eigen::VectorXd x_next_, y_, x0_, weighted_y_;
   Eigen::MatrixXd dy_;
 };
 

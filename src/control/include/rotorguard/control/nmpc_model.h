@@ -31,6 +31,7 @@ class NmpcModel {
   int nu_;
   Eigen::Matrix3d inertia_, inertia_inv_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> torque_map_;  // rows 1..3 of the effectiveness matrix
+  Eigen::Matrix<double, 3, Eigen::Dynamic> alpha_map_;   // I^-1 torque_map_
 };
 
 /// One RK4 step of NmpcModel over `dt` with `substeps` equal sub-steps, input held, and the exact

@@ -87,7 +87,7 @@ class CondensingQpSolver {
   Eigen::MatrixXd tmp_;
   std::vector<Eigen::MatrixXd> phi_;  // Phi_k0 = A_{k-1} ... A_0, k = 0..N
   Eigen::MatrixXd g_x0_, c_x0_;       // d g / d x0, d (C z bound rows) / d x0
-  Eigen::VectorXd g0_, lc0_, uc0_, prepared_x0_, dx0_, cdx_;
+  Eigen::VectorXd g0_, lc0_, uc0_, prepared_x0_, dx0_, cdx_, qx_, ru_;
   const OcpQp* prepared_ = nullptr;
   DenseQp dense_;
   DenseQpSolver dense_solver_;

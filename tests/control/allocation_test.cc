@@ -1,0 +1,107 @@
+// The control-rate path allocates nothing once warmed up (STYLE.md, "Model / Data"): malloc is
+// interposed in this test executable (glibc's own allocator does the work) and counted while the
+// NMPC, its QP solvers and the fault detector run.
+#include <atomic>
+#include <cstddef>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/control/nmpc.h"
+#include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/planning/references.h"
+#include "vehicle/vehicle_fixture.h"
+
+extern "C" {
+void* __libc_malloc(std::size_t size);
+void* __libc_calloc(std::size_t count, std::size_t size);
+void* __libc_realloc(void* pointer, std::size_t size);
+}
+
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+extern "C" {
+void* malloc(std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t count, std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(count, size);
+}
+void* realloc(void* pointer, std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(pointer, size);
+}
+}
+
+namespace rotorguard::control {
+namespace {
+
+/// Counts the allocations made by `f`.
+template <typename F>
+long CountAllocations(F&& f) {
+  g_allocations = 0;
+  g_counting = true;
+  f();
+  g_counting = false;
+  return g_allocations;
+}
+
+TEST(Allocation, TheCounterSeesAllocations) {
+  // The counter itself must work, or the zero counts below would prove nothing.
+  EXPECT_GT(CountAllocations([] { Eigen::VectorXd v(100); v.setZero(); }), 0);
+}
+
+TEST(Allocation, NmpcRealTimeIterationsAllocateNothing) {
+  for (int failed : {-1, 0}) {
+    NmpcController nmpc(rotorguard::testing::ReferenceQuad(), {});
+    planning::LemniscateOptions lo;
+    lo.center_m = Vector3(0, 0, 1.5);
+    const planning::LemniscateReference ref(lo);
+    StateEstimate est;
+    est.valid = true;
+    est.p_W = Vector3(0.1, -0.05, 1.45);
+    est.w_B = Vector3(0.1, 0.2, failed >= 0 ? 10.0 : 0.3);
+    est.motor_thrust_n = RotorVector::Constant(4, 2.82);
+    RotorVector cmd;
+    double t = 0.0;
+    nmpc.Compute(est, ref, t, 0.0, &cmd);
+    if (failed >= 0) nmpc.SetRotorFailed(failed);
+    for (int k = 0; k < 5; ++k) nmpc.Compute(est, ref, t += 0.005, 0.005, &cmd);  // warm up
+    const long n = CountAllocations([&] {
+      for (int k = 0; k < 50; ++k) nmpc.Compute(est, ref, t += 0.005, 0.005, &cmd);
+    });
+    EXPECT_EQ(n, 0) << (failed >= 0 ? "after a failure" : "nominal");
+    EXPECT_TRUE(nmpc.summary().IsSolutionUsable());
+  }
+}
+
+TEST(Allocation, FaultDetectionAllocatesNothing) {
+  const vehicle::VehicleParams vehicle = rotorguard::testing::ReferenceQuad();
+  fdd::CompositeFdd detector(vehicle, {});
+  EscTelemetry esc;
+  esc.motor_speed_rad_s = RotorVector::Constant(4, std::sqrt(2.82 / vehicle.thrust_coefficient_n_s2));
+  ImuSample imu;
+  imu.specific_force_B = Vector3(0, 0, kGravity);
+  StateEstimate est;
+  est.valid = true;
+  est.p_W = Vector3(0, 0, 1);
+  const auto step = [&](TimeNs t) {
+    esc.t_ns = imu.t_ns = est.t_ns = t;
+    detector.OnEscTelemetry(esc);
+    detector.OnImu(imu);
+    detector.SetEstimate(est);
+    detector.SetCommand(RotorVector::Constant(4, 2.82));
+  };
+  for (int k = 0; k < 10; ++k) step(k * 3'000'000);
+  EXPECT_EQ(CountAllocations([&] {
+              for (int k = 10; k < 200; ++k) step(k * 3'000'000);
+            }),
+            0);
+}
+
+}  // namespace
+}  // namespace rotorguard::control
