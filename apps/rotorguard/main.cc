@@ -10,17 +10,20 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "rotorguard/bench/ftc_bench.h"
 #include "rotorguard/bench/nmpc_bench.h"
 #include "rotorguard/bench/qp_bench.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/bench/sim_bench.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/files.h"
 
 namespace {
 
@@ -174,6 +177,19 @@ int main(int argc, char** argv) {
               "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
   bench_nmpc->add_flag("--json", nmpc_json, "Print JSON instead of a table");
 
+  std::string ftc_trials_text = "20", ftc_seed_text = "1", ftc_methods = "rotorguard,none", ftc_out, ftc_jobs_text;
+  bool ftc_json = false;
+  CLI::App* bench_ftc = bench->add_subcommand(
+      "ftc", "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
+             "tracking the 2 m/s lemniscate and during take-off, plus fault-free trials for the false-alarm rate.\n"
+             "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).");
+  bench_ftc->add_option("--trials", ftc_trials_text, "Trials per cell (default 20, the paper's count)");
+  bench_ftc->add_option("--seed", ftc_seed_text, "Benchmark seed (default 1); trial seeds derive from it");
+  bench_ftc->add_option("--methods", ftc_methods, "Comma-separated methods: rotorguard, none (default both)");
+  bench_ftc->add_option("--jobs", ftc_jobs_text, "Worker threads (default: the number of cores)");
+  bench_ftc->add_option("--out", ftc_out, "Folder for results.json and tables.md");
+  bench_ftc->add_flag("--json", ftc_json, "Print JSON instead of Markdown");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -224,6 +240,44 @@ int main(int argc, char** argv) {
         fmt::print("cpu               {}\n", result["host"]["cpu"].get<std::string>());
       }
       return result["crashed"].get<bool>() ? kRunFailed : kOk;
+    }
+    if (*bench_ftc) {
+      rotorguard::bench::FtcBenchOptions o;
+      o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_text, 1, 1'000'000));
+      o.seed = ParseUnsigned("--seed", ftc_seed_text, 0, UINT64_MAX);
+      o.jobs = ftc_jobs_text.empty() ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
+                                     : static_cast<int>(ParseUnsigned("--jobs", ftc_jobs_text, 1, 256));
+      o.methods.clear();
+      const std::vector<std::string> known = rotorguard::bench::FtcMethods();
+      for (std::size_t start = 0; start <= ftc_methods.size();) {
+        const std::size_t comma = std::min(ftc_methods.find(',', start), ftc_methods.size());
+        const std::string m = ftc_methods.substr(start, comma - start);
+        if (std::find(known.begin(), known.end(), m) == known.end()) {
+          throw UsageError(fmt::format("--methods: '{}' is invalid; expected a comma-separated list of rotorguard, none", m));
+        }
+        o.methods.push_back(m);
+        start = comma + 1;
+      }
+      const std::string dir = fs::path(DefaultBenchScenario()).parent_path().parent_path().string();
+      o.vehicle = rotorguard::bench::LoadVehicle(dir + "/vehicles/zhou2025_quad.yaml");
+      if (!ftc_out.empty()) {
+        std::error_code ec;
+        fs::create_directories(ftc_out, ec);
+        if (ec || !fs::is_directory(ftc_out)) throw UsageError(fmt::format("--out: cannot create folder '{}'", ftc_out));
+      }
+      const bool tty = ::isatty(STDERR_FILENO);
+      o.progress = [tty](int done, int total) {
+        if (tty) std::fprintf(stderr, "\rtrials %d / %d", done, total);
+        if (tty && done == total) std::fprintf(stderr, "\n");
+      };
+      const nlohmann::json r = rotorguard::bench::RunFtcBenchmark(o);
+      const std::string md = rotorguard::bench::FtcMarkdown(r);
+      if (!ftc_out.empty()) {
+        rotorguard::io::WriteFileAtomically((fs::path(ftc_out) / "results.json").string(), r.dump(2) + "\n");
+        rotorguard::io::WriteFileAtomically((fs::path(ftc_out) / "tables.md").string(), md);
+      }
+      fmt::print("{}", ftc_json ? r.dump(2) + "\n" : md);
+      return r["errors"].get<int>() > 0 ? kRunFailed : kOk;
     }
     if (*bench_nmpc) {
       const std::string dir = fs::path(DefaultBenchScenario()).parent_path().string();

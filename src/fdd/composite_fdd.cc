@@ -149,7 +149,11 @@ void CompositeFdd::RunObserver(double t) {
                                           wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
   if (flying && !airborne_since_s_) airborne_since_s_ = t;
   if (!flying) airborne_since_s_.reset();
-  if (!airborne_since_s_) {
+  // The observer and the take-off detector assume one failure in a vehicle that otherwise flies
+  // as modelled (paper 000 treats single failures). After an isolation the reconfigured vehicle
+  // spins, saturates rotors and may touch down, which they would misread as further failures;
+  // the motor index, a direct measurement, keeps watching every motor.
+  if (!airborne_since_s_ || first_isolated_) {
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
     return;
   }

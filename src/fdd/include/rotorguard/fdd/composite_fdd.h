@@ -3,6 +3,7 @@
 /// ESC telemetry, the thrust/torque-loss observer (eqs. 14-17) on filtered IMU data and measured
 /// rotor speeds, and the take-off detector (eq. 18). It sees only sensor messages, the stack's
 /// estimate and its own commands; docs/fdd.md gives the filter design and the measured latencies.
+/// After the first isolation only the motor index keeps watching (single failures, as the paper).
 #include <optional>
 #include <string>
 #include <string_view>

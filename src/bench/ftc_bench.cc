@@ -1,0 +1,299 @@
+#include "rotorguard/bench/ftc_bench.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "rotorguard/bench/runner.h"
+#include "rotorguard/bench/scenario.h"
+#include "rotorguard/bench/sim_bench.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/planning/references.h"
+
+namespace rotorguard::bench {
+
+namespace {
+
+struct Cell {
+  const char* test;   // the paper's test number, "-" for fault-free trials
+  const char* phase;  // hover, tracking, takeoff
+  const char* fault;  // propeller_loss, motor_stop, none
+};
+
+constexpr Cell kCells[] = {
+    {"#1", "hover", "propeller_loss"},    {"#2", "hover", "motor_stop"},
+    {"#1", "tracking", "propeller_loss"}, {"#2", "tracking", "motor_stop"},
+    {"#3", "takeoff", "propeller_loss"},  {"#4", "takeoff", "motor_stop"},
+    {"-", "hover", "none"},               {"-", "tracking", "none"},
+    {"-", "takeoff", "none"},
+};
+constexpr int kNumCells = sizeof(kCells) / sizeof(kCells[0]);
+
+/// A trial's scenario: the phase's mission, the drawn fault, gust and noise seed, the method's stack.
+Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOptions& o, std::uint64_t trial_seed) {
+  Rng rng(trial_seed);
+  const int rotor = std::min(o.vehicle.num_rotors() - 1, static_cast<int>(rng.Uniform() * o.vehicle.num_rotors()));
+  const double gust = rng.Uniform(0.0, 0.3);
+  const double draw = rng.Uniform();
+  Scenario s;
+  s.name = fmt::format("ftc_{}_{}_{}", cell.phase, cell.fault, method);
+  s.vehicle = o.vehicle;
+  s.seed = trial_seed;
+  s.sim.wind.gust_std_m_s = gust;
+  s.sim.wind.gust_time_constant_s = 2.0;
+  const std::string phase = cell.phase;
+  sim::FaultOnset onset;
+  if (phase == "hover") {
+    s.duration_s = 8.0;
+    s.initial_position_m = Vector3(0, 0, 2.0);
+    s.mission_type = "hover";
+    planning::HoverOptions h;
+    h.position_m = s.initial_position_m;
+    s.reference = std::make_shared<planning::HoverReference>(h);
+    onset = {sim::FaultOnset::Kind::kAtTime, 1.5 + 1.5 * draw};
+  } else if (phase == "tracking") {
+    s.duration_s = 14.0;
+    s.initial_position_m = Vector3(0, 0, 1.5);
+    s.mission_type = "lemniscate";
+    planning::LemniscateOptions l;  // the paper's 6 x 3 x 1 m at 2 m/s
+    l.center_m = s.initial_position_m;
+    l.max_speed_m_s = 2.0;
+    s.reference = std::make_shared<planning::LemniscateReference>(l);
+    onset = {sim::FaultOnset::Kind::kAtTime, 4.0 + 4.0 * draw};
+  } else {
+    s.duration_s = 8.0;
+    s.initial_position_m = Vector3::Zero();
+    s.mission_type = "takeoff";
+    planning::TakeoffOptions t;
+    t.altitude_m = 1.5;
+    s.reference = std::make_shared<planning::TakeoffReference>(t);
+    onset = {sim::FaultOnset::Kind::kDuringTakeoff, 0.05 + 0.25 * draw};
+  }
+  if (std::string(cell.fault) != "none") {
+    sim::FaultSpec f;
+    f.rotor = rotor;
+    f.kind = *vehicle::ParseFaultKind(cell.fault);
+    f.onset = onset;
+    s.faults.push_back(f);
+  }
+  s.stack.composite_fdd.imu_rate_hz = s.sim.imu.rate_hz;
+  s.stack.composite_fdd.imu_position_m = s.sim.imu.position_m;
+  if (method == "rotorguard") {
+    s.stack.controller = "nmpc";
+    s.stack.fdd = "composite";
+  } else {  // none: the nominal controller without fault detection
+    s.stack.controller = "nominal";
+    s.stack.fdd = "none";
+  }
+  s.log_rate_hz = 10.0;
+  return s;
+}
+
+struct TrialResult {
+  bool success = false;
+  bool has_fdd = false;
+  bool correct = false;
+  bool false_alarm = false;
+  double latency_s = -1.0;
+  double min_altitude_m = 0.0;
+  std::string error;
+  std::string failure;  // the run's failure reason, if it failed
+  std::uint64_t seed = 0;
+};
+
+double Mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+std::vector<std::string> FtcMethods() { return {"rotorguard", "none"}; }
+
+void FtcBenchOptions::Validate() const {
+  if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
+  if (jobs < 1 || jobs > 256) ThrowInvalidArgument("FtcBenchOptions", "jobs", jobs, "a count in [1, 256]");
+  if (methods.empty()) ThrowInvalidArgument("FtcBenchOptions", "methods", "(none)", "at least one method");
+  const std::vector<std::string> known = FtcMethods();
+  for (const std::string& m : methods) {
+    if (std::find(known.begin(), known.end(), m) == known.end()) {
+      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, none");
+    }
+  }
+  vehicle.Validate();
+}
+
+nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
+  o.Validate();
+  const int methods = static_cast<int>(o.methods.size());
+  const int total = kNumCells * methods * o.trials;
+  std::vector<TrialResult> results(static_cast<std::size_t>(total));
+  std::atomic<int> next{0}, done{0};
+  std::mutex progress_mutex;
+  const auto worker = [&] {
+    for (int task = next++; task < total; task = next++) {
+      const int trial = task % o.trials;
+      const int method = (task / o.trials) % methods;
+      const int cell = task / (o.trials * methods);
+      // The same draws for every method: the seed depends on the cell and trial only.
+      const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
+      TrialResult& r = results[task];
+      try {
+        const RunSummary s = RunScenario(MakeTrial(kCells[cell], o.methods[method], o, seed));
+        r.success = s.success;
+        r.failure = s.failure_reason;
+        r.seed = seed;
+        r.min_altitude_m = s.min_altitude_m;
+        if (s.fdd) {
+          r.has_fdd = true;
+          r.correct = s.fdd->correct;
+          r.false_alarm = s.fdd->false_alarm;
+          r.latency_s = s.fdd->latency_s;
+        }
+      } catch (const std::exception& e) {
+        r.error = e.what();
+      }
+      const int d = ++done;
+      if (o.progress) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        o.progress(d, total);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int j = 1; j < o.jobs; ++j) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+
+  nlohmann::json cells = nlohmann::json::array();
+  int errors = 0;
+  for (int c = 0; c < kNumCells; ++c) {
+    for (int m = 0; m < methods; ++m) {
+      const bool faulty = std::string(kCells[c].fault) != "none";
+      std::vector<double> latencies;
+      int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
+      nlohmann::json failures = nlohmann::json::array();  // the first few, to reproduce them
+      double min_alt = std::numeric_limits<double>::infinity();
+      for (int t = 0; t < o.trials; ++t) {
+        const TrialResult& r = results[(c * methods + m) * o.trials + t];
+        if (!r.error.empty()) ++errors;
+        success += r.success ? 1 : 0;
+        if (!r.success && failures.size() < 5) {
+          failures.push_back({{"trial", t}, {"seed", r.seed}, {"reason", r.error.empty() ? r.failure : r.error}});
+        }
+        min_alt = std::min(min_alt, r.min_altitude_m);
+        if (!r.has_fdd) continue;
+        ++with_fdd;
+        false_alarms += r.false_alarm ? 1 : 0;
+        // A missed detection: no correct isolation within 1 s of the onset (DESIGN.md, MDR).
+        if (faulty && (!r.correct || r.latency_s > 1.0)) ++missed;
+        if (r.correct) latencies.push_back(r.latency_s);
+      }
+      const double n = o.trials;
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      cells.push_back({{"test", kCells[c].test},
+                       {"phase", kCells[c].phase},
+                       {"fault", kCells[c].fault},
+                       {"method", o.methods[m]},
+                       {"trials", o.trials},
+                       {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
+                       {"fdd_latency_s_max",
+                        NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
+                       {"sucr", success / n},
+                       {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
+                       {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
+                       {"mini_alt_m", NullIfNan(min_alt)},
+                       {"failures", failures}});
+    }
+  }
+  return {{"benchmark", "ftc"},
+          {"cells", cells},
+          {"errors", errors},
+          {"options", {{"trials", o.trials}, {"seed", o.seed}, {"methods", o.methods}, {"jobs", o.jobs}}},
+          {"host", HostInfo()}};
+}
+
+namespace {
+std::string Fmt(const nlohmann::json& v, const char* format, double scale = 1.0) {
+  if (v.is_null()) return "/";
+  return fmt::format(fmt::runtime(format), v.get<double>() * scale);
+}
+
+/// The paper's figures (DESIGN.md, "Reference numbers"): "ours / FixedA" where it gives both.
+std::string Paper(const std::string& phase, const std::string& fault, const std::string& metric) {
+  if (metric == "latency") {
+    if (phase == "hover") return fault == "propeller_loss" ? "0.105" : "0.032";
+    if (phase == "tracking") return fault == "propeller_loss" ? "0.184 / 0.253" : "0.028 / 0.225";
+    return "0.020";
+  }
+  if (metric == "sucr") {
+    if (phase == "tracking") return fault == "propeller_loss" ? "90 / 60" : "100 / 70";
+    if (phase == "hover") return "100";
+    return "ok / crash";
+  }
+  if (metric == "none") return "";
+  if (metric == "mini_alt") return phase == "takeoff" ? (fault == "propeller_loss" ? "0 (UnifP -0.262, FixedA -9.278)" : "0 (UnifP -0.228)") : "";
+  return "0";
+}
+}  // namespace
+
+std::string FtcMarkdown(const nlohmann::json& result) {
+  std::vector<std::string> methods;
+  for (const auto& m : result["options"]["methods"]) methods.push_back(m.get<std::string>());
+  std::string out = fmt::format("FTC benchmark, {} trials per cell, seed {}\n\n", result["options"]["trials"].get<int>(),
+                                result["options"]["seed"].get<std::uint64_t>());
+  std::string header = "| test | phase | fault | metric |";
+  std::string rule = "|---|---|---|---|";
+  for (const auto& m : methods) {
+    header += " " + m + " |";
+    rule += "---|";
+  }
+  out += header + " paper (ours / FixedA) |\n" + rule + "---|\n";
+  const auto cell = [&](const std::string& phase, const std::string& fault, const std::string& method) {
+    for (const auto& c : result["cells"]) {
+      if (c["phase"] == phase && c["fault"] == fault && c["method"] == method) return c;
+    }
+    return nlohmann::json();
+  };
+  for (const auto& c0 : result["cells"]) {
+    if (c0["method"] != methods.front()) continue;
+    const std::string phase = c0["phase"], fault = c0["fault"], test = c0["test"];
+    struct Row {
+      const char* name;
+      const char* key;
+      const char* format;
+      double scale;
+      const char* paper;
+    };
+    const Row rows[] = {{"FDD latency mean (s)", "fdd_latency_s_mean", "{:.3f}", 1.0, "latency"},
+                        {"FDD latency max (s)", "fdd_latency_s_max", "{:.3f}", 1.0, "none"},
+                        {"SucR (%)", "sucr", "{:.1f}", 100.0, "sucr"},
+                        {"MDR (%)", "mdr", "{:.1f}", 100.0, "rate"},
+                        {"FAR (%)", "far", "{:.1f}", 100.0, "rate"},
+                        {"MiniA (m)", "mini_alt_m", "{:.3f}", 1.0, "mini_alt"}};
+    for (const Row& row : rows) {
+      if (fault == "none" && (std::string(row.key) == "fdd_latency_s_mean" || std::string(row.key) == "fdd_latency_s_max" ||
+                              std::string(row.key) == "mdr")) {
+        continue;
+      }
+      if (std::string(row.key) == "mini_alt_m" && phase != "takeoff") continue;
+      std::string line = fmt::format("| {} | {} | {} | {} |", test, phase, fault, row.name);
+      for (const auto& m : methods) line += " " + Fmt(cell(phase, fault, m)[row.key], row.format, row.scale) + " |";
+      const std::string paper = fault == "none" ? (std::string(row.key) == "far" ? "0" : "") : Paper(phase, fault, row.paper);
+      out += line + " " + paper + " |\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace rotorguard::bench

@@ -1,0 +1,41 @@
+#pragma once
+/// `rotorguard bench ftc`: paper 000's FTC benchmark (Sec. VI-A, Tables III and IV) as Monte Carlo
+/// trials. Test #1 propeller and Test #2 motor failure while hovering and while tracking the 2 m/s
+/// lemniscate, Tests #3 / #4 the same during take-off, plus fault-free trials of every phase for the
+/// false-alarm rate. Each trial draws its onset, rotor, noise seed and a light gust from a seed
+/// derived from the benchmark seed and the trial index, so results do not depend on the job count.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::bench {
+
+struct FtcBenchOptions {
+  int trials = 20;                 ///< per cell (the paper's count), >= 1
+  std::uint64_t seed = 1;
+  /// Methods by name: rotorguard (composite FDD + NMPC), none (nominal controller, no FDD).
+  std::vector<std::string> methods = {"rotorguard", "none"};
+  int jobs = 1;                    ///< worker threads, >= 1
+  vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
+  /// Called after each finished trial with (done, total).
+  std::function<void(int, int)> progress;
+  void Validate() const;
+};
+
+/// The method names RunFtcBenchmark knows.
+std::vector<std::string> FtcMethods();
+
+/// Runs every cell and method; returns {"cells": [...], "options": {...}, "host": {...}} with, per
+/// cell, test, phase, fault, method, trials, fdd_latency_s_mean, fdd_latency_s_max, sucr, mdr,
+/// far and mini_alt_m (DESIGN.md, Metrics).
+nlohmann::json RunFtcBenchmark(const FtcBenchOptions& options);
+
+/// Markdown tables shaped like the paper's Tables III and IV, the paper's figures beside ours.
+std::string FtcMarkdown(const nlohmann::json& result);
+
+}  // namespace rotorguard::bench
