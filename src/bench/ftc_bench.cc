@@ -96,18 +96,6 @@ Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOp
   return s;
 }
 
-struct TrialResult {
-  bool success = false;
-  bool has_fdd = false;
-  bool correct = false;
-  bool false_alarm = false;
-  double latency_s = -1.0;
-  double min_altitude_m = 0.0;
-  std::string error;
-  std::string failure;  // the run's failure reason, if it failed
-  std::uint64_t seed = 0;
-};
-
 double Mean(const std::vector<double>& v) {
   double s = 0.0;
   for (double x : v) s += x;
@@ -117,6 +105,35 @@ double Mean(const std::vector<double>& v) {
 nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 }  // namespace
+
+nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty) {
+  std::vector<double> latencies;
+  int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
+  double min_alt = std::numeric_limits<double>::infinity();
+  nlohmann::json failures = nlohmann::json::array();  // the first few, to reproduce them
+  for (std::size_t t = 0; t < trials.size(); ++t) {
+    const FtcTrial& r = trials[t];
+    success += r.success ? 1 : 0;
+    if (!r.success && failures.size() < 5) failures.push_back({{"trial", t}, {"seed", r.seed}, {"reason", r.failure}});
+    min_alt = std::min(min_alt, r.min_altitude_m);
+    if (!r.has_fdd) continue;
+    ++with_fdd;
+    false_alarms += r.false_alarm ? 1 : 0;
+    // A missed detection: no correct isolation within 1 s of the onset (DESIGN.md, MDR).
+    if (faulty && (!r.correct || r.latency_s > 1.0)) ++missed;
+    if (r.correct) latencies.push_back(r.latency_s);
+  }
+  const double n = static_cast<double>(trials.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {{"trials", trials.size()},
+          {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
+          {"fdd_latency_s_max", NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
+          {"sucr", n > 0 ? success / n : 0.0},
+          {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
+          {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
+          {"mini_alt_m", NullIfNan(min_alt)},
+          {"failures", failures}};
+}
 
 std::vector<std::string> FtcMethods() { return {"rotorguard", "none"}; }
 
@@ -137,7 +154,7 @@ nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
   o.Validate();
   const int methods = static_cast<int>(o.methods.size());
   const int total = kNumCells * methods * o.trials;
-  std::vector<TrialResult> results(static_cast<std::size_t>(total));
+  std::vector<FtcTrial> results(static_cast<std::size_t>(total));
   std::atomic<int> next{0}, done{0};
   std::mutex progress_mutex;
   const auto worker = [&] {
@@ -147,12 +164,11 @@ nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
       const int cell = task / (o.trials * methods);
       // The same draws for every method: the seed depends on the cell and trial only.
       const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
-      TrialResult& r = results[task];
+      FtcTrial& r = results[task];
       try {
         const RunSummary s = RunScenario(MakeTrial(kCells[cell], o.methods[method], o, seed));
         r.success = s.success;
         r.failure = s.failure_reason;
-        r.seed = seed;
         r.min_altitude_m = s.min_altitude_m;
         if (s.fdd) {
           r.has_fdd = true;
@@ -161,8 +177,9 @@ nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
           r.latency_s = s.fdd->latency_s;
         }
       } catch (const std::exception& e) {
-        r.error = e.what();
+        r.failure = std::string("error: ") + e.what();
       }
+      r.seed = seed;
       const int d = ++done;
       if (o.progress) {
         std::lock_guard<std::mutex> lock(progress_mutex);
@@ -179,41 +196,15 @@ nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
   int errors = 0;
   for (int c = 0; c < kNumCells; ++c) {
     for (int m = 0; m < methods; ++m) {
-      const bool faulty = std::string(kCells[c].fault) != "none";
-      std::vector<double> latencies;
-      int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
-      nlohmann::json failures = nlohmann::json::array();  // the first few, to reproduce them
-      double min_alt = std::numeric_limits<double>::infinity();
-      for (int t = 0; t < o.trials; ++t) {
-        const TrialResult& r = results[(c * methods + m) * o.trials + t];
-        if (!r.error.empty()) ++errors;
-        success += r.success ? 1 : 0;
-        if (!r.success && failures.size() < 5) {
-          failures.push_back({{"trial", t}, {"seed", r.seed}, {"reason", r.error.empty() ? r.failure : r.error}});
-        }
-        min_alt = std::min(min_alt, r.min_altitude_m);
-        if (!r.has_fdd) continue;
-        ++with_fdd;
-        false_alarms += r.false_alarm ? 1 : 0;
-        // A missed detection: no correct isolation within 1 s of the onset (DESIGN.md, MDR).
-        if (faulty && (!r.correct || r.latency_s > 1.0)) ++missed;
-        if (r.correct) latencies.push_back(r.latency_s);
-      }
-      const double n = o.trials;
-      const double nan = std::numeric_limits<double>::quiet_NaN();
-      cells.push_back({{"test", kCells[c].test},
-                       {"phase", kCells[c].phase},
-                       {"fault", kCells[c].fault},
-                       {"method", o.methods[m]},
-                       {"trials", o.trials},
-                       {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
-                       {"fdd_latency_s_max",
-                        NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
-                       {"sucr", success / n},
-                       {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
-                       {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
-                       {"mini_alt_m", NullIfNan(min_alt)},
-                       {"failures", failures}});
+      const auto first = results.begin() + (c * methods + m) * o.trials;
+      const std::vector<FtcTrial> trials(first, first + o.trials);
+      for (const FtcTrial& t : trials) errors += t.failure.rfind("error: ", 0) == 0 ? 1 : 0;
+      nlohmann::json cell = AggregateFtcCell(trials, std::string(kCells[c].fault) != "none");
+      cell["test"] = kCells[c].test;
+      cell["phase"] = kCells[c].phase;
+      cell["fault"] = kCells[c].fault;
+      cell["method"] = o.methods[m];
+      cells.push_back(cell);
     }
   }
   return {{"benchmark", "ftc"},

@@ -75,41 +75,6 @@ void Deliver(const sim::SensorOutputs& o, stack::FlightStack* st) {
 
 double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
 
-/// Whether a diagnosis names the injected fault kind.
-bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis) {
-  switch (truth) {
-    case vehicle::FaultKind::kMotorStop: return diagnosis == fdd::RotorHealth::kMotorFailed;
-    case vehicle::FaultKind::kPropellerLoss: return diagnosis == fdd::RotorHealth::kPropellerFailed;
-    case vehicle::FaultKind::kLossOfEffectiveness: return diagnosis == fdd::RotorHealth::kDegraded;
-    case vehicle::FaultKind::kStuck: return diagnosis != fdd::RotorHealth::kOk;  // any diagnosis of the rotor
-    case vehicle::FaultKind::kNone: return false;
-  }
-  return false;
-}
-
-FddRecord ScoreFdd(const fdd::CompositeFdd& detector, const std::vector<sim::FaultEvent>& events) {
-  FddRecord r;
-  const auto& rotors = detector.rotors();
-  for (int i = 0; i < static_cast<int>(rotors.size()); ++i) {
-    if (!rotors[i].detected_s) continue;
-    if (!r.detected || *rotors[i].detected_s < r.detection_s) {
-      r.detected = true;
-      r.rotor = i;
-      r.detection_s = *rotors[i].detected_s;
-      r.kind = std::string(fdd::ToString(rotors[i].health));
-      r.detector = rotors[i].detector;
-    }
-  }
-  if (!r.detected) return r;
-  if (events.empty() || r.detection_s < events.front().onset_s) {
-    r.false_alarm = true;
-    return r;
-  }
-  const sim::FaultEvent& first = events.front();
-  r.correct = r.rotor == first.rotor && KindMatches(first.kind, rotors[r.rotor].health);
-  if (r.correct) r.latency_s = r.detection_s - first.onset_s;
-  return r;
-}
 }  // namespace
 
 nlohmann::json RunSummary::ToJson() const {
@@ -273,7 +238,9 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     // Still tilted at the very end: it never settled.
     summary.tilt_recovery_s = settle >= summary.sim_time_s - 2.0 * dt ? -1.0 : std::max(0.0, settle - onset);
   }
-  if (const fdd::CompositeFdd* detector = st.fault_detector()) summary.fdd = ScoreFdd(*detector, sim.fault_events());
+  if (const fdd::CompositeFdd* detector = st.fault_detector()) {
+    summary.fdd = ScoreFdd(detector->rotors(), sim.fault_events());
+  }
   for (const sim::FaultEvent& e : sim.fault_events()) {
     summary.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
   }

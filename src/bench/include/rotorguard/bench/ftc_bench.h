@@ -27,6 +27,23 @@ struct FtcBenchOptions {
   void Validate() const;
 };
 
+/// One trial's outcome, as the cells aggregate it.
+struct FtcTrial {
+  bool success = false;
+  bool has_fdd = false;      ///< the method runs fault detection
+  bool correct = false;      ///< right rotor and kind, at or after the onset
+  bool false_alarm = false;  ///< a diagnosis without a fault, or before the onset
+  double latency_s = -1.0;   ///< when correct
+  double min_altitude_m = 0.0;
+  std::string failure;       ///< why it failed (run failure or error), "" on success
+  std::uint64_t seed = 0;
+};
+
+/// A cell's metrics (DESIGN.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty
+/// cells: no correct isolation within 1 s), far, mini_alt_m (least altitude after the fault), and
+/// the first failures. Null where a metric does not apply (no FDD; MDR of fault-free cells).
+nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty);
+
 /// The method names RunFtcBenchmark knows.
 std::vector<std::string> FtcMethods();
 

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/scenario.h"
 
 namespace rotorguard::bench {
@@ -16,18 +17,6 @@ struct FaultRecord {
   int rotor = 0;
   std::string kind;
   double onset_s = 0.0;
-};
-
-/// What fault detection concluded, scored against the injected faults (DESIGN.md, Metrics).
-struct FddRecord {
-  bool detected = false;      ///< some rotor left the ok state
-  int rotor = -1;             ///< the first rotor diagnosed
-  std::string kind;           ///< motor_failed, propeller_failed or degraded
-  std::string detector;       ///< motor_index, thrust_loss_observer or takeoff
-  double detection_s = 0.0;
-  bool correct = false;       ///< right rotor and kind, at or after the first onset
-  bool false_alarm = false;   ///< a diagnosis without a fault, or before the first onset
-  double latency_s = -1.0;    ///< detection - onset when correct, else negative
 };
 
 /// The outcome of one run; the fields of summary.json (DESIGN.md keys; later features add keys).
