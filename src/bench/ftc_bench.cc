@@ -85,9 +85,14 @@ Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOp
   }
   s.stack.composite_fdd.imu_rate_hz = s.sim.imu.rate_hz;
   s.stack.composite_fdd.imu_position_m = s.sim.imu.position_m;
+  s.stack.fixed_time_fdd.imu_rate_hz = s.sim.imu.rate_hz;
+  s.stack.fixed_time_fdd.imu_position_m = s.sim.imu.position_m;
   if (method == "rotorguard") {
     s.stack.controller = "nmpc";
     s.stack.fdd = "composite";
+  } else if (method == "fixedtime") {  // FixedA: the fixed-time observer driving the same NMPC
+    s.stack.controller = "nmpc";
+    s.stack.fdd = "fixedtime";
   } else {  // none: the nominal controller without fault detection
     s.stack.controller = "nominal";
     s.stack.fdd = "none";
@@ -135,7 +140,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
           {"failures", failures}};
 }
 
-std::vector<std::string> FtcMethods() { return {"rotorguard", "none"}; }
+std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "none"}; }
 
 void FtcBenchOptions::Validate() const {
   if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
@@ -144,7 +149,7 @@ void FtcBenchOptions::Validate() const {
   const std::vector<std::string> known = FtcMethods();
   for (const std::string& m : methods) {
     if (std::find(known.begin(), known.end(), m) == known.end()) {
-      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, none");
+      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, none");
     }
   }
   vehicle.Validate();

@@ -22,8 +22,11 @@ double TrackingErrorAccumulator::rmse_eq37() const {
 
 bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis) {
   switch (truth) {
-    case vehicle::FaultKind::kMotorStop: return diagnosis == fdd::RotorHealth::kMotorFailed;
-    case vehicle::FaultKind::kPropellerLoss: return diagnosis == fdd::RotorHealth::kPropellerFailed;
+    // kFailed: a method that cannot tell the motor from the propeller isolates either correctly.
+    case vehicle::FaultKind::kMotorStop:
+      return diagnosis == fdd::RotorHealth::kMotorFailed || diagnosis == fdd::RotorHealth::kFailed;
+    case vehicle::FaultKind::kPropellerLoss:
+      return diagnosis == fdd::RotorHealth::kPropellerFailed || diagnosis == fdd::RotorHealth::kFailed;
     case vehicle::FaultKind::kLossOfEffectiveness: return diagnosis == fdd::RotorHealth::kDegraded;
     case vehicle::FaultKind::kStuck: return diagnosis != fdd::RotorHealth::kOk;
     case vehicle::FaultKind::kNone: return false;

@@ -238,7 +238,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     // Still tilted at the very end: it never settled.
     summary.tilt_recovery_s = settle >= summary.sim_time_s - 2.0 * dt ? -1.0 : std::max(0.0, settle - onset);
   }
-  if (const fdd::CompositeFdd* detector = st.fault_detector()) {
+  if (const fdd::FaultDetector* detector = st.fault_detector()) {
     summary.fdd = ScoreFdd(detector->rotors(), sim.fault_events());
   }
   for (const sim::FaultEvent& e : sim.fault_events()) {

@@ -316,7 +316,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { m.Validate(); });
   }
-  if (const auto f = node.Optional("fdd")) o->fdd = f->AsEnum({"none", "composite"});
+  if (const auto f = node.Optional("fdd")) o->fdd = f->AsEnum({"none", "composite", "fixedtime"});
   if (const auto c = node.Optional("composite_fdd")) {
     fdd::CompositeFddOptions& d = o->composite_fdd;
     d.motor_index_threshold = OptionalDouble(*c, "motor_index_threshold", d.motor_index_threshold);
@@ -473,6 +473,8 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   // The fault detector knows its own IMU: the sensor's rate and mounting point (hardware facts).
   s.stack.composite_fdd.imu_rate_hz = s.sim.imu.rate_hz;
   s.stack.composite_fdd.imu_position_m = s.sim.imu.position_m;
+  s.stack.fixed_time_fdd.imu_rate_hz = s.sim.imu.rate_hz;
+  s.stack.fixed_time_fdd.imu_position_m = s.sim.imu.position_m;
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
   for (std::size_t i = 0; i < s.stack.known_faults.size(); ++i) {
     if (s.stack.known_faults[i].rotor >= s.vehicle.num_rotors()) {

@@ -22,6 +22,7 @@ std::string_view ToString(RotorHealth h) {
     case RotorHealth::kMotorFailed: return "motor_failed";
     case RotorHealth::kPropellerFailed: return "propeller_failed";
     case RotorHealth::kDegraded: return "degraded";
+    case RotorHealth::kFailed: return "failed";
   }
   return "unknown";
 }

@@ -23,8 +23,11 @@ void FlightStackOptions::Validate() const {
                       "a time >= 0 s");
     }
   }
-  if (fdd != "none" && fdd != "composite") ThrowValidation("FlightStackOptions", "fdd", fdd, "one of: none, composite");
+  if (fdd != "none" && fdd != "composite" && fdd != "fixedtime") {
+    ThrowValidation("FlightStackOptions", "fdd", fdd, "one of: none, composite, fixedtime");
+  }
   composite_fdd.Validate();
+  fixed_time_fdd.Validate();
   if (!known_faults.empty() && controller != "nmpc") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,
                     "controller nmpc (the only controller that reconfigures)");
@@ -56,6 +59,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
   }
   known_fault_applied_.assign(options_.known_faults.size(), false);
   if (options_.fdd == "composite") fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
+  if (options_.fdd == "fixedtime") fdd_ = std::make_unique<fdd::FixedTimeFdd>(model_.params(), options_.fixed_time_fdd);
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
 }

@@ -2,6 +2,7 @@
 // is known exactly: speeds from the drive thrusts, specific force and rates from the thrusts that
 // actually act.
 #include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/fdd/fixed_time_fdd.h"
 
 #include <cmath>
 
@@ -20,9 +21,10 @@ using rotorguard::testing::ReferenceQuad;
 /// A vehicle hovering at 1 m whose rotors drive `drive` thrusts while `actual` thrusts act (they
 /// differ by the fault); integrates the rotation the torque imbalance causes and feeds the FDD
 /// IMU (333 Hz, polled at 1 kHz), telemetry (1 kHz) and estimates (200 Hz).
-class Bench {
+template <typename Detector, typename Options>
+class BenchOf {
  public:
-  explicit Bench(double noise = 0.0, CompositeFddOptions options = {})
+  explicit BenchOf(double noise = 0.0, Options options = {})
       : vehicle_(ReferenceQuad()), fdd_(vehicle_, options), rng_(3), noise_(noise) {
     hover_ = RotorVector::Constant(4, vehicle_.weight_n() / 4.0);
     drive_ = actual_ = hover_;
@@ -74,7 +76,7 @@ class Bench {
   double now() const { return ToSeconds(t_); }
 
   vehicle::VehicleParams vehicle_;
-  CompositeFdd fdd_;
+  Detector fdd_;
   Rng rng_;
   double noise_;
   RotorVector hover_, drive_, actual_;
@@ -83,6 +85,8 @@ class Bench {
   TimeNs t_ = 0;
   std::optional<double> first_;
 };
+
+using Bench = BenchOf<CompositeFdd, CompositeFddOptions>;
 
 TEST(CompositeFdd, NoDetectionOnNoiseOnly) {
   Bench b(1.0);
@@ -161,6 +165,25 @@ TEST(CompositeFdd, TakeoffDetectorIsolatesEveryRotorJustAfterLiftOff) {
     EXPECT_EQ(b.fdd_.rotors()[rotor].health, RotorHealth::kPropellerFailed);
     EXPECT_LT(*detected - onset, 0.03);
   }
+}
+
+TEST(FixedTimeFdd, IsolatesEveryRotorFromTheObserverWithoutTelemetry) {
+  // The FixedA baseline sees only commands, IMU and estimates: it isolates the rotor, not the kind.
+  for (int rotor = 0; rotor < 4; ++rotor) {
+    for (bool motor : {false, true}) {
+      BenchOf<FixedTimeFdd, FixedTimeFddOptions> b(1.0);
+      ASSERT_FALSE(b.Run(1.0));
+      const double onset = b.now();
+      b.actual_[rotor] = 0.0;
+      if (motor) b.drive_[rotor] = 0.0;
+      const auto detected = b.Run(1.0);
+      ASSERT_TRUE(detected) << "rotor " << rotor;
+      EXPECT_EQ(b.fdd_.rotors()[rotor].health, RotorHealth::kFailed);
+      EXPECT_LT(*detected - onset, 0.3);
+    }
+  }
+  BenchOf<FixedTimeFdd, FixedTimeFddOptions> quiet(1.0);
+  EXPECT_FALSE(quiet.Run(5.0));  // noise only
 }
 
 TEST(CompositeFdd, OptionsValidationNamesTheField) {

@@ -18,8 +18,9 @@ namespace rotorguard::bench {
 struct FtcBenchOptions {
   int trials = 20;                 ///< per cell (the paper's count), >= 1
   std::uint64_t seed = 1;
-  /// Methods by name: rotorguard (composite FDD + NMPC), none (nominal controller, no FDD).
-  std::vector<std::string> methods = {"rotorguard", "none"};
+  /// Methods by name: rotorguard (composite FDD + NMPC), fixedtime (FixedA: fixed-time observer
+  /// + the same NMPC), none (nominal controller, no FDD).
+  std::vector<std::string> methods = {"rotorguard", "fixedtime", "none"};
   int jobs = 1;                    ///< worker threads, >= 1
   vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
   /// Called after each finished trial with (done, total).

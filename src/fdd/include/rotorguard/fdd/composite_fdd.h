@@ -53,7 +53,8 @@ struct CompositeFddOptions {
   void Validate() const;
 };
 
-enum class RotorHealth { kOk, kMotorFailed, kPropellerFailed, kDegraded };
+/// kFailed: a rotor isolated as failed by a method that cannot tell the motor from the propeller.
+enum class RotorHealth { kOk, kMotorFailed, kPropellerFailed, kDegraded, kFailed };
 std::string_view ToString(RotorHealth health);
 
 struct RotorStatus {
@@ -65,20 +66,35 @@ struct RotorStatus {
   std::string detector;          ///< "motor_index", "thrust_loss_observer", "takeoff"
 };
 
-class CompositeFdd {
+/// The interface every fault detector implements, so that a stack or a benchmark swaps them by name.
+class FaultDetector {
+ public:
+  virtual ~FaultDetector() = default;
+  virtual std::string_view name() const = 0;
+  virtual void OnImu(const ImuSample& imu) = 0;
+  virtual void OnEscTelemetry(const EscTelemetry& esc) = 0;
+  /// The commanded thrusts sent to the motors and the stack's current estimate.
+  virtual void SetCommand(const RotorVector& thrust_command) = 0;
+  virtual void SetEstimate(const StateEstimate& estimate) = 0;
+  virtual const std::vector<RotorStatus>& rotors() const = 0;
+  /// Rotors isolated as failed since the last call; cleared by the call.
+  virtual std::vector<int> TakeNewIsolations() = 0;
+};
+
+class CompositeFdd final : public FaultDetector {
  public:
   CompositeFdd(const vehicle::VehicleParams& vehicle, const CompositeFddOptions& options);
 
-  void OnImu(const ImuSample& imu);
-  void OnEscTelemetry(const EscTelemetry& esc);
+  std::string_view name() const override { return "composite"; }
+  void OnImu(const ImuSample& imu) override;
+  void OnEscTelemetry(const EscTelemetry& esc) override;
   /// The commanded thrusts sent to the motors (the motor index's reference) and the stack's
   /// current estimate (attitude, velocity, altitude).
-  void SetCommand(const RotorVector& thrust_command);
-  void SetEstimate(const StateEstimate& estimate);
+  void SetCommand(const RotorVector& thrust_command) override;
+  void SetEstimate(const StateEstimate& estimate) override;
 
-  const std::vector<RotorStatus>& rotors() const { return rotors_; }
-  /// Rotors isolated as failed (motor or propeller) since the last call; cleared by the call.
-  std::vector<int> TakeNewIsolations();
+  const std::vector<RotorStatus>& rotors() const override { return rotors_; }
+  std::vector<int> TakeNewIsolations() override;
   /// The first isolation (rotor, time), if any.
   std::optional<int> first_isolated_rotor() const { return first_isolated_; }
   /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16), for logs.

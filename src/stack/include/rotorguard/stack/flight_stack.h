@@ -12,6 +12,7 @@
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/fdd/fixed_time_fdd.h"
 #include "rotorguard/stack/estimator.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -31,10 +32,11 @@ struct FlightStackOptions {
   control::NominalControllerOptions nominal;
   control::NmpcOptions nmpc;
   std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc only)
-  /// Fault detection: "none" or "composite" (paper 000, Sec. V-B). On isolation the NMPC is
-  /// reconfigured (ignored by the nominal controller, which cannot).
+  /// Fault detection: "none", "composite" (paper 000, Sec. V-B) or "fixedtime" (the FixedA
+  /// baseline). On isolation the NMPC is reconfigured (the nominal controller cannot be).
   std::string fdd = "none";
   fdd::CompositeFddOptions composite_fdd;
+  fdd::FixedTimeFddOptions fixed_time_fdd;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -59,7 +61,7 @@ class FlightStack {
   /// The NMPC, when it is the controller (for its solve statistics); else null.
   const control::NmpcController* nmpc() const { return nmpc_; }
   /// The fault detector, when there is one; else null.
-  const fdd::CompositeFdd* fault_detector() const { return fdd_.get(); }
+  const fdd::FaultDetector* fault_detector() const { return fdd_.get(); }
 
  private:
   vehicle::MultirotorModel model_;
@@ -68,7 +70,7 @@ class FlightStack {
   OdometryPassThroughEstimator estimator_;
   std::unique_ptr<control::Controller> controller_;
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
-  std::unique_ptr<fdd::CompositeFdd> fdd_;
+  std::unique_ptr<fdd::FaultDetector> fdd_;
   std::vector<bool> known_fault_applied_;
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
