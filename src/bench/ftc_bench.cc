@@ -93,6 +93,9 @@ Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOp
   } else if (method == "fixedtime") {  // FixedA: the fixed-time observer driving the same NMPC
     s.stack.controller = "nmpc";
     s.stack.fdd = "fixedtime";
+  } else if (method == "passive") {  // UnifP: one passive fault-tolerant controller, no FDD
+    s.stack.controller = "passive";
+    s.stack.fdd = "none";
   } else {  // none: the nominal controller without fault detection
     s.stack.controller = "nominal";
     s.stack.fdd = "none";
@@ -140,7 +143,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
           {"failures", failures}};
 }
 
-std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "none"}; }
+std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "passive", "none"}; }
 
 void FtcBenchOptions::Validate() const {
   if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
@@ -149,7 +152,7 @@ void FtcBenchOptions::Validate() const {
   const std::vector<std::string> known = FtcMethods();
   for (const std::string& m : methods) {
     if (std::find(known.begin(), known.end(), m) == known.end()) {
-      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, none");
+      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, passive, none");
     }
   }
   vehicle.Validate();

@@ -282,7 +282,7 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
 }
 
 void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
-  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc"});
+  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive"});
   o->control_rate_hz = OptionalDouble(node, "control_rate_hz", o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;

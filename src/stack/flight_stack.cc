@@ -12,10 +12,11 @@ void FlightStackOptions::Validate() const {
   if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > 10000.0) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
   }
-  if (controller != "nominal" && controller != "nmpc") {
-    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc");
+  if (controller != "nominal" && controller != "nmpc" && controller != "passive") {
+    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc, passive");
   }
   nominal.Validate();
+  passive.Validate();
   nmpc.Validate();
   for (std::size_t i = 0; i < known_faults.size(); ++i) {
     if (!std::isfinite(known_faults[i].at_time_s) || known_faults[i].at_time_s < 0.0) {
@@ -47,6 +48,8 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     auto nmpc = std::make_unique<control::NmpcController>(model_.params(), options_.nmpc);
     nmpc_ = nmpc.get();
     controller_ = std::move(nmpc);
+  } else if (options_.controller == "passive") {
+    controller_ = std::make_unique<control::PassiveController>(model_, options_.passive);
   } else {
     controller_ = std::make_unique<control::NominalController>(model_, options_.nominal);
   }

@@ -139,3 +139,16 @@ TEST(FddClosedLoop, AFaultDuringTakeoffOnEachRotorEndsInAStableHover) {
 
 }  // namespace
 }  // namespace rotorguard::bench
+
+namespace rotorguard::bench {
+namespace {
+
+TEST(PassiveClosedLoop, TracksTheNominalLemniscateWithYawLeftFree) {
+  const RunSummary r = RunScenario(
+      LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "passive"}, {"duration_s", "20"}}));
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_LT(r.tracking_rmse_m, 0.10);
+}
+
+}  // namespace
+}  // namespace rotorguard::bench

@@ -9,6 +9,7 @@
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/control/nominal_controller.h"
+#include "rotorguard/control/passive_controller.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/fdd/composite_fdd.h"
@@ -28,8 +29,9 @@ struct KnownFault {
 
 struct FlightStackOptions {
   double control_rate_hz = 200.0;    ///< controller rate (paper 000: 200 Hz), in (0, 10000]
-  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc
+  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc, passive
   control::NominalControllerOptions nominal;
+  control::PassiveControllerOptions passive;
   control::NmpcOptions nmpc;
   std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc only)
   /// Fault detection: "none", "composite" (paper 000, Sec. V-B) or "fixedtime" (the FixedA

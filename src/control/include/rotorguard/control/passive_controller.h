@@ -1,0 +1,46 @@
+#pragma once
+/// Baseline "UnifP" of paper 000: one fixed controller that never reconfigures (no fault
+/// detection), in the spirit of Ke, Cai and Quan's uniform passive FTC (T-RO 2023); our
+/// re-implementation. It controls position through the thrust direction only (a reduced attitude:
+/// yaw is left free to spin) and allocates with priority on thrust and tilt torques: a small
+/// box-constrained least-squares problem that gives up the yaw torque entirely.
+#include "rotorguard/control/controller.h"
+#include "rotorguard/control/dense_qp.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace rotorguard::control {
+
+struct PassiveControllerOptions {
+  Vector3 kp_position = Vector3(9.0, 9.0, 12.0);  ///< [1/s^2], >= 0
+  Vector3 kd_velocity = Vector3(6.0, 6.0, 7.0);   ///< [1/s], >= 0
+  Vector3 ki_position = Vector3(1.0, 1.0, 2.0);   ///< [1/s^3], >= 0
+  double integral_limit_m_s2 = 2.0;               ///< [m/s^2], >= 0
+  double max_tilt_rad = 0.7;                      ///< thrust-direction tilt limit, in (0, pi/2)
+  double k_tilt = 9.0;   ///< reduced-attitude error -> roll/pitch rate [1/s], > 0
+  double k_rate = 22.0;  ///< roll/pitch rate error -> angular acceleration [1/s], > 0
+  /// Regularisation towards equal rotor thrusts (makes the 4-rotor, 3-objective allocation
+  /// unique), relative to the thrust weight, > 0.
+  double regularisation = 1e-3;
+  void Validate() const;
+};
+
+class PassiveController final : public Controller {
+ public:
+  PassiveController(const vehicle::MultirotorModel& model, const PassiveControllerOptions& options);
+  std::string_view name() const override { return "passive"; }
+  void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
+               RotorVector* thrust_command) override;
+  void Reset() override { integral_.setZero(); }
+
+ private:
+  const vehicle::MultirotorModel& model_;
+  PassiveControllerOptions options_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> allocation_map_;  // rows [T; tau_x; tau_y] of M_t
+  Eigen::Vector3d objective_weights_;                        // thrust, roll, pitch
+  DenseQp qp_;
+  DenseQpSolver solver_;
+  RotorVector hover_;
+  Vector3 integral_ = Vector3::Zero();
+};
+
+}  // namespace rotorguard::control
