@@ -118,6 +118,7 @@ void NmpcController::SetRotorFailed(int rotor) {
   if (rotor < 0 || rotor >= nu_) {
     ThrowInvalidArgument("NmpcController::SetRotorFailed", "rotor", rotor, fmt::format("an index in [0, {})", nu_));
   }
+  if (failed_[rotor]) return;  // already reconfigured
   failed_[rotor] = true;
   u_max_[rotor] = 0.0;  // u_bar_i = 0 (paper 000, Sec. V-A)
   UpdateThrustSplit();

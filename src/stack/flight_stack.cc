@@ -31,7 +31,7 @@ void FlightStackOptions::Validate() const {
   fixed_time_fdd.Validate();
   if (!known_faults.empty() && controller != "nmpc") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,
-                    "controller nmpc (the only controller that reconfigures)");
+                    "controller nmpc (the controller that reconfigures)");
   }
 }
 
@@ -92,16 +92,15 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   }
   for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
     if (!known_fault_applied_[i] && ToSeconds(t) >= options_.known_faults[i].at_time_s) {
-      nmpc_->SetRotorFailed(options_.known_faults[i].rotor);
+      controller_->SetRotorFailed(options_.known_faults[i].rotor);
       known_fault_applied_[i] = true;
     }
   }
   if (fdd_) {
     fdd_->SetEstimate(estimate_);
-    // Isolation reconfigures the NMPC: u_bar_i = 0, yaw given up, post-failure thrust reference.
-    for (int rotor : fdd_->TakeNewIsolations()) {
-      if (nmpc_ && !nmpc_->failed_rotors()[rotor]) nmpc_->SetRotorFailed(rotor);
-    }
+    // Isolation reconfigures the controller (the NMPC: u_bar_i = 0, yaw given up, post-failure
+    // thrust reference); controllers that cannot reconfigure ignore it.
+    for (int rotor : fdd_->TakeNewIsolations()) controller_->SetRotorFailed(rotor);
   }
   controller_->Compute(estimate_, *reference_, ToSeconds(t), dt, &command_.thrust_n);
   if (fdd_) fdd_->SetCommand(command_.thrust_n);

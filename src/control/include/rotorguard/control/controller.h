@@ -20,6 +20,9 @@ class Controller {
                        RotorVector* thrust_command) = 0;
   /// Clears internal state (integrators, filters).
   virtual void Reset() = 0;
+  /// A rotor has been isolated as failed. Controllers that can reconfigure do; the default ignores
+  /// it (the nominal and passive controllers never reconfigure).
+  virtual void SetRotorFailed(int /*rotor*/) {}
 };
 
 }  // namespace rotorguard::control

@@ -81,7 +81,7 @@ class NmpcController final : public Controller {
   /// (a healthy diagonal twin idles, the others share the weight with zero roll/pitch torque, in
   /// the least-squares sense when that is impossible) and reference spin. No rebuild. Throws
   /// std::invalid_argument for a rotor out of range.
-  void SetRotorFailed(int rotor);
+  void SetRotorFailed(int rotor) override;
   const std::vector<bool>& failed_rotors() const { return failed_; }
   const NmpcSummary& summary() const { return summary_; }
   const NmpcOptions& options() const { return options_; }
