@@ -286,11 +286,11 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
   o->control_rate_hz = OptionalDouble(node, "control_rate_hz", o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;
-    g.kp_position = OptionalVector3(*n, "kp_position", g.kp_position);
-    g.kd_velocity = OptionalVector3(*n, "kd_velocity", g.kd_velocity);
-    g.ki_position = OptionalVector3(*n, "ki_position", g.ki_position);
-    g.integral_limit_m_s2 = OptionalDouble(*n, "integral_limit_m_s2", g.integral_limit_m_s2);
-    g.max_tilt_rad = OptionalDouble(*n, "max_tilt_rad", g.max_tilt_rad);
+    g.position.kp_position = OptionalVector3(*n, "kp_position", g.position.kp_position);
+    g.position.kd_velocity = OptionalVector3(*n, "kd_velocity", g.position.kd_velocity);
+    g.position.ki_position = OptionalVector3(*n, "ki_position", g.position.ki_position);
+    g.position.integral_limit_m_s2 = OptionalDouble(*n, "integral_limit_m_s2", g.position.integral_limit_m_s2);
+    g.position.max_tilt_rad = OptionalDouble(*n, "max_tilt_rad", g.position.max_tilt_rad);
     g.k_attitude = OptionalVector3(*n, "k_attitude", g.k_attitude);
     g.k_rate = OptionalVector3(*n, "k_rate", g.k_rate);
     g.max_rate_rad_s = OptionalDouble(*n, "max_rate_rad_s", g.max_rate_rad_s);

@@ -10,12 +10,6 @@
 namespace rotorguard::control {
 
 namespace {
-void RequireNonNegative(const char* field, const Vector3& v) {
-  if (!v.allFinite() || v.minCoeff() < 0.0) {
-    ThrowValidation("NominalControllerOptions", field, "(a negative or non-finite entry)",
-                    "finite values >= 0");
-  }
-}
 void RequirePositive(const char* field, const Vector3& v) {
   if (!v.allFinite() || v.minCoeff() <= 0.0) {
     ThrowValidation("NominalControllerOptions", field, "(a non-positive or non-finite entry)",
@@ -25,15 +19,7 @@ void RequirePositive(const char* field, const Vector3& v) {
 }  // namespace
 
 void NominalControllerOptions::Validate() const {
-  RequireNonNegative("kp_position", kp_position);
-  RequireNonNegative("kd_velocity", kd_velocity);
-  RequireNonNegative("ki_position", ki_position);
-  if (!std::isfinite(integral_limit_m_s2) || integral_limit_m_s2 < 0.0) {
-    ThrowValidation("NominalControllerOptions", "integral_limit_m_s2", integral_limit_m_s2, "a value >= 0");
-  }
-  if (!std::isfinite(max_tilt_rad) || max_tilt_rad <= 0.0 || max_tilt_rad >= 0.5 * std::numbers::pi) {
-    ThrowValidation("NominalControllerOptions", "max_tilt_rad", max_tilt_rad, "an angle in (0, pi/2)");
-  }
+  position.Validate("NominalControllerOptions");
   RequirePositive("k_attitude", k_attitude);
   RequirePositive("k_rate", k_rate);
   if (!std::isfinite(max_rate_rad_s) || max_rate_rad_s <= 0.0) {
@@ -43,7 +29,11 @@ void NominalControllerOptions::Validate() const {
 
 NominalController::NominalController(const vehicle::MultirotorModel& model,
                                      const NominalControllerOptions& options)
-    : model_(model), options_(options), allocator_(model), hover_(model.HoverThrusts()) {
+    : model_(model),
+      options_(options),
+      position_loop_(options.position),
+      allocator_(model),
+      hover_(model.HoverThrusts()) {
   options_.Validate();
 }
 
@@ -63,23 +53,8 @@ void NominalController::Compute(const StateEstimate& est, const ReferenceTraject
   const double m = vp.mass_kg;
   const Matrix3 R = est.q_WB.normalized().toRotationMatrix();
 
-  // Position loop: commanded acceleration with reference feedforward.
-  const Vector3 e_p = ref.p_W - est.p_W;
-  const Vector3 e_v = ref.v_W - est.v_W;
-  if (dt > 0.0) {
-    integral_ += options_.ki_position.cwiseProduct(e_p) * dt;
-    integral_ = integral_.cwiseMax(-options_.integral_limit_m_s2).cwiseMin(options_.integral_limit_m_s2);
-  }
-  const Vector3 a_cmd = ref.a_W + options_.kp_position.cwiseProduct(e_p) +
-                        options_.kd_velocity.cwiseProduct(e_v) + integral_;
-  // Desired force: gravity and the model's rotor drag compensated (eq. 1 solved for T z_B).
-  const Vector3 drag_W = -R * vp.rotor_drag_kg_s.cwiseProduct(R.transpose() * est.v_W);
-  Vector3 f_des = m * (a_cmd + Vector3(0.0, 0.0, kGravity)) - drag_W;
-  // Tilt limit: shrink the horizontal part so the angle to vertical stays below max_tilt.
-  f_des.z() = std::max(f_des.z(), 0.1 * m * kGravity);
-  const double max_horizontal = f_des.z() * std::tan(options_.max_tilt_rad);
-  const double horizontal = f_des.head<2>().norm();
-  if (horizontal > max_horizontal) f_des.head<2>() *= max_horizontal / horizontal;
+  // Position loop: the thrust vector for the reference, with acceleration feedforward.
+  const Vector3 f_des = position_loop_.DesiredThrustVector(vp, est, ref, dt);
 
   // Desired attitude from the thrust direction and the reference yaw.
   const Vector3 z_des = f_des.normalized();

@@ -9,16 +9,7 @@
 namespace rotorguard::control {
 
 void PassiveControllerOptions::Validate() const {
-  const auto non_negative = [](const char* f, const Vector3& v) {
-    if (!v.allFinite() || v.minCoeff() < 0.0) ThrowValidation("PassiveControllerOptions", f, "(negative)", ">= 0");
-  };
-  non_negative("kp_position", kp_position);
-  non_negative("kd_velocity", kd_velocity);
-  non_negative("ki_position", ki_position);
-  if (!(integral_limit_m_s2 >= 0.0)) ThrowValidation("PassiveControllerOptions", "integral_limit_m_s2", integral_limit_m_s2, ">= 0");
-  if (!(max_tilt_rad > 0.0) || max_tilt_rad >= 0.5 * std::numbers::pi) {
-    ThrowValidation("PassiveControllerOptions", "max_tilt_rad", max_tilt_rad, "an angle in (0, pi/2)");
-  }
+  position.Validate("PassiveControllerOptions");
   if (!(k_tilt > 0.0)) ThrowValidation("PassiveControllerOptions", "k_tilt", k_tilt, "> 0");
   if (!(k_rate > 0.0)) ThrowValidation("PassiveControllerOptions", "k_rate", k_rate, "> 0");
   if (!(regularisation > 0.0)) ThrowValidation("PassiveControllerOptions", "regularisation", regularisation, "> 0");
@@ -27,6 +18,7 @@ void PassiveControllerOptions::Validate() const {
 PassiveController::PassiveController(const vehicle::MultirotorModel& model, const PassiveControllerOptions& options)
     : model_(model),
       options_(options),
+      position_loop_(options.position),
       qp_(model.num_rotors(), 0),
       solver_(model.num_rotors(), 0),
       hover_(model.HoverThrusts()) {
@@ -51,19 +43,7 @@ void PassiveController::Compute(const StateEstimate& est, const ReferenceTraject
   }
   const vehicle::VehicleParams& vp = model_.params();
   const Matrix3 R = est.q_WB.normalized().toRotationMatrix();
-  const Vector3 e_p = ref.p_W - est.p_W;
-  if (dt > 0.0) {
-    integral_ = (integral_ + options_.ki_position.cwiseProduct(e_p) * dt)
-                    .cwiseMax(-options_.integral_limit_m_s2)
-                    .cwiseMin(options_.integral_limit_m_s2);
-  }
-  const Vector3 a_cmd = ref.a_W + options_.kp_position.cwiseProduct(e_p) +
-                        options_.kd_velocity.cwiseProduct(ref.v_W - est.v_W) + integral_;
-  Vector3 f_des = vp.mass_kg * (a_cmd + Vector3(0.0, 0.0, kGravity)) +
-                  R * vp.rotor_drag_kg_s.cwiseProduct(R.transpose() * est.v_W);
-  f_des.z() = std::max(f_des.z(), 0.1 * vp.weight_n());
-  const double max_horizontal = f_des.z() * std::tan(options_.max_tilt_rad);
-  if (f_des.head<2>().norm() > max_horizontal) f_des.head<2>() *= max_horizontal / f_des.head<2>().norm();
+  const Vector3 f_des = position_loop_.DesiredThrustVector(vp, est, ref, dt);
   // Reduced attitude: turn the thrust axis towards f_des; yaw is free (no yaw error, no yaw torque).
   const Vector3 z_des = f_des.normalized();
   const Vector3 e_B = R.transpose() * R.col(2).cross(z_des);  // axis * sin(angle), body frame

@@ -46,12 +46,11 @@ void CompositeFddOptions::Validate() const {
 }
 
 CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const CompositeFddOptions& options)
-    : vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
+    : FaultDetectorBase(vehicle.num_rotors()), vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
   vehicle_.Validate();
   options_.Validate();
   effectiveness_ = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors);
   pinv_ = vehicle::PseudoInverse(effectiveness_);
-  rotors_.assign(n_, RotorStatus{});
   command_ = RotorVector::Zero(n_);
   expected_thrust_ = RotorVector::Zero(n_);
   measured_thrust_ = RotorVector::Zero(n_);
@@ -67,36 +66,41 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   wrench_filter_ = LowPass2<4>(options_.filter_cutoff_hz, options_.imu_rate_hz);
 }
 
-std::vector<int> CompositeFdd::TakeNewIsolations() {
+FaultDetectorBase::FaultDetectorBase(int num_rotors) : rotors_(static_cast<std::size_t>(num_rotors)) {}
+
+std::vector<int> FaultDetectorBase::TakeNewIsolations() {
   std::vector<int> out;
   out.swap(new_isolations_);
   return out;
 }
 
-void CompositeFdd::Isolate(int rotor, RotorHealth health, double t, const char* detector) {
+void FaultDetectorBase::Isolate(int rotor, RotorHealth health, double t, const char* detector) {
   RotorStatus& r = rotors_[rotor];
-  if (r.health == RotorHealth::kMotorFailed || r.health == RotorHealth::kPropellerFailed) return;
+  if (r.health == RotorHealth::kMotorFailed || r.health == RotorHealth::kPropellerFailed ||
+      r.health == RotorHealth::kFailed) {
+    return;
+  }
   r.health = health;
   r.detected_s = t;
   r.detector = detector;
-  if (health == RotorHealth::kMotorFailed || health == RotorHealth::kPropellerFailed) {
+  if (health != RotorHealth::kDegraded) {
     r.eta = 1.0;
     new_isolations_.push_back(rotor);
     if (!first_isolated_) first_isolated_ = rotor;
   }
 }
 
-void CompositeFdd::SetCommand(const RotorVector& thrust_command) {
-  if (thrust_command.size() == n_ && thrust_command.allFinite()) command_ = thrust_command;
-}
-
-void CompositeFdd::SetEstimate(const StateEstimate& estimate) {
+void FaultDetectorBase::SetEstimate(const StateEstimate& estimate) {
   if (!estimate.valid || !estimate.p_W.allFinite() || !estimate.v_W.allFinite() ||
       !estimate.q_WB.coeffs().allFinite()) {
-    return;
+    return;  // a corrupt estimate is ignored; the previous one stays
   }
   estimate_ = estimate;
   have_estimate_ = true;
+}
+
+void CompositeFdd::SetCommand(const RotorVector& thrust_command) {
+  if (thrust_command.size() == n_ && thrust_command.allFinite()) command_ = thrust_command;
 }
 
 void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {

@@ -37,12 +37,11 @@ void FixedTimeFddOptions::Validate() const {
 }
 
 FixedTimeFdd::FixedTimeFdd(const vehicle::VehicleParams& vehicle, const FixedTimeFddOptions& options)
-    : vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
+    : FaultDetectorBase(vehicle.num_rotors()), vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
   vehicle_.Validate();
   options_.Validate();
   effectiveness_ = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors);
   pinv_ = vehicle::PseudoInverse(effectiveness_);
-  rotors_.assign(n_, RotorStatus{});
   command_ = modelled_thrust_ = RotorVector::Zero(n_);
   above_since_s_.assign(n_, -1.0);
   loss_ = Eigen::VectorXd::Zero(n_);
@@ -53,22 +52,8 @@ FixedTimeFdd::FixedTimeFdd(const vehicle::VehicleParams& vehicle, const FixedTim
   thrust_filter_ = LowPass2<1>(options_.estimate_cutoff_hz, options_.imu_rate_hz);
 }
 
-std::vector<int> FixedTimeFdd::TakeNewIsolations() {
-  std::vector<int> out;
-  out.swap(new_isolations_);
-  return out;
-}
-
 void FixedTimeFdd::SetCommand(const RotorVector& thrust_command) {
   if (thrust_command.size() == n_ && thrust_command.allFinite()) command_ = thrust_command;
-}
-
-void FixedTimeFdd::SetEstimate(const StateEstimate& estimate) {
-  if (!estimate.valid || !estimate.p_W.allFinite() || !estimate.v_W.allFinite() || !estimate.q_WB.coeffs().allFinite()) {
-    return;
-  }
-  estimate_ = estimate;
-  have_estimate_ = true;
 }
 
 void FixedTimeFdd::OnImu(const ImuSample& imu) {
@@ -104,7 +89,7 @@ void FixedTimeFdd::OnImu(const ImuSample& imu) {
       thrust_filter_.Step(Eigen::Matrix<double, 1, 1>(wrench[0] - vp.mass_kg * f_cog.z() - vp.rotor_drag_kg_s.z() * v_z))[0];
 
   const bool flying = have_estimate_ && (estimate_.p_W.z() > 0.05 || wrench[0] > 0.9 * vp.weight_n());
-  if (!flying || isolated_) return;
+  if (!flying || first_isolated_) return;  // a single failure, as the method assumes
   Eigen::Vector4d lost;
   lost << thrust_loss, torque_loss;
   loss_ = pinv_ * lost;
@@ -115,12 +100,7 @@ void FixedTimeFdd::OnImu(const ImuSample& imu) {
     if (fraction > options_.loss_threshold) {
       if (above_since_s_[i] < 0.0) above_since_s_[i] = t;
       if (t - above_since_s_[i] >= options_.persistence_s) {
-        rotors_[i].health = RotorHealth::kFailed;
-        rotors_[i].eta = 1.0;
-        rotors_[i].detected_s = t;
-        rotors_[i].detector = "fixed_time_observer";
-        new_isolations_.push_back(i);
-        isolated_ = true;  // a single failure, as the method assumes
+        Isolate(i, RotorHealth::kFailed, t, "fixed_time_observer");
         return;
       }
     } else {

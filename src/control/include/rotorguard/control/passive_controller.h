@@ -6,16 +6,13 @@
 /// box-constrained least-squares problem that gives up the yaw torque entirely.
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/dense_qp.h"
+#include "rotorguard/control/position_loop.h"
 #include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::control {
 
 struct PassiveControllerOptions {
-  Vector3 kp_position = Vector3(9.0, 9.0, 12.0);  ///< [1/s^2], >= 0
-  Vector3 kd_velocity = Vector3(6.0, 6.0, 7.0);   ///< [1/s], >= 0
-  Vector3 ki_position = Vector3(1.0, 1.0, 2.0);   ///< [1/s^3], >= 0
-  double integral_limit_m_s2 = 2.0;               ///< [m/s^2], >= 0
-  double max_tilt_rad = 0.7;                      ///< thrust-direction tilt limit, in (0, pi/2)
+  PositionLoopOptions position;  ///< the outer loop, as the nominal controller's
   double k_tilt = 9.0;   ///< reduced-attitude error -> roll/pitch rate [1/s], > 0
   double k_rate = 22.0;  ///< roll/pitch rate error -> angular acceleration [1/s], > 0
   /// Regularisation towards equal rotor thrusts (makes the 4-rotor, 3-objective allocation
@@ -30,17 +27,17 @@ class PassiveController final : public Controller {
   std::string_view name() const override { return "passive"; }
   void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
                RotorVector* thrust_command) override;
-  void Reset() override { integral_.setZero(); }
+  void Reset() override { position_loop_.Reset(); }
 
  private:
   const vehicle::MultirotorModel& model_;
   PassiveControllerOptions options_;
+  PositionLoop position_loop_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> allocation_map_;  // rows [T; tau_x; tau_y] of M_t
   Eigen::Vector3d objective_weights_;                        // thrust, roll, pitch
   DenseQp qp_;
   DenseQpSolver solver_;
   RotorVector hover_;
-  Vector3 integral_ = Vector3::Zero();
 };
 
 }  // namespace rotorguard::control

@@ -81,27 +81,41 @@ class FaultDetector {
   virtual std::vector<int> TakeNewIsolations() = 0;
 };
 
-class CompositeFdd final : public FaultDetector {
+/// Bookkeeping every detector shares: per-rotor statuses, isolations not yet taken, the estimate.
+class FaultDetectorBase : public FaultDetector {
+ public:
+  void SetEstimate(const StateEstimate& estimate) override;
+  const std::vector<RotorStatus>& rotors() const override { return rotors_; }
+  std::vector<int> TakeNewIsolations() override;
+  /// The first rotor isolated as failed, if any.
+  std::optional<int> first_isolated_rotor() const { return first_isolated_; }
+
+ protected:
+  explicit FaultDetectorBase(int num_rotors);
+  /// Marks a rotor's health at time t; a failure (motor, propeller or unclassified) isolates it
+  /// once. A rotor already isolated keeps its diagnosis.
+  void Isolate(int rotor, RotorHealth health, double t, const char* detector);
+
+  std::vector<RotorStatus> rotors_;
+  std::vector<int> new_isolations_;
+  std::optional<int> first_isolated_;
+  StateEstimate estimate_;
+  bool have_estimate_ = false;
+};
+
+class CompositeFdd final : public FaultDetectorBase {
  public:
   CompositeFdd(const vehicle::VehicleParams& vehicle, const CompositeFddOptions& options);
 
   std::string_view name() const override { return "composite"; }
   void OnImu(const ImuSample& imu) override;
   void OnEscTelemetry(const EscTelemetry& esc) override;
-  /// The commanded thrusts sent to the motors (the motor index's reference) and the stack's
-  /// current estimate (attitude, velocity, altitude).
+  /// The commanded thrusts sent to the motors: the motor index's reference.
   void SetCommand(const RotorVector& thrust_command) override;
-  void SetEstimate(const StateEstimate& estimate) override;
-
-  const std::vector<RotorStatus>& rotors() const override { return rotors_; }
-  std::vector<int> TakeNewIsolations() override;
-  /// The first isolation (rotor, time), if any.
-  std::optional<int> first_isolated_rotor() const { return first_isolated_; }
   /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16), for logs.
   const Eigen::VectorXd& thrust_loss() const { return thrust_loss_; }
 
  private:
-  void Isolate(int rotor, RotorHealth health, double t, const char* detector);
   void RunObserver(double t);
 
   vehicle::VehicleParams vehicle_;
@@ -109,9 +123,6 @@ class CompositeFdd final : public FaultDetector {
   int n_;
   EffectivenessMatrix effectiveness_;
   AllocationMatrix pinv_;
-  std::vector<RotorStatus> rotors_;
-  std::vector<int> new_isolations_;
-  std::optional<int> first_isolated_;
   // Motor index.
   RotorVector command_, expected_thrust_;
   std::vector<int> low_index_count_;
@@ -125,8 +136,6 @@ class CompositeFdd final : public FaultDetector {
   FilteredDerivative<3> alpha_filter_;
   LowPass2<4> wrench_filter_;
   bool filters_ready_ = false;
-  StateEstimate estimate_;
-  bool have_estimate_ = false;
   std::optional<double> airborne_since_s_;
   std::vector<double> above_since_s_, degraded_since_s_, degraded_sum_;
   std::vector<int> degraded_count_;

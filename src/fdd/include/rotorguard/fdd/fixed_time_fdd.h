@@ -28,16 +28,13 @@ struct FixedTimeFddOptions {
   void Validate() const;
 };
 
-class FixedTimeFdd final : public FaultDetector {
+class FixedTimeFdd final : public FaultDetectorBase {
  public:
   FixedTimeFdd(const vehicle::VehicleParams& vehicle, const FixedTimeFddOptions& options);
   std::string_view name() const override { return "fixedtime"; }
   void OnImu(const ImuSample& imu) override;
   void OnEscTelemetry(const EscTelemetry&) override {}  // the method does not use telemetry
   void SetCommand(const RotorVector& thrust_command) override;
-  void SetEstimate(const StateEstimate& estimate) override;
-  const std::vector<RotorStatus>& rotors() const override { return rotors_; }
-  std::vector<int> TakeNewIsolations() override;
   /// Latest estimated loss of effectiveness per rotor.
   const Eigen::VectorXd& loss() const { return loss_; }
 
@@ -47,9 +44,6 @@ class FixedTimeFdd final : public FaultDetector {
   int n_;
   EffectivenessMatrix effectiveness_;
   AllocationMatrix pinv_;
-  std::vector<RotorStatus> rotors_;
-  std::vector<int> new_isolations_;
-  bool isolated_ = false;
   RotorVector command_, modelled_thrust_;
   std::optional<TimeNs> last_imu_ns_;
   Vector3 w_hat_ = Vector3::Zero(), d_hat_ = Vector3::Zero();
@@ -57,8 +51,6 @@ class FixedTimeFdd final : public FaultDetector {
   LowPass2<3> torque_filter_, force_filter_, rate_filter_;
   FilteredDerivative<3> alpha_filter_;
   LowPass2<1> thrust_filter_;
-  StateEstimate estimate_;
-  bool have_estimate_ = false;
   std::vector<double> above_since_s_;
   Eigen::VectorXd loss_;
 };

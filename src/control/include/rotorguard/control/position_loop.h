@@ -1,0 +1,37 @@
+#pragma once
+/// The outer position loop shared by the cascaded controllers: a PID on position with the
+/// reference's acceleration as feedforward, solved through eq. (1) of paper 000 for the thrust
+/// vector (gravity and the model's rotor drag compensated), with its tilt limited.
+#include <string>
+
+#include "rotorguard/core/messages.h"
+#include "rotorguard/core/trajectory.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::control {
+
+struct PositionLoopOptions {
+  Vector3 kp_position = Vector3(9.0, 9.0, 12.0);  ///< position gain [1/s^2], >= 0
+  Vector3 kd_velocity = Vector3(6.0, 6.0, 7.0);   ///< velocity gain [1/s], >= 0
+  Vector3 ki_position = Vector3(1.0, 1.0, 2.0);   ///< integral gain [1/s^3], >= 0
+  double integral_limit_m_s2 = 2.0;   ///< clamp on the integral's acceleration [m/s^2], >= 0
+  double max_tilt_rad = 0.7;          ///< thrust vector tilt limit [rad], in (0, pi/2)
+  /// Throws ValidationError naming `owner` and the field.
+  void Validate(const std::string& owner) const;
+};
+
+class PositionLoop {
+ public:
+  explicit PositionLoop(const PositionLoopOptions& options) : options_(options) {}
+  /// The desired thrust vector (world frame) for the estimate and reference; `dt` [s] advances the
+  /// integral (0 leaves it).
+  Vector3 DesiredThrustVector(const vehicle::VehicleParams& vehicle, const StateEstimate& estimate,
+                              const ReferencePoint& reference, double dt);
+  void Reset() { integral_.setZero(); }
+
+ private:
+  PositionLoopOptions options_;
+  Vector3 integral_ = Vector3::Zero();
+};
+
+}  // namespace rotorguard::control
