@@ -297,6 +297,19 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { g.Validate(); });
   }
+  if (const auto n = node.Optional("passive")) {
+    control::PassiveControllerOptions& g = o->passive;
+    g.position.kp_position = OptionalVector3(*n, "kp_position", g.position.kp_position);
+    g.position.kd_velocity = OptionalVector3(*n, "kd_velocity", g.position.kd_velocity);
+    g.position.ki_position = OptionalVector3(*n, "ki_position", g.position.ki_position);
+    g.position.integral_limit_m_s2 = OptionalDouble(*n, "integral_limit_m_s2", g.position.integral_limit_m_s2);
+    g.position.max_tilt_rad = OptionalDouble(*n, "max_tilt_rad", g.position.max_tilt_rad);
+    g.k_tilt = OptionalDouble(*n, "k_tilt", g.k_tilt);
+    g.k_rate = OptionalDouble(*n, "k_rate", g.k_rate);
+    g.regularisation = OptionalDouble(*n, "regularisation", g.regularisation);
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] { g.Validate(); });
+  }
   if (const auto n = node.Optional("nmpc")) {
     control::NmpcOptions& m = o->nmpc;
     if (const auto v = n->Optional("horizon_steps")) m.horizon_steps = static_cast<int>(v->AsIntIn(1, 200));
