@@ -105,6 +105,16 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
   fmt::print("max spin          {:.2f} rad/s\n", s.max_spin_rad_s);
   if (s.tilt_recovery_s >= 0.0) fmt::print("tilt recovery     {:.2f} s after the first fault\n", s.tilt_recovery_s);
   fmt::print("faults            {}\n", faults.empty() ? "none" : faults);
+  if (s.fdd) {
+    const auto& f = *s.fdd;
+    if (!f.detected) {
+      fmt::print("fault detection   nothing detected\n");
+    } else {
+      fmt::print("fault detection   rotor {} {} by {} at {:.3f} s{}\n", f.rotor, f.kind, f.detector, f.detection_s,
+                 f.correct ? fmt::format(" (correct, {:.3f} s after onset)", f.latency_s)
+                           : (f.false_alarm ? " (false alarm)" : " (wrong rotor or kind)"));
+    }
+  }
   fmt::print("seed              {}\n", s.seed);
   if (!out_dir.empty()) {
     fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());
