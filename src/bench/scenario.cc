@@ -281,16 +281,21 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
   node.RejectUnknownKeys();
 }
 
+/// The outer-loop gains shared by the cascaded controllers' blocks (stack.nominal, stack.passive).
+void ParsePositionLoop(const ConfigNode& n, control::PositionLoopOptions* p) {
+  p->kp_position = OptionalVector3(n, "kp_position", p->kp_position);
+  p->kd_velocity = OptionalVector3(n, "kd_velocity", p->kd_velocity);
+  p->ki_position = OptionalVector3(n, "ki_position", p->ki_position);
+  p->integral_limit_m_s2 = OptionalDouble(n, "integral_limit_m_s2", p->integral_limit_m_s2);
+  p->max_tilt_rad = OptionalDouble(n, "max_tilt_rad", p->max_tilt_rad);
+}
+
 void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
   if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive"});
   o->control_rate_hz = OptionalDouble(node, "control_rate_hz", o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;
-    g.position.kp_position = OptionalVector3(*n, "kp_position", g.position.kp_position);
-    g.position.kd_velocity = OptionalVector3(*n, "kd_velocity", g.position.kd_velocity);
-    g.position.ki_position = OptionalVector3(*n, "ki_position", g.position.ki_position);
-    g.position.integral_limit_m_s2 = OptionalDouble(*n, "integral_limit_m_s2", g.position.integral_limit_m_s2);
-    g.position.max_tilt_rad = OptionalDouble(*n, "max_tilt_rad", g.position.max_tilt_rad);
+    ParsePositionLoop(*n, &g.position);
     g.k_attitude = OptionalVector3(*n, "k_attitude", g.k_attitude);
     g.k_rate = OptionalVector3(*n, "k_rate", g.k_rate);
     g.max_rate_rad_s = OptionalDouble(*n, "max_rate_rad_s", g.max_rate_rad_s);
@@ -299,11 +304,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
   }
   if (const auto n = node.Optional("passive")) {
     control::PassiveControllerOptions& g = o->passive;
-    g.position.kp_position = OptionalVector3(*n, "kp_position", g.position.kp_position);
-    g.position.kd_velocity = OptionalVector3(*n, "kd_velocity", g.position.kd_velocity);
-    g.position.ki_position = OptionalVector3(*n, "ki_position", g.position.ki_position);
-    g.position.integral_limit_m_s2 = OptionalDouble(*n, "integral_limit_m_s2", g.position.integral_limit_m_s2);
-    g.position.max_tilt_rad = OptionalDouble(*n, "max_tilt_rad", g.position.max_tilt_rad);
+    ParsePositionLoop(*n, &g.position);
     g.k_tilt = OptionalDouble(*n, "k_tilt", g.k_tilt);
     g.k_rate = OptionalDouble(*n, "k_rate", g.k_rate);
     g.regularisation = OptionalDouble(*n, "regularisation", g.regularisation);
