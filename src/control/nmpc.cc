@@ -166,17 +166,19 @@ void NmpcController::UpdateThrustSplit() {
   for (int c = 0; c < static_cast<int>(active.size()); ++c) unit_split_[active[c]] = std::max(0.0, t[c]);
 }
 
-double NmpcController::ReferenceTotalThrust(const ReferencePoint& ref) const {
+Eigen::Vector3d NmpcController::ReferenceThrustVector(const ReferencePoint& ref) const {
   // Eq. (1) solved for the thrust vector along the reference, with the drag of the reference
   // velocity (body and world frames taken as aligned for the drag term).
-  const Eigen::Vector3d f = vehicle_.mass_kg * (ref.a_W + Eigen::Vector3d(0.0, 0.0, kGravity)) +
-                            vehicle_.rotor_drag_kg_s.cwiseProduct(ref.v_W);
-  return f.norm();
+  return vehicle_.mass_kg * (ref.a_W + Eigen::Vector3d(0.0, 0.0, kGravity)) +
+         vehicle_.rotor_drag_kg_s.cwiseProduct(ref.v_W);
+}
+
+double NmpcController::ReferenceTotalThrust(const ReferencePoint& ref) const {
+  return ReferenceThrustVector(ref).norm();
 }
 
 Eigen::Quaterniond NmpcController::ReferenceAttitude(const ReferencePoint& ref) const {
-  Eigen::Vector3d f = vehicle_.mass_kg * (ref.a_W + Eigen::Vector3d(0.0, 0.0, kGravity)) +
-                      vehicle_.rotor_drag_kg_s.cwiseProduct(ref.v_W);
+  Eigen::Vector3d f = ReferenceThrustVector(ref);
   if (f.norm() < 1e-6) f = Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d z = f.normalized();
   const Eigen::Vector3d heading(std::cos(ref.yaw), std::sin(ref.yaw), 0.0);

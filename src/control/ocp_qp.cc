@@ -41,13 +41,6 @@ OcpQp::OcpQp(const OcpQpDims& d) : dims(d) {
   x_upper.assign(N + 1, Eigen::VectorXd::Constant(nbx, kInf));
 }
 
-double OcpQp::Objective(const std::vector<Eigen::VectorXd>& x, const std::vector<Eigen::VectorXd>& u) const {
-  double f = 0.0;
-  for (int k = 0; k <= dims.horizon; ++k) f += 0.5 * x[k].dot(Q[k] * x[k]) + q[k].dot(x[k]);
-  for (int k = 0; k < dims.horizon; ++k) f += 0.5 * u[k].dot(R[k] * u[k]) + r[k].dot(u[k]);
-  return f;
-}
-
 std::string OcpQpSummary::BriefReport() const {
   return fmt::format("OCP QP {}: {} iterations, {} active, objective {:.6g}, condense {:.1f} us, solve {:.1f} us",
                      ToString(status), iterations, active_constraints, objective, condense_time_s * 1e6,

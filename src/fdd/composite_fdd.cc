@@ -141,7 +141,6 @@ void CompositeFdd::OnImu(const ImuSample& imu) {
   alpha_filter_.Step(imu.w_B, dt);
   Eigen::Vector4d wrench = effectiveness_ * measured_thrust_;
   wrench_filter_.Step(wrench);
-  filters_ready_ = true;
   RunObserver(ToSeconds(imu.t_ns));
 }
 

@@ -110,6 +110,7 @@ class NmpcController final : public Controller {
   /// The prepared QP for the measured state, and the plan update.
   bool FeedbackIteration(const Eigen::VectorXd& x0);
   Eigen::Quaterniond ReferenceAttitude(const ReferencePoint& ref) const;
+  Eigen::Vector3d ReferenceThrustVector(const ReferencePoint& ref) const;
   double ReferenceTotalThrust(const ReferencePoint& ref) const;
   void HoverCommand(RotorVector* thrust_command) const;
 

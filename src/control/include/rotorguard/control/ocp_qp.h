@@ -40,8 +40,6 @@ struct OcpQp {
   std::vector<Eigen::VectorXd> r;     ///< N
   std::vector<Eigen::VectorXd> u_lower, u_upper;  ///< N
   std::vector<Eigen::VectorXd> x_lower, x_upper;  ///< N + 1; entry 0 is unused
-  /// The objective of a trajectory (inputs u_0..u_{N-1}, states x_0..x_N).
-  double Objective(const std::vector<Eigen::VectorXd>& x, const std::vector<Eigen::VectorXd>& u) const;
 };
 
 struct OcpQpSummary {

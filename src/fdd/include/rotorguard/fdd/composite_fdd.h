@@ -112,7 +112,7 @@ class CompositeFdd final : public FaultDetectorBase {
   void OnEscTelemetry(const EscTelemetry& esc) override;
   /// The commanded thrusts sent to the motors: the motor index's reference.
   void SetCommand(const RotorVector& thrust_command) override;
-  /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16), for logs.
+  /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16), for inspection.
   const Eigen::VectorXd& thrust_loss() const { return thrust_loss_; }
 
  private:
@@ -135,7 +135,6 @@ class CompositeFdd final : public FaultDetectorBase {
   LowPass2<3> force_filter_, rate_filter_;
   FilteredDerivative<3> alpha_filter_;
   LowPass2<4> wrench_filter_;
-  bool filters_ready_ = false;
   std::optional<double> airborne_since_s_;
   std::vector<double> above_since_s_, degraded_since_s_, degraded_sum_;
   std::vector<int> degraded_count_;
