@@ -93,6 +93,9 @@ Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOp
   } else if (method == "fixedtime") {  // FixedA: the fixed-time observer driving the same NMPC
     s.stack.controller = "nmpc";
     s.stack.fdd = "fixedtime";
+  } else if (method == "indi") {  // the composite FDD's isolation handed to the INDI controller
+    s.stack.controller = "indi";
+    s.stack.fdd = "composite";
   } else if (method == "passive") {  // UnifP: one passive fault-tolerant controller, no FDD
     s.stack.controller = "passive";
     s.stack.fdd = "none";
@@ -143,7 +146,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
           {"failures", failures}};
 }
 
-std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "passive", "none"}; }
+std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "indi", "passive", "none"}; }
 
 void FtcBenchOptions::Validate() const {
   if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
@@ -152,7 +155,7 @@ void FtcBenchOptions::Validate() const {
   const std::vector<std::string> known = FtcMethods();
   for (const std::string& m : methods) {
     if (std::find(known.begin(), known.end(), m) == known.end()) {
-      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, passive, none");
+      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, indi, passive, none");
     }
   }
   vehicle.Validate();

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "rotorguard/bench/metrics.h"
+#include "rotorguard/bench/sensor_log.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/io/files.h"
@@ -67,10 +68,20 @@ void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, std::str
   out->push_back('\n');
 }
 
-void Deliver(const sim::SensorOutputs& o, stack::FlightStack* st) {
-  if (o.imu) st->OnImu(*o.imu);
-  if (o.esc) st->OnEscTelemetry(*o.esc);
-  if (o.odometry) st->OnOdometry(*o.odometry);
+/// Hands the sensor messages to the stack, recording them in the sensor log when there is one.
+void Deliver(const sim::SensorOutputs& o, stack::FlightStack* st, std::string* sensor_log) {
+  if (o.imu) {
+    st->OnImu(*o.imu);
+    if (sensor_log) AppendImu(*o.imu, sensor_log);
+  }
+  if (o.esc) {
+    st->OnEscTelemetry(*o.esc);
+    if (sensor_log) AppendEsc(*o.esc, sensor_log);
+  }
+  if (o.odometry) {
+    st->OnOdometry(*o.odometry);
+    if (sensor_log) AppendOdometry(*o.odometry, sensor_log);
+  }
 }
 
 double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
@@ -110,6 +121,8 @@ nlohmann::json RunSummary::ToJson() const {
   } else {
     j["fdd"] = nullptr;  // the stack ran no fault detection
   }
+  j["sensors"] = {{"imu_rate_hz", imu_rate_hz},
+                  {"imu_position_m", {imu_position_m.x(), imu_position_m.y(), imu_position_m.z()}}};
   j["physics_steps"] = physics_steps;
   j["control_cycles"] = control_cycles;
   return j;
@@ -123,7 +136,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   }
   const auto wall_start = std::chrono::steady_clock::now();
 
-  std::optional<io::AtomicFileWriter> log;
+  std::optional<io::AtomicFileWriter> log, sensors;
   if (!options.out_dir.empty()) {
     std::error_code ec;
     fs::create_directories(options.out_dir, ec);
@@ -131,6 +144,9 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     // A summary left by an earlier run must not pass for this run's.
     fs::remove(fs::path(options.out_dir) / "summary.json", ec);
     log.emplace((fs::path(options.out_dir) / "log.csv").string());
+    sensors.emplace((fs::path(options.out_dir) / "sensors.csv").string());
+    // The vehicle the stack flew, so that the run's folder is enough to replay its sensor log.
+    io::WriteFileAtomically((fs::path(options.out_dir) / "vehicle.yaml").string(), VehicleToYaml(sc.vehicle));
   }
 
   const vehicle::MultirotorModel truth_model(sc.vehicle);
@@ -141,7 +157,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
                      truth_model.MakeState(sc.initial_position_m, sc.initial_yaw_rad, initial_motors));
   // The stack builds its own model from the vehicle parameters: it never holds the simulator.
   stack::FlightStack st(sc.vehicle, sc.reference, sc.stack);
-  Deliver(sim.outputs(), &st);
+  std::string sensor_buffer;
+  std::string* sensor_log = sensors ? &sensor_buffer : nullptr;
+  if (sensor_log) sensor_buffer = kSensorLogHeader;
+  Deliver(sim.outputs(), &st, sensor_log);
 
   const TimeNs dt_ns = sim.step_ns();
   const double dt = ToSeconds(dt_ns);
@@ -156,6 +175,8 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   RunSummary summary;
   summary.scenario = sc.name;
   summary.seed = sc.seed;
+  summary.imu_rate_hz = sc.sim.imu.rate_hz;
+  summary.imu_position_m = sc.sim.imu.position_m;
   TrackingErrorAccumulator tracking;
   // Success (DESIGN.md, SucR): no crash, and the error within success_error_m over the last
   // success_hold_s of the flight. Remember the last time it was exceeded.
@@ -172,6 +193,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     const TimeNs t = sim.time_ns();
     if (t >= next_control) {
       command = st.Update(t);
+      if (sensor_log) AppendCommand(command, sensor_log);
       next_control += control_period;
       ++summary.control_cycles;
       if (options.on_control_cycle) options.on_control_cycle(st);
@@ -197,7 +219,11 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
         buffer.clear();
       }
     }
-    Deliver(sim.Step(command), &st);
+    Deliver(sim.Step(command), &st, sensor_log);
+    if (sensor_log && sensor_buffer.size() > (1u << 20)) {
+      sensors->Write(sensor_buffer);
+      sensor_buffer.clear();
+    }
     ++summary.physics_steps;
     if (sim.crashed()) break;
     if (options.progress && k >= next_progress) {
@@ -214,6 +240,8 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     AppendRow(sim, st, &buffer);
     log->Write(buffer);
     log->Commit();
+    sensors->Write(sensor_buffer);
+    sensors->Commit();
   }
   if (options.progress) options.progress(1.0);
 

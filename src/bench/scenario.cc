@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
@@ -80,6 +81,33 @@ vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
   ValidateAt(root, [&] { v.Validate(); });
   return v;
 }
+
+}  // namespace
+
+std::string VehicleToYaml(const vehicle::VehicleParams& v) {
+  auto out = fmt::memory_buffer();
+  auto it = std::back_inserter(out);
+  const auto vec = [](const Vector3& x) { return fmt::format("[{}, {}, {}]", x.x(), x.y(), x.z()); };
+  const double rpm_per_rad_s = vehicle::RadPerSecondToRpm(1.0);
+  fmt::format_to(it, "# Written by rotorguard: the vehicle a run flew (the format of configs/vehicles/).\n");
+  // A JSON string is a valid YAML double-quoted scalar.
+  fmt::format_to(it, "name: {}\nmass_kg: {}\ninertia_kg_m2:\n", nlohmann::json(v.name).dump(), v.mass_kg);
+  for (int r = 0; r < 3; ++r) fmt::format_to(it, "  - {}\n", vec(v.inertia_kg_m2.row(r).transpose()));
+  fmt::format_to(it, "rotor_drag_kg_s: {}\nyaw_damping_n_m_s: {}\n", vec(v.rotor_drag_kg_s), v.yaw_damping_n_m_s);
+  fmt::format_to(it, "thrust_coefficient_n_per_rpm2: {}\n", v.thrust_coefficient_n_s2 / (rpm_per_rad_s * rpm_per_rad_s));
+  fmt::format_to(it, "motor_time_constant_s: {}\nmotor_stop_time_constant_s: {}\n", v.motor_time_constant_s,
+                 v.motor_stop_time_constant_s);
+  fmt::format_to(it, "unloaded_rpm_ratio: {}\ncollision_radius_m: {}\nrotors:\n", v.unloaded_speed_ratio,
+                 v.collision_radius_m);
+  for (const vehicle::Rotor& r : v.rotors) {
+    fmt::format_to(it, "  - {{position_m: {}, direction: {}, yaw_coefficient_m: {}, max_thrust_n: {}}}\n",
+                   vec(r.p_B), r.direction == vehicle::SpinDirection::kClockwise ? "cw" : "ccw", r.yaw_coefficient_m,
+                   r.max_thrust_n);
+  }
+  return fmt::to_string(out);
+}
+
+namespace {
 
 void ApplyOverrides(ConfigDocument* doc, const std::vector<Override>& overrides, bool vehicle_part) {
   constexpr std::string_view kVehiclePrefix = "vehicle.";
@@ -291,7 +319,7 @@ void ParsePositionLoop(const ConfigNode& n, control::PositionLoopOptions* p) {
 }
 
 void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
-  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive"});
+  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive", "indi"});
   o->control_rate_hz = OptionalDouble(node, "control_rate_hz", o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;
@@ -310,6 +338,16 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     g.regularisation = OptionalDouble(*n, "regularisation", g.regularisation);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { g.Validate(); });
+  }
+  if (const auto n = node.Optional("indi")) {
+    control::IndiControllerOptions& g = o->indi;
+    ParsePositionLoop(*n, &g.position);
+    g.k_h = OptionalDouble(*n, "k_h", g.k_h);
+    g.d_h = OptionalDouble(*n, "d_h", g.d_h);
+    g.opposite_ratio = OptionalDouble(*n, "opposite_ratio", g.opposite_ratio);
+    g.filter_cutoff_hz = OptionalDouble(*n, "filter_cutoff_hz", g.filter_cutoff_hz);
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] { stack::IndiOptionsInStack(*o).Validate(); });
   }
   if (const auto n = node.Optional("nmpc")) {
     control::NmpcOptions& m = o->nmpc;

@@ -157,6 +157,7 @@ void CompositeFdd::RunObserver(double t) {
   // as modelled (paper 000 treats single failures). After an isolation the reconfigured vehicle
   // spins, saturates rotors and may touch down, which they would misread as further failures;
   // the motor index, a direct measurement, keeps watching every motor.
+  takeoff_angular_acceleration_ = 0.0;
   if (!airborne_since_s_ || first_isolated_) {
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
     return;
@@ -186,6 +187,7 @@ void CompositeFdd::RunObserver(double t) {
   // pointing like the loss of one rotor's thrust: alpha ~ -I^-1 (r_i x T e3).
   const bool takeoff = t - *airborne_since_s_ <= options_.takeoff_window_s &&
                        estimate_.p_W.z() <= options_.takeoff_max_altitude_m;
+  if (takeoff) takeoff_angular_acceleration_ = alpha.head<2>().norm();
   if (takeoff && alpha.head<2>().norm() > options_.takeoff_angular_acceleration_rad_s2) {
     int best = -1;
     double best_cos = options_.takeoff_direction_cosine;

@@ -8,16 +8,24 @@
 
 namespace rotorguard::stack {
 
+control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& o) {
+  control::IndiControllerOptions indi = o.indi;
+  indi.sample_hz = o.control_rate_hz;
+  indi.nominal = o.nominal;
+  return indi;
+}
+
 void FlightStackOptions::Validate() const {
   if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > 10000.0) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
   }
-  if (controller != "nominal" && controller != "nmpc" && controller != "passive") {
-    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc, passive");
+  if (controller != "nominal" && controller != "nmpc" && controller != "passive" && controller != "indi") {
+    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc, passive, indi");
   }
   nominal.Validate();
   passive.Validate();
   nmpc.Validate();
+  if (controller == "indi") IndiOptionsInStack(*this).Validate();  // its filters depend on the rate
   for (std::size_t i = 0; i < known_faults.size(); ++i) {
     if (!std::isfinite(known_faults[i].at_time_s) || known_faults[i].at_time_s < 0.0) {
       ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.at_time_s", i), known_faults[i].at_time_s,
@@ -29,9 +37,9 @@ void FlightStackOptions::Validate() const {
   }
   composite_fdd.Validate();
   fixed_time_fdd.Validate();
-  if (!known_faults.empty() && controller != "nmpc") {
+  if (!known_faults.empty() && controller != "nmpc" && controller != "indi") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,
-                    "controller nmpc (the controller that reconfigures)");
+                    "controller nmpc or indi (the controllers that reconfigure)");
   }
 }
 
@@ -48,6 +56,8 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     auto nmpc = std::make_unique<control::NmpcController>(model_.params(), options_.nmpc);
     nmpc_ = nmpc.get();
     controller_ = std::move(nmpc);
+  } else if (options_.controller == "indi") {
+    controller_ = std::make_unique<control::IndiController>(model_, IndiOptionsInStack(options_));
   } else if (options_.controller == "passive") {
     controller_ = std::make_unique<control::PassiveController>(model_, options_.passive);
   } else {

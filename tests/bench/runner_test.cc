@@ -152,3 +152,26 @@ TEST(PassiveClosedLoop, TracksTheNominalLemniscateWithYawLeftFree) {
 
 }  // namespace
 }  // namespace rotorguard::bench
+
+namespace rotorguard::bench {
+namespace {
+
+// The INDI baseline, driven by the composite FDD's isolation, keeps a hover through either fault
+// kind on every rotor (the reconfiguration path through the stack for the second FTC controller).
+TEST(IndiClosedLoop, KeepsHoveringAfterEitherFaultOnEveryRotor) {
+  for (int rotor = 0; rotor < 4; ++rotor) {
+    for (const char* kind : {"propeller_loss", "motor_stop"}) {
+      const RunSummary r = RunScenario(LoadScenario(
+          Config("fdd_hover_propeller_loss.yaml"),
+          {{"stack.controller", "indi"}, {"faults.0.rotor", std::to_string(rotor)}, {"faults.0.kind", kind}}));
+      EXPECT_TRUE(r.success) << "rotor " << rotor << " " << kind << ": " << r.failure_reason;
+      ASSERT_TRUE(r.fdd.has_value());
+      EXPECT_TRUE(r.fdd->correct) << "rotor " << rotor << " " << kind;
+      EXPECT_GT(r.max_spin_rad_s, 9.0) << "yaw is given up: the vehicle spins";
+      EXPECT_GT(r.min_altitude_m, 1.0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rotorguard::bench

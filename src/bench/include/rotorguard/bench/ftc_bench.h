@@ -19,9 +19,9 @@ struct FtcBenchOptions {
   int trials = 20;                 ///< per cell (the paper's count), >= 1
   std::uint64_t seed = 1;
   /// Methods by name: rotorguard (composite FDD + NMPC), fixedtime (FixedA: fixed-time observer
-  /// + the same NMPC), passive (UnifP: reduced-attitude control with yaw free, no FDD), none
-  /// (nominal controller, no FDD).
-  std::vector<std::string> methods = {"rotorguard", "fixedtime", "passive", "none"};
+  /// + the same NMPC), indi (composite FDD + incremental nonlinear dynamic inversion), passive
+  /// (UnifP: reduced-attitude control with yaw free, no FDD), none (nominal controller, no FDD).
+  std::vector<std::string> methods = {"rotorguard", "fixedtime", "indi", "passive", "none"};
   int jobs = 1;                    ///< worker threads, >= 1
   vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
   /// Called after each finished trial with (done, total).

@@ -1,6 +1,8 @@
 #pragma once
 /// Flies a scenario: the simulator and the flight stack in closed loop, exchanging only sensor
-/// messages and rotor commands. Writes log.csv and summary.json when given an output folder.
+/// messages and rotor commands. Given an output folder it writes log.csv (truth, estimate and
+/// commands at the log rate), sensors.csv (every message the stack received; sensor_log.h),
+/// vehicle.yaml (the vehicle flown) and summary.json.
 #include <functional>
 #include <optional>
 #include <string>
@@ -42,6 +44,9 @@ struct RunSummary {
   double tilt_recovery_s = -1.0;
   std::vector<FaultRecord> faults;
   std::optional<FddRecord> fdd;  ///< present when the stack runs fault detection
+  /// The IMU the stack read (summary.json "sensors"): what a replay of sensors.csv needs.
+  double imu_rate_hz = 0.0;
+  Vector3 imu_position_m = Vector3::Zero();
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;
 

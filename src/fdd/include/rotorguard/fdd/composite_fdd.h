@@ -11,7 +11,7 @@
 
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/types.h"
-#include "rotorguard/fdd/filters.h"
+#include "rotorguard/core/filters.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::fdd {
@@ -114,6 +114,9 @@ class CompositeFdd final : public FaultDetectorBase {
   void SetCommand(const RotorVector& thrust_command) override;
   /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16), for inspection.
   const Eigen::VectorXd& thrust_loss() const { return thrust_loss_; }
+  /// The take-off detector's statistic: the filtered roll/pitch angular acceleration magnitude
+  /// [rad/s^2] while its window is active, else 0 (for threshold calibration).
+  double takeoff_angular_acceleration() const { return takeoff_angular_acceleration_; }
 
  private:
   void RunObserver(double t);
@@ -139,6 +142,7 @@ class CompositeFdd final : public FaultDetectorBase {
   std::vector<double> above_since_s_, degraded_since_s_, degraded_sum_;
   std::vector<int> degraded_count_;
   Eigen::VectorXd thrust_loss_;
+  double takeoff_angular_acceleration_ = 0.0;
 };
 
 }  // namespace rotorguard::fdd

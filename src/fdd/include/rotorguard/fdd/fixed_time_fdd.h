@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "rotorguard/fdd/composite_fdd.h"
-#include "rotorguard/fdd/filters.h"
+#include "rotorguard/core/filters.h"
 
 namespace rotorguard::fdd {
 

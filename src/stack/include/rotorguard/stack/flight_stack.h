@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rotorguard/control/controller.h"
+#include "rotorguard/control/indi_controller.h"
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/control/nominal_controller.h"
 #include "rotorguard/control/passive_controller.h"
@@ -29,19 +30,26 @@ struct KnownFault {
 
 struct FlightStackOptions {
   double control_rate_hz = 200.0;    ///< controller rate (paper 000: 200 Hz), in (0, 10000]
-  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc, passive
+  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc, passive, indi
   control::NominalControllerOptions nominal;
   control::PassiveControllerOptions passive;
   control::NmpcOptions nmpc;
-  std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc only)
+  /// The INDI baseline; the stack sets its sample_hz and its pre-failure gains (IndiOptionsInStack).
+  control::IndiControllerOptions indi;
+  std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc, indi)
   /// Fault detection: "none", "composite" (paper 000, Sec. V-B) or "fixedtime" (the FixedA
-  /// baseline). On isolation the NMPC is reconfigured (the nominal controller cannot be).
+  /// baseline). On isolation the NMPC or INDI is reconfigured (the nominal and passive
+  /// controllers cannot be).
   std::string fdd = "none";
   fdd::CompositeFddOptions composite_fdd;
   fdd::FixedTimeFddOptions fixed_time_fdd;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
+
+/// The INDI options as the stack builds the controller: sampled at control_rate_hz, flying with
+/// the `nominal` gains until a failure.
+control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& options);
 
 class FlightStack {
  public:

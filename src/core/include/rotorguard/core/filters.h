@@ -1,10 +1,10 @@
 #pragma once
-/// Discrete filters for fault detection: a second-order Butterworth low-pass (bilinear transform
+/// Discrete filters for estimation (fault detection, INDI): a second-order Butterworth low-pass (bilinear transform
 /// with frequency pre-warping) applied per channel, and a filtered differentiator. Both take their
 /// sample time at construction (their design depends on it) and allocate nothing when stepping.
 #include <Eigen/Core>
 
-namespace rotorguard::fdd {
+namespace rotorguard {
 
 /// y = H(z) x per channel with H a second-order Butterworth low-pass of cut-off `cutoff_hz` at
 /// `sample_hz`. Unit DC gain; group delay at low frequency sqrt(2) / (2 pi fc) seconds.
@@ -47,4 +47,4 @@ class FilteredDerivative {
   bool initialised_ = false;
 };
 
-}  // namespace rotorguard::fdd
+}  // namespace rotorguard

@@ -1,11 +1,11 @@
-#include "rotorguard/fdd/filters.h"
+#include "rotorguard/core/filters.h"
 
 #include <cmath>
 #include <numbers>
 
 #include "rotorguard/core/error.h"
 
-namespace rotorguard::fdd {
+namespace rotorguard {
 
 template <int N>
 LowPass2<N>::LowPass2(double cutoff_hz, double sample_hz) {
@@ -63,4 +63,4 @@ template class LowPass2<3>;
 template class LowPass2<4>;
 template class FilteredDerivative<3>;
 
-}  // namespace rotorguard::fdd
+}  // namespace rotorguard

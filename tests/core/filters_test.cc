@@ -1,11 +1,11 @@
-#include "rotorguard/fdd/filters.h"
+#include "rotorguard/core/filters.h"
 
 #include <cmath>
 #include <numbers>
 
 #include <gtest/gtest.h>
 
-namespace rotorguard::fdd {
+namespace rotorguard {
 namespace {
 
 /// Steady-state amplitude of the filter's response to a unit sine at `f_hz`.
@@ -52,4 +52,4 @@ TEST(FilteredDerivative, RecoversTheSlopeOfARampWithIrregularSamples) {
 }
 
 }  // namespace
-}  // namespace rotorguard::fdd
+}  // namespace rotorguard

@@ -1,0 +1,77 @@
+#pragma once
+/// Threshold calibration of the composite FDD from saved runs (rotorguard fdd-calibrate): the
+/// sensor logs of fault-free and faulty flights are replayed offline through the real detector
+/// while one threshold sweeps, giving per value the detection latency, the misses and the false
+/// alarms (an ROC-style table), and the margin to the most alarming value the indices reached in
+/// fault-free flight. A suggestion picks the fastest value that keeps a stated margin.
+///
+/// A replay is exact up to the first isolation of the recorded flight (the detector sees what the
+/// stack saw). After it the recorded stack had reconfigured, so a threshold that detects later
+/// than the recorded one is scored on a flight that already flew reconfigured.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/bench/runner.h"
+#include "rotorguard/bench/sensor_log.h"
+#include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::bench {
+
+/// A saved run, as `rotorguard run --out DIR` leaves it: sensors.csv, vehicle.yaml, summary.json.
+struct CalibrationLog {
+  std::string dir;
+  vehicle::VehicleParams vehicle;
+  double imu_rate_hz = 0.0;
+  Vector3 imu_position_m = Vector3::Zero();
+  std::vector<FaultRecord> faults;  ///< the injected faults (ground truth for scoring)
+  std::vector<SensorRecord> records;
+};
+
+/// Loads a run folder. Throws io::InputFileError for a missing or malformed file (naming it, and
+/// the line and byte for sensors.csv) and io::ConfigError for an invalid vehicle.yaml.
+CalibrationLog LoadCalibrationLog(const std::string& dir);
+
+struct ReplayOutcome {
+  bool detected = false;  ///< any rotor isolated (motor or propeller failure)
+  int rotor = -1;
+  std::string kind;      ///< "motor_stop" or "propeller_loss" (the fault kind the health names)
+  std::string detector;
+  double detection_s = 0.0;
+  /// The most alarming values the indices took in fault-free flight (the whole log without
+  /// faults, the part before the first onset with): the lowest motor index M_i, the highest
+  /// propeller index P_i, the highest take-off statistic.
+  double min_motor_index = 1.0;
+  double max_propeller_index = 0.0;
+  double max_takeoff_alpha = 0.0;
+};
+
+/// Replays a log through a CompositeFdd built with `options` (the log's IMU rate and position
+/// are filled in).
+ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, fdd::CompositeFddOptions options);
+
+struct FddCalibrationOptions {
+  fdd::CompositeFddOptions fdd;  ///< the thresholds not being swept
+  /// Required margin to the fault-free extreme: gamma_P and the take-off threshold at least
+  /// `margin` times the largest fault-free value, gamma_M at most the smallest fault-free M_i
+  /// divided by it. > 1.
+  double margin = 1.5;
+  void Validate() const;
+};
+
+/// Runs the three sweeps (motor_index_threshold, propeller_index_threshold,
+/// takeoff_angular_acceleration_rad_s2) over the logs. The document:
+/// {"logs": [{"dir", "faulty", "fault": {...}|null, "recorded": {...}}],
+///  "fault_free_extremes": {"min_motor_index", "max_propeller_index", "max_takeoff_alpha"},
+///  "sweeps": [{"threshold", "configured", "rows": [{"value", "detected", "missed", "false_alarms",
+///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null, "note"}]}
+/// Throws std::invalid_argument when `logs` is empty.
+nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, const FddCalibrationOptions& options);
+
+/// The calibration as Markdown tables with the suggestions.
+std::string CalibrationMarkdown(const nlohmann::json& calibration);
+
+}  // namespace rotorguard::bench
