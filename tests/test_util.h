@@ -1,6 +1,10 @@
 #pragma once
 /// Shared test helpers: matrix comparison with an informative message, expect-throw-with-message,
-/// central finite differences.
+/// central finite differences, a fixture with a fresh temporary folder.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -39,6 +43,29 @@ inline Eigen::MatrixXd NumericalJacobian(
   }
   return j;
 }
+
+/// A fixture with a fresh folder per test (named after the process and the test), removed after.
+class TempFolderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("rotorguard_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+  /// Writes `text` to dir_/name byte for byte; returns the path.
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::filesystem::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  std::filesystem::path dir_;
+};
 
 }  // namespace rotorguard::testing
 

@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "rotorguard/bench/fdd_calibration.h"
 #include "rotorguard/bench/ftc_bench.h"
 #include "rotorguard/bench/nmpc_bench.h"
 #include "rotorguard/bench/qp_bench.h"
@@ -142,7 +143,8 @@ int main(int argc, char** argv) {
   std::string scenario_path, out_dir, seed_text;
   std::vector<std::string> sets;
   bool quiet = false;
-  CLI::App* run = app.add_subcommand("run", "Fly a scenario; write DIR/log.csv and DIR/summary.json.\n"
+  CLI::App* run = app.add_subcommand("run", "Fly a scenario; write DIR/log.csv, DIR/sensors.csv, DIR/vehicle.yaml and\n"
+                                            "DIR/summary.json.\n"
                                             "Exit 0 when the mission succeeds, 1 when it fails (crash).");
   run->add_option("scenario", scenario_path, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
   run->add_option("--out", out_dir, "Output folder (default: out/<scenario name>)");
@@ -157,6 +159,22 @@ int main(int argc, char** argv) {
   CLI::App* validate = app.add_subcommand("validate", "Check a scenario or vehicle file without flying it.\n"
                                                       "Exit 0 when valid, 2 when invalid, 3 when unreadable.");
   validate->add_option("file", validate_path, "Scenario or vehicle file (YAML)")->required();
+
+  // fdd-calibrate
+  std::vector<std::string> calibrate_dirs;
+  std::string margin_text = "1.5", calibrate_out;
+  bool calibrate_json = false;
+  CLI::App* calibrate = app.add_subcommand(
+      "fdd-calibrate",
+      "Replay saved runs (folders written by 'rotorguard run --out DIR', fault-free and faulty) through the\n"
+      "composite FDD offline while each threshold sweeps (gamma_M, gamma_P, take-off): detection latency,\n"
+      "misses and false alarms per value, the margin to the fault-free extremes, and a suggested value.");
+  calibrate->add_option("runs", calibrate_dirs, "Run folders (each with sensors.csv, vehicle.yaml, summary.json)")
+      ->required();
+  calibrate->add_option("--margin", margin_text,
+                        "Required margin to the fault-free extreme of each index (default 1.5, > 1)");
+  calibrate->add_option("--out", calibrate_out, "Folder for calibration.json and calibration.md");
+  calibrate->add_flag("--json", calibrate_json, "Print JSON instead of Markdown");
 
   // bench
   CLI::App* bench = app.add_subcommand("bench", "Benchmarks; results as a table or JSON.");
@@ -233,6 +251,25 @@ int main(int argc, char** argv) {
     if (*validate) {
       const rotorguard::bench::ValidationReport r = rotorguard::bench::ValidateConfigFile(validate_path);
       fmt::print("{}: valid {} ({})\n", validate_path, r.kind, r.summary);
+      return kOk;
+    }
+    if (*calibrate) {
+      rotorguard::bench::FddCalibrationOptions o;
+      o.margin = ParseFinite("--margin", margin_text, 1.0 + 1e-9, 1e6);
+      std::vector<rotorguard::bench::CalibrationLog> logs;
+      for (const std::string& d : calibrate_dirs) logs.push_back(rotorguard::bench::LoadCalibrationLog(d));
+      const nlohmann::json r = rotorguard::bench::CalibrateCompositeFdd(logs, o);
+      const std::string md = rotorguard::bench::CalibrationMarkdown(r);
+      if (!calibrate_out.empty()) {
+        std::error_code ec;
+        fs::create_directories(calibrate_out, ec);
+        if (ec || !fs::is_directory(calibrate_out)) {
+          throw UsageError(fmt::format("--out: cannot create folder '{}'", calibrate_out));
+        }
+        rotorguard::io::WriteFileAtomically((fs::path(calibrate_out) / "calibration.json").string(), r.dump(2) + "\n");
+        rotorguard::io::WriteFileAtomically((fs::path(calibrate_out) / "calibration.md").string(), md);
+      }
+      fmt::print("{}", calibrate_json ? r.dump(2) + "\n" : md);
       return kOk;
     }
     if (*bench_sim) {

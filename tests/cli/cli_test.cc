@@ -16,6 +16,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "test_util.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -60,22 +62,8 @@ std::string Scenario(const std::string& vehicle, const std::string& extra = "") 
          extra;
 }
 
-class CliTest : public ::testing::Test {
+class CliTest : public rotorguard::testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rotorguard_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string Write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
   /// A copy of the reference vehicle file with `from` replaced by `to` in its text.
   std::string VehicleWith(const std::string& from, const std::string& to) {
     std::string text = ReadText(kVehicle);
@@ -94,14 +82,12 @@ class CliTest : public ::testing::Test {
     for (const std::string& n : needles) EXPECT_NE(r.out.find(n), std::string::npos) << "'" << n << "' not in: " << r.out;
   }
   std::string Out() const { return (dir_ / "out").string(); }
-
-  fs::path dir_;
 };
 
 TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
   const Result r = Cli("--help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* s : {"run", "validate", "bench", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  for (const char* s : {"run", "validate", "bench", "fdd-calibrate", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
   const Result run = Cli("run --help");
   EXPECT_EQ(run.exit_code, 0);
   for (const char* s : {"--out", "--set", "--seed", "--quiet"}) EXPECT_NE(run.out.find(s), std::string::npos) << s;
@@ -135,6 +121,37 @@ TEST_F(CliTest, HoverRunSucceedsAndWritesLogAndSummary) {
   EXPECT_EQ(log.rfind("t,p_x,p_y,p_z", 0), 0u);
   // 100 Hz over 1 s plus the header and the final row.
   EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 102);
+}
+
+TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
+  const std::string fault_free = Write("free.yaml", Scenario(kVehicle, "stack: {controller: nmpc, fdd: composite}\n"));
+  const std::string faulty = Write("faulty.yaml", Scenario(kVehicle,
+                                                           "faults:\n"
+                                                           "  - {rotor: 1, kind: motor_stop, onset: {at_time_s: 0.5}}\n"
+                                                           "stack: {controller: nmpc, fdd: composite}\n"));
+  ASSERT_EQ(Cli("run " + fault_free + " --quiet --out " + Out() + "/free").exit_code, 0);
+  Cli("run " + faulty + " --quiet --out " + Out() + "/faulty");  // a 1 s flight: the outcome does not matter
+  const Result r = Cli("fdd-calibrate " + Out() + "/free " + Out() + "/faulty --out " + Out() + "/cal");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("2 logs (1 faulty, 1 fault-free)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("### motor_index_threshold"), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "cal" / "calibration.json"));
+  EXPECT_EQ(j["sweeps"].size(), 3u);
+  EXPECT_EQ(j["logs"][1]["with_configured_thresholds"]["correct"], true);
+
+  EXPECT_EQ(Cli("fdd-calibrate " + Out() + "/free --margin 1").exit_code, 2);
+  EXPECT_EQ(Cli("fdd-calibrate").exit_code, 2);
+  const Result missing = Cli("fdd-calibrate " + Out() + "/no_such_run");
+  EXPECT_EQ(missing.exit_code, 3);
+  EXPECT_NE(missing.out.find("no such folder"), std::string::npos) << missing.out;
+  // A sensor log cut in the middle of a line: exit 3, naming the file, line and byte.
+  const fs::path sensors = fs::path(Out()) / "free" / "sensors.csv";
+  const std::string text = ReadText(sensors);
+  std::ofstream(sensors, std::ios::binary | std::ios::trunc) << text.substr(0, text.size() / 2);
+  const Result cut = Cli("fdd-calibrate " + Out() + "/free");
+  EXPECT_EQ(cut.exit_code, 3);
+  EXPECT_TRUE(std::regex_search(cut.out, std::regex("sensors.csv: cannot read input file: line [0-9]+ \\(byte [0-9]+\\)")))
+      << cut.out;
 }
 
 TEST_F(CliTest, NominalControllerLosingAMotorCrashesAndExitsOne) {

@@ -79,25 +79,13 @@ TEST(ConfigError, WhatOmitsUnknownLineColumnAndEmptyKeyPath) {
 // ---------------------------------------------------------------------------------------------
 // Files
 
-class TempDir : public ::testing::Test {
+class TempDir : public rotorguard::testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("rotorguard_io_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
   void TearDown() override {
     std::error_code ec;
     std::filesystem::permissions(dir_ / "secret.yaml", std::filesystem::perms::owner_all, ec);
-    std::filesystem::remove_all(dir_, ec);
+    TempFolderTest::TearDown();
   }
-  std::string Write(const std::string& name, const std::string& text) {
-    const std::filesystem::path path = dir_ / name;
-    std::ofstream(path) << text;
-    return path.string();
-  }
-  std::filesystem::path dir_;
 };
 
 TEST_F(TempDir, LoadFileMissingThrowsInputFileError) {
