@@ -57,6 +57,10 @@ RelaxedHover SolveRelaxedHover(const vehicle::MultirotorModel& model, int failed
     ThrowInvalidArgument("SolveRelaxedHover", "opposite_ratio", opposite_ratio, "a ratio in [0, 1)");
   }
   const vehicle::VehicleParams& vp = model.params();
+  if (!(vp.yaw_damping_n_m_s > 0.0)) {
+    ThrowInvalidArgument("SolveRelaxedHover", "yaw_damping_n_m_s", vp.yaw_damping_n_m_s,
+                         "> 0 (without yaw damping the spin has no steady rate)");
+  }
   const int twin = DiagonalTwin(vp, failed);
   RotorVector pattern = RotorVector::Ones(4);
   pattern[failed] = 0.0;
@@ -67,7 +71,8 @@ RelaxedHover SolveRelaxedHover(const vehicle::MultirotorModel& model, int failed
   const double ixx = I(0, 0), iyy = I(1, 1), izz = I(2, 2);
   RelaxedHover out;
   Vector3 n = Vector3::UnitZ();
-  for (int it = 0; it < 200; ++it) {
+  bool converged = false;
+  for (int it = 0; it < 200 && !converged; ++it) {
     // Weight along n_B: s * T_unit * n_z = m g.
     const double s = vp.weight_n() / (unit[0] * n.z());
     // w = r n; with a diagonal inertia, w x I w = (w_y w_z (Izz - Iyy), w_x w_z (Ixx - Izz), w_x w_y (Iyy - Ixx)).
@@ -82,10 +87,13 @@ RelaxedHover SolveRelaxedHover(const vehicle::MultirotorModel& model, int failed
     }
     const Vector3 n_new = (wz >= 0.0 ? 1.0 : -1.0) * w.normalized();  // n_B points up
     out.spin_rate_rad_s = w.norm() * (wz >= 0.0 ? 1.0 : -1.0);
-    const bool converged = (n_new - n).norm() < 1e-13;
+    converged = (n_new - n).norm() < 1e-13;
     n = n_new;
-    out.thrust_n = s * pattern;
-    if (converged) break;
+  }
+  out.thrust_n = vp.weight_n() / (unit[0] * n.z()) * pattern;  // the weight along the final n_B
+  if (!converged) {
+    ThrowInvalidArgument("SolveRelaxedHover", "opposite_ratio", opposite_ratio,
+                         "a ratio whose relaxed hover the fixed-point iteration finds (it did not converge)");
   }
   if (n.z() < 0.5 || out.thrust_n.maxCoeff() > model.max_thrust().minCoeff()) {
     ThrowInvalidArgument("SolveRelaxedHover", "opposite_ratio", opposite_ratio,
@@ -102,6 +110,9 @@ IndiController::IndiController(const vehicle::MultirotorModel& model, const Indi
   if (model_.num_rotors() != 4) {
     ThrowInvalidArgument("IndiController", "num_rotors", model_.num_rotors(), "4 (the method is for a quadrotor)");
   }
+  // Every rotor's relaxed hover, solved now: an infeasible one is a configuration error found at
+  // start-up, not an exception in the middle of a flight.
+  for (int i = 0; i < 4; ++i) hovers_.push_back(SolveRelaxedHover(model_, i, options_.opposite_ratio));
   alpha_filter_ = FilteredDerivative<3>(options_.filter_cutoff_hz, options_.sample_hz);
   thrust_filter_ = LowPass2<4>(options_.filter_cutoff_hz, options_.sample_hz);
 }
@@ -118,7 +129,7 @@ void IndiController::SetRotorFailed(int rotor) {
   }
   if (failed_) return;  // the method handles one lost rotor; later isolations change nothing
   failed_ = rotor;
-  hover_ = SolveRelaxedHover(model_, rotor, options_.opposite_ratio);
+  hover_ = hovers_[static_cast<std::size_t>(rotor)];
   Eigen::Matrix3d G;  // rows [T; tau_x; tau_y] of the three remaining rotors (eq. 5)
   int c = 0;
   for (int i = 0; i < 4; ++i) {
@@ -167,7 +178,8 @@ void IndiController::Compute(const StateEstimate& est, const ReferenceTrajectory
   // after the failure: the target axis leans from body z towards n_B as the square of the spin
   // (the gyroscopic torque's scaling), so that the vehicle is not asked for a tilt it cannot hold.
   const double spin_fraction =
-      std::clamp(std::pow(w.dot(hover_->primary_axis_B) / hover_->spin_rate_rad_s, 2), 0.0, 1.0);
+      std::pow(std::clamp(w.dot(hover_->primary_axis_B) / hover_->spin_rate_rad_s, 0.0, 1.0), 2);  // a spin
+  // the wrong way round holds no lean
   const Vector3 n = (Vector3::UnitZ() + spin_fraction * (hover_->primary_axis_B - Vector3::UnitZ())).normalized();
   const Eigen::Vector2d h_ddot_des =
       options_.k_h * (n - h).head<2>() - options_.d_h * h_dot.head<2>();
@@ -184,7 +196,11 @@ void IndiController::Compute(const StateEstimate& est, const ReferenceTrajectory
   acting[*failed_] = 0.0;
   const Eigen::Vector3d torque_now = model_.effectiveness().topRows<3>() * acting;  // [T; tau_x; tau_y]
   const Vector3 d_tau = vp.inertia_kg_m2 * (alpha_des - alpha_f);
-  const Eigen::Vector3d wrench(f_des.norm() / hz, torque_now[1] + d_tau.x(), torque_now[2] + d_tau.y());
+  // Thrust: |f_des| along n_des needs |f_des| / h_z along body z. Far off the axis (h_z < 0.7) that
+  // would multiply the thrust; it fades to zero instead, leaving the rotors to the tilt torques.
+  const double thrust =
+      h.z() >= 0.7 ? f_des.norm() / h.z() : f_des.norm() * std::max(h.z(), 0.0) / (0.7 * 0.7);
+  const Eigen::Vector3d wrench(thrust, torque_now[1] + d_tau.x(), torque_now[2] + d_tau.y());
   const Eigen::Vector3d t3 = inverse_map_ * wrench;
   thrust_command->setZero(4);
   for (int k = 0; k < 3; ++k) {

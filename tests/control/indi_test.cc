@@ -141,6 +141,59 @@ TEST(IndiController, AtTheRelaxedHoverCommandsTheEquilibrium) {
   }
 }
 
+// The inversion against kinematics: off the relaxed hover (tilted, with a perturbed rate), the
+// commanded torques give an angular acceleration whose effect on h = R^T e_z, differentiated
+// numerically along R' = R [w]x, w' = alpha, is the asked h''_xy = k_h (n_B - h)_xy - d_h h'_xy.
+TEST(IndiController, CommandedTorquesGiveTheAskedReducedAttitudeAcceleration) {
+  const vehicle::MultirotorModel model(ReferenceQuad());
+  const Matrix3& I = model.params().inertia_kg_m2;
+  for (int failed : {0, 3}) {
+    IndiControllerOptions o;
+    o.position.ki_position.setZero();
+    IndiController indi(model, o);
+    indi.SetRotorFailed(failed);
+    const RelaxedHover& eq = *indi.relaxed_hover();
+    planning::HoverOptions ho;
+    ho.position_m = Vector3(0, 0, 2);
+    const planning::HoverReference ref(ho);
+    StateEstimate e;
+    e.valid = true;
+    e.p_W = Vector3(0, 0, 2);
+    const Quaternion upright = Quaternion::FromTwoVectors(eq.primary_axis_B, Vector3::UnitZ());
+    e.q_WB = Quaternion(Eigen::AngleAxisd(0.01, Vector3(1, 1, 0).normalized())) * upright;
+    // Spinning a little faster than the equilibrium: the target axis is n_B itself.
+    e.w_B = 1.05 * eq.spin_rate_rad_s * eq.primary_axis_B + Vector3(0.05, -0.03, 0.0);
+    e.motor_thrust_n = eq.thrust_n;
+    RotorVector u;
+    for (int k = 0; k < 60; ++k) indi.Compute(e, ref, 0.005 * k, 0.005, &u);  // constant rate: alpha_f = 0
+    for (int i = 0; i < 4; ++i) {
+      if (i == failed) {
+        EXPECT_EQ(u[i], 0.0);
+      } else {
+        ASSERT_GT(u[i], 0.0) << "the check needs unsaturated rotors";
+        ASSERT_LT(u[i], 11.5);
+      }
+    }
+    RotorVector acting = eq.thrust_n;
+    acting[failed] = 0.0;
+    const Eigen::Vector3d d_wrench = model.effectiveness().topRows<3>() * (u - acting);
+    const Vector3 alpha(d_wrench[1] / I(0, 0), d_wrench[2] / I(1, 1), 0.0);
+    const Matrix3 R = e.q_WB.toRotationMatrix();
+    const auto h_at = [&](double t) {
+      const Vector3 theta = e.w_B * t + 0.5 * alpha * t * t;
+      const Matrix3 Rt = R * Eigen::AngleAxisd(theta.norm(), theta.normalized()).toRotationMatrix();
+      return Vector3(Rt.transpose() * Vector3::UnitZ());
+    };
+    const double d = 1e-4;
+    const Vector3 h = h_at(0.0);
+    const Vector3 h_ddot = (h_at(d) - 2.0 * h + h_at(-d)) / (d * d);
+    const Vector3 asked = o.k_h * (eq.primary_axis_B - h) - o.d_h * h.cross(e.w_B);
+    for (int a = 0; a < 2; ++a) {
+      EXPECT_NEAR(h_ddot[a], asked[a], 1e-3 * std::abs(asked[a]) + 1e-4) << "rotor " << failed << " axis " << a;
+    }
+  }
+}
+
 TEST(IndiController, NonFiniteEstimateGivesAFiniteCommand) {
   const vehicle::MultirotorModel model(ReferenceQuad());
   IndiController indi(model, IndiControllerOptions{});

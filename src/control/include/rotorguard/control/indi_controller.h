@@ -18,6 +18,7 @@
 /// synchronous (Sun et al., Sec. III). Thrust and the two tilt torques are inverted through the
 /// three remaining rotors.
 #include <optional>
+#include <vector>
 
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/nominal_controller.h"
@@ -54,15 +55,16 @@ struct RelaxedHover {
 
 /// Solves the relaxed hover for `failed` with the diagonal twin at `opposite_ratio` of its
 /// neighbours: weight carried along n_B, yaw torque against the yaw damping, roll/pitch torque
-/// against the gyroscopic torque of w = r n_B (fixed-point iteration). Throws std::invalid_argument
-/// for a vehicle that is not a quadrotor, or when the balance has no solution (an inertia with
-/// I_zz = I_xx cannot hold a tilted spin).
+/// against the gyroscopic torque of w = r n_B (fixed-point iteration; a diagonal inertia is
+/// assumed). Throws std::invalid_argument for a vehicle that is not a quadrotor, without yaw
+/// damping, or when the balance has no feasible solution (an inertia with I_zz = I_xx cannot hold
+/// a tilted spin).
 RelaxedHover SolveRelaxedHover(const vehicle::MultirotorModel& model, int failed, double opposite_ratio);
 
 class IndiController final : public Controller {
  public:
   /// Throws ValidationError for bad options and std::invalid_argument for a vehicle that is not a
-  /// quadrotor (the method is for one).
+  /// quadrotor (the method is for one) or whose relaxed hover cannot be solved for some rotor.
   IndiController(const vehicle::MultirotorModel& model, const IndiControllerOptions& options);
   std::string_view name() const override { return "indi"; }
   void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
@@ -78,6 +80,7 @@ class IndiController final : public Controller {
   NominalController nominal_;
   PositionLoop position_loop_;
   std::optional<int> failed_;
+  std::vector<RelaxedHover> hovers_;  // per failed rotor
   std::optional<RelaxedHover> hover_;
   Eigen::Matrix3d inverse_map_ = Eigen::Matrix3d::Identity();  // [T; tau_x; tau_y] -> three rotors
   int remaining_[3] = {0, 0, 0};
