@@ -186,7 +186,7 @@ void IndiController::Compute(const StateEstimate& est, const ReferenceTrajectory
   const Eigen::Vector2d c = h_ddot_des - h_dot.cross(w).head<2>();
   // Solve (h x w')_xy = c for the roll and pitch accelerations, the yaw acceleration as measured.
   // h_z is kept away from 0 so that a vehicle far off its axis still gets a bounded command.
-  const double hz = std::max(h.z(), 0.3);
+  const double hz = std::max(h.z(), 0.3);  // the same bound as the thrust's below
   const Vector3& alpha_f = alpha_filter_.value();
   const Vector3 alpha_des((c.y() + h.x() * alpha_f.z()) / hz, (h.y() * alpha_f.z() - c.x()) / hz, alpha_f.z());
   // Incremental inversion: the torque the rotors give now (telemetry; the failed rotor's counted as
@@ -196,10 +196,12 @@ void IndiController::Compute(const StateEstimate& est, const ReferenceTrajectory
   acting[*failed_] = 0.0;
   const Eigen::Vector3d torque_now = model_.effectiveness().topRows<3>() * acting;  // [T; tau_x; tau_y]
   const Vector3 d_tau = vp.inertia_kg_m2 * (alpha_des - alpha_f);
-  // Thrust: |f_des| along n_des needs |f_des| / h_z along body z. Far off the axis (h_z < 0.7) that
-  // would multiply the thrust; it fades to zero instead, leaving the rotors to the tilt torques.
+  // Thrust: |f_des| along n_des needs |f_des| / h_z along body z. Far off the axis (h_z < 0.3,
+  // beyond 72 degrees) that would multiply the thrust without bound; it fades to zero instead,
+  // leaving the rotors to the tilt torques. (A fade from 0.7 down crashed take-offs: the spinning
+  // vehicle needs the extra thrust while its axis swings in.)
   const double thrust =
-      h.z() >= 0.7 ? f_des.norm() / h.z() : f_des.norm() * std::max(h.z(), 0.0) / (0.7 * 0.7);
+      h.z() >= 0.3 ? f_des.norm() / h.z() : f_des.norm() * std::max(h.z(), 0.0) / (0.3 * 0.3);
   const Eigen::Vector3d wrench(thrust, torque_now[1] + d_tau.x(), torque_now[2] + d_tau.y());
   const Eigen::Vector3d t3 = inverse_map_ * wrench;
   thrust_command->setZero(4);
