@@ -258,6 +258,9 @@ int main(int argc, char** argv) {
       o.margin = ParseFinite("--margin", margin_text, 1.0 + 1e-9, 1e6);
       std::vector<rotorguard::bench::CalibrationLog> logs;
       for (const std::string& d : calibrate_dirs) logs.push_back(rotorguard::bench::LoadCalibrationLog(d));
+      std::string note;
+      o.fdd = rotorguard::bench::RecordedFddOptions(logs, &note);
+      if (!note.empty()) fmt::print(stderr, "note: {}\n", note);
       const nlohmann::json r = rotorguard::bench::CalibrateCompositeFdd(logs, o);
       const std::string md = rotorguard::bench::CalibrationMarkdown(r);
       if (!calibrate_out.empty()) {

@@ -69,15 +69,7 @@ struct Scored {
 Scored ReplayAndScore(const CalibrationLog& log, const fdd::CompositeFddOptions& options) {
   Scored s;
   s.outcome = ReplayCompositeFdd(log, options);
-  // Score as the benchmarks do (metrics.h): the outcome's first isolation as a status list.
-  std::vector<fdd::RotorStatus> statuses(static_cast<std::size_t>(log.vehicle.num_rotors()));
-  if (s.outcome.detected) {
-    fdd::RotorStatus& st = statuses[static_cast<std::size_t>(s.outcome.rotor)];
-    st.health = s.outcome.kind == "motor_stop" ? fdd::RotorHealth::kMotorFailed : fdd::RotorHealth::kPropellerFailed;
-    st.detected_s = s.outcome.detection_s;
-    st.detector = s.outcome.detector;
-  }
-  s.record = ScoreFdd(statuses, Events(log));
+  s.record = ScoreFdd(s.outcome.statuses, Events(log));  // as the benchmarks score a run (metrics.h)
   return s;
 }
 
@@ -92,9 +84,11 @@ struct Sweep {
 }  // namespace
 
 CalibrationLog LoadCalibrationLog(const std::string& dir) {
-  if (!fs::is_directory(dir)) {
-    throw io::InputFileError(dir, fs::exists(dir) ? "not a folder; expected a run folder" : "no such folder");
-  }
+  std::error_code ec;
+  const fs::file_status status = fs::status(dir, ec);
+  if (status.type() == fs::file_type::not_found) throw io::InputFileError(dir, "no such folder");
+  if (ec) throw io::InputFileError(dir, ec.message());
+  if (status.type() != fs::file_type::directory) throw io::InputFileError(dir, "not a folder; expected a run folder");
   CalibrationLog log;
   log.dir = dir;
   const std::string summary_path = (fs::path(dir) / "summary.json").string();
@@ -108,12 +102,75 @@ CalibrationLog LoadCalibrationLog(const std::string& dir) {
     for (const nlohmann::json& f : summary.at("faults")) {
       log.faults.push_back({f.at("rotor").get<int>(), f.at("kind").get<std::string>(), f.at("onset_s").get<double>()});
     }
+    if (summary.contains("composite_fdd") && !summary["composite_fdd"].is_null()) {
+      log.recorded_fdd = CompositeFddOptionsFromJson(summary["composite_fdd"]);
+    }
+    // The IMU setup must be one the detector accepts.
+    fdd::CompositeFddOptions check = log.recorded_fdd.value_or(fdd::CompositeFddOptions{});
+    check.imu_rate_hz = log.imu_rate_hz;
+    check.imu_position_m = log.imu_position_m;
+    check.Validate();
   } catch (const std::exception& e) {
-    throw io::InputFileError(summary_path, fmt::format("not a run summary with 'sensors' and 'faults': {}", e.what()));
+    throw io::InputFileError(summary_path, fmt::format("not a valid run summary: {}", e.what()));
   }
-  log.vehicle = LoadVehicle((fs::path(dir) / "vehicle.yaml").string());
+  const std::string vehicle_path = (fs::path(dir) / "vehicle.yaml").string();
+  try {
+    log.vehicle = LoadVehicle(vehicle_path);
+  } catch (const io::ConfigError& e) {
+    // The run's own record of its vehicle: a bad one is a corrupt input, not a user's config.
+    throw io::InputFileError(vehicle_path, e.what());
+  }
   log.records = ReadSensorLog((fs::path(dir) / "sensors.csv").string(), log.vehicle.num_rotors());
   return log;
+}
+
+nlohmann::json CompositeFddOptionsToJson(const fdd::CompositeFddOptions& o) {
+  return {{"motor_index_threshold", o.motor_index_threshold},
+          {"motor_index_samples", o.motor_index_samples},
+          {"motor_index_min_thrust_n", o.motor_index_min_thrust_n},
+          {"propeller_index_threshold", o.propeller_index_threshold},
+          {"propeller_persistence_s", o.propeller_persistence_s},
+          {"degraded_threshold", o.degraded_threshold},
+          {"degraded_persistence_s", o.degraded_persistence_s},
+          {"filter_cutoff_hz", o.filter_cutoff_hz},
+          {"takeoff_max_altitude_m", o.takeoff_max_altitude_m},
+          {"takeoff_window_s", o.takeoff_window_s},
+          {"takeoff_angular_acceleration_rad_s2", o.takeoff_angular_acceleration_rad_s2},
+          {"takeoff_direction_cosine", o.takeoff_direction_cosine}};
+}
+
+fdd::CompositeFddOptions CompositeFddOptionsFromJson(const nlohmann::json& j) {
+  fdd::CompositeFddOptions o;
+  o.motor_index_threshold = j.at("motor_index_threshold").get<double>();
+  o.motor_index_samples = j.at("motor_index_samples").get<int>();
+  o.motor_index_min_thrust_n = j.at("motor_index_min_thrust_n").get<double>();
+  o.propeller_index_threshold = j.at("propeller_index_threshold").get<double>();
+  o.propeller_persistence_s = j.at("propeller_persistence_s").get<double>();
+  o.degraded_threshold = j.at("degraded_threshold").get<double>();
+  o.degraded_persistence_s = j.at("degraded_persistence_s").get<double>();
+  o.filter_cutoff_hz = j.at("filter_cutoff_hz").get<double>();
+  o.takeoff_max_altitude_m = j.at("takeoff_max_altitude_m").get<double>();
+  o.takeoff_window_s = j.at("takeoff_window_s").get<double>();
+  o.takeoff_angular_acceleration_rad_s2 = j.at("takeoff_angular_acceleration_rad_s2").get<double>();
+  o.takeoff_direction_cosine = j.at("takeoff_direction_cosine").get<double>();
+  return o;
+}
+
+fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& logs, std::string* note) {
+  const CalibrationLog* first = nullptr;
+  for (const CalibrationLog& log : logs) {
+    if (!log.recorded_fdd) continue;
+    if (!first) {
+      first = &log;
+    } else if (CompositeFddOptionsToJson(*log.recorded_fdd) != CompositeFddOptionsToJson(*first->recorded_fdd)) {
+      if (note) {
+        *note = fmt::format("{} and {} were flown with different FDD settings; all are replayed with those of {}",
+                            first->dir, log.dir, first->dir);
+      }
+      break;
+    }
+  }
+  return first ? *first->recorded_fdd : fdd::CompositeFddOptions{};
 }
 
 ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, fdd::CompositeFddOptions options) {
@@ -168,6 +225,7 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, fdd::CompositeFddOpt
       out.max_takeoff_alpha = std::max(out.max_takeoff_alpha, detector.takeoff_angular_acceleration());
     }
   }
+  out.statuses = detector.rotors();
   return out;
 }
 
@@ -225,6 +283,8 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
   nlohmann::json sweep_docs = nlohmann::json::array();
   for (const Sweep& sw : sweeps) {
     const double extreme = extremes.*sw.extreme;
+    // An index no fault-free flight moved (the motor index stays 1, the others 0) gives no margin.
+    const bool exercised = sw.alarm_when_low ? extreme < 1.0 : extreme > 0.0;
     nlohmann::json rows = nlohmann::json::array();
     std::optional<std::size_t> best;
     double best_latency = std::numeric_limits<double>::infinity();
@@ -251,12 +311,8 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
         }
       }
       // Margin: how far the threshold sits beyond the most alarming fault-free value.
-      double margin = std::numeric_limits<double>::infinity();
-      if (sw.alarm_when_low) {
-        margin = value > 0.0 ? extreme / value : margin;
-      } else if (extreme > 0.0) {
-        margin = value / extreme;
-      }
+      double margin = std::numeric_limits<double>::quiet_NaN();
+      if (exercised) margin = sw.alarm_when_low ? extreme / value : value / extreme;
       double mean = std::numeric_limits<double>::quiet_NaN(), max = mean;
       if (!latencies.empty()) {
         mean = 0.0;
@@ -273,7 +329,7 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
                       {"latency_s_max", finite_or_null(max)},
                       {"margin", finite_or_null(margin)}});
       // Suggested: the fastest value with the margin, no false alarm and no miss; ties go to the
-      // value with the larger margin (later in the list for the motor index, earlier otherwise).
+      // value with the larger margin (earlier in the list for the motor index, later otherwise).
       const bool acceptable = std::isfinite(margin) && margin >= options.margin && false_alarms == 0 && missed == 0 && !latencies.empty();
       const bool tie_with_larger_margin = !sw.alarm_when_low && std::abs(mean - best_latency) <= 1e-9;
       if (acceptable && (mean < best_latency - 1e-9 || tie_with_larger_margin)) {
@@ -291,7 +347,7 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
     } else {
       doc["suggested"] = nullptr;
       doc["note"] = faulty_logs == 0 ? std::string("no faulty logs: latency cannot be measured (add runs with faults)")
-                    : !(sw.alarm_when_low ? extreme < 1.0 : extreme > 0.0)
+                    : !exercised
                         ? std::string("no fault-free flight exercised this index (a take-off, for the take-off "
                                       "detector): no margin can be stated")
                         : fmt::format("no value keeps a {:g}x margin with no miss and no false alarm; add flights "
@@ -303,9 +359,10 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
   return {{"logs", log_docs},
           {"margin_required", options.margin},
           {"fault_free_extremes",
-           {{"min_motor_index", extremes.min_motor_index},
-            {"max_propeller_index", extremes.max_propeller_index},
-            {"max_takeoff_alpha", extremes.max_takeoff_alpha}}},
+           {{"min_motor_index", extremes.min_motor_index < 1.0 ? nlohmann::json(extremes.min_motor_index) : nullptr},
+            {"max_propeller_index",
+             extremes.max_propeller_index > 0.0 ? nlohmann::json(extremes.max_propeller_index) : nullptr},
+            {"max_takeoff_alpha", extremes.max_takeoff_alpha > 0.0 ? nlohmann::json(extremes.max_takeoff_alpha) : nullptr}}},
           {"sweeps", sweep_docs}};
 }
 
@@ -317,12 +374,12 @@ std::string CalibrationMarkdown(const nlohmann::json& c) {
   const auto& x = c["fault_free_extremes"];
   fmt::format_to(it, "FDD threshold calibration: {} logs ({} faulty, {} fault-free)\n\n", c["logs"].size(), faulty,
                  c["logs"].size() - static_cast<std::size_t>(faulty));
-  fmt::format_to(it, "Fault-free extremes: min M_i {:.3f}, max P_i {:.3f}, max take-off alpha {:.2f} rad/s^2\n",
-                 x["min_motor_index"].get<double>(), x["max_propeller_index"].get<double>(),
-                 x["max_takeoff_alpha"].get<double>());
   const auto num = [](const nlohmann::json& v, const char* f) {
     return v.is_null() ? std::string("/") : fmt::format(fmt::runtime(f), v.get<double>());
   };
+  fmt::format_to(it, "Fault-free extremes (/: not exercised): min M_i {}, max P_i {}, max take-off alpha {} rad/s^2\n",
+                 num(x["min_motor_index"], "{:.3f}"), num(x["max_propeller_index"], "{:.3f}"),
+                 num(x["max_takeoff_alpha"], "{:.2f}"));
   for (const auto& sw : c["sweeps"]) {
     fmt::format_to(it, "\n### {} (configured {:g})\n\n", sw["threshold"].get<std::string>(), sw["configured"].get<double>());
     fmt::format_to(it, "| value | detected | missed | false alarms | latency mean (s) | latency max (s) | margin |\n");

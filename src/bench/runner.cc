@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "rotorguard/bench/fdd_calibration.h"
 #include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/sensor_log.h"
 #include "rotorguard/core/error.h"
@@ -121,6 +122,7 @@ nlohmann::json RunSummary::ToJson() const {
   } else {
     j["fdd"] = nullptr;  // the stack ran no fault detection
   }
+  j["composite_fdd"] = composite_fdd ? CompositeFddOptionsToJson(*composite_fdd) : nlohmann::json(nullptr);
   j["sensors"] = {{"imu_rate_hz", imu_rate_hz},
                   {"imu_position_m", {imu_position_m.x(), imu_position_m.y(), imu_position_m.z()}}};
   j["physics_steps"] = physics_steps;
@@ -145,8 +147,6 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     fs::remove(fs::path(options.out_dir) / "summary.json", ec);
     log.emplace((fs::path(options.out_dir) / "log.csv").string());
     sensors.emplace((fs::path(options.out_dir) / "sensors.csv").string());
-    // The vehicle the stack flew, so that the run's folder is enough to replay its sensor log.
-    io::WriteFileAtomically((fs::path(options.out_dir) / "vehicle.yaml").string(), VehicleToYaml(sc.vehicle));
   }
 
   const vehicle::MultirotorModel truth_model(sc.vehicle);
@@ -177,6 +177,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   summary.seed = sc.seed;
   summary.imu_rate_hz = sc.sim.imu.rate_hz;
   summary.imu_position_m = sc.sim.imu.position_m;
+  if (sc.stack.fdd == "composite") summary.composite_fdd = sc.stack.composite_fdd;
   TrackingErrorAccumulator tracking;
   // Success (DESIGN.md, SucR): no crash, and the error within success_error_m over the last
   // success_hold_s of the flight. Remember the last time it was exceeded.
@@ -242,6 +243,8 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     log->Commit();
     sensors->Write(sensor_buffer);
     sensors->Commit();
+    // The vehicle the stack flew, so that the run's folder is enough to replay its sensor log.
+    io::WriteFileAtomically((fs::path(options.out_dir) / "vehicle.yaml").string(), VehicleToYaml(sc.vehicle));
   }
   if (options.progress) options.progress(1.0);
 

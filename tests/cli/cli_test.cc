@@ -147,7 +147,8 @@ TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
   // A sensor log cut in the middle of a line: exit 3, naming the file, line and byte.
   const fs::path sensors = fs::path(Out()) / "free" / "sensors.csv";
   const std::string text = ReadText(sensors);
-  std::ofstream(sensors, std::ios::binary | std::ios::trunc) << text.substr(0, text.size() / 2);
+  const std::size_t line_start = text.find('\n', text.size() / 2) + 1;
+  std::ofstream(sensors, std::ios::binary | std::ios::trunc) << text.substr(0, line_start + 5);  // mid-line
   const Result cut = Cli("fdd-calibrate " + Out() + "/free");
   EXPECT_EQ(cut.exit_code, 3);
   EXPECT_TRUE(std::regex_search(cut.out, std::regex("sensors.csv: cannot read input file: line [0-9]+ \\(byte [0-9]+\\)")))

@@ -28,12 +28,24 @@ struct CalibrationLog {
   double imu_rate_hz = 0.0;
   Vector3 imu_position_m = Vector3::Zero();
   std::vector<FaultRecord> faults;  ///< the injected faults (ground truth for scoring)
+  /// The composite FDD's settings in the recorded flight (summary.json "composite_fdd"), when the
+  /// stack ran it.
+  std::optional<fdd::CompositeFddOptions> recorded_fdd;
   std::vector<SensorRecord> records;
 };
 
 /// Loads a run folder. Throws io::InputFileError for a missing or malformed file (naming it, and
-/// the line and byte for sensors.csv) and io::ConfigError for an invalid vehicle.yaml.
+/// the line and byte for sensors.csv), an invalid vehicle.yaml included.
 CalibrationLog LoadCalibrationLog(const std::string& dir);
+
+/// The composite FDD's thresholds as summary.json records them ("composite_fdd"), and back (throws
+/// nlohmann::json::exception for a missing or mistyped key).
+nlohmann::json CompositeFddOptionsToJson(const fdd::CompositeFddOptions& options);
+fdd::CompositeFddOptions CompositeFddOptionsFromJson(const nlohmann::json& json);
+
+/// The settings to replay with: those the first log recorded, else the defaults. When logs
+/// recorded different settings, `note` (if given) says so.
+fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& logs, std::string* note);
 
 struct ReplayOutcome {
   bool detected = false;  ///< any rotor isolated (motor or propeller failure)
@@ -47,6 +59,9 @@ struct ReplayOutcome {
   double min_motor_index = 1.0;
   double max_propeller_index = 0.0;
   double max_takeoff_alpha = 0.0;
+  /// The detector's per-rotor statuses when the replay stopped (after the onset, once a rotor was
+  /// isolated; else at the end of the log), for ScoreFdd.
+  std::vector<fdd::RotorStatus> statuses;
 };
 
 /// Replays a log through a CompositeFdd built with `options` (the log's IMU rate and position
@@ -64,10 +79,13 @@ struct FddCalibrationOptions {
 
 /// Runs the three sweeps (motor_index_threshold, propeller_index_threshold,
 /// takeoff_angular_acceleration_rad_s2) over the logs. The document:
-/// {"logs": [{"dir", "faulty", "fault": {...}|null, "recorded": {...}}],
-///  "fault_free_extremes": {"min_motor_index", "max_propeller_index", "max_takeoff_alpha"},
+/// {"logs": [{"dir", "faulty", "fault": {...}|null, "with_configured_thresholds": {...}}],
+///  "fault_free_extremes": {"min_motor_index", "max_propeller_index", "max_takeoff_alpha"} (null:
+///  no fault-free flight moved the index),
 ///  "sweeps": [{"threshold", "configured", "rows": [{"value", "detected", "missed", "false_alarms",
 ///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null, "note"}]}
+/// A value that is not valid with the other thresholds (gamma_P at or below the degraded
+/// threshold) is left out.
 /// Throws std::invalid_argument when `logs` is empty.
 nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, const FddCalibrationOptions& options);
 

@@ -47,6 +47,8 @@ struct RunSummary {
   /// The IMU the stack read (summary.json "sensors"): what a replay of sensors.csv needs.
   double imu_rate_hz = 0.0;
   Vector3 imu_position_m = Vector3::Zero();
+  /// The composite FDD's thresholds when the stack ran it (summary.json "composite_fdd").
+  std::optional<fdd::CompositeFddOptions> composite_fdd;
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;
 

@@ -53,7 +53,8 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
 
 /// Loads and validates a vehicle file (same error contract).
 vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Override>& overrides = {});
-/// The vehicle in the format LoadVehicle reads (numbers in their shortest exact form).
+/// The vehicle in the format LoadVehicle reads, every number in its shortest exact form (the
+/// thrust coefficient, converted to per rpm^2, reads back within one part in 1e15).
 std::string VehicleToYaml(const vehicle::VehicleParams& vehicle);
 
 /// What `rotorguard validate` found in a file.

@@ -9,6 +9,8 @@
 ///   odom,T,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z
 ///   cmd,T,u_0,...,u_{n-1}                        the stack's thrust command [N] at its cycle T
 /// T is the message's time stamp [ns] (an ESC sample's is when it was measured, before transport).
+/// Numbers are in their shortest exact form; nan and inf are written as such (the stack ignores a
+/// non-finite message, and a replay must see it to ignore it too).
 #include <string>
 #include <vector>
 
@@ -33,8 +35,8 @@ void AppendOdometry(const OdometrySample& m, std::string* out);
 void AppendCommand(const RotorCommand& m, std::string* out);
 
 /// Reads a sensor log for a vehicle of `num_rotors`. Throws io::InputFileError when the file cannot
-/// be read or is malformed (truncated, a bad number, a wrong field count, time going backwards per
-/// type); the reason names the line and its byte offset.
+/// be read or is malformed (truncated, something that is not a number, a wrong field count, time
+/// going backwards per message type); the reason names the line and its byte offset.
 std::vector<SensorRecord> ReadSensorLog(const std::string& path, int num_rotors);
 
 }  // namespace rotorguard::bench
