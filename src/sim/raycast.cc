@@ -1,0 +1,217 @@
+#include "rotorguard/sim/raycast.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::sim {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Rotation of a world vector into a box frame yawed by `yaw` (and back with -yaw).
+Vector3 RotateZ(const Vector3& v, double c, double s) { return Vector3(c * v.x() - s * v.y(), s * v.x() + c * v.y(), v.z()); }
+
+/// Keeps the nearer of two hits.
+void Nearer(const std::optional<RayHit>& candidate, std::optional<RayHit>* best) {
+  if (candidate && (!*best || candidate->distance_m < (*best)->distance_m)) *best = candidate;
+}
+
+}  // namespace
+
+std::optional<RayHit> IntersectGround(const Vector3& o, const Vector3& d, double max_m) {
+  if (!(o.z() > 0.0) || !(d.z() < 0.0)) return std::nullopt;
+  const double t = -o.z() / d.z();
+  if (t > max_m) return std::nullopt;
+  return RayHit{t, Vector3::UnitZ()};
+}
+
+std::optional<RayHit> IntersectBox(const Box& box, const Vector3& o, const Vector3& d, double max_m) {
+  // Slab test in the box frame.
+  const double c = std::cos(box.yaw_rad), s = std::sin(box.yaw_rad);
+  const Vector3 lo = RotateZ(o - box.center_m, c, -s);
+  const Vector3 ld = RotateZ(d, c, -s);
+  const Vector3 h = 0.5 * box.size_m;
+  double t_near = -kInf, t_far = kInf;
+  int axis = -1;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(ld[i]) < 1e-15) {
+      if (std::abs(lo[i]) > h[i]) return std::nullopt;  // parallel to this slab and outside it
+      continue;
+    }
+    double t1 = (-h[i] - lo[i]) / ld[i], t2 = (h[i] - lo[i]) / ld[i];
+    if (t1 > t2) std::swap(t1, t2);
+    if (t1 > t_near) {
+      t_near = t1;
+      axis = i;
+    }
+    t_far = std::min(t_far, t2);
+  }
+  // Missed, behind, starting inside (t_near <= 0), or beyond the range.
+  if (axis < 0 || t_near > t_far || !(t_near > 0.0) || t_near > max_m) return std::nullopt;
+  Vector3 n = Vector3::Zero();
+  n[axis] = ld[axis] > 0.0 ? -1.0 : 1.0;
+  return RayHit{t_near, RotateZ(n, c, s)};
+}
+
+std::optional<RayHit> IntersectCylinder(const Cylinder& cyl, const Vector3& o, const Vector3& d, double max_m) {
+  const Eigen::Vector2d o2 = o.head<2>() - cyl.center_m;
+  const Eigen::Vector2d d2 = d.head<2>();
+  const double r2 = cyl.radius_m * cyl.radius_m;
+  const bool inside_circle = o2.squaredNorm() < r2;
+  if (inside_circle && o.z() >= 0.0 && o.z() <= cyl.height_m) return std::nullopt;  // inside the trunk
+  std::optional<RayHit> best;
+  // Side: |o2 + t d2|^2 = r^2, entering from outside the circle.
+  const double a = d2.squaredNorm();
+  if (a > 1e-15 && !inside_circle) {
+    const double b = 2.0 * o2.dot(d2);
+    const double c = o2.squaredNorm() - r2;
+    const double disc = b * b - 4.0 * a * c;
+    if (disc >= 0.0) {
+      const double t = (-b - std::sqrt(disc)) / (2.0 * a);
+      const double z = o.z() + t * d.z();
+      if (t > 0.0 && t <= max_m && z >= 0.0 && z <= cyl.height_m) {
+        const Eigen::Vector2d n2 = (o2 + t * d2) / cyl.radius_m;
+        best = RayHit{t, Vector3(n2.x(), n2.y(), 0.0)};
+      }
+    }
+  }
+  // Top cap, from above.
+  if (o.z() > cyl.height_m && d.z() < 0.0) {
+    const double t = (cyl.height_m - o.z()) / d.z();
+    if (t <= max_m && (o2 + t * d2).squaredNorm() <= r2) Nearer(RayHit{t, Vector3::UnitZ()}, &best);
+  }
+  return best;
+}
+
+void RayCasterOptions::Validate() const {
+  if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m)) {
+    ThrowValidation("RayCasterOptions", "cell_size_m", cell_size_m, "a cell edge > 0 m");
+  }
+}
+
+RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std::move(world)) {
+  options.Validate();
+  cell_ = options.cell_size_m;
+  // Horizontal bounding boxes of the static obstacles.
+  const int n_static = static_cast<int>(world_.boxes.size() + world_.cylinders.size());
+  std::vector<Eigen::Vector4d> bounds;  // min x, min y, max x, max y
+  bounds.reserve(static_cast<std::size_t>(n_static));
+  for (const Box& b : world_.boxes) {
+    const double c = std::abs(std::cos(b.yaw_rad)), s = std::abs(std::sin(b.yaw_rad));
+    const double ex = 0.5 * (c * b.size_m.x() + s * b.size_m.y()), ey = 0.5 * (s * b.size_m.x() + c * b.size_m.y());
+    bounds.emplace_back(b.center_m.x() - ex, b.center_m.y() - ey, b.center_m.x() + ex, b.center_m.y() + ey);
+  }
+  for (const Cylinder& cy : world_.cylinders) {
+    bounds.emplace_back(cy.center_m.x() - cy.radius_m, cy.center_m.y() - cy.radius_m, cy.center_m.x() + cy.radius_m,
+                        cy.center_m.y() + cy.radius_m);
+  }
+  last_ray_.assign(static_cast<std::size_t>(n_static), 0);
+  if (n_static == 0) return;
+  Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
+  for (const Eigen::Vector4d& b : bounds) {
+    lo = lo.cwiseMin(b.head<2>());
+    hi = hi.cwiseMax(b.tail<2>());
+  }
+  // At most 2048 cells per side: a huge world gets larger cells rather than a huge grid.
+  cell_ = std::max(cell_, (hi - lo).maxCoeff() / 2048.0);
+  min_ = lo;
+  nx_ = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) / cell_)));
+  ny_ = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) / cell_)));
+  const auto cell_range = [&](const Eigen::Vector4d& b, int* x0, int* y0, int* x1, int* y1) {
+    *x0 = std::clamp(static_cast<int>(std::floor((b[0] - min_.x()) / cell_)), 0, nx_ - 1);
+    *y0 = std::clamp(static_cast<int>(std::floor((b[1] - min_.y()) / cell_)), 0, ny_ - 1);
+    *x1 = std::clamp(static_cast<int>(std::floor((b[2] - min_.x()) / cell_)), 0, nx_ - 1);
+    *y1 = std::clamp(static_cast<int>(std::floor((b[3] - min_.y()) / cell_)), 0, ny_ - 1);
+  };
+  // Compressed rows: count, prefix-sum, fill.
+  cell_start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+  int x0, y0, x1, y1;
+  for (const Eigen::Vector4d& b : bounds) {
+    cell_range(b, &x0, &y0, &x1, &y1);
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) ++cell_start_[static_cast<std::size_t>(y) * nx_ + x + 1];
+    }
+  }
+  for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
+  items_.resize(static_cast<std::size_t>(cell_start_.back()));
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (int i = 0; i < n_static; ++i) {
+    cell_range(bounds[static_cast<std::size_t>(i)], &x0, &y0, &x1, &y1);
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) items_[static_cast<std::size_t>(fill[static_cast<std::size_t>(y) * nx_ + x]++)] = i;
+    }
+  }
+}
+
+std::optional<RayHit> RayCaster::IntersectStatic(int index, const Vector3& o, const Vector3& d, double max_m) const {
+  const int n_boxes = static_cast<int>(world_.boxes.size());
+  return index < n_boxes ? IntersectBox(world_.boxes[static_cast<std::size_t>(index)], o, d, max_m)
+                         : IntersectCylinder(world_.cylinders[static_cast<std::size_t>(index - n_boxes)], o, d, max_m);
+}
+
+std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double max_m, double t) {
+  std::optional<RayHit> best = IntersectGround(o, d, max_m);
+  for (const MovingBox& m : world_.moving_boxes) Nearer(IntersectBox(m.At(t), o, d, max_m), &best);
+  if (nx_ == 0) return best;
+  if (++ray_id_ == 0) {  // the mailbox counter wrapped: forget every mark
+    std::fill(last_ray_.begin(), last_ray_.end(), 0u);
+    ray_id_ = 1;
+  }
+  // The part of the ray inside the grid's horizontal bounds: [t_in, t_out].
+  const Eigen::Vector2d o2 = o.head<2>(), d2 = d.head<2>();
+  const Eigen::Vector2d hi = min_ + cell_ * Eigen::Vector2d(nx_, ny_);
+  double t_in = 0.0, t_out = best ? best->distance_m : max_m;
+  for (int i = 0; i < 2; ++i) {
+    if (std::abs(d2[i]) < 1e-15) {
+      if (o2[i] < min_[i] || o2[i] > hi[i]) return best;
+      continue;
+    }
+    double t1 = (min_[i] - o2[i]) / d2[i], t2 = (hi[i] - o2[i]) / d2[i];
+    if (t1 > t2) std::swap(t1, t2);
+    t_in = std::max(t_in, t1);
+    t_out = std::min(t_out, t2);
+  }
+  if (t_in > t_out) return best;
+  // Amanatides-Woo traversal of the cells the ray crosses, nearest first.
+  const Eigen::Vector2d start = o2 + t_in * d2;
+  int cx = std::clamp(static_cast<int>(std::floor((start.x() - min_.x()) / cell_)), 0, nx_ - 1);
+  int cy = std::clamp(static_cast<int>(std::floor((start.y() - min_.y()) / cell_)), 0, ny_ - 1);
+  const int step_x = d2.x() > 0.0 ? 1 : -1, step_y = d2.y() > 0.0 ? 1 : -1;
+  const auto boundary_t = [&](int i, int cell, int step) {
+    if (std::abs(d2[i]) < 1e-15) return kInf;
+    const double edge = min_[i] + cell_ * (cell + (step > 0 ? 1 : 0));
+    return (edge - o2[i]) / d2[i];
+  };
+  double t_next_x = boundary_t(0, cx, step_x), t_next_y = boundary_t(1, cy, step_y);
+  const double dt_x = std::abs(d2.x()) < 1e-15 ? kInf : cell_ / std::abs(d2.x());
+  const double dt_y = std::abs(d2.y()) < 1e-15 ? kInf : cell_ / std::abs(d2.y());
+  double t_cell = t_in;
+  while (true) {
+    const double range = best ? best->distance_m : max_m;
+    if (t_cell > range) break;  // every later cell lies beyond the nearest hit
+    const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
+    for (int k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+      const int obstacle = items_[static_cast<std::size_t>(k)];
+      if (last_ray_[static_cast<std::size_t>(obstacle)] == ray_id_) continue;
+      last_ray_[static_cast<std::size_t>(obstacle)] = ray_id_;
+      Nearer(IntersectStatic(obstacle, o, d, range), &best);
+    }
+    if (t_next_x < t_next_y) {
+      cx += step_x;
+      t_cell = t_next_x;
+      t_next_x += dt_x;
+    } else {
+      cy += step_y;
+      t_cell = t_next_y;
+      t_next_y += dt_y;
+    }
+    if (cx < 0 || cx >= nx_ || cy < 0 || cy >= ny_) break;
+  }
+  return best;
+}
+
+}  // namespace rotorguard::sim
