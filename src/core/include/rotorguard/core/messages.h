@@ -1,6 +1,9 @@
 #pragma once
 /// The messages that cross the boundary between the simulator (or a real vehicle) and the flight
 /// stack. The stack's only inputs are these sensor messages; its only output is RotorCommand.
+#include <cstdint>
+#include <vector>
+
 #include "rotorguard/core/types.h"
 
 namespace rotorguard {
@@ -24,6 +27,18 @@ struct OdometrySample {
   Vector3 p_W = Vector3::Zero();
   Quaternion q_WB = Quaternion::Identity();
   Vector3 v_W = Vector3::Zero();
+};
+
+/// One LiDAR frame (paper 000 Sec. IV-B: a Livox MID-360 at 10 Hz). Each point was measured from
+/// the sensor's pose at its own time and is expressed in the sensor frame of that instant, so a
+/// spinning vehicle's frame is distorted until deskewed with the stack's estimates.
+struct LidarFrame {
+  TimeNs t_start_ns = 0;  ///< the frame's first instant
+  TimeNs t_end_ns = 0;    ///< the frame's last instant (exclusive)
+  std::vector<Eigen::Vector3f> points_S;  ///< returns in the sensor frame at their own time [m]
+  std::vector<std::uint32_t> offset_ns;  ///< per point: time after t_start_ns [ns]
+  /// Pulses with no usable return: nothing within range, closer than the minimum range, or lost.
+  int dropped = 0;
 };
 
 /// The stack's output: commanded thrust per rotor [N] (paper 000: u_i, eq. 6).

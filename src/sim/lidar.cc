@@ -1,0 +1,98 @@
+#include "rotorguard/sim/lidar.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::sim {
+
+void LidarOptions::Validate() const {
+  const auto require = [](bool ok, const char* key, double value, const char* rule) {
+    if (!ok) ThrowValidation("LidarOptions", key, value, rule);
+  };
+  require(std::isfinite(frame_rate_hz) && frame_rate_hz > 0.0 && frame_rate_hz <= 1000.0, "frame_rate_hz",
+          frame_rate_hz, "a rate in (0, 1000] Hz");
+  require(std::isfinite(points_per_s) && points_per_s > 0.0 && points_per_s <= 1e8, "points_per_s", points_per_s,
+          "a rate in (0, 1e8] points/s");
+  require(std::isfinite(min_range_m) && min_range_m >= 0.0, "min_range_m", min_range_m, "a range >= 0 m");
+  require(std::isfinite(max_range_m) && max_range_m > min_range_m && max_range_m <= 1e4, "max_range_m", max_range_m,
+          "a range above min_range_m, at most 1e4 m");
+  require(std::isfinite(min_elevation_rad) && min_elevation_rad >= -0.5 * std::numbers::pi, "min_elevation_rad",
+          min_elevation_rad, "an angle in [-pi/2, max_elevation_rad)");
+  require(std::isfinite(max_elevation_rad) && max_elevation_rad > min_elevation_rad &&
+              max_elevation_rad <= 0.5 * std::numbers::pi,
+          "max_elevation_rad", max_elevation_rad, "an angle in (min_elevation_rad, pi/2]");
+  require(std::isfinite(range_noise_m) && range_noise_m >= 0.0, "range_noise_m", range_noise_m, "a value >= 0 m");
+  require(dropout_probability >= 0.0 && dropout_probability < 1.0, "dropout_probability", dropout_probability,
+          "a probability in [0, 1)");
+  if (!position_m.allFinite()) ThrowValidation("LidarOptions", "position_m", "(non-finite)", "finite numbers");
+  require(std::isfinite(grid_cell_m) && grid_cell_m > 0.0, "grid_cell_m", grid_cell_m, "a cell edge > 0 m");
+}
+
+Vector3 LidarPatternDirection(std::uint64_t k, const LidarOptions& o) {
+  // R2 sequence: alpha = (1/g, 1/g^2), g the plastic number (the real root of x^3 = x + 1).
+  constexpr double g = 1.32471795724474602596;
+  constexpr double a1 = 1.0 / g, a2 = 1.0 / (g * g);
+  const double kd = static_cast<double>(k);
+  const double u = std::fmod(0.5 + a1 * kd, 1.0), v = std::fmod(0.5 + a2 * kd, 1.0);
+  const double azimuth = 2.0 * std::numbers::pi * u;
+  // Uniform in solid angle over the band: sin(elevation) uniform.
+  const double s0 = std::sin(o.min_elevation_rad), s1 = std::sin(o.max_elevation_rad);
+  const double sin_el = s0 + v * (s1 - s0);
+  const double cos_el = std::sqrt(std::max(0.0, 1.0 - sin_el * sin_el));
+  return Vector3(cos_el * std::cos(azimuth), cos_el * std::sin(azimuth), sin_el);
+}
+
+LidarSimulator::LidarSimulator(const LidarOptions& options, const World& world, std::uint64_t seed)
+    : options_(options), caster_(world, RayCasterOptions{options.grid_cell_m}), rng_(seed) {
+  options_.Validate();
+  frame_ns_ = PeriodFromRate(options_.frame_rate_hz);
+  frame_.t_start_ns = 0;
+  frame_.t_end_ns = frame_ns_;
+}
+
+TimeNs LidarSimulator::PulseTime(std::uint64_t k) const {
+  return static_cast<TimeNs>(std::llround(static_cast<double>(k) * 1e9 / options_.points_per_s));
+}
+
+std::optional<LidarFrame> LidarSimulator::Step(TimeNs t0, const BodyPose& pose0, TimeNs t1, const BodyPose& pose1) {
+  if (t1 <= t0) return std::nullopt;
+  // Attitude across the step: q(s) = q0 * exp(s * log(q0^-1 q1)), the shortest arc.
+  const Quaternion q0 = pose0.q_WB.normalized();
+  Quaternion rel = q0.conjugate() * pose1.q_WB.normalized();
+  if (rel.w() < 0.0) rel.coeffs() = -rel.coeffs();
+  const Eigen::AngleAxisd arc(rel);
+  const double span = static_cast<double>(t1 - t0);
+  std::optional<LidarFrame> done;
+  while (PulseTime(next_pulse_) <= t1) {
+    const TimeNs t = PulseTime(next_pulse_);
+    if (t <= t0 && next_pulse_ > 0) {  // pulses at or before t0 belonged to the previous step
+      ++next_pulse_;
+      continue;
+    }
+    while (t >= frame_.t_end_ns) {  // the pulse opens a new frame: hand over the finished one
+      done = std::move(frame_);
+      frame_ = LidarFrame{};
+      frame_.t_start_ns = done->t_end_ns;
+      frame_.t_end_ns = done->t_end_ns + frame_ns_;
+    }
+    const double s = std::clamp(static_cast<double>(t - t0) / span, 0.0, 1.0);
+    const Vector3 p = pose0.p_W + s * (pose1.p_W - pose0.p_W);
+    const Matrix3 R = (q0 * Quaternion(Eigen::AngleAxisd(s * arc.angle(), arc.axis()))).toRotationMatrix();
+    const Vector3 dir_S = LidarPatternDirection(next_pulse_, options_);
+    const Vector3 origin = p + R * options_.position_m;
+    const auto hit = caster_.Cast(origin, R * dir_S, options_.max_range_m, ToSeconds(t));
+    ++next_pulse_;
+    if (!hit || hit->distance_m < options_.min_range_m || rng_.Uniform() < options_.dropout_probability) {
+      ++frame_.dropped;
+      continue;
+    }
+    const double range = hit->distance_m + options_.range_noise_m * rng_.Normal();
+    frame_.points_S.push_back((range * dir_S).cast<float>());
+    frame_.offset_ns.push_back(static_cast<std::uint32_t>(t - frame_.t_start_ns));
+  }
+  return done;
+}
+
+}  // namespace rotorguard::sim
