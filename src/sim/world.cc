@@ -63,4 +63,12 @@ std::optional<std::string> World::SphereCollision(const Vector3& p, double radiu
   return std::nullopt;
 }
 
+double World::DistanceToSurface(const Vector3& p, double t) const {
+  double d = std::abs(p.z());
+  for (const Box& b : boxes) d = std::min(d, b.Distance(p));
+  for (const Cylinder& c : cylinders) d = std::min(d, c.Distance(p));
+  for (const MovingBox& m : moving_boxes) d = std::min(d, m.At(t).Distance(p));
+  return d;
+}
+
 }  // namespace rotorguard::sim

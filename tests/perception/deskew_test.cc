@@ -6,27 +6,10 @@
 #include <gtest/gtest.h>
 
 #include "rotorguard/sim/lidar.h"
+#include "sim/room_fixture.h"
 
 namespace rotorguard::perception {
 namespace {
-
-/// A room of four walls and a pillar, 8 x 6 m inside.
-sim::World Room() {
-  sim::World w;
-  w.boxes = {{Vector3(4.5, 0, 1.5), Vector3(1, 8, 3), 0.0},
-             {Vector3(-4.5, 0, 1.5), Vector3(1, 8, 3), 0.0},
-             {Vector3(0, 3.5, 1.5), Vector3(10, 1, 3), 0.3},
-             {Vector3(0, -3.5, 1.5), Vector3(10, 1, 3), 0.0}};
-  w.cylinders = {{Eigen::Vector2d(1.5, 1.0), 0.2, 3.0}};
-  return w;
-}
-
-double DistanceToSurfaces(const sim::World& w, const Vector3& p) {
-  double d = std::abs(p.z());
-  for (const sim::Box& b : w.boxes) d = std::min(d, b.Distance(p));
-  for (const sim::Cylinder& c : w.cylinders) d = std::min(d, c.Distance(p));
-  return d;
-}
 
 // With perfect estimates (exact gyro at 333 Hz, exact velocity and frame-end attitude) the
 // deskewed points, placed with the frame-end pose, lie on the room's surfaces to float precision,
@@ -36,7 +19,7 @@ TEST(Deskew, IsExactWithPerfectEstimates) {
   lo.enabled = true;
   lo.range_noise_m = 0.0;
   lo.dropout_probability = 0.0;
-  const sim::World room = Room();
+  const sim::World room = rotorguard::testing::Room();
   sim::LidarSimulator lidar(lo, room, 2);
   const Vector3 w_B(0.8, -0.5, 11.0);  // constant body rate: R(t) = R0 Exp(w t)
   const Vector3 v_W(0.6, -0.3, 0.1);
@@ -70,9 +53,9 @@ TEST(Deskew, IsExactWithPerfectEstimates) {
     double deskewed_max = 0.0, raw_mean = 0.0;
     for (std::size_t i = 0; i < out.size(); ++i) {
       deskewed_max = std::max(deskewed_max,
-                              DistanceToSurfaces(room, end.p_W + end.q_WB * (o.sensor_position_m + out[i].cast<double>())));
-      raw_mean += DistanceToSurfaces(
-          room, end.p_W + end.q_WB * (o.sensor_position_m + frame->points_S[i].cast<double>()));
+                              room.DistanceToSurface(end.p_W + end.q_WB * (o.sensor_position_m + out[i].cast<double>()), 0.0));
+      raw_mean +=
+          room.DistanceToSurface(end.p_W + end.q_WB * (o.sensor_position_m + frame->points_S[i].cast<double>()), 0.0);
     }
     raw_mean /= static_cast<double>(out.size());
     EXPECT_LT(deskewed_max, 5e-4) << "frame " << frames;

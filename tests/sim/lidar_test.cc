@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "rotorguard/core/error.h"
+#include "sim/room_fixture.h"
 
 namespace rotorguard::sim {
 namespace {
@@ -58,24 +59,6 @@ TEST(LidarPattern, StaysInTheFieldOfViewAndCoversItMoreTheLongerItIntegrates) {
   EXPECT_EQ(repeated, 0);
 }
 
-/// A room of four walls (1 m thick boxes) around the origin, 8 x 6 x 3 m inside.
-World Room() {
-  World w;
-  w.boxes = {{Vector3(4.5, 0, 1.5), Vector3(1, 8, 3), 0.0},
-             {Vector3(-4.5, 0, 1.5), Vector3(1, 8, 3), 0.0},
-             {Vector3(0, 3.5, 1.5), Vector3(10, 1, 3), 0.0},
-             {Vector3(0, -3.5, 1.5), Vector3(10, 1, 3), 0.0}};
-  w.cylinders = {{Eigen::Vector2d(1.5, 1.0), 0.2, 3.0}};
-  return w;
-}
-
-double DistanceToSurfaces(const World& w, const Vector3& p) {
-  double d = std::abs(p.z());  // the ground
-  for (const Box& b : w.boxes) d = std::min(d, b.Distance(p));
-  for (const Cylinder& c : w.cylinders) d = std::min(d, c.Distance(p));
-  return d;
-}
-
 /// Flies the sensor for `duration_s` with 1 ms steps along poses given by `pose_at(t)`; returns
 /// the frames.
 std::vector<LidarFrame> Fly(LidarSimulator* lidar, double duration_s, const std::function<BodyPose(double)>& pose_at) {
@@ -95,7 +78,7 @@ TEST(LidarSimulator, PointsLieOnSurfacesFromTheirOwnPoseAndSmearFromTheFrameEnd)
   o.enabled = true;
   o.range_noise_m = 0.0;
   o.dropout_probability = 0.0;
-  const World room = Room();
+  const World room = rotorguard::testing::Room();
   LidarSimulator lidar(o, room, 3);
   constexpr double kSpin = 11.0;
   const auto pose_at = [](double t) {
@@ -115,8 +98,8 @@ TEST(LidarSimulator, PointsLieOnSurfacesFromTheirOwnPoseAndSmearFromTheFrameEnd)
     for (std::size_t i = 0; i < f.points_S.size(); ++i) {
       const BodyPose at = pose_at(ToSeconds(f.t_start_ns + f.offset_ns[i]));
       const Vector3 p_S = f.points_S[i].cast<double>();
-      own_max = std::max(own_max, DistanceToSurfaces(room, at.p_W + at.q_WB * (o.position_m + p_S)));
-      end_mean += DistanceToSurfaces(room, end.p_W + end.q_WB * (o.position_m + p_S));
+      own_max = std::max(own_max, room.DistanceToSurface(at.p_W + at.q_WB * (o.position_m + p_S), 0.0));
+      end_mean += room.DistanceToSurface(end.p_W + end.q_WB * (o.position_m + p_S), 0.0);
     }
     end_mean /= static_cast<double>(f.points_S.size());
     EXPECT_LT(own_max, 2e-4) << "float precision";

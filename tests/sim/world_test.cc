@@ -48,5 +48,20 @@ TEST(World, SphereCollisionNamesTheObstacle) {
   EXPECT_FALSE(w.SphereCollision(Vector3(0, 4.5, 1), 0.2, 0.0));  // 0.3 m from the trunk
 }
 
+TEST(World, DistanceToSurfaceIsTheNearestOfGroundAndObstacles) {
+  World w;
+  w.boxes.push_back({Vector3(5, 0, 1), Vector3(2, 2, 2), 0.0});
+  MovingBox m;
+  m.size_m = Vector3(1, 1, 1);
+  m.waypoints_m = {Vector3(0, 5, 3), Vector3(10, 5, 3)};
+  m.speed_m_s = 1.0;
+  m.loop = false;
+  w.moving_boxes.push_back(m);
+  EXPECT_DOUBLE_EQ(w.DistanceToSurface(Vector3(0, 0, 0.7), 0.0), 0.7);           // the ground
+  EXPECT_DOUBLE_EQ(w.DistanceToSurface(Vector3(3.5, 0, 1.5), 0.0), 0.5);         // the box's face
+  EXPECT_DOUBLE_EQ(w.DistanceToSurface(Vector3(4, 5, 4.0), 4.0), 0.5);           // the moving box at t = 4 s
+  EXPECT_DOUBLE_EQ(w.DistanceToSurface(Vector3(4, 5, 4.0), 0.0), std::hypot(3.5, 0.5));  // it has not come yet
+}
+
 }  // namespace
 }  // namespace rotorguard::sim

@@ -47,6 +47,8 @@ class World {
   /// Name of the first obstacle a sphere at `p` of `radius` intersects at time t, if any
   /// ("box 3", "cylinder 12", "moving box 0"). The ground is handled by the simulator.
   std::optional<std::string> SphereCollision(const Vector3& p, double radius, double t) const;
+  /// Distance from `p` to the nearest surface at time t, the ground plane included (0 inside).
+  double DistanceToSurface(const Vector3& p, double t) const;
 };
 
 }  // namespace rotorguard::sim
