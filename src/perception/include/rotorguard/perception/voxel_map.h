@@ -1,0 +1,102 @@
+#pragma once
+/// Local occupancy map for planning among obstacles the vehicle discovers (paper 000 Sec. V-C
+/// plans on a LiDAR map built while spinning). Voxels (0.1 m by default) in a window that follows
+/// the vehicle, stored as a ring buffer so that moving the window clears only the slabs it leaves.
+/// Each frame updates log-odds (Thrun, Burgard, Fox, Probabilistic Robotics, Sec. 9.2): the voxel
+/// of every return is hit, the voxels its ray crossed are missed, each voxel updated at most once
+/// per frame (hits win), so that an obstacle that moved away is cleared by the rays that now pass
+/// through it. Occupied voxels are inflated by the vehicle radius in a second layer kept up to
+/// date incrementally, which the planner's queries read.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "rotorguard/core/types.h"
+
+namespace rotorguard::perception {
+
+struct VoxelMapOptions {
+  double resolution_m = 0.1;                      ///< voxel edge [m], > 0
+  /// Extent of the local window [m], > resolution; rounded up to a power of two voxels per axis
+  /// (24 x 24 x 6 m at 0.1 m gives 25.6 x 25.6 x 6.4 m).
+  Vector3 window_size_m = Vector3(24.0, 24.0, 6.0);
+  double log_odds_hit = 0.85;   ///< added on a return (p = 0.7), > 0
+  double log_odds_miss = -0.4;  ///< added when a ray passes (p = 0.4), < 0
+  double log_odds_min = -2.0;   ///< clamp, < 0
+  double log_odds_max = 3.5;    ///< clamp, > 0
+  double occupied_threshold = 0.7;  ///< occupied above this log-odds (two hits from unknown), in (0, max)
+  double inflation_radius_m = 0.2;  ///< the vehicle's radius [m], >= 0
+  /// Rays longer than this only clear up to it (and still mark their return) [m], > 0.
+  double max_clearing_range_m = 20.0;
+  void Validate() const;
+};
+
+struct MapUpdateSummary {
+  int points_used = 0;
+  int points_dropped = 0;  ///< non-finite, or their voxel outside the window
+  int voxels_updated = 0;
+};
+
+/// The nearest occupied voxel to a query point.
+struct NearestObstacle {
+  Vector3 point_W;   ///< the voxel's centre
+  double distance_m = 0.0;
+  Vector3 normal_W;  ///< unit vector from the obstacle towards the query (the obstacle's outward normal there)
+};
+
+class VoxelMap {
+ public:
+  explicit VoxelMap(const VoxelMapOptions& options);
+
+  /// Moves the window so that it is centred on `center_W` (to the voxel); voxels that leave are
+  /// forgotten. Cheap when the centre moved little.
+  void Recenter(const Vector3& center_W);
+  /// Integrates one frame of returns (world frame) measured from `origin_W`.
+  MapUpdateSummary Insert(const Vector3& origin_W, const std::vector<Eigen::Vector3f>& points_W);
+
+  bool InWindow(const Vector3& p_W) const;
+  /// The window's extent in voxels per axis (powers of two).
+  Eigen::Vector3i size_voxels() const { return size_; }
+  /// Occupied (log-odds above the threshold). Outside the window: false.
+  bool IsOccupied(const Vector3& p_W) const;
+  /// Observed at least once (hit or missed). Outside the window: false.
+  bool IsKnown(const Vector3& p_W) const;
+  /// Within the inflation radius of an occupied voxel. Outside the window: false.
+  bool IsInflated(const Vector3& p_W) const;
+  /// The nearest occupied voxel within `radius_m` of p, if any.
+  std::optional<NearestObstacle> Nearest(const Vector3& p_W, double radius_m) const;
+  /// Whether the segment a-b passes through an inflated voxel (unknown and outside-window space
+  /// count as free: the planner is optimistic about what it has not seen).
+  bool SegmentCollides(const Vector3& a_W, const Vector3& b_W) const;
+
+  /// Centres of all occupied voxels (for scoring and display).
+  std::vector<Vector3> OccupiedVoxels() const;
+  int occupied_count() const { return occupied_count_; }
+  double resolution() const { return res_; }
+
+ private:
+  using Index = Eigen::Vector3i;
+  Index ToIndex(const Vector3& p) const;
+  Vector3 Center(const Index& i) const;
+  bool InWindow(const Index& i) const;
+  std::size_t Address(const Index& i) const;
+  /// Sets a voxel's log-odds, maintaining the occupied count and the inflation layer.
+  void SetLogOdds(const Index& i, float value);
+  void Inflate(const Index& i, int delta);
+  void ClearVoxel(const Index& i);
+
+  VoxelMapOptions options_;
+  double res_;
+  Index size_;            // voxels per axis
+  Index origin_;          // global index of the window's lower corner
+  std::vector<float> log_odds_;
+  std::vector<std::uint8_t> known_;
+  std::vector<std::uint16_t> inflation_;  // occupied voxels within the radius
+  std::vector<std::uint32_t> stamp_;      // frame that last touched the voxel
+  std::uint32_t frame_ = 0;
+  std::vector<Index> stencil_;            // offsets within the inflation radius
+  std::vector<Index> touched_hit_, touched_miss_;
+  int occupied_count_ = 0;
+};
+
+}  // namespace rotorguard::perception

@@ -1,0 +1,333 @@
+#include "rotorguard/perception/voxel_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::perception {
+
+namespace {
+
+/// a mod n for n a power of two, also for negative a (two's complement).
+int PositiveMod(int a, int n) { return a & (n - 1); }
+
+/// Visits the voxels a segment from a to b crosses, in order (Amanatides and Woo 1987), calling
+/// visit(index) for each until it returns false. Coordinates are in voxel units.
+template <typename Visit>
+void TraverseVoxels(const Vector3& a, const Vector3& b, Visit&& visit) {
+  Eigen::Vector3i i(static_cast<int>(std::floor(a.x())), static_cast<int>(std::floor(a.y())),
+                    static_cast<int>(std::floor(a.z())));
+  const Eigen::Vector3i end(static_cast<int>(std::floor(b.x())), static_cast<int>(std::floor(b.y())),
+                            static_cast<int>(std::floor(b.z())));
+  const Vector3 d = b - a;
+  Eigen::Vector3i step;
+  Vector3 t_max, t_delta;
+  for (int k = 0; k < 3; ++k) {
+    step[k] = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
+    if (step[k] == 0) {
+      t_max[k] = std::numeric_limits<double>::infinity();
+      t_delta[k] = std::numeric_limits<double>::infinity();
+    } else {
+      const double boundary = step[k] > 0 ? std::floor(a[k]) + 1.0 : std::floor(a[k]);
+      t_max[k] = (boundary - a[k]) / d[k];
+      t_delta[k] = 1.0 / std::abs(d[k]);
+    }
+  }
+  const int max_steps = (end - i).cwiseAbs().sum() + 1;
+  for (int s = 0; s < max_steps; ++s) {
+    if (!visit(i)) return;
+    if (i == end) return;
+    int k = 0;
+    if (t_max[1] < t_max[k]) k = 1;
+    if (t_max[2] < t_max[k]) k = 2;
+    if (t_max[k] > 1.0) return;  // past the segment's end (rounding)
+    i[k] += step[k];
+    t_max[k] += t_delta[k];
+  }
+}
+
+}  // namespace
+
+void VoxelMapOptions::Validate() const {
+  const auto require = [](bool ok, const char* field, double v, const char* rule) {
+    if (!ok) ThrowValidation("VoxelMapOptions", field, v, rule);
+  };
+  require(std::isfinite(resolution_m) && resolution_m > 0.0, "resolution_m", resolution_m, "a voxel edge > 0 m");
+  for (int k = 0; k < 3; ++k) {
+    require(std::isfinite(window_size_m[k]) && window_size_m[k] > resolution_m &&
+                window_size_m[k] / resolution_m <= 4096.0,
+            "window_size_m", window_size_m[k], "extents above resolution_m, at most 4096 voxels each");
+  }
+  require(std::isfinite(log_odds_hit) && log_odds_hit > 0.0, "log_odds_hit", log_odds_hit, "> 0");
+  require(std::isfinite(log_odds_miss) && log_odds_miss < 0.0, "log_odds_miss", log_odds_miss, "< 0");
+  require(std::isfinite(log_odds_min) && log_odds_min < 0.0, "log_odds_min", log_odds_min, "< 0");
+  require(std::isfinite(log_odds_max) && log_odds_max > 0.0, "log_odds_max", log_odds_max, "> 0");
+  require(occupied_threshold > 0.0 && occupied_threshold < log_odds_max, "occupied_threshold", occupied_threshold,
+          "a log-odds in (0, log_odds_max)");
+  require(std::isfinite(inflation_radius_m) && inflation_radius_m >= 0.0 && inflation_radius_m <= 100.0 * resolution_m,
+          "inflation_radius_m", inflation_radius_m, "a radius in [0, 100 voxels]");
+  require(std::isfinite(max_clearing_range_m) && max_clearing_range_m > 0.0, "max_clearing_range_m",
+          max_clearing_range_m, "a range > 0 m");
+  const double voxels = (window_size_m / resolution_m).prod();
+  require(voxels <= 64e6, "window_size_m", voxels, "at most 64 million voxels");
+}
+
+VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
+  options_.Validate();
+  res_ = options_.resolution_m;
+  // Voxels per axis: the requested extent rounded up to a power of two, so that the ring buffer's
+  // index arithmetic is a mask rather than a division (the map's hottest path).
+  for (int k = 0; k < 3; ++k) {
+    const int needed = static_cast<int>(std::ceil(options_.window_size_m[k] / res_));
+    size_[k] = 1;
+    while (size_[k] < needed) size_[k] *= 2;
+  }
+  origin_ = -size_ / 2;
+  const std::size_t n = static_cast<std::size_t>(size_.x()) * size_.y() * size_.z();
+  log_odds_.assign(n, 0.0f);
+  known_.assign(n, 0);
+  inflation_.assign(n, 0);
+  stamp_.assign(n, 0);
+  // Offsets whose voxel centres lie within the radius of the centre voxel's.
+  const int r = static_cast<int>(std::ceil(options_.inflation_radius_m / res_));
+  const double r2 = std::pow(options_.inflation_radius_m / res_ + 1e-9, 2);
+  for (int x = -r; x <= r; ++x) {
+    for (int y = -r; y <= r; ++y) {
+      for (int z = -r; z <= r; ++z) {
+        if (x * x + y * y + z * z <= r2) stencil_.emplace_back(x, y, z);
+      }
+    }
+  }
+}
+
+VoxelMap::Index VoxelMap::ToIndex(const Vector3& p) const {
+  return Index(static_cast<int>(std::floor(p.x() / res_)), static_cast<int>(std::floor(p.y() / res_)),
+               static_cast<int>(std::floor(p.z() / res_)));
+}
+
+Vector3 VoxelMap::Center(const Index& i) const { return (i.cast<double>() + Vector3::Constant(0.5)) * res_; }
+
+bool VoxelMap::InWindow(const Index& i) const {
+  return (i.array() >= origin_.array()).all() && (i.array() < (origin_ + size_).array()).all();
+}
+
+bool VoxelMap::InWindow(const Vector3& p) const { return p.allFinite() && InWindow(ToIndex(p)); }
+
+std::size_t VoxelMap::Address(const Index& i) const {
+  return (static_cast<std::size_t>(PositiveMod(i.x(), size_.x())) * size_.y() + PositiveMod(i.y(), size_.y())) *
+             size_.z() +
+         PositiveMod(i.z(), size_.z());
+}
+
+void VoxelMap::Inflate(const Index& i, int delta) {
+  for (const Index& o : stencil_) {
+    const Index j = i + o;
+    if (InWindow(j)) inflation_[Address(j)] = static_cast<std::uint16_t>(inflation_[Address(j)] + delta);
+  }
+}
+
+void VoxelMap::SetLogOdds(const Index& i, float value) {
+  const std::size_t a = Address(i);
+  const bool was = log_odds_[a] > options_.occupied_threshold;
+  const bool now = value > options_.occupied_threshold;
+  log_odds_[a] = value;
+  known_[a] = 1;
+  if (was == now) return;
+  occupied_count_ += now ? 1 : -1;
+  Inflate(i, now ? 1 : -1);
+}
+
+void VoxelMap::ClearVoxel(const Index& i) {
+  SetLogOdds(i, 0.0f);
+  known_[Address(i)] = 0;
+}
+
+void VoxelMap::Recenter(const Vector3& center_W) {
+  if (!center_W.allFinite()) return;
+  const Index new_origin = ToIndex(center_W) - size_ / 2;
+  if (new_origin == origin_) return;
+  const Index shift = new_origin - origin_;
+  if ((shift.cwiseAbs().array() >= size_.array()).any()) {  // nothing stays
+    std::fill(log_odds_.begin(), log_odds_.end(), 0.0f);
+    std::fill(known_.begin(), known_.end(), 0);
+    std::fill(inflation_.begin(), inflation_.end(), 0);
+    occupied_count_ = 0;
+    origin_ = new_origin;
+    return;
+  }
+  const auto in_new = [&](const Index& i) {
+    return (i.array() >= new_origin.array()).all() && (i.array() < (new_origin + size_).array()).all();
+  };
+  // Voxels of the old window outside the new one: a slab along each axis that moved. A voxel in
+  // two slabs (a corner) is taken with the first.
+  const auto slab = [&](int k, Eigen::Vector2i* range) {
+    (*range)[0] = shift[k] > 0 ? origin_[k] : new_origin[k] + size_[k];
+    (*range)[1] = shift[k] > 0 ? new_origin[k] : origin_[k] + size_[k];  // exclusive
+  };
+  std::vector<Index> leaving;
+  for (int k = 0; k < 3; ++k) {
+    if (shift[k] == 0) continue;
+    Eigen::Vector2i range;
+    slab(k, &range);
+    Index i;
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    for (i[k] = range[0]; i[k] < range[1]; ++i[k]) {
+      for (i[a] = origin_[a]; i[a] < origin_[a] + size_[a]; ++i[a]) {
+        for (i[b] = origin_[b]; i[b] < origin_[b] + size_[b]; ++i[b]) {
+          bool earlier = false;
+          for (int j = 0; j < k && !earlier; ++j) {
+            Eigen::Vector2i other;
+            slab(j, &other);
+            earlier = shift[j] != 0 && i[j] >= other[0] && i[j] < other[1];
+          }
+          if (!earlier && !in_new(i)) leaving.push_back(i);
+        }
+      }
+    }
+  }
+  // Forget them (their inflation of the voxels that stay goes too), then free their slots.
+  for (const Index& i : leaving) ClearVoxel(i);
+  for (const Index& i : leaving) inflation_[Address(i)] = 0;
+  const Index old_origin = origin_;
+  origin_ = new_origin;
+  // Voxels that entered (the freed slots) get the inflation of the occupied voxels near them.
+  const auto in_old = [&](const Index& i) {
+    return (i.array() >= old_origin.array()).all() && (i.array() < (old_origin + size_).array()).all();
+  };
+  for (const Index& left : leaving) {
+    // The entering voxel that took this slot: the same address inside the new window.
+    Index e;
+    for (int k = 0; k < 3; ++k) e[k] = new_origin[k] + PositiveMod(left[k] - new_origin[k], size_[k]);
+    if (in_old(e)) continue;
+    int count = 0;
+    for (const Index& o : stencil_) {
+      const Index j = e + o;
+      if (InWindow(j) && log_odds_[Address(j)] > options_.occupied_threshold) ++count;
+    }
+    inflation_[Address(e)] = static_cast<std::uint16_t>(count);
+  }
+}
+
+MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eigen::Vector3f>& points_W) {
+  MapUpdateSummary summary;
+  if (!origin_W.allFinite()) {
+    summary.points_dropped = static_cast<int>(points_W.size());
+    return summary;
+  }
+  // Stamps: 2f marks a miss in frame f, 2f + 1 a hit (hits win over misses in the same frame).
+  ++frame_;
+  if (frame_ >= (1u << 30)) {  // far in the future: restart the stamps
+    std::fill(stamp_.begin(), stamp_.end(), 0u);
+    frame_ = 1;
+  }
+  const std::uint32_t miss = 2 * frame_, hit = 2 * frame_ + 1;
+  touched_hit_.clear();
+  touched_miss_.clear();
+  const Vector3 o = origin_W / res_;
+  const double max_cells = options_.max_clearing_range_m / res_;
+  for (const Eigen::Vector3f& pf : points_W) {
+    const Vector3 p = pf.cast<double>();
+    if (!p.allFinite()) {
+      ++summary.points_dropped;
+      continue;
+    }
+    const Index end = ToIndex(p);
+    const bool end_in = InWindow(end);
+    // Free space along the ray (the return's own voxel excluded), up to the clearing range.
+    Vector3 e = p / res_;
+    const double len = (e - o).norm();
+    if (len > max_cells) e = o + (e - o) * (max_cells / len);
+    TraverseVoxels(o, e, [&](const Index& i) {
+      if (i == end) return false;
+      if (InWindow(i)) {
+        std::uint32_t& s = stamp_[Address(i)];
+        if (s < miss) {
+          s = miss;
+          touched_miss_.push_back(i);
+        }
+      }
+      return true;
+    });
+    if (!end_in) {
+      ++summary.points_dropped;
+      continue;
+    }
+    std::uint32_t& s = stamp_[Address(end)];
+    if (s != hit) {
+      s = hit;
+      touched_hit_.push_back(end);
+    }
+    ++summary.points_used;
+  }
+  const auto clamp = [&](float v) {
+    return std::clamp(v, static_cast<float>(options_.log_odds_min), static_cast<float>(options_.log_odds_max));
+  };
+  for (const Index& i : touched_hit_) SetLogOdds(i, clamp(log_odds_[Address(i)] + static_cast<float>(options_.log_odds_hit)));
+  for (const Index& i : touched_miss_) {
+    if (stamp_[Address(i)] != miss) continue;  // hit in this frame after all
+    SetLogOdds(i, clamp(log_odds_[Address(i)] + static_cast<float>(options_.log_odds_miss)));
+  }
+  summary.voxels_updated = static_cast<int>(touched_hit_.size() + touched_miss_.size());
+  return summary;
+}
+
+bool VoxelMap::IsOccupied(const Vector3& p) const {
+  if (!InWindow(p)) return false;
+  return log_odds_[Address(ToIndex(p))] > options_.occupied_threshold;
+}
+
+bool VoxelMap::IsKnown(const Vector3& p) const { return InWindow(p) && known_[Address(ToIndex(p))] != 0; }
+
+bool VoxelMap::IsInflated(const Vector3& p) const { return InWindow(p) && inflation_[Address(ToIndex(p))] > 0; }
+
+std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius_m) const {
+  if (!p.allFinite() || !(radius_m >= 0.0)) return std::nullopt;
+  const Index c = ToIndex(p);
+  const int r = static_cast<int>(std::ceil(radius_m / res_)) + 1;
+  std::optional<NearestObstacle> best;
+  for (int x = -r; x <= r; ++x) {
+    for (int y = -r; y <= r; ++y) {
+      for (int z = -r; z <= r; ++z) {
+        const Index i = c + Index(x, y, z);
+        if (!InWindow(i) || log_odds_[Address(i)] <= options_.occupied_threshold) continue;
+        const Vector3 q = Center(i);
+        const double d = (p - q).norm();
+        if (d > radius_m || (best && d >= best->distance_m)) continue;
+        const Vector3 n = d > 1e-12 ? Vector3((p - q) / d) : Vector3::UnitZ();
+        best = NearestObstacle{q, d, n};
+      }
+    }
+  }
+  return best;
+}
+
+bool VoxelMap::SegmentCollides(const Vector3& a, const Vector3& b) const {
+  if (!a.allFinite() || !b.allFinite()) return true;  // a corrupt query is never declared safe
+  bool collides = false;
+  TraverseVoxels(a / res_, b / res_, [&](const Index& i) {
+    if (InWindow(i) && inflation_[Address(i)] > 0) {
+      collides = true;
+      return false;
+    }
+    return true;
+  });
+  return collides;
+}
+
+std::vector<Vector3> VoxelMap::OccupiedVoxels() const {
+  std::vector<Vector3> out;
+  out.reserve(static_cast<std::size_t>(occupied_count_));
+  Index i;
+  for (i.x() = origin_.x(); i.x() < origin_.x() + size_.x(); ++i.x()) {
+    for (i.y() = origin_.y(); i.y() < origin_.y() + size_.y(); ++i.y()) {
+      for (i.z() = origin_.z(); i.z() < origin_.z() + size_.z(); ++i.z()) {
+        if (log_odds_[Address(i)] > options_.occupied_threshold) out.push_back(Center(i));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace rotorguard::perception
