@@ -10,43 +10,7 @@ namespace rotorguard::perception {
 
 namespace {
 
-/// a mod n for n a power of two, also for negative a (two's complement).
-int PositiveMod(int a, int n) { return a & (n - 1); }
-
-/// Visits the voxels a segment from a to b crosses, in order (Amanatides and Woo 1987), calling
-/// visit(index) for each until it returns false. Coordinates are in voxel units.
-template <typename Visit>
-void TraverseVoxels(const Vector3& a, const Vector3& b, Visit&& visit) {
-  Eigen::Vector3i i(static_cast<int>(std::floor(a.x())), static_cast<int>(std::floor(a.y())),
-                    static_cast<int>(std::floor(a.z())));
-  const Eigen::Vector3i end(static_cast<int>(std::floor(b.x())), static_cast<int>(std::floor(b.y())),
-                            static_cast<int>(std::floor(b.z())));
-  const Vector3 d = b - a;
-  Eigen::Vector3i step;
-  Vector3 t_max, t_delta;
-  for (int k = 0; k < 3; ++k) {
-    step[k] = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
-    if (step[k] == 0) {
-      t_max[k] = std::numeric_limits<double>::infinity();
-      t_delta[k] = std::numeric_limits<double>::infinity();
-    } else {
-      const double boundary = step[k] > 0 ? std::floor(a[k]) + 1.0 : std::floor(a[k]);
-      t_max[k] = (boundary - a[k]) / d[k];
-      t_delta[k] = 1.0 / std::abs(d[k]);
-    }
-  }
-  const int max_steps = (end - i).cwiseAbs().sum() + 1;
-  for (int s = 0; s < max_steps; ++s) {
-    if (!visit(i)) return;
-    if (i == end) return;
-    int k = 0;
-    if (t_max[1] < t_max[k]) k = 1;
-    if (t_max[2] < t_max[k]) k = 2;
-    if (t_max[k] > 1.0) return;  // past the segment's end (rounding)
-    i[k] += step[k];
-    t_max[k] += t_delta[k];
-  }
-}
+using internal::PositiveMod;
 
 }  // namespace
 
@@ -77,11 +41,11 @@ void VoxelMapOptions::Validate() const {
 VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   options_.Validate();
   res_ = options_.resolution_m;
-  // Voxels per axis: the requested extent rounded up to a power of two, so that the ring buffer's
-  // index arithmetic is a mask rather than a division (the map's hottest path).
+  // Voxels per axis: the requested extent rounded up to a power of two (at least a brick of 8), so
+  // that the ring buffer's index arithmetic is a mask rather than a division (the hottest path).
   for (int k = 0; k < 3; ++k) {
     const int needed = static_cast<int>(std::ceil(options_.window_size_m[k] / res_));
-    size_[k] = 1;
+    size_[k] = 8;
     while (size_[k] < needed) size_[k] *= 2;
   }
   origin_ = -size_ / 2;
@@ -92,6 +56,7 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   stamp_.assign(n, 0);
   // Offsets whose voxel centres lie within the radius of the centre voxel's.
   const int r = static_cast<int>(std::ceil(options_.inflation_radius_m / res_));
+  stencil_radius_ = r;
   const double r2 = std::pow(options_.inflation_radius_m / res_ + 1e-9, 2);
   for (int x = -r; x <= r; ++x) {
     for (int y = -r; y <= r; ++y) {
@@ -109,16 +74,58 @@ VoxelMap::Index VoxelMap::ToIndex(const Vector3& p) const {
 
 Vector3 VoxelMap::Center(const Index& i) const { return (i.cast<double>() + Vector3::Constant(0.5)) * res_; }
 
-bool VoxelMap::InWindow(const Index& i) const {
-  return (i.array() >= origin_.array()).all() && (i.array() < (origin_ + size_).array()).all();
-}
-
 bool VoxelMap::InWindow(const Vector3& p) const { return p.allFinite() && InWindow(ToIndex(p)); }
 
-std::size_t VoxelMap::Address(const Index& i) const {
-  return (static_cast<std::size_t>(PositiveMod(i.x(), size_.x())) * size_.y() + PositiveMod(i.y(), size_.y())) *
-             size_.z() +
-         PositiveMod(i.z(), size_.z());
+template <typename Visit>
+void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const {
+  // Clip to the window [origin, origin + size) in voxel units.
+  const Vector3 d = b - a;
+  double s_in = 0.0, s_out = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    const double lo = origin_[k], hi = origin_[k] + size_[k];
+    if (std::abs(d[k]) < 1e-12) {
+      if (a[k] < lo || a[k] >= hi) return;
+      continue;
+    }
+    double s0 = (lo - a[k]) / d[k], s1 = (hi - a[k]) / d[k];
+    if (s0 > s1) std::swap(s0, s1);
+    s_in = std::max(s_in, s0);
+    s_out = std::min(s_out, s1);
+  }
+  if (s_in > s_out) return;
+  const Vector3 start = a + s_in * d, stop = a + s_out * d;
+  Index i, end;
+  Eigen::Vector3i step, w;
+  Vector3 t_max, t_delta;
+  for (int k = 0; k < 3; ++k) {
+    const int lo = origin_[k], hi = origin_[k] + size_[k] - 1;
+    i[k] = std::clamp(static_cast<int>(std::floor(start[k])), lo, hi);
+    end[k] = std::clamp(static_cast<int>(std::floor(stop[k])), lo, hi);
+    step[k] = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
+    if (step[k] == 0) {
+      t_max[k] = t_delta[k] = std::numeric_limits<double>::infinity();
+    } else {
+      // Parameter (in units of the whole segment) of the next voxel boundary along k.
+      const double boundary = step[k] > 0 ? i[k] + 1.0 : static_cast<double>(i[k]);
+      t_max[k] = (boundary - a[k]) / d[k];
+      t_delta[k] = 1.0 / std::abs(d[k]);
+    }
+    w[k] = PositiveMod(i[k], size_[k]);
+  }
+  const auto address = [&] { return WrappedAddress(w); };
+  const int max_steps = (end - i).cwiseAbs().sum() + 1;
+  for (int n = 0; n < max_steps; ++n) {
+    if (!visit(i, address())) return;
+    if (i == end) return;
+    int k = 0;
+    if (t_max[1] < t_max[k]) k = 1;
+    if (t_max[2] < t_max[k]) k = 2;
+    if (t_max[k] > s_out) return;  // past the clipped segment's end (rounding)
+    i[k] += step[k];
+    if (i[k] < origin_[k] || i[k] >= origin_[k] + size_[k]) return;
+    w[k] = PositiveMod(w[k] + step[k], size_[k]);
+    t_max[k] += t_delta[k];
+  }
 }
 
 void VoxelMap::Inflate(const Index& i, int delta) {
@@ -192,21 +199,42 @@ void VoxelMap::Recenter(const Vector3& center_W) {
   for (const Index& i : leaving) inflation_[Address(i)] = 0;
   const Index old_origin = origin_;
   origin_ = new_origin;
-  // Voxels that entered (the freed slots) get the inflation of the occupied voxels near them.
+  // The voxels that entered (in the freed slots, all unknown) get the inflation of the occupied
+  // voxels within the radius of them. Those lie in the part of the window that stayed, in a band
+  // of the radius along each entering face; each is visited once (corners belong to the first
+  // axis' band).
   const auto in_old = [&](const Index& i) {
     return (i.array() >= old_origin.array()).all() && (i.array() < (old_origin + size_).array()).all();
   };
-  for (const Index& left : leaving) {
-    // The entering voxel that took this slot: the same address inside the new window.
-    Index e;
-    for (int k = 0; k < 3; ++k) e[k] = new_origin[k] + PositiveMod(left[k] - new_origin[k], size_[k]);
-    if (in_old(e)) continue;
-    int count = 0;
-    for (const Index& o : stencil_) {
-      const Index j = e + o;
-      if (InWindow(j) && log_odds_[Address(j)] > options_.occupied_threshold) ++count;
+  const Index keep_lo = old_origin.cwiseMax(new_origin), keep_hi = (old_origin + size_).cwiseMin(new_origin + size_);
+  const auto band = [&](int k, Eigen::Vector2i* range) {
+    (*range)[0] = shift[k] > 0 ? std::max(keep_lo[k], keep_hi[k] - stencil_radius_) : keep_lo[k];
+    (*range)[1] = shift[k] > 0 ? keep_hi[k] : std::min(keep_hi[k], keep_lo[k] + stencil_radius_);
+  };
+  for (int k = 0; k < 3; ++k) {
+    if (shift[k] == 0) continue;
+    Eigen::Vector2i range;
+    band(k, &range);
+    const int a = (k + 1) % 3, b = (k + 2) % 3;
+    Index v;
+    for (v[k] = range[0]; v[k] < range[1]; ++v[k]) {
+      for (v[a] = keep_lo[a]; v[a] < keep_hi[a]; ++v[a]) {
+        for (v[b] = keep_lo[b]; v[b] < keep_hi[b]; ++v[b]) {
+          if (log_odds_[Address(v)] <= options_.occupied_threshold) continue;
+          bool earlier = false;
+          for (int j = 0; j < k && !earlier; ++j) {
+            Eigen::Vector2i other;
+            band(j, &other);
+            earlier = shift[j] != 0 && v[j] >= other[0] && v[j] < other[1];
+          }
+          if (earlier) continue;
+          for (const Index& o : stencil_) {
+            const Index e = v + o;
+            if (InWindow(e) && !in_old(e)) ++inflation_[Address(e)];
+          }
+        }
+      }
     }
-    inflation_[Address(e)] = static_cast<std::uint16_t>(count);
   }
 }
 
@@ -235,18 +263,24 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     }
     const Index end = ToIndex(p);
     const bool end_in = InWindow(end);
-    // Free space along the ray (the return's own voxel excluded), up to the clearing range.
+    if (end_in && stamp_[Address(end)] == hit) {
+      // Another return in this voxel was cast this frame: from the same origin its ray crossed
+      // (nearly) the same voxels (ego-planner's per-frame voxel cache makes the same trade).
+      ++summary.points_used;
+      continue;
+    }
+    // Free space along the ray (the return's own voxel excluded), up to the clearing range. The
+    // whole walk: stopping where another ray of the frame already passed leaves gaps between
+    // converging rays, and with them obstacles that moved away (a test shows it).
     Vector3 e = p / res_;
     const double len = (e - o).norm();
     if (len > max_cells) e = o + (e - o) * (max_cells / len);
-    TraverseVoxels(o, e, [&](const Index& i) {
+    TraverseWindow(o, e, [&](const Index& i, std::size_t address) {
       if (i == end) return false;
-      if (InWindow(i)) {
-        std::uint32_t& s = stamp_[Address(i)];
-        if (s < miss) {
-          s = miss;
-          touched_miss_.push_back(i);
-        }
+      std::uint32_t& s = stamp_[address];
+      if (s < miss) {
+        s = miss;
+        touched_miss_.push_back(i);
       }
       return true;
     });
@@ -306,8 +340,8 @@ std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius
 bool VoxelMap::SegmentCollides(const Vector3& a, const Vector3& b) const {
   if (!a.allFinite() || !b.allFinite()) return true;  // a corrupt query is never declared safe
   bool collides = false;
-  TraverseVoxels(a / res_, b / res_, [&](const Index& i) {
-    if (InWindow(i) && inflation_[Address(i)] > 0) {
+  TraverseWindow(a / res_, b / res_, [&](const Index&, std::size_t address) {
+    if (inflation_[address] > 0) {
       collides = true;
       return false;
     }

@@ -15,6 +15,11 @@
 
 namespace rotorguard::perception {
 
+namespace internal {
+/// a mod n for n a power of two, also for negative a (two's complement).
+inline int PositiveMod(int a, int n) { return a & (n - 1); }
+}  // namespace internal
+
 struct VoxelMapOptions {
   double resolution_m = 0.1;                      ///< voxel edge [m], > 0
   /// Extent of the local window [m], > resolution; rounded up to a power of two voxels per axis
@@ -78,12 +83,30 @@ class VoxelMap {
   using Index = Eigen::Vector3i;
   Index ToIndex(const Vector3& p) const;
   Vector3 Center(const Index& i) const;
-  bool InWindow(const Index& i) const;
-  std::size_t Address(const Index& i) const;
+  bool InWindow(const Index& i) const {
+    return (i.array() >= origin_.array()).all() && (i.array() < (origin_ + size_).array()).all();
+  }
+  std::size_t Address(const Index& i) const {
+    return WrappedAddress(Index(internal::PositiveMod(i.x(), size_.x()), internal::PositiveMod(i.y(), size_.y()),
+                                internal::PositiveMod(i.z(), size_.z())));
+  }
+  /// From coordinates already wrapped into [0, size). Bricks of 8 x 8 x 8 voxels, each contiguous:
+  /// a ray stays in one brick (a few cache lines) for several steps in any direction, where a
+  /// row-major layout jumps a whole plane per step.
+  std::size_t WrappedAddress(const Index& w) const {
+    const std::size_t brick =
+        (static_cast<std::size_t>(w.x() >> 3) * (size_.y() >> 3) + (w.y() >> 3)) * (size_.z() >> 3) + (w.z() >> 3);
+    return brick * 512 + static_cast<std::size_t>(((w.x() & 7) << 6) | ((w.y() & 7) << 3) | (w.z() & 7));
+  }
   /// Sets a voxel's log-odds, maintaining the occupied count and the inflation layer.
   void SetLogOdds(const Index& i, float value);
   void Inflate(const Index& i, int delta);
   void ClearVoxel(const Index& i);
+  /// Visits the window's voxels that the segment a-b (voxel units) crosses, in order (Amanatides
+  /// and Woo 1987), as visit(index, address) until it returns false. The segment is clipped to
+  /// the window first and the ring-buffer address follows each step, the map's hottest loop.
+  template <typename Visit>
+  void TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const;
 
   VoxelMapOptions options_;
   double res_;
@@ -95,6 +118,7 @@ class VoxelMap {
   std::vector<std::uint32_t> stamp_;      // frame that last touched the voxel
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
+  int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
   std::vector<Index> touched_hit_, touched_miss_;
   int occupied_count_ = 0;
 };
