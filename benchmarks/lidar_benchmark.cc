@@ -58,6 +58,7 @@ void BM_MapInsertFrame(benchmark::State& state) {
   map.Recenter(PoseAt(0).p_W);
   TimeNs t = 0;
   std::size_t frames = 0, points = 0;
+  double steps = 0.0, updated = 0.0;
   std::vector<Eigen::Vector3f> world;
   for (auto _ : state) {
     state.PauseTiming();
@@ -75,11 +76,16 @@ void BM_MapInsertFrame(benchmark::State& state) {
     const Vector3 origin = end.p_W + end.q_WB * o.position_m;
     state.ResumeTiming();
     map.Recenter(origin);
-    benchmark::DoNotOptimize(map.Insert(origin, world));
+    const perception::MapUpdateSummary s = map.Insert(origin, world);
+    steps += s.voxels_traversed;
+    updated += s.voxels_updated;
     points += world.size();
     ++frames;
   }
-  state.counters["points_per_frame"] = benchmark::Counter(static_cast<double>(points) / std::max<std::size_t>(1, frames));
+  const double n = static_cast<double>(std::max<std::size_t>(1, frames));
+  state.counters["points_per_frame"] = benchmark::Counter(static_cast<double>(points) / n);
+  state.counters["ray_steps_per_frame"] = benchmark::Counter(steps / n);
+  state.counters["voxels_updated_per_frame"] = benchmark::Counter(updated / n);
 }
 BENCHMARK(BM_MapInsertFrame)->Unit(benchmark::kMillisecond);
 

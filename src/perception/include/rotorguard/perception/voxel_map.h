@@ -40,6 +40,7 @@ struct MapUpdateSummary {
   int points_used = 0;
   int points_dropped = 0;  ///< non-finite, or their voxel outside the window
   int voxels_updated = 0;
+  long voxels_traversed = 0;  ///< steps of the rays' walks (the update's cost)
 };
 
 /// The nearest occupied voxel to a query point.
@@ -115,7 +116,7 @@ class VoxelMap {
   std::vector<float> log_odds_;
   std::vector<std::uint8_t> known_;
   std::vector<std::uint16_t> inflation_;  // occupied voxels within the radius
-  std::vector<std::uint32_t> stamp_;      // frame that last touched the voxel
+  std::vector<std::uint8_t> stamp_;  // 2f: missed in frame f, 2f + 1: hit (f in 1..127)
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
