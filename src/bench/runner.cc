@@ -83,6 +83,7 @@ void Deliver(const sim::SensorOutputs& o, stack::FlightStack* st, std::string* s
     st->OnOdometry(*o.odometry);
     if (sensor_log) AppendOdometry(*o.odometry, sensor_log);
   }
+  if (o.lidar) st->OnLidar(*o.lidar);  // not in sensors.csv: 200k points/s would swamp it
 }
 
 double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
@@ -125,6 +126,8 @@ nlohmann::json RunSummary::ToJson() const {
   j["composite_fdd"] = composite_fdd ? CompositeFddOptionsToJson(*composite_fdd) : nlohmann::json(nullptr);
   j["sensors"] = {{"imu_rate_hz", imu_rate_hz},
                   {"imu_position_m", {imu_position_m.x(), imu_position_m.y(), imu_position_m.z()}}};
+  j["map_voxels_occupied"] = map_voxels_occupied >= 0 ? nlohmann::json(map_voxels_occupied) : nlohmann::json(nullptr);
+  j["lidar_points_dropped"] = lidar_points_dropped;
   j["physics_steps"] = physics_steps;
   j["control_cycles"] = control_cycles;
   return j;
@@ -269,6 +272,8 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     // Still tilted at the very end: it never settled.
     summary.tilt_recovery_s = settle >= summary.sim_time_s - 2.0 * dt ? -1.0 : std::max(0.0, settle - onset);
   }
+  summary.map_voxels_occupied = st.map() ? st.map()->occupied_count() : -1;
+  summary.lidar_points_dropped = st.lidar_points_dropped();
   if (const fdd::FaultDetector* detector = st.fault_detector()) {
     summary.fdd = ScoreFdd(detector->rotors(), sim.fault_events());
   }

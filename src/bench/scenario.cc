@@ -306,6 +306,22 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
     d.rate_noise_gain = OptionalDouble(*odom, "rate_noise_gain", d.rate_noise_gain);
     odom->RejectUnknownKeys();
   }
+  if (const auto lidar = node.Optional("lidar")) {
+    sim::LidarOptions& l = o->lidar;
+    l.enabled = true;  // a lidar block switches the sensor on unless it says otherwise
+    if (const auto e = lidar->Optional("enabled")) l.enabled = e->AsBool();
+    l.frame_rate_hz = OptionalDouble(*lidar, "frame_rate_hz", l.frame_rate_hz);
+    l.points_per_s = OptionalDouble(*lidar, "points_per_s", l.points_per_s);
+    l.min_range_m = OptionalDouble(*lidar, "min_range_m", l.min_range_m);
+    l.max_range_m = OptionalDouble(*lidar, "max_range_m", l.max_range_m);
+    l.min_elevation_rad = OptionalDouble(*lidar, "min_elevation_rad", l.min_elevation_rad);
+    l.max_elevation_rad = OptionalDouble(*lidar, "max_elevation_rad", l.max_elevation_rad);
+    l.range_noise_m = OptionalDouble(*lidar, "range_noise_m", l.range_noise_m);
+    l.dropout_probability = OptionalDouble(*lidar, "dropout_probability", l.dropout_probability);
+    l.position_m = OptionalVector3(*lidar, "position_m", l.position_m);
+    l.grid_cell_m = OptionalDouble(*lidar, "grid_cell_m", l.grid_cell_m);
+    lidar->RejectUnknownKeys();
+  }
   node.RejectUnknownKeys();
 }
 
@@ -525,6 +541,9 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   // The fault detector knows its own IMU: the sensor's rate and mounting point (hardware facts).
   s.stack.composite_fdd.imu_rate_hz = s.sim.imu.rate_hz;
   s.stack.composite_fdd.imu_position_m = s.sim.imu.position_m;
+  // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius.
+  s.stack.deskew.sensor_position_m = s.sim.lidar.position_m;
+  s.stack.map.inflation_radius_m = s.vehicle.collision_radius_m;
   s.stack.fixed_time_fdd.imu_rate_hz = s.sim.imu.rate_hz;
   s.stack.fixed_time_fdd.imu_position_m = s.sim.imu.position_m;
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);

@@ -16,7 +16,7 @@ using vehicle::StateIndex;
 using vehicle::StateView;
 
 // Independent random streams of one run.
-enum Stream : std::uint64_t { kImuStream = 1, kEscStream = 2, kOdometryStream = 3, kWindStream = 4 };
+enum Stream : std::uint64_t { kImuStream = 1, kEscStream = 2, kOdometryStream = 3, kWindStream = 4, kLidarStream = 5 };
 }  // namespace
 
 const SimulatorOptions& Simulator::Validated(const SimulatorOptions& options,
@@ -50,6 +50,13 @@ void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
   prefixed("sensors.esc.", [&] { esc.Validate(physics_rate_hz); });
   prefixed("sensors.odometry.", [&] { odometry.Validate(physics_rate_hz); });
   prefixed("wind.", [&] { wind.Validate(); });
+  if (lidar.enabled) {
+    prefixed("sensors.lidar.", [&] { lidar.Validate(); });
+    if (lidar.frame_rate_hz > 0.5 * physics_rate_hz) {
+      ThrowValidation("SimulatorOptions", "sensors.lidar.frame_rate_hz", lidar.frame_rate_hz,
+                      fmt::format("a rate of at most {:g} Hz (half the physics rate)", 0.5 * physics_rate_hz));
+    }
+  }
   if (!std::isfinite(crash_speed_m_s) || crash_speed_m_s <= 0.0) {
     ThrowValidation("SimulatorOptions", "sim.crash_speed_m_s", crash_speed_m_s, "a speed > 0 m/s");
   }
@@ -76,6 +83,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world,
       dt_ns_(PeriodFromRate(options_.physics_rate_hz)),
       x_(initial),
       faults_(model.num_rotors()) {
+  if (options_.lidar.enabled) lidar_.emplace(options_.lidar, world_, DeriveSeed(seed, kLidarStream));
   if (initial.size() != model.state_size() || !initial.allFinite()) {
     throw std::invalid_argument(fmt::format(
         "Simulator: initial state has size {} or non-finite entries; expected {} finite values",
@@ -184,6 +192,12 @@ const SensorOutputs& Simulator::Step(const RotorCommand& command) {
     }
   }
 
+  if (lidar_) {
+    // Each pulse is cast from the pose at its own time within this step.
+    const StateView before(x_before_), after(x_);
+    outputs_.lidar = lidar_->Step(t_ns_ - dt_ns_, BodyPose{before.p_W(), before.q_WB()}, t_ns_,
+                                  BodyPose{after.p_W(), after.q_WB()});
+  }
   SampleSensors(disturbance);
   return outputs_;
 }

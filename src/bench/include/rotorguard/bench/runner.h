@@ -49,6 +49,9 @@ struct RunSummary {
   Vector3 imu_position_m = Vector3::Zero();
   /// The composite FDD's thresholds when the stack ran it (summary.json "composite_fdd").
   std::optional<fdd::CompositeFddOptions> composite_fdd;
+  /// Occupied voxels of the stack's map at the end; -1 without a LiDAR (null in summary.json).
+  int map_voxels_occupied = -1;
+  long lidar_points_dropped = 0;  ///< LiDAR pulses that gave no map point (FlightStack)
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;
 

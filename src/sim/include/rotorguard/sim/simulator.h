@@ -9,6 +9,7 @@
 
 #include "rotorguard/core/messages.h"
 #include "rotorguard/sim/fault_injector.h"
+#include "rotorguard/sim/lidar.h"
 #include "rotorguard/sim/sensors.h"
 #include "rotorguard/sim/wind.h"
 #include "rotorguard/sim/world.h"
@@ -21,6 +22,7 @@ struct SimulatorOptions {
   ImuOptions imu;
   EscOptions esc;
   OdometryOptions odometry;
+  LidarOptions lidar;  ///< off by default
   WindOptions wind;
   /// Touching the ground faster than this (any direction) is a crash [m/s], > 0.
   double crash_speed_m_s = 1.0;
@@ -36,6 +38,7 @@ struct SensorOutputs {
   std::optional<ImuSample> imu;
   std::optional<EscTelemetry> esc;
   std::optional<OdometrySample> odometry;
+  std::optional<LidarFrame> lidar;  ///< a frame completed in this step
 };
 
 class Simulator {
@@ -86,6 +89,7 @@ class Simulator {
   EscModel esc_;
   OdometryModel odometry_;
   WindModel wind_;
+  std::optional<LidarSimulator> lidar_;
   RateTimer imu_timer_, esc_timer_, odometry_timer_;
   TimeNs t_ns_ = 0;
   TimeNs dt_ns_;

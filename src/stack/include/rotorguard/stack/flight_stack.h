@@ -15,6 +15,8 @@
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/fdd/fixed_time_fdd.h"
+#include "rotorguard/perception/deskew.h"
+#include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/stack/estimator.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -43,6 +45,12 @@ struct FlightStackOptions {
   std::string fdd = "none";
   fdd::CompositeFddOptions composite_fdd;
   fdd::FixedTimeFddOptions fixed_time_fdd;
+  /// LiDAR mapping, run on every frame a vehicle with a LiDAR delivers (docs/perception.md):
+  /// frames deskewed to their end pose (unless `deskew_frames` is false), placed with the
+  /// estimate, inserted into the local occupancy map.
+  bool deskew_frames = true;
+  perception::DeskewOptions deskew;
+  perception::VoxelMapOptions map;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -59,6 +67,8 @@ class FlightStack {
   void OnImu(const ImuSample& imu);
   void OnEscTelemetry(const EscTelemetry& esc);
   void OnOdometry(const OdometrySample& odometry);
+  /// A LiDAR frame: deskewed and inserted into the map (the map is created with the first frame).
+  void OnLidar(const LidarFrame& frame);
   /// One control cycle at time t: estimate, reference, controller. Call every control_period_ns().
   const RotorCommand& Update(TimeNs t);
 
@@ -72,6 +82,11 @@ class FlightStack {
   const control::NmpcController* nmpc() const { return nmpc_; }
   /// The fault detector, when there is one; else null.
   const fdd::FaultDetector* fault_detector() const { return fdd_.get(); }
+  /// The occupancy map, once a LiDAR frame arrived; else null.
+  const perception::VoxelMap* map() const { return map_.get(); }
+  /// LiDAR pulses without a usable point: no return (counted by the sensor), non-finite, outside
+  /// the map's window, or arriving before the estimate is valid.
+  long lidar_points_dropped() const { return lidar_points_dropped_; }
 
  private:
   vehicle::MultirotorModel model_;
@@ -81,6 +96,10 @@ class FlightStack {
   std::unique_ptr<control::Controller> controller_;
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
   std::unique_ptr<fdd::FaultDetector> fdd_;
+  perception::Deskewer deskewer_;
+  std::unique_ptr<perception::VoxelMap> map_;
+  std::vector<Eigen::Vector3f> points_scratch_;
+  long lidar_points_dropped_ = 0;
   std::vector<bool> known_fault_applied_;
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
