@@ -253,9 +253,14 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   }
   const std::uint8_t miss = static_cast<std::uint8_t>(2 * frame_), hit = static_cast<std::uint8_t>(2 * frame_ + 1);
   touched_hit_.clear();
-  touched_miss_.clear();
-  const Vector3 o = origin_W / res_;
-  const double max_cells = options_.max_clearing_range_m / res_;
+  const auto clamp = [&](float v) {
+    return std::clamp(v, static_cast<float>(options_.log_odds_min), static_cast<float>(options_.log_odds_max));
+  };
+  // Pass 1: the returns' voxels, stamped as hits, and one ray per hit voxel (from the same origin
+  // the other returns in it crossed nearly the same voxels; ego-planner's per-frame voxel cache
+  // makes the same trade). Returns outside the window still clear the window along their rays.
+  std::vector<Vector3>& rays = ray_ends_;
+  rays.clear();
   for (const Eigen::Vector3f& pf : points_W) {
     const Vector3 p = pf.cast<double>();
     if (!p.allFinite()) {
@@ -263,49 +268,47 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
       continue;
     }
     const Index end = ToIndex(p);
-    const bool end_in = InWindow(end);
-    if (end_in && stamp_[Address(end)] == hit) {
-      // Another return in this voxel was cast this frame: from the same origin its ray crossed
-      // (nearly) the same voxels (ego-planner's per-frame voxel cache makes the same trade).
-      ++summary.points_used;
+    if (!InWindow(end)) {
+      ++summary.points_dropped;
+      rays.push_back(p);
       continue;
     }
-    // Free space along the ray (the return's own voxel excluded), up to the clearing range. The
-    // whole walk: stopping where another ray of the frame already passed leaves gaps between
-    // converging rays, and with them obstacles that moved away (a test shows it).
+    ++summary.points_used;
+    std::uint8_t& s = stamp_[Address(end)];
+    if (s == hit) continue;
+    s = hit;
+    touched_hit_.push_back(end);
+    rays.push_back(p);
+  }
+  // Pass 2: free space along each ray (its own return voxel excluded), up to the clearing range,
+  // updated as the walk passes (the voxel is in cache then). A voxel hit in this frame is not
+  // missed; one missed already is not missed twice. The whole walk: stopping where another ray
+  // already passed leaves gaps between converging rays, and obstacles that moved away with them.
+  const Vector3 o = origin_W / res_;
+  const double max_cells = options_.max_clearing_range_m / res_;
+  const float miss_step = static_cast<float>(options_.log_odds_miss);
+  long steps = 0;
+  int missed = 0;
+  for (const Vector3& p : rays) {
+    const Index end = ToIndex(p);
     Vector3 e = p / res_;
     const double len = (e - o).norm();
     if (len > max_cells) e = o + (e - o) * (max_cells / len);
     TraverseWindow(o, e, [&](const Index& i, std::size_t address) {
-      ++summary.voxels_traversed;
+      ++steps;
       if (i == end) return false;
       std::uint8_t& s = stamp_[address];
       if (s < miss) {
         s = miss;
-        touched_miss_.push_back(i);
+        SetLogOdds(i, clamp(log_odds_[address] + miss_step));
+        ++missed;
       }
       return true;
     });
-    if (!end_in) {
-      ++summary.points_dropped;
-      continue;
-    }
-    std::uint8_t& s = stamp_[Address(end)];
-    if (s != hit) {
-      s = hit;
-      touched_hit_.push_back(end);
-    }
-    ++summary.points_used;
   }
-  const auto clamp = [&](float v) {
-    return std::clamp(v, static_cast<float>(options_.log_odds_min), static_cast<float>(options_.log_odds_max));
-  };
   for (const Index& i : touched_hit_) SetLogOdds(i, clamp(log_odds_[Address(i)] + static_cast<float>(options_.log_odds_hit)));
-  for (const Index& i : touched_miss_) {
-    if (stamp_[Address(i)] != miss) continue;  // hit in this frame after all
-    SetLogOdds(i, clamp(log_odds_[Address(i)] + static_cast<float>(options_.log_odds_miss)));
-  }
-  summary.voxels_updated = static_cast<int>(touched_hit_.size() + touched_miss_.size());
+  summary.voxels_traversed = steps;
+  summary.voxels_updated = static_cast<int>(touched_hit_.size()) + missed;
   return summary;
 }
 

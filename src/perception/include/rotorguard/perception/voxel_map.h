@@ -120,7 +120,8 @@ class VoxelMap {
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
-  std::vector<Index> touched_hit_, touched_miss_;
+  std::vector<Index> touched_hit_;
+  std::vector<Vector3> ray_ends_;  // the returns whose rays a frame walks
   int occupied_count_ = 0;
 };
 
