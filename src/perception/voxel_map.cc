@@ -94,36 +94,34 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
   }
   if (s_in > s_out) return;
   const Vector3 start = a + s_in * d, stop = a + s_out * d;
-  Index i, end;
-  Eigen::Vector3i step, w;
-  Vector3 t_max, t_delta;
+  // Plain scalars in the loop: it runs hundreds of thousands of times per frame.
+  int ix[3], ie[3], st[3], w[3];
+  double t_max[3], t_delta[3];
   for (int k = 0; k < 3; ++k) {
     const int lo = origin_[k], hi = origin_[k] + size_[k] - 1;
-    i[k] = std::clamp(static_cast<int>(std::floor(start[k])), lo, hi);
-    end[k] = std::clamp(static_cast<int>(std::floor(stop[k])), lo, hi);
-    step[k] = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
-    if (step[k] == 0) {
+    ix[k] = std::clamp(static_cast<int>(std::floor(start[k])), lo, hi);
+    ie[k] = std::clamp(static_cast<int>(std::floor(stop[k])), lo, hi);
+    st[k] = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
+    if (st[k] == 0) {
       t_max[k] = t_delta[k] = std::numeric_limits<double>::infinity();
     } else {
       // Parameter (in units of the whole segment) of the next voxel boundary along k.
-      const double boundary = step[k] > 0 ? i[k] + 1.0 : static_cast<double>(i[k]);
+      const double boundary = st[k] > 0 ? ix[k] + 1.0 : static_cast<double>(ix[k]);
       t_max[k] = (boundary - a[k]) / d[k];
       t_delta[k] = 1.0 / std::abs(d[k]);
     }
-    w[k] = PositiveMod(i[k], size_[k]);
+    w[k] = PositiveMod(ix[k], size_[k]);
   }
-  const auto address = [&] { return WrappedAddress(w); };
-  const int max_steps = (end - i).cwiseAbs().sum() + 1;
+  const int max_steps = std::abs(ie[0] - ix[0]) + std::abs(ie[1] - ix[1]) + std::abs(ie[2] - ix[2]) + 1;
   for (int n = 0; n < max_steps; ++n) {
-    if (!visit(i, address())) return;
-    if (i == end) return;
-    int k = 0;
-    if (t_max[1] < t_max[k]) k = 1;
-    if (t_max[2] < t_max[k]) k = 2;
+    if (!visit(Index(ix[0], ix[1], ix[2]), WrappedAddress(Index(w[0], w[1], w[2])))) return;
+    if (ix[0] == ie[0] && ix[1] == ie[1] && ix[2] == ie[2]) return;
+    const int k = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
     if (t_max[k] > s_out) return;  // past the clipped segment's end (rounding)
-    i[k] += step[k];
-    if (i[k] < origin_[k] || i[k] >= origin_[k] + size_[k]) return;
-    w[k] = PositiveMod(w[k] + step[k], size_[k]);
+    ix[k] += st[k];
+    // Never leave the window (the masked address would wrap to its other side).
+    if (static_cast<unsigned>(ix[k] - origin_[k]) >= static_cast<unsigned>(size_[k])) return;
+    w[k] = (w[k] + st[k]) & (size_[k] - 1);
     t_max[k] += t_delta[k];
   }
 }
