@@ -177,9 +177,9 @@ void IndiController::Compute(const StateEstimate& est, const ReferenceTrajectory
   // The tilt of the primary axis is held by the gyroscopic torque of the spin, which builds up
   // after the failure: the target axis leans from body z towards n_B as the square of the spin
   // (the gyroscopic torque's scaling), so that the vehicle is not asked for a tilt it cannot hold.
+  // A spin the wrong way round holds no lean.
   const double spin_fraction =
-      std::pow(std::clamp(w.dot(hover_->primary_axis_B) / hover_->spin_rate_rad_s, 0.0, 1.0), 2);  // a spin
-  // the wrong way round holds no lean
+      std::pow(std::clamp(w.dot(hover_->primary_axis_B) / hover_->spin_rate_rad_s, 0.0, 1.0), 2);
   const Vector3 n = (Vector3::UnitZ() + spin_fraction * (hover_->primary_axis_B - Vector3::UnitZ())).normalized();
   const Eigen::Vector2d h_ddot_des =
       options_.k_h * (n - h).head<2>() - options_.d_h * h_dot.head<2>();
