@@ -8,9 +8,7 @@
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/core/error.h"
 
-#ifndef ROTORGUARD_GIT_REVISION
-#define ROTORGUARD_GIT_REVISION "unknown"
-#endif
+#include "rotorguard_git_revision.h"  // generated at build time
 #ifndef ROTORGUARD_VERSION
 #define ROTORGUARD_VERSION "unknown"
 #endif
