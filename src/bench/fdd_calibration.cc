@@ -31,34 +31,12 @@ nlohmann::json ReadJson(const std::string& path) {
   }
 }
 
-/// The fault events of a log, for ScoreFdd.
-std::vector<sim::FaultEvent> Events(const CalibrationLog& log) {
-  std::vector<sim::FaultEvent> events;
-  for (const FaultRecord& f : log.faults) {
-    events.push_back({f.rotor, vehicle::ParseFaultKind(f.kind).value_or(vehicle::FaultKind::kNone), f.onset_s});
-  }
-  return events;
-}
-
 double FirstOnset(const CalibrationLog& log) {
   double onset = std::numeric_limits<double>::infinity();
   for (const FaultRecord& f : log.faults) onset = std::min(onset, f.onset_s);
   return onset;
 }
 
-TimeNs RecordTime(const SensorRecord& r) {
-  switch (r.type) {
-    case SensorRecord::Type::kImu:
-      return r.imu.t_ns;
-    case SensorRecord::Type::kEsc:
-      return r.esc.t_ns;
-    case SensorRecord::Type::kOdometry:
-      return r.odometry.t_ns;
-    case SensorRecord::Type::kCommand:
-      return r.command.t_ns;
-  }
-  return 0;
-}
 
 /// The scored replay of one log for one set of thresholds.
 struct Scored {
@@ -69,7 +47,7 @@ struct Scored {
 Scored ReplayAndScore(const CalibrationLog& log, const fdd::CompositeFddOptions& options) {
   Scored s;
   s.outcome = ReplayCompositeFdd(log, options);
-  s.record = ScoreFdd(s.outcome.statuses, Events(log));  // as the benchmarks score a run (metrics.h)
+  s.record = ScoreFdd(s.outcome.statuses, FaultEvents(log));  // as the benchmarks score a run (metrics.h)
   return s;
 }
 
@@ -81,7 +59,22 @@ struct Sweep {
   bool alarm_when_low;  // the motor index alarms below its threshold, the others above
 };
 
+/// The detector's options with the IMU the log's run read.
+fdd::CompositeFddOptions WithLogImu(fdd::CompositeFddOptions options, const CalibrationLog& log) {
+  options.imu_rate_hz = log.imu_rate_hz;
+  options.imu_position_m = log.imu_position_m;
+  return options;
+}
+
 }  // namespace
+
+std::vector<sim::FaultEvent> FaultEvents(const CalibrationLog& log) {
+  std::vector<sim::FaultEvent> events;
+  for (const FaultRecord& f : log.faults) {
+    events.push_back({f.rotor, vehicle::ParseFaultKind(f.kind).value_or(vehicle::FaultKind::kNone), f.onset_s});
+  }
+  return events;
+}
 
 CalibrationLog LoadCalibrationLog(const std::string& dir) {
   std::error_code ec;
@@ -106,10 +99,7 @@ CalibrationLog LoadCalibrationLog(const std::string& dir) {
       log.recorded_fdd = CompositeFddOptionsFromJson(summary["composite_fdd"]);
     }
     // The IMU setup must be one the detector accepts.
-    fdd::CompositeFddOptions check = log.recorded_fdd.value_or(fdd::CompositeFddOptions{});
-    check.imu_rate_hz = log.imu_rate_hz;
-    check.imu_position_m = log.imu_position_m;
-    check.Validate();
+    WithLogImu(log.recorded_fdd.value_or(fdd::CompositeFddOptions{}), log).Validate();
   } catch (const std::exception& e) {
     throw io::InputFileError(summary_path, fmt::format("not a valid run summary: {}", e.what()));
   }
@@ -173,47 +163,32 @@ fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& l
   return first ? *first->recorded_fdd : fdd::CompositeFddOptions{};
 }
 
-ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, fdd::CompositeFddOptions options) {
-  options.imu_rate_hz = log.imu_rate_hz;
-  options.imu_position_m = log.imu_position_m;
-  fdd::CompositeFdd detector(log.vehicle, options);
+ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::CompositeFddOptions& options) {
+  fdd::CompositeFdd detector(log.vehicle, WithLogImu(options, log));
   // The stack's estimator, fed as the stack fed it: the estimate the detector saw.
   stack::OdometryPassThroughEstimator estimator(log.vehicle.thrust_coefficient_n_s2);
   const double onset = FirstOnset(log);
   ReplayOutcome out;
   for (const SensorRecord& r : log.records) {
-    switch (r.type) {
-      case SensorRecord::Type::kImu:
-        estimator.OnImu(r.imu);
-        detector.OnImu(r.imu);
-        break;
-      case SensorRecord::Type::kEsc:
-        estimator.OnEscTelemetry(r.esc);
-        detector.OnEscTelemetry(r.esc);
-        break;
-      case SensorRecord::Type::kOdometry:
-        estimator.OnOdometry(r.odometry);
-        break;
-      case SensorRecord::Type::kCommand: {
-        // A control cycle: FlightStack::Update hands the estimate, then the command, to the
-        // detector, and neither while the estimate is not valid.
-        const StateEstimate e = estimator.Estimate(r.command.t_ns);
-        if (!e.valid) break;
+    if (const auto* imu = std::get_if<ImuSample>(&r)) {
+      estimator.OnImu(*imu);
+      detector.OnImu(*imu);
+    } else if (const auto* esc = std::get_if<EscTelemetry>(&r)) {
+      estimator.OnEscTelemetry(*esc);
+      detector.OnEscTelemetry(*esc);
+    } else if (const auto* odometry = std::get_if<OdometrySample>(&r)) {
+      estimator.OnOdometry(*odometry);
+    } else {
+      // A control cycle: FlightStack::Update hands the estimate, then the command, to the
+      // detector, and neither while the estimate is not valid.
+      const RotorCommand& command = std::get<RotorCommand>(r);
+      const StateEstimate e = estimator.Estimate(command.t_ns);
+      if (e.valid) {
         detector.SetEstimate(e);
-        detector.SetCommand(r.command.thrust_n);
-        break;
+        detector.SetCommand(command.thrust_n);
       }
     }
-    if (!out.detected && detector.first_isolated_rotor()) {
-      const int rotor = *detector.first_isolated_rotor();
-      const fdd::RotorStatus& st = detector.rotors()[static_cast<std::size_t>(rotor)];
-      out.detected = true;
-      out.rotor = rotor;
-      out.kind = st.health == fdd::RotorHealth::kMotorFailed ? "motor_stop" : "propeller_loss";
-      out.detector = st.detector;
-      out.detection_s = st.detected_s.value_or(ToSeconds(RecordTime(r)));
-    }
-    if (out.detected) {
+    if (detector.first_isolated_rotor()) {
       if (ToSeconds(RecordTime(r)) >= onset) break;  // nothing left to learn
       continue;  // extremes only from flight the detector still considers healthy
     }
@@ -225,6 +200,7 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, fdd::CompositeFddOpt
       out.max_takeoff_alpha = std::max(out.max_takeoff_alpha, detector.takeoff_angular_acceleration());
     }
   }
+  out.isolated_rotor = detector.first_isolated_rotor();
   out.statuses = detector.rotors();
   return out;
 }

@@ -86,10 +86,7 @@ Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOp
     f.onset = onset;
     s.faults.push_back(f);
   }
-  s.stack.composite_fdd.imu_rate_hz = s.sim.imu.rate_hz;
-  s.stack.composite_fdd.imu_position_m = s.sim.imu.position_m;
-  s.stack.fixed_time_fdd.imu_rate_hz = s.sim.imu.rate_hz;
-  s.stack.fixed_time_fdd.imu_position_m = s.sim.imu.position_m;
+  FitStackToHardware(&s);
   if (method == "rotorguard") {
     s.stack.controller = "nmpc";
     s.stack.fdd = "composite";

@@ -84,6 +84,17 @@ vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
 
 }  // namespace
 
+void FitStackToHardware(Scenario* s) {
+  // The fault detectors know their own IMU: the sensor's rate and mounting point.
+  s->stack.composite_fdd.imu_rate_hz = s->sim.imu.rate_hz;
+  s->stack.composite_fdd.imu_position_m = s->sim.imu.position_m;
+  s->stack.fixed_time_fdd.imu_rate_hz = s->sim.imu.rate_hz;
+  s->stack.fixed_time_fdd.imu_position_m = s->sim.imu.position_m;
+  // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius.
+  s->stack.deskew.sensor_position_m = s->sim.lidar.position_m;
+  s->stack.map.inflation_radius_m = s->vehicle.collision_radius_m;
+}
+
 std::string VehicleToYaml(const vehicle::VehicleParams& v) {
   auto out = fmt::memory_buffer();
   auto it = std::back_inserter(out);
@@ -538,14 +549,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     });
   }
   CheckFaultsAgainstScenario(root, s);
-  // The fault detector knows its own IMU: the sensor's rate and mounting point (hardware facts).
-  s.stack.composite_fdd.imu_rate_hz = s.sim.imu.rate_hz;
-  s.stack.composite_fdd.imu_position_m = s.sim.imu.position_m;
-  // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius.
-  s.stack.deskew.sensor_position_m = s.sim.lidar.position_m;
-  s.stack.map.inflation_radius_m = s.vehicle.collision_radius_m;
-  s.stack.fixed_time_fdd.imu_rate_hz = s.sim.imu.rate_hz;
-  s.stack.fixed_time_fdd.imu_position_m = s.sim.imu.position_m;
+  FitStackToHardware(&s);
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
   for (std::size_t i = 0; i < s.stack.known_faults.size(); ++i) {
     if (s.stack.known_faults[i].rotor >= s.vehicle.num_rotors()) {

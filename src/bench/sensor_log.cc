@@ -72,19 +72,18 @@ std::vector<SensorRecord> ReadSensorLog(const std::string& path, int num_rotors)
     const std::size_t comma = line.find(',');
     if (comma == std::string_view::npos) fail("expected type,t_ns,values");
     const std::string_view type = line.substr(0, comma);
-    SensorRecord r;
-    int expected = 0;
+    int kind = 0, expected = 0;  // kind: the message's index in SensorRecord
     if (type == "imu") {
-      r.type = SensorRecord::Type::kImu;
+      kind = 0;
       expected = 6;
     } else if (type == "esc") {
-      r.type = SensorRecord::Type::kEsc;
+      kind = 1;
       expected = num_rotors;
     } else if (type == "odom") {
-      r.type = SensorRecord::Type::kOdometry;
+      kind = 2;
       expected = 10;
     } else if (type == "cmd") {
-      r.type = SensorRecord::Type::kCommand;
+      kind = 3;
       expected = num_rotors;
     } else {
       fail(fmt::format("unknown message type '{}'; expected imu, esc, odom or cmd", type));
@@ -112,32 +111,25 @@ std::vector<SensorRecord> ReadSensorLog(const std::string& path, int num_rotors)
     if (static_cast<int>(values.size()) != expected) {
       fail(fmt::format("{} has {} values; expected {}", type, values.size(), expected));
     }
-    const int k = static_cast<int>(r.type);
-    if (t < last_t[k]) fail(fmt::format("{} time stamp {} ns is before the previous one ({} ns)", type, t, last_t[k]));
-    last_t[k] = t;
+    if (t < last_t[kind]) {
+      fail(fmt::format("{} time stamp {} ns is before the previous one ({} ns)", type, t, last_t[kind]));
+    }
+    last_t[kind] = t;
     const Eigen::Map<const Eigen::VectorXd> vv(values.data(), static_cast<Eigen::Index>(values.size()));
-    switch (r.type) {
-      case SensorRecord::Type::kImu:
-        r.imu.t_ns = t;
-        r.imu.specific_force_B = vv.head<3>();
-        r.imu.w_B = vv.tail<3>();
+    switch (kind) {
+      case 0:
+        records.emplace_back(ImuSample{t, vv.head<3>(), vv.tail<3>()});
         break;
-      case SensorRecord::Type::kEsc:
-        r.esc.t_ns = t;
-        r.esc.motor_speed_rad_s = vv;
+      case 1:
+        records.emplace_back(EscTelemetry{t, vv});
         break;
-      case SensorRecord::Type::kOdometry:
-        r.odometry.t_ns = t;
-        r.odometry.p_W = vv.head<3>();
-        r.odometry.q_WB = Quaternion(vv[3], vv[4], vv[5], vv[6]);
-        r.odometry.v_W = vv.segment<3>(7);
+      case 2:
+        records.emplace_back(OdometrySample{t, vv.head<3>(), Quaternion(vv[3], vv[4], vv[5], vv[6]), vv.segment<3>(7)});
         break;
-      case SensorRecord::Type::kCommand:
-        r.command.t_ns = t;
-        r.command.thrust_n = vv;
+      default:
+        records.emplace_back(RotorCommand{t, vv});
         break;
     }
-    records.push_back(std::move(r));
     offset = end + 1;
   }
   if (line_no == 0) throw io::InputFileError(path, "line 1 (byte 0): empty file; expected the sensor log header");

@@ -55,15 +55,15 @@ TEST_F(SensorLog, RoundTripsEveryMessageExactly) {
   AppendCommand(cmd, &text);
   const std::vector<SensorRecord> r = ReadSensorLog(Write("sensors.csv", text), 4);
   ASSERT_EQ(r.size(), 4u);
-  EXPECT_EQ(r[0].imu.t_ns, 123);
-  EXPECT_EQ(r[0].imu.specific_force_B, imu.specific_force_B);
-  EXPECT_EQ(r[0].imu.w_B, imu.w_B);
-  EXPECT_EQ(r[1].esc.motor_speed_rad_s, esc.motor_speed_rad_s);
-  EXPECT_EQ(r[2].odometry.p_W, odom.p_W);
-  EXPECT_EQ(r[2].odometry.q_WB.coeffs(), odom.q_WB.coeffs());
-  EXPECT_EQ(r[2].odometry.v_W, odom.v_W);
-  EXPECT_EQ(r[3].command.t_ns, 126);
-  EXPECT_EQ(r[3].command.thrust_n, cmd.thrust_n);
+  EXPECT_EQ(std::get<ImuSample>(r[0]).t_ns, 123);
+  EXPECT_EQ(std::get<ImuSample>(r[0]).specific_force_B, imu.specific_force_B);
+  EXPECT_EQ(std::get<ImuSample>(r[0]).w_B, imu.w_B);
+  EXPECT_EQ(std::get<EscTelemetry>(r[1]).motor_speed_rad_s, esc.motor_speed_rad_s);
+  EXPECT_EQ(std::get<OdometrySample>(r[2]).p_W, odom.p_W);
+  EXPECT_EQ(std::get<OdometrySample>(r[2]).q_WB.coeffs(), odom.q_WB.coeffs());
+  EXPECT_EQ(std::get<OdometrySample>(r[2]).v_W, odom.v_W);
+  EXPECT_EQ(std::get<RotorCommand>(r[3]).t_ns, 126);
+  EXPECT_EQ(std::get<RotorCommand>(r[3]).thrust_n, cmd.thrust_n);
 }
 
 TEST_F(SensorLog, RejectsCorruptionNamingTheLineAndByte) {
@@ -132,11 +132,7 @@ TEST_F(FddReplay, FindsTheLiveRunsDiagnosisExactly) {
     ASSERT_EQ(log.faults.size(), s.faults.size());
     ASSERT_TRUE(log.recorded_fdd.has_value());
     const ReplayOutcome replay = ReplayCompositeFdd(log, *log.recorded_fdd);
-    const FddRecord scored = ScoreFdd(replay.statuses, [&] {
-      std::vector<sim::FaultEvent> events;
-      for (const FaultRecord& f : log.faults) events.push_back({f.rotor, *vehicle::ParseFaultKind(f.kind), f.onset_s});
-      return events;
-    }());
+    const FddRecord scored = ScoreFdd(replay.statuses, FaultEvents(log));
     EXPECT_EQ(scored.detected, live.fdd->detected) << file;
     EXPECT_EQ(scored.rotor, live.fdd->rotor) << file;
     EXPECT_EQ(scored.kind, live.fdd->kind) << file;
@@ -195,9 +191,9 @@ TEST_F(FddReplay, CalibrationTableAndSuggestionAreConsistent) {
     if (sw["threshold"] == "takeoff_angular_acceleration_rad_s2") at.takeoff_angular_acceleration_rad_s2 = suggested;
     for (const CalibrationLog& log : logs) {
       const ReplayOutcome r = ReplayCompositeFdd(log, at);
-      EXPECT_EQ(r.detected, !log.faults.empty()) << sw["threshold"] << " " << log.dir;
-      if (r.detected) {
-        EXPECT_EQ(r.rotor, log.faults.front().rotor);
+      EXPECT_EQ(r.isolated_rotor.has_value(), !log.faults.empty()) << sw["threshold"] << " " << log.dir;
+      if (r.isolated_rotor) {
+        EXPECT_EQ(*r.isolated_rotor, log.faults.front().rotor);
       }
     }
     const double configured = sw["configured"].get<double>();

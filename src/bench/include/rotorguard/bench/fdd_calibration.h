@@ -17,6 +17,7 @@
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/sensor_log.h"
 #include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/sim/fault_injector.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::bench {
@@ -47,12 +48,13 @@ fdd::CompositeFddOptions CompositeFddOptionsFromJson(const nlohmann::json& json)
 /// recorded different settings, `note` (if given) says so.
 fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& logs, std::string* note);
 
+/// The log's injected faults as the simulator reports them, for ScoreFdd.
+std::vector<sim::FaultEvent> FaultEvents(const CalibrationLog& log);
+
 struct ReplayOutcome {
-  bool detected = false;  ///< any rotor isolated (motor or propeller failure)
-  int rotor = -1;
-  std::string kind;      ///< "motor_stop" or "propeller_loss" (the fault kind the health names)
-  std::string detector;
-  double detection_s = 0.0;
+  /// The first rotor isolated as failed (motor or propeller), if any; its diagnosis, detector and
+  /// time are in `statuses`.
+  std::optional<int> isolated_rotor;
   /// The most alarming values the indices took in fault-free flight (the whole log without
   /// faults, the part before the first onset with): the lowest motor index M_i, the highest
   /// propeller index P_i, the highest take-off statistic.
@@ -66,7 +68,7 @@ struct ReplayOutcome {
 
 /// Replays a log through a CompositeFdd built with `options` (the log's IMU rate and position
 /// are filled in).
-ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, fdd::CompositeFddOptions options);
+ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::CompositeFddOptions& options);
 
 struct FddCalibrationOptions {
   fdd::CompositeFddOptions fdd;  ///< the thresholds not being swept

@@ -47,6 +47,11 @@ struct Scenario {
 /// A `--set key.path=value` override. Paths starting with "vehicle." apply to the vehicle file.
 using Override = std::pair<std::string, std::string>;
 
+/// Copies the hardware facts the flight stack is configured with from the vehicle and its sensors
+/// (IMU rate and mounting point for the fault detectors, LiDAR mount and vehicle radius for the
+/// mapper). LoadScenario calls it; a scenario built in code calls it once its sensors are set.
+void FitStackToHardware(Scenario* scenario);
+
 /// Loads and validates a scenario file. Throws io::ConfigError (bad content, with file, line and
 /// key path) or io::InputFileError (a file that cannot be read).
 Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides = {});

@@ -12,20 +12,20 @@
 /// Numbers are in their shortest exact form; nan and inf are written as such (the stack ignores a
 /// non-finite message, and a replay must see it to ignore it too).
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "rotorguard/core/messages.h"
 
 namespace rotorguard::bench {
 
-struct SensorRecord {
-  enum class Type { kImu, kEsc, kOdometry, kCommand };
-  Type type = Type::kImu;
-  ImuSample imu;
-  EscTelemetry esc;
-  OdometrySample odometry;
-  RotorCommand command;
-};
+/// One line of a sensor log: the message it holds.
+using SensorRecord = std::variant<ImuSample, EscTelemetry, OdometrySample, RotorCommand>;
+
+/// A record's time stamp [ns].
+inline TimeNs RecordTime(const SensorRecord& r) {
+  return std::visit([](const auto& message) { return message.t_ns; }, r);
+}
 
 inline constexpr std::string_view kSensorLogHeader = "type,t_ns,values...\n";
 
