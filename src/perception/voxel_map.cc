@@ -138,7 +138,6 @@ void VoxelMap::SetLogOdds(const Index& i, float value) {
   const bool was = log_odds_[a] > options_.occupied_threshold;
   const bool now = value > options_.occupied_threshold;
   log_odds_[a] = value;
-  known_[a] = 1;
   if (was == now) return;
   occupied_count_ += now ? 1 : -1;
   Inflate(i, now ? 1 : -1);
@@ -147,6 +146,12 @@ void VoxelMap::SetLogOdds(const Index& i, float value) {
 void VoxelMap::ClearVoxel(const Index& i) {
   SetLogOdds(i, 0.0f);
   known_[Address(i)] = 0;
+}
+
+void VoxelMap::Observe(const Index& i, std::size_t address, double log_odds_step) {
+  known_[address] = 1;
+  SetLogOdds(i, std::clamp(log_odds_[address] + static_cast<float>(log_odds_step),
+                           static_cast<float>(options_.log_odds_min), static_cast<float>(options_.log_odds_max)));
 }
 
 void VoxelMap::Recenter(const Vector3& center_W) {
@@ -162,9 +167,6 @@ void VoxelMap::Recenter(const Vector3& center_W) {
     origin_ = new_origin;
     return;
   }
-  const auto in_new = [&](const Index& i) {
-    return (i.array() >= new_origin.array()).all() && (i.array() < (new_origin + size_).array()).all();
-  };
   // Voxels of the old window outside the new one: a slab along each axis that moved. A voxel in
   // two slabs (a corner) is taken with the first.
   const auto slab = [&](int k, Eigen::Vector2i* range) {
@@ -187,7 +189,7 @@ void VoxelMap::Recenter(const Vector3& center_W) {
             slab(j, &other);
             earlier = shift[j] != 0 && i[j] >= other[0] && i[j] < other[1];
           }
-          if (!earlier && !in_new(i)) leaving.push_back(i);
+          if (!earlier && !InWindowAt(i, new_origin)) leaving.push_back(i);
         }
       }
     }
@@ -201,9 +203,6 @@ void VoxelMap::Recenter(const Vector3& center_W) {
   // voxels within the radius of them. Those lie in the part of the window that stayed, in a band
   // of the radius along each entering face; each is visited once (corners belong to the first
   // axis' band).
-  const auto in_old = [&](const Index& i) {
-    return (i.array() >= old_origin.array()).all() && (i.array() < (old_origin + size_).array()).all();
-  };
   const Index keep_lo = old_origin.cwiseMax(new_origin), keep_hi = (old_origin + size_).cwiseMin(new_origin + size_);
   const auto band = [&](int k, Eigen::Vector2i* range) {
     (*range)[0] = shift[k] > 0 ? std::max(keep_lo[k], keep_hi[k] - stencil_radius_) : keep_lo[k];
@@ -228,7 +227,7 @@ void VoxelMap::Recenter(const Vector3& center_W) {
           if (earlier) continue;
           for (const Index& o : stencil_) {
             const Index e = v + o;
-            if (InWindow(e) && !in_old(e)) ++inflation_[Address(e)];
+            if (InWindow(e) && !InWindowAt(e, old_origin)) ++inflation_[Address(e)];
           }
         }
       }
@@ -251,9 +250,6 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   }
   const std::uint8_t miss = static_cast<std::uint8_t>(2 * frame_), hit = static_cast<std::uint8_t>(2 * frame_ + 1);
   touched_hit_.clear();
-  const auto clamp = [&](float v) {
-    return std::clamp(v, static_cast<float>(options_.log_odds_min), static_cast<float>(options_.log_odds_max));
-  };
   // Pass 1: the returns' voxels, stamped as hits, and one ray per hit voxel (from the same origin
   // the other returns in it crossed nearly the same voxels; ego-planner's per-frame voxel cache
   // makes the same trade). Returns outside the window still clear the window along their rays.
@@ -284,7 +280,6 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // already passed leaves gaps between converging rays, and obstacles that moved away with them.
   const Vector3 o = origin_W / res_;
   const double max_cells = options_.max_clearing_range_m / res_;
-  const float miss_step = static_cast<float>(options_.log_odds_miss);
   long steps = 0;
   int missed = 0;
   for (const Vector3& p : rays) {
@@ -298,13 +293,13 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
       std::uint8_t& s = stamp_[address];
       if (s < miss) {
         s = miss;
-        SetLogOdds(i, clamp(log_odds_[address] + miss_step));
+        Observe(i, address, options_.log_odds_miss);
         ++missed;
       }
       return true;
     });
   }
-  for (const Index& i : touched_hit_) SetLogOdds(i, clamp(log_odds_[Address(i)] + static_cast<float>(options_.log_odds_hit)));
+  for (const Index& i : touched_hit_) Observe(i, Address(i), options_.log_odds_hit);
   summary.voxels_traversed = steps;
   summary.voxels_updated = static_cast<int>(touched_hit_.size()) + missed;
   return summary;

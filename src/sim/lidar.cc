@@ -30,7 +30,10 @@ void LidarOptions::Validate() const {
   require(std::isfinite(grid_cell_m) && grid_cell_m > 0.0, "grid_cell_m", grid_cell_m, "a cell edge > 0 m");
 }
 
-Vector3 LidarPatternDirection(std::uint64_t k, const LidarOptions& o) {
+LidarPattern::LidarPattern(const LidarOptions& o)
+    : sin_min_(std::sin(o.min_elevation_rad)), sin_max_(std::sin(o.max_elevation_rad)) {}
+
+Vector3 LidarPattern::Direction(std::uint64_t k) const {
   // R2 sequence: alpha = (1/g, 1/g^2), g the plastic number (the real root of x^3 = x + 1).
   constexpr double g = 1.32471795724474602596;
   constexpr double a1 = 1.0 / g, a2 = 1.0 / (g * g);
@@ -38,14 +41,13 @@ Vector3 LidarPatternDirection(std::uint64_t k, const LidarOptions& o) {
   const double u = std::fmod(0.5 + a1 * kd, 1.0), v = std::fmod(0.5 + a2 * kd, 1.0);
   const double azimuth = 2.0 * std::numbers::pi * u;
   // Uniform in solid angle over the band: sin(elevation) uniform.
-  const double s0 = std::sin(o.min_elevation_rad), s1 = std::sin(o.max_elevation_rad);
-  const double sin_el = s0 + v * (s1 - s0);
+  const double sin_el = sin_min_ + v * (sin_max_ - sin_min_);
   const double cos_el = std::sqrt(std::max(0.0, 1.0 - sin_el * sin_el));
   return Vector3(cos_el * std::cos(azimuth), cos_el * std::sin(azimuth), sin_el);
 }
 
 LidarSimulator::LidarSimulator(const LidarOptions& options, const World& world, std::uint64_t seed)
-    : options_(options), caster_(world, RayCasterOptions{options.grid_cell_m}), rng_(seed) {
+    : options_(options), pattern_(options), caster_(world, RayCasterOptions{options.grid_cell_m}), rng_(seed) {
   options_.Validate();
   frame_ns_ = PeriodFromRate(options_.frame_rate_hz);
   frame_.t_start_ns = 0;
@@ -65,8 +67,7 @@ std::optional<LidarFrame> LidarSimulator::Step(TimeNs t0, const BodyPose& pose0,
   const Eigen::AngleAxisd arc(rel);
   const double span = static_cast<double>(t1 - t0);
   std::optional<LidarFrame> done;
-  while (PulseTime(next_pulse_) <= t1) {
-    const TimeNs t = PulseTime(next_pulse_);
+  for (TimeNs t = PulseTime(next_pulse_); t <= t1; t = PulseTime(next_pulse_)) {
     if (t <= t0 && next_pulse_ > 0) {  // pulses at or before t0 belonged to the previous step
       ++next_pulse_;
       continue;
@@ -80,7 +81,7 @@ std::optional<LidarFrame> LidarSimulator::Step(TimeNs t0, const BodyPose& pose0,
     const double s = std::clamp(static_cast<double>(t - t0) / span, 0.0, 1.0);
     const Vector3 p = pose0.p_W + s * (pose1.p_W - pose0.p_W);
     const Matrix3 R = (q0 * Quaternion(Eigen::AngleAxisd(s * arc.angle(), arc.axis()))).toRotationMatrix();
-    const Vector3 dir_S = LidarPatternDirection(next_pulse_, options_);
+    const Vector3 dir_S = pattern_.Direction(next_pulse_);
     const Vector3 origin = p + R * options_.position_m;
     const auto hit = caster_.Cast(origin, R * dir_S, options_.max_range_m, ToSeconds(t));
     ++next_pulse_;

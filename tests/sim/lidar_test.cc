@@ -17,11 +17,12 @@ namespace {
 /// Fraction of equal-solid-angle cells of the field of view (2 degrees of azimuth by 1/60 of the
 /// sine-of-elevation band) that the first n pulses visit.
 double Coverage(std::uint64_t n, const LidarOptions& o) {
+  const LidarPattern pattern(o);
   constexpr int kAz = 180, kEl = 60;
   std::vector<bool> seen(kAz * kEl, false);
   const double s0 = std::sin(o.min_elevation_rad), s1 = std::sin(o.max_elevation_rad);
   for (std::uint64_t k = 0; k < n; ++k) {
-    const Vector3 d = LidarPatternDirection(k, o);
+    const Vector3 d = pattern.Direction(k);
     const double az = std::atan2(d.y(), d.x()) + std::numbers::pi;
     const int a = std::min(kAz - 1, static_cast<int>(az / (2.0 * std::numbers::pi) * kAz));
     const int e = std::min(kEl - 1, static_cast<int>((d.z() - s0) / (s1 - s0) * kEl));
@@ -32,8 +33,9 @@ double Coverage(std::uint64_t n, const LidarOptions& o) {
 
 TEST(LidarPattern, StaysInTheFieldOfViewAndCoversItMoreTheLongerItIntegrates) {
   const LidarOptions o;
+  const LidarPattern pattern(o);
   for (std::uint64_t k = 0; k < 200000; ++k) {
-    const Vector3 d = LidarPatternDirection(k, o);
+    const Vector3 d = pattern.Direction(k);
     ASSERT_NEAR(d.norm(), 1.0, 1e-12);
     const double el = std::asin(d.z());
     ASSERT_GE(el, o.min_elevation_rad - 1e-12);
@@ -48,12 +50,12 @@ TEST(LidarPattern, StaysInTheFieldOfViewAndCoversItMoreTheLongerItIntegrates) {
   // Non-repetitive: the second frame's directions are not the first's.
   std::set<std::pair<long, long>> first;
   for (std::uint64_t k = 0; k < 20000; ++k) {
-    const Vector3 d = LidarPatternDirection(k, o);
+    const Vector3 d = pattern.Direction(k);
     first.insert({std::lround(d.x() * 1e6), std::lround(d.y() * 1e6)});
   }
   int repeated = 0;
   for (std::uint64_t k = 20000; k < 40000; ++k) {
-    const Vector3 d = LidarPatternDirection(k, o);
+    const Vector3 d = pattern.Direction(k);
     repeated += first.count({std::lround(d.x() * 1e6), std::lround(d.y() * 1e6)}) > 0 ? 1 : 0;
   }
   EXPECT_EQ(repeated, 0);

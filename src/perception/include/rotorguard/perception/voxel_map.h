@@ -84,9 +84,11 @@ class VoxelMap {
   using Index = Eigen::Vector3i;
   Index ToIndex(const Vector3& p) const;
   Vector3 Center(const Index& i) const;
-  bool InWindow(const Index& i) const {
-    return (i.array() >= origin_.array()).all() && (i.array() < (origin_ + size_).array()).all();
+  /// Whether i lies in the window of this size whose lower corner is `origin`.
+  bool InWindowAt(const Index& i, const Index& origin) const {
+    return (i.array() >= origin.array()).all() && (i.array() < (origin + size_).array()).all();
   }
+  bool InWindow(const Index& i) const { return InWindowAt(i, origin_); }
   std::size_t Address(const Index& i) const {
     return WrappedAddress(Index(internal::PositiveMod(i.x(), size_.x()), internal::PositiveMod(i.y(), size_.y()),
                                 internal::PositiveMod(i.z(), size_.z())));
@@ -103,6 +105,8 @@ class VoxelMap {
   void SetLogOdds(const Index& i, float value);
   void Inflate(const Index& i, int delta);
   void ClearVoxel(const Index& i);
+  /// A hit or a miss: the voxel is known and its log-odds move by the step, clamped.
+  void Observe(const Index& i, std::size_t address, double log_odds_step);
   /// Visits the window's voxels that the segment a-b (voxel units) crosses, in order (Amanatides
   /// and Woo 1987), as visit(index, address) until it returns false. The segment is clipped to
   /// the window first and the ring-buffer address follows each step, the map's hottest loop.

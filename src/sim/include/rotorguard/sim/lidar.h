@@ -41,8 +41,15 @@ struct BodyPose {
   Quaternion q_WB = Quaternion::Identity();
 };
 
-/// Unit direction (sensor frame) of pulse k of the pattern.
-Vector3 LidarPatternDirection(std::uint64_t k, const LidarOptions& options);
+/// The scan pattern: the unit direction (sensor frame) of each pulse.
+class LidarPattern {
+ public:
+  explicit LidarPattern(const LidarOptions& options);
+  Vector3 Direction(std::uint64_t k) const;
+
+ private:
+  double sin_min_, sin_max_;  // the band's bounds in sin(elevation), computed once
+};
 
 class LidarSimulator {
  public:
@@ -58,6 +65,7 @@ class LidarSimulator {
   TimeNs PulseTime(std::uint64_t k) const;
 
   LidarOptions options_;
+  LidarPattern pattern_;
   RayCaster caster_;
   Rng rng_;
   TimeNs frame_ns_;
