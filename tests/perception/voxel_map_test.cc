@@ -132,6 +132,14 @@ TEST(VoxelMapOptions, ValidationNamesTheField) {
   o = {};
   o.occupied_threshold = 5.0;
   EXPECT_THROW(o.Validate(), ValidationError);
+  o = {};
+  o.log_odds_max = 40.0;  // beyond the fixed-point store's range
+  try {
+    o.Validate();
+    ADD_FAILURE();
+  } catch (const ValidationError& e) {
+    EXPECT_EQ(e.field(), "log_odds_max");
+  }
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 /// per frame (hits win), so that an obstacle that moved away is cleared by the rays that now pass
 /// through it. Occupied voxels are inflated by the vehicle radius in a second layer kept up to
 /// date incrementally, which the planner's queries read.
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -25,10 +26,12 @@ struct VoxelMapOptions {
   /// Extent of the local window [m], > resolution; rounded up to a power of two voxels per axis
   /// (24 x 24 x 6 m at 0.1 m gives 25.6 x 25.6 x 6.4 m).
   Vector3 window_size_m = Vector3(24.0, 24.0, 6.0);
-  double log_odds_hit = 0.85;   ///< added on a return (p = 0.7), > 0
-  double log_odds_miss = -0.4;  ///< added when a ray passes (p = 0.4), < 0
-  double log_odds_min = -2.0;   ///< clamp, < 0
-  double log_odds_max = 3.5;    ///< clamp, > 0
+  // Log-odds are stored in fixed point (steps of 0.001, |value| <= 30) so that a voxel's state
+  // fits the 4 bytes one ray step touches.
+  double log_odds_hit = 0.85;   ///< added on a return (p = 0.7), in (0, 30]
+  double log_odds_miss = -0.4;  ///< added when a ray passes (p = 0.4), in [-30, 0)
+  double log_odds_min = -2.0;   ///< clamp, in [-30, 0)
+  double log_odds_max = 3.5;    ///< clamp, in (0, 30]
   double occupied_threshold = 0.7;  ///< occupied above this log-odds (two hits from unknown), in (0, max)
   double inflation_radius_m = 0.2;  ///< the vehicle's radius [m], >= 0
   /// Rays longer than this only clear up to it (and still mark their return) [m], > 0.
@@ -93,6 +96,8 @@ class VoxelMap {
     return WrappedAddress(Index(internal::PositiveMod(i.x(), size_.x()), internal::PositiveMod(i.y(), size_.y()),
                                 internal::PositiveMod(i.z(), size_.z())));
   }
+  /// The window's voxel stored at this address.
+  Index IndexOf(std::size_t address) const;
   /// From coordinates already wrapped into [0, size). Bricks of 8 x 8 x 8 voxels, each contiguous:
   /// a ray stays in one brick (a few cache lines) for several steps in any direction, where a
   /// row-major layout jumps a whole plane per step.
@@ -101,14 +106,30 @@ class VoxelMap {
         (static_cast<std::size_t>(w.x() >> 3) * (size_.y() >> 3) + (w.y() >> 3)) * (size_.z() >> 3) + (w.z() >> 3);
     return brick * 512 + static_cast<std::size_t>(((w.x() & 7) << 6) | ((w.y() & 7) << 3) | (w.z() & 7));
   }
-  /// Sets a voxel's log-odds, maintaining the occupied count and the inflation layer.
-  void SetLogOdds(const Index& i, float value);
+  /// One voxel's state, packed so that a ray step reads and writes a single cache line.
+  struct Cell {
+    std::int16_t log_odds = 0;  // fixed point, kLogOddsScale per unit
+    std::uint8_t stamp = 0;     // 2f: missed in frame f, 2f + 1: hit (f in 1..127)
+    std::uint8_t known = 0;     // observed at least once
+  };
+  static constexpr double kLogOddsScale = 1000.0;
+  bool Occupied(const Cell& c) const { return c.log_odds > occupied_q_; }
   void Inflate(const Index& i, int delta);
   void ClearVoxel(const Index& i);
-  /// A hit or a miss: the voxel is known and its log-odds move by the step, clamped.
-  void Observe(const Index& i, std::size_t address, double log_odds_step);
+  /// A hit or a miss: the voxel is known and its log-odds move by the step (fixed point),
+  /// clamped; the occupied count and the inflation layer follow a change of state.
+  void Observe(std::size_t address, int log_odds_step) {
+    Cell& cell = cells_[address];
+    cell.known = 1;
+    const bool was = Occupied(cell);
+    cell.log_odds = static_cast<std::int16_t>(std::clamp(cell.log_odds + log_odds_step, min_q_, max_q_));
+    const bool now = Occupied(cell);
+    if (was == now) return;
+    occupied_count_ += now ? 1 : -1;
+    Inflate(IndexOf(address), now ? 1 : -1);
+  }
   /// Visits the window's voxels that the segment a-b (voxel units) crosses, in order (Amanatides
-  /// and Woo 1987), as visit(index, address) until it returns false. The segment is clipped to
+  /// and Woo 1987), as visit(address) until it returns false. The segment is clipped to
   /// the window first and the ring-buffer address follows each step, the map's hottest loop.
   template <typename Visit>
   void TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const;
@@ -117,15 +138,15 @@ class VoxelMap {
   double res_;
   Index size_;            // voxels per axis
   Index origin_;          // global index of the window's lower corner
-  std::vector<float> log_odds_;
-  std::vector<std::uint8_t> known_;
+  int hit_q_, miss_q_, min_q_, max_q_, occupied_q_;  // the options' log-odds in fixed point
+  std::vector<Cell> cells_;
   std::vector<std::uint16_t> inflation_;  // occupied voxels within the radius
-  std::vector<std::uint8_t> stamp_;  // 2f: missed in frame f, 2f + 1: hit (f in 1..127)
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
   std::vector<Index> touched_hit_;
   std::vector<Vector3> ray_ends_;  // the returns whose rays a frame walks
+  std::vector<std::uint32_t> walk_;  // the addresses of the voxels a batch of rays crosses, in order
   int occupied_count_ = 0;
 };
 
