@@ -91,8 +91,8 @@ void FitStackToHardware(Scenario* s) {
   s->stack.fixed_time_fdd.imu_rate_hz = s->sim.imu.rate_hz;
   s->stack.fixed_time_fdd.imu_position_m = s->sim.imu.position_m;
   // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius.
-  s->stack.deskew.sensor_position_m = s->sim.lidar.position_m;
-  s->stack.map.inflation_radius_m = s->vehicle.collision_radius_m;
+  s->stack.lidar.deskew.sensor_position_m = s->sim.lidar.position_m;
+  s->stack.lidar.map.inflation_radius_m = s->vehicle.collision_radius_m;
 }
 
 std::string VehicleToYaml(const vehicle::VehicleParams& v) {

@@ -37,8 +37,7 @@ void FlightStackOptions::Validate() const {
   }
   composite_fdd.Validate();
   fixed_time_fdd.Validate();
-  deskew.Validate();
-  map.Validate();
+  lidar.Validate();
   if (!known_faults.empty() && controller != "nmpc" && controller != "indi") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,
                     "controller nmpc or indi (the controllers that reconfigure)");
@@ -52,7 +51,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
       reference_(std::move(reference)),
       options_(options),
       estimator_(model_.params().thrust_coefficient_n_s2),
-      deskewer_(options.deskew) {
+      mapper_(options.lidar) {
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
   if (options_.controller == "nmpc") {
@@ -82,7 +81,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
 
 void FlightStack::OnImu(const ImuSample& imu) {
   estimator_.OnImu(imu);
-  deskewer_.OnImu(imu);
+  mapper_.OnImu(imu);
   if (fdd_) fdd_->OnImu(imu);
 }
 
@@ -94,26 +93,7 @@ void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
 void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_.OnOdometry(odometry); }
 
 void FlightStack::OnLidar(const LidarFrame& frame) {
-  lidar_points_dropped_ += frame.dropped;
-  const StateEstimate e = estimator_.Estimate(frame.t_end_ns);
-  if (!e.valid || !e.p_W.allFinite() || !e.q_WB.coeffs().allFinite() || !e.v_W.allFinite()) {
-    lidar_points_dropped_ += static_cast<long>(frame.points_S.size());  // nowhere to put them yet
-    return;
-  }
-  if (!map_) map_ = std::make_unique<perception::VoxelMap>(options_.map);
-  // In the sensor frame at the frame's end (deskewed), or each at its own time taken as the end's.
-  if (options_.deskew_frames) {
-    deskewer_.Deskew(frame, e.v_W, e.q_WB, &points_scratch_);
-    lidar_points_dropped_ += static_cast<long>(frame.points_S.size() - points_scratch_.size());  // non-finite
-  } else {
-    points_scratch_ = frame.points_S;
-  }
-  const Matrix3 R = e.q_WB.normalized().toRotationMatrix();
-  const Vector3& l = options_.deskew.sensor_position_m;
-  const Vector3 origin = e.p_W + R * l;
-  for (Eigen::Vector3f& p : points_scratch_) p = (origin + R * p.cast<double>()).cast<float>();
-  map_->Recenter(e.p_W);
-  lidar_points_dropped_ += map_->Insert(origin, points_scratch_).points_dropped;
+  lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_.Estimate(frame.t_end_ns)).points_dropped;
 }
 
 const RotorCommand& FlightStack::Update(TimeNs t) {

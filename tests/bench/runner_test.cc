@@ -198,7 +198,7 @@ TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
   for (int deskew = 0; deskew < 2; ++deskew) {
     const Scenario s = LoadScenario(Config("room_lidar_propeller_loss.yaml"));
     Scenario variant = s;
-    variant.stack.deskew_frames = deskew == 1;
+    variant.stack.lidar.deskew_frames = deskew == 1;
     RunOptions o;
     double p = 0.0;
     o.on_control_cycle = [&](const stack::FlightStack& st) {

@@ -15,8 +15,7 @@
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/fdd/fixed_time_fdd.h"
-#include "rotorguard/perception/deskew.h"
-#include "rotorguard/perception/voxel_map.h"
+#include "rotorguard/perception/lidar_mapper.h"
 #include "rotorguard/stack/estimator.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -46,11 +45,9 @@ struct FlightStackOptions {
   fdd::CompositeFddOptions composite_fdd;
   fdd::FixedTimeFddOptions fixed_time_fdd;
   /// LiDAR mapping, run on every frame a vehicle with a LiDAR delivers (docs/perception.md):
-  /// frames deskewed to their end pose (unless `deskew_frames` is false), placed with the
+  /// frames deskewed to their end pose (unless `lidar.deskew_frames` is false), placed with the
   /// estimate, inserted into the local occupancy map.
-  bool deskew_frames = true;
-  perception::DeskewOptions deskew;
-  perception::VoxelMapOptions map;
+  perception::LidarMapperOptions lidar;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -83,7 +80,7 @@ class FlightStack {
   /// The fault detector, when there is one; else null.
   const fdd::FaultDetector* fault_detector() const { return fdd_.get(); }
   /// The occupancy map, once a LiDAR frame arrived; else null.
-  const perception::VoxelMap* map() const { return map_.get(); }
+  const perception::VoxelMap* map() const { return mapper_.map(); }
   /// LiDAR pulses without a usable point: no return (counted by the sensor), non-finite, outside
   /// the map's window, or arriving before the estimate is valid.
   long lidar_points_dropped() const { return lidar_points_dropped_; }
@@ -96,9 +93,7 @@ class FlightStack {
   std::unique_ptr<control::Controller> controller_;
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
   std::unique_ptr<fdd::FaultDetector> fdd_;
-  perception::Deskewer deskewer_;
-  std::unique_ptr<perception::VoxelMap> map_;
-  std::vector<Eigen::Vector3f> points_scratch_;
+  perception::LidarMapper mapper_;
   long lidar_points_dropped_ = 0;
   std::vector<bool> known_fault_applied_;
   TimeNs control_period_ns_;

@@ -1,0 +1,51 @@
+#pragma once
+/// The LiDAR path of the flight stack (paper 000 Sec. IV-B and V-C): each frame deskewed to its
+/// end pose with the stack's gyro samples and estimate, placed in the world with the estimate,
+/// and inserted into the local occupancy map that follows the vehicle. One class so that the
+/// flight stack and `rotorguard bench perception` run the same code.
+#include <memory>
+#include <vector>
+
+#include "rotorguard/core/messages.h"
+#include "rotorguard/perception/deskew.h"
+#include "rotorguard/perception/voxel_map.h"
+
+namespace rotorguard::perception {
+
+struct LidarMapperOptions {
+  /// Move every point to the frame-end pose first; false inserts each point as if measured at the
+  /// frame's end (the distorted frame, for comparison).
+  bool deskew_frames = true;
+  DeskewOptions deskew;
+  VoxelMapOptions map;
+  /// Throws ValidationError naming the field.
+  void Validate() const;
+};
+
+struct LidarFrameSummary {
+  /// Pulses of the frame without a usable point: no return (counted by the sensor), non-finite,
+  /// outside the map's window, or all of them when the estimate is not valid yet.
+  long points_dropped = 0;
+  MapUpdateSummary map;
+};
+
+class LidarMapper {
+ public:
+  explicit LidarMapper(const LidarMapperOptions& options);
+  /// Buffers a gyro sample for deskewing.
+  void OnImu(const ImuSample& imu);
+  /// Deskews, places and inserts one frame with `estimate` taken at the frame's end. The map is
+  /// created with the first frame that has a valid estimate.
+  LidarFrameSummary OnFrame(const LidarFrame& frame, const StateEstimate& estimate);
+  /// The occupancy map, once a frame was inserted; else null.
+  const VoxelMap* map() const { return map_.get(); }
+  const LidarMapperOptions& options() const { return options_; }
+
+ private:
+  LidarMapperOptions options_;
+  Deskewer deskewer_;
+  std::unique_ptr<VoxelMap> map_;
+  std::vector<Eigen::Vector3f> points_;
+};
+
+}  // namespace rotorguard::perception

@@ -1,0 +1,40 @@
+#include "rotorguard/perception/lidar_mapper.h"
+
+namespace rotorguard::perception {
+
+void LidarMapperOptions::Validate() const {
+  deskew.Validate();
+  map.Validate();
+}
+
+LidarMapper::LidarMapper(const LidarMapperOptions& options) : options_(options), deskewer_(options.deskew) {
+  options_.Validate();
+}
+
+void LidarMapper::OnImu(const ImuSample& imu) { deskewer_.OnImu(imu); }
+
+LidarFrameSummary LidarMapper::OnFrame(const LidarFrame& frame, const StateEstimate& e) {
+  LidarFrameSummary summary;
+  summary.points_dropped = frame.dropped;
+  if (!e.valid || !e.p_W.allFinite() || !e.q_WB.coeffs().allFinite() || !e.v_W.allFinite()) {
+    summary.points_dropped += static_cast<long>(frame.points_S.size());  // nowhere to put them yet
+    return summary;
+  }
+  if (!map_) map_ = std::make_unique<VoxelMap>(options_.map);
+  // In the sensor frame at the frame's end (deskewed), or each at its own time taken as the end's.
+  if (options_.deskew_frames) {
+    deskewer_.Deskew(frame, e.v_W, e.q_WB, &points_);
+    summary.points_dropped += static_cast<long>(frame.points_S.size() - points_.size());  // non-finite
+  } else {
+    points_ = frame.points_S;
+  }
+  const Matrix3 R = e.q_WB.normalized().toRotationMatrix();
+  const Vector3 origin = e.p_W + R * options_.deskew.sensor_position_m;
+  for (Eigen::Vector3f& p : points_) p = (origin + R * p.cast<double>()).cast<float>();
+  map_->Recenter(e.p_W);
+  summary.map = map_->Insert(origin, points_);
+  summary.points_dropped += summary.map.points_dropped;
+  return summary;
+}
+
+}  // namespace rotorguard::perception
