@@ -1,11 +1,11 @@
-// The simulated MID-360 in a 500-tree forest, spinning at 11 rad/s while flying 1 m/s.
+// The simulated MID-360 in the 500-tree forest of `rotorguard bench perception`, spinning at 11 rad/s while flying 1 m/s.
 // BM_LidarForestStep: one iteration is one 1 ms physics step (200 pulses); items per second are
 // pulses simulated per second (target >= 2 M/s). BM_MapInsertFrame: one iteration inserts one
 // 10 Hz frame into the occupancy map (target <= 5 ms for a 20k-point frame).
 // Run: build/bin/lidar_benchmark
 #include <benchmark/benchmark.h>
 
-#include "rotorguard/core/rng.h"
+#include "rotorguard/bench/perception_bench.h"
 #include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/sim/lidar.h"
 
@@ -13,20 +13,12 @@ namespace {
 
 using namespace rotorguard;
 
-sim::World Forest() {
-  Rng rng(11);
-  sim::World w;
-  for (int i = 0; i < 500; ++i) {
-    w.cylinders.push_back({Eigen::Vector2d(rng.Uniform(-15, 15), rng.Uniform(-10, 10)), rng.Uniform(0.05, 0.3),
-                           rng.Uniform(3, 10)});
-  }
-  return w;
-}
+sim::World Forest() { return bench::PerceptionForest(11); }
 
 sim::BodyPose PoseAt(TimeNs t) {
   const double s = ToSeconds(t);
   sim::BodyPose p;
-  p.p_W = Vector3(-12.0 + std::fmod(s, 24.0), 0.3, 1.5);
+  p.p_W = Vector3(-12.0 + std::fmod(s, 24.0), 0.0, 1.5);  // along the forest's clear lane
   p.q_WB = Quaternion(Eigen::AngleAxisd(11.0 * s, Vector3::UnitZ()));
   return p;
 }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "rotorguard/bench/perception_bench.h"
 #include "rotorguard/bench/scenario.h"
 
 namespace rotorguard::bench {
@@ -179,17 +180,6 @@ TEST(IndiClosedLoop, KeepsHoveringAfterEitherFaultOnEveryRotor) {
 namespace rotorguard::bench {
 namespace {
 
-/// Share of the map's occupied voxels within one voxel of a true surface (centre to surface at
-/// most the voxel's half diagonal plus one voxel).
-double MapPrecision(const stack::FlightStack& st, const sim::World& world) {
-  const std::vector<Vector3> occupied = st.map()->OccupiedVoxels();
-  const double res = st.map()->resolution();
-  const double tolerance = res * (0.5 * std::sqrt(3.0) + 1.0);
-  int good = 0;
-  for (const Vector3& c : occupied) good += world.DistanceToSurface(c, 0.0) <= tolerance ? 1 : 0;
-  return occupied.empty() ? 0.0 : static_cast<double>(good) / static_cast<double>(occupied.size());
-}
-
 // The whole LiDAR path in the loop: a vehicle spinning at about 11 rad/s after a propeller loss
 // maps the room's walls, ground and pillar from deskewed frames; without deskewing the same frames
 // smear into free space.
@@ -203,7 +193,7 @@ TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
     double p = 0.0;
     o.on_control_cycle = [&](const stack::FlightStack& st) {
       if (st.map() && st.command().t_ns == FromSeconds(s.duration_s) - st.control_period_ns()) {
-        p = MapPrecision(st, s.world);
+        p = MapPrecision(*st.map(), s.world);
       }
     };
     const RunSummary r = RunScenario(variant, o);

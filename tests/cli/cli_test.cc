@@ -92,6 +92,9 @@ TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
   EXPECT_EQ(run.exit_code, 0);
   for (const char* s : {"--out", "--set", "--seed", "--quiet"}) EXPECT_NE(run.out.find(s), std::string::npos) << s;
   EXPECT_EQ(Cli("bench sim --help").exit_code, 0);
+  const Result perception = Cli("bench perception --help");
+  EXPECT_EQ(perception.exit_code, 0);
+  for (const char* s : {"--duration", "--seed", "--json"}) EXPECT_NE(perception.out.find(s), std::string::npos) << s;
   EXPECT_EQ(Cli("validate --help").exit_code, 0);
 }
 
@@ -288,6 +291,8 @@ TEST_F(CliTest, NumericOptionsRejectNonFiniteNegativeAndGarbage) {
     expect_usage_error("run " + s + " --quiet --seed '" + bad + "' --out " + Out());
     expect_usage_error("bench sim --scenario " + s + " --duration '" + bad + "'");
     expect_usage_error("bench sim --scenario " + s + " --repetitions '" + bad + "'");
+    expect_usage_error("bench perception --duration '" + bad + "'");
+    expect_usage_error("bench perception --seed '" + bad + "'");
   }
   // Integers only where a count is expected.
   expect_usage_error("run " + s + " --quiet --seed 1.5 --out " + Out());
