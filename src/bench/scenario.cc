@@ -413,6 +413,22 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     d.takeoff_direction_cosine = OptionalDouble(*c, "takeoff_direction_cosine", d.takeoff_direction_cosine);
     c->RejectUnknownKeys();
   }
+  if (const auto d = node.Optional("deskew_frames")) o->lidar.deskew_frames = d->AsBool();
+  if (const auto n = node.Optional("map")) {
+    // The inflation radius is the vehicle's collision radius and the deskew lever arm the LiDAR's
+    // mounting point (FitStackToHardware): neither is a key here.
+    perception::VoxelMapOptions& m = o->lidar.map;
+    m.resolution_m = OptionalDouble(*n, "resolution_m", m.resolution_m);
+    m.window_size_m = OptionalVector3(*n, "window_size_m", m.window_size_m);
+    m.log_odds_hit = OptionalDouble(*n, "log_odds_hit", m.log_odds_hit);
+    m.log_odds_miss = OptionalDouble(*n, "log_odds_miss", m.log_odds_miss);
+    m.log_odds_min = OptionalDouble(*n, "log_odds_min", m.log_odds_min);
+    m.log_odds_max = OptionalDouble(*n, "log_odds_max", m.log_odds_max);
+    m.occupied_threshold = OptionalDouble(*n, "occupied_threshold", m.occupied_threshold);
+    m.max_clearing_range_m = OptionalDouble(*n, "max_clearing_range_m", m.max_clearing_range_m);
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] { m.Validate(); });
+  }
   if (const auto kf = node.Optional("known_faults")) {
     if (!kf->IsSequence()) kf->Fail("expected a list of {rotor, at_time_s}");
     for (std::size_t i = 0; i < kf->size(); ++i) {

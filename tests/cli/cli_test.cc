@@ -229,6 +229,10 @@ TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
   ExpectConfigError("run " + f, f, 9, {"faults.0.onset.during_takeoff_s", "on the ground"});
   f = Write("rate.yaml", Scenario(v, "stack: {control_rate_hz: 5000}\n"));
   ExpectConfigError("run " + f, f, 8, {"stack.control_rate_hz", "physics rate"});
+  f = Write("map.yaml", Scenario(v, "stack:\n  map: {resolution_m: 0.1, log_odds_max: 40}\n"));
+  ExpectConfigError("run " + f, f, 9, {"stack.map.log_odds_max", "40", "(0, 30]"});
+  f = Write("mapkey.yaml", Scenario(v, "stack:\n  map: {inflation_radius_m: 0.3}\n"));
+  ExpectConfigError("run " + f, f, 9, {"stack.map.inflation_radius_m", "unknown key"});
   f = Write("malformed.yaml", "vehicle: " + v + "\nduration_s: [1, 2\nmission: {type: hover}\n");
   {
     const Result r = Cli("run " + f);
