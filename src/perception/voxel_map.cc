@@ -195,36 +195,35 @@ void VoxelMap::Recenter(const Vector3& center_W) {
     origin_ = new_origin;
     return;
   }
-  // Voxels of the old window outside the new one: a slab along each axis that moved. A voxel in
-  // two slabs (a corner) is taken with the first.
-  const auto slab = [&](int k, Eigen::Vector2i* range) {
-    (*range)[0] = shift[k] > 0 ? origin_[k] : new_origin[k] + size_[k];
-    (*range)[1] = shift[k] > 0 ? new_origin[k] : origin_[k] + size_[k];  // exclusive
-  };
-  std::vector<Index> leaving;
-  for (int k = 0; k < 3; ++k) {
-    if (shift[k] == 0) continue;
-    Eigen::Vector2i range;
-    slab(k, &range);
-    Index i;
-    const int a = (k + 1) % 3, b = (k + 2) % 3;
-    for (i[k] = range[0]; i[k] < range[1]; ++i[k]) {
-      for (i[a] = origin_[a]; i[a] < origin_[a] + size_[a]; ++i[a]) {
-        for (i[b] = origin_[b]; i[b] < origin_[b] + size_[b]; ++i[b]) {
-          bool earlier = false;
-          for (int j = 0; j < k && !earlier; ++j) {
-            Eigen::Vector2i other;
-            slab(j, &other);
-            earlier = shift[j] != 0 && i[j] >= other[0] && i[j] < other[1];
-          }
-          if (!earlier && !InWindowAt(i, new_origin)) leaving.push_back(i);
+  // Voxels of the old window outside the new one: a slab along each axis that moved, each voxel
+  // visited once (along the axes of earlier slabs only the part that stays is walked).
+  const Index stay_lo = origin_.cwiseMax(new_origin), stay_hi = (origin_ + size_).cwiseMin(new_origin + size_);
+  const auto for_each_leaving = [&](auto&& f) {
+    for (int k = 0; k < 3; ++k) {
+      if (shift[k] == 0) continue;
+      Index lo = origin_, hi = origin_ + size_;
+      for (int j = 0; j < k; ++j) {
+        if (shift[j] != 0) lo[j] = stay_lo[j], hi[j] = stay_hi[j];
+      }
+      lo[k] = shift[k] > 0 ? origin_[k] : stay_hi[k];
+      hi[k] = shift[k] > 0 ? stay_lo[k] : origin_[k] + size_[k];
+      Index i;
+      for (i.x() = lo.x(); i.x() < hi.x(); ++i.x()) {
+        for (i.y() = lo.y(); i.y() < hi.y(); ++i.y()) {
+          for (i.z() = lo.z(); i.z() < hi.z(); ++i.z()) f(i);
         }
       }
     }
-  }
+  };
   // Forget them (their inflation of the voxels that stay goes too), then free their slots.
-  for (const Index& i : leaving) ClearVoxel(i);
-  for (const Index& i : leaving) inflation_[Address(i)] = 0;
+  for_each_leaving([&](const Index& i) {
+    if (Occupied(cells_[Address(i)])) ClearVoxel(i);
+  });
+  for_each_leaving([&](const Index& i) {
+    const std::size_t address = Address(i);
+    cells_[address] = Cell{0, cells_[address].stamp, 0};
+    inflation_[address] = 0;
+  });
   const Index old_origin = origin_;
   origin_ = new_origin;
   // The voxels that entered (in the freed slots, all unknown) get the inflation of the occupied
