@@ -113,26 +113,41 @@ TEST(IndiController, FliesAsTheNominalCascadeBeforeAFailure) {
   }
 }
 
+IndiControllerOptions WithoutIntegral() {
+  IndiControllerOptions o;
+  o.position.ki_position.setZero();
+  return o;
+}
+
+planning::HoverReference HoverAt2m() {
+  planning::HoverOptions ho;
+  ho.position_m = Vector3(0, 0, 2);
+  return planning::HoverReference(ho);
+}
+
+/// At the hover reference on the relaxed hover `h`: primary axis upright, spinning at its rate,
+/// the motors measured at its thrusts.
+StateEstimate AtRelaxedHover(const RelaxedHover& h) {
+  StateEstimate e;
+  e.valid = true;
+  e.p_W = Vector3(0, 0, 2);
+  e.q_WB = Quaternion::FromTwoVectors(h.primary_axis_B, Vector3::UnitZ());
+  e.w_B = h.spin_rate_rad_s * h.primary_axis_B;
+  e.motor_thrust_n = h.thrust_n;
+  return e;
+}
+
 // After a failure: the failed rotor gets nothing, the others stay within their limits, and at the
 // relaxed hover itself (upright primary axis, spinning at r, the measured thrusts the equilibrium's)
 // the command is the equilibrium.
 TEST(IndiController, AtTheRelaxedHoverCommandsTheEquilibrium) {
   const vehicle::MultirotorModel model(ReferenceQuad());
   for (int failed = 0; failed < 4; ++failed) {
-    IndiControllerOptions o;
-    o.position.ki_position.setZero();
-    IndiController indi(model, o);
+    IndiController indi(model, WithoutIntegral());
     indi.SetRotorFailed(failed);
     const RelaxedHover& h = *indi.relaxed_hover();
-    planning::HoverOptions ho;
-    ho.position_m = Vector3(0, 0, 2);
-    const planning::HoverReference ref(ho);
-    StateEstimate e;
-    e.valid = true;
-    e.p_W = Vector3(0, 0, 2);
-    e.q_WB = Quaternion::FromTwoVectors(h.primary_axis_B, Vector3::UnitZ());
-    e.w_B = h.spin_rate_rad_s * h.primary_axis_B;
-    e.motor_thrust_n = h.thrust_n;
+    const planning::HoverReference ref = HoverAt2m();
+    StateEstimate e = AtRelaxedHover(h);
     e.motor_thrust_n[failed] = 2.0;  // a lost propeller's motor still reports thrust: ignored
     RotorVector u;
     for (int k = 0; k < 50; ++k) indi.Compute(e, ref, 0.005 * k, 0.005, &u);  // filters settle
@@ -148,22 +163,15 @@ TEST(IndiController, CommandedTorquesGiveTheAskedReducedAttitudeAcceleration) {
   const vehicle::MultirotorModel model(ReferenceQuad());
   const Matrix3& I = model.params().inertia_kg_m2;
   for (int failed : {0, 3}) {
-    IndiControllerOptions o;
-    o.position.ki_position.setZero();
+    const IndiControllerOptions o = WithoutIntegral();
     IndiController indi(model, o);
     indi.SetRotorFailed(failed);
     const RelaxedHover& eq = *indi.relaxed_hover();
-    planning::HoverOptions ho;
-    ho.position_m = Vector3(0, 0, 2);
-    const planning::HoverReference ref(ho);
-    StateEstimate e;
-    e.valid = true;
-    e.p_W = Vector3(0, 0, 2);
-    const Quaternion upright = Quaternion::FromTwoVectors(eq.primary_axis_B, Vector3::UnitZ());
-    e.q_WB = Quaternion(Eigen::AngleAxisd(0.01, Vector3(1, 1, 0).normalized())) * upright;
+    const planning::HoverReference ref = HoverAt2m();
+    StateEstimate e = AtRelaxedHover(eq);
+    e.q_WB = Quaternion(Eigen::AngleAxisd(0.01, Vector3(1, 1, 0).normalized())) * e.q_WB;
     // Spinning a little faster than the equilibrium: the target axis is n_B itself.
     e.w_B = 1.05 * eq.spin_rate_rad_s * eq.primary_axis_B + Vector3(0.05, -0.03, 0.0);
-    e.motor_thrust_n = eq.thrust_n;
     RotorVector u;
     for (int k = 0; k < 60; ++k) indi.Compute(e, ref, 0.005 * k, 0.005, &u);  // constant rate: alpha_f = 0
     for (int i = 0; i < 4; ++i) {
