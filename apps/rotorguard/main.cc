@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -92,6 +93,16 @@ class ProgressBar {
   bool enabled_;
   double duration_s_;
 };
+
+/// "\r<what> done / total" on a terminal's stderr, for benchmarks that report whole units of work.
+std::function<void(int, int)> CountProgress(const char* what) {
+  const bool tty = ::isatty(STDERR_FILENO);
+  return [tty, what](int done, int total) {
+    if (!tty) return;
+    std::fprintf(stderr, "\r%s %d / %d", what, done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+  };
+}
 
 void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out_dir) {
   std::string faults;
@@ -326,11 +337,7 @@ int main(int argc, char** argv) {
         fs::create_directories(ftc_out, ec);
         if (ec || !fs::is_directory(ftc_out)) throw UsageError(fmt::format("--out: cannot create folder '{}'", ftc_out));
       }
-      const bool tty = ::isatty(STDERR_FILENO);
-      o.progress = [tty](int done, int total) {
-        if (tty) std::fprintf(stderr, "\rtrials %d / %d", done, total);
-        if (tty && done == total) std::fprintf(stderr, "\n");
-      };
+      o.progress = CountProgress("trials");
       const nlohmann::json r = rotorguard::bench::RunFtcBenchmark(o);
       const std::string md = rotorguard::bench::FtcMarkdown(r);
       if (!ftc_out.empty()) {
@@ -344,11 +351,7 @@ int main(int argc, char** argv) {
       rotorguard::bench::PerceptionBenchOptions o;
       o.duration_s = ParseFinite("--duration", perception_duration_text, 1e-3, 600.0);
       o.seed = ParseUnsigned("--seed", perception_seed_text, 0, UINT64_MAX);
-      const bool tty = ::isatty(STDERR_FILENO);
-      o.progress = [tty](int done, int total) {
-        if (tty) std::fprintf(stderr, "\rruns %d / %d", done, total);
-        if (tty && done == total) std::fprintf(stderr, "\n");
-      };
+      o.progress = CountProgress("runs");
       const nlohmann::json r = rotorguard::bench::RunPerceptionBenchmark(o);
       fmt::print("{}", perception_json ? r.dump(2) + "\n" : rotorguard::bench::PerceptionMarkdown(r));
       return kOk;

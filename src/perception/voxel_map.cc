@@ -173,16 +173,6 @@ void VoxelMap::Inflate(const Index& i, int delta) {
   }
 }
 
-void VoxelMap::ClearVoxel(const Index& i) {
-  Cell& c = cells_[Address(i)];
-  if (Occupied(c)) {
-    --occupied_count_;
-    Inflate(i, -1);
-  }
-  c.log_odds = 0;
-  c.known = 0;
-}
-
 void VoxelMap::Recenter(const Vector3& center_W) {
   if (!center_W.allFinite()) return;
   const Index new_origin = ToIndex(center_W) - size_ / 2;
@@ -215,9 +205,12 @@ void VoxelMap::Recenter(const Vector3& center_W) {
       }
     }
   };
-  // Forget them (their inflation of the voxels that stay goes too), then free their slots.
+  // Forget them (the occupied ones' inflation of the voxels that stay goes too), then free their
+  // slots.
   for_each_leaving([&](const Index& i) {
-    if (Occupied(cells_[Address(i)])) ClearVoxel(i);
+    if (!Occupied(cells_[Address(i)])) return;
+    --occupied_count_;
+    Inflate(i, -1);
   });
   for_each_leaving([&](const Index& i) {
     const std::size_t address = Address(i);

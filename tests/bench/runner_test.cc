@@ -57,12 +57,6 @@ TEST(Runner, NominalControllerCrashesAfterAMotorStop) {
   EXPECT_GT(r.sim_time_s, 2.0);  // it was flying until the failure
 }
 
-}  // namespace
-}  // namespace rotorguard::bench
-
-namespace rotorguard::bench {
-namespace {
-
 // Closed-loop NMPC flights (paper 000, Sec. VI-A/B), the failure handed to the controller.
 
 TEST(NmpcClosedLoop, HoversAndTracksTheNominal2msLemniscate) {
@@ -91,12 +85,6 @@ TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {
   EXPECT_LE(r.tracking_rmse_m, 0.15);  // paper 000's hardware: 0.14-0.15 m
   EXPECT_GT(r.max_spin_rad_s, 9.0);
 }
-
-}  // namespace
-}  // namespace rotorguard::bench
-
-namespace rotorguard::bench {
-namespace {
 
 // Composite FDD + NMPC in closed loop: the stack discovers the failure from its sensors.
 
@@ -138,24 +126,12 @@ TEST(FddClosedLoop, AFaultDuringTakeoffOnEachRotorEndsInAStableHover) {
   }
 }
 
-}  // namespace
-}  // namespace rotorguard::bench
-
-namespace rotorguard::bench {
-namespace {
-
 TEST(PassiveClosedLoop, TracksTheNominalLemniscateWithYawLeftFree) {
   const RunSummary r = RunScenario(
       LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "passive"}, {"duration_s", "20"}}));
   EXPECT_TRUE(r.success) << r.failure_reason;
   EXPECT_LT(r.tracking_rmse_m, 0.10);
 }
-
-}  // namespace
-}  // namespace rotorguard::bench
-
-namespace rotorguard::bench {
-namespace {
 
 // The INDI baseline, driven by the composite FDD's isolation, keeps a hover through either fault
 // kind on every rotor (the reconfiguration path through the stack for the second FTC controller).
@@ -174,19 +150,13 @@ TEST(IndiClosedLoop, KeepsHoveringAfterEitherFaultOnEveryRotor) {
   }
 }
 
-}  // namespace
-}  // namespace rotorguard::bench
-
-namespace rotorguard::bench {
-namespace {
-
 // The whole LiDAR path in the loop: a vehicle spinning at about 11 rad/s after a propeller loss
 // maps the room's walls, ground and pillar from deskewed frames; without deskewing the same frames
 // smear into free space.
 TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
   double precision[2] = {0.0, 0.0};
+  const Scenario s = LoadScenario(Config("room_lidar_propeller_loss.yaml"));
   for (int deskew = 0; deskew < 2; ++deskew) {
-    const Scenario s = LoadScenario(Config("room_lidar_propeller_loss.yaml"));
     Scenario variant = s;
     variant.stack.lidar.deskew_frames = deskew == 1;
     RunOptions o;

@@ -115,7 +115,6 @@ class VoxelMap {
   static constexpr double kLogOddsScale = 1000.0;
   bool Occupied(const Cell& c) const { return c.log_odds > occupied_q_; }
   void Inflate(const Index& i, int delta);
-  void ClearVoxel(const Index& i);
   /// A hit or a miss: the voxel is known and its log-odds move by the step (fixed point),
   /// clamped; the occupied count and the inflation layer follow a change of state.
   void Observe(std::size_t address, int log_odds_step) {
