@@ -41,6 +41,15 @@ Vector3 OptionalVector3(const ConfigNode& map, std::string_view key, const Vecto
   return n ? n->AsVector3() : fallback;
 }
 
+/// Overwrites *value with the key's value when the key is present (the field's default stays
+/// otherwise).
+void ReadOptional(const ConfigNode& map, std::string_view key, double* value) {
+  *value = OptionalDouble(map, key, *value);
+}
+void ReadOptional(const ConfigNode& map, std::string_view key, Vector3* value) {
+  *value = OptionalVector3(map, key, *value);
+}
+
 // ---------------------------------------------------------------- vehicle
 
 vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
@@ -203,7 +212,7 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       planning::TakeoffOptions o;
       o.start_m = s.initial_position_m;
       o.altitude_m = node.Required("altitude_m").AsDouble();
-      o.max_speed_m_s = OptionalDouble(node, "max_speed_m_s", o.max_speed_m_s);
+      ReadOptional(node, "max_speed_m_s", &o.max_speed_m_s);
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::TakeoffReference>(o);
     } else if (*type == "lemniscate") {
@@ -214,7 +223,7 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       o.size_y_m = size.y();
       o.size_z_m = size.z();
       o.max_speed_m_s = node.Required("max_speed_m_s").AsDouble();
-      o.ramp_s = OptionalDouble(node, "ramp_s", o.ramp_s);
+      ReadOptional(node, "ramp_s", &o.ramp_s);
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::LemniscateReference>(o);
     } else if (*type == "circle") {
@@ -222,7 +231,7 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       o.center_m = node.Required("center_m").AsVector3();
       o.radius_m = node.Required("radius_m").AsDouble();
       o.speed_m_s = node.Required("speed_m_s").AsDouble();
-      o.ramp_s = OptionalDouble(node, "ramp_s", o.ramp_s);
+      ReadOptional(node, "ramp_s", &o.ramp_s);
       if (const auto cw = node.Optional("clockwise")) o.clockwise = cw->AsBool();
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::CircleReference>(o);
@@ -233,8 +242,8 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       if (!wps.IsSequence() || wps.size() == 0) wps.Fail("expected a non-empty list of [x, y, z] points");
       for (std::size_t k = 0; k < wps.size(); ++k) o.waypoints_m.push_back(wps.At(k).AsVector3());
       o.max_speed_m_s = node.Required("max_speed_m_s").AsDouble();
-      o.max_accel_m_s2 = OptionalDouble(node, "max_accel_m_s2", o.max_accel_m_s2);
-      o.dwell_s = OptionalDouble(node, "dwell_s", o.dwell_s);
+      ReadOptional(node, "max_accel_m_s2", &o.max_accel_m_s2);
+      ReadOptional(node, "dwell_s", &o.dwell_s);
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::WaypointReference>(o);
     }
@@ -290,47 +299,47 @@ sim::FaultSpec ParseFault(const ConfigNode& f) {
 void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
   if (const auto imu = node.Optional("imu")) {
     sim::ImuOptions& i = o->imu;
-    i.rate_hz = OptionalDouble(*imu, "rate_hz", i.rate_hz);
-    i.position_m = OptionalVector3(*imu, "position_m", i.position_m);
-    i.accel_noise_density = OptionalDouble(*imu, "accel_noise_density", i.accel_noise_density);
-    i.gyro_noise_density = OptionalDouble(*imu, "gyro_noise_density", i.gyro_noise_density);
-    i.accel_bias_random_walk = OptionalDouble(*imu, "accel_bias_random_walk", i.accel_bias_random_walk);
-    i.gyro_bias_random_walk = OptionalDouble(*imu, "gyro_bias_random_walk", i.gyro_bias_random_walk);
-    i.accel_bias_initial = OptionalDouble(*imu, "accel_bias_initial", i.accel_bias_initial);
-    i.gyro_bias_initial = OptionalDouble(*imu, "gyro_bias_initial", i.gyro_bias_initial);
+    ReadOptional(*imu, "rate_hz", &i.rate_hz);
+    ReadOptional(*imu, "position_m", &i.position_m);
+    ReadOptional(*imu, "accel_noise_density", &i.accel_noise_density);
+    ReadOptional(*imu, "gyro_noise_density", &i.gyro_noise_density);
+    ReadOptional(*imu, "accel_bias_random_walk", &i.accel_bias_random_walk);
+    ReadOptional(*imu, "gyro_bias_random_walk", &i.gyro_bias_random_walk);
+    ReadOptional(*imu, "accel_bias_initial", &i.accel_bias_initial);
+    ReadOptional(*imu, "gyro_bias_initial", &i.gyro_bias_initial);
     imu->RejectUnknownKeys();
   }
   if (const auto esc = node.Optional("esc")) {
     sim::EscOptions& e = o->esc;
-    e.rate_hz = OptionalDouble(*esc, "rate_hz", e.rate_hz);
-    e.noise_rpm = OptionalDouble(*esc, "noise_rpm", e.noise_rpm);
-    e.quantization_rpm = OptionalDouble(*esc, "quantization_rpm", e.quantization_rpm);
-    e.delay_s = OptionalDouble(*esc, "delay_s", e.delay_s);
+    ReadOptional(*esc, "rate_hz", &e.rate_hz);
+    ReadOptional(*esc, "noise_rpm", &e.noise_rpm);
+    ReadOptional(*esc, "quantization_rpm", &e.quantization_rpm);
+    ReadOptional(*esc, "delay_s", &e.delay_s);
     esc->RejectUnknownKeys();
   }
   if (const auto odom = node.Optional("odometry")) {
     sim::OdometryOptions& d = o->odometry;
-    d.rate_hz = OptionalDouble(*odom, "rate_hz", d.rate_hz);
-    d.position_noise_m = OptionalDouble(*odom, "position_noise_m", d.position_noise_m);
-    d.velocity_noise_m_s = OptionalDouble(*odom, "velocity_noise_m_s", d.velocity_noise_m_s);
-    d.attitude_noise_rad = OptionalDouble(*odom, "attitude_noise_rad", d.attitude_noise_rad);
-    d.rate_noise_gain = OptionalDouble(*odom, "rate_noise_gain", d.rate_noise_gain);
+    ReadOptional(*odom, "rate_hz", &d.rate_hz);
+    ReadOptional(*odom, "position_noise_m", &d.position_noise_m);
+    ReadOptional(*odom, "velocity_noise_m_s", &d.velocity_noise_m_s);
+    ReadOptional(*odom, "attitude_noise_rad", &d.attitude_noise_rad);
+    ReadOptional(*odom, "rate_noise_gain", &d.rate_noise_gain);
     odom->RejectUnknownKeys();
   }
   if (const auto lidar = node.Optional("lidar")) {
     sim::LidarOptions& l = o->lidar;
     l.enabled = true;  // a lidar block switches the sensor on unless it says otherwise
     if (const auto e = lidar->Optional("enabled")) l.enabled = e->AsBool();
-    l.frame_rate_hz = OptionalDouble(*lidar, "frame_rate_hz", l.frame_rate_hz);
-    l.points_per_s = OptionalDouble(*lidar, "points_per_s", l.points_per_s);
-    l.min_range_m = OptionalDouble(*lidar, "min_range_m", l.min_range_m);
-    l.max_range_m = OptionalDouble(*lidar, "max_range_m", l.max_range_m);
-    l.min_elevation_rad = OptionalDouble(*lidar, "min_elevation_rad", l.min_elevation_rad);
-    l.max_elevation_rad = OptionalDouble(*lidar, "max_elevation_rad", l.max_elevation_rad);
-    l.range_noise_m = OptionalDouble(*lidar, "range_noise_m", l.range_noise_m);
-    l.dropout_probability = OptionalDouble(*lidar, "dropout_probability", l.dropout_probability);
-    l.position_m = OptionalVector3(*lidar, "position_m", l.position_m);
-    l.grid_cell_m = OptionalDouble(*lidar, "grid_cell_m", l.grid_cell_m);
+    ReadOptional(*lidar, "frame_rate_hz", &l.frame_rate_hz);
+    ReadOptional(*lidar, "points_per_s", &l.points_per_s);
+    ReadOptional(*lidar, "min_range_m", &l.min_range_m);
+    ReadOptional(*lidar, "max_range_m", &l.max_range_m);
+    ReadOptional(*lidar, "min_elevation_rad", &l.min_elevation_rad);
+    ReadOptional(*lidar, "max_elevation_rad", &l.max_elevation_rad);
+    ReadOptional(*lidar, "range_noise_m", &l.range_noise_m);
+    ReadOptional(*lidar, "dropout_probability", &l.dropout_probability);
+    ReadOptional(*lidar, "position_m", &l.position_m);
+    ReadOptional(*lidar, "grid_cell_m", &l.grid_cell_m);
     lidar->RejectUnknownKeys();
   }
   node.RejectUnknownKeys();
@@ -338,59 +347,59 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
 
 /// The outer-loop gains shared by the cascaded controllers' blocks (stack.nominal, stack.passive).
 void ParsePositionLoop(const ConfigNode& n, control::PositionLoopOptions* p) {
-  p->kp_position = OptionalVector3(n, "kp_position", p->kp_position);
-  p->kd_velocity = OptionalVector3(n, "kd_velocity", p->kd_velocity);
-  p->ki_position = OptionalVector3(n, "ki_position", p->ki_position);
-  p->integral_limit_m_s2 = OptionalDouble(n, "integral_limit_m_s2", p->integral_limit_m_s2);
-  p->max_tilt_rad = OptionalDouble(n, "max_tilt_rad", p->max_tilt_rad);
+  ReadOptional(n, "kp_position", &p->kp_position);
+  ReadOptional(n, "kd_velocity", &p->kd_velocity);
+  ReadOptional(n, "ki_position", &p->ki_position);
+  ReadOptional(n, "integral_limit_m_s2", &p->integral_limit_m_s2);
+  ReadOptional(n, "max_tilt_rad", &p->max_tilt_rad);
 }
 
 void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
   if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive", "indi"});
-  o->control_rate_hz = OptionalDouble(node, "control_rate_hz", o->control_rate_hz);
+  ReadOptional(node, "control_rate_hz", &o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;
     ParsePositionLoop(*n, &g.position);
-    g.k_attitude = OptionalVector3(*n, "k_attitude", g.k_attitude);
-    g.k_rate = OptionalVector3(*n, "k_rate", g.k_rate);
-    g.max_rate_rad_s = OptionalDouble(*n, "max_rate_rad_s", g.max_rate_rad_s);
+    ReadOptional(*n, "k_attitude", &g.k_attitude);
+    ReadOptional(*n, "k_rate", &g.k_rate);
+    ReadOptional(*n, "max_rate_rad_s", &g.max_rate_rad_s);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { g.Validate(); });
   }
   if (const auto n = node.Optional("passive")) {
     control::PassiveControllerOptions& g = o->passive;
     ParsePositionLoop(*n, &g.position);
-    g.k_tilt = OptionalDouble(*n, "k_tilt", g.k_tilt);
-    g.k_rate = OptionalDouble(*n, "k_rate", g.k_rate);
-    g.regularisation = OptionalDouble(*n, "regularisation", g.regularisation);
+    ReadOptional(*n, "k_tilt", &g.k_tilt);
+    ReadOptional(*n, "k_rate", &g.k_rate);
+    ReadOptional(*n, "regularisation", &g.regularisation);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { g.Validate(); });
   }
   if (const auto n = node.Optional("indi")) {
     control::IndiControllerOptions& g = o->indi;
     ParsePositionLoop(*n, &g.position);
-    g.k_h = OptionalDouble(*n, "k_h", g.k_h);
-    g.d_h = OptionalDouble(*n, "d_h", g.d_h);
-    g.opposite_ratio = OptionalDouble(*n, "opposite_ratio", g.opposite_ratio);
-    g.filter_cutoff_hz = OptionalDouble(*n, "filter_cutoff_hz", g.filter_cutoff_hz);
+    ReadOptional(*n, "k_h", &g.k_h);
+    ReadOptional(*n, "d_h", &g.d_h);
+    ReadOptional(*n, "opposite_ratio", &g.opposite_ratio);
+    ReadOptional(*n, "filter_cutoff_hz", &g.filter_cutoff_hz);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { stack::IndiOptionsInStack(*o).Validate(); });
   }
   if (const auto n = node.Optional("nmpc")) {
     control::NmpcOptions& m = o->nmpc;
     if (const auto v = n->Optional("horizon_steps")) m.horizon_steps = static_cast<int>(v->AsIntIn(1, 200));
-    m.step_s = OptionalDouble(*n, "step_s", m.step_s);
+    ReadOptional(*n, "step_s", &m.step_s);
     if (const auto v = n->Optional("integrator_substeps")) m.integrator_substeps = static_cast<int>(v->AsIntIn(1, 20));
-    m.q_position = OptionalVector3(*n, "q_position", m.q_position);
+    ReadOptional(*n, "q_position", &m.q_position);
     if (const auto v = n->Optional("q_attitude")) {
       const std::vector<double> qa = v->AsDoubleList(4);
       m.q_attitude = Eigen::Vector4d(qa[0], qa[1], qa[2], qa[3]);
     }
-    m.q_velocity = OptionalVector3(*n, "q_velocity", m.q_velocity);
-    m.q_rate = OptionalVector3(*n, "q_rate", m.q_rate);
-    m.q_thrust = OptionalDouble(*n, "q_thrust", m.q_thrust);
-    m.r_input = OptionalDouble(*n, "r_input", m.r_input);
-    m.max_rate_rad_s = OptionalVector3(*n, "max_rate_rad_s", m.max_rate_rad_s);
+    ReadOptional(*n, "q_velocity", &m.q_velocity);
+    ReadOptional(*n, "q_rate", &m.q_rate);
+    ReadOptional(*n, "q_thrust", &m.q_thrust);
+    ReadOptional(*n, "r_input", &m.r_input);
+    ReadOptional(*n, "max_rate_rad_s", &m.max_rate_rad_s);
     if (const auto v = n->Optional("max_sqp_iterations")) m.max_sqp_iterations = static_cast<int>(v->AsIntIn(1, 1000));
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { m.Validate(); });
@@ -398,19 +407,18 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
   if (const auto f = node.Optional("fdd")) o->fdd = f->AsEnum({"none", "composite", "fixedtime"});
   if (const auto c = node.Optional("composite_fdd")) {
     fdd::CompositeFddOptions& d = o->composite_fdd;
-    d.motor_index_threshold = OptionalDouble(*c, "motor_index_threshold", d.motor_index_threshold);
+    ReadOptional(*c, "motor_index_threshold", &d.motor_index_threshold);
     if (const auto v = c->Optional("motor_index_samples")) d.motor_index_samples = static_cast<int>(v->AsIntIn(1, 1000));
-    d.motor_index_min_thrust_n = OptionalDouble(*c, "motor_index_min_thrust_n", d.motor_index_min_thrust_n);
-    d.propeller_index_threshold = OptionalDouble(*c, "propeller_index_threshold", d.propeller_index_threshold);
-    d.propeller_persistence_s = OptionalDouble(*c, "propeller_persistence_s", d.propeller_persistence_s);
-    d.degraded_threshold = OptionalDouble(*c, "degraded_threshold", d.degraded_threshold);
-    d.degraded_persistence_s = OptionalDouble(*c, "degraded_persistence_s", d.degraded_persistence_s);
-    d.filter_cutoff_hz = OptionalDouble(*c, "filter_cutoff_hz", d.filter_cutoff_hz);
-    d.takeoff_max_altitude_m = OptionalDouble(*c, "takeoff_max_altitude_m", d.takeoff_max_altitude_m);
-    d.takeoff_window_s = OptionalDouble(*c, "takeoff_window_s", d.takeoff_window_s);
-    d.takeoff_angular_acceleration_rad_s2 =
-        OptionalDouble(*c, "takeoff_angular_acceleration_rad_s2", d.takeoff_angular_acceleration_rad_s2);
-    d.takeoff_direction_cosine = OptionalDouble(*c, "takeoff_direction_cosine", d.takeoff_direction_cosine);
+    ReadOptional(*c, "motor_index_min_thrust_n", &d.motor_index_min_thrust_n);
+    ReadOptional(*c, "propeller_index_threshold", &d.propeller_index_threshold);
+    ReadOptional(*c, "propeller_persistence_s", &d.propeller_persistence_s);
+    ReadOptional(*c, "degraded_threshold", &d.degraded_threshold);
+    ReadOptional(*c, "degraded_persistence_s", &d.degraded_persistence_s);
+    ReadOptional(*c, "filter_cutoff_hz", &d.filter_cutoff_hz);
+    ReadOptional(*c, "takeoff_max_altitude_m", &d.takeoff_max_altitude_m);
+    ReadOptional(*c, "takeoff_window_s", &d.takeoff_window_s);
+    ReadOptional(*c, "takeoff_angular_acceleration_rad_s2", &d.takeoff_angular_acceleration_rad_s2);
+    ReadOptional(*c, "takeoff_direction_cosine", &d.takeoff_direction_cosine);
     c->RejectUnknownKeys();
   }
   if (const auto d = node.Optional("deskew_frames")) o->lidar.deskew_frames = d->AsBool();
@@ -418,14 +426,14 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     // The inflation radius is the vehicle's collision radius and the deskew lever arm the LiDAR's
     // mounting point (FitStackToHardware): neither is a key here.
     perception::VoxelMapOptions& m = o->lidar.map;
-    m.resolution_m = OptionalDouble(*n, "resolution_m", m.resolution_m);
-    m.window_size_m = OptionalVector3(*n, "window_size_m", m.window_size_m);
-    m.log_odds_hit = OptionalDouble(*n, "log_odds_hit", m.log_odds_hit);
-    m.log_odds_miss = OptionalDouble(*n, "log_odds_miss", m.log_odds_miss);
-    m.log_odds_min = OptionalDouble(*n, "log_odds_min", m.log_odds_min);
-    m.log_odds_max = OptionalDouble(*n, "log_odds_max", m.log_odds_max);
-    m.occupied_threshold = OptionalDouble(*n, "occupied_threshold", m.occupied_threshold);
-    m.max_clearing_range_m = OptionalDouble(*n, "max_clearing_range_m", m.max_clearing_range_m);
+    ReadOptional(*n, "resolution_m", &m.resolution_m);
+    ReadOptional(*n, "window_size_m", &m.window_size_m);
+    ReadOptional(*n, "log_odds_hit", &m.log_odds_hit);
+    ReadOptional(*n, "log_odds_miss", &m.log_odds_miss);
+    ReadOptional(*n, "log_odds_min", &m.log_odds_min);
+    ReadOptional(*n, "log_odds_max", &m.log_odds_max);
+    ReadOptional(*n, "occupied_threshold", &m.occupied_threshold);
+    ReadOptional(*n, "max_clearing_range_m", &m.max_clearing_range_m);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { m.Validate(); });
   }
@@ -520,7 +528,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   if (const auto seed = root.Optional("seed")) s.seed = seed->AsUint64();
 
   if (const auto initial = root.Optional("initial")) {
-    s.initial_position_m = OptionalVector3(*initial, "position_m", s.initial_position_m);
+    ReadOptional(*initial, "position_m", &s.initial_position_m);
     s.initial_yaw_rad = OptionalDouble(*initial, "yaw_rad", 0.0);
     if (s.initial_position_m.z() < 0.0) initial->FailAt("position_m", "the start must be at or above the ground (z >= 0)");
     initial->RejectUnknownKeys();
@@ -529,10 +537,10 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
 
   // Simulation settings first: sensor rates are checked against the physics rate.
   if (const auto simn = root.Optional("sim")) {
-    s.sim.physics_rate_hz = OptionalDouble(*simn, "physics_rate_hz", s.sim.physics_rate_hz);
-    s.log_rate_hz = OptionalDouble(*simn, "log_rate_hz", s.log_rate_hz);
-    s.sim.crash_speed_m_s = OptionalDouble(*simn, "crash_speed_m_s", s.sim.crash_speed_m_s);
-    s.sim.crash_tilt_rad = OptionalDouble(*simn, "crash_tilt_rad", s.sim.crash_tilt_rad);
+    ReadOptional(*simn, "physics_rate_hz", &s.sim.physics_rate_hz);
+    ReadOptional(*simn, "log_rate_hz", &s.log_rate_hz);
+    ReadOptional(*simn, "crash_speed_m_s", &s.sim.crash_speed_m_s);
+    ReadOptional(*simn, "crash_tilt_rad", &s.sim.crash_tilt_rad);
     simn->RejectUnknownKeys();
     if (s.log_rate_hz <= 0.0 || s.log_rate_hz > s.sim.physics_rate_hz) {
       simn->FailAt("log_rate_hz", fmt::format("log_rate_hz = {} is invalid; expected a rate in (0, {}] Hz "
@@ -541,9 +549,9 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   }
   if (const auto sensors = root.Optional("sensors")) ParseSensors(*sensors, &s.sim);
   if (const auto wind = root.Optional("wind")) {
-    s.sim.wind.mean_m_s = OptionalVector3(*wind, "mean_m_s", s.sim.wind.mean_m_s);
-    s.sim.wind.gust_std_m_s = OptionalDouble(*wind, "gust_std_m_s", s.sim.wind.gust_std_m_s);
-    s.sim.wind.gust_time_constant_s = OptionalDouble(*wind, "gust_time_constant_s", s.sim.wind.gust_time_constant_s);
+    ReadOptional(*wind, "mean_m_s", &s.sim.wind.mean_m_s);
+    ReadOptional(*wind, "gust_std_m_s", &s.sim.wind.gust_std_m_s);
+    ReadOptional(*wind, "gust_time_constant_s", &s.sim.wind.gust_time_constant_s);
     wind->RejectUnknownKeys();
   }
   // Field names are scenario key paths ("sensors.esc.rate_hz"): defaults that clash are reported
