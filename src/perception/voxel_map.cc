@@ -49,6 +49,9 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
     while (size_[k] < needed) size_[k] *= 2;
   }
   origin_ = -size_ / 2;
+  for (int k = 0; k < 3; ++k) pack_mask_ |= static_cast<std::uint64_t>(size_[k] - 1) << (kPackShift * k);
+  while ((8 << brick_shift_y_) < size_.y()) ++brick_shift_y_;
+  while ((8 << brick_shift_z_) < size_.z()) ++brick_shift_z_;
   const std::size_t n = static_cast<std::size_t>(size_.x()) * size_.y() * size_.z();
   const auto fixed = [](double v) { return static_cast<int>(std::lround(v * kLogOddsScale)); };
   hit_q_ = fixed(options_.log_odds_hit);
@@ -98,61 +101,55 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
   }
   if (s_in > s_out) return;
   const Vector3 start = a + s_in * d, stop = a + s_out * d;
-  // Plain local scalars: the loop runs half a million times per frame, and members or arrays
-  // indexed by the stepping axis would go through memory on every step.
-  int i[3], w[3], st[3], max_steps = 1;
+  int i[3], max_steps = 1;
   double t_max[3], t_delta[3];
+  std::uint64_t packed = 0, step[3];
   for (int k = 0; k < 3; ++k) {
     const int lo = origin_[k], hi = origin_[k] + size_[k] - 1;
     i[k] = std::clamp(static_cast<int>(std::floor(start[k])), lo, hi);
     max_steps += std::abs(std::clamp(static_cast<int>(std::floor(stop[k])), lo, hi) - i[k]);
-    st[k] = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
-    if (st[k] == 0) {
+    const int st = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
+    if (st == 0) {
       t_max[k] = t_delta[k] = std::numeric_limits<double>::infinity();
     } else {
       // Parameter (in units of the whole segment) of the next voxel boundary along k.
-      const double boundary = st[k] > 0 ? i[k] + 1.0 : static_cast<double>(i[k]);
+      const double boundary = st > 0 ? i[k] + 1.0 : static_cast<double>(i[k]);
       t_max[k] = (boundary - a[k]) / d[k];
       t_delta[k] = 1.0 / std::abs(d[k]);
     }
-    w[k] = PositiveMod(i[k], size_[k]);
+    packed |= static_cast<std::uint64_t>(PositiveMod(i[k], size_[k])) << (kPackShift * k);
+    // A step of -1 adds size - 1: the field's mask below then wraps it.
+    step[k] = static_cast<std::uint64_t>(st >= 0 ? 1 : size_[k] - 1) << (kPackShift * k);
   }
   // The boundary parameters in fixed point (2^-32 of the segment): integer min and compare have
   // a shorter latency than double, and the step's dependency chain runs through them. Beyond the
   // segment's end (> 1) only the order matters, so larger values are capped to stay in range.
+  // Each of the n steps adds a truncation error below one unit, so the end is moved in by
+  // max_steps + 2 units: a boundary at or beyond the clipped end (the window's face) then always
+  // compares beyond it, and no step leaves the window, without a per-step bound check.
   const auto fixed = [](double t) { return static_cast<std::int64_t>(std::min(t, 4.0) * 4294967296.0); };
   std::int64_t tx = fixed(t_max[0]), ty = fixed(t_max[1]), tz = fixed(t_max[2]);
-  const std::int64_t dx = fixed(t_delta[0]), dy = fixed(t_delta[1]), dz = fixed(t_delta[2]), t_end = fixed(s_out);
-  int wx = w[0], wy = w[1], wz = w[2];
-  const int sx = st[0], sy = st[1], sz = st[2];
-  const int mx = size_.x() - 1, my = size_.y() - 1, mz = size_.z() - 1;
-  const std::size_t bricks_y = static_cast<std::size_t>(size_.y() >> 3), bricks_z = static_cast<std::size_t>(size_.z() >> 3);
-  // Steps left before the walk would leave the window along each axis (the wrapped address
-  // must not cross to the window's other side).
-  int room_x = sx > 0 ? origin_.x() + mx - i[0] : i[0] - origin_.x();
-  int room_y = sy > 0 ? origin_.y() + my - i[1] : i[1] - origin_.y();
-  int room_z = sz > 0 ? origin_.z() + mz - i[2] : i[2] - origin_.z();
-  for (int n = 0;;) {
-    const std::size_t brick = (static_cast<std::size_t>(wx >> 3) * bricks_y + static_cast<std::size_t>(wy >> 3)) *
-                                  bricks_z + static_cast<std::size_t>(wz >> 3);
-    if (!visit(brick * 512 + static_cast<std::size_t>(((wx & 7) << 6) | ((wy & 7) << 3) | (wz & 7)))) return;
-    if (++n == max_steps) return;  // one voxel boundary per step
-    // The axis whose boundary comes first, chosen without branches: which way a ray turns next
-    // is what a branch predictor cannot guess.
-    // (Bitwise & on the comparisons: && would compile to the branches this avoids.)
-    const std::int64_t t_next = std::min(tx, std::min(ty, tz));
-    if (t_next > t_end) return;  // past the clipped segment's end (rounding)
-    const bool step_x = tx == t_next, step_y = !step_x & (ty == t_next), step_z = !step_x & !step_y;
-    room_x -= step_x;
-    room_y -= step_y;
-    room_z -= step_z;
-    if ((room_x | room_y | room_z) < 0) return;
-    wx = (wx + (step_x ? sx : 0)) & mx;
-    wy = (wy + (step_y ? sy : 0)) & my;
-    wz = (wz + (step_z ? sz : 0)) & mz;
-    tx += step_x ? dx : 0;
-    ty += step_y ? dy : 0;
-    tz += step_z ? dz : 0;
+  const std::int64_t dx = fixed(t_delta[0]), dy = fixed(t_delta[1]), dz = fixed(t_delta[2]);
+  const std::int64_t t_end = fixed(s_out) - (max_steps + 2);
+  const std::uint64_t step_x = step[0], step_y = step[1], step_z = step[2], keep = pack_mask_;
+  for (;;) {
+    if (!visit(packed)) return;
+    // The axis whose boundary comes first, chosen without branches (which way a ray turns next is
+    // what a branch predictor cannot guess): all-ones masks from the comparisons, because with
+    // ternaries or && the compiler emits the very branches this avoids.
+    // The comparisons run in parallel, so the chain from one step's t to the next is a compare,
+    // an and and an add; the end test (predicted) is off it.
+    const std::int64_t x_first = -static_cast<std::int64_t>(tx <= ty) & -static_cast<std::int64_t>(tx <= tz);
+    const std::int64_t on_x = x_first;
+    const std::int64_t on_y = ~x_first & -static_cast<std::int64_t>(ty <= tz);
+    const std::int64_t on_z = ~(on_x | on_y);
+    if (std::min(tx, std::min(ty, tz)) > t_end) return;  // past the clipped segment's end
+    packed = (packed + ((step_x & static_cast<std::uint64_t>(on_x)) | (step_y & static_cast<std::uint64_t>(on_y)) |
+                        (step_z & static_cast<std::uint64_t>(on_z)))) &
+             keep;
+    tx += dx & on_x;
+    ty += dy & on_y;
+    tz += dz & on_z;
   }
 }
 
@@ -307,31 +304,38 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   long steps = 0;
   int missed = 0;
   constexpr std::size_t kRaysPerBatch = 64, kPrefetchAhead = 64;
+  Cell* const cells = cells_.data();
+  const int shift_y = brick_shift_y_, shift_z = brick_shift_z_;
   for (std::size_t first = 0; first < rays.size(); first += kRaysPerBatch) {
     // Room for the batch's walks (a walk crosses at most size_.sum() voxels), written through a
     // local pointer: push_back would store and reload the vector's end on every step.
     walk_.resize(kRaysPerBatch * static_cast<std::size_t>(size_.sum()));
-    std::uint32_t* out = walk_.data();
+    addresses_.resize(walk_.size());
+    std::uint64_t* out = walk_.data();
     for (std::size_t r = first; r < std::min(rays.size(), first + kRaysPerBatch); ++r) {
       const Index end_index = ToIndex(rays[r]);
-      const std::size_t end = InWindow(end_index) ? Address(end_index) : cells_.size();
+      const std::uint64_t end = InWindow(end_index) ? Pack(end_index) : ~std::uint64_t{0};
       Vector3 e = rays[r] / res_;
       const double len = (e - o).norm();
       if (len > max_cells) e = o + (e - o) * (max_cells / len);
-      TraverseWindow(o, e, [&](std::size_t address) {
-        *out = static_cast<std::uint32_t>(address);
-        out += address != end;
-        return address != end;
+      TraverseWindow(o, e, [&](std::uint64_t packed) {
+        *out = packed;
+        out += packed != end;
+        return packed != end;
       });
     }
-    const std::size_t walked = static_cast<std::size_t>(out - walk_.data());
+    const std::uint64_t* const walk = walk_.data();
+    const std::size_t walked = static_cast<std::size_t>(out - walk);
     steps += static_cast<long>(walked);
+    std::uint32_t* const addresses = addresses_.data();
+    for (std::size_t k = 0; k < walked; ++k) addresses[k] = AddressOfPacked(walk[k], shift_y, shift_z);
     for (std::size_t k = 0; k < walked; ++k) {
-      if (k + kPrefetchAhead < walked) __builtin_prefetch(&cells_[walk_[k + kPrefetchAhead]], 1);
-      Cell& c = cells_[walk_[k]];
+      if (k + kPrefetchAhead < walked) __builtin_prefetch(cells + addresses[k + kPrefetchAhead], 1);
+      const std::uint32_t address = addresses[k];
+      Cell& c = cells[address];
       if (c.stamp < miss) {
         c.stamp = miss;
-        Observe(walk_[k], miss_q_);
+        Observe(address, miss_q_);
         ++missed;
       }
     }
@@ -375,8 +379,8 @@ std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius
 bool VoxelMap::SegmentCollides(const Vector3& a, const Vector3& b) const {
   if (!a.allFinite() || !b.allFinite()) return true;  // a corrupt query is never declared safe
   bool collides = false;
-  TraverseWindow(a / res_, b / res_, [&](std::size_t address) {
-    if (inflation_[address] > 0) {
+  TraverseWindow(a / res_, b / res_, [&](std::uint64_t packed) {
+    if (inflation_[AddressOfPacked(packed)] > 0) {
       collides = true;
       return false;
     }

@@ -108,6 +108,99 @@ TEST(VoxelMap, NearestObstacleAndSegmentQueries) {
   EXPECT_TRUE(map.SegmentCollides(Vector3(std::nan(""), 0, 0), Vector3(1, 1, 1))) << "a corrupt query is not safe";
 }
 
+// Whether the segment a-b meets the axis-aligned box [lo, hi] (slab clipping, Kay and Kajiya).
+bool SegmentMeetsBox(const Vector3& a, const Vector3& b, const Vector3& lo, const Vector3& hi) {
+  double s0 = 0.0, s1 = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = b[k] - a[k];
+    if (std::abs(d) < 1e-15) {
+      if (a[k] < lo[k] || a[k] > hi[k]) return false;
+      continue;
+    }
+    double u = (lo[k] - a[k]) / d, v = (hi[k] - a[k]) / d;
+    if (u > v) std::swap(u, v);
+    s0 = std::max(s0, u);
+    s1 = std::min(s1, v);
+  }
+  return s0 <= s1;
+}
+
+/// The oracle's verdict on the voxel of centre c: +1 the segment surely crosses it, -1 surely not,
+/// 0 within 1e-6 m of its boundary (either answer is right there).
+int Crosses(const Vector3& a, const Vector3& b, const Vector3& c, double res) {
+  const Vector3 half = Vector3::Constant(0.5 * res), eps = Vector3::Constant(1e-6);
+  if (SegmentMeetsBox(a, b, c - half + eps, c + half - eps)) return 1;
+  return SegmentMeetsBox(a, b, c - half - eps, c + half + eps) ? 0 : -1;
+}
+
+// The ray walk against an exact oracle: one ray into an empty map makes known exactly the voxels
+// its segment crosses (clipped to the window, which sits off the origin so that its ring buffer
+// wraps), for rays that end inside the window and rays that leave it.
+TEST(VoxelMap, ARayMarksExactlyTheVoxelsItsSegmentCrosses) {
+  VoxelMapOptions o;
+  o.window_size_m = Vector3(1.6, 1.6, 0.8);
+  Rng rng(7);
+  int checked = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    VoxelMap map(o);
+    const Vector3 center(0.73, -0.41, 0.26);
+    map.Recenter(center);
+    const Vector3 from = center + Vector3(rng.Uniform(-0.7, 0.7), rng.Uniform(-0.7, 0.7), rng.Uniform(-0.3, 0.3));
+    const Vector3 to = center + Vector3(rng.Uniform(-1.5, 1.5), rng.Uniform(-1.5, 1.5), rng.Uniform(-0.8, 0.8));
+    const Eigen::Vector3f to_f = to.cast<float>();
+    map.Insert(from, {to_f});
+    const Vector3 end = to_f.cast<double>();
+    for (double x = center.x() - 1.0; x < center.x() + 1.0; x += 0.1) {
+      for (double y = center.y() - 1.0; y < center.y() + 1.0; y += 0.1) {
+        for (double z = center.z() - 0.6; z < center.z() + 0.6; z += 0.1) {
+          const Vector3 c = (Vector3(x, y, z) / 0.1).array().floor().matrix() * 0.1 + Vector3::Constant(0.05);
+          if (!map.InWindow(c)) continue;
+          const int verdict = Crosses(from, end, c, 0.1);
+          if (verdict == 0) continue;
+          ++checked;
+          ASSERT_EQ(map.IsKnown(c), verdict > 0) << "trial " << trial << ", voxel at " << c.transpose();
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 300 * 1000);
+}
+
+// The collision query's walk, against the same oracle: segments that start and end anywhere,
+// also outside the window and across its faces, collide exactly when they cross an occupied voxel
+// (no inflation), and never through a voxel on the window's far side (the ring buffer's wrap).
+TEST(VoxelMap, SegmentCollidesExactlyWhenItCrossesAnOccupiedVoxel) {
+  VoxelMapOptions o;
+  o.window_size_m = Vector3(1.6, 1.6, 0.8);
+  o.inflation_radius_m = 0.0;
+  VoxelMap map(o);
+  const Vector3 center(0.73, -0.41, 0.26);
+  map.Recenter(center);
+  // Occupied voxels near the window's faces and corners, and one inside.
+  // (The window spans -0.83..0.77, -0.89..0.71 and -0.46..0.34 m about the centre.)
+  const std::vector<Vector3> targets = {center + Vector3(-0.78, 0.1, 0.0), center + Vector3(0.72, -0.75, 0.3),
+                                        center + Vector3(0.2, 0.68, -0.4), center + Vector3(0.1, 0.1, 0.05)};
+  std::vector<Eigen::Vector3f> points;
+  for (const Vector3& t : targets) points.push_back(t.cast<float>());
+  map.Insert(center, points);
+  ASSERT_EQ(map.occupied_count(), static_cast<int>(targets.size()));
+  std::vector<Vector3> boxes;
+  for (const Vector3& c : map.OccupiedVoxels()) boxes.push_back(c);
+  Rng rng(11);
+  int hits = 0, misses = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Vector3 a = center + Vector3(rng.Uniform(-1.5, 1.5), rng.Uniform(-1.5, 1.5), rng.Uniform(-0.8, 0.8));
+    const Vector3 b = center + Vector3(rng.Uniform(-1.5, 1.5), rng.Uniform(-1.5, 1.5), rng.Uniform(-0.8, 0.8));
+    int verdict = -1;
+    for (const Vector3& c : boxes) verdict = std::max(verdict, Crosses(a, b, c, 0.1));
+    if (verdict == 0) continue;
+    ASSERT_EQ(map.SegmentCollides(a, b), verdict > 0) << "trial " << trial;
+    (verdict > 0 ? hits : misses) += 1;
+  }
+  EXPECT_GT(hits, 200);
+  EXPECT_GT(misses, 10000);
+}
+
 TEST(VoxelMap, NonFiniteAndOutOfWindowPointsAreDroppedAndCountedEmptyFramesAreHarmless) {
   VoxelMap map(Small());
   EXPECT_EQ(map.Insert(Vector3(0, 0, 1), {}).points_used, 0);

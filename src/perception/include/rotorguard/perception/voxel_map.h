@@ -96,6 +96,25 @@ class VoxelMap {
     return WrappedAddress(Index(internal::PositiveMod(i.x(), size_.x()), internal::PositiveMod(i.y(), size_.y()),
                                 internal::PositiveMod(i.z(), size_.z())));
   }
+  /// Wrapped coordinates packed in one word, a 16-bit field per axis (12 used; the gap keeps a
+  /// field's carry from reaching the next before the mask wraps it): what a ray step updates with
+  /// one add and one and, the address following only when a voxel is visited.
+  static constexpr int kPackShift = 16;
+  std::uint64_t Pack(const Index& i) const {
+    return static_cast<std::uint64_t>(internal::PositiveMod(i.x(), size_.x())) |
+           static_cast<std::uint64_t>(internal::PositiveMod(i.y(), size_.y())) << kPackShift |
+           static_cast<std::uint64_t>(internal::PositiveMod(i.z(), size_.z())) << (2 * kPackShift);
+  }
+  std::uint32_t AddressOfPacked(std::uint64_t p) const { return AddressOfPacked(p, brick_shift_y_, brick_shift_z_); }
+  /// WrappedAddress from packed coordinates, with log2 of the bricks along y and z passed in: the
+  /// hot loops keep them in registers (a byte store may alias the members, which the compiler
+  /// would otherwise reload after every stamp written).
+  static std::uint32_t AddressOfPacked(std::uint64_t p, int shift_y, int shift_z) {
+    const auto x = static_cast<std::uint32_t>(p & 0xffff), y = static_cast<std::uint32_t>((p >> kPackShift) & 0xffff),
+               z = static_cast<std::uint32_t>(p >> (2 * kPackShift));
+    const std::uint32_t brick = ((x >> 3) << (shift_y + shift_z)) | ((y >> 3) << shift_z) | (z >> 3);
+    return (brick << 9) | ((x & 7) << 6) | ((y & 7) << 3) | (z & 7);
+  }
   /// The window's voxel stored at this address.
   Index IndexOf(std::size_t address) const;
   /// From coordinates already wrapped into [0, size). Bricks of 8 x 8 x 8 voxels, each contiguous:
@@ -128,8 +147,9 @@ class VoxelMap {
     Inflate(IndexOf(address), now ? 1 : -1);
   }
   /// Visits the window's voxels that the segment a-b (voxel units) crosses, in order (Amanatides
-  /// and Woo 1987), as visit(address) until it returns false. The segment is clipped to
-  /// the window first and the ring-buffer address follows each step, the map's hottest loop.
+  /// and Woo 1987), as visit(packed) until it returns false. The segment is clipped to
+  /// the window first and the packed ring-buffer coordinates follow each step, the map's hottest
+  /// loop.
   template <typename Visit>
   void TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const;
 
@@ -145,7 +165,10 @@ class VoxelMap {
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
   std::vector<Index> touched_hit_;
   std::vector<Vector3> ray_ends_;  // the returns whose rays a frame walks
-  std::vector<std::uint32_t> walk_;  // the addresses of the voxels a batch of rays crosses, in order
+  std::vector<std::uint64_t> walk_;   // the packed voxels a batch of rays crosses, in order
+  std::vector<std::uint32_t> addresses_;  // their addresses
+  std::uint64_t pack_mask_ = 0;       // each packed field's wrap mask (size - 1)
+  int brick_shift_y_ = 0, brick_shift_z_ = 0;  // log2 of the bricks along y and z
   int occupied_count_ = 0;
 };
 
