@@ -434,6 +434,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ReadOptional(*n, "log_odds_max", &m.log_odds_max);
     ReadOptional(*n, "occupied_threshold", &m.occupied_threshold);
     ReadOptional(*n, "max_clearing_range_m", &m.max_clearing_range_m);
+    ReadOptional(*n, "recenter_hysteresis_m", &m.recenter_hysteresis_m);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { m.Validate(); });
   }

@@ -6,6 +6,23 @@
 
 namespace rotorguard {
 
+Matrix3 ExpSO3(const Vector3& theta) {
+  // R = I + a K + b K^2, K = Skew(theta), a = sin|θ| / |θ|, b = (1 - cos|θ|) / |θ|^2; the series
+  // to |θ|^6 leaves terms below 1e-16 for |θ| < 0.05.
+  const double t2 = theta.squaredNorm();
+  double a, b;
+  if (t2 < 0.05 * 0.05) {
+    a = 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0));
+    b = 0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0)));
+  } else {
+    const double angle = std::sqrt(t2);
+    a = std::sin(angle) / angle;
+    b = (1.0 - std::cos(angle)) / t2;
+  }
+  const Matrix3 K = Skew(theta);
+  return Matrix3::Identity() + a * K + b * (K * K);
+}
+
 Matrix3 Skew(const Vector3& a) {
   Matrix3 s;
   s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;

@@ -4,19 +4,9 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
 
 namespace rotorguard::perception {
-
-namespace {
-
-/// Exp of a rotation vector (body frame) as a matrix.
-Matrix3 Exp(const Vector3& theta) {
-  const double angle = theta.norm();
-  if (angle < 1e-12) return Matrix3::Identity();
-  return Eigen::AngleAxisd(angle, theta / angle).toRotationMatrix();
-}
-
-}  // namespace
 
 void DeskewOptions::Validate() const {
   if (!sensor_position_m.allFinite()) {
@@ -70,7 +60,7 @@ DeskewSummary Deskewer::Deskew(const LidarFrame& frame, const Vector3& v_W, cons
   for (TimeNs t : times) {
     const Knot& later = knots.back();
     const Vector3 w = rate_before(t);  // the rate over [t, later.t)
-    knots.push_back({t, later.R_end_from_t * Exp(-w * ToSeconds(later.t - t)), w});
+    knots.push_back({t, later.R_end_from_t * ExpSO3(-w * ToSeconds(later.t - t)), w});
   }
   const Matrix3 R_end_T = q_WB_end.normalized().toRotationMatrix().transpose();
   const Vector3 v_end_B = R_end_T * v_W;
@@ -86,7 +76,7 @@ DeskewSummary Deskewer::Deskew(const LidarFrame& frame, const Vector3& v_W, cons
         std::partition_point(knots.begin() + 1, knots.end(), [t](const Knot& kn) { return kn.t > t; }) - knots.begin());
     const Knot& after = knots[k - 1];
     const Vector3 w = k < knots.size() ? knots[k].w : rate_before(t);
-    const Matrix3 R = after.R_end_from_t * Exp(-w * ToSeconds(after.t - t));
+    const Matrix3 R = after.R_end_from_t * ExpSO3(-w * ToSeconds(after.t - t));
     const Vector3 p_end_B = R * (l + p_S) - v_end_B * ToSeconds(t_end - t);
     out->push_back((p_end_B - l).cast<float>());
     ++summary.points;

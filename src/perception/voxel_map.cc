@@ -34,6 +34,9 @@ void VoxelMapOptions::Validate() const {
           "inflation_radius_m", inflation_radius_m, "a radius in [0, 100 voxels]");
   require(std::isfinite(max_clearing_range_m) && max_clearing_range_m > 0.0, "max_clearing_range_m",
           max_clearing_range_m, "a range > 0 m");
+  require(std::isfinite(recenter_hysteresis_m) && recenter_hysteresis_m >= 0.0 &&
+              recenter_hysteresis_m <= 0.25 * window_size_m.minCoeff(),
+          "recenter_hysteresis_m", recenter_hysteresis_m, "a distance in [0, a quarter of the smallest window extent] m");
   const double voxels = (window_size_m / resolution_m).prod();
   require(voxels <= 64e6, "window_size_m", voxels, "at most 64 million voxels");
 }
@@ -49,6 +52,7 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
     while (size_[k] < needed) size_[k] *= 2;
   }
   origin_ = -size_ / 2;
+  hysteresis_voxels_ = static_cast<int>(std::floor(options_.recenter_hysteresis_m / res_ + 1e-9));
   for (int k = 0; k < 3; ++k) pack_mask_ |= static_cast<std::uint64_t>(size_[k] - 1) << (kPackShift * k);
   while ((8 << brick_shift_y_) < size_.y()) ++brick_shift_y_;
   while ((8 << brick_shift_z_) < size_.z()) ++brick_shift_z_;
@@ -85,22 +89,28 @@ bool VoxelMap::InWindow(const Vector3& p) const { return p.allFinite() && InWind
 
 template <typename Visit>
 void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const {
-  // Clip to the window [origin, origin + size) in voxel units.
+  // Clip to the window [origin, origin + size) in voxel units. (Reciprocals once per axis: the
+  // setup runs for every ray of a frame, and a division costs as much as a few steps.)
   const Vector3 d = b - a;
-  double s_in = 0.0, s_out = 1.0;
+  double s_in = 0.0, s_out = 1.0, inv_d[3];
   for (int k = 0; k < 3; ++k) {
     const double lo = origin_[k], hi = origin_[k] + size_[k];
+    inv_d[k] = 0.0;
     if (std::abs(d[k]) < 1e-12) {
       if (a[k] < lo || a[k] >= hi) return;
       continue;
     }
-    double s0 = (lo - a[k]) / d[k], s1 = (hi - a[k]) / d[k];
+    inv_d[k] = 1.0 / d[k];
+    double s0 = (lo - a[k]) * inv_d[k], s1 = (hi - a[k]) * inv_d[k];
     if (s0 > s1) std::swap(s0, s1);
     s_in = std::max(s_in, s0);
     s_out = std::min(s_out, s1);
   }
   if (s_in > s_out) return;
-  const Vector3 start = a + s_in * d, stop = a + s_out * d;
+  // From here on the parameter runs over the clipped segment, so that one voxel is never more
+  // than 1/4096 of it (the fixed point below then resolves every step, however long the query).
+  const Vector3 start = a + s_in * d, stop = a + s_out * d, c = stop - start;
+  const double inv_span = s_out > s_in ? 1.0 / (s_out - s_in) : 0.0;
   int i[3], max_steps = 1;
   double t_max[3], t_delta[3];
   std::uint64_t packed = 0, step[3];
@@ -108,42 +118,54 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
     const int lo = origin_[k], hi = origin_[k] + size_[k] - 1;
     i[k] = std::clamp(static_cast<int>(std::floor(start[k])), lo, hi);
     max_steps += std::abs(std::clamp(static_cast<int>(std::floor(stop[k])), lo, hi) - i[k]);
-    const int st = d[k] > 0.0 ? 1 : (d[k] < 0.0 ? -1 : 0);
-    if (st == 0) {
+    const int st = c[k] > 0.0 ? 1 : (c[k] < 0.0 ? -1 : 0);
+    if (st == 0 || inv_d[k] == 0.0) {
       t_max[k] = t_delta[k] = std::numeric_limits<double>::infinity();
     } else {
-      // Parameter (in units of the whole segment) of the next voxel boundary along k.
+      // Parameter of the next voxel boundary along k (1 / c[k] = inv_d[k] / span).
+      const double inv_c = inv_d[k] * inv_span;
       const double boundary = st > 0 ? i[k] + 1.0 : static_cast<double>(i[k]);
-      t_max[k] = (boundary - a[k]) / d[k];
-      t_delta[k] = 1.0 / std::abs(d[k]);
+      t_max[k] = (boundary - start[k]) * inv_c;
+      t_delta[k] = std::abs(inv_c);
     }
     packed |= static_cast<std::uint64_t>(PositiveMod(i[k], size_[k])) << (kPackShift * k);
     // A step of -1 adds size - 1: the field's mask below then wraps it.
     step[k] = static_cast<std::uint64_t>(st >= 0 ? 1 : size_[k] - 1) << (kPackShift * k);
   }
-  // The boundary parameters in fixed point (2^-32 of the segment): integer min and compare have
-  // a shorter latency than double, and the step's dependency chain runs through them. Beyond the
+  // The boundary parameters in fixed point (2^-32 of the segment): integer compares have a
+  // shorter latency than double, and the step's dependency chain runs through them. Beyond the
   // segment's end (> 1) only the order matters, so larger values are capped to stay in range.
   // Each of the n steps adds a truncation error below one unit, so the end is moved in by
   // max_steps + 2 units: a boundary at or beyond the clipped end (the window's face) then always
-  // compares beyond it, and no step leaves the window, without a per-step bound check.
+  // compares beyond it, and no step leaves the window.
   const auto fixed = [](double t) { return static_cast<std::int64_t>(std::min(t, 4.0) * 4294967296.0); };
   std::int64_t tx = fixed(t_max[0]), ty = fixed(t_max[1]), tz = fixed(t_max[2]);
   const std::int64_t dx = fixed(t_delta[0]), dy = fixed(t_delta[1]), dz = fixed(t_delta[2]);
-  const std::int64_t t_end = fixed(s_out) - (max_steps + 2);
+  const std::int64_t t_end = fixed(1.0) - (max_steps + 2);
+  // The walk takes the boundaries in increasing order (a merge of the three axes' sequences), so
+  // it steps exactly once per boundary at or before the end: the count is known before the first
+  // step, and the loop needs no end test of its own.
+  const auto crossings = [t_end](std::int64_t t0, std::int64_t dt, double per_unit) -> std::int64_t {
+    if (t0 > t_end) return 0;
+    // per_unit ~ 1 / dt: the estimate is then corrected to the exact integer count.
+    std::int64_t n = static_cast<std::int64_t>(static_cast<double>(t_end - t0) * per_unit) + 1;
+    while (n > 0 && t0 + (n - 1) * dt > t_end) --n;
+    while (t0 + n * dt <= t_end) ++n;
+    return n;
+  };
+  constexpr double kUnit = 1.0 / 4294967296.0;
+  const std::int64_t steps = crossings(tx, dx, std::abs(c[0]) * kUnit) + crossings(ty, dy, std::abs(c[1]) * kUnit) +
+                             crossings(tz, dz, std::abs(c[2]) * kUnit);
   const std::uint64_t step_x = step[0], step_y = step[1], step_z = step[2], keep = pack_mask_;
-  for (;;) {
-    if (!visit(packed)) return;
+  for (std::int64_t n = 0;; ++n) {
+    if (!visit(packed) || n == steps) return;
     // The axis whose boundary comes first, chosen without branches (which way a ray turns next is
     // what a branch predictor cannot guess): all-ones masks from the comparisons, because with
-    // ternaries or && the compiler emits the very branches this avoids.
-    // The comparisons run in parallel, so the chain from one step's t to the next is a compare,
-    // an and and an add; the end test (predicted) is off it.
-    const std::int64_t x_first = -static_cast<std::int64_t>(tx <= ty) & -static_cast<std::int64_t>(tx <= tz);
-    const std::int64_t on_x = x_first;
-    const std::int64_t on_y = ~x_first & -static_cast<std::int64_t>(ty <= tz);
+    // ternaries or && the compiler emits the very branches this avoids. The comparisons run in
+    // parallel, so the chain from one step's t to the next is a compare, an and and an add.
+    const std::int64_t on_x = -static_cast<std::int64_t>(tx <= ty) & -static_cast<std::int64_t>(tx <= tz);
+    const std::int64_t on_y = ~on_x & -static_cast<std::int64_t>(ty <= tz);
     const std::int64_t on_z = ~(on_x | on_y);
-    if (std::min(tx, std::min(ty, tz)) > t_end) return;  // past the clipped segment's end
     packed = (packed + ((step_x & static_cast<std::uint64_t>(on_x)) | (step_y & static_cast<std::uint64_t>(on_y)) |
                         (step_z & static_cast<std::uint64_t>(on_z)))) &
              keep;
@@ -172,7 +194,11 @@ void VoxelMap::Inflate(const Index& i, int delta) {
 
 void VoxelMap::Recenter(const Vector3& center_W) {
   if (!center_W.allFinite()) return;
-  const Index new_origin = ToIndex(center_W) - size_ / 2;
+  const Index target = ToIndex(center_W) - size_ / 2;
+  Index new_origin = origin_;
+  for (int k = 0; k < 3; ++k) {
+    if (std::abs(target[k] - origin_[k]) > hysteresis_voxels_) new_origin[k] = target[k];
+  }
   if (new_origin == origin_) return;
   const Index shift = new_origin - origin_;
   if ((shift.cwiseAbs().array() >= size_.array()).any()) {  // nothing stays
@@ -299,7 +325,8 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // Much of the cost is the first touch of each voxel's cache line (a frame misses ~150k voxels of
   // a window larger than the caches), so a batch of rays is walked first and its voxels updated
   // after, each prefetched ahead: the memory latencies then overlap instead of adding up.
-  const Vector3 o = origin_W / res_;
+  const double inv_res = 1.0 / res_;
+  const Vector3 o = origin_W * inv_res;
   const double max_cells = options_.max_clearing_range_m / res_;
   long steps = 0;
   int missed = 0;
@@ -315,13 +342,13 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     for (std::size_t r = first; r < std::min(rays.size(), first + kRaysPerBatch); ++r) {
       const Index end_index = ToIndex(rays[r]);
       const std::uint64_t end = InWindow(end_index) ? Pack(end_index) : ~std::uint64_t{0};
-      Vector3 e = rays[r] / res_;
+      Vector3 e = rays[r] * inv_res;
       const double len = (e - o).norm();
       if (len > max_cells) e = o + (e - o) * (max_cells / len);
       TraverseWindow(o, e, [&](std::uint64_t packed) {
         *out = packed;
-        out += packed != end;
-        return packed != end;
+        out += packed != end;  // the walk ends in the return's voxel (hit, not missed)
+        return true;
       });
     }
     const std::uint64_t* const walk = walk_.data();
@@ -329,6 +356,8 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     steps += static_cast<long>(walked);
     std::uint32_t* const addresses = addresses_.data();
     for (std::size_t k = 0; k < walked; ++k) addresses[k] = AddressOfPacked(walk[k], shift_y, shift_z);
+    // (Branches: applying every step's miss without them, scaled to zero on repeated visits,
+    // stores on every step, and the stores to lines not yet cached then fill the store buffer.)
     for (std::size_t k = 0; k < walked; ++k) {
       if (k + kPrefetchAhead < walked) __builtin_prefetch(cells + addresses[k + kPrefetchAhead], 1);
       const std::uint32_t address = addresses[k];

@@ -231,6 +231,8 @@ TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
   ExpectConfigError("run " + f, f, 8, {"stack.control_rate_hz", "physics rate"});
   f = Write("map.yaml", Scenario(v, "stack:\n  map: {resolution_m: 0.1, log_odds_max: 40}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.map.log_odds_max", "40", "(0, 30]"});
+  f = Write("hysteresis.yaml", Scenario(v, "stack:\n  map: {window_size_m: [8, 8, 1.6], recenter_hysteresis_m: 0.5}\n"));
+  ExpectConfigError("run " + f, f, 9, {"stack.map.recenter_hysteresis_m", "0.5", "a quarter of the smallest window extent"});
   f = Write("mapkey.yaml", Scenario(v, "stack:\n  map: {inflation_radius_m: 0.3}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.map.inflation_radius_m", "unknown key"});
   f = Write("malformed.yaml", "vehicle: " + v + "\nduration_s: [1, 2\nmission: {type: hover}\n");

@@ -60,6 +60,7 @@ TEST(VoxelMap, AnObstacleThatMovedAwayIsClearedByTheRaysThroughIt) {
 TEST(VoxelMap, InflationMatchesBruteForceAlsoAfterTheWindowMoves) {
   VoxelMapOptions o = Small();
   o.inflation_radius_m = 0.25;
+  o.recenter_hysteresis_m = 0.0;  // every move below shifts all three axes
   VoxelMap map(o);
   Rng rng(4);
   std::vector<Eigen::Vector3f> pts;
@@ -139,6 +140,7 @@ int Crosses(const Vector3& a, const Vector3& b, const Vector3& c, double res) {
 TEST(VoxelMap, ARayMarksExactlyTheVoxelsItsSegmentCrosses) {
   VoxelMapOptions o;
   o.window_size_m = Vector3(1.6, 1.6, 0.8);
+  o.recenter_hysteresis_m = 0.0;
   Rng rng(7);
   int checked = 0;
   for (int trial = 0; trial < 300; ++trial) {
@@ -172,6 +174,7 @@ TEST(VoxelMap, ARayMarksExactlyTheVoxelsItsSegmentCrosses) {
 TEST(VoxelMap, SegmentCollidesExactlyWhenItCrossesAnOccupiedVoxel) {
   VoxelMapOptions o;
   o.window_size_m = Vector3(1.6, 1.6, 0.8);
+  o.recenter_hysteresis_m = 0.0;
   o.inflation_radius_m = 0.0;
   VoxelMap map(o);
   const Vector3 center(0.73, -0.41, 0.26);
@@ -213,6 +216,22 @@ TEST(VoxelMap, NonFiniteAndOutOfWindowPointsAreDroppedAndCountedEmptyFramesAreHa
   EXPECT_FALSE(map.IsOccupied(Vector3(std::nan(""), 0, 0)));
 }
 
+// The window (12.8 m along x: [-6.4, 6.4) m) follows its centre along an axis only beyond the
+// hysteresis (0.5 m), and then onto the centre.
+TEST(VoxelMap, TheWindowFollowsAnAxisOnlyBeyondTheHysteresis) {
+  VoxelMap map(Small());
+  map.Recenter(Vector3(0.45, -0.45, 0.45));  // within 0.5 m on every axis: no move
+  EXPECT_TRUE(map.InWindow(Vector3(-6.35, -6.35, 0.0)));
+  EXPECT_FALSE(map.InWindow(Vector3(6.45, 0.0, 0.0)));
+  map.Recenter(Vector3(0.65, -0.45, 0.0));  // x moves onto 0.6 (origin -5.8 m), y stays
+  EXPECT_FALSE(map.InWindow(Vector3(-5.85, 0.0, 0.0)));
+  EXPECT_TRUE(map.InWindow(Vector3(-5.75, 0.0, 0.0)));
+  EXPECT_TRUE(map.InWindow(Vector3(6.95, 0.0, 0.0)));
+  EXPECT_TRUE(map.InWindow(Vector3(0.0, -6.35, 0.0))) << "y within the hysteresis";
+  map.Recenter(Vector3(0.2, 0.0, 0.0));  // back by 0.4 m along x: no move
+  EXPECT_TRUE(map.InWindow(Vector3(6.95, 0.0, 0.0)));
+}
+
 TEST(VoxelMapOptions, ValidationNamesTheField) {
   VoxelMapOptions o;
   o.resolution_m = 0.0;
@@ -232,6 +251,14 @@ TEST(VoxelMapOptions, ValidationNamesTheField) {
     ADD_FAILURE();
   } catch (const ValidationError& e) {
     EXPECT_EQ(e.field(), "log_odds_max");
+  }
+  o = {};
+  o.window_size_m = Vector3(1.6, 1.6, 0.8);  // the default hysteresis (0.5 m) exceeds 0.8 / 4
+  try {
+    o.Validate();
+    ADD_FAILURE();
+  } catch (const ValidationError& e) {
+    EXPECT_EQ(e.field(), "recenter_hysteresis_m");
   }
 }
 

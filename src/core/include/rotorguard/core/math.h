@@ -7,6 +7,11 @@ namespace rotorguard {
 /// Skew-symmetric matrix: Skew(a) * b == a.cross(b).
 Matrix3 Skew(const Vector3& a);
 
+/// The rotation matrix of a rotation vector (SO(3) exponential, Rodrigues). Below 0.05 rad it
+/// takes a series instead of trigonometric calls, exact to double precision there: the deskewer
+/// evaluates one per LiDAR point, over at most an IMU period.
+Matrix3 ExpSO3(const Vector3& theta);
+
 /// Time derivative of q_WB for body rates w_B: q_dot = 0.5 * q (x) [0, w_B] (paper 000, eq. 2).
 Eigen::Vector4d QuaternionDerivative(const Quaternion& q_WB, const Vector3& w_B);
 

@@ -36,6 +36,11 @@ struct VoxelMapOptions {
   double inflation_radius_m = 0.2;  ///< the vehicle's radius [m], >= 0
   /// Rays longer than this only clear up to it (and still mark their return) [m], > 0.
   double max_clearing_range_m = 20.0;
+  /// The window follows its centre along an axis only once the centre is more than this from the
+  /// window's centre there [m], in [0, a quarter of the smallest extent]. Without it a centre on a
+  /// voxel boundary (a level flight at z = 1.5 m) moves the window back and forth with the
+  /// estimate's noise, and each move of a whole face costs more than a frame's rays.
+  double recenter_hysteresis_m = 0.5;
   void Validate() const;
 };
 
@@ -57,8 +62,9 @@ class VoxelMap {
  public:
   explicit VoxelMap(const VoxelMapOptions& options);
 
-  /// Moves the window so that it is centred on `center_W` (to the voxel); voxels that leave are
-  /// forgotten. Cheap when the centre moved little.
+  /// Moves the window so that it is centred on `center_W` (to the voxel) along each axis where the
+  /// centre is beyond the hysteresis; voxels that leave are forgotten. Cheap when the centre moved
+  /// little.
   void Recenter(const Vector3& center_W);
   /// Integrates one frame of returns (world frame) measured from `origin_W`.
   MapUpdateSummary Insert(const Vector3& origin_W, const std::vector<Eigen::Vector3f>& points_W);
@@ -163,6 +169,7 @@ class VoxelMap {
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
+  int hysteresis_voxels_ = 0;             // recenter_hysteresis_m in whole voxels
   std::vector<Index> touched_hit_;
   std::vector<Vector3> ray_ends_;  // the returns whose rays a frame walks
   std::vector<std::uint64_t> walk_;   // the packed voxels a batch of rays crosses, in order
