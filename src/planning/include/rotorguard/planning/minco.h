@@ -1,0 +1,71 @@
+#pragma once
+/// Minimum-jerk piecewise polynomials parameterised by their waypoints and durations: MINCO with
+/// s = 3 (paper 000, eqs. 19-21 and 24; Wang et al., T-RO 2022). M pieces of degree 5 join at the
+/// intermediate waypoints q_1..q_{M-1} with continuous derivatives up to the fourth; the head and
+/// tail states (position, velocity, acceleration) are fixed. For given (q, T) the coefficients
+/// c = M(q, T) minimise the jerk energy, and follow from a banded linear system in O(M); the
+/// gradient of any cost of (c, T) maps back to (q, T) through one solve with the transposed
+/// system, so that an optimiser moves the waypoints and durations directly.
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "rotorguard/core/trajectory.h"
+#include "rotorguard/core/types.h"
+#include "rotorguard/planning/banded.h"
+
+namespace rotorguard::planning {
+
+/// Position, velocity and acceleration as the columns of a 3 x 3 matrix.
+using PvaState = Eigen::Matrix3d;
+
+class MinimumJerkTrajectory final : public ReferenceTrajectory {
+ public:
+  static constexpr int kCoefficients = 6;  // degree 5 = 2s - 1
+
+  MinimumJerkTrajectory() = default;
+
+  /// Builds the minimum-jerk coefficients for `waypoints` (3 x (M - 1), the junctions) and
+  /// `durations` (M, each > 0). Returns false (leaving the trajectory empty) when a duration is not
+  /// positive and finite, an input is not finite or the sizes do not match.
+  bool Build(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
+             const Eigen::VectorXd& durations);
+
+  int pieces() const { return static_cast<int>(durations_.size()); }
+  bool empty() const { return durations_.size() == 0; }
+  const Eigen::VectorXd& durations() const { return durations_; }
+  /// Coefficients, 6M x 3: row 6i + k multiplies t^k on piece i (t from the piece's start).
+  const Eigen::MatrixX3d& coefficients() const { return coefficients_; }
+
+  /// J_s = sum over pieces of the integral of |jerk|^2 (eq. 24), in closed form.
+  double Energy() const;
+  /// The partial derivatives of J_s: with respect to the coefficients (6M x 3) and, with the
+  /// coefficients held, to the durations (|jerk(T_i)|^2).
+  void EnergyPartials(Eigen::MatrixX3d* d_coefficients, Eigen::VectorXd* d_durations) const;
+
+  /// Maps the partial derivatives of a cost J(c, T) to its total derivatives with respect to the
+  /// waypoints (3 x (M - 1)) and durations (M) through the adjoint of the banded system.
+  void PropagateGradient(const Eigen::MatrixX3d& d_coefficients, const Eigen::VectorXd& d_durations_partial,
+                         Eigen::Matrix3Xd* d_waypoints, Eigen::VectorXd* d_durations) const;
+
+  /// Derivative `order` (0 position .. 5) of piece i at local time t in [0, T_i].
+  Vector3 PieceDerivative(int piece, double t, int order) const;
+
+  /// ReferenceTrajectory: position through jerk at time t since `start_time()`; before it the
+  /// first point, after the end the final state with zero velocity and higher derivatives (the
+  /// tail is a rest state when the trajectory stops at a goal).
+  ReferencePoint Evaluate(double t) const override;
+  double duration() const override { return start_time_ + total_duration_; }
+  void set_start_time(double t0) { start_time_ = t0; }
+  double start_time() const { return start_time_; }
+  double total_duration() const { return total_duration_; }
+  void set_yaw(double yaw) { yaw_ = yaw; }
+
+ private:
+  Eigen::VectorXd durations_;
+  Eigen::MatrixX3d coefficients_;
+  BandedMatrix system_{0, 4, 3};  // factored
+  double total_duration_ = 0.0, start_time_ = 0.0, yaw_ = 0.0;
+};
+
+}  // namespace rotorguard::planning

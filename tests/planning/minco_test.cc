@@ -1,0 +1,147 @@
+#include "rotorguard/planning/minco.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/core/rng.h"
+
+namespace rotorguard::planning {
+namespace {
+
+// The banded LU against Eigen's dense LU with partial pivoting, for A X = B and A^T X = B, on
+// random diagonally dominant matrices with the MINCO bandwidths and others.
+TEST(BandedMatrix, SolvesMatchADenseSolve) {
+  Rng rng(1);
+  for (const auto& [n, lower, upper] : {std::tuple{1, 0, 0}, std::tuple{12, 4, 2}, std::tuple{30, 2, 5}, std::tuple{7, 6, 6}, std::tuple{40, 4, 3}}) {
+    BandedMatrix a(n, lower, upper);
+    for (int i = 0; i < n; ++i) {
+      for (int j = std::max(0, i - lower); j <= std::min(n - 1, i + upper); ++j) a(i, j) = rng.Uniform(-1, 1);
+      a(i, i) += (i % 2 ? -1.0 : 1.0) * (lower + upper + 2);
+    }
+    const Eigen::MatrixXd dense = a.ToDense();
+    ASSERT_TRUE(a.Factorize());
+    const Eigen::MatrixXd rhs = Eigen::MatrixXd::Random(n, 3);
+    Eigen::MatrixXd x = rhs, xt = rhs;
+    a.Solve(x);
+    a.SolveTransposed(xt);
+    EXPECT_LT((x - dense.partialPivLu().solve(rhs)).cwiseAbs().maxCoeff(), 1e-12) << n;
+    EXPECT_LT((xt - dense.transpose().partialPivLu().solve(rhs)).cwiseAbs().maxCoeff(), 1e-12) << n;
+  }
+  BandedMatrix singular(3, 1, 1);
+  EXPECT_FALSE(singular.Factorize()) << "a zero pivot is reported";
+}
+
+PvaState RandomState(Rng& rng) {
+  PvaState s;
+  for (int k = 0; k < 3; ++k) s.col(k) = Vector3(rng.Uniform(-2, 2), rng.Uniform(-2, 2), rng.Uniform(-2, 2));
+  return s;
+}
+
+struct Problem {
+  PvaState head, tail;
+  Eigen::Matrix3Xd q;
+  Eigen::VectorXd t;
+};
+
+Problem RandomProblem(Rng& rng, int pieces, double t_lo, double t_hi) {
+  Problem p{RandomState(rng), RandomState(rng), Eigen::Matrix3Xd(3, pieces - 1), Eigen::VectorXd(pieces)};
+  for (int i = 0; i + 1 < pieces; ++i) p.q.col(i) = Vector3(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(0, 3));
+  for (int i = 0; i < pieces; ++i) p.t(i) = std::exp(rng.Uniform(std::log(t_lo), std::log(t_hi)));
+  return p;
+}
+
+// The 6M conditions that define the coefficients (head and tail states, the waypoints, continuity
+// of derivatives 0..4 at each junction) hold, for 1 to 12 pieces and durations from 0.02 s to
+// 50 s: the banded solve without pivoting finds the one solution of the system.
+TEST(MinimumJerkTrajectory, MeetsBoundaryWaypointAndContinuityConditions) {
+  Rng rng(2);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int m = 1 + trial % 12;
+    const Problem p = RandomProblem(rng, m, trial % 2 ? 0.02 : 0.5, trial % 2 ? 2.0 : 50.0);
+    MinimumJerkTrajectory traj;
+    ASSERT_TRUE(traj.Build(p.head, p.tail, p.q, p.t));
+    const auto near = [](const Vector3& a, const Vector3& b) {
+      return (a - b).norm() <= 1e-8 * std::max({1.0, a.norm(), b.norm()});
+    };
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_TRUE(near(traj.PieceDerivative(0, 0.0, d), p.head.col(d))) << "head, derivative " << d;
+      EXPECT_TRUE(near(traj.PieceDerivative(m - 1, p.t(m - 1), d), p.tail.col(d))) << "tail, derivative " << d;
+    }
+    for (int i = 0; i + 1 < m; ++i) {
+      EXPECT_TRUE(near(traj.PieceDerivative(i, p.t(i), 0), p.q.col(i))) << "waypoint " << i;
+      for (int d = 0; d < 5; ++d) {
+        EXPECT_TRUE(near(traj.PieceDerivative(i, p.t(i), d), traj.PieceDerivative(i + 1, 0.0, d)))
+            << "trial " << trial << ", junction " << i << ", derivative " << d;
+      }
+    }
+  }
+}
+
+// One piece from rest to rest is the classic minimum-jerk polynomial
+// p0 + (p1 - p0)(10 s^3 - 15 s^4 + 6 s^5), s = t / T, with energy 720 |p1 - p0|^2 / T^5.
+TEST(MinimumJerkTrajectory, RestToRestIsTheClosedForm) {
+  PvaState head = PvaState::Zero(), tail = PvaState::Zero();
+  head.col(0) = Vector3(1, 2, 3);
+  tail.col(0) = Vector3(4, -2, 3.5);
+  const double T = 2.5;
+  MinimumJerkTrajectory traj;
+  ASSERT_TRUE(traj.Build(head, tail, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, T)));
+  for (double t = 0.0; t <= T; t += 0.1) {
+    const double s = t / T;
+    const Vector3 expected = head.col(0) + (tail.col(0) - head.col(0)) * (10 * std::pow(s, 3) - 15 * std::pow(s, 4) + 6 * std::pow(s, 5));
+    EXPECT_LT((traj.Evaluate(t).p_W - expected).norm(), 1e-12);
+  }
+  EXPECT_NEAR(traj.Energy(), 720.0 * (tail.col(0) - head.col(0)).squaredNorm() / std::pow(T, 5), 1e-9);
+}
+
+// The energy's total gradient with respect to waypoints and durations (partials propagated
+// through the adjoint) against central differences of the rebuilt trajectory's energy.
+TEST(MinimumJerkTrajectory, EnergyGradientMatchesFiniteDifferences) {
+  Rng rng(3);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Problem p = RandomProblem(rng, 1 + trial % 8, 0.4, 3.0);
+    MinimumJerkTrajectory traj;
+    ASSERT_TRUE(traj.Build(p.head, p.tail, p.q, p.t));
+    Eigen::MatrixX3d dc;
+    Eigen::VectorXd dt_partial, dt;
+    Eigen::Matrix3Xd dq;
+    traj.EnergyPartials(&dc, &dt_partial);
+    traj.PropagateGradient(dc, dt_partial, &dq, &dt);
+    const auto energy = [&](const Eigen::Matrix3Xd& q, const Eigen::VectorXd& t) {
+      MinimumJerkTrajectory other;
+      EXPECT_TRUE(other.Build(p.head, p.tail, q, t));
+      return other.Energy();
+    };
+    const double scale = std::max(1.0, traj.Energy());
+    for (int i = 0; i < p.q.cols(); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const double h = 1e-6;
+        Eigen::Matrix3Xd plus = p.q, minus = p.q;
+        plus(k, i) += h;
+        minus(k, i) -= h;
+        EXPECT_NEAR(dq(k, i), (energy(plus, p.t) - energy(minus, p.t)) / (2 * h), 1e-6 * scale) << "q " << i << "," << k;
+      }
+    }
+    for (int i = 0; i < p.t.size(); ++i) {
+      const double h = 1e-6 * p.t(i);
+      Eigen::VectorXd plus = p.t, minus = p.t;
+      plus(i) += h;
+      minus(i) -= h;
+      EXPECT_NEAR(dt(i), (energy(p.q, plus) - energy(p.q, minus)) / (2 * h), 1e-6 * scale) << "T " << i;
+    }
+  }
+}
+
+TEST(MinimumJerkTrajectory, RejectsBadInputs) {
+  MinimumJerkTrajectory traj;
+  const PvaState z = PvaState::Zero();
+  EXPECT_FALSE(traj.Build(z, z, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, 0.0)));
+  EXPECT_FALSE(traj.Build(z, z, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, std::nan(""))));
+  EXPECT_FALSE(traj.Build(z, z, Eigen::Matrix3Xd(3, 1), Eigen::VectorXd::Constant(1, 1.0))) << "sizes";
+  EXPECT_TRUE(traj.empty());
+  EXPECT_TRUE(traj.Evaluate(1.0).p_W.allFinite());
+}
+
+}  // namespace
+}  // namespace rotorguard::planning
