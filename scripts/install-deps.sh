@@ -13,6 +13,7 @@ packages=(
   libfmt-dev           # formatting in messages and logs
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev     # micro-benchmarks
+  libceres-dev         # L-BFGS for trajectory optimisation (planning)
   coinor-libipopt-dev  # Ipopt: the NMPC's correctness oracle in tests (not linked by the product)
 )
 

@@ -9,18 +9,22 @@ namespace {
 
 constexpr int kC = MinimumJerkTrajectory::kCoefficients;
 
-/// Row of the polynomial basis' derivative `order` at t: d^order/dt^order [1, t, ..., t^5].
-Eigen::Matrix<double, 1, kC> BasisDerivative(double t, int order) {
+}  // namespace
+
+Eigen::Matrix<double, 1, kC> MinimumJerkTrajectory::Basis(double t, int order) {
+  // k! / (k - order)! t^(k - order) for k >= order, the factors tabulated (the optimiser evaluates
+  // five rows per penalty sample).
+  static constexpr double kFactor[6][kC] = {{1, 1, 1, 1, 1, 1},       {0, 1, 2, 3, 4, 5},
+                                            {0, 0, 2, 6, 12, 20},     {0, 0, 0, 6, 24, 60},
+                                            {0, 0, 0, 0, 24, 120},    {0, 0, 0, 0, 0, 120}};
   Eigen::Matrix<double, 1, kC> b = Eigen::Matrix<double, 1, kC>::Zero();
+  double power = 1.0;
   for (int k = order; k < kC; ++k) {
-    double f = 1.0;  // k! / (k - order)!
-    for (int m = 0; m < order; ++m) f *= k - m;
-    b(k) = f * std::pow(t, k - order);
+    b(k) = kFactor[order][k] * power;
+    power *= t;
   }
   return b;
 }
-
-}  // namespace
 
 bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
                                   const Eigen::VectorXd& durations) {
@@ -48,21 +52,21 @@ bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, co
   for (int i = 0; i + 1 < m; ++i) {
     const int r = kC * i + 3, c = kC * i;
     const double t = durations(i);
-    const Eigen::Matrix<double, 1, kC> position = BasisDerivative(t, 0);
+    const Eigen::Matrix<double, 1, kC> position = Basis(t, 0);
     for (int k = 0; k < kC; ++k) a(r, c + k) = position(k);
     b.row(r) = waypoints.col(i).transpose();
     a(r + 3, c + kC) = 1.0;
     b.row(r + 3) = waypoints.col(i).transpose();
     for (int d = 1; d < 5; ++d) {
       const int row = r + (d < 3 ? d : d + 1);
-      const Eigen::Matrix<double, 1, kC> basis = BasisDerivative(t, d);
+      const Eigen::Matrix<double, 1, kC> basis = Basis(t, d);
       for (int k = d; k < kC; ++k) a(row, c + k) = basis(k);
       a(row, c + kC + d) = -factorial[d];
     }
   }
   const int last = kC * (m - 1);
   for (int d = 0; d < 3; ++d) {
-    const Eigen::Matrix<double, 1, kC> row = BasisDerivative(durations(m - 1), d);
+    const Eigen::Matrix<double, 1, kC> row = Basis(durations(m - 1), d);
     for (int k = d; k < kC; ++k) a(n - 3 + d, last + k) = row(k);
     b.row(n - 3 + d) = tail.col(d).transpose();
   }
@@ -128,7 +132,7 @@ void MinimumJerkTrajectory::PropagateGradient(const Eigen::MatrixX3d& d_coeffici
 }
 
 Vector3 MinimumJerkTrajectory::PieceDerivative(int piece, double t, int order) const {
-  return (BasisDerivative(t, order) * coefficients_.middleRows<kC>(kC * piece)).transpose();
+  return (Basis(t, order) * coefficients_.middleRows<kC>(kC * piece)).transpose();
 }
 
 ReferencePoint MinimumJerkTrajectory::Evaluate(double t) const {

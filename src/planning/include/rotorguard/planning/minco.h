@@ -48,6 +48,10 @@ class MinimumJerkTrajectory final : public ReferenceTrajectory {
   void PropagateGradient(const Eigen::MatrixX3d& d_coefficients, const Eigen::VectorXd& d_durations_partial,
                          Eigen::Matrix3Xd* d_waypoints, Eigen::VectorXd* d_durations) const;
 
+  /// The row d^order/dt^order [1, t, ..., t^5]: a piece's derivative is Basis(t, order) times its
+  /// 6 x 3 coefficients.
+  static Eigen::Matrix<double, 1, kCoefficients> Basis(double t, int order);
+
   /// Derivative `order` (0 position .. 5) of piece i at local time t in [0, T_i].
   Vector3 PieceDerivative(int piece, double t, int order) const;
 

@@ -1,0 +1,109 @@
+#pragma once
+/// Spatio-temporal optimisation of a minimum-jerk trajectory (paper 000, Sec. V-C, eq. 22):
+///   min over {q, T} of  λ_t J_t + λ_s J_s + λ_d J_d + λ_c J_c
+/// with J_t the total time (eq. 23), J_s the jerk energy (eq. 24), J_d the velocity, acceleration
+/// and jerk limits sampled along each piece (eqs. 25-29) and J_c the clearance from obstacle planes
+/// (eqs. 34-36). Durations are optimised through a smooth positive map, T = τ + sqrt(τ² + 1), so
+/// that the problem is unconstrained, and solved by Ceres' L-BFGS (GradientProblemSolver) behind a
+/// wrapper that treats any non-finite cost or gradient as a failed evaluation.
+///
+/// Penalties alone do not guarantee limits, so the result is checked densely afterwards and, where
+/// a limit is exceeded, the offending pieces are slowed down until it holds (see `Summary`).
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "rotorguard/core/types.h"
+#include "rotorguard/planning/minco.h"
+
+namespace rotorguard::planning {
+
+/// Magnitude limits on the trajectory's derivatives.
+struct DynamicLimits {
+  double v_max = 1.0;  ///< [m/s], > 0
+  double a_max = 2.0;  ///< [m/s²], > 0 (a_max,n nominal; a_max,f of eq. 33 after a failure)
+  double j_max = 6.0;  ///< [m/s³], > 0
+  void Validate() const;
+};
+
+/// Eq. (33): the acceleration a post-failure vehicle can still command horizontally when the rotor
+/// opposite the failed one is assumed lost too, so that two rotors of max thrust `rotor_max_thrust_n`
+/// remain: γ |(sqrt((2 T̄)² - (m g)²) - f_max) / m| with f_max = ||R D R^T|| v_max (= the largest
+/// drag coefficient times v_max). Returns 0 when two rotors cannot hold the weight.
+double PostFailureAccelerationLimit(double mass_kg, double rotor_max_thrust_n, double max_drag_coefficient_kg_s,
+                                    double v_max, double safety_factor);
+
+/// The nearest obstacle point to a position within a search radius, and the unit normal of its
+/// plane pointing to free space (eq. 34: the plane through `point` with normal `normal`).
+struct ObstaclePlane {
+  Vector3 point;
+  Vector3 normal;
+};
+using ObstacleQuery = std::function<std::optional<ObstaclePlane>(const Vector3& position, double radius_m)>;
+
+struct TrajectoryOptimizerOptions {
+  // Eq. (22)'s weights λ = [λ_t, λ_s, λ_d, λ_c]; paper 000 Sec. VI uses [10, 1, 1e4, 1e4].
+  double weight_time = 10.0;
+  double weight_smoothness = 1.0;
+  double weight_feasibility = 1e4;
+  double weight_collision = 1e4;
+  double clearance_m = 0.3;      ///< C_o of eq. (36), the safe distance [m], >= 0
+  int samples_per_piece = 16;    ///< penalty samples per piece (κ / M), >= 2
+  int max_iterations = 200;      ///< L-BFGS iterations, >= 1
+  /// The dense feasibility check: samples per piece, and the at most `max_slowdowns` rounds that
+  /// lengthen the offending pieces by `slowdown_factor` each.
+  int check_samples_per_piece = 64;
+  int max_slowdowns = 30;
+  double slowdown_factor = 1.1;
+  void Validate() const;
+};
+
+struct TrajectoryOptimizerSummary {
+  enum class Status { kSuccess, kInvalidInput, kSolverFailure, kInfeasible };
+  Status status = Status::kInvalidInput;
+  std::string message;
+  int iterations = 0;
+  int evaluations = 0;
+  int slowdowns = 0;            ///< rounds of the feasibility repair
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  double solve_ms = 0.0;
+  /// min over v, a, j of (limit - max value) / limit on the dense check: >= 0 when all hold.
+  double limit_margin = 0.0;
+  /// The smallest distance from the sampled trajectory to an obstacle within the search radius
+  /// (clearance_m + 1 m); that radius when none was found.
+  double min_clearance_m = 0.0;
+  bool ok() const { return status == Status::kSuccess; }
+};
+const char* ToString(TrajectoryOptimizerSummary::Status status);
+
+class TrajectoryOptimizer {
+ public:
+  /// Throws ValidationError on invalid options.
+  explicit TrajectoryOptimizer(const TrajectoryOptimizerOptions& options);
+
+  /// Optimises the waypoints and durations from an initial guess (waypoints 3 x (M - 1), durations
+  /// M > 0); `obstacles` may be empty (free space). On success `out` holds a trajectory within
+  /// `limits` on the dense check.
+  TrajectoryOptimizerSummary Optimize(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
+                                      const Eigen::VectorXd& durations, const DynamicLimits& limits,
+                                      const ObstacleQuery& obstacles, MinimumJerkTrajectory* out) const;
+
+  /// The objective of eq. (22) at x = [q (column by column), τ] and its gradient (may be null); the
+  /// problem's head, tail, limits and obstacles as for Optimize. Returns NaN when the trajectory
+  /// cannot be built. Public for the gradient tests.
+  double Objective(const PvaState& head, const PvaState& tail, const DynamicLimits& limits,
+                   const ObstacleQuery& obstacles, const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const;
+
+  /// T(τ) = τ + sqrt(τ² + 1) and its inverse.
+  static double DurationOf(double tau) { return tau + std::sqrt(tau * tau + 1.0); }
+  static double TauOf(double duration) { return (duration * duration - 1.0) / (2.0 * duration); }
+
+  const TrajectoryOptimizerOptions& options() const { return options_; }
+
+ private:
+  TrajectoryOptimizerOptions options_;
+};
+
+}  // namespace rotorguard::planning

@@ -1,0 +1,282 @@
+#include "rotorguard/planning/trajectory_optimizer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include <ceres/first_order_function.h>
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::planning {
+
+namespace {
+
+constexpr int kC = MinimumJerkTrajectory::kCoefficients;
+
+/// max(x, 0)^3 and its derivative: the penalty of eqs. (26)-(29) and (36), cubed throughout so
+/// that the objective is twice differentiable where a limit becomes active (the paper cubes the
+/// clearance term only).
+double Cubed(double x, double* slope) {
+  if (x <= 0.0) {
+    *slope = 0.0;
+    return 0.0;
+  }
+  *slope = 3.0 * x * x;
+  return x * x * x;
+}
+
+/// Splits x = [q columns, τ] into waypoints and durations.
+void Unpack(const Eigen::VectorXd& x, int pieces, Eigen::Matrix3Xd* q, Eigen::VectorXd* t) {
+  *q = Eigen::Map<const Eigen::Matrix3Xd>(x.data(), 3, pieces - 1);
+  t->resize(pieces);
+  for (int i = 0; i < pieces; ++i) (*t)(i) = TrajectoryOptimizer::DurationOf(x(3 * (pieces - 1) + i));
+}
+
+}  // namespace
+
+void DynamicLimits::Validate() const {
+  const auto require = [](double v, const char* field) {
+    if (!(std::isfinite(v) && v > 0.0)) ThrowValidation("DynamicLimits", field, v, "a finite limit > 0");
+  };
+  require(v_max, "v_max");
+  require(a_max, "a_max");
+  require(j_max, "j_max");
+}
+
+double PostFailureAccelerationLimit(double mass_kg, double rotor_max_thrust_n, double max_drag_coefficient_kg_s,
+                                    double v_max, double safety_factor) {
+  const double weight = mass_kg * 9.81, thrust = 2.0 * rotor_max_thrust_n;
+  if (thrust <= weight) return 0.0;
+  const double f_max = max_drag_coefficient_kg_s * v_max;
+  return safety_factor * std::abs((std::sqrt(thrust * thrust - weight * weight) - f_max) / mass_kg);
+}
+
+void TrajectoryOptimizerOptions::Validate() const {
+  const auto require = [](bool ok, const char* field, double v, const char* rule) {
+    if (!ok) ThrowValidation("TrajectoryOptimizerOptions", field, v, rule);
+  };
+  for (const auto& [v, f] : {std::pair{weight_time, "weight_time"}, std::pair{weight_smoothness, "weight_smoothness"},
+                             std::pair{weight_feasibility, "weight_feasibility"},
+                             std::pair{weight_collision, "weight_collision"}}) {
+    require(std::isfinite(v) && v >= 0.0, f, v, "a finite weight >= 0");
+  }
+  require(std::isfinite(clearance_m) && clearance_m >= 0.0, "clearance_m", clearance_m, "a distance >= 0 m");
+  require(samples_per_piece >= 2 && samples_per_piece <= 1000, "samples_per_piece", samples_per_piece, "in [2, 1000]");
+  require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
+  require(check_samples_per_piece >= samples_per_piece, "check_samples_per_piece", check_samples_per_piece,
+          "at least samples_per_piece");
+  require(max_slowdowns >= 0, "max_slowdowns", max_slowdowns, ">= 0");
+  require(slowdown_factor > 1.0 && slowdown_factor <= 2.0, "slowdown_factor", slowdown_factor, "in (1, 2]");
+}
+
+const char* ToString(TrajectoryOptimizerSummary::Status status) {
+  switch (status) {
+    case TrajectoryOptimizerSummary::Status::kSuccess: return "success";
+    case TrajectoryOptimizerSummary::Status::kInvalidInput: return "invalid_input";
+    case TrajectoryOptimizerSummary::Status::kSolverFailure: return "solver_failure";
+    case TrajectoryOptimizerSummary::Status::kInfeasible: return "infeasible";
+  }
+  return "unknown";
+}
+
+TrajectoryOptimizer::TrajectoryOptimizer(const TrajectoryOptimizerOptions& options) : options_(options) {
+  options_.Validate();
+}
+
+double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail, const DynamicLimits& limits,
+                                      const ObstacleQuery& obstacles, const Eigen::VectorXd& x,
+                                      Eigen::VectorXd* gradient) const {
+  const int pieces = static_cast<int>((x.size() + 3) / 4);
+  Eigen::Matrix3Xd q;
+  Eigen::VectorXd t;
+  Unpack(x, pieces, &q, &t);
+  MinimumJerkTrajectory traj;
+  if (!traj.Build(head, tail, q, t)) return std::numeric_limits<double>::quiet_NaN();
+  const TrajectoryOptimizerOptions& o = options_;
+  Eigen::MatrixX3d dc;
+  Eigen::VectorXd dt;
+  traj.EnergyPartials(&dc, &dt);
+  double cost = o.weight_time * t.sum() + o.weight_smoothness * traj.Energy();
+  dc *= o.weight_smoothness;
+  dt = dt * o.weight_smoothness + Eigen::VectorXd::Constant(pieces, o.weight_time);
+  // Sampled penalties. A sample at t = s T_i moves with T_i: its explicit derivative is the next
+  // derivative of the sampled quantity times s.
+  const double limit2[3] = {limits.v_max * limits.v_max, limits.a_max * limits.a_max, limits.j_max * limits.j_max};
+  const int k_samples = o.samples_per_piece;
+  for (int i = 0; i < pieces; ++i) {
+    const auto c = traj.coefficients().middleRows<kC>(kC * i);
+    for (int j = 0; j <= k_samples; ++j) {
+      const double s = static_cast<double>(j) / k_samples, ts = s * t(i);
+      Eigen::Matrix<double, 5, kC> basis;
+      for (int d = 0; d < 5; ++d) basis.row(d) = MinimumJerkTrajectory::Basis(ts, d);
+      const Eigen::Matrix<double, 5, 3> der = basis * c;  // p, v, a, j, snap
+      for (int d = 1; d <= 3; ++d) {  // J_d: velocity, acceleration, jerk (eqs. 26-29)
+        double slope;
+        const double pen = Cubed(der.row(d).squaredNorm() - limit2[d - 1], &slope);
+        if (slope == 0.0) continue;
+        cost += o.weight_feasibility * pen;
+        const Eigen::RowVector3d dp = o.weight_feasibility * slope * 2.0 * der.row(d);  // d cost / d derivative
+        dc.middleRows<kC>(kC * i) += basis.row(d).transpose() * dp;
+        dt(i) += dp.dot(der.row(d + 1)) * s;
+      }
+      if (obstacles && o.weight_collision > 0.0) {  // J_c (eqs. 34-36)
+        const Vector3 p = der.row(0).transpose();
+        if (const std::optional<ObstaclePlane> plane = obstacles(p, o.clearance_m)) {
+          double slope;
+          const double pen = Cubed(o.clearance_m - (p - plane->point).dot(plane->normal), &slope);
+          if (slope != 0.0) {  // (a NaN plane makes the cost NaN: a failed evaluation, not a skip)
+            cost += o.weight_collision * pen;
+            const Eigen::RowVector3d dp = -o.weight_collision * slope * plane->normal.transpose();
+            dc.middleRows<kC>(kC * i) += basis.row(0).transpose() * dp;
+            dt(i) += dp.dot(der.row(1)) * s;
+          }
+        }
+      }
+    }
+  }
+  if (gradient) {
+    Eigen::Matrix3Xd dq;
+    Eigen::VectorXd d_durations;
+    traj.PropagateGradient(dc, dt, &dq, &d_durations);
+    gradient->resize(x.size());
+    gradient->head(3 * (pieces - 1)) = Eigen::Map<const Eigen::VectorXd>(dq.data(), 3 * (pieces - 1));
+    for (int i = 0; i < pieces; ++i) {
+      const double tau = x(3 * (pieces - 1) + i);
+      (*gradient)(3 * (pieces - 1) + i) = d_durations(i) * t(i) / std::sqrt(tau * tau + 1.0);  // dT/dτ
+    }
+  }
+  return cost;
+}
+
+namespace {
+
+/// The objective for Ceres. A non-finite cost or gradient is reported as a failed evaluation, which
+/// the line search backs away from: Ceres alone can accept a NaN cost and declare convergence.
+class CeresObjective final : public ceres::FirstOrderFunction {
+ public:
+  CeresObjective(const TrajectoryOptimizer& optimizer, const PvaState& head, const PvaState& tail,
+                 const DynamicLimits& limits, const ObstacleQuery& obstacles, int size, int* evaluations)
+      : optimizer_(optimizer), head_(head), tail_(tail), limits_(limits), obstacles_(obstacles), size_(size),
+        evaluations_(evaluations) {}
+  bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
+    ++*evaluations_;
+    const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(parameters, size_);
+    Eigen::VectorXd g;
+    *cost = optimizer_.Objective(head_, tail_, limits_, obstacles_, x, gradient ? &g : nullptr);
+    if (!std::isfinite(*cost)) return false;
+    if (gradient) {
+      if (!g.allFinite()) return false;
+      Eigen::Map<Eigen::VectorXd>(gradient, size_) = g;
+    }
+    return true;
+  }
+  int NumParameters() const override { return size_; }
+
+ private:
+  const TrajectoryOptimizer& optimizer_;
+  const PvaState& head_;
+  const PvaState& tail_;
+  const DynamicLimits& limits_;
+  const ObstacleQuery& obstacles_;
+  int size_;
+  int* evaluations_;
+};
+
+}  // namespace
+
+TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, const PvaState& tail,
+                                                         const Eigen::Matrix3Xd& waypoints,
+                                                         const Eigen::VectorXd& durations, const DynamicLimits& limits,
+                                                         const ObstacleQuery& obstacles,
+                                                         MinimumJerkTrajectory* out) const {
+  using Status = TrajectoryOptimizerSummary::Status;
+  const auto start = std::chrono::steady_clock::now();
+  TrajectoryOptimizerSummary summary;
+  const int pieces = static_cast<int>(durations.size());
+  const auto fail = [&](Status status, std::string message) {
+    summary.status = status;
+    summary.message = std::move(message);
+    summary.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+  };
+  try {
+    limits.Validate();
+  } catch (const ValidationError& e) {
+    return fail(Status::kInvalidInput, e.what());
+  }
+  if (pieces < 1 || waypoints.cols() != pieces - 1 || !waypoints.allFinite() || !durations.allFinite() ||
+      (durations.array() <= 0.0).any() || !head.allFinite() || !tail.allFinite()) {
+    return fail(Status::kInvalidInput, "need finite head, tail, M - 1 waypoints and M positive durations");
+  }
+  const int n = 4 * pieces - 3;
+  Eigen::VectorXd x(n);
+  x.head(3 * (pieces - 1)) = Eigen::Map<const Eigen::VectorXd>(waypoints.data(), 3 * (pieces - 1));
+  for (int i = 0; i < pieces; ++i) x(3 * (pieces - 1) + i) = TauOf(durations(i));
+  summary.initial_cost = Objective(head, tail, limits, obstacles, x, nullptr);
+  if (!std::isfinite(summary.initial_cost)) return fail(Status::kInvalidInput, "the initial guess has no trajectory");
+
+  ceres::GradientProblemSolver::Options solver_options;
+  solver_options.line_search_direction_type = ceres::LBFGS;
+  solver_options.max_num_iterations = options_.max_iterations;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.function_tolerance = 1e-5;  // relative decrease per iteration
+  solver_options.gradient_tolerance = 1e-8;
+  ceres::GradientProblem problem(new CeresObjective(*this, head, tail, limits, obstacles, n, &summary.evaluations));
+  ceres::GradientProblemSolver::Summary ceres_summary;
+  ceres::Solve(solver_options, problem, x.data(), &ceres_summary);
+  summary.iterations = static_cast<int>(ceres_summary.iterations.size());
+  summary.final_cost = Objective(head, tail, limits, obstacles, x, nullptr);
+  if (!x.allFinite() || !std::isfinite(summary.final_cost) ||
+      ceres_summary.termination_type == ceres::FAILURE) {
+    return fail(Status::kSolverFailure, "L-BFGS: " + ceres_summary.message);
+  }
+
+  // Honest feasibility: check densely, lengthen the pieces that exceed a limit until none does.
+  Eigen::Matrix3Xd q;
+  Eigen::VectorXd t;
+  Unpack(x, pieces, &q, &t);
+  MinimumJerkTrajectory traj;
+  const double search = options_.clearance_m + 1.0;
+  for (;;) {
+    if (!traj.Build(head, tail, q, t)) return fail(Status::kSolverFailure, "the optimised trajectory cannot be built");
+    summary.limit_margin = std::numeric_limits<double>::infinity();
+    summary.min_clearance_m = search;
+    std::vector<bool> slow(static_cast<std::size_t>(pieces), false);
+    const double limit[3] = {limits.v_max, limits.a_max, limits.j_max};
+    for (int i = 0; i < pieces; ++i) {
+      for (int j = 0; j <= options_.check_samples_per_piece; ++j) {
+        const double ts = t(i) * j / options_.check_samples_per_piece;
+        for (int d = 1; d <= 3; ++d) {
+          const double margin = (limit[d - 1] - traj.PieceDerivative(i, ts, d).norm()) / limit[d - 1];
+          summary.limit_margin = std::min(summary.limit_margin, margin);
+          if (margin < 0.0) slow[static_cast<std::size_t>(i)] = true;
+        }
+        if (obstacles) {
+          const Vector3 p = traj.PieceDerivative(i, ts, 0);
+          if (const auto plane = obstacles(p, search)) {
+            summary.min_clearance_m = std::min(summary.min_clearance_m, (p - plane->point).norm());
+          }
+        }
+      }
+    }
+    if (summary.limit_margin >= 0.0) break;
+    if (summary.slowdowns == options_.max_slowdowns) {
+      return fail(Status::kInfeasible, "a limit still exceeded after lengthening the pieces " +
+                                           std::to_string(summary.slowdowns) + " times");
+    }
+    ++summary.slowdowns;
+    for (int i = 0; i < pieces; ++i) {
+      if (slow[static_cast<std::size_t>(i)]) t(i) *= options_.slowdown_factor;
+    }
+  }
+  *out = std::move(traj);
+  summary.status = Status::kSuccess;
+  summary.message = ceres_summary.message;
+  summary.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace rotorguard::planning
