@@ -21,6 +21,7 @@
 #include "rotorguard/bench/ftc_bench.h"
 #include "rotorguard/bench/nmpc_bench.h"
 #include "rotorguard/bench/perception_bench.h"
+#include "rotorguard/bench/planner_bench.h"
 #include "rotorguard/bench/qp_bench.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
@@ -240,6 +241,17 @@ int main(int argc, char** argv) {
   bench_perception->add_option("--seed", perception_seed_text, "Sensor noise and forest layout (default 1)");
   bench_perception->add_flag("--json", perception_json, "Print JSON instead of Markdown");
 
+  std::string planner_pairs_text = "100", planner_seed_text = "1", planner_worlds_text = "10";
+  bool planner_json = false;
+  CLI::App* bench_planner = bench->add_subcommand(
+      "planner", "The trajectory planner (A*, MINCO, L-BFGS) on random forests (30 x 20 m) and rooms (10 x 8 m),\n"
+                 "random start/goal pairs, nominal and post-failure limits, on the map of the true world:\n"
+                 "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.");
+  bench_planner->add_option("--pairs", planner_pairs_text, "Start/goal pairs per world kind (default 100)");
+  bench_planner->add_option("--worlds", planner_worlds_text, "Distinct worlds per kind (default 10, at most --pairs)");
+  bench_planner->add_option("--seed", planner_seed_text, "Worlds and pairs (default 1)");
+  bench_planner->add_flag("--json", planner_json, "Print JSON instead of Markdown");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -354,6 +366,16 @@ int main(int argc, char** argv) {
       o.progress = CountProgress("runs");
       const nlohmann::json r = rotorguard::bench::RunPerceptionBenchmark(o);
       fmt::print("{}", perception_json ? r.dump(2) + "\n" : rotorguard::bench::PerceptionMarkdown(r));
+      return kOk;
+    }
+    if (*bench_planner) {
+      rotorguard::bench::PlannerBenchOptions o;
+      o.pairs = static_cast<int>(ParseUnsigned("--pairs", planner_pairs_text, 1, 100000));
+      o.worlds = static_cast<int>(ParseUnsigned("--worlds", planner_worlds_text, 1, static_cast<std::uint64_t>(o.pairs)));
+      o.seed = ParseUnsigned("--seed", planner_seed_text, 0, UINT64_MAX);
+      o.progress = CountProgress("plans");
+      const nlohmann::json r = rotorguard::bench::RunPlannerBenchmark(o);
+      fmt::print("{}", planner_json ? r.dump(2) + "\n" : rotorguard::bench::PlannerMarkdown(r));
       return kOk;
     }
     if (*bench_nmpc) {

@@ -76,6 +76,17 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
       }
     }
   }
+  const int s = kSortedOffsetRadius;
+  for (int x = -s; x <= s; ++x) {
+    for (int y = -s; y <= s; ++y) {
+      for (int z = -s; z <= s; ++z) {
+        const double d = std::sqrt(static_cast<double>(x * x + y * y + z * z));
+        if (d <= s) sorted_offsets_.push_back({Index(x, y, z), d});
+      }
+    }
+  }
+  std::sort(sorted_offsets_.begin(), sorted_offsets_.end(),
+            [](const SortedOffset& a, const SortedOffset& b) { return a.distance < b.distance; });
 }
 
 VoxelMap::Index VoxelMap::ToIndex(const Vector3& p) const {
@@ -375,6 +386,12 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   return summary;
 }
 
+void VoxelMap::MarkOccupied(const Vector3& p) {
+  if (!InWindow(p)) return;
+  const std::size_t address = Address(ToIndex(p));
+  Observe(address, max_q_ - min_q_);  // from anywhere to the upper clamp
+}
+
 bool VoxelMap::IsOccupied(const Vector3& p) const {
   if (!InWindow(p)) return false;
   return Occupied(cells_[Address(ToIndex(p))]);
@@ -387,19 +404,31 @@ bool VoxelMap::IsInflated(const Vector3& p) const { return InWindow(p) && inflat
 std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius_m) const {
   if (!p.allFinite() || !(radius_m >= 0.0)) return std::nullopt;
   const Index c = ToIndex(p);
-  const int r = static_cast<int>(std::ceil(radius_m / res_)) + 1;
+  // The query lies within half a diagonal of its voxel's centre, so a voxel whose centre is d from
+  // that centre is at least d - half_diagonal from the query: the offsets, visited by increasing
+  // d, can stop once that bound exceeds the radius or the best distance found.
+  const double half_diagonal = 0.5 * std::sqrt(3.0) * res_;
   std::optional<NearestObstacle> best;
+  const auto consider = [&](const Index& i) {
+    if (!InWindow(i) || !Occupied(cells_[Address(i)])) return;
+    const Vector3 q = Center(i);
+    const double d = (p - q).norm();
+    if (d > radius_m || (best && d >= best->distance_m)) return;
+    const Vector3 n = d > 1e-12 ? Vector3((p - q) / d) : Vector3::UnitZ();
+    best = NearestObstacle{q, d, n};
+  };
+  if (radius_m + half_diagonal <= kSortedOffsetRadius * res_) {
+    for (const SortedOffset& o : sorted_offsets_) {
+      const double lower = o.distance * res_ - half_diagonal;
+      if (lower > radius_m || (best && lower > best->distance_m)) break;
+      consider(c + o.offset);
+    }
+    return best;
+  }
+  const int r = static_cast<int>(std::ceil(radius_m / res_)) + 1;
   for (int x = -r; x <= r; ++x) {
     for (int y = -r; y <= r; ++y) {
-      for (int z = -r; z <= r; ++z) {
-        const Index i = c + Index(x, y, z);
-        if (!InWindow(i) || !Occupied(cells_[Address(i)])) continue;
-        const Vector3 q = Center(i);
-        const double d = (p - q).norm();
-        if (d > radius_m || (best && d >= best->distance_m)) continue;
-        const Vector3 n = d > 1e-12 ? Vector3((p - q) / d) : Vector3::UnitZ();
-        best = NearestObstacle{q, d, n};
-      }
+      for (int z = -r; z <= r; ++z) consider(c + Index(x, y, z));
     }
   }
   return best;

@@ -135,6 +135,16 @@ Vector3 MinimumJerkTrajectory::PieceDerivative(int piece, double t, int order) c
   return (Basis(t, order) * coefficients_.middleRows<kC>(kC * piece)).transpose();
 }
 
+double MinimumJerkTrajectory::MaxNorm(int order, int samples_per_piece) const {
+  double m = 0.0;
+  for (int i = 0; i < pieces(); ++i) {
+    for (int j = 0; j <= samples_per_piece; ++j) {
+      m = std::max(m, PieceDerivative(i, durations_(i) * j / samples_per_piece, order).norm());
+    }
+  }
+  return m;
+}
+
 ReferencePoint MinimumJerkTrajectory::Evaluate(double t) const {
   ReferencePoint r;
   r.yaw = yaw_;

@@ -72,6 +72,17 @@ void TrajectoryOptimizerOptions::Validate() const {
   require(slowdown_factor > 1.0 && slowdown_factor <= 2.0, "slowdown_factor", slowdown_factor, "in (1, 2]");
 }
 
+PlaneSet BuildSamplePlanes(const MinimumJerkTrajectory& traj, int samples_per_piece, const NearestPlane& nearest) {
+  PlaneSet planes(static_cast<std::size_t>(traj.pieces()));
+  for (int i = 0; i < traj.pieces(); ++i) {
+    for (int j = 0; j <= samples_per_piece; ++j) {
+      const Vector3 p = traj.PieceDerivative(i, traj.durations()(i) * j / samples_per_piece, 0);
+      if (const std::optional<ObstaclePlane> plane = nearest(p)) planes[static_cast<std::size_t>(i)].push_back({j, *plane});
+    }
+  }
+  return planes;
+}
+
 const char* ToString(TrajectoryOptimizerSummary::Status status) {
   switch (status) {
     case TrajectoryOptimizerSummary::Status::kSuccess: return "success";
@@ -87,7 +98,7 @@ TrajectoryOptimizer::TrajectoryOptimizer(const TrajectoryOptimizerOptions& optio
 }
 
 double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail, const DynamicLimits& limits,
-                                      const ObstacleQuery& obstacles, const Eigen::VectorXd& x,
+                                      const PlaneSet& planes, const Eigen::VectorXd& x,
                                       Eigen::VectorXd* gradient) const {
   const int pieces = static_cast<int>((x.size() + 3) / 4);
   Eigen::Matrix3Xd q;
@@ -108,7 +119,12 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   const int k_samples = o.samples_per_piece;
   for (int i = 0; i < pieces; ++i) {
     const auto c = traj.coefficients().middleRows<kC>(kC * i);
+    std::size_t cursor = 0;  // the piece's planes, sorted by sample: the first of sample j
     for (int j = 0; j <= k_samples; ++j) {
+      if (!planes.empty()) {
+        const std::vector<SamplePlane>& list = planes[static_cast<std::size_t>(i)];
+        while (cursor < list.size() && list[cursor].sample < j) ++cursor;
+      }
       const double s = static_cast<double>(j) / k_samples, ts = s * t(i);
       Eigen::Matrix<double, 5, kC> basis;
       for (int d = 0; d < 5; ++d) basis.row(d) = MinimumJerkTrajectory::Basis(ts, d);
@@ -122,17 +138,18 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
         dc.middleRows<kC>(kC * i) += basis.row(d).transpose() * dp;
         dt(i) += dp.dot(der.row(d + 1)) * s;
       }
-      if (obstacles && o.weight_collision > 0.0) {  // J_c (eqs. 34-36)
+      if (!planes.empty() && o.weight_collision > 0.0) {  // J_c (eqs. 34-36)
         const Vector3 p = der.row(0).transpose();
-        if (const std::optional<ObstaclePlane> plane = obstacles(p, o.clearance_m)) {
+        const std::vector<SamplePlane>& list = planes[static_cast<std::size_t>(i)];
+        for (std::size_t k = cursor; k < list.size() && list[k].sample == j; ++k) {
+          const ObstaclePlane& plane = list[k].plane;
           double slope;
-          const double pen = Cubed(o.clearance_m - (p - plane->point).dot(plane->normal), &slope);
-          if (slope != 0.0) {  // (a NaN plane makes the cost NaN: a failed evaluation, not a skip)
-            cost += o.weight_collision * pen;
-            const Eigen::RowVector3d dp = -o.weight_collision * slope * plane->normal.transpose();
-            dc.middleRows<kC>(kC * i) += basis.row(0).transpose() * dp;
-            dt(i) += dp.dot(der.row(1)) * s;
-          }
+          const double pen = Cubed(o.clearance_m - (p - plane.point).dot(plane.normal), &slope);
+          if (slope == 0.0) continue;  // (a NaN plane makes the cost NaN: a failed evaluation, not a skip)
+          cost += o.weight_collision * pen;
+          const Eigen::RowVector3d dp = -o.weight_collision * slope * plane.normal.transpose();
+          dc.middleRows<kC>(kC * i) += basis.row(0).transpose() * dp;
+          dt(i) += dp.dot(der.row(1)) * s;
         }
       }
     }
@@ -158,14 +175,14 @@ namespace {
 class CeresObjective final : public ceres::FirstOrderFunction {
  public:
   CeresObjective(const TrajectoryOptimizer& optimizer, const PvaState& head, const PvaState& tail,
-                 const DynamicLimits& limits, const ObstacleQuery& obstacles, int size, int* evaluations)
-      : optimizer_(optimizer), head_(head), tail_(tail), limits_(limits), obstacles_(obstacles), size_(size),
+                 const DynamicLimits& limits, const PlaneSet& planes, int size, int* evaluations)
+      : optimizer_(optimizer), head_(head), tail_(tail), limits_(limits), planes_(planes), size_(size),
         evaluations_(evaluations) {}
   bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
     ++*evaluations_;
     const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(parameters, size_);
     Eigen::VectorXd g;
-    *cost = optimizer_.Objective(head_, tail_, limits_, obstacles_, x, gradient ? &g : nullptr);
+    *cost = optimizer_.Objective(head_, tail_, limits_, planes_, x, gradient ? &g : nullptr);
     if (!std::isfinite(*cost)) return false;
     if (gradient) {
       if (!g.allFinite()) return false;
@@ -180,7 +197,7 @@ class CeresObjective final : public ceres::FirstOrderFunction {
   const PvaState& head_;
   const PvaState& tail_;
   const DynamicLimits& limits_;
-  const ObstacleQuery& obstacles_;
+  const PlaneSet& planes_;
   int size_;
   int* evaluations_;
 };
@@ -190,7 +207,7 @@ class CeresObjective final : public ceres::FirstOrderFunction {
 TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, const PvaState& tail,
                                                          const Eigen::Matrix3Xd& waypoints,
                                                          const Eigen::VectorXd& durations, const DynamicLimits& limits,
-                                                         const ObstacleQuery& obstacles,
+                                                         const PlaneSet& planes,
                                                          MinimumJerkTrajectory* out) const {
   using Status = TrajectoryOptimizerSummary::Status;
   const auto start = std::chrono::steady_clock::now();
@@ -208,14 +225,20 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
     return fail(Status::kInvalidInput, e.what());
   }
   if (pieces < 1 || waypoints.cols() != pieces - 1 || !waypoints.allFinite() || !durations.allFinite() ||
-      (durations.array() <= 0.0).any() || !head.allFinite() || !tail.allFinite()) {
-    return fail(Status::kInvalidInput, "need finite head, tail, M - 1 waypoints and M positive durations");
+      (durations.array() <= 0.0).any() || !head.allFinite() || !tail.allFinite() ||
+      (!planes.empty() && static_cast<int>(planes.size()) != pieces)) {
+    return fail(Status::kInvalidInput,
+                "need finite head, tail, M - 1 waypoints, M positive durations and no planes or M lists");
+  }
+  PlaneSet sorted = planes;  // the objective walks each piece's planes in sample order
+  for (std::vector<SamplePlane>& list : sorted) {
+    std::stable_sort(list.begin(), list.end(), [](const SamplePlane& a, const SamplePlane& b) { return a.sample < b.sample; });
   }
   const int n = 4 * pieces - 3;
   Eigen::VectorXd x(n);
   x.head(3 * (pieces - 1)) = Eigen::Map<const Eigen::VectorXd>(waypoints.data(), 3 * (pieces - 1));
   for (int i = 0; i < pieces; ++i) x(3 * (pieces - 1) + i) = TauOf(durations(i));
-  summary.initial_cost = Objective(head, tail, limits, obstacles, x, nullptr);
+  summary.initial_cost = Objective(head, tail, limits, sorted, x, nullptr);
   if (!std::isfinite(summary.initial_cost)) return fail(Status::kInvalidInput, "the initial guess has no trajectory");
 
   ceres::GradientProblemSolver::Options solver_options;
@@ -224,53 +247,37 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   solver_options.logging_type = ceres::SILENT;
   solver_options.function_tolerance = 1e-5;  // relative decrease per iteration
   solver_options.gradient_tolerance = 1e-8;
-  ceres::GradientProblem problem(new CeresObjective(*this, head, tail, limits, obstacles, n, &summary.evaluations));
+  ceres::GradientProblem problem(new CeresObjective(*this, head, tail, limits, sorted, n, &summary.evaluations));
   ceres::GradientProblemSolver::Summary ceres_summary;
   ceres::Solve(solver_options, problem, x.data(), &ceres_summary);
   summary.iterations = static_cast<int>(ceres_summary.iterations.size());
-  summary.final_cost = Objective(head, tail, limits, obstacles, x, nullptr);
+  summary.final_cost = Objective(head, tail, limits, sorted, x, nullptr);
   if (!x.allFinite() || !std::isfinite(summary.final_cost) ||
       ceres_summary.termination_type == ceres::FAILURE) {
     return fail(Status::kSolverFailure, "L-BFGS: " + ceres_summary.message);
   }
 
-  // Honest feasibility: check densely, lengthen the pieces that exceed a limit until none does.
+  // Honest feasibility: check densely and, while a limit is exceeded, stretch time. With the
+  // durations scaled by k a trajectory between rest states is the same path with v / k, a / k² and
+  // j / k³; with a moving head it is close to that. So k comes from the worst excess of each.
   Eigen::Matrix3Xd q;
   Eigen::VectorXd t;
   Unpack(x, pieces, &q, &t);
   MinimumJerkTrajectory traj;
-  const double search = options_.clearance_m + 1.0;
+  const double limit[3] = {limits.v_max, limits.a_max, limits.j_max};
   for (;;) {
     if (!traj.Build(head, tail, q, t)) return fail(Status::kSolverFailure, "the optimised trajectory cannot be built");
-    summary.limit_margin = std::numeric_limits<double>::infinity();
-    summary.min_clearance_m = search;
-    std::vector<bool> slow(static_cast<std::size_t>(pieces), false);
-    const double limit[3] = {limits.v_max, limits.a_max, limits.j_max};
-    for (int i = 0; i < pieces; ++i) {
-      for (int j = 0; j <= options_.check_samples_per_piece; ++j) {
-        const double ts = t(i) * j / options_.check_samples_per_piece;
-        for (int d = 1; d <= 3; ++d) {
-          const double margin = (limit[d - 1] - traj.PieceDerivative(i, ts, d).norm()) / limit[d - 1];
-          summary.limit_margin = std::min(summary.limit_margin, margin);
-          if (margin < 0.0) slow[static_cast<std::size_t>(i)] = true;
-        }
-        if (obstacles) {
-          const Vector3 p = traj.PieceDerivative(i, ts, 0);
-          if (const auto plane = obstacles(p, search)) {
-            summary.min_clearance_m = std::min(summary.min_clearance_m, (p - plane->point).norm());
-          }
-        }
-      }
-    }
+    double ratio[3];  // max |derivative| / limit
+    for (int d = 1; d <= 3; ++d) ratio[d - 1] = traj.MaxNorm(d, options_.check_samples_per_piece) / limit[d - 1];
+    summary.limit_margin = 1.0 - std::max({ratio[0], ratio[1], ratio[2]});
     if (summary.limit_margin >= 0.0) break;
     if (summary.slowdowns == options_.max_slowdowns) {
-      return fail(Status::kInfeasible, "a limit still exceeded after lengthening the pieces " +
+      return fail(Status::kInfeasible, "a limit still exceeded after stretching time " +
                                            std::to_string(summary.slowdowns) + " times");
     }
     ++summary.slowdowns;
-    for (int i = 0; i < pieces; ++i) {
-      if (slow[static_cast<std::size_t>(i)]) t(i) *= options_.slowdown_factor;
-    }
+    const double k = std::max({ratio[0], std::sqrt(ratio[1]), std::cbrt(ratio[2]), 1.0}) * options_.slowdown_factor;
+    t *= std::min(k, 2.0);
   }
   *out = std::move(traj);
   summary.status = Status::kSuccess;

@@ -95,6 +95,9 @@ TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
   const Result perception = Cli("bench perception --help");
   EXPECT_EQ(perception.exit_code, 0);
   for (const char* s : {"--duration", "--seed", "--json"}) EXPECT_NE(perception.out.find(s), std::string::npos) << s;
+  const Result planner = Cli("bench planner --help");
+  EXPECT_EQ(planner.exit_code, 0);
+  for (const char* s : {"--pairs", "--worlds", "--seed", "--json"}) EXPECT_NE(planner.out.find(s), std::string::npos) << s;
   EXPECT_EQ(Cli("validate --help").exit_code, 0);
 }
 
@@ -299,7 +302,11 @@ TEST_F(CliTest, NumericOptionsRejectNonFiniteNegativeAndGarbage) {
     expect_usage_error("bench sim --scenario " + s + " --repetitions '" + bad + "'");
     expect_usage_error("bench perception --duration '" + bad + "'");
     expect_usage_error("bench perception --seed '" + bad + "'");
+    expect_usage_error("bench planner --pairs '" + bad + "'");
+    expect_usage_error("bench planner --seed '" + bad + "'");
   }
+  expect_usage_error("bench planner --pairs 0");
+  expect_usage_error("bench planner --pairs 4 --worlds 5");
   // Integers only where a count is expected.
   expect_usage_error("run " + s + " --quiet --seed 1.5 --out " + Out());
   expect_usage_error("bench sim --scenario " + s + " --repetitions 1.5");

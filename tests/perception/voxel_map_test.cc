@@ -1,6 +1,7 @@
 #include "rotorguard/perception/voxel_map.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -202,6 +203,33 @@ TEST(VoxelMap, SegmentCollidesExactlyWhenItCrossesAnOccupiedVoxel) {
   }
   EXPECT_GT(hits, 200);
   EXPECT_GT(misses, 10000);
+}
+
+// Nearest against a brute-force search over the list of occupied voxels, for radii that take the
+// sorted-offset path (up to 1.1 m at 0.1 m) and the cube scan beyond it.
+TEST(VoxelMap, NearestEqualsABruteForceSearch) {
+  VoxelMap map(Small());
+  Rng rng(9);
+  for (int k = 0; k < 200; ++k) map.MarkOccupied(Vector3(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(0.2, 1.8)));
+  const std::vector<Vector3> occupied = map.OccupiedVoxels();
+  ASSERT_GT(occupied.size(), 150u);
+  int found = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Vector3 p(rng.Uniform(-3.5, 3.5), rng.Uniform(-3.5, 3.5), rng.Uniform(0.0, 2.0));
+    const double radius = k % 4 == 3 ? 1.6 : rng.Uniform(0.0, 1.0);
+    double truth = std::numeric_limits<double>::infinity();
+    for (const Vector3& c : occupied) truth = std::min(truth, (c - p).norm());
+    const auto n = map.Nearest(p, radius);
+    if (truth > radius) {
+      EXPECT_FALSE(n) << "nothing within " << radius << " of " << p.transpose();
+      continue;
+    }
+    ASSERT_TRUE(n) << p.transpose();
+    EXPECT_NEAR(n->distance_m, truth, 1e-12);
+    EXPECT_NEAR((n->point_W - p).norm(), truth, 1e-12);
+    ++found;
+  }
+  EXPECT_GT(found, 500);
 }
 
 TEST(VoxelMap, NonFiniteAndOutOfWindowPointsAreDroppedAndCountedEmptyFramesAreHarmless) {

@@ -69,7 +69,14 @@ class VoxelMap {
   /// Integrates one frame of returns (world frame) measured from `origin_W`.
   MapUpdateSummary Insert(const Vector3& origin_W, const std::vector<Eigen::Vector3f>& points_W);
 
+  /// Sets the voxel of `p_W` occupied with the largest log-odds (known), as if hit many times:
+  /// for maps built from a known world (planner benchmarks, tests). Outside the window: nothing.
+  void MarkOccupied(const Vector3& p_W);
+
   bool InWindow(const Vector3& p_W) const;
+  /// The window's corners [m]: it covers [window_min_W, window_max_W).
+  Vector3 window_min_W() const { return origin_.cast<double>() * res_; }
+  Vector3 window_max_W() const { return (origin_ + size_).cast<double>() * res_; }
   /// The window's extent in voxels per axis (powers of two).
   Eigen::Vector3i size_voxels() const { return size_; }
   /// Occupied (log-odds above the threshold). Outside the window: false.
@@ -168,6 +175,14 @@ class VoxelMap {
   std::vector<std::uint16_t> inflation_;  // occupied voxels within the radius
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
+  /// Offsets within kSortedOffsetRadius voxels, by increasing distance: Nearest visits them in
+  /// order and stops early (the planner asks it for every penalty sample).
+  static constexpr int kSortedOffsetRadius = 12;
+  struct SortedOffset {
+    Index offset;
+    double distance;  // [voxels]
+  };
+  std::vector<SortedOffset> sorted_offsets_;
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
   int hysteresis_voxels_ = 0;             // recenter_hysteresis_m in whole voxels
   std::vector<Index> touched_hit_;

@@ -55,6 +55,10 @@ class MinimumJerkTrajectory final : public ReferenceTrajectory {
   /// Derivative `order` (0 position .. 5) of piece i at local time t in [0, T_i].
   Vector3 PieceDerivative(int piece, double t, int order) const;
 
+  /// The largest |derivative `order`| over the trajectory, sampled at samples_per_piece + 1 evenly
+  /// spaced instants of every piece (ends included).
+  double MaxNorm(int order, int samples_per_piece) const;
+
   /// ReferenceTrajectory: position through jerk at time t since `start_time()`; before it the
   /// first point, after the end the final state with zero velocity and higher derivatives (the
   /// tail is a rest state when the trajectory stops at a goal).

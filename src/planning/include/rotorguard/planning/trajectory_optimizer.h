@@ -3,15 +3,16 @@
 ///   min over {q, T} of  λ_t J_t + λ_s J_s + λ_d J_d + λ_c J_c
 /// with J_t the total time (eq. 23), J_s the jerk energy (eq. 24), J_d the velocity, acceleration
 /// and jerk limits sampled along each piece (eqs. 25-29) and J_c the clearance from obstacle planes
-/// (eqs. 34-36). Durations are optimised through a smooth positive map, T = τ + sqrt(τ² + 1), so
+/// (eqs. 34-36), a set of planes per piece. Durations are optimised through a smooth positive map, T = τ + sqrt(τ² + 1), so
 /// that the problem is unconstrained, and solved by Ceres' L-BFGS (GradientProblemSolver) behind a
 /// wrapper that treats any non-finite cost or gradient as a failed evaluation.
 ///
-/// Penalties alone do not guarantee limits, so the result is checked densely afterwards and, where
-/// a limit is exceeded, the offending pieces are slowed down until it holds (see `Summary`).
+/// Penalties alone do not guarantee limits, so the result is checked densely afterwards and, while
+/// a limit is exceeded, time is stretched until it holds (see `Summary`).
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "rotorguard/core/types.h"
@@ -34,13 +35,31 @@ struct DynamicLimits {
 double PostFailureAccelerationLimit(double mass_kg, double rotor_max_thrust_n, double max_drag_coefficient_kg_s,
                                     double v_max, double safety_factor);
 
-/// The nearest obstacle point to a position within a search radius, and the unit normal of its
-/// plane pointing to free space (eq. 34: the plane through `point` with normal `normal`).
+/// An obstacle as the plane of eq. (34): through `point`, with unit `normal` pointing to free space;
+/// a position p is at signed distance (p - point) . normal from it (eq. 35).
 struct ObstaclePlane {
   Vector3 point;
   Vector3 normal;
 };
-using ObstacleQuery = std::function<std::optional<ObstaclePlane>(const Vector3& position, double radius_m)>;
+/// A plane that one penalty sample keeps clear of (eq. 36): sample `sample` (0..samples_per_piece)
+/// of its piece. The planner builds them from each sample's nearest obstacle along the initial
+/// trajectory (the front end's path) and holds them during a solve: a linearisation of the
+/// distance to the obstacles, exact in its gradient, that spares the cost any map query.
+struct SamplePlane {
+  int sample = 0;
+  ObstaclePlane plane;
+};
+/// One list per piece; empty for free space. Optimize takes the lists in any order; Objective
+/// needs each sorted by sample (as BuildSamplePlanes makes them).
+using PlaneSet = std::vector<std::vector<SamplePlane>>;
+
+/// The nearest obstacle's plane at a position (point on its surface, normal towards the
+/// position), if one lies within the caller's search radius.
+using NearestPlane = std::function<std::optional<ObstaclePlane>(const Vector3& position)>;
+
+/// The planes for `traj`'s penalty samples (samples_per_piece + 1 per piece, as the optimiser
+/// places them), each sample's nearest obstacle where `nearest` finds one.
+PlaneSet BuildSamplePlanes(const MinimumJerkTrajectory& traj, int samples_per_piece, const NearestPlane& nearest);
 
 struct TrajectoryOptimizerOptions {
   // Eq. (22)'s weights λ = [λ_t, λ_s, λ_d, λ_c]; paper 000 Sec. VI uses [10, 1, 1e4, 1e4].
@@ -52,10 +71,11 @@ struct TrajectoryOptimizerOptions {
   int samples_per_piece = 16;    ///< penalty samples per piece (κ / M), >= 2
   int max_iterations = 200;      ///< L-BFGS iterations, >= 1
   /// The dense feasibility check: samples per piece, and the at most `max_slowdowns` rounds that
-  /// lengthen the offending pieces by `slowdown_factor` each.
+  /// stretch all durations by the factor that the worst excess calls for (v / k, a / k², j / k³),
+  /// times `slowdown_factor` for a margin.
   int check_samples_per_piece = 64;
-  int max_slowdowns = 30;
-  double slowdown_factor = 1.1;
+  int max_slowdowns = 10;
+  double slowdown_factor = 1.02;
   void Validate() const;
 };
 
@@ -65,15 +85,12 @@ struct TrajectoryOptimizerSummary {
   std::string message;
   int iterations = 0;
   int evaluations = 0;
-  int slowdowns = 0;            ///< rounds of the feasibility repair
+  int slowdowns = 0;            ///< rounds of time stretching by the feasibility repair
   double initial_cost = 0.0;
   double final_cost = 0.0;
   double solve_ms = 0.0;
   /// min over v, a, j of (limit - max value) / limit on the dense check: >= 0 when all hold.
   double limit_margin = 0.0;
-  /// The smallest distance from the sampled trajectory to an obstacle within the search radius
-  /// (clearance_m + 1 m); that radius when none was found.
-  double min_clearance_m = 0.0;
   bool ok() const { return status == Status::kSuccess; }
 };
 const char* ToString(TrajectoryOptimizerSummary::Status status);
@@ -84,17 +101,17 @@ class TrajectoryOptimizer {
   explicit TrajectoryOptimizer(const TrajectoryOptimizerOptions& options);
 
   /// Optimises the waypoints and durations from an initial guess (waypoints 3 x (M - 1), durations
-  /// M > 0); `obstacles` may be empty (free space). On success `out` holds a trajectory within
-  /// `limits` on the dense check.
+  /// M > 0); `planes` is empty (free space) or holds one list per piece. On success `out` holds a
+  /// trajectory within `limits` on the dense check.
   TrajectoryOptimizerSummary Optimize(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
                                       const Eigen::VectorXd& durations, const DynamicLimits& limits,
-                                      const ObstacleQuery& obstacles, MinimumJerkTrajectory* out) const;
+                                      const PlaneSet& planes, MinimumJerkTrajectory* out) const;
 
   /// The objective of eq. (22) at x = [q (column by column), τ] and its gradient (may be null); the
   /// problem's head, tail, limits and obstacles as for Optimize. Returns NaN when the trajectory
   /// cannot be built. Public for the gradient tests.
-  double Objective(const PvaState& head, const PvaState& tail, const DynamicLimits& limits,
-                   const ObstacleQuery& obstacles, const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const;
+  double Objective(const PvaState& head, const PvaState& tail, const DynamicLimits& limits, const PlaneSet& planes,
+                   const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const;
 
   /// T(τ) = τ + sqrt(τ² + 1) and its inverse.
   static double DurationOf(double tau) { return tau + std::sqrt(tau * tau + 1.0); }

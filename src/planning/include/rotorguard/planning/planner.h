@@ -1,0 +1,65 @@
+#pragma once
+/// One planning query (paper 000, Sec. V-C): the A* front end on the occupancy map, its path cut
+/// into pieces as MINCO's initial waypoints and durations, obstacle planes from each penalty
+/// sample's nearest occupied voxel, the spatio-temporal optimisation, then checks of the result
+/// against the map: where it passes through an inflated voxel, planes are added where it does
+/// and the optimisation runs again from its last result, a bounded number of times.
+#include <string>
+
+#include "rotorguard/perception/voxel_map.h"
+#include "rotorguard/planning/astar.h"
+#include "rotorguard/planning/minco.h"
+#include "rotorguard/planning/trajectory_optimizer.h"
+
+namespace rotorguard::planning {
+
+struct PlannerOptions {
+  AStarOptions search;
+  TrajectoryOptimizerOptions optimizer;
+  double max_piece_length_m = 1.5;  ///< the path is cut into pieces at most this long [m], > 0
+  double plane_search_m = 0.5;      ///< a sample gets the plane of an obstacle within this [m], >= clearance
+  int clearance_rounds = 4;         ///< re-optimisations with planes added where the result collides, >= 0
+  double check_step_m = 0.05;       ///< spacing of the collision check along the result [m], > 0
+  void Validate() const;
+};
+
+struct PlanSummary {
+  enum class Status {
+    kSuccess,
+    kStartOutOfBounds,
+    kGoalOutOfBounds,
+    kGoalBlocked,
+    kNoPath,
+    kOptimizerFailed,
+    kInfeasible,
+    kCollision
+  };
+  Status status = Status::kNoPath;
+  std::string message;
+  PathResult path;
+  TrajectoryOptimizerSummary optimizer;  ///< the last optimisation
+  int pieces = 0;
+  int clearance_rounds = 0;  ///< re-optimisations for clearance
+  double search_ms = 0.0, optimize_ms = 0.0, total_ms = 0.0;
+  double limit_margin = 0.0;    ///< the optimiser's dense check: min (limit - max) / limit
+  double min_clearance_m = 0.0; ///< the smallest distance to an occupied voxel centre along the result (capped at plane_search_m)
+  bool ok() const { return status == Status::kSuccess; }
+};
+const char* ToString(PlanSummary::Status status);
+
+class Planner {
+ public:
+  /// Throws ValidationError on invalid options.
+  explicit Planner(const PlannerOptions& options);
+  /// Plans from `start` (position, velocity, acceleration) to rest at `goal` within `limits` on
+  /// `map`. On success `out` holds the trajectory (start time 0).
+  PlanSummary Plan(const PvaState& start, const Vector3& goal, const DynamicLimits& limits,
+                   const perception::VoxelMap& map, MinimumJerkTrajectory* out) const;
+  const PlannerOptions& options() const { return options_; }
+
+ private:
+  PlannerOptions options_;
+  TrajectoryOptimizer optimizer_;
+};
+
+}  // namespace rotorguard::planning

@@ -1,0 +1,167 @@
+#include "rotorguard/planning/planner.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::planning {
+
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+void PlannerOptions::Validate() const {
+  search.Validate();
+  optimizer.Validate();
+  const auto require = [](bool ok, const char* field, double v, const char* rule) {
+    if (!ok) ThrowValidation("PlannerOptions", field, v, rule);
+  };
+  require(std::isfinite(max_piece_length_m) && max_piece_length_m > 0.0, "max_piece_length_m", max_piece_length_m,
+          "a length > 0 m");
+  require(std::isfinite(plane_search_m) && plane_search_m >= optimizer.clearance_m, "plane_search_m", plane_search_m,
+          "a distance >= optimizer.clearance_m");
+  require(clearance_rounds >= 0, "clearance_rounds", clearance_rounds, ">= 0");
+  require(std::isfinite(check_step_m) && check_step_m > 0.0, "check_step_m", check_step_m, "a step > 0 m");
+}
+
+const char* ToString(PlanSummary::Status status) {
+  switch (status) {
+    case PlanSummary::Status::kSuccess: return "success";
+    case PlanSummary::Status::kStartOutOfBounds: return "start_out_of_bounds";
+    case PlanSummary::Status::kGoalOutOfBounds: return "goal_out_of_bounds";
+    case PlanSummary::Status::kGoalBlocked: return "goal_blocked";
+    case PlanSummary::Status::kNoPath: return "no_path";
+    case PlanSummary::Status::kOptimizerFailed: return "optimizer_failed";
+    case PlanSummary::Status::kInfeasible: return "infeasible";
+    case PlanSummary::Status::kCollision: return "collision";
+  }
+  return "unknown";
+}
+
+Planner::Planner(const PlannerOptions& options) : options_(options), optimizer_(options.optimizer) {
+  options_.Validate();
+}
+
+PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const DynamicLimits& limits,
+                          const perception::VoxelMap& map, MinimumJerkTrajectory* out) const {
+  using Status = PlanSummary::Status;
+  const auto t0 = std::chrono::steady_clock::now();
+  PlanSummary summary;
+  const auto finish = [&](Status status, std::string message) {
+    summary.status = status;
+    summary.message = std::move(message);
+    summary.total_ms = MsSince(t0);
+    return summary;
+  };
+  summary.path = FindPath(map, start.col(0), goal, options_.search);
+  summary.search_ms = MsSince(t0);
+  switch (summary.path.status) {
+    case PathStatus::kFound: break;
+    case PathStatus::kStartOutOfBounds: return finish(Status::kStartOutOfBounds, "the start lies outside the map");
+    case PathStatus::kGoalOutOfBounds: return finish(Status::kGoalOutOfBounds, "the goal lies outside the map");
+    case PathStatus::kGoalBlocked: return finish(Status::kGoalBlocked, "the goal lies within an obstacle's inflation");
+    case PathStatus::kNoPath: return finish(Status::kNoPath, "no collision-free path to the goal in the map");
+    case PathStatus::kExpansionLimit:
+      return finish(Status::kNoPath, "the path search reached its expansion limit");
+  }
+  // Initial guess: the pruned path cut into pieces of at most max_piece_length_m, flown at
+  // v_max (at least 0.2 s each, so that short pieces stay well conditioned).
+  std::vector<Vector3> knots;
+  const std::vector<Vector3>& pts = summary.path.points;
+  for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
+    const int parts = std::max(1, static_cast<int>(std::ceil((pts[k + 1] - pts[k]).norm() / options_.max_piece_length_m)));
+    for (int j = 0; j < parts; ++j) knots.push_back(pts[k] + (pts[k + 1] - pts[k]) * j / parts);
+  }
+  knots.push_back(pts.back());
+  const int pieces = static_cast<int>(knots.size()) - 1;
+  summary.pieces = pieces;
+  Eigen::Matrix3Xd q(3, pieces - 1);
+  Eigen::VectorXd t(pieces);
+  for (int i = 0; i < pieces; ++i) {
+    if (i > 0) q.col(i - 1) = knots[static_cast<std::size_t>(i)];
+    t(i) = std::max(0.2, (knots[static_cast<std::size_t>(i) + 1] - knots[static_cast<std::size_t>(i)]).norm() / limits.v_max);
+  }
+  PvaState tail = PvaState::Zero();
+  tail.col(0) = goal;
+  MinimumJerkTrajectory traj;
+  if (!traj.Build(start, tail, q, t)) return finish(Status::kOptimizerFailed, "the initial guess has no trajectory");
+  const double res = map.resolution();
+  const NearestPlane nearest = [&](const Vector3& p) -> std::optional<ObstaclePlane> {
+    const std::optional<perception::NearestObstacle> o = map.Nearest(p, options_.plane_search_m);
+    if (!o) return std::nullopt;
+    // The plane on the voxel's face towards the sample rather than through its centre.
+    return ObstaclePlane{o->point_W + 0.5 * res * o->normal_W, o->normal_W};
+  };
+  const int samples = options_.optimizer.samples_per_piece;
+  const MinimumJerkTrajectory guide = traj;
+  PlaneSet planes = BuildSamplePlanes(traj, samples, nearest);
+  // The altitude band of the search holds for the trajectory too: a floor and a ceiling plane per
+  // sample, placed so that the clearance term pushes exactly to the band's edges.
+  const double c_o = options_.optimizer.clearance_m;
+  for (int i = 0; i < pieces; ++i) {
+    for (int j = 0; j <= samples; ++j) {
+      planes[static_cast<std::size_t>(i)].push_back(
+          {j, ObstaclePlane{Vector3(0, 0, options_.search.z_min_m - c_o), Vector3::UnitZ()}});
+      planes[static_cast<std::size_t>(i)].push_back(
+          {j, ObstaclePlane{Vector3(0, 0, options_.search.z_max_m + c_o), -Vector3::UnitZ()}});
+    }
+  }
+  const auto t_opt = std::chrono::steady_clock::now();
+  for (int round = 0;; ++round) {
+    summary.optimizer = optimizer_.Optimize(start, tail, q, t, limits, planes, &traj);
+    if (!summary.optimizer.ok()) {
+      summary.optimize_ms = MsSince(t_opt);
+      return finish(summary.optimizer.status == TrajectoryOptimizerSummary::Status::kInfeasible ? Status::kInfeasible
+                                                                                               : Status::kOptimizerFailed,
+                    summary.optimizer.message);
+    }
+    // Check the result against the map, every check_step_m of path at most.
+    const double dt = options_.check_step_m / std::max(limits.v_max, 1e-3);
+    bool collides = false;
+    summary.min_clearance_m = options_.plane_search_m;
+    for (double s = 0.0; s <= traj.total_duration() + 1e-9; s += dt) {
+      const Vector3 p = traj.Evaluate(s).p_W;
+      if (map.IsInflated(p)) collides = true;
+      if (const auto o = map.Nearest(p, options_.plane_search_m)) {
+        summary.min_clearance_m = std::min(summary.min_clearance_m, o->distance_m);
+      }
+    }
+    if (!collides) break;
+    if (round == options_.clearance_rounds) {
+      summary.optimize_ms = MsSince(t_opt);
+      return finish(Status::kCollision, "the trajectory still meets an inflated voxel after " +
+                                            std::to_string(round) + " re-optimisations");
+    }
+    // Where a sample of the result lies in an inflated voxel, a plane through the nearest obstacle
+    // facing the same sample of the initial guess (the front end's collision-free path): the
+    // obstacle's own normal points anywhere from inside it, the guide's side is where the path
+    // went round. Then again from the result.
+    ++summary.clearance_rounds;
+    for (int i = 0; i < pieces; ++i) {
+      for (int j = 0; j <= samples; ++j) {
+        const Vector3 p = traj.PieceDerivative(i, traj.durations()(i) * j / samples, 0);
+        if (!map.IsInflated(p)) continue;
+        const std::optional<perception::NearestObstacle> o = map.Nearest(p, options_.plane_search_m);
+        if (!o) continue;
+        const Vector3 away = guide.PieceDerivative(i, guide.durations()(i) * j / samples, 0) - o->point_W;
+        if (away.norm() < 1e-9) continue;
+        const Vector3 n = away.normalized();
+        planes[static_cast<std::size_t>(i)].push_back({j, ObstaclePlane{o->point_W + 0.5 * res * n, n}});
+      }
+    }
+    t = traj.durations();
+    for (int i = 0; i + 1 < pieces; ++i) q.col(i) = traj.PieceDerivative(i, t(i), 0);
+  }
+  summary.optimize_ms = MsSince(t_opt);
+  summary.limit_margin = summary.optimizer.limit_margin;
+  *out = std::move(traj);
+  return finish(Status::kSuccess, "");
+}
+
+}  // namespace rotorguard::planning

@@ -1,0 +1,128 @@
+#include "rotorguard/planning/planner.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/planning/astar.h"
+
+namespace rotorguard::planning {
+namespace {
+
+perception::VoxelMap EmptyMap() {
+  perception::VoxelMapOptions o;
+  o.window_size_m = Vector3(12.8, 12.8, 6.4);  // [-6.4, 6.4) x [-6.4, 6.4) x [-3.2, 3.2)
+  o.inflation_radius_m = 0.2;
+  return perception::VoxelMap(o);
+}
+
+/// A wall x in [2, 2.2] across y in [-5, 5], z in [0, 3], with a 1 m gap at y in [2, 3].
+void AddWallWithGap(perception::VoxelMap* map) {
+  for (double x = 2.05; x < 2.2; x += 0.1) {
+    for (double y = -4.95; y < 5.0; y += 0.1) {
+      if (y > 2.0 && y < 3.0) continue;
+      for (double z = 0.05; z < 3.0; z += 0.1) map->MarkOccupied(Vector3(x, y, z));
+    }
+  }
+}
+
+/// Samples the trajectory every 2 cm of time at 1 m/s or finer.
+bool EverInflated(const MinimumJerkTrajectory& traj, const perception::VoxelMap& map) {
+  for (double t = 0.0; t <= traj.total_duration(); t += 0.01) {
+    if (map.IsInflated(traj.Evaluate(t).p_W)) return true;
+  }
+  return false;
+}
+
+// Through the gap: the pruned path's segments cross no inflated voxel, and it bends through the
+// gap (the straight line is blocked).
+TEST(AStar, FindsThePathThroughTheGapAndItsSegmentsAreFree) {
+  perception::VoxelMap map = EmptyMap();
+  AddWallWithGap(&map);
+  const Vector3 start(0, 0, 1.5), goal(4, 0, 1.5);
+  ASSERT_TRUE(map.SegmentCollides(start, goal));
+  const PathResult r = FindPath(map, start, goal, AStarOptions{});
+  ASSERT_EQ(r.status, PathStatus::kFound);
+  ASSERT_GE(r.points.size(), 3u);
+  EXPECT_EQ(r.points.front(), start);
+  EXPECT_EQ(r.points.back(), goal);
+  bool through_gap = false;
+  for (std::size_t k = 0; k + 1 < r.points.size(); ++k) {
+    EXPECT_FALSE(map.SegmentCollides(r.points[k], r.points[k + 1])) << "segment " << k;
+    through_gap |= r.points[k].y() > 2.0 || r.points[k + 1].y() > 2.0;
+  }
+  EXPECT_TRUE(through_gap);
+  // Shortest route via the gap's lower edge (inflated by 0.2 m + half a voxel): about 6.1 m.
+  EXPECT_LT(r.length_m, 1.2 * 6.2);
+}
+
+// A goal inside an obstacle, outside the map, or enclosed: a status, quickly, and no path.
+TEST(AStar, BlockedOutsideAndEnclosedGoalsGiveTheirStatus) {
+  perception::VoxelMap map = EmptyMap();
+  AddWallWithGap(&map);
+  EXPECT_EQ(FindPath(map, Vector3(0, 0, 1.5), Vector3(2.1, 0, 1.5), AStarOptions{}).status, PathStatus::kGoalBlocked);
+  EXPECT_EQ(FindPath(map, Vector3(0, 0, 1.5), Vector3(20, 0, 1.5), AStarOptions{}).status, PathStatus::kGoalOutOfBounds);
+  EXPECT_EQ(FindPath(map, Vector3(0, 0, 1.5), Vector3(0, 0, 5.0), AStarOptions{}).status, PathStatus::kGoalOutOfBounds)
+      << "above the altitude band";
+  EXPECT_EQ(FindPath(map, Vector3(std::nan(""), 0, 1.5), Vector3(1, 0, 1.5), AStarOptions{}).status,
+            PathStatus::kStartOutOfBounds);
+  // A closed shell 1 m across around the goal (0.3 m thick, so no diagonal slips through).
+  for (double x = -3.45; x < -1.6; x += 0.1) {
+    for (double y = -0.95; y < 1.0; y += 0.1) {
+      for (double z = 0.05; z < 3.0; z += 0.1) {
+        if (std::abs(x + 2.5) < 0.65 && std::abs(y) < 0.65 && z > 0.3 && z < 2.7) continue;  // the hollow
+        map.MarkOccupied(Vector3(x, y, z));
+      }
+    }
+  }
+  const PathResult r = FindPath(map, Vector3(0, 0, 1.5), Vector3(-2.5, 0.0, 1.5), AStarOptions{});
+  EXPECT_EQ(r.status, PathStatus::kNoPath);
+  EXPECT_TRUE(r.points.empty());
+  AStarOptions capped;
+  capped.max_expansions = 100;
+  EXPECT_EQ(FindPath(map, Vector3(0, 0, 1.5), Vector3(-2.5, 0.0, 1.5), capped).status, PathStatus::kExpansionLimit);
+}
+
+/// The wall with its gap, the default planner and a start at rest before the wall.
+class PlannerAtTheWall : public ::testing::Test {
+ protected:
+  PlannerAtTheWall() : map_(EmptyMap()), planner_(PlannerOptions{}) {
+    AddWallWithGap(&map_);
+    start_.col(0) = Vector3(0, 0, 1.5);
+  }
+  perception::VoxelMap map_;
+  const Planner planner_;
+  PvaState start_ = PvaState::Zero();
+};
+
+// The whole query through the gap, with nominal limits and with a post-failure acceleration
+// limit: never in an inflated voxel, within the limits on 2000 samples per piece, at rest at the
+// goal.
+TEST_F(PlannerAtTheWall, PlansThroughTheGapWithinItsLimits) {
+  const Vector3 goal(4, 0, 1.5);
+  for (const double a_max : {2.0, 0.5}) {
+    const DynamicLimits limits{1.0, a_max, 6.0};
+    MinimumJerkTrajectory traj;
+    const PlanSummary s = planner_.Plan(start_, goal, limits, map_, &traj);
+    ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
+    EXPECT_FALSE(EverInflated(traj, map_));
+    EXPECT_LE(traj.MaxNorm(1, 2000), limits.v_max * 1.001);
+    EXPECT_LE(traj.MaxNorm(2, 2000), limits.a_max * 1.001);
+    EXPECT_LE(traj.MaxNorm(3, 2000), limits.j_max * 1.001);
+    EXPECT_GE(s.limit_margin, 0.0);
+    EXPECT_LT((traj.Evaluate(1e9).p_W - goal).norm(), 1e-9);
+    EXPECT_GT(s.min_clearance_m, 0.2);
+  }
+}
+
+TEST_F(PlannerAtTheWall, FailuresHaveAStatusAndNoTrajectory) {
+  MinimumJerkTrajectory traj;
+  EXPECT_EQ(planner_.Plan(start_, Vector3(2.1, 0, 1.5), DynamicLimits{}, map_, &traj).status,
+            PlanSummary::Status::kGoalBlocked);
+  EXPECT_EQ(planner_.Plan(start_, Vector3(50, 0, 1.5), DynamicLimits{}, map_, &traj).status,
+            PlanSummary::Status::kGoalOutOfBounds);
+  EXPECT_TRUE(traj.empty());
+}
+
+}  // namespace
+}  // namespace rotorguard::planning
