@@ -99,8 +99,19 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     return ObstaclePlane{o->point_W + 0.5 * res * o->normal_W, o->normal_W};
   };
   const int samples = options_.optimizer.samples_per_piece;
-  const MinimumJerkTrajectory guide = traj;
-  PlaneSet planes = BuildSamplePlanes(traj, samples, nearest);
+  // The guide: the front end's path itself, sample j of piece i at the same fraction along the
+  // piece's straight segment (collision-free by construction, where the initial polynomial may
+  // cut a corner into an obstacle). Each sample's plane comes from the guide's nearest obstacle.
+  const auto guide = [&](int i, int j) {
+    const Vector3& a = knots[static_cast<std::size_t>(i)];
+    return Vector3(a + (knots[static_cast<std::size_t>(i) + 1] - a) * (static_cast<double>(j) / samples));
+  };
+  PlaneSet planes(static_cast<std::size_t>(pieces));
+  for (int i = 0; i < pieces; ++i) {
+    for (int j = 0; j <= samples; ++j) {
+      if (const std::optional<ObstaclePlane> plane = nearest(guide(i, j))) planes[static_cast<std::size_t>(i)].push_back({j, *plane});
+    }
+  }
   // The altitude band of the search holds for the trajectory too: a floor and a ceiling plane per
   // sample, placed so that the clearance term pushes exactly to the band's edges.
   const double c_o = options_.optimizer.clearance_m;
@@ -149,7 +160,7 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
         if (!map.IsInflated(p)) continue;
         const std::optional<perception::NearestObstacle> o = map.Nearest(p, options_.plane_search_m);
         if (!o) continue;
-        const Vector3 away = guide.PieceDerivative(i, guide.durations()(i) * j / samples, 0) - o->point_W;
+        const Vector3 away = guide(i, j) - o->point_W;
         if (away.norm() < 1e-9) continue;
         const Vector3 n = away.normalized();
         planes[static_cast<std::size_t>(i)].push_back({j, ObstaclePlane{o->point_W + 0.5 * res * n, n}});
