@@ -264,7 +264,11 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   Eigen::VectorXd t;
   Unpack(x, pieces, &q, &t);
   MinimumJerkTrajectory traj;
-  const double limit[3] = {limits.v_max, limits.a_max, limits.j_max};
+  // The head state is given: where it already exceeds a limit (a replan right after the limit
+  // dropped on a failure) the check holds the trajectory to the head's own value instead, which
+  // no choice of waypoints or durations could undercut.
+  const double limit[3] = {std::max(limits.v_max, head.col(1).norm()), std::max(limits.a_max, head.col(2).norm()),
+                           limits.j_max};
   for (;;) {
     if (!traj.Build(head, tail, q, t)) return fail(Status::kSolverFailure, "the optimised trajectory cannot be built");
     double ratio[3];  // max |derivative| / limit

@@ -90,6 +90,7 @@ struct TrajectoryOptimizerSummary {
   double final_cost = 0.0;
   double solve_ms = 0.0;
   /// min over v, a, j of (limit - max value) / limit on the dense check: >= 0 when all hold.
+  /// (A head velocity or acceleration beyond its limit raises that limit to the head's value.)
   double limit_margin = 0.0;
   bool ok() const { return status == Status::kSuccess; }
 };

@@ -1,0 +1,83 @@
+#pragma once
+/// The planner's state machine (paper 000, Sec. V-C, navigation in unknown environments): it plans
+/// when given a goal, and plans again from the current reference state
+///   - when the trajectory ahead meets an inflated voxel (an obstacle newly mapped or moved),
+///   - when FDD reports a failure (the acceleration limit drops to the post-failure one, eq. 33),
+///   - periodically (the map fills in as the vehicle flies).
+/// The reference it hands on is continuous in position, velocity and acceleration: every new
+/// trajectory starts from the old one's state at the switching instant. When no plan can be made
+/// and the trajectory ahead is unsafe, it brakes to rest within the limits, holds, and keeps
+/// trying.
+#include <string>
+#include <vector>
+
+#include "rotorguard/core/trajectory.h"
+#include "rotorguard/perception/voxel_map.h"
+#include "rotorguard/planning/planner.h"
+
+namespace rotorguard::planning {
+
+struct ReplannerOptions {
+  PlannerOptions planner;
+  DynamicLimits nominal{1.0, 2.0, 6.0};
+  /// The acceleration limit after a failure (a_max,f of eq. 33, see PostFailureAccelerationLimit).
+  double post_failure_a_max = 0.84;
+  double replan_period_s = 1.0;     ///< periodic replanning [s], > 0
+  double check_horizon_s = 3.0;     ///< how far ahead the trajectory is checked against the map [s], > 0
+  double check_step_m = 0.05;       ///< spacing of that check along the path [m], > 0
+  void Validate() const;
+};
+
+class Replanner {
+ public:
+  enum class Mode { kIdle, kFollowing, kBraking, kHolding };
+  struct Event {
+    double t = 0.0;
+    std::string reason;   ///< "goal", "failure", "obstacle ahead", "periodic"
+    PlanSummary::Status status = PlanSummary::Status::kSuccess;
+    Mode mode_after = Mode::kIdle;
+  };
+
+  /// Throws ValidationError on invalid options. Holds `hold_position` until given a goal.
+  Replanner(const ReplannerOptions& options, const Vector3& hold_position);
+
+  void SetGoal(const Vector3& goal_W);
+  /// FDD isolated a failure: the post-failure limits from now on.
+  void OnFailure();
+  /// Runs the state machine at time t [s] on the current map (at the planner's rate).
+  void Update(double t, const perception::VoxelMap& map);
+
+  /// The reference at time t (continuous across replans).
+  ReferencePoint Reference(double t) const;
+  Mode mode() const { return mode_; }
+  const std::vector<Event>& events() const { return events_; }
+  const DynamicLimits& limits() const { return limits_; }
+  /// The trajectory being followed (empty while holding before any plan).
+  const MinimumJerkTrajectory& trajectory() const { return trajectory_; }
+  /// The last planning query's summary.
+  const PlanSummary& last_plan() const { return last_plan_; }
+
+ private:
+  /// Plans from the reference state at t; on success switches to the new trajectory.
+  bool Replan(double t, const perception::VoxelMap& map);
+  /// Whether the trajectory from t to t + check_horizon meets an inflated voxel.
+  bool UnsafeAhead(double t, const perception::VoxelMap& map) const;
+  /// A one-piece trajectory from the reference state at t to rest, stretched until within limits.
+  void Brake(double t);
+
+  ReplannerOptions options_;
+  Planner planner_;
+  DynamicLimits limits_;
+  Mode mode_ = Mode::kIdle;
+  MinimumJerkTrajectory trajectory_;
+  Vector3 hold_;
+  Vector3 goal_ = Vector3::Zero();
+  bool new_goal_ = false, failure_pending_ = false, has_goal_ = false;
+  double last_plan_t_ = -1e9;
+  PlanSummary last_plan_;
+  std::vector<Event> events_;
+};
+
+const char* ToString(Replanner::Mode mode);
+
+}  // namespace rotorguard::planning

@@ -1,0 +1,142 @@
+#include "rotorguard/planning/replanner.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rotorguard/core/error.h"
+
+namespace rotorguard::planning {
+
+namespace {
+
+PvaState StateOf(const ReferencePoint& r) {
+  PvaState s;
+  s << r.p_W, r.v_W, r.a_W;
+  return s;
+}
+
+}  // namespace
+
+void ReplannerOptions::Validate() const {
+  planner.Validate();
+  nominal.Validate();
+  const auto require = [](bool ok, const char* field, double v, const char* rule) {
+    if (!ok) ThrowValidation("ReplannerOptions", field, v, rule);
+  };
+  require(std::isfinite(post_failure_a_max) && post_failure_a_max > 0.0, "post_failure_a_max", post_failure_a_max,
+          "an acceleration > 0 m/s²");
+  require(std::isfinite(replan_period_s) && replan_period_s > 0.0, "replan_period_s", replan_period_s, "a period > 0 s");
+  require(std::isfinite(check_horizon_s) && check_horizon_s > 0.0, "check_horizon_s", check_horizon_s, "a horizon > 0 s");
+  require(std::isfinite(check_step_m) && check_step_m > 0.0, "check_step_m", check_step_m, "a step > 0 m");
+}
+
+const char* ToString(Replanner::Mode mode) {
+  switch (mode) {
+    case Replanner::Mode::kIdle: return "idle";
+    case Replanner::Mode::kFollowing: return "following";
+    case Replanner::Mode::kBraking: return "braking";
+    case Replanner::Mode::kHolding: return "holding";
+  }
+  return "unknown";
+}
+
+Replanner::Replanner(const ReplannerOptions& options, const Vector3& hold_position)
+    : options_(options), planner_(options.planner), limits_(options.nominal), hold_(hold_position) {
+  options_.Validate();
+}
+
+void Replanner::SetGoal(const Vector3& goal_W) {
+  goal_ = goal_W;
+  has_goal_ = new_goal_ = true;
+}
+
+void Replanner::OnFailure() {
+  if (limits_.a_max == options_.post_failure_a_max) return;  // already
+  limits_.a_max = std::min(limits_.a_max, options_.post_failure_a_max);
+  failure_pending_ = true;
+}
+
+ReferencePoint Replanner::Reference(double t) const {
+  if (!trajectory_.empty()) return trajectory_.Evaluate(t);
+  ReferencePoint r;
+  r.p_W = hold_;
+  return r;
+}
+
+bool Replanner::UnsafeAhead(double t, const perception::VoxelMap& map) const {
+  if (trajectory_.empty()) return false;
+  const double end = std::min(trajectory_.duration(), t + options_.check_horizon_s);
+  const double dt = options_.check_step_m / std::max(limits_.v_max, 1e-3);
+  for (double s = t; s <= end; s += dt) {
+    if (map.IsInflated(trajectory_.Evaluate(s).p_W)) return true;
+  }
+  return false;
+}
+
+bool Replanner::Replan(double t, const perception::VoxelMap& map) {
+  MinimumJerkTrajectory traj;
+  last_plan_ = planner_.Plan(StateOf(Reference(t)), goal_, limits_, map, &traj);
+  last_plan_t_ = t;
+  const bool ok = last_plan_.ok();
+  if (ok) {
+    traj.set_start_time(t);
+    trajectory_ = std::move(traj);
+    mode_ = Mode::kFollowing;
+  }
+  return ok;
+}
+
+void Replanner::Brake(double t) {
+  // A rest state ahead along the velocity at the distance a constant deceleration would take
+  // (v T / 2), one minimum-jerk piece of duration T, lengthened until within the limits (the
+  // head's own velocity and acceleration excepted, as the optimiser's check does).
+  const PvaState head = StateOf(Reference(t));
+  const Vector3 v = head.col(1);
+  const double v_limit = std::max(limits_.v_max, v.norm()), a_limit = std::max(limits_.a_max, head.col(2).norm());
+  double duration = std::max(0.5, 2.0 * v.norm() / limits_.a_max);
+  MinimumJerkTrajectory brake;
+  for (int k = 0; k < 40; ++k, duration *= 1.25) {
+    PvaState tail = PvaState::Zero();
+    tail.col(0) = head.col(0) + 0.5 * duration * v;
+    if (!brake.Build(head, tail, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, duration))) continue;
+    if (brake.MaxNorm(1, 200) <= v_limit && brake.MaxNorm(2, 200) <= a_limit && brake.MaxNorm(3, 200) <= limits_.j_max) {
+      break;
+    }
+  }
+  brake.set_start_time(t);
+  trajectory_ = std::move(brake);
+  mode_ = Mode::kBraking;
+}
+
+void Replanner::Update(double t, const perception::VoxelMap& map) {
+  const bool finished = !trajectory_.empty() && t >= trajectory_.duration();
+  if (mode_ == Mode::kFollowing && finished && (Reference(t).p_W - goal_).norm() < 1e-6) {
+    mode_ = Mode::kHolding;  // arrived
+    has_goal_ = false;
+  }
+  if (mode_ == Mode::kBraking && finished) mode_ = Mode::kHolding;
+  std::string reason;
+  if (new_goal_) {
+    reason = "goal";
+  } else if (failure_pending_ && mode_ != Mode::kIdle && has_goal_) {
+    reason = "failure";
+  } else if (mode_ == Mode::kFollowing && UnsafeAhead(t, map)) {
+    reason = "obstacle ahead";
+  } else if (has_goal_ && t - last_plan_t_ >= options_.replan_period_s) {
+    reason = "periodic";
+  }
+  new_goal_ = false;
+  if (failure_pending_ && (reason == "failure" || !has_goal_)) failure_pending_ = false;
+  if (reason.empty()) return;
+  const bool ok = Replan(t, map);
+  if (!ok) {
+    // A failed periodic replan keeps a trajectory that is still safe ahead; otherwise (an
+    // obstacle ahead, limits that dropped, a goal that cannot be reached) brake to rest.
+    const bool keep = reason == "periodic" && (mode_ != Mode::kFollowing || !UnsafeAhead(t, map));
+    if (!keep && mode_ != Mode::kHolding && mode_ != Mode::kIdle) Brake(t);
+    if (!keep && (mode_ == Mode::kIdle || mode_ == Mode::kHolding)) mode_ = Mode::kHolding;
+  }
+  events_.push_back({t, reason, last_plan_.status, mode_});
+}
+
+}  // namespace rotorguard::planning

@@ -1,0 +1,140 @@
+#include "rotorguard/planning/replanner.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace rotorguard::planning {
+namespace {
+
+perception::VoxelMap EmptyMap() {
+  perception::VoxelMapOptions o;
+  o.window_size_m = Vector3(12.8, 12.8, 6.4);
+  o.inflation_radius_m = 0.2;
+  return perception::VoxelMap(o);
+}
+
+/// A wall x in [x0, x0 + 0.2] across y in [-5, 5] (z 0-3 m) with a 1 m gap at y in [2, 3], or
+/// across the whole window (y in [-6.4, 6.4], above the planner's altitude band) without one.
+void AddWall(perception::VoxelMap* map, double x0, bool gap) {
+  const double half = gap ? 5.0 : 6.4;
+  for (double x = x0 + 0.05; x < x0 + 0.2; x += 0.1) {
+    for (double y = -half + 0.05; y < half; y += 0.1) {
+      if (gap && y > 2.0 && y < 3.0) continue;
+      for (double z = 0.05; z < 3.0; z += 0.1) map->MarkOccupied(Vector3(x, y, z));
+    }
+  }
+}
+
+/// Runs the replanner at 10 Hz from t0 to t1, with `before(t)` called ahead of each update; checks
+/// at every update that the reference is continuous in p, v and a across it.
+template <typename Before>
+void Fly(Replanner* r, const perception::VoxelMap& map, double t0, double t1, Before before) {
+  for (double t = t0; t <= t1 + 1e-9; t += 0.1) {
+    before(t);
+    const ReferencePoint a = r->Reference(t);
+    r->Update(t, map);
+    const ReferencePoint b = r->Reference(t);
+    ASSERT_LT((a.p_W - b.p_W).norm(), 1e-9) << "t = " << t;
+    ASSERT_LT((a.v_W - b.v_W).norm(), 1e-9) << "t = " << t;
+    ASSERT_LT((a.a_W - b.a_W).norm(), 1e-9) << "t = " << t;
+  }
+}
+
+bool EntersInflated(const Replanner& r, const perception::VoxelMap& map, double t0, double t1) {
+  for (double t = t0; t <= t1; t += 0.01) {
+    if (map.IsInflated(r.Reference(t).p_W)) return true;
+  }
+  return false;
+}
+
+int Count(const Replanner& r, const std::string& reason) {
+  int n = 0;
+  for (const Replanner::Event& e : r.events()) n += e.reason == reason;
+  return n;
+}
+
+// A goal in free space: planned at once, replanned periodically, reached and held, and the
+// reference never jumps.
+TEST(Replanner, PlansOnAGoalReplansPeriodicallyAndArrives) {
+  const perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));
+  EXPECT_EQ(r.mode(), Replanner::Mode::kIdle);
+  r.SetGoal(Vector3(5, 1, 1.5));
+  Fly(&r, map, 0.0, 15.0, [](double) {});
+  ASSERT_GE(r.events().size(), 2u);
+  EXPECT_EQ(r.events().front().reason, "goal");
+  EXPECT_GE(Count(r, "periodic"), 1);
+  EXPECT_EQ(r.mode(), Replanner::Mode::kHolding);
+  EXPECT_LT((r.Reference(15.0).p_W - Vector3(5, 1, 1.5)).norm(), 1e-6);
+  EXPECT_LT(r.Reference(15.0).v_W.norm(), 1e-9);
+}
+
+// A wall (with a gap) appears across the trajectory after it was planned: the next update sees it
+// ahead, replans from the current reference, and the reference keeps clear of it.
+TEST(Replanner, AnObstacleAppearingAheadTriggersAReplanAroundIt) {
+  perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));
+  r.SetGoal(Vector3(5, 0, 1.5));
+  Fly(&r, map, 0.0, 20.0, [&](double t) {
+    if (std::abs(t - 0.5) < 1e-6) AddWall(&map, 2.5, true);
+  });
+  EXPECT_GE(Count(r, "obstacle ahead"), 1);
+  EXPECT_FALSE(EntersInflated(r, map, 0.5, 20.0));
+  EXPECT_EQ(r.mode(), Replanner::Mode::kHolding);
+  EXPECT_LT((r.Reference(20.0).p_W - Vector3(5, 0, 1.5)).norm(), 1e-6);
+}
+
+// FDD reports a failure mid-flight: the next update replans from the current state with the
+// post-failure acceleration limit, which the new trajectory respects (beyond the head's own
+// acceleration at the switch).
+TEST(Replanner, AFailureReplansWithThePostFailureAccelerationLimit) {
+  const perception::VoxelMap map = EmptyMap();
+  ReplannerOptions o;
+  o.post_failure_a_max = 0.3;
+  Replanner r(o, Vector3(0, 0, 1.5));
+  r.SetGoal(Vector3(6, 0, 1.5));
+  double switch_t = -1.0, head_a = 0.0;
+  Fly(&r, map, 0.0, 25.0, [&](double t) {
+    if (std::abs(t - 1.0) < 1e-6) {
+      r.OnFailure();
+      switch_t = t;
+      head_a = r.Reference(t).a_W.norm();
+    }
+  });
+  ASSERT_EQ(Count(r, "failure"), 1);
+  EXPECT_EQ(r.limits().a_max, 0.3);
+  double a_max = 0.0;
+  for (double t = switch_t; t <= 25.0; t += 0.005) a_max = std::max(a_max, r.Reference(t).a_W.norm());
+  EXPECT_LE(a_max, std::max(0.3, head_a) * 1.001);
+  EXPECT_LT((r.Reference(25.0).p_W - Vector3(6, 0, 1.5)).norm(), 1e-6);
+}
+
+// A wall without a gap closes the way: no plan exists, so the replanner brakes to rest within
+// its limits before the wall, then holds (and keeps trying).
+TEST(Replanner, NoWayThroughBrakesToRestAndHolds) {
+  perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));
+  r.SetGoal(Vector3(6, 0, 1.5));
+  double closed_at = -1.0;
+  Fly(&r, map, 0.0, 12.0, [&](double t) {
+    if (closed_at < 0.0 && r.Reference(t).v_W.norm() > 0.8) {  // closed while cruising
+      AddWall(&map, r.Reference(t).p_W.x() + 2.0, false);
+      closed_at = t;
+    }
+  });
+  ASSERT_GT(closed_at, 0.0);
+  bool braked = false;
+  for (const Replanner::Event& e : r.events()) braked |= e.mode_after == Replanner::Mode::kBraking;
+  EXPECT_TRUE(braked);
+  EXPECT_EQ(r.mode(), Replanner::Mode::kHolding);
+  EXPECT_LT(r.Reference(12.0).v_W.norm(), 1e-9);
+  EXPECT_FALSE(EntersInflated(r, map, closed_at, 12.0));
+  double a_max = 0.0;
+  for (double t = closed_at; t <= 12.0; t += 0.005) a_max = std::max(a_max, r.Reference(t).a_W.norm());
+  EXPECT_LE(a_max, r.limits().a_max * 1.001);
+  EXPECT_GE(Count(r, "periodic"), 1) << "keeps trying while holding";
+}
+
+}  // namespace
+}  // namespace rotorguard::planning
