@@ -70,12 +70,30 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     case PathStatus::kExpansionLimit:
       return finish(Status::kNoPath, "the path search reached its expansion limit");
   }
-  // Initial guess: the pruned path cut into pieces of at most max_piece_length_m, flown at
+  // The back end, and once more with pieces half as long when the result still collides: more
+  // waypoints keep it closer to the front end's path.
+  PlanSummary::Status status = Refine(start, goal, limits, map, options_.max_piece_length_m, &summary, out);
+  if (status == Status::kCollision) {
+    status = Refine(start, goal, limits, map, 0.5 * options_.max_piece_length_m, &summary, out);
+  }
+  return finish(status, summary.message);
+}
+
+PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, const DynamicLimits& limits,
+                                    const perception::VoxelMap& map, double piece_length, PlanSummary* summary_out,
+                                    MinimumJerkTrajectory* out) const {
+  using Status = PlanSummary::Status;
+  PlanSummary& summary = *summary_out;
+  const auto fail = [&](Status status, std::string message) {
+    summary.message = std::move(message);
+    return status;
+  };
+  // Initial guess: the pruned path cut into pieces of at most piece_length, flown at
   // v_max (at least 0.2 s each, so that short pieces stay well conditioned).
   std::vector<Vector3> knots;
   const std::vector<Vector3>& pts = summary.path.points;
   for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
-    const int parts = std::max(1, static_cast<int>(std::ceil((pts[k + 1] - pts[k]).norm() / options_.max_piece_length_m)));
+    const int parts = std::max(1, static_cast<int>(std::ceil((pts[k + 1] - pts[k]).norm() / piece_length)));
     for (int j = 0; j < parts; ++j) knots.push_back(pts[k] + (pts[k + 1] - pts[k]) * j / parts);
   }
   knots.push_back(pts.back());
@@ -90,7 +108,7 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
   PvaState tail = PvaState::Zero();
   tail.col(0) = goal;
   MinimumJerkTrajectory traj;
-  if (!traj.Build(start, tail, q, t)) return finish(Status::kOptimizerFailed, "the initial guess has no trajectory");
+  if (!traj.Build(start, tail, q, t)) return fail(Status::kOptimizerFailed, "the initial guess has no trajectory");
   const double res = map.resolution();
   const NearestPlane nearest = [&](const Vector3& p) -> std::optional<ObstaclePlane> {
     const std::optional<perception::NearestObstacle> o = map.Nearest(p, options_.plane_search_m);
@@ -127,10 +145,10 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
   for (int round = 0;; ++round) {
     summary.optimizer = optimizer_.Optimize(start, tail, q, t, limits, planes, &traj);
     if (!summary.optimizer.ok()) {
-      summary.optimize_ms = MsSince(t_opt);
-      return finish(summary.optimizer.status == TrajectoryOptimizerSummary::Status::kInfeasible ? Status::kInfeasible
-                                                                                               : Status::kOptimizerFailed,
-                    summary.optimizer.message);
+      summary.optimize_ms += MsSince(t_opt);
+      return fail(summary.optimizer.status == TrajectoryOptimizerSummary::Status::kInfeasible ? Status::kInfeasible
+                                                                                             : Status::kOptimizerFailed,
+                  summary.optimizer.message);
     }
     // Check the result against the map, every check_step_m of path at most.
     const double dt = options_.check_step_m / std::max(limits.v_max, 1e-3);
@@ -145,8 +163,8 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     }
     if (!collides) break;
     if (round == options_.clearance_rounds) {
-      summary.optimize_ms = MsSince(t_opt);
-      return finish(Status::kCollision, "the trajectory still meets an inflated voxel after " +
+      summary.optimize_ms += MsSince(t_opt);
+      return fail(Status::kCollision, "the trajectory still meets an inflated voxel after " +
                                             std::to_string(round) + " re-optimisations");
     }
     // Where a sample of the result lies in an inflated voxel, a plane through the nearest obstacle
@@ -169,10 +187,11 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     t = traj.durations();
     for (int i = 0; i + 1 < pieces; ++i) q.col(i) = traj.PieceDerivative(i, t(i), 0);
   }
-  summary.optimize_ms = MsSince(t_opt);
+  summary.optimize_ms += MsSince(t_opt);
   summary.limit_margin = summary.optimizer.limit_margin;
+  summary.message.clear();
   *out = std::move(traj);
-  return finish(Status::kSuccess, "");
+  return Status::kSuccess;
 }
 
 }  // namespace rotorguard::planning

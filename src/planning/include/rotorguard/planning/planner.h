@@ -3,7 +3,8 @@
 /// into pieces as MINCO's initial waypoints and durations, obstacle planes from each penalty
 /// sample's nearest occupied voxel, the spatio-temporal optimisation, then checks of the result
 /// against the map: where it passes through an inflated voxel, planes are added where it does
-/// and the optimisation runs again from its last result, a bounded number of times.
+/// and the optimisation runs again from its last result, a bounded number of times; if it still
+/// collides, the whole back end once more with pieces half as long.
 #include <string>
 
 #include "rotorguard/perception/voxel_map.h"
@@ -58,6 +59,12 @@ class Planner {
   const PlannerOptions& options() const { return options_; }
 
  private:
+  /// The back end on the path in `summary->path`: pieces of at most `piece_length`, planes,
+  /// optimisation and the map checks; fills the summary's back-end fields.
+  PlanSummary::Status Refine(const PvaState& start, const Vector3& goal, const DynamicLimits& limits,
+                             const perception::VoxelMap& map, double piece_length, PlanSummary* summary,
+                             MinimumJerkTrajectory* out) const;
+
   PlannerOptions options_;
   TrajectoryOptimizer optimizer_;
 };
