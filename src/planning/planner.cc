@@ -152,16 +152,29 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     }
     // Check the result against the map, every check_step_m of path at most.
     const double dt = options_.check_step_m / std::max(limits.v_max, 1e-3);
-    bool collides = false;
-    summary.min_clearance_m = options_.plane_search_m;
-    for (double s = 0.0; s <= traj.total_duration() + 1e-9; s += dt) {
-      const Vector3 p = traj.Evaluate(s).p_W;
-      if (map.IsInflated(p)) collides = true;
-      if (const auto o = map.Nearest(p, options_.plane_search_m)) {
-        summary.min_clearance_m = std::min(summary.min_clearance_m, o->distance_m);
+    // Positions every dt along each piece (its end included).
+    const auto for_each_position = [&](auto&& f) {
+      for (int i = 0; i < pieces; ++i) {
+        const int steps = std::max(1, static_cast<int>(std::ceil(traj.durations()(i) / dt)));
+        for (int k = 0; k <= steps; ++k) {
+          if (!f(traj.PieceDerivative(i, traj.durations()(i) * k / steps, 0))) return;
+        }
       }
+    };
+    bool collides = false;
+    for_each_position([&](const Vector3& p) { return !(collides = map.IsInflated(p)); });
+    if (!collides) {
+      // The clearance the summary reports, at the same spacing (once: a nearest-voxel search
+      // costs as much as hundreds of inflation lookups).
+      summary.min_clearance_m = options_.plane_search_m;
+      for_each_position([&](const Vector3& p) {
+        if (const auto o = map.Nearest(p, options_.plane_search_m)) {
+          summary.min_clearance_m = std::min(summary.min_clearance_m, o->distance_m);
+        }
+        return true;
+      });
+      break;
     }
-    if (!collides) break;
     if (round == options_.clearance_rounds) {
       summary.optimize_ms += MsSince(t_opt);
       return fail(Status::kCollision, "the trajectory still meets an inflated voxel after " +

@@ -245,6 +245,7 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   solver_options.line_search_direction_type = ceres::LBFGS;
   solver_options.max_num_iterations = options_.max_iterations;
   solver_options.logging_type = ceres::SILENT;
+  solver_options.use_approximate_eigenvalue_bfgs_scaling = true;
   solver_options.function_tolerance = 1e-5;  // relative decrease per iteration
   solver_options.gradient_tolerance = 1e-8;
   ceres::GradientProblem problem(new CeresObjective(*this, head, tail, limits, sorted, n, &summary.evaluations));
