@@ -11,17 +11,31 @@ constexpr int kC = MinimumJerkTrajectory::kCoefficients;
 
 }  // namespace
 
+namespace {
+
+// k! / (k - order)!: the factor of t^(k - order) in the order-th derivative of t^k.
+constexpr double kFactor[6][kC] = {{1, 1, 1, 1, 1, 1},    {0, 1, 2, 3, 4, 5},     {0, 0, 2, 6, 12, 20},
+                                   {0, 0, 0, 6, 24, 60},  {0, 0, 0, 0, 24, 120},  {0, 0, 0, 0, 0, 120}};
+
+}  // namespace
+
 Eigen::Matrix<double, 1, kC> MinimumJerkTrajectory::Basis(double t, int order) {
-  // k! / (k - order)! t^(k - order) for k >= order, the factors tabulated (the optimiser evaluates
-  // five rows per penalty sample).
-  static constexpr double kFactor[6][kC] = {{1, 1, 1, 1, 1, 1},       {0, 1, 2, 3, 4, 5},
-                                            {0, 0, 2, 6, 12, 20},     {0, 0, 0, 6, 24, 60},
-                                            {0, 0, 0, 0, 24, 120},    {0, 0, 0, 0, 0, 120}};
   Eigen::Matrix<double, 1, kC> b = Eigen::Matrix<double, 1, kC>::Zero();
   double power = 1.0;
   for (int k = order; k < kC; ++k) {
     b(k) = kFactor[order][k] * power;
     power *= t;
+  }
+  return b;
+}
+
+Eigen::Matrix<double, 5, kC> MinimumJerkTrajectory::BasisRows(double t) {
+  double power[kC];
+  power[0] = 1.0;
+  for (int k = 1; k < kC; ++k) power[k] = power[k - 1] * t;
+  Eigen::Matrix<double, 5, kC> b = Eigen::Matrix<double, 5, kC>::Zero();
+  for (int order = 0; order < 5; ++order) {
+    for (int k = order; k < kC; ++k) b(order, k) = kFactor[order][k] * power[k - order];
   }
   return b;
 }

@@ -126,8 +126,7 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
         while (cursor < list.size() && list[cursor].sample < j) ++cursor;
       }
       const double s = static_cast<double>(j) / k_samples, ts = s * t(i);
-      Eigen::Matrix<double, 5, kC> basis;
-      for (int d = 0; d < 5; ++d) basis.row(d) = MinimumJerkTrajectory::Basis(ts, d);
+      const Eigen::Matrix<double, 5, kC> basis = MinimumJerkTrajectory::BasisRows(ts);
       const Eigen::Matrix<double, 5, 3> der = basis * c;  // p, v, a, j, snap
       for (int d = 1; d <= 3; ++d) {  // J_d: velocity, acceleration, jerk (eqs. 26-29)
         double slope;

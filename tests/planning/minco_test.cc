@@ -133,6 +133,22 @@ TEST(MinimumJerkTrajectory, EnergyGradientMatchesFiniteDifferences) {
   }
 }
 
+// The polynomial basis' derivatives against the power rule applied by hand, for every order.
+TEST(MinimumJerkTrajectory, BasisRowsAreThePolynomialDerivatives) {
+  for (const double t : {0.0, 0.3, 1.0, 2.7}) {
+    const Eigen::Matrix<double, 5, 6> rows = MinimumJerkTrajectory::BasisRows(t);
+    for (int order = 0; order < 5; ++order) {
+      for (int k = 0; k < 6; ++k) {
+        // d^order/dt^order t^k = k (k - 1) ... (k - order + 1) t^(k - order)
+        double expected = k >= order ? std::pow(t, k - order) : 0.0;
+        for (int m = 0; m < order; ++m) expected *= k - m;
+        EXPECT_NEAR(rows(order, k), expected, 1e-12) << "t " << t << ", order " << order << ", k " << k;
+        EXPECT_EQ(MinimumJerkTrajectory::Basis(t, order)(k), rows(order, k));
+      }
+    }
+  }
+}
+
 TEST(MinimumJerkTrajectory, RejectsBadInputs) {
   MinimumJerkTrajectory traj;
   const PvaState z = PvaState::Zero();

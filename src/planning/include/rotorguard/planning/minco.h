@@ -51,6 +51,8 @@ class MinimumJerkTrajectory final : public ReferenceTrajectory {
   /// The row d^order/dt^order [1, t, ..., t^5]: a piece's derivative is Basis(t, order) times its
   /// 6 x 3 coefficients.
   static Eigen::Matrix<double, 1, kCoefficients> Basis(double t, int order);
+  /// The rows of Basis(t, 0) .. Basis(t, 4) at once (the optimiser's samples need all five).
+  static Eigen::Matrix<double, 5, kCoefficients> BasisRows(double t);
 
   /// Derivative `order` (0 position .. 5) of piece i at local time t in [0, T_i].
   Vector3 PieceDerivative(int piece, double t, int order) const;
