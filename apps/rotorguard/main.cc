@@ -117,6 +117,10 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
   fmt::print("tracking RMSE     {:.3f} m (max error {:.3f} m)\n", s.tracking_rmse_m, s.max_position_error_m);
   fmt::print("min altitude      {:.3f} m\n", s.min_altitude_m);
   fmt::print("max spin          {:.2f} rad/s\n", s.max_spin_rad_s);
+  if (s.waypoints_total >= 0) {
+    fmt::print("navigation        {} of {} waypoints, {} plans ({} failed)\n", s.waypoints_reached, s.waypoints_total,
+               s.plans, s.plans_failed);
+  }
   if (s.tilt_recovery_s >= 0.0) fmt::print("tilt recovery     {:.2f} s after the first fault\n", s.tilt_recovery_s);
   fmt::print("faults            {}\n", faults.empty() ? "none" : faults);
   if (s.fdd) {

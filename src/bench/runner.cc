@@ -127,6 +127,13 @@ nlohmann::json RunSummary::ToJson() const {
   j["sensors"] = {{"imu_rate_hz", imu_rate_hz},
                   {"imu_position_m", {imu_position_m.x(), imu_position_m.y(), imu_position_m.z()}}};
   j["map_voxels_occupied"] = map_voxels_occupied >= 0 ? nlohmann::json(map_voxels_occupied) : nlohmann::json(nullptr);
+  if (waypoints_total >= 0) {
+    j["navigation"] = {{"waypoints_reached", waypoints_reached},
+                       {"waypoints_total", waypoints_total},
+                       {"plans", plans},
+                       {"plans_failed", plans_failed},
+                       {"failed_plans", failed_plans}};
+  }
   j["lidar_points_dropped"] = lidar_points_dropped;
   j["physics_steps"] = physics_steps;
   j["control_cycles"] = control_cycles;
@@ -203,7 +210,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       if (options.on_control_cycle) options.on_control_cycle(st);
     }
     const StateView s(sim.state());
-    const Vector3 p_ref = sc.reference->Evaluate(ToSeconds(t)).p_W;
+    const Vector3 p_ref = st.reference().Evaluate(ToSeconds(t)).p_W;  // the planner's when navigating
     if (t >= tracking_start) tracking.Add(dt, s.p_W(), p_ref);
     const double error = (s.p_W() - p_ref).norm();
     if (!(error <= sc.success_error_m)) {
@@ -252,6 +259,16 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   if (options.progress) options.progress(1.0);
 
   summary.sim_time_s = sim.time_s();
+  if (const planning::Replanner* nav = st.navigator()) {
+    summary.waypoints_reached = st.waypoints_reached();
+    summary.waypoints_total = static_cast<int>(sc.stack.navigation.waypoints.size()) * sc.stack.navigation.rounds;
+    summary.plans = static_cast<int>(nav->events().size());
+    for (const planning::Replanner::Event& e : nav->events()) {
+      if (e.status == planning::PlanSummary::Status::kSuccess) continue;
+      ++summary.plans_failed;
+      summary.failed_plans.push_back(fmt::format("{:.2f} s {}: {}", e.t, e.reason, planning::ToString(e.status)));
+    }
+  }
   summary.crashed = sim.crashed();
   summary.crash_reason = sim.crash_reason().value_or("");
   if (summary.crashed) {
@@ -260,6 +277,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     summary.failure_reason =
         fmt::format("position error {:.2f} m > {:g} m at t = {:.2f} s, within the last {:g} s", last_violation_error,
                     sc.success_error_m, *last_violation_s, sc.success_hold_s);
+  }
+  if (summary.failure_reason.empty() && summary.waypoints_reached < summary.waypoints_total) {
+    summary.failure_reason = fmt::format("navigation reached {} of {} waypoints", summary.waypoints_reached,
+                                         summary.waypoints_total);
   }
   summary.success = summary.failure_reason.empty();
   summary.tracking_rmse_m = Finite(tracking.rmse());

@@ -197,9 +197,10 @@ sim::World ParseWorld(const ConfigNode& node) {
 
 // ---------------------------------------------------------------- mission
 
-std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, const Scenario& s,
+std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, Scenario* scenario,
                                                         std::string* type) {
-  *type = node.Required("type").AsEnum({"hover", "takeoff", "lemniscate", "circle", "waypoints"});
+  const Scenario& s = *scenario;
+  *type = node.Required("type").AsEnum({"hover", "takeoff", "lemniscate", "circle", "waypoints", "navigate"});
   std::shared_ptr<const ReferenceTrajectory> ref;
   const double yaw = OptionalDouble(node, "yaw_rad", s.initial_yaw_rad);
   try {
@@ -235,6 +236,20 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       if (const auto cw = node.Optional("clockwise")) o.clockwise = cw->AsBool();
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::CircleReference>(o);
+    } else if (*type == "navigate") {
+      // Planned on the LiDAR map (docs/planning.md): the stack holds the initial position until
+      // its first plan, then flies the waypoints in turn, `rounds` times.
+      if (!s.sim.lidar.enabled) node.Fail("the navigate mission plans on the LiDAR map; expected sensors.lidar");
+      const ConfigNode wps = node.Required("waypoints_m");
+      if (!wps.IsSequence() || wps.size() == 0) wps.Fail("expected a non-empty list of [x, y, z] points");
+      stack::NavigationOptions& n = scenario->stack.navigation;
+      n.waypoints.clear();
+      for (std::size_t k = 0; k < wps.size(); ++k) n.waypoints.push_back(wps.At(k).AsVector3());
+      if (const auto r = node.Optional("rounds")) n.rounds = static_cast<int>(r->AsIntIn(1, 1000));
+      planning::HoverOptions o;
+      o.position_m = s.initial_position_m;
+      o.yaw_rad = yaw;
+      ref = std::make_shared<planning::HoverReference>(o);
     } else {
       planning::WaypointOptions o;
       o.waypoints_m.push_back(s.initial_position_m);
@@ -422,6 +437,39 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     c->RejectUnknownKeys();
   }
   if (const auto d = node.Optional("deskew_frames")) o->lidar.deskew_frames = d->AsBool();
+  if (const auto n = node.Optional("planner")) {
+    // The navigate mission's planner (docs/planning.md): rate, nominal limits, eq. (33)'s safety
+    // factor, eq. (22)'s weights, clearance, replanning period and altitude band.
+    stack::NavigationOptions& nav = o->navigation;
+    planning::ReplannerOptions& r = nav.replanner;
+    ReadOptional(*n, "rate_hz", &nav.planner_rate_hz);
+    ReadOptional(*n, "v_max", &r.nominal.v_max);
+    ReadOptional(*n, "a_max", &r.nominal.a_max);
+    ReadOptional(*n, "j_max", &r.nominal.j_max);
+    ReadOptional(*n, "post_failure_safety_factor", &nav.post_failure_safety_factor);
+    ReadOptional(*n, "replan_period_s", &r.replan_period_s);
+    ReadOptional(*n, "clearance_m", &r.planner.optimizer.clearance_m);
+    if (const auto band = n->Optional("altitude_band_m")) {
+      const std::vector<double> b = band->AsDoubleList(2);
+      r.planner.search.z_min_m = b[0];
+      r.planner.search.z_max_m = b[1];
+    }
+    if (const auto w = n->Optional("weights")) {
+      ReadOptional(*w, "time", &r.planner.optimizer.weight_time);
+      ReadOptional(*w, "smoothness", &r.planner.optimizer.weight_smoothness);
+      ReadOptional(*w, "feasibility", &r.planner.optimizer.weight_feasibility);
+      ReadOptional(*w, "collision", &r.planner.optimizer.weight_collision);
+      w->RejectUnknownKeys();
+    }
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] {
+      r.Validate();
+      if (!(nav.post_failure_safety_factor > 0.0 && nav.post_failure_safety_factor <= 1.0)) {
+        ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", nav.post_failure_safety_factor,
+                        "in (0, 1]");
+      }
+    });
+  }
   if (const auto n = node.Optional("map")) {
     // The inflation radius is the vehicle's collision radius and the deskew lever arm the LiDAR's
     // mounting point (FitStackToHardware): neither is a key here.
@@ -559,7 +607,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   // at the key they would have, or its nearest existing parent.
   ValidateAt(root, [&] { s.sim.Validate(s.vehicle); });
 
-  s.reference = ParseMission(root.Required("mission"), s, &s.mission_type);
+  s.reference = ParseMission(root.Required("mission"), &s, &s.mission_type);
 
   if (const auto faults = root.Optional("faults")) {
     if (!faults->IsSequence() && !faults->IsNull()) faults->Fail("expected a list of faults");

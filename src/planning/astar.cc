@@ -50,7 +50,11 @@ PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const
     return (c->array() >= 0).all() && (c->array() < n.array()).all();
   };
   Eigen::Vector3i start_cell, goal_cell;
-  if (!cell_of(start, &start_cell)) {
+  // A start just outside the altitude band (a trajectory may graze its edges) searches from the
+  // band's nearest cell; the path still begins at the start itself.
+  Vector3 start_in_band = start;
+  start_in_band.z() = std::clamp(start.z(), lo.z() + 0.5 * res, hi.z() - 0.5 * res);
+  if (!cell_of(start_in_band, &start_cell)) {
     result.status = PathStatus::kStartOutOfBounds;
     return result;
   }

@@ -48,6 +48,7 @@ Replanner::Replanner(const ReplannerOptions& options, const Vector3& hold_positi
 void Replanner::SetGoal(const Vector3& goal_W) {
   goal_ = goal_W;
   has_goal_ = new_goal_ = true;
+  arrived_ = false;
 }
 
 void Replanner::OnFailure() {
@@ -113,6 +114,7 @@ void Replanner::Update(double t, const perception::VoxelMap& map) {
   if (mode_ == Mode::kFollowing && finished && (Reference(t).p_W - goal_).norm() < 1e-6) {
     mode_ = Mode::kHolding;  // arrived
     has_goal_ = false;
+    arrived_ = true;
   }
   if (mode_ == Mode::kBraking && finished) mode_ = Mode::kHolding;
   std::string reason;

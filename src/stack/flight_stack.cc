@@ -1,6 +1,8 @@
 #include "rotorguard/stack/flight_stack.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -38,6 +40,23 @@ void FlightStackOptions::Validate() const {
   composite_fdd.Validate();
   fixed_time_fdd.Validate();
   lidar.Validate();
+  if (!navigation.waypoints.empty()) {
+    const NavigationOptions& n = navigation;
+    for (std::size_t i = 0; i < n.waypoints.size(); ++i) {
+      if (!n.waypoints[i].allFinite()) {
+        ThrowValidation("FlightStackOptions", fmt::format("navigation.waypoints.{}", i), "(non-finite)", "finite numbers");
+      }
+    }
+    if (n.rounds < 1) ThrowValidation("FlightStackOptions", "navigation.rounds", n.rounds, ">= 1");
+    if (!(n.planner_rate_hz > 0.0 && n.planner_rate_hz <= control_rate_hz)) {
+      ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", n.planner_rate_hz, "a rate in (0, control_rate_hz]");
+    }
+    if (!(n.post_failure_safety_factor > 0.0 && n.post_failure_safety_factor <= 1.0)) {
+      ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", n.post_failure_safety_factor,
+                      "in (0, 1]");
+    }
+    n.replanner.Validate();
+  }
   if (!known_faults.empty() && controller != "nmpc" && controller != "indi") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,
                     "controller nmpc or indi (the controllers that reconfigure)");
@@ -77,6 +96,19 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
   if (options_.fdd == "fixedtime") fdd_ = std::make_unique<fdd::FixedTimeFdd>(model_.params(), options_.fixed_time_fdd);
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
+  if (!options_.navigation.waypoints.empty()) {
+    // Eq. (33) for this vehicle: the weakest rotor's thrust, the largest drag coefficient. A
+    // vehicle whose two remaining rotors cannot hold its weight gets a token limit (it cannot fly
+    // on after a failure anyway).
+    const vehicle::VehicleParams& p = model_.params();
+    double rotor_thrust = std::numeric_limits<double>::infinity();
+    for (const auto& r : p.rotors) rotor_thrust = std::min(rotor_thrust, r.max_thrust_n);
+    planning::ReplannerOptions r = options_.navigation.replanner;
+    r.post_failure_a_max = std::max(0.05, planning::PostFailureAccelerationLimit(
+                                              p.mass_kg, rotor_thrust, p.rotor_drag_kg_s.maxCoeff(), r.nominal.v_max,
+                                              options_.navigation.post_failure_safety_factor));
+    navigator_ = std::make_unique<planning::Replanner>(r, reference_->Evaluate(0.0).p_W);
+  }
 }
 
 void FlightStack::OnImu(const ImuSample& imu) {
@@ -100,7 +132,19 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   const double dt = last_update_ns_ ? ToSeconds(t - *last_update_ns_) : 0.0;
   last_update_ns_ = t;
   estimate_ = estimator_.Estimate(t);
-  reference_point_ = reference_->Evaluate(ToSeconds(t));
+  const double ts = ToSeconds(t);
+  if (navigator_ && map() && ts >= next_plan_s_) {
+    // The waypoints in turn, each once the last was reached; the planner at its own rate.
+    next_plan_s_ = ts + 1.0 / options_.navigation.planner_rate_hz;
+    const std::vector<Vector3>& w = options_.navigation.waypoints;
+    const int total = static_cast<int>(w.size()) * options_.navigation.rounds;
+    if (next_waypoint_ < total && (next_waypoint_ == 0 || navigator_->arrived())) {
+      navigator_->SetGoal(w[static_cast<std::size_t>(next_waypoint_++) % w.size()]);
+    }
+    navigator_->Update(ts, *map());
+  }
+  const ReferenceTrajectory& reference = this->reference();
+  reference_point_ = reference.Evaluate(ts);
   command_.t_ns = t;
   if (!estimate_.valid) {
     // Nothing to act on yet: motors idle (a vehicle on the ground stays there).
@@ -110,6 +154,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
     if (!known_fault_applied_[i] && ToSeconds(t) >= options_.known_faults[i].at_time_s) {
       controller_->SetRotorFailed(options_.known_faults[i].rotor);
+      if (navigator_) navigator_->OnFailure();
       known_fault_applied_[i] = true;
     }
   }
@@ -117,9 +162,13 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
     fdd_->SetEstimate(estimate_);
     // Isolation reconfigures the controller (the NMPC: u_bar_i = 0, yaw given up, post-failure
     // thrust reference); controllers that cannot reconfigure ignore it.
-    for (int rotor : fdd_->TakeNewIsolations()) controller_->SetRotorFailed(rotor);
+    // The planner replans with the post-failure acceleration limit.
+    for (int rotor : fdd_->TakeNewIsolations()) {
+      controller_->SetRotorFailed(rotor);
+      if (navigator_) navigator_->OnFailure();
+    }
   }
-  controller_->Compute(estimate_, *reference_, ToSeconds(t), dt, &command_.thrust_n);
+  controller_->Compute(estimate_, reference, ts, dt, &command_.thrust_n);
   if (fdd_) fdd_->SetCommand(command_.thrust_n);
   return command_;
 }

@@ -236,6 +236,12 @@ TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
   ExpectConfigError("run " + f, f, 9, {"stack.map.log_odds_max", "40", "(0, 30]"});
   f = Write("hysteresis.yaml", Scenario(v, "stack:\n  map: {window_size_m: [8, 8, 1.6], recenter_hysteresis_m: 0.5}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.map.recenter_hysteresis_m", "0.5", "a quarter of the smallest window extent"});
+  f = Write("planner.yaml", Scenario(v, "stack:\n  planner: {v_max: -1}\n"));
+  ExpectConfigError("run " + f, f, 9, {"stack.planner", "v_max", "> 0"});
+  std::string navigate = Scenario(v);
+  navigate.replace(navigate.find("mission:\n  type: hover"), 23, "mission: {type: navigate, waypoints_m: [[1, 0, 1]]}");
+  f = Write("navigate.yaml", navigate);
+  ExpectConfigError("run " + f, f, 6, {"mission", "sensors.lidar"});
   f = Write("mapkey.yaml", Scenario(v, "stack:\n  map: {inflation_radius_m: 0.3}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.map.inflation_radius_m", "unknown key"});
   f = Write("malformed.yaml", "vehicle: " + v + "\nduration_s: [1, 2\nmission: {type: hover}\n");

@@ -66,6 +66,8 @@ TEST(AStar, BlockedOutsideAndEnclosedGoalsGiveTheirStatus) {
       << "above the altitude band";
   EXPECT_EQ(FindPath(map, Vector3(std::nan(""), 0, 1.5), Vector3(1, 0, 1.5), AStarOptions{}).status,
             PathStatus::kStartOutOfBounds);
+  EXPECT_EQ(FindPath(map, Vector3(0, 0, 0.45), Vector3(1, 0, 1.5), AStarOptions{}).status, PathStatus::kFound)
+      << "a start grazing the altitude band's floor searches from inside it";
   // A closed shell 1 m across around the goal (0.3 m thick, so no diagonal slips through).
   for (double x = -3.45; x < -1.6; x += 0.1) {
     for (double y = -0.95; y < 1.0; y += 0.1) {

@@ -66,6 +66,7 @@ TEST(Replanner, PlansOnAGoalReplansPeriodicallyAndArrives) {
   EXPECT_EQ(r.events().front().reason, "goal");
   EXPECT_GE(Count(r, "periodic"), 1);
   EXPECT_EQ(r.mode(), Replanner::Mode::kHolding);
+  EXPECT_TRUE(r.arrived());
   EXPECT_LT((r.Reference(15.0).p_W - Vector3(5, 1, 1.5)).norm(), 1e-6);
   EXPECT_LT(r.Reference(15.0).v_W.norm(), 1e-9);
 }
@@ -128,6 +129,7 @@ TEST(Replanner, NoWayThroughBrakesToRestAndHolds) {
   for (const Replanner::Event& e : r.events()) braked |= e.mode_after == Replanner::Mode::kBraking;
   EXPECT_TRUE(braked);
   EXPECT_EQ(r.mode(), Replanner::Mode::kHolding);
+  EXPECT_FALSE(r.arrived());
   EXPECT_LT(r.Reference(12.0).v_W.norm(), 1e-9);
   EXPECT_FALSE(EntersInflated(r, map, closed_at, 12.0));
   double a_max = 0.0;

@@ -52,6 +52,13 @@ struct RunSummary {
   /// Occupied voxels of the stack's map at the end; -1 without a LiDAR (null in summary.json).
   int map_voxels_occupied = -1;
   long lidar_points_dropped = 0;  ///< LiDAR pulses that gave no map point (FlightStack)
+  /// The navigate mission: waypoints reached of those to fly (x rounds); -1 for other missions.
+  int waypoints_reached = -1;
+  int waypoints_total = -1;
+  /// Planning queries and their results in the navigate mission (the replanner's events).
+  int plans = 0, plans_failed = 0;
+  /// Each failed planning query: time [s], reason and status ("12.30 s periodic: no_path").
+  std::vector<std::string> failed_plans;
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;
 

@@ -8,6 +8,7 @@
 /// trajectory starts from the old one's state at the switching instant. When no plan can be made
 /// and the trajectory ahead is unsafe, it brakes to rest within the limits, holds, and keeps
 /// trying.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,9 @@ struct ReplannerOptions {
   void Validate() const;
 };
 
-class Replanner {
+/// The replanner is the reference the controller follows (its Evaluate is `Reference`), so that a
+/// predictive controller sees the current trajectory over its horizon.
+class Replanner final : public ReferenceTrajectory {
  public:
   enum class Mode { kIdle, kFollowing, kBraking, kHolding };
   struct Event {
@@ -49,6 +52,11 @@ class Replanner {
 
   /// The reference at time t (continuous across replans).
   ReferencePoint Reference(double t) const;
+  ReferencePoint Evaluate(double t) const override { return Reference(t); }
+  /// Never constant for good: a new goal or an obstacle may start a new trajectory.
+  double duration() const override { return std::numeric_limits<double>::infinity(); }
+  /// Whether the last goal was reached (and is held).
+  bool arrived() const { return arrived_; }
   Mode mode() const { return mode_; }
   const std::vector<Event>& events() const { return events_; }
   const DynamicLimits& limits() const { return limits_; }
@@ -72,7 +80,7 @@ class Replanner {
   MinimumJerkTrajectory trajectory_;
   Vector3 hold_;
   Vector3 goal_ = Vector3::Zero();
-  bool new_goal_ = false, failure_pending_ = false, has_goal_ = false;
+  bool new_goal_ = false, failure_pending_ = false, has_goal_ = false, arrived_ = false;
   double last_plan_t_ = -1e9;
   PlanSummary last_plan_;
   std::vector<Event> events_;

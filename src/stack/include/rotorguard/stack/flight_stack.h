@@ -2,6 +2,7 @@
 /// FlightStack: what flies on the vehicle. Sensor messages in, rotor commands out. It is built from
 /// its own copy of the vehicle parameters (the stack's model, not the simulator's truth) and a
 /// mission reference.
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/fdd/fixed_time_fdd.h"
 #include "rotorguard/perception/lidar_mapper.h"
+#include "rotorguard/planning/replanner.h"
 #include "rotorguard/stack/estimator.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -27,6 +29,18 @@ namespace rotorguard::stack {
 struct KnownFault {
   int rotor = 0;
   double at_time_s = 0.0;
+};
+
+/// Navigation among obstacles (mission type navigate; docs/planning.md): the waypoints flown in
+/// order, `rounds` times, each planned on the LiDAR map by the replanner at `planner_rate_hz`.
+/// After an isolated failure the acceleration limit drops to eq. (33)'s a_max,f for the stack's
+/// vehicle model with the safety factor `post_failure_safety_factor`.
+struct NavigationOptions {
+  std::vector<Vector3> waypoints;  ///< empty: the mission reference is flown instead
+  int rounds = 1;                  ///< >= 1
+  double planner_rate_hz = 10.0;   ///< in (0, control_rate_hz]
+  double post_failure_safety_factor = 0.05;  ///< γ_a,f of eq. (33), in (0, 1]
+  planning::ReplannerOptions replanner;      ///< its post_failure_a_max is set from eq. (33)
 };
 
 struct FlightStackOptions {
@@ -48,6 +62,7 @@ struct FlightStackOptions {
   /// frames deskewed to their end pose (unless `lidar.deskew_frames` is false), placed with the
   /// estimate, inserted into the local occupancy map.
   perception::LidarMapperOptions lidar;
+  NavigationOptions navigation;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -72,6 +87,10 @@ class FlightStack {
   TimeNs control_period_ns() const { return control_period_ns_; }
   const StateEstimate& estimate() const { return estimate_; }
   const ReferencePoint& reference_point() const { return reference_point_; }
+  /// The reference the controller follows: the navigator when navigating, else the mission's.
+  const ReferenceTrajectory& reference() const {
+    return navigator_ ? static_cast<const ReferenceTrajectory&>(*navigator_) : *reference_;
+  }
   const RotorCommand& command() const { return command_; }
   const vehicle::MultirotorModel& model() const { return model_; }
   const control::Controller& controller() const { return *controller_; }
@@ -79,6 +98,13 @@ class FlightStack {
   const control::NmpcController* nmpc() const { return nmpc_; }
   /// The fault detector, when there is one; else null.
   const fdd::FaultDetector* fault_detector() const { return fdd_.get(); }
+  /// Waypoints reached so far (counting repeats over the rounds); the navigate mission is complete
+  /// when it equals waypoints x rounds.
+  int waypoints_reached() const {
+    return navigator_ ? std::max(0, next_waypoint_ - (navigator_->arrived() ? 0 : 1)) : 0;
+  }
+  /// The navigation's replanner (mission type navigate); else null.
+  const planning::Replanner* navigator() const { return navigator_.get(); }
   /// The occupancy map, once a LiDAR frame arrived; else null.
   const perception::VoxelMap* map() const { return mapper_.map(); }
   /// LiDAR pulses without a usable point: no return (counted by the sensor), non-finite, outside
@@ -94,6 +120,9 @@ class FlightStack {
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
   std::unique_ptr<fdd::FaultDetector> fdd_;
   perception::LidarMapper mapper_;
+  std::unique_ptr<planning::Replanner> navigator_;
+  int next_waypoint_ = 0;       // of the waypoints repeated `rounds` times
+  double next_plan_s_ = 0.0;    // the navigator's next update
   long lidar_points_dropped_ = 0;
   std::vector<bool> known_fault_applied_;
   TimeNs control_period_ns_;
