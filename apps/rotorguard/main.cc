@@ -284,6 +284,7 @@ int main(int argc, char** argv) {
       options.progress = [&bar](double f) { bar(f); };
       const rotorguard::bench::RunSummary summary = rotorguard::bench::RunScenario(scenario, options);
       if (!quiet) PrintSummary(summary, out_dir);
+      if (summary.infeasible_request) return kInfeasible;
       return summary.success ? kOk : kRunFailed;
     }
     if (*validate) {

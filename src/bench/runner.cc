@@ -132,7 +132,8 @@ nlohmann::json RunSummary::ToJson() const {
                        {"waypoints_total", waypoints_total},
                        {"plans", plans},
                        {"plans_failed", plans_failed},
-                       {"failed_plans", failed_plans}};
+                       {"failed_plans", failed_plans},
+                       {"infeasible_request", infeasible_request}};
   }
   j["lidar_points_dropped"] = lidar_points_dropped;
   j["physics_steps"] = physics_steps;
@@ -281,6 +282,18 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   if (summary.failure_reason.empty() && summary.waypoints_reached < summary.waypoints_total) {
     summary.failure_reason = fmt::format("navigation reached {} of {} waypoints", summary.waypoints_reached,
                                          summary.waypoints_total);
+    // The waypoint being flown to, and what its last plan said.
+    const planning::Replanner& nav = *st.navigator();
+    using Status = planning::PlanSummary::Status;
+    const Status last = nav.last_plan().status;
+    if (!nav.events().empty() && (last == Status::kGoalBlocked || last == Status::kGoalOutOfBounds || last == Status::kNoPath)) {
+      const std::vector<Vector3>& w = sc.stack.navigation.waypoints;
+      const Vector3& goal = w[static_cast<std::size_t>(summary.waypoints_reached) % w.size()];
+      summary.infeasible_request = true;
+      summary.failure_reason += fmt::format("; waypoint {} at [{:g}, {:g}, {:g}] is unreachable: {} ({})",
+                                            summary.waypoints_reached + 1, goal.x(), goal.y(), goal.z(),
+                                            planning::ToString(last), nav.last_plan().message);
+    }
   }
   summary.success = summary.failure_reason.empty();
   summary.tracking_rmse_m = Finite(tracking.rmse());

@@ -161,6 +161,29 @@ TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
       << cut.out;
 }
 
+// A navigate mission whose waypoint lies just behind a box's face (mapped by the LiDAR, never told
+// to the stack, so the goal falls in the face's inflation) or outside the map: the run ends in its
+// scenario time with exit 4 (an infeasible request) and names the waypoint and the planner's status.
+TEST_F(CliTest, UnreachableWaypointExitsFourNamingIt) {
+  for (const auto& [waypoint, status] : {std::pair{"[1.6, 0.0, 1.0]", "goal_blocked"},
+                                         std::pair{"[40.0, 0.0, 1.0]", "goal_out_of_bounds"}}) {
+    std::string text = Scenario(kVehicle, std::string("world:\n  boxes:\n    - {center_m: [2, 0, 1.5], size_m: [1, 1, 3]}\n") +
+                                              "sensors:\n  lidar: {}\n");
+    text.replace(text.find("duration_s: 1.0"), 15, "duration_s: 1.5");
+    const std::string hover = "mission:\n  type: hover";
+    text.replace(text.find(hover), hover.size(), std::string("mission: {type: navigate, waypoints_m: [") + waypoint + "]}");
+    const std::string f = Write("unreachable.yaml", text);
+    const Result r = Cli("run " + f + " --out " + Out());
+    EXPECT_EQ(r.exit_code, 4) << r.out;
+    EXPECT_NE(r.out.find("waypoint 1"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("unreachable"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(status), std::string::npos) << r.out;
+    const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
+    EXPECT_EQ(j["navigation"]["infeasible_request"], true);
+    EXPECT_EQ(j["crashed"], false);
+  }
+}
+
 TEST_F(CliTest, NominalControllerLosingAMotorCrashesAndExitsOne) {
   const std::string s = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/hover_motor_stop_nominal.yaml";
   const Result r = Cli("run " + s + " --quiet --out " + Out());
@@ -239,7 +262,8 @@ TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
   f = Write("planner.yaml", Scenario(v, "stack:\n  planner: {v_max: -1}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.planner", "v_max", "> 0"});
   std::string navigate = Scenario(v);
-  navigate.replace(navigate.find("mission:\n  type: hover"), 23, "mission: {type: navigate, waypoints_m: [[1, 0, 1]]}");
+  const std::string hover = "mission:\n  type: hover";
+  navigate.replace(navigate.find(hover), hover.size(), "mission: {type: navigate, waypoints_m: [[1, 0, 1]]}");
   f = Write("navigate.yaml", navigate);
   ExpectConfigError("run " + f, f, 6, {"mission", "sensors.lidar"});
   f = Write("mapkey.yaml", Scenario(v, "stack:\n  map: {inflation_radius_m: 0.3}\n"));

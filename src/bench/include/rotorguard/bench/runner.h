@@ -59,6 +59,9 @@ struct RunSummary {
   int plans = 0, plans_failed = 0;
   /// Each failed planning query: time [s], reason and status ("12.30 s periodic: no_path").
   std::vector<std::string> failed_plans;
+  /// The navigate mission asked for a waypoint the planner found unreachable at the end (inside an
+  /// obstacle's inflation, outside the map, or enclosed): an infeasible request (CLI exit 4).
+  bool infeasible_request = false;
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;
 
