@@ -66,6 +66,8 @@ void TrajectoryOptimizerOptions::Validate() const {
   require(std::isfinite(clearance_m) && clearance_m >= 0.0, "clearance_m", clearance_m, "a distance >= 0 m");
   require(samples_per_piece >= 2 && samples_per_piece <= 1000, "samples_per_piece", samples_per_piece, "in [2, 1000]");
   require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
+  require(relative_cost_tolerance > 0.0 && relative_cost_tolerance <= 0.1, "relative_cost_tolerance",
+          relative_cost_tolerance, "in (0, 0.1]");
   require(check_samples_per_piece >= samples_per_piece, "check_samples_per_piece", check_samples_per_piece,
           "at least samples_per_piece");
   require(max_slowdowns >= 0, "max_slowdowns", max_slowdowns, ">= 0");
@@ -245,7 +247,7 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   solver_options.max_num_iterations = options_.max_iterations;
   solver_options.logging_type = ceres::SILENT;
   solver_options.use_approximate_eigenvalue_bfgs_scaling = true;
-  solver_options.function_tolerance = 1e-5;  // relative decrease per iteration
+  solver_options.function_tolerance = options_.relative_cost_tolerance;
   solver_options.gradient_tolerance = 1e-8;
   ceres::GradientProblem problem(new CeresObjective(*this, head, tail, limits, sorted, n, &summary.evaluations));
   ceres::GradientProblemSolver::Summary ceres_summary;

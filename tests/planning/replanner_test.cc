@@ -78,7 +78,7 @@ TEST(Replanner, AnObstacleAppearingAheadTriggersAReplanAroundIt) {
   Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));
   r.SetGoal(Vector3(5, 0, 1.5));
   Fly(&r, map, 0.0, 20.0, [&](double t) {
-    if (std::abs(t - 0.5) < 1e-6) AddWall(&map, 2.5, true);
+    if (std::abs(t - 0.5) < 1e-6) AddWall(&map, 1.5, true);
   });
   EXPECT_GE(Count(r, "obstacle ahead"), 1);
   EXPECT_FALSE(EntersInflated(r, map, 0.5, 20.0));
