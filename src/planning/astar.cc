@@ -120,9 +120,15 @@ PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const
     result.status = PathStatus::kNoPath;
     return result;
   }
+  // Cell centres from the goal back to the start, the ends replaced by the goal and start points
+  // themselves (both kept when they share a cell).
   std::vector<Vector3> raw;
   for (int i = t; i != -1; i = parent[static_cast<std::size_t>(i)]) raw.push_back(i == t ? goal : center(i));
-  raw.back() = start;
+  if (raw.size() == 1) {
+    raw.push_back(start);
+  } else {
+    raw.back() = start;
+  }
   std::reverse(raw.begin(), raw.end());
   // Line-of-sight pruning: from each kept point, on to the farthest of the following points it sees
   // without a break (out of an inflated start, the next point).

@@ -117,6 +117,20 @@ TEST_F(PlannerAtTheWall, PlansThroughTheGapWithinItsLimits) {
   }
 }
 
+// A goal in the start's own grid cell: a two-point path, and a plan that ends at the goal.
+TEST_F(PlannerAtTheWall, AGoalInTheStartsCellIsPlanned) {
+  const Vector3 goal = start_.col(0) + Vector3(0.05, 0.03, 0.0);
+  const PathResult path = FindPath(map_, start_.col(0), goal, AStarOptions{});
+  ASSERT_EQ(path.status, PathStatus::kFound);
+  ASSERT_EQ(path.points.size(), 2u);
+  EXPECT_EQ(path.points.front(), start_.col(0));
+  EXPECT_EQ(path.points.back(), goal);
+  MinimumJerkTrajectory traj;
+  const PlanSummary s = planner_.Plan(start_, goal, DynamicLimits{}, map_, &traj);
+  ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
+  EXPECT_LT((traj.Evaluate(1e9).p_W - goal).norm(), 1e-9);
+}
+
 TEST_F(PlannerAtTheWall, FailuresHaveAStatusAndNoTrajectory) {
   MinimumJerkTrajectory traj;
   EXPECT_EQ(planner_.Plan(start_, Vector3(2.1, 0, 1.5), DynamicLimits{}, map_, &traj).status,
