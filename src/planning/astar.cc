@@ -43,11 +43,17 @@ PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const
   Vector3 lo = map.window_min_W(), hi = map.window_max_W();
   lo.z() = std::max(lo.z(), options.z_min_m);
   hi.z() = std::min(hi.z(), options.z_max_m);
-  const Eigen::Vector3i n = ((hi - lo) / res).array().floor().cast<int>().max(1);
+  if (hi.z() - lo.z() < res) {  // the band and the window overlap by less than a cell
+    result.status = PathStatus::kStartOutOfBounds;
+    return result;
+  }
+  // Cells cover [lo, hi] (the last may reach past hi by less than a cell: an extent just below a
+  // whole number of cells keeps its last one), a point on the upper face in the last cell.
+  const Eigen::Vector3i n = ((hi - lo) / res - Vector3::Constant(1e-9)).array().ceil().cast<int>().max(1);
   const auto cell_of = [&](const Vector3& p, Eigen::Vector3i* c) {
-    if (!p.allFinite()) return false;
-    *c = ((p - lo) / res).array().floor().cast<int>();
-    return (c->array() >= 0).all() && (c->array() < n.array()).all();
+    if (!p.allFinite() || (p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return false;
+    *c = ((p - lo) / res).array().floor().cast<int>().min(n.array() - 1);
+    return true;
   };
   Eigen::Vector3i start_cell, goal_cell;
   // A start just outside the altitude band (a trajectory may graze its edges) searches from the

@@ -37,6 +37,7 @@ const char* ToString(PlanSummary::Status status) {
     case PlanSummary::Status::kGoalOutOfBounds: return "goal_out_of_bounds";
     case PlanSummary::Status::kGoalBlocked: return "goal_blocked";
     case PlanSummary::Status::kNoPath: return "no_path";
+    case PlanSummary::Status::kSearchLimit: return "search_limit";
     case PlanSummary::Status::kOptimizerFailed: return "optimizer_failed";
     case PlanSummary::Status::kInfeasible: return "infeasible";
     case PlanSummary::Status::kCollision: return "collision";
@@ -68,7 +69,7 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     case PathStatus::kGoalBlocked: return finish(Status::kGoalBlocked, "the goal lies within an obstacle's inflation");
     case PathStatus::kNoPath: return finish(Status::kNoPath, "no collision-free path to the goal in the map");
     case PathStatus::kExpansionLimit:
-      return finish(Status::kNoPath, "the path search reached its expansion limit");
+      return finish(Status::kSearchLimit, "the path search reached its expansion limit");
   }
   // The back end, and once more with pieces half as long when the result still collides: more
   // waypoints keep it closer to the front end's path.
@@ -152,12 +153,19 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     }
     // Check the result against the map, every check_step_m of path at most.
     const double dt = options_.check_step_m / std::max(limits.v_max, 1e-3);
-    // Positions every dt along each piece (its end included).
+    // Positions every dt along each piece (its end included). A start inside an inflation layer
+    // may leave it (as the front end allows): the positions before the first free one are not
+    // held against the result.
+    const bool start_inflated = map.IsInflated(start.col(0));
     const auto for_each_position = [&](auto&& f) {
+      bool leaving = start_inflated;
       for (int i = 0; i < pieces; ++i) {
         const int steps = std::max(1, static_cast<int>(std::ceil(traj.durations()(i) / dt)));
         for (int k = 0; k <= steps; ++k) {
-          if (!f(traj.PieceDerivative(i, traj.durations()(i) * k / steps, 0))) return;
+          const Vector3 p = traj.PieceDerivative(i, traj.durations()(i) * k / steps, 0);
+          if (leaving && map.IsInflated(p)) continue;
+          leaving = false;
+          if (!f(p)) return;
         }
       }
     };
@@ -185,10 +193,13 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     // obstacle's own normal points anywhere from inside it, the guide's side is where the path
     // went round. Then again from the result.
     ++summary.clearance_rounds;
+    bool leaving = start_inflated;
     for (int i = 0; i < pieces; ++i) {
       for (int j = 0; j <= samples; ++j) {
         const Vector3 p = traj.PieceDerivative(i, traj.durations()(i) * j / samples, 0);
-        if (!map.IsInflated(p)) continue;
+        const bool inflated = map.IsInflated(p);
+        leaving = leaving && inflated;
+        if (!inflated || leaving) continue;
         const std::optional<perception::NearestObstacle> o = map.Nearest(p, options_.plane_search_m);
         if (!o) continue;
         const Vector3 away = guide(i, j) - o->point_W;

@@ -40,8 +40,8 @@ const char* ToString(Replanner::Mode mode) {
   return "unknown";
 }
 
-Replanner::Replanner(const ReplannerOptions& options, const Vector3& hold_position)
-    : options_(options), planner_(options.planner), limits_(options.nominal), hold_(hold_position) {
+Replanner::Replanner(const ReplannerOptions& options, const Vector3& hold_position, double yaw)
+    : options_(options), planner_(options.planner), limits_(options.nominal), hold_(hold_position), yaw_(yaw) {
   options_.Validate();
 }
 
@@ -61,6 +61,7 @@ ReferencePoint Replanner::Reference(double t) const {
   if (!trajectory_.empty()) return trajectory_.Evaluate(t);
   ReferencePoint r;
   r.p_W = hold_;
+  r.yaw = yaw_;
   return r;
 }
 
@@ -81,6 +82,7 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   const bool ok = last_plan_.ok();
   if (ok) {
     traj.set_start_time(t);
+    traj.set_yaw(yaw_);
     trajectory_ = std::move(traj);
     mode_ = Mode::kFollowing;
   }
@@ -105,6 +107,7 @@ void Replanner::Brake(double t) {
     }
   }
   brake.set_start_time(t);
+  brake.set_yaw(yaw_);
   trajectory_ = std::move(brake);
   mode_ = Mode::kBraking;
 }

@@ -107,7 +107,8 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     r.post_failure_a_max = std::max(0.05, planning::PostFailureAccelerationLimit(
                                               p.mass_kg, rotor_thrust, p.rotor_drag_kg_s.maxCoeff(), r.nominal.v_max,
                                               options_.navigation.post_failure_safety_factor));
-    navigator_ = std::make_unique<planning::Replanner>(r, reference_->Evaluate(0.0).p_W);
+    const ReferencePoint start = reference_->Evaluate(0.0);
+    navigator_ = std::make_unique<planning::Replanner>(r, start.p_W, start.yaw);
   }
 }
 

@@ -131,6 +131,37 @@ TEST_F(PlannerAtTheWall, AGoalInTheStartsCellIsPlanned) {
   EXPECT_LT((traj.Evaluate(1e9).p_W - goal).norm(), 1e-9);
 }
 
+// A start 0.15 m from a post (inside its 0.2 m inflation) may leave it, as the front end allows:
+// the plan succeeds, and after its first free position the trajectory stays out of inflation.
+TEST_F(PlannerAtTheWall, AStartInsideAnInflationLayerLeavesIt) {
+  for (double z = 0.05; z < 3.0; z += 0.1) map_.MarkOccupied(Vector3(0.55, -1.05, z));
+  PvaState start = PvaState::Zero();
+  start.col(0) = Vector3(0.70, -1.05, 1.5);
+  ASSERT_TRUE(map_.IsInflated(start.col(0)));
+  MinimumJerkTrajectory traj;
+  const PlanSummary s = planner_.Plan(start, Vector3(0.0, -3.0, 1.5), DynamicLimits{}, map_, &traj);
+  ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
+  bool left = false;
+  for (double t = 0.0; t <= traj.total_duration(); t += 0.01) {
+    const bool inflated = map_.IsInflated(traj.Evaluate(t).p_W);
+    left = left || !inflated;
+    EXPECT_FALSE(left && inflated) << "back in the inflation at t = " << t;
+  }
+  EXPECT_TRUE(left);
+}
+
+// Goals on the altitude band's upper edge are inside the grid; a search cut short by its cap says
+// so rather than claiming there is no path.
+TEST_F(PlannerAtTheWall, BandEdgesAndTheSearchCapHaveTheirStatus) {
+  EXPECT_EQ(FindPath(map_, start_.col(0), Vector3(-2, 0, 2.5), AStarOptions{}).status, PathStatus::kFound);
+  EXPECT_EQ(FindPath(map_, start_.col(0), Vector3(-2, 0, 0.5), AStarOptions{}).status, PathStatus::kFound);
+  PlannerOptions capped;
+  capped.search.max_expansions = 10;
+  MinimumJerkTrajectory traj;
+  EXPECT_EQ(Planner(capped).Plan(start_, Vector3(4, 0, 1.5), DynamicLimits{}, map_, &traj).status,
+            PlanSummary::Status::kSearchLimit);
+}
+
 TEST_F(PlannerAtTheWall, FailuresHaveAStatusAndNoTrajectory) {
   MinimumJerkTrajectory traj;
   EXPECT_EQ(planner_.Plan(start_, Vector3(2.1, 0, 1.5), DynamicLimits{}, map_, &traj).status,

@@ -71,6 +71,16 @@ TEST(Replanner, PlansOnAGoalReplansPeriodicallyAndArrives) {
   EXPECT_LT(r.Reference(15.0).v_W.norm(), 1e-9);
 }
 
+// The heading given at construction is held before and through every plan.
+TEST(Replanner, KeepsTheHeadingItWasGiven) {
+  const perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5), 2.5);
+  EXPECT_EQ(r.Reference(0.0).yaw, 2.5);
+  r.SetGoal(Vector3(2, 0, 1.5));
+  Fly(&r, map, 0.0, 6.0, [](double) {});
+  for (double t = 0.0; t <= 6.0; t += 0.5) EXPECT_EQ(r.Reference(t).yaw, 2.5) << t;
+}
+
 // A wall (with a gap) appears across the trajectory after it was planned: the next update sees it
 // ahead, replans from the current reference, and the reference keeps clear of it.
 TEST(Replanner, AnObstacleAppearingAheadTriggersAReplanAroundIt) {

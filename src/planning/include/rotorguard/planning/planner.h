@@ -31,6 +31,7 @@ struct PlanSummary {
     kGoalOutOfBounds,
     kGoalBlocked,
     kNoPath,
+    kSearchLimit,  ///< the front end's expansion cap, reached before the goal (not proof of no path)
     kOptimizerFailed,
     kInfeasible,
     kCollision

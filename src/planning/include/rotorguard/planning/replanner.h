@@ -41,8 +41,9 @@ class Replanner final : public ReferenceTrajectory {
     Mode mode_after = Mode::kIdle;
   };
 
-  /// Throws ValidationError on invalid options. Holds `hold_position` until given a goal.
-  Replanner(const ReplannerOptions& options, const Vector3& hold_position);
+  /// Throws ValidationError on invalid options. Holds `hold_position` until given a goal; every
+  /// reference it hands out keeps the heading `yaw` (the planner plans position only).
+  Replanner(const ReplannerOptions& options, const Vector3& hold_position, double yaw = 0.0);
 
   void SetGoal(const Vector3& goal_W);
   /// FDD isolated a failure: the post-failure limits from now on.
@@ -79,6 +80,7 @@ class Replanner final : public ReferenceTrajectory {
   Mode mode_ = Mode::kIdle;
   MinimumJerkTrajectory trajectory_;
   Vector3 hold_;
+  double yaw_ = 0.0;
   Vector3 goal_ = Vector3::Zero();
   bool new_goal_ = false, failure_pending_ = false, has_goal_ = false, arrived_ = false;
   double last_plan_t_ = -1e9;
