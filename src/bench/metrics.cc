@@ -57,4 +57,11 @@ FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vecto
   return r;
 }
 
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(i, v.size() - 1)];
+}
+
 }  // namespace rotorguard::bench

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/sim_bench.h"
 #include "rotorguard/core/error.h"
@@ -38,12 +39,6 @@ Flight Fly(const Scenario& s) {
   return f;
 }
 
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
-  return v[std::min(i, v.size() - 1)];
-}
 }  // namespace
 
 nlohmann::json RunNmpcBenchmark(const Scenario& nominal, const Scenario& failed) {

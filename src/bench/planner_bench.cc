@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/sim_bench.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
@@ -48,16 +49,13 @@ void Check(const planning::MinimumJerkTrajectory& traj, const planning::DynamicL
   *clearance = std::numeric_limits<double>::infinity();
   for (int i = 0; i < traj.pieces(); ++i) {
     for (int j = 0; j <= 100; ++j) {
-      const Vector3 p = traj.PieceDerivative(i, traj.durations()(i) * j / 100.0, 0);
-      for (const sim::Box& b : world.boxes) *clearance = std::min(*clearance, b.Distance(p));
-      for (const sim::Cylinder& c : world.cylinders) *clearance = std::min(*clearance, c.Distance(p));
+      *clearance = std::min(*clearance, world.DistanceToObstacles(traj.PieceDerivative(i, traj.durations()(i) * j / 100.0, 0), 0.0));
     }
   }
 }
 
 nlohmann::json GroupJson(const Group& g) {
-  std::vector<double> ms = g.plan_ms;
-  std::sort(ms.begin(), ms.end());
+  const std::vector<double>& ms = g.plan_ms;
   double mean = 0.0;
   for (double v : ms) mean += v;
   mean = ms.empty() ? 0.0 : mean / static_cast<double>(ms.size());
@@ -68,8 +66,8 @@ nlohmann::json GroupJson(const Group& g) {
           {"pairs_without_path", g.no_path},
           {"success_rate", with_path > 0 ? static_cast<double>(g.succeeded) / with_path : 0.0},
           {"plan_ms_mean", mean},
-          {"plan_ms_median", ms.empty() ? 0.0 : ms[ms.size() / 2]},
-          {"plan_ms_p99", ms.empty() ? 0.0 : ms[std::min(ms.size() - 1, static_cast<std::size_t>(0.99 * ms.size()))]},
+          {"plan_ms_median", Percentile(ms, 0.5)},
+          {"plan_ms_p99", Percentile(ms, 0.99)},
           {"mean_traj_duration_s", g.succeeded > 0 ? g.duration_sum / g.succeeded : 0.0},
           {"search_ms_mean", g.attempted > 0 ? g.search_ms / g.attempted : 0.0},
           {"optimize_ms_mean", g.attempted > 0 ? g.optimize_ms / g.attempted : 0.0},

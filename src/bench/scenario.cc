@@ -462,13 +462,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
       w->RejectUnknownKeys();
     }
     n->RejectUnknownKeys();
-    ValidateAt(*n, [&] {
-      r.Validate();
-      if (!(nav.post_failure_safety_factor > 0.0 && nav.post_failure_safety_factor <= 1.0)) {
-        ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", nav.post_failure_safety_factor,
-                        "in (0, 1]");
-      }
-    });
+    ValidateAt(*n, [&] { nav.Validate(); });
   }
   if (const auto n = node.Optional("map")) {
     // The inflation radius is the vehicle's collision radius and the deskew lever arm the LiDAR's

@@ -187,7 +187,7 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
 }
 
 VoxelMap::Index VoxelMap::IndexOf(std::size_t address) const {
-  // Undo WrappedAddress, then unwrap: the window holds the one index with these residues.
+  // Undo AddressOfPacked, then unwrap: the window holds the one index with these residues.
   const int brick = static_cast<int>(address >> 9), cell = static_cast<int>(address & 511);
   const int bz = size_.z() >> 3, by = size_.y() >> 3;
   const Index w((brick / (by * bz)) * 8 + (cell >> 6), ((brick / bz) % by) * 8 + ((cell >> 3) & 7),
@@ -344,11 +344,12 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   constexpr std::size_t kRaysPerBatch = 64, kPrefetchAhead = 64;
   Cell* const cells = cells_.data();
   const int shift_y = brick_shift_y_, shift_z = brick_shift_z_;
+  // Room for a batch's walks (a walk crosses at most size_.sum() voxels).
+  walk_.resize(kRaysPerBatch * static_cast<std::size_t>(size_.sum()));
+  addresses_.resize(walk_.size());
   for (std::size_t first = 0; first < rays.size(); first += kRaysPerBatch) {
-    // Room for the batch's walks (a walk crosses at most size_.sum() voxels), written through a
-    // local pointer: push_back would store and reload the vector's end on every step.
-    walk_.resize(kRaysPerBatch * static_cast<std::size_t>(size_.sum()));
-    addresses_.resize(walk_.size());
+    // Written through a local pointer: push_back would store and reload the vector's end on
+    // every step.
     std::uint64_t* out = walk_.data();
     for (std::size_t r = first; r < std::min(rays.size(), first + kRaysPerBatch); ++r) {
       const Index end_index = ToIndex(rays[r]);

@@ -212,7 +212,6 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     for (int i = 0; i + 1 < pieces; ++i) q.col(i) = traj.PieceDerivative(i, t(i), 0);
   }
   summary.optimize_ms += MsSince(t_opt);
-  summary.limit_margin = summary.optimizer.limit_margin;
   summary.message.clear();
   *out = std::move(traj);
   return Status::kSuccess;

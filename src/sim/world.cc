@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -64,7 +65,11 @@ std::optional<std::string> World::SphereCollision(const Vector3& p, double radiu
 }
 
 double World::DistanceToSurface(const Vector3& p, double t) const {
-  double d = std::abs(p.z());
+  return std::min(std::abs(p.z()), DistanceToObstacles(p, t));
+}
+
+double World::DistanceToObstacles(const Vector3& p, double t) const {
+  double d = std::numeric_limits<double>::infinity();
   for (const Box& b : boxes) d = std::min(d, b.Distance(p));
   for (const Cylinder& c : cylinders) d = std::min(d, c.Distance(p));
   for (const MovingBox& m : moving_boxes) d = std::min(d, m.At(t).Distance(p));

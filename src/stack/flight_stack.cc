@@ -17,6 +17,23 @@ control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& o) {
   return indi;
 }
 
+void NavigationOptions::Validate() const {
+  for (std::size_t i = 0; i < waypoints.size(); ++i) {
+    if (!waypoints[i].allFinite()) {
+      ThrowValidation("FlightStackOptions", fmt::format("navigation.waypoints.{}", i), "(non-finite)", "finite numbers");
+    }
+  }
+  if (rounds < 1) ThrowValidation("FlightStackOptions", "navigation.rounds", rounds, ">= 1");
+  if (!(planner_rate_hz > 0.0)) {
+    ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", planner_rate_hz, "a rate in (0, control_rate_hz]");
+  }
+  if (!(post_failure_safety_factor > 0.0 && post_failure_safety_factor <= 1.0)) {
+    ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", post_failure_safety_factor,
+                    "in (0, 1]");
+  }
+  replanner.Validate();
+}
+
 void FlightStackOptions::Validate() const {
   if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > 10000.0) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
@@ -41,21 +58,11 @@ void FlightStackOptions::Validate() const {
   fixed_time_fdd.Validate();
   lidar.Validate();
   if (!navigation.waypoints.empty()) {
-    const NavigationOptions& n = navigation;
-    for (std::size_t i = 0; i < n.waypoints.size(); ++i) {
-      if (!n.waypoints[i].allFinite()) {
-        ThrowValidation("FlightStackOptions", fmt::format("navigation.waypoints.{}", i), "(non-finite)", "finite numbers");
-      }
+    navigation.Validate();
+    if (navigation.planner_rate_hz > control_rate_hz) {
+      ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", navigation.planner_rate_hz,
+                      "a rate in (0, control_rate_hz]");
     }
-    if (n.rounds < 1) ThrowValidation("FlightStackOptions", "navigation.rounds", n.rounds, ">= 1");
-    if (!(n.planner_rate_hz > 0.0 && n.planner_rate_hz <= control_rate_hz)) {
-      ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", n.planner_rate_hz, "a rate in (0, control_rate_hz]");
-    }
-    if (!(n.post_failure_safety_factor > 0.0 && n.post_failure_safety_factor <= 1.0)) {
-      ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", n.post_failure_safety_factor,
-                      "in (0, 1]");
-    }
-    n.replanner.Validate();
   }
   if (!known_faults.empty() && controller != "nmpc" && controller != "indi") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,

@@ -101,5 +101,17 @@ TEST(ScoreFdd, CorrectLateWrongAndFalseDiagnosesOnHandMadeCases) {
   EXPECT_EQ(ScoreFdd(rotors, prop0).rotor, 1);
 }
 
+// Nearest rank on a hand-made sample (unsorted on input): 1..101 shuffled.
+TEST(Percentile, NearestRankOfTheSortedSample) {
+  std::vector<double> v;
+  for (int k = 101; k >= 1; --k) v.push_back(k % 2 ? k : 102 - k);  // every value 1..101 once
+  EXPECT_EQ(Percentile(v, 0.0), 1.0);
+  EXPECT_EQ(Percentile(v, 0.5), 51.0);
+  EXPECT_EQ(Percentile(v, 0.99), 100.0);
+  EXPECT_EQ(Percentile(v, 1.0), 101.0);
+  EXPECT_EQ(Percentile({}, 0.5), 0.0);
+  EXPECT_EQ(Percentile({4.0, 1.0}, 0.5), 4.0) << "index round(0.5) = 1";
+}
+
 }  // namespace
 }  // namespace rotorguard::bench

@@ -17,15 +17,9 @@ TEST(PlannerBench, RasterizedMapMatchesTheWorld) {
   perception::VoxelMap map(o);
   RasterizeWorld(world, &map);
   const double half_diagonal = 0.5 * std::sqrt(3.0) * 0.1;
-  const auto obstacle_distance = [&](const Vector3& p) {
-    double d = 1e9;
-    for (const sim::Box& b : world.boxes) d = std::min(d, b.Distance(p));
-    for (const sim::Cylinder& c : world.cylinders) d = std::min(d, c.Distance(p));
-    return d;
-  };
   const std::vector<Vector3> occupied = map.OccupiedVoxels();
   ASSERT_GT(occupied.size(), 10000u);
-  for (const Vector3& c : occupied) ASSERT_LE(obstacle_distance(c), half_diagonal + 1e-9) << c.transpose();
+  for (const Vector3& c : occupied) ASSERT_LE(world.DistanceToObstacles(c, 0.0), half_diagonal + 1e-9) << c.transpose();
   // Inside: 0.05 m into the walls' and furniture's interior along a grid of probes.
   int inside = 0;
   for (double x = -5.45; x < 5.5; x += 0.1) {

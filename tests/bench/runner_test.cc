@@ -186,11 +186,8 @@ TEST(NavigationClosedLoop, FliesTheRoomsWaypointsOnItsLidarMap) {
   double closest = 1e9;
   RunOptions o;
   o.on_control_cycle = [&](const stack::FlightStack& st) {
-    const Vector3 p = st.reference_point().p_W;  // the planned reference, as flown
-    double d = 1e9;
-    for (const sim::Box& b : s.world.boxes) d = std::min(d, b.Distance(p));
-    for (const sim::Cylinder& c : s.world.cylinders) d = std::min(d, c.Distance(p));
-    closest = std::min(closest, d);
+    // The planned reference, as flown, against the furniture and walls (not the floor).
+    closest = std::min(closest, s.world.DistanceToObstacles(st.reference_point().p_W, 0.0));
   };
   const RunSummary r = RunScenario(s, o);
   EXPECT_TRUE(r.success) << r.failure_reason;

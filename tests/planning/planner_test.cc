@@ -111,7 +111,7 @@ TEST_F(PlannerAtTheWall, PlansThroughTheGapWithinItsLimits) {
     EXPECT_LE(traj.MaxNorm(1, 2000), limits.v_max * 1.001);
     EXPECT_LE(traj.MaxNorm(2, 2000), limits.a_max * 1.001);
     EXPECT_LE(traj.MaxNorm(3, 2000), limits.j_max * 1.001);
-    EXPECT_GE(s.limit_margin, 0.0);
+    EXPECT_GE(s.optimizer.limit_margin, 0.0);
     EXPECT_LT((traj.Evaluate(1e9).p_W - goal).norm(), 1e-9);
     EXPECT_GT(s.min_clearance_m, 0.2);
   }

@@ -1,6 +1,7 @@
 #include "rotorguard/sim/world.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -61,6 +62,10 @@ TEST(World, DistanceToSurfaceIsTheNearestOfGroundAndObstacles) {
   EXPECT_DOUBLE_EQ(w.DistanceToSurface(Vector3(3.5, 0, 1.5), 0.0), 0.5);         // the box's face
   EXPECT_DOUBLE_EQ(w.DistanceToSurface(Vector3(4, 5, 4.0), 4.0), 0.5);           // the moving box at t = 4 s
   EXPECT_DOUBLE_EQ(w.DistanceToSurface(Vector3(4, 5, 4.0), 0.0), std::hypot(3.5, 0.5));  // it has not come yet
+  // Without the ground: the box's face x = 4 from (0, 0, 0.7).
+  EXPECT_DOUBLE_EQ(w.DistanceToObstacles(Vector3(0, 0, 0.7), 0.0), 4.0);
+  EXPECT_DOUBLE_EQ(w.DistanceToObstacles(Vector3(4, 5, 4.0), 4.0), 0.5);
+  EXPECT_EQ(World{}.DistanceToObstacles(Vector3::Zero(), 0.0), std::numeric_limits<double>::infinity());
 }
 
 }  // namespace

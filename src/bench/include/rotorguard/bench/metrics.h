@@ -10,6 +10,10 @@
 
 namespace rotorguard::bench {
 
+/// The p-quantile (p in [0, 1]) of a sample by nearest rank on the sorted values: index
+/// round(p (n - 1)); 0 for an empty sample. Benchmarks report medians and 99th percentiles with it.
+double Percentile(std::vector<double> values, double p);
+
 /// Tracking error over [t1, t2]: RMSE = sqrt( (1/(t2-t1)) * integral |p - p_ref|^2 dt ), and
 /// paper 000's eq. (37), which divides outside the root: sqrt( integral |p - p_ref|^2 dt ) / (t2-t1).
 /// Integrated with the rectangle rule at the sampling step.

@@ -105,10 +105,10 @@ class VoxelMap {
     return (i.array() >= origin.array()).all() && (i.array() < (origin + size_).array()).all();
   }
   bool InWindow(const Index& i) const { return InWindowAt(i, origin_); }
-  std::size_t Address(const Index& i) const {
-    return WrappedAddress(Index(internal::PositiveMod(i.x(), size_.x()), internal::PositiveMod(i.y(), size_.y()),
-                                internal::PositiveMod(i.z(), size_.z())));
-  }
+  /// Where voxel i is stored: its coordinates wrapped into the ring buffer, in bricks of
+  /// 8 x 8 x 8 voxels, each contiguous (a ray stays in one brick, a few cache lines, for several
+  /// steps in any direction, where a row-major layout jumps a whole plane per step).
+  std::size_t Address(const Index& i) const { return AddressOfPacked(Pack(i)); }
   /// Wrapped coordinates packed in one word, a 16-bit field per axis (12 used; the gap keeps a
   /// field's carry from reaching the next before the mask wraps it): what a ray step updates with
   /// one add and one and, the address following only when a voxel is visited.
@@ -119,9 +119,9 @@ class VoxelMap {
            static_cast<std::uint64_t>(internal::PositiveMod(i.z(), size_.z())) << (2 * kPackShift);
   }
   std::uint32_t AddressOfPacked(std::uint64_t p) const { return AddressOfPacked(p, brick_shift_y_, brick_shift_z_); }
-  /// WrappedAddress from packed coordinates, with log2 of the bricks along y and z passed in: the
-  /// hot loops keep them in registers (a byte store may alias the members, which the compiler
-  /// would otherwise reload after every stamp written).
+  /// The address of packed coordinates, with log2 of the bricks along y and z passed in: the hot
+  /// loops keep them in registers (a byte store may alias the members, which the compiler would
+  /// otherwise reload after every stamp written).
   static std::uint32_t AddressOfPacked(std::uint64_t p, int shift_y, int shift_z) {
     const auto x = static_cast<std::uint32_t>(p & 0xffff), y = static_cast<std::uint32_t>((p >> kPackShift) & 0xffff),
                z = static_cast<std::uint32_t>(p >> (2 * kPackShift));
@@ -130,14 +130,6 @@ class VoxelMap {
   }
   /// The window's voxel stored at this address.
   Index IndexOf(std::size_t address) const;
-  /// From coordinates already wrapped into [0, size). Bricks of 8 x 8 x 8 voxels, each contiguous:
-  /// a ray stays in one brick (a few cache lines) for several steps in any direction, where a
-  /// row-major layout jumps a whole plane per step.
-  std::size_t WrappedAddress(const Index& w) const {
-    const std::size_t brick =
-        (static_cast<std::size_t>(w.x() >> 3) * (size_.y() >> 3) + (w.y() >> 3)) * (size_.z() >> 3) + (w.z() >> 3);
-    return brick * 512 + static_cast<std::size_t>(((w.x() & 7) << 6) | ((w.y() & 7) << 3) | (w.z() & 7));
-  }
   /// One voxel's state, packed so that a ray step reads and writes a single cache line.
   struct Cell {
     std::int16_t log_odds = 0;  // fixed point, kLogOddsScale per unit

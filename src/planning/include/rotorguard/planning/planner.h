@@ -39,11 +39,10 @@ struct PlanSummary {
   Status status = Status::kNoPath;
   std::string message;
   PathResult path;
-  TrajectoryOptimizerSummary optimizer;  ///< the last optimisation
+  TrajectoryOptimizerSummary optimizer;  ///< the last optimisation (its limit_margin: the dense check's)
   int pieces = 0;
   int clearance_rounds = 0;  ///< re-optimisations for clearance
   double search_ms = 0.0, optimize_ms = 0.0, total_ms = 0.0;
-  double limit_margin = 0.0;    ///< the optimiser's dense check: min (limit - max) / limit
   double min_clearance_m = 0.0; ///< the smallest distance to an occupied voxel centre along the result (capped at plane_search_m)
   bool ok() const { return status == Status::kSuccess; }
 };

@@ -71,7 +71,7 @@ struct TrajectoryOptimizerOptions {
   int samples_per_piece = 16;    ///< penalty samples per piece (κ / M), >= 2
   int max_iterations = 200;      ///< L-BFGS iterations, >= 1
   /// L-BFGS stops once an iteration lowers the cost by less than this fraction, in (0, 0.1]:
-  /// 1e-4 plans the 400 bench queries in about 4-5 ms on average, 1e-5 in 6-6.6 ms for trajectories 4 %
+  /// 1e-4 plans the 400 bench queries in 3.7-5.1 ms on average, 1e-5 in 6-6.6 ms for trajectories 4 %
   /// shorter in time (docs/planning.md).
   double relative_cost_tolerance = 1e-4;
   /// The dense feasibility check: samples per piece, and the at most `max_slowdowns` rounds that

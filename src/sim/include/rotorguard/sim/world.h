@@ -49,6 +49,8 @@ class World {
   std::optional<std::string> SphereCollision(const Vector3& p, double radius, double t) const;
   /// Distance from `p` to the nearest surface at time t, the ground plane included (0 inside).
   double DistanceToSurface(const Vector3& p, double t) const;
+  /// The same without the ground: boxes, cylinders and moving boxes (infinity when there are none).
+  double DistanceToObstacles(const Vector3& p, double t) const;
 };
 
 }  // namespace rotorguard::sim

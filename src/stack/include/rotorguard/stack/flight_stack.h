@@ -41,6 +41,9 @@ struct NavigationOptions {
   double planner_rate_hz = 10.0;   ///< in (0, control_rate_hz]
   double post_failure_safety_factor = 0.05;  ///< γ_a,f of eq. (33), in (0, 1]
   planning::ReplannerOptions replanner;      ///< its post_failure_a_max is set from eq. (33)
+  /// Throws ValidationError naming the field ("navigation.rounds"); the rate is checked against
+  /// the control rate by FlightStackOptions.
+  void Validate() const;
 };
 
 struct FlightStackOptions {
