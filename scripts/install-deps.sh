@@ -15,7 +15,12 @@ packages=(
   libbenchmark-dev     # micro-benchmarks
   libceres-dev         # L-BFGS for trajectory optimisation (planning)
   coinor-libipopt-dev  # Ipopt: the NMPC's correctness oracle in tests (not linked by the product)
+  chromium             # headless browser of the report's browser test (viewer/test)
 )
+# Node.js and npm build the report viewer (viewer/); a machine that has them already keeps its own.
+if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

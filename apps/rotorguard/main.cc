@@ -23,11 +23,13 @@
 #include "rotorguard/bench/perception_bench.h"
 #include "rotorguard/bench/planner_bench.h"
 #include "rotorguard/bench/qp_bench.h"
+#include "rotorguard/bench/report.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/bench/sim_bench.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
+#include "rotorguard/io/report_html.h"
 
 namespace {
 
@@ -105,7 +107,7 @@ std::function<void(int, int)> CountProgress(const char* what) {
   };
 }
 
-void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out_dir) {
+void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out_dir, bool csv, bool mcap, bool report) {
   std::string faults;
   for (const auto& f : s.faults) {
     faults += fmt::format("{}rotor {} {} at {:.3f} s", faults.empty() ? "" : "; ", f.rotor, f.kind, f.onset_s);
@@ -135,8 +137,10 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
   }
   fmt::print("seed              {}\n", s.seed);
   if (!out_dir.empty()) {
-    fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());
+    if (csv) fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());
+    if (mcap) fmt::print("mcap              {}\n", (fs::path(out_dir) / "flight.mcap").string());
     fmt::print("summary           {}\n", (fs::path(out_dir) / "summary.json").string());
+    if (report) fmt::print("report            {}\n", (fs::path(out_dir) / "report.html").string());
   }
 }
 
@@ -157,12 +161,14 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   // run
-  std::string scenario_path, out_dir, seed_text;
+  std::string scenario_path, out_dir, seed_text, log_format = "csv";
   std::vector<std::string> sets;
-  bool quiet = false;
-  CLI::App* run = app.add_subcommand("run", "Fly a scenario; write DIR/log.csv, DIR/sensors.csv, DIR/vehicle.yaml and\n"
-                                            "DIR/summary.json.\n"
-                                            "Exit 0 when the mission succeeds, 1 when it fails (crash).");
+  bool quiet = false, no_report = false;
+  CLI::App* run = app.add_subcommand("run", "Fly a scenario; write DIR/summary.json, DIR/report.html, the flight's log\n"
+                                            "(DIR/log.csv and DIR/scene.json, and/or DIR/flight.mcap), DIR/sensors.csv\n"
+                                            "and DIR/vehicle.yaml.\n"
+                                            "Exit 0 when the mission succeeds, 1 when it fails (crash), 4 when a\n"
+                                            "waypoint is unreachable.");
   run->add_option("scenario", scenario_path, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
   run->add_option("--out", out_dir, "Output folder (default: out/<scenario name>)");
   run->add_option("--set", sets,
@@ -170,6 +176,17 @@ int main(int argc, char** argv) {
                   "the key must exist in the file. Repeatable.");
   run->add_option("--seed", seed_text, "Random seed, an integer in [0, 2^64-1] (overrides the file's seed)");
   run->add_flag("--quiet,-q", quiet, "No progress bar and no summary table");
+  run->add_option("--log-format", log_format,
+                  "csv (log.csv, scene.json, sensors.csv; the default), mcap (flight.mcap, for Foxglove and "
+                  "PlotJuggler) or both");
+  run->add_flag("--no-report", no_report, "Do not write report.html");
+
+  // report
+  std::string report_dir, report_out;
+  CLI::App* report = app.add_subcommand("report", "Rebuild DIR/report.html from a saved run (summary.json with log.csv and\n"
+                                                  "scene.json, or flight.mcap). Exit 3 when a file is missing or damaged.");
+  report->add_option("dir", report_dir, "Run folder written by 'rotorguard run --out DIR'")->required();
+  report->add_option("--out", report_out, "Report file (default DIR/report.html)");
 
   // validate
   std::string validate_path;
@@ -256,6 +273,17 @@ int main(int argc, char** argv) {
   bench_planner->add_option("--seed", planner_seed_text, "Worlds and pairs (default 1)");
   bench_planner->add_flag("--json", planner_json, "Print JSON instead of Markdown");
 
+  // Every benchmark can also write its page: tables and distributions (report.h).
+  std::string bench_html;
+  for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner}) {
+    b->add_option("--html", bench_html, "Also write the result as an HTML page to this file");
+  }
+  const auto write_bench_html = [&bench_html](const char* name, const nlohmann::json& result) {
+    if (bench_html.empty()) return;
+    rotorguard::bench::WriteBenchReport(name, result, bench_html);
+    fmt::print(stderr, "report: {}\n", bench_html);
+  };
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {
@@ -272,6 +300,20 @@ int main(int argc, char** argv) {
       if (run->count("--seed") > 0) seed = ParseUnsigned("--seed", seed_text, 0, UINT64_MAX);
       rotorguard::bench::Scenario scenario = rotorguard::bench::LoadScenario(scenario_path, overrides);
       if (seed) scenario.seed = *seed;
+      rotorguard::bench::RunOptions options;
+      if (log_format == "csv") {
+        options.log_format = rotorguard::bench::LogFormat::kCsv;
+      } else if (log_format == "mcap") {
+        options.log_format = rotorguard::bench::LogFormat::kMcap;
+      } else if (log_format == "both") {
+        options.log_format = rotorguard::bench::LogFormat::kBoth;
+      } else {
+        throw UsageError(fmt::format("--log-format: '{}' is invalid; expected csv, mcap or both", log_format));
+      }
+      options.report = !no_report && rotorguard::io::HasViewer();
+      if (!no_report && !options.report) {
+        fmt::print(stderr, "note: no report.html: this rotorguard was built without the report viewer (npm)\n");
+      }
       if (out_dir.empty()) out_dir = (fs::path("out") / scenario.name).string();
       std::error_code ec;
       fs::create_directories(out_dir, ec);
@@ -279,13 +321,22 @@ int main(int argc, char** argv) {
         throw UsageError(fmt::format("--out: cannot create folder '{}'{}", out_dir, ec ? ": " + ec.message() : ""));
       }
       ProgressBar bar(!quiet && ::isatty(STDERR_FILENO), scenario.duration_s);
-      rotorguard::bench::RunOptions options;
       options.out_dir = out_dir;
       options.progress = [&bar](double f) { bar(f); };
       const rotorguard::bench::RunSummary summary = rotorguard::bench::RunScenario(scenario, options);
-      if (!quiet) PrintSummary(summary, out_dir);
+      if (!quiet) {
+        PrintSummary(summary, out_dir, options.log_format != rotorguard::bench::LogFormat::kMcap,
+                     options.log_format != rotorguard::bench::LogFormat::kCsv, options.report);
+      }
       if (summary.infeasible_request) return kInfeasible;
       return summary.success ? kOk : kRunFailed;
+    }
+    if (*report) {
+      const rotorguard::bench::FlightLog log = rotorguard::bench::ReadFlightLog(report_dir);
+      const std::string path = report_out.empty() ? (fs::path(report_dir) / "report.html").string() : report_out;
+      rotorguard::bench::WriteFlightReport(log, path);
+      fmt::print("{}\n", path);
+      return kOk;
     }
     if (*validate) {
       const rotorguard::bench::ValidationReport r = rotorguard::bench::ValidateConfigFile(validate_path);
@@ -320,6 +371,7 @@ int main(int argc, char** argv) {
       o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", repetitions_text, 1, 1000));
       const std::string path = bench_scenario.empty() ? DefaultBenchScenario() : bench_scenario;
       const nlohmann::json result = rotorguard::bench::RunSimBenchmark(rotorguard::bench::LoadScenario(path), o);
+      write_bench_html("sim", result);
       if (json) {
         fmt::print("{}\n", result.dump(2));
       } else {
@@ -357,6 +409,7 @@ int main(int argc, char** argv) {
       o.progress = CountProgress("trials");
       const nlohmann::json r = rotorguard::bench::RunFtcBenchmark(o);
       const std::string md = rotorguard::bench::FtcMarkdown(r);
+      write_bench_html("ftc", r);
       if (!ftc_out.empty()) {
         rotorguard::io::WriteFileAtomically((fs::path(ftc_out) / "results.json").string(), r.dump(2) + "\n");
         rotorguard::io::WriteFileAtomically((fs::path(ftc_out) / "tables.md").string(), md);
@@ -370,6 +423,7 @@ int main(int argc, char** argv) {
       o.seed = ParseUnsigned("--seed", perception_seed_text, 0, UINT64_MAX);
       o.progress = CountProgress("runs");
       const nlohmann::json r = rotorguard::bench::RunPerceptionBenchmark(o);
+      write_bench_html("perception", r);
       fmt::print("{}", perception_json ? r.dump(2) + "\n" : rotorguard::bench::PerceptionMarkdown(r));
       return kOk;
     }
@@ -380,6 +434,7 @@ int main(int argc, char** argv) {
       o.seed = ParseUnsigned("--seed", planner_seed_text, 0, UINT64_MAX);
       o.progress = CountProgress("plans");
       const nlohmann::json r = rotorguard::bench::RunPlannerBenchmark(o);
+      write_bench_html("planner", r);
       fmt::print("{}", planner_json ? r.dump(2) + "\n" : rotorguard::bench::PlannerMarkdown(r));
       return kOk;
     }
@@ -388,6 +443,7 @@ int main(int argc, char** argv) {
       const nlohmann::json r = rotorguard::bench::RunNmpcBenchmark(
           rotorguard::bench::LoadScenario(dir + "/lemniscate_2ms.yaml", {{"stack.controller", "nmpc"}}),
           rotorguard::bench::LoadScenario(dir + "/nmpc_lemniscate_1ms_rotor0_failed.yaml"));
+      write_bench_html("nmpc", r);
       if (nmpc_json) {
         fmt::print("{}\n", r.dump(2));
       } else {
@@ -405,6 +461,7 @@ int main(int argc, char** argv) {
       rotorguard::bench::QpBenchOptions o;
       o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", qp_repetitions_text, 1, 1000));
       const nlohmann::json r = rotorguard::bench::RunQpBenchmark(qp_instance, o);
+      write_bench_html("qp", r);
       if (qp_json) {
         fmt::print("{}\n", r.dump(2));
       } else {
@@ -429,6 +486,9 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kUsage;
   } catch (const rotorguard::io::InputFileError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kUnreadable;
+  } catch (const rotorguard::io::CorruptFileError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kUnreadable;
   } catch (const std::invalid_argument& e) {

@@ -8,6 +8,9 @@
 #include <fmt/format.h>
 
 #include "rotorguard/bench/fdd_calibration.h"
+#include "rotorguard/bench/flight_log.h"
+#include "rotorguard/bench/flight_mcap.h"
+#include "rotorguard/bench/report.h"
 #include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/sensor_log.h"
 #include "rotorguard/core/error.h"
@@ -22,28 +25,15 @@ namespace rotorguard::bench {
 namespace {
 using vehicle::StateView;
 
-// Fault column codes in log.csv (docs/scenarios.md, "Outputs").
-int FaultCode(vehicle::FaultKind kind) { return static_cast<int>(kind); }
-
-std::string LogHeader(int n) {
-  std::string h =
-      "t,p_x,p_y,p_z,q_w,q_x,q_y,q_z,v_x,v_y,v_z,w_x,w_y,w_z,"
-      "ref_p_x,ref_p_y,ref_p_z,ref_v_x,ref_v_y,ref_v_z,ref_yaw,"
-      "est_p_x,est_p_y,est_p_z,est_q_w,est_q_x,est_q_y,est_q_z,est_v_x,est_v_y,est_v_z,"
-      "est_w_x,est_w_y,est_w_z,wind_x,wind_y,wind_z,landed";
-  for (const char* prefix : {"cmd_", "thrust_", "rpm_", "fault_"}) {
-    for (int i = 0; i < n; ++i) h += fmt::format(",{}{}", prefix, i);
-  }
-  return h + "\n";
-}
-
-void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, std::string* out) {
+/// One row of log.csv (flight_log.h, LogColumns): the truth, the stack's reference, estimate and
+/// outputs, the rotors, and the FDD indices and NMPC solve time when the stack has them.
+void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::NumericTable* table) {
   const StateView s(sim.state());
-  const auto v3 = [&](const Vector3& v) { fmt::format_to(std::back_inserter(*out), ",{:.9g},{:.9g},{:.9g}", v.x(), v.y(), v.z()); };
-  const auto q4 = [&](const Quaternion& q) {
-    fmt::format_to(std::back_inserter(*out), ",{:.9g},{:.9g},{:.9g},{:.9g}", q.w(), q.x(), q.y(), q.z());
-  };
-  fmt::format_to(std::back_inserter(*out), "{:.6f}", sim.time_s());
+  std::size_t c = 0;
+  const auto put = [&](double v) { table->values[c++].push_back(v); };
+  const auto v3 = [&](const Vector3& v) { put(v.x()), put(v.y()), put(v.z()); };
+  const auto q4 = [&](const Quaternion& q) { put(q.w()), put(q.x()), put(q.y()), put(q.z()); };
+  put(sim.time_s());
   v3(s.p_W());
   q4(s.q_WB());
   v3(s.v_W());
@@ -51,22 +41,27 @@ void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, std::str
   const ReferencePoint& r = st.reference_point();
   v3(r.p_W);
   v3(r.v_W);
-  fmt::format_to(std::back_inserter(*out), ",{:.9g}", r.yaw);
+  put(r.yaw);
   const StateEstimate& e = st.estimate();
   v3(e.p_W);
   q4(e.q_WB);
   v3(e.v_W);
   v3(e.w_B);
   v3(sim.wind());
-  fmt::format_to(std::back_inserter(*out), ",{}", sim.landed() ? 1 : 0);
+  put(sim.landed() ? 1.0 : 0.0);
   const int n = sim.model().num_rotors();
-  for (int i = 0; i < n; ++i) fmt::format_to(std::back_inserter(*out), ",{:.9g}", sim.applied_command()[i]);
-  for (int i = 0; i < n; ++i) fmt::format_to(std::back_inserter(*out), ",{:.9g}", sim.rotor_thrusts()[i]);
-  for (int i = 0; i < n; ++i) {
-    fmt::format_to(std::back_inserter(*out), ",{:.1f}", vehicle::RadPerSecondToRpm(sim.motor_speeds()[i]));
+  for (int i = 0; i < n; ++i) put(sim.applied_command()[i]);
+  for (int i = 0; i < n; ++i) put(sim.rotor_thrusts()[i]);
+  for (int i = 0; i < n; ++i) put(vehicle::RadPerSecondToRpm(sim.motor_speeds()[i]));
+  for (int i = 0; i < n; ++i) put(static_cast<int>(sim.faults()[i].kind));  // docs/scenarios.md, "Outputs"
+  if (const fdd::FaultDetector* detector = st.fault_detector()) {
+    const std::vector<fdd::RotorStatus>& rotors = detector->rotors();
+    for (int i = 0; i < n; ++i) put(rotors[i].motor_index);
+    for (int i = 0; i < n; ++i) put(rotors[i].propeller_index);
+    for (int i = 0; i < n; ++i) put(static_cast<int>(rotors[i].health));
   }
-  for (int i = 0; i < n; ++i) fmt::format_to(std::back_inserter(*out), ",{}", FaultCode(sim.faults()[i].kind));
-  out->push_back('\n');
+  if (const control::NmpcController* nmpc = st.nmpc()) put(1e3 * nmpc->summary().solve_time_s);
+  RG_INVARIANT(c == table->columns.size(), "log row and LogColumns disagree");
 }
 
 /// Hands the sensor messages to the stack, recording them in the sensor log when there is one.
@@ -149,15 +144,19 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   }
   const auto wall_start = std::chrono::steady_clock::now();
 
-  std::optional<io::AtomicFileWriter> log, sensors;
-  if (!options.out_dir.empty()) {
+  const bool record = !options.out_dir.empty();
+  const bool write_csv = options.log_format != LogFormat::kMcap;
+  std::optional<io::AtomicFileWriter> sensors;
+  if (record) {
     std::error_code ec;
     fs::create_directories(options.out_dir, ec);
     if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", options.out_dir, ec.message()));
     // A summary left by an earlier run must not pass for this run's.
     fs::remove(fs::path(options.out_dir) / "summary.json", ec);
-    log.emplace((fs::path(options.out_dir) / "log.csv").string());
-    sensors.emplace((fs::path(options.out_dir) / "sensors.csv").string());
+    for (const char* name : {"report.html", "flight.mcap", "log.csv", "scene.json", "sensors.csv"}) {
+      fs::remove(fs::path(options.out_dir) / name, ec);  // an older run's files would mix with this one's
+    }
+    if (write_csv) sensors.emplace((fs::path(options.out_dir) / "sensors.csv").string());
   }
 
   const vehicle::MultirotorModel truth_model(sc.vehicle);
@@ -197,8 +196,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   double last_violation_error = 0.0;
   double min_alt_all = std::numeric_limits<double>::infinity();
   double min_alt_after_fault = std::numeric_limits<double>::infinity();
-  std::string buffer;
-  if (log) buffer = LogHeader(truth_model.num_rotors());
+  FlightLog flight;
+  flight.table.columns = LogColumns(truth_model.num_rotors(), st.fault_detector() != nullptr, st.nmpc() != nullptr);
+  flight.table.values.resize(flight.table.columns.size());
+  SceneRecorder scene(sc.vehicle, sc.world);
   RotorCommand command = st.command();
 
   for (std::int64_t k = 0; k < steps; ++k) {
@@ -209,6 +210,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       next_control += control_period;
       ++summary.control_cycles;
       if (options.on_control_cycle) options.on_control_cycle(st);
+      if (record) scene.OnControlCycle(ToSeconds(t), st);
     }
     const StateView s(sim.state());
     const Vector3 p_ref = st.reference().Evaluate(ToSeconds(t)).p_W;  // the planner's when navigating
@@ -223,13 +225,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     if (!sim.fault_events().empty()) min_alt_after_fault = std::min(min_alt_after_fault, alt);
     summary.max_spin_rad_s = std::max(summary.max_spin_rad_s, std::abs(s.w_B().z()));
     if (!sim.fault_events().empty() && TiltOf(s.q_WB()) > sc.recovered_tilt_rad) last_tilted_s = ToSeconds(t);
-    if (log && t >= next_log) {
-      AppendRow(sim, st, &buffer);
+    if (record && t >= next_log) {
+      AppendRow(sim, st, &flight.table);
+      scene.OnTime(ToSeconds(t));
       next_log += log_period;
-      if (buffer.size() > (1u << 20)) {
-        log->Write(buffer);
-        buffer.clear();
-      }
     }
     Deliver(sim.Step(command), &st, sensor_log);
     if (sensor_log && sensor_buffer.size() > (1u << 20)) {
@@ -248,12 +247,14 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     min_alt_all = std::min(min_alt_all, alt);
     if (!sim.fault_events().empty()) min_alt_after_fault = std::min(min_alt_after_fault, alt);
   }
-  if (log) {
-    AppendRow(sim, st, &buffer);
-    log->Write(buffer);
-    log->Commit();
-    sensors->Write(sensor_buffer);
-    sensors->Commit();
+  if (record) {
+    AppendRow(sim, st, &flight.table);
+    flight.scene = scene.ToJson();
+    if (write_csv) {
+      WriteFlightLogFiles(flight, options.out_dir);
+      sensors->Write(sensor_buffer);
+      sensors->Commit();
+    }
     // The vehicle the stack flew, so that the run's folder is enough to replay its sensor log.
     io::WriteFileAtomically((fs::path(options.out_dir) / "vehicle.yaml").string(), VehicleToYaml(sc.vehicle));
   }
@@ -316,9 +317,13 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   }
   summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   summary.realtime_factor = summary.wall_time_s > 0.0 ? summary.sim_time_s / summary.wall_time_s : 0.0;
-  if (!options.out_dir.empty()) {
-    io::WriteFileAtomically((fs::path(options.out_dir) / "summary.json").string(),
-                            summary.ToJson().dump(2) + "\n");
+  if (record) {
+    flight.summary = summary.ToJson();
+    if (options.log_format != LogFormat::kCsv) {
+      WriteFlightMcap(flight, (fs::path(options.out_dir) / "flight.mcap").string());
+    }
+    io::WriteFileAtomically((fs::path(options.out_dir) / "summary.json").string(), flight.summary.dump(2) + "\n");
+    if (options.report) WriteFlightReport(flight, (fs::path(options.out_dir) / "report.html").string());
   }
   return summary;
 }

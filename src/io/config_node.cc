@@ -644,12 +644,13 @@ InputFileError::InputFileError(std::string path, std::string reason)
       path_(std::move(path)),
       reason_(std::move(reason)) {}
 
-// ---- ConfigDocument.
+CorruptFileError::CorruptFileError(std::string path, std::uint64_t byte_offset, std::string message)
+    : std::runtime_error(fmt::format("{}: corrupt at byte {}: {}", path, byte_offset, message)),
+      path_(std::move(path)),
+      byte_offset_(byte_offset),
+      message_(std::move(message)) {}
 
-ConfigDocument::ConfigDocument(std::shared_ptr<detail::DocumentState> state)
-    : state_(std::move(state)) {}
-
-ConfigDocument ConfigDocument::LoadFile(const std::string& path) {
+std::string ReadInputFile(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw InputFileError(path, "is a directory");
   errno = 0;
@@ -657,7 +658,16 @@ ConfigDocument ConfigDocument::LoadFile(const std::string& path) {
   if (!in) throw InputFileError(path, ReasonFromErrno(errno));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw InputFileError(path, ReasonFromErrno(errno));
-  return LoadString(text, path);
+  return text;
+}
+
+// ---- ConfigDocument.
+
+ConfigDocument::ConfigDocument(std::shared_ptr<detail::DocumentState> state)
+    : state_(std::move(state)) {}
+
+ConfigDocument ConfigDocument::LoadFile(const std::string& path) {
+  return LoadString(ReadInputFile(path), path);
 }
 
 ConfigDocument ConfigDocument::LoadString(const std::string& text, const std::string& name) {

@@ -87,10 +87,12 @@ class CliTest : public rotorguard::testing::TempFolderTest {
 TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
   const Result r = Cli("--help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* s : {"run", "validate", "bench", "fdd-calibrate", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  for (const char* s : {"run", "validate", "bench", "fdd-calibrate", "report", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
   const Result run = Cli("run --help");
   EXPECT_EQ(run.exit_code, 0);
-  for (const char* s : {"--out", "--set", "--seed", "--quiet"}) EXPECT_NE(run.out.find(s), std::string::npos) << s;
+  for (const char* s : {"--out", "--set", "--seed", "--quiet", "--log-format", "--no-report"}) EXPECT_NE(run.out.find(s), std::string::npos) << s;
+  EXPECT_EQ(Cli("report --help").exit_code, 0);
+  EXPECT_NE(Cli("bench planner --help").out.find("--html"), std::string::npos);
   EXPECT_EQ(Cli("bench sim --help").exit_code, 0);
   const Result perception = Cli("bench perception --help");
   EXPECT_EQ(perception.exit_code, 0);
@@ -389,7 +391,7 @@ TEST_F(CliTest, KilledRunLeavesNoSummaryThatLooksComplete) {
   // Wait until the run has started writing, then kill it without warning.
   for (int i = 0; i < 200; ++i) {
     bool started = false;
-    for (const auto& e : fs::directory_iterator(Out())) started |= e.path().filename().string().rfind("log.csv.tmp", 0) == 0;
+    for (const auto& e : fs::directory_iterator(Out())) started |= e.path().filename().string().rfind("sensors.csv.tmp", 0) == 0;
     if (started) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -399,6 +401,79 @@ TEST_F(CliTest, KilledRunLeavesNoSummaryThatLooksComplete) {
   ::waitpid(pid, &status, 0);
   EXPECT_FALSE(fs::exists(fs::path(Out()) / "summary.json")) << "a stale or partial summary survived";
   EXPECT_FALSE(fs::exists(fs::path(Out()) / "log.csv")) << "a partial log carries the final name";
+}
+
+TEST_F(CliTest, RunWritesAReportAndReportRebuildsItFromCsvOrMcap) {
+  const std::string s = Write("hover.yaml", Scenario(kVehicle));
+  const Result r = Cli("run " + s + " --out " + Out() + " --log-format both");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  for (const char* f : {"log.csv", "scene.json", "sensors.csv", "flight.mcap", "summary.json", "report.html"}) {
+    EXPECT_TRUE(fs::exists(fs::path(Out()) / f)) << f;
+  }
+  EXPECT_NE(r.out.find("report.html"), std::string::npos) << "the run prints the report's path";
+  const std::string page = ReadText(fs::path(Out()) / "report.html");
+  EXPECT_NE(page.find("rotorguard-data"), std::string::npos);
+  // Rebuilt from the CSV log: the same page.
+  fs::remove(fs::path(Out()) / "report.html");
+  const Result rebuilt = Cli("report " + Out());
+  ASSERT_EQ(rebuilt.exit_code, 0) << rebuilt.out;
+  // The run's report came from the flight in memory, the rebuilt one from log.csv's 9 digits: the
+  // same page but for a last-decimal rounding here and there.
+  const auto data = [](const std::string& html) {
+    const std::string tag = "type=\"application/json\">";
+    const std::size_t a = html.find(tag) + tag.size();
+    return nlohmann::json::parse(html.substr(a, html.find("</script>", a) - a));
+  };
+  nlohmann::json a = data(page), b = data(ReadText(fs::path(Out()) / "report.html"));
+  for (const auto& [name, column] : a["series"].items()) {
+    ASSERT_EQ(column.size(), b["series"][name].size()) << name;
+    for (std::size_t i = 0; i < column.size(); ++i) {
+      EXPECT_NEAR(column[i].get<double>(), b["series"][name][i].get<double>(), 1.01) << name;
+      if (name.rfind("rpm_", 0) != 0) {
+        EXPECT_NEAR(column[i].get<double>(), b["series"][name][i].get<double>(), 1.01e-4) << name;
+      }
+    }
+  }
+  a.erase("series");
+  b.erase("series");
+  EXPECT_EQ(a, b);
+  // Rebuilt from the MCAP file alone (with the MCAP's exact numbers rather than the CSV's 9 digits).
+  fs::remove(fs::path(Out()) / "log.csv");
+  fs::remove(fs::path(Out()) / "scene.json");
+  const std::string other = (fs::path(Out()) / "from_mcap.html").string();
+  ASSERT_EQ(Cli("report " + Out() + " --out " + other).exit_code, 0);
+  EXPECT_GT(ReadText(other).size(), 10000u);
+}
+
+TEST_F(CliTest, McapOnlyRunWritesNoCsv) {
+  const std::string s = Write("hover.yaml", Scenario(kVehicle));
+  const Result r = Cli("run " + s + " --out " + Out() + " --log-format mcap --no-report");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(fs::path(Out()) / "flight.mcap"));
+  for (const char* f : {"log.csv", "scene.json", "sensors.csv", "report.html"}) EXPECT_FALSE(fs::exists(fs::path(Out()) / f)) << f;
+  const Result bad = Cli("run " + s + " --out " + Out() + " --log-format parquet");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.out.find("--log-format: 'parquet' is invalid; expected csv, mcap or both"), std::string::npos) << bad.out;
+}
+
+TEST_F(CliTest, ReportOfADamagedRunExitsThreeWithTheByteOffset) {
+  const std::string s = Write("hover.yaml", Scenario(kVehicle));
+  ASSERT_EQ(Cli("run " + s + " --out " + Out() + " --log-format both --quiet").exit_code, 0);
+  const std::string log = ReadText(fs::path(Out()) / "log.csv");
+  Write("out/log.csv", log.substr(0, log.size() - 5));
+  const Result truncated = Cli("report " + Out());
+  EXPECT_EQ(truncated.exit_code, 3) << truncated.out;
+  EXPECT_NE(truncated.out.find("log.csv: corrupt at byte " + std::to_string(log.size() - 5)), std::string::npos)
+      << truncated.out;
+  // The MCAP file with one byte of a chunk changed: its CRC names the damage.
+  fs::remove(fs::path(Out()) / "log.csv");
+  std::string mcap = ReadText(fs::path(Out()) / "flight.mcap");
+  mcap[mcap.size() / 3] ^= 0x20;
+  Write("out/flight.mcap", mcap);
+  const Result corrupt = Cli("report " + Out());
+  EXPECT_EQ(corrupt.exit_code, 3) << corrupt.out;
+  EXPECT_NE(corrupt.out.find("flight.mcap: corrupt at byte "), std::string::npos) << corrupt.out;
+  EXPECT_EQ(Cli("report " + Out() + "/missing").exit_code, 3);
 }
 
 }  // namespace

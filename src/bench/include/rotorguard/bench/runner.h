@@ -1,8 +1,9 @@
 #pragma once
 /// Flies a scenario: the simulator and the flight stack in closed loop, exchanging only sensor
-/// messages and rotor commands. Given an output folder it writes log.csv (truth, estimate and
-/// commands at the log rate), sensors.csv (every message the stack received; sensor_log.h),
-/// vehicle.yaml (the vehicle flown) and summary.json.
+/// messages and rotor commands. Given an output folder it writes the flight's record
+/// (flight_log.h: log.csv and scene.json, or flight.mcap), sensors.csv (every message the stack
+/// received; sensor_log.h), vehicle.yaml (the vehicle flown), summary.json and, when asked,
+/// report.html.
 #include <functional>
 #include <optional>
 #include <string>
@@ -68,8 +69,15 @@ struct RunSummary {
   nlohmann::json ToJson() const;
 };
 
+/// What a run folder holds besides summary.json (flight_log.h): kCsv log.csv, scene.json and
+/// sensors.csv; kMcap flight.mcap (flight_mcap.h); kBoth all of them.
+enum class LogFormat { kCsv, kMcap, kBoth };
+
 struct RunOptions {
   std::string out_dir;  ///< "" writes nothing
+  LogFormat log_format = LogFormat::kCsv;
+  /// Also write report.html (report.h); needs a program built with the viewer (io::HasViewer).
+  bool report = false;
   /// Called about every 1 % of simulated time with the completed fraction in [0, 1].
   std::function<void(double)> progress;
   /// Called after every control cycle with the stack (benchmarks read solver statistics).

@@ -66,6 +66,26 @@ class InputFileError : public std::runtime_error {
   std::string reason_;
 };
 
+/// An input file whose content is damaged (truncated, a bad record, a checksum mismatch). what()
+/// is "PATH: corrupt at byte OFFSET: MESSAGE"; the CLI exits 3 on it, as on InputFileError.
+class CorruptFileError : public std::runtime_error {
+ public:
+  CorruptFileError(std::string path, std::uint64_t byte_offset, std::string message);
+
+  const std::string& path() const { return path_; }
+  /// Offset of the first byte found wrong, from the start of the file.
+  std::uint64_t byte_offset() const { return byte_offset_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string path_;
+  std::uint64_t byte_offset_;
+  std::string message_;
+};
+
+/// Reads a whole input file; throws InputFileError (missing, a directory, unreadable).
+std::string ReadInputFile(const std::string& path);
+
 namespace detail {
 struct Value;
 struct DocumentState;
