@@ -143,6 +143,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
           {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
           {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
           {"mini_alt_m", NullIfNan(min_alt)},
+          {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
           {"failures", failures}};
 }
 

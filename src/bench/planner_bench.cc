@@ -68,6 +68,7 @@ nlohmann::json GroupJson(const Group& g) {
           {"plan_ms_mean", mean},
           {"plan_ms_median", Percentile(ms, 0.5)},
           {"plan_ms_p99", Percentile(ms, 0.99)},
+          {"plan_ms_samples", ms},  // the distribution, for the HTML page's histogram
           {"mean_traj_duration_s", g.succeeded > 0 ? g.duration_sum / g.succeeded : 0.0},
           {"search_ms_mean", g.attempted > 0 ? g.search_ms / g.attempted : 0.0},
           {"optimize_ms_mean", g.attempted > 0 ? g.optimize_ms / g.attempted : 0.0},

@@ -107,6 +107,14 @@ function replaySection(app, data, clock) {
       const fault = s[`fault_${r}`][i] > 0 ? " ✗" : "";
       rows += `<tr><td>rotor ${r}${fault}</td><td class="num">${fmt(s[`thrust_${r}`][i], 2)} N · ${fmt(s[`rpm_${r}`][i], 0)} rpm</td></tr>`;
     }
+    if (s.mi_0) {
+      const names = ["ok", "motor failed", "propeller failed", "degraded", "failed"];
+      rows += `<tr><td colspan="2"><b>FDD</b></td></tr>`;
+      for (let r = 0; r < n; r += 1) {
+        rows += `<tr><td>M_${r} · P_${r}</td><td class="num">${s[`mi_${r}`][i].toFixed(2)} · ${s[`pi_${r}`][i].toFixed(2)} · ${names[s[`health_${r}`][i]] ?? "?"}</td></tr>`;
+      }
+    }
+    if (s.nmpc_ms) rows += `<tr><td>NMPC solve</td><td class="num">${fmt(s.nmpc_ms[i], 2)} ms</td></tr>`;
     side.innerHTML = `<table>${rows}</table>`;
   };
   clock.onChange(update);

@@ -25,6 +25,8 @@ function start() {
   } else {
     throw new Error(`unknown report kind '${data.kind}'`);
   }
+  // Milliseconds from the start of navigation until the page is drawn (bench/report_open.mjs).
+  window.rotorguardReport.readyMs = performance.now();
   window.rotorguardReport.ready = true;
 }
 

@@ -10,7 +10,7 @@ export function color(i) {
 
 /**
  * A chart in `parent`.
- * spec: { title, x (times), series: [{label, values, color, dash, width}], yLabel,
+ * spec: { title, x (times, or another abscissa named by xLabel), series: [{label, values, color, dash, width}], yLabel,
  *         markers: [{t, color, label}], thresholds: [{y, color, label}], yRange: [lo, hi] }
  * clock: { time(), onChange(fn), set(t) } — the replay's time.
  */
@@ -65,7 +65,7 @@ export function makePlot(parent, spec, clock) {
     ctx.restore();
   };
 
-  const series = [{ label: "t [s]" }];
+  const series = [{ label: spec.xLabel || "t [s]" }];
   const data = [spec.x];
   for (const [i, s] of spec.series.entries()) {
     series.push({
@@ -74,6 +74,8 @@ export function makePlot(parent, spec, clock) {
       width: s.width || 1.5,
       dash: s.dash,
       points: { show: false },
+      paths: s.steps ? uPlot.paths.stepped({ align: 1 }) : undefined,
+      fill: s.steps ? `${s.color || color(i)}22` : undefined,
       value: (u, v) => (v == null ? "–" : v.toFixed(3)),
     });
     data.push(s.values);
@@ -84,7 +86,7 @@ export function makePlot(parent, spec, clock) {
     height: spec.height || 220,
     series,
     scales: { x: { time: false }, y: spec.yRange ? { range: spec.yRange } : {} },
-    axes: [{ label: "t [s]", size: 36 }, { label: spec.yLabel || "", size: 56 }],
+    axes: [{ label: spec.xLabel || "t [s]", size: 36 }, { label: spec.yLabel || "", size: 56 }],
     legend: { live: true },
     cursor: { sync: { key: "rotorguard-time" }, drag: { x: true, y: false } },
     hooks: { draw: [draw] },

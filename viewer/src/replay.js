@@ -64,7 +64,7 @@ export class Replay {
     const size = this.bounds.getSize(new THREE.Vector3()).length();
     // Start behind and above the vehicle's first position, at a distance that shows its
     // surroundings; "follow" keeps this offset as the vehicle moves.
-    this.viewDistance = Math.max(2, Math.min(6, 0.15 * size));
+    this.viewDistance = Math.max(1.2, Math.min(5, 0.1 * size));
     const s0 = this.series;
     const start = new THREE.Vector3(s0.p_x[0], s0.p_y[0], s0.p_z[0]);
     this.camera.position.set(start.x - this.viewDistance, start.y - 0.8 * this.viewDistance, start.z + 0.7 * this.viewDistance);

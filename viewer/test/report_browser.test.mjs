@@ -1,14 +1,14 @@
 // Browser test of a flight report (run by ctest): opens REPORT.html in headless Chromium and checks
 // that the page loads without console errors, the 3D canvas has drawn something, moving the time
 // slider moves the vehicle to where the log says it was, and the plots are present. Saves a
-// screenshot to SCREENSHOT.png.
-//   node test/report_browser.test.mjs REPORT.html SCREENSHOT.png
+// screenshot to SCREENSHOT.png. Given a benchmark's page too, checks its tables and histograms.
+//   node test/report_browser.test.mjs REPORT.html SCREENSHOT.png [BENCH.html]
 import { existsSync } from "node:fs";
 import { resolve } from "node:path";
 import { pathToFileURL } from "node:url";
 import { check, finish } from "./check.mjs";
 
-const [reportPath, screenshotPath] = process.argv.slice(2);
+const [reportPath, screenshotPath, benchPath] = process.argv.slice(2);
 if (!reportPath || !screenshotPath) {
   console.error("usage: node test/report_browser.test.mjs REPORT.html SCREENSHOT.png");
   process.exit(2);
@@ -104,6 +104,21 @@ try {
   await page.screenshot({ path: screenshotPath, fullPage: false });
   console.log(`info screenshot ${screenshotPath}`);
   check(errors.length === 0, `no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
+  if (benchPath) {
+    const bench = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+    const benchErrors = [];
+    bench.on("console", (m) => {
+      if (m.type() === "error") benchErrors.push(m.text());
+    });
+    bench.on("pageerror", (e) => benchErrors.push(String(e)));
+    await bench.goto(pathToFileURL(resolve(benchPath)).href);
+    await bench.waitForFunction(() => window.rotorguardReport && window.rotorguardReport.ready === true, null, { timeout: 30000 });
+    const tables = await bench.locator("table.data").count();
+    const histograms = await bench.evaluate(() => Array.from(document.querySelectorAll(".uplot canvas")).filter((c) => c.width > 100).length);
+    check(tables >= 2, `the benchmark page has its tables (${tables})`);
+    check(histograms >= 1, `the benchmark page has its distributions (${histograms} histograms)`);
+    check(benchErrors.length === 0, `no console errors on the benchmark page${benchErrors.length ? ": " + benchErrors.join(" | ") : ""}`);
+  }
 } finally {
   await browser.close();
 }
