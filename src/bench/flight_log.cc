@@ -86,7 +86,10 @@ SceneRecorder::SceneRecorder(const vehicle::VehicleParams& vehicle, const sim::W
     rotors.push_back({{"position_m", Vec(r.p_B)},
                       {"spin", r.direction == vehicle::SpinDirection::kClockwise ? "cw" : "ccw"}});
   }
-  scene_["vehicle"] = {{"name", vehicle.name}, {"collision_radius_m", vehicle.collision_radius_m}, {"rotors", rotors}};
+  scene_["vehicle"] = {{"name", vehicle.name},
+                       {"collision_radius_m", vehicle.collision_radius_m},
+                       {"thrust_coefficient_n_s2", vehicle.thrust_coefficient_n_s2},  // commanded rpm from thrust
+                       {"rotors", rotors}};
   nlohmann::json boxes = nlohmann::json::array(), cylinders = nlohmann::json::array(), moving = nlohmann::json::array();
   for (const sim::Box& b : world.boxes) {
     boxes.push_back({{"center_m", Vec(b.center_m)}, {"size_m", Vec(b.size_m)}, {"yaw_rad", b.yaw_rad}});

@@ -174,10 +174,17 @@ function plotsSection(app, data, clock) {
       ],
     }, clock);
   }
-  makePlot(rotorPlots, {
-    title: "Rotor speeds (ESC telemetry)", x: t, yLabel: "rpm", markers,
-    series: Array.from({ length: n }, (_, r) => ({ label: `rotor ${r}`, values: s[`rpm_${r}`], color: color(r) })),
-  }, clock);
+  // Commanded speeds from the commanded thrusts (T = k_n w^2), dashed beside the actual ones.
+  const kn = data.scene.vehicle.thrust_coefficient_n_s2;
+  const rpmSeries = [];
+  for (let r = 0; r < n; r += 1) {
+    rpmSeries.push({ label: `rotor ${r}`, values: s[`rpm_${r}`], color: color(r) });
+    if (kn > 0) {
+      const commanded = s[`cmd_${r}`].map((c) => (Math.sqrt(Math.max(0, c) / kn) * 60) / (2 * Math.PI));
+      rpmSeries.push({ label: `rotor ${r} commanded`, values: commanded, color: color(r), dash: [5, 3], width: 1 });
+    }
+  }
+  makePlot(rotorPlots, { title: "Rotor speeds: actual and commanded", x: t, yLabel: "rpm", markers, series: rpmSeries }, clock);
 
   if (s.mi_0) {
     const fdd = summary.composite_fdd || {};
