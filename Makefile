@@ -2,7 +2,7 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 ROTORGUARD_WARNINGS_AS_ERRORS ?= OFF
-DEMO_SCENARIO ?= configs/scenarios/fdd_hover_propeller_loss.yaml
+DEMO_SCENARIO ?= configs/scenarios/forest.yaml
 DEMO_OUT ?= out/demo
 
 .PHONY: all deps configure build demo test bench clean

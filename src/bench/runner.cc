@@ -127,6 +127,7 @@ nlohmann::json RunSummary::ToJson() const {
                        {"waypoints_total", waypoints_total},
                        {"plans", plans},
                        {"plans_failed", plans_failed},
+                       {"plans_by_reason", plans_by_reason},
                        {"failed_plans", failed_plans},
                        {"infeasible_request", infeasible_request}};
   }
@@ -266,6 +267,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     summary.waypoints_total = static_cast<int>(sc.stack.navigation.waypoints.size()) * sc.stack.navigation.rounds;
     summary.plans = static_cast<int>(nav->events().size());
     for (const planning::Replanner::Event& e : nav->events()) {
+      ++summary.plans_by_reason[e.reason];
       if (e.status == planning::PlanSummary::Status::kSuccess) continue;
       ++summary.plans_failed;
       summary.failed_plans.push_back(fmt::format("{:.2f} s {}: {}", e.t, e.reason, planning::ToString(e.status)));

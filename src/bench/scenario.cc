@@ -187,6 +187,7 @@ sim::World ParseWorld(const ConfigNode& node) {
       for (std::size_t k = 0; k < wps.size(); ++k) mb.waypoints_m.push_back(wps.At(k).AsVector3());
       mb.speed_m_s = m.Required("speed_m_s").AsNonNegative();
       if (const auto loop = m.Optional("loop")) mb.loop = loop->AsBool();
+      if (const auto start = m.Optional("start_s")) mb.start_s = start->AsNonNegative();
       m.RejectUnknownKeys();
       w.moving_boxes.push_back(mb);
     }

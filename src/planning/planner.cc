@@ -65,7 +65,7 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
   switch (summary.path.status) {
     case PathStatus::kFound: break;
     case PathStatus::kStartOutOfBounds: return finish(Status::kStartOutOfBounds, "the start lies outside the map");
-    case PathStatus::kGoalOutOfBounds: return finish(Status::kGoalOutOfBounds, "the goal lies outside the map");
+    case PathStatus::kGoalOutOfBounds: return finish(Status::kGoalOutOfBounds, "the goal lies outside the map or its altitude band");
     case PathStatus::kGoalBlocked: return finish(Status::kGoalBlocked, "the goal lies within an obstacle's inflation");
     case PathStatus::kNoPath: return finish(Status::kNoPath, "no collision-free path to the goal in the map");
     case PathStatus::kExpansionLimit:

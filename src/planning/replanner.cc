@@ -28,6 +28,30 @@ void ReplannerOptions::Validate() const {
   require(std::isfinite(replan_period_s) && replan_period_s > 0.0, "replan_period_s", replan_period_s, "a period > 0 s");
   require(std::isfinite(check_horizon_s) && check_horizon_s > 0.0, "check_horizon_s", check_horizon_s, "a horizon > 0 s");
   require(std::isfinite(check_step_m) && check_step_m > 0.0, "check_step_m", check_step_m, "a step > 0 m");
+  require(std::isfinite(local_goal_margin_m) && local_goal_margin_m >= 0.0, "local_goal_margin_m", local_goal_margin_m,
+          "a distance >= 0 m");
+}
+
+std::optional<Vector3> LocalGoal(const perception::VoxelMap& map, const Vector3& start, const Vector3& goal,
+                                 double margin_m) {
+  const Vector3 lo = map.window_min_W().array() + margin_m, hi = map.window_max_W().array() - margin_m;
+  const auto inside = [&](const Vector3& p) { return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all(); };
+  if (inside(goal)) return goal;
+  // The segment's parameter where it leaves the shrunk window (slab clipping), from a start inside.
+  const Vector3 d = goal - start;
+  double s_max = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    if (d[a] > 0.0) s_max = std::min(s_max, (hi[a] - start[a]) / d[a]);
+    if (d[a] < 0.0) s_max = std::min(s_max, (lo[a] - start[a]) / d[a]);
+  }
+  if (!(s_max > 0.0)) return std::nullopt;  // the start itself is outside the shrunk window
+  const double length = d.norm() * s_max;
+  const double step = map.resolution();
+  for (double back = 0.0; back < length; back += step) {
+    const Vector3 p = start + d * (s_max * (1.0 - back / length));
+    if (!map.IsInflated(p)) return p;
+  }
+  return std::nullopt;
 }
 
 const char* ToString(Replanner::Mode mode) {
@@ -77,7 +101,11 @@ bool Replanner::UnsafeAhead(double t, const perception::VoxelMap& map) const {
 
 bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   MinimumJerkTrajectory traj;
-  last_plan_ = planner_.Plan(StateOf(Reference(t)), goal_, limits_, map, &traj);
+  const PvaState start = StateOf(Reference(t));
+  // A goal beyond the window is approached through a local goal at its edge (receding horizon);
+  // when the whole way there is blocked, the planner is asked for the goal itself and says why.
+  planned_goal_ = LocalGoal(map, start.col(0), goal_, options_.local_goal_margin_m).value_or(goal_);
+  last_plan_ = planner_.Plan(start, planned_goal_, limits_, map, &traj);
   last_plan_t_ = t;
   const bool ok = last_plan_.ok();
   if (ok) {

@@ -35,7 +35,7 @@ Box MovingBox::At(double t) const {
   const std::size_t segments = loop ? n : n - 1;
   double total = 0.0;
   for (std::size_t i = 0; i < segments; ++i) total += (waypoints_m[(i + 1) % n] - waypoints_m[i]).norm();
-  double s = speed_m_s * std::max(0.0, t);
+  double s = speed_m_s * std::max(0.0, t - start_s);
   if (loop && total > 0.0) s = std::fmod(s, total);
   for (std::size_t i = 0; i < segments; ++i) {
     const Vector3& a = waypoints_m[i];

@@ -164,11 +164,12 @@ TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
 }
 
 // A navigate mission whose waypoint lies just behind a box's face (mapped by the LiDAR, never told
-// to the stack, so the goal falls in the face's inflation) or outside the map: the run ends in its
+// to the stack, so the goal falls in the face's inflation) or above the planner's altitude band (a
+// goal merely beyond the map's window is flown towards through local goals): the run ends in its
 // scenario time with exit 4 (an infeasible request) and names the waypoint and the planner's status.
 TEST_F(CliTest, UnreachableWaypointExitsFourNamingIt) {
   for (const auto& [waypoint, status] : {std::pair{"[1.6, 0.0, 1.0]", "goal_blocked"},
-                                         std::pair{"[40.0, 0.0, 1.0]", "goal_out_of_bounds"}}) {
+                                         std::pair{"[1.0, 0.0, 10.0]", "goal_out_of_bounds"}}) {
     std::string text = Scenario(kVehicle, std::string("world:\n  boxes:\n    - {center_m: [2, 0, 1.5], size_m: [1, 1, 3]}\n") +
                                               "sensors:\n  lidar: {}\n");
     text.replace(text.find("duration_s: 1.0"), 15, "duration_s: 1.5");

@@ -54,6 +54,42 @@ int Count(const Replanner& r, const std::string& reason) {
   return n;
 }
 
+TEST(LocalGoal, AGoalInsideTheWindowIsItself) {
+  perception::VoxelMap map = EmptyMap();
+  map.Recenter(Vector3(0, 0, 1.5));
+  const Vector3 goal(3, -2, 1.5);
+  EXPECT_EQ(*LocalGoal(map, Vector3::Zero() + Vector3(0, 0, 1.5), goal, 1.0), goal);
+}
+
+TEST(LocalGoal, AGoalBeyondTheWindowBecomesTheSegmentsExitPointWithTheMargin) {
+  perception::VoxelMap map = EmptyMap();
+  map.Recenter(Vector3(0, 0, 1.5));
+  const Vector3 start(0, 0, 1.5), goal(30, 10, 1.5);
+  const std::optional<Vector3> g = LocalGoal(map, start, goal, 1.0);
+  ASSERT_TRUE(g.has_value());
+  // On the segment (closed form: parallel to goal - start) ...
+  EXPECT_NEAR((*g - start).normalized().dot((goal - start).normalized()), 1.0, 1e-12);
+  // ... exactly one margin inside the window along x, the axis it leaves by.
+  EXPECT_NEAR(g->x(), map.window_max_W().x() - 1.0, 1e-9);
+  EXPECT_LE(g->y(), map.window_max_W().y() - 1.0);
+}
+
+TEST(LocalGoal, AnObstacleAtTheExitPointIsWalkedBackPast) {
+  perception::VoxelMap map = EmptyMap();
+  map.Recenter(Vector3(0, 0, 1.5));
+  const Vector3 start(0, 0, 1.5), goal(30, 0, 1.5);
+  const double exit_x = map.window_max_W().x() - 1.0;
+  for (double x = exit_x - 0.55; x < exit_x + 0.05; x += 0.1) map.MarkOccupied(Vector3(x, 0.05, 1.55));
+  const std::optional<Vector3> g = LocalGoal(map, start, goal, 1.0);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_FALSE(map.IsInflated(*g));
+  EXPECT_LT(g->x(), exit_x - 0.55);
+  EXPECT_GT(g->x(), exit_x - 0.55 - 0.2 - 0.3);  // just past the inflation, not further
+  // Everything between the start and the edge blocked: no local goal.
+  for (double x = 0.05; x < exit_x; x += 0.1) map.MarkOccupied(Vector3(x, 0.05, 1.55));
+  EXPECT_FALSE(LocalGoal(map, start, goal, 1.0).has_value());
+}
+
 // A goal in free space: planned at once, replanned periodically, reached and held, and the
 // reference never jumps.
 TEST(Replanner, PlansOnAGoalReplansPeriodicallyAndArrives) {
@@ -123,6 +159,19 @@ TEST(Replanner, AFailureReplansWithThePostFailureAccelerationLimit) {
 
 // A wall without a gap closes the way: no plan exists, so the replanner brakes to rest within
 // its limits before the wall, then holds (and keeps trying).
+TEST(Replanner, AGoalBeyondTheMapIsReachedThroughLocalGoalsAsTheWindowMoves) {
+  perception::VoxelMap map = EmptyMap();
+  map.Recenter(Vector3(0, 0, 1.5));
+  ReplannerOptions o;
+  Replanner r(o, Vector3(0, 0, 1.5));
+  const Vector3 goal(20, 0, 1.5);  // beyond the 12.8 m window
+  r.SetGoal(goal);
+  Fly(&r, map, 0.0, 40.0, [&](double t) { map.Recenter(r.Reference(t).p_W); });
+  for (const Replanner::Event& e : r.events()) EXPECT_EQ(e.status, PlanSummary::Status::kSuccess) << e.t;
+  EXPECT_TRUE(r.arrived());
+  EXPECT_LT((r.Reference(40.0).p_W - goal).norm(), 1e-6);
+}
+
 TEST(Replanner, NoWayThroughBrakesToRestAndHolds) {
   perception::VoxelMap map = EmptyMap();
   Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));

@@ -39,6 +39,18 @@ TEST(World, MovingBoxFollowsItsWaypointsAtConstantSpeed) {
   EXPECT_NEAR((m.At(100.0).center_m - Vector3(4, 3, 1)).norm(), 0.0, 1e-12);
 }
 
+TEST(World, MovingBoxRestsAtItsFirstWaypointUntilItsStartTime) {
+  MovingBox m;
+  m.waypoints_m = {Vector3(0, 0, 1), Vector3(4, 0, 1)};
+  m.speed_m_s = 2.0;
+  m.loop = false;
+  m.start_s = 10.0;
+  EXPECT_EQ(m.At(0.0).center_m, Vector3(0, 0, 1));
+  EXPECT_EQ(m.At(10.0).center_m, Vector3(0, 0, 1));
+  EXPECT_NEAR((m.At(11.0).center_m - Vector3(2, 0, 1)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(m.At(20.0).center_m, Vector3(4, 0, 1));
+}
+
 TEST(World, SphereCollisionNamesTheObstacle) {
   World w;
   w.boxes.push_back(Box{Vector3(5, 0, 1), Vector3(1, 1, 2), 0.0});

@@ -5,6 +5,7 @@
 /// received; sensor_log.h), vehicle.yaml (the vehicle flown), summary.json and, when asked,
 /// report.html.
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,6 +59,8 @@ struct RunSummary {
   int waypoints_total = -1;
   /// Planning queries and their results in the navigate mission (the replanner's events).
   int plans = 0, plans_failed = 0;
+  /// Planning queries by what started them: "goal", "failure", "obstacle ahead", "periodic".
+  std::map<std::string, int> plans_by_reason;
   /// Each failed planning query: time [s], reason and status ("12.30 s periodic: no_path").
   std::vector<std::string> failed_plans;
   /// The navigate mission asked for a waypoint the planner found unreachable at the end (inside an

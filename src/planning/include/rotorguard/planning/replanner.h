@@ -9,6 +9,7 @@
 /// and the trajectory ahead is unsafe, it brakes to rest within the limits, holds, and keeps
 /// trying.
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,8 +27,19 @@ struct ReplannerOptions {
   double replan_period_s = 1.0;     ///< periodic replanning [s], > 0
   double check_horizon_s = 3.0;     ///< how far ahead the trajectory is checked against the map [s], > 0
   double check_step_m = 0.05;       ///< spacing of that check along the path [m], > 0
+  /// A goal beyond the map's window is approached through a local goal: the last free point of
+  /// the straight line towards it that lies this far inside the window [m], >= 0. Replanning as
+  /// the window follows the vehicle moves the local goal on (receding horizon).
+  double local_goal_margin_m = 1.0;
   void Validate() const;
 };
+
+/// Where to plan to when `goal` may lie beyond the map's window: `goal` itself when the window
+/// holds it (with `margin_m` to spare); else the point where the segment from `start` leaves the
+/// window shrunk by `margin_m`, walked back towards `start` in voxel steps past inflated voxels.
+/// nullopt when the whole segment inside the window is inflated.
+std::optional<Vector3> LocalGoal(const perception::VoxelMap& map, const Vector3& start, const Vector3& goal,
+                                 double margin_m);
 
 /// The replanner is the reference the controller follows (its Evaluate is `Reference`), so that a
 /// predictive controller sees the current trajectory over its horizon.
@@ -65,6 +77,8 @@ class Replanner final : public ReferenceTrajectory {
   const MinimumJerkTrajectory& trajectory() const { return trajectory_; }
   /// The last planning query's summary.
   const PlanSummary& last_plan() const { return last_plan_; }
+  /// The goal the last query planned to: the goal, or a local goal towards it (LocalGoal).
+  const Vector3& planned_goal() const { return planned_goal_; }
 
  private:
   /// Plans from the reference state at t; on success switches to the new trajectory.
@@ -81,7 +95,7 @@ class Replanner final : public ReferenceTrajectory {
   MinimumJerkTrajectory trajectory_;
   Vector3 hold_;
   double yaw_ = 0.0;
-  Vector3 goal_ = Vector3::Zero();
+  Vector3 goal_ = Vector3::Zero(), planned_goal_ = Vector3::Zero();
   bool new_goal_ = false, failure_pending_ = false, has_goal_ = false, arrived_ = false;
   double last_plan_t_ = -1e9;
   PlanSummary last_plan_;

@@ -34,6 +34,7 @@ struct MovingBox {
   std::vector<Vector3> waypoints_m;
   double speed_m_s = 0.5;
   bool loop = true;
+  double start_s = 0.0;  ///< it rests at its first waypoint until then [s] (an obstacle moved mid-flight)
   /// The box's pose at time t [s].
   Box At(double t) const;
 };
