@@ -135,6 +135,11 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
                            : (f.false_alarm ? " (false alarm)" : " (wrong rotor or kind)"));
     }
   }
+  for (std::size_t i = 0; i < s.mode_transitions.size(); ++i) {
+    const auto& m = s.mode_transitions[i];
+    fmt::print("{}{} -> {} at {:.2f} s: {}\n", i == 0 ? "flight modes      " : "                  ", m.from, m.to, m.t,
+               m.reason);
+  }
   fmt::print("seed              {}\n", s.seed);
   if (!out_dir.empty()) {
     if (csv) fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());

@@ -166,7 +166,7 @@ fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& l
 ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::CompositeFddOptions& options) {
   fdd::CompositeFdd detector(log.vehicle, WithLogImu(options, log));
   // The stack's estimator, fed as the stack fed it: the estimate the detector saw.
-  stack::OdometryPassThroughEstimator estimator(log.vehicle.thrust_coefficient_n_s2);
+  stack::OdometryImuEstimator estimator(log.vehicle.thrust_coefficient_n_s2);
   const double onset = FirstOnset(log);
   ReplayOutcome out;
   for (const SensorRecord& r : log.records) {

@@ -51,7 +51,7 @@ std::vector<std::string> LogColumns(int n, bool with_fdd, bool with_nmpc) {
                                 "ref_p_x", "ref_p_y", "ref_p_z", "ref_v_x", "ref_v_y", "ref_v_z", "ref_yaw",
                                 "est_p_x", "est_p_y", "est_p_z", "est_q_w", "est_q_x", "est_q_y", "est_q_z",
                                 "est_v_x", "est_v_y", "est_v_z", "est_w_x", "est_w_y", "est_w_z", "wind_x",
-                                "wind_y",  "wind_z",  "landed"};
+                                "wind_y",  "wind_z",  "landed",  "mode"};
   std::vector<const char*> prefixes = {"cmd_", "thrust_", "rpm_", "fault_"};
   if (with_fdd) prefixes.insert(prefixes.end(), {"mi_", "pi_", "health_"});
   for (const char* prefix : prefixes) {

@@ -77,7 +77,7 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
   sim::ImuModel imu(imu_options, DeriveSeed(options.seed, 2));
   sim::OdometryModel odometry(odometry_options, DeriveSeed(options.seed, 3));
   sim::RateTimer imu_timer(imu_options.rate_hz), odometry_timer(odometry_options.rate_hz);
-  stack::OdometryPassThroughEstimator estimator(1.0);  // no ESC telemetry here: the coefficient is unused
+  stack::OdometryImuEstimator estimator(1.0);  // no ESC telemetry here: the coefficient is unused
   perception::LidarMapperOptions mapper_options;
   mapper_options.deskew_frames = deskew;
   mapper_options.deskew.sensor_position_m = lidar_options.position_m;

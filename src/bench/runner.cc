@@ -49,6 +49,7 @@ void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::Nume
   v3(e.w_B);
   v3(sim.wind());
   put(sim.landed() ? 1.0 : 0.0);
+  put(static_cast<int>(st.supervisor().mode()));
   const int n = sim.model().num_rotors();
   for (int i = 0; i < n; ++i) put(sim.applied_command()[i]);
   for (int i = 0; i < n; ++i) put(sim.rotor_thrusts()[i]);
@@ -132,6 +133,10 @@ nlohmann::json RunSummary::ToJson() const {
                        {"infeasible_request", infeasible_request}};
   }
   j["lidar_points_dropped"] = lidar_points_dropped;
+  j["supervisor"] = {{"final_mode", final_mode}, {"transitions", nlohmann::json::array()}};
+  for (const ModeRecord& m : mode_transitions) {
+    j["supervisor"]["transitions"].push_back({{"t", m.t}, {"from", m.from}, {"to", m.to}, {"reason", m.reason}});
+  }
   j["physics_steps"] = physics_steps;
   j["control_cycles"] = control_cycles;
   return j;
@@ -275,8 +280,24 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   }
   summary.crashed = sim.crashed();
   summary.crash_reason = sim.crash_reason().value_or("");
+  for (const stack::ModeTransition& m : st.supervisor().transitions()) {
+    summary.mode_transitions.push_back({m.t, stack::ToString(m.from), stack::ToString(m.to), m.reason});
+  }
+  summary.final_mode = stack::ToString(st.supervisor().mode());
+  // Why the run failed, the most fundamental first: a crash; a mission the supervisor gave up (not
+  // a success, however well the landing went); a position error at the end; waypoints missed.
+  std::string emergency;
+  for (const stack::ModeTransition& m : st.supervisor().transitions()) {
+    if (m.to == stack::FlightMode::kEmergencyLanding) {
+      emergency = fmt::format("emergency landing at t = {:.2f} s: {}{}", m.t, m.reason,
+                              st.supervisor().mode() == stack::FlightMode::kLanded ? " (landed)" : "");
+      break;
+    }
+  }
   if (summary.crashed) {
     summary.failure_reason = "crash: " + summary.crash_reason;
+  } else if (!emergency.empty()) {
+    summary.failure_reason = emergency;
   } else if (last_violation_s && *last_violation_s >= summary.sim_time_s - sc.success_hold_s) {
     summary.failure_reason =
         fmt::format("position error {:.2f} m > {:g} m at t = {:.2f} s, within the last {:g} s", last_violation_error,

@@ -99,6 +99,7 @@ void FitStackToHardware(Scenario* s) {
   s->stack.composite_fdd.imu_position_m = s->sim.imu.position_m;
   s->stack.fixed_time_fdd.imu_rate_hz = s->sim.imu.rate_hz;
   s->stack.fixed_time_fdd.imu_position_m = s->sim.imu.position_m;
+  s->stack.estimator.imu_position_m = s->sim.imu.position_m;  // its dead-reckoning removes the lever arm
   // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius.
   s->stack.lidar.deskew.sensor_position_m = s->sim.lidar.position_m;
   s->stack.lidar.map.inflation_radius_m = s->vehicle.collision_radius_m;
@@ -213,7 +214,7 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
     } else if (*type == "takeoff") {
       planning::TakeoffOptions o;
       o.start_m = s.initial_position_m;
-      o.altitude_m = node.Required("altitude_m").AsDouble();
+      o.altitude_m = node.Required("altitude_m").AsPositive();  // a take-off climbs
       ReadOptional(node, "max_speed_m_s", &o.max_speed_m_s);
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::TakeoffReference>(o);
@@ -340,6 +341,16 @@ void ParseSensors(const ConfigNode& node, sim::SimulatorOptions* o) {
     ReadOptional(*odom, "velocity_noise_m_s", &d.velocity_noise_m_s);
     ReadOptional(*odom, "attitude_noise_rad", &d.attitude_noise_rad);
     ReadOptional(*odom, "rate_noise_gain", &d.rate_noise_gain);
+    if (const auto outages = odom->Optional("outages")) {
+      for (std::size_t i = 0; i < outages->size(); ++i) {
+        const ConfigNode entry = outages->At(i);
+        sim::OdometryOptions::Outage outage;
+        outage.start_s = entry.Required("start_s").AsNonNegative();
+        outage.duration_s = entry.Required("duration_s").AsNonNegative();
+        entry.RejectUnknownKeys();
+        d.outages.push_back(outage);
+      }
+    }
     odom->RejectUnknownKeys();
   }
   if (const auto lidar = node.Optional("lidar")) {
@@ -438,6 +449,22 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     c->RejectUnknownKeys();
   }
   if (const auto d = node.Optional("deskew_frames")) o->lidar.deskew_frames = d->AsBool();
+  if (const auto sup = node.Optional("supervisor")) {
+    // The supervisor's thresholds (docs/navigation.md): recovery, no-plan timeout, estimator
+    // checks, the emergency landing's descent and touchdown.
+    stack::SupervisorOptions& v = o->supervisor;
+    ReadOptional(*sup, "recovery_tilt_rad", &v.recovery_tilt_rad);
+    ReadOptional(*sup, "recovery_hold_s", &v.recovery_hold_s);
+    ReadOptional(*sup, "no_plan_timeout_s", &v.no_plan_timeout_s);
+    ReadOptional(*sup, "odometry_timeout_s", &v.odometry_timeout_s);
+    ReadOptional(*sup, "max_speed_m_s", &v.max_speed_m_s);
+    ReadOptional(*sup, "landing_speed_m_s", &v.landing_speed_m_s);
+    ReadOptional(*sup, "landing_depth_m", &v.landing_depth_m);
+    ReadOptional(*sup, "touchdown_thrust_ratio", &v.touchdown_thrust_ratio);
+    ReadOptional(*sup, "touchdown_hold_s", &v.touchdown_hold_s);
+    sup->RejectUnknownKeys();
+    ValidateAt(*sup, [&] { v.Validate(); });
+  }
   if (const auto n = node.Optional("planner")) {
     // The navigate mission's planner (docs/planning.md): rate, nominal limits, eq. (33)'s safety
     // factor, eq. (22)'s weights, clearance, replanning period and altitude band.
@@ -450,6 +477,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ReadOptional(*n, "post_failure_safety_factor", &nav.post_failure_safety_factor);
     ReadOptional(*n, "replan_period_s", &r.replan_period_s);
     ReadOptional(*n, "clearance_m", &r.planner.optimizer.clearance_m);
+    if (const auto aware = n->Optional("failure_aware")) nav.failure_aware = aware->AsBool();
     if (const auto band = n->Optional("altitude_band_m")) {
       const std::vector<double> b = band->AsDoubleList(2);
       r.planner.search.z_min_m = b[0];

@@ -131,11 +131,13 @@ ReferencePoint HoverReference::Evaluate(double /*t*/) const {
 
 TakeoffReference::TakeoffReference(const TakeoffOptions& options) : options_(options) {
   RequireFinite(kTakeoff, "start_m", options_.start_m);
-  RequirePositive(kTakeoff, "altitude_m", options_.altitude_m);
+  if (!std::isfinite(options_.altitude_m) || options_.altitude_m == 0.0) {
+    ThrowValidation(kTakeoff, "altitude_m", options_.altitude_m, "a finite nonzero height (< 0 descends)");
+  }
   RequirePositive(kTakeoff, "max_speed_m_s", options_.max_speed_m_s);
   RequireFinite(kTakeoff, "yaw_rad", options_.yaw_rad);
   // Peak of h d/dt(10 s^3 - 15 s^4 + 6 s^5) = h/T 30 s^2 (1 - s)^2 is at s = 1/2: 1.875 h / T.
-  climb_time_s_ = 1.875 * options_.altitude_m / options_.max_speed_m_s;
+  climb_time_s_ = 1.875 * std::abs(options_.altitude_m) / options_.max_speed_m_s;
 }
 
 ReferencePoint TakeoffReference::Evaluate(double t) const {

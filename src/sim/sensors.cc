@@ -15,7 +15,7 @@ void RequireRate(const char* owner, double rate_hz, double physics_rate_hz) {
                     fmt::format("a rate in (0, {}] Hz (the physics rate)", physics_rate_hz));
   }
 }
-void RequireNonNegative(const char* owner, const char* field, double v) {
+void RequireNonNegative(const char* owner, const std::string& field, double v) {
   if (!std::isfinite(v) || v < 0.0) ThrowValidation(owner, field, v, "a finite value >= 0");
 }
 Vector3 NormalVector(Rng& rng, double stddev) {
@@ -50,6 +50,17 @@ void OdometryOptions::Validate(double physics_rate_hz) const {
   RequireNonNegative("OdometryOptions", "velocity_noise_m_s", velocity_noise_m_s);
   RequireNonNegative("OdometryOptions", "attitude_noise_rad", attitude_noise_rad);
   RequireNonNegative("OdometryOptions", "rate_noise_gain", rate_noise_gain);
+  for (std::size_t i = 0; i < outages.size(); ++i) {
+    RequireNonNegative("OdometryOptions", fmt::format("outages.{}.start_s", i), outages[i].start_s);
+    RequireNonNegative("OdometryOptions", fmt::format("outages.{}.duration_s", i), outages[i].duration_s);
+  }
+}
+
+bool OdometryOptions::InOutage(double t) const {
+  for (const Outage& o : outages) {
+    if (t >= o.start_s && t < o.start_s + o.duration_s) return true;
+  }
+  return false;
 }
 
 ImuModel::ImuModel(const ImuOptions& options, std::uint64_t seed)

@@ -57,6 +57,8 @@ void FlightStackOptions::Validate() const {
   composite_fdd.Validate();
   fixed_time_fdd.Validate();
   lidar.Validate();
+  estimator.Validate();
+  supervisor.Validate();
   if (!navigation.waypoints.empty()) {
     navigation.Validate();
     if (navigation.planner_rate_hz > control_rate_hz) {
@@ -76,7 +78,8 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     : model_(vehicle),
       reference_(std::move(reference)),
       options_(options),
-      estimator_(model_.params().thrust_coefficient_n_s2),
+      estimator_(model_.params().thrust_coefficient_n_s2, options.estimator),
+      supervisor_(options.supervisor),
       mapper_(options.lidar) {
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
@@ -136,47 +139,81 @@ void FlightStack::OnLidar(const LidarFrame& frame) {
   lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_.Estimate(frame.t_end_ns)).points_dropped;
 }
 
+void FlightStack::OnRotorFailed(int rotor) {
+  if (std::find(isolated_.begin(), isolated_.end(), rotor) != isolated_.end()) return;
+  isolated_.push_back(rotor);
+  controller_->SetRotorFailed(rotor);
+  if (navigator_ && options_.navigation.failure_aware) navigator_->OnFailure();
+}
+
+void FlightStack::Navigate(double t, FlightMode mode) {
+  if (!navigator_ || !map() || t < next_plan_s_) return;
+  // The waypoints in turn, each once the last was reached; the planner at its own rate. While the
+  // attitude recovers from a failure the mission waits: no new waypoint.
+  next_plan_s_ = t + 1.0 / options_.navigation.planner_rate_hz;
+  const std::vector<Vector3>& w = options_.navigation.waypoints;
+  const int total = static_cast<int>(w.size()) * options_.navigation.rounds;
+  if (mode != FlightMode::kFailureRecovery && next_waypoint_ < total && (next_waypoint_ == 0 || navigator_->arrived())) {
+    if (next_waypoint_ == 0) last_plan_ok_s_ = t;  // the no-plan clock starts with the mission
+    navigator_->SetGoal(w[static_cast<std::size_t>(next_waypoint_++) % w.size()]);
+  }
+  navigator_->Update(t, *map());
+  for (; plan_events_seen_ < navigator_->events().size(); ++plan_events_seen_) {
+    if (navigator_->events()[plan_events_seen_].status == planning::PlanSummary::Status::kSuccess) last_plan_ok_s_ = t;
+  }
+  if (navigator_->arrived()) last_plan_ok_s_ = t;  // holding at a waypoint is not a planning failure
+}
+
 const RotorCommand& FlightStack::Update(TimeNs t) {
   const double dt = last_update_ns_ ? ToSeconds(t - *last_update_ns_) : 0.0;
   last_update_ns_ = t;
   estimate_ = estimator_.Estimate(t);
   const double ts = ToSeconds(t);
-  if (navigator_ && map() && ts >= next_plan_s_) {
-    // The waypoints in turn, each once the last was reached; the planner at its own rate.
-    next_plan_s_ = ts + 1.0 / options_.navigation.planner_rate_hz;
-    const std::vector<Vector3>& w = options_.navigation.waypoints;
-    const int total = static_cast<int>(w.size()) * options_.navigation.rounds;
-    if (next_waypoint_ < total && (next_waypoint_ == 0 || navigator_->arrived())) {
-      navigator_->SetGoal(w[static_cast<std::size_t>(next_waypoint_++) % w.size()]);
-    }
-    navigator_->Update(ts, *map());
-  }
-  const ReferenceTrajectory& reference = this->reference();
-  reference_point_ = reference.Evaluate(ts);
   command_.t_ns = t;
-  if (!estimate_.valid) {
-    // Nothing to act on yet: motors idle (a vehicle on the ground stays there).
+  if (estimate_.valid) {
+    for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
+      if (!known_fault_applied_[i] && ts >= options_.known_faults[i].at_time_s) {
+        OnRotorFailed(options_.known_faults[i].rotor);
+        known_fault_applied_[i] = true;
+      }
+    }
+    if (fdd_) {
+      fdd_->SetEstimate(estimate_);
+      // Isolation reconfigures the controller (the NMPC: u_bar_i = 0, yaw given up, post-failure
+      // thrust reference; controllers that cannot reconfigure ignore it) and the planner.
+      for (int rotor : fdd_->TakeNewIsolations()) OnRotorFailed(rotor);
+    }
+  }
+  SupervisorInputs in;
+  in.t = ts;
+  in.estimate = estimate_;
+  in.odometry_age_s = estimator_.odometry_age_s(t);
+  in.isolated_rotors = static_cast<int>(isolated_.size());
+  in.navigating = navigator_ && next_waypoint_ > 0 && !navigator_->arrived();
+  in.since_last_plan_s = ts - last_plan_ok_s_;
+  in.thrust_ratio = command_.thrust_n.sum() / model_.params().weight_n();
+  const FlightMode mode = supervisor_.Update(in);
+
+  if (mode == FlightMode::kEmergencyLanding && !landing_) {
+    // Straight down from where the vehicle is, aiming below the ground (z = 0) so that it gets
+    // there even with a drifted estimate, keeping the heading.
+    planning::TakeoffOptions o;
+    o.start_m = supervisor_.landing_start();
+    o.altitude_m = -(std::max(0.0, o.start_m.z()) + options_.supervisor.landing_depth_m);
+    o.max_speed_m_s = options_.supervisor.landing_speed_m_s;
+    o.yaw_rad = reference_point_.yaw;
+    landing_.emplace(o);
+    descent_.emplace(*landing_, supervisor_.landing_start_s());
+  }
+  if (!landing_) Navigate(ts, mode);
+  const ReferenceTrajectory& followed = reference();
+  reference_point_ = followed.Evaluate(ts);
+  if (!estimate_.valid || mode == FlightMode::kLanded) {
+    // Nothing to act on yet, or on the ground after a landing: motors off.
     command_.thrust_n.setZero();
     return command_;
   }
-  for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
-    if (!known_fault_applied_[i] && ToSeconds(t) >= options_.known_faults[i].at_time_s) {
-      controller_->SetRotorFailed(options_.known_faults[i].rotor);
-      if (navigator_) navigator_->OnFailure();
-      known_fault_applied_[i] = true;
-    }
-  }
-  if (fdd_) {
-    fdd_->SetEstimate(estimate_);
-    // Isolation reconfigures the controller (the NMPC: u_bar_i = 0, yaw given up, post-failure
-    // thrust reference); controllers that cannot reconfigure ignore it.
-    // The planner replans with the post-failure acceleration limit.
-    for (int rotor : fdd_->TakeNewIsolations()) {
-      controller_->SetRotorFailed(rotor);
-      if (navigator_) navigator_->OnFailure();
-    }
-  }
-  controller_->Compute(estimate_, reference, ts, dt, &command_.thrust_n);
+  controller_->Compute(estimate_, followed, ts, dt, &command_.thrust_n);
   if (fdd_) fdd_->SetCommand(command_.thrust_n);
   return command_;
 }

@@ -172,10 +172,23 @@ TEST(TakeoffReferenceTest, DerivativesAreConsistent) {
   EXPECT_DOUBLE_EQ(TakeoffReference(TakeoffOptions{.altitude_m = 1.0}).duration(), 3.75);
 }
 
+TEST(TakeoffReferenceTest, ANegativeAltitudeDescendsToRestAsTheMirrorOfTheClimb) {
+  const TakeoffReference down({.start_m = Vector3(1, 2, 2), .altitude_m = -2.0, .max_speed_m_s = 0.4});
+  const TakeoffReference up({.start_m = Vector3(1, 2, 0), .altitude_m = 2.0, .max_speed_m_s = 0.4});
+  EXPECT_DOUBLE_EQ(down.duration(), 1.875 * 2.0 / 0.4);
+  for (double t = 0.0; t <= down.duration() + 1.0; t += 0.37) {
+    // z_down(t) = 2 - z_up(t): the same quintic, mirrored.
+    EXPECT_NEAR(down.Evaluate(t).p_W.z(), 2.0 - up.Evaluate(t).p_W.z(), 1e-12);
+    EXPECT_NEAR(down.Evaluate(t).v_W.z(), -up.Evaluate(t).v_W.z(), 1e-12);
+    EXPECT_GE(down.Evaluate(t).v_W.z(), -0.4 - 1e-12);
+  }
+  EXPECT_NEAR(down.Evaluate(down.duration()).p_W.z(), 0.0, 1e-12);
+}
+
 TEST(TakeoffReferenceTest, RejectsInvalidOptions) {
   RG_EXPECT_THROW_WITH((void)TakeoffReference({.altitude_m = 0.0}), std::invalid_argument,
-                       "TakeoffOptions::altitude_m = 0 is invalid; expected > 0");
-  RG_EXPECT_THROW_WITH((void)TakeoffReference({.altitude_m = -2.0}), std::invalid_argument,
+                       "TakeoffOptions::altitude_m = 0 is invalid; expected a finite nonzero height");
+  RG_EXPECT_THROW_WITH((void)TakeoffReference({.altitude_m = NAN}), std::invalid_argument,
                        "TakeoffOptions::altitude_m");
   RG_EXPECT_THROW_WITH((void)TakeoffReference({.max_speed_m_s = -1.0}), std::invalid_argument,
                        "TakeoffOptions::max_speed_m_s = -1 is invalid; expected > 0");

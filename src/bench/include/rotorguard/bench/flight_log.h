@@ -25,7 +25,8 @@ struct FlightLog {
   io::NumericTable table;  ///< log.csv
 };
 
-/// The names of the log's columns for a vehicle of n rotors, with the FDD columns (motor index
+/// The names of the log's columns for a vehicle of n rotors (`mode` is the supervisor's flight
+/// mode, stack::FlightMode's code), with the FDD columns (motor index
 /// mi_i, propeller index pi_i, diagnosed health code health_i) when the stack runs fault
 /// detection, and nmpc_ms (the NMPC's last solve time) when it flies the NMPC.
 std::vector<std::string> LogColumns(int num_rotors, bool with_fdd, bool with_nmpc);

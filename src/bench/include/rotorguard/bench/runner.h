@@ -17,6 +17,12 @@
 
 namespace rotorguard::bench {
 
+/// A flight-mode transition of the stack's supervisor (stack/supervisor.h).
+struct ModeRecord {
+  double t = 0.0;
+  std::string from, to, reason;
+};
+
 struct FaultRecord {
   int rotor = 0;
   std::string kind;
@@ -66,6 +72,9 @@ struct RunSummary {
   /// The navigate mission asked for a waypoint the planner found unreachable at the end (inside an
   /// obstacle's inflation, outside the map, or enclosed): an infeasible request (CLI exit 4).
   bool infeasible_request = false;
+  /// The supervisor's transitions and the mode the flight ended in (summary.json "supervisor").
+  std::vector<ModeRecord> mode_transitions;
+  std::string final_mode = "nominal";
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;
 

@@ -24,4 +24,16 @@ class ReferenceTrajectory {
   [[nodiscard]] virtual double duration() const = 0;
 };
 
+/// A reference started at `t0`: Evaluate(t) is the inner reference's Evaluate(t - t0).
+class TimeShiftedReference final : public ReferenceTrajectory {
+ public:
+  TimeShiftedReference(const ReferenceTrajectory& inner, double t0) : inner_(inner), t0_(t0) {}
+  [[nodiscard]] ReferencePoint Evaluate(double t) const override { return inner_.Evaluate(t - t0_); }
+  [[nodiscard]] double duration() const override { return t0_ + inner_.duration(); }
+
+ private:
+  const ReferenceTrajectory& inner_;
+  double t0_;
+};
+
 }  // namespace rotorguard

@@ -39,15 +39,15 @@ class HoverReference final : public ReferenceTrajectory {
 
 struct TakeoffOptions {
   Vector3 start_m = Vector3::Zero();  ///< position at t = 0, world frame [m]; finite
-  double altitude_m = 1.0;            ///< climb above start_m [m]; finite, > 0
+  double altitude_m = 1.0;            ///< climb above start_m [m]; finite, nonzero (< 0: a descent)
   double max_speed_m_s = 0.5;         ///< peak climb speed [m/s]; finite, > 0
   double yaw_rad = 0.0;               ///< heading held throughout [rad]; finite
 };
 
-/// Vertical climb from rest to rest along the minimum-jerk quintic
+/// Vertical climb (or, with a negative altitude, descent) from rest to rest along the minimum-jerk quintic
 ///   z(t) = z0 + h (10 s^3 - 15 s^4 + 6 s^5),  s = t / T,
 /// whose velocity and acceleration are zero at both ends. The peak speed (at s = 1/2) is
-/// 1.875 h / T, so T = 1.875 h / max_speed. Holds start + h after T. Jerk is the analytic
+/// 1.875 |h| / T, so T = 1.875 |h| / max_speed. Holds start + h after T. Jerk is the analytic
 /// derivative h / T^3 (60 - 360 s + 360 s^2); it jumps at t = 0 and t = T (from/to zero), as it
 /// does for every minimum-jerk rest-to-rest profile.
 class TakeoffReference final : public ReferenceTrajectory {

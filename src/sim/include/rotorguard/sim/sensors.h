@@ -38,6 +38,15 @@ struct OdometryOptions {
   double attitude_noise_rad = 0.002;   ///< std of each small-angle component at rest [rad], >= 0
   /// Noise grows with body rate: std = std_at_rest * (1 + rate_noise_gain * |w_B|) [per rad/s].
   double rate_noise_gain = 0.1;
+  /// Intervals [start, start + duration) [s] in which no odometry arrives (the odometry front end
+  /// lost track): what the stack's estimator must notice.
+  struct Outage {
+    double start_s = 0.0;
+    double duration_s = 0.0;
+  };
+  std::vector<Outage> outages;
+  /// Whether time t [s] lies in an outage.
+  bool InOutage(double t) const;
   void Validate(double physics_rate_hz) const;
 };
 

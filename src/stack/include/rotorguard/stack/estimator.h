@@ -14,25 +14,47 @@ class Estimator {
   virtual StateEstimate Estimate(TimeNs t) const = 0;
 };
 
-/// Pose and velocity from the latest odometry, body rates from the latest gyro sample. The
-/// stand-in until a filter exists; odometry is assumed to be LiDAR-inertial odometry's output.
-/// Motor thrusts come from ESC telemetry through the thrust coefficient k_n.
-class OdometryPassThroughEstimator final : public Estimator {
+struct EstimatorOptions {
+  /// The IMU's mounting point relative to the centre of gravity, body frame [m]: the centripetal
+  /// acceleration it feels while the vehicle spins is removed before dead-reckoning.
+  Vector3 imu_position_m = Vector3::Zero();
+  /// Odometry older than this [s] is carried forward by integrating the IMU, > 0.
+  double dead_reckoning_after_s = 0.05;
+  /// Throws ValidationError naming the field.
+  void Validate() const;
+};
+
+/// Pose and velocity from the latest odometry (assumed to be LiDAR-inertial odometry's output),
+/// body rates from the latest gyro sample, motor thrusts from ESC telemetry through k_n. When the
+/// odometry stops (its front end lost track), the last odometry is carried forward by strapdown
+/// integration of the IMU: attitude by the gyro, velocity and position by the specific force
+/// rotated to the world with gravity added (the IMU's lever arm removed), never below the ground
+/// (z = 0). The estimate stays usable for the seconds an emergency landing takes (it drifts with
+/// the accelerometer's bias and the gyro's, docs/navigation.md); `odometry_age_s` tells the
+/// supervisor.
+class OdometryImuEstimator final : public Estimator {
  public:
   /// `thrust_coefficient_n_s2`: k_n with motor speed in rad/s (> 0).
-  explicit OdometryPassThroughEstimator(double thrust_coefficient_n_s2);
+  OdometryImuEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options = {});
   void OnImu(const ImuSample& imu) override;
   void OnOdometry(const OdometrySample& odometry) override;
   void OnEscTelemetry(const EscTelemetry& esc) override;
   StateEstimate Estimate(TimeNs t) const override;
+  /// Seconds since the last odometry at time t (infinity before the first).
+  double odometry_age_s(TimeNs t) const;
 
  private:
+  EstimatorOptions options_;
   bool have_odometry_ = false;
   bool have_imu_ = false;
   OdometrySample odometry_;
   Vector3 w_B_ = Vector3::Zero();
   double thrust_coefficient_;
   RotorVector motor_thrust_;
+  // Dead-reckoned state, restarted at every odometry sample.
+  TimeNs dr_t_ns_ = 0;
+  Vector3 dr_p_ = Vector3::Zero(), dr_v_ = Vector3::Zero();
+  Quaternion dr_q_ = Quaternion::Identity();
 };
 
 }  // namespace rotorguard::stack

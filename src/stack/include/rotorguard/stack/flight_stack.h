@@ -4,6 +4,7 @@
 /// mission reference.
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,9 @@
 #include "rotorguard/fdd/fixed_time_fdd.h"
 #include "rotorguard/perception/lidar_mapper.h"
 #include "rotorguard/planning/replanner.h"
+#include "rotorguard/planning/references.h"
 #include "rotorguard/stack/estimator.h"
+#include "rotorguard/stack/supervisor.h"
 #include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::stack {
@@ -40,6 +43,9 @@ struct NavigationOptions {
   int rounds = 1;                  ///< >= 1
   double planner_rate_hz = 10.0;   ///< in (0, control_rate_hz]
   double post_failure_safety_factor = 0.05;  ///< γ_a,f of eq. (33), in (0, 1]
+  /// false: the failure-unaware variant, whose planner keeps its nominal acceleration limit after
+  /// a failure (the NMPC still reconfigures): the comparison row of `rotorguard bench nav`.
+  bool failure_aware = true;
   planning::ReplannerOptions replanner;      ///< its post_failure_a_max is set from eq. (33)
   /// Throws ValidationError naming the field ("navigation.rounds"); the rate is checked against
   /// the control rate by FlightStackOptions.
@@ -66,6 +72,8 @@ struct FlightStackOptions {
   /// estimate, inserted into the local occupancy map.
   perception::LidarMapperOptions lidar;
   NavigationOptions navigation;
+  EstimatorOptions estimator;
+  SupervisorOptions supervisor;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -78,6 +86,9 @@ class FlightStack {
  public:
   FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<const ReferenceTrajectory> reference,
               const FlightStackOptions& options);
+  // descent_ refers to landing_: neither copied nor moved.
+  FlightStack(const FlightStack&) = delete;
+  FlightStack& operator=(const FlightStack&) = delete;
 
   void OnImu(const ImuSample& imu);
   void OnEscTelemetry(const EscTelemetry& esc);
@@ -90,8 +101,10 @@ class FlightStack {
   TimeNs control_period_ns() const { return control_period_ns_; }
   const StateEstimate& estimate() const { return estimate_; }
   const ReferencePoint& reference_point() const { return reference_point_; }
-  /// The reference the controller follows: the navigator when navigating, else the mission's.
+  /// The reference the controller follows: the emergency landing's descent once one started,
+  /// else the navigator when navigating, else the mission's.
   const ReferenceTrajectory& reference() const {
+    if (descent_) return *descent_;
     return navigator_ ? static_cast<const ReferenceTrajectory&>(*navigator_) : *reference_;
   }
   const RotorCommand& command() const { return command_; }
@@ -113,12 +126,29 @@ class FlightStack {
   /// LiDAR pulses without a usable point: no return (counted by the sensor), non-finite, outside
   /// the map's window, or arriving before the estimate is valid.
   long lidar_points_dropped() const { return lidar_points_dropped_; }
+  /// The supervisor: the flight mode and its logged transitions.
+  const Supervisor& supervisor() const { return supervisor_; }
+  /// Rotors the stack treats as failed (isolated by its FDD or handed over as known faults).
+  int isolated_rotors() const { return static_cast<int>(isolated_.size()); }
 
  private:
+  /// One rotor found failed (FDD) or handed over (known fault): the controller reconfigures and,
+  /// unless the failure-unaware variant flies, the planner switches to the post-failure limit.
+  void OnRotorFailed(int rotor);
+  /// The navigator's part of a control cycle: the next waypoint when due (not while recovering
+  /// from a failure), the planner at its rate, the time of its last success.
+  void Navigate(double t, FlightMode mode);
+
   vehicle::MultirotorModel model_;
   std::shared_ptr<const ReferenceTrajectory> reference_;
   FlightStackOptions options_;
-  OdometryPassThroughEstimator estimator_;
+  OdometryImuEstimator estimator_;
+  Supervisor supervisor_;
+  std::vector<int> isolated_;            // rotors treated as failed, in the order they failed
+  std::optional<planning::TakeoffReference> landing_;  // the emergency landing's descent ...
+  std::optional<TimeShiftedReference> descent_;         // ... from the time it started
+  std::size_t plan_events_seen_ = 0;
+  double last_plan_ok_s_ = 0.0;          // the planner's last success (or the first goal's time)
   std::unique_ptr<control::Controller> controller_;
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
   std::unique_ptr<fdd::FaultDetector> fdd_;

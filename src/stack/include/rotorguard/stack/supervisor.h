@@ -1,0 +1,84 @@
+#pragma once
+/// The supervisor: arbitrates the flight modes from what the stack knows (its estimate, its fault
+/// detector's isolations, its planner's state) and logs every transition with its reason.
+///
+///   nominal ──isolation──► failure_recovery ──attitude settled──► degraded_navigation
+///      │                        │                                        │
+///      └──────── second failure, no plan for too long, estimator lost ───┴──► emergency_landing ──touchdown──► landed
+///
+/// In failure recovery the NMPC has reconfigured and the planner has replanned with the
+/// post-failure limit; the mission takes no new waypoint until the attitude has settled. An
+/// emergency landing descends vertically from where the vehicle is at `landing_speed_m_s` to a
+/// point `landing_depth_m` below the ground (z = 0 in the world frame), so that it reaches the
+/// ground even when its estimate has drifted; touchdown is what a land detector sees: the
+/// controller, held up by the ground, commanding less than `touchdown_thrust_ratio` of the weight
+/// for `touchdown_hold_s`. Then the motors stop. No planner runs while landing.
+#include <string>
+#include <vector>
+
+#include "rotorguard/core/messages.h"
+
+namespace rotorguard::stack {
+
+enum class FlightMode { kNominal, kFailureRecovery, kDegradedNavigation, kEmergencyLanding, kLanded };
+const char* ToString(FlightMode mode);
+
+struct SupervisorOptions {
+  /// Recovery ends once roll and pitch stay below this [rad] for `recovery_hold_s` [s].
+  double recovery_tilt_rad = 0.35;
+  double recovery_hold_s = 1.0;
+  /// A goal without a successful plan for this long [s] is given up: land. > 0.
+  double no_plan_timeout_s = 10.0;
+  /// Odometry older than this [s] means the estimator has lost its reference: land. > 0.
+  double odometry_timeout_s = 0.5;
+  /// A speed estimate above this [m/s] is a diverged estimator: land. > 0.
+  double max_speed_m_s = 15.0;
+  double landing_speed_m_s = 0.4;       ///< peak descent rate of an emergency landing [m/s], > 0
+  double landing_depth_m = 0.5;         ///< how far below the ground the descent aims [m], > 0
+  double touchdown_thrust_ratio = 0.5;  ///< collective command / weight below which ... (0, 1)
+  double touchdown_hold_s = 0.3;        ///< ... for this long [s] is a touchdown, > 0
+  /// Throws ValidationError naming the field.
+  void Validate() const;
+};
+
+/// What the supervisor looks at in one control cycle.
+struct SupervisorInputs {
+  double t = 0.0;
+  StateEstimate estimate;
+  double odometry_age_s = 0.0;
+  int isolated_rotors = 0;           ///< rotors the stack treats as failed (FDD or known faults)
+  bool navigating = false;           ///< a goal is pending
+  double since_last_plan_s = 0.0;    ///< time since the planner last succeeded (0 when it just did)
+  double thrust_ratio = 1.0;         ///< the last collective thrust command / the vehicle's weight
+};
+
+struct ModeTransition {
+  double t = 0.0;
+  FlightMode from = FlightMode::kNominal, to = FlightMode::kNominal;
+  std::string reason;
+};
+
+class Supervisor {
+ public:
+  explicit Supervisor(const SupervisorOptions& options = {});
+  /// One control cycle; returns the mode to fly in.
+  FlightMode Update(const SupervisorInputs& in);
+  FlightMode mode() const { return mode_; }
+  const std::vector<ModeTransition>& transitions() const { return transitions_; }
+  /// Where the emergency landing started (valid in kEmergencyLanding and kLanded).
+  const Vector3& landing_start() const { return landing_start_; }
+  double landing_start_s() const { return landing_start_s_; }
+
+ private:
+  void Enter(FlightMode to, double t, std::string reason);
+
+  SupervisorOptions options_;
+  FlightMode mode_ = FlightMode::kNominal;
+  double settled_since_ = -1.0;
+  double low_thrust_since_ = -1.0;
+  Vector3 landing_start_ = Vector3::Zero();
+  double landing_start_s_ = 0.0;
+  std::vector<ModeTransition> transitions_;
+};
+
+}  // namespace rotorguard::stack

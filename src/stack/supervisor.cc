@@ -1,0 +1,107 @@
+#include "rotorguard/stack/supervisor.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+
+namespace rotorguard::stack {
+
+const char* ToString(FlightMode mode) {
+  switch (mode) {
+    case FlightMode::kNominal: return "nominal";
+    case FlightMode::kFailureRecovery: return "failure_recovery";
+    case FlightMode::kDegradedNavigation: return "degraded_navigation";
+    case FlightMode::kEmergencyLanding: return "emergency_landing";
+    case FlightMode::kLanded: return "landed";
+  }
+  return "unknown";
+}
+
+void SupervisorOptions::Validate() const {
+  const auto positive = [](double v, const char* field) {
+    if (!(std::isfinite(v) && v > 0.0)) ThrowValidation("SupervisorOptions", field, v, "a finite value > 0");
+  };
+  positive(recovery_tilt_rad, "recovery_tilt_rad");
+  if (!(std::isfinite(recovery_hold_s) && recovery_hold_s >= 0.0)) {
+    ThrowValidation("SupervisorOptions", "recovery_hold_s", recovery_hold_s, "a time >= 0 s");
+  }
+  positive(no_plan_timeout_s, "no_plan_timeout_s");
+  positive(odometry_timeout_s, "odometry_timeout_s");
+  positive(max_speed_m_s, "max_speed_m_s");
+  positive(landing_speed_m_s, "landing_speed_m_s");
+  positive(landing_depth_m, "landing_depth_m");
+  if (!(touchdown_thrust_ratio > 0.0 && touchdown_thrust_ratio < 1.0)) {
+    ThrowValidation("SupervisorOptions", "touchdown_thrust_ratio", touchdown_thrust_ratio, "in (0, 1)");
+  }
+  positive(touchdown_hold_s, "touchdown_hold_s");
+}
+
+Supervisor::Supervisor(const SupervisorOptions& options) : options_(options) { options_.Validate(); }
+
+void Supervisor::Enter(FlightMode to, double t, std::string reason) {
+  transitions_.push_back({t, mode_, to, std::move(reason)});
+  mode_ = to;
+}
+
+FlightMode Supervisor::Update(const SupervisorInputs& in) {
+  const double t = in.t;
+  const StateEstimate& e = in.estimate;
+  if (mode_ == FlightMode::kLanded) return mode_;
+  if (mode_ == FlightMode::kEmergencyLanding) {
+    // A land detector: the ground holds the vehicle up, so the controller chasing a reference
+    // below it commands ever less thrust.
+    if (in.thrust_ratio >= options_.touchdown_thrust_ratio) {
+      low_thrust_since_ = -1.0;
+    } else if (low_thrust_since_ < 0.0) {
+      low_thrust_since_ = t;
+    }
+    if (low_thrust_since_ >= 0.0 && t - low_thrust_since_ >= options_.touchdown_hold_s) {
+      Enter(FlightMode::kLanded, t,
+            fmt::format("touchdown: thrust below {:.0f} % of the weight for {:.1f} s (estimated altitude {:.2f} m)",
+                        100.0 * options_.touchdown_thrust_ratio, options_.touchdown_hold_s, e.p_W.z()));
+    }
+    return mode_;
+  }
+  if (!e.valid) return mode_;  // not flying yet: nothing to judge
+  // Reasons to give the mission up, most fundamental first.
+  std::string land;
+  if (!e.p_W.allFinite() || !e.v_W.allFinite() || !e.q_WB.coeffs().allFinite()) {
+    land = "estimator diverged: non-finite estimate";
+  } else if (in.odometry_age_s > options_.odometry_timeout_s) {
+    land = fmt::format("estimator lost its reference: no odometry for {:.2f} s", in.odometry_age_s);
+  } else if (e.v_W.norm() > options_.max_speed_m_s) {
+    land = fmt::format("estimator diverged: speed estimate {:.1f} m/s", e.v_W.norm());
+  } else if (in.isolated_rotors >= 2) {
+    land = fmt::format("a second rotor failed ({} isolated)", in.isolated_rotors);
+  } else if (in.navigating && in.since_last_plan_s > options_.no_plan_timeout_s) {
+    land = fmt::format("no feasible trajectory for {:.1f} s", in.since_last_plan_s);
+  }
+  if (!land.empty()) {
+    landing_start_ = e.p_W.allFinite() ? e.p_W : Vector3::Zero();
+    landing_start_s_ = t;
+    Enter(FlightMode::kEmergencyLanding, t, land);
+    return mode_;
+  }
+  if (mode_ == FlightMode::kNominal && in.isolated_rotors >= 1) {
+    settled_since_ = -1.0;
+    Enter(FlightMode::kFailureRecovery, t, "rotor failure isolated");
+  } else if (mode_ == FlightMode::kFailureRecovery) {
+    const bool settled = TiltOf(e.q_WB) < options_.recovery_tilt_rad;
+    if (!settled) {
+      settled_since_ = -1.0;
+    } else if (settled_since_ < 0.0) {
+      settled_since_ = t;
+    }
+    if (settled && t - settled_since_ >= options_.recovery_hold_s) {
+      Enter(FlightMode::kDegradedNavigation, t,
+            fmt::format("attitude settled: tilt below {:.2f} rad for {:.1f} s", options_.recovery_tilt_rad,
+                        options_.recovery_hold_s));
+    }
+  }
+  return mode_;
+}
+
+}  // namespace rotorguard::stack
