@@ -33,11 +33,13 @@ void OdometryImuEstimator::OnImu(const ImuSample& imu) {
   // Strapdown step from the last odometry (or the last step): first-order in dt, enough for the
   // 3 ms between IMU samples over the seconds of an outage.
   const double dt = ToSeconds(imu.t_ns - dr_t_ns_);
+  // The attitude first, to the sample's instant, so that its specific force is rotated by the
+  // attitude it was measured in (at 11 rad/s a step behind would turn it by 0.03 rad).
+  dr_q_ = (dr_q_ * Quaternion(ExpSO3(imu.w_B * dt))).normalized();
   const Vector3 f_cg = imu.specific_force_B - imu.w_B.cross(imu.w_B.cross(options_.imu_position_m));  // centripetal part removed
   const Vector3 a_W = dr_q_ * f_cg + Vector3(0.0, 0.0, -kGravity);
   dr_p_ += dr_v_ * dt + 0.5 * a_W * dt * dt;
   dr_v_ += a_W * dt;
-  dr_q_ = (dr_q_ * Quaternion(ExpSO3(imu.w_B * dt))).normalized();
   // The ground (z = 0 of the world frame) stops the vehicle: the estimate never goes below it.
   if (dr_p_.z() < 0.0) {
     dr_p_.z() = 0.0;

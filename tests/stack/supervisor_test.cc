@@ -1,0 +1,204 @@
+// The supervisor's transitions on hand-made inputs (one rule at a time), and the estimator's
+// dead-reckoning against closed-form motion.
+#include "rotorguard/stack/supervisor.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/stack/estimator.h"
+
+namespace rotorguard::stack {
+namespace {
+
+SupervisorInputs Hovering(double t) {
+  SupervisorInputs in;
+  in.t = t;
+  in.estimate.valid = true;
+  in.estimate.p_W = Vector3(1, 2, 1.5);
+  in.odometry_age_s = 0.005;
+  return in;
+}
+
+TEST(Supervisor, StaysNominalWhileAllIsWell) {
+  Supervisor s;
+  for (double t = 0.0; t < 30.0; t += 0.005) EXPECT_EQ(s.Update(Hovering(t)), FlightMode::kNominal);
+  EXPECT_TRUE(s.transitions().empty());
+}
+
+TEST(Supervisor, AnIsolationRecoversThenFliesDegradedOnceTheAttitudeHasSettled) {
+  SupervisorOptions o;
+  o.recovery_tilt_rad = 0.3;
+  o.recovery_hold_s = 1.0;
+  Supervisor s(o);
+  SupervisorInputs in = Hovering(1.0);
+  in.isolated_rotors = 1;
+  in.estimate.q_WB = Quaternion(Eigen::AngleAxisd(0.5, Vector3::UnitX()));  // tilted 0.5 rad
+  EXPECT_EQ(s.Update(in), FlightMode::kFailureRecovery);
+  for (double t = 1.0; t < 2.0; t += 0.005) {
+    in.t = t;
+    EXPECT_EQ(s.Update(in), FlightMode::kFailureRecovery) << "still tilted at " << t;
+  }
+  in.estimate.q_WB = Quaternion(Eigen::AngleAxisd(0.2, Vector3::UnitY()));
+  double degraded_at = -1.0;
+  for (double t = 2.0; t < 4.0 && degraded_at < 0.0; t += 0.005) {
+    in.t = t;
+    if (s.Update(in) == FlightMode::kDegradedNavigation) degraded_at = t;
+  }
+  EXPECT_NEAR(degraded_at, 3.0, 0.006);  // settled at 2.0 s, held for 1 s
+  ASSERT_EQ(s.transitions().size(), 2u);
+  EXPECT_EQ(s.transitions()[0].from, FlightMode::kNominal);
+  EXPECT_EQ(s.transitions()[1].to, FlightMode::kDegradedNavigation);
+}
+
+TEST(Supervisor, ASecondFailureLands) {
+  Supervisor s;
+  SupervisorInputs in = Hovering(1.0);
+  in.isolated_rotors = 1;
+  s.Update(in);
+  in.t = 5.0;
+  in.isolated_rotors = 2;
+  EXPECT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+  EXPECT_NE(s.transitions().back().reason.find("second rotor"), std::string::npos);
+  EXPECT_EQ(s.landing_start(), in.estimate.p_W);
+  EXPECT_EQ(s.landing_start_s(), 5.0);
+}
+
+TEST(Supervisor, NoPlanForLongerThanTheTimeoutLands) {
+  SupervisorOptions o;
+  o.no_plan_timeout_s = 4.0;
+  Supervisor s(o);
+  SupervisorInputs in = Hovering(10.0);
+  in.navigating = true;
+  in.since_last_plan_s = 3.99;
+  EXPECT_EQ(s.Update(in), FlightMode::kNominal);
+  in.since_last_plan_s = 4.01;
+  EXPECT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+  // Not navigating (holding at the last waypoint): the planner's silence is no reason.
+  Supervisor idle(o);
+  in.navigating = false;
+  in.since_last_plan_s = 100.0;
+  EXPECT_EQ(idle.Update(in), FlightMode::kNominal);
+}
+
+TEST(Supervisor, ALostOrDivergedEstimatorLands) {
+  SupervisorOptions o;
+  o.odometry_timeout_s = 0.5;
+  o.max_speed_m_s = 15.0;
+  {
+    Supervisor s(o);
+    SupervisorInputs in = Hovering(2.0);
+    in.odometry_age_s = 0.51;
+    EXPECT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+    EXPECT_NE(s.transitions().back().reason.find("no odometry"), std::string::npos);
+  }
+  {
+    Supervisor s(o);
+    SupervisorInputs in = Hovering(2.0);
+    in.estimate.v_W = Vector3(0, 16, 0);
+    EXPECT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+  }
+  {
+    Supervisor s(o);
+    SupervisorInputs in = Hovering(2.0);
+    in.estimate.p_W.x() = std::nan("");
+    EXPECT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+    EXPECT_TRUE(s.landing_start().allFinite());
+  }
+}
+
+TEST(Supervisor, TouchdownIsTheThrustHeldDownByTheGround) {
+  SupervisorOptions o;
+  o.touchdown_thrust_ratio = 0.5;
+  o.touchdown_hold_s = 0.3;
+  Supervisor s(o);
+  SupervisorInputs in = Hovering(1.0);
+  in.isolated_rotors = 2;
+  ASSERT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+  in.thrust_ratio = 0.95;  // descending
+  for (double t = 1.0; t < 5.0; t += 0.005) {
+    in.t = t;
+    EXPECT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+  }
+  in.thrust_ratio = 0.3;  // on the ground: the controller pushes down
+  double landed_at = -1.0;
+  for (double t = 5.0; t < 6.0 && landed_at < 0.0; t += 0.005) {
+    in.t = t;
+    if (s.Update(in) == FlightMode::kLanded) landed_at = t;
+  }
+  EXPECT_NEAR(landed_at, 5.3, 0.006);
+  in.t = 7.0;
+  in.isolated_rotors = 0;
+  EXPECT_EQ(s.Update(in), FlightMode::kLanded);  // final
+}
+
+TEST(Supervisor, RejectsInvalidOptions) {
+  SupervisorOptions o;
+  o.touchdown_thrust_ratio = 1.0;
+  EXPECT_THROW(Supervisor{o}, ValidationError);
+  o = {};
+  o.no_plan_timeout_s = 0.0;
+  EXPECT_THROW(Supervisor{o}, ValidationError);
+}
+
+// Dead-reckoning against the closed form: a vehicle spinning at a constant yaw rate while
+// accelerating along world x at a constant rate. The IMU (at its lever arm) reads the specific
+// force of the centre of gravity plus the centripetal term; the estimate after 2 s of odometry
+// silence must follow p = p0 + v0 t + a t^2 / 2 and the yaw r t.
+TEST(OdometryImuEstimator, DeadReckonsThroughAnOdometryGapExactlyEnoughForConstantMotion) {
+  EstimatorOptions o;
+  o.imu_position_m = Vector3(0.02, 0.0, 0.03);
+  o.dead_reckoning_after_s = 0.05;
+  OdometryImuEstimator e(1e-6, o);
+  const double r = 11.0;  // rad/s, the paper's spin
+  const Vector3 p0(1, 2, 1.5), v0(0.5, 0, 0), a(0.3, 0, 0);
+  OdometrySample odom;
+  odom.t_ns = 0;
+  odom.p_W = p0;
+  odom.v_W = v0;
+  odom.q_WB = Quaternion::Identity();
+  e.OnOdometry(odom);
+  const TimeNs dt = 1'000'000;  // a 1 kHz IMU for the test
+  for (TimeNs t = dt; t <= 2'000'000'000; t += dt) {
+    const double ts = ToSeconds(t);
+    const Quaternion q(Eigen::AngleAxisd(r * ts, Vector3::UnitZ()));
+    ImuSample imu;
+    imu.t_ns = t;
+    imu.w_B = Vector3(0, 0, r);
+    // f = R^T (a - g) at the centre of gravity, plus w x (w x r_imu) at the IMU.
+    imu.specific_force_B = q.conjugate() * (a + Vector3(0, 0, kGravity)) + imu.w_B.cross(imu.w_B.cross(o.imu_position_m));
+    e.OnImu(imu);
+  }
+  const StateEstimate s = e.Estimate(2'000'000'000);
+  EXPECT_NEAR((s.p_W - (p0 + 2.0 * v0 + 2.0 * a)).norm(), 0.0, 2e-3);
+  EXPECT_NEAR((s.v_W - (v0 + 2.0 * a)).norm(), 0.0, 2e-3);
+  EXPECT_NEAR(std::remainder(YawOf(s.q_WB) - r * 2.0, 2.0 * std::acos(-1.0)), 0.0, 1e-6);
+  EXPECT_NEAR(e.odometry_age_s(2'000'000'000), 2.0, 1e-12);
+  // Fresh odometry replaces the dead-reckoned state at once.
+  odom.t_ns = 2'000'000'000;
+  odom.p_W = Vector3(9, 9, 9);
+  e.OnOdometry(odom);
+  EXPECT_EQ(e.Estimate(2'000'000'000).p_W, Vector3(9, 9, 9));
+}
+
+TEST(OdometryImuEstimator, TheDeadReckonedEstimateStopsAtTheGround) {
+  OdometryImuEstimator e(1e-6);
+  OdometrySample odom;
+  odom.p_W = Vector3(0, 0, 0.2);
+  odom.v_W = Vector3(0, 0, -1.0);
+  e.OnOdometry(odom);
+  for (TimeNs t = 3'000'000; t <= 1'000'000'000; t += 3'000'000) {
+    ImuSample imu;
+    imu.t_ns = t;
+    imu.specific_force_B = Vector3(0, 0, kGravity);  // no acceleration measured: it keeps falling
+    e.OnImu(imu);
+  }
+  const StateEstimate s = e.Estimate(1'000'000'000);
+  EXPECT_EQ(s.p_W.z(), 0.0);
+  EXPECT_GE(s.v_W.z(), 0.0);
+}
+
+}  // namespace
+}  // namespace rotorguard::stack
