@@ -19,6 +19,7 @@
 
 #include "rotorguard/bench/fdd_calibration.h"
 #include "rotorguard/bench/ftc_bench.h"
+#include "rotorguard/bench/nav_bench.h"
 #include "rotorguard/bench/nmpc_bench.h"
 #include "rotorguard/bench/perception_bench.h"
 #include "rotorguard/bench/planner_bench.h"
@@ -278,9 +279,25 @@ int main(int argc, char** argv) {
   bench_planner->add_option("--seed", planner_seed_text, "Worlds and pairs (default 1)");
   bench_planner->add_flag("--json", planner_json, "Print JSON instead of Markdown");
 
+  std::string nav_trials_text = "100", nav_seed_text = "1", nav_jobs_text, nav_kinds = "forest,room", nav_replay, nav_out;
+  bool nav_json = false;
+  CLI::App* bench_nav = bench->add_subcommand(
+      "nav", "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
+             "mid-flight on a random rotor, flown by rotorguard and by its failure-unaware variant:\n"
+             "success_rate, collision_rate, tracking_rmse_m, max_spin_rad_s, mission_time_s, planner_ms_mean,\n"
+             "stack_ms_per_cycle_mean, realtime_factor.");
+  bench_nav->add_option("--trials", nav_trials_text, "Random worlds per kind, each flown by both variants (default 100)");
+  bench_nav->add_option("--seed", nav_seed_text, "Benchmark seed (default 1); trial seeds derive from it");
+  bench_nav->add_option("--jobs", nav_jobs_text, "Worker threads (default: the number of cores)");
+  bench_nav->add_option("--kinds", nav_kinds, "Comma-separated world kinds: forest, room (default both)");
+  bench_nav->add_option("--replay", nav_replay,
+                        "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out");
+  bench_nav->add_option("--out", nav_out, "With --replay: the run folder (default out/nav_KIND_SEED)");
+  bench_nav->add_flag("--json", nav_json, "Print JSON instead of Markdown");
+
   // Every benchmark can also write its page: tables and distributions (report.h).
   std::string bench_html;
-  for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner}) {
+  for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner, bench_nav}) {
     b->add_option("--html", bench_html, "Also write the result as an HTML page to this file");
   }
   const auto write_bench_html = [&bench_html](const char* name, const nlohmann::json& result) {
@@ -441,6 +458,47 @@ int main(int argc, char** argv) {
       const nlohmann::json r = rotorguard::bench::RunPlannerBenchmark(o);
       write_bench_html("planner", r);
       fmt::print("{}", planner_json ? r.dump(2) + "\n" : rotorguard::bench::PlannerMarkdown(r));
+      return kOk;
+    }
+    if (*bench_nav) {
+      rotorguard::bench::NavBenchOptions o;
+      o.trials = static_cast<int>(ParseUnsigned("--trials", nav_trials_text, 1, 100000));
+      o.seed = ParseUnsigned("--seed", nav_seed_text, 0, UINT64_MAX);
+      o.jobs = nav_jobs_text.empty() ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
+                                     : static_cast<int>(ParseUnsigned("--jobs", nav_jobs_text, 1, 256));
+      o.kinds.clear();
+      for (std::size_t start = 0; start <= nav_kinds.size();) {
+        const std::size_t comma = std::min(nav_kinds.find(',', start), nav_kinds.size());
+        const std::string k = nav_kinds.substr(start, comma - start);
+        if (k != "forest" && k != "room") {
+          throw UsageError(fmt::format("--kinds: '{}' is invalid; expected a comma-separated list of forest, room", k));
+        }
+        o.kinds.push_back(k);
+        start = comma + 1;
+      }
+      o.base = rotorguard::bench::LoadScenario(fs::path(DefaultBenchScenario()).parent_path().string() + "/forest.yaml");
+      if (!nav_replay.empty()) {
+        // KIND:SEED[:unaware]
+        const std::size_t a = nav_replay.find(':');
+        const std::size_t b = a == std::string::npos ? a : nav_replay.find(':', a + 1);
+        const std::string kind = nav_replay.substr(0, a);
+        const std::string variant = b == std::string::npos ? "" : nav_replay.substr(b + 1);
+        if (a == std::string::npos || (kind != "forest" && kind != "room") || (!variant.empty() && variant != "unaware")) {
+          throw UsageError(fmt::format("--replay: '{}' is invalid; expected KIND:SEED or KIND:SEED:unaware, KIND forest or room", nav_replay));
+        }
+        const std::uint64_t seed = ParseUnsigned("--replay", nav_replay.substr(a + 1, b == std::string::npos ? b : b - a - 1), 0, UINT64_MAX);
+        const rotorguard::bench::Scenario trial = rotorguard::bench::MakeNavTrial(o.base, kind, seed, variant.empty());
+        rotorguard::bench::RunOptions replay;
+        replay.out_dir = nav_out.empty() ? (fs::path("out") / trial.name).string() : nav_out;
+        replay.report = rotorguard::io::HasViewer();
+        const rotorguard::bench::RunSummary s = rotorguard::bench::RunScenario(trial, replay);
+        PrintSummary(s, replay.out_dir, true, false, replay.report);
+        return s.success ? kOk : kRunFailed;
+      }
+      o.progress = CountProgress("flights");
+      const nlohmann::json r = rotorguard::bench::RunNavBenchmark(o);
+      write_bench_html("nav", r);
+      fmt::print("{}", nav_json ? r.dump(2) + "\n" : rotorguard::bench::NavMarkdown(r));
       return kOk;
     }
     if (*bench_nmpc) {

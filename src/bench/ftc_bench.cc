@@ -1,15 +1,13 @@
 #include "rotorguard/bench/ftc_bench.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <mutex>
-#include <thread>
 
 #include <fmt/format.h>
 
+#include "rotorguard/bench/parallel.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/bench/sim_bench.h"
@@ -167,42 +165,29 @@ nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
   const int methods = static_cast<int>(o.methods.size());
   const int total = kNumCells * methods * o.trials;
   std::vector<FtcTrial> results(static_cast<std::size_t>(total));
-  std::atomic<int> next{0}, done{0};
-  std::mutex progress_mutex;
-  const auto worker = [&] {
-    for (int task = next++; task < total; task = next++) {
-      const int trial = task % o.trials;
-      const int method = (task / o.trials) % methods;
-      const int cell = task / (o.trials * methods);
-      // The same draws for every method: the seed depends on the cell and trial only.
-      const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
-      FtcTrial& r = results[task];
-      try {
-        const RunSummary s = RunScenario(MakeTrial(kCells[cell], o.methods[method], o, seed));
-        r.success = s.success;
-        r.failure = s.failure_reason;
-        r.min_altitude_m = s.min_altitude_m;
-        if (s.fdd) {
-          r.has_fdd = true;
-          r.correct = s.fdd->correct;
-          r.false_alarm = s.fdd->false_alarm;
-          r.latency_s = s.fdd->latency_s;
-        }
-      } catch (const std::exception& e) {
-        r.failure = std::string("error: ") + e.what();
+  ParallelFor(total, o.jobs, [&](int task) {
+    const int trial = task % o.trials;
+    const int method = (task / o.trials) % methods;
+    const int cell = task / (o.trials * methods);
+    // The same draws for every method: the seed depends on the cell and trial only.
+    const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
+    FtcTrial& r = results[task];
+    try {
+      const RunSummary s = RunScenario(MakeTrial(kCells[cell], o.methods[method], o, seed));
+      r.success = s.success;
+      r.failure = s.failure_reason;
+      r.min_altitude_m = s.min_altitude_m;
+      if (s.fdd) {
+        r.has_fdd = true;
+        r.correct = s.fdd->correct;
+        r.false_alarm = s.fdd->false_alarm;
+        r.latency_s = s.fdd->latency_s;
       }
-      r.seed = seed;
-      const int d = ++done;
-      if (o.progress) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        o.progress(d, total);
-      }
+    } catch (const std::exception& e) {
+      r.failure = std::string("error: ") + e.what();
     }
-  };
-  std::vector<std::thread> pool;
-  for (int j = 1; j < o.jobs; ++j) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+    r.seed = seed;
+  }, o.progress);
 
   nlohmann::json cells = nlohmann::json::array();
   int errors = 0;

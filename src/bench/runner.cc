@@ -129,6 +129,8 @@ nlohmann::json RunSummary::ToJson() const {
                        {"plans", plans},
                        {"plans_failed", plans_failed},
                        {"plans_by_reason", plans_by_reason},
+                       {"mission_time_s", mission_time_s >= 0.0 ? nlohmann::json(mission_time_s) : nlohmann::json(nullptr)},
+                       {"planner_ms_mean", planner_ms_mean},
                        {"failed_plans", failed_plans},
                        {"infeasible_request", infeasible_request}};
   }
@@ -137,6 +139,7 @@ nlohmann::json RunSummary::ToJson() const {
   for (const ModeRecord& m : mode_transitions) {
     j["supervisor"]["transitions"].push_back({{"t", m.t}, {"from", m.from}, {"to", m.to}, {"reason", m.reason}});
   }
+  j["stack_ms_per_cycle_mean"] = stack_ms_per_cycle_mean;
   j["physics_steps"] = physics_steps;
   j["control_cycles"] = control_cycles;
   return j;
@@ -207,11 +210,15 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   flight.table.values.resize(flight.table.columns.size());
   SceneRecorder scene(sc.vehicle, sc.world);
   RotorCommand command = st.command();
+  std::chrono::steady_clock::duration stack_time{};
+  const int waypoints_total = static_cast<int>(sc.stack.navigation.waypoints.size()) * sc.stack.navigation.rounds;
 
   for (std::int64_t k = 0; k < steps; ++k) {
     const TimeNs t = sim.time_ns();
     if (t >= next_control) {
+      const auto stack_start = std::chrono::steady_clock::now();
       command = st.Update(t);
+      stack_time += std::chrono::steady_clock::now() - stack_start;
       if (sensor_log) AppendCommand(command, sensor_log);
       next_control += control_period;
       ++summary.control_cycles;
@@ -236,13 +243,25 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       scene.OnTime(ToSeconds(t));
       next_log += log_period;
     }
-    Deliver(sim.Step(command), &st, sensor_log);
+    const sim::SensorOutputs& outputs = sim.Step(command);
+    const auto deliver_start = std::chrono::steady_clock::now();
+    Deliver(outputs, &st, sensor_log);
+    stack_time += std::chrono::steady_clock::now() - deliver_start;
     if (sensor_log && sensor_buffer.size() > (1u << 20)) {
       sensors->Write(sensor_buffer);
       sensor_buffer.clear();
     }
     ++summary.physics_steps;
     if (sim.crashed()) break;
+    if (summary.mission_time_s < 0.0 && st.navigator() && st.waypoints_reached() >= waypoints_total) {
+      summary.mission_time_s = sim.time_s();
+    }
+    // Done once the last waypoint was reached, the vehicle had 3 s to settle on it and held it for
+    // the success rule's window.
+    if (options.stop_when_mission_complete && summary.mission_time_s >= 0.0 &&
+        sim.time_s() >= summary.mission_time_s + 3.0 + sc.success_hold_s) {
+      break;
+    }
     if (options.progress && k >= next_progress) {
       options.progress(static_cast<double>(k) / static_cast<double>(steps));
       next_progress += progress_stride;
@@ -273,6 +292,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     summary.plans = static_cast<int>(nav->events().size());
     for (const planning::Replanner::Event& e : nav->events()) {
       ++summary.plans_by_reason[e.reason];
+      summary.planner_ms_mean += e.plan_ms / static_cast<double>(nav->events().size());
       if (e.status == planning::PlanSummary::Status::kSuccess) continue;
       ++summary.plans_failed;
       summary.failed_plans.push_back(fmt::format("{:.2f} s {}: {}", e.t, e.reason, planning::ToString(e.status)));
@@ -339,6 +359,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     summary.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
   }
   summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  summary.stack_ms_per_cycle_mean =
+      summary.control_cycles > 0
+          ? 1e3 * std::chrono::duration<double>(stack_time).count() / static_cast<double>(summary.control_cycles)
+          : 0.0;
   summary.realtime_factor = summary.wall_time_s > 0.0 ? summary.sim_time_s / summary.wall_time_s : 0.0;
   if (record) {
     flight.summary = summary.ToJson();

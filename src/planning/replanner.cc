@@ -169,7 +169,7 @@ void Replanner::Update(double t, const perception::VoxelMap& map) {
     if (!keep && mode_ != Mode::kHolding && mode_ != Mode::kIdle) Brake(t);
     if (!keep && (mode_ == Mode::kIdle || mode_ == Mode::kHolding)) mode_ = Mode::kHolding;
   }
-  events_.push_back({t, reason, last_plan_.status, mode_});
+  events_.push_back({t, reason, last_plan_.status, mode_, last_plan_.total_ms});
 }
 
 }  // namespace rotorguard::planning

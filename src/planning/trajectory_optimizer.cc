@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <mutex>
 
 #include <ceres/first_order_function.h>
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
+#include <glog/logging.h>
 
 #include "rotorguard/core/error.h"
 
@@ -96,6 +98,10 @@ const char* ToString(TrajectoryOptimizerSummary::Status status) {
 }
 
 TrajectoryOptimizer::TrajectoryOptimizer(const TrajectoryOptimizerOptions& options) : options_(options) {
+  // Ceres's line search logs a harmless glog warning whenever its interpolating polynomial is
+  // constant; a library does not print (DESIGN.md), so glog is kept to errors.
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { FLAGS_minloglevel = std::max(FLAGS_minloglevel, static_cast<int>(google::GLOG_ERROR)); });
   options_.Validate();
 }
 

@@ -14,6 +14,9 @@ function el(tag, attrs = {}, children = []) {
   return e;
 }
 
+/** Two decimals, without a "-0.00". */
+const fixed2 = (v) => (Math.abs(v) < 0.005 ? 0 : v).toFixed(2);
+
 function header(app, data) {
   const s = data.summary;
   app.appendChild(el("h1", { text: `rotorguard · ${data.title}` }));
@@ -111,7 +114,7 @@ function replaySection(app, data, clock) {
       const names = ["ok", "motor failed", "propeller failed", "degraded", "failed"];
       rows += `<tr><td colspan="2"><b>FDD</b></td></tr>`;
       for (let r = 0; r < n; r += 1) {
-        rows += `<tr><td>M_${r} · P_${r}</td><td class="num">${s[`mi_${r}`][i].toFixed(2)} · ${s[`pi_${r}`][i].toFixed(2)} · ${names[s[`health_${r}`][i]] ?? "?"}</td></tr>`;
+        rows += `<tr><td>M_${r} · P_${r}</td><td class="num">${fixed2(s[`mi_${r}`][i])} · ${fixed2(s[`pi_${r}`][i])} · ${names[s[`health_${r}`][i]] ?? "?"}</td></tr>`;
       }
     }
     if (s.nmpc_ms) rows += `<tr><td>NMPC solve</td><td class="num">${fmt(s.nmpc_ms[i], 2)} ms</td></tr>`;

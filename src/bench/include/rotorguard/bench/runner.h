@@ -67,6 +67,12 @@ struct RunSummary {
   int plans = 0, plans_failed = 0;
   /// Planning queries by what started them: "goal", "failure", "obstacle ahead", "periodic".
   std::map<std::string, int> plans_by_reason;
+  /// When the navigate mission reached its last waypoint [s]; -1 when it did not (or another mission).
+  double mission_time_s = -1.0;
+  double planner_ms_mean = 0.0;  ///< wall-clock time of a planning query, mean (0 without queries)
+  /// Wall-clock time the flight stack took per control cycle, its sensor callbacks (mapping
+  /// included) counted: the whole stack's cost [ms].
+  double stack_ms_per_cycle_mean = 0.0;
   /// Each failed planning query: time [s], reason and status ("12.30 s periodic: no_path").
   std::vector<std::string> failed_plans;
   /// The navigate mission asked for a waypoint the planner found unreachable at the end (inside an
@@ -94,6 +100,10 @@ struct RunOptions {
   std::function<void(double)> progress;
   /// Called after every control cycle with the stack (benchmarks read solver statistics).
   std::function<void(const stack::FlightStack&)> on_control_cycle;
+  /// End the run once a navigate mission has reached its last waypoint, settled there for 3 s and
+  /// held it for the scenario's success_hold_s (Monte Carlo trials need not fly out their whole
+  /// duration).
+  bool stop_when_mission_complete = false;
 };
 
 /// Runs the scenario to its duration or to a crash. Throws std::runtime_error when an output

@@ -51,6 +51,7 @@ class Replanner final : public ReferenceTrajectory {
     std::string reason;   ///< "goal", "failure", "obstacle ahead", "periodic"
     PlanSummary::Status status = PlanSummary::Status::kSuccess;
     Mode mode_after = Mode::kIdle;
+    double plan_ms = 0.0;  ///< the query's wall-clock time (search and optimisation)
   };
 
   /// Throws ValidationError on invalid options. Holds `hold_position` until given a goal; every

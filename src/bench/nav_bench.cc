@@ -1,0 +1,217 @@
+#include "rotorguard/bench/nav_bench.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "rotorguard/bench/metrics.h"
+#include "rotorguard/bench/parallel.h"
+#include "rotorguard/bench/planner_bench.h"
+#include "rotorguard/bench/runner.h"
+#include "rotorguard/bench/sim_bench.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/planning/references.h"
+
+namespace rotorguard::bench {
+
+namespace {
+
+constexpr const char* kVariants[] = {"rotorguard", "failure_unaware"};
+
+/// A point with `clearance` to every obstacle: `guess` moved along y (forest) or redrawn in the
+/// room's interior until free; the last draw when none is.
+Vector3 FreePoint(const sim::World& w, Rng* rng, Vector3 p, double y_lo, double y_hi, double x_lo, double x_hi,
+                  double clearance) {
+  for (int k = 0; k < 200 && w.DistanceToObstacles(p, 0.0) < clearance; ++k) {
+    p.x() = rng->Uniform(x_lo, x_hi);
+    p.y() = rng->Uniform(y_lo, y_hi);
+  }
+  return p;
+}
+
+struct NavTrial {
+  bool success = false, collision = false, crashed = false;
+  double tracking_rmse_m = 0.0, max_spin_rad_s = 0.0, mission_time_s = -1.0;
+  double planner_ms_mean = 0.0, stack_ms_per_cycle_mean = 0.0, realtime_factor = 0.0;
+  std::string failure;
+};
+
+nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::vector<std::uint64_t>& seeds,
+                         const std::vector<std::string>& kinds) {
+  const double n = static_cast<double>(trials.size());
+  double success = 0, collision = 0, crash = 0, rmse = 0, spin = 0, planner = 0, stack = 0, rtf = 0, time = 0;
+  int completed = 0;
+  nlohmann::json failures = nlohmann::json::array();
+  for (std::size_t i = 0; i < trials.size(); ++i) {
+    const NavTrial& t = *trials[i];
+    success += t.success;
+    collision += t.collision;
+    crash += t.crashed;
+    rmse += t.tracking_rmse_m / n;
+    spin += t.max_spin_rad_s / n;
+    planner += t.planner_ms_mean / n;
+    stack += t.stack_ms_per_cycle_mean / n;
+    rtf += t.realtime_factor / n;
+    if (t.mission_time_s >= 0.0) time += t.mission_time_s, ++completed;
+    if (!t.success && failures.size() < 10) failures.push_back({{"kind", kinds[i]}, {"seed", seeds[i]}, {"reason", t.failure}});
+  }
+  return {{"trials", trials.size()},
+          {"success_rate", success / n},
+          {"collision_rate", collision / n},
+          {"crash_rate", crash / n},
+          {"tracking_rmse_m", rmse},
+          {"max_spin_rad_s", spin},
+          {"mission_time_s", completed > 0 ? nlohmann::json(time / completed) : nlohmann::json(nullptr)},
+          {"planner_ms_mean", planner},
+          {"stack_ms_per_cycle_mean", stack},
+          {"realtime_factor", rtf},
+          {"failures", failures}};
+}
+
+}  // namespace
+
+void NavBenchOptions::Validate() const {
+  if (trials < 1 || trials > 100000) ThrowInvalidArgument("NavBenchOptions", "trials", trials, "a count in [1, 100000]");
+  if (jobs < 1 || jobs > 256) ThrowInvalidArgument("NavBenchOptions", "jobs", jobs, "a count in [1, 256]");
+  if (kinds.empty()) ThrowInvalidArgument("NavBenchOptions", "kinds", "(none)", "at least one of forest, room");
+  for (const std::string& k : kinds) {
+    if (k != "forest" && k != "room") ThrowInvalidArgument("NavBenchOptions", "kinds", k, "forest or room");
+  }
+  if (base.stack.navigation.waypoints.empty()) {
+    ThrowInvalidArgument("NavBenchOptions", "base", base.name, "a navigate scenario (its stack flies every trial)");
+  }
+}
+
+Scenario MakeNavTrial(const Scenario& base, const std::string& kind, std::uint64_t seed, bool failure_aware) {
+  Scenario s = base;
+  Rng rng(DeriveSeed(seed, 21));
+  s.name = fmt::format("nav_{}_{}", kind, seed);
+  s.seed = seed;
+  std::vector<Vector3> points;  // start, then the waypoints
+  if (kind == "forest") {
+    s.world = PlannerForest(DeriveSeed(seed, 22));
+    // West to east across the forest through a point in its middle, 1.5 m up.
+    for (const double x : {-13.5, 0.0, 13.5}) {
+      points.push_back(FreePoint(s.world, &rng, Vector3(x, rng.Uniform(-7, 7), 1.5), -7, 7, x - 1.0, x + 1.0, 1.0));
+    }
+  } else {
+    s.world = PlannerRoom(DeriveSeed(seed, 23));
+    // Three corners of the room in turn, 1.3 m up.
+    for (const Vector3& corner : {Vector3(-3.8, -2.8, 1.3), Vector3(3.8, 2.8, 1.3), Vector3(-3.8, 2.8, 1.3)}) {
+      points.push_back(FreePoint(s.world, &rng, corner, -3.2, 3.2, -4.2, 4.2, 0.8));
+    }
+  }
+  s.initial_position_m = points.front();
+  s.initial_yaw_rad = 0.0;
+  planning::HoverOptions hold;  // the mission's reference: hold the start until the first plan
+  hold.position_m = points.front();
+  s.reference = std::make_shared<planning::HoverReference>(hold);
+  s.stack.navigation.waypoints.assign(points.begin() + 1, points.end());
+  s.stack.navigation.rounds = 1;
+  s.stack.navigation.failure_aware = failure_aware;
+  double length = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) length += (points[i] - points[i - 1]).norm();
+  // Time enough to fly the legs at half the speed limit, plus the start and the hold.
+  s.duration_s = std::ceil(2.0 * length / s.stack.navigation.replanner.nominal.v_max + 20.0);
+  sim::FaultSpec fault;
+  fault.rotor = std::min(3, static_cast<int>(rng.Uniform() * 4.0));
+  fault.kind = vehicle::FaultKind::kPropellerLoss;
+  fault.onset.value = rng.Uniform(4.0, 10.0);  // mid-flight: after the first plan, well before the end
+  s.faults = {fault};
+  s.sim.wind.mean_m_s = Vector3(rng.Uniform(-0.3, 0.3), rng.Uniform(-0.3, 0.3), 0.0);
+  s.sim.wind.gust_std_m_s = rng.Uniform(0.0, 0.4);
+  // The scene is rebuilt, the stack's hardware facts stay those of the base vehicle.
+  return s;
+}
+
+nlohmann::json RunNavBenchmark(const NavBenchOptions& o) {
+  o.Validate();
+  const int kinds = static_cast<int>(o.kinds.size());
+  const int total = kinds * o.trials * 2;
+  std::vector<NavTrial> results(static_cast<std::size_t>(total));
+  std::vector<std::uint64_t> seeds(static_cast<std::size_t>(total));
+  ParallelFor(total, o.jobs, [&](int task) {
+    const int variant = task % 2;
+    const int trial = (task / 2) % o.trials;
+    const int kind = task / (2 * o.trials);
+    // Both variants fly the same trial: the seed depends on the kind and trial only.
+    const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(kind) * 1'000'003ull + trial);
+    seeds[task] = seed;
+    NavTrial& r = results[task];
+    try {
+      RunOptions run;
+      run.stop_when_mission_complete = true;
+      const RunSummary s = RunScenario(MakeNavTrial(o.base, o.kinds[kind], seed, variant == 0), run);
+      r.success = s.success;
+      r.crashed = s.crashed;
+      r.collision = s.crashed && s.crash_reason.rfind("collision", 0) == 0;
+      r.tracking_rmse_m = s.tracking_rmse_m;
+      r.max_spin_rad_s = s.max_spin_rad_s;
+      r.mission_time_s = s.mission_time_s;
+      r.planner_ms_mean = s.planner_ms_mean;
+      r.stack_ms_per_cycle_mean = s.stack_ms_per_cycle_mean;
+      r.realtime_factor = s.realtime_factor;
+      r.failure = s.failure_reason;
+    } catch (const std::exception& e) {
+      r.failure = std::string("error: ") + e.what();
+    }
+  }, o.progress);
+
+  nlohmann::json result = {{"benchmark", "nav"}};
+  nlohmann::json groups = nlohmann::json::object();
+  for (int v = 0; v < 2; ++v) {
+    std::vector<const NavTrial*> all;
+    std::vector<std::uint64_t> all_seeds;
+    std::vector<std::string> all_kinds;
+    for (int k = 0; k < kinds; ++k) {
+      std::vector<const NavTrial*> group;
+      std::vector<std::uint64_t> group_seeds;
+      std::vector<std::string> group_kinds;
+      for (int t = 0; t < o.trials; ++t) {
+        const int task = (k * o.trials + t) * 2 + v;
+        group.push_back(&results[task]);
+        group_seeds.push_back(seeds[task]);
+        group_kinds.push_back(o.kinds[k]);
+      }
+      groups[o.kinds[k]][kVariants[v]] = Aggregate(group, group_seeds, group_kinds);
+      all.insert(all.end(), group.begin(), group.end());
+      all_seeds.insert(all_seeds.end(), group_seeds.begin(), group_seeds.end());
+      all_kinds.insert(all_kinds.end(), group_kinds.begin(), group_kinds.end());
+    }
+    result[kVariants[v]] = Aggregate(all, all_seeds, all_kinds);
+  }
+  result["groups"] = groups;
+  result["options"] = {{"trials", o.trials}, {"seed", o.seed}, {"jobs", o.jobs}, {"kinds", o.kinds}, {"base", o.base.name}};
+  result["host"] = HostInfo();
+  return result;
+}
+
+std::string NavMarkdown(const nlohmann::json& r) {
+  std::string md = "| kind | variant | trials | success | collisions | tracking RMSE [m] | max spin [rad/s] | "
+                   "mission [s] | planner [ms] | stack [ms/cycle] | real-time factor |\n"
+                   "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const auto row = [&](const std::string& kind, const std::string& variant, const nlohmann::json& g) {
+    md += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {} | {:.2f} | {:.3f} | {:.1f} |\n", kind, variant,
+                      g["trials"].get<int>(), g["success_rate"].get<double>(), g["collision_rate"].get<double>(),
+                      g["tracking_rmse_m"].get<double>(), g["max_spin_rad_s"].get<double>(),
+                      g["mission_time_s"].is_null() ? std::string("–") : fmt::format("{:.1f}", g["mission_time_s"].get<double>()),
+                      g["planner_ms_mean"].get<double>(), g["stack_ms_per_cycle_mean"].get<double>(),
+                      g["realtime_factor"].get<double>());
+  };
+  for (const auto& [kind, variants] : r["groups"].items()) {
+    for (const char* v : kVariants) row(kind, v, variants[v]);
+  }
+  for (const char* v : kVariants) row("all", v, r[v]);
+  for (const char* v : kVariants) {
+    for (const auto& f : r[v]["failures"]) {
+      md += fmt::format("\n{} failed: {} seed {}: {}", v, f["kind"].get<std::string>(), f["seed"].get<std::uint64_t>(),
+                        f["reason"].get<std::string>());
+    }
+  }
+  return md + "\n";
+}
+
+}  // namespace rotorguard::bench
