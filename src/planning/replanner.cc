@@ -117,21 +117,43 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   return ok;
 }
 
-void Replanner::Brake(double t) {
+void Replanner::Brake(double t, const perception::VoxelMap& map) {
   // A rest state ahead along the velocity at the distance a constant deceleration would take
   // (v T / 2), one minimum-jerk piece of duration T, lengthened until within the limits (the
   // head's own velocity and acceleration excepted, as the optimiser's check does).
   const PvaState head = StateOf(Reference(t));
   const Vector3 v = head.col(1);
   const double v_limit = std::max(limits_.v_max, v.norm()), a_limit = std::max(limits_.a_max, head.col(2).norm());
+  const auto build = [&](double duration, MinimumJerkTrajectory* out) {
+    PvaState tail = PvaState::Zero();
+    tail.col(0) = head.col(0) + 0.5 * duration * v;
+    return out->Build(head, tail, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, duration));
+  };
+  const auto collides = [&](const MinimumJerkTrajectory& brake, double duration) {
+    const double step = options_.check_step_m / std::max(v.norm(), 1e-3);
+    for (double s = 0.0; s <= duration + 1e-9; s += std::min(step, 0.05)) {
+      if (map.IsInflated(brake.Evaluate(brake.start_time() + s).p_W)) return true;
+    }
+    return false;
+  };
   double duration = std::max(0.5, 2.0 * v.norm() / limits_.a_max);
   MinimumJerkTrajectory brake;
   for (int k = 0; k < 40; ++k, duration *= 1.25) {
-    PvaState tail = PvaState::Zero();
-    tail.col(0) = head.col(0) + 0.5 * duration * v;
-    if (!brake.Build(head, tail, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, duration))) continue;
+    if (!build(duration, &brake)) continue;
     if (brake.MaxNorm(1, 200) <= v_limit && brake.MaxNorm(2, 200) <= a_limit && brake.MaxNorm(3, 200) <= limits_.j_max) {
       break;
+    }
+  }
+  // Within the limits it would run into an obstacle the planner could not get around: brake
+  // harder, down to a quarter of a second, rather than reach it (a collision is worse than a
+  // limit exceeded for a moment).
+  if (collides(brake, duration)) {
+    for (double shorter = duration / 1.25; shorter >= 0.25; shorter /= 1.25) {
+      MinimumJerkTrajectory harder;
+      if (!build(shorter, &harder)) continue;
+      brake = harder;
+      duration = shorter;
+      if (!collides(brake, duration)) break;
     }
   }
   brake.set_start_time(t);
@@ -166,7 +188,7 @@ void Replanner::Update(double t, const perception::VoxelMap& map) {
     // A failed periodic replan keeps a trajectory that is still safe ahead; otherwise (an
     // obstacle ahead, limits that dropped, a goal that cannot be reached) brake to rest.
     const bool keep = reason == "periodic" && (mode_ != Mode::kFollowing || !UnsafeAhead(t, map));
-    if (!keep && mode_ != Mode::kHolding && mode_ != Mode::kIdle) Brake(t);
+    if (!keep && mode_ != Mode::kHolding && mode_ != Mode::kIdle) Brake(t, map);
     if (!keep && (mode_ == Mode::kIdle || mode_ == Mode::kHolding)) mode_ = Mode::kHolding;
   }
   events_.push_back({t, reason, last_plan_.status, mode_, last_plan_.total_ms});

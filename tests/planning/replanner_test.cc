@@ -197,5 +197,24 @@ TEST(Replanner, NoWayThroughBrakesToRestAndHolds) {
   EXPECT_GE(Count(r, "periodic"), 1) << "keeps trying while holding";
 }
 
+// A wall closing the way nearer than a brake within the limits needs (0.6 m of free space ahead
+// at 1 m/s, where a_max = 2 m/s^2 needs v^2 / a = 1 m for the minimum-jerk stop): the brake comes
+// harder and stops short of the wall's inflation.
+TEST(Replanner, AWallTooCloseForTheLimitsIsBrakedForHarderRatherThanReached) {
+  perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));
+  r.SetGoal(Vector3(6, 0, 1.5));
+  double closed_at = -1.0;
+  Fly(&r, map, 0.0, 12.0, [&](double t) {
+    if (closed_at < 0.0 && r.Reference(t).v_W.norm() > 0.95) {
+      AddWall(&map, r.Reference(t).p_W.x() + 0.6 + 0.2, false);  // 0.6 m to the inflation
+      closed_at = t;
+    }
+  });
+  ASSERT_GT(closed_at, 0.0);
+  EXPECT_FALSE(EntersInflated(r, map, closed_at, 12.0));
+  EXPECT_LT(r.Reference(12.0).v_W.norm(), 1e-9);
+}
+
 }  // namespace
 }  // namespace rotorguard::planning

@@ -39,6 +39,7 @@ function header(app, data) {
   if (s.tilt_recovery_s !== null && s.tilt_recovery_s !== undefined) card("tilt recovered", `${fmt(s.tilt_recovery_s, 2)} s`);
   if (s.navigation) card("waypoints", `${s.navigation.waypoints_reached} / ${s.navigation.waypoints_total}`);
   if (s.map_voxels_occupied !== null && s.map_voxels_occupied !== undefined) card("map voxels", String(s.map_voxels_occupied));
+  if (s.supervisor && s.supervisor.transitions.length > 0) card("flight mode at the end", s.supervisor.final_mode.replace("_", " "));
   card("real-time factor", `${fmt(s.realtime_factor, 0)}×`);
   app.appendChild(cards);
 }
@@ -164,6 +165,9 @@ function plotsSection(app, data, clock) {
   const markers = [];
   for (const f of summary.faults || []) markers.push({ t: f.onset_s, color: "#d62728", label: `fault r${f.rotor}` });
   if (summary.fdd && summary.fdd.detected) markers.push({ t: summary.fdd.detection_s, color: "#ff7f0e", label: "detected" });
+  for (const m of (summary.supervisor && summary.supervisor.transitions) || []) {
+    if (m.to === "emergency_landing" || m.to === "landed") markers.push({ t: m.t, color: "#7f3fbf", label: m.to.replace("_", " ") });
+  }
 
   app.appendChild(el("h2", { text: "Rotors (paper 000, Fig. 7)" }));
   const rotorPlots = el("div", { class: "plots" });

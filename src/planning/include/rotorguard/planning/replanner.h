@@ -86,8 +86,10 @@ class Replanner final : public ReferenceTrajectory {
   bool Replan(double t, const perception::VoxelMap& map);
   /// Whether the trajectory from t to t + check_horizon meets an inflated voxel.
   bool UnsafeAhead(double t, const perception::VoxelMap& map) const;
-  /// A one-piece trajectory from the reference state at t to rest, stretched until within limits.
-  void Brake(double t);
+  /// A one-piece trajectory from the reference state at t to rest, stretched until within limits;
+  /// shortened again (harder braking, past the limits if it must) while it would run into an
+  /// inflated voxel of `map`.
+  void Brake(double t, const perception::VoxelMap& map);
 
   ReplannerOptions options_;
   Planner planner_;
