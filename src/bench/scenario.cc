@@ -72,6 +72,7 @@ vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
   v.motor_stop_time_constant_s = root.Required("motor_stop_time_constant_s").AsDouble();
   v.unloaded_speed_ratio = root.Required("unloaded_rpm_ratio").AsDouble();
   v.collision_radius_m = root.Required("collision_radius_m").AsDouble();
+  if (root.Has("pwm_gain_n")) v.pwm_gain_n = root.Required("pwm_gain_n").AsPositive();
   const ConfigNode rotors = root.Required("rotors");
   if (!rotors.IsSequence() || rotors.size() == 0) rotors.Fail("expected a non-empty list of rotors");
   for (std::size_t i = 0; i < rotors.size(); ++i) {
@@ -100,9 +101,9 @@ void FitStackToHardware(Scenario* s) {
   s->stack.fixed_time_fdd.imu_rate_hz = s->sim.imu.rate_hz;
   s->stack.fixed_time_fdd.imu_position_m = s->sim.imu.position_m;
   s->stack.estimator.imu_position_m = s->sim.imu.position_m;  // its dead-reckoning removes the lever arm
-  // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius.
+  // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius and a margin.
   s->stack.lidar.deskew.sensor_position_m = s->sim.lidar.position_m;
-  s->stack.lidar.map.inflation_radius_m = s->vehicle.collision_radius_m;
+  s->stack.lidar.map.inflation_radius_m = s->vehicle.collision_radius_m + s->stack.lidar.inflation_margin_m;
 }
 
 std::string VehicleToYaml(const vehicle::VehicleParams& v) {
@@ -118,8 +119,9 @@ std::string VehicleToYaml(const vehicle::VehicleParams& v) {
   fmt::format_to(it, "thrust_coefficient_n_per_rpm2: {}\n", v.thrust_coefficient_n_s2 / (rpm_per_rad_s * rpm_per_rad_s));
   fmt::format_to(it, "motor_time_constant_s: {}\nmotor_stop_time_constant_s: {}\n", v.motor_time_constant_s,
                  v.motor_stop_time_constant_s);
-  fmt::format_to(it, "unloaded_rpm_ratio: {}\ncollision_radius_m: {}\nrotors:\n", v.unloaded_speed_ratio,
-                 v.collision_radius_m);
+  fmt::format_to(it, "unloaded_rpm_ratio: {}\ncollision_radius_m: {}\n", v.unloaded_speed_ratio, v.collision_radius_m);
+  if (v.pwm_gain_n > 0.0) fmt::format_to(it, "pwm_gain_n: {}\n", v.pwm_gain_n);
+  fmt::format_to(it, "rotors:\n");
   for (const vehicle::Rotor& r : v.rotors) {
     fmt::format_to(it, "  - {{position_m: {}, direction: {}, yaw_coefficient_m: {}, max_thrust_n: {}}}\n",
                    vec(r.p_B), r.direction == vehicle::SpinDirection::kClockwise ? "cw" : "ccw", r.yaw_coefficient_m,
@@ -429,7 +431,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ReadOptional(*n, "max_rate_rad_s", &m.max_rate_rad_s);
     if (const auto v = n->Optional("max_sqp_iterations")) m.max_sqp_iterations = static_cast<int>(v->AsIntIn(1, 1000));
     n->RejectUnknownKeys();
-    ValidateAt(*n, [&] { m.Validate(); });
+    ValidateAt(*n, [&] { o->lidar.Validate(); });
   }
   if (const auto f = node.Optional("fdd")) o->fdd = f->AsEnum({"none", "composite", "fixedtime"});
   if (const auto c = node.Optional("composite_fdd")) {
@@ -494,9 +496,10 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ValidateAt(*n, [&] { nav.Validate(); });
   }
   if (const auto n = node.Optional("map")) {
-    // The inflation radius is the vehicle's collision radius and the deskew lever arm the LiDAR's
-    // mounting point (FitStackToHardware): neither is a key here.
+    // The inflation radius is the vehicle's collision radius plus inflation_margin_m and the
+    // deskew lever arm the LiDAR's mounting point (FitStackToHardware): neither is a key here.
     perception::VoxelMapOptions& m = o->lidar.map;
+    ReadOptional(*n, "inflation_margin_m", &o->lidar.inflation_margin_m);
     ReadOptional(*n, "resolution_m", &m.resolution_m);
     ReadOptional(*n, "window_size_m", &m.window_size_m);
     ReadOptional(*n, "log_odds_hit", &m.log_odds_hit);
@@ -507,7 +510,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ReadOptional(*n, "max_clearing_range_m", &m.max_clearing_range_m);
     ReadOptional(*n, "recenter_hysteresis_m", &m.recenter_hysteresis_m);
     n->RejectUnknownKeys();
-    ValidateAt(*n, [&] { m.Validate(); });
+    ValidateAt(*n, [&] { o->lidar.Validate(); });
   }
   if (const auto kf = node.Optional("known_faults")) {
     if (!kf->IsSequence()) kf->Fail("expected a list of {rotor, at_time_s}");

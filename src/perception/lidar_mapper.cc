@@ -1,10 +1,17 @@
 #include "rotorguard/perception/lidar_mapper.h"
 
+#include <cmath>
+
+#include "rotorguard/core/error.h"
+
 namespace rotorguard::perception {
 
 void LidarMapperOptions::Validate() const {
   deskew.Validate();
   map.Validate();
+  if (!(std::isfinite(inflation_margin_m) && inflation_margin_m >= 0.0)) {
+    ThrowValidation("LidarMapperOptions", "inflation_margin_m", inflation_margin_m, "a distance >= 0 m");
+  }
 }
 
 LidarMapper::LidarMapper(const LidarMapperOptions& options) : options_(options), deskewer_(options.deskew) {

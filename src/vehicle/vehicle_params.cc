@@ -61,6 +61,7 @@ void VehicleParams::Validate() const {
     ThrowValidation(kOwner, "unloaded_rpm_ratio", unloaded_speed_ratio, "a value in [1, 3]");
   }
   RequirePositive("collision_radius_m", collision_radius_m);
+  RequireNonNegative("pwm_gain_n", pwm_gain_n);
   if (rotors.empty() || num_rotors() > kMaxRotors) {
     ThrowValidation(kOwner, "rotors", fmt::format("({} rotors)", rotors.size()),
                     fmt::format("between 1 and {} rotors", kMaxRotors));

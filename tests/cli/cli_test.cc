@@ -262,6 +262,8 @@ TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
   ExpectConfigError("run " + f, f, 9, {"stack.map.log_odds_max", "40", "(0, 30]"});
   f = Write("hysteresis.yaml", Scenario(v, "stack:\n  map: {window_size_m: [8, 8, 1.6], recenter_hysteresis_m: 0.5}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.map.recenter_hysteresis_m", "0.5", "a quarter of the smallest window extent"});
+  f = Write("margin.yaml", Scenario(v, "stack:\n  map: {inflation_margin_m: -0.1}\n"));
+  ExpectConfigError("run " + f, f, 9, {"stack.map.inflation_margin_m", "-0.1", ">= 0"});
   f = Write("planner.yaml", Scenario(v, "stack:\n  planner: {v_max: -1}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.planner", "v_max", "> 0"});
   std::string navigate = Scenario(v);

@@ -18,6 +18,11 @@ struct LidarMapperOptions {
   bool deskew_frames = true;
   DeskewOptions deskew;
   VoxelMapOptions map;
+  /// What the obstacles are inflated by beyond the vehicle's radius [m], >= 0: the map's
+  /// quantisation (a free voxel's centre can lie a voxel's half-diagonal from the surface point
+  /// that made its occupied neighbour) plus the tracking error. The scenario loader sets
+  /// map.inflation_radius_m to the vehicle's collision radius plus this (FitStackToHardware).
+  double inflation_margin_m = 0.1;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };

@@ -32,6 +32,9 @@ struct VehicleParams {
   double motor_stop_time_constant_s = 0.0;         ///< decay of a stopped motor's speed
   double unloaded_speed_ratio = 1.0;               ///< speed of a motor without propeller / loaded
   double collision_radius_m = 0.0;                 ///< sphere used for collision checks
+  /// K of paper 004, eq. (2): thrust per unit of PWM input [N] (T_i = K u_i), for vehicles driven
+  /// by PWM inputs (PwmQuadModel); 0 when the vehicle has no PWM model.
+  double pwm_gain_n = 0.0;
   std::vector<Rotor> rotors;
 
   int num_rotors() const { return static_cast<int>(rotors.size()); }
