@@ -14,6 +14,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/planning/flatness.h"
 #include "rotorguard/vehicle/multirotor.h"
+#include "vehicle/vehicle_fixture.h"
 
 namespace rotorguard::control {
 namespace {
@@ -95,34 +96,10 @@ TEST(Dare, ZeroOrderHoldOfADoubleIntegratorIsItsClosedForm) {
   EXPECT_NEAR(Bd(1, 0), 2.0 * dt, 1e-15);
 }
 
-vehicle::VehicleParams QballVehicle() {
-  vehicle::VehicleParams v;
-  v.name = "qball";
-  v.mass_kg = 1.4;
-  v.inertia_kg_m2 = Vector3(0.03, 0.03, 0.04).asDiagonal();
-  v.rotor_drag_kg_s = Vector3(0.3, 0.3, 0.4);
-  v.yaw_damping_n_m_s = 0.01;
-  v.thrust_coefficient_n_s2 = vehicle::ThrustCoefficientFromRpm(9.5e-8);
-  v.motor_time_constant_s = 0.0667;
-  v.motor_stop_time_constant_s = 0.02;
-  v.unloaded_speed_ratio = 1.1;
-  v.collision_radius_m = 0.35;
-  v.pwm_gain_n = 120.0;
-  const Vector3 p[4] = {{-0.2, 0, 0}, {0.2, 0, 0}, {0, 0.2, 0}, {0, -0.2, 0}};
-  for (int i = 0; i < 4; ++i) {
-    vehicle::Rotor r;
-    r.p_B = p[i];
-    r.direction = i < 2 ? vehicle::SpinDirection::kClockwise : vehicle::SpinDirection::kCounterClockwise;
-    r.yaw_coefficient_m = 4.0 / 120.0;
-    r.max_thrust_n = 7.2;
-    v.rotors.push_back(r);
-  }
-  v.Validate();
-  return v;
-}
+using ::rotorguard::testing::QballX4;
 
 TEST(LqrController, DesignModelIsEq1And2) {
-  const vehicle::PwmQuadModel m = vehicle::PwmQuadModel::FromVehicle(QballVehicle());
+  const vehicle::PwmQuadModel m = vehicle::PwmQuadModel::FromVehicle(QballX4());
   const LqrDesignModel d = BuildLqrDesignModel(m);
   // A PWM step on motor 1 alone: θ̈ = K L / J1, z̈ = K / m, ψ̈ = K K_ψ / J3, no roll.
   EXPECT_NEAR(d.B(3, 0), 120.0 * 0.2 / 0.03, 1e-9);
@@ -176,7 +153,7 @@ Flight FlyMove(const vehicle::VehicleParams& vp, const vehicle::RotorFaults& fau
 }
 
 TEST(LqrController, FliesThePapersMoveOnTheNonlinearModel) {
-  const Flight f = FlyMove(QballVehicle(), vehicle::RotorFaults(4), 12.0);
+  const Flight f = FlyMove(QballX4(), vehicle::RotorFaults(4), 12.0);
   EXPECT_TRUE(f.finite);
   // The reference's acceleration steps at its start (θ* jumps to its bound, eq. 15): the motors'
   // lag puts the vehicle a few centimetres behind before it catches up.
@@ -191,13 +168,13 @@ TEST(LqrController, IntegralActionHoldsAMotorThatLost40Percent) {
   vehicle::RotorFaults faults(4);
   faults[1].kind = vehicle::FaultKind::kLossOfEffectiveness;
   faults[1].eta = 0.4;
-  const Flight f = FlyMove(QballVehicle(), faults, 20.0);
+  const Flight f = FlyMove(QballX4(), faults, 20.0);
   EXPECT_TRUE(f.finite);
   EXPECT_LT(f.final_error_m, 0.02);
 }
 
 TEST(LqrController, RejectsAVehicleWithoutAPwmModelAndBadOptions) {
-  vehicle::VehicleParams v = QballVehicle();
+  vehicle::VehicleParams v = QballX4();
   v.pwm_gain_n = 0.0;
   EXPECT_THROW(vehicle::PwmQuadModel::FromVehicle(v), ValidationError);
   LqrControllerOptions o;

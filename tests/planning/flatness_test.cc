@@ -11,24 +11,15 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/vehicle/pwm_model.h"
+#include "vehicle/vehicle_fixture.h"
 
 namespace rotorguard::planning {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-/// The Qball-X4-like vehicle of configs/vehicles/qball_x4.yaml (its model values).
-vehicle::PwmQuadModel Qball() {
-  vehicle::PwmQuadModel m;
-  m.mass_kg = 1.4;
-  m.gain_n = 120.0;
-  m.arm_m = 0.2;
-  m.yaw_coefficient_m = 4.0 / 120.0;
-  m.j1 = m.j2 = 0.03;
-  m.j3 = 0.04;
-  m.u_max = 0.06;
-  return m;
-}
+/// The Qball-X4-like vehicle of configs/vehicles/qball_x4.yaml.
+vehicle::PwmQuadModel Qball() { return vehicle::PwmQuadModel::FromVehicle(::rotorguard::testing::QballX4()); }
 
 /// The largest value of f over [0, t_end]: a dense grid, then golden-section refinement around the
 /// best sample (an extremum between samples is found to ~1e-12 of the interval).
@@ -202,19 +193,8 @@ TEST(Flatness, InvalidLimitsAreRejectedNamingTheField) {
 }
 
 TEST(PwmQuadModel, FromTheVehicleLayoutOfEq2) {
-  vehicle::VehicleParams v;
-  v.mass_kg = 1.4;
-  v.inertia_kg_m2 = Vector3(0.03, 0.03, 0.04).asDiagonal();
-  v.pwm_gain_n = 120.0;
+  vehicle::VehicleParams v = ::rotorguard::testing::QballX4();
   const Vector3 p[4] = {{-0.2, 0, 0}, {0.2, 0, 0}, {0, 0.2, 0}, {0, -0.2, 0}};
-  for (int i = 0; i < 4; ++i) {
-    vehicle::Rotor r;
-    r.p_B = p[i];
-    r.direction = i < 2 ? vehicle::SpinDirection::kClockwise : vehicle::SpinDirection::kCounterClockwise;
-    r.yaw_coefficient_m = 0.0333;
-    r.max_thrust_n = 7.2;
-    v.rotors.push_back(r);
-  }
   const vehicle::PwmQuadModel m = vehicle::PwmQuadModel::FromVehicle(v);
   EXPECT_DOUBLE_EQ(m.arm_m, 0.2);
   EXPECT_DOUBLE_EQ(m.u_max, 0.06);
@@ -226,7 +206,7 @@ TEST(PwmQuadModel, FromTheVehicleLayoutOfEq2) {
   for (int i = 0; i < 4; ++i) {
     const double T = 120.0 * u[i];
     thrust += T;
-    torque += p[i].cross(Vector3(0, 0, T)) + Vector3(0, 0, v.rotors[i].yaw_sign() * 0.0333 * T);
+    torque += p[i].cross(Vector3(0, 0, T)) + Vector3(0, 0, v.rotors[i].yaw_sign() * (4.0 / 120.0) * T);
   }
   const Eigen::Vector4d wrench = m.Mixer() * u;  // (u_z, u_theta about y, u_phi about x, u_psi)
   EXPECT_NEAR(wrench[0], thrust, 1e-12);

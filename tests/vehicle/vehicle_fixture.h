@@ -30,4 +30,31 @@ inline vehicle::VehicleParams ReferenceQuad() {
   return p;
 }
 
+/// The Qball-X4-like vehicle of paper 004 (configs/vehicles/qball_x4.yaml): a + quadrotor with a
+/// PWM gain, rotors 0..3 the paper's motors 1..4 (vehicle/pwm_model.h).
+inline vehicle::VehicleParams QballX4() {
+  using vehicle::Rotor;
+  using vehicle::SpinDirection;
+  vehicle::VehicleParams p;
+  p.name = "qball_x4";
+  p.mass_kg = 1.4;
+  p.inertia_kg_m2 = Eigen::Vector3d(0.03, 0.03, 0.04).asDiagonal();
+  p.rotor_drag_kg_s = Eigen::Vector3d(0.3, 0.3, 0.4);
+  p.yaw_damping_n_m_s = 0.01;
+  p.thrust_coefficient_n_s2 = vehicle::ThrustCoefficientFromRpm(9.5e-8);
+  p.motor_time_constant_s = 0.0667;
+  p.motor_stop_time_constant_s = 0.02;
+  p.unloaded_speed_ratio = 1.1;
+  p.collision_radius_m = 0.35;
+  p.pwm_gain_n = 120.0;
+  const double kappa = 4.0 / 120.0;
+  p.rotors = {
+      Rotor{{-0.2, 0.0, 0.0}, SpinDirection::kClockwise, kappa, 7.2},
+      Rotor{{0.2, 0.0, 0.0}, SpinDirection::kClockwise, kappa, 7.2},
+      Rotor{{0.0, 0.2, 0.0}, SpinDirection::kCounterClockwise, kappa, 7.2},
+      Rotor{{0.0, -0.2, 0.0}, SpinDirection::kCounterClockwise, kappa, 7.2},
+  };
+  return p;
+}
+
 }  // namespace rotorguard::testing
