@@ -19,6 +19,7 @@
 
 #include "rotorguard/bench/fdd_calibration.h"
 #include "rotorguard/bench/ftc_bench.h"
+#include "rotorguard/bench/flatness_bench.h"
 #include "rotorguard/bench/nav_bench.h"
 #include "rotorguard/bench/nmpc_bench.h"
 #include "rotorguard/bench/perception_bench.h"
@@ -135,6 +136,20 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
                  f.correct ? fmt::format(" (correct, {:.3f} s after onset)", f.latency_s)
                            : (f.false_alarm ? " (false alarm)" : " (wrong rotor or kind)"));
     }
+  }
+  for (std::size_t i = 0; i < s.flatness_decisions.size(); ++i) {
+    // Paper 004's re-planning: hold, then continue, return or land.
+    const auto& d = s.flatness_decisions[i];
+    const std::string kind = d["kind"].get<std::string>();
+    std::string what = fmt::format("{} at {:.2f} s", kind, d["t"].get<double>());
+    if (kind != "land") what += fmt::format(", t_s {:.2f} s", d["t_s"].get<double>());
+    if (!d["binding"].get<std::string>().empty()) what += fmt::format(" ({})", d["binding"].get<std::string>());
+    if (kind == "continue" || kind == "return" || kind == "land") {
+      const auto& w = d["w_hat"];
+      what += fmt::format(", w_hat [{:.2f}, {:.2f}, {:.2f}, {:.2f}]", w[0].get<double>(), w[1].get<double>(),
+                          w[2].get<double>(), w[3].get<double>());
+    }
+    fmt::print("{}{}: {}\n", i == 0 ? "re-planning       " : "                  ", what, d["reason"].get<std::string>());
   }
   for (std::size_t i = 0; i < s.mode_transitions.size(); ++i) {
     const auto& m = s.mode_transitions[i];
@@ -295,9 +310,20 @@ int main(int argc, char** argv) {
   bench_nav->add_option("--out", nav_out, "With --replay: the run folder (default out/nav_KIND_SEED)");
   bench_nav->add_flag("--json", nav_json, "Print JSON instead of Markdown");
 
+  std::string flat_seeds_text = "20", flat_seed_text = "1", flat_jobs_text;
+  bool flat_json = false;
+  CLI::App* bench_flatness = bench->add_subcommand(
+      "flatness", "Paper 004: closed-form settling times of Fig. 1 (ts_envelope_s, ts_actuator_s) and the Fig. 2\n"
+                  "flight (configs/scenarios/flatness_fig2.yaml) over many seeds: ukf_w_estimate, ukf_settle_s,\n"
+                  "replan_ts_s against a fault-free re-plan, max_pitch_deg against theta_max.");
+  bench_flatness->add_option("--seeds", flat_seeds_text, "Flights of the Fig. 2 scenario (default 20)");
+  bench_flatness->add_option("--seed", flat_seed_text, "The first flight's seed (default 1)");
+  bench_flatness->add_option("--jobs", flat_jobs_text, "Worker threads (default: the number of cores)");
+  bench_flatness->add_flag("--json", flat_json, "Print JSON instead of Markdown");
+
   // Every benchmark can also write its page: tables and distributions (report.h).
   std::string bench_html;
-  for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner, bench_nav}) {
+  for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner, bench_nav, bench_flatness}) {
     b->add_option("--html", bench_html, "Also write the result as an HTML page to this file");
   }
   const auto write_bench_html = [&bench_html](const char* name, const nlohmann::json& result) {
@@ -499,6 +525,19 @@ int main(int argc, char** argv) {
       const nlohmann::json r = rotorguard::bench::RunNavBenchmark(o);
       write_bench_html("nav", r);
       fmt::print("{}", nav_json ? r.dump(2) + "\n" : rotorguard::bench::NavMarkdown(r));
+      return kOk;
+    }
+    if (*bench_flatness) {
+      rotorguard::bench::FlatnessBenchOptions o;
+      o.seeds = static_cast<int>(ParseUnsigned("--seeds", flat_seeds_text, 1, 10000));
+      o.seed = ParseUnsigned("--seed", flat_seed_text, 0, UINT64_MAX);
+      o.jobs = flat_jobs_text.empty() ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
+                                      : static_cast<int>(ParseUnsigned("--jobs", flat_jobs_text, 1, 256));
+      o.fig2 = rotorguard::bench::LoadScenario(fs::path(DefaultBenchScenario()).parent_path().string() + "/flatness_fig2.yaml");
+      o.progress = CountProgress("flights");
+      const nlohmann::json r = rotorguard::bench::RunFlatnessBenchmark(o);
+      write_bench_html("flatness", r);
+      fmt::print("{}", flat_json ? r.dump(2) + "\n" : rotorguard::bench::FlatnessMarkdown(r));
       return kOk;
     }
     if (*bench_nmpc) {

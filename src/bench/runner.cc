@@ -102,6 +102,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["max_position_error_m"] = max_position_error_m;
   j["min_altitude_m"] = min_altitude_m;
   j["max_spin_rad_s"] = max_spin_rad_s;
+  j["max_tilt_rad"] = max_tilt_rad;
   j["tilt_recovery_s"] = tilt_recovery_s >= 0.0 ? nlohmann::json(tilt_recovery_s) : nlohmann::json(nullptr);
   j["faults"] = nlohmann::json::array();
   for (const FaultRecord& f : faults) {
@@ -133,6 +134,10 @@ nlohmann::json RunSummary::ToJson() const {
                        {"planner_ms_mean", planner_ms_mean},
                        {"failed_plans", failed_plans},
                        {"infeasible_request", infeasible_request}};
+  }
+  if (!flatness_decisions.empty()) j["flatness"] = {{"decisions", flatness_decisions}};
+  if (!ukf_w_hat.empty()) {
+    j["ukf"] = {{"w_hat", ukf_w_hat}, {"settled_s", ukf_settled_s >= 0.0 ? nlohmann::json(ukf_settled_s) : nlohmann::json(nullptr)}};
   }
   j["lidar_points_dropped"] = lidar_points_dropped;
   j["supervisor"] = {{"final_mode", final_mode}, {"transitions", nlohmann::json::array()}};
@@ -238,6 +243,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     if (!sim.fault_events().empty()) min_alt_after_fault = std::min(min_alt_after_fault, alt);
     summary.max_spin_rad_s = std::max(summary.max_spin_rad_s, std::abs(s.w_B().z()));
     if (!sim.fault_events().empty() && TiltOf(s.q_WB()) > sc.recovered_tilt_rad) last_tilted_s = ToSeconds(t);
+    summary.max_tilt_rad = std::max(summary.max_tilt_rad, TiltOf(s.q_WB()));
     if (record && t >= next_log) {
       AppendRow(sim, st, &flight.table);
       scene.OnTime(ToSeconds(t));
@@ -253,7 +259,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     }
     ++summary.physics_steps;
     if (sim.crashed()) break;
-    if (summary.mission_time_s < 0.0 && st.navigator() && st.waypoints_reached() >= waypoints_total) {
+    if (summary.mission_time_s < 0.0 && (st.navigator() || st.flatness()) && st.waypoints_reached() >= waypoints_total) {
       summary.mission_time_s = sim.time_s();
     }
     // Done once the last waypoint was reached, the vehicle had 3 s to settle on it and held it for
@@ -298,6 +304,23 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       summary.failed_plans.push_back(fmt::format("{:.2f} s {}: {}", e.t, e.reason, planning::ToString(e.status)));
     }
   }
+  if (const planning::FlatnessNavigator* f = st.flatness()) {
+    summary.waypoints_reached = st.waypoints_reached();
+    summary.waypoints_total = static_cast<int>(sc.stack.navigation.waypoints.size()) * sc.stack.navigation.rounds;
+    for (const planning::FlatnessDecision& d : f->decisions()) {
+      summary.flatness_decisions.push_back({{"t", d.t}, {"kind", d.kind}, {"t_s", d.t_s}, {"binding", d.binding},
+                                            {"w_hat", {d.w_hat[0], d.w_hat[1], d.w_hat[2], d.w_hat[3]}},
+                                            {"reason", d.reason},
+                                            {"delta_m", {d.delta_m.x(), d.delta_m.y(), d.delta_m.z()}},
+                                            {"envelope_s", d.envelope_s},
+                                            {"actuator_s", d.actuator_s}});
+    }
+  }
+  if (const auto* ukf = dynamic_cast<const fdd::UkfFdd*>(st.fault_detector())) {
+    const Eigen::VectorXd w = ukf->loss();
+    summary.ukf_w_hat.assign(w.data(), w.data() + w.size());
+    summary.ukf_settled_s = ukf->settled_after_detection_s().value_or(-1.0);
+  }
   summary.crashed = sim.crashed();
   summary.crash_reason = sim.crash_reason().value_or("");
   for (const stack::ModeTransition& m : st.supervisor().transitions()) {
@@ -327,16 +350,16 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     summary.failure_reason = fmt::format("navigation reached {} of {} waypoints", summary.waypoints_reached,
                                          summary.waypoints_total);
     // The waypoint being flown to, and what its last plan said.
-    const planning::Replanner& nav = *st.navigator();
     using Status = planning::PlanSummary::Status;
-    const Status last = nav.last_plan().status;
-    if (!nav.events().empty() && (last == Status::kGoalBlocked || last == Status::kGoalOutOfBounds || last == Status::kNoPath)) {
+    const planning::Replanner* nav = st.navigator();
+    const Status last = nav ? nav->last_plan().status : Status::kSuccess;
+    if (nav && !nav->events().empty() && (last == Status::kGoalBlocked || last == Status::kGoalOutOfBounds || last == Status::kNoPath)) {
       const std::vector<Vector3>& w = sc.stack.navigation.waypoints;
       const Vector3& goal = w[static_cast<std::size_t>(summary.waypoints_reached) % w.size()];
       summary.infeasible_request = true;
       summary.failure_reason += fmt::format("; waypoint {} at [{:g}, {:g}, {:g}] is unreachable: {} ({})",
                                             summary.waypoints_reached + 1, goal.x(), goal.y(), goal.z(),
-                                            planning::ToString(last), nav.last_plan().message);
+                                            planning::ToString(last), nav->last_plan().message);
     }
   }
   summary.success = summary.failure_reason.empty();

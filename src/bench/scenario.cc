@@ -100,6 +100,8 @@ void FitStackToHardware(Scenario* s) {
   s->stack.composite_fdd.imu_position_m = s->sim.imu.position_m;
   s->stack.fixed_time_fdd.imu_rate_hz = s->sim.imu.rate_hz;
   s->stack.fixed_time_fdd.imu_position_m = s->sim.imu.position_m;
+  s->stack.ukf_fdd.imu_rate_hz = s->sim.imu.rate_hz;
+  s->stack.ukf_fdd.imu_position_m = s->sim.imu.position_m;
   s->stack.estimator.imu_position_m = s->sim.imu.position_m;  // its dead-reckoning removes the lever arm
   // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius and a margin.
   s->stack.lidar.deskew.sensor_position_m = s->sim.lidar.position_m;
@@ -243,7 +245,6 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
     } else if (*type == "navigate") {
       // Planned on the LiDAR map (docs/planning.md): the stack holds the initial position until
       // its first plan, then flies the waypoints in turn, `rounds` times.
-      if (!s.sim.lidar.enabled) node.Fail("the navigate mission plans on the LiDAR map; expected sensors.lidar");
       const ConfigNode wps = node.Required("waypoints_m");
       if (!wps.IsSequence() || wps.size() == 0) wps.Fail("expected a non-empty list of [x, y, z] points");
       stack::NavigationOptions& n = scenario->stack.navigation;
@@ -384,7 +385,7 @@ void ParsePositionLoop(const ConfigNode& n, control::PositionLoopOptions* p) {
 }
 
 void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
-  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive", "indi"});
+  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive", "indi", "lqr"});
   ReadOptional(node, "control_rate_hz", &o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;
@@ -431,9 +432,9 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ReadOptional(*n, "max_rate_rad_s", &m.max_rate_rad_s);
     if (const auto v = n->Optional("max_sqp_iterations")) m.max_sqp_iterations = static_cast<int>(v->AsIntIn(1, 1000));
     n->RejectUnknownKeys();
-    ValidateAt(*n, [&] { o->lidar.Validate(); });
+    ValidateAt(*n, [&] { m.Validate(); });
   }
-  if (const auto f = node.Optional("fdd")) o->fdd = f->AsEnum({"none", "composite", "fixedtime"});
+  if (const auto f = node.Optional("fdd")) o->fdd = f->AsEnum({"none", "composite", "fixedtime", "ukf"});
   if (const auto c = node.Optional("composite_fdd")) {
     fdd::CompositeFddOptions& d = o->composite_fdd;
     ReadOptional(*c, "motor_index_threshold", &d.motor_index_threshold);
@@ -467,11 +468,15 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     sup->RejectUnknownKeys();
     ValidateAt(*sup, [&] { v.Validate(); });
   }
-  if (const auto n = node.Optional("planner")) {
+  if (const auto n = node.Optional("planner"); n && !n->IsMap()) {
+    o->navigation.method = n->AsEnum({"minco", "flatness"});  // `planner: flatness`, the defaults
+  } else if (n) {
     // The navigate mission's planner (docs/planning.md): rate, nominal limits, eq. (33)'s safety
     // factor, eq. (22)'s weights, clearance, replanning period and altitude band.
     stack::NavigationOptions& nav = o->navigation;
     planning::ReplannerOptions& r = nav.replanner;
+    if (const auto m = n->Optional("method")) nav.method = m->AsEnum({"minco", "flatness"});
+    ReadOptional(*n, "start_s", &nav.start_s);
     ReadOptional(*n, "rate_hz", &nav.planner_rate_hz);
     ReadOptional(*n, "v_max", &r.nominal.v_max);
     ReadOptional(*n, "a_max", &r.nominal.a_max);
@@ -494,6 +499,29 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     }
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { nav.Validate(); });
+  }
+  if (const auto n = node.Optional("flatness")) {
+    // Paper 004's planner (docs/flatness.md): envelope and actuator limits, the hold after a
+    // detection and the time budget of the re-planned leg.
+    planning::FlatnessNavigatorOptions& f = o->navigation.flatness;
+    constexpr double kDeg = 3.14159265358979323846 / 180.0;
+    for (const auto& [key, angle] : {std::pair{"theta_max_deg", &f.limits.theta_max_rad}, std::pair{"phi_max_deg", &f.limits.phi_max_rad}}) {
+      if (const auto v = n->Optional(key)) {
+        const double deg = v->AsDouble();
+        if (!(deg > 0.0 && deg < 90.0)) v->Fail(fmt::format("{} = {:g} is invalid; expected an angle in (0, 90) deg", key, deg));
+        *angle = deg * kDeg;
+      }
+    }
+    ReadOptional(*n, "rho_angle", &f.limits.rho_angle);
+    ReadOptional(*n, "u_max", &f.limits.u_max);
+    ReadOptional(*n, "rho_u", &f.limits.rho_u);
+    ReadOptional(*n, "hold_t_s", &f.hold_t_s);
+    ReadOptional(*n, "min_hold_s", &f.min_hold_s);
+    ReadOptional(*n, "max_hold_s", &f.max_hold_s);
+    ReadOptional(*n, "time_budget_s", &f.time_budget_s);
+    ReadOptional(*n, "min_t_s", &f.min_t_s);
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] { f.Validate(); });
   }
   if (const auto n = node.Optional("map")) {
     // The inflation radius is the vehicle's collision radius plus inflation_margin_m and the
@@ -671,6 +699,13 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     metrics->RejectUnknownKeys();
   }
   root.RejectUnknownKeys();
+  if (s.mission_type == "navigate" && s.stack.navigation.method == "minco" && !s.sim.lidar.enabled) {
+    root.Required("mission").Fail("the navigate mission plans on the LiDAR map; expected sensors.lidar");
+  }
+  if (s.stack.navigation.method == "flatness" || s.stack.controller == "lqr") {
+    // Paper 004's planner and controller work on the vehicle's PWM model: its layout is checked now.
+    ValidateAt(root.Required("vehicle"), [&] { vehicle::PwmQuadModel::FromVehicle(s.vehicle); });
+  }
   CheckReferenceAboveGround(root.Required("mission"), s);
   return s;
 }

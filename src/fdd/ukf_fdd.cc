@@ -120,6 +120,7 @@ void UkfFdd::OnImu(const ImuSample& imu) {
   while (history_.size() > 1 && t - history_[1].first >= options_.settle_window_s) history_.pop_front();
   settled_ = t - history_.front().first >= options_.settle_window_s - 1e-9;
   for (const auto& [ts, w_old] : history_) settled_ = settled_ && (w_old - w_hat).cwiseAbs().maxCoeff() <= options_.settle_tolerance;
+  if (detected_s_ && settled_ && !settled_after_detection_s_) settled_after_detection_s_ = t;
   // Detection on the largest loss (one fault at a time, as the paper).
   if (first_isolated_) return;
   int worst = 0;

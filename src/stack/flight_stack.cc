@@ -31,31 +31,41 @@ void NavigationOptions::Validate() const {
     ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", post_failure_safety_factor,
                     "in (0, 1]");
   }
+  if (method != "minco" && method != "flatness") {
+    ThrowValidation("FlightStackOptions", "navigation.method", method, "minco or flatness");
+  }
+  if (!(std::isfinite(start_s) && start_s >= 0.0)) {
+    ThrowValidation("FlightStackOptions", "navigation.start_s", start_s, "a time >= 0 s");
+  }
   replanner.Validate();
+  flatness.Validate();
 }
 
 void FlightStackOptions::Validate() const {
   if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > 10000.0) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
   }
-  if (controller != "nominal" && controller != "nmpc" && controller != "passive" && controller != "indi") {
-    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc, passive, indi");
+  if (controller != "nominal" && controller != "nmpc" && controller != "passive" && controller != "indi" &&
+      controller != "lqr") {
+    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc, passive, indi, lqr");
   }
   nominal.Validate();
   passive.Validate();
   nmpc.Validate();
   if (controller == "indi") IndiOptionsInStack(*this).Validate();  // its filters depend on the rate
+  lqr.Validate();
   for (std::size_t i = 0; i < known_faults.size(); ++i) {
     if (!std::isfinite(known_faults[i].at_time_s) || known_faults[i].at_time_s < 0.0) {
       ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.at_time_s", i), known_faults[i].at_time_s,
                       "a time >= 0 s");
     }
   }
-  if (fdd != "none" && fdd != "composite" && fdd != "fixedtime") {
-    ThrowValidation("FlightStackOptions", "fdd", fdd, "one of: none, composite, fixedtime");
+  if (fdd != "none" && fdd != "composite" && fdd != "fixedtime" && fdd != "ukf") {
+    ThrowValidation("FlightStackOptions", "fdd", fdd, "one of: none, composite, fixedtime, ukf");
   }
   composite_fdd.Validate();
   fixed_time_fdd.Validate();
+  ukf_fdd.Validate();
   lidar.Validate();
   estimator.Validate();
   supervisor.Validate();
@@ -89,6 +99,10 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     controller_ = std::move(nmpc);
   } else if (options_.controller == "indi") {
     controller_ = std::make_unique<control::IndiController>(model_, IndiOptionsInStack(options_));
+  } else if (options_.controller == "lqr") {
+    control::LqrControllerOptions lqr = options_.lqr;
+    lqr.sample_hz = options_.control_rate_hz;
+    controller_ = std::make_unique<control::LqrController>(vehicle::PwmQuadModel::FromVehicle(model_.params()), lqr);
   } else if (options_.controller == "passive") {
     controller_ = std::make_unique<control::PassiveController>(model_, options_.passive);
   } else {
@@ -104,9 +118,14 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
   known_fault_applied_.assign(options_.known_faults.size(), false);
   if (options_.fdd == "composite") fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
   if (options_.fdd == "fixedtime") fdd_ = std::make_unique<fdd::FixedTimeFdd>(model_.params(), options_.fixed_time_fdd);
+  if (options_.fdd == "ukf") fdd_ = std::make_unique<fdd::UkfFdd>(model_.params(), options_.ukf_fdd);
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
-  if (!options_.navigation.waypoints.empty()) {
+  if (!options_.navigation.waypoints.empty() && options_.navigation.method == "flatness") {
+    const ReferencePoint start = reference_->Evaluate(0.0);
+    flatness_ = std::make_unique<planning::FlatnessNavigator>(vehicle::PwmQuadModel::FromVehicle(model_.params()),
+                                                              options_.navigation.flatness, start.p_W, start.yaw);
+  } else if (!options_.navigation.waypoints.empty()) {
     // Eq. (33) for this vehicle: the weakest rotor's thrust, the largest drag coefficient. A
     // vehicle whose two remaining rotors cannot hold its weight gets a token limit (it cannot fly
     // on after a failure anyway).
@@ -146,8 +165,37 @@ void FlightStack::OnRotorFailed(int rotor) {
   if (navigator_ && options_.navigation.failure_aware) navigator_->OnFailure();
 }
 
+void FlightStack::NavigateFlatness(double t) {
+  if (t < next_plan_s_ || t < options_.navigation.start_s) return;
+  next_plan_s_ = t + 1.0 / options_.navigation.planner_rate_hz;
+  // Any detection starts the hold; the UKF's losses and settling drive the re-plan (other
+  // detectors give their eta and are taken as settled).
+  Eigen::Vector4d w_hat = Eigen::Vector4d::Zero();
+  bool detected = false, settled = true;
+  if (fdd_) {
+    for (int i = 0; i < std::min(4, model_.num_rotors()); ++i) {
+      const fdd::RotorStatus& r = fdd_->rotors()[static_cast<std::size_t>(i)];
+      w_hat[i] = std::clamp(r.eta, 0.0, 0.99);
+      detected = detected || r.detected_s.has_value();
+    }
+    if (const auto* ukf = dynamic_cast<const fdd::UkfFdd*>(fdd_.get())) settled = ukf->settled();
+  }
+  if (detected && !flatness_told_) {
+    flatness_told_ = true;
+    flatness_->OnFaultDetected(t);
+  }
+  flatness_->Update(t, settled, w_hat);
+  const std::vector<Vector3>& w = options_.navigation.waypoints;
+  const int total = static_cast<int>(w.size()) * options_.navigation.rounds;
+  if (next_waypoint_ > 0 && flatness_->arrived(t) && !flatness_->returning()) flatness_reached_ = next_waypoint_;
+  if (next_waypoint_ < total && !flatness_->returning() && (next_waypoint_ == 0 || flatness_->arrived(t))) {
+    flatness_->SetGoal(w[static_cast<std::size_t>(next_waypoint_++) % w.size()], t);
+  }
+}
+
 void FlightStack::Navigate(double t, FlightMode mode) {
-  if (!navigator_ || !map() || t < next_plan_s_) return;
+  if (flatness_) return NavigateFlatness(t);
+  if (!navigator_ || !map() || t < next_plan_s_ || t < options_.navigation.start_s) return;
   // The waypoints in turn, each once the last was reached; the planner at its own rate. While the
   // attitude recovers from a failure the mission waits: no new waypoint.
   next_plan_s_ = t + 1.0 / options_.navigation.planner_rate_hz;
@@ -192,6 +240,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   in.navigating = navigator_ && next_waypoint_ > 0 && !navigator_->arrived();
   in.since_last_plan_s = ts - last_plan_ok_s_;
   in.thrust_ratio = command_.thrust_n.sum() / model_.params().weight_n();
+  if (flatness_ && flatness_->land_request()) in.land_request = "re-planning decided to land: " + *flatness_->land_request();
   const FlightMode mode = supervisor_.Update(in);
 
   if (mode == FlightMode::kEmergencyLanding && !landing_) {

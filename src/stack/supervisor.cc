@@ -78,6 +78,8 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
     land = fmt::format("a second rotor failed ({} isolated)", in.isolated_rotors);
   } else if (in.navigating && in.since_last_plan_s > options_.no_plan_timeout_s) {
     land = fmt::format("no feasible trajectory for {:.1f} s", in.since_last_plan_s);
+  } else if (!in.land_request.empty()) {
+    land = in.land_request;
   }
   if (!land.empty()) {
     landing_start_ = e.p_W.allFinite() ? e.p_W : Vector3::Zero();

@@ -1,4 +1,5 @@
 #include "rotorguard/planning/flatness.h"
+#include "rotorguard/planning/flatness_navigator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -224,6 +225,90 @@ TEST(PwmQuadModel, FromTheVehicleLayoutOfEq2) {
   v.rotors[2].p_B = p[2];
   v.rotors[1].direction = vehicle::SpinDirection::kCounterClockwise;
   EXPECT_THROW(vehicle::PwmQuadModel::FromVehicle(v), ValidationError);
+}
+
+}  // namespace
+}  // namespace rotorguard::planning
+
+namespace rotorguard::planning {
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+TEST(FlatnessNavigator, HoldsOnADetectionThenReplansTheRemainingDistanceWithTheIdentifiedLoss) {
+  const vehicle::PwmQuadModel m = vehicle::PwmQuadModel::FromVehicle(::rotorguard::testing::QballX4());
+  FlatnessNavigatorOptions o;
+  o.min_hold_s = 3.0;
+  FlatnessNavigator nav(m, o, Vector3(0, 0, 1));
+  nav.SetGoal(Vector3(-1.5, 0, 1), 0.0);
+  ASSERT_EQ(nav.decisions().size(), 1u);
+  EXPECT_NEAR(nav.decisions()[0].t_s, EnvelopeSettlingTime(-1.5, 10.0 * kDegree, 1.0), 1e-12);
+  EXPECT_FALSE(nav.arrived(5.0));
+  nav.OnFaultDetected(2.0);
+  EXPECT_TRUE(nav.holding());
+  // The hold starts where the reference is and barely moves while the estimate converges.
+  const Vector3 at_fault = nav.Evaluate(2.0 - 1e-9).p_W;
+  EXPECT_LT((nav.Evaluate(2.0 + 1e-9).p_W - at_fault).norm(), 1e-6);
+  EXPECT_LT((nav.Evaluate(5.0).p_W - at_fault).norm(), 2e-3);
+  const Eigen::Vector4d w(0.0, 0.4, 0.0, 0.0);
+  nav.Update(4.0, true, w);  // settled, but before min_hold_s
+  EXPECT_TRUE(nav.holding());
+  nav.Update(5.0, true, w);
+  ASSERT_FALSE(nav.holding());
+  const FlatnessDecision& d = nav.decisions().back();
+  EXPECT_EQ(d.kind, "continue");
+  EXPECT_EQ(d.w_hat, w);
+  // The re-plan is the closed form for the remaining distance with the degraded limit.
+  const Vector3 remaining = Vector3(-1.5, 0, 1) - nav.Evaluate(5.0 - 1e-9).p_W;
+  const SettlingTime expected = PlanSettlingTime(m, o.limits, remaining.head<2>(), w);
+  EXPECT_NEAR(d.t_s, expected.t_s, 1e-6);
+  EXPECT_LT((d.delta_m - remaining).norm(), 1e-6);
+  // ... and its actuator candidate is longer than a fault-free one over the same distance.
+  EXPECT_GT(d.actuator_s, PlanSettlingTime(m, o.limits, remaining.head<2>()).actuator_s);
+  EXPECT_TRUE(nav.arrived(5.0 + d.t_s + 1e-6));
+  EXPECT_LT((nav.Evaluate(5.0 + 40.0 * d.t_s).p_W - Vector3(-1.5, 0, 1)).norm(), 1e-9);
+  EXPECT_FALSE(nav.land_request());
+}
+
+TEST(FlatnessNavigator, ReturnsHomeOrLandsWhenTheLegExceedsTheBudgetOrCannotBeFlown) {
+  const vehicle::PwmQuadModel m = vehicle::PwmQuadModel::FromVehicle(::rotorguard::testing::QballX4());
+  FlatnessNavigatorOptions o;
+  o.time_budget_s = 10.0;
+  o.min_hold_s = 0.0;
+  {  // 20 m to go take 20 s at 10 deg; home is close: return.
+    FlatnessNavigator nav(m, o, Vector3(0, 0, 1));
+    nav.SetGoal(Vector3(-20, 0, 1), 0.0);
+    nav.OnFaultDetected(0.5);
+    nav.Update(0.6, true, Eigen::Vector4d(0, 0.3, 0, 0));
+    EXPECT_EQ(nav.decisions().back().kind, "return");
+    EXPECT_TRUE(nav.returning());
+    EXPECT_NE(nav.decisions().back().reason.find("budget"), std::string::npos);
+  }
+  {  // 1 - w = 0.4 leaves motor 2 less than its share of the weight: land, saying why.
+    FlatnessNavigator nav(m, o, Vector3(0, 0, 1));
+    nav.SetGoal(Vector3(-1.0, 0, 1), 0.0);
+    nav.OnFaultDetected(0.5);
+    nav.Update(0.6, true, Eigen::Vector4d(0, 0.6, 0, 0));
+    EXPECT_EQ(nav.decisions().back().kind, "land");
+    ASSERT_TRUE(nav.land_request());
+    EXPECT_NE(nav.land_request()->find("hover"), std::string::npos) << *nav.land_request();
+  }
+  {  // An estimate that never settles is re-planned once max_hold_s is over.
+    o.min_hold_s = 1.0;
+    o.max_hold_s = 5.0;
+    FlatnessNavigator nav(m, o, Vector3(0, 0, 1));
+    nav.SetGoal(Vector3(-1.0, 0, 1), 0.0);
+    nav.OnFaultDetected(0.5);
+    nav.Update(5.0, false, Eigen::Vector4d(0, 0.3, 0, 0));
+    EXPECT_TRUE(nav.holding());
+    nav.Update(5.6, false, Eigen::Vector4d(0, 0.3, 0, 0));
+    EXPECT_EQ(nav.decisions().back().kind, "continue");
+    EXPECT_EQ(nav.decisions().back().reason, "hold timed out");
+  }
+  FlatnessNavigatorOptions bad;
+  bad.max_hold_s = 1.0;
+  bad.min_hold_s = 2.0;
+  EXPECT_THROW(FlatnessNavigator(m, bad, Vector3::Zero()), ValidationError);
 }
 
 }  // namespace

@@ -46,6 +46,7 @@ struct RunSummary {
   double max_position_error_m = 0.0;
   double min_altitude_m = 0.0;  ///< after the first fault onset when there is one, else whole run
   double max_spin_rad_s = 0.0;  ///< largest |yaw rate| of the body
+  double max_tilt_rad = 0.0;    ///< largest tilt of the body z axis from the vertical
   /// Time from the first fault onset until the tilt stays below metrics.recovered_tilt_rad to the
   /// end (paper 000: roll and pitch recovered in about 3 s); negative when there is no fault or
   /// the tilt never settles.
@@ -80,6 +81,13 @@ struct RunSummary {
   bool infeasible_request = false;
   /// The supervisor's transitions and the mode the flight ended in (summary.json "supervisor").
   std::vector<ModeRecord> mode_transitions;
+  /// Paper 004's planner: each decision {t, kind (plan, hold, continue, return, land), t_s,
+  /// binding, w_hat, reason} (summary.json "flatness").
+  std::vector<nlohmann::json> flatness_decisions;
+  /// With fdd: ukf, its final loss estimates and when it first settled after a detection (-1:
+  /// never; summary.json "ukf").
+  std::vector<double> ukf_w_hat;
+  double ukf_settled_s = -1.0;
   std::string final_mode = "nominal";
   std::uint64_t physics_steps = 0;
   std::uint64_t control_cycles = 0;

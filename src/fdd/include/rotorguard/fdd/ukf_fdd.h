@@ -56,6 +56,8 @@ class UkfFdd final : public FaultDetectorBase {
   bool settled() const { return settled_; }
   /// When a fault was first detected [s], if one was.
   std::optional<double> detected_s() const { return detected_s_; }
+  /// When the estimate first settled after the detection [s], if it has.
+  std::optional<double> settled_after_detection_s() const { return settled_after_detection_s_; }
 
  private:
   vehicle::VehicleParams vehicle_;
@@ -66,7 +68,7 @@ class UkfFdd final : public FaultDetectorBase {
   std::optional<TimeNs> last_imu_ns_;
   std::optional<UnscentedKalmanFilter> ukf_;
   std::vector<double> above_since_s_;
-  std::optional<double> detected_s_;
+  std::optional<double> detected_s_, settled_after_detection_s_;
   std::deque<std::pair<double, Eigen::VectorXd>> history_;  // (t, ŵ) at 10 Hz over the settle window
   bool settled_ = false;
 };

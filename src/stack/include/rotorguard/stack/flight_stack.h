@@ -10,6 +10,7 @@
 
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/indi_controller.h"
+#include "rotorguard/control/lqr.h"
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/control/nominal_controller.h"
 #include "rotorguard/control/passive_controller.h"
@@ -17,7 +18,9 @@
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/fdd/fixed_time_fdd.h"
+#include "rotorguard/fdd/ukf_fdd.h"
 #include "rotorguard/perception/lidar_mapper.h"
+#include "rotorguard/planning/flatness_navigator.h"
 #include "rotorguard/planning/replanner.h"
 #include "rotorguard/planning/references.h"
 #include "rotorguard/stack/estimator.h"
@@ -46,7 +49,14 @@ struct NavigationOptions {
   /// false: the failure-unaware variant, whose planner keeps its nominal acceleration limit after
   /// a failure (the NMPC still reconfigures): the comparison row of `rotorguard bench nav`.
   bool failure_aware = true;
+  /// "minco": paper 000's failure-aware MINCO planner on the LiDAR map (the Replanner);
+  /// "flatness": paper 004's closed-form critically damped legs with hold-then-replan after a
+  /// detected fault (FlatnessNavigator; no map, no obstacles; needs a vehicle with a PWM model).
+  std::string method = "minco";
   planning::ReplannerOptions replanner;      ///< its post_failure_a_max is set from eq. (33)
+  planning::FlatnessNavigatorOptions flatness;
+  /// The mission starts at this time [s] (the vehicle holds its start until then), >= 0.
+  double start_s = 0.0;
   /// Throws ValidationError naming the field ("navigation.rounds"); the rate is checked against
   /// the control rate by FlightStackOptions.
   void Validate() const;
@@ -54,19 +64,23 @@ struct NavigationOptions {
 
 struct FlightStackOptions {
   double control_rate_hz = 200.0;    ///< controller rate (paper 000: 200 Hz), in (0, 10000]
-  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc, passive, indi
+  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc, passive, indi, lqr
   control::NominalControllerOptions nominal;
   control::PassiveControllerOptions passive;
   control::NmpcOptions nmpc;
   /// The INDI baseline; the stack sets its sample_hz and its pre-failure gains (IndiOptionsInStack).
   control::IndiControllerOptions indi;
+  /// Paper 004's LQR baseline (vehicles with a PWM model); the stack sets its sample_hz.
+  control::LqrControllerOptions lqr;
   std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc, indi)
-  /// Fault detection: "none", "composite" (paper 000, Sec. V-B) or "fixedtime" (the FixedA
-  /// baseline). On isolation the NMPC or INDI is reconfigured (the nominal and passive
-  /// controllers cannot be).
+  /// Fault detection: "none", "composite" (paper 000, Sec. V-B), "fixedtime" (the FixedA
+  /// baseline) or "ukf" (paper 004's loss-of-effectiveness UKF). On isolation the NMPC or INDI is
+  /// reconfigured (the nominal, passive and LQR controllers cannot be); the flatness planner holds
+  /// and re-plans on any detection.
   std::string fdd = "none";
   fdd::CompositeFddOptions composite_fdd;
   fdd::FixedTimeFddOptions fixed_time_fdd;
+  fdd::UkfFddOptions ukf_fdd;
   /// LiDAR mapping, run on every frame a vehicle with a LiDAR delivers (docs/perception.md):
   /// frames deskewed to their end pose (unless `lidar.deskew_frames` is false), placed with the
   /// estimate, inserted into the local occupancy map.
@@ -105,6 +119,7 @@ class FlightStack {
   /// else the navigator when navigating, else the mission's.
   const ReferenceTrajectory& reference() const {
     if (descent_) return *descent_;
+    if (flatness_) return *flatness_;
     return navigator_ ? static_cast<const ReferenceTrajectory&>(*navigator_) : *reference_;
   }
   const RotorCommand& command() const { return command_; }
@@ -117,10 +132,13 @@ class FlightStack {
   /// Waypoints reached so far (counting repeats over the rounds); the navigate mission is complete
   /// when it equals waypoints x rounds.
   int waypoints_reached() const {
+    if (flatness_) return flatness_reached_;
     return navigator_ ? std::max(0, next_waypoint_ - (navigator_->arrived() ? 0 : 1)) : 0;
   }
-  /// The navigation's replanner (mission type navigate); else null.
+  /// The navigation's replanner (mission type navigate, method minco); else null.
   const planning::Replanner* navigator() const { return navigator_.get(); }
+  /// The flatness navigator (mission type navigate, method flatness); else null.
+  const planning::FlatnessNavigator* flatness() const { return flatness_.get(); }
   /// The occupancy map, once a LiDAR frame arrived; else null.
   const perception::VoxelMap* map() const { return mapper_.map(); }
   /// LiDAR pulses without a usable point: no return (counted by the sensor), non-finite, outside
@@ -138,6 +156,9 @@ class FlightStack {
   /// The navigator's part of a control cycle: the next waypoint when due (not while recovering
   /// from a failure), the planner at its rate, the time of its last success.
   void Navigate(double t, FlightMode mode);
+  /// The flatness navigator's part: waypoints in turn once each leg settled, hold on a detection,
+  /// re-plan once the estimate settled.
+  void NavigateFlatness(double t);
 
   vehicle::MultirotorModel model_;
   std::shared_ptr<const ReferenceTrajectory> reference_;
@@ -154,6 +175,9 @@ class FlightStack {
   std::unique_ptr<fdd::FaultDetector> fdd_;
   perception::LidarMapper mapper_;
   std::unique_ptr<planning::Replanner> navigator_;
+  std::unique_ptr<planning::FlatnessNavigator> flatness_;
+  int flatness_reached_ = 0;
+  bool flatness_told_ = false;  // the navigator heard of the detection
   int next_waypoint_ = 0;       // of the waypoints repeated `rounds` times
   double next_plan_s_ = 0.0;    // the navigator's next update
   long lidar_points_dropped_ = 0;

@@ -50,6 +50,7 @@ struct SupervisorInputs {
   bool navigating = false;           ///< a goal is pending
   double since_last_plan_s = 0.0;    ///< time since the planner last succeeded (0 when it just did)
   double thrust_ratio = 1.0;         ///< the last collective thrust command / the vehicle's weight
+  std::string land_request;          ///< a planner's decision to land, with its reason ("" = none)
 };
 
 struct ModeTransition {
