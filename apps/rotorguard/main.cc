@@ -260,7 +260,7 @@ int main(int argc, char** argv) {
               "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
   bench_nmpc->add_flag("--json", nmpc_json, "Print JSON instead of a table");
 
-  std::string ftc_trials_text = "20", ftc_seed_text = "1", ftc_methods = "rotorguard,fixedtime,indi,passive,none", ftc_out, ftc_jobs_text;
+  std::string ftc_trials_text = "20", ftc_seed_text = "1", ftc_methods = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_out, ftc_jobs_text;
   bool ftc_json = false;
   CLI::App* bench_ftc = bench->add_subcommand(
       "ftc", "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
@@ -268,7 +268,7 @@ int main(int argc, char** argv) {
              "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).");
   bench_ftc->add_option("--trials", ftc_trials_text, "Trials per cell (default 20, the paper's count)");
   bench_ftc->add_option("--seed", ftc_seed_text, "Benchmark seed (default 1); trial seeds derive from it");
-  bench_ftc->add_option("--methods", ftc_methods, "Comma-separated methods: rotorguard, fixedtime, indi, passive, none (default all)");
+  bench_ftc->add_option("--methods", ftc_methods, "Comma-separated methods: rotorguard, fixedtime, ukf, indi, passive, none (default all)");
   bench_ftc->add_option("--jobs", ftc_jobs_text, "Worker threads (default: the number of cores)");
   bench_ftc->add_option("--out", ftc_out, "Folder for results.json and tables.md");
   bench_ftc->add_flag("--json", ftc_json, "Print JSON instead of Markdown");
@@ -442,7 +442,7 @@ int main(int argc, char** argv) {
         const std::size_t comma = std::min(ftc_methods.find(',', start), ftc_methods.size());
         const std::string m = ftc_methods.substr(start, comma - start);
         if (std::find(known.begin(), known.end(), m) == known.end()) {
-          throw UsageError(fmt::format("--methods: '{}' is invalid; expected a comma-separated list of rotorguard, fixedtime, indi, passive, none", m));
+          throw UsageError(fmt::format("--methods: '{}' is invalid; expected a comma-separated list of rotorguard, fixedtime, ukf, indi, passive, none", m));
         }
         o.methods.push_back(m);
         start = comma + 1;

@@ -91,6 +91,9 @@ Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOp
   } else if (method == "fixedtime") {  // FixedA: the fixed-time observer driving the same NMPC
     s.stack.controller = "nmpc";
     s.stack.fdd = "fixedtime";
+  } else if (method == "ukf") {  // paper 004's UKF loss estimation driving the same NMPC
+    s.stack.controller = "nmpc";
+    s.stack.fdd = "ukf";
   } else if (method == "indi") {  // the composite FDD's isolation handed to the INDI controller
     s.stack.controller = "indi";
     s.stack.fdd = "composite";
@@ -145,7 +148,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
           {"failures", failures}};
 }
 
-std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "indi", "passive", "none"}; }
+std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "ukf", "indi", "passive", "none"}; }
 
 void FtcBenchOptions::Validate() const {
   if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
@@ -154,7 +157,7 @@ void FtcBenchOptions::Validate() const {
   const std::vector<std::string> known = FtcMethods();
   for (const std::string& m : methods) {
     if (std::find(known.begin(), known.end(), m) == known.end()) {
-      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, indi, passive, none");
+      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, ukf, indi, passive, none");
     }
   }
   vehicle.Validate();
