@@ -676,8 +676,9 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     });
   }
   CheckFaultsAgainstScenario(root, s);
-  FitStackToHardware(&s);
+  FitStackToHardware(&s);  // the stack's validation below sees the sensors' rates ...
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
+  FitStackToHardware(&s);  // ... and what the hardware implies follows the stack's keys (inflation margin)
   for (std::size_t i = 0; i < s.stack.known_faults.size(); ++i) {
     if (s.stack.known_faults[i].rotor >= s.vehicle.num_rotors()) {
       root.FailAt(fmt::format("stack.known_faults.{}.rotor", i),
