@@ -57,4 +57,29 @@ inline vehicle::VehicleParams QballX4() {
   return p;
 }
 
+/// One unit of a modular assembly (configs/vehicles/mars_unit.yaml).
+inline vehicle::VehicleParams MarsUnit() {
+  using vehicle::Rotor;
+  using vehicle::SpinDirection;
+  vehicle::VehicleParams p;
+  p.name = "mars_unit";
+  p.mass_kg = 0.5;
+  p.inertia_kg_m2 = Eigen::Vector3d(2.2e-3, 2.2e-3, 4.0e-3).asDiagonal();
+  p.rotor_drag_kg_s = Eigen::Vector3d(0.10, 0.10, 0.15);
+  p.yaw_damping_n_m_s = 0.004;
+  p.thrust_coefficient_n_s2 = vehicle::ThrustCoefficientFromRpm(1.2e-8);
+  p.motor_time_constant_s = 0.03;
+  p.motor_stop_time_constant_s = 0.005;
+  p.unloaded_speed_ratio = 1.1;
+  p.collision_radius_m = 0.15;
+  const double a = 0.075, kappa = 0.016;
+  p.rotors = {
+      Rotor{{a, -a, 0.0}, SpinDirection::kCounterClockwise, kappa, 2.6},
+      Rotor{{-a, a, 0.0}, SpinDirection::kCounterClockwise, kappa, 2.6},
+      Rotor{{a, a, 0.0}, SpinDirection::kClockwise, kappa, 2.6},
+      Rotor{{-a, -a, 0.0}, SpinDirection::kClockwise, kappa, 2.6},
+  };
+  return p;
+}
+
 }  // namespace rotorguard::testing
