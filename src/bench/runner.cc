@@ -16,6 +16,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/io/files.h"
+#include "rotorguard/modular/assembly_controller.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/stack/flight_stack.h"
 #include "rotorguard/vehicle/multirotor.h"
@@ -180,7 +181,15 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   sim::Simulator sim(truth_model, sc.world, sc.faults, sc.sim, sc.seed,
                      truth_model.MakeState(sc.initial_position_m, sc.initial_yaw_rad, initial_motors));
   // The stack builds its own model from the vehicle parameters: it never holds the simulator.
-  stack::FlightStack st(sc.vehicle, sc.reference, sc.stack);
+  std::unique_ptr<control::Controller> controller;
+  if (sc.stack.controller == "assembly") {
+    if (!sc.assembly) throw std::invalid_argument("RunScenario: controller assembly needs the scenario's assembly");
+    modular::AssemblyControllerOptions ac;
+    ac.cascade = sc.stack.nominal;
+    ac.allocation = sc.allocation;
+    controller = std::make_unique<modular::AssemblyController>(*sc.assembly, ac);
+  }
+  stack::FlightStack st(sc.vehicle, sc.reference, sc.stack, std::move(controller));
   std::string sensor_buffer;
   std::string* sensor_log = sensors ? &sensor_buffer : nullptr;
   if (sensor_log) sensor_buffer = kSensorLogHeader;

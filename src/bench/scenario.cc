@@ -240,6 +240,7 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       o.speed_m_s = node.Required("speed_m_s").AsDouble();
       ReadOptional(node, "ramp_s", &o.ramp_s);
       if (const auto cw = node.Optional("clockwise")) o.clockwise = cw->AsBool();
+      ReadOptional(node, "climb_m_s", &o.climb_m_s);
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::CircleReference>(o);
     } else if (*type == "navigate") {
@@ -384,8 +385,17 @@ void ParsePositionLoop(const ConfigNode& n, control::PositionLoopOptions* p) {
   ReadOptional(n, "max_tilt_rad", &p->max_tilt_rad);
 }
 
-void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
-  if (const auto c = node.Optional("controller")) o->controller = c->AsEnum({"nominal", "nmpc", "passive", "indi", "lqr"});
+void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o, modular::AllocatorOptions* allocation) {
+  if (const auto c = node.Optional("controller")) {
+    o->controller = c->AsEnum({"nominal", "nmpc", "passive", "indi", "lqr", "assembly"});
+  }
+  if (const auto n = node.Optional("assembly")) {
+    if (const auto r = n->Optional("reallocation")) {
+      allocation->method = *modular::ParseReallocation(r->AsEnum({"none", "partial", "full"}));
+    }
+    n->RejectUnknownKeys();
+    ValidateAt(*n, [&] { allocation->Validate(); });
+  }
   ReadOptional(node, "control_rate_hz", &o->control_rate_hz);
   if (const auto n = node.Optional("nominal")) {
     control::NominalControllerOptions& g = o->nominal;
@@ -465,6 +475,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ReadOptional(*sup, "landing_depth_m", &v.landing_depth_m);
     ReadOptional(*sup, "touchdown_thrust_ratio", &v.touchdown_thrust_ratio);
     ReadOptional(*sup, "touchdown_hold_s", &v.touchdown_hold_s);
+    if (const auto m = sup->Optional("max_failed_rotors")) v.max_failed_rotors = static_cast<int>(m->AsIntIn(0, kMaxRotors));
     sup->RejectUnknownKeys();
     ValidateAt(*sup, [&] { v.Validate(); });
   }
@@ -541,12 +552,13 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o) {
     ValidateAt(*n, [&] { o->lidar.Validate(); });
   }
   if (const auto kf = node.Optional("known_faults")) {
-    if (!kf->IsSequence()) kf->Fail("expected a list of {rotor, at_time_s}");
+    if (!kf->IsSequence()) kf->Fail("expected a list of {rotor, at_time_s, loss}");
     for (std::size_t i = 0; i < kf->size(); ++i) {
       const ConfigNode f = kf->At(i);
       stack::KnownFault k;
       k.rotor = static_cast<int>(f.Required("rotor").AsIntIn(0, kMaxRotors - 1));
       k.at_time_s = f.Required("at_time_s").AsNonNegative();
+      k.loss = OptionalDouble(f, "loss", 1.0);
       f.RejectUnknownKeys();
       o->known_faults.push_back(k);
     }
@@ -609,6 +621,37 @@ vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Ov
   return LoadVehicleDocument(ConfigDocument::LoadFile(path), overrides);
 }
 
+modular::Assembly LoadAssembly(const std::string& path) {
+  const ConfigDocument doc = ConfigDocument::LoadFile(path);
+  const ConfigNode root = doc.root();
+  modular::AssemblySpec spec;
+  spec.name = root.Has("name") ? root.Required("name").AsString() : std::filesystem::path(path).stem().string();
+  const ConfigNode unit = root.Required("unit");
+  const std::string unit_file = ResolveRelative(path, unit.AsString());
+  try {
+    spec.unit = LoadVehicle(unit_file);
+  } catch (const io::InputFileError& e) {
+    throw io::InputFileError(e.path(), fmt::format("{} (named by 'unit' at {})", e.reason(), unit.Location()));
+  }
+  spec.spacing_m = root.Required("spacing_m").AsPositive();
+  if (root.Has("shape") == root.Has("slots")) root.Fail("expected exactly one of 'shape' and 'slots'");
+  if (const auto shape = root.Optional("shape")) {
+    spec.slots = modular::ShapeSlots(shape->AsEnum({"3x1", "4x1", "3x2", "3x3", "3x3_plus"}));
+  } else {
+    const ConfigNode slots = root.Required("slots");
+    if (!slots.IsSequence()) slots.Fail("expected a list of grid cells [i, j]");
+    for (std::size_t k = 0; k < slots.size(); ++k) {
+      const ConfigNode cell = slots.At(k);
+      if (!cell.IsSequence() || cell.size() != 2) cell.Fail("expected a grid cell [i, j] of two integers");
+      spec.slots.emplace_back(static_cast<int>(cell.At(0).AsIntIn(-64, 64)), static_cast<int>(cell.At(1).AsIntIn(-64, 64)));
+    }
+  }
+  root.RejectUnknownKeys();
+  modular::Assembly assembly;
+  ValidateAt(root, [&] { assembly = modular::BuildAssembly(spec); });
+  return assembly;
+}
+
 Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides) {
   ConfigDocument doc = ConfigDocument::LoadFile(path);
   ApplyOverrides(&doc, overrides, /*vehicle_part=*/false);
@@ -618,13 +661,23 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   s.name = root.Has("name") ? root.Required("name").AsString()
                             : std::filesystem::path(path).stem().string();
   if (root.Has("description")) root.Required("description").AsString();
-  const ConfigNode vehicle_node = root.Required("vehicle");
+  if (root.Has("assembly") == root.Has("vehicle")) {
+    root.Fail("expected exactly one of 'vehicle' (a vehicle file) and 'assembly' (an assembly file)");
+  }
+  const char* vehicle_key = root.Has("assembly") ? "assembly" : "vehicle";
+  const ConfigNode vehicle_node = root.Required(vehicle_key);
   s.vehicle_file = ResolveRelative(path, vehicle_node.AsString());
   try {
-    s.vehicle = LoadVehicle(s.vehicle_file, overrides);
+    if (root.Has("assembly")) {
+      auto assembly = std::make_shared<modular::Assembly>(LoadAssembly(s.vehicle_file));
+      s.vehicle = assembly->vehicle;
+      s.assembly = std::move(assembly);
+    } else {
+      s.vehicle = LoadVehicle(s.vehicle_file, overrides);
+    }
   } catch (const io::InputFileError& e) {
     // Still an unreadable input (exit 3), with the scenario line that names it.
-    throw io::InputFileError(e.path(), fmt::format("{} (named by 'vehicle' at {})", e.reason(),
+    throw io::InputFileError(e.path(), fmt::format("{} (named by '{}' at {})", e.reason(), vehicle_key,
                                                    vehicle_node.Location()));
   }
   s.duration_s = root.Required("duration_s").AsDoubleIn(1e-3, 1e6);
@@ -677,7 +730,10 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   }
   CheckFaultsAgainstScenario(root, s);
   FitStackToHardware(&s);  // the stack's validation below sees the sensors' rates ...
-  if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack);
+  // An assembly reallocates over its rotors: it flies on while four remain (stack.supervisor keys
+  // below may lower it).
+  if (s.assembly) s.stack.supervisor.max_failed_rotors = s.vehicle.num_rotors() - 4;
+  if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack, &s.allocation);
   FitStackToHardware(&s);  // ... and what the hardware implies follows the stack's keys (inflation margin)
   for (std::size_t i = 0; i < s.stack.known_faults.size(); ++i) {
     if (s.stack.known_faults[i].rotor >= s.vehicle.num_rotors()) {
@@ -685,6 +741,9 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
                   fmt::format("rotor {} does not exist; expected an index in [0, {}]", s.stack.known_faults[i].rotor,
                               s.vehicle.num_rotors() - 1));
     }
+  }
+  if (s.stack.controller == "assembly" && !s.assembly) {
+    root.FailAt("stack.controller", "controller assembly flies an assembly; expected the key 'assembly' in place of 'vehicle'");
   }
   if (s.stack.control_rate_hz > s.sim.physics_rate_hz) {
     root.FailAt("stack.control_rate_hz",
@@ -705,7 +764,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   }
   if (s.stack.navigation.method == "flatness" || s.stack.controller == "lqr") {
     // Paper 004's planner and controller work on the vehicle's PWM model: its layout is checked now.
-    ValidateAt(root.Required("vehicle"), [&] { vehicle::PwmQuadModel::FromVehicle(s.vehicle); });
+    ValidateAt(root.Required(vehicle_key), [&] { vehicle::PwmQuadModel::FromVehicle(s.vehicle); });
   }
   CheckReferenceAboveGround(root.Required("mission"), s);
   return s;
@@ -721,7 +780,13 @@ ValidationReport ValidateConfigFile(const std::string& path) {
     return {"vehicle", fmt::format("vehicle '{}': {} rotors, {:g} kg, thrust-to-weight {:.2f}", v.name,
                                    v.num_rotors(), v.mass_kg, v.total_max_thrust_n() / v.weight_n())};
   }
-  if (has("mission") || has("vehicle")) {
+  if (has("unit") && has("spacing_m")) {
+    const modular::Assembly a = LoadAssembly(path);
+    return {"assembly", fmt::format("assembly '{}': {} units, {} rotors, {:g} kg, thrust-to-weight {:.2f}", a.name,
+                                    a.num_units, a.vehicle.num_rotors(), a.vehicle.mass_kg,
+                                    a.vehicle.total_max_thrust_n() / a.vehicle.weight_n())};
+  }
+  if (has("mission") || has("vehicle") || has("assembly")) {
     const Scenario s = LoadScenario(path);
     return {"scenario", fmt::format("scenario '{}': {} mission, {:g} s, {} fault(s), vehicle {}", s.name,
                                     s.mission_type, s.duration_s, s.faults.size(), s.vehicle_file)};

@@ -27,29 +27,20 @@ void NominalControllerOptions::Validate() const {
   }
 }
 
-NominalController::NominalController(const vehicle::MultirotorModel& model,
-                                     const NominalControllerOptions& options)
-    : model_(model),
-      options_(options),
-      position_loop_(options.position),
-      allocator_(model),
-      hover_(model.HoverThrusts()) {
+CascadedWrenchLaw::CascadedWrenchLaw(const vehicle::VehicleParams& vehicle, const NominalControllerOptions& options)
+    : vehicle_(vehicle), options_(options), position_loop_(options.position) {
   options_.Validate();
 }
 
-void NominalController::Compute(const StateEstimate& est, const ReferenceTrajectory& reference, double t,
-                                double dt, RotorVector* thrust_command) {
-  const ReferencePoint ref = reference.Evaluate(t);
+bool CascadedWrenchLaw::Compute(const StateEstimate& est, const ReferencePoint& ref, double dt,
+                                Eigen::Vector4d* wrench) {
   const bool finite_input = est.p_W.allFinite() && est.v_W.allFinite() && est.w_B.allFinite() &&
                             est.q_WB.coeffs().allFinite() && ref.p_W.allFinite() &&
                             ref.v_W.allFinite() && ref.a_W.allFinite() && ref.j_W.allFinite() &&
                             std::isfinite(ref.yaw) && std::isfinite(ref.yaw_rate) &&
                             std::isfinite(dt);
-  if (!est.valid || !finite_input) {
-    *thrust_command = hover_;
-    return;
-  }
-  const vehicle::VehicleParams& vp = model_.params();
+  if (!est.valid || !finite_input) return false;
+  const vehicle::VehicleParams& vp = vehicle_;
   const double m = vp.mass_kg;
   const Matrix3 R = est.q_WB.normalized().toRotationMatrix();
 
@@ -84,9 +75,21 @@ void NominalController::Compute(const StateEstimate& est, const ReferenceTraject
   const Vector3& w = est.w_B;
   const Vector3 alpha_des = options_.k_rate.cwiseProduct(w_des - w);
   const Vector3 tau = I * alpha_des + w.cross(I * w) + Vector3(0.0, 0.0, vp.yaw_damping_n_m_s * w.z());
+  *wrench << thrust, tau;
+  return wrench->allFinite();
+}
 
+NominalController::NominalController(const vehicle::MultirotorModel& model,
+                                     const NominalControllerOptions& options)
+    : law_(model.params(), options), allocator_(model), hover_(model.HoverThrusts()) {}
+
+void NominalController::Compute(const StateEstimate& est, const ReferenceTrajectory& reference, double t,
+                                double dt, RotorVector* thrust_command) {
   Eigen::Vector4d wrench;
-  wrench << thrust, tau;
+  if (!law_.Compute(est, reference.Evaluate(t), dt, &wrench)) {
+    *thrust_command = hover_;
+    return;
+  }
   allocator_.Allocate(wrench, thrust_command);
   if (!thrust_command->allFinite()) *thrust_command = hover_;
 }

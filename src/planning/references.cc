@@ -106,6 +106,7 @@ const CircleOptions& Validated(const CircleOptions& o) {
   RequirePositive(kCircle, "speed_m_s", o.speed_m_s);
   RequireNonNegative(kCircle, "ramp_s", o.ramp_s);
   RequireFinite(kCircle, "yaw_rad", o.yaw_rad);
+  RequireFinite(kCircle, "climb_m_s", o.climb_m_s);
   return o;
 }
 
@@ -235,9 +236,10 @@ RampedPhaseCurveReference::CurvePoint CircleReference::CurveAt(double theta) con
   const double sign = options_.clockwise ? -1.0 : 1.0;
   const double s = std::sin(theta);
   const double c = std::cos(theta);
+  const double rise = options_.climb_m_s * r / options_.speed_m_s;  // per radian: climb / Omega
   CurvePoint p;
-  p.c = options_.center_m + Vector3(r * c, sign * r * s, 0.0);
-  p.dc = Vector3(-r * s, sign * r * c, 0.0);
+  p.c = options_.center_m + Vector3(r * c, sign * r * s, rise * theta);
+  p.dc = Vector3(-r * s, sign * r * c, rise);
   p.ddc = Vector3(-r * c, -sign * r * s, 0.0);
   p.dddc = Vector3(r * s, -sign * r * c, 0.0);
   return p;

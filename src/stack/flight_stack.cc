@@ -46,8 +46,9 @@ void FlightStackOptions::Validate() const {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
   }
   if (controller != "nominal" && controller != "nmpc" && controller != "passive" && controller != "indi" &&
-      controller != "lqr") {
-    ThrowValidation("FlightStackOptions", "controller", controller, "one of: nominal, nmpc, passive, indi, lqr");
+      controller != "lqr" && controller != "assembly") {
+    ThrowValidation("FlightStackOptions", "controller", controller,
+                    "one of: nominal, nmpc, passive, indi, lqr, assembly");
   }
   nominal.Validate();
   passive.Validate();
@@ -58,6 +59,14 @@ void FlightStackOptions::Validate() const {
     if (!std::isfinite(known_faults[i].at_time_s) || known_faults[i].at_time_s < 0.0) {
       ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.at_time_s", i), known_faults[i].at_time_s,
                       "a time >= 0 s");
+    }
+    if (!(known_faults[i].loss > 0.0 && known_faults[i].loss <= 1.0)) {
+      ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.loss", i), known_faults[i].loss,
+                      "a fraction in (0, 1] (1: the rotor failed)");
+    }
+    if (known_faults[i].loss < 1.0 && controller != "assembly") {
+      ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.loss", i), known_faults[i].loss,
+                      "1 unless the controller is assembly (the one that reallocates a partial loss)");
     }
   }
   if (fdd != "none" && fdd != "composite" && fdd != "fixedtime" && fdd != "ukf") {
@@ -76,15 +85,15 @@ void FlightStackOptions::Validate() const {
                       "a rate in (0, control_rate_hz]");
     }
   }
-  if (!known_faults.empty() && controller != "nmpc" && controller != "indi") {
+  if (!known_faults.empty() && controller != "nmpc" && controller != "indi" && controller != "assembly") {
     ThrowValidation("FlightStackOptions", "known_faults", controller,
-                    "controller nmpc or indi (the controllers that reconfigure)");
+                    "controller nmpc, indi or assembly (the controllers that reconfigure)");
   }
 }
 
 FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
                          std::shared_ptr<const ReferenceTrajectory> reference,
-                         const FlightStackOptions& options)
+                         const FlightStackOptions& options, std::unique_ptr<control::Controller> controller)
     : model_(vehicle),
       reference_(std::move(reference)),
       options_(options),
@@ -93,7 +102,16 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
       mapper_(options.lidar) {
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
-  if (options_.controller == "nmpc") {
+  if (controller) {
+    if (controller->name() != options_.controller) {
+      ThrowValidation("FlightStackOptions", "controller", options_.controller,
+                      fmt::format("the name of the controller handed in ({})", controller->name()));
+    }
+    controller_ = std::move(controller);
+  } else if (options_.controller == "assembly") {
+    ThrowValidation("FlightStackOptions", "controller", options_.controller,
+                    "a controller built by the caller (the assembly controller lives in the modular module)");
+  } else if (options_.controller == "nmpc") {
     auto nmpc = std::make_unique<control::NmpcController>(model_.params(), options_.nmpc);
     nmpc_ = nmpc.get();
     controller_ = std::move(nmpc);
@@ -221,7 +239,12 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   if (estimate_.valid) {
     for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
       if (!known_fault_applied_[i] && ts >= options_.known_faults[i].at_time_s) {
-        OnRotorFailed(options_.known_faults[i].rotor);
+        const KnownFault& k = options_.known_faults[i];
+        if (k.loss >= 1.0) {
+          OnRotorFailed(k.rotor);
+        } else {
+          controller_->SetRotorEffectiveness(k.rotor, 1.0 - k.loss);
+        }
         known_fault_applied_[i] = true;
       }
     }

@@ -37,6 +37,7 @@ void SupervisorOptions::Validate() const {
     ThrowValidation("SupervisorOptions", "touchdown_thrust_ratio", touchdown_thrust_ratio, "in (0, 1)");
   }
   positive(touchdown_hold_s, "touchdown_hold_s");
+  if (max_failed_rotors < 0) ThrowValidation("SupervisorOptions", "max_failed_rotors", max_failed_rotors, "a count >= 0");
 }
 
 Supervisor::Supervisor(const SupervisorOptions& options) : options_(options) { options_.Validate(); }
@@ -74,8 +75,11 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
     land = fmt::format("estimator lost its reference: no odometry for {:.2f} s", in.odometry_age_s);
   } else if (e.v_W.norm() > options_.max_speed_m_s) {
     land = fmt::format("estimator diverged: speed estimate {:.1f} m/s", e.v_W.norm());
-  } else if (in.isolated_rotors >= 2) {
-    land = fmt::format("a second rotor failed ({} isolated)", in.isolated_rotors);
+  } else if (in.isolated_rotors > options_.max_failed_rotors) {
+    land = options_.max_failed_rotors == 1
+               ? fmt::format("a second rotor failed ({} isolated)", in.isolated_rotors)
+               : fmt::format("{} rotors failed (the vehicle flies on at most {})", in.isolated_rotors,
+                             options_.max_failed_rotors);
   } else if (in.navigating && in.since_last_plan_s > options_.no_plan_timeout_s) {
     land = fmt::format("no feasible trajectory for {:.1f} s", in.since_last_plan_s);
   } else if (!in.land_request.empty()) {

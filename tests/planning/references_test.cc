@@ -420,6 +420,21 @@ TEST(CircleReferenceTest, DerivativesAreConsistentAndFinite) {
   }
 }
 
+TEST(CircleReferenceTest, HelixClimbsAtItsRateOnceRampedAndKeepsConsistentDerivatives) {
+  const CircleReference ref({.center_m = Vector3(0.0, 0.0, 1.0), .radius_m = 1.5, .speed_m_s = 1.0, .ramp_s = 2.0,
+                             .climb_m_s = 0.2});
+  ExpectDerivativesMatchFiniteDifferences(ref, 100.0);
+  ExpectFiniteEverywhere(ref);
+  // At full speed: tangential speed 1 m/s horizontally, 0.2 m/s up; a turn (2 pi r / v = 3 pi s)
+  // later it is 0.2 * 3 pi higher, right above.
+  const ReferencePoint a = ref.Evaluate(10.0), b = ref.Evaluate(10.0 + 3.0 * std::numbers::pi);
+  EXPECT_NEAR(a.v_W.z(), 0.2, 1e-12);
+  EXPECT_NEAR(a.v_W.head<2>().norm(), 1.0, 1e-12);
+  EXPECT_NEAR(b.p_W.z() - a.p_W.z(), 0.2 * 3.0 * std::numbers::pi, 1e-9);
+  EXPECT_NEAR((b.p_W - a.p_W).head<2>().norm(), 0.0, 1e-9);
+  EXPECT_NEAR(ref.Evaluate(0.0).p_W.z(), 1.0, 1e-15);
+}
+
 TEST(CircleReferenceTest, RejectsInvalidOptions) {
   RG_EXPECT_THROW_WITH((void)CircleReference({.radius_m = 0.0}), std::invalid_argument,
                        "CircleOptions::radius_m = 0 is invalid; expected > 0");

@@ -8,6 +8,7 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
+#include "test_util.h"
 #include "rotorguard/stack/estimator.h"
 
 namespace rotorguard::stack {
@@ -64,6 +65,21 @@ TEST(Supervisor, ASecondFailureLands) {
   EXPECT_NE(s.transitions().back().reason.find("second rotor"), std::string::npos);
   EXPECT_EQ(s.landing_start(), in.estimate.p_W);
   EXPECT_EQ(s.landing_start_s(), 5.0);
+}
+
+TEST(Supervisor, AnAssemblyFliesOnUpToItsAllowanceOfFailedRotors) {
+  SupervisorOptions o;
+  o.max_failed_rotors = 4;  // a dead unit of four rotors
+  Supervisor s(o);
+  SupervisorInputs in = Hovering(1.0);
+  in.isolated_rotors = 4;
+  EXPECT_NE(s.Update(in), FlightMode::kEmergencyLanding);
+  in.t = 2.0;
+  in.isolated_rotors = 5;
+  EXPECT_EQ(s.Update(in), FlightMode::kEmergencyLanding);
+  EXPECT_NE(s.transitions().back().reason.find("5 rotors failed (the vehicle flies on at most 4)"), std::string::npos);
+  o.max_failed_rotors = -1;
+  RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "max_failed_rotors = -1");
 }
 
 TEST(Supervisor, NoPlanForLongerThanTheTimeoutLands) {

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "rotorguard/core/trajectory.h"
+#include "rotorguard/modular/allocation.h"
+#include "rotorguard/modular/assembly.h"
 #include "rotorguard/sim/fault_injector.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/sim/world.h"
@@ -21,7 +23,12 @@ namespace rotorguard::bench {
 struct Scenario {
   std::string name;
   std::string file;           ///< the scenario file it came from ("" when built in code)
-  std::string vehicle_file;
+  std::string vehicle_file;   ///< the vehicle's file, or the assembly's (key `assembly`)
+  /// An assembly of units (paper 002; key `assembly` in place of `vehicle`): its geometry, with
+  /// `vehicle` the combined multirotor. Null for a single vehicle.
+  std::shared_ptr<const modular::Assembly> assembly;
+  /// stack.assembly: the reallocation of controller `assembly` (its cascade is stack.nominal's).
+  modular::AllocatorOptions allocation;
   double duration_s = 10.0;
   std::uint64_t seed = 1;
   vehicle::VehicleParams vehicle;
@@ -55,6 +62,10 @@ void FitStackToHardware(Scenario* scenario);
 /// Loads and validates a scenario file. Throws io::ConfigError (bad content, with file, line and
 /// key path) or io::InputFileError (a file that cannot be read).
 Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides = {});
+
+/// Loads and validates an assembly file (configs/assemblies/: unit, spacing_m, shape or slots),
+/// the unit's vehicle file resolved relative to it (same error contract).
+modular::Assembly LoadAssembly(const std::string& path);
 
 /// Loads and validates a vehicle file (same error contract).
 vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Override>& overrides = {});

@@ -23,6 +23,12 @@ class Controller {
   /// A rotor has been isolated as failed. Controllers that can reconfigure do; the default ignores
   /// it (the nominal and passive controllers never reconfigure).
   virtual void SetRotorFailed(int /*rotor*/) {}
+  /// A rotor is known to deliver only `effectiveness` (in [0, 1]) of its commanded thrust (a
+  /// partial loss, eta of paper 002's Table I). Controllers that reallocate use it; the default
+  /// treats a total loss as a failure and ignores a partial one.
+  virtual void SetRotorEffectiveness(int rotor, double effectiveness) {
+    if (effectiveness <= 0.0) SetRotorFailed(rotor);
+  }
 };
 
 }  // namespace rotorguard::control

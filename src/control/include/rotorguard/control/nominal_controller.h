@@ -18,18 +18,35 @@ struct NominalControllerOptions {
   void Validate() const;
 };
 
+/// The cascade of NominalController up to the wrench: position loop -> thrust vector -> attitude ->
+/// body rates -> [T; tau] about the centre of mass, for any rigid multirotor (an assembly of
+/// units too: the torques scale with its inertia). Allocation is the caller's.
+class CascadedWrenchLaw {
+ public:
+  /// Validates `options` (throws ValidationError).
+  CascadedWrenchLaw(const vehicle::VehicleParams& vehicle, const NominalControllerOptions& options);
+  /// [T; tau_x; tau_y; tau_z] in the body frame for the estimate and the reference point; `dt`
+  /// advances the position loop's integral. False when an input is not finite or the estimate is
+  /// not valid (the wrench is then not to be used).
+  bool Compute(const StateEstimate& estimate, const ReferencePoint& reference, double dt, Eigen::Vector4d* wrench);
+  void Reset() { position_loop_.Reset(); }
+
+ private:
+  vehicle::VehicleParams vehicle_;
+  NominalControllerOptions options_;
+  PositionLoop position_loop_;
+};
+
 class NominalController final : public Controller {
  public:
   NominalController(const vehicle::MultirotorModel& model, const NominalControllerOptions& options);
   std::string_view name() const override { return "nominal"; }
   void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
                RotorVector* thrust_command) override;
-  void Reset() override { position_loop_.Reset(); }
+  void Reset() override { law_.Reset(); }
 
  private:
-  const vehicle::MultirotorModel& model_;
-  NominalControllerOptions options_;
-  PositionLoop position_loop_;
+  CascadedWrenchLaw law_;
   PseudoInverseAllocator allocator_;
   RotorVector hover_;
 };

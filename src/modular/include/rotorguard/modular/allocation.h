@@ -91,7 +91,7 @@ class AssemblyAllocator {
   void Prepare(const std::vector<int>& cols, Subset* s) const;
   Eigen::VectorXd SolveSubset(Subset* s, const Eigen::Vector4d& w);
 
-  const Assembly& assembly_;
+  Assembly assembly_;
   AllocatorOptions options_;
   EffectivenessMatrix B_;
   AllocationMatrix pinv_;

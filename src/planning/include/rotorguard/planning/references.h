@@ -149,10 +149,14 @@ struct CircleOptions {
   double ramp_s = 3.0;                 ///< time to reach full speed from rest [s]; finite, >= 0
   double yaw_rad = 0.0;                ///< heading held throughout [rad]; finite
   bool clockwise = false;              ///< seen from above (z up); false: counter-clockwise
+  /// Vertical speed once ramped up [m/s]: non-zero makes the circle a helix (paper 002's spiral),
+  /// z = center.z + climb_m_s * theta / Omega; finite.
+  double climb_m_s = 0.0;
 };
 
 /// Horizontal circle c(theta) = center + radius [cos(theta), +-sin(theta), 0] (minus when
-/// clockwise), starting at center + [radius, 0, 0] at rest; Omega = speed / radius.
+/// clockwise), starting at center + [radius, 0, 0] at rest; Omega = speed / radius. With a climb
+/// it rises climb_m_s / Omega per radian: a helix.
 class CircleReference final : public RampedPhaseCurveReference {
  public:
   /// Throws ValidationError (std::invalid_argument) naming the first invalid field of `options`.

@@ -35,6 +35,9 @@ namespace rotorguard::stack {
 struct KnownFault {
   int rotor = 0;
   double at_time_s = 0.0;
+  /// Fraction of the rotor's thrust lost, in (0, 1]: 1 is a failure (isolated as FDD would), less
+  /// a partial loss handed to controllers that reallocate (the sim's loss_of_effectiveness eta).
+  double loss = 1.0;
 };
 
 /// Navigation among obstacles (mission type navigate; docs/planning.md): the waypoints flown in
@@ -64,7 +67,9 @@ struct NavigationOptions {
 
 struct FlightStackOptions {
   double control_rate_hz = 200.0;    ///< controller rate (paper 000: 200 Hz), in (0, 10000]
-  std::string controller = "nominal";  ///< controller name; one of: nominal, nmpc, passive, indi, lqr
+  /// Controller name; one of: nominal, nmpc, passive, indi, lqr, or assembly (the modular
+  /// controller, built by the caller and handed to the FlightStack).
+  std::string controller = "nominal";
   control::NominalControllerOptions nominal;
   control::PassiveControllerOptions passive;
   control::NmpcOptions nmpc;
@@ -98,8 +103,10 @@ control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& opti
 
 class FlightStack {
  public:
+  /// `controller`, when given, is flown instead of one built from options.controller (which must
+  /// then equal its name): controllers of modules above the stack, such as the assembly's.
   FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<const ReferenceTrajectory> reference,
-              const FlightStackOptions& options);
+              const FlightStackOptions& options, std::unique_ptr<control::Controller> controller = nullptr);
   // descent_ refers to landing_: neither copied nor moved.
   FlightStack(const FlightStack&) = delete;
   FlightStack& operator=(const FlightStack&) = delete;

@@ -4,7 +4,7 @@
 ///
 ///   nominal ──isolation──► failure_recovery ──attitude settled──► degraded_navigation
 ///      │                        │                                        │
-///      └──────── second failure, no plan for too long, estimator lost ───┴──► emergency_landing ──touchdown──► landed
+///      └──────── too many failures, no plan for too long, estimator lost ───┴──► emergency_landing ──touchdown──► landed
 ///
 /// In failure recovery the NMPC has reconfigured and the planner has replanned with the
 /// post-failure limit; the mission takes no new waypoint until the attitude has settled. An
@@ -33,6 +33,10 @@ struct SupervisorOptions {
   double odometry_timeout_s = 0.5;
   /// A speed estimate above this [m/s] is a diverged estimator: land. > 0.
   double max_speed_m_s = 15.0;
+  /// Failed rotors the vehicle flies on; one more lands it. A quadrotor flies on one (paper
+  /// 000); an assembly of n units reallocates over its 4n rotors (scenarios with an assembly
+  /// default to 4n - 4). >= 0.
+  int max_failed_rotors = 1;
   double landing_speed_m_s = 0.4;       ///< peak descent rate of an emergency landing [m/s], > 0
   double landing_depth_m = 0.5;         ///< how far below the ground the descent aims [m], > 0
   double touchdown_thrust_ratio = 0.5;  ///< collective command / weight below which ... (0, 1)
