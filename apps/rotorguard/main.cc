@@ -20,6 +20,7 @@
 #include "rotorguard/bench/fdd_calibration.h"
 #include "rotorguard/bench/ftc_bench.h"
 #include "rotorguard/bench/flatness_bench.h"
+#include "rotorguard/bench/mars_bench.h"
 #include "rotorguard/bench/nav_bench.h"
 #include "rotorguard/bench/nmpc_bench.h"
 #include "rotorguard/bench/perception_bench.h"
@@ -163,6 +164,12 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
     fmt::print("summary           {}\n", (fs::path(out_dir) / "summary.json").string());
     if (report) fmt::print("report            {}\n", (fs::path(out_dir) / "report.html").string());
   }
+}
+
+/// --jobs: worker threads, the number of cores when not given.
+int ParseJobs(const std::string& text) {
+  if (text.empty()) return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return static_cast<int>(ParseUnsigned("--jobs", text, 1, 256));
 }
 
 std::string DefaultBenchScenario() {
@@ -321,9 +328,21 @@ int main(int argc, char** argv) {
   bench_flatness->add_option("--jobs", flat_jobs_text, "Worker threads (default: the number of cores)");
   bench_flatness->add_flag("--json", flat_json, "Print JSON instead of Markdown");
 
+  std::string mars_trials_text = "10", mars_seed_text = "1", mars_jobs_text;
+  bool mars_json = false;
+  CLI::App* bench_mars = bench->add_subcommand(
+      "mars", "Paper 002: the 3x2 assembly on Table I's spiral (configs/scenarios/mars_spiral_3x2.yaml) with the\n"
+              "paper's rotor faults and Fig. 3's dead units, without reallocation, partial and full: table1\n"
+              "(mean tracking RMSE, success rate); alloc_us_mean for nine units (configs/assemblies/3x3.yaml).");
+  bench_mars->add_option("--trials", mars_trials_text, "Flights per case and method (default 10, the paper's)");
+  bench_mars->add_option("--seed", mars_seed_text, "The first flight's seed (default 1)");
+  bench_mars->add_option("--jobs", mars_jobs_text, "Worker threads (default: the number of cores)");
+  bench_mars->add_flag("--json", mars_json, "Print JSON instead of Markdown");
+
   // Every benchmark can also write its page: tables and distributions (report.h).
   std::string bench_html;
-  for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner, bench_nav, bench_flatness}) {
+  for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner, bench_nav, bench_flatness,
+                      bench_mars}) {
     b->add_option("--html", bench_html, "Also write the result as an HTML page to this file");
   }
   const auto write_bench_html = [&bench_html](const char* name, const nlohmann::json& result) {
@@ -434,8 +453,7 @@ int main(int argc, char** argv) {
       rotorguard::bench::FtcBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_text, 1, 1'000'000));
       o.seed = ParseUnsigned("--seed", ftc_seed_text, 0, UINT64_MAX);
-      o.jobs = ftc_jobs_text.empty() ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
-                                     : static_cast<int>(ParseUnsigned("--jobs", ftc_jobs_text, 1, 256));
+      o.jobs = ParseJobs(ftc_jobs_text);
       o.methods.clear();
       const std::vector<std::string> known = rotorguard::bench::FtcMethods();
       for (std::size_t start = 0; start <= ftc_methods.size();) {
@@ -490,8 +508,7 @@ int main(int argc, char** argv) {
       rotorguard::bench::NavBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", nav_trials_text, 1, 100000));
       o.seed = ParseUnsigned("--seed", nav_seed_text, 0, UINT64_MAX);
-      o.jobs = nav_jobs_text.empty() ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
-                                     : static_cast<int>(ParseUnsigned("--jobs", nav_jobs_text, 1, 256));
+      o.jobs = ParseJobs(nav_jobs_text);
       o.kinds.clear();
       for (std::size_t start = 0; start <= nav_kinds.size();) {
         const std::size_t comma = std::min(nav_kinds.find(',', start), nav_kinds.size());
@@ -531,13 +548,26 @@ int main(int argc, char** argv) {
       rotorguard::bench::FlatnessBenchOptions o;
       o.seeds = static_cast<int>(ParseUnsigned("--seeds", flat_seeds_text, 1, 10000));
       o.seed = ParseUnsigned("--seed", flat_seed_text, 0, UINT64_MAX);
-      o.jobs = flat_jobs_text.empty() ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
-                                      : static_cast<int>(ParseUnsigned("--jobs", flat_jobs_text, 1, 256));
+      o.jobs = ParseJobs(flat_jobs_text);
       o.fig2 = rotorguard::bench::LoadScenario(fs::path(DefaultBenchScenario()).parent_path().string() + "/flatness_fig2.yaml");
       o.progress = CountProgress("flights");
       const nlohmann::json r = rotorguard::bench::RunFlatnessBenchmark(o);
       write_bench_html("flatness", r);
       fmt::print("{}", flat_json ? r.dump(2) + "\n" : rotorguard::bench::FlatnessMarkdown(r));
+      return kOk;
+    }
+    if (*bench_mars) {
+      rotorguard::bench::MarsBenchOptions o;
+      o.trials = static_cast<int>(ParseUnsigned("--trials", mars_trials_text, 1, 10000));
+      o.seed = ParseUnsigned("--seed", mars_seed_text, 0, UINT64_MAX);
+      o.jobs = ParseJobs(mars_jobs_text);
+      const fs::path configs = fs::path(DefaultBenchScenario()).parent_path().parent_path();
+      o.spiral = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_spiral_3x2.yaml").string());
+      o.nine_units = rotorguard::bench::LoadAssembly((configs / "assemblies" / "3x3.yaml").string());
+      o.progress = CountProgress("flights");
+      const nlohmann::json r = rotorguard::bench::RunMarsBenchmark(o);
+      write_bench_html("mars", r);
+      fmt::print("{}", mars_json ? r.dump(2) + "\n" : rotorguard::bench::MarsMarkdown(r));
       return kOk;
     }
     if (*bench_nmpc) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "rotorguard/bench/mars_bench.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/io/config_node.h"
@@ -67,6 +68,34 @@ TEST(MarsScenario, AssemblyKeysAreCheckedNamingTheKey) {
   m = message("scenarios/nmpc_hover_motor_stop_known.yaml",
               {{"stack.known_faults", "[{rotor: 0, at_time_s: 1, loss: 0.5}]"}});
   EXPECT_NE(m.find("1 unless the controller is assembly"), std::string::npos) << m;
+}
+
+TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError) {
+  MarsBenchOptions o;
+  o.trials = 1;
+  o.jobs = 2;
+  o.alloc_samples = 1000;
+  o.spiral = LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), {{"duration_s", "15"}});
+  o.nine_units = LoadAssembly(Config("assemblies/3x3.yaml"));
+  const nlohmann::json r = RunMarsBenchmark(o);
+  ASSERT_EQ(r["table1"].size(), 6u);
+  for (const auto& row : r["table1"]) {
+    SCOPED_TRACE(row["case"].get<std::string>());
+    // Units No. 1 and 3 dead leave unit No. 2 alone on its side of the roll axis: it would have to
+    // carry half the weight (14.7 N), four rotors of 2.6 N give 10.4 N. Every other case can hover.
+    const bool one_row = row["case"].get<std::string>().find("No. 1 and 3") != std::string::npos;
+    EXPECT_EQ(row["hover_attainable"].get<bool>(), !one_row);
+    if (one_row) continue;
+    EXPECT_EQ(row["full_success_rate"].get<double>(), 1.0);
+    EXPECT_LE(row["full_over_fault_free"].get<double>(), 1.5);
+  }
+  // A dead unit: the fault-blind allocation errs far more than the reallocation.
+  EXPECT_GT(r["table1"][3]["none_error_m"].get<double>(), 4.0 * r["table1"][3]["full_error_m"].get<double>());
+  EXPECT_TRUE(r["table1_full_within_1_5x_fault_free"].get<bool>());
+  EXPECT_GT(r["alloc_us_mean"].get<double>(), 0.0);
+  EXPECT_EQ(r["alloc_units"].get<int>(), 9);
+  o.trials = 0;
+  RG_EXPECT_THROW_WITH(RunMarsBenchmark(o), std::invalid_argument, "trials = 0");
 }
 
 class AssemblyFile : public testing::TempFolderTest {};

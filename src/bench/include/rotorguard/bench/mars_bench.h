@@ -1,0 +1,39 @@
+#pragma once
+/// `rotorguard bench mars` (paper 002): the 3x2 assembly on the climbing spiral of Table I with the
+/// paper's rotor faults (eta = 0.5 on one and on two rotors of unit No. 2) and Fig. 3's dead units,
+/// each flown without fault-tolerant reallocation, with the partial one (eqs. 3-5) and with the
+/// full one (eq. 6), over many seeds (gusts and sensor noise); and the reallocation's solve time
+/// for a 3x3 assembly of nine units.
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/bench/scenario.h"
+
+namespace rotorguard::bench {
+
+struct MarsBenchOptions {
+  int trials = 10;         ///< flights per row and method (the paper: 10), in [1, 10000]
+  std::uint64_t seed = 1;  ///< the first flight's seed; the others follow
+  int jobs = 1;            ///< worker threads, in [1, 256]
+  /// configs/scenarios/mars_spiral_3x2.yaml: the assembly, the spiral, the stack; its faults and
+  /// known faults are replaced by each row's.
+  Scenario spiral;
+  /// The assembly whose allocation is timed (configs/assemblies/3x3.yaml: nine units).
+  modular::Assembly nine_units;
+  int alloc_samples = 20000;  ///< allocations timed, in [100, 10^7]
+  std::function<void(int, int)> progress;
+  /// Throws std::invalid_argument naming the field.
+  void Validate() const;
+};
+
+/// {table1: [{case, faults, hover_attainable, none_error_m, partial_error_m, full_error_m,
+/// ..._success_rate, full_over_fault_free}], table1_full_within_1_5x_fault_free (over the cases
+/// that can hover), alloc_us_mean, alloc_us_p99, ...}. Errors are per-flight tracking RMSEs
+/// averaged over the trials.
+nlohmann::json RunMarsBenchmark(const MarsBenchOptions& options);
+std::string MarsMarkdown(const nlohmann::json& result);
+
+}  // namespace rotorguard::bench

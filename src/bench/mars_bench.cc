@@ -1,0 +1,211 @@
+#include "rotorguard/bench/mars_bench.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "rotorguard/bench/metrics.h"
+#include "rotorguard/bench/parallel.h"
+#include "rotorguard/bench/runner.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/modular/allocation.h"
+
+namespace rotorguard::bench {
+
+namespace {
+
+/// A row of Table I (or Fig. 3): what each faulty rotor keeps of its thrust, rotor by rotor.
+struct FaultCase {
+  std::string name;
+  std::vector<std::pair<int, double>> rotors;  ///< (rotor, loss); loss 1 is a stopped motor
+};
+
+std::vector<FaultCase> TableOneCases() {
+  // Unit No. k is index k - 1, its rotor j is index 4 (k - 1) + j - 1 (modular::Assembly).
+  const auto unit = [](int k) {
+    std::vector<std::pair<int, double>> r;
+    for (int j = 0; j < 4; ++j) r.emplace_back(4 * (k - 1) + j, 1.0);
+    return r;
+  };
+  std::vector<std::pair<int, double>> two_units = unit(1);
+  for (const auto& r : unit(6)) two_units.push_back(r);
+  std::vector<std::pair<int, double>> same_row = unit(1);
+  for (const auto& r : unit(3)) same_row.push_back(r);
+  return {{"no failure", {}},
+          {"eta_2,2 = 0.5", {{5, 0.5}}},
+          {"eta_2,1 = eta_2,2 = 0.5", {{4, 0.5}, {5, 0.5}}},
+          {"unit No. 1 dead", unit(1)},
+          {"units No. 1 and 6 dead (diagonal)", two_units},
+          {"units No. 1 and 3 dead (one row)", same_row}};
+}
+
+const std::vector<modular::Reallocation> kMethods = {modular::Reallocation::kNone, modular::Reallocation::kPartial,
+                                                     modular::Reallocation::kFull};
+
+struct Flight {
+  bool success = false;
+  double rmse = 0.0, max_error = 0.0;
+  std::string failure;
+};
+
+Scenario WithFaults(const Scenario& base, const FaultCase& c, modular::Reallocation method, std::uint64_t seed) {
+  Scenario s = base;
+  s.seed = seed;
+  s.allocation.method = method;
+  s.faults.clear();
+  s.stack.known_faults.clear();
+  for (const auto& [rotor, loss] : c.rotors) {
+    sim::FaultSpec f;
+    f.rotor = rotor;
+    f.kind = loss >= 1.0 ? vehicle::FaultKind::kMotorStop : vehicle::FaultKind::kLossOfEffectiveness;
+    f.eta = loss >= 1.0 ? 0.0 : loss;
+    f.onset.value = 0.0;
+    s.faults.push_back(f);
+    s.stack.known_faults.push_back({rotor, 0.0, loss});
+  }
+  return s;
+}
+
+/// Mean and 99th percentile [us] of the full reallocation on `a` with a dead unit and random
+/// partial losses, for random wrenches around hover.
+std::pair<double, double> TimeAllocation(const modular::Assembly& a, int samples, std::uint64_t seed) {
+  modular::AssemblyAllocator alloc(a, {});
+  Rng rng(seed);
+  const int n = a.vehicle.num_rotors();
+  RotorVector eta = RotorVector::Ones(n);
+  eta.segment(0, a.rotors_per_unit).setZero();  // unit No. 1 dead
+  for (int k = a.rotors_per_unit; k < n; ++k) eta[k] = rng.Uniform() < 0.15 ? rng.Uniform(0.3, 0.9) : 1.0;
+  alloc.SetEffectiveness(eta);
+  std::vector<double> us;
+  us.reserve(static_cast<std::size_t>(samples));
+  RotorVector u;
+  const double w = a.vehicle.weight_n();
+  for (int i = 0; i < samples; ++i) {
+    const Eigen::Vector4d wrench(w * rng.Uniform(0.7, 1.4), rng.Uniform(-0.5, 0.5), rng.Uniform(-0.5, 0.5),
+                                 rng.Uniform(-0.1, 0.1));
+    const auto start = std::chrono::steady_clock::now();
+    alloc.Allocate(wrench, &u);
+    us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+  }
+  double mean = 0.0;
+  for (const double v : us) mean += v / samples;
+  return {mean, Percentile(us, 99.0)};
+}
+
+}  // namespace
+
+void MarsBenchOptions::Validate() const {
+  if (trials < 1 || trials > 10000) ThrowInvalidArgument("MarsBenchOptions", "trials", trials, "a count in [1, 10000]");
+  if (jobs < 1 || jobs > 256) ThrowInvalidArgument("MarsBenchOptions", "jobs", jobs, "a count in [1, 256]");
+  if (alloc_samples < 100 || alloc_samples > 10'000'000) {
+    ThrowInvalidArgument("MarsBenchOptions", "alloc_samples", alloc_samples, "a count in [100, 10^7]");
+  }
+  if (!spiral.assembly || spiral.stack.controller != "assembly") {
+    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "an assembly scenario flown by controller assembly");
+  }
+  if (spiral.assembly->num_units != 6) {
+    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "the 3x2 assembly of Table I (six units)");
+  }
+}
+
+nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
+  o.Validate();
+  const std::vector<FaultCase> cases = TableOneCases();
+  const int methods = static_cast<int>(kMethods.size());
+  const int total = static_cast<int>(cases.size()) * methods * o.trials;
+  std::vector<Flight> flights(static_cast<std::size_t>(total));
+  ParallelFor(total, o.jobs, [&](int task) {
+    const int trial = task % o.trials, method = (task / o.trials) % methods, row = task / (o.trials * methods);
+    Flight& f = flights[static_cast<std::size_t>(task)];
+    try {
+      // Every method and row flies the same seeds: the rows differ by their faults only.
+      const RunSummary r = RunScenario(WithFaults(o.spiral, cases[row], kMethods[method], o.seed + trial), RunOptions{});
+      f.success = r.success;
+      f.rmse = r.tracking_rmse_m;
+      f.max_error = r.max_position_error_m;
+      f.failure = r.failure_reason;
+    } catch (const std::exception& e) {
+      f.failure = std::string("error: ") + e.what();
+    }
+  }, o.progress);
+
+  nlohmann::json table1 = nlohmann::json::array();
+  double fault_free = 0.0;
+  bool within = true;
+  for (std::size_t row = 0; row < cases.size(); ++row) {
+    // Whether the rotors that still deliver can hold the assembly's weight at all (the allocator's
+    // exact QP): a case that cannot hover is reported, not held against the target.
+    modular::AssemblyAllocator check(*o.spiral.assembly, {});
+    RotorVector eta = RotorVector::Ones(o.spiral.vehicle.num_rotors());
+    for (const auto& [rotor, loss] : cases[row].rotors) eta[rotor] = 1.0 - loss;
+    check.SetEffectiveness(eta);
+    RotorVector hover;
+    const bool can_hover = check.Allocate(Eigen::Vector4d(o.spiral.vehicle.weight_n(), 0, 0, 0), &hover).attainable;
+    nlohmann::json r = {{"case", cases[row].name}, {"hover_attainable", can_hover}};
+    nlohmann::json faults = nlohmann::json::array();
+    for (const auto& [rotor, loss] : cases[row].rotors) faults.push_back({{"rotor", rotor}, {"loss", loss}});
+    r["faults"] = faults;
+    for (int m = 0; m < methods; ++m) {
+      double rmse = 0.0, max_error = 0.0;
+      int success = 0;
+      for (int t = 0; t < o.trials; ++t) {
+        const Flight& f = flights[static_cast<std::size_t>((static_cast<int>(row) * methods + m) * o.trials + t)];
+        rmse += f.rmse / o.trials;
+        max_error = std::max(max_error, f.max_error);
+        success += f.success;
+      }
+      const std::string name(modular::ToString(kMethods[m]));
+      r[name + "_error_m"] = rmse;
+      r[name + "_max_error_m"] = max_error;
+      r[name + "_success_rate"] = static_cast<double>(success) / o.trials;
+    }
+    if (row == 0) fault_free = r["full_error_m"].get<double>();
+    r["full_over_fault_free"] = fault_free > 0.0 ? r["full_error_m"].get<double>() / fault_free : 0.0;
+    if (can_hover) {
+      within = within && r["full_over_fault_free"].get<double>() <= 1.5 && r["full_success_rate"].get<double>() == 1.0;
+    }
+    table1.push_back(r);
+  }
+  const auto [alloc_mean, alloc_p99] = TimeAllocation(o.nine_units, o.alloc_samples, o.seed);
+  nlohmann::json failures = nlohmann::json::array();
+  for (int task = 0; task < total && failures.size() < 10; ++task) {
+    const Flight& f = flights[static_cast<std::size_t>(task)];
+    if (f.success || kMethods[(task / o.trials) % methods] == modular::Reallocation::kNone) continue;
+    failures.push_back({{"case", cases[task / (o.trials * methods)].name},
+                        {"method", modular::ToString(kMethods[(task / o.trials) % methods])},
+                        {"seed", o.seed + task % o.trials},
+                        {"reason", f.failure}});
+  }
+  return {{"benchmark", "mars"},
+          {"assembly", o.spiral.assembly->name},
+          {"trials", o.trials},
+          {"table1", table1},
+          {"table1_full_within_1_5x_fault_free", within},
+          {"alloc_units", o.nine_units.num_units},
+          {"alloc_us_mean", alloc_mean},
+          {"alloc_us_p99", alloc_p99},
+          {"failures", failures}};
+}
+
+std::string MarsMarkdown(const nlohmann::json& r) {
+  std::string s = fmt::format("Table I ({} assembly on the spiral, {} flights per cell: mean tracking RMSE, "
+                              "success rate)\n\n",
+                              r["assembly"].get<std::string>(), r["trials"].get<int>());
+  s += "| case | without FTC | partial (eqs. 3-5) | full (eq. 6) | full / fault-free |\n|---|---|---|---|---|\n";
+  for (const auto& row : r["table1"]) {
+    const auto cell = [&](const char* m) {
+      return fmt::format("{:.3f} m ({:.0f} %)", row[std::string(m) + "_error_m"].get<double>(),
+                         100.0 * row[std::string(m) + "_success_rate"].get<double>());
+    };
+    s += fmt::format("| {}{} | {} | {} | {} | {:.2f} |\n", row["case"].get<std::string>(),
+                     row["hover_attainable"].get<bool>() ? "" : " (cannot hover: beyond the rotors' reach)",
+                     cell("none"), cell("partial"), cell("full"), row["full_over_fault_free"].get<double>());
+  }
+  s += fmt::format("\nallocation ({} units, full reallocation with a dead unit): {:.1f} us mean, {:.1f} us p99\n",
+                   r["alloc_units"].get<int>(), r["alloc_us_mean"].get<double>(), r["alloc_us_p99"].get<double>());
+  return s;
+}
+
+}  // namespace rotorguard::bench
