@@ -78,18 +78,25 @@ std::string FormatLogCsv(const io::NumericTable& table) {
 }
 
 SceneRecorder::SceneRecorder(const vehicle::VehicleParams& vehicle, const sim::World& world,
-                             const SceneRecorderOptions& options)
+                             const SceneRecorderOptions& options, const modular::Assembly* assembly)
     : options_(options), world_(&world) {
   scene_["format"] = "rotorguard-scene/1";
   nlohmann::json rotors = nlohmann::json::array();
-  for (const vehicle::Rotor& r : vehicle.rotors) {
+  for (int k = 0; k < vehicle.num_rotors(); ++k) {
+    const vehicle::Rotor& r = vehicle.rotors[static_cast<std::size_t>(k)];
     rotors.push_back({{"position_m", Vec(r.p_B)},
                       {"spin", r.direction == vehicle::SpinDirection::kClockwise ? "cw" : "ccw"}});
+    if (assembly) rotors.back()["unit"] = assembly->UnitOfRotor(k);
   }
   scene_["vehicle"] = {{"name", vehicle.name},
                        {"collision_radius_m", vehicle.collision_radius_m},
                        {"thrust_coefficient_n_s2", vehicle.thrust_coefficient_n_s2},  // commanded rpm from thrust
                        {"rotors", rotors}};
+  if (assembly) {
+    nlohmann::json units = nlohmann::json::array();
+    for (const Vector3& c : assembly->unit_position_B) units.push_back({{"center_m", Vec(c)}});
+    scene_["vehicle"]["units"] = units;
+  }
   nlohmann::json boxes = nlohmann::json::array(), cylinders = nlohmann::json::array(), moving = nlohmann::json::array();
   for (const sim::Box& b : world.boxes) {
     boxes.push_back({{"center_m", Vec(b.center_m)}, {"size_m", Vec(b.size_m)}, {"yaw_rad", b.yaw_rad}});

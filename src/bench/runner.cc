@@ -222,7 +222,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   FlightLog flight;
   flight.table.columns = LogColumns(truth_model.num_rotors(), st.fault_detector() != nullptr, st.nmpc() != nullptr);
   flight.table.values.resize(flight.table.columns.size());
-  SceneRecorder scene(sc.vehicle, sc.world);
+  SceneRecorder scene(sc.vehicle, sc.world, {}, sc.assembly.get());
   RotorCommand command = st.command();
   std::chrono::steady_clock::duration stack_time{};
   const int waypoints_total = static_cast<int>(sc.stack.navigation.waypoints.size()) * sc.stack.navigation.rounds;

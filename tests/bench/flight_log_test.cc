@@ -121,6 +121,25 @@ TEST_F(FlightLogTest, MovingBoxesAreSampledWhereTheWorldPutsThem) {
   EXPECT_TRUE(log.scene["map"].is_null());  // no LiDAR on this vehicle
 }
 
+TEST_F(FlightLogTest, AnAssemblysSceneCarriesItsUnitsAndEachRotorsUnit) {
+  const Scenario s = LoadScenario(Config("mars_spiral_3x2.yaml"), {{"duration_s", "1"}});
+  RunOptions o;
+  o.out_dir = dir_.string();
+  ASSERT_TRUE(RunScenario(s, o).success);
+  const FlightLog log = ReadFlightLog(dir_.string());
+  const nlohmann::json& v = log.scene["vehicle"];
+  ASSERT_EQ(v["units"].size(), 6u);
+  ASSERT_EQ(v["rotors"].size(), 24u);
+  for (int r = 0; r < 24; ++r) {
+    const int unit = v["rotors"][r]["unit"].get<int>();
+    EXPECT_EQ(unit, r / 4);
+    // Each rotor sits within the unit's arm of its unit's centre.
+    const double dx = v["rotors"][r]["position_m"][0].get<double>() - v["units"][unit]["center_m"][0].get<double>();
+    const double dy = v["rotors"][r]["position_m"][1].get<double>() - v["units"][unit]["center_m"][1].get<double>();
+    EXPECT_NEAR(std::hypot(dx, dy), 0.075 * std::sqrt(2.0), 1e-9);
+  }
+}
+
 TEST_F(FlightLogTest, PlansAreTheTrajectoriesTheReferenceFollowed) {
   const Scenario s = LoadScenario(Config("room_navigate.yaml"), {{"duration_s", "4"}});
   RunOptions o;

@@ -133,20 +133,34 @@ export class Replay {
   addVehicle() {
     const rotors = this.scene.vehicle.rotors;
     this.vehicle = new THREE.Group();
+    // An assembly (scene.vehicle.units) is drawn as its docked units, each a body with arms to its
+    // own rotors; a single vehicle is one unit at the centre of gravity.
+    const units = this.scene.vehicle.units || [{ center_m: [0, 0, 0] }];
+    const unitOf = (r) => (r.unit === undefined ? 0 : r.unit);
     let arm = 0.1;
-    for (const r of rotors) arm = Math.max(arm, Math.hypot(r.position_m[0], r.position_m[1]));
+    for (const r of rotors) {
+      const c = units[unitOf(r)].center_m;
+      arm = Math.max(arm, Math.hypot(r.position_m[0] - c[0], r.position_m[1] - c[1]));
+    }
     // Drawn larger than life when the scene is large, so that it stays visible.
-    const body = new THREE.Mesh(new THREE.BoxGeometry(0.5 * arm, 0.5 * arm, 0.15 * arm), new THREE.MeshLambertMaterial({ color: 0x30343c }));
-    this.vehicle.add(body);
+    const bodyMaterial = new THREE.MeshLambertMaterial({ color: 0x30343c });
+    let front = 0;
+    for (const u of units) {
+      const body = new THREE.Mesh(new THREE.BoxGeometry(0.5 * arm, 0.5 * arm, 0.15 * arm), bodyMaterial);
+      body.position.set(...u.center_m);
+      this.vehicle.add(body);
+      front = Math.max(front, u.center_m[0]);
+    }
     const nose = new THREE.Mesh(new THREE.ConeGeometry(0.08 * arm, 0.3 * arm, 12), new THREE.MeshLambertMaterial({ color: 0xffffff }));
     nose.rotation.z = -Math.PI / 2;
-    nose.position.set(0.4 * arm, 0, 0);
+    nose.position.set(front + 0.4 * arm, 0, 0);
     this.vehicle.add(nose);
     this.rotorDiscs = [];
     this.rotorRings = [];
     for (const r of rotors) {
       const p = new THREE.Vector3(...r.position_m);
-      const armLine = line([0, 0, 0, p.x, p.y, p.z], 0x30343c);
+      const c = units[unitOf(r)].center_m;
+      const armLine = line([c[0], c[1], c[2], p.x, p.y, p.z], 0x30343c);
       this.vehicle.add(armLine);
       const disc = new THREE.Mesh(new THREE.CylinderGeometry(0.42 * arm, 0.42 * arm, 0.03 * arm, 24),
                                   new THREE.MeshLambertMaterial({ color: HEALTH_COLORS.ok, transparent: true, opacity: 0.85 }));

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotorguard/io/csv.h"
+#include "rotorguard/modular/assembly.h"
 #include "rotorguard/sim/world.h"
 #include "rotorguard/stack/flight_stack.h"
 #include "rotorguard/vehicle/vehicle_params.h"
@@ -44,8 +45,10 @@ struct SceneRecorderOptions {
 /// world the simulator flies in: it is a logger, outside the loop.
 class SceneRecorder {
  public:
+  /// `assembly`, when the vehicle is one, adds its units (vehicle.units, each rotor's unit) so
+  /// that the replay draws the docked units.
   SceneRecorder(const vehicle::VehicleParams& vehicle, const sim::World& world,
-                const SceneRecorderOptions& options = {});
+                const SceneRecorderOptions& options = {}, const modular::Assembly* assembly = nullptr);
   /// After each control cycle at time t [s].
   void OnControlCycle(double t, const stack::FlightStack& stack);
   /// Samples the moving boxes when due (call at every physics step or so).
