@@ -48,6 +48,7 @@ Assembly BuildAssembly(const AssemblySpec& spec) {
   a.num_units = n;
   a.rotors_per_unit = u.num_rotors();
   a.slots = spec.slots;
+  a.unit_radius_m = u.collision_radius_m;
   Vector3 com = Vector3::Zero();
   std::vector<Vector3> grid(n);
   for (int k = 0; k < n; ++k) {

@@ -34,6 +34,7 @@ struct Assembly {
   vehicle::VehicleParams vehicle;
   std::vector<Vector3> unit_position_B;  ///< each unit's centre relative to the assembly's CoM [m]
   std::vector<Eigen::Vector2i> slots;    ///< the grid cells, as in the spec
+  double unit_radius_m = 0.0;            ///< each unit's collision sphere (the unit's collision_radius_m)
 
   int UnitOfRotor(int rotor) const { return rotor / rotors_per_unit; }
   /// First rotor index of `unit`.

@@ -61,6 +61,7 @@ struct NearestObstacle {
 class VoxelMap {
  public:
   explicit VoxelMap(const VoxelMapOptions& options);
+  const VoxelMapOptions& options() const { return options_; }
 
   /// Moves the window so that it is centred on `center_W` (to the voxel) along each axis where the
   /// centre is beyond the hysteresis; voxels that leave are forgotten. Cheap when the centre moved
