@@ -67,6 +67,36 @@ void AssemblyAllocator::SetEffectiveness(const RotorVector& eta) {
   }
   Prepare(alive, &alive_);
   Prepare(healthy, &healthy_);
+  if (detaching_ >= 0) {
+    const int unit = detaching_;
+    detaching_ = -1;  // re-prepared for the new effectiveness
+    SetDetaching(unit, blend_);
+  }
+}
+
+void AssemblyAllocator::SetDetaching(int unit, double blend) {
+  if (unit < -1 || unit >= assembly_.num_units) {
+    ThrowInvalidArgument("AssemblyAllocator::SetDetaching", "unit", unit,
+                         fmt::format("-1 (none) or a unit in [0, {}]", assembly_.num_units - 1));
+  }
+  if (!(blend >= 0.0 && blend <= 1.0)) ThrowInvalidArgument("AssemblyAllocator::SetDetaching", "blend", blend, "in [0, 1]");
+  blend_ = unit < 0 ? 0.0 : blend;
+  if (unit == detaching_) return;
+  detaching_ = unit;
+  if (unit < 0 || assembly_.rotors_per_unit != 4) {
+    detaching_ = -1;
+    return;
+  }
+  // The unit's rotors about its own centre: its own quadrotor allocation.
+  std::vector<vehicle::Rotor> local(assembly_.vehicle.rotors.begin() + assembly_.FirstRotor(unit),
+                                    assembly_.vehicle.rotors.begin() + assembly_.FirstRotor(unit) + 4);
+  for (vehicle::Rotor& r : local) r.p_B -= assembly_.unit_position_B[static_cast<std::size_t>(unit)];
+  unit_pinv_ = vehicle::PseudoInverse(vehicle::ComputeEffectivenessMatrix(local));
+  std::vector<int> others;
+  for (const int k : alive_.cols) {
+    if (assembly_.UnitOfRotor(k) != unit) others.push_back(k);
+  }
+  Prepare(others, &others_);
 }
 
 void AssemblyAllocator::Prepare(const std::vector<int>& cols, Subset* s) const {
@@ -159,6 +189,29 @@ const AllocationSummary& AssemblyAllocator::Allocate(const Eigen::Vector4d& wren
       const int k = healthy_.cols[j];
       (*command)[k] = std::clamp(t[j], 0.0, max_thrust_[k]);
     }
+  }
+  if (detaching_ >= 0 && blend_ > 0.0 && !others_.cols.empty()) {
+    // The split allocation (SetDetaching), blended in: both satisfy B t = w within the bounds when
+    // attainable, and so does their convex combination.
+    const int first = assembly_.FirstRotor(detaching_);
+    const double share = 1.0 / assembly_.num_units;  // identical units: its mass over the assembly's
+    const Eigen::Vector4d own = unit_pinv_ * Eigen::Vector4d(share * wrench[0], 0.0, 0.0, 0.0);
+    RotorVector split = RotorVector::Zero(n);
+    Eigen::Vector4d rest = wrench;
+    for (int j = 0; j < 4; ++j) {
+      const int k = first + j;
+      const double t = std::clamp(own[j], 0.0, eta_[k] * max_thrust_[k]);
+      split[k] = eta_[k] > options_.dead_eta ? t / eta_[k] : 0.0;
+      rest -= B_.col(k) * t;
+    }
+    const bool attainable = summary_.attainable;
+    const Eigen::VectorXd t = SolveSubset(&others_, rest);
+    for (std::size_t j = 0; j < others_.cols.size(); ++j) {
+      const int k = others_.cols[j];
+      split[k] = std::clamp(t[j] / eta_[k], 0.0, max_thrust_[k]);
+    }
+    summary_.attainable = attainable && summary_.attainable;
+    *command = (1.0 - blend_) * *command + blend_ * split;
   }
   summary_.residual = B_ * eta_.cwiseProduct(*command) - wrench;
   if (!command->allFinite()) command->setZero(n);

@@ -188,6 +188,38 @@ TEST(AssemblyAllocator, WithoutReallocationTheFaultIsIgnoredAndTheWrenchMissed) 
   EXPECT_GT(s.residual.segment(1, 2).norm(), 1e-3);
 }
 
+TEST(AssemblyAllocator, BeforeASeparationTheUnitCarriesExactlyItsOwnShare) {
+  const Assembly a = testing::MarsAssembly("3x1");
+  AssemblyAllocator alloc(a, {});
+  RotorVector eta = RotorVector::Ones(12);
+  eta[5] = 0.3;  // the middle unit's rotor weakened: the min-variance allocation leans on unit No. 1
+  alloc.SetEffectiveness(eta);
+  const Eigen::Vector4d w(a.vehicle.weight_n() * 1.05, 0.05, -0.02, 0.01);
+  const EffectivenessMatrix B = vehicle::ComputeEffectivenessMatrix(a.vehicle.rotors);
+  // The unit's own wrench about its centre, from its four rotors.
+  const auto unit_wrench = [&](const RotorVector& u) {
+    Eigen::Vector4d f = Eigen::Vector4d::Zero();
+    for (int k = 0; k < 4; ++k) {
+      vehicle::Rotor r = a.vehicle.rotors[k];
+      r.p_B -= a.unit_position_B[0];
+      f += vehicle::ComputeEffectivenessMatrix({r}).col(0) * eta[k] * u[k];
+    }
+    return f;
+  };
+  RotorVector u;
+  ASSERT_TRUE(alloc.Allocate(w, &u).attainable);
+  EXPECT_GT(unit_wrench(u).segment(1, 3).norm(), 1e-3);  // min variance: torque through the latch
+  alloc.SetDetaching(0, 1.0);
+  ASSERT_TRUE(alloc.Allocate(w, &u).attainable);
+  EXPECT_TRUE(testing::MatricesNear(unit_wrench(u), Eigen::Vector4d(w[0] / 3.0, 0, 0, 0), 1e-9));
+  EXPECT_TRUE(testing::MatricesNear(B * eta.cwiseProduct(u), w, 1e-8));
+  alloc.SetDetaching(0, 0.5);
+  ASSERT_TRUE(alloc.Allocate(w, &u).attainable);
+  EXPECT_TRUE(testing::MatricesNear(B * eta.cwiseProduct(u), w, 1e-8));
+  RG_EXPECT_THROW_WITH(alloc.SetDetaching(3, 1.0), std::invalid_argument, "unit = 3");
+  RG_EXPECT_THROW_WITH(alloc.SetDetaching(0, 1.5), std::invalid_argument, "blend = 1.5");
+}
+
 TEST(AssemblyAllocator, BadInputIsAClearErrorOrAFiniteFallback) {
   const Assembly a = testing::MarsAssembly("3x1");
   AssemblyAllocator alloc(a, {});

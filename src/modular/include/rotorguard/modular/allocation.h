@@ -73,6 +73,13 @@ class AssemblyAllocator {
   /// std::invalid_argument naming the rotor for a wrong size or an eta outside [0, 1].
   void SetEffectiveness(const RotorVector& eta);
   const RotorVector& effectiveness() const { return eta_; }
+  /// Prepares `unit`'s separation (-1: none): with weight `blend` in [0, 1] the allocation moves
+  /// towards the split one, where the unit's rotors give it exactly its own share of the
+  /// collective thrust (its mass over the assembly's) with no torque about its own centre and the
+  /// other rotors deliver the rest with the least variance. At blend 1 nothing acts through the
+  /// latch, so releasing it leaves both bodies' accelerations as they were (for a small angular
+  /// acceleration, the assembly's). Throws std::invalid_argument for a unit or blend out of range.
+  void SetDetaching(int unit, double blend);
   /// Rotor commands [N] (what each motor is asked to drive, before its eta) for `wrench`; never
   /// non-finite (a non-finite wrench yields zero thrust and summary().attainable false).
   const AllocationSummary& Allocate(const Eigen::Vector4d& wrench, RotorVector* command);
@@ -98,6 +105,10 @@ class AssemblyAllocator {
   RotorVector max_thrust_, eta_;
   Subset alive_;    ///< every rotor that delivers (kFull)
   Subset healthy_;  ///< the rotors of units without a fault (kPartial)
+  Subset others_;   ///< the rotors that deliver, but the detaching unit's
+  int detaching_ = -1;
+  double blend_ = 0.0;
+  Eigen::Matrix4d unit_pinv_ = Eigen::Matrix4d::Zero();  ///< the detaching unit's own allocation
   std::vector<bool> unit_faulty_;
   AllocationSummary summary_;
 };

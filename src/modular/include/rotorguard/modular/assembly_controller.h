@@ -34,6 +34,8 @@ class AssemblyController final : public control::Controller {
   /// Throws std::invalid_argument for a rotor outside the assembly or an effectiveness outside
   /// [0, 1].
   void SetRotorEffectiveness(int rotor, double effectiveness) override;
+  /// AssemblyAllocator::SetDetaching: prepares `unit`'s separation with weight `blend`.
+  void SetDetaching(int unit, double blend) { allocator_.SetDetaching(unit, blend); }
   const AllocationSummary& allocation() const { return allocator_.summary(); }
   const Eigen::Vector4d& last_wrench() const { return wrench_; }
 
