@@ -564,6 +564,7 @@ int main(int argc, char** argv) {
       const fs::path configs = fs::path(DefaultBenchScenario()).parent_path().parent_path();
       o.spiral = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_spiral_3x2.yaml").string());
       o.nine_units = rotorguard::bench::LoadAssembly((configs / "assemblies" / "3x3.yaml").string());
+      o.reconfigure = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_reconfigure_3x1.yaml").string());
       o.progress = CountProgress("flights");
       const nlohmann::json r = rotorguard::bench::RunMarsBenchmark(o);
       write_bench_html("mars", r);

@@ -7,6 +7,7 @@
 
 #include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/parallel.h"
+#include "rotorguard/bench/reconfiguration.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
@@ -169,6 +170,48 @@ nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
     table1.push_back(r);
   }
   const auto [alloc_mean, alloc_p99] = TimeAllocation(o.nine_units, o.alloc_samples, o.seed);
+  nlohmann::json reconfig = nullptr;
+  if (o.reconfigure.assembly) {
+    // Self-reconfiguration, prepared (the split allocation blended in) and naive, on the same seeds.
+    std::vector<ReconfigurationResult> runs(static_cast<std::size_t>(2 * o.trials));
+    ParallelFor(2 * o.trials, o.jobs, [&](int task) {
+      ReconfigurationOptions r;
+      r.base = o.reconfigure;
+      r.base.seed = o.seed + static_cast<std::uint64_t>(task / 2);
+      r.naive = task % 2 == 1;
+      try {
+        runs[static_cast<std::size_t>(task)] = RunReconfiguration(r);
+      } catch (const std::exception& e) {
+        runs[static_cast<std::size_t>(task)].failure = std::string("error: ") + e.what();
+      }
+    }, nullptr);
+    nlohmann::json variants;
+    for (int v = 0; v < 2; ++v) {
+      double sep = 0.0, dock = 0.0, sep_acc = 0.0, dock_acc = 0.0, unit_tilt = 0.0, steady = 0.0;
+      int success = 0;
+      std::string failure;
+      for (int t = 0; t < o.trials; ++t) {
+        const ReconfigurationResult& r = runs[static_cast<std::size_t>(2 * t + v)];
+        success += r.success;
+        if (!r.success && failure.empty()) failure = r.failure;
+        sep = std::max(sep, r.separation_max_attitude_deg);
+        dock = std::max(dock, r.docking_max_attitude_deg);
+        sep_acc = std::max(sep_acc, r.separation_max_accel_m_s2);
+        dock_acc = std::max(dock_acc, r.docking_max_accel_m_s2);
+        unit_tilt = std::max(unit_tilt, r.unit_max_tilt_deg);
+        steady = std::max(steady, r.steady_max_attitude_deg);
+      }
+      variants[v == 0 ? "prepared" : "naive"] = {{"success_rate", static_cast<double>(success) / o.trials},
+                                                 {"separation_max_attitude_deg", sep},
+                                                 {"docking_max_attitude_deg", dock},
+                                                 {"separation_max_accel_m_s2", sep_acc},
+                                                 {"docking_max_accel_m_s2", dock_acc},
+                                                 {"unit_max_tilt_deg", unit_tilt},
+                                                 {"steady_max_attitude_deg", steady},
+                                                 {"first_failure", failure}};
+    }
+    reconfig = variants;
+  }
   nlohmann::json failures = nlohmann::json::array();
   for (int task = 0; task < total && failures.size() < 10; ++task) {
     const Flight& f = flights[static_cast<std::size_t>(task)];
@@ -186,6 +229,15 @@ nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
           {"alloc_units", o.nine_units.num_units},
           {"alloc_us_mean", alloc_mean},
           {"alloc_us_p99", alloc_p99},
+          {"reconfig", reconfig},
+          {"reconfig_max_attitude_deg",
+           reconfig.is_null() ? nlohmann::json(nullptr)
+                              : nlohmann::json(std::max(reconfig["prepared"]["separation_max_attitude_deg"].get<double>(),
+                                                        reconfig["prepared"]["docking_max_attitude_deg"].get<double>()))},
+          {"reconfig_max_attitude_deg_naive",
+           reconfig.is_null() ? nlohmann::json(nullptr)
+                              : nlohmann::json(std::max(reconfig["naive"]["separation_max_attitude_deg"].get<double>(),
+                                                        reconfig["naive"]["docking_max_attitude_deg"].get<double>()))},
           {"failures", failures}};
 }
 
@@ -205,6 +257,18 @@ std::string MarsMarkdown(const nlohmann::json& r) {
   }
   s += fmt::format("\nallocation ({} units, full reallocation with a dead unit): {:.1f} us mean, {:.1f} us p99\n",
                    r["alloc_units"].get<int>(), r["alloc_us_mean"].get<double>(), r["alloc_us_p99"].get<double>());
+  if (!r["reconfig"].is_null()) {
+    s += "\nSelf-reconfiguration (largest over the trials)\n\n| switch | success | steady hover | separation | docking | "
+         "unit's tilt |\n|---|---|---|---|---|---|\n";
+    for (const char* v : {"prepared", "naive"}) {
+      const nlohmann::json& x = r["reconfig"][v];
+      s += fmt::format("| {} | {:.0f} % | {:.2f} deg | {:.2f} deg, {:.2f} m/s^2 | {:.2f} deg, {:.2f} m/s^2 | {:.1f} deg |\n", v,
+                       100.0 * x["success_rate"].get<double>(), x["steady_max_attitude_deg"].get<double>(),
+                       x["separation_max_attitude_deg"].get<double>(),
+                       x["separation_max_accel_m_s2"].get<double>(), x["docking_max_attitude_deg"].get<double>(),
+                       x["docking_max_accel_m_s2"].get<double>(), x["unit_max_tilt_deg"].get<double>());
+    }
+  }
   return s;
 }
 

@@ -67,7 +67,9 @@ void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::Nume
 }
 
 /// Hands the sensor messages to the stack, recording them in the sensor log when there is one.
-void Deliver(const sim::SensorOutputs& o, stack::FlightStack* st, std::string* sensor_log) {
+}  // namespace
+
+void DeliverToStack(const sim::SensorOutputs& o, stack::FlightStack* st, std::string* sensor_log) {
   if (o.imu) {
     st->OnImu(*o.imu);
     if (sensor_log) AppendImu(*o.imu, sensor_log);
@@ -84,8 +86,6 @@ void Deliver(const sim::SensorOutputs& o, stack::FlightStack* st, std::string* s
 }
 
 double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
-
-}  // namespace
 
 nlohmann::json RunSummary::ToJson() const {
   nlohmann::json j;
@@ -193,7 +193,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   std::string sensor_buffer;
   std::string* sensor_log = sensors ? &sensor_buffer : nullptr;
   if (sensor_log) sensor_buffer = kSensorLogHeader;
-  Deliver(sim.outputs(), &st, sensor_log);
+  DeliverToStack(sim.outputs(), &st, sensor_log);
 
   const TimeNs dt_ns = sim.step_ns();
   const double dt = ToSeconds(dt_ns);
@@ -260,7 +260,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     }
     const sim::SensorOutputs& outputs = sim.Step(command);
     const auto deliver_start = std::chrono::steady_clock::now();
-    Deliver(outputs, &st, sensor_log);
+    DeliverToStack(outputs, &st, sensor_log);
     stack_time += std::chrono::steady_clock::now() - deliver_start;
     if (sensor_log && sensor_buffer.size() > (1u << 20)) {
       sensors->Write(sensor_buffer);

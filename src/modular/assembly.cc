@@ -49,6 +49,8 @@ Assembly BuildAssembly(const AssemblySpec& spec) {
   a.rotors_per_unit = u.num_rotors();
   a.slots = spec.slots;
   a.unit_radius_m = u.collision_radius_m;
+  a.unit = u;
+  a.spacing_m = spec.spacing_m;
   Vector3 com = Vector3::Zero();
   std::vector<Vector3> grid(n);
   for (int k = 0; k < n; ++k) {

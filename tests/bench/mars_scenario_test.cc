@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "rotorguard/bench/mars_bench.h"
+#include "rotorguard/bench/reconfiguration.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/io/config_node.h"
@@ -77,6 +78,7 @@ TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError
   o.alloc_samples = 1000;
   o.spiral = LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), {{"duration_s", "15"}});
   o.nine_units = LoadAssembly(Config("assemblies/3x3.yaml"));
+  o.reconfigure = LoadScenario(Config("scenarios/mars_reconfigure_3x1.yaml"));
   const nlohmann::json r = RunMarsBenchmark(o);
   ASSERT_EQ(r["table1"].size(), 6u);
   for (const auto& row : r["table1"]) {
@@ -94,8 +96,28 @@ TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError
   EXPECT_TRUE(r["table1_full_within_1_5x_fault_free"].get<bool>());
   EXPECT_GT(r["alloc_us_mean"].get<double>(), 0.0);
   EXPECT_EQ(r["alloc_units"].get<int>(), 9);
+  EXPECT_LT(r["reconfig_max_attitude_deg"].get<double>(), 1.0);
+  EXPECT_EQ(r["reconfig"]["prepared"]["success_rate"].get<double>(), 1.0);
   o.trials = 0;
   RG_EXPECT_THROW_WITH(RunMarsBenchmark(o), std::invalid_argument, "trials = 0");
+}
+
+TEST(Reconfiguration, AUnitSeparatesFliesOverAndDocksWhileTheAssemblyStaysLevel) {
+  ReconfigurationOptions o;
+  o.base = LoadScenario(Config("scenarios/mars_reconfigure_3x1.yaml"));
+  const ReconfigurationResult prepared = RunReconfiguration(o);
+  ASSERT_TRUE(prepared.success) << prepared.failure;
+  EXPECT_GT(prepared.docking_s, prepared.separation_s + 3.0);  // up, across and down at 0.3 m/s
+  EXPECT_LT(prepared.separation_max_attitude_deg, 1.0);        // paper: at most about 1 degree
+  EXPECT_LT(prepared.docking_max_attitude_deg, 1.0);
+  o.naive = true;
+  const ReconfigurationResult naive = RunReconfiguration(o);
+  ASSERT_TRUE(naive.success) << naive.failure;
+  // Prepared, nothing acts through the latch when it opens: the assembly's acceleration does not
+  // jump as it does when the unit is let go carrying its share of the fault's compensation.
+  EXPECT_LT(prepared.separation_max_accel_m_s2, naive.separation_max_accel_m_s2);
+  o.target_slot = Eigen::Vector2i(1, 0);  // occupied
+  RG_EXPECT_THROW_WITH(RunReconfiguration(o), std::invalid_argument, "target_slot");
 }
 
 class AssemblyFile : public testing::TempFolderTest {};

@@ -24,6 +24,10 @@ struct MarsBenchOptions {
   /// The assembly whose allocation is timed (configs/assemblies/3x3.yaml: nine units).
   modular::Assembly nine_units;
   int alloc_samples = 20000;  ///< allocations timed, in [100, 10^7]
+  /// configs/scenarios/mars_reconfigure_3x1.yaml: the self-reconfiguration (reconfiguration.h),
+  /// flown over `trials` seeds with the separation prepared and with a naive switch. Skipped when
+  /// it has no assembly.
+  Scenario reconfigure;
   std::function<void(int, int)> progress;
   /// Throws std::invalid_argument naming the field.
   void Validate() const;
@@ -31,7 +35,9 @@ struct MarsBenchOptions {
 
 /// {table1: [{case, faults, hover_attainable, none_error_m, partial_error_m, full_error_m,
 /// ..._success_rate, full_over_fault_free}], table1_full_within_1_5x_fault_free (over the cases
-/// that can hover), alloc_us_mean, alloc_us_p99, ...}. Errors are per-flight tracking RMSEs
+/// that can hover), alloc_us_mean, alloc_us_p99, reconfig_max_attitude_deg (the largest over the
+/// separations and dockings of all trials, prepared separation) and reconfig_max_attitude_deg_naive,
+/// ...}. Errors are per-flight tracking RMSEs
 /// averaged over the trials.
 nlohmann::json RunMarsBenchmark(const MarsBenchOptions& options);
 std::string MarsMarkdown(const nlohmann::json& result);

@@ -118,4 +118,8 @@ struct RunOptions {
 /// file cannot be written (nothing half-written is left behind).
 RunSummary RunScenario(const Scenario& scenario, const RunOptions& options = {});
 
+/// Hands a simulator step's sensor messages to the stack (the only way the truth reaches it), and
+/// appends them to `sensor_log` (sensors.csv's format) when given.
+void DeliverToStack(const sim::SensorOutputs& outputs, stack::FlightStack* stack, std::string* sensor_log = nullptr);
+
 }  // namespace rotorguard::bench

@@ -35,10 +35,12 @@ struct Assembly {
   std::vector<Vector3> unit_position_B;  ///< each unit's centre relative to the assembly's CoM [m]
   std::vector<Eigen::Vector2i> slots;    ///< the grid cells, as in the spec
   double unit_radius_m = 0.0;            ///< each unit's collision sphere (the unit's collision_radius_m)
+  vehicle::VehicleParams unit;           ///< the spec's unit, for assemblies built from this one
+  double spacing_m = 0.0;                ///< the spec's docking distance [m]
 
   int UnitOfRotor(int rotor) const { return rotor / rotors_per_unit; }
-  /// First rotor index of `unit`.
-  int FirstRotor(int unit) const { return unit * rotors_per_unit; }
+  /// First rotor index of unit `unit_index`.
+  int FirstRotor(int unit_index) const { return unit_index * rotors_per_unit; }
 };
 
 /// Builds the assembly of `spec` (validated). Units keep their own drag and yaw damping (summed);
