@@ -9,6 +9,8 @@
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/planning/flatness.h"
+#include "rotorguard/vehicle/pwm_model.h"
 
 namespace rotorguard::bench {
 namespace {
@@ -35,6 +37,14 @@ TEST(FlatnessScenario, Fig2DetectsIdentifiesHoldsAndReplans) {
   EXPECT_GE(r.flatness_decisions[1]["t"].get<double>(), r.fdd->detection_s);
   EXPECT_EQ(r.flatness_decisions[2]["kind"], "continue");
   EXPECT_GE(r.flatness_decisions[2]["t"].get<double>(), r.ukf_settled_s);
+  // The re-plan is bound by the damaged motor 2 and slower than a fault-free re-plan of the same
+  // remaining distance, by eqs. (16)-(23) evaluated here without the fault.
+  const nlohmann::json& replan = r.flatness_decisions[2];
+  EXPECT_EQ(replan["binding"], "motor 2");
+  const Eigen::Vector2d delta(replan["delta_m"][0].get<double>(), replan["delta_m"][1].get<double>());
+  const planning::SettlingTime fault_free = planning::PlanSettlingTime(
+      vehicle::PwmQuadModel::FromVehicle(s.vehicle), s.stack.navigation.flatness.limits, delta);
+  EXPECT_GT(replan["t_s"].get<double>(), fault_free.t_s + 0.2);
   EXPECT_EQ(r.waypoints_reached, 1);
   // The pitch the plan allows, within the LQR's tracking of its steps.
   EXPECT_LT(r.max_tilt_rad, 11.0 * 3.14159265358979 / 180.0);
