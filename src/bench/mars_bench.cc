@@ -1,7 +1,6 @@
 #include "rotorguard/bench/mars_bench.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include <fmt/format.h>
 
@@ -86,9 +85,7 @@ std::pair<double, double> TimeAllocation(const modular::Assembly& a, int samples
   for (int i = 0; i < samples; ++i) {
     const Eigen::Vector4d wrench(w * rng.Uniform(0.7, 1.4), rng.Uniform(-0.5, 0.5), rng.Uniform(-0.5, 0.5),
                                  rng.Uniform(-0.1, 0.1));
-    const auto start = std::chrono::steady_clock::now();
-    alloc.Allocate(wrench, &u);
-    us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+    us.push_back(1e6 * alloc.Allocate(wrench, &u).solve_time_s);  // the allocator times itself
   }
   double mean = 0.0;
   for (const double v : us) mean += v / samples;

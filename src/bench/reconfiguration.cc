@@ -76,11 +76,8 @@ std::unique_ptr<Body> MakeBody(const Scenario& base, const vehicle::VehicleParam
       k.at_time_s = 0.0;
       if (k.rotor >= 0) o.known_faults.push_back(k);
     }
-    o.supervisor.max_failed_rotors = params.num_rotors() - 4;
-    modular::AssemblyControllerOptions ac;
-    ac.cascade = base.stack.nominal;
-    ac.allocation = base.allocation;
-    auto c = std::make_unique<modular::AssemblyController>(*assembly, ac);
+    o.supervisor.max_failed_rotors = assembly->FailedRotorAllowance();
+    auto c = std::make_unique<modular::AssemblyController>(*assembly, AssemblyControllerOptionsOf(base));
     b->controller = c.get();
     controller = std::move(c);
   } else {

@@ -16,7 +16,6 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/io/files.h"
-#include "rotorguard/modular/assembly_controller.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/stack/flight_stack.h"
 #include "rotorguard/vehicle/multirotor.h"
@@ -184,10 +183,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   std::unique_ptr<control::Controller> controller;
   if (sc.stack.controller == "assembly") {
     if (!sc.assembly) throw std::invalid_argument("RunScenario: controller assembly needs the scenario's assembly");
-    modular::AssemblyControllerOptions ac;
-    ac.cascade = sc.stack.nominal;
-    ac.allocation = sc.allocation;
-    controller = std::make_unique<modular::AssemblyController>(*sc.assembly, ac);
+    controller = std::make_unique<modular::AssemblyController>(*sc.assembly, AssemblyControllerOptionsOf(sc));
   }
   stack::FlightStack st(sc.vehicle, sc.reference, sc.stack, std::move(controller));
   std::string sensor_buffer;

@@ -621,6 +621,13 @@ vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Ov
   return LoadVehicleDocument(ConfigDocument::LoadFile(path), overrides);
 }
 
+modular::AssemblyControllerOptions AssemblyControllerOptionsOf(const Scenario& scenario) {
+  modular::AssemblyControllerOptions o;
+  o.cascade = scenario.stack.nominal;
+  o.allocation = scenario.allocation;
+  return o;
+}
+
 modular::Assembly LoadAssembly(const std::string& path) {
   const ConfigDocument doc = ConfigDocument::LoadFile(path);
   const ConfigNode root = doc.root();
@@ -732,7 +739,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   FitStackToHardware(&s);  // the stack's validation below sees the sensors' rates ...
   // An assembly reallocates over its rotors: it flies on while four remain (stack.supervisor keys
   // below may lower it).
-  if (s.assembly) s.stack.supervisor.max_failed_rotors = s.vehicle.num_rotors() - 4;
+  if (s.assembly) s.stack.supervisor.max_failed_rotors = s.assembly->FailedRotorAllowance();
   if (const auto st = root.Optional("stack")) ParseStack(*st, &s.stack, &s.allocation);
   FitStackToHardware(&s);  // ... and what the hardware implies follows the stack's keys (inflation margin)
   for (std::size_t i = 0; i < s.stack.known_faults.size(); ++i) {

@@ -61,6 +61,7 @@ void AssemblyAllocator::SetEffectiveness(const RotorVector& eta) {
   for (int k = 0; k < n; ++k) {
     if (eta[k] < 1.0) unit_faulty_[assembly_.UnitOfRotor(k)] = true;
   }
+  any_faulty_ = std::find(unit_faulty_.begin(), unit_faulty_.end(), true) != unit_faulty_.end();
   for (int k = 0; k < n; ++k) {
     if (eta[k] > options_.dead_eta) alive.push_back(k);
     if (!unit_faulty_[assembly_.UnitOfRotor(k)]) healthy.push_back(k);
@@ -83,13 +84,10 @@ void AssemblyAllocator::SetDetaching(int unit, double blend) {
   blend_ = unit < 0 ? 0.0 : blend;
   if (unit == detaching_) return;
   detaching_ = unit;
-  if (unit < 0 || assembly_.rotors_per_unit != 4) {
-    detaching_ = -1;
-    return;
-  }
-  // The unit's rotors about its own centre: its own quadrotor allocation.
-  std::vector<vehicle::Rotor> local(assembly_.vehicle.rotors.begin() + assembly_.FirstRotor(unit),
-                                    assembly_.vehicle.rotors.begin() + assembly_.FirstRotor(unit) + 4);
+  if (unit < 0) return;
+  // The unit's rotors about its own centre: its own multirotor allocation.
+  const auto first = assembly_.vehicle.rotors.begin() + assembly_.FirstRotor(unit);
+  std::vector<vehicle::Rotor> local(first, first + assembly_.rotors_per_unit);
   for (vehicle::Rotor& r : local) r.p_B -= assembly_.unit_position_B[static_cast<std::size_t>(unit)];
   unit_pinv_ = vehicle::PseudoInverse(vehicle::ComputeEffectivenessMatrix(local));
   std::vector<int> others;
@@ -128,6 +126,13 @@ void AssemblyAllocator::Prepare(const std::vector<int>& cols, Subset* s) const {
   s->fallback_solver->Factorize(s->fallback.H);
 }
 
+void AssemblyAllocator::Scatter(const Subset& s, const Eigen::VectorXd& t, RotorVector* command) const {
+  for (std::size_t j = 0; j < s.cols.size(); ++j) {
+    const int k = s.cols[j];
+    (*command)[k] = std::clamp(t[static_cast<Eigen::Index>(j)] / eta_[k], 0.0, max_thrust_[k]);
+  }
+}
+
 Eigen::VectorXd AssemblyAllocator::SolveSubset(Subset* s, const Eigen::Vector4d& w) {
   s->exact.lc = w;
   s->exact.uc = w;
@@ -157,37 +162,28 @@ const AllocationSummary& AssemblyAllocator::Allocate(const Eigen::Vector4d& wren
     summary_.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return summary_;
   }
-  // The fault-free allocation, clipped: the method kNone, and the faulty units' share in kPartial.
-  const RotorVector nominal = (pinv_ * wrench).cwiseMax(0.0).cwiseMin(max_thrust_);
-  bool any_faulty = false;
-  for (const bool f : unit_faulty_) any_faulty = any_faulty || f;
   Reallocation method = options_.method;
   // Partial reallocation needs a healthy unit to hand the missing wrench to; without a fault it
   // is the full reallocation over all rotors.
-  if (method == Reallocation::kPartial && (!any_faulty || healthy_.cols.empty())) method = Reallocation::kFull;
-  if (method == Reallocation::kNone) {
-    *command = nominal;
-    summary_.attainable = (pinv_ * wrench - nominal).cwiseAbs().maxCoeff() < 1e-12;
-    summary_.status = control::QpStatus::kSolved;
-  } else if (method == Reallocation::kFull) {
-    if (!alive_.cols.empty()) {
-      const Eigen::VectorXd t = SolveSubset(&alive_, wrench);
-      for (std::size_t j = 0; j < alive_.cols.size(); ++j) {
-        const int k = alive_.cols[j];
-        (*command)[k] = std::clamp(t[j] / eta_[k], 0.0, max_thrust_[k]);
+  if (method == Reallocation::kPartial && (!any_faulty_ || healthy_.cols.empty())) method = Reallocation::kFull;
+  if (method == Reallocation::kFull) {
+    if (!alive_.cols.empty()) Scatter(alive_, SolveSubset(&alive_, wrench), command);
+  } else {
+    // The fault-free allocation, clipped: the method kNone, and the faulty units' share in kPartial.
+    const RotorVector unclipped = pinv_ * wrench;
+    const RotorVector nominal = unclipped.cwiseMax(0.0).cwiseMin(max_thrust_);
+    if (method == Reallocation::kNone) {
+      *command = nominal;
+      summary_.attainable = (unclipped - nominal).cwiseAbs().maxCoeff() < 1e-12;
+      summary_.status = control::QpStatus::kSolved;
+    } else {  // kPartial: eqs. (3)-(4), then the healthy units' minimum-variance share
+      Eigen::Vector4d remaining = wrench;
+      for (int k = 0; k < n; ++k) {
+        if (!unit_faulty_[assembly_.UnitOfRotor(k)]) continue;
+        (*command)[k] = nominal[k];
+        remaining -= B_.col(k) * eta_[k] * nominal[k];
       }
-    }
-  } else {  // kPartial: eqs. (3)-(4), then the healthy units' minimum-variance share
-    Eigen::Vector4d remaining = wrench;
-    for (int k = 0; k < n; ++k) {
-      if (!unit_faulty_[assembly_.UnitOfRotor(k)]) continue;
-      (*command)[k] = nominal[k];
-      remaining -= B_.col(k) * eta_[k] * nominal[k];
-    }
-    const Eigen::VectorXd t = SolveSubset(&healthy_, remaining);
-    for (std::size_t j = 0; j < healthy_.cols.size(); ++j) {
-      const int k = healthy_.cols[j];
-      (*command)[k] = std::clamp(t[j], 0.0, max_thrust_[k]);
+      Scatter(healthy_, SolveSubset(&healthy_, remaining), command);
     }
   }
   if (detaching_ >= 0 && blend_ > 0.0 && !others_.cols.empty()) {
@@ -195,21 +191,17 @@ const AllocationSummary& AssemblyAllocator::Allocate(const Eigen::Vector4d& wren
     // attainable, and so does their convex combination.
     const int first = assembly_.FirstRotor(detaching_);
     const double share = 1.0 / assembly_.num_units;  // identical units: its mass over the assembly's
-    const Eigen::Vector4d own = unit_pinv_ * Eigen::Vector4d(share * wrench[0], 0.0, 0.0, 0.0);
+    const RotorVector own = unit_pinv_ * Eigen::Vector4d(share * wrench[0], 0.0, 0.0, 0.0);
     RotorVector split = RotorVector::Zero(n);
     Eigen::Vector4d rest = wrench;
-    for (int j = 0; j < 4; ++j) {
+    for (int j = 0; j < assembly_.rotors_per_unit; ++j) {
       const int k = first + j;
       const double t = std::clamp(own[j], 0.0, eta_[k] * max_thrust_[k]);
       split[k] = eta_[k] > options_.dead_eta ? t / eta_[k] : 0.0;
       rest -= B_.col(k) * t;
     }
     const bool attainable = summary_.attainable;
-    const Eigen::VectorXd t = SolveSubset(&others_, rest);
-    for (std::size_t j = 0; j < others_.cols.size(); ++j) {
-      const int k = others_.cols[j];
-      split[k] = std::clamp(t[j] / eta_[k], 0.0, max_thrust_[k]);
-    }
+    Scatter(others_, SolveSubset(&others_, rest), &split);
     summary_.attainable = attainable && summary_.attainable;
     *command = (1.0 - blend_) * *command + blend_ * split;
   }

@@ -10,14 +10,14 @@ void AssemblyControllerOptions::Validate() const {
 }
 
 AssemblyController::AssemblyController(const Assembly& assembly, const AssemblyControllerOptions& options)
-    : assembly_(assembly), law_(assembly_.vehicle, options.cascade), allocator_(assembly_, options.allocation) {
+    : law_(assembly.vehicle, options.cascade), allocator_(assembly, options.allocation) {
   options.Validate();
-  const int n = assembly_.vehicle.num_rotors();
-  hover_ = RotorVector::Constant(n, assembly_.vehicle.weight_n() / n);
+  const int n = assembly.vehicle.num_rotors();
+  hover_ = RotorVector::Constant(n, assembly.vehicle.weight_n() / n);
 }
 
 void AssemblyController::SetRotorEffectiveness(int rotor, double effectiveness) {
-  const int n = assembly_.vehicle.num_rotors();
+  const int n = allocator_.assembly().vehicle.num_rotors();
   if (rotor < 0 || rotor >= n) {
     ThrowInvalidArgument("AssemblyController::SetRotorEffectiveness", "rotor", rotor,
                          fmt::format("an index in [0, {}]", n - 1));

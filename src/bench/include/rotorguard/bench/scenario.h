@@ -11,6 +11,7 @@
 
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/modular/allocation.h"
+#include "rotorguard/modular/assembly_controller.h"
 #include "rotorguard/modular/assembly.h"
 #include "rotorguard/sim/fault_injector.h"
 #include "rotorguard/sim/simulator.h"
@@ -62,6 +63,10 @@ void FitStackToHardware(Scenario* scenario);
 /// Loads and validates a scenario file. Throws io::ConfigError (bad content, with file, line and
 /// key path) or io::InputFileError (a file that cannot be read).
 Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides = {});
+
+/// The options of controller `assembly` in `scenario`: stack.nominal's cascade and stack.assembly's
+/// reallocation.
+modular::AssemblyControllerOptions AssemblyControllerOptionsOf(const Scenario& scenario);
 
 /// Loads and validates an assembly file (configs/assemblies/: unit, spacing_m, shape or slots),
 /// the unit's vehicle file resolved relative to it (same error contract).

@@ -73,6 +73,7 @@ class AssemblyAllocator {
   /// std::invalid_argument naming the rotor for a wrong size or an eta outside [0, 1].
   void SetEffectiveness(const RotorVector& eta);
   const RotorVector& effectiveness() const { return eta_; }
+  const Assembly& assembly() const { return assembly_; }
   /// Prepares `unit`'s separation (-1: none): with weight `blend` in [0, 1] the allocation moves
   /// towards the split one, where the unit's rotors give it exactly its own share of the
   /// collective thrust (its mass over the assembly's) with no torque about its own centre and the
@@ -97,6 +98,8 @@ class AssemblyAllocator {
   };
   void Prepare(const std::vector<int>& cols, Subset* s) const;
   Eigen::VectorXd SolveSubset(Subset* s, const Eigen::Vector4d& w);
+  /// The commands of the rotors of `s` that deliver the thrusts `t` (t / eta, within the bounds).
+  void Scatter(const Subset& s, const Eigen::VectorXd& t, RotorVector* command) const;
 
   Assembly assembly_;
   AllocatorOptions options_;
@@ -108,8 +111,9 @@ class AssemblyAllocator {
   Subset others_;   ///< the rotors that deliver, but the detaching unit's
   int detaching_ = -1;
   double blend_ = 0.0;
-  Eigen::Matrix4d unit_pinv_ = Eigen::Matrix4d::Zero();  ///< the detaching unit's own allocation
+  AllocationMatrix unit_pinv_;  ///< the detaching unit's own allocation, about its centre
   std::vector<bool> unit_faulty_;
+  bool any_faulty_ = false;  ///< a unit has a rotor with eta < 1
   AllocationSummary summary_;
 };
 

@@ -39,6 +39,8 @@ struct Assembly {
   double spacing_m = 0.0;                ///< the spec's docking distance [m]
 
   int UnitOfRotor(int rotor) const { return rotor / rotors_per_unit; }
+  /// Failed rotors the assembly flies on with reallocation: all but one unit's worth (4n - 4).
+  int FailedRotorAllowance() const { return vehicle.num_rotors() - rotors_per_unit; }
   /// First rotor index of unit `unit_index`.
   int FirstRotor(int unit_index) const { return unit_index * rotors_per_unit; }
 };

@@ -24,7 +24,7 @@ struct AssemblyControllerOptions {
 
 class AssemblyController final : public control::Controller {
  public:
-  /// Keeps a copy of `assembly`. Throws ValidationError for invalid options.
+  /// Keeps a copy of `assembly` (in its allocator). Throws ValidationError for invalid options.
   AssemblyController(const Assembly& assembly, const AssemblyControllerOptions& options);
   std::string_view name() const override { return "assembly"; }
   void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
@@ -40,7 +40,6 @@ class AssemblyController final : public control::Controller {
   const Eigen::Vector4d& last_wrench() const { return wrench_; }
 
  private:
-  Assembly assembly_;
   control::CascadedWrenchLaw law_;
   AssemblyAllocator allocator_;
   RotorVector hover_;
