@@ -333,7 +333,9 @@ int main(int argc, char** argv) {
   CLI::App* bench_mars = bench->add_subcommand(
       "mars", "Paper 002: the 3x2 assembly on Table I's spiral (configs/scenarios/mars_spiral_3x2.yaml) with the\n"
               "paper's rotor faults and Fig. 3's dead units, without reallocation, partial and full: table1\n"
-              "(mean tracking RMSE, success rate); alloc_us_mean for nine units (configs/assemblies/3x3.yaml).");
+              "(mean tracking RMSE, success rate); alloc_us_mean for nine units (configs/assemblies/3x3.yaml);\n"
+              "the self-reconfiguration (mars_reconfigure_3x1.yaml); table2: the 4x1 and 3x2 assemblies planned\n"
+              "through a door by ours and the baseline (mars_plan_4x1.yaml, mars_plan_3x2.yaml) and flown.");
   bench_mars->add_option("--trials", mars_trials_text, "Flights per case and method (default 10, the paper's)");
   bench_mars->add_option("--seed", mars_seed_text, "The first flight's seed (default 1)");
   bench_mars->add_option("--jobs", mars_jobs_text, "Worker threads (default: the number of cores)");
@@ -565,6 +567,8 @@ int main(int argc, char** argv) {
       o.spiral = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_spiral_3x2.yaml").string());
       o.nine_units = rotorguard::bench::LoadAssembly((configs / "assemblies" / "3x3.yaml").string());
       o.reconfigure = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_reconfigure_3x1.yaml").string());
+      o.plan_4x1 = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_plan_4x1.yaml").string());
+      o.plan_3x2 = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_plan_3x2.yaml").string());
       o.progress = CountProgress("flights");
       const nlohmann::json r = rotorguard::bench::RunMarsBenchmark(o);
       write_bench_html("mars", r);

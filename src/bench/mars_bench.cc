@@ -1,9 +1,11 @@
 #include "rotorguard/bench/mars_bench.h"
 
 #include <algorithm>
+#include <numbers>
 
 #include <fmt/format.h>
 
+#include "rotorguard/bench/assembly_mission.h"
 #include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/parallel.h"
 #include "rotorguard/bench/reconfiguration.h"
@@ -50,6 +52,21 @@ struct Flight {
   std::string failure;
 };
 
+/// Flies `s` once; an exception is the flight's failure.
+Flight FlyOnce(const Scenario& s) {
+  Flight f;
+  try {
+    const RunSummary r = RunScenario(s, RunOptions{});
+    f.success = r.success;
+    f.rmse = r.tracking_rmse_m;
+    f.max_error = r.max_position_error_m;
+    f.failure = r.failure_reason;
+  } catch (const std::exception& e) {
+    f.failure = std::string("error: ") + e.what();
+  }
+  return f;
+}
+
 Scenario WithFaults(const Scenario& base, const FaultCase& c, modular::Reallocation method, std::uint64_t seed) {
   Scenario s = base;
   s.seed = seed;
@@ -92,6 +109,96 @@ std::pair<double, double> TimeAllocation(const modular::Assembly& a, int samples
   return {mean, Percentile(us, 99.0)};
 }
 
+/// The rotors of unit No. k (index k - 1), all stopped.
+std::vector<std::pair<int, double>> DeadUnit(int k) {
+  std::vector<std::pair<int, double>> r;
+  for (int j = 0; j < 4; ++j) r.emplace_back(4 * (k - 1) + j, 1.0);
+  return r;
+}
+
+/// Table II: each scene and fault planned by ours and by the baseline (once: planning is
+/// deterministic) and flown over the trials' seeds with the full reallocation.
+nlohmann::json RunTableTwo(const MarsBenchOptions& o) {
+  struct Row {
+    const Scenario* scene;
+    std::string fault;
+    int dead_unit;  ///< paper's No.; 0: none
+  };
+  const std::vector<Row> rows = {{&o.plan_4x1, "normal", 0}, {&o.plan_4x1, "No. 3", 3}, {&o.plan_4x1, "No. 4", 4},
+                                 {&o.plan_3x2, "normal", 0}, {&o.plan_3x2, "No. 2", 2}};
+  const char* methods[2] = {"baseline", "ours"};
+  std::vector<Scenario> planned;  // row-major: row, method
+  std::vector<AssemblyPlanResult> plans;
+  for (const Row& row : rows) {
+    for (const char* m : methods) {
+      const FaultCase c{row.fault, row.dead_unit > 0 ? DeadUnit(row.dead_unit) : std::vector<std::pair<int, double>>{}};
+      Scenario s = WithFaults(*row.scene, c, modular::Reallocation::kFull, o.seed);
+      s.assembly_plan->method = m;
+      plans.push_back(PlanAssemblyMission(s));
+      if (plans.back().ok) s.reference = plans.back().trajectory;
+      planned.push_back(std::move(s));
+    }
+  }
+  const int total = static_cast<int>(planned.size()) * o.trials;
+  std::vector<Flight> flights(static_cast<std::size_t>(total));
+  ParallelFor(total, o.jobs, [&](int task) {
+    const std::size_t k = static_cast<std::size_t>(task / o.trials);
+    if (!plans[k].ok) return;
+    Scenario s = planned[k];
+    s.seed = o.seed + static_cast<std::uint64_t>(task % o.trials);
+    flights[static_cast<std::size_t>(task)] = FlyOnce(s);
+  }, nullptr);
+  nlohmann::json table = nlohmann::json::array();
+  double sum[2] = {0.0, 0.0}, improvement_sum = 0.0;
+  bool all_better = true;
+  for (std::size_t row = 0; row < rows.size(); ++row) {
+    nlohmann::json r = {{"shape", rows[row].scene->assembly->name}, {"fault", rows[row].fault}};
+    double error[2] = {0.0, 0.0};
+    for (int m = 0; m < 2; ++m) {
+      const std::size_t k = 2 * row + static_cast<std::size_t>(m);
+      const AssemblyPlanResult& plan = plans[k];
+      const std::string name = methods[m];
+      r[name + "_planned"] = plan.ok;
+      if (!plan.ok) {
+        r[name + "_plan_failure"] = plan.message;
+        all_better = false;
+        continue;
+      }
+      int success = 0;
+      double max_error = 0.0;
+      std::string failure;
+      for (int t = 0; t < o.trials; ++t) {
+        const Flight& f = flights[k * static_cast<std::size_t>(o.trials) + static_cast<std::size_t>(t)];
+        error[m] += f.rmse / o.trials;
+        max_error = std::max(max_error, f.max_error);
+        success += f.success;
+        if (!f.success && failure.empty()) failure = f.failure;
+      }
+      sum[m] += error[m];
+      r[name + "_error_m"] = error[m];
+      r[name + "_max_error_m"] = max_error;
+      r[name + "_success_rate"] = static_cast<double>(success) / o.trials;
+      r[name + "_first_failure"] = failure;
+      r[name + "_duration_s"] = plan.trajectory_summary.duration_s;
+      r[name + "_attitude_deviation_deg"] = plan.trajectory_summary.attitude_deviation_rad * 180.0 / std::numbers::pi;
+      r[name + "_plan_ms"] = plan.astar_ms + plan.trajectory_summary.solve_ms;
+      // What the plan asks of the assembly, beside what it can give (the mechanism of the rows).
+      r[name + "_max_accel_m_s2"] = plan.trajectory->position().MaxNorm(2, 64);
+      r[name + "_max_yaw_accel_rad_s2"] = plan.trajectory->yaw().MaxNorm(2, 64);
+      r["capacity_accel_m_s2"] = plan.capacity.max_acceleration_m_s2;
+      r["capacity_yaw_accel_rad_s2"] = plan.capacity.max_yaw_acceleration_rad_s2;
+    }
+    r["improvement"] = error[0] > 0.0 ? 1.0 - error[1] / error[0] : 0.0;
+    improvement_sum += r["improvement"].get<double>() / static_cast<double>(rows.size());
+    all_better = all_better && error[1] < error[0];
+    table.push_back(r);
+  }
+  return {{"table2", table},
+          {"table2_improvement_average", sum[0] > 0.0 ? 1.0 - sum[1] / sum[0] : 0.0},
+          {"table2_improvement_row_mean", improvement_sum},
+          {"table2_ours_better_in_every_row", all_better}};
+}
+
 }  // namespace
 
 void MarsBenchOptions::Validate() const {
@@ -116,17 +223,8 @@ nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
   std::vector<Flight> flights(static_cast<std::size_t>(total));
   ParallelFor(total, o.jobs, [&](int task) {
     const int trial = task % o.trials, method = (task / o.trials) % methods, row = task / (o.trials * methods);
-    Flight& f = flights[static_cast<std::size_t>(task)];
-    try {
-      // Every method and row flies the same seeds: the rows differ by their faults only.
-      const RunSummary r = RunScenario(WithFaults(o.spiral, cases[row], kMethods[method], o.seed + trial), RunOptions{});
-      f.success = r.success;
-      f.rmse = r.tracking_rmse_m;
-      f.max_error = r.max_position_error_m;
-      f.failure = r.failure_reason;
-    } catch (const std::exception& e) {
-      f.failure = std::string("error: ") + e.what();
-    }
+    // Every method and row flies the same seeds: the rows differ by their faults only.
+    flights[static_cast<std::size_t>(task)] = FlyOnce(WithFaults(o.spiral, cases[row], kMethods[method], o.seed + trial));
   }, o.progress);
 
   nlohmann::json table1 = nlohmann::json::array();
@@ -209,6 +307,7 @@ nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
     }
     reconfig = variants;
   }
+  const nlohmann::json table2 = o.plan_4x1.assembly_plan && o.plan_3x2.assembly_plan ? RunTableTwo(o) : nlohmann::json();
   nlohmann::json failures = nlohmann::json::array();
   for (int task = 0; task < total && failures.size() < 10; ++task) {
     const Flight& f = flights[static_cast<std::size_t>(task)];
@@ -218,7 +317,7 @@ nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
                         {"seed", o.seed + task % o.trials},
                         {"reason", f.failure}});
   }
-  return {{"benchmark", "mars"},
+  nlohmann::json result = {{"benchmark", "mars"},
           {"assembly", o.spiral.assembly->name},
           {"trials", o.trials},
           {"table1", table1},
@@ -236,6 +335,11 @@ nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
                               : nlohmann::json(std::max(reconfig["naive"]["separation_max_attitude_deg"].get<double>(),
                                                         reconfig["naive"]["docking_max_attitude_deg"].get<double>()))},
           {"failures", failures}};
+  for (const char* key : {"table2", "table2_improvement_average", "table2_improvement_row_mean",
+                          "table2_ours_better_in_every_row"}) {
+    result[key] = table2.is_null() ? nlohmann::json(nullptr) : table2[key];
+  }
+  return result;
 }
 
 std::string MarsMarkdown(const nlohmann::json& r) {
@@ -265,6 +369,25 @@ std::string MarsMarkdown(const nlohmann::json& r) {
                        x["separation_max_accel_m_s2"].get<double>(), x["docking_max_attitude_deg"].get<double>(),
                        x["docking_max_accel_m_s2"].get<double>(), x["unit_max_tilt_deg"].get<double>());
     }
+  }
+  if (!r["table2"].is_null()) {
+    s += "\nTable II (planned by each method, flown with the full reallocation: mean tracking RMSE, success rate, "
+         "the trajectory's duration)\n\n| shape | fault | baseline (SVSDF) | ours | improvement |\n|---|---|---|---|---|\n";
+    for (const auto& row : r["table2"]) {
+      const auto cell = [&](const std::string& m) {
+        if (!row[m + "_planned"].get<bool>()) return "no plan: " + row[m + "_plan_failure"].get<std::string>();
+        return fmt::format("{:.3f} m ({:.0f} %, {:.1f} s)", row[m + "_error_m"].get<double>(),
+                           100.0 * row[m + "_success_rate"].get<double>(), row[m + "_duration_s"].get<double>());
+      };
+      s += fmt::format("| {} | {} | {} | {} | {:.1f} % |\n", row["shape"].get<std::string>(),
+                       row["fault"].get<std::string>(), cell("baseline"), cell("ours"),
+                       100.0 * row["improvement"].get<double>());
+    }
+    s += fmt::format("\naverage improvement {:.1f} % (1 - mean ours / mean baseline, the paper's Average row; "
+                     "{:.1f} % as the mean of the rows'); ours better in every row: {}\n",
+                     100.0 * r["table2_improvement_average"].get<double>(),
+                     100.0 * r["table2_improvement_row_mean"].get<double>(),
+                     r["table2_ours_better_in_every_row"].get<bool>() ? "yes" : "no");
   }
   return s;
 }

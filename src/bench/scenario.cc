@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "rotorguard/bench/assembly_mission.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/planning/references.h"
@@ -206,7 +207,8 @@ sim::World ParseWorld(const ConfigNode& node) {
 std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, Scenario* scenario,
                                                         std::string* type) {
   const Scenario& s = *scenario;
-  *type = node.Required("type").AsEnum({"hover", "takeoff", "lemniscate", "circle", "waypoints", "navigate"});
+  *type = node.Required("type").AsEnum(
+      {"hover", "takeoff", "lemniscate", "circle", "waypoints", "navigate", "assembly_plan"});
   std::shared_ptr<const ReferenceTrajectory> ref;
   const double yaw = OptionalDouble(node, "yaw_rad", s.initial_yaw_rad);
   try {
@@ -243,6 +245,26 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       ReadOptional(node, "climb_m_s", &o.climb_m_s);
       o.yaw_rad = yaw;
       ref = std::make_shared<planning::CircleReference>(o);
+    } else if (*type == "assembly_plan") {
+      // Planned once the stack's keys are read (its known faults): LoadScenario's end.
+      if (!s.assembly) node.Fail("mission assembly_plan plans for an assembly; expected the key 'assembly'");
+      AssemblyPlanSpec p;
+      p.goal_m = node.Required("goal_m").AsVector3();
+      if (const auto m = node.Optional("method")) p.method = m->AsEnum({"ours", "baseline"});
+      for (const auto& [key, field] : {std::pair{"max_speed_m_s", &p.max_speed_m_s},
+                                       std::pair{"max_accel_m_s2", &p.max_accel_m_s2},
+                                       std::pair{"max_jerk_m_s3", &p.max_jerk_m_s3},
+                                       std::pair{"max_yaw_rate_rad_s", &p.max_yaw_rate_rad_s}}) {
+        if (const auto v = node.Optional(key)) *field = v->AsPositive();
+      }
+      if (const auto v = node.Optional("safety_factor")) p.safety_factor = v->AsDoubleIn(0.01, 1.0);
+      if (const auto v = node.Optional("attitude_weight")) p.attitude_weight = v->AsDoubleIn(0.0, 100.0);
+      if (const auto v = node.Optional("map_resolution_m")) p.map_resolution_m = v->AsDoubleIn(0.02, 1.0);
+      scenario->assembly_plan = p;
+      planning::HoverOptions o;
+      o.position_m = s.initial_position_m;
+      o.yaw_rad = s.initial_yaw_rad;
+      ref = std::make_shared<planning::HoverReference>(o);
     } else if (*type == "navigate") {
       // Planned on the LiDAR map (docs/planning.md): the stack holds the initial position until
       // its first plan, then flies the waypoints in turn, `rounds` times.
@@ -772,6 +794,11 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   if (s.stack.navigation.method == "flatness" || s.stack.controller == "lqr") {
     // Paper 004's planner and controller work on the vehicle's PWM model: its layout is checked now.
     ValidateAt(root.Required(vehicle_key), [&] { vehicle::PwmQuadModel::FromVehicle(s.vehicle); });
+  }
+  if (s.assembly_plan) {
+    const AssemblyPlanResult plan = PlanAssemblyMission(s);
+    if (!plan.ok) root.Required("mission").Fail("cannot plan the assembly's path: " + plan.message);
+    s.reference = plan.trajectory;
   }
   CheckReferenceAboveGround(root.Required("mission"), s);
   return s;

@@ -76,6 +76,7 @@ Assembly BuildAssembly(const AssemblySpec& spec) {
       v.rotors.push_back(rotor);
     }
     radius = std::max(radius, r.norm() + u.collision_radius_m);
+    v.collision_spheres.push_back({r, u.collision_radius_m});  // the footprint: a sphere per unit
   }
   v.collision_radius_m = radius;
   v.Validate();

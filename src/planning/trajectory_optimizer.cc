@@ -3,32 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
-#include <mutex>
-
-#include <ceres/first_order_function.h>
-#include <ceres/gradient_problem.h>
-#include <ceres/gradient_problem_solver.h>
-#include <glog/logging.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/planning/lbfgs.h"
 
 namespace rotorguard::planning {
 
 namespace {
 
 constexpr int kC = MinimumJerkTrajectory::kCoefficients;
-
-/// max(x, 0)^3 and its derivative: the penalty of eqs. (26)-(29) and (36), cubed throughout so
-/// that the objective is twice differentiable where a limit becomes active (the paper cubes the
-/// clearance term only).
-double Cubed(double x, double* slope) {
-  if (x <= 0.0) {
-    *slope = 0.0;
-    return 0.0;
-  }
-  *slope = 3.0 * x * x;
-  return x * x * x;
-}
 
 /// Splits x = [q columns, τ] into waypoints and durations.
 void Unpack(const Eigen::VectorXd& x, int pieces, Eigen::Matrix3Xd* q, Eigen::VectorXd* t) {
@@ -98,10 +81,6 @@ const char* ToString(TrajectoryOptimizerSummary::Status status) {
 }
 
 TrajectoryOptimizer::TrajectoryOptimizer(const TrajectoryOptimizerOptions& options) : options_(options) {
-  // Ceres's line search logs a harmless glog warning whenever its interpolating polynomial is
-  // constant; a library does not print (DESIGN.md), so glog is kept to errors.
-  static std::once_flag quiet;
-  std::call_once(quiet, [] { FLAGS_minloglevel = std::max(FLAGS_minloglevel, static_cast<int>(google::GLOG_ERROR)); });
   options_.Validate();
 }
 
@@ -121,8 +100,9 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   double cost = o.weight_time * t.sum() + o.weight_smoothness * traj.Energy();
   dc *= o.weight_smoothness;
   dt = dt * o.weight_smoothness + Eigen::VectorXd::Constant(pieces, o.weight_time);
-  // Sampled penalties. A sample at t = s T_i moves with T_i: its explicit derivative is the next
-  // derivative of the sampled quantity times s.
+  // Sampled penalties, cubed throughout (the paper cubes the clearance term only). A sample at
+  // t = s T_i moves with T_i: its explicit derivative is the next derivative of the sampled
+  // quantity times s.
   const double limit2[3] = {limits.v_max * limits.v_max, limits.a_max * limits.a_max, limits.j_max * limits.j_max};
   const int k_samples = o.samples_per_piece;
   for (int i = 0; i < pieces; ++i) {
@@ -138,7 +118,7 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
       const Eigen::Matrix<double, 5, 3> der = basis * c;  // p, v, a, j, snap
       for (int d = 1; d <= 3; ++d) {  // J_d: velocity, acceleration, jerk (eqs. 26-29)
         double slope;
-        const double pen = Cubed(der.row(d).squaredNorm() - limit2[d - 1], &slope);
+        const double pen = CubicPenalty(der.row(d).squaredNorm() - limit2[d - 1], &slope);
         if (slope == 0.0) continue;
         cost += o.weight_feasibility * pen;
         const Eigen::RowVector3d dp = o.weight_feasibility * slope * 2.0 * der.row(d);  // d cost / d derivative
@@ -151,7 +131,7 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
         for (std::size_t k = cursor; k < list.size() && list[k].sample == j; ++k) {
           const ObstaclePlane& plane = list[k].plane;
           double slope;
-          const double pen = Cubed(o.clearance_m - (p - plane.point).dot(plane.normal), &slope);
+          const double pen = CubicPenalty(o.clearance_m - (p - plane.point).dot(plane.normal), &slope);
           if (slope == 0.0) continue;  // (a NaN plane makes the cost NaN: a failed evaluation, not a skip)
           cost += o.weight_collision * pen;
           const Eigen::RowVector3d dp = -o.weight_collision * slope * plane.normal.transpose();
@@ -175,41 +155,6 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   return cost;
 }
 
-namespace {
-
-/// The objective for Ceres. A non-finite cost or gradient is reported as a failed evaluation, which
-/// the line search backs away from: Ceres alone can accept a NaN cost and declare convergence.
-class CeresObjective final : public ceres::FirstOrderFunction {
- public:
-  CeresObjective(const TrajectoryOptimizer& optimizer, const PvaState& head, const PvaState& tail,
-                 const DynamicLimits& limits, const PlaneSet& planes, int size, int* evaluations)
-      : optimizer_(optimizer), head_(head), tail_(tail), limits_(limits), planes_(planes), size_(size),
-        evaluations_(evaluations) {}
-  bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
-    ++*evaluations_;
-    const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(parameters, size_);
-    Eigen::VectorXd g;
-    *cost = optimizer_.Objective(head_, tail_, limits_, planes_, x, gradient ? &g : nullptr);
-    if (!std::isfinite(*cost)) return false;
-    if (gradient) {
-      if (!g.allFinite()) return false;
-      Eigen::Map<Eigen::VectorXd>(gradient, size_) = g;
-    }
-    return true;
-  }
-  int NumParameters() const override { return size_; }
-
- private:
-  const TrajectoryOptimizer& optimizer_;
-  const PvaState& head_;
-  const PvaState& tail_;
-  const DynamicLimits& limits_;
-  const PlaneSet& planes_;
-  int size_;
-  int* evaluations_;
-};
-
-}  // namespace
 
 TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, const PvaState& tail,
                                                          const Eigen::Matrix3Xd& waypoints,
@@ -248,21 +193,14 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   summary.initial_cost = Objective(head, tail, limits, sorted, x, nullptr);
   if (!std::isfinite(summary.initial_cost)) return fail(Status::kInvalidInput, "the initial guess has no trajectory");
 
-  ceres::GradientProblemSolver::Options solver_options;
-  solver_options.line_search_direction_type = ceres::LBFGS;
-  solver_options.max_num_iterations = options_.max_iterations;
-  solver_options.logging_type = ceres::SILENT;
-  solver_options.use_approximate_eigenvalue_bfgs_scaling = true;
-  solver_options.function_tolerance = options_.relative_cost_tolerance;
-  solver_options.gradient_tolerance = 1e-8;
-  ceres::GradientProblem problem(new CeresObjective(*this, head, tail, limits, sorted, n, &summary.evaluations));
-  ceres::GradientProblemSolver::Summary ceres_summary;
-  ceres::Solve(solver_options, problem, x.data(), &ceres_summary);
-  summary.iterations = static_cast<int>(ceres_summary.iterations.size());
+  const LbfgsSummary lbfgs = MinimizeLbfgs(
+      [&](const Eigen::VectorXd& v, Eigen::VectorXd* g) { return Objective(head, tail, limits, sorted, v, g); },
+      {options_.max_iterations, options_.relative_cost_tolerance}, &x);
+  summary.iterations = lbfgs.iterations;
+  summary.evaluations = lbfgs.evaluations;
   summary.final_cost = Objective(head, tail, limits, sorted, x, nullptr);
-  if (!x.allFinite() || !std::isfinite(summary.final_cost) ||
-      ceres_summary.termination_type == ceres::FAILURE) {
-    return fail(Status::kSolverFailure, "L-BFGS: " + ceres_summary.message);
+  if (!x.allFinite() || !std::isfinite(summary.final_cost) || lbfgs.failed) {
+    return fail(Status::kSolverFailure, "L-BFGS: " + lbfgs.message);
   }
 
   // Honest feasibility: check densely and, while a limit is exceeded, stretch time. With the
@@ -293,7 +231,7 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   }
   *out = std::move(traj);
   summary.status = Status::kSuccess;
-  summary.message = ceres_summary.message;
+  summary.message = lbfgs.message;
   summary.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }

@@ -187,8 +187,17 @@ const SensorOutputs& Simulator::Step(const RotorCommand& command) {
   UpdateOutputs();
   if (!crash_reason_ && !landed_) {
     const StateView s(x_);
-    if (auto hit = world_.SphereCollision(s.p_W(), model_.params().collision_radius_m, time_s())) {
-      crash_reason_ = "collision with " + *hit;
+    const vehicle::VehicleParams& v = model_.params();
+    if (v.collision_spheres.empty()) {
+      if (auto hit = world_.SphereCollision(s.p_W(), v.collision_radius_m, time_s())) crash_reason_ = "collision with " + *hit;
+    } else {
+      const Matrix3 R = s.q_WB().toRotationMatrix();
+      for (const vehicle::CollisionSphere& c : v.collision_spheres) {
+        if (auto hit = world_.SphereCollision(s.p_W() + R * c.centre_B, c.radius_m, time_s())) {
+          crash_reason_ = "collision with " + *hit;
+          break;
+        }
+      }
     }
   }
 

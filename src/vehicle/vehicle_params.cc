@@ -61,6 +61,17 @@ void VehicleParams::Validate() const {
     ThrowValidation(kOwner, "unloaded_rpm_ratio", unloaded_speed_ratio, "a value in [1, 3]");
   }
   RequirePositive("collision_radius_m", collision_radius_m);
+  for (std::size_t i = 0; i < collision_spheres.size(); ++i) {
+    const CollisionSphere& c = collision_spheres[i];
+    if (!c.centre_B.allFinite()) {
+      ThrowValidation(kOwner, fmt::format("collision_spheres.{}.centre_m", i), "(non-finite)", "finite numbers");
+    }
+    RequirePositive(fmt::format("collision_spheres.{}.radius_m", i), c.radius_m);
+    if (c.centre_B.norm() + c.radius_m > collision_radius_m * (1.0 + 1e-9)) {
+      ThrowValidation(kOwner, fmt::format("collision_spheres.{}", i), c.centre_B.norm() + c.radius_m,
+                      fmt::format("within the bounding collision_radius_m = {} m", collision_radius_m));
+    }
+  }
   RequireNonNegative("pwm_gain_n", pwm_gain_n);
   if (rotors.empty() || num_rotors() > kMaxRotors) {
     ThrowValidation(kOwner, "rotors", fmt::format("({} rotors)", rotors.size()),

@@ -42,36 +42,8 @@ TEST(AttitudeObjective, TheOptimalAttitudeFliesARowLengthwise) {
   EXPECT_NEAR(OptimalYaws(a, dead, Eigen::Vector2d::UnitX(), 24)[0], 0.0, 1e-12);
 }
 
-/// A wall across x = 0..0.2 with a gap of `gap_m` around y = 0 (voxel centres with |y| below half
-/// the gap are free), in a map inflated by the unit's radius plus 5 cm; `centres` gets the wall's
-/// voxel centres.
-perception::VoxelMap WallWithGap(double gap_m, std::vector<Vector3>* centres = nullptr) {
-  perception::VoxelMapOptions o;
-  o.resolution_m = 0.1;
-  o.window_size_m = Vector3(6.4, 6.4, 4.0);
-  o.inflation_radius_m = 0.2;
-  perception::VoxelMap map(o);
-  for (int i = 0; i < 2; ++i) {
-    for (int j = -32; j < 32; ++j) {
-      const double y = 0.1 * j + 0.05;
-      if (std::abs(y) < 0.5 * gap_m) continue;
-      for (int k = 0; k < 20; ++k) {
-        const Vector3 c(0.1 * i + 0.05, y, 0.1 * k + 0.05);
-        map.MarkOccupied(c);
-        if (centres) centres->push_back(c);
-      }
-    }
-  }
-  return map;
-}
-
-AssemblyAStarOptions Band() {
-  AssemblyAStarOptions o;
-  o.z_min_m = 1.45;
-  o.z_max_m = 1.55;  // one layer: the wall cannot be flown over
-  o.yaw_bins = 8;
-  return o;
-}
+using testing::Band;
+using testing::WallWithGap;
 
 TEST(AssemblyAStar, ARowTurnsLengthwiseToPassAGapNarrowerThanItIsLong) {
   const Assembly a = testing::MarsAssembly("4x1");  // 1.05 m long, 0.3 m wide
@@ -85,13 +57,7 @@ TEST(AssemblyAStar, ARowTurnsLengthwiseToPassAGapNarrowerThanItIsLong) {
   bool crossed_lengthwise = false;
   for (const AssemblyPose& pose : path.poses) {
     // The truth, by brute force: every unit's sphere clear of every wall voxel centre.
-    const double c = std::cos(pose.yaw_rad), s = std::sin(pose.yaw_rad);
-    for (const Vector3& u : a.unit_position_B) {
-      const Vector3 p = pose.p_W + Vector3(c * u.x() - s * u.y(), s * u.x() + c * u.y(), 0.0);
-      double nearest = 1e9;
-      for (const Vector3& w : wall) nearest = std::min(nearest, (w - p).norm());
-      EXPECT_GE(nearest, a.unit_radius_m) << "unit at " << p.transpose();
-    }
+    EXPECT_GE(testing::NearestUnitToPoints(a, pose, wall), a.unit_radius_m) << "at " << pose.p_W.transpose();
     if (pose.p_W.x() > -0.1 && pose.p_W.x() < 0.3) {
       crossed_lengthwise = std::abs(std::sin(pose.yaw_rad)) < 1e-9;
     }

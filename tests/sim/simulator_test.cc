@@ -116,6 +116,32 @@ TEST(Simulator, FlyingIntoABoxIsACollision) {
   EXPECT_EQ(*rig.sim.crash_reason(), "collision with box 0");
 }
 
+/// A body made of two spheres 0.8 m apart (an assembly's footprint) hovering beside a box that
+/// lies inside the bounding sphere but clear of both spheres: no collision; the same box under
+/// one of the spheres is one.
+TEST(Simulator, CollisionSpheresAreTheBodysShape) {
+  vehicle::VehicleParams p = ReferenceQuad();
+  p.collision_radius_m = 0.6;
+  p.collision_spheres = {{Vector3(0.4, 0.0, 0.0), 0.15}, {Vector3(-0.4, 0.0, 0.0), 0.15}};
+  const auto hover_beside = [&](const Vector3& box_centre) {
+    World w;
+    w.boxes.push_back(Box{box_centre, Vector3(0.1, 0.1, 0.1), 0.0});
+    vehicle::MultirotorModel model(p);
+    Simulator sim(model, std::move(w), {}, SimulatorOptions{}, 1,
+                  model.MakeState(Vector3(0, 0, 2.0), 0.0, model.HoverThrusts()));
+    RotorCommand hover;
+    hover.thrust_n = model.HoverThrusts();
+    for (int k = 0; k < 100; ++k) sim.Step(hover);
+    return sim.crashed();
+  };
+  // 0.35 m beside the centre: within the 0.6 m bounding sphere, 0.48 m from either sphere's centre.
+  EXPECT_FALSE(hover_beside(Vector3(0.0, 0.35, 2.0)));
+  // Under the sphere at x = 0.4: its 0.15 m reach touches the box's top face 0.1 m below.
+  EXPECT_TRUE(hover_beside(Vector3(0.4, 0.0, 1.85)));
+  p.collision_spheres[1].radius_m = 0.3;  // beyond the bounding sphere: invalid
+  EXPECT_THROW(p.Validate(), ValidationError);
+}
+
 TEST(Simulator, NonFiniteCommandsReachTheMotorsAsZero) {
   Rig rig({}, 2.0);
   RotorCommand bad = rig.hover;

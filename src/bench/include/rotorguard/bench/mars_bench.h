@@ -28,6 +28,10 @@ struct MarsBenchOptions {
   /// flown over `trials` seeds with the separation prepared and with a naive switch. Skipped when
   /// it has no assembly.
   Scenario reconfigure;
+  /// configs/scenarios/mars_plan_4x1.yaml and mars_plan_3x2.yaml: Table II's scenes (mission
+  /// assembly_plan), each planned by ours and by the baseline for every row's fault and flown over
+  /// `trials` seeds. Table II is skipped when either has no assembly_plan mission.
+  Scenario plan_4x1, plan_3x2;
   std::function<void(int, int)> progress;
   /// Throws std::invalid_argument naming the field.
   void Validate() const;
@@ -37,8 +41,9 @@ struct MarsBenchOptions {
 /// ..._success_rate, full_over_fault_free}], table1_full_within_1_5x_fault_free (over the cases
 /// that can hover), alloc_us_mean, alloc_us_p99, reconfig_max_attitude_deg (the largest over the
 /// separations and dockings of all trials, prepared separation) and reconfig_max_attitude_deg_naive,
-/// ...}. Errors are per-flight tracking RMSEs
-/// averaged over the trials.
+/// table2: [{shape, fault, baseline_error_m, ours_error_m, improvement, ..._success_rate,
+/// ..._duration_s, ..._plan_ms}], table2_improvement_average (1 - mean ours / mean baseline, the
+/// paper's Average row), ...}. Errors are per-flight tracking RMSEs averaged over the trials.
 nlohmann::json RunMarsBenchmark(const MarsBenchOptions& options);
 std::string MarsMarkdown(const nlohmann::json& result);
 

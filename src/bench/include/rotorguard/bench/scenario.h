@@ -21,6 +21,24 @@
 
 namespace rotorguard::bench {
 
+/// Mission `assembly_plan` (paper 002, Sec. III): the assembly plans from its initial pose to
+/// `goal_m` on the world's geometry (a known map, the paper's setting) with the dynamically
+/// feasible A* and the shape-aware trajectory optimisation (modular/assembly_trajectory.h), for the
+/// rotors the stack knows of (stack.known_faults), and flies the result.
+struct AssemblyPlanSpec {
+  Vector3 goal_m = Vector3::Zero();
+  /// "ours" (eqs. 9 and 11-12 with the assembly's dynamics) or "baseline" (Table II's SVSDF row:
+  /// kinematic limits only, no attitude terms).
+  std::string method = "ours";
+  double max_speed_m_s = 1.0;
+  double max_accel_m_s2 = 2.0;
+  double max_jerk_m_s3 = 6.0;
+  double max_yaw_rate_rad_s = 1.0;  ///< ours: the yaw's rate limit [rad/s]
+  double safety_factor = 0.7;       ///< ours: the share of the assembly's capacity planned for, in (0, 1]
+  double attitude_weight = 0.3;     ///< ours: L_Phi of the A* (eq. 9b) [m/rad]
+  double map_resolution_m = 0.1;
+};
+
 struct Scenario {
   std::string name;
   std::string file;           ///< the scenario file it came from ("" when built in code)
@@ -36,8 +54,9 @@ struct Scenario {
   sim::World world;
   Vector3 initial_position_m = Vector3::Zero();
   double initial_yaw_rad = 0.0;
-  std::string mission_type;   ///< hover, takeoff, lemniscate, circle, waypoints
+  std::string mission_type;   ///< hover, takeoff, lemniscate, circle, waypoints, navigate, assembly_plan
   std::shared_ptr<const ReferenceTrajectory> reference;
+  std::optional<AssemblyPlanSpec> assembly_plan;  ///< mission assembly_plan
   std::vector<sim::FaultSpec> faults;
   sim::SimulatorOptions sim;
   stack::FlightStackOptions stack;

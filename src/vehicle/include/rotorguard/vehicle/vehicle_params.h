@@ -21,6 +21,12 @@ struct Rotor {
   double yaw_sign() const { return direction == SpinDirection::kClockwise ? 1.0 : -1.0; }
 };
 
+/// A sphere of the body that must not touch an obstacle (body frame).
+struct CollisionSphere {
+  Vector3 centre_B = Vector3::Zero();
+  double radius_m = 0.0;
+};
+
 struct VehicleParams {
   std::string name;
   double mass_kg = 0.0;                            ///< m_0
@@ -31,7 +37,10 @@ struct VehicleParams {
   double motor_time_constant_s = 0.0;              ///< sigma (eq. 6)
   double motor_stop_time_constant_s = 0.0;         ///< decay of a stopped motor's speed
   double unloaded_speed_ratio = 1.0;               ///< speed of a motor without propeller / loaded
-  double collision_radius_m = 0.0;                 ///< sphere used for collision checks
+  double collision_radius_m = 0.0;                 ///< sphere about the CoG that bounds the body [m]
+  /// The body's shape for collision checks when it is not one sphere (an assembly: one sphere per
+  /// unit, paper 002's footprint); empty: the sphere of collision_radius_m about the CoG.
+  std::vector<CollisionSphere> collision_spheres;
   /// K of paper 004, eq. (2): thrust per unit of PWM input [N] (T_i = K u_i), for vehicles driven
   /// by PWM inputs (PwmQuadModel); 0 when the vehicle has no PWM model.
   double pwm_gain_n = 0.0;

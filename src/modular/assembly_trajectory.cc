@@ -1,0 +1,469 @@
+#include "rotorguard/modular/assembly_trajectory.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/modular/allocation.h"
+#include "rotorguard/planning/lbfgs.h"
+
+namespace rotorguard::modular {
+
+namespace {
+
+constexpr int kC = planning::MinimumJerkTrajectory::kCoefficients;
+using planning::CubicPenalty;
+using planning::TrajectoryOptimizer;  // for its duration map T(τ)
+
+/// d/dψ of R_z(ψ) r for a horizontal offset r.
+Vector3 RotatedDerivative(double yaw, const Vector3& r) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return Vector3(-s * r.x() - c * r.y(), c * r.x() - s * r.y(), 0.0);
+}
+
+Vector3 Rotated(double yaw, const Vector3& r) {
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return Vector3(c * r.x() - s * r.y(), s * r.x() + c * r.y(), r.z());
+}
+
+/// The yaw as a 3-D state: the yaw in x, y and z zero.
+planning::PvaState YawState(double yaw) {
+  planning::PvaState s = planning::PvaState::Zero();
+  s(0, 0) = yaw;
+  return s;
+}
+
+planning::PvaState RestState(const Vector3& p) {
+  planning::PvaState s = planning::PvaState::Zero();
+  s.col(0) = p;
+  return s;
+}
+
+/// The largest s in [lo, hi] with ok(s) (ok(lo) holds), to `tolerance`.
+template <typename Ok>
+double Bisect(double lo, double hi, double tolerance, const Ok& ok) {
+  if (ok(hi)) return hi;
+  while (hi - lo > tolerance) {
+    const double mid = 0.5 * (lo + hi);
+    (ok(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+AssemblyTrajectory::AssemblyTrajectory(planning::MinimumJerkTrajectory position, planning::MinimumJerkTrajectory yaw)
+    : position_(std::move(position)), yaw_(std::move(yaw)) {}
+
+ReferencePoint AssemblyTrajectory::Evaluate(double t) const {
+  ReferencePoint r = position_.Evaluate(t);
+  const ReferencePoint y = yaw_.Evaluate(t);
+  r.yaw = y.p_W.x();
+  r.yaw_rate = y.v_W.x();
+  return r;
+}
+
+AssemblyPose AssemblyTrajectory::PoseAt(double t) const {
+  const ReferencePoint r = Evaluate(t);
+  return {r.p_W, r.yaw};
+}
+
+// ---------------------------------------------------------------------------------------------
+
+AssemblyCapacity CapacityOf(const Assembly& assembly, const RotorVector& eta) {
+  AssemblyAllocator alloc(assembly, {});
+  alloc.SetEffectiveness(eta);
+  RotorVector u;
+  const auto attainable = [&](const Eigen::Vector4d& w) { return alloc.Allocate(w, &u).attainable; };
+  const vehicle::VehicleParams& v = assembly.vehicle;
+  const double weight = v.weight_n();
+  AssemblyCapacity c;
+  c.hover_attainable = attainable(Eigen::Vector4d(weight, 0.0, 0.0, 0.0));
+  if (!c.hover_attainable) return c;
+  const double total = v.total_max_thrust_n();
+  c.max_thrust_n = Bisect(weight, total, 1e-4 * total,
+                          [&](double f) { return attainable(Eigen::Vector4d(f, 0.0, 0.0, 0.0)); });
+  double yaw_reach = 0.0;  // an upper bound: every rotor's reaction torque at full thrust
+  for (const vehicle::Rotor& r : v.rotors) yaw_reach += r.yaw_coefficient_m * r.max_thrust_n;
+  const auto yaw_torque = [&](double sign) {
+    return Bisect(0.0, yaw_reach, 1e-4 * yaw_reach,
+                  [&](double tz) { return attainable(Eigen::Vector4d(weight, 0.0, 0.0, sign * tz)); });
+  };
+  c.max_yaw_torque_n_m = std::min(yaw_torque(1.0), yaw_torque(-1.0));
+  const double f = c.max_thrust_n / v.mass_kg;
+  c.max_acceleration_m_s2 = std::sqrt(std::max(f * f - kGravity * kGravity, 0.0));
+  c.max_yaw_acceleration_rad_s2 = c.max_yaw_torque_n_m / v.inertia_kg_m2(2, 2);
+  return c;
+}
+
+void AssemblyLimits::Validate() const {
+  kinematic.Validate();
+  if (!(std::isfinite(yaw_rate_max) && yaw_rate_max >= 0.0)) {
+    ThrowValidation("AssemblyLimits", "yaw_rate_max", yaw_rate_max, "a finite limit >= 0 (0: none)");
+  }
+  if (!(std::isfinite(yaw_acceleration_max) && yaw_acceleration_max >= 0.0)) {
+    ThrowValidation("AssemblyLimits", "yaw_acceleration_max", yaw_acceleration_max, "a finite limit >= 0 (0: none)");
+  }
+}
+
+AssemblyLimits DynamicsAwareLimits(const planning::DynamicLimits& kinematic, const AssemblyCapacity& capacity,
+                                   double yaw_rate_max, double safety_factor) {
+  if (!(safety_factor > 0.0 && safety_factor <= 1.0)) {
+    ThrowInvalidArgument("DynamicsAwareLimits", "safety_factor", safety_factor, "a factor in (0, 1]");
+  }
+  if (!capacity.hover_attainable || capacity.max_acceleration_m_s2 <= 0.0 ||
+      capacity.max_yaw_acceleration_rad_s2 <= 0.0) {
+    ThrowInvalidArgument("DynamicsAwareLimits", "capacity", capacity.max_acceleration_m_s2,
+                         "an assembly that can hover with thrust and yaw torque to spare");
+  }
+  AssemblyLimits l;
+  l.kinematic = kinematic;
+  l.kinematic.a_max = std::min(kinematic.a_max, safety_factor * capacity.max_acceleration_m_s2);
+  l.yaw_rate_max = yaw_rate_max;
+  l.yaw_acceleration_max = safety_factor * capacity.max_yaw_acceleration_rad_s2;
+  return l;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void AssemblyTrajectoryOptions::Validate() const {
+  const auto require = [](bool ok, const char* field, double v, const char* rule) {
+    if (!ok) ThrowValidation("AssemblyTrajectoryOptions", field, v, rule);
+  };
+  for (const auto& [v, f] : {std::pair{weight_time, "weight_time"}, std::pair{weight_smoothness, "weight_smoothness"},
+                             std::pair{weight_obstacle, "weight_obstacle"},
+                             std::pair{weight_dynamics, "weight_dynamics"},
+                             std::pair{weight_attitude, "weight_attitude"}}) {
+    require(std::isfinite(v) && v >= 0.0, f, v, "a finite weight >= 0");
+  }
+  require(std::isfinite(clearance_m) && clearance_m >= 0.0, "clearance_m", clearance_m, "a distance >= 0 m");
+  require(std::isfinite(obstacle_range_m) && obstacle_range_m > clearance_m, "obstacle_range_m", obstacle_range_m,
+          "a distance > clearance_m");
+  require(samples_per_piece >= 2 && samples_per_piece <= 1000, "samples_per_piece", samples_per_piece, "in [2, 1000]");
+  require(plane_rounds >= 1, "plane_rounds", plane_rounds, ">= 1");
+  require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
+  require(relative_cost_tolerance > 0.0 && relative_cost_tolerance <= 0.1, "relative_cost_tolerance",
+          relative_cost_tolerance, "in (0, 0.1]");
+  require(std::isfinite(waypoint_spacing_m) && waypoint_spacing_m > 0.0, "waypoint_spacing_m", waypoint_spacing_m,
+          "a distance > 0 m");
+  require(check_samples_per_piece >= samples_per_piece, "check_samples_per_piece", check_samples_per_piece,
+          "at least samples_per_piece");
+  require(max_slowdowns >= 0, "max_slowdowns", max_slowdowns, ">= 0");
+  require(slowdown_factor > 1.0 && slowdown_factor <= 2.0, "slowdown_factor", slowdown_factor, "in (1, 2]");
+  require(attitude_bins >= 4 && attitude_bins <= 3600, "attitude_bins", attitude_bins, "in [4, 3600]");
+}
+
+const char* ToString(AssemblyTrajectorySummary::Status status) {
+  using S = AssemblyTrajectorySummary::Status;
+  switch (status) {
+    case S::kSuccess: return "success";
+    case S::kInvalidInput: return "invalid_input";
+    case S::kSolverFailure: return "solver_failure";
+    case S::kInfeasible: return "infeasible";
+    case S::kCollides: return "collides";
+  }
+  return "unknown";
+}
+
+AssemblyTrajectoryOptimizer::AssemblyTrajectoryOptimizer(const Assembly& assembly, const RotorVector& eta,
+                                                         const AssemblyTrajectoryOptions& options)
+    : assembly_(assembly), options_(options) {
+  options_.Validate();
+  // Eq. (7) depends on the yaw relative to the direction of flight only: solve it once, flying
+  // along x.
+  optimal_relative_yaws_ = OptimalYaws(assembly, eta, Eigen::Vector2d::UnitX(), options_.attitude_bins);
+  for (double& a : optimal_relative_yaws_) a = std::fmod(a + 2.0 * std::numbers::pi, 2.0 * std::numbers::pi);
+  std::sort(optimal_relative_yaws_.begin(), optimal_relative_yaws_.end());
+  for (const Vector3& r : assembly.unit_position_B) yaw_length_m_ = std::max(yaw_length_m_, r.head<2>().norm());
+}
+
+double AssemblyTrajectoryOptimizer::AttitudeError(double yaw, double heading) const {
+  double best = std::numeric_limits<double>::infinity();
+  for (const double a : optimal_relative_yaws_) {
+    const double e = WrapAngle(heading + a - yaw);
+    if (std::abs(e) < std::abs(best)) best = e;
+  }
+  return best;
+}
+
+bool AssemblyTrajectoryOptimizer::Build(const Problem& problem, const Eigen::VectorXd& x,
+                                        AssemblyTrajectory* out) const {
+  const int m = static_cast<int>((x.size() + 4) / 5);
+  if (m < 1 || x.size() != 5 * m - 4) return false;
+  const Eigen::Matrix3Xd qp = Eigen::Map<const Eigen::Matrix3Xd>(x.data(), 3, m - 1);
+  Eigen::Matrix3Xd qy = Eigen::Matrix3Xd::Zero(3, m - 1);
+  qy.row(0) = x.segment(3 * (m - 1), m - 1).transpose();
+  Eigen::VectorXd t(m);
+  for (int i = 0; i < m; ++i) t(i) = TrajectoryOptimizer::DurationOf(x(4 * (m - 1) + i));
+  planning::MinimumJerkTrajectory pos, yaw;
+  if (!pos.Build(RestState(problem.start.p_W), RestState(problem.goal.p_W), qp, t)) return false;
+  if (!yaw.Build(YawState(problem.start.yaw_rad), YawState(problem.goal.yaw_rad), qy, t)) return false;
+  *out = AssemblyTrajectory(std::move(pos), std::move(yaw));
+  return true;
+}
+
+double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eigen::VectorXd& x,
+                                              Eigen::VectorXd* gradient) const {
+  AssemblyTrajectory traj;
+  if (!Build(problem, x, &traj)) return std::numeric_limits<double>::quiet_NaN();
+  const planning::MinimumJerkTrajectory& pos = traj.position();
+  const planning::MinimumJerkTrajectory& yaw = traj.yaw();
+  const int m = pos.pieces();
+  const Eigen::VectorXd& t = pos.durations();
+  const AssemblyTrajectoryOptions& o = options_;
+  const AssemblyLimits& lim = problem.limits;
+
+  // J_t and J_m: the yaw's jerk energy counts as its farthest unit's (ψ times that distance).
+  const double l2 = yaw_length_m_ * yaw_length_m_;
+  Eigen::MatrixX3d dcp, dcy;
+  Eigen::VectorXd dtp, dty;
+  pos.EnergyPartials(&dcp, &dtp);
+  yaw.EnergyPartials(&dcy, &dty);
+  double cost = o.weight_time * t.sum() + o.weight_smoothness * (pos.Energy() + l2 * yaw.Energy());
+  dcp *= o.weight_smoothness;
+  dcy *= o.weight_smoothness * l2;
+  Eigen::VectorXd dt = o.weight_smoothness * (dtp + l2 * dty) + Eigen::VectorXd::Constant(m, o.weight_time);
+
+  const double limit2[3] = {lim.kinematic.v_max * lim.kinematic.v_max, lim.kinematic.a_max * lim.kinematic.a_max,
+                            lim.kinematic.j_max * lim.kinematic.j_max};
+  const double yaw_limit2[2] = {lim.yaw_rate_max * lim.yaw_rate_max,
+                                lim.yaw_acceleration_max * lim.yaw_acceleration_max};
+  const double required = assembly_.unit_radius_m + o.clearance_m;
+  const int k_samples = o.samples_per_piece;
+  for (int i = 0; i < m; ++i) {
+    const auto cp = pos.coefficients().middleRows<kC>(kC * i);
+    const auto cy = yaw.coefficients().middleRows<kC>(kC * i).col(0);
+    std::size_t cursor = 0;
+    for (int j = 0; j <= k_samples; ++j) {
+      const double s = static_cast<double>(j) / k_samples, ts = s * t(i);
+      const Eigen::Matrix<double, 5, kC> basis = planning::MinimumJerkTrajectory::BasisRows(ts);
+      const Eigen::Matrix<double, 5, 3> der = basis * cp;  // p, v, a, j, snap
+      const Eigen::Matrix<double, 5, 1> psi = basis * cy;  // ψ and its derivatives
+      // Accumulates d cost / d (position derivative `d`) and d cost / d (yaw derivative `d`).
+      const auto add_position = [&](int d, const Eigen::RowVector3d& g) {
+        dcp.middleRows<kC>(kC * i) += basis.row(d).transpose() * g;
+        dt(i) += g.dot(der.row(d + 1)) * s;  // the sample moves with T_i
+      };
+      const auto add_yaw = [&](int d, double g) {
+        dcy.middleRows<kC>(kC * i).col(0) += basis.row(d).transpose() * g;
+        dt(i) += g * psi(d + 1) * s;
+      };
+      // G_v, G_a, G_j (kinematic).
+      for (int d = 1; d <= 3; ++d) {
+        double slope;
+        const double pen = CubicPenalty(der.row(d).squaredNorm() - limit2[d - 1], &slope);
+        if (slope == 0.0) continue;
+        cost += o.weight_dynamics * pen;
+        add_position(d, o.weight_dynamics * slope * 2.0 * der.row(d));
+      }
+      // The yaw's rate and acceleration (the assembly's dynamics; 0: off).
+      for (int d = 1; d <= 2; ++d) {
+        if (yaw_limit2[d - 1] <= 0.0) continue;
+        double slope;
+        const double pen = CubicPenalty(psi(d) * psi(d) - yaw_limit2[d - 1], &slope);
+        if (slope == 0.0) continue;
+        cost += o.weight_dynamics * pen;
+        add_yaw(d, o.weight_dynamics * slope * 2.0 * psi(d));
+      }
+      // G_Φ (eq. 12b): |v_xy|² e², e = ψ* - ψ with ψ* = χ + α*, χ = atan2(v_y, v_x). The weight
+      // cancels the heading's singularity: dχ/dv_xy = (-v_y, v_x) / |v_xy|², so
+      // d/dv_xy = 2 e² v_xy + 2 e (-v_y, v_x).
+      const Eigen::Vector2d vh = der.row(1).head<2>().transpose();
+      if (o.weight_attitude > 0.0 && vh.squaredNorm() > 1e-12) {
+        const double e = AttitudeError(psi(0), std::atan2(vh.y(), vh.x()));
+        const double w = o.weight_attitude;
+        cost += w * vh.squaredNorm() * e * e;
+        Eigen::RowVector3d gv = Eigen::RowVector3d::Zero();
+        gv.head<2>() = w * (2.0 * e * e * vh + 2.0 * e * Eigen::Vector2d(-vh.y(), vh.x())).transpose();
+        add_position(1, gv);
+        add_yaw(0, -w * 2.0 * vh.squaredNorm() * e);
+      }
+      // G_o: each unit's centre p + R_z(ψ) r_k against its plane.
+      if (!problem.planes.empty() && o.weight_obstacle > 0.0) {
+        const std::vector<FootprintPlane>& list = problem.planes[static_cast<std::size_t>(i)];
+        while (cursor < list.size() && list[cursor].sample < j) ++cursor;
+        for (std::size_t k = cursor; k < list.size() && list[k].sample == j; ++k) {
+          const Vector3& r = assembly_.unit_position_B[static_cast<std::size_t>(list[k].unit)];
+          const planning::ObstaclePlane& plane = list[k].plane;
+          const Vector3 c = der.row(0).transpose() + Rotated(psi(0), r);
+          double slope;
+          const double pen = CubicPenalty(required - (c - plane.point).dot(plane.normal), &slope);
+          if (slope == 0.0) continue;
+          cost += o.weight_obstacle * pen;
+          const Eigen::RowVector3d gc = -o.weight_obstacle * slope * plane.normal.transpose();
+          add_position(0, gc);
+          add_yaw(0, gc.dot(RotatedDerivative(psi(0), r).transpose()));
+        }
+      }
+    }
+  }
+  if (gradient) {
+    Eigen::Matrix3Xd dqp, dqy;
+    Eigen::VectorXd dtp_total, dty_total;
+    pos.PropagateGradient(dcp, dt, &dqp, &dtp_total);
+    yaw.PropagateGradient(dcy, Eigen::VectorXd::Zero(m), &dqy, &dty_total);
+    gradient->resize(x.size());
+    gradient->head(3 * (m - 1)) = Eigen::Map<const Eigen::VectorXd>(dqp.data(), 3 * (m - 1));
+    gradient->segment(3 * (m - 1), m - 1) = dqy.row(0).transpose();
+    for (int i = 0; i < m; ++i) {
+      const double tau = x(4 * (m - 1) + i);
+      (*gradient)(4 * (m - 1) + i) = (dtp_total(i) + dty_total(i)) * t(i) / std::sqrt(tau * tau + 1.0);
+    }
+  }
+  return cost;
+}
+
+FootprintPlaneSet AssemblyTrajectoryOptimizer::BuildPlanes(const perception::VoxelMap& map,
+                                                           const AssemblyTrajectory& traj) const {
+  const planning::MinimumJerkTrajectory& pos = traj.position();
+  FootprintPlaneSet planes(static_cast<std::size_t>(pos.pieces()));
+  for (int i = 0; i < pos.pieces(); ++i) {
+    for (int j = 0; j <= options_.samples_per_piece; ++j) {
+      const double ts = pos.durations()(i) * j / options_.samples_per_piece;
+      const Vector3 p = pos.PieceDerivative(i, ts, 0);
+      const double psi = traj.yaw().PieceDerivative(i, ts, 0).x();
+      for (int k = 0; k < assembly_.num_units; ++k) {
+        const Vector3 c = p + Rotated(psi, assembly_.unit_position_B[static_cast<std::size_t>(k)]);
+        if (const auto hit = map.Nearest(c, options_.obstacle_range_m)) {
+          planes[static_cast<std::size_t>(i)].push_back({j, k, {hit->point_W, hit->normal_W}});
+        }
+      }
+    }
+  }
+  return planes;
+}
+
+AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception::VoxelMap& map,
+                                                                const AssemblyPath& path,
+                                                                const AssemblyLimits& limits,
+                                                                AssemblyTrajectory* out) const {
+  using Status = AssemblyTrajectorySummary::Status;
+  const auto start = std::chrono::steady_clock::now();
+  AssemblyTrajectorySummary summary;
+  const auto finish = [&](Status status, std::string message) {
+    summary.status = status;
+    summary.message = std::move(message);
+    summary.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+  };
+  try {
+    limits.Validate();
+  } catch (const ValidationError& e) {
+    return finish(Status::kInvalidInput, e.what());
+  }
+  if (path.status != AssemblyPathStatus::kFound || path.poses.size() < 2) {
+    return finish(Status::kInvalidInput, "need a found A* path of at least two poses");
+  }
+
+  // The initial guess: the A* poses, one per waypoint_spacing_m of the path and at every yaw
+  // turn, the yaw unwrapped so that each step turns the short way.
+  std::vector<AssemblyPose> poses = path.poses;
+  std::vector<AssemblyPose> keep{poses.front()};
+  double since = 0.0;
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    const double turn = WrapAngle(poses[k].yaw_rad - path.poses[k - 1].yaw_rad);
+    poses[k].yaw_rad = poses[k - 1].yaw_rad + turn;
+    since += (poses[k].p_W - poses[k - 1].p_W).norm();
+    if (since >= options_.waypoint_spacing_m || std::abs(turn) > 1e-9 || k + 1 == poses.size()) {
+      keep.push_back(poses[k]);
+      since = 0.0;
+    }
+  }
+  const int m = static_cast<int>(keep.size()) - 1;
+  Problem problem;
+  problem.start = keep.front();
+  problem.goal = keep.back();
+  problem.limits = limits;
+  const double v_guess = 0.5 * limits.kinematic.v_max;
+  const double w_guess = limits.yaw_rate_max > 0.0 ? 0.5 * limits.yaw_rate_max : 0.5;
+  Eigen::VectorXd x(5 * m - 4);
+  for (int i = 0; i < m; ++i) {
+    const AssemblyPose &a = keep[static_cast<std::size_t>(i)], &b = keep[static_cast<std::size_t>(i) + 1];
+    if (i + 1 < m) {
+      x.segment<3>(3 * i) = b.p_W;
+      x(3 * (m - 1) + i) = b.yaw_rad;
+    }
+    const double duration =
+        std::max({(b.p_W - a.p_W).norm() / v_guess, std::abs(b.yaw_rad - a.yaw_rad) / w_guess, 0.2});
+    x(4 * (m - 1) + i) = TrajectoryOptimizer::TauOf(duration);
+  }
+
+  AssemblyTrajectory traj;
+  if (!Build(problem, x, &traj)) return finish(Status::kInvalidInput, "the initial guess has no trajectory");
+  std::string message;
+  for (int round = 0; round < options_.plane_rounds; ++round) {
+    problem.planes = BuildPlanes(map, traj);
+    const planning::LbfgsSummary lbfgs = planning::MinimizeLbfgs(
+        [&](const Eigen::VectorXd& v, Eigen::VectorXd* g) { return Objective(problem, v, g); },
+        {options_.max_iterations, options_.relative_cost_tolerance}, &x);
+    summary.iterations += lbfgs.iterations;
+    summary.evaluations += lbfgs.evaluations;
+    message = lbfgs.message;
+    if (!x.allFinite() || lbfgs.failed || !Build(problem, x, &traj)) {
+      return finish(Status::kSolverFailure, "L-BFGS: " + lbfgs.message);
+    }
+  }
+
+  // Honest feasibility: check densely and stretch time while a limit is exceeded (between rest
+  // states, durations times k scale v, a, j by 1/k, 1/k², 1/k³ and the yaw's rate and
+  // acceleration by 1/k, 1/k²).
+  const int dense = options_.check_samples_per_piece;
+  for (;;) {
+    const planning::MinimumJerkTrajectory& pos = traj.position();
+    std::vector<double> ratio = {pos.MaxNorm(1, dense) / limits.kinematic.v_max,
+                                 std::sqrt(pos.MaxNorm(2, dense) / limits.kinematic.a_max),
+                                 std::cbrt(pos.MaxNorm(3, dense) / limits.kinematic.j_max)};
+    if (limits.yaw_rate_max > 0.0) ratio.push_back(traj.yaw().MaxNorm(1, dense) / limits.yaw_rate_max);
+    if (limits.yaw_acceleration_max > 0.0) {
+      ratio.push_back(std::sqrt(traj.yaw().MaxNorm(2, dense) / limits.yaw_acceleration_max));
+    }
+    const double worst = *std::max_element(ratio.begin(), ratio.end());
+    summary.limit_margin = 1.0 - worst;  // of the stretch factor's scale: >= 0 when all hold
+    if (worst <= 1.0) break;
+    if (summary.slowdowns == options_.max_slowdowns) {
+      return finish(Status::kInfeasible, "a limit still exceeded after stretching time " +
+                                             std::to_string(summary.slowdowns) + " times");
+    }
+    ++summary.slowdowns;
+    const double k = std::min(worst * options_.slowdown_factor, 2.0);
+    for (int i = 0; i < m; ++i) x(4 * (m - 1) + i) = TrajectoryOptimizer::TauOf(k * pos.durations()(i));
+    if (!Build(problem, x, &traj)) return finish(Status::kSolverFailure, "the stretched trajectory cannot be built");
+  }
+
+  // The dense check of the footprint and of eq. (12b).
+  const planning::MinimumJerkTrajectory& pos = traj.position();
+  summary.duration_s = pos.total_duration();
+  summary.min_clearance_m = options_.obstacle_range_m;
+  double deviation = 0.0;
+  int moving = 0;
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j <= dense; ++j) {
+      const double ts = pos.durations()(i) * j / dense;
+      const AssemblyPose pose{pos.PieceDerivative(i, ts, 0), traj.yaw().PieceDerivative(i, ts, 0).x()};
+      const Vector3 v = pos.PieceDerivative(i, ts, 1);
+      if (v.head<2>().norm() > 0.1) {
+        deviation += std::abs(AttitudeError(pose.yaw_rad, std::atan2(v.y(), v.x())));
+        ++moving;
+      }
+      for (const Vector3& r : assembly_.unit_position_B) {
+        if (const auto hit = map.Nearest(pose.p_W + Rotated(pose.yaw_rad, r), options_.obstacle_range_m)) {
+          summary.min_clearance_m = std::min(summary.min_clearance_m, hit->distance_m - assembly_.unit_radius_m);
+        }
+      }
+    }
+  }
+  summary.attitude_deviation_rad = moving > 0 ? deviation / moving : 0.0;
+  *out = traj;
+  if (summary.min_clearance_m < 0.0) {
+    return finish(Status::kCollides, "a unit's sphere reaches an occupied voxel's centre");
+  }
+  return finish(Status::kSuccess, message);
+}
+
+}  // namespace rotorguard::modular

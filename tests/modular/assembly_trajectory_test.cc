@@ -1,0 +1,210 @@
+#include "rotorguard/modular/assembly_trajectory.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "modular/assembly_fixture.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "test_util.h"
+
+namespace rotorguard::modular {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+using testing::Band;
+using testing::WallWithGap;
+
+/// A single MARS unit as a one-unit assembly.
+Assembly OneUnit() {
+  AssemblySpec s = testing::MarsSpec("3x1");
+  s.slots = {Eigen::Vector2i(0, 0)};
+  return BuildAssembly(s);
+}
+
+TEST(AssemblyCapacity, OneUnitMatchesTheClosedForms) {
+  const Assembly a = OneUnit();
+  const AssemblyCapacity c = CapacityOf(a, RotorVector::Ones(4));
+  ASSERT_TRUE(c.hover_attainable);
+  EXPECT_NEAR(c.max_thrust_n, 4 * 2.6, 1e-3 * 10.4);  // every rotor at full thrust
+  // At the hover thrust W the largest yaw torque puts W on one diagonal pair (W / 2 = 2.45 N each,
+  // within 2.6 N) and nothing on the other: kappa W.
+  const double w = 0.5 * kGravity;
+  EXPECT_NEAR(c.max_yaw_torque_n_m, 0.016 * w, 1e-3 * 0.016 * w);
+  EXPECT_NEAR(c.max_yaw_acceleration_rad_s2, 0.016 * w / 4.0e-3, 1e-3 * 0.016 * w / 4.0e-3);
+  EXPECT_NEAR(c.max_acceleration_m_s2, std::sqrt(std::pow(10.4 / 0.5, 2) - kGravity * kGravity), 0.05);
+}
+
+TEST(AssemblyCapacity, ADeadEndUnitLeavesTheThrustOfTheLinearProgramSolvedByHand) {
+  // 4x1 with unit No. 4 (x = +0.375 m) dead. Zero pitch torque: the rotors at x = +0.05, +0.2 m
+  // (four, at 2.6 N: 1.3 N m) balance the nearest rotors behind the centre, x = -0.05, -0.2 m
+  // (four at 2.6 N: exactly 1.3 N m). Most thrust: those eight at full, 20.8 N.
+  const Assembly a = testing::MarsAssembly("4x1");
+  RotorVector eta = RotorVector::Ones(16);
+  eta.segment(12, 4).setZero();
+  const AssemblyCapacity c = CapacityOf(a, eta);
+  ASSERT_TRUE(c.hover_attainable);
+  EXPECT_NEAR(c.max_thrust_n, 20.8, 0.01);
+  EXPECT_NEAR(c.max_acceleration_m_s2, std::sqrt(10.4 * 10.4 - kGravity * kGravity), 0.01);
+  // Two dead units at one end cannot hover: no capacity, and ours has no limits to give.
+  eta.segment(8, 4).setZero();
+  const AssemblyCapacity none = CapacityOf(a, eta);
+  EXPECT_FALSE(none.hover_attainable);
+  EXPECT_THROW(DynamicsAwareLimits({}, none, 1.0, 0.8), std::invalid_argument);
+}
+
+TEST(AssemblyTrajectoryOptimizer, AttitudeErrorIsTheDistanceToTheNearestOptimalYaw) {
+  const Assembly a = testing::MarsAssembly("4x1");
+  const AssemblyTrajectoryOptimizer opt(a, RotorVector::Ones(16), {});
+  ASSERT_EQ(opt.optimal_relative_yaws().size(), 2u);  // lengthwise, either way round
+  EXPECT_NEAR(opt.AttitudeError(0.3, 0.0), -0.3, 1e-12);
+  EXPECT_NEAR(opt.AttitudeError(0.5 * kPi + 0.1, 0.0), 0.5 * kPi - 0.1, 1e-12);  // towards pi
+  EXPECT_NEAR(opt.AttitudeError(1.0, 1.2), 0.2, 1e-12);
+}
+
+/// A problem with every term active: tight limits, yaw limits, the attitude term and planes.
+AssemblyTrajectoryOptimizer::Problem ActiveProblem() {
+  AssemblyTrajectoryOptimizer::Problem p;
+  p.start = {Vector3(0.0, 0.0, 1.5), 0.3};
+  p.goal = {Vector3(3.0, 1.0, 1.6), 1.1};
+  p.limits.kinematic = {0.5, 0.3, 0.3};
+  p.limits.yaw_rate_max = 0.3;
+  p.limits.yaw_acceleration_max = 0.2;
+  p.planes.resize(3);
+  p.planes[1].push_back({3, 0, {Vector3(1.5, 0.7, 1.5), Vector3(0.0, -1.0, 0.0)}});
+  p.planes[1].push_back({3, 2, {Vector3(1.5, 0.7, 1.5), Vector3(0.0, -1.0, 0.0)}});
+  p.planes[1].push_back({5, 3, {Vector3(1.4, 0.6, 1.5), Vector3(-0.6, -0.8, 0.0)}});
+  return p;
+}
+
+TEST(AssemblyTrajectoryOptimizer, GradientMatchesFiniteDifferences) {
+  const Assembly a = testing::MarsAssembly("4x1");
+  AssemblyTrajectoryOptions o;
+  o.samples_per_piece = 8;
+  const AssemblyTrajectoryOptimizer opt(a, RotorVector::Ones(16), o);
+  const AssemblyTrajectoryOptimizer::Problem p = ActiveProblem();
+  const int m = 3;
+  Eigen::VectorXd x(5 * m - 4);
+  x << 1.0, 0.3, 1.55, 2.0, 0.6, 1.5, 1.8, -0.6, 1.2, 0.9, 1.2;
+  Eigen::VectorXd g;
+  const double f = opt.Objective(p, x, &g);
+  ASSERT_TRUE(std::isfinite(f));
+  // Every term is active at x: dropping any lowers the cost.
+  const auto without = [&](auto change) {
+    AssemblyTrajectoryOptions less = o;
+    AssemblyTrajectoryOptimizer::Problem q = p;
+    change(&less, &q);
+    return AssemblyTrajectoryOptimizer(a, RotorVector::Ones(16), less).Objective(q, x, nullptr);
+  };
+  EXPECT_LT(without([](auto* w, auto*) { w->weight_obstacle = 0.0; }), f - 1.0);
+  EXPECT_LT(without([](auto* w, auto*) { w->weight_attitude = 0.0; }), f - 1.0);
+  EXPECT_LT(without([](auto*, auto* q) { q->limits.kinematic = {10.0, 10.0, 10.0}; }), f - 1.0);
+  EXPECT_LT(without([](auto*, auto* q) { q->limits.yaw_rate_max = 0.0; }), f - 1.0);
+  EXPECT_LT(without([](auto*, auto* q) { q->limits.yaw_acceleration_max = 0.0; }), f - 1.0);
+  ASSERT_EQ(g.size(), x.size());
+  for (int k = 0; k < x.size(); ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd xp = x, xm = x;
+    xp(k) += h;
+    xm(k) -= h;
+    const double fd = (opt.Objective(p, xp, nullptr) - opt.Objective(p, xm, nullptr)) / (2.0 * h);
+    const double rounding = 1e-15 * std::abs(f) / h;  // of the difference quotient itself
+    EXPECT_NEAR(g(k), fd, 1e-5 * std::max(1.0, std::abs(fd)) + 10.0 * rounding) << "variable " << k;
+  }
+}
+
+/// The straight A* path of a row from (-2, 0) to (2, 0) at yaw `yaw`, a pose per 0.1 m.
+AssemblyPath StraightPath(double yaw) {
+  AssemblyPath path;
+  path.status = AssemblyPathStatus::kFound;
+  for (int k = 0; k <= 40; ++k) path.poses.push_back({Vector3(-2.0 + 0.1 * k, 0.0, 1.5), yaw});
+  return path;
+}
+
+AssemblyLimits Limits() {
+  AssemblyLimits l;
+  l.kinematic = {1.0, 1.5, 4.0};
+  l.yaw_rate_max = 1.0;
+  l.yaw_acceleration_max = 1.5;
+  return l;
+}
+
+TEST(AssemblyTrajectoryOptimizer, TheAttitudeTermTurnsABroadsideRowLengthwiseWithinTheLimits) {
+  const Assembly a = testing::MarsAssembly("4x1");
+  const perception::VoxelMap map = WallWithGap(100.0);  // open space
+  AssemblyTrajectoryOptions ours;
+  AssemblyTrajectoryOptions baseline = ours;
+  baseline.weight_attitude = 0.0;
+  AssemblyTrajectory t_ours, t_base;
+  const AssemblyTrajectorySummary s_ours =
+      AssemblyTrajectoryOptimizer(a, RotorVector::Ones(16), ours).Optimize(map, StraightPath(0.5 * kPi), Limits(), &t_ours);
+  const AssemblyTrajectorySummary s_base = AssemblyTrajectoryOptimizer(a, RotorVector::Ones(16), baseline)
+                                               .Optimize(map, StraightPath(0.5 * kPi), Limits(), &t_base);
+  ASSERT_TRUE(s_ours.ok()) << s_ours.message;
+  ASSERT_TRUE(s_base.ok()) << s_base.message;
+  // Both end where asked, at rest, and hold every limit on an independent dense check.
+  for (const AssemblyTrajectory* t : {&t_ours, &t_base}) {
+    EXPECT_TRUE(testing::MatricesNear(t->Evaluate(t->duration()).p_W, Vector3(2.0, 0.0, 1.5), 1e-9));
+    EXPECT_NEAR(t->Evaluate(t->duration()).yaw, 0.5 * kPi, 1e-9);
+    for (double time = 0.0; time <= t->duration(); time += 0.005) {
+      const ReferencePoint r = t->Evaluate(time);
+      EXPECT_LE(r.v_W.norm(), 1.0 + 1e-6);
+      EXPECT_LE(r.a_W.norm(), 1.5 + 1e-6);
+      EXPECT_LE(r.j_W.norm(), 4.0 + 1e-6);
+      EXPECT_LE(std::abs(r.yaw_rate), 1.0 + 1e-6);
+    }
+  }
+  // The baseline has no reason to turn; ours turns the row towards its flight at mid-course.
+  EXPECT_LT(s_base.attitude_deviation_rad, 0.5 * kPi + 1e-6);
+  EXPECT_GT(s_base.attitude_deviation_rad, 0.5 * kPi - 0.05);
+  EXPECT_LT(s_ours.attitude_deviation_rad, 0.5 * s_base.attitude_deviation_rad)
+      << s_ours.attitude_deviation_rad << " rad against " << s_base.attitude_deviation_rad;
+}
+
+TEST(AssemblyTrajectoryOptimizer, TheFootprintPassesAGapNarrowerThanTheRowIsLong) {
+  const Assembly a = testing::MarsAssembly("4x1");  // 1.05 m long, 0.3 m wide
+  std::vector<Vector3> wall;
+  const perception::VoxelMap map = WallWithGap(0.8, &wall);
+  const RotorVector eta = RotorVector::Ones(16);
+  const AssemblyPath path =
+      FindAssemblyPath(map, a, eta, {Vector3(-1.5, 0.0, 1.5), 0.5 * kPi}, Vector3(1.5, 0.0, 1.5), Band());
+  ASSERT_EQ(path.status, AssemblyPathStatus::kFound);
+  for (const double weight : {50.0, 0.0}) {  // ours and the baseline
+    AssemblyTrajectoryOptions o;
+    o.weight_attitude = weight;
+    AssemblyTrajectory traj;
+    const AssemblyTrajectorySummary s = AssemblyTrajectoryOptimizer(a, eta, o).Optimize(map, path, Limits(), &traj);
+    ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
+    EXPECT_GE(s.min_clearance_m, 0.0);
+    double nearest = 1e9;
+    for (double time = 0.0; time <= traj.duration(); time += 0.01) {
+      nearest = std::min(nearest, testing::NearestUnitToPoints(a, traj.PoseAt(time), wall));
+    }
+    // The truth by brute force: no unit's sphere reaches a wall voxel's centre.
+    EXPECT_GE(nearest, a.unit_radius_m) << "weight " << weight;
+  }
+}
+
+TEST(AssemblyTrajectoryOptimizer, BadInputIsReportedNotFlown) {
+  const Assembly a = testing::MarsAssembly("4x1");
+  AssemblyTrajectoryOptions o;
+  o.samples_per_piece = 1;
+  RG_EXPECT_THROW_WITH(AssemblyTrajectoryOptimizer(a, RotorVector::Ones(16), o), ValidationError,
+                       "samples_per_piece = 1");
+  const AssemblyTrajectoryOptimizer opt(a, RotorVector::Ones(16), {});
+  AssemblyTrajectory traj;
+  AssemblyPath none;
+  EXPECT_EQ(opt.Optimize(WallWithGap(100.0), none, Limits(), &traj).status,
+            AssemblyTrajectorySummary::Status::kInvalidInput);
+  AssemblyLimits bad = Limits();
+  bad.yaw_rate_max = -1.0;
+  const AssemblyTrajectorySummary s = opt.Optimize(WallWithGap(100.0), StraightPath(0.0), bad, &traj);
+  EXPECT_EQ(s.status, AssemblyTrajectorySummary::Status::kInvalidInput);
+  EXPECT_NE(s.message.find("yaw_rate_max"), std::string::npos);
+  EXPECT_TRUE(traj.empty());
+}
+
+}  // namespace
+}  // namespace rotorguard::modular
