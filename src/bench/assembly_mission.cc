@@ -21,7 +21,10 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
   const bool ours = spec.method == "ours";
   // What the stack knows of its rotors (the paper plans for the known faults, as FTC flies them).
   RotorVector eta = RotorVector::Ones(a.vehicle.num_rotors());
-  for (const stack::KnownFault& f : s.stack.known_faults) eta[f.rotor] = std::min(eta[f.rotor], 1.0 - f.loss);
+  // Faults the stack learns later in the flight are not known when it plans, at the start.
+  for (const stack::KnownFault& f : s.stack.known_faults) {
+    if (f.at_time_s <= 0.0) eta[f.rotor] = std::min(eta[f.rotor], 1.0 - f.loss);
+  }
 
   // The world's geometry as a known map, inflated by a unit's radius and a margin for the A*.
   perception::VoxelMapOptions mo;
@@ -36,14 +39,20 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
     r.message = "the rotors the stack knows of cannot hold the assembly's weight";
     return r;
   }
+  if (ours && !modular::HasMargin(r.capacity)) {
+    r.message = "the rotors the stack knows of leave no thrust or yaw torque to spare beyond hover";
+    return r;
+  }
   const planning::DynamicLimits kinematic{spec.max_speed_m_s, spec.max_accel_m_s2, spec.max_jerk_m_s3};
   modular::AssemblyAStarOptions ao;
   ao.resolution_m = spec.map_resolution_m;
   ao.z_min_m = std::min(s.initial_position_m.z(), spec.goal_m.z()) - 0.05;
   ao.z_max_m = std::max(s.initial_position_m.z(), spec.goal_m.z()) + 0.05;
   modular::AssemblyTrajectoryOptions to;
+  to.weight_time = spec.time_weight;
   if (ours) {
-    r.limits = modular::DynamicsAwareLimits(kinematic, r.capacity, spec.max_yaw_rate_rad_s, spec.safety_factor);
+    r.limits = modular::DynamicsAwareLimits(kinematic, r.capacity, a.vehicle.mass_kg, spec.max_yaw_rate_rad_s,
+                                            spec.safety_factor);
     ao.attitude_weight = spec.attitude_weight;
   } else {  // SVSDF: the footprint and kinematic limits only
     r.limits.kinematic = kinematic;
@@ -62,7 +71,12 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
     return r;
   }
   auto traj = std::make_shared<modular::AssemblyTrajectory>();
-  r.trajectory_summary = modular::AssemblyTrajectoryOptimizer(a, eta, to).Optimize(map, path, r.limits, traj.get());
+  try {
+    r.trajectory_summary = modular::AssemblyTrajectoryOptimizer(a, eta, to).Optimize(map, path, r.limits, traj.get());
+  } catch (const std::invalid_argument& e) {
+    r.message = std::string("trajectory optimisation: ") + e.what();
+    return r;
+  }
   if (!r.trajectory_summary.ok()) {
     r.message = fmt::format("trajectory optimisation: {}: {}", modular::ToString(r.trajectory_summary.status),
                             r.trajectory_summary.message);

@@ -248,6 +248,9 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
     } else if (*type == "assembly_plan") {
       // Planned once the stack's keys are read (its known faults): LoadScenario's end.
       if (!s.assembly) node.Fail("mission assembly_plan plans for an assembly; expected the key 'assembly'");
+      if (!s.world.moving_boxes.empty()) {
+        node.Fail("mission assembly_plan plans once, on a fixed map; expected a world without moving_boxes");
+      }
       AssemblyPlanSpec p;
       p.goal_m = node.Required("goal_m").AsVector3();
       if (const auto m = node.Optional("method")) p.method = m->AsEnum({"ours", "baseline"});
@@ -259,6 +262,7 @@ std::shared_ptr<const ReferenceTrajectory> ParseMission(const ConfigNode& node, 
       }
       if (const auto v = node.Optional("safety_factor")) p.safety_factor = v->AsDoubleIn(0.01, 1.0);
       if (const auto v = node.Optional("attitude_weight")) p.attitude_weight = v->AsDoubleIn(0.0, 100.0);
+      if (const auto v = node.Optional("time_weight")) p.time_weight = v->AsDoubleIn(0.0, 1e6);
       if (const auto v = node.Optional("map_resolution_m")) p.map_resolution_m = v->AsDoubleIn(0.02, 1.0);
       scenario->assembly_plan = p;
       planning::HoverOptions o;

@@ -6,6 +6,8 @@
 #include <limits>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/modular/allocation.h"
@@ -110,21 +112,28 @@ void AssemblyLimits::Validate() const {
   if (!(std::isfinite(yaw_acceleration_max) && yaw_acceleration_max >= 0.0)) {
     ThrowValidation("AssemblyLimits", "yaw_acceleration_max", yaw_acceleration_max, "a finite limit >= 0 (0: none)");
   }
+  if (!(std::isfinite(thrust_acceleration_max) && (thrust_acceleration_max == 0.0 || thrust_acceleration_max > kGravity))) {
+    ThrowValidation("AssemblyLimits", "thrust_acceleration_max", thrust_acceleration_max, "0 (none) or above g");
+  }
+}
+
+bool HasMargin(const AssemblyCapacity& c) {
+  return c.hover_attainable && c.max_acceleration_m_s2 > 0.0 && c.max_yaw_acceleration_rad_s2 > 0.0;
 }
 
 AssemblyLimits DynamicsAwareLimits(const planning::DynamicLimits& kinematic, const AssemblyCapacity& capacity,
-                                   double yaw_rate_max, double safety_factor) {
+                                   double mass_kg, double yaw_rate_max, double safety_factor) {
   if (!(safety_factor > 0.0 && safety_factor <= 1.0)) {
     ThrowInvalidArgument("DynamicsAwareLimits", "safety_factor", safety_factor, "a factor in (0, 1]");
   }
-  if (!capacity.hover_attainable || capacity.max_acceleration_m_s2 <= 0.0 ||
-      capacity.max_yaw_acceleration_rad_s2 <= 0.0) {
+  if (!HasMargin(capacity)) {
     ThrowInvalidArgument("DynamicsAwareLimits", "capacity", capacity.max_acceleration_m_s2,
                          "an assembly that can hover with thrust and yaw torque to spare");
   }
+  if (!(std::isfinite(mass_kg) && mass_kg > 0.0)) ThrowInvalidArgument("DynamicsAwareLimits", "mass_kg", mass_kg, "> 0");
   AssemblyLimits l;
   l.kinematic = kinematic;
-  l.kinematic.a_max = std::min(kinematic.a_max, safety_factor * capacity.max_acceleration_m_s2);
+  l.thrust_acceleration_max = kGravity + safety_factor * (capacity.max_thrust_n / mass_kg - kGravity);
   l.yaw_rate_max = yaw_rate_max;
   l.yaw_acceleration_max = safety_factor * capacity.max_yaw_acceleration_rad_s2;
   return l;
@@ -179,6 +188,9 @@ AssemblyTrajectoryOptimizer::AssemblyTrajectoryOptimizer(const Assembly& assembl
   // along x.
   optimal_relative_yaws_ = OptimalYaws(assembly, eta, Eigen::Vector2d::UnitX(), options_.attitude_bins);
   for (double& a : optimal_relative_yaws_) a = std::fmod(a + 2.0 * std::numbers::pi, 2.0 * std::numbers::pi);
+  if (optimal_relative_yaws_.empty()) {
+    ThrowInvalidArgument("AssemblyTrajectoryOptimizer", "eta", "(no minimiser)", "rotors whose eq. (7) is finite");
+  }
   std::sort(optimal_relative_yaws_.begin(), optimal_relative_yaws_.end());
   for (const Vector3& r : assembly.unit_position_B) yaw_length_m_ = std::max(yaw_length_m_, r.head<2>().norm());
 }
@@ -261,6 +273,18 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
         if (slope == 0.0) continue;
         cost += o.weight_dynamics * pen;
         add_position(d, o.weight_dynamics * slope * 2.0 * der.row(d));
+      }
+      // The thrust per kilogram, |a + g e_z| (the assembly's dynamics; 0: off).
+      if (lim.thrust_acceleration_max > 0.0) {
+        Eigen::RowVector3d f = der.row(2);
+        f.z() += kGravity;
+        double slope;
+        const double pen = CubicPenalty(f.squaredNorm() - lim.thrust_acceleration_max * lim.thrust_acceleration_max,
+                                        &slope);
+        if (slope != 0.0) {
+          cost += o.weight_dynamics * pen;
+          add_position(2, o.weight_dynamics * slope * 2.0 * f);
+        }
       }
       // The yaw's rate and acceleration (the assembly's dynamics; 0: off).
       for (int d = 1; d <= 2; ++d) {
@@ -423,6 +447,20 @@ AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception
     if (limits.yaw_acceleration_max > 0.0) {
       ratio.push_back(std::sqrt(traj.yaw().MaxNorm(2, dense) / limits.yaw_acceleration_max));
     }
+    if (limits.thrust_acceleration_max > 0.0) {
+      // |a + g e_z| <= |a| + g: stretching until |a| <= limit - g is enough (a scales by 1 / k²).
+      double thrust = 0.0;
+      for (int i = 0; i < m; ++i) {
+        for (int j = 0; j <= dense; ++j) {
+          Vector3 f = pos.PieceDerivative(i, pos.durations()(i) * j / dense, 2);
+          f.z() += kGravity;
+          thrust = std::max(thrust, f.norm());
+        }
+      }
+      if (thrust > limits.thrust_acceleration_max) {
+        ratio.push_back(std::sqrt(pos.MaxNorm(2, dense) / (limits.thrust_acceleration_max - kGravity)));
+      }
+    }
     const double worst = *std::max_element(ratio.begin(), ratio.end());
     summary.limit_margin = 1.0 - worst;  // of the stretch factor's scale: >= 0 when all hold
     if (worst <= 1.0) break;
@@ -460,8 +498,12 @@ AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception
   }
   summary.attitude_deviation_rad = moving > 0 ? deviation / moving : 0.0;
   *out = traj;
-  if (summary.min_clearance_m < 0.0) {
-    return finish(Status::kCollides, "a unit's sphere reaches an occupied voxel's centre");
+  const double reach = 0.5 * std::sqrt(3.0) * map.resolution();
+  if (summary.min_clearance_m < reach) {
+    return finish(Status::kCollides,
+                  fmt::format("a unit's sphere may reach an occupied voxel: it comes within {:.3f} m of a voxel's "
+                              "centre beyond its radius, less than the voxel's half-diagonal {:.3f} m",
+                              summary.min_clearance_m, reach));
   }
   return finish(Status::kSuccess, message);
 }

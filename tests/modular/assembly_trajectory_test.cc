@@ -52,7 +52,8 @@ TEST(AssemblyCapacity, ADeadEndUnitLeavesTheThrustOfTheLinearProgramSolvedByHand
   eta.segment(8, 4).setZero();
   const AssemblyCapacity none = CapacityOf(a, eta);
   EXPECT_FALSE(none.hover_attainable);
-  EXPECT_THROW(DynamicsAwareLimits({}, none, 1.0, 0.8), std::invalid_argument);
+  EXPECT_FALSE(HasMargin(none));
+  EXPECT_THROW(DynamicsAwareLimits({}, none, a.vehicle.mass_kg, 1.0, 0.8), std::invalid_argument);
 }
 
 TEST(AssemblyTrajectoryOptimizer, AttitudeErrorIsTheDistanceToTheNearestOptimalYaw) {
@@ -72,6 +73,7 @@ AssemblyTrajectoryOptimizer::Problem ActiveProblem() {
   p.limits.kinematic = {0.5, 0.3, 0.3};
   p.limits.yaw_rate_max = 0.3;
   p.limits.yaw_acceleration_max = 0.2;
+  p.limits.thrust_acceleration_max = 9.815;  // above g by less than the climb's acceleration
   p.planes.resize(3);
   p.planes[1].push_back({3, 0, {Vector3(1.5, 0.7, 1.5), Vector3(0.0, -1.0, 0.0)}});
   p.planes[1].push_back({3, 2, {Vector3(1.5, 0.7, 1.5), Vector3(0.0, -1.0, 0.0)}});
@@ -103,6 +105,7 @@ TEST(AssemblyTrajectoryOptimizer, GradientMatchesFiniteDifferences) {
   EXPECT_LT(without([](auto*, auto* q) { q->limits.kinematic = {10.0, 10.0, 10.0}; }), f - 1.0);
   EXPECT_LT(without([](auto*, auto* q) { q->limits.yaw_rate_max = 0.0; }), f - 1.0);
   EXPECT_LT(without([](auto*, auto* q) { q->limits.yaw_acceleration_max = 0.0; }), f - 1.0);
+  EXPECT_LT(without([](auto*, auto* q) { q->limits.thrust_acceleration_max = 0.0; }), f - 1e-6);
   ASSERT_EQ(g.size(), x.size());
   for (int k = 0; k < x.size(); ++k) {
     const double h = 1e-6;
@@ -128,6 +131,7 @@ AssemblyLimits Limits() {
   l.kinematic = {1.0, 1.5, 4.0};
   l.yaw_rate_max = 1.0;
   l.yaw_acceleration_max = 1.5;
+  l.thrust_acceleration_max = 10.5;  // a climb of at most 0.69 m/s²
   return l;
 }
 
@@ -154,10 +158,11 @@ TEST(AssemblyTrajectoryOptimizer, TheAttitudeTermTurnsABroadsideRowLengthwiseWit
       EXPECT_LE(r.a_W.norm(), 1.5 + 1e-6);
       EXPECT_LE(r.j_W.norm(), 4.0 + 1e-6);
       EXPECT_LE(std::abs(r.yaw_rate), 1.0 + 1e-6);
+      EXPECT_LE((r.a_W + Vector3(0.0, 0.0, kGravity)).norm(), 10.5 + 1e-6);
     }
   }
-  // The baseline has no reason to turn; ours turns the row towards its flight at mid-course.
-  EXPECT_LT(s_base.attitude_deviation_rad, 0.5 * kPi + 1e-6);
+  // The baseline has no reason to turn (it stays broadside, 90 degrees off); ours turns the row
+  // towards its flight.
   EXPECT_GT(s_base.attitude_deviation_rad, 0.5 * kPi - 0.05);
   EXPECT_LT(s_ours.attitude_deviation_rad, 0.5 * s_base.attitude_deviation_rad)
       << s_ours.attitude_deviation_rad << " rad against " << s_base.attitude_deviation_rad;
@@ -178,11 +183,19 @@ TEST(AssemblyTrajectoryOptimizer, TheFootprintPassesAGapNarrowerThanTheRowIsLong
     const AssemblyTrajectorySummary s = AssemblyTrajectoryOptimizer(a, eta, o).Optimize(map, path, Limits(), &traj);
     ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
     EXPECT_GE(s.min_clearance_m, 0.0);
+    // The truth by brute force: no unit's sphere reaches a wall voxel's cube (0.1 m, about its
+    // centre), every 10 ms.
     double nearest = 1e9;
     for (double time = 0.0; time <= traj.duration(); time += 0.01) {
-      nearest = std::min(nearest, testing::NearestUnitToPoints(a, traj.PoseAt(time), wall));
+      const AssemblyPose pose = traj.PoseAt(time);
+      const double c = std::cos(pose.yaw_rad), sn = std::sin(pose.yaw_rad);
+      for (const Vector3& u : a.unit_position_B) {
+        const Vector3 p = pose.p_W + Vector3(c * u.x() - sn * u.y(), sn * u.x() + c * u.y(), 0.0);
+        for (const Vector3& w : wall) {
+          nearest = std::min(nearest, ((p - w).cwiseAbs().array() - 0.05).cwiseMax(0.0).matrix().norm());
+        }
+      }
     }
-    // The truth by brute force: no unit's sphere reaches a wall voxel's centre.
     EXPECT_GE(nearest, a.unit_radius_m) << "weight " << weight;
   }
 }

@@ -22,8 +22,9 @@ struct AssemblyPlanResult {
   std::shared_ptr<const modular::AssemblyTrajectory> trajectory;  ///< when ok
 };
 
-/// Plans `scenario`'s assembly_plan mission (which must have an assembly and the spec). Never
-/// throws for an unplannable mission: the result says why.
+/// Plans `scenario`'s assembly_plan mission (which must have an assembly and the spec) for the
+/// faults known at the start (stack.known_faults at 0 s). Never throws for an unplannable mission:
+/// the result says why. The map holds the world's boxes and cylinders, not its moving boxes.
 AssemblyPlanResult PlanAssemblyMission(const Scenario& scenario);
 
 }  // namespace rotorguard::bench

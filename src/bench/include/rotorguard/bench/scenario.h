@@ -36,6 +36,8 @@ struct AssemblyPlanSpec {
   double max_yaw_rate_rad_s = 1.0;  ///< ours: the yaw's rate limit [rad/s]
   double safety_factor = 0.7;       ///< ours: the share of the assembly's capacity planned for, in (0, 1]
   double attitude_weight = 0.3;     ///< ours: L_Phi of the A* (eq. 9b) [m/rad]
+  /// λ_t of eq. (11) for both methods: the larger, the more agile (closer to the limits) the plan.
+  double time_weight = 10.0;
   double map_resolution_m = 0.1;
 };
 

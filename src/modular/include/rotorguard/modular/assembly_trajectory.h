@@ -57,7 +57,8 @@ struct AssemblyCapacity {
   bool hover_attainable = false;
   double max_thrust_n = 0.0;         ///< largest collective thrust with zero torque [N]
   double max_yaw_torque_n_m = 0.0;   ///< largest |yaw torque| of either sign at the hover thrust [N m]
-  /// sqrt((max_thrust / m)^2 - g^2): the horizontal acceleration the thrust holds level flight at.
+  /// sqrt((max_thrust / m)^2 - g^2): the largest horizontal acceleration in level flight (the
+  /// planner bounds the thrust itself, AssemblyLimits::thrust_acceleration_max).
   double max_acceleration_m_s2 = 0.0;
   double max_yaw_acceleration_rad_s2 = 0.0;  ///< max_yaw_torque / I_zz
 };
@@ -65,18 +66,24 @@ struct AssemblyCapacity {
 /// Bisects the allocator's attainability (to 1e-4 of the range) for the rotors' effectiveness `eta`.
 AssemblyCapacity CapacityOf(const Assembly& assembly, const RotorVector& eta);
 
-/// The limits of G_d. Yaw limits of 0 are off (the kinematic baseline).
+/// The limits of G_d. The dynamic ones at 0 are off (the kinematic baseline).
 struct AssemblyLimits {
   planning::DynamicLimits kinematic;
   double yaw_rate_max = 0.0;          ///< [rad/s], >= 0
   double yaw_acceleration_max = 0.0;  ///< [rad/s²], >= 0
+  /// The thrust the assembly may ask for, per kilogram: |a + g e_z| <= this [m/s²]; 0 (off) or > g.
+  double thrust_acceleration_max = 0.0;
   void Validate() const;
 };
 
-/// Ours: the kinematic limits, tightened to `safety_factor` (in (0, 1]) of what the assembly can
-/// give (its acceleration and yaw acceleration, AssemblyCapacity), with `yaw_rate_max`.
+/// Whether the assembly has thrust and yaw torque to spare at hover (what DynamicsAwareLimits needs).
+bool HasMargin(const AssemblyCapacity& capacity);
+
+/// Ours: the kinematic limits with the assembly's dynamics, each at `safety_factor` (in (0, 1]) of
+/// its margin: the thrust per kilogram g + γ (F_max / m - g), the yaw acceleration γ τ_z / I_zz, and
+/// `yaw_rate_max`. Throws std::invalid_argument when !HasMargin(capacity).
 AssemblyLimits DynamicsAwareLimits(const planning::DynamicLimits& kinematic, const AssemblyCapacity& capacity,
-                                   double yaw_rate_max, double safety_factor);
+                                   double mass_kg, double yaw_rate_max, double safety_factor);
 
 struct AssemblyTrajectoryOptions {
   double weight_time = 10.0;        ///< λ_t, >= 0
@@ -87,10 +94,10 @@ struct AssemblyTrajectoryOptions {
   /// squared and speed-weighted form of eq. (12b) (smooth, and silent at rest where the direction
   /// of flight, hence ψ*, is undefined). >= 0; 0 is the baseline.
   double weight_attitude = 50.0;
-  double clearance_m = 0.1;  ///< distance kept beyond a unit's radius from an occupied voxel's centre [m], >= 0
+  double clearance_m = 0.15;  ///< distance kept beyond a unit's radius from an occupied voxel's centre [m], >= 0
   /// Obstacles farther than this from a unit's centre are not penalised [m], > clearance + unit radius.
   double obstacle_range_m = 1.0;
-  int samples_per_piece = 12;    ///< penalty samples per piece, in [2, 1000]
+  int samples_per_piece = 32;    ///< penalty samples per piece, in [2, 1000]
   int plane_rounds = 3;          ///< solves, each with the planes of the last one's trajectory, >= 1
   int max_iterations = 300;      ///< L-BFGS iterations per solve, >= 1
   double relative_cost_tolerance = 1e-5;  ///< in (0, 0.1]
@@ -118,9 +125,12 @@ struct AssemblyTrajectorySummary {
   /// |ψ* - ψ| [rad], ψ* the optimal yaw nearest to ψ.
   double attitude_deviation_rad = 0.0;
   /// The smallest distance from a unit's centre to an occupied voxel's centre minus the unit's
-  /// radius on the dense check [m] (capped at obstacle_range_m).
+  /// radius on the dense check [m] (capped at obstacle_range_m). Below the voxel's half-diagonal
+  /// the sphere may reach the occupied cube: kCollides.
   double min_clearance_m = 0.0;
-  double limit_margin = 0.0;  ///< min over the limits of (limit - max) / limit on the dense check
+  /// 1 - the time-stretch factor the dense check would still call for (v / v_max, sqrt(a / a_max),
+  /// cbrt(j / j_max) and the yaw's and thrust's likewise, the largest): >= 0 when every limit holds.
+  double limit_margin = 0.0;
   bool ok() const { return status == Status::kSuccess; }
 };
 const char* ToString(AssemblyTrajectorySummary::Status status);
@@ -135,13 +145,15 @@ using FootprintPlaneSet = std::vector<std::vector<FootprintPlane>>;  ///< per pi
 
 class AssemblyTrajectoryOptimizer {
  public:
-  /// Throws ValidationError on invalid options.
+  /// Throws ValidationError on invalid options, std::invalid_argument when eq. (7) has no
+  /// minimiser (a non-finite objective).
   AssemblyTrajectoryOptimizer(const Assembly& assembly, const RotorVector& eta,
                               const AssemblyTrajectoryOptions& options);
 
   /// From `path` (the A* sequence, start at rest to goal at rest) on `map` under `limits`. On
-  /// success and on kCollides (on the dense check a unit's sphere reaches an occupied voxel's
-  /// centre: min_clearance_m < 0; reported, not hidden) `out` holds the trajectory.
+  /// success and on kCollides (on the dense check a unit's sphere may reach an occupied voxel:
+  /// min_clearance_m below the voxel's half-diagonal; reported, not hidden) `out` holds the
+  /// trajectory.
   AssemblyTrajectorySummary Optimize(const perception::VoxelMap& map, const AssemblyPath& path,
                                      const AssemblyLimits& limits, AssemblyTrajectory* out) const;
 
