@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -20,6 +21,7 @@
 #include "rotorguard/bench/fdd_calibration.h"
 #include "rotorguard/bench/ftc_bench.h"
 #include "rotorguard/bench/flatness_bench.h"
+#include "rotorguard/bench/campaign.h"
 #include "rotorguard/bench/mars_bench.h"
 #include "rotorguard/bench/nav_bench.h"
 #include "rotorguard/bench/nmpc_bench.h"
@@ -106,6 +108,19 @@ std::function<void(int, int)> CountProgress(const char* what) {
   return [tty, what](int done, int total) {
     if (!tty) return;
     std::fprintf(stderr, "\r%s %d / %d", what, done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+  };
+}
+
+/// "\r<what> done / total, ETA" on a terminal's stderr, for long runs of equal units of work.
+std::function<void(int, int)> EtaProgress(const char* what) {
+  const bool tty = ::isatty(STDERR_FILENO);
+  const auto start = std::chrono::steady_clock::now();
+  return [tty, what, start](int done, int total) {
+    if (!tty) return;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double eta = done > 0 ? elapsed * (total - done) / done : 0.0;
+    std::fprintf(stderr, "\r%s %d / %d, %.0f s elapsed, ETA %.0f s   ", what, done, total, elapsed, eta);
     if (done == total) std::fprintf(stderr, "\n");
   };
 }
@@ -341,6 +356,29 @@ int main(int argc, char** argv) {
   bench_mars->add_option("--jobs", mars_jobs_text, "Worker threads (default: the number of cores)");
   bench_mars->add_flag("--json", mars_json, "Print JSON instead of Markdown");
 
+  // campaign
+  CLI::App* campaign = app.add_subcommand("campaign", "Monte Carlo campaigns: sweeps over a scenario's keys, run in\n"
+                                                      "crash-safe, resumable shards and merged (docs/campaigns.md).");
+  campaign->require_subcommand(1);
+  std::string campaign_spec, campaign_out, campaign_jobs_text, campaign_shard = "0/1", merge_out;
+  bool campaign_resume = false, campaign_quiet = false;
+  std::vector<std::string> merge_dirs;
+  CLI::App* campaign_run = campaign->add_subcommand(
+      "run", "Run a campaign spec's trials (or one shard of them): each finished trial appends a line to\n"
+             "DIR/results.jsonl (results.shard-i.jsonl), synced; DIR/manifest.json records the run.\n"
+             "Exit 0 when every trial ran (a trial's crash or error is recorded, not fatal).");
+  campaign_run->add_option("spec", campaign_spec, "Campaign spec (YAML), e.g. configs/campaigns/ftc_demo.yaml")->required();
+  campaign_run->add_option("--out", campaign_out, "Results folder")->required();
+  campaign_run->add_option("--jobs", campaign_jobs_text, "Worker threads (default: the number of cores)");
+  campaign_run->add_option("--shard", campaign_shard, "Run shard i of N (i/N, 0 <= i < N; default 0/1: all)");
+  campaign_run->add_flag("--resume", campaign_resume, "Continue the results in --out: skip finished trials");
+  campaign_run->add_flag("--quiet,-q", campaign_quiet, "No progress line");
+  CLI::App* campaign_merge = campaign->add_subcommand(
+      "merge", "Join the shards in the given folders (every trial exactly once, one spec, one program) and\n"
+               "write summary.json and summary.md.");
+  campaign_merge->add_option("dirs", merge_dirs, "Results folders")->required();
+  campaign_merge->add_option("--out", merge_out, "Where to write the summary (default: the first folder)");
+
   // Every benchmark can also write its page: tables and distributions (report.h).
   std::string bench_html;
   for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner, bench_nav, bench_flatness,
@@ -556,6 +594,30 @@ int main(int argc, char** argv) {
       const nlohmann::json r = rotorguard::bench::RunFlatnessBenchmark(o);
       write_bench_html("flatness", r);
       fmt::print("{}", flat_json ? r.dump(2) + "\n" : rotorguard::bench::FlatnessMarkdown(r));
+      return kOk;
+    }
+    if (*campaign_run) {
+      const rotorguard::bench::CampaignSpec spec = rotorguard::bench::LoadCampaignSpec(campaign_spec);
+      rotorguard::bench::CampaignRunOptions o;
+      o.out_dir = campaign_out;
+      o.jobs = ParseJobs(campaign_jobs_text);
+      o.shard = rotorguard::bench::Shard::Parse(campaign_shard);
+      o.resume = campaign_resume;
+      o.version = fmt::format("{} ({})", ROTORGUARD_VERSION, rotorguard::bench::GitRevision());
+      if (!campaign_quiet) o.progress = EtaProgress("trials");
+      const rotorguard::bench::CampaignRunSummary r = rotorguard::bench::RunCampaign(spec, o);
+      fmt::print("campaign          {} (spec {})\n", spec.name, spec.hash);
+      fmt::print("shard             {}/{}: {} trials, {} already done, {} run, {} error or diverged\n", o.shard.index,
+                 o.shard.count, r.trials, r.skipped, r.ran, r.errors);
+      fmt::print("results           {}\n", r.results_file);
+      return kOk;
+    }
+    if (*campaign_merge) {
+      const std::string out = merge_out.empty() ? merge_dirs.front() : merge_out;
+      const nlohmann::json s = rotorguard::bench::MergeCampaign(merge_dirs, out);
+      fmt::print("campaign          {}: {} trials merged\n", s["campaign"].get<std::string>(), s["trials"].get<int>());
+      fmt::print("summary           {}\n", (fs::path(out) / "summary.json").string());
+      fmt::print("                  {}\n", (fs::path(out) / "summary.md").string());
       return kOk;
     }
     if (*bench_mars) {

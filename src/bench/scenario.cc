@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotorguard/bench/assembly_mission.h"
+#include "rotorguard/bench/campaign.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/planning/references.h"
@@ -823,6 +824,11 @@ ValidationReport ValidateConfigFile(const std::string& path) {
     return {"assembly", fmt::format("assembly '{}': {} units, {} rotors, {:g} kg, thrust-to-weight {:.2f}", a.name,
                                     a.num_units, a.vehicle.num_rotors(), a.vehicle.mass_kg,
                                     a.vehicle.total_max_thrust_n() / a.vehicle.weight_n())};
+  }
+  if (has("scenario") && !has("mission")) {
+    const CampaignSpec c = LoadCampaignSpec(path);
+    return {"campaign", fmt::format("campaign '{}': {} trials of {} ({} grid key(s), {} random), spec {}", c.name,
+                                    c.trials(), c.scenario, c.grid.size(), c.random.size(), c.hash)};
   }
   if (has("mission") || has("vehicle") || has("assembly")) {
     const Scenario s = LoadScenario(path);

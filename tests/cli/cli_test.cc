@@ -3,8 +3,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -84,10 +86,67 @@ class CliTest : public rotorguard::testing::TempFolderTest {
   std::string Out() const { return (dir_ / "out").string(); }
 };
 
+/// A campaign killed without warning mid-run and resumed merges to the same bytes as one that ran
+/// through (docs/campaigns.md).
+TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
+  const std::string spec = Write("c.yaml", "name: kill_test\n"
+                                           "scenario: " + std::string(ROTORGUARD_SOURCE_DIR) +
+                                               "/configs/scenarios/fdd_hover_motor_stop.yaml\n"
+                                           "repeats: 4\n"
+                                           "grid:\n"
+                                           "  duration_s: [3.0]\n"
+                                           "  faults.0.rotor: [0, 2]\n"
+                                           "metrics: [success, tracking_rmse_m, fdd.latency_s]\n");
+  const std::string whole = (dir_ / "whole").string(), killed = (dir_ / "killed").string();
+  ASSERT_EQ(Cli("campaign run " + spec + " --out " + whole + " --jobs 1 --quiet").exit_code, 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::execl(ROTORGUARD_CLI, ROTORGUARD_CLI, "campaign", "run", spec.c_str(), "--out", killed.c_str(), "--jobs", "1",
+            "--quiet", static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Kill it once two trials are recorded and before the last one is.
+  const fs::path results = fs::path(killed) / "results.jsonl";
+  const auto lines = [&] {
+    const std::string text = ReadText(results);
+    return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+  };
+  for (int i = 0; i < 1000 && lines() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the campaign finished before it could be killed";
+  const int recorded = lines();
+  EXPECT_GE(recorded, 2);
+  EXPECT_LT(recorded, 8);
+  const Result early = Cli("campaign merge " + killed);
+  EXPECT_EQ(early.exit_code, 2) << early.out;  // unfinished: refused
+  const Result resumed = Cli("campaign run " + spec + " --out " + killed + " --jobs 2 --resume --quiet");
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.out;
+  EXPECT_NE(resumed.out.find(std::to_string(recorded) + " already done"), std::string::npos) << resumed.out;
+  ASSERT_EQ(Cli("campaign merge " + whole).exit_code, 0);
+  ASSERT_EQ(Cli("campaign merge " + killed).exit_code, 0);
+  EXPECT_EQ(ReadText(fs::path(killed) / "summary.json"), ReadText(fs::path(whole) / "summary.json"));
+  EXPECT_EQ(ReadText(fs::path(killed) / "summary.md"), ReadText(fs::path(whole) / "summary.md"));
+  // Without --resume the results are not touched; shard and spec errors exit 2.
+  const std::string before = ReadText(results);
+  EXPECT_EQ(Cli("campaign run " + spec + " --out " + killed).exit_code, 2);
+  EXPECT_EQ(ReadText(results), before);
+  for (const char* shard : {"4/4", "0/0", "-1/2"}) {
+    const Result r = Cli("campaign run " + spec + " --out " + (dir_ / "s").string() + " --shard=" + shard);
+    EXPECT_EQ(r.exit_code, 2) << shard << ": " << r.out;
+    EXPECT_NE(r.out.find("--shard"), std::string::npos) << r.out;
+  }
+  const Result unknown = Cli("campaign run " + Write("u.yaml", "name: u\nscenario: " + spec + "\n") + " --out " +
+                             (dir_ / "u").string());
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+}
+
 TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
   const Result r = Cli("--help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* s : {"run", "validate", "bench", "fdd-calibrate", "report", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  for (const char* s : {"run", "validate", "bench", "campaign", "fdd-calibrate", "report", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
   const Result run = Cli("run --help");
   EXPECT_EQ(run.exit_code, 0);
   for (const char* s : {"--out", "--set", "--seed", "--quiet", "--log-format", "--no-report"}) EXPECT_NE(run.out.find(s), std::string::npos) << s;

@@ -1,0 +1,100 @@
+#pragma once
+/// Monte Carlo campaigns (docs/campaigns.md): a spec names a base scenario and sweeps over its keys
+/// (a grid, and random draws per trial); every trial is one run of the scenario with the sweep's
+/// values set (as `--set` would) and its own seed, derived counter-style from the campaign's seed
+/// and the trial's index, so that results depend on neither the number of worker threads nor the
+/// sharding.
+///
+/// Each finished trial appends one whole JSON line to DIR/results.jsonl (or results.shard-i.jsonl),
+/// flushed and synced before the next: a kill loses at most the trials in flight, and a resume
+/// discards a partial last line and skips what is done. `MergeCampaign` joins the shards, refusing
+/// gaps, duplicates and mismatched specs or versions, and writes summary.json and summary.md.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace rotorguard::bench {
+
+/// A key's random draw per trial: uniform in [lo, hi), or one of a list's values with equal odds.
+struct RandomSweep {
+  enum class Kind { kUniform, kChoice };
+  Kind kind = Kind::kUniform;
+  double lo = 0.0, hi = 0.0;
+  std::vector<std::string> choices;  ///< YAML values, as written in the spec
+};
+
+struct CampaignSpec {
+  std::string name;
+  std::string file;      ///< the spec's path
+  std::string scenario;  ///< the base scenario's path (resolved against the spec's folder)
+  std::uint64_t seed = 1;
+  int repeats = 1;  ///< trials per grid point, >= 1
+  /// Key path -> values (YAML text), in the spec's order; the trials cover their product, the
+  /// last key varying fastest.
+  std::vector<std::pair<std::string, std::vector<std::string>>> grid;
+  std::vector<std::pair<std::string, RandomSweep>> random;
+  /// RunSummary::ToJson keys recorded per trial (numbers or booleans; deterministic ones only).
+  std::vector<std::string> metrics;
+  /// The spec's canonical content (with the base scenario's text): what shards must share.
+  std::string hash;
+
+  int trials() const;
+};
+
+/// Loads and validates a spec. Throws io::ConfigError naming file, line and key (an unknown key,
+/// an empty sweep, a sweep over a key the scenario does not have, an unknown metric) or
+/// io::InputFileError.
+CampaignSpec LoadCampaignSpec(const std::string& path);
+
+/// Trial `index`'s resolved parameters: every swept key's value (YAML text) and "seed".
+std::map<std::string, std::string> TrialParameters(const CampaignSpec& spec, int index);
+/// The trial's id: a 64-bit FNV-1a hash of its resolved parameters, in hex.
+std::string TrialId(const std::map<std::string, std::string>& parameters);
+
+/// Which trials a shard runs: shard `index` of `count` takes a contiguous range.
+struct Shard {
+  int index = 0;
+  int count = 1;
+  /// "i/N" with 0 <= i < N. Throws std::invalid_argument naming the text.
+  static Shard Parse(const std::string& text);
+  std::pair<int, int> Range(int trials) const;  ///< [first, last)
+};
+
+struct CampaignRunOptions {
+  std::string out_dir;
+  int jobs = 1;
+  Shard shard;
+  bool resume = false;
+  std::string version;  ///< the program's version and revision, recorded and checked
+  std::function<void(int done, int total)> progress;
+};
+
+struct CampaignRunSummary {
+  int trials = 0;    ///< in the shard
+  int skipped = 0;   ///< already done (resume)
+  int ran = 0;
+  int errors = 0;    ///< status error or diverged
+  std::string results_file, manifest_file;
+};
+
+/// Runs the shard's trials not yet recorded. Throws io::ConfigError for bad input (an existing
+/// results file without `resume`, a resume against another spec or version) and leaves every
+/// existing file as it was.
+CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOptions& options);
+
+/// Joins the results of `dirs` (every shard's manifest and results), checks that they form the
+/// whole campaign exactly once, with one spec and one version, and writes summary.json and
+/// summary.md into `out_dir`. Throws io::CorruptFileError or io::ConfigError naming the file.
+nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::string& out_dir);
+
+/// The source revision this program was built from (git's short hash; "unknown" outside a clone).
+std::string GitRevision();
+
+/// Wilson score interval of `successes` in `n` at 95 %: [lo, hi] ([0, 1] for n = 0).
+std::pair<double, double> WilsonInterval(int successes, int n);
+
+}  // namespace rotorguard::bench

@@ -1,0 +1,192 @@
+// Campaigns (bench/campaign.h): trial parameters and seeds, crash-safe results, resume, shards and
+// the merge's checks. The oracle for "results do not depend on how they were run" is a byte
+// comparison of merged summaries.
+#include "rotorguard/bench/campaign.h"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/core/rng.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/io/files.h"
+#include "test_util.h"
+
+namespace rotorguard::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Scenario(const std::string& name) {
+  return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
+}
+
+class Campaign : public testing::TempFolderTest {
+ protected:
+  /// A spec of 6 short trials: the nominal controller losing a motor or a propeller in hover, over
+  /// the rotor, with random onsets, 1.5 s each.
+  std::string Spec(const std::string& extra = "", const std::string& name = "spec.yaml") {
+    return Write(name, "name: test_campaign\n"
+                       "scenario: " + Scenario("hover_motor_stop_nominal.yaml") + "\n"
+                       "seed: 7\n"
+                       "repeats: 2\n"
+                       "grid:\n"
+                       "  duration_s: [1.5]\n"
+                       "  faults.0.rotor: [0, 1, 2]\n"
+                       "random:\n"
+                       "  faults.0.onset.at_time_s: {uniform: [0.5, 1.0]}\n"
+                       "  faults.0.kind: {choice: [motor_stop, propeller_loss]}\n"
+                       "metrics: [success, crashed, tracking_rmse_m, max_tilt_rad]\n" + extra);
+  }
+  CampaignRunSummary Run(const CampaignSpec& spec, const std::string& out, int jobs = 1, Shard shard = {},
+                         bool resume = false) {
+    CampaignRunOptions o;
+    o.out_dir = (dir_ / out).string();
+    o.jobs = jobs;
+    o.shard = shard;
+    o.resume = resume;
+    o.version = "test";
+    return RunCampaign(spec, o);
+  }
+  std::string Merge(const std::vector<std::string>& outs, const std::string& into) {
+    std::vector<std::string> dirs;
+    for (const std::string& o : outs) dirs.push_back((dir_ / o).string());
+    MergeCampaign(dirs, (dir_ / into).string());
+    return io::ReadFile((dir_ / into / "summary.json").string()) + io::ReadFile((dir_ / into / "summary.md").string());
+  }
+};
+
+TEST_F(Campaign, TrialsCoverTheGridWithCounterStyleSeedsAndDraws) {
+  const CampaignSpec spec = LoadCampaignSpec(Spec());
+  ASSERT_EQ(spec.trials(), 6);  // 1 x 3 grid points, 2 repeats each
+  std::set<std::string> rotors, ids;
+  for (int i = 0; i < spec.trials(); ++i) {
+    const auto p = TrialParameters(spec, i);
+    EXPECT_EQ(p.at("faults.0.rotor"), std::to_string(i / 2));  // the last key varies fastest, repeats inner
+    EXPECT_EQ(p.at("seed"), std::to_string(DeriveSeed(7, static_cast<std::uint64_t>(i))));
+    const double onset = std::stod(p.at("faults.0.onset.at_time_s"));
+    EXPECT_GE(onset, 0.5);
+    EXPECT_LT(onset, 1.0);
+    EXPECT_TRUE(p.at("faults.0.kind") == "motor_stop" || p.at("faults.0.kind") == "propeller_loss");
+    EXPECT_EQ(TrialParameters(spec, i), p);  // a pure function of the spec and the index
+    ids.insert(TrialId(p));
+    rotors.insert(p.at("faults.0.rotor"));
+  }
+  EXPECT_EQ(ids.size(), 6u);
+  EXPECT_EQ(rotors.size(), 3u);
+}
+
+TEST_F(Campaign, JobsAndShardsGiveByteIdenticalSummaries) {
+  const CampaignSpec spec = LoadCampaignSpec(Spec());
+  const CampaignRunSummary one = Run(spec, "one", 1);
+  EXPECT_EQ(one.ran, 6);
+  EXPECT_EQ(one.errors, 0);
+  Run(spec, "two", 2);
+  for (int i = 0; i < 4; ++i) Run(spec, "shards", 1, Shard{i, 4});
+  const std::string reference = Merge({"one"}, "m1");
+  EXPECT_EQ(Merge({"two"}, "m2"), reference);
+  EXPECT_EQ(Merge({"shards"}, "m4"), reference);
+  // The summary holds what the trials measured: the nominal controller crashes after a motor stop.
+  const nlohmann::json s = nlohmann::json::parse(io::ReadFile((dir_ / "m1" / "summary.json").string()));
+  EXPECT_EQ(s["trials"].get<int>(), 6);
+  EXPECT_EQ(s["overall"]["metrics"]["success"]["n"].get<int>(), 6);
+  const auto wilson = s["overall"]["metrics"]["success"]["wilson95"];
+  EXPECT_LE(wilson[0].get<double>(), s["overall"]["metrics"]["success"]["rate"].get<double>());
+  EXPECT_GE(wilson[1].get<double>(), s["overall"]["metrics"]["success"]["rate"].get<double>());
+  EXPECT_EQ(s["by_grid_point"].size(), 3u);
+}
+
+TEST_F(Campaign, AKilledShardResumesToTheSameSummaryAndLosesOnlyTheTrialInFlight) {
+  const CampaignSpec spec = LoadCampaignSpec(Spec());
+  Run(spec, "whole");
+  const std::string reference = Merge({"whole"}, "m_whole");
+  // A kill after three trials, in the middle of writing the fourth: three whole lines and a cut one,
+  // and a manifest that never finished.
+  Run(spec, "killed");
+  const std::string results = (dir_ / "killed" / "results.jsonl").string();
+  std::string text = io::ReadFile(results);
+  std::size_t cut = 0;
+  for (int k = 0; k < 3; ++k) cut = text.find('\n', cut) + 1;
+  text = text.substr(0, cut) + text.substr(cut, 25);
+  { std::ofstream(results, std::ios::binary | std::ios::trunc) << text; }
+  const std::string manifest = (dir_ / "killed" / "manifest.json").string();
+  nlohmann::json m = nlohmann::json::parse(io::ReadFile(manifest));
+  m["finished"] = nullptr;
+  { std::ofstream(manifest, std::ios::trunc) << m.dump(2); }
+  RG_EXPECT_THROW_WITH(Merge({"killed"}, "m_early"), std::invalid_argument, "unfinished");
+  const CampaignRunSummary resumed = Run(spec, "killed", 2, {}, /*resume=*/true);
+  EXPECT_EQ(resumed.skipped, 3);
+  EXPECT_EQ(resumed.ran, 3);
+  EXPECT_EQ(Merge({"killed"}, "m_killed"), reference);
+}
+
+TEST_F(Campaign, AnErroringTrialIsRecordedAndTheCampaignGoesOn) {
+  // Rotor 9 of a quadrotor: trials 0-1 load, trials 2-3 fail at load time and are recorded.
+  const CampaignSpec spec = LoadCampaignSpec(Write("err.yaml", "name: err\n"
+                                                               "scenario: " + Scenario("hover_motor_stop_nominal.yaml") + "\n"
+                                                               "repeats: 2\n"
+                                                               "grid:\n"
+                                                               "  duration_s: [2.5]\n"
+                                                               "  faults.0.rotor: [0, 9]\n"));
+  const CampaignRunSummary r = Run(spec, "err", 2);
+  EXPECT_EQ(r.ran, 4);
+  EXPECT_EQ(r.errors, 2);
+  Merge({"err"}, "m");
+  const nlohmann::json s = nlohmann::json::parse(io::ReadFile((dir_ / "m" / "summary.json").string()));
+  EXPECT_EQ(s["overall"]["status"]["error"].get<int>(), 2);
+  EXPECT_EQ(s["overall"]["status"]["ok"].get<int>(), 2);
+  ASSERT_EQ(s["errors"].size(), 2u);
+  EXPECT_NE(s["errors"][0]["message"].get<std::string>().find("rotor"), std::string::npos);
+}
+
+TEST_F(Campaign, BadInputIsRejectedNamingTheKeyAndNothingIsOverwritten) {
+  RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("u.yaml", "name: u\nscenario: " + Scenario("hover.yaml") +
+                                                             "\ngrid:\n  wind.gusty: [0.1]\n")),
+                       io::ConfigError, "grid.wind.gusty");
+  RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("e.yaml", "name: e\nscenario: " + Scenario("hover.yaml") +
+                                                             "\ngrid:\n  duration_s: []\n")),
+                       io::ConfigError, "an empty sweep");
+  RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("m.yaml", "name: m\nscenario: " + Scenario("hover.yaml") +
+                                                             "\nmetrics: [wall_time_s]\n")),
+                       io::ConfigError, "not a recorded metric");
+  RG_EXPECT_THROW_WITH(Shard::Parse("4/4"), std::invalid_argument, "0 <= i < N");
+  RG_EXPECT_THROW_WITH(Shard::Parse("0/0"), std::invalid_argument, "0 <= i < N");
+  RG_EXPECT_THROW_WITH(Shard::Parse("a/2"), std::invalid_argument, "--shard 'a/2'");
+
+  const CampaignSpec spec = LoadCampaignSpec(Spec());
+  Run(spec, "out");
+  const std::string results = (dir_ / "out" / "results.jsonl").string();
+  const std::string before = io::ReadFile(results);
+  RG_EXPECT_THROW_WITH(Run(spec, "out"), std::invalid_argument, "--resume");
+  // Another spec (another seed) cannot resume these results, nor merge with them.
+  std::string text = io::ReadFile((dir_ / "spec.yaml").string());
+  text.replace(text.find("seed: 7"), 7, "seed: 8");
+  const CampaignSpec other = LoadCampaignSpec(Write("other.yaml", text));
+  EXPECT_NE(other.hash, spec.hash);
+  RG_EXPECT_THROW_WITH(Run(other, "out", 1, {}, true), std::invalid_argument, "spec_hash");
+  EXPECT_EQ(io::ReadFile(results), before);
+  Run(other, "other_out");
+  RG_EXPECT_THROW_WITH(Merge({"out", "other_out"}, "m"), std::invalid_argument, "spec_hash");
+  // Half the shards: a gap.
+  Run(spec, "half", 1, Shard{0, 2});
+  RG_EXPECT_THROW_WITH(Merge({"half"}, "mh"), std::invalid_argument, "missing");
+  // The same shard twice: duplicates.
+  Run(spec, "dup_a", 1, Shard{1, 2});
+  Run(spec, "dup_b", 1, Shard{1, 2});
+  RG_EXPECT_THROW_WITH(Merge({"half", "dup_a", "dup_b"}, "md"), std::invalid_argument, "is in both");
+  EXPECT_FALSE(fs::exists(dir_ / "m" / "summary.json"));
+}
+
+TEST(WilsonInterval, MatchesTheClosedFormAtKnownPoints) {
+  // 0 of 10: [0, z^2 / (n + z^2)] = [0, 0.2775]; 10 of 10 mirrors it; 5 of 10: 0.5 -+ 0.2866.
+  EXPECT_NEAR(WilsonInterval(0, 10).first, 0.0, 1e-12);
+  EXPECT_NEAR(WilsonInterval(0, 10).second, 0.27753, 1e-4);
+  EXPECT_NEAR(WilsonInterval(10, 10).first, 1.0 - 0.27753, 1e-4);
+  EXPECT_NEAR(WilsonInterval(5, 10).first, 0.23659, 1e-4);
+  EXPECT_NEAR(WilsonInterval(5, 10).second, 0.76341, 1e-4);
+}
+
+}  // namespace
+}  // namespace rotorguard::bench
