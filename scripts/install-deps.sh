@@ -16,6 +16,8 @@ packages=(
   libceres-dev         # L-BFGS for trajectory optimisation (planning)
   coinor-libipopt-dev  # Ipopt: the NMPC's correctness oracle in tests (not linked by the product)
   chromium             # headless browser of the report's browser test (viewer/test)
+  slurm-wlm munge      # campaigns as Slurm job arrays; a single-node cluster in tests (scripts/local-slurm.sh)
+  parallel             # GNU parallel: campaign shards across machines over ssh
 )
 # Node.js and npm build the report viewer (viewer/); a machine that has them already keeps its own.
 if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then

@@ -356,6 +356,16 @@ int main(int argc, char** argv) {
   bench_mars->add_option("--jobs", mars_jobs_text, "Worker threads (default: the number of cores)");
   bench_mars->add_flag("--json", mars_json, "Print JSON instead of Markdown");
 
+  std::string bcamp_spec, bcamp_dir;
+  bool bcamp_json = false;
+  CLI::App* bench_campaign = bench->add_subcommand(
+      "campaign", "The campaign engine (docs/campaigns.md): a spec run with one worker and with two\n"
+                  "(trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency), killed and resumed, and\n"
+                  "in 4 shards; each merged summary compared byte for byte with the uninterrupted one.");
+  bench_campaign->add_option("--spec", bcamp_spec, "Campaign spec (default configs/campaigns/bench_campaign.yaml)");
+  bench_campaign->add_option("--work", bcamp_dir, "A new folder for the runs (default: a temporary one, removed after)");
+  bench_campaign->add_flag("--json", bcamp_json, "Print JSON instead of a table");
+
   // campaign
   CLI::App* campaign = app.add_subcommand("campaign", "Monte Carlo campaigns: sweeps over a scenario's keys, run in\n"
                                                       "crash-safe, resumable shards and merged (docs/campaigns.md).");
@@ -373,6 +383,17 @@ int main(int argc, char** argv) {
   campaign_run->add_option("--shard", campaign_shard, "Run shard i of N (i/N, 0 <= i < N; default 0/1: all)");
   campaign_run->add_flag("--resume", campaign_resume, "Continue the results in --out: skip finished trials");
   campaign_run->add_flag("--quiet,-q", campaign_quiet, "No progress line");
+  std::string slurm_shards_text, slurm_cpus_text = "1", slurm_partition, slurm_time;
+  CLI::App* campaign_slurm = campaign->add_subcommand(
+      "slurm", "Write DIR/campaign.sbatch: a Slurm job array whose task i runs shard i/N of the spec into DIR\n"
+               "(with --resume, so resubmitting it or its failed tasks is safe). Submit it with sbatch;\n"
+               "merge DIR when every task is done.");
+  campaign_slurm->add_option("spec", campaign_spec, "Campaign spec (YAML)")->required();
+  campaign_slurm->add_option("--shards", slurm_shards_text, "Array tasks, one shard each")->required();
+  campaign_slurm->add_option("--out", campaign_out, "Results folder (on a file system every node sees)")->required();
+  campaign_slurm->add_option("--cpus-per-task", slurm_cpus_text, "CPUs per task, and its --jobs (default 1)");
+  campaign_slurm->add_option("--partition", slurm_partition, "Slurm partition (default: the cluster's)");
+  campaign_slurm->add_option("--time", slurm_time, "Slurm time limit per task, e.g. 02:00:00");
   CLI::App* campaign_merge = campaign->add_subcommand(
       "merge", "Join the shards in the given folders (every trial exactly once, one spec, one program) and\n"
                "write summary.json and summary.md.");
@@ -382,7 +403,7 @@ int main(int argc, char** argv) {
   // Every benchmark can also write its page: tables and distributions (report.h).
   std::string bench_html;
   for (CLI::App* b : {bench_sim, bench_qp, bench_nmpc, bench_ftc, bench_perception, bench_planner, bench_nav, bench_flatness,
-                      bench_mars}) {
+                      bench_mars, bench_campaign}) {
     b->add_option("--html", bench_html, "Also write the result as an HTML page to this file");
   }
   const auto write_bench_html = [&bench_html](const char* name, const nlohmann::json& result) {
@@ -596,6 +617,39 @@ int main(int argc, char** argv) {
       fmt::print("{}", flat_json ? r.dump(2) + "\n" : rotorguard::bench::FlatnessMarkdown(r));
       return kOk;
     }
+    if (*bench_campaign) {
+      const fs::path configs = fs::path(DefaultBenchScenario()).parent_path().parent_path();
+      const std::string spec_path =
+          bcamp_spec.empty() ? (configs / "campaigns" / "bench_campaign.yaml").string() : bcamp_spec;
+      const rotorguard::bench::CampaignSpec spec = rotorguard::bench::LoadCampaignSpec(spec_path);
+      const bool temporary = bcamp_dir.empty();
+      const std::string work = temporary ? (fs::temp_directory_path() / fmt::format("rotorguard-bench-campaign-{}",
+                                                                                     ::getpid())).string()
+                                         : bcamp_dir;
+      nlohmann::json r;
+      try {
+        r = rotorguard::bench::RunCampaignBenchmark(
+            spec, work, fmt::format("{} ({})", ROTORGUARD_VERSION, rotorguard::bench::GitRevision()));
+      } catch (...) {
+        if (temporary) fs::remove_all(work);
+        throw;
+      }
+      if (temporary) fs::remove_all(work);
+      write_bench_html("campaign", r);
+      if (bcamp_json) {
+        fmt::print("{}\n", r.dump(2));
+      } else {
+        fmt::print("campaign          {} ({} trials)\n", r["campaign"].get<std::string>(), r["trials"].get<int>());
+        fmt::print("trials/s          {:.2f} with 1 worker, {:.2f} with 2 (scaling efficiency {:.2f})\n",
+                   r["trials_per_s_1worker"].get<double>(), r["trials_per_s_2workers"].get<double>(),
+                   r["scaling_efficiency"].get<double>());
+        fmt::print("identical         jobs {}, kill and resume {}, 4 shards {}\n", r["jobs_identical"].get<bool>(),
+                   r["resume_identical"].get<bool>(), r["shards_identical"].get<bool>());
+      }
+      const bool same = r["jobs_identical"].get<bool>() && r["resume_identical"].get<bool>() &&
+                        r["shards_identical"].get<bool>();
+      return same ? kOk : kRunFailed;
+    }
     if (*campaign_run) {
       const rotorguard::bench::CampaignSpec spec = rotorguard::bench::LoadCampaignSpec(campaign_spec);
       rotorguard::bench::CampaignRunOptions o;
@@ -610,6 +664,25 @@ int main(int argc, char** argv) {
       fmt::print("shard             {}/{}: {} trials, {} already done, {} run, {} error or diverged\n", o.shard.index,
                  o.shard.count, r.trials, r.skipped, r.ran, r.errors);
       fmt::print("results           {}\n", r.results_file);
+      return kOk;
+    }
+    if (*campaign_slurm) {
+      const rotorguard::bench::CampaignSpec spec = rotorguard::bench::LoadCampaignSpec(campaign_spec);
+      rotorguard::bench::SlurmScriptOptions o;
+      o.shards = static_cast<int>(ParseUnsigned("--shards", slurm_shards_text, 1, 1'000'000));
+      o.cpus_per_task = static_cast<int>(ParseUnsigned("--cpus-per-task", slurm_cpus_text, 1, 256));
+      o.out_dir = campaign_out;
+      o.rotorguard = fs::read_symlink("/proc/self/exe").string();
+      o.partition = slurm_partition;
+      o.time_limit = slurm_time;
+      const std::string script = rotorguard::bench::SlurmArrayScript(spec, o);
+      fs::create_directories(campaign_out);
+      const std::string path = (fs::path(campaign_out) / "campaign.sbatch").string();
+      rotorguard::io::WriteFileAtomically(path, script);
+      fmt::print("campaign          {} (spec {}): {} trials in {} array tasks\n", spec.name, spec.hash, spec.trials(),
+                 o.shards);
+      fmt::print("script            {}\n", path);
+      fmt::print("submit            sbatch {}\n", path);
       return kOk;
     }
     if (*campaign_merge) {

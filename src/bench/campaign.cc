@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <filesystem>
@@ -411,6 +412,61 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
   return summary;
 }
 
+namespace {
+
+/// `text` quoted for a POSIX shell.
+std::string ShellQuote(const std::string& text) {
+  std::string q = "'";
+  for (const char c : text) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+std::string SlurmArrayScript(const CampaignSpec& spec, const SlurmScriptOptions& o) {
+  if (o.shards < 1 || o.shards > spec.trials()) {
+    throw std::invalid_argument(fmt::format("--shards {} is invalid; expected a count in [1, {}] (the campaign's "
+                                            "trials)", o.shards, spec.trials()));
+  }
+  if (o.cpus_per_task < 1 || o.cpus_per_task > 256) {
+    throw std::invalid_argument(fmt::format("--cpus-per-task {} is invalid; expected a count in [1, 256]", o.cpus_per_task));
+  }
+  if (o.out_dir.empty() || o.rotorguard.empty()) throw std::invalid_argument("the script needs --out and the program");
+  for (const std::string* v : {&o.partition, &o.time_limit}) {
+    if (v->find_first_of(" \t\n'\"\\$`") != std::string::npos) {
+      throw std::invalid_argument(fmt::format("'{}' is invalid; expected a Slurm name without spaces or quotes", *v));
+    }
+  }
+  const std::string out = fs::absolute(o.out_dir).lexically_normal().string();
+  if (out.find_first_of(" \t\n%") != std::string::npos) {
+    throw std::invalid_argument(fmt::format("--out '{}' is invalid; expected a folder without spaces or '%' (an "
+                                            "#SBATCH line cannot quote them)", o.out_dir));
+  }
+  const std::string spec_path = fs::absolute(spec.file).lexically_normal().string();
+  std::string s = fmt::format(
+      "#!/bin/bash\n"
+      "# rotorguard campaign '{name}' (spec {hash}): {trials} trials in {n} shards, one per array task.\n"
+      "# Submit: sbatch {script}\n"
+      "# Each task resumes its shard, so resubmitting this script, or only the failed tasks\n"
+      "# (sbatch --array=<their ids> {script}), is safe. When all are done:\n"
+      "#   {exe} campaign merge {outq}\n"
+      "#SBATCH --job-name=rg-{name}\n"
+      "#SBATCH --array=0-{last}\n"
+      "#SBATCH --cpus-per-task={cpus}\n"
+      "#SBATCH --output={out}/slurm-%A_%a.out\n",
+      fmt::arg("name", spec.name), fmt::arg("hash", spec.hash), fmt::arg("trials", spec.trials()),
+      fmt::arg("n", o.shards), fmt::arg("script", ShellQuote(out + "/campaign.sbatch")),
+      fmt::arg("exe", ShellQuote(o.rotorguard)), fmt::arg("outq", ShellQuote(out)), fmt::arg("last", o.shards - 1),
+      fmt::arg("cpus", o.cpus_per_task), fmt::arg("out", out));
+  if (!o.partition.empty()) s += "#SBATCH --partition=" + o.partition + "\n";
+  if (!o.time_limit.empty()) s += "#SBATCH --time=" + o.time_limit + "\n";
+  s += fmt::format("set -euo pipefail\n"
+                   "exec {} campaign run {} --out {} --shard \"${{SLURM_ARRAY_TASK_ID}}/{}\" "
+                   "--jobs \"${{SLURM_CPUS_PER_TASK:-{}}}\" --resume --quiet\n",
+                   ShellQuote(o.rotorguard), ShellQuote(spec_path), ShellQuote(out), o.shards, o.cpus_per_task);
+  return s;
+}
+
 std::string GitRevision() { return ROTORGUARD_GIT_REVISION; }
 
 std::pair<double, double> WilsonInterval(int successes, int n) {
@@ -606,6 +662,55 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
   io::WriteFileAtomically((fs::path(out_dir) / "summary.json").string(), summary.dump(2) + "\n");
   io::WriteFileAtomically((fs::path(out_dir) / "summary.md").string(), md);
   return summary;
+}
+
+nlohmann::json RunCampaignBenchmark(const CampaignSpec& spec, const std::string& work_dir, const std::string& version) {
+  if (fs::exists(work_dir) && !fs::is_empty(work_dir)) {
+    throw std::invalid_argument(fmt::format("bench campaign: '{}' is not empty; expected a new folder", work_dir));
+  }
+  const auto run = [&](const std::string& name, int jobs, Shard shard, bool resume) {
+    CampaignRunOptions o;
+    o.out_dir = (fs::path(work_dir) / name).string();
+    o.jobs = jobs;
+    o.shard = shard;
+    o.resume = resume;
+    o.version = version;
+    const auto t0 = std::chrono::steady_clock::now();
+    RunCampaign(spec, o);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  const auto summary = [&](const std::string& name) {
+    const fs::path dir = fs::path(work_dir) / name;
+    MergeCampaign({dir.string()}, dir.string());
+    return io::ReadFile((dir / "summary.json").string()) + io::ReadFile((dir / "summary.md").string());
+  };
+  const int trials = spec.trials();
+  const double one = run("jobs1", 1, {}, false), two = run("jobs2", 2, {}, false);
+  const std::string reference = summary("jobs1");
+  // Kill and resume: the state a SIGKILL leaves (whole lines, one cut short, no finish time).
+  run("killed", 2, {}, false);
+  const std::string results = (fs::path(work_dir) / "killed" / ResultsName({})).string();
+  std::string text = io::ReadFile(results);
+  std::size_t cut = 0;
+  for (int k = 0; k < trials / 3; ++k) cut = text.find('\n', cut) + 1;
+  const std::size_t next = text.find('\n', cut);
+  text = text.substr(0, cut) + text.substr(cut, (next - cut) / 2);
+  io::WriteFileAtomically(results, text);
+  const std::string manifest = (fs::path(work_dir) / "killed" / ManifestName({})).string();
+  nlohmann::json m = ReadJsonFile(manifest);
+  m["finished"] = nullptr;
+  io::WriteFileAtomically(manifest, m.dump(2) + "\n");
+  run("killed", 2, {}, true);
+  for (int i = 0; i < 4; ++i) run("shards", 1, Shard{i, 4}, false);
+  return {{"benchmark", "campaign"},
+          {"campaign", spec.name},
+          {"trials", trials},
+          {"trials_per_s_1worker", trials / one},
+          {"trials_per_s_2workers", trials / two},
+          {"scaling_efficiency", one / (2.0 * two)},
+          {"jobs_identical", summary("jobs2") == reference},
+          {"resume_identical", summary("killed") == reference},
+          {"shards_identical", summary("shards") == reference}};
 }
 
 }  // namespace rotorguard::bench

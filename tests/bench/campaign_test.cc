@@ -179,6 +179,44 @@ TEST_F(Campaign, BadInputIsRejectedNamingTheKeyAndNothingIsOverwritten) {
   EXPECT_FALSE(fs::exists(dir_ / "m" / "summary.json"));
 }
 
+TEST_F(Campaign, TheSlurmScriptRunsOneResumableShardPerArrayTask) {
+  const CampaignSpec spec = LoadCampaignSpec(Spec());
+  SlurmScriptOptions o;
+  o.shards = 3;
+  o.cpus_per_task = 2;
+  o.out_dir = (dir_ / "results").string();
+  o.rotorguard = "/opt/rg/bin/rotorguard";
+  o.partition = "short";
+  const std::string script = SlurmArrayScript(spec, o);
+  for (const std::string& needle :
+       {std::string("#SBATCH --array=0-2\n"), std::string("#SBATCH --cpus-per-task=2\n"),
+        std::string("#SBATCH --partition=short\n"), std::string("--shard \"${SLURM_ARRAY_TASK_ID}/3\""),
+        std::string("--resume"), std::string("'/opt/rg/bin/rotorguard' campaign run"),
+        "--out '" + (dir_ / "results").string() + "'"}) {
+    EXPECT_NE(script.find(needle), std::string::npos) << needle << " not in\n" << script;
+  }
+  o.shards = 7;  // more than the 6 trials
+  RG_EXPECT_THROW_WITH(SlurmArrayScript(spec, o), std::invalid_argument, "--shards 7");
+  o.shards = 3;
+  o.partition = "a b";
+  RG_EXPECT_THROW_WITH(SlurmArrayScript(spec, o), std::invalid_argument, "'a b'");
+  o.partition = "";
+  o.out_dir = (dir_ / "with space").string();
+  RG_EXPECT_THROW_WITH(SlurmArrayScript(spec, o), std::invalid_argument, "without spaces");
+}
+
+TEST_F(Campaign, TheBenchmarkFindsJobsResumeAndShardsIdenticalAndRefusesAFullFolder) {
+  const CampaignSpec spec = LoadCampaignSpec(Spec());
+  const nlohmann::json r = RunCampaignBenchmark(spec, (dir_ / "bench").string(), "test");
+  EXPECT_EQ(r["trials"].get<int>(), 6);
+  EXPECT_TRUE(r["jobs_identical"].get<bool>());
+  EXPECT_TRUE(r["resume_identical"].get<bool>());
+  EXPECT_TRUE(r["shards_identical"].get<bool>());
+  EXPECT_GT(r["trials_per_s_1worker"].get<double>(), 0.0);
+  RG_EXPECT_THROW_WITH(RunCampaignBenchmark(spec, (dir_ / "bench").string(), "test"), std::invalid_argument,
+                       "not empty");
+}
+
 TEST(WilsonInterval, MatchesTheClosedFormAtKnownPoints) {
   // 0 of 10: [0, z^2 / (n + z^2)] = [0, 0.2775]; 10 of 10 mirrors it; 5 of 10: 0.5 -+ 0.2866.
   EXPECT_NEAR(WilsonInterval(0, 10).first, 0.0, 1e-12);

@@ -86,10 +86,31 @@ struct CampaignRunSummary {
 /// existing file as it was.
 CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOptions& options);
 
+struct SlurmScriptOptions {
+  int shards = 1;              ///< array tasks, one shard each, in [1, trials]
+  int cpus_per_task = 1;       ///< --cpus-per-task, and each task's --jobs, in [1, 256]
+  std::string out_dir;         ///< the results folder (made absolute in the script)
+  std::string rotorguard;      ///< the program each task runs (absolute path)
+  std::string partition;       ///< "" for the cluster's default
+  std::string time_limit;      ///< Slurm's --time ("" for the partition's default)
+};
+
+/// An `sbatch --array` script: task i runs `campaign run SPEC --shard i/N --resume` into the
+/// results folder, so resubmitting the script, or only its failed tasks, is safe. Throws
+/// std::invalid_argument naming a bad option.
+std::string SlurmArrayScript(const CampaignSpec& spec, const SlurmScriptOptions& options);
+
 /// Joins the results of `dirs` (every shard's manifest and results), checks that they form the
 /// whole campaign exactly once, with one spec and one version, and writes summary.json and
 /// summary.md into `out_dir`. Throws io::CorruptFileError or io::ConfigError naming the file.
 nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::string& out_dir);
+
+/// `rotorguard bench campaign`: runs `spec` in `work_dir` (which it fills) with one worker and
+/// with two, then a kill-and-resume (a run cut after a third of its trials, mid-line, unfinished,
+/// then resumed) and 4 shards, and compares their merged summaries with the uninterrupted one's:
+/// {trials, trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency (the 2-worker rate over
+/// twice the 1-worker rate), resume_identical, shards_identical, jobs_identical}.
+nlohmann::json RunCampaignBenchmark(const CampaignSpec& spec, const std::string& work_dir, const std::string& version);
 
 /// The source revision this program was built from (git's short hash; "unknown" outside a clone).
 std::string GitRevision();
