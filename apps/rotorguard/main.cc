@@ -396,7 +396,7 @@ int main(int argc, char** argv) {
   campaign_slurm->add_option("--time", slurm_time, "Slurm time limit per task, e.g. 02:00:00");
   CLI::App* campaign_merge = campaign->add_subcommand(
       "merge", "Join the shards in the given folders (every trial exactly once, one spec, one program) and\n"
-               "write summary.json and summary.md.");
+               "write summary.json, summary.md and (with the report viewer) summary.html.");
   campaign_merge->add_option("dirs", merge_dirs, "Results folders")->required();
   campaign_merge->add_option("--out", merge_out, "Where to write the summary (default: the first folder)");
 
@@ -691,6 +691,11 @@ int main(int argc, char** argv) {
       fmt::print("campaign          {}: {} trials merged\n", s["campaign"].get<std::string>(), s["trials"].get<int>());
       fmt::print("summary           {}\n", (fs::path(out) / "summary.json").string());
       fmt::print("                  {}\n", (fs::path(out) / "summary.md").string());
+      if (rotorguard::io::HasViewer()) {  // the report viewer's page of any benchmark result
+        const std::string html = (fs::path(out) / "summary.html").string();
+        rotorguard::bench::WriteBenchReport("campaign " + s["campaign"].get<std::string>(), s, html);
+        fmt::print("                  {}\n", html);
+      }
       return kOk;
     }
     if (*bench_mars) {

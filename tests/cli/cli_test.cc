@@ -129,6 +129,9 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   ASSERT_EQ(Cli("campaign merge " + killed).exit_code, 0);
   EXPECT_EQ(ReadText(fs::path(killed) / "summary.json"), ReadText(fs::path(whole) / "summary.json"));
   EXPECT_EQ(ReadText(fs::path(killed) / "summary.md"), ReadText(fs::path(whole) / "summary.md"));
+  // The viewer's page of the summary (the CI build always has the viewer), its data the summary's.
+  const std::string page = ReadText(fs::path(whole) / "summary.html");
+  EXPECT_NE(page.find("kill_test"), std::string::npos);
   // Without --resume the results are not touched; shard and spec errors exit 2.
   const std::string before = ReadText(results);
   EXPECT_EQ(Cli("campaign run " + spec + " --out " + killed).exit_code, 2);
