@@ -3,6 +3,7 @@
 // 2 usage or invalid config; 3 an input file is unreadable; 4 an infeasible request.
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <chrono>
@@ -183,7 +184,7 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
 
 /// --jobs: worker threads, the number of cores when not given.
 int ParseJobs(const std::string& text) {
-  if (text.empty()) return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (text.empty()) return static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 256u));
   return static_cast<int>(ParseUnsigned("--jobs", text, 1, 256));
 }
 

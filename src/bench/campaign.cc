@@ -1,6 +1,7 @@
 #include "rotorguard/bench/campaign.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -122,40 +123,77 @@ class AppendFile {
   int fd_ = -1;
 };
 
-/// The trials recorded in `path`, by index. With `repair`, a last line cut short by a kill is cut
-/// off the file; otherwise it is an error. Any other unreadable line is corruption.
-std::map<int, nlohmann::json> ReadResults(const std::string& path, bool repair) {
-  std::map<int, nlohmann::json> trials;
-  if (!fs::exists(path)) return trials;
-  std::string text = io::ReadFile(path);
-  const std::size_t end = text.rfind('\n');
-  const std::size_t whole = end == std::string::npos ? 0 : end + 1;
-  if (whole < text.size()) {
-    if (!repair) throw io::CorruptFileError(path, whole, "the last line is cut short (resume the shard first)");
-    fs::resize_file(path, whole);  // a partial last line: the trial in flight when it was killed
-    text.resize(whole);
+/// A file's text; an unreadable file is bad input (exit 3), not a failed run.
+std::string ReadInput(const std::string& path) {
+  try {
+    return io::ReadFile(path);
+  } catch (const std::runtime_error& e) {
+    throw io::InputFileError(path, e.what());
   }
+}
+
+/// The trials recorded in a results file, by index, and where its whole lines end (a last line cut
+/// short by a kill starts there). Every line must be one trial's record; anything else is corruption.
+struct Recorded {
+  std::map<int, nlohmann::json> trials;
+  std::size_t whole_size = 0;
+  bool cut = false;  ///< the file ends in a partial line
+};
+Recorded ReadResults(const std::string& path) {
+  Recorded r;
+  if (!fs::exists(path)) return r;
+  std::string text = ReadInput(path);
+  const std::size_t end = text.rfind('\n');
+  r.whole_size = end == std::string::npos ? 0 : end + 1;
+  r.cut = r.whole_size < text.size();
+  text.resize(r.whole_size);
   std::size_t offset = 0;
   while (offset < text.size()) {
     const std::size_t nl = text.find('\n', offset);
-    const std::string line = text.substr(offset, nl - offset);
-    nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
-    if (j.is_discarded() || !j.is_object() || !j.contains("trial") || !j["trial"].is_number_integer()) {
-      throw io::CorruptFileError(path, offset, "expected one JSON object with an integer 'trial' per line");
+    nlohmann::json j = nlohmann::json::parse(text.substr(offset, nl - offset), nullptr, false);
+    const bool valid = !j.is_discarded() && j.is_object() && j.contains("trial") && j["trial"].is_number_integer() &&
+                       j.contains("id") && j["id"].is_string() && j.contains("params") && j["params"].is_object() &&
+                       j.contains("status") && j["status"].is_string() && j.contains("message") &&
+                       j["message"].is_string() && j.contains("metrics") &&
+                       (j["metrics"].is_object() || j["metrics"].is_null());
+    if (!valid) {
+      throw io::CorruptFileError(path, offset, "expected one trial record per line: {trial, id, params, status, "
+                                               "message, metrics}");
     }
     const int index = j["trial"].get<int>();
-    if (trials.count(index)) throw io::CorruptFileError(path, offset, fmt::format("trial {} recorded twice", index));
-    trials.emplace(index, std::move(j));
+    if (r.trials.count(index)) throw io::CorruptFileError(path, offset, fmt::format("trial {} recorded twice", index));
+    r.trials.emplace(index, std::move(j));
     offset = nl + 1;
   }
-  return trials;
+  return r;
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {
-  nlohmann::json j = nlohmann::json::parse(io::ReadFile(path), nullptr, false);
+  nlohmann::json j = nlohmann::json::parse(ReadInput(path), nullptr, false);
   if (j.is_discarded() || !j.is_object()) throw io::CorruptFileError(path, 0, "expected a JSON object");
   return j;
 }
+
+/// An exclusive lock on a shard for the life of a run: a second run of the same shard (a resubmitted
+/// task whose first copy still runs) is refused instead of appending the same trials twice.
+class ShardLock {
+ public:
+  explicit ShardLock(const std::string& path) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw io::InputFileError(path, "cannot open the shard's lock file");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw std::invalid_argument(fmt::format("{} is held: this shard is already running (wait for it, or stop "
+                                              "it, then --resume)", path));
+    }
+  }
+  ~ShardLock() { ::close(fd_); }  // closing releases the lock
+  ShardLock(const ShardLock&) = delete;
+  ShardLock& operator=(const ShardLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 }  // namespace
 
@@ -171,8 +209,15 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
   CampaignSpec spec;
   spec.file = path;
   spec.name = root.Required("name").AsString();
+  if (spec.name.empty() || spec.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") !=
+                               std::string::npos) {
+    root.FailAt("name", fmt::format("'{}' is invalid; expected letters, digits, '_', '.' or '-' (it names files and "
+                                    "Slurm jobs)", spec.name));
+  }
   const io::ConfigNode scenario = root.Required("scenario");
-  spec.scenario = (fs::path(path).parent_path() / scenario.AsString()).lexically_normal().string();
+  // Canonical, so that every machine and every way of naming the spec records the same path (it
+  // appears in trials' error messages, part of the summary).
+  spec.scenario = fs::weakly_canonical(fs::absolute(fs::path(path).parent_path() / scenario.AsString())).string();
   if (const auto s = root.Optional("seed")) spec.seed = s->AsUint64();
   if (const auto r = root.Optional("repeats")) spec.repeats = static_cast<int>(r->AsIntIn(1, 10'000'000));
   nlohmann::json canonical = {{"name", spec.name}, {"seed", spec.seed}, {"repeats", spec.repeats}};
@@ -209,6 +254,10 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
         draw.Fail("expected {uniform: [lo, hi]} or {choice: [values]}");
       }
       draw.RejectUnknownKeys();
+      for (const auto& [grid_key, values] : spec.grid) {
+        if (grid_key == key) random->FailAt(key, "swept by grid too; expected each key in one sweep only");
+      }
+      if (key == "seed") random->FailAt(key, "the seed is the campaign's (key seed): each trial derives its own");
       spec.random.emplace_back(key, r);
       canonical["random"].push_back({key, r.kind == RandomSweep::Kind::kUniform ? nlohmann::json({r.lo, r.hi})
                                                                                   : nlohmann::json(r.choices)});
@@ -239,7 +288,7 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
   // before any trial runs, at the spec's key.
   std::string scenario_text;
   try {
-    scenario_text = io::ReadFile(spec.scenario);
+    scenario_text = ReadInput(spec.scenario);
   } catch (const std::runtime_error&) {
     scenario.Fail(fmt::format("cannot read the scenario '{}'", spec.scenario));
   }
@@ -320,7 +369,12 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
     throw std::invalid_argument(fmt::format("--shard {}/{}: more shards than the campaign's {} trials",
                                             options.shard.index, options.shard.count, spec.trials()));
   }
-  fs::create_directories(options.out_dir);
+  std::error_code ec;
+  fs::create_directories(options.out_dir, ec);
+  if (ec || !fs::is_directory(options.out_dir)) {
+    throw std::invalid_argument(fmt::format("--out: cannot create the folder '{}'{}", options.out_dir,
+                                            ec ? ": " + ec.message() : ""));
+  }
   CampaignRunSummary summary;
   summary.results_file = (fs::path(options.out_dir) / ResultsName(options.shard)).string();
   summary.manifest_file = (fs::path(options.out_dir) / ManifestName(options.shard)).string();
@@ -341,6 +395,7 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
                              {"finished", nullptr}};
   for (const auto& [key, values] : spec.grid) manifest["grid_keys"].push_back(key);
 
+  const ShardLock lock(summary.manifest_file + ".lock");
   const bool exists = fs::exists(summary.results_file) || fs::exists(summary.manifest_file);
   std::map<int, nlohmann::json> done;
   if (exists && !options.resume) {
@@ -360,13 +415,16 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
       }
     }
     manifest["started"] = old.value("started", manifest["started"]);
-    done = ReadResults(summary.results_file, /*repair=*/true);
-    for (const auto& [index, line] : done) {
-      if (index < first || index >= last || line.value("id", "") != TrialId(TrialParameters(spec, index))) {
+    Recorded recorded = ReadResults(summary.results_file);
+    for (const auto& [index, line] : recorded.trials) {
+      if (index < first || index >= last || line["id"].get<std::string>() != TrialId(TrialParameters(spec, index))) {
         throw io::CorruptFileError(summary.results_file, 0,
                                    fmt::format("trial {} does not belong to this shard of this spec", index));
       }
     }
+    // Only now, with every check passed, cut the line a kill left unfinished.
+    if (recorded.cut) fs::resize_file(summary.results_file, recorded.whole_size);
+    done = std::move(recorded.trials);
   }
   io::WriteFileAtomically(summary.manifest_file, manifest.dump(2) + "\n");
 
@@ -378,6 +436,7 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
   AppendFile results(summary.results_file);
   std::mutex mutex;
   int errors = 0;
+  std::exception_ptr write_error;
   ParallelFor(static_cast<int>(todo.size()), options.jobs, [&](int task) {
     const int index = todo[static_cast<std::size_t>(task)];
     const std::map<std::string, std::string> params = TrialParameters(spec, index);
@@ -400,11 +459,23 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
       line["status"] = "error";
       line["message"] = e.what();
       line["metrics"] = nullptr;
+    } catch (...) {
+      line["status"] = "error";
+      line["message"] = "an exception of unknown type";
+      line["metrics"] = nullptr;
     }
-    const std::lock_guard<std::mutex> lock(mutex);
+    // Invalid UTF-8 in a message is replaced rather than thrown: the trial is recorded either way.
+    const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    const std::lock_guard<std::mutex> guard(mutex);
     if (line["status"] != "ok") ++errors;
-    results.AppendLine(line.dump());
+    if (write_error) return;  // the disk failed: no more lines; the run reports it below
+    try {
+      results.AppendLine(text);
+    } catch (...) {
+      write_error = std::current_exception();
+    }
   }, options.progress);
+  if (write_error) std::rethrow_exception(write_error);  // the manifest stays unfinished: resume later
   summary.ran = static_cast<int>(todo.size());
   summary.errors = errors;
   manifest["finished"] = UtcNow();
@@ -557,7 +628,8 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
     std::sort(found.begin(), found.end());
     for (const fs::path& m : found) {
       const nlohmann::json manifest = ReadJsonFile(m.string());
-      for (const char* key : {"spec_hash", "version", "trials_total", "shard", "metrics", "grid_keys", "campaign"}) {
+      for (const char* key :
+           {"spec_hash", "version", "trials_total", "shard", "metrics", "grid_keys", "campaign", "finished"}) {
         if (!manifest.contains(key)) throw io::CorruptFileError(m.string(), 0, fmt::format("no key '{}'", key));
       }
       if (!manifests.empty()) {
@@ -571,8 +643,10 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
         }
       }
       if (manifest["finished"].is_null()) {
-        throw std::invalid_argument(fmt::format("campaign merge: {} is unfinished (its shard was stopped); resume "
-                                                "it with `campaign run ... --resume` first", m.string()));
+        throw std::invalid_argument(fmt::format("campaign merge: {} is unfinished (shard {} was stopped before its "
+                                                "last trial); resume it with `campaign run ... --shard {} --resume` "
+                                                "first", m.string(), manifest["shard"].dump(),
+                                                manifest["shard"].dump()));
       }
       const std::string shard = manifest["shard"].get<std::string>();
       const std::string results =
@@ -580,7 +654,11 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
                                   ? std::string("results.jsonl")
                                   : "results.shard-" + shard.substr(0, shard.find('/')) + ".jsonl"))
               .string();
-      for (auto& [index, line] : ReadResults(results, /*repair=*/false)) {
+      Recorded recorded = ReadResults(results);
+      if (recorded.cut) {
+        throw io::CorruptFileError(results, recorded.whole_size, "the last line is cut short (resume the shard first)");
+      }
+      for (auto& [index, line] : recorded.trials) {
         if (trials.count(index)) {
           throw std::invalid_argument(fmt::format("campaign merge: trial {} is in both {} and {}", index,
                                                   source[index], results));

@@ -3,6 +3,10 @@
 // comparison of merged summaries.
 #include "rotorguard/bench/campaign.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -176,7 +180,61 @@ TEST_F(Campaign, BadInputIsRejectedNamingTheKeyAndNothingIsOverwritten) {
   Run(spec, "dup_a", 1, Shard{1, 2});
   Run(spec, "dup_b", 1, Shard{1, 2});
   RG_EXPECT_THROW_WITH(Merge({"half", "dup_a", "dup_b"}, "md"), std::invalid_argument, "is in both");
-  EXPECT_FALSE(fs::exists(dir_ / "m" / "summary.json"));
+  // A refused merge leaves an earlier summary as it was.
+  fs::create_directories(dir_ / "md");
+  Write("md/summary.json", "{\"earlier\": true}");
+  RG_EXPECT_THROW_WITH(Merge({"half", "dup_a", "dup_b"}, "md"), std::invalid_argument, "is in both");
+  EXPECT_EQ(io::ReadFile((dir_ / "md" / "summary.json").string()), "{\"earlier\": true}");
+}
+
+TEST_F(Campaign, SpecRulesNameTheKey) {
+  const std::string base = "name: s\nscenario: " + Scenario("hover.yaml") + "\n";
+  RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("k.yaml", base + "trials: 5\n")), io::ConfigError, "trials");
+  RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("o.yaml", base + "grid:\n  duration_s: [1.0]\nrandom:\n  duration_s: "
+                                                               "{uniform: [1.0, 2.0]}\n")),
+                       io::ConfigError, "in one sweep only");
+  RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("n.yaml", "name: a b\nscenario: " + Scenario("hover.yaml") + "\n")),
+                       io::ConfigError, "'a b' is invalid");
+  RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("r.yaml", base + "random:\n  duration_s: {uniform: [2.0, 1.0]}\n")),
+                       io::ConfigError, "lo < hi");
+}
+
+TEST_F(Campaign, ARunningShardIsNotRunTwiceAndDamagedResultsAreRefusedUntouched) {
+  const CampaignSpec spec = LoadCampaignSpec(Spec());
+  // Another process holds the shard.
+  fs::create_directories(dir_ / "busy");
+  const int fd = ::open((dir_ / "busy" / "manifest.json.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  RG_EXPECT_THROW_WITH(Run(spec, "busy"), std::invalid_argument, "already running");
+  ::close(fd);
+  EXPECT_EQ(Run(spec, "busy").ran, 6);  // released: it runs
+
+  // A cut last line and another spec's resume: refused, and the file keeps its cut line.
+  const std::string results = (dir_ / "busy" / "results.jsonl").string();
+  { std::ofstream(results, std::ios::app | std::ios::binary) << "{\"trial\": 3, \"id\""; }
+  const std::string cut = io::ReadFile(results);
+  std::string text = io::ReadFile((dir_ / "spec.yaml").string());
+  text.replace(text.find("seed: 7"), 7, "seed: 9");
+  RG_EXPECT_THROW_WITH(Run(LoadCampaignSpec(Write("other.yaml", text)), "busy", 1, {}, true), std::invalid_argument,
+                       "spec_hash");
+  EXPECT_EQ(io::ReadFile(results), cut);
+  // Merge refuses the cut line (resume first), and a damaged line in the middle.
+  RG_EXPECT_THROW_WITH(Merge({"busy"}, "m1"), io::CorruptFileError, "cut short");
+  std::string lines = cut.substr(0, cut.rfind('\n') + 1);
+  lines.replace(lines.find("\"status\""), 8, "\"statuz\"");
+  { std::ofstream(results, std::ios::trunc | std::ios::binary) << lines; }
+  RG_EXPECT_THROW_WITH(Merge({"busy"}, "m2"), io::CorruptFileError, "one trial record per line");
+  // Shards of two builds of the program do not merge.
+  CampaignRunOptions o;
+  o.out_dir = (dir_ / "versions").string();
+  o.shard = {0, 2};
+  o.version = "build A";
+  RunCampaign(spec, o);
+  o.shard = {1, 2};
+  o.version = "build B";
+  RunCampaign(spec, o);
+  RG_EXPECT_THROW_WITH(Merge({"versions"}, "m3"), std::invalid_argument, "version");
 }
 
 TEST_F(Campaign, TheSlurmScriptRunsOneResumableShardPerArrayTask) {

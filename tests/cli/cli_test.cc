@@ -112,7 +112,7 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
     const std::string text = ReadText(results);
     return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
   };
-  for (int i = 0; i < 1000 && lines() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  for (int i = 0; i < 6000 && lines() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   ::kill(pid, SIGKILL);
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -129,7 +129,7 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   ASSERT_EQ(Cli("campaign merge " + killed).exit_code, 0);
   EXPECT_EQ(ReadText(fs::path(killed) / "summary.json"), ReadText(fs::path(whole) / "summary.json"));
   EXPECT_EQ(ReadText(fs::path(killed) / "summary.md"), ReadText(fs::path(whole) / "summary.md"));
-  // The viewer's page of the summary (the CI build always has the viewer), its data the summary's.
+  // The viewer's page of the summary (the CI build always has the viewer) names the campaign.
   const std::string page = ReadText(fs::path(whole) / "summary.html");
   EXPECT_NE(page.find("kill_test"), std::string::npos);
   // Without --resume the results are not touched; shard and spec errors exit 2.
@@ -144,6 +144,16 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   const Result unknown = Cli("campaign run " + Write("u.yaml", "name: u\nscenario: " + spec + "\n") + " --out " +
                              (dir_ / "u").string());
   EXPECT_EQ(unknown.exit_code, 2) << unknown.out;
+  const Result typo = Cli("campaign run " + Write("t.yaml", ReadText(spec) + "repeat: 3\n") + " --out " +
+                          (dir_ / "t").string());
+  EXPECT_EQ(typo.exit_code, 2) << typo.out;
+  EXPECT_NE(typo.out.find("repeat"), std::string::npos) << typo.out;
+  // Results that cannot be read exit 3.
+  const std::string damaged = (dir_ / "damaged").string();
+  fs::create_directories(damaged);
+  std::ofstream(fs::path(damaged) / "manifest.json") << "not json";
+  const Result corrupt = Cli("campaign merge " + damaged);
+  EXPECT_EQ(corrupt.exit_code, 3) << corrupt.out;
 }
 
 TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {

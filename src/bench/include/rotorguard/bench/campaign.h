@@ -81,9 +81,11 @@ struct CampaignRunSummary {
   std::string results_file, manifest_file;
 };
 
-/// Runs the shard's trials not yet recorded. Throws io::ConfigError for bad input (an existing
-/// results file without `resume`, a resume against another spec or version) and leaves every
-/// existing file as it was.
+/// Runs the shard's trials not yet recorded. Throws std::invalid_argument for a bad request (an
+/// existing results file without `resume`, a resume against another spec or version, the shard
+/// already running in another process), io::InputFileError or io::CorruptFileError for unreadable
+/// or damaged results, and leaves every existing file as it was; an I/O failure while appending
+/// is rethrown once the trials in flight are done (the manifest stays unfinished: resume later).
 CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOptions& options);
 
 struct SlurmScriptOptions {
