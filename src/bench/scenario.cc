@@ -75,6 +75,14 @@ vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
   v.unloaded_speed_ratio = root.Required("unloaded_rpm_ratio").AsDouble();
   v.collision_radius_m = root.Required("collision_radius_m").AsDouble();
   if (root.Has("pwm_gain_n")) v.pwm_gain_n = root.Required("pwm_gain_n").AsPositive();
+  if (const auto spheres = root.Optional("collision_spheres")) {
+    if (!spheres->IsSequence() || spheres->size() == 0) spheres->Fail("expected a non-empty list of spheres");
+    for (std::size_t i = 0; i < spheres->size(); ++i) {
+      const ConfigNode c = spheres->At(i);
+      v.collision_spheres.push_back({c.Required("centre_m").AsVector3(), c.Required("radius_m").AsPositive()});
+      c.RejectUnknownKeys();
+    }
+  }
   const ConfigNode rotors = root.Required("rotors");
   if (!rotors.IsSequence() || rotors.size() == 0) rotors.Fail("expected a non-empty list of rotors");
   for (std::size_t i = 0; i < rotors.size(); ++i) {
@@ -125,6 +133,12 @@ std::string VehicleToYaml(const vehicle::VehicleParams& v) {
                  v.motor_stop_time_constant_s);
   fmt::format_to(it, "unloaded_rpm_ratio: {}\ncollision_radius_m: {}\n", v.unloaded_speed_ratio, v.collision_radius_m);
   if (v.pwm_gain_n > 0.0) fmt::format_to(it, "pwm_gain_n: {}\n", v.pwm_gain_n);
+  if (!v.collision_spheres.empty()) {  // an assembly's footprint, unit by unit
+    fmt::format_to(it, "collision_spheres:\n");
+    for (const vehicle::CollisionSphere& c : v.collision_spheres) {
+      fmt::format_to(it, "  - {{centre_m: {}, radius_m: {}}}\n", vec(c.centre_B), c.radius_m);
+    }
+  }
   fmt::format_to(it, "rotors:\n");
   for (const vehicle::Rotor& r : v.rotors) {
     fmt::format_to(it, "  - {{position_m: {}, direction: {}, yaw_coefficient_m: {}, max_thrust_n: {}}}\n",

@@ -88,7 +88,9 @@ TEST_F(SensorLog, RejectsCorruptionNamingTheLineAndByte) {
 }
 
 TEST_F(TempFolder, VehicleYamlRoundTripsThroughTheLoader) {
-  const vehicle::VehicleParams v = rotorguard::testing::ReferenceQuad();
+  vehicle::VehicleParams v = rotorguard::testing::ReferenceQuad();
+  // Collision spheres as an assembly has them (one per unit), within the bounding radius.
+  v.collision_spheres = {{Vector3(0.08, -0.04, 0.0), 0.1}, {Vector3(-0.1, 0.05, 0.0), 0.1 / 3.0}};
   const vehicle::VehicleParams back = LoadVehicle(Write("vehicle.yaml", VehicleToYaml(v)));
   EXPECT_EQ(back.name, v.name);
   EXPECT_EQ(back.mass_kg, v.mass_kg);
@@ -100,6 +102,11 @@ TEST_F(TempFolder, VehicleYamlRoundTripsThroughTheLoader) {
   EXPECT_EQ(back.motor_stop_time_constant_s, v.motor_stop_time_constant_s);
   EXPECT_EQ(back.unloaded_speed_ratio, v.unloaded_speed_ratio);
   EXPECT_EQ(back.collision_radius_m, v.collision_radius_m);
+  ASSERT_EQ(back.collision_spheres.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back.collision_spheres[i].centre_B, v.collision_spheres[i].centre_B);
+    EXPECT_EQ(back.collision_spheres[i].radius_m, v.collision_spheres[i].radius_m);
+  }
   ASSERT_EQ(back.rotors.size(), v.rotors.size());
   for (std::size_t i = 0; i < v.rotors.size(); ++i) {
     EXPECT_EQ(back.rotors[i].p_B, v.rotors[i].p_B);
