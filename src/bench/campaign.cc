@@ -572,14 +572,19 @@ nlohmann::json MetricStats(const std::vector<const nlohmann::json*>& trials, con
     return {{"n", bools}, {"rate", static_cast<double>(trues) / bools}, {"wilson95", {lo, hi}}};
   }
   if (values.empty()) return {{"n", 0}};
-  double mean = 0.0;
-  for (const double v : values) mean += v;
-  mean /= static_cast<double>(values.size());
-  double var = 0.0;
-  for (const double v : values) var += (v - mean) * (v - mean);
+  // Welford's running mean and squared deviations: no sum of raw values that could overflow.
+  double mean = 0.0, m2 = 0.0;
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const double delta = values[k] - mean;
+    mean += delta / static_cast<double>(k + 1);
+    m2 += delta * (values[k] - mean);
+  }
   const double n = static_cast<double>(values.size());
-  const double sd = values.size() > 1 ? std::sqrt(var / (n - 1.0)) : 0.0;
+  const double sd = values.size() > 1 ? std::sqrt(m2 / (n - 1.0)) : 0.0;
   const double half = 1.959963984540054 * sd / std::sqrt(n);
+  if (!std::isfinite(mean) || !std::isfinite(sd) || !std::isfinite(half)) {
+    return {{"n", values.size()}, {"overflow", true}};  // never a NaN in the summary
+  }
   return {{"n", values.size()},
           {"mean", mean},
           {"std", sd},
@@ -598,7 +603,7 @@ nlohmann::json GroupStats(const std::vector<const nlohmann::json*>& trials, cons
 }
 
 std::string StatsCell(const nlohmann::json& s) {
-  if (s["n"].get<int>() == 0) return "-";
+  if (s["n"].get<int>() == 0 || s.contains("overflow")) return "-";
   if (s.contains("rate")) {
     return fmt::format("{:.3f} [{:.3f}, {:.3f}]", s["rate"].get<double>(), s["wilson95"][0].get<double>(),
                        s["wilson95"][1].get<double>());

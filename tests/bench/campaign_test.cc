@@ -7,6 +7,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -273,6 +274,36 @@ TEST_F(Campaign, TheBenchmarkFindsJobsResumeAndShardsIdenticalAndRefusesAFullFol
   EXPECT_GT(r["trials_per_s_1worker"].get<double>(), 0.0);
   RG_EXPECT_THROW_WITH(RunCampaignBenchmark(spec, (dir_ / "bench").string(), "test"), std::invalid_argument,
                        "not empty");
+}
+
+TEST_F(Campaign, TheSummaryStatisticsMatchTheClosedFormsOnHandMadeResults) {
+  // A campaign of three trials written by hand: x = 1, 2, 3 (mean 2, std 1), flag true twice.
+  fs::create_directories(dir_ / "hand");
+  Write("hand/manifest.json", R"({"campaign": "hand", "spec_hash": "h", "version": "v", "trials_total": 3,
+      "shard": "0/1", "metrics": ["x", "flag", "big"], "grid_keys": [], "finished": "t"})");
+  std::string lines;
+  const double xs[3] = {1.0, 2.0, 3.0};
+  for (int i = 0; i < 3; ++i) {
+    lines += nlohmann::json({{"trial", i}, {"id", "i"}, {"params", nlohmann::json::object()}, {"status", "ok"},
+                             {"message", ""},
+                             {"metrics", {{"x", xs[i]}, {"flag", i < 2}, {"big", 1.5e308}}}})
+                 .dump() +
+             "\n";
+  }
+  Write("hand/results.jsonl", lines);
+  const nlohmann::json s = MergeCampaign({(dir_ / "hand").string()}, (dir_ / "hand").string());
+  const nlohmann::json& x = s["overall"]["metrics"]["x"];
+  EXPECT_DOUBLE_EQ(x["mean"].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(x["std"].get<double>(), 1.0);
+  EXPECT_NEAR(x["ci95"][0].get<double>(), 2.0 - 1.959963984540054 / std::sqrt(3.0), 1e-12);
+  EXPECT_DOUBLE_EQ(x["min"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(x["max"].get<double>(), 3.0);
+  const nlohmann::json& flag = s["overall"]["metrics"]["flag"];
+  EXPECT_NEAR(flag["rate"].get<double>(), 2.0 / 3.0, 1e-15);
+  EXPECT_EQ(flag["wilson95"][0].get<double>(), WilsonInterval(2, 3).first);
+  // Three values of 1.5e308 sum past the largest double; the running mean stays exact.
+  EXPECT_DOUBLE_EQ(s["overall"]["metrics"]["big"]["mean"].get<double>(), 1.5e308);
+  EXPECT_EQ(io::ReadFile((dir_ / "hand" / "summary.md").string()).find("nan"), std::string::npos);
 }
 
 TEST(WilsonInterval, MatchesTheClosedFormAtKnownPoints) {
