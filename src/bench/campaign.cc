@@ -123,15 +123,6 @@ class AppendFile {
   int fd_ = -1;
 };
 
-/// A file's text; an unreadable file is bad input (exit 3), not a failed run.
-std::string ReadInput(const std::string& path) {
-  try {
-    return io::ReadFile(path);
-  } catch (const std::runtime_error& e) {
-    throw io::InputFileError(path, e.what());
-  }
-}
-
 /// The trials recorded in a results file, by index, and where its whole lines end (a last line cut
 /// short by a kill starts there). Every line must be one trial's record; anything else is corruption.
 struct Recorded {
@@ -142,7 +133,7 @@ struct Recorded {
 Recorded ReadResults(const std::string& path) {
   Recorded r;
   if (!fs::exists(path)) return r;
-  std::string text = ReadInput(path);
+  std::string text = io::ReadInputFile(path);
   const std::size_t end = text.rfind('\n');
   r.whole_size = end == std::string::npos ? 0 : end + 1;
   r.cut = r.whole_size < text.size();
@@ -169,7 +160,7 @@ Recorded ReadResults(const std::string& path) {
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {
-  nlohmann::json j = nlohmann::json::parse(ReadInput(path), nullptr, false);
+  nlohmann::json j = nlohmann::json::parse(io::ReadInputFile(path), nullptr, false);
   if (j.is_discarded() || !j.is_object()) throw io::CorruptFileError(path, 0, "expected a JSON object");
   return j;
 }
@@ -288,7 +279,7 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
   // before any trial runs, at the spec's key.
   std::string scenario_text;
   try {
-    scenario_text = ReadInput(spec.scenario);
+    scenario_text = io::ReadInputFile(spec.scenario);
   } catch (const std::runtime_error&) {
     scenario.Fail(fmt::format("cannot read the scenario '{}'", spec.scenario));
   }

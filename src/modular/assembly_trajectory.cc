@@ -21,17 +21,6 @@ constexpr int kC = planning::MinimumJerkTrajectory::kCoefficients;
 using planning::CubicPenalty;
 using planning::TrajectoryOptimizer;  // for its duration map T(τ)
 
-/// d/dψ of R_z(ψ) r for a horizontal offset r.
-Vector3 RotatedDerivative(double yaw, const Vector3& r) {
-  const double c = std::cos(yaw), s = std::sin(yaw);
-  return Vector3(-s * r.x() - c * r.y(), c * r.x() - s * r.y(), 0.0);
-}
-
-Vector3 Rotated(double yaw, const Vector3& r) {
-  const double c = std::cos(yaw), s = std::sin(yaw);
-  return Vector3(c * r.x() - s * r.y(), s * r.x() + c * r.y(), r.z());
-}
-
 /// The yaw as a 3-D state: the yaw in x, y and z zero.
 planning::PvaState YawState(double yaw) {
   planning::PvaState s = planning::PvaState::Zero();
@@ -315,14 +304,15 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
         for (std::size_t k = cursor; k < list.size() && list[k].sample == j; ++k) {
           const Vector3& r = assembly_.unit_position_B[static_cast<std::size_t>(list[k].unit)];
           const planning::ObstaclePlane& plane = list[k].plane;
-          const Vector3 c = der.row(0).transpose() + Rotated(psi(0), r);
+          const Vector3 offset = QuaternionFromYaw(psi(0)) * r;  // R_z(ψ) r
+          const Vector3 c = der.row(0).transpose() + offset;
           double slope;
           const double pen = CubicPenalty(required - (c - plane.point).dot(plane.normal), &slope);
           if (slope == 0.0) continue;
           cost += o.weight_obstacle * pen;
           const Eigen::RowVector3d gc = -o.weight_obstacle * slope * plane.normal.transpose();
           add_position(0, gc);
-          add_yaw(0, gc.dot(RotatedDerivative(psi(0), r).transpose()));
+          add_yaw(0, gc.dot(Vector3::UnitZ().cross(offset).transpose()));  // d(R_z(ψ) r)/dψ = e_z × R_z(ψ) r
         }
       }
     }
@@ -353,7 +343,7 @@ FootprintPlaneSet AssemblyTrajectoryOptimizer::BuildPlanes(const perception::Vox
       const Vector3 p = pos.PieceDerivative(i, ts, 0);
       const double psi = traj.yaw().PieceDerivative(i, ts, 0).x();
       for (int k = 0; k < assembly_.num_units; ++k) {
-        const Vector3 c = p + Rotated(psi, assembly_.unit_position_B[static_cast<std::size_t>(k)]);
+        const Vector3 c = p + QuaternionFromYaw(psi) * assembly_.unit_position_B[static_cast<std::size_t>(k)];
         if (const auto hit = map.Nearest(c, options_.obstacle_range_m)) {
           planes[static_cast<std::size_t>(i)].push_back({j, k, {hit->point_W, hit->normal_W}});
         }
@@ -490,7 +480,7 @@ AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception
         ++moving;
       }
       for (const Vector3& r : assembly_.unit_position_B) {
-        if (const auto hit = map.Nearest(pose.p_W + Rotated(pose.yaw_rad, r), options_.obstacle_range_m)) {
+        if (const auto hit = map.Nearest(pose.p_W + QuaternionFromYaw(pose.yaw_rad) * r, options_.obstacle_range_m)) {
           summary.min_clearance_m = std::min(summary.min_clearance_m, hit->distance_m - assembly_.unit_radius_m);
         }
       }

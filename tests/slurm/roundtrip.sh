@@ -11,7 +11,7 @@ for tool in sbatch slurmctld slurmd munged parallel; do
 done
 [ "$(id -u)" -eq 0 ] || { echo "skipped: a local slurmd needs root"; exit 77; }
 
-work=$(mktemp -d /tmp/rotorguard-slurm.XXXXXX)
+work=$(mktemp -d -t rotorguard-slurm.XXXXXX)
 chmod 0755 "$work"  # munged (user munge) lives below it
 cleanup() { "$src/scripts/local-slurm.sh" stop "$work/cluster" || true; rm -rf "$work"; }
 trap cleanup EXIT
