@@ -22,6 +22,7 @@
 #include "rotorguard/bench/fdd_calibration.h"
 #include "rotorguard/bench/ftc_bench.h"
 #include "rotorguard/bench/flatness_bench.h"
+#include "rotorguard/bench/bench_campaigns.h"
 #include "rotorguard/bench/campaign.h"
 #include "rotorguard/bench/mars_bench.h"
 #include "rotorguard/bench/nav_bench.h"
@@ -188,6 +189,21 @@ int ParseJobs(const std::string& text) {
   return static_cast<int>(ParseUnsigned("--jobs", text, 1, 256));
 }
 
+/// The version recorded in and checked against campaign manifests: the release and the revision.
+std::string ProgramVersion() { return fmt::format("{} ({})", ROTORGUARD_VERSION, rotorguard::bench::GitRevision()); }
+
+/// A campaign run's options from the command line (shared by `campaign run` and the benchmarks).
+rotorguard::bench::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,
+                                                           const std::string& shard, bool resume) {
+  rotorguard::bench::CampaignRunOptions o;
+  o.out_dir = out;
+  o.jobs = ParseJobs(jobs_text);
+  o.shard = rotorguard::bench::Shard::Parse(shard);
+  o.resume = resume;
+  o.version = ProgramVersion();
+  return o;
+}
+
 std::string DefaultBenchScenario() {
   const std::string rel = "configs/scenarios/lemniscate_2ms.yaml";
   if (fs::exists(rel)) return rel;
@@ -283,7 +299,7 @@ int main(int argc, char** argv) {
               "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
   bench_nmpc->add_flag("--json", nmpc_json, "Print JSON instead of a table");
 
-  std::string ftc_trials_text = "20", ftc_seed_text = "1", ftc_methods = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_out, ftc_jobs_text;
+  std::string ftc_trials_text = "20", ftc_seed_text = "1", ftc_methods = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_jobs_text;
   bool ftc_json = false;
   CLI::App* bench_ftc = bench->add_subcommand(
       "ftc", "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
@@ -293,7 +309,6 @@ int main(int argc, char** argv) {
   bench_ftc->add_option("--seed", ftc_seed_text, "Benchmark seed (default 1); trial seeds derive from it");
   bench_ftc->add_option("--methods", ftc_methods, "Comma-separated methods: rotorguard, fixedtime, ukf, indi, passive, none (default all)");
   bench_ftc->add_option("--jobs", ftc_jobs_text, "Worker threads (default: the number of cores)");
-  bench_ftc->add_option("--out", ftc_out, "Folder for results.json and tables.md");
   bench_ftc->add_flag("--json", ftc_json, "Print JSON instead of Markdown");
 
   std::string perception_duration_text = "10", perception_seed_text = "1";
@@ -317,7 +332,7 @@ int main(int argc, char** argv) {
   bench_planner->add_option("--seed", planner_seed_text, "Worlds and pairs (default 1)");
   bench_planner->add_flag("--json", planner_json, "Print JSON instead of Markdown");
 
-  std::string nav_trials_text = "100", nav_seed_text = "1", nav_jobs_text, nav_kinds = "forest,room", nav_replay, nav_out;
+  std::string nav_trials_text = "100", nav_seed_text = "1", nav_jobs_text, nav_kinds = "forest,room", nav_replay;
   bool nav_json = false;
   CLI::App* bench_nav = bench->add_subcommand(
       "nav", "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
@@ -330,7 +345,6 @@ int main(int argc, char** argv) {
   bench_nav->add_option("--kinds", nav_kinds, "Comma-separated world kinds: forest, room (default both)");
   bench_nav->add_option("--replay", nav_replay,
                         "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out");
-  bench_nav->add_option("--out", nav_out, "With --replay: the run folder (default out/nav_KIND_SEED)");
   bench_nav->add_flag("--json", nav_json, "Print JSON instead of Markdown");
 
   std::string flat_seeds_text = "20", flat_seed_text = "1", flat_jobs_text;
@@ -356,6 +370,21 @@ int main(int argc, char** argv) {
   bench_mars->add_option("--seed", mars_seed_text, "The first flight's seed (default 1)");
   bench_mars->add_option("--jobs", mars_jobs_text, "Worker threads (default: the number of cores)");
   bench_mars->add_flag("--json", mars_json, "Print JSON instead of Markdown");
+
+  // The campaign benchmarks run on the campaign engine (bench_campaigns.h): their trials can be
+  // kept, resumed, sharded and merged like a campaign's.
+  std::string bench_out, bench_shard = "0/1";
+  bool bench_resume = false;
+  for (CLI::App* b : {bench_ftc, bench_nav, bench_mars}) {
+    b->add_option("--out", bench_out,
+                  b == bench_nav ? "The trials' records and the result (bench.json, bench.md); with --replay: the\n"
+                                   "run folder (default out/nav_KIND_SEED)"
+                                 : "Keep the trials' records (results.jsonl, manifest.json) and the result\n"
+                                   "(bench.json, bench.md) in this folder (default: a temporary folder)");
+    b->add_option("--shard", bench_shard, "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
+                                          "with `campaign merge` when all are done");
+    b->add_flag("--resume", bench_resume, "Continue the trials recorded in --out");
+  }
 
   std::string bcamp_spec, bcamp_dir;
   bool bcamp_json = false;
@@ -411,6 +440,31 @@ int main(int argc, char** argv) {
     if (bench_html.empty()) return;
     rotorguard::bench::WriteBenchReport(name, result, bench_html);
     fmt::print(stderr, "report: {}\n", bench_html);
+  };
+
+  // A benchmark's campaign: its trials in --out (or a temporary folder), then its result printed
+  // and, with --out, written as bench.json and bench.md. A shard of several only records its trials.
+  const auto run_bench_campaign = [&](const rotorguard::bench::Campaign& c, const std::string& jobs_text, bool as_json,
+                                      const char* name) -> std::optional<nlohmann::json> {
+    rotorguard::bench::CampaignRunOptions o = CampaignRunOptionsOf(bench_out, jobs_text, bench_shard, bench_resume);
+    if ((o.resume || o.shard.count > 1) && o.out_dir.empty()) {
+      throw UsageError(fmt::format("{} needs --out: the folder that keeps the trials", o.resume ? "--resume" : "--shard"));
+    }
+    o.progress = EtaProgress("trials");
+    const std::optional<std::vector<nlohmann::json>> records = rotorguard::bench::RunCampaignRecords(c, o);
+    if (!records) {
+      fmt::print("shard {} of {} done in {}; when every shard is: rotorguard campaign merge {} ...\n", o.shard.index,
+                 o.shard.count, o.out_dir, o.out_dir);
+      return std::nullopt;
+    }
+    const rotorguard::bench::BenchReport r = rotorguard::bench::BenchResult(c.bench, *records);
+    write_bench_html(name, r.result);
+    if (!bench_out.empty()) {
+      rotorguard::io::WriteFileAtomically((fs::path(bench_out) / "bench.json").string(), r.result.dump(2) + "\n");
+      rotorguard::io::WriteFileAtomically((fs::path(bench_out) / "bench.md").string(), r.markdown);
+    }
+    fmt::print("{}", as_json ? r.result.dump(2) + "\n" : r.markdown);
+    return r.result;
   };
 
   try {
@@ -515,7 +569,6 @@ int main(int argc, char** argv) {
       rotorguard::bench::FtcBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_text, 1, 1'000'000));
       o.seed = ParseUnsigned("--seed", ftc_seed_text, 0, UINT64_MAX);
-      o.jobs = ParseJobs(ftc_jobs_text);
       o.methods.clear();
       const std::vector<std::string> known = rotorguard::bench::FtcMethods();
       for (std::size_t start = 0; start <= ftc_methods.size();) {
@@ -529,21 +582,8 @@ int main(int argc, char** argv) {
       }
       const std::string dir = fs::path(DefaultBenchScenario()).parent_path().parent_path().string();
       o.vehicle = rotorguard::bench::LoadVehicle(dir + "/vehicles/zhou2025_quad.yaml");
-      if (!ftc_out.empty()) {
-        std::error_code ec;
-        fs::create_directories(ftc_out, ec);
-        if (ec || !fs::is_directory(ftc_out)) throw UsageError(fmt::format("--out: cannot create folder '{}'", ftc_out));
-      }
-      o.progress = CountProgress("trials");
-      const nlohmann::json r = rotorguard::bench::RunFtcBenchmark(o);
-      const std::string md = rotorguard::bench::FtcMarkdown(r);
-      write_bench_html("ftc", r);
-      if (!ftc_out.empty()) {
-        rotorguard::io::WriteFileAtomically((fs::path(ftc_out) / "results.json").string(), r.dump(2) + "\n");
-        rotorguard::io::WriteFileAtomically((fs::path(ftc_out) / "tables.md").string(), md);
-      }
-      fmt::print("{}", ftc_json ? r.dump(2) + "\n" : md);
-      return r["errors"].get<int>() > 0 ? kRunFailed : kOk;
+      const std::optional<nlohmann::json> r = run_bench_campaign(rotorguard::bench::FtcCampaign(o), ftc_jobs_text, ftc_json, "ftc");
+      return r && (*r)["errors"].get<int>() > 0 ? kRunFailed : kOk;
     }
     if (*bench_perception) {
       rotorguard::bench::PerceptionBenchOptions o;
@@ -570,7 +610,6 @@ int main(int argc, char** argv) {
       rotorguard::bench::NavBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", nav_trials_text, 1, 100000));
       o.seed = ParseUnsigned("--seed", nav_seed_text, 0, UINT64_MAX);
-      o.jobs = ParseJobs(nav_jobs_text);
       o.kinds.clear();
       for (std::size_t start = 0; start <= nav_kinds.size();) {
         const std::size_t comma = std::min(nav_kinds.find(',', start), nav_kinds.size());
@@ -594,16 +633,13 @@ int main(int argc, char** argv) {
         const std::uint64_t seed = ParseUnsigned("--replay", nav_replay.substr(a + 1, b == std::string::npos ? b : b - a - 1), 0, UINT64_MAX);
         const rotorguard::bench::Scenario trial = rotorguard::bench::MakeNavTrial(o.base, kind, seed, variant.empty());
         rotorguard::bench::RunOptions replay;
-        replay.out_dir = nav_out.empty() ? (fs::path("out") / trial.name).string() : nav_out;
+        replay.out_dir = bench_out.empty() ? (fs::path("out") / trial.name).string() : bench_out;
         replay.report = rotorguard::io::HasViewer();
         const rotorguard::bench::RunSummary s = rotorguard::bench::RunScenario(trial, replay);
         PrintSummary(s, replay.out_dir, true, false, replay.report);
         return s.success ? kOk : kRunFailed;
       }
-      o.progress = CountProgress("flights");
-      const nlohmann::json r = rotorguard::bench::RunNavBenchmark(o);
-      write_bench_html("nav", r);
-      fmt::print("{}", nav_json ? r.dump(2) + "\n" : rotorguard::bench::NavMarkdown(r));
+      run_bench_campaign(rotorguard::bench::NavCampaign(o), nav_jobs_text, nav_json, "nav");
       return kOk;
     }
     if (*bench_flatness) {
@@ -622,7 +658,7 @@ int main(int argc, char** argv) {
       const fs::path configs = fs::path(DefaultBenchScenario()).parent_path().parent_path();
       const std::string spec_path =
           bcamp_spec.empty() ? (configs / "campaigns" / "bench_campaign.yaml").string() : bcamp_spec;
-      const rotorguard::bench::CampaignSpec spec = rotorguard::bench::LoadCampaignSpec(spec_path);
+      const rotorguard::bench::Campaign spec = rotorguard::bench::LoadCampaign(spec_path);
       const bool temporary = bcamp_dir.empty();
       const std::string work = temporary ? (fs::temp_directory_path() / fmt::format("rotorguard-bench-campaign-{}",
                                                                                      ::getpid())).string()
@@ -630,7 +666,7 @@ int main(int argc, char** argv) {
       nlohmann::json r;
       try {
         r = rotorguard::bench::RunCampaignBenchmark(
-            spec, work, fmt::format("{} ({})", ROTORGUARD_VERSION, rotorguard::bench::GitRevision()));
+            spec, work, ProgramVersion());
       } catch (...) {
         if (temporary) fs::remove_all(work);
         throw;
@@ -652,13 +688,9 @@ int main(int argc, char** argv) {
       return same ? kOk : kRunFailed;
     }
     if (*campaign_run) {
-      const rotorguard::bench::CampaignSpec spec = rotorguard::bench::LoadCampaignSpec(campaign_spec);
-      rotorguard::bench::CampaignRunOptions o;
-      o.out_dir = campaign_out;
-      o.jobs = ParseJobs(campaign_jobs_text);
-      o.shard = rotorguard::bench::Shard::Parse(campaign_shard);
-      o.resume = campaign_resume;
-      o.version = fmt::format("{} ({})", ROTORGUARD_VERSION, rotorguard::bench::GitRevision());
+      const rotorguard::bench::Campaign spec = rotorguard::bench::LoadCampaign(campaign_spec);
+      rotorguard::bench::CampaignRunOptions o =
+          CampaignRunOptionsOf(campaign_out, campaign_jobs_text, campaign_shard, campaign_resume);
       if (!campaign_quiet) o.progress = EtaProgress("trials");
       const rotorguard::bench::CampaignRunSummary r = rotorguard::bench::RunCampaign(spec, o);
       fmt::print("campaign          {} (spec {})\n", spec.name, spec.hash);
@@ -668,7 +700,7 @@ int main(int argc, char** argv) {
       return kOk;
     }
     if (*campaign_slurm) {
-      const rotorguard::bench::CampaignSpec spec = rotorguard::bench::LoadCampaignSpec(campaign_spec);
+      const rotorguard::bench::Campaign spec = rotorguard::bench::LoadCampaign(campaign_spec);
       rotorguard::bench::SlurmScriptOptions o;
       o.shards = static_cast<int>(ParseUnsigned("--shards", slurm_shards_text, 1, 1'000'000));
       o.cpus_per_task = static_cast<int>(ParseUnsigned("--cpus-per-task", slurm_cpus_text, 1, 256));
@@ -680,7 +712,7 @@ int main(int argc, char** argv) {
       fs::create_directories(campaign_out);
       const std::string path = (fs::path(campaign_out) / "campaign.sbatch").string();
       rotorguard::io::WriteFileAtomically(path, script);
-      fmt::print("campaign          {} (spec {}): {} trials in {} array tasks\n", spec.name, spec.hash, spec.trials(),
+      fmt::print("campaign          {} (spec {}): {} trials in {} array tasks\n", spec.name, spec.hash, spec.trials,
                  o.shards);
       fmt::print("script            {}\n", path);
       fmt::print("submit            sbatch {}\n", path);
@@ -692,9 +724,17 @@ int main(int argc, char** argv) {
       fmt::print("campaign          {}: {} trials merged\n", s["campaign"].get<std::string>(), s["trials"].get<int>());
       fmt::print("summary           {}\n", (fs::path(out) / "summary.json").string());
       fmt::print("                  {}\n", (fs::path(out) / "summary.md").string());
+      if (s.contains("bench")) {  // a benchmark's campaign: its own result and tables too
+        fmt::print("                  {}\n", (fs::path(out) / "bench.json").string());
+        fmt::print("                  {}\n", (fs::path(out) / "bench.md").string());
+      }
       if (rotorguard::io::HasViewer()) {  // the report viewer's page of any benchmark result
         const std::string html = (fs::path(out) / "summary.html").string();
-        rotorguard::bench::WriteBenchReport("campaign " + s["campaign"].get<std::string>(), s, html);
+        if (s.contains("bench")) {
+          rotorguard::bench::WriteBenchReport(s["bench"]["benchmark"].get<std::string>(), s["bench"], html);
+        } else {
+          rotorguard::bench::WriteBenchReport("campaign " + s["campaign"].get<std::string>(), s, html);
+        }
         fmt::print("                  {}\n", html);
       }
       return kOk;
@@ -703,17 +743,13 @@ int main(int argc, char** argv) {
       rotorguard::bench::MarsBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", mars_trials_text, 1, 10000));
       o.seed = ParseUnsigned("--seed", mars_seed_text, 0, UINT64_MAX);
-      o.jobs = ParseJobs(mars_jobs_text);
       const fs::path configs = fs::path(DefaultBenchScenario()).parent_path().parent_path();
       o.spiral = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_spiral_3x2.yaml").string());
       o.nine_units = rotorguard::bench::LoadAssembly((configs / "assemblies" / "3x3.yaml").string());
       o.reconfigure = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_reconfigure_3x1.yaml").string());
       o.plan_4x1 = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_plan_4x1.yaml").string());
       o.plan_3x2 = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_plan_3x2.yaml").string());
-      o.progress = CountProgress("flights");
-      const nlohmann::json r = rotorguard::bench::RunMarsBenchmark(o);
-      write_bench_html("mars", r);
-      fmt::print("{}", mars_json ? r.dump(2) + "\n" : rotorguard::bench::MarsMarkdown(r));
+      run_bench_campaign(rotorguard::bench::MarsCampaign(o), mars_jobs_text, mars_json, "mars");
       return kOk;
     }
     if (*bench_nmpc) {

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -16,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "rotorguard/bench/bench_campaigns.h"
 #include "rotorguard/bench/parallel.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
@@ -194,14 +196,18 @@ int CampaignSpec::trials() const {
   return static_cast<int>(n);
 }
 
+bool IsValidCampaignName(const std::string& name) {
+  return !name.empty() &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") == std::string::npos;
+}
+
 CampaignSpec LoadCampaignSpec(const std::string& path) {
   io::ConfigDocument doc = io::ConfigDocument::LoadFile(path);
   const io::ConfigNode root = doc.root();
   CampaignSpec spec;
   spec.file = path;
   spec.name = root.Required("name").AsString();
-  if (spec.name.empty() || spec.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") !=
-                               std::string::npos) {
+  if (!IsValidCampaignName(spec.name)) {
     root.FailAt("name", fmt::format("'{}' is invalid; expected letters, digits, '_', '.' or '-' (it names files and "
                                     "Slurm jobs)", spec.name));
   }
@@ -295,7 +301,7 @@ CampaignSpec LoadCampaignSpec(const std::string& path) {
     }
     root.FailAt(where, fmt::format("the scenario rejects trial 0: {}", e.what()));
   }
-  spec.hash = Hex(Fnv1a(canonical.dump() + "\n" + scenario_text));
+  spec.hash = Fingerprint(canonical.dump() + "\n" + scenario_text);
   return spec;
 }
 
@@ -324,7 +330,28 @@ std::map<std::string, std::string> TrialParameters(const CampaignSpec& spec, int
 std::string TrialId(const std::map<std::string, std::string>& parameters) {
   std::string text;
   for (const auto& [key, value] : parameters) text += key + "=" + value + "\n";
-  return Hex(Fnv1a(text));
+  return Fingerprint(text);
+}
+
+std::string Fingerprint(const std::string& text) { return Hex(Fnv1a(text)); }
+
+Campaign ScenarioCampaign(const CampaignSpec& spec) {
+  Campaign c;
+  c.name = spec.name;
+  c.file = spec.file;
+  c.hash = spec.hash;
+  c.seed = spec.seed;
+  c.trials = spec.trials();
+  for (const auto& [key, values] : spec.grid) c.group_keys.push_back(key);
+  c.metrics = spec.metrics;
+  c.parameters = [spec](int index) { return TrialParameters(spec, index); };
+  c.run = [spec](int, const std::map<std::string, std::string>& params) {
+    const nlohmann::json r = RunScenario(LoadScenario(spec.scenario, OverridesOf(params)), RunOptions{}).ToJson();
+    TrialOutcome out;
+    for (const std::string& m : spec.metrics) out.metrics[m] = AtPath(r, m);
+    return out;
+  };
+  return c;
 }
 
 Shard Shard::Parse(const std::string& text) {
@@ -352,13 +379,13 @@ std::pair<int, int> Shard::Range(int trials) const {
   return {at(index), at(index + 1)};
 }
 
-CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOptions& options) {
+CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOptions& options) {
   if (options.jobs < 1 || options.jobs > 256) {
     throw std::invalid_argument(fmt::format("--jobs {} is invalid; expected a count in [1, 256]", options.jobs));
   }
-  if (options.shard.count > spec.trials()) {
+  if (options.shard.count > campaign.trials) {
     throw std::invalid_argument(fmt::format("--shard {}/{}: more shards than the campaign's {} trials",
-                                            options.shard.index, options.shard.count, spec.trials()));
+                                            options.shard.index, options.shard.count, campaign.trials));
   }
   std::error_code ec;
   fs::create_directories(options.out_dir, ec);
@@ -369,22 +396,22 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
   CampaignRunSummary summary;
   summary.results_file = (fs::path(options.out_dir) / ResultsName(options.shard)).string();
   summary.manifest_file = (fs::path(options.out_dir) / ManifestName(options.shard)).string();
-  const auto [first, last] = options.shard.Range(spec.trials());
+  const auto [first, last] = options.shard.Range(campaign.trials);
   summary.trials = last - first;
-  nlohmann::json manifest = {{"campaign", spec.name},
-                             {"spec", spec.file},
-                             {"spec_hash", spec.hash},
+  nlohmann::json manifest = {{"campaign", campaign.name},
+                             {"spec", campaign.file},
+                             {"spec_hash", campaign.hash},
                              {"version", options.version},
-                             {"seed", spec.seed},
-                             {"trials_total", spec.trials()},
+                             {"seed", campaign.seed},
+                             {"trials_total", campaign.trials},
                              {"shard", fmt::format("{}/{}", options.shard.index, options.shard.count)},
                              {"trial_range", {first, last}},
-                             {"grid_keys", nlohmann::json::array()},
-                             {"metrics", spec.metrics},
+                             {"grid_keys", campaign.group_keys},
+                             {"metrics", campaign.metrics},
                              {"host", Host()},
                              {"started", UtcNow()},
                              {"finished", nullptr}};
-  for (const auto& [key, values] : spec.grid) manifest["grid_keys"].push_back(key);
+  if (!campaign.bench.is_null()) manifest["bench"] = campaign.bench;
 
   const ShardLock lock(summary.manifest_file + ".lock");
   const bool exists = fs::exists(summary.results_file) || fs::exists(summary.manifest_file);
@@ -408,7 +435,7 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
     manifest["started"] = old.value("started", manifest["started"]);
     Recorded recorded = ReadResults(summary.results_file);
     for (const auto& [index, line] : recorded.trials) {
-      if (index < first || index >= last || line["id"].get<std::string>() != TrialId(TrialParameters(spec, index))) {
+      if (index < first || index >= last || line["id"].get<std::string>() != TrialId(campaign.parameters(index))) {
         throw io::CorruptFileError(summary.results_file, 0,
                                    fmt::format("trial {} does not belong to this shard of this spec", index));
       }
@@ -430,22 +457,20 @@ CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOption
   std::exception_ptr write_error;
   ParallelFor(static_cast<int>(todo.size()), options.jobs, [&](int task) {
     const int index = todo[static_cast<std::size_t>(task)];
-    const std::map<std::string, std::string> params = TrialParameters(spec, index);
+    const std::map<std::string, std::string> params = campaign.parameters(index);
     nlohmann::json line = {{"trial", index}, {"id", TrialId(params)}, {"params", params}};
     try {
-      const nlohmann::json r = RunScenario(LoadScenario(spec.scenario, OverridesOf(params)), RunOptions{}).ToJson();
-      nlohmann::json metrics = nlohmann::json::object();
+      TrialOutcome r = campaign.run(index, params);
       bool finite = true;
-      for (const std::string& m : spec.metrics) {
-        metrics[m] = AtPath(r, m);
-        if (metrics[m].is_number_float() && !std::isfinite(metrics[m].get<double>())) {
+      for (auto& [name, value] : r.metrics.items()) {
+        if (value.is_number_float() && !std::isfinite(value.get<double>())) {
           finite = false;
-          metrics[m] = nullptr;  // JSON has no NaN
+          value = nullptr;  // JSON has no NaN
         }
       }
       line["status"] = finite ? "ok" : "diverged";
-      line["message"] = finite ? "" : "a metric is not finite";
-      line["metrics"] = metrics;
+      line["message"] = finite ? r.message : "a metric is not finite" + (r.message.empty() ? "" : "; " + r.message);
+      line["metrics"] = std::move(r.metrics);
     } catch (const std::exception& e) {
       line["status"] = "error";
       line["message"] = e.what();
@@ -485,10 +510,14 @@ std::string ShellQuote(const std::string& text) {
 
 }  // namespace
 
-std::string SlurmArrayScript(const CampaignSpec& spec, const SlurmScriptOptions& o) {
-  if (o.shards < 1 || o.shards > spec.trials()) {
+std::string SlurmArrayScript(const Campaign& campaign, const SlurmScriptOptions& o) {
+  if (campaign.file.empty()) {
+    throw std::invalid_argument(fmt::format("campaign '{}' has no spec file for the tasks to run; write it as a "
+                                            "spec (docs/campaigns.md)", campaign.name));
+  }
+  if (o.shards < 1 || o.shards > campaign.trials) {
     throw std::invalid_argument(fmt::format("--shards {} is invalid; expected a count in [1, {}] (the campaign's "
-                                            "trials)", o.shards, spec.trials()));
+                                            "trials)", o.shards, campaign.trials));
   }
   if (o.cpus_per_task < 1 || o.cpus_per_task > 256) {
     throw std::invalid_argument(fmt::format("--cpus-per-task {} is invalid; expected a count in [1, 256]", o.cpus_per_task));
@@ -504,7 +533,7 @@ std::string SlurmArrayScript(const CampaignSpec& spec, const SlurmScriptOptions&
     throw std::invalid_argument(fmt::format("--out '{}' is invalid; expected a folder without spaces or '%' (an "
                                             "#SBATCH line cannot quote them)", o.out_dir));
   }
-  const std::string spec_path = fs::absolute(spec.file).lexically_normal().string();
+  const std::string spec_path = fs::absolute(campaign.file).lexically_normal().string();
   std::string s = fmt::format(
       "#!/bin/bash\n"
       "# rotorguard campaign '{name}' (spec {hash}): {trials} trials in {n} shards, one per array task.\n"
@@ -516,7 +545,7 @@ std::string SlurmArrayScript(const CampaignSpec& spec, const SlurmScriptOptions&
       "#SBATCH --array=0-{last}\n"
       "#SBATCH --cpus-per-task={cpus}\n"
       "#SBATCH --output={out}/slurm-%A_%a.out\n",
-      fmt::arg("name", spec.name), fmt::arg("hash", spec.hash), fmt::arg("trials", spec.trials()),
+      fmt::arg("name", campaign.name), fmt::arg("hash", campaign.hash), fmt::arg("trials", campaign.trials),
       fmt::arg("n", o.shards), fmt::arg("script", ShellQuote(out + "/campaign.sbatch")),
       fmt::arg("exe", ShellQuote(o.rotorguard)), fmt::arg("outq", ShellQuote(out)), fmt::arg("last", o.shards - 1),
       fmt::arg("cpus", o.cpus_per_task), fmt::arg("out", out));
@@ -605,7 +634,7 @@ std::string StatsCell(const nlohmann::json& s) {
 
 }  // namespace
 
-nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::string& out_dir) {
+std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& dirs, nlohmann::json* manifest_out) {
   if (dirs.empty()) throw std::invalid_argument("campaign merge: expected at least one results folder");
   std::vector<nlohmann::json> manifests;
   std::vector<std::string> manifest_files;
@@ -679,21 +708,31 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
   if (static_cast<int>(trials.size()) != total) {
     throw std::invalid_argument(fmt::format("campaign merge: trials beyond the campaign's {}", total));
   }
-  const nlohmann::json& head = manifests.front();
+  if (manifest_out != nullptr) *manifest_out = manifests.front();
+  std::vector<nlohmann::json> records;
+  records.reserve(trials.size());
+  for (auto& [index, t] : trials) records.push_back(std::move(t));
+  return records;
+}
+
+nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::string& out_dir) {
+  nlohmann::json head;
+  const std::vector<nlohmann::json> records = ReadCampaignRecords(dirs, &head);
+  const int total = static_cast<int>(records.size());
   const std::vector<std::string> metrics = head["metrics"].get<std::vector<std::string>>();
   const std::vector<std::string> grid_keys = head["grid_keys"].get<std::vector<std::string>>();
   std::vector<const nlohmann::json*> all;
   std::map<std::vector<std::string>, std::vector<const nlohmann::json*>> groups;  // by grid values
   std::vector<std::vector<std::string>> group_order;
   nlohmann::json errors = nlohmann::json::array();
-  for (const auto& [index, t] : trials) {
+  for (const nlohmann::json& t : records) {
     all.push_back(&t);
     std::vector<std::string> point;
     for (const std::string& k : grid_keys) point.push_back(t["params"].value(k, ""));
     if (!groups.count(point)) group_order.push_back(point);
     groups[point].push_back(&t);
     if (t["status"] != "ok" && errors.size() < 20) {
-      errors.push_back({{"trial", index}, {"status", t["status"]}, {"message", t["message"]}});
+      errors.push_back({{"trial", t["trial"]}, {"status", t["status"]}, {"message", t["message"]}});
     }
   }
   nlohmann::json summary = {{"campaign", head["campaign"]},
@@ -735,10 +774,51 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
   fs::create_directories(out_dir);
   io::WriteFileAtomically((fs::path(out_dir) / "summary.json").string(), summary.dump(2) + "\n");
   io::WriteFileAtomically((fs::path(out_dir) / "summary.md").string(), md);
+  if (head.contains("bench")) {  // a benchmark's campaign: its own tables too
+    const BenchReport report = BenchResult(head["bench"], records);
+    io::WriteFileAtomically((fs::path(out_dir) / "bench.json").string(), report.result.dump(2) + "\n");
+    io::WriteFileAtomically((fs::path(out_dir) / "bench.md").string(), report.markdown);
+    summary["bench"] = report.result;
+  }
   return summary;
 }
 
-nlohmann::json RunCampaignBenchmark(const CampaignSpec& spec, const std::string& work_dir, const std::string& version) {
+std::optional<std::vector<nlohmann::json>> RunCampaignRecords(const Campaign& campaign, CampaignRunOptions options) {
+  const bool temporary = options.out_dir.empty();
+  if (temporary) {
+    static std::atomic<int> runs{0};  // one folder per call, also for calls side by side
+    options.out_dir =
+        (fs::temp_directory_path() / fmt::format("rotorguard-{}-{}-{}", campaign.name, ::getpid(), runs++)).string();
+    options.resume = false;
+  }
+  const auto cleanup = [&] {
+    if (temporary) fs::remove_all(options.out_dir);
+  };
+  try {
+    const CampaignRunSummary run = RunCampaign(campaign, options);
+    if (options.shard.count > 1) {
+      cleanup();
+      return std::nullopt;
+    }
+    nlohmann::json manifest;
+    std::vector<nlohmann::json> records = ReadCampaignRecords({options.out_dir}, &manifest);
+    cleanup();
+    return records;
+  } catch (...) {
+    cleanup();
+    throw;
+  }
+}
+
+std::vector<nlohmann::json> RunWholeCampaign(const Campaign& campaign, int jobs,
+                                             const std::function<void(int, int)>& progress) {
+  CampaignRunOptions o;
+  o.jobs = jobs;
+  o.progress = progress;
+  return *RunCampaignRecords(campaign, o);
+}
+
+nlohmann::json RunCampaignBenchmark(const Campaign& campaign, const std::string& work_dir, const std::string& version) {
   if (fs::exists(work_dir) && !fs::is_empty(work_dir)) {
     throw std::invalid_argument(fmt::format("bench campaign: '{}' is not empty; expected a new folder", work_dir));
   }
@@ -750,7 +830,7 @@ nlohmann::json RunCampaignBenchmark(const CampaignSpec& spec, const std::string&
     o.resume = resume;
     o.version = version;
     const auto t0 = std::chrono::steady_clock::now();
-    RunCampaign(spec, o);
+    RunCampaign(campaign, o);
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   };
   const auto summary = [&](const std::string& name) {
@@ -758,7 +838,7 @@ nlohmann::json RunCampaignBenchmark(const CampaignSpec& spec, const std::string&
     MergeCampaign({dir.string()}, dir.string());
     return io::ReadFile((dir / "summary.json").string()) + io::ReadFile((dir / "summary.md").string());
   };
-  const int trials = spec.trials();
+  const int trials = campaign.trials;
   const double one = run("jobs1", 1, {}, false), two = run("jobs2", 2, {}, false);
   const std::string reference = summary("jobs1");
   // Kill and resume: the state a SIGKILL leaves (whole lines, one cut short, no finish time).
@@ -777,7 +857,7 @@ nlohmann::json RunCampaignBenchmark(const CampaignSpec& spec, const std::string&
   run("killed", 2, {}, true);
   for (int i = 0; i < 4; ++i) run("shards", 1, Shard{i, 4}, false);
   return {{"benchmark", "campaign"},
-          {"campaign", spec.name},
+          {"campaign", campaign.name},
           {"trials", trials},
           {"trials_per_s_1worker", trials / one},
           {"trials_per_s_2workers", trials / two},

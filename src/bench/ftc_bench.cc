@@ -1,13 +1,14 @@
 #include "rotorguard/bench/ftc_bench.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
 
 #include <fmt/format.h>
 
-#include "rotorguard/bench/parallel.h"
+#include "rotorguard/bench/campaign.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/bench/sim_bench.h"
@@ -163,55 +164,96 @@ void FtcBenchOptions::Validate() const {
   vehicle.Validate();
 }
 
-nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
+Campaign FtcCampaign(const FtcBenchOptions& o) {
   o.Validate();
   const int methods = static_cast<int>(o.methods.size());
-  const int total = kNumCells * methods * o.trials;
-  std::vector<FtcTrial> results(static_cast<std::size_t>(total));
-  ParallelFor(total, o.jobs, [&](int task) {
-    const int trial = task % o.trials;
-    const int method = (task / o.trials) % methods;
-    const int cell = task / (o.trials * methods);
-    // The same draws for every method: the seed depends on the cell and trial only.
+  Campaign c;
+  c.name = "bench_ftc";
+  c.seed = o.seed;
+  c.trials = kNumCells * methods * o.trials;
+  c.group_keys = {"phase", "fault", "method"};
+  c.metrics = {"success", "correct", "false_alarm", "latency_s", "min_altitude_m"};
+  const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"methods", o.methods},
+                                  {"vehicle", o.vehicle.name}};
+  c.bench = {{"name", "ftc"}, {"options", options}};
+  c.hash = Fingerprint(c.bench.dump() + "\n" + VehicleToYaml(o.vehicle));
+  // Trial index = (cell, method, trial), the trial fastest. Every method flies the same draws: the
+  // seed depends on the cell and trial only.
+  const auto decompose = [o, methods](int index) {
+    return std::array<int, 3>{index / (o.trials * methods), (index / o.trials) % methods, index % o.trials};
+  };
+  c.parameters = [o, decompose](int index) {
+    const auto [cell, method, trial] = decompose(index);
     const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
-    FtcTrial& r = results[task];
-    try {
-      const RunSummary s = RunScenario(MakeTrial(kCells[cell], o.methods[method], o, seed));
-      r.success = s.success;
-      r.failure = s.failure_reason;
-      r.min_altitude_m = s.min_altitude_m;
-      if (s.fdd) {
-        r.has_fdd = true;
-        r.correct = s.fdd->correct;
-        r.false_alarm = s.fdd->false_alarm;
-        r.latency_s = s.fdd->latency_s;
-      }
-    } catch (const std::exception& e) {
-      r.failure = std::string("error: ") + e.what();
+    return std::map<std::string, std::string>{{"test", kCells[cell].test},   {"phase", kCells[cell].phase},
+                                              {"fault", kCells[cell].fault}, {"method", o.methods[method]},
+                                              {"trial", std::to_string(trial)}, {"seed", std::to_string(seed)}};
+  };
+  c.run = [o, decompose](int index, const std::map<std::string, std::string>& params) {
+    const auto [cell, method, trial] = decompose(index);
+    const RunSummary s = RunScenario(MakeTrial(kCells[cell], o.methods[method], o, std::stoull(params.at("seed"))));
+    TrialOutcome out;
+    out.metrics = {{"success", s.success}, {"min_altitude_m", s.min_altitude_m}};
+    if (s.fdd) {
+      out.metrics["correct"] = s.fdd->correct;
+      out.metrics["false_alarm"] = s.fdd->false_alarm;
+      out.metrics["latency_s"] = s.fdd->correct ? nlohmann::json(s.fdd->latency_s) : nlohmann::json(nullptr);
     }
-    r.seed = seed;
-  }, o.progress);
+    out.message = s.failure_reason;
+    return out;
+  };
+  return c;
+}
 
+nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
+  const std::vector<std::string> methods = options.at("methods").get<std::vector<std::string>>();
+  const int trials = options.at("trials").get<int>();
+  const int m_count = static_cast<int>(methods.size());
+  if (static_cast<int>(records.size()) != kNumCells * m_count * trials) {
+    throw std::invalid_argument(fmt::format("ftc: {} trial records for {} cells x {} methods x {} trials",
+                                            records.size(), kNumCells, m_count, trials));
+  }
   nlohmann::json cells = nlohmann::json::array();
   int errors = 0;
   for (int c = 0; c < kNumCells; ++c) {
-    for (int m = 0; m < methods; ++m) {
-      const auto first = results.begin() + (c * methods + m) * o.trials;
-      const std::vector<FtcTrial> trials(first, first + o.trials);
-      for (const FtcTrial& t : trials) errors += t.failure.rfind("error: ", 0) == 0 ? 1 : 0;
-      nlohmann::json cell = AggregateFtcCell(trials, std::string(kCells[c].fault) != "none");
+    for (int m = 0; m < m_count; ++m) {
+      std::vector<FtcTrial> cell_trials;
+      for (int t = 0; t < trials; ++t) {
+        const nlohmann::json& r = records[static_cast<std::size_t>((c * m_count + m) * trials + t)];
+        FtcTrial trial;
+        trial.seed = std::stoull(r["params"]["seed"].get<std::string>());
+        if (r["status"] != "ok") {  // an error or a non-finite metric: the trial failed
+          trial.failure = r["status"].get<std::string>() + ": " + r["message"].get<std::string>();
+          ++errors;
+          cell_trials.push_back(trial);
+          continue;
+        }
+        const nlohmann::json& x = r["metrics"];
+        trial.success = x["success"].get<bool>();
+        trial.failure = r["message"].get<std::string>();
+        trial.min_altitude_m = x["min_altitude_m"].get<double>();
+        if (x.contains("correct")) {
+          trial.has_fdd = true;
+          trial.correct = x["correct"].get<bool>();
+          trial.false_alarm = x["false_alarm"].get<bool>();
+          trial.latency_s = x["latency_s"].is_null() ? -1.0 : x["latency_s"].get<double>();
+        }
+        cell_trials.push_back(trial);
+      }
+      nlohmann::json cell = AggregateFtcCell(cell_trials, std::string(kCells[c].fault) != "none");
       cell["test"] = kCells[c].test;
       cell["phase"] = kCells[c].phase;
       cell["fault"] = kCells[c].fault;
-      cell["method"] = o.methods[m];
+      cell["method"] = methods[static_cast<std::size_t>(m)];
       cells.push_back(cell);
     }
   }
-  return {{"benchmark", "ftc"},
-          {"cells", cells},
-          {"errors", errors},
-          {"options", {{"trials", o.trials}, {"seed", o.seed}, {"methods", o.methods}, {"jobs", o.jobs}}},
-          {"host", HostInfo()}};
+  return {{"benchmark", "ftc"}, {"cells", cells}, {"errors", errors}, {"options", options}, {"host", HostInfo()}};
+}
+
+nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
+  const Campaign c = FtcCampaign(o);
+  return FtcResult(c.bench["options"], RunWholeCampaign(c, o.jobs, o.progress));
 }
 
 namespace {
@@ -279,7 +321,7 @@ std::string FtcMarkdown(const nlohmann::json& result) {
       }
       if (std::string(row.key) == "mini_alt_m" && phase != "takeoff") continue;
       std::string line = fmt::format("| {} | {} | {} | {} |", test, phase, fault, row.name);
-      for (const auto& m : methods) line += " " + Fmt(cell(phase, fault, m)[row.key], row.format, row.scale) + " |";
+      for (const auto& m : methods) line += fmt::format(" {} |", Fmt(cell(phase, fault, m)[row.key], row.format, row.scale));
       const std::string paper = fault == "none" ? (std::string(row.key) == "far" ? "0" : "") : Paper(phase, fault, row.paper);
       out += line + " " + paper + " |\n";
     }

@@ -1,13 +1,15 @@
 #include "rotorguard/bench/mars_bench.h"
 
 #include <algorithm>
+#include <array>
+#include <mutex>
 #include <numbers>
 
 #include <fmt/format.h>
 
 #include "rotorguard/bench/assembly_mission.h"
 #include "rotorguard/bench/metrics.h"
-#include "rotorguard/bench/parallel.h"
+#include "rotorguard/bench/campaign.h"
 #include "rotorguard/bench/reconfiguration.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/core/error.h"
@@ -45,27 +47,6 @@ std::vector<FaultCase> TableOneCases() {
 
 const std::vector<modular::Reallocation> kMethods = {modular::Reallocation::kNone, modular::Reallocation::kPartial,
                                                      modular::Reallocation::kFull};
-
-struct Flight {
-  bool success = false;
-  double rmse = 0.0, max_error = 0.0;
-  std::string failure;
-};
-
-/// Flies `s` once; an exception is the flight's failure.
-Flight FlyOnce(const Scenario& s) {
-  Flight f;
-  try {
-    const RunSummary r = RunScenario(s, RunOptions{});
-    f.success = r.success;
-    f.rmse = r.tracking_rmse_m;
-    f.max_error = r.max_position_error_m;
-    f.failure = r.failure_reason;
-  } catch (const std::exception& e) {
-    f.failure = std::string("error: ") + e.what();
-  }
-  return f;
-}
 
 Scenario WithFaults(const Scenario& base, const FaultCase& c, modular::Reallocation method, std::uint64_t seed) {
   Scenario s = base;
@@ -133,81 +114,316 @@ PlanDemands DemandsOf(const modular::AssemblyTrajectory& t) {
   return d;
 }
 
-/// Table II: each scene and fault planned by ours and by the baseline (once: planning is
-/// deterministic) and flown over the trials' seeds with the full reallocation.
-nlohmann::json RunTableTwo(const MarsBenchOptions& o) {
-  struct Row {
-    const Scenario* scene;
-    std::string fault;
-    int dead_unit;  ///< paper's No.; 0: none
-  };
-  const std::vector<Row> rows = {{&o.plan_4x1, "normal", 0}, {&o.plan_4x1, "No. 3", 3}, {&o.plan_4x1, "No. 4", 4},
-                                 {&o.plan_3x2, "normal", 0}, {&o.plan_3x2, "No. 2", 2}};
-  const char* methods[2] = {"baseline", "ours"};
-  std::vector<Scenario> planned;  // row-major: row, method
-  std::vector<AssemblyPlanResult> plans;
-  for (const Row& row : rows) {
-    for (const char* m : methods) {
-      const FaultCase c{row.fault, row.dead_unit > 0 ? DeadUnit(row.dead_unit) : std::vector<std::pair<int, double>>{}};
-      Scenario s = WithFaults(*row.scene, c, modular::Reallocation::kFull, o.seed);
-      s.assembly_plan->method = m;
-      plans.push_back(PlanAssemblyMission(s));  // never throws: a failure is the row's
-      if (plans.back().ok) s.reference = plans.back().trajectory;
-      planned.push_back(std::move(s));
-    }
+/// A row of Table II: a scene and the unit that is dead in it.
+struct PlanRow {
+  const Scenario* scene;
+  std::string fault;
+  int dead_unit;  ///< paper's No.; 0: none
+};
+std::vector<PlanRow> TableTwoRows(const MarsBenchOptions& o) {
+  return {{&o.plan_4x1, "normal", 0}, {&o.plan_4x1, "No. 3", 3}, {&o.plan_4x1, "No. 4", 4},
+          {&o.plan_3x2, "normal", 0}, {&o.plan_3x2, "No. 2", 2}};
+}
+constexpr const char* kPlanners[2] = {"baseline", "ours"};
+constexpr const char* kSwitches[2] = {"prepared", "naive"};
+
+/// Table II's plans, made once per process on first use (planning is deterministic) and shared by
+/// the flights that fly them: slot = row * 2 + planner.
+struct PlanCache {
+  std::array<std::once_flag, 10> once;
+  std::array<Scenario, 10> scenes;  ///< the row's scenario flying the plan
+  std::array<AssemblyPlanResult, 10> plans;
+};
+
+/// The records of `part`, in trial order.
+std::vector<const nlohmann::json*> PartOf(const std::vector<nlohmann::json>& records, const std::string& part) {
+  std::vector<const nlohmann::json*> r;
+  for (const nlohmann::json& x : records) {
+    if (x["params"]["part"] == part) r.push_back(&x);
   }
-  const int total = static_cast<int>(planned.size()) * o.trials;
-  std::vector<Flight> flights(static_cast<std::size_t>(total));
-  ParallelFor(total, o.jobs, [&](int task) {
-    const std::size_t k = static_cast<std::size_t>(task / o.trials);
-    if (!plans[k].ok) return;
-    Scenario s = planned[k];
-    s.seed = o.seed + static_cast<std::uint64_t>(task % o.trials);
-    flights[static_cast<std::size_t>(task)] = FlyOnce(s);
-  }, nullptr);
+  return r;
+}
+
+/// A record's metric, or `fallback` when the trial did not record it (an error).
+double MetricOr(const nlohmann::json& record, const char* key, double fallback) {
+  const nlohmann::json& m = record["metrics"];
+  return m.is_object() && m.contains(key) && m[key].is_number() ? m[key].get<double>() : fallback;
+}
+bool Succeeded(const nlohmann::json& record) {
+  return record["status"] == "ok" && record["metrics"].value("success", false);
+}
+std::string FailureOf(const nlohmann::json& record) {
+  return record["status"] == "ok" ? record["message"].get<std::string>()
+                                  : record["status"].get<std::string>() + ": " + record["message"].get<std::string>();
+}
+
+}  // namespace
+
+void MarsBenchOptions::Validate() const {
+  if (trials < 1 || trials > 10000) ThrowInvalidArgument("MarsBenchOptions", "trials", trials, "a count in [1, 10000]");
+  if (jobs < 1 || jobs > 256) ThrowInvalidArgument("MarsBenchOptions", "jobs", jobs, "a count in [1, 256]");
+  if (alloc_samples < 100 || alloc_samples > 10'000'000) {
+    ThrowInvalidArgument("MarsBenchOptions", "alloc_samples", alloc_samples, "a count in [100, 10^7]");
+  }
+  if (!spiral.assembly || spiral.stack.controller != "assembly") {
+    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "an assembly scenario flown by controller assembly");
+  }
+  if (spiral.assembly->num_units != 6) {
+    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "the 3x2 assembly of Table I (six units)");
+  }
+}
+
+Campaign MarsCampaign(const MarsBenchOptions& o) {
+  o.Validate();
+  const std::vector<FaultCase> cases = TableOneCases();
+  const bool reconfig = o.reconfigure.assembly != nullptr;
+  const bool table2 = o.plan_4x1.assembly_plan && o.plan_3x2.assembly_plan;
+  // Parts in trial order: the allocation's timing (one trial), Table I (case, method, trial), the
+  // self-reconfiguration (trial, switch) and Table II (row, planner, trial).
+  const int n1 = static_cast<int>(cases.size() * kMethods.size()) * o.trials;
+  const int n2 = reconfig ? 2 * o.trials : 0;
+  const int n3 = table2 ? 10 * o.trials : 0;
+  Campaign c;
+  c.name = "bench_mars";
+  c.seed = o.seed;
+  c.trials = 1 + n1 + n2 + n3;
+  c.group_keys = {"part", "case", "shape", "fault", "method", "variant"};
+  c.metrics = {"success", "rmse_m", "max_error_m", "separation_max_attitude_deg", "docking_max_attitude_deg",
+               "alloc_us_mean"};
+  const nlohmann::json options = {{"trials", o.trials},
+                                  {"seed", o.seed},
+                                  {"alloc_samples", o.alloc_samples},
+                                  {"assembly", o.spiral.assembly->name},
+                                  {"alloc_units", o.nine_units.num_units},
+                                  {"reconfigure", reconfig},
+                                  {"table2", table2}};
+  c.bench = {{"name", "mars"}, {"options", options}};
+  std::string inputs = c.bench.dump() + "\n" + ScenarioFingerprint(o.spiral) + VehicleToYaml(o.nine_units.vehicle);
+  if (reconfig) inputs += ScenarioFingerprint(o.reconfigure);
+  if (table2) inputs += ScenarioFingerprint(o.plan_4x1) + ScenarioFingerprint(o.plan_3x2);
+  c.hash = Fingerprint(inputs);
+  const int trials = o.trials;
+  c.parameters = [o, cases, n1, n2, trials](int index) -> std::map<std::string, std::string> {
+    if (index == 0) return {{"part", "alloc"}, {"seed", std::to_string(o.seed)}};
+    int k = index - 1;
+    // Every row and method flies the same seeds: the rows differ by their faults only.
+    const auto seed = [&](int trial) { return std::to_string(o.seed + static_cast<std::uint64_t>(trial)); };
+    if (k < n1) {
+      const int trial = k % trials, method = (k / trials) % static_cast<int>(kMethods.size());
+      const int row = k / (trials * static_cast<int>(kMethods.size()));
+      return {{"part", "table1"}, {"case", cases[static_cast<std::size_t>(row)].name},
+              {"method", std::string(modular::ToString(kMethods[static_cast<std::size_t>(method)]))},
+              {"trial", std::to_string(trial)}, {"seed", seed(trial)}};
+    }
+    k -= n1;
+    if (k < n2) return {{"part", "reconfig"}, {"variant", kSwitches[k % 2]}, {"trial", std::to_string(k / 2)}, {"seed", seed(k / 2)}};
+    k -= n2;
+    const PlanRow row = TableTwoRows(o)[static_cast<std::size_t>(k / (2 * trials))];
+    return {{"part", "table2"}, {"shape", row.scene->assembly->name}, {"fault", row.fault},
+            {"method", kPlanners[(k / trials) % 2]}, {"trial", std::to_string(k % trials)}, {"seed", seed(k % trials)}};
+  };
+  const auto cache = std::make_shared<PlanCache>();
+  c.run = [o, cases, n1, n2, trials, cache](int index, const std::map<std::string, std::string>& params) {
+    TrialOutcome out;
+    const std::uint64_t seed = std::stoull(params.at("seed"));
+    const std::string part = params.at("part");
+    if (part == "alloc") {
+      const auto [mean, p99] = TimeAllocation(o.nine_units, o.alloc_samples, seed);
+      out.metrics = {{"alloc_us_mean", mean}, {"alloc_us_p99", p99}};
+      return out;
+    }
+    RunSummary r;
+    if (part == "table1") {
+      const int k = index - 1;
+      const FaultCase& fault = cases[static_cast<std::size_t>(k / (trials * static_cast<int>(kMethods.size())))];
+      // Whether the rotors that still deliver can hold the assembly's weight at all (the
+      // allocator's exact QP): a case that cannot hover is reported, not held against the target.
+      modular::AssemblyAllocator check(*o.spiral.assembly, {});
+      RotorVector eta = RotorVector::Ones(o.spiral.vehicle.num_rotors());
+      for (const auto& [rotor, loss] : fault.rotors) eta[rotor] = 1.0 - loss;
+      check.SetEffectiveness(eta);
+      RotorVector hover;
+      out.metrics["hover_attainable"] =
+          check.Allocate(Eigen::Vector4d(o.spiral.vehicle.weight_n(), 0, 0, 0), &hover).attainable;
+      r = RunScenario(WithFaults(o.spiral, fault, kMethods[static_cast<std::size_t>((k / trials) % 3)], seed), RunOptions{});
+    } else if (part == "reconfig") {
+      ReconfigurationOptions ro;
+      ro.base = o.reconfigure;
+      ro.base.seed = seed;
+      ro.naive = params.at("variant") == kSwitches[1];
+      const ReconfigurationResult x = RunReconfiguration(ro);
+      out.metrics = {{"success", x.success},
+                     {"separation_max_attitude_deg", x.separation_max_attitude_deg},
+                     {"docking_max_attitude_deg", x.docking_max_attitude_deg},
+                     {"separation_max_accel_m_s2", x.separation_max_accel_m_s2},
+                     {"docking_max_accel_m_s2", x.docking_max_accel_m_s2},
+                     {"unit_max_tilt_deg", x.unit_max_tilt_deg},
+                     {"steady_max_attitude_deg", x.steady_max_attitude_deg}};
+      out.message = x.failure;
+      return out;
+    } else {
+      const int k = index - 1 - n1 - n2;
+      const std::size_t slot = static_cast<std::size_t>(k / trials);
+      std::call_once(cache->once[slot], [&] {
+        const PlanRow row = TableTwoRows(o)[slot / 2];
+        const FaultCase fault{row.fault, row.dead_unit > 0 ? DeadUnit(row.dead_unit) : std::vector<std::pair<int, double>>{}};
+        Scenario s = WithFaults(*row.scene, fault, modular::Reallocation::kFull, o.seed);
+        s.assembly_plan->method = kPlanners[slot % 2];
+        cache->plans[slot] = PlanAssemblyMission(s);  // never throws: a failure is the row's
+        if (cache->plans[slot].ok) s.reference = cache->plans[slot].trajectory;
+        cache->scenes[slot] = std::move(s);
+      });
+      const AssemblyPlanResult& plan = cache->plans[slot];
+      out.metrics["planned"] = plan.ok;
+      if (!plan.ok) {
+        out.message = plan.message;
+        return out;
+      }
+      // What the plan asks of the assembly, beside what it can give (the mechanism of the rows).
+      const PlanDemands demands = DemandsOf(*plan.trajectory);
+      out.metrics["duration_s"] = plan.trajectory_summary.duration_s;
+      out.metrics["attitude_deviation_deg"] = plan.trajectory_summary.attitude_deviation_rad * 180.0 / std::numbers::pi;
+      out.metrics["plan_ms"] = plan.astar_ms + plan.trajectory_summary.solve_ms;
+      out.metrics["max_accel_m_s2"] = demands.accel;
+      out.metrics["max_thrust_accel_m_s2"] = demands.thrust_accel;
+      out.metrics["max_yaw_accel_rad_s2"] = demands.yaw_accel;
+      out.metrics["capacity_accel_m_s2"] = plan.capacity.max_acceleration_m_s2;
+      out.metrics["capacity_thrust_accel_m_s2"] = plan.capacity.max_thrust_n / cache->scenes[slot].vehicle.mass_kg;
+      out.metrics["capacity_yaw_accel_rad_s2"] = plan.capacity.max_yaw_acceleration_rad_s2;
+      Scenario s = cache->scenes[slot];
+      s.seed = seed;
+      r = RunScenario(s, RunOptions{});
+    }
+    out.metrics["success"] = r.success;
+    out.metrics["rmse_m"] = r.tracking_rmse_m;
+    out.metrics["max_error_m"] = r.max_position_error_m;
+    out.message = r.failure_reason;
+    return out;
+  };
+  return c;
+}
+
+namespace {
+
+/// Table I from its records: (case, method, trial), the trial fastest.
+nlohmann::json TableOne(const std::vector<const nlohmann::json*>& records, int trials, bool* within) {
+  nlohmann::json table1 = nlohmann::json::array();
+  const std::vector<FaultCase> cases = TableOneCases();
+  const int methods = static_cast<int>(kMethods.size());
+  if (records.size() != cases.size() * static_cast<std::size_t>(methods * trials)) {
+    throw std::invalid_argument(fmt::format("mars: {} Table I records for {} cases x {} methods x {} trials",
+                                            records.size(), cases.size(), methods, trials));
+  }
+  double fault_free = 0.0;
+  *within = true;
+  for (std::size_t row = 0; row < cases.size(); ++row) {
+    const nlohmann::json& first = *records[row * static_cast<std::size_t>(methods * trials)];
+    const bool can_hover = first["metrics"].is_object() && first["metrics"].value("hover_attainable", false);
+    nlohmann::json r = {{"case", cases[row].name}, {"hover_attainable", can_hover}};
+    nlohmann::json faults = nlohmann::json::array();
+    for (const auto& [rotor, loss] : cases[row].rotors) faults.push_back({{"rotor", rotor}, {"loss", loss}});
+    r["faults"] = faults;
+    for (int m = 0; m < methods; ++m) {
+      double rmse = 0.0, max_error = 0.0;
+      int success = 0;
+      for (int t = 0; t < trials; ++t) {
+        const nlohmann::json& f = *records[(row * static_cast<std::size_t>(methods) + static_cast<std::size_t>(m)) *
+                                               static_cast<std::size_t>(trials) + static_cast<std::size_t>(t)];
+        rmse += MetricOr(f, "rmse_m", 0.0) / trials;
+        max_error = std::max(max_error, MetricOr(f, "max_error_m", 0.0));
+        success += Succeeded(f);
+      }
+      const std::string name(modular::ToString(kMethods[static_cast<std::size_t>(m)]));
+      r[name + "_error_m"] = rmse;
+      r[name + "_max_error_m"] = max_error;
+      r[name + "_success_rate"] = static_cast<double>(success) / trials;
+    }
+    if (row == 0) fault_free = r["full_error_m"].get<double>();
+    r["full_over_fault_free"] = fault_free > 0.0 ? r["full_error_m"].get<double>() / fault_free : 0.0;
+    if (can_hover) {
+      *within = *within && r["full_over_fault_free"].get<double>() <= 1.5 && r["full_success_rate"].get<double>() == 1.0;
+    }
+    table1.push_back(r);
+  }
+  return table1;
+}
+
+/// The self-reconfiguration from its records: (trial, switch), the switch fastest; the largest
+/// figures over the trials.
+nlohmann::json Reconfiguration(const std::vector<const nlohmann::json*>& records, int trials) {
+  nlohmann::json variants;
+  for (int v = 0; v < 2; ++v) {
+    nlohmann::json x = {{"success_rate", 0.0}, {"first_failure", ""}};
+    int success = 0;
+    for (const char* key : {"separation_max_attitude_deg", "docking_max_attitude_deg", "separation_max_accel_m_s2",
+                            "docking_max_accel_m_s2", "unit_max_tilt_deg", "steady_max_attitude_deg"}) {
+      double worst = 0.0;
+      for (int t = 0; t < trials; ++t) worst = std::max(worst, MetricOr(*records[static_cast<std::size_t>(2 * t + v)], key, 0.0));
+      x[key] = worst;
+    }
+    for (int t = 0; t < trials; ++t) {
+      const nlohmann::json& r = *records[static_cast<std::size_t>(2 * t + v)];
+      success += Succeeded(r);
+      if (!Succeeded(r) && x["first_failure"] == "") x["first_failure"] = FailureOf(r);
+    }
+    x["success_rate"] = static_cast<double>(success) / trials;
+    variants[kSwitches[v]] = x;
+  }
+  return variants;
+}
+
+/// Table II from its records: (row, planner, trial), the trial fastest.
+nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int trials) {
   nlohmann::json table = nlohmann::json::array();
   double sum[2] = {0.0, 0.0}, improvement_sum = 0.0;
   int compared = 0;
   bool all_better = true;
-  for (std::size_t row = 0; row < rows.size(); ++row) {
-    nlohmann::json r = {{"shape", rows[row].scene->assembly->name}, {"fault", rows[row].fault}};
+  const std::size_t rows = records.size() / static_cast<std::size_t>(2 * trials);
+  for (std::size_t row = 0; row < rows; ++row) {
+    const nlohmann::json& head = *records[row * static_cast<std::size_t>(2 * trials)];
+    nlohmann::json r = {{"shape", head["params"]["shape"]}, {"fault", head["params"]["fault"]}};
     double error[2] = {0.0, 0.0};
     bool both_planned = true;
     for (int m = 0; m < 2; ++m) {
-      const std::size_t k = 2 * row + static_cast<std::size_t>(m);
-      const AssemblyPlanResult& plan = plans[k];
-      const std::string name = methods[m];
-      r[name + "_planned"] = plan.ok;
-      if (!plan.ok) {
-        r[name + "_plan_failure"] = plan.message;
+      const auto at = [&](int t) -> const nlohmann::json& {
+        return *records[(2 * row + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials) + static_cast<std::size_t>(t)];
+      };
+      const std::string name = kPlanners[m];
+      // The plan's figures, from the first flight that recorded them (every flight flies one plan).
+      const nlohmann::json* plan = nullptr;
+      for (int t = 0; t < trials && plan == nullptr; ++t) {
+        if (at(t)["status"] == "ok") plan = &at(t);
+      }
+      const bool planned = plan != nullptr && (*plan)["metrics"]["planned"].get<bool>();
+      r[name + "_planned"] = planned;
+      if (!planned) {
+        r[name + "_plan_failure"] = plan != nullptr ? (*plan)["message"].get<std::string>() : FailureOf(at(0));
         both_planned = false;
         continue;
       }
       int success = 0;
       double max_error = 0.0;
       std::string failure;
-      for (int t = 0; t < o.trials; ++t) {
-        const Flight& f = flights[k * static_cast<std::size_t>(o.trials) + static_cast<std::size_t>(t)];
-        error[m] += f.rmse / o.trials;
-        max_error = std::max(max_error, f.max_error);
-        success += f.success;
-        if (!f.success && failure.empty()) failure = f.failure;
+      for (int t = 0; t < trials; ++t) {
+        error[m] += MetricOr(at(t), "rmse_m", 0.0) / trials;
+        max_error = std::max(max_error, MetricOr(at(t), "max_error_m", 0.0));
+        success += Succeeded(at(t));
+        if (!Succeeded(at(t)) && failure.empty()) failure = FailureOf(at(t));
       }
       r[name + "_error_m"] = error[m];
       r[name + "_max_error_m"] = max_error;
-      r[name + "_success_rate"] = static_cast<double>(success) / o.trials;
+      r[name + "_success_rate"] = static_cast<double>(success) / trials;
       r[name + "_first_failure"] = failure;
-      r[name + "_duration_s"] = plan.trajectory_summary.duration_s;
-      r[name + "_attitude_deviation_deg"] = plan.trajectory_summary.attitude_deviation_rad * 180.0 / std::numbers::pi;
-      r[name + "_plan_ms"] = plan.astar_ms + plan.trajectory_summary.solve_ms;
-      // What the plan asks of the assembly, beside what it can give (the mechanism of the rows).
-      const PlanDemands demands = DemandsOf(*plan.trajectory);
-      r[name + "_max_accel_m_s2"] = demands.accel;
-      r[name + "_max_thrust_accel_m_s2"] = demands.thrust_accel;
-      r[name + "_max_yaw_accel_rad_s2"] = demands.yaw_accel;
-      r["capacity_accel_m_s2"] = plan.capacity.max_acceleration_m_s2;
-      r["capacity_thrust_accel_m_s2"] = plan.capacity.max_thrust_n / rows[row].scene->vehicle.mass_kg;
-      r["capacity_yaw_accel_rad_s2"] = plan.capacity.max_yaw_acceleration_rad_s2;
+      const nlohmann::json& x = (*plan)["metrics"];
+      r[name + "_duration_s"] = x["duration_s"];
+      r[name + "_attitude_deviation_deg"] = x["attitude_deviation_deg"];
+      r[name + "_plan_ms"] = x["plan_ms"];
+      r[name + "_max_accel_m_s2"] = x["max_accel_m_s2"];
+      r[name + "_max_thrust_accel_m_s2"] = x["max_thrust_accel_m_s2"];
+      r[name + "_max_yaw_accel_rad_s2"] = x["max_yaw_accel_rad_s2"];
+      r["capacity_accel_m_s2"] = x["capacity_accel_m_s2"];
+      r["capacity_thrust_accel_m_s2"] = x["capacity_thrust_accel_m_s2"];
+      r["capacity_yaw_accel_rad_s2"] = x["capacity_yaw_accel_rad_s2"];
     }
     // A row that either method could not plan has no comparison: null, left out of the averages.
     all_better = all_better && both_planned && error[1] < error[0];
@@ -231,145 +447,53 @@ nlohmann::json RunTableTwo(const MarsBenchOptions& o) {
 
 }  // namespace
 
-void MarsBenchOptions::Validate() const {
-  if (trials < 1 || trials > 10000) ThrowInvalidArgument("MarsBenchOptions", "trials", trials, "a count in [1, 10000]");
-  if (jobs < 1 || jobs > 256) ThrowInvalidArgument("MarsBenchOptions", "jobs", jobs, "a count in [1, 256]");
-  if (alloc_samples < 100 || alloc_samples > 10'000'000) {
-    ThrowInvalidArgument("MarsBenchOptions", "alloc_samples", alloc_samples, "a count in [100, 10^7]");
-  }
-  if (!spiral.assembly || spiral.stack.controller != "assembly") {
-    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "an assembly scenario flown by controller assembly");
-  }
-  if (spiral.assembly->num_units != 6) {
-    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "the 3x2 assembly of Table I (six units)");
-  }
-}
-
-nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
-  o.Validate();
-  const std::vector<FaultCase> cases = TableOneCases();
-  const int methods = static_cast<int>(kMethods.size());
-  const int total = static_cast<int>(cases.size()) * methods * o.trials;
-  std::vector<Flight> flights(static_cast<std::size_t>(total));
-  ParallelFor(total, o.jobs, [&](int task) {
-    const int trial = task % o.trials, method = (task / o.trials) % methods, row = task / (o.trials * methods);
-    // Every method and row flies the same seeds: the rows differ by their faults only.
-    flights[static_cast<std::size_t>(task)] = FlyOnce(WithFaults(o.spiral, cases[row], kMethods[method], o.seed + trial));
-  }, o.progress);
-
-  nlohmann::json table1 = nlohmann::json::array();
-  double fault_free = 0.0;
+nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
+  const int trials = options.at("trials").get<int>();
+  const std::vector<const nlohmann::json*> alloc = PartOf(records, "alloc"), t1 = PartOf(records, "table1"),
+                                           rc = PartOf(records, "reconfig"), t2 = PartOf(records, "table2");
+  if (alloc.size() != 1) throw std::invalid_argument(fmt::format("mars: {} allocation timings; expected 1", alloc.size()));
   bool within = true;
-  for (std::size_t row = 0; row < cases.size(); ++row) {
-    // Whether the rotors that still deliver can hold the assembly's weight at all (the allocator's
-    // exact QP): a case that cannot hover is reported, not held against the target.
-    modular::AssemblyAllocator check(*o.spiral.assembly, {});
-    RotorVector eta = RotorVector::Ones(o.spiral.vehicle.num_rotors());
-    for (const auto& [rotor, loss] : cases[row].rotors) eta[rotor] = 1.0 - loss;
-    check.SetEffectiveness(eta);
-    RotorVector hover;
-    const bool can_hover = check.Allocate(Eigen::Vector4d(o.spiral.vehicle.weight_n(), 0, 0, 0), &hover).attainable;
-    nlohmann::json r = {{"case", cases[row].name}, {"hover_attainable", can_hover}};
-    nlohmann::json faults = nlohmann::json::array();
-    for (const auto& [rotor, loss] : cases[row].rotors) faults.push_back({{"rotor", rotor}, {"loss", loss}});
-    r["faults"] = faults;
-    for (int m = 0; m < methods; ++m) {
-      double rmse = 0.0, max_error = 0.0;
-      int success = 0;
-      for (int t = 0; t < o.trials; ++t) {
-        const Flight& f = flights[static_cast<std::size_t>((static_cast<int>(row) * methods + m) * o.trials + t)];
-        rmse += f.rmse / o.trials;
-        max_error = std::max(max_error, f.max_error);
-        success += f.success;
-      }
-      const std::string name(modular::ToString(kMethods[m]));
-      r[name + "_error_m"] = rmse;
-      r[name + "_max_error_m"] = max_error;
-      r[name + "_success_rate"] = static_cast<double>(success) / o.trials;
-    }
-    if (row == 0) fault_free = r["full_error_m"].get<double>();
-    r["full_over_fault_free"] = fault_free > 0.0 ? r["full_error_m"].get<double>() / fault_free : 0.0;
-    if (can_hover) {
-      within = within && r["full_over_fault_free"].get<double>() <= 1.5 && r["full_success_rate"].get<double>() == 1.0;
-    }
-    table1.push_back(r);
-  }
-  const auto [alloc_mean, alloc_p99] = TimeAllocation(o.nine_units, o.alloc_samples, o.seed);
-  nlohmann::json reconfig = nullptr;
-  if (o.reconfigure.assembly) {
-    // Self-reconfiguration, prepared (the split allocation blended in) and naive, on the same seeds.
-    std::vector<ReconfigurationResult> runs(static_cast<std::size_t>(2 * o.trials));
-    ParallelFor(2 * o.trials, o.jobs, [&](int task) {
-      ReconfigurationOptions r;
-      r.base = o.reconfigure;
-      r.base.seed = o.seed + static_cast<std::uint64_t>(task / 2);
-      r.naive = task % 2 == 1;
-      try {
-        runs[static_cast<std::size_t>(task)] = RunReconfiguration(r);
-      } catch (const std::exception& e) {
-        runs[static_cast<std::size_t>(task)].failure = std::string("error: ") + e.what();
-      }
-    }, nullptr);
-    nlohmann::json variants;
-    for (int v = 0; v < 2; ++v) {
-      double sep = 0.0, dock = 0.0, sep_acc = 0.0, dock_acc = 0.0, unit_tilt = 0.0, steady = 0.0;
-      int success = 0;
-      std::string failure;
-      for (int t = 0; t < o.trials; ++t) {
-        const ReconfigurationResult& r = runs[static_cast<std::size_t>(2 * t + v)];
-        success += r.success;
-        if (!r.success && failure.empty()) failure = r.failure;
-        sep = std::max(sep, r.separation_max_attitude_deg);
-        dock = std::max(dock, r.docking_max_attitude_deg);
-        sep_acc = std::max(sep_acc, r.separation_max_accel_m_s2);
-        dock_acc = std::max(dock_acc, r.docking_max_accel_m_s2);
-        unit_tilt = std::max(unit_tilt, r.unit_max_tilt_deg);
-        steady = std::max(steady, r.steady_max_attitude_deg);
-      }
-      variants[v == 0 ? "prepared" : "naive"] = {{"success_rate", static_cast<double>(success) / o.trials},
-                                                 {"separation_max_attitude_deg", sep},
-                                                 {"docking_max_attitude_deg", dock},
-                                                 {"separation_max_accel_m_s2", sep_acc},
-                                                 {"docking_max_accel_m_s2", dock_acc},
-                                                 {"unit_max_tilt_deg", unit_tilt},
-                                                 {"steady_max_attitude_deg", steady},
-                                                 {"first_failure", failure}};
-    }
-    reconfig = variants;
-  }
-  const nlohmann::json table2 = o.plan_4x1.assembly_plan && o.plan_3x2.assembly_plan ? RunTableTwo(o) : nlohmann::json();
+  const nlohmann::json table1 = TableOne(t1, trials, &within);
+  const nlohmann::json reconfig =
+      options.at("reconfigure").get<bool>() ? Reconfiguration(rc, trials) : nlohmann::json();
+  const nlohmann::json table2 = options.at("table2").get<bool>() ? TableTwo(t2, trials) : nlohmann::json();
   nlohmann::json failures = nlohmann::json::array();
-  for (int task = 0; task < total && failures.size() < 10; ++task) {
-    const Flight& f = flights[static_cast<std::size_t>(task)];
-    if (f.success || kMethods[(task / o.trials) % methods] == modular::Reallocation::kNone) continue;
-    failures.push_back({{"case", cases[task / (o.trials * methods)].name},
-                        {"method", modular::ToString(kMethods[(task / o.trials) % methods])},
-                        {"seed", o.seed + task % o.trials},
-                        {"reason", f.failure}});
+  for (const nlohmann::json* f : t1) {
+    if (failures.size() >= 10) break;
+    if (Succeeded(*f) || (*f)["params"]["method"] == "none") continue;
+    failures.push_back({{"case", (*f)["params"]["case"]},
+                        {"method", (*f)["params"]["method"]},
+                        {"seed", std::stoull((*f)["params"]["seed"].get<std::string>())},
+                        {"reason", FailureOf(*f)}});
   }
+  const auto worst = [&](const char* variant) {
+    return reconfig.is_null() ? nlohmann::json(nullptr)
+                              : nlohmann::json(std::max(reconfig[variant]["separation_max_attitude_deg"].get<double>(),
+                                                        reconfig[variant]["docking_max_attitude_deg"].get<double>()));
+  };
   nlohmann::json result = {{"benchmark", "mars"},
-          {"assembly", o.spiral.assembly->name},
-          {"trials", o.trials},
-          {"table1", table1},
-          {"table1_full_within_1_5x_fault_free", within},
-          {"alloc_units", o.nine_units.num_units},
-          {"alloc_us_mean", alloc_mean},
-          {"alloc_us_p99", alloc_p99},
-          {"reconfig", reconfig},
-          {"reconfig_max_attitude_deg",
-           reconfig.is_null() ? nlohmann::json(nullptr)
-                              : nlohmann::json(std::max(reconfig["prepared"]["separation_max_attitude_deg"].get<double>(),
-                                                        reconfig["prepared"]["docking_max_attitude_deg"].get<double>()))},
-          {"reconfig_max_attitude_deg_naive",
-           reconfig.is_null() ? nlohmann::json(nullptr)
-                              : nlohmann::json(std::max(reconfig["naive"]["separation_max_attitude_deg"].get<double>(),
-                                                        reconfig["naive"]["docking_max_attitude_deg"].get<double>()))},
-          {"failures", failures}};
+                           {"assembly", options.at("assembly")},
+                           {"trials", trials},
+                           {"table1", table1},
+                           {"table1_full_within_1_5x_fault_free", within},
+                           {"alloc_units", options.at("alloc_units")},
+                           {"alloc_us_mean", MetricOr(*alloc[0], "alloc_us_mean", 0.0)},
+                           {"alloc_us_p99", MetricOr(*alloc[0], "alloc_us_p99", 0.0)},
+                           {"reconfig", reconfig},
+                           {"reconfig_max_attitude_deg", worst("prepared")},
+                           {"reconfig_max_attitude_deg_naive", worst("naive")},
+                           {"failures", failures},
+                           {"options", options}};
   for (const char* key : {"table2", "table2_rows_compared", "table2_improvement_average",
                           "table2_improvement_row_mean", "table2_ours_better_in_every_row"}) {
     result[key] = table2.is_null() ? nlohmann::json(nullptr) : table2[key];
   }
   return result;
+}
+
+nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
+  const Campaign c = MarsCampaign(o);
+  return MarsResult(c.bench["options"], RunWholeCampaign(c, o.jobs, o.progress));
 }
 
 std::string MarsMarkdown(const nlohmann::json& r) {

@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 
 #include "rotorguard/bench/metrics.h"
-#include "rotorguard/bench/parallel.h"
 #include "rotorguard/bench/planner_bench.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/sim_bench.h"
@@ -127,56 +126,91 @@ Scenario MakeNavTrial(const Scenario& base, const std::string& kind, std::uint64
   return s;
 }
 
-nlohmann::json RunNavBenchmark(const NavBenchOptions& o) {
+Campaign NavCampaign(const NavBenchOptions& o) {
   o.Validate();
-  const int kinds = static_cast<int>(o.kinds.size());
-  const int total = kinds * o.trials * 2;
-  std::vector<NavTrial> results(static_cast<std::size_t>(total));
-  std::vector<std::uint64_t> seeds(static_cast<std::size_t>(total));
-  ParallelFor(total, o.jobs, [&](int task) {
-    const int variant = task % 2;
-    const int trial = (task / 2) % o.trials;
-    const int kind = task / (2 * o.trials);
-    // Both variants fly the same trial: the seed depends on the kind and trial only.
+  Campaign c;
+  c.name = "bench_nav";
+  c.seed = o.seed;
+  c.trials = static_cast<int>(o.kinds.size()) * o.trials * 2;
+  c.group_keys = {"kind", "variant"};
+  c.metrics = {"success", "collision", "tracking_rmse_m", "max_spin_rad_s", "mission_time_s", "realtime_factor"};
+  const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"kinds", o.kinds}, {"base", o.base.name}};
+  c.bench = {{"name", "nav"}, {"options", options}};
+  c.hash = Fingerprint(c.bench.dump() + "\n" + ScenarioFingerprint(o.base));
+  // Trial index = (kind, trial, variant), the variant fastest: both variants fly the same world,
+  // fault and noise (the seed depends on the kind and trial only).
+  c.parameters = [o](int index) {
+    const int kind = index / (2 * o.trials), trial = (index / 2) % o.trials;
     const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(kind) * 1'000'003ull + trial);
-    seeds[task] = seed;
-    NavTrial& r = results[task];
-    try {
-      RunOptions run;
-      run.stop_when_mission_complete = true;
-      const RunSummary s = RunScenario(MakeNavTrial(o.base, o.kinds[kind], seed, variant == 0), run);
-      r.success = s.success;
-      r.crashed = s.crashed;
-      r.collision = s.crashed && s.crash_reason.rfind("collision", 0) == 0;
-      r.tracking_rmse_m = s.tracking_rmse_m;
-      r.max_spin_rad_s = s.max_spin_rad_s;
-      r.mission_time_s = s.mission_time_s;
-      r.planner_ms_mean = s.planner_ms_mean;
-      r.stack_ms_per_cycle_mean = s.stack_ms_per_cycle_mean;
-      r.realtime_factor = s.realtime_factor;
-      r.failure = s.failure_reason;
-    } catch (const std::exception& e) {
-      r.failure = std::string("error: ") + e.what();
-    }
-  }, o.progress);
+    return std::map<std::string, std::string>{{"kind", o.kinds[static_cast<std::size_t>(kind)]},
+                                              {"variant", kVariants[index % 2]},
+                                              {"trial", std::to_string(trial)},
+                                              {"seed", std::to_string(seed)}};
+  };
+  c.run = [base = o.base](int, const std::map<std::string, std::string>& params) {
+    RunOptions run;
+    run.stop_when_mission_complete = true;
+    const RunSummary s = RunScenario(MakeNavTrial(base, params.at("kind"), std::stoull(params.at("seed")),
+                                                  params.at("variant") == kVariants[0]), run);
+    TrialOutcome out;
+    out.metrics = {{"success", s.success},
+                   {"crashed", s.crashed},
+                   {"collision", s.crashed && s.crash_reason.rfind("collision", 0) == 0},
+                   {"tracking_rmse_m", s.tracking_rmse_m},
+                   {"max_spin_rad_s", s.max_spin_rad_s},
+                   {"mission_time_s", s.mission_time_s >= 0.0 ? nlohmann::json(s.mission_time_s) : nlohmann::json()},
+                   {"planner_ms_mean", s.planner_ms_mean},
+                   {"stack_ms_per_cycle_mean", s.stack_ms_per_cycle_mean},
+                   {"realtime_factor", s.realtime_factor}};
+    out.message = s.failure_reason;
+    return out;
+  };
+  return c;
+}
 
+nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
+  const std::vector<std::string> kinds = options.at("kinds").get<std::vector<std::string>>();
+  const int trials = options.at("trials").get<int>();
+  if (records.size() != kinds.size() * static_cast<std::size_t>(trials) * 2) {
+    throw std::invalid_argument(fmt::format("nav: {} trial records for {} kinds x {} trials x 2 variants",
+                                            records.size(), kinds.size(), trials));
+  }
+  std::vector<NavTrial> results;
+  for (const nlohmann::json& r : records) {
+    NavTrial t;
+    if (r["status"] != "ok") {
+      t.failure = r["status"].get<std::string>() + ": " + r["message"].get<std::string>();
+    } else {
+      const nlohmann::json& x = r["metrics"];
+      t.success = x["success"].get<bool>();
+      t.crashed = x["crashed"].get<bool>();
+      t.collision = x["collision"].get<bool>();
+      t.tracking_rmse_m = x["tracking_rmse_m"].get<double>();
+      t.max_spin_rad_s = x["max_spin_rad_s"].get<double>();
+      t.mission_time_s = x["mission_time_s"].is_null() ? -1.0 : x["mission_time_s"].get<double>();
+      t.planner_ms_mean = x["planner_ms_mean"].get<double>();
+      t.stack_ms_per_cycle_mean = x["stack_ms_per_cycle_mean"].get<double>();
+      t.realtime_factor = x["realtime_factor"].get<double>();
+      t.failure = r["message"].get<std::string>();
+    }
+    results.push_back(t);
+  }
   nlohmann::json result = {{"benchmark", "nav"}};
   nlohmann::json groups = nlohmann::json::object();
   for (int v = 0; v < 2; ++v) {
     std::vector<const NavTrial*> all;
     std::vector<std::uint64_t> all_seeds;
     std::vector<std::string> all_kinds;
-    for (int k = 0; k < kinds; ++k) {
+    for (std::size_t k = 0; k < kinds.size(); ++k) {
       std::vector<const NavTrial*> group;
       std::vector<std::uint64_t> group_seeds;
-      std::vector<std::string> group_kinds;
-      for (int t = 0; t < o.trials; ++t) {
-        const int task = (k * o.trials + t) * 2 + v;
-        group.push_back(&results[task]);
-        group_seeds.push_back(seeds[task]);
-        group_kinds.push_back(o.kinds[k]);
+      for (int t = 0; t < trials; ++t) {
+        const std::size_t index = (k * static_cast<std::size_t>(trials) + static_cast<std::size_t>(t)) * 2 + v;
+        group.push_back(&results[index]);
+        group_seeds.push_back(std::stoull(records[index]["params"]["seed"].get<std::string>()));
       }
-      groups[o.kinds[k]][kVariants[v]] = Aggregate(group, group_seeds, group_kinds);
+      const std::vector<std::string> group_kinds(group.size(), kinds[k]);
+      groups[kinds[k]][kVariants[v]] = Aggregate(group, group_seeds, group_kinds);
       all.insert(all.end(), group.begin(), group.end());
       all_seeds.insert(all_seeds.end(), group_seeds.begin(), group_seeds.end());
       all_kinds.insert(all_kinds.end(), group_kinds.begin(), group_kinds.end());
@@ -184,9 +218,14 @@ nlohmann::json RunNavBenchmark(const NavBenchOptions& o) {
     result[kVariants[v]] = Aggregate(all, all_seeds, all_kinds);
   }
   result["groups"] = groups;
-  result["options"] = {{"trials", o.trials}, {"seed", o.seed}, {"jobs", o.jobs}, {"kinds", o.kinds}, {"base", o.base.name}};
+  result["options"] = options;
   result["host"] = HostInfo();
   return result;
+}
+
+nlohmann::json RunNavBenchmark(const NavBenchOptions& o) {
+  const Campaign c = NavCampaign(o);
+  return NavResult(c.bench["options"], RunWholeCampaign(c, o.jobs, o.progress));
 }
 
 std::string NavMarkdown(const nlohmann::json& r) {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotorguard/bench/assembly_mission.h"
+#include "rotorguard/bench/bench_campaigns.h"
 #include "rotorguard/bench/campaign.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
@@ -116,6 +117,11 @@ void FitStackToHardware(Scenario* s) {
   // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius and a margin.
   s->stack.lidar.deskew.sensor_position_m = s->sim.lidar.position_m;
   s->stack.lidar.map.inflation_radius_m = s->vehicle.collision_radius_m + s->stack.lidar.inflation_margin_m;
+}
+
+std::string ScenarioFingerprint(const Scenario& scenario) {
+  return (scenario.file.empty() ? std::string() : io::ReadInputFile(scenario.file)) + "\n" +
+         VehicleToYaml(scenario.vehicle);
 }
 
 std::string VehicleToYaml(const vehicle::VehicleParams& v) {
@@ -838,6 +844,11 @@ ValidationReport ValidateConfigFile(const std::string& path) {
     return {"assembly", fmt::format("assembly '{}': {} units, {} rotors, {:g} kg, thrust-to-weight {:.2f}", a.name,
                                     a.num_units, a.vehicle.num_rotors(), a.vehicle.mass_kg,
                                     a.vehicle.total_max_thrust_n() / a.vehicle.weight_n())};
+  }
+  if (has("bench") && !has("mission")) {
+    const Campaign c = LoadCampaign(path);
+    return {"campaign", fmt::format("campaign '{}': {} trials of benchmark {}, spec {}", c.name, c.trials,
+                                    c.bench["name"].get<std::string>(), c.hash)};
   }
   if (has("scenario") && !has("mission")) {
     const CampaignSpec c = LoadCampaignSpec(path);

@@ -28,7 +28,7 @@ std::string Scenario(const std::string& name) {
   return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
 }
 
-class Campaign : public testing::TempFolderTest {
+class Campaigns : public testing::TempFolderTest {
  protected:
   /// A spec of 6 short trials: the nominal controller losing a motor or a propeller in hover, over
   /// the rotor, with random onsets, 1.5 s each.
@@ -53,7 +53,7 @@ class Campaign : public testing::TempFolderTest {
     o.shard = shard;
     o.resume = resume;
     o.version = "test";
-    return RunCampaign(spec, o);
+    return RunCampaign(ScenarioCampaign(spec), o);
   }
   std::string Merge(const std::vector<std::string>& outs, const std::string& into) {
     std::vector<std::string> dirs;
@@ -63,7 +63,7 @@ class Campaign : public testing::TempFolderTest {
   }
 };
 
-TEST_F(Campaign, TrialsCoverTheGridWithCounterStyleSeedsAndDraws) {
+TEST_F(Campaigns, TrialsCoverTheGridWithCounterStyleSeedsAndDraws) {
   const CampaignSpec spec = LoadCampaignSpec(Spec());
   ASSERT_EQ(spec.trials(), 6);  // 1 x 3 grid points, 2 repeats each
   std::set<std::string> rotors, ids;
@@ -83,7 +83,7 @@ TEST_F(Campaign, TrialsCoverTheGridWithCounterStyleSeedsAndDraws) {
   EXPECT_EQ(rotors.size(), 3u);
 }
 
-TEST_F(Campaign, JobsAndShardsGiveByteIdenticalSummaries) {
+TEST_F(Campaigns, JobsAndShardsGiveByteIdenticalSummaries) {
   const CampaignSpec spec = LoadCampaignSpec(Spec());
   const CampaignRunSummary one = Run(spec, "one", 1);
   EXPECT_EQ(one.ran, 6);
@@ -103,7 +103,7 @@ TEST_F(Campaign, JobsAndShardsGiveByteIdenticalSummaries) {
   EXPECT_EQ(s["by_grid_point"].size(), 3u);
 }
 
-TEST_F(Campaign, AKilledShardResumesToTheSameSummaryAndLosesOnlyTheTrialInFlight) {
+TEST_F(Campaigns, AKilledShardResumesToTheSameSummaryAndLosesOnlyTheTrialInFlight) {
   const CampaignSpec spec = LoadCampaignSpec(Spec());
   Run(spec, "whole");
   const std::string reference = Merge({"whole"}, "m_whole");
@@ -127,7 +127,7 @@ TEST_F(Campaign, AKilledShardResumesToTheSameSummaryAndLosesOnlyTheTrialInFlight
   EXPECT_EQ(Merge({"killed"}, "m_killed"), reference);
 }
 
-TEST_F(Campaign, AnErroringTrialIsRecordedAndTheCampaignGoesOn) {
+TEST_F(Campaigns, AnErroringTrialIsRecordedAndTheCampaignGoesOn) {
   // Rotor 9 of a quadrotor: trials 0-1 load, trials 2-3 fail at load time and are recorded.
   const CampaignSpec spec = LoadCampaignSpec(Write("err.yaml", "name: err\n"
                                                                "scenario: " + Scenario("hover_motor_stop_nominal.yaml") + "\n"
@@ -146,7 +146,7 @@ TEST_F(Campaign, AnErroringTrialIsRecordedAndTheCampaignGoesOn) {
   EXPECT_NE(s["errors"][0]["message"].get<std::string>().find("rotor"), std::string::npos);
 }
 
-TEST_F(Campaign, BadInputIsRejectedNamingTheKeyAndNothingIsOverwritten) {
+TEST_F(Campaigns, BadInputIsRejectedNamingTheKeyAndNothingIsOverwritten) {
   RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("u.yaml", "name: u\nscenario: " + Scenario("hover.yaml") +
                                                              "\ngrid:\n  wind.gusty: [0.1]\n")),
                        io::ConfigError, "grid.wind.gusty");
@@ -188,7 +188,7 @@ TEST_F(Campaign, BadInputIsRejectedNamingTheKeyAndNothingIsOverwritten) {
   EXPECT_EQ(io::ReadFile((dir_ / "md" / "summary.json").string()), "{\"earlier\": true}");
 }
 
-TEST_F(Campaign, SpecRulesNameTheKey) {
+TEST_F(Campaigns, SpecRulesNameTheKey) {
   const std::string base = "name: s\nscenario: " + Scenario("hover.yaml") + "\n";
   RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("k.yaml", base + "trials: 5\n")), io::ConfigError, "trials");
   RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("o.yaml", base + "grid:\n  duration_s: [1.0]\nrandom:\n  duration_s: "
@@ -200,7 +200,7 @@ TEST_F(Campaign, SpecRulesNameTheKey) {
                        io::ConfigError, "lo < hi");
 }
 
-TEST_F(Campaign, ARunningShardIsNotRunTwiceAndDamagedResultsAreRefusedUntouched) {
+TEST_F(Campaigns, ARunningShardIsNotRunTwiceAndDamagedResultsAreRefusedUntouched) {
   const CampaignSpec spec = LoadCampaignSpec(Spec());
   // Another process holds the shard.
   fs::create_directories(dir_ / "busy");
@@ -231,14 +231,14 @@ TEST_F(Campaign, ARunningShardIsNotRunTwiceAndDamagedResultsAreRefusedUntouched)
   o.out_dir = (dir_ / "versions").string();
   o.shard = {0, 2};
   o.version = "build A";
-  RunCampaign(spec, o);
+  RunCampaign(ScenarioCampaign(spec), o);
   o.shard = {1, 2};
   o.version = "build B";
-  RunCampaign(spec, o);
+  RunCampaign(ScenarioCampaign(spec), o);
   RG_EXPECT_THROW_WITH(Merge({"versions"}, "m3"), std::invalid_argument, "version");
 }
 
-TEST_F(Campaign, TheSlurmScriptRunsOneResumableShardPerArrayTask) {
+TEST_F(Campaigns, TheSlurmScriptRunsOneResumableShardPerArrayTask) {
   const CampaignSpec spec = LoadCampaignSpec(Spec());
   SlurmScriptOptions o;
   o.shards = 3;
@@ -246,7 +246,7 @@ TEST_F(Campaign, TheSlurmScriptRunsOneResumableShardPerArrayTask) {
   o.out_dir = (dir_ / "results").string();
   o.rotorguard = "/opt/rg/bin/rotorguard";
   o.partition = "short";
-  const std::string script = SlurmArrayScript(spec, o);
+  const std::string script = SlurmArrayScript(ScenarioCampaign(spec), o);
   for (const std::string& needle :
        {std::string("#SBATCH --array=0-2\n"), std::string("#SBATCH --cpus-per-task=2\n"),
         std::string("#SBATCH --partition=short\n"), std::string("--shard \"${SLURM_ARRAY_TASK_ID}/3\""),
@@ -255,28 +255,28 @@ TEST_F(Campaign, TheSlurmScriptRunsOneResumableShardPerArrayTask) {
     EXPECT_NE(script.find(needle), std::string::npos) << needle << " not in\n" << script;
   }
   o.shards = 7;  // more than the 6 trials
-  RG_EXPECT_THROW_WITH(SlurmArrayScript(spec, o), std::invalid_argument, "--shards 7");
+  RG_EXPECT_THROW_WITH(SlurmArrayScript(ScenarioCampaign(spec), o), std::invalid_argument, "--shards 7");
   o.shards = 3;
   o.partition = "a b";
-  RG_EXPECT_THROW_WITH(SlurmArrayScript(spec, o), std::invalid_argument, "'a b'");
+  RG_EXPECT_THROW_WITH(SlurmArrayScript(ScenarioCampaign(spec), o), std::invalid_argument, "'a b'");
   o.partition = "";
   o.out_dir = (dir_ / "with space").string();
-  RG_EXPECT_THROW_WITH(SlurmArrayScript(spec, o), std::invalid_argument, "without spaces");
+  RG_EXPECT_THROW_WITH(SlurmArrayScript(ScenarioCampaign(spec), o), std::invalid_argument, "without spaces");
 }
 
-TEST_F(Campaign, TheBenchmarkFindsJobsResumeAndShardsIdenticalAndRefusesAFullFolder) {
+TEST_F(Campaigns, TheBenchmarkFindsJobsResumeAndShardsIdenticalAndRefusesAFullFolder) {
   const CampaignSpec spec = LoadCampaignSpec(Spec());
-  const nlohmann::json r = RunCampaignBenchmark(spec, (dir_ / "bench").string(), "test");
+  const nlohmann::json r = RunCampaignBenchmark(ScenarioCampaign(spec), (dir_ / "bench").string(), "test");
   EXPECT_EQ(r["trials"].get<int>(), 6);
   EXPECT_TRUE(r["jobs_identical"].get<bool>());
   EXPECT_TRUE(r["resume_identical"].get<bool>());
   EXPECT_TRUE(r["shards_identical"].get<bool>());
   EXPECT_GT(r["trials_per_s_1worker"].get<double>(), 0.0);
-  RG_EXPECT_THROW_WITH(RunCampaignBenchmark(spec, (dir_ / "bench").string(), "test"), std::invalid_argument,
+  RG_EXPECT_THROW_WITH(RunCampaignBenchmark(ScenarioCampaign(spec), (dir_ / "bench").string(), "test"), std::invalid_argument,
                        "not empty");
 }
 
-TEST_F(Campaign, TheSummaryStatisticsMatchTheClosedFormsOnHandMadeResults) {
+TEST_F(Campaigns, TheSummaryStatisticsMatchTheClosedFormsOnHandMadeResults) {
   // A campaign of three trials written by hand: x = 1, 2, 3 (mean 2, std 1), flag true twice.
   fs::create_directories(dir_ / "hand");
   Write("hand/manifest.json", R"({"campaign": "hand", "spec_hash": "h", "version": "v", "trials_total": 3,

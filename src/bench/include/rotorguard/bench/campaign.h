@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct CampaignSpec {
   int trials() const;
 };
 
+/// Whether `name` may name a campaign (its files and Slurm jobs): letters, digits, '_', '.', '-'.
+bool IsValidCampaignName(const std::string& name);
+
 /// Loads and validates a spec. Throws io::ConfigError naming file, line and key (an unknown key,
 /// an empty sweep, a sweep over a key the scenario does not have, an unknown metric) or
 /// io::InputFileError.
@@ -54,6 +58,41 @@ CampaignSpec LoadCampaignSpec(const std::string& path);
 std::map<std::string, std::string> TrialParameters(const CampaignSpec& spec, int index);
 /// The trial's id: a 64-bit FNV-1a hash of its resolved parameters, in hex.
 std::string TrialId(const std::map<std::string, std::string>& parameters);
+/// 64-bit FNV-1a of `text`, in hex: campaign and trial fingerprints.
+std::string Fingerprint(const std::string& text);
+
+/// What one trial recorded besides its parameters: its metrics (numbers, booleans or null, keyed by
+/// name) and a message (why a flight failed; "" for none).
+struct TrialOutcome {
+  nlohmann::json metrics = nlohmann::json::object();
+  std::string message;
+};
+
+/// What the engine runs: `trials` numbered trials, each a pure function of its index. A scenario
+/// sweep (ScenarioCampaign) is one kind; the benchmarks' trial sets (`bench ftc|nav|mars`,
+/// bench_campaigns.h) are others, and all of them shard, resume, merge and run on Slurm alike.
+struct Campaign {
+  std::string name;  ///< letters, digits, '_', '.', '-': it names files and Slurm jobs
+  std::string file;  ///< the spec file that defines it ("" when built in code: no Slurm script)
+  std::string hash;  ///< the fingerprint of everything the trials depend on: what shards must share
+  std::uint64_t seed = 1;
+  int trials = 0;
+  /// Parameters whose values group the summary's rows (a grid's keys), in order.
+  std::vector<std::string> group_keys;
+  /// The metrics the summary reports, in order (a trial may record more).
+  std::vector<std::string> metrics;
+  /// Trial `index`'s resolved parameters (with "seed"): its identity, recorded with its results.
+  std::function<std::map<std::string, std::string>(int index)> parameters;
+  /// Runs trial `index`; thread-safe. An exception is recorded as the trial's error.
+  std::function<TrialOutcome(int index, const std::map<std::string, std::string>& parameters)> run;
+  /// A benchmark's campaign: {"name": "ftc"|"nav"|"mars", "options": {...}}, recorded in the
+  /// manifests so that a merge also writes the benchmark's own tables. Null for a scenario sweep.
+  nlohmann::json bench;
+};
+
+/// The spec's trials: each one run of the scenario with its parameters set (as `--set` would),
+/// recording the spec's metrics from RunSummary::ToJson.
+Campaign ScenarioCampaign(const CampaignSpec& spec);
 
 /// Which trials a shard runs: shard `index` of `count` takes a contiguous range.
 struct Shard {
@@ -86,7 +125,7 @@ struct CampaignRunSummary {
 /// already running in another process), io::InputFileError or io::CorruptFileError for unreadable
 /// or damaged results, and leaves every existing file as it was; an I/O failure while appending
 /// is rethrown once the trials in flight are done (the manifest stays unfinished: resume later).
-CampaignRunSummary RunCampaign(const CampaignSpec& spec, const CampaignRunOptions& options);
+CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOptions& options);
 
 struct SlurmScriptOptions {
   int shards = 1;              ///< array tasks, one shard each, in [1, trials]
@@ -100,19 +139,34 @@ struct SlurmScriptOptions {
 /// An `sbatch --array` script: task i runs `campaign run SPEC --shard i/N --resume` into the
 /// results folder, so resubmitting the script, or only its failed tasks, is safe. Throws
 /// std::invalid_argument naming a bad option.
-std::string SlurmArrayScript(const CampaignSpec& spec, const SlurmScriptOptions& options);
+std::string SlurmArrayScript(const Campaign& campaign, const SlurmScriptOptions& options);
 
-/// Joins the results of `dirs` (every shard's manifest and results), checks that they form the
-/// whole campaign exactly once, with one spec and one version, and writes summary.json and
-/// summary.md into `out_dir`. Throws io::CorruptFileError or io::ConfigError naming the file.
+/// Every trial record of a whole campaign, in trial order, read from `dirs` (every shard's manifest
+/// and results) once checked to form the campaign exactly once, with one spec and one version;
+/// `manifest` receives the first shard's manifest. Throws io::CorruptFileError, io::InputFileError
+/// or std::invalid_argument naming the file.
+std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& dirs, nlohmann::json* manifest);
+
+/// Joins the results of `dirs` (ReadCampaignRecords) and writes summary.json and summary.md into
+/// `out_dir`; for a benchmark's campaign also the benchmark's result, bench.json and bench.md
+/// (bench_campaigns.h). Returns the summary, with the benchmark's result under "bench" when there
+/// is one.
 nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::string& out_dir);
+
+/// Runs `options.shard` of `campaign` (RunCampaign) and, when that is the whole campaign, returns
+/// every trial's record in trial order; nullopt for one shard of several (merge the folders when all
+/// are done). An empty `options.out_dir` runs in a temporary folder, removed afterwards.
+std::optional<std::vector<nlohmann::json>> RunCampaignRecords(const Campaign& campaign, CampaignRunOptions options);
+/// The whole campaign on `jobs` threads in a temporary folder: every trial's record, in trial order.
+std::vector<nlohmann::json> RunWholeCampaign(const Campaign& campaign, int jobs,
+                                             const std::function<void(int, int)>& progress = {});
 
 /// `rotorguard bench campaign`: runs `spec` in `work_dir` (which it fills) with one worker and
 /// with two, then a kill-and-resume (a run cut after a third of its trials, mid-line, unfinished,
 /// then resumed) and 4 shards, and compares their merged summaries with the uninterrupted one's:
 /// {trials, trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency (the 2-worker rate over
 /// twice the 1-worker rate), resume_identical, shards_identical, jobs_identical}.
-nlohmann::json RunCampaignBenchmark(const CampaignSpec& spec, const std::string& work_dir, const std::string& version);
+nlohmann::json RunCampaignBenchmark(const Campaign& campaign, const std::string& work_dir, const std::string& version);
 
 /// The source revision this program was built from (git's short hash; "unknown" outside a clone).
 std::string GitRevision();

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rotorguard/bench/campaign.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::bench {
@@ -49,9 +50,20 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
 /// The method names RunFtcBenchmark knows.
 std::vector<std::string> FtcMethods();
 
-/// Runs every cell and method; returns {"cells": [...], "options": {...}, "host": {...}} with, per
-/// cell, test, phase, fault, method, trials, fdd_latency_s_mean, fdd_latency_s_max, sucr, mdr,
-/// far and mini_alt_m (DESIGN.md, Metrics).
+/// The benchmark as a campaign (campaign.h), so that it shards, resumes and merges like any other:
+/// trial index = (cell, method, trial), the trial fastest; parameters {test, phase, fault, method,
+/// trial, seed}. Its hash covers the options and the vehicle. Throws std::invalid_argument for bad
+/// options.
+Campaign FtcCampaign(const FtcBenchOptions& options);
+/// RunFtcBenchmark's result from the campaign's records (in trial order) and its options
+/// (`Campaign::bench["options"]`). A trial recorded as error or diverged counts as a failure and in
+/// "errors".
+nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records);
+
+/// Runs every cell and method (FtcCampaign, on `jobs` threads in a temporary folder); returns
+/// {"cells": [...], "options": {...}, "errors": n, "host": {...}} with, per cell, test, phase,
+/// fault, method, trials, fdd_latency_s_mean, fdd_latency_s_max, sucr, mdr, far and mini_alt_m
+/// (DESIGN.md, Metrics).
 nlohmann::json RunFtcBenchmark(const FtcBenchOptions& options);
 
 /// Markdown tables shaped like the paper's Tables III and IV, the paper's figures beside ours.

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rotorguard/bench/campaign.h"
 #include "rotorguard/bench/scenario.h"
 
 namespace rotorguard::bench {
@@ -37,6 +38,16 @@ struct MarsBenchOptions {
   void Validate() const;
 };
 
+/// The benchmark as a campaign (campaign.h): one trial timing the allocation, then Table I's
+/// flights (part table1: case, method, trial), the self-reconfiguration's (part reconfig: trial,
+/// switch) and Table II's (part table2: row, planner, trial; each plan made once per process).
+/// Its hash covers the options and every scene. Throws std::invalid_argument for bad options.
+Campaign MarsCampaign(const MarsBenchOptions& options);
+/// RunMarsBenchmark's result from the campaign's records (in trial order) and its options
+/// (`Campaign::bench["options"]`). A trial recorded as error or diverged counts as a failure.
+nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records);
+
+/// Runs MarsCampaign on `jobs` threads in a temporary folder:
 /// {table1: [{case, faults, hover_attainable, none_error_m, partial_error_m, full_error_m,
 /// ..._success_rate, full_over_fault_free}], table1_full_within_1_5x_fault_free (over the cases
 /// that can hover), alloc_us_mean, alloc_us_p99, reconfig_max_attitude_deg (the largest over the

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rotorguard/bench/campaign.h"
 #include "rotorguard/bench/scenario.h"
 
 namespace rotorguard::bench {
@@ -31,6 +32,15 @@ struct NavBenchOptions {
 /// One trial's scenario: `kind` "forest" or "room", the failure-aware planner or not.
 Scenario MakeNavTrial(const Scenario& base, const std::string& kind, std::uint64_t seed, bool failure_aware);
 
+/// The benchmark as a campaign (campaign.h): trial index = (kind, trial, variant), the variant
+/// fastest; parameters {kind, variant, trial, seed}. Its hash covers the options and the base
+/// scenario. Throws std::invalid_argument for bad options.
+Campaign NavCampaign(const NavBenchOptions& options);
+/// RunNavBenchmark's result from the campaign's records (in trial order) and its options
+/// (`Campaign::bench["options"]`). A trial recorded as error or diverged counts as a failure.
+nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records);
+
+/// Runs NavCampaign on `jobs` threads in a temporary folder:
 /// {"rotorguard": {...}, "failure_unaware": {...}, "groups": {kind: {variant: {...}}}, ...} with
 /// success_rate, collision_rate, tracking_rmse_m, max_spin_rad_s, mission_time_s,
 /// planner_ms_mean, stack_ms_per_cycle_mean, realtime_factor and the first failures' seeds.

@@ -98,6 +98,9 @@ vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Ov
 /// The vehicle in the format LoadVehicle reads, every number in its shortest exact form (the
 /// thrust coefficient, converted to per rpm^2, reads back within one part in 1e15).
 std::string VehicleToYaml(const vehicle::VehicleParams& vehicle);
+/// What a scenario depends on, as text, for fingerprints (campaign hashes): its file's content
+/// (when it came from one) and its vehicle in VehicleToYaml's form.
+std::string ScenarioFingerprint(const Scenario& scenario);
 
 /// What `rotorguard validate` found in a file.
 struct ValidationReport {
