@@ -86,6 +86,36 @@ class CliTest : public rotorguard::testing::TempFolderTest {
   std::string Out() const { return (dir_ / "out").string(); }
 };
 
+/// A benchmark run in two shards and merged prints the same tables as one run of it, and its
+/// campaign flags are checked (docs/campaigns.md, "Benchmarks as campaigns").
+TEST_F(CliTest, ABenchmarkInShardsMergesToTheTablesOfOneRun) {
+  const std::string args = "bench ftc --trials 1 --methods none --seed 3 --jobs 1";
+  const Result whole = Cli(args);
+  ASSERT_EQ(whole.exit_code, 0) << whole.out;
+  const std::string out = (dir_ / "shards").string();
+  for (const char* shard : {"0/2", "1/2"}) {
+    const Result r = Cli(args + " --out " + out + " --shard " + shard);
+    ASSERT_EQ(r.exit_code, 0) << r.out;
+    EXPECT_NE(r.out.find("campaign merge"), std::string::npos) << r.out;  // what to do next
+  }
+  const Result merged = Cli("campaign merge " + out);
+  ASSERT_EQ(merged.exit_code, 0) << merged.out;
+  EXPECT_EQ(ReadText(fs::path(out) / "bench.md"), whole.out);
+  EXPECT_TRUE(fs::exists(fs::path(out) / "bench.json"));
+  // The same trials again into the folder: refused without --resume, nothing to do with it.
+  const std::string before = ReadText(fs::path(out) / "results.shard-0.jsonl");
+  EXPECT_EQ(Cli(args + " --out " + out + " --shard 0/2").exit_code, 2);
+  const Result resumed = Cli(args + " --out " + out + " --shard 0/2 --resume");
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.out;
+  EXPECT_EQ(ReadText(fs::path(out) / "results.shard-0.jsonl"), before);
+  // Shards and resumes need a folder to keep the trials in.
+  const Result no_out = Cli(args + " --shard 0/2");
+  EXPECT_EQ(no_out.exit_code, 2);
+  EXPECT_NE(no_out.out.find("--shard needs --out"), std::string::npos) << no_out.out;
+  EXPECT_EQ(Cli(args + " --resume").exit_code, 2);
+  EXPECT_EQ(Cli(args + " --out " + out + " --shard 2/2").exit_code, 2);
+}
+
 /// A campaign killed without warning mid-run and resumed merges to the same bytes as one that ran
 /// through (docs/campaigns.md).
 TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
