@@ -70,6 +70,15 @@ Campaign LoadCampaign(const std::string& path) {
   const auto file = [&](const char* key) {  // a path relative to the spec's folder
     return (fs::path(path).parent_path() / root.Required(key).AsString()).lexically_normal().string();
   };
+  // A file that cannot be read is reported at the key that names it.
+  const auto load = [&](const char* key, auto loader) {
+    try {
+      return loader(file(key));
+    } catch (const io::InputFileError& e) {
+      root.FailAt(key, e.what());
+    }
+  };
+  const auto scenario = [&](const char* key) { return load(key, [](const std::string& p) { return LoadScenario(p); }); };
   const std::uint64_t seed = root.Has("seed") ? root.Required("seed").AsUint64() : 1;
   Campaign c;
   if (bench == "ftc") {
@@ -77,25 +86,30 @@ Campaign LoadCampaign(const std::string& path) {
     o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, 1'000'000));
     o.seed = seed;
     if (root.Has("methods")) o.methods = WordList(root.Required("methods"), FtcMethods());
-    o.vehicle = LoadVehicle(file("vehicle"));
+    o.vehicle = load("vehicle", [](const std::string& p) { return LoadVehicle(p); });
     c = Checked(root, [&] { return FtcCampaign(o); });
   } else if (bench == "nav") {
     NavBenchOptions o;
     o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, 100'000));
     o.seed = seed;
     if (root.Has("kinds")) o.kinds = WordList(root.Required("kinds"), {"forest", "room"});
-    o.base = LoadScenario(file("base"));
+    o.base = scenario("base");
     c = Checked(root, [&] { return NavCampaign(o); });
   } else {
     MarsBenchOptions o;
     o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, 10'000));
     o.seed = seed;
     if (root.Has("alloc_samples")) o.alloc_samples = static_cast<int>(root.Required("alloc_samples").AsIntIn(100, 10'000'000));
-    o.spiral = LoadScenario(file("spiral"));
-    o.nine_units = LoadAssembly(file("nine_units"));
-    if (root.Has("reconfigure")) o.reconfigure = LoadScenario(file("reconfigure"));
-    if (root.Has("plan_4x1")) o.plan_4x1 = LoadScenario(file("plan_4x1"));
-    if (root.Has("plan_3x2")) o.plan_3x2 = LoadScenario(file("plan_3x2"));
+    o.spiral = scenario("spiral");
+    o.nine_units = load("nine_units", [](const std::string& p) { return LoadAssembly(p); });
+    if (root.Has("reconfigure")) o.reconfigure = scenario("reconfigure");
+    if (root.Has("plan_4x1") != root.Has("plan_3x2")) {
+      root.Fail("expected both plan_4x1 and plan_3x2 (Table II's two scenes) or neither");
+    }
+    if (root.Has("plan_4x1")) {
+      o.plan_4x1 = scenario("plan_4x1");
+      o.plan_3x2 = scenario("plan_3x2");
+    }
     c = Checked(root, [&] { return MarsCampaign(o); });
   }
   root.RejectUnknownKeys();

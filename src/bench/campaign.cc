@@ -579,7 +579,12 @@ nlohmann::json MetricStats(const std::vector<const nlohmann::json*>& trials, con
   int trues = 0, bools = 0;
   for (const nlohmann::json* t : trials) {
     if ((*t)["status"] != "ok") continue;
-    const nlohmann::json& v = (*t)["metrics"][metric];
+    // A trial may lack a metric (a benchmark's parts record different ones): find, never operator[]
+    // on a const object, which does not check.
+    const nlohmann::json& m = (*t)["metrics"];
+    const auto it = m.find(metric);
+    if (it == m.end()) continue;
+    const nlohmann::json& v = *it;
     if (v.is_boolean()) {
       ++bools;
       trues += v.get<bool>();
@@ -800,8 +805,16 @@ std::optional<std::vector<nlohmann::json>> RunCampaignRecords(const Campaign& ca
       cleanup();
       return std::nullopt;
     }
-    nlohmann::json manifest;
-    std::vector<nlohmann::json> records = ReadCampaignRecords({options.out_dir}, &manifest);
+    // This run's results only: the folder may also hold another sharding's files.
+    Recorded recorded = ReadResults(run.results_file);
+    if (recorded.cut || static_cast<int>(recorded.trials.size()) != campaign.trials) {
+      throw io::CorruptFileError(run.results_file, recorded.whole_size,
+                                 fmt::format("{} of {} trials recorded after the run", recorded.trials.size(),
+                                             campaign.trials));
+    }
+    std::vector<nlohmann::json> records;
+    records.reserve(recorded.trials.size());
+    for (auto& [index, line] : recorded.trials) records.push_back(std::move(line));
     cleanup();
     return records;
   } catch (...) {

@@ -133,6 +133,7 @@ struct PlanCache {
   std::array<std::once_flag, 10> once;
   std::array<Scenario, 10> scenes;  ///< the row's scenario flying the plan
   std::array<AssemblyPlanResult, 10> plans;
+  std::array<PlanDemands, 10> demands;  ///< what each plan asks of the assembly
 };
 
 /// The records of `part`, in trial order.
@@ -270,7 +271,10 @@ Campaign MarsCampaign(const MarsBenchOptions& o) {
         Scenario s = WithFaults(*row.scene, fault, modular::Reallocation::kFull, o.seed);
         s.assembly_plan->method = kPlanners[slot % 2];
         cache->plans[slot] = PlanAssemblyMission(s);  // never throws: a failure is the row's
-        if (cache->plans[slot].ok) s.reference = cache->plans[slot].trajectory;
+        if (cache->plans[slot].ok) {
+          s.reference = cache->plans[slot].trajectory;
+          cache->demands[slot] = DemandsOf(*cache->plans[slot].trajectory);
+        }
         cache->scenes[slot] = std::move(s);
       });
       const AssemblyPlanResult& plan = cache->plans[slot];
@@ -280,7 +284,7 @@ Campaign MarsCampaign(const MarsBenchOptions& o) {
         return out;
       }
       // What the plan asks of the assembly, beside what it can give (the mechanism of the rows).
-      const PlanDemands demands = DemandsOf(*plan.trajectory);
+      const PlanDemands& demands = cache->demands[slot];
       out.metrics["duration_s"] = plan.trajectory_summary.duration_s;
       out.metrics["attitude_deviation_deg"] = plan.trajectory_summary.attitude_deviation_rad * 180.0 / std::numbers::pi;
       out.metrics["plan_ms"] = plan.astar_ms + plan.trajectory_summary.solve_ms;
@@ -317,8 +321,15 @@ nlohmann::json TableOne(const std::vector<const nlohmann::json*>& records, int t
   double fault_free = 0.0;
   *within = true;
   for (std::size_t row = 0; row < cases.size(); ++row) {
-    const nlohmann::json& first = *records[row * static_cast<std::size_t>(methods * trials)];
-    const bool can_hover = first["metrics"].is_object() && first["metrics"].value("hover_attainable", false);
+    // Every trial of the row records the allocator's verdict; one that threw records nothing.
+    bool can_hover = false;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(methods * trials); ++k) {
+      const nlohmann::json& m = (*records[row * static_cast<std::size_t>(methods * trials) + k])["metrics"];
+      if (m.is_object() && m.contains("hover_attainable")) {
+        can_hover = m["hover_attainable"].get<bool>();
+        break;
+      }
+    }
     nlohmann::json r = {{"case", cases[row].name}, {"hover_attainable", can_hover}};
     nlohmann::json faults = nlohmann::json::array();
     for (const auto& [rotor, loss] : cases[row].rotors) faults.push_back({{"rotor", rotor}, {"loss", loss}});
@@ -351,6 +362,9 @@ nlohmann::json TableOne(const std::vector<const nlohmann::json*>& records, int t
 /// The self-reconfiguration from its records: (trial, switch), the switch fastest; the largest
 /// figures over the trials.
 nlohmann::json Reconfiguration(const std::vector<const nlohmann::json*>& records, int trials) {
+  if (records.size() != static_cast<std::size_t>(2 * trials)) {
+    throw std::invalid_argument(fmt::format("mars: {} reconfiguration records for {} trials x 2", records.size(), trials));
+  }
   nlohmann::json variants;
   for (int v = 0; v < 2; ++v) {
     nlohmann::json x = {{"success_rate", 0.0}, {"first_failure", ""}};
@@ -378,7 +392,11 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
   double sum[2] = {0.0, 0.0}, improvement_sum = 0.0;
   int compared = 0;
   bool all_better = true;
-  const std::size_t rows = records.size() / static_cast<std::size_t>(2 * trials);
+  if (records.size() != static_cast<std::size_t>(10 * trials)) {
+    throw std::invalid_argument(fmt::format("mars: {} Table II records for 5 rows x 2 planners x {} trials",
+                                            records.size(), trials));
+  }
+  const std::size_t rows = 5;
   for (std::size_t row = 0; row < rows; ++row) {
     const nlohmann::json& head = *records[row * static_cast<std::size_t>(2 * trials)];
     nlohmann::json r = {{"shape", head["params"]["shape"]}, {"fault", head["params"]["fault"]}};
@@ -397,7 +415,8 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
       const bool planned = plan != nullptr && (*plan)["metrics"]["planned"].get<bool>();
       r[name + "_planned"] = planned;
       if (!planned) {
-        r[name + "_plan_failure"] = plan != nullptr ? (*plan)["message"].get<std::string>() : FailureOf(at(0));
+        r[name + "_plan_failure"] = plan != nullptr ? (*plan)["message"].get<std::string>()
+                                                    : "every flight failed; the first: " + FailureOf(at(0));
         both_planned = false;
         continue;
       }
@@ -477,8 +496,9 @@ nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohm
                            {"table1", table1},
                            {"table1_full_within_1_5x_fault_free", within},
                            {"alloc_units", options.at("alloc_units")},
-                           {"alloc_us_mean", MetricOr(*alloc[0], "alloc_us_mean", 0.0)},
-                           {"alloc_us_p99", MetricOr(*alloc[0], "alloc_us_p99", 0.0)},
+                           // Null when the timing trial failed (never a figure that passes the target).
+                           {"alloc_us_mean", (*alloc[0])["status"] == "ok" ? (*alloc[0])["metrics"]["alloc_us_mean"] : nlohmann::json()},
+                           {"alloc_us_p99", (*alloc[0])["status"] == "ok" ? (*alloc[0])["metrics"]["alloc_us_p99"] : nlohmann::json()},
                            {"reconfig", reconfig},
                            {"reconfig_max_attitude_deg", worst("prepared")},
                            {"reconfig_max_attitude_deg_naive", worst("naive")},
@@ -510,8 +530,10 @@ std::string MarsMarkdown(const nlohmann::json& r) {
                      row["hover_attainable"].get<bool>() ? "" : " (cannot hover: beyond the rotors' reach)",
                      cell("none"), cell("partial"), cell("full"), row["full_over_fault_free"].get<double>());
   }
-  s += fmt::format("\nallocation ({} units, full reallocation with a dead unit): {:.1f} us mean, {:.1f} us p99\n",
-                   r["alloc_units"].get<int>(), r["alloc_us_mean"].get<double>(), r["alloc_us_p99"].get<double>());
+  s += r["alloc_us_mean"].is_null()
+           ? std::string("\nallocation: the timing trial failed (see the campaign's errors)\n")
+           : fmt::format("\nallocation ({} units, full reallocation with a dead unit): {:.1f} us mean, {:.1f} us p99\n",
+                         r["alloc_units"].get<int>(), r["alloc_us_mean"].get<double>(), r["alloc_us_p99"].get<double>());
   if (!r["reconfig"].is_null()) {
     s += "\nSelf-reconfiguration (largest over the trials)\n\n| switch | success | steady hover | separation | docking | "
          "unit's tilt |\n|---|---|---|---|---|---|\n";

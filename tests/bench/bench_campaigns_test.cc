@@ -58,6 +58,10 @@ TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSa
   }
   const nlohmann::json merged = MergeCampaign({(dir_ / "a").string(), (dir_ / "b").string()}, (dir_ / "m").string());
   ASSERT_TRUE(merged.contains("bench"));
+  // The generic summary counts only the trials that record a metric: `none` runs no FDD.
+  for (const auto& g : merged["by_grid_point"]) {
+    EXPECT_EQ(g["metrics"]["correct"]["n"], g["grid"]["method"] == "none" ? 0 : 1) << g.dump();
+  }
   EXPECT_EQ(merged["bench"]["cells"], direct["cells"]);
   EXPECT_EQ(io::ReadFile((dir_ / "m" / "bench.md").string()), FtcMarkdown(direct));
   // The benchmark's own figures: the project's method isolates every fault and flies every cell.
@@ -147,6 +151,15 @@ TEST_F(BenchCampaigns, BadBenchmarkSpecsNameTheKey) {
   RG_EXPECT_THROW_WITH(LoadCampaign(Write("e.yaml", "name: e\nbench: ftc\ntrials: 1\n")), io::ConfigError, "vehicle");
   RG_EXPECT_THROW_WITH(LoadCampaign(Write("f.yaml", "name: a b\nbench: ftc\ntrials: 1\n" + vehicle)), io::ConfigError,
                        "name");
+  // A file that cannot be read is reported at the key that names it.
+  RG_EXPECT_THROW_WITH(LoadCampaign(Write("g.yaml", "name: g\nbench: nav\ntrials: 1\nbase: no_such.yaml\n")),
+                       io::ConfigError, "base");
+  // Table II needs both of its scenes.
+  RG_EXPECT_THROW_WITH(LoadCampaign(Write("h.yaml", "name: h\nbench: mars\ntrials: 1\nspiral: " + kConfigs +
+                                                        "/scenarios/mars_spiral_3x2.yaml\nnine_units: " + kConfigs +
+                                                        "/assemblies/3x3.yaml\nplan_4x1: " + kConfigs +
+                                                        "/scenarios/mars_plan_4x1.yaml\n")),
+                       io::ConfigError, "plan_3x2");
   // A spec without a file cannot make a Slurm script.
   SlurmScriptOptions s;
   s.out_dir = dir_.string();

@@ -102,6 +102,10 @@ TEST_F(CliTest, ABenchmarkInShardsMergesToTheTablesOfOneRun) {
   ASSERT_EQ(merged.exit_code, 0) << merged.out;
   EXPECT_EQ(ReadText(fs::path(out) / "bench.md"), whole.out);
   EXPECT_TRUE(fs::exists(fs::path(out) / "bench.json"));
+  // A whole run into the same folder keeps its own files and reads only them.
+  const Result again = Cli(args + " --out " + out);
+  EXPECT_EQ(again.exit_code, 0) << again.out;
+  EXPECT_EQ(again.out, whole.out);
   // The same trials again into the folder: refused without --resume, nothing to do with it.
   const std::string before = ReadText(fs::path(out) / "results.shard-0.jsonl");
   EXPECT_EQ(Cli(args + " --out " + out + " --shard 0/2").exit_code, 2);

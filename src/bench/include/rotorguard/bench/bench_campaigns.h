@@ -7,13 +7,14 @@
 ///
 ///     name: bench_ftc_100
 ///     bench: ftc                     # ftc, nav or mars
-///     trials: 100                    # per cell (ftc), per world kind (nav), per row (mars)
+///     trials: 100                    # per cell (ftc), world kind (nav), row and method (mars)
 ///     seed: 1
 ///     vehicle: ../vehicles/zhou2025_quad.yaml   # ftc; and methods: [rotorguard, ...]
 ///
 /// nav takes `base` (the navigate scenario every trial flies) and `kinds`; mars takes `spiral`,
-/// `nine_units`, `alloc_samples` and, optionally, `reconfigure`, `plan_4x1` and `plan_3x2`. Paths
-/// are relative to the spec's folder.
+/// `nine_units`, `alloc_samples` and, optionally, `reconfigure` and (both or neither) `plan_4x1` and
+/// `plan_3x2`. Paths are relative to the spec's folder; a file that cannot be read is an error at
+/// its key.
 #include <string>
 #include <vector>
 

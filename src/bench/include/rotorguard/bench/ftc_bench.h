@@ -16,13 +16,17 @@
 
 namespace rotorguard::bench {
 
+/// The method names RunFtcBenchmark knows.
+std::vector<std::string> FtcMethods();
+
 struct FtcBenchOptions {
   int trials = 20;                 ///< per cell (the paper's count), >= 1
   std::uint64_t seed = 1;
   /// Methods by name: rotorguard (composite FDD + NMPC), fixedtime (FixedA: fixed-time observer
-  /// + the same NMPC), indi (composite FDD + incremental nonlinear dynamic inversion), passive
-  /// (UnifP: reduced-attitude control with yaw free, no FDD), none (nominal controller, no FDD).
-  std::vector<std::string> methods = {"rotorguard", "fixedtime", "indi", "passive", "none"};
+  /// + the same NMPC), ukf (paper 004's UKF loss estimation + the same NMPC), indi (composite FDD
+  /// + incremental nonlinear dynamic inversion), passive (UnifP: reduced-attitude control with yaw
+  /// free, no FDD), none (nominal controller, no FDD). All of them by default.
+  std::vector<std::string> methods = FtcMethods();
   int jobs = 1;                    ///< worker threads, >= 1
   vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
   /// Called after each finished trial with (done, total).
@@ -46,9 +50,6 @@ struct FtcTrial {
 /// cells: no correct isolation within 1 s), far, mini_alt_m (least altitude after the fault), and
 /// the first failures. Null where a metric does not apply (no FDD; MDR of fault-free cells).
 nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty);
-
-/// The method names RunFtcBenchmark knows.
-std::vector<std::string> FtcMethods();
 
 /// The benchmark as a campaign (campaign.h), so that it shards, resumes and merges like any other:
 /// trial index = (cell, method, trial), the trial fastest; parameters {test, phase, fault, method,
