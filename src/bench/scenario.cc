@@ -542,6 +542,10 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o, modular::A
     ReadOptional(*n, "post_failure_safety_factor", &nav.post_failure_safety_factor);
     ReadOptional(*n, "replan_period_s", &r.replan_period_s);
     ReadOptional(*n, "clearance_m", &r.planner.optimizer.clearance_m);
+    if (const auto c = n->Optional("post_failure_clearance_m")) r.post_failure_clearance_m = c->AsNonNegative();
+    // A guide sample looks for its obstacle plane at least as far as the clearance it keeps.
+    r.planner.plane_search_m =
+        std::max({r.planner.plane_search_m, r.planner.optimizer.clearance_m, r.post_failure_clearance_m.value_or(0.0)});
     if (const auto aware = n->Optional("failure_aware")) nav.failure_aware = aware->AsBool();
     if (const auto band = n->Optional("altitude_band_m")) {
       const std::vector<double> b = band->AsDoubleList(2);

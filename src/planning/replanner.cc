@@ -30,6 +30,11 @@ void ReplannerOptions::Validate() const {
   require(std::isfinite(check_step_m) && check_step_m > 0.0, "check_step_m", check_step_m, "a step > 0 m");
   require(std::isfinite(local_goal_margin_m) && local_goal_margin_m >= 0.0, "local_goal_margin_m", local_goal_margin_m,
           "a distance >= 0 m");
+  if (post_failure_clearance_m) {
+    require(std::isfinite(*post_failure_clearance_m) && *post_failure_clearance_m >= 0.0 &&
+                *post_failure_clearance_m <= planner.plane_search_m,
+            "post_failure_clearance_m", *post_failure_clearance_m, "a distance in [0, planner.plane_search_m] m");
+  }
 }
 
 std::optional<Vector3> LocalGoal(const perception::VoxelMap& map, const Vector3& start, const Vector3& goal,
@@ -76,8 +81,14 @@ void Replanner::SetGoal(const Vector3& goal_W) {
 }
 
 void Replanner::OnFailure() {
-  if (limits_.a_max == options_.post_failure_a_max) return;  // already
+  if (failed_) return;  // already
+  failed_ = true;
   limits_.a_max = std::min(limits_.a_max, options_.post_failure_a_max);
+  if (options_.post_failure_clearance_m) {
+    PlannerOptions o = options_.planner;
+    o.optimizer.clearance_m = *options_.post_failure_clearance_m;
+    planner_ = Planner(o);
+  }
   failure_pending_ = true;
 }
 
