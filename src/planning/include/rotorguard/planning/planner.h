@@ -19,7 +19,7 @@ struct PlannerOptions {
   TrajectoryOptimizerOptions optimizer;
   double max_piece_length_m = 2.0;  ///< the path is cut into pieces at most this long [m], > 0
   double plane_search_m = 0.5;      ///< a sample gets the plane of an obstacle within this [m], >= clearance
-  int clearance_rounds = 4;         ///< re-optimisations with planes added where the result collides, >= 0
+  int clearance_rounds = 8;         ///< re-optimisations with planes added where the result collides, >= 0
   double check_step_m = 0.05;       ///< spacing of the collision check along the result [m], > 0
   void Validate() const;
 };
