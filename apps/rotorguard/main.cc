@@ -459,10 +459,7 @@ int main(int argc, char** argv) {
     }
     const rotorguard::bench::BenchReport r = rotorguard::bench::BenchResult(c.bench, *records);
     write_bench_html(name, r.result);
-    if (!bench_out.empty()) {
-      rotorguard::io::WriteFileAtomically((fs::path(bench_out) / "bench.json").string(), r.result.dump(2) + "\n");
-      rotorguard::io::WriteFileAtomically((fs::path(bench_out) / "bench.md").string(), r.markdown);
-    }
+    if (!bench_out.empty()) rotorguard::bench::WriteBenchFiles(r, bench_out);
     fmt::print("{}", as_json ? r.result.dump(2) + "\n" : r.markdown);
     return r.result;
   };
@@ -659,19 +656,10 @@ int main(int argc, char** argv) {
       const std::string spec_path =
           bcamp_spec.empty() ? (configs / "campaigns" / "bench_campaign.yaml").string() : bcamp_spec;
       const rotorguard::bench::Campaign spec = rotorguard::bench::LoadCampaign(spec_path);
-      const bool temporary = bcamp_dir.empty();
-      const std::string work = temporary ? (fs::temp_directory_path() / fmt::format("rotorguard-bench-campaign-{}",
-                                                                                     ::getpid())).string()
-                                         : bcamp_dir;
-      nlohmann::json r;
-      try {
-        r = rotorguard::bench::RunCampaignBenchmark(
-            spec, work, ProgramVersion());
-      } catch (...) {
-        if (temporary) fs::remove_all(work);
-        throw;
-      }
-      if (temporary) fs::remove_all(work);
+      std::optional<rotorguard::io::TemporaryFolder> temporary;  // removed after, also on an error
+      if (bcamp_dir.empty()) temporary.emplace("rotorguard-bench-campaign");
+      const nlohmann::json r =
+          rotorguard::bench::RunCampaignBenchmark(spec, temporary ? temporary->path() : bcamp_dir, ProgramVersion());
       write_bench_html("campaign", r);
       if (bcamp_json) {
         fmt::print("{}\n", r.dump(2));

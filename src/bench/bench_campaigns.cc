@@ -10,6 +10,7 @@
 #include "rotorguard/bench/nav_bench.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/files.h"
 
 namespace rotorguard::bench {
 
@@ -32,6 +33,11 @@ BenchReport BenchResult(const nlohmann::json& bench, const std::vector<nlohmann:
     throw std::invalid_argument(fmt::format("benchmark '{}' is unknown; expected ftc, nav or mars", name));
   }
   return r;
+}
+
+void WriteBenchFiles(const BenchReport& report, const std::string& dir) {
+  io::WriteFileAtomically((fs::path(dir) / "bench.json").string(), report.result.dump(2) + "\n");
+  io::WriteFileAtomically((fs::path(dir) / "bench.md").string(), report.markdown);
 }
 
 namespace {

@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -334,6 +333,11 @@ std::string TrialId(const std::map<std::string, std::string>& parameters) {
 }
 
 std::string Fingerprint(const std::string& text) { return Hex(Fnv1a(text)); }
+
+std::string TrialFailure(const nlohmann::json& record) {
+  const std::string message = record.value("message", "");
+  return record.value("status", "") == "ok" ? message : record.value("status", "") + ": " + message;
+}
 
 Campaign ScenarioCampaign(const CampaignSpec& spec) {
   Campaign c;
@@ -781,46 +785,32 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
   io::WriteFileAtomically((fs::path(out_dir) / "summary.md").string(), md);
   if (head.contains("bench")) {  // a benchmark's campaign: its own tables too
     const BenchReport report = BenchResult(head["bench"], records);
-    io::WriteFileAtomically((fs::path(out_dir) / "bench.json").string(), report.result.dump(2) + "\n");
-    io::WriteFileAtomically((fs::path(out_dir) / "bench.md").string(), report.markdown);
+    WriteBenchFiles(report, out_dir);
     summary["bench"] = report.result;
   }
   return summary;
 }
 
 std::optional<std::vector<nlohmann::json>> RunCampaignRecords(const Campaign& campaign, CampaignRunOptions options) {
-  const bool temporary = options.out_dir.empty();
-  if (temporary) {
-    static std::atomic<int> runs{0};  // one folder per call, also for calls side by side
-    options.out_dir =
-        (fs::temp_directory_path() / fmt::format("rotorguard-{}-{}-{}", campaign.name, ::getpid(), runs++)).string();
+  std::optional<io::TemporaryFolder> temporary;  // removed on return and on an exception
+  if (options.out_dir.empty()) {
+    temporary.emplace("rotorguard-" + campaign.name);
+    options.out_dir = temporary->path();
     options.resume = false;
   }
-  const auto cleanup = [&] {
-    if (temporary) fs::remove_all(options.out_dir);
-  };
-  try {
-    const CampaignRunSummary run = RunCampaign(campaign, options);
-    if (options.shard.count > 1) {
-      cleanup();
-      return std::nullopt;
-    }
-    // This run's results only: the folder may also hold another sharding's files.
-    Recorded recorded = ReadResults(run.results_file);
-    if (recorded.cut || static_cast<int>(recorded.trials.size()) != campaign.trials) {
-      throw io::CorruptFileError(run.results_file, recorded.whole_size,
-                                 fmt::format("{} of {} trials recorded after the run", recorded.trials.size(),
-                                             campaign.trials));
-    }
-    std::vector<nlohmann::json> records;
-    records.reserve(recorded.trials.size());
-    for (auto& [index, line] : recorded.trials) records.push_back(std::move(line));
-    cleanup();
-    return records;
-  } catch (...) {
-    cleanup();
-    throw;
+  const CampaignRunSummary run = RunCampaign(campaign, options);
+  if (options.shard.count > 1) return std::nullopt;
+  // This run's results only: the folder may also hold another sharding's files.
+  Recorded recorded = ReadResults(run.results_file);
+  if (recorded.cut || static_cast<int>(recorded.trials.size()) != campaign.trials) {
+    throw io::CorruptFileError(run.results_file, recorded.whole_size,
+                               fmt::format("{} of {} trials recorded after the run", recorded.trials.size(),
+                                           campaign.trials));
   }
+  std::vector<nlohmann::json> records;
+  records.reserve(recorded.trials.size());
+  for (auto& [index, line] : recorded.trials) records.push_back(std::move(line));
+  return records;
 }
 
 std::vector<nlohmann::json> RunWholeCampaign(const Campaign& campaign, int jobs,

@@ -222,15 +222,14 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         const nlohmann::json& r = records[static_cast<std::size_t>((c * m_count + m) * trials + t)];
         FtcTrial trial;
         trial.seed = std::stoull(r["params"]["seed"].get<std::string>());
+        trial.failure = TrialFailure(r);
         if (r["status"] != "ok") {  // an error or a non-finite metric: the trial failed
-          trial.failure = r["status"].get<std::string>() + ": " + r["message"].get<std::string>();
           ++errors;
           cell_trials.push_back(trial);
           continue;
         }
         const nlohmann::json& x = r["metrics"];
         trial.success = x["success"].get<bool>();
-        trial.failure = r["message"].get<std::string>();
         trial.min_altitude_m = x["min_altitude_m"].get<double>();
         if (x.contains("correct")) {
           trial.has_fdd = true;

@@ -120,20 +120,22 @@ struct PlanRow {
   std::string fault;
   int dead_unit;  ///< paper's No.; 0: none
 };
-std::vector<PlanRow> TableTwoRows(const MarsBenchOptions& o) {
-  return {{&o.plan_4x1, "normal", 0}, {&o.plan_4x1, "No. 3", 3}, {&o.plan_4x1, "No. 4", 4},
-          {&o.plan_3x2, "normal", 0}, {&o.plan_3x2, "No. 2", 2}};
+constexpr int kTableTwoRows = 5;
+std::array<PlanRow, kTableTwoRows> TableTwoRows(const MarsBenchOptions& o) {
+  return {{{&o.plan_4x1, "normal", 0}, {&o.plan_4x1, "No. 3", 3}, {&o.plan_4x1, "No. 4", 4},
+           {&o.plan_3x2, "normal", 0}, {&o.plan_3x2, "No. 2", 2}}};
 }
 constexpr const char* kPlanners[2] = {"baseline", "ours"};
+constexpr int kPlanSlots = 2 * kTableTwoRows;  ///< a plan per row and planner
 constexpr const char* kSwitches[2] = {"prepared", "naive"};
 
 /// Table II's plans, made once per process on first use (planning is deterministic) and shared by
 /// the flights that fly them: slot = row * 2 + planner.
 struct PlanCache {
-  std::array<std::once_flag, 10> once;
-  std::array<Scenario, 10> scenes;  ///< the row's scenario flying the plan
-  std::array<AssemblyPlanResult, 10> plans;
-  std::array<PlanDemands, 10> demands;  ///< what each plan asks of the assembly
+  std::array<std::once_flag, kPlanSlots> once;
+  std::array<Scenario, kPlanSlots> scenes;  ///< the row's scenario flying the plan
+  std::array<AssemblyPlanResult, kPlanSlots> plans;
+  std::array<PlanDemands, kPlanSlots> demands;  ///< what each plan asks of the assembly
 };
 
 /// The records of `part`, in trial order.
@@ -152,10 +154,6 @@ double MetricOr(const nlohmann::json& record, const char* key, double fallback) 
 }
 bool Succeeded(const nlohmann::json& record) {
   return record["status"] == "ok" && record["metrics"].value("success", false);
-}
-std::string FailureOf(const nlohmann::json& record) {
-  return record["status"] == "ok" ? record["message"].get<std::string>()
-                                  : record["status"].get<std::string>() + ": " + record["message"].get<std::string>();
 }
 
 }  // namespace
@@ -183,7 +181,7 @@ Campaign MarsCampaign(const MarsBenchOptions& o) {
   // self-reconfiguration (trial, switch) and Table II (row, planner, trial).
   const int n1 = static_cast<int>(cases.size() * kMethods.size()) * o.trials;
   const int n2 = reconfig ? 2 * o.trials : 0;
-  const int n3 = table2 ? 10 * o.trials : 0;
+  const int n3 = table2 ? kPlanSlots * o.trials : 0;
   Campaign c;
   c.name = "bench_mars";
   c.seed = o.seed;
@@ -378,7 +376,7 @@ nlohmann::json Reconfiguration(const std::vector<const nlohmann::json*>& records
     for (int t = 0; t < trials; ++t) {
       const nlohmann::json& r = *records[static_cast<std::size_t>(2 * t + v)];
       success += Succeeded(r);
-      if (!Succeeded(r) && x["first_failure"] == "") x["first_failure"] = FailureOf(r);
+      if (!Succeeded(r) && x["first_failure"] == "") x["first_failure"] = TrialFailure(r);
     }
     x["success_rate"] = static_cast<double>(success) / trials;
     variants[kSwitches[v]] = x;
@@ -392,11 +390,11 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
   double sum[2] = {0.0, 0.0}, improvement_sum = 0.0;
   int compared = 0;
   bool all_better = true;
-  if (records.size() != static_cast<std::size_t>(10 * trials)) {
-    throw std::invalid_argument(fmt::format("mars: {} Table II records for 5 rows x 2 planners x {} trials",
-                                            records.size(), trials));
+  if (records.size() != static_cast<std::size_t>(kPlanSlots * trials)) {
+    throw std::invalid_argument(fmt::format("mars: {} Table II records for {} rows x 2 planners x {} trials",
+                                            records.size(), kTableTwoRows, trials));
   }
-  const std::size_t rows = 5;
+  const std::size_t rows = kTableTwoRows;
   for (std::size_t row = 0; row < rows; ++row) {
     const nlohmann::json& head = *records[row * static_cast<std::size_t>(2 * trials)];
     nlohmann::json r = {{"shape", head["params"]["shape"]}, {"fault", head["params"]["fault"]}};
@@ -416,7 +414,7 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
       r[name + "_planned"] = planned;
       if (!planned) {
         r[name + "_plan_failure"] = plan != nullptr ? (*plan)["message"].get<std::string>()
-                                                    : "every flight failed; the first: " + FailureOf(at(0));
+                                                    : "every flight failed; the first: " + TrialFailure(at(0));
         both_planned = false;
         continue;
       }
@@ -427,7 +425,7 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
         error[m] += MetricOr(at(t), "rmse_m", 0.0) / trials;
         max_error = std::max(max_error, MetricOr(at(t), "max_error_m", 0.0));
         success += Succeeded(at(t));
-        if (!Succeeded(at(t)) && failure.empty()) failure = FailureOf(at(t));
+        if (!Succeeded(at(t)) && failure.empty()) failure = TrialFailure(at(t));
       }
       r[name + "_error_m"] = error[m];
       r[name + "_max_error_m"] = max_error;
@@ -483,7 +481,7 @@ nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohm
     failures.push_back({{"case", (*f)["params"]["case"]},
                         {"method", (*f)["params"]["method"]},
                         {"seed", std::stoull((*f)["params"]["seed"].get<std::string>())},
-                        {"reason", FailureOf(*f)}});
+                        {"reason", TrialFailure(*f)}});
   }
   const auto worst = [&](const char* variant) {
     return reconfig.is_null() ? nlohmann::json(nullptr)

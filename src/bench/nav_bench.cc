@@ -178,9 +178,8 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
   std::vector<NavTrial> results;
   for (const nlohmann::json& r : records) {
     NavTrial t;
-    if (r["status"] != "ok") {
-      t.failure = r["status"].get<std::string>() + ": " + r["message"].get<std::string>();
-    } else {
+    t.failure = TrialFailure(r);
+    if (r["status"] == "ok") {
       const nlohmann::json& x = r["metrics"];
       t.success = x["success"].get<bool>();
       t.crashed = x["crashed"].get<bool>();
@@ -191,7 +190,6 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
       t.planner_ms_mean = x["planner_ms_mean"].get<double>();
       t.stack_ms_per_cycle_mean = x["stack_ms_per_cycle_mean"].get<double>();
       t.realtime_factor = x["realtime_factor"].get<double>();
-      t.failure = r["message"].get<std::string>();
     }
     results.push_back(t);
   }

@@ -2,6 +2,8 @@
 // independent truth (published check values, RFC test vectors, the MCAP specification's layout)
 // and against damaged input, which must be rejected at the right byte.
 #include <cstring>
+#include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -9,6 +11,7 @@
 
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/csv.h"
+#include "rotorguard/io/files.h"
 #include "rotorguard/io/mcap.h"
 #include "test_util.h"
 
@@ -24,6 +27,33 @@ CorruptFileError CatchCorrupt(F&& fn) {
   }
   ADD_FAILURE() << "expected a CorruptFileError";
   return CorruptFileError("", 0, "");
+}
+
+// Temporary folders: new and empty, distinct side by side, removed with their content when they
+// go, also when an exception unwinds past them.
+TEST(TemporaryFolder, IsNewDistinctAndRemovedWithItsContentEvenOnAnException) {
+  namespace fs = std::filesystem;
+  std::string a_path, b_path;
+  {
+    const TemporaryFolder a("rg-test"), b("rg-test");
+    a_path = a.path();
+    b_path = b.path();
+    EXPECT_NE(a_path, b_path);
+    EXPECT_TRUE(fs::is_directory(a_path) && fs::is_empty(a_path));
+    fs::create_directories(fs::path(a_path) / "sub");
+    WriteFileAtomically((fs::path(a_path) / "sub" / "f.txt").string(), "x");
+  }
+  EXPECT_FALSE(fs::exists(a_path));
+  EXPECT_FALSE(fs::exists(b_path));
+  std::string c_path;
+  try {
+    const TemporaryFolder c("rg-test");
+    c_path = c.path();
+    throw std::runtime_error("unwind");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_FALSE(c_path.empty());
+  EXPECT_FALSE(fs::exists(c_path));
 }
 
 TEST(NumericCsv, ParsesHeaderAndColumns) {

@@ -35,6 +35,9 @@ struct BenchReport {
 /// for an unknown benchmark or records that do not fit its options.
 BenchReport BenchResult(const nlohmann::json& bench, const std::vector<nlohmann::json>& records);
 
+/// Writes `report` as bench.json and bench.md into `dir` (atomically).
+void WriteBenchFiles(const BenchReport& report, const std::string& dir);
+
 /// Loads any campaign spec: a benchmark's (key `bench`) or a scenario sweep (LoadCampaignSpec).
 /// Throws io::ConfigError naming file, line and key, or io::InputFileError.
 Campaign LoadCampaign(const std::string& path);

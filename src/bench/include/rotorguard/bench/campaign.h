@@ -61,6 +61,10 @@ std::string TrialId(const std::map<std::string, std::string>& parameters);
 /// 64-bit FNV-1a of `text`, in hex: campaign and trial fingerprints.
 std::string Fingerprint(const std::string& text);
 
+/// Why a recorded trial failed, as the benchmarks report it: its message when it ran (why the flight
+/// failed, "" for none), "error: ..." or "diverged: ..." when it did not.
+std::string TrialFailure(const nlohmann::json& record);
+
 /// What one trial recorded besides its parameters: its metrics (numbers, booleans or null, keyed by
 /// name) and a message (why a flight failed; "" for none).
 struct TrialOutcome {

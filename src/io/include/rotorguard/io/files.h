@@ -26,6 +26,21 @@ class AtomicFileWriter {
   bool committed_ = false;
 };
 
+/// A new, empty folder under the system's temporary directory, removed with everything in it when
+/// the object goes (also on an exception). Its name holds `prefix`, the process id and a counter, so
+/// that folders made side by side never collide.
+class TemporaryFolder {
+ public:
+  explicit TemporaryFolder(const std::string& prefix);
+  ~TemporaryFolder();
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
 /// Writes a whole file atomically.
 void WriteFileAtomically(const std::string& path, const std::string& content);
 
