@@ -44,18 +44,24 @@ void VoxelMapOptions::Validate() const {
 VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   options_.Validate();
   res_ = options_.resolution_m;
-  // Voxels per axis: the requested extent rounded up to a power of two (at least a brick of 8), so
-  // that the ring buffer's index arithmetic is a mask rather than a division (the hottest path).
+  // Voxels per axis: the requested extent rounded up to a power of two (at least 8), so that the
+  // ring buffer's index arithmetic is a mask rather than a division (the hottest path).
   for (int k = 0; k < 3; ++k) {
     const int needed = static_cast<int>(std::ceil(options_.window_size_m[k] / res_));
     size_[k] = 8;
     while (size_[k] < needed) size_[k] *= 2;
   }
-  origin_ = -size_ / 2;
+  const auto log2 = [](int v) {
+    int l = 0;
+    while ((1 << l) < v) ++l;
+    return l;
+  };
+  shift_y_ = log2(size_.z());
+  shift_x_ = shift_y_ + log2(size_.y());
+  field_top_bits_ = (static_cast<std::uint64_t>(size_.x() / 2) << shift_x_) |
+                    (static_cast<std::uint64_t>(size_.y() / 2) << shift_y_) | static_cast<std::uint64_t>(size_.z() / 2);
+  SetOrigin(-size_ / 2);
   hysteresis_voxels_ = static_cast<int>(std::floor(options_.recenter_hysteresis_m / res_ + 1e-9));
-  for (int k = 0; k < 3; ++k) pack_mask_ |= static_cast<std::uint64_t>(size_[k] - 1) << (kPackShift * k);
-  while ((8 << brick_shift_y_) < size_.y()) ++brick_shift_y_;
-  while ((8 << brick_shift_z_) < size_.z()) ++brick_shift_z_;
   const std::size_t n = static_cast<std::size_t>(size_.x()) * size_.y() * size_.z();
   const auto fixed = [](double v) { return static_cast<int>(std::lround(v * kLogOddsScale)); };
   hit_q_ = fixed(options_.log_odds_hit);
@@ -65,6 +71,7 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   occupied_q_ = fixed(options_.occupied_threshold);
   cells_.assign(n, Cell{});
   inflation_.assign(n, 0);
+  settled_free_.assign(n / 64, 0);  // n is a multiple of 512 (at least 8 voxels per axis)
   // Offsets whose voxel centres lie within the radius of the centre voxel's.
   const int r = static_cast<int>(std::ceil(options_.inflation_radius_m / res_));
   stencil_radius_ = r;
@@ -94,12 +101,16 @@ VoxelMap::Index VoxelMap::ToIndex(const Vector3& p) const {
                static_cast<int>(std::floor(p.z() / res_)));
 }
 
+void VoxelMap::SetOrigin(const Index& origin) {
+  origin_ = origin;
+  origin_residues_ = Address(origin);
+}
+
 Vector3 VoxelMap::Center(const Index& i) const { return (i.cast<double>() + Vector3::Constant(0.5)) * res_; }
 
 bool VoxelMap::InWindow(const Vector3& p) const { return p.allFinite() && InWindow(ToIndex(p)); }
 
-template <typename Visit>
-void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const {
+bool VoxelMap::StartWalk(const Vector3& a, const Vector3& b, WindowWalk* walk) const {
   // Clip to the window [origin, origin + size) in voxel units. (Reciprocals once per axis: the
   // setup runs for every ray of a frame, and a division costs as much as a few steps.)
   const Vector3 d = b - a;
@@ -108,7 +119,7 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
     const double lo = origin_[k], hi = origin_[k] + size_[k];
     inv_d[k] = 0.0;
     if (std::abs(d[k]) < 1e-12) {
-      if (a[k] < lo || a[k] >= hi) return;
+      if (a[k] < lo || a[k] >= hi) return false;
       continue;
     }
     inv_d[k] = 1.0 / d[k];
@@ -117,14 +128,15 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
     s_in = std::max(s_in, s0);
     s_out = std::min(s_out, s1);
   }
-  if (s_in > s_out) return;
+  if (s_in > s_out) return false;
   // From here on the parameter runs over the clipped segment, so that one voxel is never more
   // than 1/4096 of it (the fixed point below then resolves every step, however long the query).
   const Vector3 start = a + s_in * d, stop = a + s_out * d, c = stop - start;
   const double inv_span = s_out > s_in ? 1.0 / (s_out - s_in) : 0.0;
   int i[3], max_steps = 1;
   double t_max[3], t_delta[3];
-  std::uint64_t packed = 0, step[3];
+  std::uint64_t step[3];
+  const int shift[3] = {shift_x_, shift_y_, 0};
   for (int k = 0; k < 3; ++k) {
     const int lo = origin_[k], hi = origin_[k] + size_[k] - 1;
     i[k] = std::clamp(static_cast<int>(std::floor(start[k])), lo, hi);
@@ -139,9 +151,8 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
       t_max[k] = (boundary - start[k]) * inv_c;
       t_delta[k] = std::abs(inv_c);
     }
-    packed |= static_cast<std::uint64_t>(PositiveMod(i[k], size_[k])) << (kPackShift * k);
-    // A step of -1 adds size - 1: the field's mask below then wraps it.
-    step[k] = static_cast<std::uint64_t>(st >= 0 ? 1 : size_[k] - 1) << (kPackShift * k);
+    // -1 in the field as two's complement: no step leaves the window, so no field borrows.
+    step[k] = st >= 0 ? std::uint64_t{1} << shift[k] : ~(std::uint64_t{1} << shift[k]) + 1;
   }
   // The boundary parameters in fixed point (2^-32 of the segment): integer compares have a
   // shorter latency than double, and the step's dependency chain runs through them. Beyond the
@@ -150,8 +161,9 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
   // max_steps + 2 units: a boundary at or beyond the clipped end (the window's face) then always
   // compares beyond it, and no step leaves the window.
   const auto fixed = [](double t) { return static_cast<std::int64_t>(std::min(t, 4.0) * 4294967296.0); };
-  std::int64_t tx = fixed(t_max[0]), ty = fixed(t_max[1]), tz = fixed(t_max[2]);
-  const std::int64_t dx = fixed(t_delta[0]), dy = fixed(t_delta[1]), dz = fixed(t_delta[2]);
+  WindowWalk& w = *walk;
+  w.tx = fixed(t_max[0]), w.ty = fixed(t_max[1]), w.tz = fixed(t_max[2]);
+  w.dx = fixed(t_delta[0]), w.dy = fixed(t_delta[1]), w.dz = fixed(t_delta[2]);
   const std::int64_t t_end = fixed(1.0) - (max_steps + 2);
   // The walk takes the boundaries in increasing order (a merge of the three axes' sequences), so
   // it steps exactly once per boundary at or before the end: the count is known before the first
@@ -165,33 +177,27 @@ void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit)
     return n;
   };
   constexpr double kUnit = 1.0 / 4294967296.0;
-  const std::int64_t steps = crossings(tx, dx, std::abs(c[0]) * kUnit) + crossings(ty, dy, std::abs(c[1]) * kUnit) +
-                             crossings(tz, dz, std::abs(c[2]) * kUnit);
-  const std::uint64_t step_x = step[0], step_y = step[1], step_z = step[2], keep = pack_mask_;
+  w.steps = crossings(w.tx, w.dx, std::abs(c[0]) * kUnit) + crossings(w.ty, w.dy, std::abs(c[1]) * kUnit) +
+            crossings(w.tz, w.dz, std::abs(c[2]) * kUnit);
+  w.relative = RelativeIndex(Index(i[0], i[1], i[2]));
+  w.step_x = step[0], w.step_y = step[1], w.step_z = step[2];
+  return true;
+}
+
+template <typename Visit>
+void VoxelMap::TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const {
+  WindowWalk w;
+  if (!StartWalk(a, b, &w)) return;
   for (std::int64_t n = 0;; ++n) {
-    if (!visit(packed) || n == steps) return;
-    // The axis whose boundary comes first, chosen without branches (which way a ray turns next is
-    // what a branch predictor cannot guess): all-ones masks from the comparisons, because with
-    // ternaries or && the compiler emits the very branches this avoids. The comparisons run in
-    // parallel, so the chain from one step's t to the next is a compare, an and and an add.
-    const std::int64_t on_x = -static_cast<std::int64_t>(tx <= ty) & -static_cast<std::int64_t>(tx <= tz);
-    const std::int64_t on_y = ~on_x & -static_cast<std::int64_t>(ty <= tz);
-    const std::int64_t on_z = ~(on_x | on_y);
-    packed = (packed + ((step_x & static_cast<std::uint64_t>(on_x)) | (step_y & static_cast<std::uint64_t>(on_y)) |
-                        (step_z & static_cast<std::uint64_t>(on_z)))) &
-             keep;
-    tx += dx & on_x;
-    ty += dy & on_y;
-    tz += dz & on_z;
+    if (!visit(AddressOfRelative(w.relative)) || n == w.steps) return;
+    WindowWalk::Advance(w, w.tx, w.ty, w.tz, w.relative);
   }
 }
 
 VoxelMap::Index VoxelMap::IndexOf(std::size_t address) const {
-  // Undo AddressOfPacked, then unwrap: the window holds the one index with these residues.
-  const int brick = static_cast<int>(address >> 9), cell = static_cast<int>(address & 511);
-  const int bz = size_.z() >> 3, by = size_.y() >> 3;
-  const Index w((brick / (by * bz)) * 8 + (cell >> 6), ((brick / bz) % by) * 8 + ((cell >> 3) & 7),
-                (brick % bz) * 8 + (cell & 7));
+  // Unwrap: the window holds the one index with these residues.
+  const auto a = static_cast<int>(address);
+  const Index w(a >> shift_x_, (a >> shift_y_) & (size_.y() - 1), a & (size_.z() - 1));
   return origin_ + Index(PositiveMod(w.x() - origin_.x(), size_.x()), PositiveMod(w.y() - origin_.y(), size_.y()),
                          PositiveMod(w.z() - origin_.z(), size_.z()));
 }
@@ -215,8 +221,9 @@ void VoxelMap::Recenter(const Vector3& center_W) {
   if ((shift.cwiseAbs().array() >= size_.array()).any()) {  // nothing stays
     for (Cell& c : cells_) c = Cell{0, c.stamp, 0};  // the frame stamps stay valid
     std::fill(inflation_.begin(), inflation_.end(), 0);
+    std::fill(settled_free_.begin(), settled_free_.end(), 0);
     occupied_count_ = 0;
-    origin_ = new_origin;
+    SetOrigin(new_origin);
     return;
   }
   // Voxels of the old window outside the new one: a slab along each axis that moved, each voxel
@@ -250,9 +257,10 @@ void VoxelMap::Recenter(const Vector3& center_W) {
     const std::size_t address = Address(i);
     cells_[address] = Cell{0, cells_[address].stamp, 0};
     inflation_[address] = 0;
+    SetSettledFree(address, false);
   });
   const Index old_origin = origin_;
-  origin_ = new_origin;
+  SetOrigin(new_origin);
   // The voxels that entered (in the freed slots, all unknown) get the inflation of the occupied
   // voxels within the radius of them. Those lie in the part of the window that stayed, in a band
   // of the radius along each entering face; each is visited once (corners belong to the first
@@ -296,19 +304,20 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     return summary;
   }
   // Stamps: 2f marks a miss in frame f, 2f + 1 a hit (hits win over misses in the same frame).
-  // One byte per voxel (the walk's memory traffic): frames count 1..127 and the stamps restart
-  // after that, a 4 MB clear every 12.7 s at 10 Hz.
+  // One byte per voxel: frames count 1..127 and the stamps restart after that, a clear of the
+  // window every 12.7 s at 10 Hz.
   if (++frame_ > 127) {
     for (Cell& c : cells_) c.stamp = 0;
     frame_ = 1;
   }
   const std::uint8_t miss = static_cast<std::uint8_t>(2 * frame_), hit = static_cast<std::uint8_t>(2 * frame_ + 1);
-  touched_hit_.clear();
-  // Pass 1: the returns' voxels, stamped as hits, and one ray per hit voxel (from the same origin
+  // Pass 1: the returns' voxels, hit once each, and one ray per hit voxel (from the same origin
   // the other returns in it crossed nearly the same voxels; ego-planner's per-frame voxel cache
   // makes the same trade). Returns outside the window still clear the window along their rays.
+  // A hit voxel is not settled free afterwards, so pass 2 looks at its cell and finds the stamp.
   std::vector<Vector3>& rays = ray_ends_;
   rays.clear();
+  int hits = 0;
   for (const Eigen::Vector3f& pf : points_W) {
     const Vector3 p = pf.cast<double>();
     if (!p.allFinite()) {
@@ -322,56 +331,96 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
       continue;
     }
     ++summary.points_used;
-    std::uint8_t& s = cells_[Address(end)].stamp;
-    if (s == hit) continue;
-    s = hit;
-    touched_hit_.push_back(end);
+    const std::size_t address = Address(end);
+    if (cells_[address].stamp == hit) continue;
+    cells_[address].stamp = hit;
+    Observe(address, hit_q_);
+    ++hits;
     rays.push_back(p);
   }
-  // Pass 2: free space along each ray (its own return voxel excluded), up to the clearing range.
-  // A voxel hit in this frame is not missed; one missed already is not missed twice. The whole
-  // walk: stopping where another ray already passed leaves gaps between converging rays, and
-  // obstacles that moved away with them (even only within 2 m of the sensor, where the rays are
-  // denser than the voxels: a repeated frame then never clears 14 of a moved wall's 382 voxels).
-  // Much of the cost is the first touch of each voxel's cache line (a frame misses ~150k voxels of
-  // a window larger than the caches), so a batch of rays is walked first and its voxels updated
-  // after, each prefetched ahead: the memory latencies then overlap instead of adding up.
+  // Pass 2: free space along each ray, up to the clearing range. A voxel hit in this frame is not
+  // missed; one missed already is not missed twice; a settled free one is left alone (its miss
+  // would change nothing). The whole walk: stopping where another ray already passed leaves gaps
+  // between converging rays, and obstacles that moved away with them (even only within 2 m of the
+  // sensor, where the rays are denser than the voxels: a repeated frame then never clears 14 of a
+  // moved wall's 382 voxels).
+  // The walks are the cost (a forest frame takes some 800 000 steps) and each is a chain of
+  // dependent compares and adds, so two rays are walked side by side and their chains overlap;
+  // a step tests the voxel's settled bit and lists the voxel only if it is clear. The voxels a
+  // batch of rays lists are updated after, each prefetched ahead, so that the memory latencies of
+  // a window larger than the caches overlap too.
   const double inv_res = 1.0 / res_;
   const Vector3 o = origin_W * inv_res;
   const double max_cells = options_.max_clearing_range_m / res_;
   long steps = 0;
   int missed = 0;
-  constexpr std::size_t kRaysPerBatch = 64, kPrefetchAhead = 64;
+  constexpr std::size_t kRaysPerBatch = 64, kPrefetchAhead = 32;
   Cell* const cells = cells_.data();
-  const int shift_y = brick_shift_y_, shift_z = brick_shift_z_;
+  const std::uint64_t* const settled = settled_free_.data();
+  const std::uint64_t residues = origin_residues_, top_bits = field_top_bits_;
   // Room for a batch's walks (a walk crosses at most size_.sum() voxels).
-  walk_.resize(kRaysPerBatch * static_cast<std::size_t>(size_.sum()));
-  addresses_.resize(walk_.size());
+  addresses_.resize(kRaysPerBatch * static_cast<std::size_t>(size_.sum()));
   for (std::size_t first = 0; first < rays.size(); first += kRaysPerBatch) {
+    const std::size_t last = std::min(rays.size(), first + kRaysPerBatch);
+    std::size_t next = first;
+    // Starts the walk of the batch's next ray that enters the window, if any is left.
+    const auto start_next = [&](WindowWalk* w) {
+      for (; next < last; ++next) {
+        Vector3 e = rays[next] * inv_res;
+        const double len = (e - o).norm();
+        if (len > max_cells) e = o + (e - o) * (max_cells / len);
+        if (StartWalk(o, e, w)) {
+          ++next;
+          steps += w->steps + 1;
+          return true;
+        }
+      }
+      w->steps = -1;  // idle
+      return false;
+    };
     // Written through a local pointer: push_back would store and reload the vector's end on
     // every step.
-    std::uint64_t* out = walk_.data();
-    for (std::size_t r = first; r < std::min(rays.size(), first + kRaysPerBatch); ++r) {
-      const Index end_index = ToIndex(rays[r]);
-      const std::uint64_t end = InWindow(end_index) ? Pack(end_index) : ~std::uint64_t{0};
-      Vector3 e = rays[r] * inv_res;
-      const double len = (e - o).norm();
-      if (len > max_cells) e = o + (e - o) * (max_cells / len);
-      TraverseWindow(o, e, [&](std::uint64_t packed) {
-        *out = packed;
-        out += packed != end;  // the walk ends in the return's voxel (hit, not missed)
-        return true;
-      });
+    std::uint32_t* out = addresses_.data();
+    const auto list = [&](std::uint64_t relative) {
+      const std::uint32_t address = AddressOfRelative(relative, residues, top_bits);
+      *out = address;
+      out += static_cast<std::ptrdiff_t>(((settled[address >> 6] >> (address & 63)) & 1U) ^ 1U);
+    };
+    // Each lane's changing state in locals (registers), its constants in its WindowWalk.
+    WindowWalk lane0, lane1;
+    start_next(&lane0);
+    start_next(&lane1);
+    std::int64_t tx0 = lane0.tx, ty0 = lane0.ty, tz0 = lane0.tz, n0 = lane0.steps;
+    std::int64_t tx1 = lane1.tx, ty1 = lane1.ty, tz1 = lane1.tz, n1 = lane1.steps;
+    std::uint64_t r0 = lane0.relative, r1 = lane1.relative;
+    while (n0 >= 0 || n1 >= 0) {
+      // Both lanes step until one is in its last voxel (n counts the steps left).
+      const std::int64_t both = std::min(n0, n1);
+      for (std::int64_t n = 0; n < both; ++n) {
+        list(r0);
+        list(r1);
+        WindowWalk::Advance(lane0, tx0, ty0, tz0, r0);
+        WindowWalk::Advance(lane1, tx1, ty1, tz1, r1);
+      }
+      if (both > 0) n0 -= both, n1 -= both;
+      // A lane in its last voxel, or walking alone, finishes its ray and takes the next.
+      if (n0 == 0 || (n0 > 0 && n1 < 0)) {
+        for (; n0 > 0; --n0) list(r0), WindowWalk::Advance(lane0, tx0, ty0, tz0, r0);
+        list(r0);
+        start_next(&lane0);
+        tx0 = lane0.tx, ty0 = lane0.ty, tz0 = lane0.tz, n0 = lane0.steps, r0 = lane0.relative;
+      }
+      if (n1 == 0 || (n1 > 0 && n0 < 0)) {
+        for (; n1 > 0; --n1) list(r1), WindowWalk::Advance(lane1, tx1, ty1, tz1, r1);
+        list(r1);
+        start_next(&lane1);
+        tx1 = lane1.tx, ty1 = lane1.ty, tz1 = lane1.tz, n1 = lane1.steps, r1 = lane1.relative;
+      }
     }
-    const std::uint64_t* const walk = walk_.data();
-    const std::size_t walked = static_cast<std::size_t>(out - walk);
-    steps += static_cast<long>(walked);
-    std::uint32_t* const addresses = addresses_.data();
-    for (std::size_t k = 0; k < walked; ++k) addresses[k] = AddressOfPacked(walk[k], shift_y, shift_z);
-    // (Branches: applying every step's miss without them, scaled to zero on repeated visits,
-    // stores on every step, and the stores to lines not yet cached then fill the store buffer.)
-    for (std::size_t k = 0; k < walked; ++k) {
-      if (k + kPrefetchAhead < walked) __builtin_prefetch(cells + addresses[k + kPrefetchAhead], 1);
+    const std::uint32_t* const addresses = addresses_.data();
+    const std::size_t listed = static_cast<std::size_t>(out - addresses);
+    for (std::size_t k = 0; k < listed; ++k) {
+      if (k + kPrefetchAhead < listed) __builtin_prefetch(cells + addresses[k + kPrefetchAhead], 1);
       const std::uint32_t address = addresses[k];
       Cell& c = cells[address];
       if (c.stamp < miss) {
@@ -381,9 +430,8 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
       }
     }
   }
-  for (const Index& i : touched_hit_) Observe(Address(i), hit_q_);
   summary.voxels_traversed = steps;
-  summary.voxels_updated = static_cast<int>(touched_hit_.size()) + missed;
+  summary.voxels_updated = hits + missed;
   return summary;
 }
 
@@ -438,8 +486,8 @@ std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius
 bool VoxelMap::SegmentCollides(const Vector3& a, const Vector3& b) const {
   if (!a.allFinite() || !b.allFinite()) return true;  // a corrupt query is never declared safe
   bool collides = false;
-  TraverseWindow(a / res_, b / res_, [&](std::uint64_t packed) {
-    if (inflation_[AddressOfPacked(packed)] > 0) {
+  TraverseWindow(a / res_, b / res_, [&](std::uint32_t address) {
+    if (inflation_[address] > 0) {
       collides = true;
       return false;
     }

@@ -106,38 +106,50 @@ class VoxelMap {
     return (i.array() >= origin.array()).all() && (i.array() < (origin + size_).array()).all();
   }
   bool InWindow(const Index& i) const { return InWindowAt(i, origin_); }
-  /// Where voxel i is stored: its coordinates wrapped into the ring buffer, in bricks of
-  /// 8 x 8 x 8 voxels, each contiguous (a ray stays in one brick, a few cache lines, for several
-  /// steps in any direction, where a row-major layout jumps a whole plane per step).
-  std::size_t Address(const Index& i) const { return AddressOfPacked(Pack(i)); }
-  /// Wrapped coordinates packed in one word, a 16-bit field per axis (12 used; the gap keeps a
-  /// field's carry from reaching the next before the mask wraps it): what a ray step updates with
-  /// one add and one and, the address following only when a voxel is visited.
-  static constexpr int kPackShift = 16;
-  std::uint64_t Pack(const Index& i) const {
-    return static_cast<std::uint64_t>(internal::PositiveMod(i.x(), size_.x())) |
-           static_cast<std::uint64_t>(internal::PositiveMod(i.y(), size_.y())) << kPackShift |
-           static_cast<std::uint64_t>(internal::PositiveMod(i.z(), size_.z())) << (2 * kPackShift);
+  /// Where voxel i is stored: its coordinates wrapped into the ring buffer (modulo the window's
+  /// size, a power of two per axis), row-major with z fastest: (x << (ly + lz)) | (y << lz) | z.
+  std::size_t Address(const Index& i) const {
+    return (static_cast<std::size_t>(i.x() & (size_.x() - 1)) << shift_x_) |
+           (static_cast<std::size_t>(i.y() & (size_.y() - 1)) << shift_y_) |
+           static_cast<std::size_t>(i.z() & (size_.z() - 1));
   }
-  std::uint32_t AddressOfPacked(std::uint64_t p) const { return AddressOfPacked(p, brick_shift_y_, brick_shift_z_); }
-  /// The address of packed coordinates, with log2 of the bricks along y and z passed in: the hot
-  /// loops keep them in registers (a byte store may alias the members, which the compiler would
-  /// otherwise reload after every stamp written).
-  static std::uint32_t AddressOfPacked(std::uint64_t p, int shift_y, int shift_z) {
-    const auto x = static_cast<std::uint32_t>(p & 0xffff), y = static_cast<std::uint32_t>((p >> kPackShift) & 0xffff),
-               z = static_cast<std::uint32_t>(p >> (2 * kPackShift));
-    const std::uint32_t brick = ((x >> 3) << (shift_y + shift_z)) | ((y >> 3) << shift_z) | (z >> 3);
-    return (brick << 9) | ((x & 7) << 6) | ((y & 7) << 3) | (z & 7);
+  /// A voxel's offset from the window's lower corner in the same bit fields as an address:
+  /// what a ray's walk carries (inside the window no field ever wraps, so a step is one add).
+  std::uint64_t RelativeIndex(const Index& i) const {
+    const Index r = i - origin_;
+    return (static_cast<std::uint64_t>(r.x()) << shift_x_) | (static_cast<std::uint64_t>(r.y()) << shift_y_) |
+           static_cast<std::uint64_t>(r.z());
   }
+  /// The address of a relative index: the origin's residues added field by field modulo each
+  /// field's size, without carries between fields (each field's top bit is added apart and
+  /// xor-ed in).
+  static std::uint32_t AddressOfRelative(std::uint64_t relative, std::uint64_t origin_residues, std::uint64_t top_bits) {
+    return static_cast<std::uint32_t>(((relative & ~top_bits) + (origin_residues & ~top_bits)) ^
+                                      ((relative ^ origin_residues) & top_bits));
+  }
+  std::uint32_t AddressOfRelative(std::uint64_t relative) const {
+    return AddressOfRelative(relative, origin_residues_, field_top_bits_);
+  }
+  /// Moves the window's lower corner (and the residues the walks' addresses add).
+  void SetOrigin(const Index& origin);
   /// The window's voxel stored at this address.
   Index IndexOf(std::size_t address) const;
-  /// One voxel's state, packed so that a ray step reads and writes a single cache line.
+  /// One voxel's state in 4 bytes: an update reads and writes one cache line.
   struct Cell {
     std::int16_t log_odds = 0;  // fixed point, kLogOddsScale per unit
     std::uint8_t stamp = 0;     // 2f: missed in frame f, 2f + 1: hit (f in 1..127)
     std::uint8_t known = 0;     // observed at least once
   };
   static constexpr double kLogOddsScale = 1000.0;
+  /// Settled free: known and at the lower clamp, where a miss changes nothing. One bit per voxel
+  /// at the voxel's address (512 KB for the default window, which a core's L2 cache can hold):
+  /// most of a frame's ray steps cross such voxels (86 % in the forest), and testing the bit
+  /// spares the first touch of the cell's line in a window larger than the caches.
+  bool SettledFree(std::size_t address) const { return (settled_free_[address >> 6] >> (address & 63)) & 1U; }
+  void SetSettledFree(std::size_t address, bool settled) {
+    const std::uint64_t bit = std::uint64_t{1} << (address & 63);
+    settled_free_[address >> 6] = settled ? settled_free_[address >> 6] | bit : settled_free_[address >> 6] & ~bit;
+  }
   bool Occupied(const Cell& c) const { return c.log_odds > occupied_q_; }
   void Inflate(const Index& i, int delta);
   /// A hit or a miss: the voxel is known and its log-odds move by the step (fixed point),
@@ -147,15 +159,44 @@ class VoxelMap {
     cell.known = 1;
     const bool was = Occupied(cell);
     cell.log_odds = static_cast<std::int16_t>(std::clamp(cell.log_odds + log_odds_step, min_q_, max_q_));
+    SetSettledFree(address, cell.log_odds == min_q_);
     const bool now = Occupied(cell);
     if (was == now) return;
     occupied_count_ += now ? 1 : -1;
     Inflate(IndexOf(address), now ? 1 : -1);
   }
-  /// Visits the window's voxels that the segment a-b (voxel units) crosses, in order (Amanatides
-  /// and Woo 1987), as visit(packed) until it returns false. The segment is clipped to
-  /// the window first and the packed ring-buffer coordinates follow each step, the map's hottest
-  /// loop.
+  /// One segment's walk through the window's voxels (Amanatides and Woo 1987), in fixed point:
+  /// the parameters of the next boundary along each axis and their increments (2^-32 of the
+  /// window-clipped segment), the current voxel as a relative index, the index's increment along
+  /// each axis (+-1 in that axis' field, two's complement), and the number of steps left (known
+  /// before the first, so the loop has no end test).
+  struct WindowWalk {
+    std::int64_t tx, ty, tz, dx, dy, dz;
+    std::uint64_t relative, step_x, step_y, step_z;
+    std::int64_t steps;
+    /// Into the next voxel: the axis whose boundary comes first, chosen without branches (which
+    /// way a ray turns next is what a branch predictor cannot guess): all-ones masks from the
+    /// signs of the differences (the parameters stay below 2^35, so no difference overflows),
+    /// because with ternaries or && the compiler emits the very branches this avoids. The
+    /// differences run in parallel, so the chain from one step's t to the next is a subtraction,
+    /// a shift, a few logic operations and an add.
+    static void Advance(const WindowWalk& c, std::int64_t& tx, std::int64_t& ty, std::int64_t& tz,
+                        std::uint64_t& relative) {
+      const std::int64_t on_x = ~(((ty - tx) | (tz - tx)) >> 63);
+      const std::int64_t on_y = ~(on_x | ((tz - ty) >> 63));
+      const std::int64_t on_z = ~(on_x | on_y);
+      relative += (c.step_x & static_cast<std::uint64_t>(on_x)) | (c.step_y & static_cast<std::uint64_t>(on_y)) |
+                  (c.step_z & static_cast<std::uint64_t>(on_z));
+      tx += c.dx & on_x;
+      ty += c.dy & on_y;
+      tz += c.dz & on_z;
+    }
+  };
+  /// Starts the walk of the segment a-b (voxel units) clipped to the window, in its first voxel;
+  /// false if the segment misses the window.
+  bool StartWalk(const Vector3& a, const Vector3& b, WindowWalk* walk) const;
+  /// Visits the window's voxels that the segment a-b (voxel units) crosses, in order, as
+  /// visit(address) until it returns false.
   template <typename Visit>
   void TraverseWindow(const Vector3& a, const Vector3& b, Visit&& visit) const;
 
@@ -166,6 +207,7 @@ class VoxelMap {
   int hit_q_, miss_q_, min_q_, max_q_, occupied_q_;  // the options' log-odds in fixed point
   std::vector<Cell> cells_;
   std::vector<std::uint16_t> inflation_;  // occupied voxels within the radius
+  std::vector<std::uint64_t> settled_free_;  // SettledFree, a bit per address
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
   /// Offsets within kSortedOffsetRadius voxels, by increasing distance: Nearest visits them in
@@ -178,12 +220,11 @@ class VoxelMap {
   std::vector<SortedOffset> sorted_offsets_;
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
   int hysteresis_voxels_ = 0;             // recenter_hysteresis_m in whole voxels
-  std::vector<Index> touched_hit_;
   std::vector<Vector3> ray_ends_;  // the returns whose rays a frame walks
-  std::vector<std::uint64_t> walk_;   // the packed voxels a batch of rays crosses, in order
-  std::vector<std::uint32_t> addresses_;  // their addresses
-  std::uint64_t pack_mask_ = 0;       // each packed field's wrap mask (size - 1)
-  int brick_shift_y_ = 0, brick_shift_z_ = 0;  // log2 of the bricks along y and z
+  std::vector<std::uint32_t> addresses_;  // the voxels a batch of rays leaves to update
+  int shift_x_ = 0, shift_y_ = 0;     // the address fields' offsets: log2 of size y * size z, of size z
+  std::uint64_t field_top_bits_ = 0;  // each address field's top bit
+  std::uint64_t origin_residues_ = 0;  // the address of the window's lower corner
   int occupied_count_ = 0;
 };
 
