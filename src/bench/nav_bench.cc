@@ -35,14 +35,19 @@ struct NavTrial {
   bool success = false, collision = false, crashed = false;
   double tracking_rmse_m = 0.0, max_spin_rad_s = 0.0, mission_time_s = -1.0;
   double planner_ms_mean = 0.0, stack_ms_per_cycle_mean = 0.0, realtime_factor = 0.0;
+  std::map<std::string, double> cost_ms_per_sim_s;  // RunCost's parts by name
   std::string failure;
 };
+
+/// A trial record's metric for a part of RunCost.
+std::string CostMetric(const std::string& part) { return "cost_" + part + "_ms_per_sim_s"; }
 
 nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::vector<std::uint64_t>& seeds,
                          const std::vector<std::string>& kinds) {
   const double n = static_cast<double>(trials.size());
   double success = 0, collision = 0, crash = 0, rmse = 0, spin = 0, planner = 0, stack = 0, rtf = 0, time = 0;
   int completed = 0;
+  std::map<std::string, double> cost;
   nlohmann::json failures = nlohmann::json::array();
   for (std::size_t i = 0; i < trials.size(); ++i) {
     const NavTrial& t = *trials[i];
@@ -54,6 +59,7 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
     planner += t.planner_ms_mean / n;
     stack += t.stack_ms_per_cycle_mean / n;
     rtf += t.realtime_factor / n;
+    for (const auto& [part, ms] : t.cost_ms_per_sim_s) cost[part] += ms / n;
     if (t.mission_time_s >= 0.0) time += t.mission_time_s, ++completed;
     if (!t.success && failures.size() < 10) failures.push_back({{"kind", kinds[i]}, {"seed", seeds[i]}, {"reason", t.failure}});
   }
@@ -67,6 +73,7 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
           {"planner_ms_mean", planner},
           {"stack_ms_per_cycle_mean", stack},
           {"realtime_factor", rtf},
+          {"cost_ms_per_sim_s", cost},
           {"failures", failures}};
 }
 
@@ -162,6 +169,8 @@ Campaign NavCampaign(const NavBenchOptions& o) {
                    {"planner_ms_mean", s.planner_ms_mean},
                    {"stack_ms_per_cycle_mean", s.stack_ms_per_cycle_mean},
                    {"realtime_factor", s.realtime_factor}};
+    const nlohmann::json cost = s.cost_ms_per_sim_s.ToJson();
+    for (const auto& [part, ms] : cost.items()) out.metrics[CostMetric(part)] = ms;
     out.message = s.failure_reason;
     return out;
   };
@@ -190,6 +199,8 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
       t.planner_ms_mean = x["planner_ms_mean"].get<double>();
       t.stack_ms_per_cycle_mean = x["stack_ms_per_cycle_mean"].get<double>();
       t.realtime_factor = x["realtime_factor"].get<double>();
+      const nlohmann::json parts = RunCost{}.ToJson();
+      for (const auto& [part, unused] : parts.items()) t.cost_ms_per_sim_s[part] = x.at(CostMetric(part)).get<double>();
     }
     results.push_back(t);
   }
@@ -242,6 +253,22 @@ std::string NavMarkdown(const nlohmann::json& r) {
     for (const char* v : kVariants) row(kind, v, variants[v]);
   }
   for (const char* v : kVariants) row("all", v, r[v]);
+  // Where the wall-clock time goes (all trials): the parts add up to 1000 / real-time factor.
+  const std::vector<std::string> parts = {"simulator", "mapper", "planner", "controller", "stack_other", "runner"};
+  md += "\nWall-clock time per simulated second [ms], all trials:\n\n| variant |";
+  for (const std::string& p : parts) md += " " + p + " |";
+  md += " total |\n|---|---|---|---|---|---|---|---|\n";
+  for (const char* v : kVariants) {
+    const nlohmann::json& c = r[v]["cost_ms_per_sim_s"];
+    double total = 0.0;
+    md += fmt::format("| {} |", v);
+    for (const std::string& p : parts) {
+      const double ms = c.value(p, 0.0);
+      total += ms;
+      md += fmt::format(" {:.1f} |", ms);
+    }
+    md += fmt::format(" {:.1f} |\n", total);
+  }
   for (const char* v : kVariants) {
     for (const auto& f : r[v]["failures"]) {
       md += fmt::format("\n{} failed: {} seed {}: {}", v, f["kind"].get<std::string>(), f["seed"].get<std::uint64_t>(),

@@ -86,6 +86,11 @@ void DeliverToStack(const sim::SensorOutputs& o, stack::FlightStack* st, std::st
 
 double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
 
+nlohmann::json RunCost::ToJson() const {
+  return {{"simulator", simulator}, {"mapper", mapper},           {"planner", planner},
+          {"controller", controller}, {"stack_other", stack_other}, {"runner", runner}};
+}
+
 nlohmann::json RunSummary::ToJson() const {
   nlohmann::json j;
   j["scenario"] = scenario;
@@ -145,6 +150,7 @@ nlohmann::json RunSummary::ToJson() const {
     j["supervisor"]["transitions"].push_back({{"t", m.t}, {"from", m.from}, {"to", m.to}, {"reason", m.reason}});
   }
   j["stack_ms_per_cycle_mean"] = stack_ms_per_cycle_mean;
+  j["cost_ms_per_sim_s"] = cost_ms_per_sim_s.ToJson();
   j["physics_steps"] = physics_steps;
   j["control_cycles"] = control_cycles;
   return j;
@@ -220,7 +226,7 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   flight.table.values.resize(flight.table.columns.size());
   SceneRecorder scene(sc.vehicle, sc.world, {}, sc.assembly.get());
   RotorCommand command = st.command();
-  std::chrono::steady_clock::duration stack_time{};
+  std::chrono::steady_clock::duration stack_time{}, sim_time{};
   const int waypoints_total = static_cast<int>(sc.stack.navigation.waypoints.size()) * sc.stack.navigation.rounds;
 
   for (std::int64_t k = 0; k < steps; ++k) {
@@ -254,8 +260,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
       scene.OnTime(ToSeconds(t));
       next_log += log_period;
     }
+    const auto sim_start = std::chrono::steady_clock::now();
     const sim::SensorOutputs& outputs = sim.Step(command);
     const auto deliver_start = std::chrono::steady_clock::now();
+    sim_time += deliver_start - sim_start;
     DeliverToStack(outputs, &st, sensor_log);
     stack_time += std::chrono::steady_clock::now() - deliver_start;
     if (sensor_log && sensor_buffer.size() > (1u << 20)) {
@@ -392,6 +400,18 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
           ? 1e3 * std::chrono::duration<double>(stack_time).count() / static_cast<double>(summary.control_cycles)
           : 0.0;
   summary.realtime_factor = summary.wall_time_s > 0.0 ? summary.sim_time_s / summary.wall_time_s : 0.0;
+  if (summary.sim_time_s > 0.0) {
+    const auto per_sim_s = [&](double wall_s) { return 1e3 * wall_s / summary.sim_time_s; };
+    const auto seconds = [](std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); };
+    const stack::StackCost& c = st.cost();
+    RunCost& cost = summary.cost_ms_per_sim_s;
+    cost.simulator = per_sim_s(seconds(sim_time));
+    cost.mapper = per_sim_s(c.mapper_s);
+    cost.planner = per_sim_s(c.planner_s);
+    cost.controller = per_sim_s(c.controller_s);
+    cost.stack_other = per_sim_s(std::max(0.0, seconds(stack_time) - c.mapper_s - c.planner_s - c.controller_s));
+    cost.runner = per_sim_s(std::max(0.0, summary.wall_time_s - seconds(stack_time) - seconds(sim_time)));
+  }
   if (record) {
     flight.summary = summary.ToJson();
     if (options.log_format != LogFormat::kCsv) {

@@ -1,6 +1,7 @@
 #include "rotorguard/stack/flight_stack.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -9,6 +10,23 @@
 #include "rotorguard/core/error.h"
 
 namespace rotorguard::stack {
+
+namespace {
+
+/// Adds the wall-clock time of its scope to *total [s].
+class ScopedCost {
+ public:
+  explicit ScopedCost(double* total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  ScopedCost(const ScopedCost&) = delete;
+  ScopedCost& operator=(const ScopedCost&) = delete;
+  ~ScopedCost() { *total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+
+ private:
+  double* total_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
 
 control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& o) {
   control::IndiControllerOptions indi = o.indi;
@@ -173,6 +191,7 @@ void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
 void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_.OnOdometry(odometry); }
 
 void FlightStack::OnLidar(const LidarFrame& frame) {
+  const ScopedCost cost(&cost_.mapper_s);
   lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_.Estimate(frame.t_end_ns)).points_dropped;
 }
 
@@ -277,7 +296,10 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
     landing_.emplace(o);
     descent_.emplace(*landing_, supervisor_.landing_start_s());
   }
-  if (!landing_) Navigate(ts, mode);
+  if (!landing_) {
+    const ScopedCost cost(&cost_.planner_s);
+    Navigate(ts, mode);
+  }
   const ReferenceTrajectory& followed = reference();
   reference_point_ = followed.Evaluate(ts);
   if (!estimate_.valid || mode == FlightMode::kLanded) {
@@ -285,7 +307,10 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
     command_.thrust_n.setZero();
     return command_;
   }
-  controller_->Compute(estimate_, followed, ts, dt, &command_.thrust_n);
+  {
+    const ScopedCost cost(&cost_.controller_s);
+    controller_->Compute(estimate_, followed, ts, dt, &command_.thrust_n);
+  }
   if (fdd_) fdd_->SetCommand(command_.thrust_n);
   return command_;
 }

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "rotorguard/bench/ftc_bench.h"
@@ -116,9 +117,15 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
   EXPECT_EQ(c.parameters(0).at("seed"), c.parameters(1).at("seed"));  // both variants fly one world
   EXPECT_NE(c.parameters(0).at("seed"), c.parameters(2).at("seed"));
   const auto metrics = [](bool success, bool collision, double rmse, nlohmann::json time) {
-    return nlohmann::json{{"success", success}, {"crashed", collision}, {"collision", collision},
-                          {"tracking_rmse_m", rmse}, {"max_spin_rad_s", 11.0}, {"mission_time_s", time},
-                          {"planner_ms_mean", 2.0}, {"stack_ms_per_cycle_mean", 0.5}, {"realtime_factor", 4.0}};
+    nlohmann::json m{{"success", success}, {"crashed", collision}, {"collision", collision},
+                     {"tracking_rmse_m", rmse}, {"max_spin_rad_s", 11.0}, {"mission_time_s", time},
+                     {"planner_ms_mean", 2.0}, {"stack_ms_per_cycle_mean", 0.5}, {"realtime_factor", 4.0}};
+    // The wall-clock parts of a run (ms per simulated second), the simulator's differing by trial.
+    for (const char* part : {"mapper", "planner", "controller", "stack_other", "runner"}) {
+      m[fmt::format("cost_{}_ms_per_sim_s", part)] = 10.0;
+    }
+    m["cost_simulator_ms_per_sim_s"] = rmse * 1000.0;
+    return m;
   };
   const std::vector<nlohmann::json> records = {
       Record(0, c.parameters(0), metrics(true, false, 0.05, 30.0)),
@@ -129,6 +136,8 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
   EXPECT_EQ(r["rotorguard"]["success_rate"], 1.0);
   EXPECT_NEAR(r["rotorguard"]["tracking_rmse_m"].get<double>(), 0.06, 1e-12);
   EXPECT_NEAR(r["rotorguard"]["mission_time_s"].get<double>(), 32.0, 1e-12);
+  EXPECT_NEAR(r["rotorguard"]["cost_ms_per_sim_s"]["simulator"].get<double>(), 60.0, 1e-9);  // (50 + 70) / 2
+  EXPECT_NEAR(r["rotorguard"]["cost_ms_per_sim_s"]["runner"].get<double>(), 10.0, 1e-12);
   EXPECT_EQ(r["failure_unaware"]["success_rate"], 0.0);
   EXPECT_EQ(r["failure_unaware"]["collision_rate"], 0.5);   // the diverged trial did not report one
   EXPECT_TRUE(r["failure_unaware"]["mission_time_s"].is_null());  // neither completed

@@ -29,6 +29,18 @@ struct FaultRecord {
   double onset_s = 0.0;
 };
 
+/// Where a run's wall-clock time went, per simulated second [ms/s] (summary.json
+/// "cost_ms_per_sim_s"): the parts add up to 1000 / realtime_factor.
+struct RunCost {
+  double simulator = 0.0;    ///< Simulator::Step: physics, faults and every sensor model (the LiDAR's ray casting)
+  double mapper = 0.0;       ///< the stack's LiDAR frames (FlightStack::cost)
+  double planner = 0.0;      ///< the stack's navigation
+  double controller = 0.0;   ///< the stack's controller
+  double stack_other = 0.0;  ///< the rest of the stack: estimator, FDD, supervisor, sensor callbacks
+  double runner = 0.0;       ///< the loop's own work: metrics, logs, the report's scene
+  nlohmann::json ToJson() const;
+};
+
 /// The outcome of one run; the fields of summary.json (DESIGN.md keys; later features add keys).
 struct RunSummary {
   std::string scenario;
@@ -74,6 +86,7 @@ struct RunSummary {
   /// Wall-clock time the flight stack took per control cycle, its sensor callbacks (mapping
   /// included) counted: the whole stack's cost [ms].
   double stack_ms_per_cycle_mean = 0.0;
+  RunCost cost_ms_per_sim_s;
   /// Each failed planning query: time [s], reason and status ("12.30 s periodic: no_path").
   std::vector<std::string> failed_plans;
   /// The navigate mission asked for a waypoint the planner found unreachable at the end (inside an

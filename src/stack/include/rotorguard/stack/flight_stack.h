@@ -101,6 +101,15 @@ struct FlightStackOptions {
 /// the `nominal` gains until a failure.
 control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& options);
 
+/// Wall-clock time the stack's parts have taken so far [s]: where a flight's computation goes
+/// (the on-board budget, and the Monte Carlo one). The rest of the stack (estimator, FDD,
+/// supervisor, references) is what its callers' total leaves.
+struct StackCost {
+  double mapper_s = 0.0;      ///< LiDAR frames: deskew, placement, map update
+  double planner_s = 0.0;     ///< navigation: replanning (and the flatness navigator)
+  double controller_s = 0.0;  ///< the controller's Compute (the NMPC's solve)
+};
+
 class FlightStack {
  public:
   /// `controller`, when given, is flown instead of one built from options.controller (which must
@@ -151,6 +160,8 @@ class FlightStack {
   /// LiDAR pulses without a usable point: no return (counted by the sensor), non-finite, outside
   /// the map's window, or arriving before the estimate is valid.
   long lidar_points_dropped() const { return lidar_points_dropped_; }
+  /// Wall-clock time taken by the mapper, the planner and the controller so far.
+  const StackCost& cost() const { return cost_; }
   /// The supervisor: the flight mode and its logged transitions.
   const Supervisor& supervisor() const { return supervisor_; }
   /// Rotors the stack treats as failed (isolated by its FDD or handed over as known faults).
@@ -188,6 +199,7 @@ class FlightStack {
   int next_waypoint_ = 0;       // of the waypoints repeated `rounds` times
   double next_plan_s_ = 0.0;    // the navigator's next update
   long lidar_points_dropped_ = 0;
+  StackCost cost_;
   std::vector<bool> known_fault_applied_;
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
