@@ -49,6 +49,7 @@ std::string OcpQpSummary::BriefReport() const {
 
 CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options)
     : dims_(dims),
+      options_(options),
       dense_(dims.horizon * dims.nu, dims.horizon * static_cast<int>(dims.state_bound_index.size())),
       dense_solver_(dims.horizon * dims.nu, dims.horizon * static_cast<int>(dims.state_bound_index.size()),
                     options) {
@@ -68,6 +69,11 @@ CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptio
   c_x0_.resize(m, nx);
   dx0_.resize(nx);
   cdx_.resize(m);
+  z_.resize(n);
+  pattern_fixed_.reserve(static_cast<std::size_t>(n));
+  pattern_free_.reserve(static_cast<std::size_t>(n));
+  fixed_.reserve(static_cast<std::size_t>(n));
+  free_.reserve(static_cast<std::size_t>(n));
   qx_.resize(nx);
   ru_.resize(nu);
 }
@@ -177,9 +183,49 @@ const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp) {
   uc0_ = dense_.uc;
   prepared_x0_ = qp.x0;
   prepared_ = &qp;
-  if (!dense_solver_.Factorize(dense_.H)) summary_.status = QpStatus::kNumericalFailure;
+  if (!PrepareReduced()) summary_.status = QpStatus::kNumericalFailure;
   summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary_;
+}
+
+bool CondensingQpSolver::PrepareReduced() {
+  // Allocation-free after the first call for a pattern (the real-time iteration's rule): the
+  // pattern is built in scratch reserved at construction, the products written out.
+  const int n = dense_.num_variables(), m = dense_.num_constraints();
+  pattern_fixed_.clear();
+  pattern_free_.clear();
+  for (int i = 0; i < n; ++i) (dense_.lb[i] == dense_.ub[i] ? pattern_fixed_ : pattern_free_).push_back(i);
+  if (pattern_fixed_.empty() || pattern_free_.empty()) {  // nothing to eliminate, or nothing left: the whole QP
+    fixed_.clear();
+    reduced_.reset();
+    return dense_solver_.Factorize(dense_.H);
+  }
+  const int nf = static_cast<int>(pattern_free_.size()), nF = static_cast<int>(pattern_fixed_.size());
+  if (pattern_fixed_ != fixed_ || !reduced_) {  // a new pattern (a rotor just failed): allocate once for it
+    fixed_ = pattern_fixed_;
+    free_ = pattern_free_;
+    reduced_ = std::make_unique<DenseQp>(nf, m);
+    reduced_solver_ = std::make_unique<DenseQpSolver>(nf, m, options_);
+    z_fixed_.resize(nF);
+    g_fixed_.resize(nf);
+    c_fixed_.resize(m);
+  }
+  for (int b = 0; b < nF; ++b) z_fixed_[b] = dense_.lb[fixed_[b]];
+  for (int a = 0; a < nf; ++a) {
+    for (int b = 0; b < nf; ++b) reduced_->H(a, b) = dense_.H(free_[a], free_[b]);
+    double shift = 0.0;
+    for (int b = 0; b < nF; ++b) shift += dense_.H(free_[a], fixed_[b]) * z_fixed_[b];
+    g_fixed_[a] = shift;
+    reduced_->lb[a] = dense_.lb[free_[a]];
+    reduced_->ub[a] = dense_.ub[free_[a]];
+  }
+  for (int r = 0; r < m; ++r) {
+    for (int a = 0; a < nf; ++a) reduced_->C(r, a) = dense_.C(r, free_[a]);
+    double shift = 0.0;
+    for (int b = 0; b < nF; ++b) shift += dense_.C(r, fixed_[b]) * z_fixed_[b];
+    c_fixed_[r] = shift;
+  }
+  return reduced_solver_->Factorize(reduced_->H);
 }
 
 const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
@@ -200,13 +246,29 @@ const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
     dense_.lc = lc0_ - cdx_;
     dense_.uc = uc0_ - cdx_;
   }
-  const DenseQpSummary& ds = dense_solver_.SolveFactorized(dense_);
-  summary_.status = ds.status;
-  summary_.iterations = ds.iterations;
-  summary_.active_constraints = ds.active_constraints;
-  summary_.max_violation = ds.max_violation;
+  const DenseQpSummary* ds = nullptr;
+  if (reduced_) {
+    // Over the free inputs: the fixed ones' share of the gradient and of C z moved to the data.
+    for (std::size_t a = 0; a < free_.size(); ++a) {
+      reduced_->g[static_cast<int>(a)] = dense_.g[free_[a]] + g_fixed_[static_cast<int>(a)];
+    }
+    if (dense_.num_constraints() > 0) {
+      reduced_->lc = dense_.lc - c_fixed_;
+      reduced_->uc = dense_.uc - c_fixed_;
+    }
+    ds = &reduced_solver_->SolveFactorized(*reduced_);
+    for (std::size_t a = 0; a < free_.size(); ++a) z_[free_[a]] = reduced_solver_->z()[static_cast<int>(a)];
+    for (std::size_t b = 0; b < fixed_.size(); ++b) z_[fixed_[b]] = z_fixed_[static_cast<int>(b)];
+  } else {
+    ds = &dense_solver_.SolveFactorized(dense_);
+    z_ = dense_solver_.z();
+  }
+  summary_.status = ds->status;
+  summary_.iterations = ds->iterations;
+  summary_.active_constraints = ds->active_constraints + static_cast<int>(reduced_ ? fixed_.size() : 0);
+  summary_.max_violation = ds->max_violation;
   // Expand the trajectory by forward simulation of the inputs.
-  const Eigen::VectorXd& z = dense_solver_.z();
+  const Eigen::VectorXd& z = z_;
   x_[0] = x0;
   for (int k = 0; k < N; ++k) {
     u_[k] = z.segment(k * nu, nu);

@@ -197,6 +197,63 @@ TEST(CondensingQp, FeedbackOnAPreparedProblemEqualsAFreshSolveAtTheMeasuredState
   }
 }
 
+// Inputs fixed by equal bounds (a failed rotor: u_bar_i = 0) are eliminated before the dense
+// solve. The oracle: the naively condensed QP with those bounds, solved whole by the dense
+// active-set solver. One solver object runs through patterns in turn (a rotor, then another
+// stage pattern, then none, then the first again), with the feedback at a measured state.
+TEST(CondensingQp, InputsFixedByEqualBoundsGiveTheSolutionOfTheWholeQp) {
+  Rng rng(33);
+  OcpQp base = RandomOcp(8, 6, 3, {0, 3}, rng);
+  // Mild dynamics from a small start and a cost that pulls the bounded states beyond their
+  // +-1.5, so that state bounds bind too (their rows carry the fixed inputs' share).
+  base.x0 *= 0.1;
+  Eigen::VectorXd target = Eigen::VectorXd::Zero(6);
+  target << 4.0, 0.0, 0.0, -4.0, 0.0, 0.0;
+  for (int k = 0; k < 8; ++k) {
+    base.A[k] = Eigen::MatrixXd::Identity(6, 6) + 0.02 * (base.A[k] - Eigen::MatrixXd::Identity(6, 6));
+    base.B[k] *= 4.0;
+    base.c[k].setZero();
+  }
+  for (int k = 0; k <= 8; ++k) base.q[k] = -base.Q[k] * target;
+  CondensingQpSolver solver(base.dims);
+  int compared = 0;
+  for (int pattern : {0, 1, 2, 0}) {
+    OcpQp qp = base;
+    for (int k = 0; k < 8; ++k) {
+      if (pattern == 0) qp.u_lower[k][1] = qp.u_upper[k][1] = 0.25;  // input 1 held at every stage
+      if (pattern == 1 && k % 3 == 0) qp.u_lower[k][2] = qp.u_upper[k][2] = -0.1;  // input 2 at some
+    }
+    const Eigen::VectorXd measured = qp.x0 + 0.05 * RandomMatrix(6, 1, rng);
+    solver.Prepare(qp);
+    const OcpQpSummary& s = solver.Feedback(measured);
+    ASSERT_TRUE(s.IsSolutionUsable()) << s.BriefReport();
+    OcpQp measured_qp = qp;
+    measured_qp.x0 = measured;
+    DenseQp whole(8 * 3, 8 * 2);
+    NaiveCondense(measured_qp, &whole.H, &whole.g, &whole.C, &whole.lc, &whole.uc);
+    for (int k = 0; k < 8; ++k) {
+      whole.lb.segment(3 * k, 3) = qp.u_lower[k];
+      whole.ub.segment(3 * k, 3) = qp.u_upper[k];
+    }
+    DenseQpSolver oracle(8 * 3, 8 * 2);
+    ASSERT_TRUE(oracle.Solve(whole).IsSolutionUsable());
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_TRUE(MatricesNear(solver.u()[k], oracle.z().segment(3 * k, 3), 1e-8)) << "pattern " << pattern << " u_" << k;
+      if (pattern == 0) {
+        EXPECT_EQ(solver.u()[k][1], 0.25);  // exactly, not to a tolerance
+      }
+      ++compared;
+    }
+    EXPECT_GE(s.active_constraints, pattern == 0 ? 8 : (pattern == 1 ? 3 : 0)) << "the fixed inputs count as active";
+    int binding = 0;  // state bounds at their limit
+    for (int k = 1; k <= 8; ++k) {
+      for (int b : {0, 3}) binding += std::abs(std::abs(solver.x()[k][b]) - 1.5) < 1e-7;
+    }
+    EXPECT_GT(binding, 0) << "pattern " << pattern;
+  }
+  EXPECT_EQ(compared, 32);
+}
+
 TEST(CondensingQp, RejectsMismatchedDimensionsAndBadDims) {
   Rng rng(1);
   const OcpQp qp = RandomOcp(4, 3, 1, {}, rng);

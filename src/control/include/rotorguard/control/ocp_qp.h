@@ -10,6 +10,7 @@
 /// and its solver by condensing: the states are eliminated (x_k = x_bar_k + sum_j S_kj u_j) with
 /// O(N^2) recursions, and the dense QP in the N*nu inputs is solved by the Goldfarb-Idnani dual
 /// active-set method (DenseQpSolver). docs/control.md explains the choice and its measurements.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -61,8 +62,11 @@ class CondensingQpSolver {
   /// Solves `qp` (whose dims must equal the solver's): Prepare(qp) then Feedback(qp.x0).
   const OcpQpSummary& Solve(const OcpQp& qp);
   /// Preparation phase of a real-time iteration: condenses `qp` around its x0, the sensitivities
-  /// of the condensed gradient and constraint bounds to x0, and factorises the Hessian. `qp` must
-  /// outlive the following Feedback calls and stay unchanged.
+  /// of the condensed gradient and constraint bounds to x0, and factorises the Hessian. Inputs
+  /// whose bounds coincide (a failed rotor's, u_bar_i = 0) are fixed: they are eliminated, and the
+  /// dense QP is solved over the free inputs only (fewer variables, and no active-set changes for
+  /// bounds that hold by construction). `qp` must outlive the following Feedback calls and stay
+  /// unchanged.
   const OcpQpSummary& Prepare(const OcpQp& qp);
   /// Feedback phase: the QP for the measured initial state x0 (only the gradient and bounds move,
   /// linearly in x0 - prepared x0), solved on the prepared factorisation, and the trajectory.
@@ -79,7 +83,12 @@ class CondensingQpSolver {
   template <int NX, int NU>
   void Condense(const OcpQp& qp);
 
+  /// Finds the inputs fixed by equal bounds in dense_ and, when there are any, builds and
+  /// factorises the QP over the others (reduced_); false when its Hessian cannot be factorised.
+  bool PrepareReduced();
+
   OcpQpDims dims_;
+  DenseQpOptions options_;
   std::vector<Eigen::MatrixXd> s_, w_matrix_, y_;
   std::vector<Eigen::VectorXd> x_bar_, w_vector_, x_, u_;
   Eigen::MatrixXd tmp_;
@@ -89,6 +98,12 @@ class CondensingQpSolver {
   const OcpQp* prepared_ = nullptr;
   DenseQp dense_;
   DenseQpSolver dense_solver_;
+  // The QP over the free inputs when some are fixed: their indices in dense_, the fixed ones and
+  // their values, and what the fixed values add to the gradient (H_fF z_F) and to C z (C_F z_F).
+  std::vector<int> free_, fixed_, pattern_free_, pattern_fixed_;
+  Eigen::VectorXd z_fixed_, g_fixed_, c_fixed_, z_;
+  std::unique_ptr<DenseQp> reduced_;
+  std::unique_ptr<DenseQpSolver> reduced_solver_;
   OcpQpSummary summary_;
 };
 
