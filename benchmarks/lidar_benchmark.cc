@@ -53,7 +53,7 @@ void BM_MapInsertFrame(benchmark::State& state) {
   map.Recenter(PoseAt(0).p_W);
   TimeNs t = 0;
   std::size_t frames = 0, points = 0;
-  double steps = 0.0, updated = 0.0;
+  double steps = 0.0, updated = 0.0, settled = 0.0;
   std::vector<Eigen::Vector3f> world;
   for (auto _ : state) {
     state.PauseTiming();
@@ -73,6 +73,7 @@ void BM_MapInsertFrame(benchmark::State& state) {
     map.Recenter(origin);
     const perception::MapUpdateSummary s = map.Insert(origin, world);
     steps += s.voxels_traversed;
+    settled += s.voxels_settled_skipped;
     updated += s.voxels_updated;
     points += world.size();
     ++frames;
@@ -81,6 +82,7 @@ void BM_MapInsertFrame(benchmark::State& state) {
   state.counters["points_per_frame"] = benchmark::Counter(static_cast<double>(points) / n);
   state.counters["ray_steps_per_frame"] = benchmark::Counter(steps / n);
   state.counters["voxels_updated_per_frame"] = benchmark::Counter(updated / n);
+  state.counters["settled_step_share"] = benchmark::Counter(steps > 0.0 ? settled / steps : 0.0);
 }
 BENCHMARK(BM_MapInsertFrame)->Arg(200000)->Arg(260000)->Unit(benchmark::kMillisecond);
 

@@ -169,8 +169,8 @@ Campaign NavCampaign(const NavBenchOptions& o) {
                    {"planner_ms_mean", s.planner_ms_mean},
                    {"stack_ms_per_cycle_mean", s.stack_ms_per_cycle_mean},
                    {"realtime_factor", s.realtime_factor}};
-    const nlohmann::json cost = s.cost_ms_per_sim_s.ToJson();
-    for (const auto& [part, ms] : cost.items()) out.metrics[CostMetric(part)] = ms;
+    const std::array<double, RunCost::kParts.size()> cost = s.cost_ms_per_sim_s.values();
+    for (std::size_t k = 0; k < cost.size(); ++k) out.metrics[CostMetric(RunCost::kParts[k])] = cost[k];
     out.message = s.failure_reason;
     return out;
   };
@@ -199,8 +199,7 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
       t.planner_ms_mean = x["planner_ms_mean"].get<double>();
       t.stack_ms_per_cycle_mean = x["stack_ms_per_cycle_mean"].get<double>();
       t.realtime_factor = x["realtime_factor"].get<double>();
-      const nlohmann::json parts = RunCost{}.ToJson();
-      for (const auto& [part, unused] : parts.items()) t.cost_ms_per_sim_s[part] = x.at(CostMetric(part)).get<double>();
+      for (const char* part : RunCost::kParts) t.cost_ms_per_sim_s[part] = x.at(CostMetric(part)).get<double>();
     }
     results.push_back(t);
   }
@@ -254,15 +253,16 @@ std::string NavMarkdown(const nlohmann::json& r) {
   }
   for (const char* v : kVariants) row("all", v, r[v]);
   // Where the wall-clock time goes (all trials): the parts add up to 1000 / real-time factor.
-  const std::vector<std::string> parts = {"simulator", "mapper", "planner", "controller", "stack_other", "runner"};
   md += "\nWall-clock time per simulated second [ms], all trials:\n\n| variant |";
-  for (const std::string& p : parts) md += " " + p + " |";
-  md += " total |\n|---|---|---|---|---|---|---|---|\n";
+  for (const char* p : RunCost::kParts) md += fmt::format(" {} |", p);
+  md += " total |\n|---|";
+  for (std::size_t k = 0; k <= RunCost::kParts.size(); ++k) md += "---|";
+  md += "\n";
   for (const char* v : kVariants) {
     const nlohmann::json& c = r[v]["cost_ms_per_sim_s"];
     double total = 0.0;
     md += fmt::format("| {} |", v);
-    for (const std::string& p : parts) {
+    for (const char* p : RunCost::kParts) {
       const double ms = c.value(p, 0.0);
       total += ms;
       md += fmt::format(" {:.1f} |", ms);

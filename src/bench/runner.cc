@@ -87,8 +87,10 @@ void DeliverToStack(const sim::SensorOutputs& o, stack::FlightStack* st, std::st
 double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
 
 nlohmann::json RunCost::ToJson() const {
-  return {{"simulator", simulator}, {"mapper", mapper},           {"planner", planner},
-          {"controller", controller}, {"stack_other", stack_other}, {"runner", runner}};
+  nlohmann::json j = nlohmann::json::object();
+  const std::array<double, kParts.size()> v = values();
+  for (std::size_t k = 0; k < kParts.size(); ++k) j[kParts[k]] = v[k];
+  return j;
 }
 
 nlohmann::json RunSummary::ToJson() const {

@@ -71,7 +71,6 @@ CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptio
   cdx_.resize(m);
   z_.resize(n);
   pattern_fixed_.reserve(static_cast<std::size_t>(n));
-  pattern_free_.reserve(static_cast<std::size_t>(n));
   fixed_.reserve(static_cast<std::size_t>(n));
   free_.reserve(static_cast<std::size_t>(n));
   qx_.resize(nx);
@@ -193,17 +192,25 @@ bool CondensingQpSolver::PrepareReduced() {
   // pattern is built in scratch reserved at construction, the products written out.
   const int n = dense_.num_variables(), m = dense_.num_constraints();
   pattern_fixed_.clear();
-  pattern_free_.clear();
-  for (int i = 0; i < n; ++i) (dense_.lb[i] == dense_.ub[i] ? pattern_fixed_ : pattern_free_).push_back(i);
-  if (pattern_fixed_.empty() || pattern_free_.empty()) {  // nothing to eliminate, or nothing left: the whole QP
+  for (int i = 0; i < n; ++i) {
+    if (dense_.lb[i] == dense_.ub[i]) pattern_fixed_.push_back(i);
+  }
+  const int nF = static_cast<int>(pattern_fixed_.size()), nf = n - nF;
+  if (nF == 0 || nf == 0) {  // nothing to eliminate, or nothing left: the whole QP
     fixed_.clear();
     reduced_.reset();
     return dense_solver_.Factorize(dense_.H);
   }
-  const int nf = static_cast<int>(pattern_free_.size()), nF = static_cast<int>(pattern_fixed_.size());
   if (pattern_fixed_ != fixed_ || !reduced_) {  // a new pattern (a rotor just failed): allocate once for it
     fixed_ = pattern_fixed_;
-    free_ = pattern_free_;
+    free_.clear();
+    for (int i = 0, b = 0; i < n; ++i) {
+      if (b < nF && fixed_[static_cast<std::size_t>(b)] == i) {
+        ++b;
+      } else {
+        free_.push_back(i);
+      }
+    }
     reduced_ = std::make_unique<DenseQp>(nf, m);
     reduced_solver_ = std::make_unique<DenseQpSolver>(nf, m, options_);
     z_fixed_.resize(nF);

@@ -352,7 +352,7 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   const double inv_res = 1.0 / res_;
   const Vector3 o = origin_W * inv_res;
   const double max_cells = options_.max_clearing_range_m / res_;
-  long steps = 0;
+  long steps = 0, listed_total = 0;
   int missed = 0;
   constexpr std::size_t kRaysPerBatch = 64, kPrefetchAhead = 32;
   Cell* const cells = cells_.data();
@@ -384,7 +384,7 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     const auto list = [&](std::uint64_t relative) {
       const std::uint32_t address = AddressOfRelative(relative, residues, top_bits);
       *out = address;
-      out += static_cast<std::ptrdiff_t>(((settled[address >> 6] >> (address & 63)) & 1U) ^ 1U);
+      out += static_cast<std::ptrdiff_t>(!SettledFree(settled, address));
     };
     // Each lane's changing state in locals (registers), its constants in its WindowWalk.
     WindowWalk lane0, lane1;
@@ -403,22 +403,22 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
         WindowWalk::Advance(lane1, tx1, ty1, tz1, r1);
       }
       if (both > 0) n0 -= both, n1 -= both;
-      // A lane in its last voxel, or walking alone, finishes its ray and takes the next.
-      if (n0 == 0 || (n0 > 0 && n1 < 0)) {
-        for (; n0 > 0; --n0) list(r0), WindowWalk::Advance(lane0, tx0, ty0, tz0, r0);
-        list(r0);
-        start_next(&lane0);
-        tx0 = lane0.tx, ty0 = lane0.ty, tz0 = lane0.tz, n0 = lane0.steps, r0 = lane0.relative;
-      }
-      if (n1 == 0 || (n1 > 0 && n0 < 0)) {
-        for (; n1 > 0; --n1) list(r1), WindowWalk::Advance(lane1, tx1, ty1, tz1, r1);
-        list(r1);
-        start_next(&lane1);
-        tx1 = lane1.tx, ty1 = lane1.ty, tz1 = lane1.tz, n1 = lane1.steps, r1 = lane1.relative;
-      }
+      // A lane in its last voxel, or walking alone (the other idle), finishes its ray and takes
+      // the next.
+      const auto finish = [&](WindowWalk& lane, std::int64_t& tx, std::int64_t& ty, std::int64_t& tz,
+                              std::int64_t& n, std::uint64_t& r, std::int64_t other_n) {
+        if (!(n == 0 || (n > 0 && other_n < 0))) return;
+        for (; n > 0; --n) list(r), WindowWalk::Advance(lane, tx, ty, tz, r);
+        list(r);
+        start_next(&lane);
+        tx = lane.tx, ty = lane.ty, tz = lane.tz, n = lane.steps, r = lane.relative;
+      };
+      finish(lane0, tx0, ty0, tz0, n0, r0, n1);
+      finish(lane1, tx1, ty1, tz1, n1, r1, n0);
     }
     const std::uint32_t* const addresses = addresses_.data();
     const std::size_t listed = static_cast<std::size_t>(out - addresses);
+    listed_total += static_cast<long>(listed);
     for (std::size_t k = 0; k < listed; ++k) {
       if (k + kPrefetchAhead < listed) __builtin_prefetch(cells + addresses[k + kPrefetchAhead], 1);
       const std::uint32_t address = addresses[k];
@@ -431,6 +431,7 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     }
   }
   summary.voxels_traversed = steps;
+  summary.voxels_settled_skipped = steps - listed_total;
   summary.voxels_updated = hits + missed;
   return summary;
 }

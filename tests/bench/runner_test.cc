@@ -171,6 +171,7 @@ TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
     EXPECT_GT(r.max_spin_rad_s, 9.0);
     EXPECT_GT(r.map_voxels_occupied, 5000);
     EXPECT_GT(r.lidar_points_dropped, 0) << "pulses into the open sky";
+    EXPECT_GT(r.cost_ms_per_sim_s.mapper, 0.0) << "the stack's LiDAR frames are timed";
     precision[deskew] = p;
   }
   EXPECT_GT(precision[1], 0.95) << "deskewed";    // measured 1.000
@@ -194,6 +195,7 @@ TEST(NavigationClosedLoop, FliesTheRoomsWaypointsOnItsLidarMap) {
   EXPECT_EQ(r.waypoints_reached, 2);
   EXPECT_EQ(r.waypoints_total, 2);
   EXPECT_GE(r.plans, 5) << "replanned as the map filled in";
+  EXPECT_GT(r.cost_ms_per_sim_s.planner, 0.0) << "the planning is timed";
   EXPECT_GT(closest, s.vehicle.collision_radius_m) << "the reference kept the vehicle's radius from the furniture";
   EXPECT_LT(r.tracking_rmse_m, 0.1);
 }

@@ -231,17 +231,14 @@ TEST_F(CliTest, HoverRunSucceedsAndWritesLogAndSummary) {
   EXPECT_EQ(j["success"], true);
   EXPECT_TRUE(j["fdd"].is_null());
   EXPECT_NEAR(j["sim_time_s"].get<double>(), 1.0, 1e-9);
-  // Where the wall-clock time went: every part present, none negative, no LiDAR hence no mapping,
-  // and together the wall time per simulated second (the runner's part is what the others leave).
-  double total = 0.0;
+  // Where the wall-clock time went: every part present, none negative, and no LiDAR hence no
+  // mapping (runner_test checks the mapper and planner are timed when they run).
   for (const char* part : {"simulator", "mapper", "planner", "controller", "stack_other", "runner"}) {
     ASSERT_TRUE(j["cost_ms_per_sim_s"].contains(part)) << part;
     EXPECT_GE(j["cost_ms_per_sim_s"][part].get<double>(), 0.0) << part;
-    total += j["cost_ms_per_sim_s"][part].get<double>();
   }
   EXPECT_EQ(j["cost_ms_per_sim_s"]["mapper"].get<double>(), 0.0);
   EXPECT_GT(j["cost_ms_per_sim_s"]["controller"].get<double>(), 0.0);
-  EXPECT_NEAR(total, 1e3 * j["wall_time_s"].get<double>() / j["sim_time_s"].get<double>(), 1e-6 * total);
   const std::string log = ReadText(fs::path(Out()) / "log.csv");
   EXPECT_EQ(log.rfind("t,p_x,p_y,p_z", 0), 0u);
   // 100 Hz over 1 s plus the header and the final row.

@@ -4,6 +4,7 @@
 /// (flight_log.h: log.csv and scene.json, or flight.mcap), sensors.csv (every message the stack
 /// received; sensor_log.h), vehicle.yaml (the vehicle flown), summary.json and, when asked,
 /// report.html.
+#include <array>
 #include <functional>
 #include <map>
 #include <optional>
@@ -38,6 +39,11 @@ struct RunCost {
   double controller = 0.0;   ///< the stack's controller
   double stack_other = 0.0;  ///< the rest of the stack: estimator, FDD, supervisor, sensor callbacks
   double runner = 0.0;       ///< the loop's own work: metrics, logs, the report's scene
+  /// The parts' names, in the order of the fields (summary.json keys, benchmark columns).
+  static constexpr std::array<const char*, 6> kParts = {"simulator",  "mapper",      "planner",
+                                                        "controller", "stack_other", "runner"};
+  /// The parts' values, in the order of kParts.
+  std::array<double, 6> values() const { return {simulator, mapper, planner, controller, stack_other, runner}; }
   nlohmann::json ToJson() const;
 };
 

@@ -99,8 +99,9 @@ class CondensingQpSolver {
   DenseQp dense_;
   DenseQpSolver dense_solver_;
   // The QP over the free inputs when some are fixed: their indices in dense_, the fixed ones and
-  // their values, and what the fixed values add to the gradient (H_fF z_F) and to C z (C_F z_F).
-  std::vector<int> free_, fixed_, pattern_free_, pattern_fixed_;
+  // their values, and what the fixed values add to the gradient (H_fF z_F) and to C z (C_F z_F);
+  // pattern_fixed_ is the scratch in which Prepare finds the fixed ones.
+  std::vector<int> free_, fixed_, pattern_fixed_;
   Eigen::VectorXd z_fixed_, g_fixed_, c_fixed_, z_;
   std::unique_ptr<DenseQp> reduced_;
   std::unique_ptr<DenseQpSolver> reduced_solver_;
