@@ -106,7 +106,7 @@ void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::Vec
 
 namespace {
 /// out = fx * M using the block sparsity of fx; NU and C are compile-time sizes when known (the
-/// quadrotor: NU = 4, C = 17 or 4), else Eigen::Dynamic.
+/// quadrotor: NU = 4, C = 21, 17 or 4), else Eigen::Dynamic.
 template <int NU, int C>
 void MultiplyBlocks(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M_in, int nu, double sigma,
                     Eigen::MatrixXd* out_full) {
@@ -140,7 +140,9 @@ void NmpcModel::MultiplyStateJacobian(const Eigen::MatrixXd& fx, const Eigen::Ma
                                       Eigen::MatrixXd* out) const {
   out->resize(nx(), M.cols());
   const double sigma = params_.motor_time_constant_s;
-  if (nu_ == 4 && M.cols() == 17) {
+  if (nu_ == 4 && M.cols() == 21) {
+    MultiplyBlocks<4, 21>(fx, M, nu_, sigma, out);
+  } else if (nu_ == 4 && M.cols() == 17) {
     MultiplyBlocks<4, 17>(fx, M, nu_, sigma, out);
   } else if (nu_ == 4 && M.cols() == 4) {
     MultiplyBlocks<4, 4>(fx, M, nu_, sigma, out);
@@ -157,26 +159,24 @@ Rk4Sensitivity::Rk4Sensitivity(const NmpcModel& model, double dt, int substeps)
   const int nx = model.nx(), nu = model.nu();
   for (int i = 0; i < 4; ++i) {
     k_[i].resize(nx);
-    fx_[i].resize(nx, nx);
-    fu_[i].resize(nx, nu);
-    dk_x_[i].resize(nx, nx);
-    dk_u_[i].resize(nx, nu);
+    dk_[i].resize(nx, nx + nu);
   }
+  fx_.resize(nx, nx);
+  fu_.resize(nx, nu);
   xs_.resize(nx);
   xtmp_.resize(nx);
-  ax_.resize(nx, nx);
-  bx_.resize(nx, nu);
-  atmp_.resize(nx, nx);
-  btmp_.resize(nx, nu);
+  ab_.resize(nx, nx + nu);
+  abtmp_.resize(nx, nx + nu);
 }
 
 void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_next,
                           Eigen::MatrixXd* A, Eigen::MatrixXd* B) {
   const bool sens = A != nullptr && B != nullptr;
+  const int nx = model_.nx(), nu = model_.nu();
   xs_ = x;
   if (sens) {
-    ax_.setIdentity();  // d xs / d x
-    bx_.setZero();      // d xs / d u
+    ab_.setZero();  // [d xs / d x, d xs / d u]
+    ab_.leftCols(nx).setIdentity();
   }
   static constexpr double kStage[4] = {0.0, 0.5, 0.5, 1.0};
   static constexpr double kWeight[4] = {1.0 / 6.0, 2.0 / 6.0, 2.0 / 6.0, 1.0 / 6.0};
@@ -188,30 +188,25 @@ void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Ei
         model_.Dynamics(xtmp_, u, &k_[i]);
         continue;
       }
-      model_.DynamicsWithJacobians(xtmp_, u, &k_[i], &fx_[i], &fu_[i]);
+      model_.DynamicsWithJacobians(xtmp_, u, &k_[i], &fx_, &fu_);
       // d k_i = f_x (d xs + c h d k_{i-1}) + f_u d u.
-      atmp_ = ax_;
-      btmp_ = bx_;
       if (i > 0) {
-        atmp_ += kStage[i] * h_ * dk_x_[i - 1];
-        btmp_ += kStage[i] * h_ * dk_u_[i - 1];
+        abtmp_ = ab_ + (kStage[i] * h_) * dk_[i - 1];
+        model_.MultiplyStateJacobian(fx_, abtmp_, &dk_[i]);
+      } else {
+        model_.MultiplyStateJacobian(fx_, ab_, &dk_[i]);
       }
-      model_.MultiplyStateJacobian(fx_[i], atmp_, &dk_x_[i]);
-      model_.MultiplyStateJacobian(fx_[i], btmp_, &dk_u_[i]);
-      dk_u_[i] += fu_[i];
+      dk_[i].rightCols(nu) += fu_;
     }
     for (int i = 0; i < 4; ++i) {
       xs_ += kWeight[i] * h_ * k_[i];
-      if (sens) {
-        ax_ += kWeight[i] * h_ * dk_x_[i];
-        bx_ += kWeight[i] * h_ * dk_u_[i];
-      }
+      if (sens) ab_ += (kWeight[i] * h_) * dk_[i];
     }
   }
   *x_next = xs_;
   if (sens) {
-    *A = ax_;
-    *B = bx_;
+    *A = ab_.leftCols(nx);
+    *B = ab_.rightCols(nu);
   }
 }
 

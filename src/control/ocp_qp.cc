@@ -64,10 +64,8 @@ CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptio
   u_.assign(N, Eigen::VectorXd::Zero(nu));
   tmp_.resize(nx, nx);
   const int n = N * nu, m = N * static_cast<int>(dims.state_bound_index.size());
-  phi_.assign(N + 1, Eigen::MatrixXd::Zero(nx, nx));
-  g_x0_.resize(n, nx);
-  c_x0_.resize(m, nx);
-  dx0_.resize(nx);
+  dx_.resize(nx);
+  dx_next_.resize(nx);
   cdx_.resize(m);
   z_.resize(n);
   pattern_fixed_.reserve(static_cast<std::size_t>(n));
@@ -110,7 +108,9 @@ void CondensingQpSolver::Condense(const OcpQp& qp) {
   for (int m = N - 1; m >= 1; --m) {
     tmp.noalias() = W(m + 1) * A(m);
     W(m) = Q(m);
-    W(m).noalias() += A(m).transpose() * tmp;
+    // Coefficient-based products (lazyProduct) where they beat Eigen's GEMM path at these sizes:
+    // A' (W A) and the 4x4 Hessian blocks (measured: docs/control.md).
+    W(m).noalias() += A(m).transpose().lazyProduct(tmp);
     wv(m) = Eigen::Map<const VecX>(qp.q[m].data(), nx);
     wv(m).noalias() += Q(m) * xb(m) + A(m).transpose() * wv(m + 1);
   }
@@ -119,7 +119,7 @@ void CondensingQpSolver::Condense(const OcpQp& qp) {
     Y(j).noalias() = W(j + 1) * B(j);
     for (int i = 0; i <= j; ++i) {
       MatUU block(nu, nu);
-      block.noalias() = Sm(j + 1, i).transpose() * Y(j);
+      block.noalias() = Sm(j + 1, i).transpose().lazyProduct(Y(j));
       if (i == j) {
         dense_.H.block(j * nu, j * nu, nu, nu) = block + Eigen::Map<const MatUU>(qp.R[j].data(), nu, nu);
       } else {
@@ -144,16 +144,6 @@ void CondensingQpSolver::Condense(const OcpQp& qp) {
         dense_.uc[row] = qp.x_upper[k][b] - x_bar_[k][idx[b]];
       }
     }
-  }
-  // Sensitivities to the initial state, for the feedback phase: x_bar_k moves by Phi_k0 dx0 with
-  // Phi_k0 = A_{k-1} ... A_0, so g_j moves by B_j' W_{j+1} Phi_{j+1,0} dx0 = Y_j' Phi_{j+1,0} dx0
-  // and the state-bound rows by -Phi_k0[idx, :] dx0.
-  const auto Phi = [&](int k) { return Eigen::Map<MatXX>(phi_[k].data(), nx, nx); };
-  Phi(0).setIdentity();
-  for (int k = 1; k <= N; ++k) Phi(k).noalias() = A(k - 1) * Phi(k - 1);
-  for (int j = 0; j < N; ++j) g_x0_.block(j * nu, 0, nu, nx).noalias() = Y(j).transpose() * Phi(j + 1);
-  for (int k = 1; k <= N; ++k) {
-    for (int b = 0; b < nbx; ++b) c_x0_.row((k - 1) * nbx + b) = Phi(k).row(idx[b]);
   }
 }
 
@@ -244,12 +234,20 @@ const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
     summary_.status = QpStatus::kNumericalFailure;
     return summary_;
   }
-  // Only what depends on the measured state: O(n nx) updates, then the active-set iterations.
-  dx0_ = x0 - prepared_x0_;
+  // Only what depends on the measured state. x_bar_k moves by dx_k = A_{k-1} dx_{k-1} (dx_0 =
+  // x0 - prepared x0), so g_j moves by B_j' W_{j+1} dx_{j+1} = Y_j' dx_{j+1} and the state-bound
+  // rows by -dx_k[idx]: one forward pass of matrix-vector products, O(N nx^2).
+  const std::vector<int>& idx = dims_.state_bound_index;
+  const int nbx = static_cast<int>(idx.size());
+  dx_ = x0 - prepared_x0_;
   dense_.g = g0_;
-  dense_.g.noalias() += g_x0_ * dx0_;
+  for (int k = 0; k < N; ++k) {
+    dx_next_.noalias() = qp.A[k] * dx_;
+    dx_.swap(dx_next_);  // dx_ now holds dx_{k+1}
+    dense_.g.segment(k * nu, nu).noalias() += y_[k].transpose() * dx_;
+    for (int b = 0; b < nbx; ++b) cdx_[k * nbx + b] = dx_[idx[b]];
+  }
   if (dense_.num_constraints() > 0) {
-    cdx_.noalias() = c_x0_ * dx0_;
     dense_.lc = lc0_ - cdx_;
     dense_.uc = uc0_ - cdx_;
   }

@@ -498,15 +498,12 @@ bool VoxelMap::SegmentCollides(const Vector3& a, const Vector3& b) const {
 }
 
 std::vector<Vector3> VoxelMap::OccupiedVoxels() const {
+  // In memory order: a linear scan of the cells (most of them free), unwrapping only the few
+  // occupied addresses. Walking the window by index wrapped every address instead.
   std::vector<Vector3> out;
   out.reserve(static_cast<std::size_t>(occupied_count_));
-  Index i;
-  for (i.x() = origin_.x(); i.x() < origin_.x() + size_.x(); ++i.x()) {
-    for (i.y() = origin_.y(); i.y() < origin_.y() + size_.y(); ++i.y()) {
-      for (i.z() = origin_.z(); i.z() < origin_.z() + size_.z(); ++i.z()) {
-        if (Occupied(cells_[Address(i)])) out.push_back(Center(i));
-      }
-    }
+  for (std::size_t a = 0; a < cells_.size(); ++a) {
+    if (Occupied(cells_[a])) out.push_back(Center(IndexOf(a)));
   }
   return out;
 }

@@ -48,7 +48,9 @@ class Rk4Sensitivity {
   double h_;
   int substeps_;
   Eigen::VectorXd k_[4], xs_, xtmp_;
-  Eigen::MatrixXd fx_[4], fu_[4], dk_x_[4], dk_u_[4], ax_, bx_, atmp_, btmp_;
+  // The sensitivities to x and u side by side, [d/dx d/du] (nx x (nx + nu)): one structured
+  // product per stage instead of two.
+  Eigen::MatrixXd fx_, fu_, dk_[4], ab_, abtmp_;
 };
 
 }  // namespace rotorguard::control

@@ -61,15 +61,16 @@ class CondensingQpSolver {
   explicit CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options = {});
   /// Solves `qp` (whose dims must equal the solver's): Prepare(qp) then Feedback(qp.x0).
   const OcpQpSummary& Solve(const OcpQp& qp);
-  /// Preparation phase of a real-time iteration: condenses `qp` around its x0, the sensitivities
-  /// of the condensed gradient and constraint bounds to x0, and factorises the Hessian. Inputs
+  /// Preparation phase of a real-time iteration: condenses `qp` around its x0 and factorises the
+  /// Hessian. Inputs
   /// whose bounds coincide (a failed rotor's, u_bar_i = 0) are fixed: they are eliminated, and the
   /// dense QP is solved over the free inputs only (fewer variables, and no active-set changes for
   /// bounds that hold by construction). `qp` must outlive the following Feedback calls and stay
   /// unchanged.
   const OcpQpSummary& Prepare(const OcpQp& qp);
   /// Feedback phase: the QP for the measured initial state x0 (only the gradient and bounds move,
-  /// linearly in x0 - prepared x0), solved on the prepared factorisation, and the trajectory.
+  /// linearly in x0 - prepared x0, by one forward pass through the A_k), solved on the prepared
+  /// factorisation, and the trajectory.
   const OcpQpSummary& Feedback(const Eigen::VectorXd& x0);
   const std::vector<Eigen::VectorXd>& u() const { return u_; }  ///< N inputs
   const std::vector<Eigen::VectorXd>& x() const { return x_; }  ///< N + 1 states
@@ -92,9 +93,8 @@ class CondensingQpSolver {
   std::vector<Eigen::MatrixXd> s_, w_matrix_, y_;
   std::vector<Eigen::VectorXd> x_bar_, w_vector_, x_, u_;
   Eigen::MatrixXd tmp_;
-  std::vector<Eigen::MatrixXd> phi_;  // Phi_k0 = A_{k-1} ... A_0, k = 0..N
-  Eigen::MatrixXd g_x0_, c_x0_;       // d g / d x0, d (C z bound rows) / d x0
-  Eigen::VectorXd g0_, lc0_, uc0_, prepared_x0_, dx0_, cdx_, qx_, ru_;
+  // The prepared gradient and state-bound rows, and the scratch of their shift by x0 in Feedback.
+  Eigen::VectorXd g0_, lc0_, uc0_, prepared_x0_, dx_, dx_next_, cdx_, qx_, ru_;
   const OcpQp* prepared_ = nullptr;
   DenseQp dense_;
   DenseQpSolver dense_solver_;

@@ -95,7 +95,7 @@ class VoxelMap {
   /// count as free: the planner is optimistic about what it has not seen).
   bool SegmentCollides(const Vector3& a_W, const Vector3& b_W) const;
 
-  /// Centres of all occupied voxels (for scoring and display).
+  /// Centres of all occupied voxels (for scoring and display), in no particular order.
   std::vector<Vector3> OccupiedVoxels() const;
   int occupied_count() const { return occupied_count_; }
   double resolution() const { return res_; }
