@@ -1,7 +1,10 @@
 #include "rotorguard/perception/deskew.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <numeric>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -59,9 +62,65 @@ TEST(Deskew, IsExactWithPerfectEstimates) {
     }
     raw_mean /= static_cast<double>(out.size());
     EXPECT_LT(deskewed_max, 5e-4) << "frame " << frames;
+
     EXPECT_GT(raw_mean, 0.1) << "frame " << frames;
   }
   EXPECT_EQ(frames, 3);
+}
+
+// A rate about body z only that changes at every gyro sample: the rotations commute, so a point's
+// rotation to the frame's end is about z by the integral of the held rate, a closed form. Every
+// point must find its own gyro segment, in time order and shuffled.
+TEST(Deskew, PiecewiseConstantRatesMatchTheClosedFormInAnyPointOrder) {
+  DeskewOptions o;
+  o.sensor_position_m = Vector3(0.05, -0.02, 0.08);
+  Deskewer d(o);
+  const TimeNs period = 3'000'000;  // 333 Hz
+  const auto rate = [](TimeNs i) { return 4.0 + 7.0 * static_cast<double>(i % 3) - 2.0 * static_cast<double>(i % 5); };
+  for (TimeNs i = 0; i < 60; ++i) d.OnImu(ImuSample{i * period, Vector3(0, 0, 9.81), Vector3(0, 0, rate(i))});
+  LidarFrame f;
+  f.t_start_ns = 50'500'000;
+  f.t_end_ns = 150'500'000;
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<float> coordinate(-5.0f, 5.0f);
+  for (std::uint32_t i = 0; i < 2000; ++i) {
+    f.offset_ns.push_back(i * 50'000 + static_cast<std::uint32_t>(gen() % 50'000));  // increasing
+    f.points_S.emplace_back(coordinate(gen), coordinate(gen), coordinate(gen));
+  }
+  // The angle turned from t to the frame's end, each sample's rate held until the next sample.
+  const auto angle_to_end = [&](TimeNs t) {
+    double angle = 0.0;
+    for (TimeNs s = t; s < f.t_end_ns;) {
+      const TimeNs i = s / period, next = std::min((i + 1) * period, f.t_end_ns);
+      angle += rate(i) * ToSeconds(next - s);
+      s = next;
+    }
+    return angle;
+  };
+  const auto expect_closed_form = [&](const LidarFrame& frame, const std::vector<Eigen::Vector3f>& out) {
+    ASSERT_EQ(out.size(), frame.points_S.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const double angle = angle_to_end(frame.t_start_ns + frame.offset_ns[i]);
+      // A world-fixed point seen from a body turned by +angle about z: Rz(-angle) in the end frame.
+      const Vector3 expected =
+          Eigen::AngleAxisd(-angle, Vector3::UnitZ()) * (o.sensor_position_m + frame.points_S[i].cast<double>()) -
+          o.sensor_position_m;
+      ASSERT_LT((out[i].cast<double>() - expected).norm(), 2e-5) << "point " << i;
+    }
+  };
+  std::vector<Eigen::Vector3f> out;
+  d.Deskew(f, Vector3::Zero(), Quaternion::Identity(), &out);
+  expect_closed_form(f, out);
+  std::vector<std::size_t> order(f.points_S.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), gen);
+  LidarFrame shuffled = f;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    shuffled.points_S[i] = f.points_S[order[i]];
+    shuffled.offset_ns[i] = f.offset_ns[order[i]];
+  }
+  d.Deskew(shuffled, Vector3::Zero(), Quaternion::Identity(), &out);
+  expect_closed_form(shuffled, out);
 }
 
 // Bad points (non-finite) are skipped, an empty frame gives nothing, and without gyro samples the
