@@ -106,7 +106,7 @@ void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::Vec
 
 namespace {
 /// out = fx * M using the block sparsity of fx; NU and C are compile-time sizes when known (the
-/// quadrotor: NU = 4, C = 21, 17 or 4), else Eigen::Dynamic.
+/// quadrotor's RK4: NU = 4, C = 21), else Eigen::Dynamic.
 template <int NU, int C>
 void MultiplyBlocks(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M_in, int nu, double sigma,
                     Eigen::MatrixXd* out_full) {
@@ -140,12 +140,8 @@ void NmpcModel::MultiplyStateJacobian(const Eigen::MatrixXd& fx, const Eigen::Ma
                                       Eigen::MatrixXd* out) const {
   out->resize(nx(), M.cols());
   const double sigma = params_.motor_time_constant_s;
-  if (nu_ == 4 && M.cols() == 21) {
+  if (nu_ == 4 && M.cols() == 21) {  // the quadrotor's RK4 sensitivities [d/dx d/du]
     MultiplyBlocks<4, 21>(fx, M, nu_, sigma, out);
-  } else if (nu_ == 4 && M.cols() == 17) {
-    MultiplyBlocks<4, 17>(fx, M, nu_, sigma, out);
-  } else if (nu_ == 4 && M.cols() == 4) {
-    MultiplyBlocks<4, 4>(fx, M, nu_, sigma, out);
   } else {
     MultiplyBlocks<Eigen::Dynamic, Eigen::Dynamic>(fx, M, nu_, sigma, out);
   }

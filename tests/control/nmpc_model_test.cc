@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <numbers>
+
 #include "rotorguard/core/rng.h"
 #include "rotorguard/vehicle/multirotor.h"
 #include "test_util.h"
@@ -15,21 +17,38 @@ using rotorguard::testing::NumericalJacobian;
 using rotorguard::testing::ReferenceQuad;
 
 /// A non-trivial state: tilted, moving, spinning, motors loaded unevenly.
-Eigen::VectorXd SomeState(Rng& rng) {
-  Eigen::VectorXd x(17);
+Eigen::VectorXd SomeState(Rng& rng, int rotors = 4) {
+  Eigen::VectorXd x(13 + rotors);
   x.segment<3>(0) << rng.Normal(), rng.Normal(), 1.0 + rng.Uniform();
   Eigen::Vector4d q(1.0, 0.3 * rng.Normal(), 0.3 * rng.Normal(), rng.Normal());
   x.segment<4>(3) = q.normalized();
   x.segment<3>(7) << 2.0 * rng.Normal(), 2.0 * rng.Normal(), rng.Normal();
   x.segment<3>(10) << rng.Normal(), rng.Normal(), 11.0 * rng.Uniform();
-  for (int i = 0; i < 4; ++i) x[13 + i] = rng.Uniform(0.5, 8.0);
+  for (int i = 0; i < rotors; ++i) x[13 + i] = rng.Uniform(0.5, 8.0);
   return x;
 }
 
-Eigen::VectorXd SomeInput(Rng& rng) {
-  Eigen::VectorXd u(4);
-  for (int i = 0; i < 4; ++i) u[i] = rng.Uniform(0.0, 11.5);
+Eigen::VectorXd SomeInput(Rng& rng, int rotors = 4) {
+  Eigen::VectorXd u(rotors);
+  for (int i = 0; i < rotors; ++i) u[i] = rng.Uniform(0.0, 11.5);
   return u;
+}
+
+/// The reference quadrotor's body with six rotors on a circle, spins alternating: the model's
+/// generic (run-time sized) paths.
+vehicle::VehicleParams Hexarotor() {
+  vehicle::VehicleParams p = ReferenceQuad();
+  p.name = "reference_hexa";
+  const vehicle::Rotor r0 = p.rotors[0];
+  p.rotors.clear();
+  for (int i = 0; i < 6; ++i) {
+    vehicle::Rotor r = r0;
+    const double angle = std::numbers::pi / 6.0 + i * std::numbers::pi / 3.0;
+    r.p_B = Vector3(0.1 * std::cos(angle), 0.1 * std::sin(angle), 0.0);
+    r.direction = i % 2 == 0 ? vehicle::SpinDirection::kCounterClockwise : vehicle::SpinDirection::kClockwise;
+    p.rotors.push_back(r);
+  }
+  return p;
 }
 
 TEST(NmpcModel, EqualsTheSimulatorModelForHealthyRotorsWithinBounds) {
@@ -76,34 +95,38 @@ TEST(NmpcModel, AnalyticJacobiansMatchFiniteDifferences) {
 }
 
 TEST(Rk4Sensitivity, DiscreteSensitivitiesMatchFiniteDifferences) {
-  const NmpcModel model(ReferenceQuad());
-  for (int substeps : {1, 3}) {
-    Rk4Sensitivity rk4(model, 0.05, substeps);
-    Rng rng(3 + substeps);
-    for (int trial = 0; trial < 10; ++trial) {
-      const Eigen::VectorXd x = SomeState(rng), u = SomeInput(rng);
-      Eigen::VectorXd next;
-      Eigen::MatrixXd A, B;
-      rk4.Step(x, u, &next, &A, &B);
-      Eigen::VectorXd plain;
-      rk4.Step(x, u, &plain);
-      EXPECT_TRUE(MatricesNear(next, plain, 1e-14));  // sensitivities do not change the step
-      const Eigen::MatrixXd A_num = NumericalJacobian(
-          [&](const Eigen::VectorXd& xx) {
-            Eigen::VectorXd out;
-            rk4.Step(xx, u, &out);
-            return out;
-          },
-          x);
-      const Eigen::MatrixXd B_num = NumericalJacobian(
-          [&](const Eigen::VectorXd& uu) {
-            Eigen::VectorXd out;
-            rk4.Step(x, uu, &out);
-            return out;
-          },
-          u);
-      EXPECT_TRUE(MatricesNear(A, A_num, 1e-6 * (1.0 + A.cwiseAbs().maxCoeff()))) << substeps << "/" << trial;
-      EXPECT_TRUE(MatricesNear(B, B_num, 1e-6 * (1.0 + B.cwiseAbs().maxCoeff()))) << substeps << "/" << trial;
+  // The quadrotor (compile-time sized products) and a hexarotor (the generic ones).
+  for (const vehicle::VehicleParams& vehicle : {ReferenceQuad(), Hexarotor()}) {
+    const NmpcModel model(vehicle);
+    const int rotors = vehicle.num_rotors();
+    for (int substeps : {1, 3}) {
+      Rk4Sensitivity rk4(model, 0.05, substeps);
+      Rng rng(3 + substeps);
+      for (int trial = 0; trial < 10; ++trial) {
+        const Eigen::VectorXd x = SomeState(rng, rotors), u = SomeInput(rng, rotors);
+        Eigen::VectorXd next;
+        Eigen::MatrixXd A, B;
+        rk4.Step(x, u, &next, &A, &B);
+        Eigen::VectorXd plain;
+        rk4.Step(x, u, &plain);
+        EXPECT_TRUE(MatricesNear(next, plain, 1e-14));  // sensitivities do not change the step
+        const Eigen::MatrixXd A_num = NumericalJacobian(
+            [&](const Eigen::VectorXd& xx) {
+              Eigen::VectorXd out;
+              rk4.Step(xx, u, &out);
+              return out;
+            },
+            x);
+        const Eigen::MatrixXd B_num = NumericalJacobian(
+            [&](const Eigen::VectorXd& uu) {
+              Eigen::VectorXd out;
+              rk4.Step(x, uu, &out);
+              return out;
+            },
+            u);
+        EXPECT_TRUE(MatricesNear(A, A_num, 1e-6 * (1.0 + A.cwiseAbs().maxCoeff()))) << substeps << "/" << trial;
+        EXPECT_TRUE(MatricesNear(B, B_num, 1e-6 * (1.0 + B.cwiseAbs().maxCoeff()))) << substeps << "/" << trial;
+      }
     }
   }
 }
@@ -144,7 +167,7 @@ TEST(NmpcModel, StructuredJacobianProductEqualsTheDenseProduct) {
   Eigen::VectorXd f;
   Eigen::MatrixXd fx, fu, out;
   model.DynamicsWithJacobians(x, u, &f, &fx, &fu);
-  for (int cols : {21, 17, 4}) {  // generic, and the two compile-time-sized paths
+  for (int cols : {21, 9}) {  // the RK4's compile-time-sized [d/dx d/du] path, and the generic one
     const Eigen::MatrixXd M = Eigen::MatrixXd::Random(17, cols);
     model.MultiplyStateJacobian(fx, M, &out);
     EXPECT_TRUE(rotorguard::testing::MatricesNear(out, fx * M, 1e-12 * (fx * M).cwiseAbs().maxCoeff())) << cols;

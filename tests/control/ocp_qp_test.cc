@@ -1,7 +1,11 @@
 #include "rotorguard/control/ocp_qp.h"
 
-#include <Eigen/Dense>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
 
 #include "rotorguard/core/rng.h"
 #include "test_util.h"
@@ -45,8 +49,8 @@ OcpQp RandomOcp(int N, int nx, int nu, std::vector<int> bounded, Rng& rng) {
 
 /// Condensing done the naive way: the prediction matrix built from explicit products, the Hessian
 /// as Gamma' Qbig Gamma + Rbig. An oracle independent of the solver's recursions.
-void NaiveCondense(const OcpQp& qp, Eigen::MatrixXd* H, Eigen::VectorXd* g, Eigen::MatrixXd* C,
-                   Eigen::VectorXd* lc, Eigen::VectorXd* uc) {
+void NaiveCondense(const OcpQp& qp, Eigen::MatrixXd* H, Eigen::VectorXd* g, Eigen::MatrixXd* C, Eigen::VectorXd* lc,
+                   Eigen::VectorXd* uc) {
   const int N = qp.dims.horizon, nx = qp.dims.nx, nu = qp.dims.nu;
   const int nbx = static_cast<int>(qp.dims.state_bound_index.size());
   Eigen::MatrixXd gamma = Eigen::MatrixXd::Zero(N * nx, N * nu);  // rows: x_1 .. x_N
@@ -179,21 +183,52 @@ TEST(CondensingQp, RespectsInputAndStateBoundsWhenTheyBind) {
 
 TEST(CondensingQp, FeedbackOnAPreparedProblemEqualsAFreshSolveAtTheMeasuredState) {
   // The real-time iteration's split: prepare around a predicted x0, feed back the measured one.
+  // The feedback shifts the condensed gradient and state-bound rows by the measured state's free
+  // response; the oracle is the QP condensed afresh at the measured state. The cost pulls the
+  // bounded states beyond their +-1.5 so that state bounds bind; a one-stage horizon and a
+  // problem without state bounds are the edge cases. Each split solver feeds back twice before
+  // the compared call (nothing may carry over between feedbacks).
   Rng rng(21);
-  for (int nx : {6, 17}) {
-    const int nu = nx == 17 ? 4 : 2;
-    OcpQp qp = RandomOcp(8, nx, nu, {0, 3}, rng);
+  struct Case {
+    int N, nx, nu;
+    std::vector<int> bounded;
+  };
+  for (const Case& c : {Case{8, 6, 2, {0, 3}}, Case{8, 17, 4, {0, 3}}, Case{1, 6, 2, {0, 3}}, Case{8, 6, 2, {}}}) {
+    OcpQp qp = RandomOcp(c.N, c.nx, c.nu, c.bounded, rng);
     qp.x0 *= 0.1;
-    const Eigen::VectorXd measured = qp.x0 + 0.05 * RandomMatrix(nx, 1, rng);
+    Eigen::VectorXd target = Eigen::VectorXd::Zero(c.nx);
+    target[0] = 4.0;
+    target[3] = -4.0;
+    for (int k = 0; k < c.N; ++k) {
+      qp.A[k] = Eigen::MatrixXd::Identity(c.nx, c.nx) + 0.02 * (qp.A[k] - Eigen::MatrixXd::Identity(c.nx, c.nx));
+      qp.B[k] *= 4.0;
+    }
+    for (int k = 0; k <= c.N; ++k) qp.q[k] = -qp.Q[k] * target;
+    const std::string name = fmt::format("N {} nx {} bounds {}", c.N, c.nx, c.bounded.size());
     CondensingQpSolver split(qp.dims), fresh(qp.dims);
     split.Prepare(qp);
+    for (int i = 0; i < 2; ++i) split.Feedback(qp.x0 + 0.3 * RandomMatrix(c.nx, 1, rng));
+    const Eigen::VectorXd measured = qp.x0 + 0.05 * RandomMatrix(c.nx, 1, rng);
     const OcpQpSummary& s = split.Feedback(measured);
-    ASSERT_TRUE(s.IsSolutionUsable()) << s.BriefReport();
+    ASSERT_TRUE(s.IsSolutionUsable()) << name << ": " << s.BriefReport();
     OcpQp measured_qp = qp;
     measured_qp.x0 = measured;
-    ASSERT_TRUE(fresh.Solve(measured_qp).IsSolutionUsable());
-    for (int k = 0; k < 8; ++k) EXPECT_TRUE(MatricesNear(split.u()[k], fresh.u()[k], 1e-9)) << "nx " << nx << " u_" << k;
-    EXPECT_TRUE(MatricesNear(split.x()[8], fresh.x()[8], 1e-9));
+    ASSERT_TRUE(fresh.Solve(measured_qp).IsSolutionUsable()) << name;
+    const DenseQp &shifted = split.condensed(), &condensed = fresh.condensed();
+    EXPECT_TRUE(MatricesNear(shifted.g, condensed.g, 1e-10)) << name;
+    if (!c.bounded.empty()) {
+      EXPECT_TRUE(MatricesNear(shifted.lc, condensed.lc, 1e-10)) << name;
+      EXPECT_TRUE(MatricesNear(shifted.uc, condensed.uc, 1e-10)) << name;
+      int binding = 0;  // the state bounds are part of the compared solution
+      for (int k = 1; k <= c.N; ++k) {
+        for (int b : c.bounded) binding += std::abs(std::abs(fresh.x()[k][b]) - 1.5) < 1e-7;
+      }
+      if (c.N > 1) {
+        EXPECT_GT(binding, 0) << name;
+      }
+    }
+    for (int k = 0; k < c.N; ++k) EXPECT_TRUE(MatricesNear(split.u()[k], fresh.u()[k], 1e-9)) << name << " u_" << k;
+    EXPECT_TRUE(MatricesNear(split.x()[c.N], fresh.x()[c.N], 1e-9)) << name;
   }
 }
 
@@ -220,7 +255,7 @@ TEST(CondensingQp, InputsFixedByEqualBoundsGiveTheSolutionOfTheWholeQp) {
   for (int pattern : {0, 1, 2, 0}) {
     OcpQp qp = base;
     for (int k = 0; k < 8; ++k) {
-      if (pattern == 0) qp.u_lower[k][1] = qp.u_upper[k][1] = 0.25;  // input 1 held at every stage
+      if (pattern == 0) qp.u_lower[k][1] = qp.u_upper[k][1] = 0.25;                // input 1 held at every stage
       if (pattern == 1 && k % 3 == 0) qp.u_lower[k][2] = qp.u_upper[k][2] = -0.1;  // input 2 at some
     }
     const Eigen::VectorXd measured = qp.x0 + 0.05 * RandomMatrix(6, 1, rng);
@@ -238,7 +273,8 @@ TEST(CondensingQp, InputsFixedByEqualBoundsGiveTheSolutionOfTheWholeQp) {
     DenseQpSolver oracle(8 * 3, 8 * 2);
     ASSERT_TRUE(oracle.Solve(whole).IsSolutionUsable());
     for (int k = 0; k < 8; ++k) {
-      EXPECT_TRUE(MatricesNear(solver.u()[k], oracle.z().segment(3 * k, 3), 1e-8)) << "pattern " << pattern << " u_" << k;
+      EXPECT_TRUE(MatricesNear(solver.u()[k], oracle.z().segment(3 * k, 3), 1e-8))
+          << "pattern " << pattern << " u_" << k;
       if (pattern == 0) {
         EXPECT_EQ(solver.u()[k][1], 0.25);  // exactly, not to a tolerance
       }

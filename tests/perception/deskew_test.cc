@@ -62,7 +62,6 @@ TEST(Deskew, IsExactWithPerfectEstimates) {
     }
     raw_mean /= static_cast<double>(out.size());
     EXPECT_LT(deskewed_max, 5e-4) << "frame " << frames;
-
     EXPECT_GT(raw_mean, 0.1) << "frame " << frames;
   }
   EXPECT_EQ(frames, 3);

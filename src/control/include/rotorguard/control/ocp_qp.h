@@ -62,9 +62,8 @@ class CondensingQpSolver {
   /// Solves `qp` (whose dims must equal the solver's): Prepare(qp) then Feedback(qp.x0).
   const OcpQpSummary& Solve(const OcpQp& qp);
   /// Preparation phase of a real-time iteration: condenses `qp` around its x0 and factorises the
-  /// Hessian. Inputs
-  /// whose bounds coincide (a failed rotor's, u_bar_i = 0) are fixed: they are eliminated, and the
-  /// dense QP is solved over the free inputs only (fewer variables, and no active-set changes for
+  /// Hessian. Inputs whose bounds coincide (a failed rotor's, u_bar_i = 0) are fixed: they are
+  /// eliminated, and the dense QP is solved over the free inputs only (fewer variables, and no active-set changes for
   /// bounds that hold by construction). `qp` must outlive the following Feedback calls and stay
   /// unchanged.
   const OcpQpSummary& Prepare(const OcpQp& qp);
