@@ -57,10 +57,14 @@ void NmpcModel::Dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eig
 
 void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot,
                                       Eigen::MatrixXd* fx, Eigen::MatrixXd* fu) const {
+  fx->setZero(nx(), nx());
+  fu->setZero(nx(), nu_);
+  UpdateDynamicsWithJacobians(x, u, x_dot, fx, fu);
+}
+
+void NmpcModel::UpdateDynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot,
+                                            Eigen::MatrixXd* fx, Eigen::MatrixXd* fu) const {
   Dynamics(x, u, x_dot);
-  const int n = nx();
-  fx->setZero(n, n);
-  fu->setZero(n, nu_);
   const double qw = x[3], qx = x[4], qy = x[5], qz = x[6];
   const Eigen::Matrix3d R = RotationOf(qw, qx, qy, qz);
   Eigen::Matrix3d dR[4];
@@ -106,7 +110,7 @@ void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::Vec
 
 namespace {
 /// out = fx * M using the block sparsity of fx; NU and C are compile-time sizes when known (the
-/// quadrotor's RK4: NU = 4, C = 21), else Eigen::Dynamic.
+/// quadrotor's RK4: NU = 4, C = 18), else Eigen::Dynamic.
 template <int NU, int C>
 void MultiplyBlocks(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M_in, int nu, double sigma,
                     Eigen::MatrixXd* out_full) {
@@ -140,8 +144,8 @@ void NmpcModel::MultiplyStateJacobian(const Eigen::MatrixXd& fx, const Eigen::Ma
                                       Eigen::MatrixXd* out) const {
   out->resize(nx(), M.cols());
   const double sigma = params_.motor_time_constant_s;
-  if (nu_ == 4 && M.cols() == 21) {  // the quadrotor's RK4 sensitivities [d/dx d/du]
-    MultiplyBlocks<4, 21>(fx, M, nu_, sigma, out);
+  if (nu_ == 4 && M.cols() == 18) {  // the quadrotor's RK4 sensitivities [d/d(q, v, w, T) d/du]
+    MultiplyBlocks<4, 18>(fx, M, nu_, sigma, out);
   } else {
     MultiplyBlocks<Eigen::Dynamic, Eigen::Dynamic>(fx, M, nu_, sigma, out);
   }
@@ -152,17 +156,18 @@ Rk4Sensitivity::Rk4Sensitivity(const NmpcModel& model, double dt, int substeps)
   if (!(dt > 0.0) || substeps < 1) {
     ThrowInvalidArgument("Rk4Sensitivity", "dt, substeps", fmt::format("{}, {}", dt, substeps), "dt > 0 and substeps >= 1");
   }
-  const int nx = model.nx(), nu = model.nu();
+  static_assert(StateIndex::kPosition == 0, "the position columns are the first three");
+  const int nx = model.nx(), nu = model.nu(), cols = nx - 3 + nu;
   for (int i = 0; i < 4; ++i) {
     k_[i].resize(nx);
-    dk_[i].resize(nx, nx + nu);
+    dk_[i].resize(nx, cols);
   }
-  fx_.resize(nx, nx);
-  fu_.resize(nx, nu);
+  fx_.setZero(nx, nx);  // UpdateDynamicsWithJacobians writes only the structural entries
+  fu_.setZero(nx, nu);
   xs_.resize(nx);
   xtmp_.resize(nx);
-  ab_.resize(nx, nx + nu);
-  abtmp_.resize(nx, nx + nu);
+  ab_.resize(nx, cols);
+  abtmp_.resize(nx, cols);
 }
 
 void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_next,
@@ -171,8 +176,8 @@ void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Ei
   const int nx = model_.nx(), nu = model_.nu();
   xs_ = x;
   if (sens) {
-    ab_.setZero();  // [d xs / d x, d xs / d u]
-    ab_.leftCols(nx).setIdentity();
+    ab_.setZero();  // [d xs / d(q, v, w, T), d xs / d u]
+    ab_.topLeftCorner(nx, nx - 3).bottomRows(nx - 3).setIdentity();
   }
   static constexpr double kStage[4] = {0.0, 0.5, 0.5, 1.0};
   static constexpr double kWeight[4] = {1.0 / 6.0, 2.0 / 6.0, 2.0 / 6.0, 1.0 / 6.0};
@@ -184,7 +189,7 @@ void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Ei
         model_.Dynamics(xtmp_, u, &k_[i]);
         continue;
       }
-      model_.DynamicsWithJacobians(xtmp_, u, &k_[i], &fx_, &fu_);
+      model_.UpdateDynamicsWithJacobians(xtmp_, u, &k_[i], &fx_, &fu_);
       // d k_i = f_x (d xs + c h d k_{i-1}) + f_u d u.
       if (i > 0) {
         abtmp_ = ab_ + (kStage[i] * h_) * dk_[i - 1];
@@ -201,7 +206,10 @@ void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Ei
   }
   *x_next = xs_;
   if (sens) {
-    *A = ab_.leftCols(nx);
+    A->resize(nx, nx);
+    A->leftCols<3>().setZero();
+    A->topLeftCorner<3, 3>().setIdentity();
+    A->rightCols(nx - 3) = ab_.leftCols(nx - 3);
     *B = ab_.rightCols(nu);
   }
 }

@@ -21,6 +21,11 @@ class NmpcModel {
   /// f and its Jacobians df/dx (nx x nx) and df/du (nx x nu).
   void DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot,
                              Eigen::MatrixXd* fx, Eigen::MatrixXd* fu) const;
+  /// DynamicsWithJacobians for a caller that keeps its Jacobians: writes only the entries the
+  /// model's structure can make nonzero. `fx` (nx x nx) and `fu` (nx x nu) must be zero elsewhere,
+  /// as after DynamicsWithJacobians or a previous call.
+  void UpdateDynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot,
+                                   Eigen::MatrixXd* fx, Eigen::MatrixXd* fu) const;
   /// out = fx * M for an fx of DynamicsWithJacobians, using its block sparsity (about a quarter of
   /// the dense product's work): p_dot depends on v only, q_dot on q and w, v_dot on q, v and T,
   /// w_dot on w and T, T_dot on T.
@@ -48,8 +53,9 @@ class Rk4Sensitivity {
   double h_;
   int substeps_;
   Eigen::VectorXd k_[4], xs_, xtmp_;
-  // The sensitivities to x and u side by side, [d/dx d/du] (nx x (nx + nu)): one structured
-  // product per stage instead of two.
+  // The sensitivities to x and u side by side, [d/dx d/du] without the position columns (nx x
+  // (nx - 3 + nu)): one structured product per stage. Nothing in the model depends on the
+  // position, so d/dp stays [I; 0] through every stage and is not propagated.
   Eigen::MatrixXd fx_, fu_, dk_[4], ab_, abtmp_;
 };
 
