@@ -207,21 +207,16 @@ bool CondensingQpSolver::PrepareReduced() {
     g_fixed_.resize(nf);
     c_fixed_.resize(m);
   }
-  for (int b = 0; b < nF; ++b) z_fixed_[b] = dense_.lb[fixed_[b]];
-  for (int a = 0; a < nf; ++a) {
-    for (int b = 0; b < nf; ++b) reduced_->H(a, b) = dense_.H(free_[a], free_[b]);
-    double shift = 0.0;
-    for (int b = 0; b < nF; ++b) shift += dense_.H(free_[a], fixed_[b]) * z_fixed_[b];
-    g_fixed_[a] = shift;
-    reduced_->lb[a] = dense_.lb[free_[a]];
-    reduced_->ub[a] = dense_.ub[free_[a]];
-  }
-  for (int r = 0; r < m; ++r) {
-    for (int a = 0; a < nf; ++a) reduced_->C(r, a) = dense_.C(r, free_[a]);
-    double shift = 0.0;
-    for (int b = 0; b < nF; ++b) shift += dense_.C(r, fixed_[b]) * z_fixed_[b];
-    c_fixed_[r] = shift;
-  }
+  // Indexed views copy coefficient by coefficient; the fixed inputs' shares are coefficient-based
+  // products (lazyProduct), which need no temporary.
+  const IndexList free = FreeInputs(), fixed = FixedInputs();
+  z_fixed_ = dense_.lb(fixed);
+  reduced_->H = dense_.H(free, free);
+  g_fixed_.noalias() = dense_.H(free, fixed).lazyProduct(z_fixed_);
+  reduced_->lb = dense_.lb(free);
+  reduced_->ub = dense_.ub(free);
+  reduced_->C = dense_.C(Eigen::all, free);
+  c_fixed_.noalias() = dense_.C(Eigen::all, fixed).lazyProduct(z_fixed_);
   return reduced_solver_->Factorize(reduced_->H);
 }
 
@@ -254,16 +249,14 @@ const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
   const DenseQpSummary* ds = nullptr;
   if (reduced_) {
     // Over the free inputs: the fixed ones' share of the gradient and of C z moved to the data.
-    for (std::size_t a = 0; a < free_.size(); ++a) {
-      reduced_->g[static_cast<int>(a)] = dense_.g[free_[a]] + g_fixed_[static_cast<int>(a)];
-    }
+    reduced_->g = dense_.g(FreeInputs()) + g_fixed_;
     if (dense_.num_constraints() > 0) {
       reduced_->lc = dense_.lc - c_fixed_;
       reduced_->uc = dense_.uc - c_fixed_;
     }
     ds = &reduced_solver_->SolveFactorized(*reduced_);
-    for (std::size_t a = 0; a < free_.size(); ++a) z_[free_[a]] = reduced_solver_->z()[static_cast<int>(a)];
-    for (std::size_t b = 0; b < fixed_.size(); ++b) z_[fixed_[b]] = z_fixed_[static_cast<int>(b)];
+    z_(FreeInputs()) = reduced_solver_->z();
+    z_(FixedInputs()) = z_fixed_;
   } else {
     ds = &dense_solver_.SolveFactorized(dense_);
     z_ = dense_solver_.z();

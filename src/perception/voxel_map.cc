@@ -1,6 +1,7 @@
 #include "rotorguard/perception/voxel_map.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -47,17 +48,11 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   // Voxels per axis: the requested extent rounded up to a power of two (at least 8), so that the
   // ring buffer's index arithmetic is a mask rather than a division (the hottest path).
   for (int k = 0; k < 3; ++k) {
-    const int needed = static_cast<int>(std::ceil(options_.window_size_m[k] / res_));
-    size_[k] = 8;
-    while (size_[k] < needed) size_[k] *= 2;
+    const auto needed = static_cast<unsigned>(std::ceil(options_.window_size_m[k] / res_));
+    size_[k] = static_cast<int>(std::bit_ceil(std::max(needed, 8U)));
   }
-  const auto log2 = [](int v) {
-    int l = 0;
-    while ((1 << l) < v) ++l;
-    return l;
-  };
-  shift_y_ = log2(size_.z());
-  shift_x_ = shift_y_ + log2(size_.y());
+  shift_y_ = std::countr_zero(static_cast<unsigned>(size_.z()));  // log2 of a power of two
+  shift_x_ = shift_y_ + std::countr_zero(static_cast<unsigned>(size_.y()));
   field_top_bits_ = (static_cast<std::uint64_t>(size_.x() / 2) << shift_x_) |
                     (static_cast<std::uint64_t>(size_.y() / 2) << shift_y_) | static_cast<std::uint64_t>(size_.z() / 2);
   SetOrigin(-size_ / 2);

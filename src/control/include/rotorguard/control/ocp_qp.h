@@ -63,9 +63,9 @@ class CondensingQpSolver {
   const OcpQpSummary& Solve(const OcpQp& qp);
   /// Preparation phase of a real-time iteration: condenses `qp` around its x0 and factorises the
   /// Hessian. Inputs whose bounds coincide (a failed rotor's, u_bar_i = 0) are fixed: they are
-  /// eliminated, and the dense QP is solved over the free inputs only (fewer variables, and no active-set changes for
-  /// bounds that hold by construction). `qp` must outlive the following Feedback calls and stay
-  /// unchanged.
+  /// eliminated, and the dense QP is solved over the free inputs only (fewer variables, and no
+  /// active-set changes for bounds that hold by construction). `qp` must outlive the following
+  /// Feedback calls and stay unchanged.
   const OcpQpSummary& Prepare(const OcpQp& qp);
   /// Feedback phase: the QP for the measured initial state x0 (only the gradient and bounds move,
   /// linearly in x0 - prepared x0, by one forward pass through the A_k), solved on the prepared
@@ -101,6 +101,11 @@ class CondensingQpSolver {
   // their values, and what the fixed values add to the gradient (H_fF z_F) and to C z (C_F z_F);
   // pattern_fixed_ is the scratch in which Prepare finds the fixed ones.
   std::vector<int> free_, fixed_, pattern_fixed_;
+  // free_ and fixed_ as index lists of Eigen's indexed views (an IndexedView of a std::vector
+  // would copy it, an allocation per use).
+  using IndexList = Eigen::Map<const Eigen::ArrayXi>;
+  IndexList FreeInputs() const { return IndexList(free_.data(), static_cast<Eigen::Index>(free_.size())); }
+  IndexList FixedInputs() const { return IndexList(fixed_.data(), static_cast<Eigen::Index>(fixed_.size())); }
   Eigen::VectorXd z_fixed_, g_fixed_, c_fixed_, z_;
   std::unique_ptr<DenseQp> reduced_;
   std::unique_ptr<DenseQpSolver> reduced_solver_;
