@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <numbers>
+#include <utility>
 
 #include "rotorguard/core/rng.h"
 #include "rotorguard/vehicle/multirotor.h"
@@ -32,6 +34,19 @@ Eigen::VectorXd SomeInput(Rng& rng, int rotors = 4) {
   Eigen::VectorXd u(rotors);
   for (int i = 0; i < rotors; ++i) u[i] = rng.Uniform(0.0, 11.5);
   return u;
+}
+
+/// Central-difference Jacobians of out = f(x, u) with respect to x and to u.
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> JacobiansByDifferences(
+    const std::function<void(const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd*)>& f,
+    const Eigen::VectorXd& x, const Eigen::VectorXd& u) {
+  const auto at = [&f](const Eigen::VectorXd& xx, const Eigen::VectorXd& uu) {
+    Eigen::VectorXd out;
+    f(xx, uu, &out);
+    return out;
+  };
+  return {NumericalJacobian([&](const Eigen::VectorXd& xx) { return at(xx, u); }, x),
+          NumericalJacobian([&](const Eigen::VectorXd& uu) { return at(x, uu); }, u)};
 }
 
 /// The reference quadrotor's body with six rotors on a circle, spins alternating: the model's
@@ -74,20 +89,9 @@ TEST(NmpcModel, AnalyticJacobiansMatchFiniteDifferences) {
     Eigen::VectorXd f;
     Eigen::MatrixXd fx, fu;
     model.DynamicsWithJacobians(x, u, &f, &fx, &fu);
-    const Eigen::MatrixXd fx_num = NumericalJacobian(
-        [&](const Eigen::VectorXd& xx) {
-          Eigen::VectorXd out;
-          model.Dynamics(xx, u, &out);
-          return out;
-        },
-        x);
-    const Eigen::MatrixXd fu_num = NumericalJacobian(
-        [&](const Eigen::VectorXd& uu) {
-          Eigen::VectorXd out;
-          model.Dynamics(x, uu, &out);
-          return out;
-        },
-        u);
+    const auto [fx_num, fu_num] = JacobiansByDifferences([&](const Eigen::VectorXd& xx, const Eigen::VectorXd& uu,
+                                                             Eigen::VectorXd* out) { model.Dynamics(xx, uu, out); },
+                                                         x, u);
     // Central differences with h = 1e-6 on entries of size ~1e2: errors ~1e-7 relative.
     EXPECT_TRUE(MatricesNear(fx, fx_num, 1e-5 * (1.0 + fx.cwiseAbs().maxCoeff()))) << "trial " << trial;
     EXPECT_TRUE(MatricesNear(fu, fu_num, 1e-6 * (1.0 + fu.cwiseAbs().maxCoeff()))) << "trial " << trial;
@@ -110,20 +114,9 @@ TEST(Rk4Sensitivity, DiscreteSensitivitiesMatchFiniteDifferences) {
         Eigen::VectorXd plain;
         rk4.Step(x, u, &plain);
         EXPECT_TRUE(MatricesNear(next, plain, 1e-14));  // sensitivities do not change the step
-        const Eigen::MatrixXd A_num = NumericalJacobian(
-            [&](const Eigen::VectorXd& xx) {
-              Eigen::VectorXd out;
-              rk4.Step(xx, u, &out);
-              return out;
-            },
-            x);
-        const Eigen::MatrixXd B_num = NumericalJacobian(
-            [&](const Eigen::VectorXd& uu) {
-              Eigen::VectorXd out;
-              rk4.Step(x, uu, &out);
-              return out;
-            },
-            u);
+        const auto [A_num, B_num] = JacobiansByDifferences(
+            [&](const Eigen::VectorXd& xx, const Eigen::VectorXd& uu, Eigen::VectorXd* out) { rk4.Step(xx, uu, out); },
+            x, u);
         EXPECT_TRUE(MatricesNear(A, A_num, 1e-6 * (1.0 + A.cwiseAbs().maxCoeff()))) << substeps << "/" << trial;
         EXPECT_TRUE(MatricesNear(B, B_num, 1e-6 * (1.0 + B.cwiseAbs().maxCoeff()))) << substeps << "/" << trial;
       }

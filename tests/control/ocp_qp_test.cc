@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rotorguard/core/rng.h"
@@ -45,6 +47,32 @@ OcpQp RandomOcp(int N, int nx, int nu, std::vector<int> bounded, Rng& rng) {
     qp.x_upper[k].setConstant(1.5);
   }
   return qp;
+}
+
+/// RandomOcp with mild dynamics from a small start and a cost that pulls states 0 and 3 to +-4,
+/// beyond the bounds' +-1.5, so that state bounds bind.
+OcpQp OcpPulledAgainstItsStateBounds(int N, int nx, int nu, std::vector<int> bounded, Rng& rng) {
+  OcpQp qp = RandomOcp(N, nx, nu, std::move(bounded), rng);
+  qp.x0 *= 0.1;
+  Eigen::VectorXd target = Eigen::VectorXd::Zero(nx);
+  target[0] = 4.0;
+  target[3] = -4.0;
+  for (int k = 0; k < N; ++k) {
+    qp.A[k] = Eigen::MatrixXd::Identity(nx, nx) + 0.02 * (qp.A[k] - Eigen::MatrixXd::Identity(nx, nx));
+    qp.B[k] *= 4.0;
+    qp.c[k].setZero();
+  }
+  for (int k = 0; k <= N; ++k) qp.q[k] = -qp.Q[k] * target;
+  return qp;
+}
+
+/// States of a trajectory at their +-1.5 bound (stages 1..N, the bounded indices).
+int StateBoundsAtTheirLimit(const std::vector<Eigen::VectorXd>& x, const std::vector<int>& bounded) {
+  int binding = 0;
+  for (std::size_t k = 1; k < x.size(); ++k) {
+    for (int b : bounded) binding += std::abs(std::abs(x[k][b]) - 1.5) < 1e-7;
+  }
+  return binding;
 }
 
 /// Condensing done the naive way: the prediction matrix built from explicit products, the Hessian
@@ -194,16 +222,7 @@ TEST(CondensingQp, FeedbackOnAPreparedProblemEqualsAFreshSolveAtTheMeasuredState
     std::vector<int> bounded;
   };
   for (const Case& c : {Case{8, 6, 2, {0, 3}}, Case{8, 17, 4, {0, 3}}, Case{1, 6, 2, {0, 3}}, Case{8, 6, 2, {}}}) {
-    OcpQp qp = RandomOcp(c.N, c.nx, c.nu, c.bounded, rng);
-    qp.x0 *= 0.1;
-    Eigen::VectorXd target = Eigen::VectorXd::Zero(c.nx);
-    target[0] = 4.0;
-    target[3] = -4.0;
-    for (int k = 0; k < c.N; ++k) {
-      qp.A[k] = Eigen::MatrixXd::Identity(c.nx, c.nx) + 0.02 * (qp.A[k] - Eigen::MatrixXd::Identity(c.nx, c.nx));
-      qp.B[k] *= 4.0;
-    }
-    for (int k = 0; k <= c.N; ++k) qp.q[k] = -qp.Q[k] * target;
+    const OcpQp qp = OcpPulledAgainstItsStateBounds(c.N, c.nx, c.nu, c.bounded, rng);
     const std::string name = fmt::format("N {} nx {} bounds {}", c.N, c.nx, c.bounded.size());
     CondensingQpSolver split(qp.dims), fresh(qp.dims);
     split.Prepare(qp);
@@ -219,12 +238,8 @@ TEST(CondensingQp, FeedbackOnAPreparedProblemEqualsAFreshSolveAtTheMeasuredState
     if (!c.bounded.empty()) {
       EXPECT_TRUE(MatricesNear(shifted.lc, condensed.lc, 1e-10)) << name;
       EXPECT_TRUE(MatricesNear(shifted.uc, condensed.uc, 1e-10)) << name;
-      int binding = 0;  // the state bounds are part of the compared solution
-      for (int k = 1; k <= c.N; ++k) {
-        for (int b : c.bounded) binding += std::abs(std::abs(fresh.x()[k][b]) - 1.5) < 1e-7;
-      }
-      if (c.N > 1) {
-        EXPECT_GT(binding, 0) << name;
+      if (c.N > 1) {  // the state bounds are part of the compared solution
+        EXPECT_GT(StateBoundsAtTheirLimit(fresh.x(), c.bounded), 0) << name;
       }
     }
     for (int k = 0; k < c.N; ++k) EXPECT_TRUE(MatricesNear(split.u()[k], fresh.u()[k], 1e-9)) << name << " u_" << k;
@@ -238,18 +253,8 @@ TEST(CondensingQp, FeedbackOnAPreparedProblemEqualsAFreshSolveAtTheMeasuredState
 // stage pattern, then none, then the first again), with the feedback at a measured state.
 TEST(CondensingQp, InputsFixedByEqualBoundsGiveTheSolutionOfTheWholeQp) {
   Rng rng(33);
-  OcpQp base = RandomOcp(8, 6, 3, {0, 3}, rng);
-  // Mild dynamics from a small start and a cost that pulls the bounded states beyond their
-  // +-1.5, so that state bounds bind too (their rows carry the fixed inputs' share).
-  base.x0 *= 0.1;
-  Eigen::VectorXd target = Eigen::VectorXd::Zero(6);
-  target << 4.0, 0.0, 0.0, -4.0, 0.0, 0.0;
-  for (int k = 0; k < 8; ++k) {
-    base.A[k] = Eigen::MatrixXd::Identity(6, 6) + 0.02 * (base.A[k] - Eigen::MatrixXd::Identity(6, 6));
-    base.B[k] *= 4.0;
-    base.c[k].setZero();
-  }
-  for (int k = 0; k <= 8; ++k) base.q[k] = -base.Q[k] * target;
+  // State bounds bind too: their rows carry the fixed inputs' share.
+  const OcpQp base = OcpPulledAgainstItsStateBounds(8, 6, 3, {0, 3}, rng);
   CondensingQpSolver solver(base.dims);
   int compared = 0;
   for (int pattern : {0, 1, 2, 0}) {
@@ -281,11 +286,7 @@ TEST(CondensingQp, InputsFixedByEqualBoundsGiveTheSolutionOfTheWholeQp) {
       ++compared;
     }
     EXPECT_GE(s.active_constraints, pattern == 0 ? 8 : (pattern == 1 ? 3 : 0)) << "the fixed inputs count as active";
-    int binding = 0;  // state bounds at their limit
-    for (int k = 1; k <= 8; ++k) {
-      for (int b : {0, 3}) binding += std::abs(std::abs(solver.x()[k][b]) - 1.5) < 1e-7;
-    }
-    EXPECT_GT(binding, 0) << "pattern " << pattern;
+    EXPECT_GT(StateBoundsAtTheirLimit(solver.x(), {0, 3}), 0) << "pattern " << pattern;
   }
   EXPECT_EQ(compared, 32);
 }
