@@ -1,6 +1,6 @@
 // Micro-benchmarks of the NMPC's parts (Google Benchmark): the RK4 step with and without exact
 // sensitivities, the condensing of an N = 20, nx = 17, nu = 4 OCP QP, the dense dual active-set
-// solve, and one real-time iteration in hover and while spinning after a failure.
+// solve and its factorisation, and one real-time iteration in hover and while spinning after a failure.
 // Run: build/bin/nmpc_benchmark
 #include <benchmark/benchmark.h>
 
@@ -90,6 +90,19 @@ void BM_CondensingQpSolve(benchmark::State& state) {
   state.counters["dense_us"] = 1e6 * dense / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_CondensingQpSolve);
+
+// The dense solver's factorisation (Cholesky and J0 = L^-T) of the condensed Hessian: 80 inputs
+// in hover, 60 once a failed rotor's 20 are eliminated (the leading block of the same Hessian).
+void BM_DenseQpFactorize(benchmark::State& state) {
+  const auto n = static_cast<int>(state.range(0));
+  const control::OcpQp qp = NmpcSizedQp();
+  control::CondensingQpSolver condensing(qp.dims);
+  condensing.Solve(qp);
+  const Eigen::MatrixXd H = condensing.condensed().H.topLeftCorner(n, n);
+  control::DenseQpSolver solver(n, 0);
+  for (auto _ : state) benchmark::DoNotOptimize(solver.Factorize(H));
+}
+BENCHMARK(BM_DenseQpFactorize)->Arg(60)->Arg(80);
 
 // One backward Riccati factorisation of the same QP (compile-time sizes): the work an interior-
 // point method with Riccati recursion (HPIPM's approach) repeats at each of its iterations.
