@@ -169,8 +169,7 @@ Campaign NavCampaign(const NavBenchOptions& o) {
                    {"planner_ms_mean", s.planner_ms_mean},
                    {"stack_ms_per_cycle_mean", s.stack_ms_per_cycle_mean},
                    {"realtime_factor", s.realtime_factor}};
-    const std::array<double, RunCost::kParts.size()> cost = s.cost_ms_per_sim_s.values();
-    for (std::size_t k = 0; k < cost.size(); ++k) out.metrics[CostMetric(RunCost::kParts[k])] = cost[k];
+    for (const RunCost::Part& p : RunCost::kParts) out.metrics[CostMetric(p.name)] = s.cost_ms_per_sim_s.*p.field;
     out.message = s.failure_reason;
     return out;
   };
@@ -199,7 +198,7 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
       t.planner_ms_mean = x["planner_ms_mean"].get<double>();
       t.stack_ms_per_cycle_mean = x["stack_ms_per_cycle_mean"].get<double>();
       t.realtime_factor = x["realtime_factor"].get<double>();
-      for (const char* part : RunCost::kParts) t.cost_ms_per_sim_s[part] = x.at(CostMetric(part)).get<double>();
+      for (const RunCost::Part& p : RunCost::kParts) t.cost_ms_per_sim_s[p.name] = x.at(CostMetric(p.name)).get<double>();
     }
     results.push_back(t);
   }
@@ -254,7 +253,7 @@ std::string NavMarkdown(const nlohmann::json& r) {
   for (const char* v : kVariants) row("all", v, r[v]);
   // Where the wall-clock time goes (all trials): the parts add up to 1000 / real-time factor.
   md += "\nWall-clock time per simulated second [ms], all trials:\n\n| variant |";
-  for (const char* p : RunCost::kParts) md += fmt::format(" {} |", p);
+  for (const RunCost::Part& p : RunCost::kParts) md += fmt::format(" {} |", p.name);
   md += " total |\n|---|";
   for (std::size_t k = 0; k <= RunCost::kParts.size(); ++k) md += "---|";
   md += "\n";
@@ -262,8 +261,8 @@ std::string NavMarkdown(const nlohmann::json& r) {
     const nlohmann::json& c = r[v]["cost_ms_per_sim_s"];
     double total = 0.0;
     md += fmt::format("| {} |", v);
-    for (const char* p : RunCost::kParts) {
-      const double ms = c.value(p, 0.0);
+    for (const RunCost::Part& p : RunCost::kParts) {
+      const double ms = c.value(p.name, 0.0);
       total += ms;
       md += fmt::format(" {:.1f} |", ms);
     }

@@ -88,8 +88,7 @@ double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
 
 nlohmann::json RunCost::ToJson() const {
   nlohmann::json j = nlohmann::json::object();
-  const std::array<double, kParts.size()> v = values();
-  for (std::size_t k = 0; k < kParts.size(); ++k) j[kParts[k]] = v[k];
+  for (const Part& p : kParts) j[p.name] = this->*p.field;
   return j;
 }
 

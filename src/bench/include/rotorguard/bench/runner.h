@@ -39,11 +39,17 @@ struct RunCost {
   double controller = 0.0;   ///< the stack's controller
   double stack_other = 0.0;  ///< the rest of the stack: estimator, FDD, supervisor, sensor callbacks
   double runner = 0.0;       ///< the loop's own work: metrics, logs, the report's scene
-  /// The parts' names, in the order of the fields (summary.json keys, benchmark columns).
-  static constexpr std::array<const char*, 6> kParts = {"simulator",  "mapper",      "planner",
-                                                        "controller", "stack_other", "runner"};
-  /// The parts' values, in the order of kParts.
-  std::array<double, 6> values() const { return {simulator, mapper, planner, controller, stack_other, runner}; }
+  /// Each part's name (summary.json key, benchmark column) and field, in one list.
+  struct Part {
+    const char* name;
+    double RunCost::*field;
+  };
+  static constexpr std::array<Part, 6> kParts = {{{"simulator", &RunCost::simulator},
+                                                  {"mapper", &RunCost::mapper},
+                                                  {"planner", &RunCost::planner},
+                                                  {"controller", &RunCost::controller},
+                                                  {"stack_other", &RunCost::stack_other},
+                                                  {"runner", &RunCost::runner}}};
   nlohmann::json ToJson() const;
 };
 
