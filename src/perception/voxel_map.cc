@@ -67,6 +67,7 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   cells_.assign(n, Cell{});
   inflation_.assign(n, 0);
   settled_free_.assign(n / 64, 0);  // n is a multiple of 512 (at least 8 voxels per axis)
+  occupied_.assign(n / 64, 0);
   // Offsets whose voxel centres lie within the radius of the centre voxel's.
   const int r = static_cast<int>(std::ceil(options_.inflation_radius_m / res_));
   stencil_radius_ = r;
@@ -217,6 +218,7 @@ void VoxelMap::Recenter(const Vector3& center_W) {
     for (Cell& c : cells_) c = Cell{0, c.stamp, 0};  // the frame stamps stay valid
     std::fill(inflation_.begin(), inflation_.end(), 0);
     std::fill(settled_free_.begin(), settled_free_.end(), 0);
+    std::fill(occupied_.begin(), occupied_.end(), 0);
     occupied_count_ = 0;
     SetOrigin(new_origin);
     return;
@@ -253,6 +255,7 @@ void VoxelMap::Recenter(const Vector3& center_W) {
     cells_[address] = Cell{0, cells_[address].stamp, 0};
     inflation_[address] = 0;
     SetSettledFree(address, false);
+    SetBit(&occupied_, address, false);
   });
   const Index old_origin = origin_;
   SetOrigin(new_origin);
@@ -493,12 +496,14 @@ bool VoxelMap::SegmentCollides(const Vector3& a, const Vector3& b) const {
 }
 
 std::vector<Vector3> VoxelMap::OccupiedVoxels() const {
-  // In memory order: a linear scan of the cells (most of them free), unwrapping only the few
-  // occupied addresses. Walking the window by index wrapped every address instead.
+  // The occupied bits in memory order, 64 addresses a word (most words are zero), unwrapping only
+  // the occupied addresses.
   std::vector<Vector3> out;
   out.reserve(static_cast<std::size_t>(occupied_count_));
-  for (std::size_t a = 0; a < cells_.size(); ++a) {
-    if (Occupied(cells_[a])) out.push_back(Center(IndexOf(a)));
+  for (std::size_t w = 0; w < occupied_.size(); ++w) {
+    for (std::uint64_t bits = occupied_[w]; bits != 0; bits &= bits - 1) {
+      out.push_back(Center(IndexOf(64 * w + static_cast<std::size_t>(std::countr_zero(bits)))));
+    }
   }
   return out;
 }

@@ -294,6 +294,22 @@ TEST(VoxelMap, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
         }
       }
     }
+    // The list of occupied voxels (the report's snapshots, kept as bits beside the cells): each
+    // once, exactly the reference's occupied voxels up to the undecided.
+    const std::vector<Vector3> listed_centers = map.OccupiedVoxels();
+    std::set<Key> listed;
+    for (const Vector3& c : listed_centers) listed.insert(key_of(c));
+    ASSERT_EQ(listed.size(), listed_centers.size()) << "frame " << frame;
+    ASSERT_EQ(static_cast<int>(listed.size()), map.occupied_count()) << "frame " << frame;
+    for (const auto& [v, log_odds] : reference) {
+      if (undecided.count(v)) continue;
+      ASSERT_EQ(listed.count(v) == 1, log_odds > o.occupied_threshold + 1e-9) << "frame " << frame;
+    }
+    for (const Key& v : listed) {
+      const auto it = reference.find(v);
+      ASSERT_TRUE(undecided.count(v) || (it != reference.end() && it->second > o.occupied_threshold))
+          << "frame " << frame << " at " << center_of(v).transpose();
+    }
   }
   EXPECT_GT(compared, 60 * 2000);  // of the window's 16 x 16 x 8, all but the undecided
   EXPECT_GT(occupied_seen, 2000);
