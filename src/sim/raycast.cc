@@ -104,10 +104,12 @@ RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std:
     const double c = std::abs(std::cos(b.yaw_rad)), s = std::abs(std::sin(b.yaw_rad));
     const double ex = 0.5 * (c * b.size_m.x() + s * b.size_m.y()), ey = 0.5 * (s * b.size_m.x() + c * b.size_m.y());
     bounds.emplace_back(b.center_m.x() - ex, b.center_m.y() - ey, b.center_m.x() + ex, b.center_m.y() + ey);
+    top_ = std::max(top_, b.center_m.z() + 0.5 * b.size_m.z());
   }
   for (const Cylinder& cy : world_.cylinders) {
     bounds.emplace_back(cy.center_m.x() - cy.radius_m, cy.center_m.y() - cy.radius_m, cy.center_m.x() + cy.radius_m,
                         cy.center_m.y() + cy.radius_m);
+    top_ = std::max(top_, cy.height_m);
   }
   last_ray_.assign(static_cast<std::size_t>(n_static), 0);
   if (n_static == 0) return;
@@ -161,10 +163,14 @@ std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double
     std::fill(last_ray_.begin(), last_ray_.end(), 0u);
     ray_id_ = 1;
   }
-  // The part of the ray inside the grid's horizontal bounds: [t_in, t_out].
+  // The part of the ray inside the grid's horizontal bounds and below the obstacles' top:
+  // [t_in, t_out]. (Most of a LiDAR's pulses are sky: those that rise leave every obstacle behind
+  // once above the tallest, long before the grid's edge.)
   const Eigen::Vector2d o2 = o.head<2>(), d2 = d.head<2>();
   const Eigen::Vector2d hi = min_ + cell_ * Eigen::Vector2d(nx_, ny_);
   double t_in = 0.0, t_out = best ? best->distance_m : max_m;
+  const double t_top = d.z() > 0.0 ? (top_ - o.z()) / d.z() : kInf;
+  t_out = std::min(t_out, t_top);
   for (int i = 0; i < 2; ++i) {
     if (std::abs(d2[i]) < 1e-15) {
       if (o2[i] < min_[i] || o2[i] > hi[i]) return best;
@@ -192,7 +198,7 @@ std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double
   double t_cell = t_in;
   while (true) {
     const double range = best ? best->distance_m : max_m;
-    if (t_cell > range) break;  // every later cell lies beyond the nearest hit
+    if (t_cell > range || t_cell > t_top) break;  // every later cell lies beyond the nearest hit or above the top
     const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
     for (int k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
       const int obstacle = items_[static_cast<std::size_t>(k)];

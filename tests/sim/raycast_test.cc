@@ -133,6 +133,36 @@ TEST(Raycast, GridMatchesBruteForceInAForest) {
   EXPECT_GT(hits, 10000);
 }
 
+// The walk stops once a rising ray is above the tallest obstacle, box or cylinder alike: rays that
+// rise to just below the top of the tallest still hit it (closed form: the face's distance along
+// the ray), and rays just above it pass.
+TEST(Raycast, RisingRaysHitTheTallestObstacleNearItsTop) {
+  for (const bool box_tallest : {true, false}) {
+    SCOPED_TRACE(box_tallest ? "a box is the tallest" : "a cylinder is the tallest");
+    World w;
+    w.cylinders.push_back({Eigen::Vector2d(-6, 3), 0.2, box_tallest ? 2.0 : 9.0});  // to the left, out of the way
+    w.boxes.push_back({Vector3(-6, -3, 1), Vector3(1, 1, 2), 0.0});
+    // The target: its near face at x = 9.5, top at z = 9.
+    if (box_tallest) {
+      w.boxes.push_back({Vector3(10, 0, 4.5), Vector3(1, 4, 9), 0.0});
+    } else {
+      w.cylinders.push_back({Eigen::Vector2d(10, 0), 0.5, 9.0});
+    }
+    RayCaster caster(w, RayCasterOptions{1.0});
+    const Vector3 o(0, 0, 1);
+    for (const double z_at_face : {8.99, 9.01}) {
+      const Vector3 d = Vector3(9.5, 0, z_at_face - 1.0).normalized();
+      const auto hit = caster.Cast(o, d, 40.0, 0.0);
+      if (z_at_face < 9.0) {
+        ASSERT_TRUE(hit);
+        EXPECT_NEAR(hit->distance_m, std::hypot(9.5, z_at_face - 1.0), 1e-9);
+      } else {
+        EXPECT_FALSE(hit) << "over the top";
+      }
+    }
+  }
+}
+
 TEST(Raycast, RejectsABadCellSize) {
   EXPECT_THROW(RayCaster(World{}, RayCasterOptions{0.0}), std::invalid_argument);
 }

@@ -48,6 +48,7 @@ class RayCaster {
   double cell_ = 1.0;
   Eigen::Vector2d min_ = Eigen::Vector2d::Zero();  // grid origin (lower corner)
   int nx_ = 0, ny_ = 0;
+  double top_ = 0.0;             // the highest point of the static obstacles [m]
   std::vector<int> cell_start_;  // CSR: obstacles of cell c are items_[cell_start_[c] .. cell_start_[c + 1])
   std::vector<int> items_;
   std::vector<std::uint32_t> last_ray_;  // mailbox: the ray that last tested each obstacle
