@@ -162,7 +162,7 @@ void NmpcController::UpdateThrustSplit() {
     const Eigen::Vector3d& p = vehicle_.rotors[active[c]].p_B;
     E.col(c) << 1.0, p.y(), -p.x();
   }
-  const Eigen::VectorXd t = E.completeOrthogonalDecomposition().solve(Eigen::Vector3d(1.0, 0.0, 0.0));
+  const Eigen::VectorXd t = E.completeOrthogonalDecomposition().solve(Eigen::VectorXd::Unit(3, 0));  // (1, 0, 0)
   for (int c = 0; c < static_cast<int>(active.size()); ++c) unit_split_[active[c]] = std::max(0.0, t[c]);
 }
 
@@ -312,9 +312,12 @@ bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, doub
       qp_.u_upper[k] = u_max_ - u_[k];
     }
     if (k > 0) {
-      const Eigen::Vector3d w = x_[k].segment<3>(StateIndex::kBodyRate);
-      qp_.x_lower[k] = -options_.max_rate_rad_s - w;
-      qp_.x_upper[k] = options_.max_rate_rad_s - w;
+      // Per axis (a fixed 3-vector assigned to a dynamic one makes GCC 12 warn of a 4-wide load).
+      for (int a = 0; a < 3; ++a) {
+        const double w = x_[k][StateIndex::kBodyRate + a];
+        qp_.x_lower[k][a] = -options_.max_rate_rad_s[a] - w;
+        qp_.x_upper[k][a] = options_.max_rate_rad_s[a] - w;
+      }
     }
   }
   qp_.x0.setZero();  // condensed around the plan's own first node; the measurement comes later

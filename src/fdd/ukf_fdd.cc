@@ -95,7 +95,9 @@ void UkfFdd::OnImu(const ImuSample& imu) {
     // Specific force at the IMU: thrust and rotor drag over the mass, plus the centripetal term.
     const Vector3 f_cog = (Vector3(0.0, 0.0, wrench_of(s)[0]) - vp.rotor_drag_kg_s.cwiseProduct(v_B)) / vp.mass_kg;
     Eigen::VectorXd z(6);
-    z << f_cog + w.cross(w.cross(r)), w;
+    // Fixed-size blocks (through a dynamic one GCC 12 warns of a 4-wide load from a 3-vector).
+    z.head<3>() = f_cog + w.cross(w.cross(r));
+    z.tail<3>() = w;
     return z;
   };
   Eigen::VectorXd q(3 + n_);

@@ -147,8 +147,9 @@ TEST(DenseQp, SatisfiesKktOnLargeProblemsWithManyActiveConstraints) {
 
 TEST(DenseQp, UnconstrainedMinimumWhenNothingBinds) {
   DenseQp qp(3, 0);
-  qp.H = Eigen::Vector3d(2.0, 4.0, 8.0).asDiagonal();
-  qp.g = Eigen::Vector3d(-2.0, 4.0, 0.0);
+  qp.H.setZero();
+  qp.H.diagonal() << 2.0, 4.0, 8.0;
+  qp.g << -2.0, 4.0, 0.0;
   DenseQpSolver solver(3, 0);
   ASSERT_TRUE(solver.Solve(qp).IsSolutionUsable());
   EXPECT_LT((solver.z() - Eigen::Vector3d(1.0, -1.0, 0.0)).norm(), 1e-14);
