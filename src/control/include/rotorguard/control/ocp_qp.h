@@ -78,7 +78,6 @@ class CondensingQpSolver {
   const DenseQp& condensed() const { return dense_; }
 
  private:
-  Eigen::MatrixXd& S(int k, int j) { return s_[k * (k - 1) / 2 + j]; }  // dx_k/du_j, 0 <= j < k <= N
   /// Fills dense_ from qp; NX and NU are the sizes when known at compile time, else Dynamic.
   template <int NX, int NU>
   void Condense(const OcpQp& qp);
@@ -89,7 +88,9 @@ class CondensingQpSolver {
 
   OcpQpDims dims_;
   DenseQpOptions options_;
-  std::vector<Eigen::MatrixXd> s_, w_matrix_, y_;
+  // s_rows_[k] = [S_k0 ... S_k,k-1] side by side (nx x k nu), S_kj = dx_k/du_j: one product per
+  // stage builds a row of them, and one per input the Hessian's column of blocks.
+  std::vector<Eigen::MatrixXd> s_rows_, w_matrix_, y_;
   std::vector<Eigen::VectorXd> x_bar_, w_vector_, x_, u_;
   Eigen::MatrixXd tmp_;
   // The prepared gradient and state-bound rows, and the scratch of their shift by x0 in Feedback.
