@@ -15,9 +15,17 @@ namespace rotorguard::control {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// Givens rotation (c, s) with [c s; -s c] (a, b)' = (hypot(a, b), 0)'.
+/// Givens rotation (c, s) with [c s; -s c] (a, b)' = (hypot(a, b), 0)'. sqrt(a² + b²) where the
+/// squares neither overflow nor underflow; std::hypot, which scales and is far slower (it was 2 %
+/// of a forest flight's time), only where they would.
 inline void Givens(double a, double b, double* c, double* s) {
-  const double h = std::hypot(a, b);
+  const double h2 = a * a + b * b;
+  double h;
+  if (h2 > std::numeric_limits<double>::min() && h2 < std::numeric_limits<double>::max()) {
+    h = std::sqrt(h2);
+  } else {
+    h = std::hypot(a, b);
+  }
   if (h == 0.0) {
     *c = 1.0;
     *s = 0.0;
