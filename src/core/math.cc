@@ -23,6 +23,35 @@ Matrix3 ExpSO3(const Vector3& theta) {
   return Matrix3::Identity() + a * K + b * (K * K);
 }
 
+void SinCosOfTurns(double u, double* sin_out, double* cos_out) {
+  // u = j / 4 + f with j the nearest quarter and |f| <= 1/8 (both exact: 4 u - j is a difference
+  // of nearby doubles), so the angle is j quarter turns plus r = 2 pi f, |r| <= pi / 4, where
+  // the series below stop at r^17 and r^18 (the next terms are below 1e-19).
+  const double turns4 = 4.0 * (u - std::floor(u));
+  const double quarters = std::nearbyint(turns4);
+  const double r = (0.5 * std::numbers::pi) * (turns4 - quarters);
+  const double r2 = r * r;
+  // Horner in r^2 with coefficients (-1)^k / (2k+1)! and (-1)^k / (2k)!.
+  double sp = 1.0 / 355687428096000.0;  // 1/17!
+  for (const double c : {-1.0 / 1307674368000.0, 1.0 / 6227020800.0, -1.0 / 39916800.0, 1.0 / 362880.0,
+                         -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0, 1.0}) {
+    sp = sp * r2 + c;
+  }
+  double cp = -1.0 / 6402373705728000.0;  // -1/18!
+  for (const double c : {1.0 / 20922789888000.0, -1.0 / 87178291200.0, 1.0 / 479001600.0, -1.0 / 3628800.0,
+                         1.0 / 40320.0, -1.0 / 720.0, 1.0 / 24.0, -0.5, 1.0}) {
+    cp = cp * r2 + c;
+  }
+  const double sr = sp * r, cr = cp;
+  // Add j quarter turns: (sin, cos) -> (cos, -sin) per quarter, selected without branches (the
+  // quadrant of successive pulses is what a branch predictor cannot guess).
+  const int j = static_cast<int>(quarters) & 3;
+  const bool odd = (j & 1) != 0, back = (j & 2) != 0;
+  const double s = odd ? cr : sr, c = odd ? -sr : cr;
+  *sin_out = back ? -s : s;
+  *cos_out = back ? -c : c;
+}
+
 Matrix3 Skew(const Vector3& a) {
   Matrix3 s;
   s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;

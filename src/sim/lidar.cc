@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
 
 namespace rotorguard::sim {
 
@@ -41,11 +42,12 @@ Vector3 LidarPattern::Direction(std::uint64_t k) const {
   // Fractional parts (x - floor(x) equals fmod(x, 1) exactly for x >= 0, and is cheaper).
   const double x = 0.5 + a1 * kd, y = 0.5 + a2 * kd;
   const double u = x - std::floor(x), v = y - std::floor(y);
-  const double azimuth = 2.0 * std::numbers::pi * u;
+  double sin_az = 0.0, cos_az = 1.0;
+  SinCosOfTurns(u, &sin_az, &cos_az);  // azimuth 2 pi u
   // Uniform in solid angle over the band: sin(elevation) uniform.
   const double sin_el = sin_min_ + v * (sin_max_ - sin_min_);
   const double cos_el = std::sqrt(std::max(0.0, 1.0 - sin_el * sin_el));
-  return Vector3(cos_el * std::cos(azimuth), cos_el * std::sin(azimuth), sin_el);
+  return Vector3(cos_el * cos_az, cos_el * sin_az, sin_el);
 }
 
 LidarSimulator::LidarSimulator(const LidarOptions& options, const World& world, std::uint64_t seed)

@@ -1,6 +1,9 @@
 #include "rotorguard/core/math.h"
 
 #include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -19,6 +22,28 @@ TEST(ExpSO3, MatchesAngleAxisOnBothSidesOfTheSeriesThreshold) {
       const Matrix3 truth = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
       EXPECT_LT((ExpSO3(angle * axis) - truth).cwiseAbs().maxCoeff(), 2e-15) << "angle " << angle;
     }
+  }
+}
+
+// Against the C library's sin and cos (the truth, correctly rounded in practice) across whole
+// turns, at the quarter turns and the eighths where the reduction changes sides, and for u
+// outside [0, 1): within 2 ulp (a coefficient of the wrong sign leaves 1e-7 or more).
+TEST(SinCosOfTurns, MatchesTheLibraryWithinTwoUlp) {
+  Rng rng(5);
+  std::vector<double> turns;
+  for (int k = 0; k < 20000; ++k) turns.push_back(rng.Uniform());
+  for (int q = -8; q <= 16; ++q) {
+    for (const double d : {-1e-12, 0.0, 1e-12}) turns.push_back(q / 8.0 + d);
+  }
+  for (const double u : {-3.7, 12.3, 1e6 + 0.1}) turns.push_back(u);
+  for (const double u : turns) {
+    double s = 0.0, c = 0.0;
+    SinCosOfTurns(u, &s, &c);
+    const double angle = 2.0 * std::numbers::pi * (u - std::floor(u));
+    // The angle itself carries a rounding of 2 pi times up to 1: compare with its own ulp as the scale.
+    const double ulp = 2.0 * std::numeric_limits<double>::epsilon();
+    EXPECT_NEAR(s, std::sin(angle), ulp * std::max(1.0, angle)) << "u = " << u;
+    EXPECT_NEAR(c, std::cos(angle), ulp * std::max(1.0, angle)) << "u = " << u;
   }
 }
 
