@@ -1,11 +1,11 @@
 #include "rotorguard/core/math.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "rotorguard/core/rng.h"
 
