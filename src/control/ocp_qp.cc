@@ -112,8 +112,8 @@ void CondensingQpSolver::Condense(const OcpQp& qp) {
   for (int m = N - 1; m >= 1; --m) {
     tmp.noalias() = W(m + 1) * A(m);
     W(m) = Q(m);
-    // Coefficient-based products (lazyProduct) where they beat Eigen's GEMM path at these sizes:
-    // A' (W A) and the 4x4 Hessian blocks (measured: docs/control.md).
+    // A coefficient-based product (lazyProduct) for A' (W A), which beats Eigen's GEMM path at
+    // this size (measured: docs/control.md).
     W(m).noalias() += A(m).transpose().lazyProduct(tmp);
     wv(m) = Eigen::Map<const VecX>(qp.q[m].data(), nx);
     wv(m).noalias() += Q(m) * xb(m) + A(m).transpose() * wv(m + 1);

@@ -76,8 +76,8 @@ DeskewSummary Deskewer::Deskew(const LidarFrame& frame, const Vector3& v_W, cons
         std::partition_point(knots.begin() + 1, knots.end(), [t](const Knot& kn) { return kn.t > t; }) - knots.begin());
     const Knot& after = knots[k - 1];
     const Vector3 w = k < knots.size() ? knots[k].w : rate_before(t);
-    const Matrix3 R = after.R_end_from_t * ExpSO3(-w * ToSeconds(after.t - t));
-    const Vector3 p_end_B = R * (l + p_S) - v_end_B * ToSeconds(t_end - t);
+    const Vector3 p_end_B =
+        after.R_end_from_t * ExpSO3Times(-w * ToSeconds(after.t - t), l + p_S) - v_end_B * ToSeconds(t_end - t);
     out->push_back((p_end_B - l).cast<float>());
     ++summary.points;
     if (t < oldest) ++summary.extrapolated;

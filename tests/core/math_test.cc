@@ -25,6 +25,19 @@ TEST(ExpSO3, MatchesAngleAxisOnBothSidesOfTheSeriesThreshold) {
   }
 }
 
+// The vector form against the matrix it stands for, on both sides of the series' threshold.
+TEST(ExpSO3Times, EqualsTheMatrixTimesTheVector) {
+  Rng rng(4);
+  for (const double angle : {0.0, 1e-6, 0.03, 0.0501, 0.7, 3.0}) {
+    for (int k = 0; k < 20; ++k) {
+      const Vector3 axis = Vector3(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1)).normalized();
+      const Vector3 v(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(-5, 5));
+      const Vector3 truth = Eigen::AngleAxisd(angle, axis).toRotationMatrix() * v;
+      EXPECT_LT((ExpSO3Times(angle * axis, v) - truth).cwiseAbs().maxCoeff(), 1e-14) << "angle " << angle;
+    }
+  }
+}
+
 // Against the C library's sin and cos (the truth, correctly rounded in practice) across whole
 // turns, at the quarter turns and the eighths where the reduction changes sides, and for u
 // outside [0, 1): within 2 ulp (a coefficient of the wrong sign leaves 1e-7 or more).

@@ -9,8 +9,10 @@ Matrix3 Skew(const Vector3& a);
 
 /// The rotation matrix of a rotation vector (SO(3) exponential, Rodrigues). Below 0.05 rad it
 /// takes a series instead of trigonometric calls, exact to double precision there: the deskewer
-/// evaluates one per LiDAR point, over at most an IMU period.
+/// evaluates one per LiDAR point (ExpSO3Times), over at most an IMU period.
 Matrix3 ExpSO3(const Vector3& theta);
+/// ExpSO3(theta) * v, without forming the matrix (Rodrigues' formula on the vector).
+Vector3 ExpSO3Times(const Vector3& theta, const Vector3& v);
 
 /// sin and cos of the angle 2 pi u, u in turns, finite (any value; exact reduction to [0, 1)).
 /// Reduced to a quarter turn exactly in turns, then Taylor series: within 2 ulp of std::sin and
