@@ -20,12 +20,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// of a forest flight's time), only where they would.
 inline void Givens(double a, double b, double* c, double* s) {
   const double h2 = a * a + b * b;
-  double h;
-  if (h2 > std::numeric_limits<double>::min() && h2 < std::numeric_limits<double>::max()) {
-    h = std::sqrt(h2);
-  } else {
-    h = std::hypot(a, b);
-  }
+  const bool squares_representable = h2 > std::numeric_limits<double>::min() && h2 < std::numeric_limits<double>::max();
+  const double h = squares_representable ? std::sqrt(h2) : std::hypot(a, b);
   if (h == 0.0) {
     *c = 1.0;
     *s = 0.0;

@@ -98,8 +98,8 @@ void CondensingQpSolver::Condense(const OcpQp& qp) {
   Eigen::Map<MatXX> tmp(tmp_.data(), nx, nx);
 
   // Free response x_bar (u = 0) and sensitivities S_kj = A_{k-1} ... A_{j+1} B_j, a stage's row
-  // [S_k0 ... S_k,k-2] = A_{k-1} [S_{k-1,0} ... S_{k-1,k-2}] as one product (one of 17 x 17 by
-  // 17 x 4(k-1) runs far faster than k-1 of 17 x 17 by 17 x 4: docs/control.md).
+  // [S_k0 ... S_k,k-2] = A_{k-1} [S_{k-1,0} ... S_{k-1,k-2}] as one product (faster than k-1
+  // products of 17 x 17 by 17 x 4: docs/control.md, "Condensing a stage at a time").
   xb(0) = qp.x0;
   for (int k = 0; k < N; ++k) xb(k + 1).noalias() = A(k) * xb(k) + Eigen::Map<const VecX>(qp.c[k].data(), nx);
   for (int k = 1; k <= N; ++k) {

@@ -56,12 +56,12 @@ void SinCosOfTurns(double u, double* sin_out, double* cos_out) {
                          1.0 / 40320.0, -1.0 / 720.0, 1.0 / 24.0, -0.5, 1.0}) {
     cp = cp * r2 + c;
   }
-  const double sr = sp * r, cr = cp;
+  const double sr = sp * r;
   // Add j quarter turns: (sin, cos) -> (cos, -sin) per quarter, selected without branches (the
   // quadrant of successive pulses is what a branch predictor cannot guess).
   const int j = static_cast<int>(quarters) & 3;
   const bool odd = (j & 1) != 0, back = (j & 2) != 0;
-  const double s = odd ? cr : sr, c = odd ? -sr : cr;
+  const double s = odd ? cp : sr, c = odd ? -sr : cp;
   *sin_out = back ? -s : s;
   *cos_out = back ? -c : c;
 }

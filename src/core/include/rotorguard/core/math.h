@@ -8,16 +8,16 @@ namespace rotorguard {
 Matrix3 Skew(const Vector3& a);
 
 /// The rotation matrix of a rotation vector (SO(3) exponential, Rodrigues). Below 0.05 rad it
-/// takes a series instead of trigonometric calls, exact to double precision there: the deskewer
-/// evaluates one per LiDAR point (ExpSO3Times), over at most an IMU period.
+/// takes a series instead of trigonometric calls, exact to double precision there.
 Matrix3 ExpSO3(const Vector3& theta);
-/// ExpSO3(theta) * v, without forming the matrix (Rodrigues' formula on the vector).
+/// ExpSO3(theta) * v, without forming the matrix (Rodrigues' formula on the vector): the deskewer
+/// rotates every LiDAR point by one, over at most an IMU period (within the series).
 Vector3 ExpSO3Times(const Vector3& theta, const Vector3& v);
 
 /// sin and cos of the angle 2 pi u, u in turns, finite (any value; exact reduction to [0, 1)).
-/// Reduced to a quarter turn exactly in turns, then Taylor series: within 2 ulp of std::sin and
-/// std::cos, and cheaper than the C library's sincos, which switches the rounding mode on every
-/// call (the LiDAR simulator evaluates one per pulse, 200 000 a second).
+/// Reduced to a quarter turn exactly in turns, then Taylor series: within 2 eps max(1, 2 pi u)
+/// of std::sin and std::cos of 2 pi u (absolute), and cheaper than the C library's sincos, which
+/// switches the rounding mode on every call (the LiDAR simulator evaluates one per pulse).
 void SinCosOfTurns(double u, double* sin_out, double* cos_out);
 
 /// Time derivative of q_WB for body rates w_B: q_dot = 0.5 * q (x) [0, w_B] (paper 000, eq. 2).
