@@ -91,28 +91,32 @@ void RayCasterOptions::Validate() const {
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m)) {
     ThrowValidation("RayCasterOptions", "cell_size_m", cell_size_m, "a cell edge > 0 m");
   }
+  if (azimuth_bins < 8 || azimuth_bins > 65536) {
+    ThrowValidation("RayCasterOptions", "azimuth_bins", azimuth_bins, "a count in [8, 65536]");
+  }
+  if (!(azimuth_margin_m > 0.0) || !std::isfinite(azimuth_margin_m)) {
+    ThrowValidation("RayCasterOptions", "azimuth_margin_m", azimuth_margin_m, "a distance > 0 m");
+  }
 }
 
 RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std::move(world)) {
   options.Validate();
   cell_ = options.cell_size_m;
-  // Horizontal bounding boxes of the static obstacles.
-  const int n_static = static_cast<int>(world_.boxes.size() + world_.cylinders.size());
+  bins_ = options.azimuth_bins;
+  margin_ = options.azimuth_margin_m;
+  for (const Cylinder& cy : world_.cylinders) cylinder_top_ = std::max(cylinder_top_, cy.height_m);
+  // Horizontal bounding boxes of the boxes.
+  const int n_boxes = static_cast<int>(world_.boxes.size());
   std::vector<Eigen::Vector4d> bounds;  // min x, min y, max x, max y
-  bounds.reserve(static_cast<std::size_t>(n_static));
+  bounds.reserve(static_cast<std::size_t>(n_boxes));
   for (const Box& b : world_.boxes) {
     const double c = std::abs(std::cos(b.yaw_rad)), s = std::abs(std::sin(b.yaw_rad));
     const double ex = 0.5 * (c * b.size_m.x() + s * b.size_m.y()), ey = 0.5 * (s * b.size_m.x() + c * b.size_m.y());
     bounds.emplace_back(b.center_m.x() - ex, b.center_m.y() - ey, b.center_m.x() + ex, b.center_m.y() + ey);
-    top_ = std::max(top_, b.center_m.z() + 0.5 * b.size_m.z());
+    box_top_ = std::max(box_top_, b.center_m.z() + 0.5 * b.size_m.z());
   }
-  for (const Cylinder& cy : world_.cylinders) {
-    bounds.emplace_back(cy.center_m.x() - cy.radius_m, cy.center_m.y() - cy.radius_m, cy.center_m.x() + cy.radius_m,
-                        cy.center_m.y() + cy.radius_m);
-    top_ = std::max(top_, cy.height_m);
-  }
-  last_ray_.assign(static_cast<std::size_t>(n_static), 0);
-  if (n_static == 0) return;
+  last_ray_.assign(static_cast<std::size_t>(n_boxes), 0);
+  if (n_boxes == 0) return;
   Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
   for (const Eigen::Vector4d& b : bounds) {
     lo = lo.cwiseMin(b.head<2>());
@@ -141,7 +145,7 @@ RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std:
   for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
   items_.resize(static_cast<std::size_t>(cell_start_.back()));
   std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
-  for (int i = 0; i < n_static; ++i) {
+  for (int i = 0; i < n_boxes; ++i) {
     cell_range(bounds[static_cast<std::size_t>(i)], &x0, &y0, &x1, &y1);
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) items_[static_cast<std::size_t>(fill[static_cast<std::size_t>(y) * nx_ + x]++)] = i;
@@ -149,31 +153,115 @@ RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std:
   }
 }
 
-std::optional<RayHit> RayCaster::IntersectStatic(int index, const Vector3& o, const Vector3& d, double max_m) const {
-  const int n_boxes = static_cast<int>(world_.boxes.size());
-  return index < n_boxes ? IntersectBox(world_.boxes[static_cast<std::size_t>(index)], o, d, max_m)
-                         : IntersectCylinder(world_.cylinders[static_cast<std::size_t>(index - n_boxes)], o, d, max_m);
+int RayCaster::AzimuthBin(double x, double y) const {
+  // A pseudo-angle in [0, 4) increasing with the azimuth like atan2 (a quarter turn per unit), for
+  // two divisions' cost: y / (|x| + |y|) turned into each quadrant.
+  double p;
+  if (y >= 0.0) {
+    p = x >= 0.0 ? y / (x + y) : 1.0 - x / (y - x);
+  } else {
+    p = x < 0.0 ? 2.0 - y / (-x - y) : 3.0 + x / (x - y);
+  }
+  return std::min(bins_ - 1, static_cast<int>(p * (0.25 * bins_)));
+}
+
+void RayCaster::IndexCylindersAround(const Eigen::Vector2d& center) {
+  // A ray from o, |o - center| <= margin, that meets the disc (x, r) runs parallel to the ray from
+  // center at most `margin` beside it, so that ray meets the disc (x, r + margin): its azimuth is
+  // within asin((r + margin) / |x - center|) of the direction to x. And it travels at least
+  // |x - center| - r - margin horizontally before it can reach the trunk.
+  ++rebuilds_;
+  indexed_ = true;
+  index_center_ = center;
+  const int n = static_cast<int>(world_.cylinders.size());
+  reach_.resize(static_cast<std::size_t>(n));
+  first_bin_.resize(static_cast<std::size_t>(n));
+  bin_count_.resize(static_cast<std::size_t>(n));
+  bin_start_.assign(static_cast<std::size_t>(bins_) + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    const Cylinder& cy = world_.cylinders[static_cast<std::size_t>(i)];
+    const Eigen::Vector2d v = cy.center_m - center;
+    const double dist = v.norm(), padded = cy.radius_m + margin_;
+    reach_[static_cast<std::size_t>(i)] = std::max(0.0, dist - padded);
+    int first = 0, count = bins_;
+    if (dist > padded) {
+      // The tangent directions, u rotated by -+alpha with sin(alpha) = padded / dist; a bin more
+      // on each side for the rounding of the endpoints.
+      const double s = padded / dist, c = std::sqrt(1.0 - s * s);
+      const Eigen::Vector2d u = v / dist;
+      const int lo = AzimuthBin(c * u.x() + s * u.y(), c * u.y() - s * u.x());
+      const int hi = AzimuthBin(c * u.x() - s * u.y(), c * u.y() + s * u.x());
+      first = (lo - 1 + bins_) % bins_;
+      count = std::min(bins_, (hi - lo + bins_) % bins_ + 3);  // alpha < pi/2: under half a turn
+    }
+    first_bin_[static_cast<std::size_t>(i)] = first;
+    bin_count_[static_cast<std::size_t>(i)] = count;
+    for (int k = 0; k < count; ++k) ++bin_start_[static_cast<std::size_t>((first + k) % bins_) + 1];
+  }
+  for (std::size_t b = 1; b < bin_start_.size(); ++b) bin_start_[b] += bin_start_[b - 1];
+  bin_items_.resize(static_cast<std::size_t>(bin_start_.back()));
+  // Filled nearest first, so each bin's entries come sorted by reach.
+  order_.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) order_[static_cast<std::size_t>(i)] = i;
+  std::sort(order_.begin(), order_.end(),
+            [&](int a, int b) { return reach_[static_cast<std::size_t>(a)] < reach_[static_cast<std::size_t>(b)]; });
+  fill_.assign(bin_start_.begin(), bin_start_.end() - 1);
+  for (const int i : order_) {
+    const std::size_t ii = static_cast<std::size_t>(i);
+    for (int k = 0; k < bin_count_[ii]; ++k) {
+      const std::size_t b = static_cast<std::size_t>((first_bin_[ii] + k) % bins_);
+      bin_items_[static_cast<std::size_t>(fill_[b]++)] = AzimuthEntry{reach_[ii], i};
+    }
+  }
+}
+
+void RayCaster::CastCylinders(const Vector3& o, const Vector3& d, double max_m, std::optional<RayHit>* best) {
+  const Eigen::Vector2d o2 = o.head<2>();
+  if (!indexed_ || (o2 - index_center_).squaredNorm() > margin_ * margin_) IndexCylindersAround(o2);
+  const double h = d.head<2>().norm();  // horizontal travel per metre along the ray
+  if (!(h > 0.0)) {                     // vertical: no azimuth; only a trunk under or over the origin can be met
+    for (const Cylinder& cy : world_.cylinders)
+      Nearer(IntersectCylinder(cy, o, d, *best ? (*best)->distance_m : max_m), best);
+    return;
+  }
+  // A rising ray is above every trunk once past the tallest's height.
+  const double beyond_top = d.z() > 0.0 ? (cylinder_top_ - o.z()) / d.z() : kInf;
+  double range = *best ? (*best)->distance_m : max_m;
+  const int b = AzimuthBin(d.x(), d.y());
+  for (int k = bin_start_[static_cast<std::size_t>(b)]; k < bin_start_[static_cast<std::size_t>(b) + 1]; ++k) {
+    const AzimuthEntry& e = bin_items_[static_cast<std::size_t>(k)];
+    if (e.reach_m > std::min(range, beyond_top) * h) break;  // this one and all later lie beyond
+    Nearer(IntersectCylinder(world_.cylinders[static_cast<std::size_t>(e.cylinder)], o, d, range), best);
+    if (*best) range = (*best)->distance_m;
+  }
 }
 
 std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double max_m, double t) {
   std::optional<RayHit> best = IntersectGround(o, d, max_m);
   for (const MovingBox& m : world_.moving_boxes) Nearer(IntersectBox(m.At(t), o, d, max_m), &best);
-  if (nx_ == 0) return best;
+  if (!o.allFinite() || !d.allFinite()) return best;
+  if (!world_.cylinders.empty()) CastCylinders(o, d, max_m, &best);
+  if (nx_ > 0) CastBoxes(o, d, max_m, &best);
+  return best;
+}
+
+void RayCaster::CastBoxes(const Vector3& o, const Vector3& d, double max_m, std::optional<RayHit>* best_out) {
+  std::optional<RayHit>& best = *best_out;
   if (++ray_id_ == 0) {  // the mailbox counter wrapped: forget every mark
     std::fill(last_ray_.begin(), last_ray_.end(), 0u);
     ray_id_ = 1;
   }
-  // The part of the ray inside the grid's horizontal bounds and below the obstacles' top:
-  // [t_in, t_out]. (Most of a LiDAR's pulses are sky: those that rise leave every obstacle behind
-  // once above the tallest, long before the grid's edge.)
+  // The part of the ray inside the grid's horizontal bounds and below the boxes' top: [t_in,
+  // t_out]. (Most of a LiDAR's pulses are sky: those that rise leave every box behind once above
+  // the tallest, long before the grid's edge.)
   const Eigen::Vector2d o2 = o.head<2>(), d2 = d.head<2>();
   const Eigen::Vector2d hi = min_ + cell_ * Eigen::Vector2d(nx_, ny_);
   double t_in = 0.0, t_out = best ? best->distance_m : max_m;
-  const double t_top = d.z() > 0.0 ? (top_ - o.z()) / d.z() : kInf;
+  const double t_top = d.z() > 0.0 ? (box_top_ - o.z()) / d.z() : kInf;
   t_out = std::min(t_out, t_top);
   for (int i = 0; i < 2; ++i) {
     if (std::abs(d2[i]) < 1e-15) {
-      if (o2[i] < min_[i] || o2[i] > hi[i]) return best;
+      if (o2[i] < min_[i] || o2[i] > hi[i]) return;
       continue;
     }
     double t1 = (min_[i] - o2[i]) / d2[i], t2 = (hi[i] - o2[i]) / d2[i];
@@ -181,7 +269,7 @@ std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double
     t_in = std::max(t_in, t1);
     t_out = std::min(t_out, t2);
   }
-  if (t_in > t_out) return best;
+  if (t_in > t_out) return;
   // Amanatides-Woo traversal of the cells the ray crosses, nearest first.
   const Eigen::Vector2d start = o2 + t_in * d2;
   int cx = std::clamp(static_cast<int>(std::floor((start.x() - min_.x()) / cell_)), 0, nx_ - 1);
@@ -204,7 +292,7 @@ std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double
       const int obstacle = items_[static_cast<std::size_t>(k)];
       if (last_ray_[static_cast<std::size_t>(obstacle)] == ray_id_) continue;
       last_ray_[static_cast<std::size_t>(obstacle)] = ray_id_;
-      Nearer(IntersectStatic(obstacle, o, d, range), &best);
+      Nearer(IntersectBox(world_.boxes[static_cast<std::size_t>(obstacle)], o, d, range), &best);
     }
     if (t_next_x < t_next_y) {
       cx += step_x;
@@ -217,7 +305,6 @@ std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double
     }
     if (cx < 0 || cx >= nx_ || cy < 0 || cy >= ny_) break;
   }
-  return best;
 }
 
 }  // namespace rotorguard::sim

@@ -133,6 +133,67 @@ TEST(Raycast, GridMatchesBruteForceInAForest) {
   EXPECT_GT(hits, 10000);
 }
 
+// The same truth for a LiDAR's rays: origins that drift along a lane and circle a spinning mount
+// (the azimuth index reused within its margin and rebuilt beyond it), rays in every direction
+// including straight up and down and ones that graze a trunk's edge, and origins inside a trunk's
+// padded disc, over the top of a trunk and inside a trunk.
+TEST(Raycast, AzimuthIndexMatchesBruteForceAlongAFlight) {
+  Rng rng(21);
+  World w;
+  for (int i = 0; i < 300; ++i) {
+    w.cylinders.push_back(
+        {Eigen::Vector2d(rng.Uniform(-15, 15), rng.Uniform(-10, 10)), rng.Uniform(0.05, 0.4), rng.Uniform(1, 6)});
+  }
+  w.cylinders.push_back({Eigen::Vector2d(0.3, 0.1), 0.2, 1.0});  // the lane passes over and through it
+  w.boxes.push_back({Vector3(3, -2, 1), Vector3(1, 2, 2), 0.4});
+  RayCasterOptions options;
+  options.azimuth_bins = 64;  // coarse bins: many trunks per bin, the nearest-first cut-off matters
+  RayCaster caster(w, options);
+  const auto brute = [&](const Vector3& o, const Vector3& d) {
+    std::optional<RayHit> best = IntersectGround(o, d, 40.0);
+    const auto keep = [&](const std::optional<RayHit>& h) {
+      if (h && (!best || h->distance_m < best->distance_m)) best = h;
+    };
+    for (const Box& b : w.boxes) keep(IntersectBox(b, o, d, 40.0));
+    for (const Cylinder& c : w.cylinders) keep(IntersectCylinder(c, o, d, 40.0));
+    return best;
+  };
+  int hits = 0, grazing = 0;
+  for (int k = 0; k < 40000; ++k) {
+    const double s = 1e-3 * k;  // 40 m of lane, a ray every millimetre
+    const Vector3 centre(-20.0 + s, 0.1 + 0.3 * std::sin(0.2 * s), 0.5 + 0.01 * s);
+    const Vector3 o = centre + 0.1 * Vector3(std::cos(11.0 * s), std::sin(11.0 * s), 0.0);
+    Vector3 d;
+    if (k % 97 == 0) {
+      d = (k % 194 == 0 ? 1.0 : -1.0) * Vector3::UnitZ();
+    } else if (k % 5 == 0) {
+      // Aimed at a trunk's silhouette edge: the tangent from o, turned by a hair either way.
+      const Cylinder& c = w.cylinders[static_cast<std::size_t>(rng.NextU64() % 301)];
+      const Eigen::Vector2d v = c.center_m - o.head<2>();
+      if (v.norm() <= c.radius_m) continue;
+      const double a = std::asin(c.radius_m / v.norm()) * (1.0 + rng.Uniform(-1e-9, 1e-9));
+      const double phi = std::atan2(v.y(), v.x()) + (rng.Uniform() < 0.5 ? a : -a);
+      d = Vector3(std::cos(phi), std::sin(phi), rng.Uniform(-0.1, 0.3)).normalized();
+      ++grazing;
+    } else {
+      const double az = rng.Uniform(-std::numbers::pi, std::numbers::pi), el = rng.Uniform(-0.6, 1.2);
+      d = Vector3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    }
+    const auto expected = brute(o, d);
+    const auto got = caster.Cast(o, d, 40.0, 0.0);
+    ASSERT_EQ(got.has_value(), expected.has_value()) << k;
+    if (got) {
+      ++hits;
+      ASSERT_EQ(got->distance_m, expected->distance_m) << k;
+    }
+  }
+  EXPECT_GT(hits, 20000);
+  EXPECT_GT(grazing, 7000);
+  // Rebuilt about once per margin of travel (40 m of lane, 0.25 m margin, the mount's circle on top).
+  EXPECT_GT(caster.index_rebuilds(), 40);
+  EXPECT_LT(caster.index_rebuilds(), 1000);
+}
+
 // The walk stops once a rising ray is above the tallest obstacle, box or cylinder alike: rays that
 // rise to just below the top of the tallest still hit it (closed form: the face's distance along
 // the ray), and rays just above it pass.
@@ -163,8 +224,14 @@ TEST(Raycast, RisingRaysHitTheTallestObstacleNearItsTop) {
   }
 }
 
-TEST(Raycast, RejectsABadCellSize) {
+TEST(Raycast, RejectsBadOptions) {
   EXPECT_THROW(RayCaster(World{}, RayCasterOptions{0.0}), std::invalid_argument);
+  RayCasterOptions bins;
+  bins.azimuth_bins = 4;
+  EXPECT_THROW(RayCaster(World{}, bins), std::invalid_argument);
+  RayCasterOptions margin;
+  margin.azimuth_margin_m = 0.0;
+  EXPECT_THROW(RayCaster(World{}, margin), std::invalid_argument);
 }
 
 }  // namespace

@@ -30,7 +30,7 @@ struct LidarOptions {
   double range_noise_m = 0.02;      ///< 1-sigma range noise [m], >= 0 (MID-360: 2 cm at 10 m)
   double dropout_probability = 0.01;  ///< chance a return is lost, in [0, 1)
   Vector3 position_m = Vector3(0.0, 0.0, 0.06);  ///< mounting point, body frame (axes aligned)
-  double grid_cell_m = 1.0;         ///< ray-casting grid cell [m], > 0
+  double grid_cell_m = 1.0;                      ///< the boxes' ray-casting grid cell [m], > 0
   /// Throws ValidationError naming the field (SimulatorOptions prefixes "sensors.lidar.").
   void Validate() const;
 };

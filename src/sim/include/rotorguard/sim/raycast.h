@@ -1,9 +1,12 @@
 #pragma once
 /// Ray casting against the world (truth side, for the simulated LiDAR): exact intersections with
-/// the ground plane, yawed boxes and vertical cylinders, and a uniform grid over the horizontal
-/// plane so that a ray visits only the cells it crosses (Amanatides and Woo, "A fast voxel
-/// traversal algorithm", Eurographics 1987). A 500-tree forest then costs a few cells per ray
-/// rather than 500 tests.
+/// the ground plane, yawed boxes and vertical cylinders. Two indices spare a ray most of the tests:
+/// - boxes lie in a uniform grid over the horizontal plane, so that a ray visits only the cells it
+///   crosses (Amanatides and Woo, "A fast voxel traversal algorithm", Eurographics 1987);
+/// - cylinders (trees) lie in an azimuth index seen from the sensor: a LiDAR casts all its rays
+///   from nearly one point, and from a point a vertical cylinder covers only an interval of
+///   azimuths, so a ray tests only the cylinders of its azimuth's bin, nearest first, and stops at
+///   the first whose distance lies beyond its hit. A 500-tree forest then costs a few tests per ray.
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -27,32 +30,63 @@ std::optional<RayHit> IntersectBox(const Box& box, const Vector3& o, const Vecto
 std::optional<RayHit> IntersectCylinder(const Cylinder& cylinder, const Vector3& o, const Vector3& d, double max_m);
 
 struct RayCasterOptions {
-  double cell_size_m = 1.0;  ///< grid cell edge [m], > 0
+  double cell_size_m = 1.0;  ///< the boxes' grid cell edge [m], > 0
+  /// Bins of the cylinders' azimuth index, in [8, 65536]: more bins, fewer candidates per ray.
+  int azimuth_bins = 1024;
+  /// The index serves rays from within this horizontal distance of the point it was built around
+  /// [m], > 0; a ray from farther rebuilds it around its own origin (a flying sensor every
+  /// `azimuth_margin_m` of travel). Larger: fewer rebuilds, more candidates per ray.
+  double azimuth_margin_m = 0.25;
   void Validate() const;
 };
 
-/// The static part of a world (ground, boxes, cylinders) in a grid, plus its moving boxes tested
-/// directly at each ray's time. Not thread-safe (per-ray bookkeeping); one per thread.
+/// The static part of a world (ground, boxes in a grid, cylinders in the azimuth index), plus its
+/// moving boxes tested directly at each ray's time. Not thread-safe (per-ray bookkeeping and the
+/// index rebuilt as the origin moves); one per thread.
 class RayCaster {
  public:
   explicit RayCaster(World world, const RayCasterOptions& options = {});
   /// The nearest hit of the ray (o, unit d) within max_m at time t [s] (moving boxes), if any.
   std::optional<RayHit> Cast(const Vector3& o, const Vector3& d, double max_m, double t);
   const World& world() const { return world_; }
+  /// How often the azimuth index was built (at each ray from beyond the margin of the last build).
+  int index_rebuilds() const { return rebuilds_; }
 
  private:
-  // Static obstacles: index < boxes.size() is a box, the rest are cylinders.
-  std::optional<RayHit> IntersectStatic(int index, const Vector3& o, const Vector3& d, double max_m) const;
+  void CastBoxes(const Vector3& o, const Vector3& d, double max_m, std::optional<RayHit>* best);
+  void CastCylinders(const Vector3& o, const Vector3& d, double max_m, std::optional<RayHit>* best);
+  /// Rebuilds the azimuth index for rays from within azimuth_margin_m of `center` (horizontal).
+  void IndexCylindersAround(const Eigen::Vector2d& center);
+  /// The azimuth bin of the horizontal direction (x, y), not both zero.
+  int AzimuthBin(double x, double y) const;
 
   World world_;
+  // Boxes: the grid.
   double cell_ = 1.0;
   Eigen::Vector2d min_ = Eigen::Vector2d::Zero();  // grid origin (lower corner)
   int nx_ = 0, ny_ = 0;
-  double top_ = 0.0;             // the highest point of the static obstacles [m]
-  std::vector<int> cell_start_;  // CSR: obstacles of cell c are items_[cell_start_[c] .. cell_start_[c + 1])
+  double box_top_ = 0.0;         // the highest point of the boxes [m]
+  std::vector<int> cell_start_;  // CSR: boxes of cell c are items_[cell_start_[c] .. cell_start_[c + 1])
   std::vector<int> items_;
-  std::vector<std::uint32_t> last_ray_;  // mailbox: the ray that last tested each obstacle
+  std::vector<std::uint32_t> last_ray_;  // mailbox: the ray that last tested each box
   std::uint32_t ray_id_ = 0;
+  // Cylinders: the azimuth index around index_center_, a CSR of bins whose entries are sorted by
+  // the horizontal distance a ray from the served disc must travel before it can reach them.
+  struct AzimuthEntry {
+    double reach_m;  // lower bound of that distance
+    int cylinder;
+  };
+  int bins_ = 1024;
+  double margin_ = 0.25;
+  double cylinder_top_ = 0.0;  // the tallest cylinder [m]
+  bool indexed_ = false;
+  Eigen::Vector2d index_center_ = Eigen::Vector2d::Zero();
+  std::vector<int> bin_start_;
+  std::vector<AzimuthEntry> bin_items_;
+  // Scratch of a rebuild, kept to reuse its memory.
+  std::vector<double> reach_;
+  std::vector<int> order_, first_bin_, bin_count_, fill_;
+  int rebuilds_ = 0;
 };
 
 }  // namespace rotorguard::sim
