@@ -79,6 +79,13 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
       }
     }
   }
+  // Each (x, y) of the stencil holds a symmetric run of z (the ball's section), in order.
+  for (const Index& o : stencil_) {
+    if (stencil_columns_.empty() || stencil_columns_.back().dx != o.x() || stencil_columns_.back().dy != o.y()) {
+      stencil_columns_.push_back({o.x(), o.y(), o.z(), o.z()});
+    }
+    stencil_columns_.back().z_hi = o.z();
+  }
   const int s = kSortedOffsetRadius;
   for (int x = -s; x <= s; ++x) {
     for (int y = -s; y <= s; ++y) {
@@ -199,9 +206,17 @@ VoxelMap::Index VoxelMap::IndexOf(std::size_t address) const {
 }
 
 void VoxelMap::Inflate(const Index& i, int delta) {
-  for (const Index& o : stencil_) {
-    const Index j = i + o;
-    if (InWindow(j)) inflation_[Address(j)] = static_cast<std::uint16_t>(inflation_[Address(j)] + delta);
+  const int z_min = origin_.z(), z_max = origin_.z() + size_.z() - 1, z_mask = size_.z() - 1;
+  for (const StencilColumn& c : stencil_columns_) {
+    const int x = i.x() + c.dx, y = i.y() + c.dy;
+    if (x < origin_.x() || x >= origin_.x() + size_.x() || y < origin_.y() || y >= origin_.y() + size_.y()) continue;
+    const std::size_t base = (static_cast<std::size_t>(x & (size_.x() - 1)) << shift_x_) |
+                             (static_cast<std::size_t>(y & (size_.y() - 1)) << shift_y_);
+    const int z1 = std::min(i.z() + c.z_hi, z_max);
+    for (int z = std::max(i.z() + c.z_lo, z_min); z <= z1; ++z) {
+      std::uint16_t& count = inflation_[base | static_cast<std::size_t>(z & z_mask)];
+      count = static_cast<std::uint16_t>(count + delta);
+    }
   }
 }
 

@@ -224,6 +224,13 @@ class VoxelMap {
   std::vector<std::uint64_t> occupied_;
   std::uint32_t frame_ = 0;
   std::vector<Index> stencil_;            // offsets within the inflation radius
+  /// The stencil as columns along z, the address' fastest axis: a column's voxels are one run of
+  /// consecutive addresses (but where z wraps around the ring), so Inflate computes an (x, y) base
+  /// and a window test once per column rather than per voxel.
+  struct StencilColumn {
+    int dx, dy, z_lo, z_hi;  // offsets (dx, dy, z) for z in [z_lo, z_hi]
+  };
+  std::vector<StencilColumn> stencil_columns_;
   /// Offsets within kSortedOffsetRadius voxels, by increasing distance: Nearest visits them in
   /// order and stops early (the planner asks it for every penalty sample).
   static constexpr int kSortedOffsetRadius = 12;
