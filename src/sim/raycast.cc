@@ -219,9 +219,11 @@ void RayCaster::CastCylinders(const Vector3& o, const Vector3& d, double max_m, 
   const Eigen::Vector2d o2 = o.head<2>();
   if (!indexed_ || (o2 - index_center_).squaredNorm() > margin_ * margin_) IndexCylindersAround(o2);
   const double h = d.head<2>().norm();  // horizontal travel per metre along the ray
-  if (!(h > 0.0)) {                     // vertical: no azimuth; only a trunk under or over the origin can be met
-    for (const Cylinder& cy : world_.cylinders)
+  // A vertical ray has no azimuth, and only a trunk under or over its origin can meet it.
+  if (!(h > 0.0)) {
+    for (const Cylinder& cy : world_.cylinders) {
       Nearer(IntersectCylinder(cy, o, d, *best ? (*best)->distance_m : max_m), best);
+    }
     return;
   }
   // A rising ray is above every trunk once past the tallest's height.
