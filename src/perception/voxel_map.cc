@@ -208,10 +208,9 @@ VoxelMap::Index VoxelMap::IndexOf(std::size_t address) const {
 void VoxelMap::Inflate(const Index& i, int delta) {
   const int z_min = origin_.z(), z_max = origin_.z() + size_.z() - 1, z_mask = size_.z() - 1;
   for (const StencilColumn& c : stencil_columns_) {
-    const int x = i.x() + c.dx, y = i.y() + c.dy;
-    if (x < origin_.x() || x >= origin_.x() + size_.x() || y < origin_.y() || y >= origin_.y() + size_.y()) continue;
-    const std::size_t base = (static_cast<std::size_t>(x & (size_.x() - 1)) << shift_x_) |
-                             (static_cast<std::size_t>(y & (size_.y() - 1)) << shift_y_);
+    const Index bottom(i.x() + c.dx, i.y() + c.dy, z_min);  // the column's (x, y) at the window's floor
+    if (!InWindow(bottom)) continue;
+    const std::size_t base = Address(bottom) & ~static_cast<std::size_t>(z_mask);  // its (x, y) fields
     const int z1 = std::min(i.z() + c.z_hi, z_max);
     for (int z = std::max(i.z() + c.z_lo, z_min); z <= z1; ++z) {
       std::uint16_t& count = inflation_[base | static_cast<std::size_t>(z & z_mask)];

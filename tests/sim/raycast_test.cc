@@ -92,8 +92,9 @@ TEST(Raycast, HitsAgreeWithDistanceFunctionMarching) {
   EXPECT_GT(hits, 250) << "most rays aim at the obstacles";
 }
 
-// The grid finds exactly what testing every obstacle finds, in a 500-tree forest with boxes.
-TEST(Raycast, GridMatchesBruteForceInAForest) {
+// The boxes' grid and the trees' azimuth index (rebuilt for each ray's new origin) find exactly
+// what testing every obstacle finds, in a 500-tree forest with boxes.
+TEST(Raycast, IndicesMatchBruteForceInAForest) {
   Rng rng(9);
   World w;
   for (int i = 0; i < 500; ++i) {

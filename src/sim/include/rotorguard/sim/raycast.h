@@ -6,7 +6,8 @@
 /// - cylinders (trees) lie in an azimuth index seen from the sensor: a LiDAR casts all its rays
 ///   from nearly one point, and from a point a vertical cylinder covers only an interval of
 ///   azimuths, so a ray tests only the cylinders of its azimuth's bin, nearest first, and stops at
-///   the first whose distance lies beyond its hit. A 500-tree forest then costs a few tests per ray.
+///   the first whose distance lies beyond its hit. In a 500-tree forest a LiDAR ray then tests 2.8
+///   trunks on average (lidar_benchmark's forest).
 #include <cstdint>
 #include <optional>
 #include <vector>
