@@ -41,6 +41,12 @@ struct VoxelMapOptions {
   /// voxel boundary (a level flight at z = 1.5 m) moves the window back and forth with the
   /// estimate's noise, and each move of a whole face costs more than a frame's rays.
   double recenter_hysteresis_m = 0.5;
+  /// How a frame's rays are walked. Both kernels list exactly the same voxels (a test compares
+  /// them frame by frame); they differ in speed only. kAuto walks four rays in one vector register
+  /// when the build targets AVX2 (x86-64-v3), else two interleaved rays; kPortable forces the
+  /// latter.
+  enum class WalkKernel { kAuto, kPortable };
+  WalkKernel walk_kernel = WalkKernel::kAuto;
   void Validate() const;
 };
 
@@ -206,6 +212,15 @@ class VoxelMap {
   /// Starts the walk of the segment a-b (voxel units) clipped to the window, in its first voxel;
   /// false if the segment misses the window.
   bool StartWalk(const Vector3& a, const Vector3& b, WindowWalk* walk) const;
+  /// The kernels of Insert's walks: every voxel each of the `count` walks crosses (its first to
+  /// its last), as an address (AddressOfRelative with these residues and top bits), written from
+  /// `out` on unless its bit in `settled` is set; the end of the list is returned. The order is
+  /// the kernel's own. `out` must have room for all the walks' voxels plus 4 (the AVX2 kernel
+  /// stores four addresses at a time).
+  static std::uint32_t* ListUnsettledPortable(const WindowWalk* walks, std::size_t count, const std::uint64_t* settled,
+                                              std::uint64_t residues, std::uint64_t top_bits, std::uint32_t* out);
+  static std::uint32_t* ListUnsettledAvx2(const WindowWalk* walks, std::size_t count, const std::uint64_t* settled,
+                                          std::uint64_t residues, std::uint64_t top_bits, std::uint32_t* out);
   /// Visits the window's voxels that the segment a-b (voxel units) crosses, in order, as
   /// visit(address) until it returns false.
   template <typename Visit>
@@ -242,6 +257,7 @@ class VoxelMap {
   int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
   int hysteresis_voxels_ = 0;             // recenter_hysteresis_m in whole voxels
   std::vector<Vector3> ray_ends_;  // the returns whose rays a frame walks
+  std::vector<WindowWalk> walks_;  // a batch of those rays' walks, started
   std::vector<std::uint32_t> addresses_;  // the voxels a batch of rays leaves to update
   int shift_x_ = 0, shift_y_ = 0;     // the address fields' offsets: log2 of size y * size z, of size z
   std::uint64_t field_top_bits_ = 0;  // each address field's top bit
