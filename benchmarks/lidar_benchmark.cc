@@ -1,10 +1,9 @@
-// The simulated MID-360 in the 500-tree forest of `rotorguard bench perception`, spinning at 11 rad/s while flying 1 m/s.
-// BM_LidarForestStep: one iteration is one 1 ms physics step (200 pulses); items per second are
-// pulses simulated per second (target >= 2 M/s). BM_MapInsertFrame/N: one iteration inserts one
-// 10 Hz frame of a sensor sending N pulses per second into the occupancy map (target <= 5 ms for a
-// 20k-point frame): the MID-360's 200 000 (about 15 500 returns per frame in the forest, the rest
-// sky) and 260 000 (about 20 000 returns).
-// Run: build/bin/lidar_benchmark
+// The simulated MID-360 in the 500-tree forest of `rotorguard bench perception`, spinning at 11 rad/s while flying 1
+// m/s. BM_LidarForestStep: one iteration is one 1 ms physics step (200 pulses); items per second are pulses simulated
+// per second (target >= 2 M/s). BM_MapInsertFrame/N: one iteration inserts one 10 Hz frame of a sensor sending N pulses
+// per second into the occupancy map (target <= 5 ms for a 20k-point frame): the MID-360's 200 000 (about 15 500 returns
+// per frame in the forest, the rest sky) and 260 000 (about 20 000 returns); MapInsertFrame/portable_kernel/N with the
+// portable walk kernel instead of the AVX2 one. Run: build/bin/lidar_benchmark
 #include <benchmark/benchmark.h>
 
 #include "rotorguard/bench/perception_bench.h"
@@ -42,14 +41,16 @@ void BM_LidarForestStep(benchmark::State& state) {
 }
 BENCHMARK(BM_LidarForestStep);
 
-void BM_MapInsertFrame(benchmark::State& state) {
+void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKernel kernel) {
   // Frames of the flight above in the world frame (each point placed with its true pose),
   // simulated between timed iterations so that the window moves as in flight.
   sim::LidarOptions o;
   o.enabled = true;
   o.points_per_s = static_cast<double>(state.range(0));
   sim::LidarSimulator lidar(o, Forest(), 1);
-  perception::VoxelMap map(perception::VoxelMapOptions{});
+  perception::VoxelMapOptions map_options;
+  map_options.walk_kernel = kernel;
+  perception::VoxelMap map(map_options);
   map.Recenter(PoseAt(0).p_W);
   TimeNs t = 0;
   std::size_t frames = 0, points = 0;
@@ -84,6 +85,13 @@ void BM_MapInsertFrame(benchmark::State& state) {
   state.counters["voxels_updated_per_frame"] = benchmark::Counter(updated / n);
   state.counters["settled_step_share"] = benchmark::Counter(steps > 0.0 ? settled / steps : 0.0);
 }
+void BM_MapInsertFrame(benchmark::State& state) {
+  MapInsertFrame(state, perception::VoxelMapOptions::WalkKernel::kAuto);
+}
 BENCHMARK(BM_MapInsertFrame)->Arg(200000)->Arg(260000)->Unit(benchmark::kMillisecond);
+// The same with the portable walk kernel (two interleaved rays instead of four in a vector).
+BENCHMARK_CAPTURE(MapInsertFrame, portable_kernel, perception::VoxelMapOptions::WalkKernel::kPortable)
+    ->Arg(200000)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -365,7 +365,8 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // then walked by a kernel that lists each voxel whose settled bit is clear (see
   // ListUnsettledPortable and ListUnsettledAvx2). The voxels a batch lists are updated after,
   // each prefetched ahead, so that the memory latencies of a window larger than the caches
-  // overlap. The order of the list changes nothing: a frame misses a voxel at most once.
+  // overlap. The order of the list changes nothing: a frame misses a voxel at most once, and what
+  // a miss changes besides the cell (the counts, the settled bit, the inflation's +-1) commutes.
   const double inv_res = 1.0 / res_;
   const Vector3 o = origin_W * inv_res;
   const double max_cells = options_.max_clearing_range_m / res_;
@@ -472,11 +473,11 @@ std::uint32_t* VoxelMap::ListUnsettledAvx2(const WindowWalk* walks, std::size_t 
                                            std::uint64_t residues, std::uint64_t top_bits, std::uint32_t* out) {
   // Four rays, one per 64-bit lane of each register: a step of all four is the portable kernel's
   // step for one (Advance) in vector compares and masks, and the listing is the four addresses in
-  // one vector, each lane's settled bit read with a scalar load (a vector gather measured 10 %
+  // one vector, each lane's settled bit read with a scalar load (a vector gather measured 11-14 %
   // slower over the whole frame), and a compress of the lanes to keep (a permutation looked up by
   // their mask) stored four at a time. Between runs of steps the lanes live in arrays, where a
-  // lane that finished its ray takes the next; a lane with no ray left idles (steps of zero, its
-  // listing masked off) until all do.
+  // lane that finished its ray takes the next; a lane with no ray left idles (zero increments,
+  // no steps counted, its listing masked off) until all do.
   constexpr std::int64_t kIdle = std::numeric_limits<std::int64_t>::max();
   alignas(32) std::int64_t tx[4], ty[4], tz[4], dx[4], dy[4], dz[4], n[4];
   alignas(32) std::uint64_t rel[4], sx[4], sy[4], sz[4];
@@ -496,7 +497,7 @@ std::uint32_t* VoxelMap::ListUnsettledAvx2(const WindowWalk* walks, std::size_t 
   for (int k = 0; k < 4; ++k) take_next(k);
   // Lane k's dword in the low half of the 64-bit lane, 2k; the 16 masks' permutations put the
   // kept lanes' dwords first, in lane order.
-  alignas(32) static const std::array<std::array<std::int32_t, 8>, 16> kCompress = [] {
+  alignas(32) static constexpr std::array<std::array<std::int32_t, 8>, 16> kCompress = [] {
     std::array<std::array<std::int32_t, 8>, 16> table{};
     for (int mask = 0; mask < 16; ++mask) {
       int j = 0;

@@ -41,8 +41,8 @@ struct VoxelMapOptions {
   /// voxel boundary (a level flight at z = 1.5 m) moves the window back and forth with the
   /// estimate's noise, and each move of a whole face costs more than a frame's rays.
   double recenter_hysteresis_m = 0.5;
-  /// How a frame's rays are walked. Both kernels list exactly the same voxels (a test compares
-  /// them frame by frame); they differ in speed only. kAuto walks four rays in one vector register
+  /// How a frame's rays are walked. Both kernels list exactly the same voxels (a test flies one
+  /// map per kernel and compares them); they differ in speed only. kAuto walks four rays in one vector register
   /// when the build targets AVX2 (x86-64-v3), else two interleaved rays; kPortable forces the
   /// latter.
   enum class WalkKernel { kAuto, kPortable };
