@@ -1,9 +1,12 @@
-// The simulated MID-360 in the 500-tree forest of `rotorguard bench perception`, spinning at 11 rad/s while flying 1
-// m/s. BM_LidarForestStep: one iteration is one 1 ms physics step (200 pulses); items per second are pulses simulated
-// per second (target >= 2 M/s). BM_MapInsertFrame/N: one iteration inserts one 10 Hz frame of a sensor sending N pulses
-// per second into the occupancy map (target <= 5 ms for a 20k-point frame): the MID-360's 200 000 (about 15 500 returns
-// per frame in the forest, the rest sky) and 260 000 (about 20 000 returns); MapInsertFrame/portable_kernel/N with the
-// portable walk kernel instead of the AVX2 one. Run: build/bin/lidar_benchmark
+// The simulated MID-360 in the 500-tree forest of `rotorguard bench perception`, spinning at
+// 11 rad/s while flying 1 m/s. BM_LidarForestStep: one iteration is one 1 ms physics step (200
+// pulses); items per second are pulses simulated per second (target >= 2 M/s).
+// BM_MapInsertFrame/N: one iteration inserts one 10 Hz frame of a sensor sending N pulses per
+// second into the occupancy map (target <= 5 ms for a 20k-point frame): the MID-360's 200 000
+// (about 15 500 returns per frame in the forest, the rest sky) and 260 000 (about 20 000
+// returns); MapInsertFrame/portable_kernel/N the same with the portable walk kernel instead of
+// the AVX2 one.
+// Run: build/bin/lidar_benchmark
 #include <benchmark/benchmark.h>
 
 #include "rotorguard/bench/perception_bench.h"

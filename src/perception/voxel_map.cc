@@ -378,9 +378,10 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // last store.
   addresses_.resize(kRaysPerBatch * static_cast<std::size_t>(size_.sum()) + 4);
 #if defined(__AVX2__)
-  const bool avx2 = options_.walk_kernel == VoxelMapOptions::WalkKernel::kAuto;
+  const auto list_unsettled =
+      options_.walk_kernel == VoxelMapOptions::WalkKernel::kAuto ? ListUnsettledAvx2 : ListUnsettledPortable;
 #else
-  const bool avx2 = false;
+  const auto list_unsettled = ListUnsettledPortable;
 #endif
   for (std::size_t first = 0; first < rays.size(); first += kRaysPerBatch) {
     const std::size_t last = std::min(rays.size(), first + kRaysPerBatch);
@@ -395,8 +396,8 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
       walks_.push_back(w);
     }
     const std::uint32_t* const addresses = addresses_.data();
-    const std::uint32_t* const end = (avx2 ? ListUnsettledAvx2 : ListUnsettledPortable)(
-        walks_.data(), walks_.size(), settled_free_.data(), origin_residues_, field_top_bits_, addresses_.data());
+    const std::uint32_t* const end = list_unsettled(walks_.data(), walks_.size(), settled_free_.data(),
+                                                    origin_residues_, field_top_bits_, addresses_.data());
     const std::size_t listed = static_cast<std::size_t>(end - addresses);
     listed_total += static_cast<long>(listed);
     for (std::size_t k = 0; k < listed; ++k) {
@@ -558,11 +559,6 @@ std::uint32_t* VoxelMap::ListUnsettledAvx2(const WindowWalk* walks, std::size_t 
     }
   }
   return out;
-}
-#else
-std::uint32_t* VoxelMap::ListUnsettledAvx2(const WindowWalk* walks, std::size_t count, const std::uint64_t* settled,
-                                           std::uint64_t residues, std::uint64_t top_bits, std::uint32_t* out) {
-  return ListUnsettledPortable(walks, count, settled, residues, top_bits, out);
 }
 #endif
 

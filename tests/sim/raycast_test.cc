@@ -1,14 +1,29 @@
 #include "rotorguard/sim/raycast.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <numbers>
-
-#include <gtest/gtest.h>
+#include <optional>
 
 #include "rotorguard/core/rng.h"
 
 namespace rotorguard::sim {
 namespace {
+
+/// The oracle of the indices: the nearest hit of the ground and of every obstacle of `w` (the
+/// moving boxes where they are at time t), each tested in turn.
+std::optional<RayHit> CastByTestingEverything(const World& w, const Vector3& o, const Vector3& d, double max_m,
+                                              double t) {
+  std::optional<RayHit> best = IntersectGround(o, d, max_m);
+  const auto keep = [&](const std::optional<RayHit>& h) {
+    if (h && (!best || h->distance_m < best->distance_m)) best = h;
+  };
+  for (const Box& b : w.boxes) keep(IntersectBox(b, o, d, max_m));
+  for (const Cylinder& c : w.cylinders) keep(IntersectCylinder(c, o, d, max_m));
+  for (const MovingBox& m : w.moving_boxes) keep(IntersectBox(m.At(t), o, d, max_m));
+  return best;
+}
 
 // Closed forms.
 TEST(Raycast, GroundBoxAndCylinderAgainstClosedForms) {
@@ -117,13 +132,7 @@ TEST(Raycast, IndicesMatchBruteForceInAForest) {
     const double az = rng.Uniform(-std::numbers::pi, std::numbers::pi), el = rng.Uniform(-0.5, 1.0);
     const Vector3 d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     const double t = rng.Uniform(0, 20);
-    std::optional<RayHit> brute = IntersectGround(o, d, 40.0);
-    const auto keep = [&](const std::optional<RayHit>& h) {
-      if (h && (!brute || h->distance_m < brute->distance_m)) brute = h;
-    };
-    for (const Box& b : w.boxes) keep(IntersectBox(b, o, d, 40.0));
-    for (const Cylinder& c : w.cylinders) keep(IntersectCylinder(c, o, d, 40.0));
-    keep(IntersectBox(mover.At(t), o, d, 40.0));
+    const std::optional<RayHit> brute = CastByTestingEverything(w, o, d, 40.0, t);
     const auto grid = caster.Cast(o, d, 40.0, t);
     ASSERT_EQ(grid.has_value(), brute.has_value()) << k;
     if (grid) {
@@ -150,15 +159,6 @@ TEST(Raycast, AzimuthIndexMatchesBruteForceAlongAFlight) {
   RayCasterOptions options;
   options.azimuth_bins = 64;  // coarse bins: many trunks per bin, the nearest-first cut-off matters
   RayCaster caster(w, options);
-  const auto brute = [&](const Vector3& o, const Vector3& d) {
-    std::optional<RayHit> best = IntersectGround(o, d, 40.0);
-    const auto keep = [&](const std::optional<RayHit>& h) {
-      if (h && (!best || h->distance_m < best->distance_m)) best = h;
-    };
-    for (const Box& b : w.boxes) keep(IntersectBox(b, o, d, 40.0));
-    for (const Cylinder& c : w.cylinders) keep(IntersectCylinder(c, o, d, 40.0));
-    return best;
-  };
   int hits = 0, grazing = 0;
   for (int k = 0; k < 40000; ++k) {
     const double s = 1e-3 * k;  // 40 m of lane, a ray every millimetre
@@ -180,7 +180,7 @@ TEST(Raycast, AzimuthIndexMatchesBruteForceAlongAFlight) {
       const double az = rng.Uniform(-std::numbers::pi, std::numbers::pi), el = rng.Uniform(-0.6, 1.2);
       d = Vector3(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     }
-    const auto expected = brute(o, d);
+    const auto expected = CastByTestingEverything(w, o, d, 40.0, 0.0);
     const auto got = caster.Cast(o, d, 40.0, 0.0);
     ASSERT_EQ(got.has_value(), expected.has_value()) << k;
     if (got) {

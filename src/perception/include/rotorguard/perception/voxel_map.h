@@ -42,9 +42,9 @@ struct VoxelMapOptions {
   /// estimate's noise, and each move of a whole face costs more than a frame's rays.
   double recenter_hysteresis_m = 0.5;
   /// How a frame's rays are walked. Both kernels list exactly the same voxels (a test flies one
-  /// map per kernel and compares them); they differ in speed only. kAuto walks four rays in one vector register
-  /// when the build targets AVX2 (x86-64-v3), else two interleaved rays; kPortable forces the
-  /// latter.
+  /// map per kernel and compares them); they differ in speed only. kAuto walks four rays in one
+  /// vector register when the build targets AVX2 (x86-64-v3), else two interleaved rays;
+  /// kPortable forces the latter.
   enum class WalkKernel { kAuto, kPortable };
   WalkKernel walk_kernel = WalkKernel::kAuto;
   void Validate() const;
@@ -216,7 +216,8 @@ class VoxelMap {
   /// its last), as an address (AddressOfRelative with these residues and top bits), written from
   /// `out` on unless its bit in `settled` is set; the end of the list is returned. The order is
   /// the kernel's own. `out` must have room for all the walks' voxels plus 4 (the AVX2 kernel
-  /// stores four addresses at a time).
+  /// stores four addresses at a time). The AVX2 kernel is defined only in builds that target AVX2,
+  /// where Insert alone selects it.
   static std::uint32_t* ListUnsettledPortable(const WindowWalk* walks, std::size_t count, const std::uint64_t* settled,
                                               std::uint64_t residues, std::uint64_t top_bits, std::uint32_t* out);
   static std::uint32_t* ListUnsettledAvx2(const WindowWalk* walks, std::size_t count, const std::uint64_t* settled,
