@@ -1,6 +1,7 @@
 // The simulated MID-360 in the 500-tree forest of `rotorguard bench perception`, spinning at
 // 11 rad/s while flying 1 m/s. BM_LidarForestStep: one iteration is one 1 ms physics step (200
 // pulses); items per second are pulses simulated per second (target >= 2 M/s).
+// CastForestRays/<kernel>: the ray caster alone on those pulses, per cylinder kernel.
 // BM_MapInsertFrame/N: one iteration inserts one 10 Hz frame of a sensor sending N pulses per
 // second into the occupancy map (target <= 5 ms for a 20k-point frame): the MID-360's 200 000
 // (about 15 500 returns per frame in the forest, the rest sky) and 260 000 (about 20 000
@@ -10,6 +11,7 @@
 #include <benchmark/benchmark.h>
 
 #include "rotorguard/bench/perception_bench.h"
+#include "rotorguard/bench/planner_bench.h"
 #include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/sim/lidar.h"
 
@@ -43,6 +45,37 @@ void BM_LidarForestStep(benchmark::State& state) {
       benchmark::Counter(static_cast<double>(points) / std::max(1.0, ToSeconds(t) * 10.0));
 }
 BENCHMARK(BM_LidarForestStep);
+
+// The ray caster alone on the same pulses, with each cylinder kernel: one iteration casts one
+// physics step's 200 pulses from the sensor's pose at the step's start.
+void CastForestRays(benchmark::State& state, const sim::World& forest, sim::RayCasterOptions::CylinderKernel kernel) {
+  sim::LidarOptions o;
+  sim::RayCasterOptions ro;
+  ro.cylinder_kernel = kernel;
+  sim::RayCaster caster(forest, ro);
+  const sim::LidarPattern pattern(o);
+  TimeNs t = 0;
+  std::uint64_t k = 0;
+  std::size_t hits = 0;
+  for (auto _ : state) {
+    const sim::BodyPose pose = PoseAt(t);
+    const Matrix3 R = pose.q_WB.toRotationMatrix();
+    const Vector3 origin = pose.p_W + R * o.position_m;
+    for (int i = 0; i < 200; ++i, ++k)
+      hits += caster.Cast(origin, R * pattern.Direction(k), o.max_range_m, 0.0) ? 1 : 0;
+    t += 1'000'000;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(k));
+  state.counters["hit_share"] =
+      benchmark::Counter(static_cast<double>(hits) / std::max<double>(1.0, static_cast<double>(k)));
+}
+BENCHMARK_CAPTURE(CastForestRays, auto_kernel, Forest(), sim::RayCasterOptions::CylinderKernel::kAuto);
+BENCHMARK_CAPTURE(CastForestRays, portable_kernel, Forest(), sim::RayCasterOptions::CylinderKernel::kPortable);
+// The same in a forest of `rotorguard bench nav` (fewer, thicker trees).
+BENCHMARK_CAPTURE(CastForestRays, nav_forest_auto_kernel, bench::PlannerForest(22),
+                  sim::RayCasterOptions::CylinderKernel::kAuto);
+BENCHMARK_CAPTURE(CastForestRays, nav_forest_portable_kernel, bench::PlannerForest(22),
+                  sim::RayCasterOptions::CylinderKernel::kPortable);
 
 void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKernel kernel) {
   // Frames of the flight above in the world frame (each point placed with its true pose),

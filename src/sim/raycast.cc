@@ -4,6 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 #include "rotorguard/core/error.h"
 
 namespace rotorguard::sim {
@@ -19,6 +23,132 @@ Vector3 RotateZ(const Vector3& v, double c, double s) { return Vector3(c * v.x()
 void Nearer(const std::optional<RayHit>& candidate, std::optional<RayHit>* best) {
   if (candidate && (!*best || candidate->distance_m < (*best)->distance_m)) *best = candidate;
 }
+
+/// a * b + c, in one rounding where the build has FMA: the scalar test and the AVX2 kernel below
+/// then compute every cylinder's distance to the same bit.
+inline double MulAdd(double a, double b, double c) {
+#if defined(__FMA__)
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
+#endif
+}
+
+/// The distance at which a ray meets one vertical cylinder (centre (cx, cy), squared radius r2,
+/// height `top`), or infinity: the side, entered from outside the circle, and the top cap, from
+/// above; nothing for a ray starting inside the trunk. `a` is |d_xy|^2. The AVX2 kernel
+/// (NearestInQuadAvx2) is this, four cylinders at a time, operation for operation.
+struct CylinderHit {
+  double distance_m = kInf;
+  bool top = false;  ///< on the cap rather than the side
+};
+inline CylinderHit HitCylinder(double cx, double cy, double r2, double top, const Vector3& o, const Vector3& d,
+                               double a, double max_m) {
+  CylinderHit hit;
+  const double ox = o.x() - cx, oy = o.y() - cy;
+  const double oo = MulAdd(oy, oy, ox * ox);
+  const bool inside_circle = oo < r2;
+  if (inside_circle && o.z() >= 0.0 && o.z() <= top) return hit;  // inside the trunk
+  // Side: |o2 + t d2|^2 = r^2, the smaller root.
+  if (a > 1e-15 && !inside_circle) {
+    const double b = 2.0 * MulAdd(oy, d.y(), ox * d.x());
+    const double disc = MulAdd(b, b, -((4.0 * a) * (oo - r2)));
+    if (disc >= 0.0) {
+      const double t = (-b - std::sqrt(disc)) * (0.5 / a);
+      const double z = MulAdd(t, d.z(), o.z());
+      if (t > 0.0 && t <= max_m && z >= 0.0 && z <= top) hit.distance_m = t;
+    }
+  }
+  // Top cap, from above.
+  if (o.z() > top && d.z() < 0.0) {
+    const double t = (top - o.z()) * (1.0 / d.z());
+    const double px = MulAdd(t, d.x(), ox), py = MulAdd(t, d.y(), oy);
+    if (t <= max_m && MulAdd(py, py, px * px) <= r2 && t < hit.distance_m) hit = CylinderHit{t, true};
+  }
+  return hit;
+}
+
+/// The hit of `h` on `cyl` with its outward normal.
+inline RayHit HitOf(const Cylinder& cyl, const Vector3& o, const Vector3& d, const CylinderHit& h) {
+  if (h.top) return RayHit{h.distance_m, Vector3::UnitZ()};
+  const Eigen::Vector2d n2 = (o.head<2>() - cyl.center_m + h.distance_m * d.head<2>()) / cyl.radius_m;
+  return RayHit{h.distance_m, Vector3(n2.x(), n2.y(), 0.0)};
+}
+
+#if defined(__AVX2__)
+/// The first of the four cylinders nearest along the ray, its lane (-1: none) and hit, testing
+/// only those within `limit` of horizontal travel; for CastCylinders.
+inline int NearestInQuadAvx2(const internal::CylinderQuad& q, const Vector3& o, const Vector3& d, double a,
+                             double range, double limit, CylinderHit* hit) {
+  // HitCylinder on the four lanes, operation for operation (the same roundings), misses as +inf.
+  const __m256d inf = _mm256_set1_pd(kInf), zero = _mm256_setzero_pd();
+  const __m256d cx = _mm256_load_pd(q.cx), cy = _mm256_load_pd(q.cy), r2 = _mm256_load_pd(q.r2);
+  const __m256d top = _mm256_load_pd(q.top);
+  const __m256d dx = _mm256_set1_pd(d.x()), dy = _mm256_set1_pd(d.y()), dz = _mm256_set1_pd(d.z());
+  const __m256d oz = _mm256_set1_pd(o.z()), vrange = _mm256_set1_pd(range);
+  const __m256d ox = _mm256_sub_pd(_mm256_set1_pd(o.x()), cx), oy = _mm256_sub_pd(_mm256_set1_pd(o.y()), cy);
+  const __m256d oo = _mm256_fmadd_pd(oy, oy, _mm256_mul_pd(ox, ox));
+  const __m256d inside_circle = _mm256_cmp_pd(oo, r2, _CMP_LT_OQ);
+  __m256d dist = inf;
+  if (a > 1e-15) {
+    const __m256d b = _mm256_mul_pd(_mm256_set1_pd(2.0), _mm256_fmadd_pd(oy, dy, _mm256_mul_pd(ox, dx)));
+    const __m256d disc = _mm256_fmsub_pd(b, b, _mm256_mul_pd(_mm256_set1_pd(4.0 * a), _mm256_sub_pd(oo, r2)));
+    const __m256d neg_b = _mm256_xor_pd(b, _mm256_set1_pd(-0.0));
+    const __m256d t = _mm256_mul_pd(_mm256_sub_pd(neg_b, _mm256_sqrt_pd(disc)), _mm256_set1_pd(0.5 / a));
+    const __m256d z = _mm256_fmadd_pd(t, dz, oz);
+    __m256d ok = _mm256_andnot_pd(inside_circle, _mm256_cmp_pd(disc, zero, _CMP_GE_OQ));
+    ok = _mm256_and_pd(ok, _mm256_cmp_pd(t, zero, _CMP_GT_OQ));
+    ok = _mm256_and_pd(ok, _mm256_cmp_pd(t, vrange, _CMP_LE_OQ));
+    ok = _mm256_and_pd(ok, _mm256_cmp_pd(z, zero, _CMP_GE_OQ));
+    ok = _mm256_and_pd(ok, _mm256_cmp_pd(z, top, _CMP_LE_OQ));
+    dist = _mm256_blendv_pd(inf, t, ok);
+  }
+  __m256d on_top = zero;
+  if (d.z() < 0.0) {
+    const __m256d t = _mm256_mul_pd(_mm256_sub_pd(top, oz), _mm256_set1_pd(1.0 / d.z()));
+    const __m256d px = _mm256_fmadd_pd(t, dx, ox), py = _mm256_fmadd_pd(t, dy, oy);
+    on_top = _mm256_cmp_pd(oz, top, _CMP_GT_OQ);
+    on_top = _mm256_and_pd(on_top, _mm256_cmp_pd(t, vrange, _CMP_LE_OQ));
+    on_top = _mm256_and_pd(on_top, _mm256_cmp_pd(_mm256_fmadd_pd(py, py, _mm256_mul_pd(px, px)), r2, _CMP_LE_OQ));
+    on_top = _mm256_and_pd(on_top, _mm256_cmp_pd(t, dist, _CMP_LT_OQ));
+    dist = _mm256_blendv_pd(dist, t, on_top);
+  }
+  // HitCylinder's early return for an origin inside the trunk needs no lane here: inside the
+  // circle rules out the side, and at or below the top the cap. Lanes beyond the ray's reach
+  // (padding included) are dropped.
+  dist = _mm256_blendv_pd(dist, inf, _mm256_cmp_pd(_mm256_load_pd(q.reach_m), _mm256_set1_pd(limit), _CMP_GT_OQ));
+  // The first lane of the smallest distance, as the scalar loop keeps it.
+  __m256d m = _mm256_min_pd(dist, _mm256_permute_pd(dist, 0b0101));
+  m = _mm256_min_pd(m, _mm256_permute2f128_pd(m, m, 1));
+  const double nearest = _mm256_cvtsd_f64(m);
+  if (!(nearest < hit->distance_m)) return -1;
+  const int lane = __builtin_ctz(static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(dist, m, _CMP_EQ_OQ))));
+  *hit = CylinderHit{nearest, ((_mm256_movemask_pd(on_top) >> lane) & 1) != 0};
+  return lane;
+}
+
+/// The nearest hit among a bin's quads [first, end), nearest first, for a ray whose best hit so
+/// far is at `range` (`have`: there is one) and which rises above every trunk after `beyond_top`:
+/// the cylinder's index (-1: none nearer) and its hit.
+int NearestInQuads(const internal::CylinderQuad* first, const internal::CylinderQuad* end, const Vector3& o,
+                   const Vector3& d, double a, double h, double beyond_top, double range, bool have, CylinderHit* won) {
+  int winner = -1;
+  for (const internal::CylinderQuad* q = first; q != end; ++q) {
+    const double limit = std::min(range, beyond_top) * h;
+    if (q->reach_m[0] > limit) break;  // this quad and all later lie beyond
+    CylinderHit hit;
+    const int lane = NearestInQuadAvx2(*q, o, d, a, range, limit, &hit);
+    // A hit at exactly the range replaces no earlier hit, as Nearer keeps the first of equals.
+    if (lane >= 0 && (hit.distance_m < range || !have)) {
+      range = hit.distance_m;
+      have = true;
+      winner = q->id[lane];
+      *won = hit;
+    }
+  }
+  return winner;
+}
+#endif
 
 }  // namespace
 
@@ -58,33 +188,11 @@ std::optional<RayHit> IntersectBox(const Box& box, const Vector3& o, const Vecto
 }
 
 std::optional<RayHit> IntersectCylinder(const Cylinder& cyl, const Vector3& o, const Vector3& d, double max_m) {
-  const Eigen::Vector2d o2 = o.head<2>() - cyl.center_m;
-  const Eigen::Vector2d d2 = d.head<2>();
   const double r2 = cyl.radius_m * cyl.radius_m;
-  const bool inside_circle = o2.squaredNorm() < r2;
-  if (inside_circle && o.z() >= 0.0 && o.z() <= cyl.height_m) return std::nullopt;  // inside the trunk
-  std::optional<RayHit> best;
-  // Side: |o2 + t d2|^2 = r^2, entering from outside the circle.
-  const double a = d2.squaredNorm();
-  if (a > 1e-15 && !inside_circle) {
-    const double b = 2.0 * o2.dot(d2);
-    const double c = o2.squaredNorm() - r2;
-    const double disc = b * b - 4.0 * a * c;
-    if (disc >= 0.0) {
-      const double t = (-b - std::sqrt(disc)) / (2.0 * a);
-      const double z = o.z() + t * d.z();
-      if (t > 0.0 && t <= max_m && z >= 0.0 && z <= cyl.height_m) {
-        const Eigen::Vector2d n2 = (o2 + t * d2) / cyl.radius_m;
-        best = RayHit{t, Vector3(n2.x(), n2.y(), 0.0)};
-      }
-    }
-  }
-  // Top cap, from above.
-  if (o.z() > cyl.height_m && d.z() < 0.0) {
-    const double t = (cyl.height_m - o.z()) / d.z();
-    if (t <= max_m && (o2 + t * d2).squaredNorm() <= r2) Nearer(RayHit{t, Vector3::UnitZ()}, &best);
-  }
-  return best;
+  const double a = MulAdd(d.y(), d.y(), d.x() * d.x());
+  const CylinderHit h = HitCylinder(cyl.center_m.x(), cyl.center_m.y(), r2, cyl.height_m, o, d, a, max_m);
+  if (!(h.distance_m < kInf)) return std::nullopt;
+  return HitOf(cyl, o, d, h);
 }
 
 void RayCasterOptions::Validate() const {
@@ -102,6 +210,9 @@ void RayCasterOptions::Validate() const {
 RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std::move(world)) {
   options.Validate();
   cell_ = options.cell_size_m;
+#if defined(__AVX2__)
+  vector_kernel_ = options.cylinder_kernel == RayCasterOptions::CylinderKernel::kAuto;
+#endif
   bins_ = options.azimuth_bins;
   margin_ = options.azimuth_margin_m;
   for (const Cylinder& cy : world_.cylinders) cylinder_top_ = std::max(cylinder_top_, cy.height_m);
@@ -213,6 +324,38 @@ void RayCaster::IndexCylindersAround(const Eigen::Vector2d& center) {
       bin_items_[static_cast<std::size_t>(fill_[b]++)] = AzimuthEntry{reach_[ii], i};
     }
   }
+  // For the AVX2 kernel, the same entries four to a quad, the last quad of a bin padded with
+  // entries that never hit.
+  if (!vector_kernel_) return;
+  quad_start_.resize(static_cast<std::size_t>(bins_) + 1);
+  quad_start_[0] = 0;
+  for (int b = 0; b < bins_; ++b) {
+    const int entries = bin_start_[static_cast<std::size_t>(b) + 1] - bin_start_[static_cast<std::size_t>(b)];
+    quad_start_[static_cast<std::size_t>(b) + 1] = quad_start_[static_cast<std::size_t>(b)] + (entries + 3) / 4;
+  }
+  quads_.resize(static_cast<std::size_t>(quad_start_.back()));
+  for (int b = 0; b < bins_; ++b) {
+    const int first = bin_start_[static_cast<std::size_t>(b)],
+              entries = bin_start_[static_cast<std::size_t>(b) + 1] - first;
+    for (int k = 0; k < 4 * ((entries + 3) / 4); ++k) {
+      internal::CylinderQuad& q = quads_[static_cast<std::size_t>(quad_start_[static_cast<std::size_t>(b)] + k / 4)];
+      const int lane = k % 4;
+      if (k >= entries) {
+        q.reach_m[lane] = kInf;
+        q.cx[lane] = q.cy[lane] = q.r2[lane] = q.top[lane] = 0.0;
+        q.id[lane] = -1;
+        continue;
+      }
+      const AzimuthEntry& e = bin_items_[static_cast<std::size_t>(first + k)];
+      const Cylinder& cy = world_.cylinders[static_cast<std::size_t>(e.cylinder)];
+      q.reach_m[lane] = e.reach_m;
+      q.cx[lane] = cy.center_m.x();
+      q.cy[lane] = cy.center_m.y();
+      q.r2[lane] = cy.radius_m * cy.radius_m;
+      q.top[lane] = cy.height_m;
+      q.id[lane] = e.cylinder;
+    }
+  }
 }
 
 void RayCaster::CastCylinders(const Vector3& o, const Vector3& d, double max_m, std::optional<RayHit>* best) {
@@ -228,14 +371,36 @@ void RayCaster::CastCylinders(const Vector3& o, const Vector3& d, double max_m, 
   }
   // A rising ray is above every trunk once past the tallest's height.
   const double beyond_top = d.z() > 0.0 ? (cylinder_top_ - o.z()) / d.z() : kInf;
+  const double a = MulAdd(d.y(), d.y(), d.x() * d.x());
   double range = *best ? (*best)->distance_m : max_m;
+  bool have = best->has_value();
   const int b = AzimuthBin(d.x(), d.y());
+  int winner = -1;
+  CylinderHit won;
+#if defined(__AVX2__)
+  if (vector_kernel_) {
+    winner = NearestInQuads(quads_.data() + quad_start_[static_cast<std::size_t>(b)],
+                            quads_.data() + quad_start_[static_cast<std::size_t>(b) + 1], o, d, a, h, beyond_top, range,
+                            have, &won);
+    if (winner >= 0) *best = HitOf(world_.cylinders[static_cast<std::size_t>(winner)], o, d, won);
+    return;
+  }
+#endif
   for (int k = bin_start_[static_cast<std::size_t>(b)]; k < bin_start_[static_cast<std::size_t>(b) + 1]; ++k) {
     const AzimuthEntry& e = bin_items_[static_cast<std::size_t>(k)];
     if (e.reach_m > std::min(range, beyond_top) * h) break;  // this one and all later lie beyond
-    Nearer(IntersectCylinder(world_.cylinders[static_cast<std::size_t>(e.cylinder)], o, d, range), best);
-    if (*best) range = (*best)->distance_m;
+    const Cylinder& cy = world_.cylinders[static_cast<std::size_t>(e.cylinder)];
+    const CylinderHit hit =
+        HitCylinder(cy.center_m.x(), cy.center_m.y(), cy.radius_m * cy.radius_m, cy.height_m, o, d, a, range);
+    // A hit at exactly the range replaces no earlier hit, as Nearer keeps the first of equals.
+    if (hit.distance_m < range || (!have && hit.distance_m < kInf)) {
+      range = hit.distance_m;
+      have = true;
+      winner = e.cylinder;
+      won = hit;
+    }
   }
+  if (winner >= 0) *best = HitOf(world_.cylinders[static_cast<std::size_t>(winner)], o, d, won);
 }
 
 std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double max_m, double t) {

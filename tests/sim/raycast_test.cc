@@ -109,7 +109,26 @@ TEST(Raycast, HitsAgreeWithDistanceFunctionMarching) {
 
 // The boxes' grid and the trees' azimuth index (rebuilt for each ray's new origin) find exactly
 // what testing every obstacle finds, in a 500-tree forest with boxes.
-TEST(Raycast, IndicesMatchBruteForceInAForest) {
+// The indices' cast equals the oracle to the bit, distance and normal, with either cylinder kernel
+// (the AVX2 one tests four trunks at once, in the same operations as IntersectCylinder).
+class RaycastKernels : public ::testing::TestWithParam<RayCasterOptions::CylinderKernel> {
+ protected:
+  RayCasterOptions Options(double cell_m) const {
+    RayCasterOptions o;
+    o.cell_size_m = cell_m;
+    o.cylinder_kernel = GetParam();
+    return o;
+  }
+};
+
+void ExpectSameHit(const std::optional<RayHit>& got, const std::optional<RayHit>& expected, int k) {
+  ASSERT_EQ(got.has_value(), expected.has_value()) << k;
+  if (!got) return;
+  ASSERT_EQ(got->distance_m, expected->distance_m) << k;
+  ASSERT_EQ(got->normal_W, expected->normal_W) << k;
+}
+
+TEST_P(RaycastKernels, IndicesMatchBruteForceInAForest) {
   Rng rng(9);
   World w;
   for (int i = 0; i < 500; ++i) {
@@ -125,7 +144,7 @@ TEST(Raycast, IndicesMatchBruteForceInAForest) {
   mover.waypoints_m = {Vector3(-5, 0, 1), Vector3(5, 0, 1)};
   mover.speed_m_s = 1.0;
   w.moving_boxes.push_back(mover);
-  RayCaster caster(w, RayCasterOptions{0.7});
+  RayCaster caster(w, Options(0.7));
   int hits = 0;
   for (int k = 0; k < 20000; ++k) {
     const Vector3 o(rng.Uniform(-20, 20), rng.Uniform(-14, 14), rng.Uniform(0.2, 3));
@@ -134,11 +153,8 @@ TEST(Raycast, IndicesMatchBruteForceInAForest) {
     const double t = rng.Uniform(0, 20);
     const std::optional<RayHit> brute = CastByTestingEverything(w, o, d, 40.0, t);
     const auto grid = caster.Cast(o, d, 40.0, t);
-    ASSERT_EQ(grid.has_value(), brute.has_value()) << k;
-    if (grid) {
-      ++hits;
-      EXPECT_EQ(grid->distance_m, brute->distance_m) << k;
-    }
+    ExpectSameHit(grid, brute, k);
+    if (grid) ++hits;
   }
   EXPECT_GT(hits, 10000);
 }
@@ -147,7 +163,7 @@ TEST(Raycast, IndicesMatchBruteForceInAForest) {
 // (the azimuth index reused within its margin and rebuilt beyond it), rays in every direction
 // including straight up and down and ones that graze a trunk's edge, and origins inside a trunk's
 // padded disc, over the top of a trunk and inside a trunk.
-TEST(Raycast, AzimuthIndexMatchesBruteForceAlongAFlight) {
+TEST_P(RaycastKernels, AzimuthIndexMatchesBruteForceAlongAFlight) {
   Rng rng(21);
   World w;
   for (int i = 0; i < 300; ++i) {
@@ -156,7 +172,7 @@ TEST(Raycast, AzimuthIndexMatchesBruteForceAlongAFlight) {
   }
   w.cylinders.push_back({Eigen::Vector2d(0.3, 0.1), 0.2, 1.0});  // the lane passes over and through it
   w.boxes.push_back({Vector3(3, -2, 1), Vector3(1, 2, 2), 0.4});
-  RayCasterOptions options;
+  RayCasterOptions options = Options(1.0);
   options.azimuth_bins = 64;  // coarse bins: many trunks per bin, the nearest-first cut-off matters
   RayCaster caster(w, options);
   int hits = 0, grazing = 0;
@@ -182,11 +198,8 @@ TEST(Raycast, AzimuthIndexMatchesBruteForceAlongAFlight) {
     }
     const auto expected = CastByTestingEverything(w, o, d, 40.0, 0.0);
     const auto got = caster.Cast(o, d, 40.0, 0.0);
-    ASSERT_EQ(got.has_value(), expected.has_value()) << k;
-    if (got) {
-      ++hits;
-      ASSERT_EQ(got->distance_m, expected->distance_m) << k;
-    }
+    ExpectSameHit(got, expected, k);
+    if (got) ++hits;
   }
   EXPECT_GT(hits, 20000);
   EXPECT_GT(grazing, 7000);
@@ -194,6 +207,13 @@ TEST(Raycast, AzimuthIndexMatchesBruteForceAlongAFlight) {
   EXPECT_GT(caster.index_rebuilds(), 40);
   EXPECT_LT(caster.index_rebuilds(), 1000);
 }
+
+INSTANTIATE_TEST_SUITE_P(Kernels, RaycastKernels,
+                         ::testing::Values(RayCasterOptions::CylinderKernel::kAuto,
+                                           RayCasterOptions::CylinderKernel::kPortable),
+                         [](const ::testing::TestParamInfo<RayCasterOptions::CylinderKernel>& kernel) {
+                           return kernel.param == RayCasterOptions::CylinderKernel::kAuto ? "Auto" : "Portable";
+                         });
 
 // The walk stops once a rising ray is above the tallest obstacle, box or cylinder alike: rays that
 // rise to just below the top of the tallest still hit it (closed form: the face's distance along

@@ -30,6 +30,15 @@ std::optional<RayHit> IntersectBox(const Box& box, const Vector3& o, const Vecto
 /// The side and the top cap of a vertical cylinder standing on the ground.
 std::optional<RayHit> IntersectCylinder(const Cylinder& cylinder, const Vector3& o, const Vector3& d, double max_m);
 
+namespace internal {
+/// Four cylinders of an azimuth bin, in the bin's order, a field per vector register (the ray
+/// caster's AVX2 kernel tests them at once). Lanes past the bin's end have reach_m = +inf.
+struct alignas(32) CylinderQuad {
+  double reach_m[4], cx[4], cy[4], r2[4], top[4];  // reach, centre, squared radius, height
+  int id[4];                                       // index in World::cylinders, -1 for padding
+};
+}  // namespace internal
+
 struct RayCasterOptions {
   double cell_size_m = 1.0;  ///< the boxes' grid cell edge [m], > 0
   /// Bins of the cylinders' azimuth index, in [8, 65536]: more bins, fewer candidates per ray.
@@ -38,6 +47,12 @@ struct RayCasterOptions {
   /// [m], > 0; a ray from farther rebuilds it around its own origin (a flying sensor every
   /// `azimuth_margin_m` of travel). Larger: fewer rebuilds, more candidates per ray.
   double azimuth_margin_m = 0.25;
+  /// How a ray tests the cylinders of its bin. Both give the same hits to the bit (a test casts
+  /// with each and compares); they differ in speed only. kAuto tests four cylinders in one
+  /// vector register when the build targets AVX2 (x86-64-v3), else one at a time; kPortable
+  /// forces the latter.
+  enum class CylinderKernel { kAuto, kPortable };
+  CylinderKernel cylinder_kernel = CylinderKernel::kAuto;
   void Validate() const;
 };
 
@@ -84,6 +99,11 @@ class RayCaster {
   Eigen::Vector2d index_center_ = Eigen::Vector2d::Zero();
   std::vector<int> bin_start_;
   std::vector<AzimuthEntry> bin_items_;
+  // For the AVX2 kernel, the same entries four at a time: bin b's are quads_[quad_start_[b] ..
+  // quad_start_[b + 1]).
+  std::vector<int> quad_start_;
+  std::vector<internal::CylinderQuad> quads_;
+  bool vector_kernel_ = false;  // the AVX2 kernel tests the quads
   // Scratch of a rebuild, kept to reuse its memory.
   std::vector<double> reach_;
   std::vector<int> order_, first_bin_, bin_count_, fill_;
