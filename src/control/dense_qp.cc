@@ -72,6 +72,7 @@ DenseQpSolver::DenseQpSolver(int n, int m, const DenseQpOptions& options)
       chol_(n, n),
       J0_(n, n),
       J_(n, n),
+      height_(static_cast<std::size_t>(std::max(n, 0)), 0),
       R_(Eigen::MatrixXd::Zero(n, n)),
       z_(n),
       d_(n),
@@ -111,19 +112,28 @@ double DenseQpSolver::NormalDotStep(const DenseQp& qp, const Side& c) const {
   return c.sign * qp.C.row(c.index - n_).dot(step_);
 }
 
+void DenseQpSolver::RotateColumns(int j, double cs, double sn) {
+  const int rows = std::max(height_[static_cast<std::size_t>(j)], height_[static_cast<std::size_t>(j) + 1]);
+  height_[static_cast<std::size_t>(j)] = height_[static_cast<std::size_t>(j) + 1] = rows;
+  double* const left = J_.col(j).data();
+  double* const right = J_.col(j + 1).data();
+  for (int i = 0; i < rows; ++i) {
+    const double a = left[i], b = right[i];
+    left[i] = cs * a + sn * b;
+    right[i] = -sn * a + cs * b;
+  }
+}
+
 void DenseQpSolver::AddToActiveSet(const Side& c) {
   // Rotate d so that only d[0..q] is non-zero; apply the same rotations to the columns of J.
   for (int j = n_ - 1; j > q_; --j) {
+    if (d_[j] == 0.0) continue;  // Givens would give sn = 0: nothing to rotate
     double cs, sn;
     Givens(d_[j - 1], d_[j], &cs, &sn);
     if (sn == 0.0) continue;
     d_[j - 1] = cs * d_[j - 1] + sn * d_[j];
     d_[j] = 0.0;
-    for (int i = 0; i < n_; ++i) {
-      const double a = J_(i, j - 1), b = J_(i, j);
-      J_(i, j - 1) = cs * a + sn * b;
-      J_(i, j) = -sn * a + cs * b;
-    }
+    RotateColumns(j - 1, cs, sn);
   }
   R_.col(q_).head(q_ + 1) = d_.head(q_ + 1);
   active_.push_back(c);
@@ -150,11 +160,7 @@ void DenseQpSolver::DropFromActiveSet(int position) {
       R_(col + 1, k) = -sn * a + cs * b;
     }
     R_(col + 1, col) = 0.0;
-    for (int i = 0; i < n_; ++i) {
-      const double a = J_(i, col), b = J_(i, col + 1);
-      J_(i, col) = cs * a + sn * b;
-      J_(i, col + 1) = -sn * a + cs * b;
-    }
+    RotateColumns(col, cs, sn);
   }
   --q_;
 }
@@ -247,6 +253,7 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
 
   // Unconstrained minimum from the factorisation H = L L', J = L^-T: z = -J J' g.
   J_ = J0_;
+  for (int j = 0; j < n_; ++j) height_[static_cast<std::size_t>(j)] = j + 1;
   d_.noalias() = J_.transpose() * qp.g;
   z_.noalias() = -J_ * d_;
 

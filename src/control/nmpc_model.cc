@@ -194,6 +194,10 @@ void Rk4Sensitivity::Step(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Ei
       if (i > 0) {
         abtmp_ = ab_ + (kStage[i] * h_) * dk_[i - 1];
         model_.MultiplyStateJacobian(fx_, abtmp_, &dk_[i]);
+      } else if (s == 0) {
+        // d xs is still [0 I | 0]: the product is f_x's columns themselves, exactly.
+        dk_[i].leftCols(nx - 3) = fx_.rightCols(nx - 3);
+        dk_[i].rightCols(nu).setZero();
       } else {
         model_.MultiplyStateJacobian(fx_, ab_, &dk_[i]);
       }

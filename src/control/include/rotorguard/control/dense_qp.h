@@ -89,6 +89,8 @@ class DenseQpSolver {
   double NormalDotStep(const DenseQp& qp, const Side& c) const;
   void AddToActiveSet(const Side& c);
   void DropFromActiveSet(int position);
+  /// Columns j and j + 1 of J_ times the rotation [cs -sn; sn cs], over their non-zero rows.
+  void RotateColumns(int j, double cs, double sn);
 
   int n_, m_;
   DenseQpOptions options_;
@@ -96,6 +98,9 @@ class DenseQpSolver {
   Eigen::MatrixXd J0_;     // L^-T of the factorised H
   bool factorized_ = false;
   Eigen::MatrixXd J_;      // L^-T Q
+  // Column j of J_ is zero below row height_[j] - 1: L^-T is upper triangular, and a rotation of
+  // two columns gives both the larger height. The rotations skip the zero rows.
+  std::vector<int> height_;
   Eigen::MatrixXd R_;      // upper triangular, q x q in the top-left corner
   Eigen::VectorXd z_, d_, step_, r_, u_, cz_;
   Eigen::VectorXd y_bound_, y_constraint_;
