@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#if defined(__AVX2__)
+#if defined(__AVX2__) && defined(__FMA__)
 #include <immintrin.h>
 #endif
 
@@ -75,7 +75,7 @@ inline RayHit HitOf(const Cylinder& cyl, const Vector3& o, const Vector3& d, con
   return RayHit{h.distance_m, Vector3(n2.x(), n2.y(), 0.0)};
 }
 
-#if defined(__AVX2__)
+#if defined(__AVX2__) && defined(__FMA__)
 /// The first of the four cylinders nearest along the ray, its lane (-1: none) and hit, testing
 /// only those within `limit` of horizontal travel; for CastCylinders.
 inline int NearestInQuadAvx2(const internal::CylinderQuad& q, const Vector3& o, const Vector3& d, double a,
@@ -210,7 +210,7 @@ void RayCasterOptions::Validate() const {
 RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std::move(world)) {
   options.Validate();
   cell_ = options.cell_size_m;
-#if defined(__AVX2__)
+#if defined(__AVX2__) && defined(__FMA__)
   vector_kernel_ = options.cylinder_kernel == RayCasterOptions::CylinderKernel::kAuto;
 #endif
   bins_ = options.azimuth_bins;
@@ -340,9 +340,10 @@ void RayCaster::IndexCylindersAround(const Eigen::Vector2d& center) {
     for (int k = 0; k < 4 * ((entries + 3) / 4); ++k) {
       internal::CylinderQuad& q = quads_[static_cast<std::size_t>(quad_start_[static_cast<std::size_t>(b)] + k / 4)];
       const int lane = k % 4;
-      if (k >= entries) {
+      if (k >= entries) {  // a lane no ray can hit, whatever its reach limit (NaN fails every test)
         q.reach_m[lane] = kInf;
-        q.cx[lane] = q.cy[lane] = q.r2[lane] = q.top[lane] = 0.0;
+        q.cx[lane] = q.cy[lane] = q.top[lane] = 0.0;
+        q.r2[lane] = std::numeric_limits<double>::quiet_NaN();
         q.id[lane] = -1;
         continue;
       }
@@ -377,7 +378,7 @@ void RayCaster::CastCylinders(const Vector3& o, const Vector3& d, double max_m, 
   const int b = AzimuthBin(d.x(), d.y());
   int winner = -1;
   CylinderHit won;
-#if defined(__AVX2__)
+#if defined(__AVX2__) && defined(__FMA__)
   if (vector_kernel_) {
     winner = NearestInQuads(quads_.data() + quad_start_[static_cast<std::size_t>(b)],
                             quads_.data() + quad_start_[static_cast<std::size_t>(b) + 1], o, d, a, h, beyond_top, range,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 
@@ -208,12 +209,53 @@ TEST_P(RaycastKernels, AzimuthIndexMatchesBruteForceAlongAFlight) {
   EXPECT_LT(caster.index_rebuilds(), 1000);
 }
 
+// Hand-made edges of the bin walk, closed forms exact in binary: a trunk at (10, 0) of radius 0.5
+// meets the ray from x = -5 along +x at 14.5 (b = -30, disc = 1). Its bin holds one trunk, so
+// three lanes of its quad are padding, one of them a zero-size trunk at the origin on the ray.
+TEST_P(RaycastKernels, ExactEdgesOfTheBinWalk) {
+  World w;
+  w.cylinders.push_back({Eigen::Vector2d(10, 0), 0.5, 5.0});
+  RayCaster caster(w, Options(1.0));
+  const Vector3 along_x = Vector3::UnitX();
+  // An unbounded range: the padding lanes lie within every reach limit and must still miss.
+  const auto unbounded = caster.Cast(Vector3(-5, 0, 0), along_x, std::numeric_limits<double>::infinity(), 0.0);
+  ASSERT_TRUE(unbounded);
+  EXPECT_EQ(unbounded->distance_m, 14.5);
+  EXPECT_EQ(unbounded->normal_W, Vector3(-1, 0, 0));
+  // A hit at exactly the range counts when nothing nearer was hit (IntersectCylinder's t <= max).
+  const auto at_range = caster.Cast(Vector3(-5, 0, 1), along_x, 14.5, 0.0);
+  ASSERT_TRUE(at_range);
+  EXPECT_EQ(at_range->distance_m, 14.5);
+  EXPECT_FALSE(caster.Cast(Vector3(-5, 0, 1), along_x, std::nextafter(14.5, 0.0), 0.0));
+}
+
 INSTANTIATE_TEST_SUITE_P(Kernels, RaycastKernels,
                          ::testing::Values(RayCasterOptions::CylinderKernel::kAuto,
                                            RayCasterOptions::CylinderKernel::kPortable),
                          [](const ::testing::TestParamInfo<RayCasterOptions::CylinderKernel>& kernel) {
                            return kernel.param == RayCasterOptions::CylinderKernel::kAuto ? "Auto" : "Portable";
                          });
+
+// Two trunks mirrored across the ray meet it at the same distance with mirrored normals: the
+// kernels keep the same one (the first in the bin), as the one-at-a-time loop does.
+TEST(Raycast, KernelsBreakTiesAlike) {
+  World w;
+  for (const double y : {0.3, -0.3}) w.cylinders.push_back({Eigen::Vector2d(10, y), 0.5, 5.0});
+  RayCasterOptions portable;
+  portable.cylinder_kernel = RayCasterOptions::CylinderKernel::kPortable;
+  RayCaster loop(w, portable), vector(w, RayCasterOptions{});
+  const Vector3 o(-5, 0, 1);
+  const auto expected = loop.Cast(o, Vector3::UnitX(), 40.0, 0.0);
+  const auto got = vector.Cast(o, Vector3::UnitX(), 40.0, 0.0);
+  ASSERT_TRUE(expected);
+  ASSERT_TRUE(got);
+  EXPECT_EQ(got->distance_m, expected->distance_m);
+  EXPECT_EQ(got->normal_W, expected->normal_W);
+  EXPECT_NE(expected->normal_W.y(), 0.0);  // a real tie: either trunk's normal leans its own way
+  // Both trunks give this distance: the tie is exact.
+  EXPECT_EQ(IntersectCylinder(w.cylinders[0], o, Vector3::UnitX(), 40.0)->distance_m,
+            IntersectCylinder(w.cylinders[1], o, Vector3::UnitX(), 40.0)->distance_m);
+}
 
 // The walk stops once a rising ray is above the tallest obstacle, box or cylinder alike: rays that
 // rise to just below the top of the tallest still hit it (closed form: the face's distance along

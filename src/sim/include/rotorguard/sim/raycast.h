@@ -32,7 +32,8 @@ std::optional<RayHit> IntersectCylinder(const Cylinder& cylinder, const Vector3&
 
 namespace internal {
 /// Four cylinders of an azimuth bin, in the bin's order, a field per vector register (the ray
-/// caster's AVX2 kernel tests them at once). Lanes past the bin's end have reach_m = +inf.
+/// caster's AVX2 kernel tests them at once). Lanes past the bin's end have reach_m = +inf and a
+/// NaN squared radius, which no ray hits.
 struct alignas(32) CylinderQuad {
   double reach_m[4], cx[4], cy[4], r2[4], top[4];  // reach, centre, squared radius, height
   int id[4];                                       // index in World::cylinders, -1 for padding
