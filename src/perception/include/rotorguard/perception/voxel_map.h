@@ -32,7 +32,7 @@ struct VoxelMapOptions {
   double log_odds_miss = -0.4;  ///< added when a ray passes (p = 0.4), in [-30, 0)
   double log_odds_min = -2.0;   ///< clamp, in [-30, 0)
   double log_odds_max = 3.5;    ///< clamp, in (0, 30]
-  double occupied_threshold = 0.7;  ///< occupied above this log-odds (two hits from unknown), in (0, max)
+  double occupied_threshold = 0.7;  ///< occupied above this log-odds (one hit from unknown: 0.85), in (0, max)
   double inflation_radius_m = 0.2;  ///< the vehicle's radius [m], >= 0
   /// Rays longer than this only clear up to it (and still mark their return) [m], > 0.
   double max_clearing_range_m = 20.0;
