@@ -216,6 +216,11 @@ TEST_P(RaycastKernels, ExactEdgesOfTheBinWalk) {
   World w;
   w.cylinders.push_back({Eigen::Vector2d(10, 0), 0.5, 5.0});
   RayCaster caster(w, Options(1.0));
+#if defined(__AVX2__) && defined(__FMA__)
+  EXPECT_EQ(caster.vector_kernel(), GetParam() == RayCasterOptions::CylinderKernel::kAuto);
+#else
+  EXPECT_FALSE(caster.vector_kernel());
+#endif
   const Vector3 along_x = Vector3::UnitX();
   // An unbounded range: the padding lanes lie within every reach limit and must still miss.
   const auto unbounded = caster.Cast(Vector3(-5, 0, 0), along_x, std::numeric_limits<double>::infinity(), 0.0);

@@ -68,6 +68,8 @@ class RayCaster {
   const World& world() const { return world_; }
   /// How often the azimuth index was built (at each ray from beyond the margin of the last build).
   int index_rebuilds() const { return rebuilds_; }
+  /// Whether the AVX2 kernel tests the trunks (kAuto in a build that targets AVX2 and FMA).
+  bool vector_kernel() const { return vector_kernel_; }
 
  private:
   void CastBoxes(const Vector3& o, const Vector3& d, double max_m, std::optional<RayHit>* best);
