@@ -1,7 +1,8 @@
 // The simulated MID-360 in the 500-tree forest of `rotorguard bench perception`, spinning at
 // 11 rad/s while flying 1 m/s. BM_LidarForestStep: one iteration is one 1 ms physics step (200
 // pulses); items per second are pulses simulated per second (target >= 2 M/s).
-// CastForestRays/<kernel>: the ray caster alone on those pulses, per cylinder kernel.
+// CastForestRays/<kernel>: the ray caster alone on those pulses, per cylinder kernel, with the
+// trunks tested per ray (RayCaster::cylinder_tests).
 // BM_MapInsertFrame/N: one iteration inserts one 10 Hz frame of a sensor sending N pulses per
 // second into the occupancy map (target <= 5 ms for a 20k-point frame): the MID-360's 200 000
 // (about 15 500 returns per frame in the forest, the rest sky) and 260 000 (about 20 000
@@ -66,8 +67,9 @@ void CastForestRays(benchmark::State& state, const sim::World& forest, sim::RayC
     t += 1'000'000;
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(k));
-  state.counters["hit_share"] =
-      benchmark::Counter(static_cast<double>(hits) / std::max<double>(1.0, static_cast<double>(k)));
+  const double rays = std::max<double>(1.0, static_cast<double>(k));
+  state.counters["hit_share"] = benchmark::Counter(static_cast<double>(hits) / rays);
+  state.counters["trunk_tests_per_ray"] = benchmark::Counter(static_cast<double>(caster.cylinder_tests()) / rays);
 }
 BENCHMARK_CAPTURE(CastForestRays, auto_kernel, Forest(), sim::RayCasterOptions::CylinderKernel::kAuto);
 BENCHMARK_CAPTURE(CastForestRays, portable_kernel, Forest(), sim::RayCasterOptions::CylinderKernel::kPortable);

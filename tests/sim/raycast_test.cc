@@ -232,6 +232,9 @@ TEST_P(RaycastKernels, ExactEdgesOfTheBinWalk) {
   ASSERT_TRUE(at_range);
   EXPECT_EQ(at_range->distance_m, 14.5);
   EXPECT_FALSE(caster.Cast(Vector3(-5, 0, 1), along_x, std::nextafter(14.5, 0.0), 0.0));
+  // Each ray tested the one trunk (its travel bound, 15 - 0.5 - 0.25 m, lies within every range
+  // above), and no padding.
+  EXPECT_EQ(caster.cylinder_tests(), 3);
 }
 
 INSTANTIATE_TEST_SUITE_P(Kernels, RaycastKernels,
