@@ -432,9 +432,7 @@ std::uint32_t* VoxelMap::ListUnsettledPortable(const WindowWalk* walks, std::siz
     }
   };
   const auto list = [&](std::uint64_t relative) {
-    const std::uint32_t address = AddressOfRelative(relative, residues, top_bits);
-    *out = address;
-    out += static_cast<std::ptrdiff_t>(!SettledFree(settled, address));
+    out = ListUnlessSettled(AddressOfRelative(relative, residues, top_bits), settled, out);
   };
   // Each lane's changing state in locals (registers), its constants in its WindowWalk.
   WindowWalk lane0, lane1;
@@ -552,9 +550,7 @@ std::uint32_t* VoxelMap::ListUnsettledAvx2(const WindowWalk* walks, std::size_t 
       if (n[k] == kIdle) continue;
       n[k] -= both;
       if (n[k] != 0) continue;
-      const std::uint32_t address = AddressOfRelative(rel[k], residues, top_bits);
-      *out = address;
-      out += static_cast<std::ptrdiff_t>(!SettledFree(settled, address));
+      out = ListUnlessSettled(AddressOfRelative(rel[k], residues, top_bits), settled, out);
       take_next(k);
     }
   }

@@ -159,6 +159,12 @@ class VoxelMap {
   static bool SettledFree(const std::uint64_t* bits, std::size_t address) {
     return (bits[address >> 6] >> (address & 63)) & 1U;
   }
+  /// The walk kernels' listing: `address` written at `out`, kept (the end moved past it) unless
+  /// its settled bit is set; without a branch, as which voxels are settled is unpredictable.
+  static std::uint32_t* ListUnlessSettled(std::uint32_t address, const std::uint64_t* settled, std::uint32_t* out) {
+    *out = address;
+    return out + static_cast<std::ptrdiff_t>(!SettledFree(settled, address));
+  }
   void SetSettledFree(std::size_t address, bool settled) { SetBit(&settled_free_, address, settled); }
   /// Bit `address` of a set of bits kept in 64-bit words.
   static void SetBit(std::vector<std::uint64_t>* bits, std::size_t address, bool value) {
