@@ -34,7 +34,9 @@ Vector3 FreePoint(const sim::World& w, Rng* rng, Vector3 p, double y_lo, double 
 struct NavTrial {
   bool success = false, collision = false, crashed = false;
   double tracking_rmse_m = 0.0, max_spin_rad_s = 0.0, mission_time_s = -1.0;
-  double planner_ms_mean = 0.0, stack_ms_per_cycle_mean = 0.0, realtime_factor = 0.0;
+  double planner_ms_mean = 0.0, stack_ms_per_cycle_mean = 0.0;
+  double realtime_factor = 0.0;                     // the stack's: RunSummary::stack_realtime_factor
+  double trial_realtime_factor = 0.0;               // the whole trial's, the simulator included
   std::map<std::string, double> cost_ms_per_sim_s;  // RunCost's parts by name
   std::string failure;
 };
@@ -45,7 +47,8 @@ std::string CostMetric(const std::string& part) { return "cost_" + part + "_ms_p
 nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::vector<std::uint64_t>& seeds,
                          const std::vector<std::string>& kinds) {
   const double n = static_cast<double>(trials.size());
-  double success = 0, collision = 0, crash = 0, rmse = 0, spin = 0, planner = 0, stack = 0, rtf = 0, time = 0;
+  double success = 0, collision = 0, crash = 0, rmse = 0, spin = 0, planner = 0, stack = 0, rtf = 0, trial_rtf = 0,
+         time = 0;
   int completed = 0;
   std::map<std::string, double> cost;
   nlohmann::json failures = nlohmann::json::array();
@@ -59,6 +62,7 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
     planner += t.planner_ms_mean / n;
     stack += t.stack_ms_per_cycle_mean / n;
     rtf += t.realtime_factor / n;
+    trial_rtf += t.trial_realtime_factor / n;
     for (const auto& [part, ms] : t.cost_ms_per_sim_s) cost[part] += ms / n;
     if (t.mission_time_s >= 0.0) time += t.mission_time_s, ++completed;
     if (!t.success && failures.size() < 10) failures.push_back({{"kind", kinds[i]}, {"seed", seeds[i]}, {"reason", t.failure}});
@@ -73,6 +77,7 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
           {"planner_ms_mean", planner},
           {"stack_ms_per_cycle_mean", stack},
           {"realtime_factor", rtf},
+          {"trial_realtime_factor", trial_rtf},
           {"cost_ms_per_sim_s", cost},
           {"failures", failures}};
 }
@@ -140,9 +145,12 @@ Campaign NavCampaign(const NavBenchOptions& o) {
   c.seed = o.seed;
   c.trials = static_cast<int>(o.kinds.size()) * o.trials * 2;
   c.group_keys = {"kind", "variant"};
-  c.metrics = {"success", "collision", "tracking_rmse_m", "max_spin_rad_s", "mission_time_s", "realtime_factor"};
+  c.metrics = {"success",        "collision",       "tracking_rmse_m",      "max_spin_rad_s",
+               "mission_time_s", "realtime_factor", "trial_realtime_factor"};
   const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"kinds", o.kinds}, {"base", o.base.name}};
-  c.bench = {{"name", "nav"}, {"options", options}};
+  // "records": what a trial records. Version 2 made realtime_factor the stack's and added
+  // trial_realtime_factor; the hash then refuses to resume or merge the folders of version 1.
+  c.bench = {{"name", "nav"}, {"records", 2}, {"options", options}};
   c.hash = Fingerprint(c.bench.dump() + "\n" + ScenarioFingerprint(o.base));
   // Trial index = (kind, trial, variant), the variant fastest: both variants fly the same world,
   // fault and noise (the seed depends on the kind and trial only).
@@ -168,7 +176,8 @@ Campaign NavCampaign(const NavBenchOptions& o) {
                    {"mission_time_s", s.mission_time_s >= 0.0 ? nlohmann::json(s.mission_time_s) : nlohmann::json()},
                    {"planner_ms_mean", s.planner_ms_mean},
                    {"stack_ms_per_cycle_mean", s.stack_ms_per_cycle_mean},
-                   {"realtime_factor", s.realtime_factor}};
+                   {"realtime_factor", s.stack_realtime_factor},
+                   {"trial_realtime_factor", s.realtime_factor}};
     for (const RunCost::Part& p : RunCost::kParts) out.metrics[CostMetric(p.name)] = s.cost_ms_per_sim_s.*p.field;
     out.message = s.failure_reason;
     return out;
@@ -198,6 +207,7 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
       t.planner_ms_mean = x["planner_ms_mean"].get<double>();
       t.stack_ms_per_cycle_mean = x["stack_ms_per_cycle_mean"].get<double>();
       t.realtime_factor = x["realtime_factor"].get<double>();
+      t.trial_realtime_factor = x["trial_realtime_factor"].get<double>();
       for (const RunCost::Part& p : RunCost::kParts) t.cost_ms_per_sim_s[p.name] = x.at(CostMetric(p.name)).get<double>();
     }
     results.push_back(t);
@@ -236,22 +246,25 @@ nlohmann::json RunNavBenchmark(const NavBenchOptions& o) {
 }
 
 std::string NavMarkdown(const nlohmann::json& r) {
-  std::string md = "| kind | variant | trials | success | collisions | tracking RMSE [m] | max spin [rad/s] | "
-                   "mission [s] | planner [ms] | stack [ms/cycle] | real-time factor |\n"
-                   "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::string md =
+      "| kind | variant | trials | success | collisions | tracking RMSE [m] | max spin [rad/s] | "
+      "mission [s] | planner [ms] | stack [ms/cycle] | real-time factor | trial real-time factor |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   const auto row = [&](const std::string& kind, const std::string& variant, const nlohmann::json& g) {
-    md += fmt::format("| {} | {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {} | {:.2f} | {:.3f} | {:.1f} |\n", kind, variant,
-                      g["trials"].get<int>(), g["success_rate"].get<double>(), g["collision_rate"].get<double>(),
-                      g["tracking_rmse_m"].get<double>(), g["max_spin_rad_s"].get<double>(),
-                      g["mission_time_s"].is_null() ? std::string("–") : fmt::format("{:.1f}", g["mission_time_s"].get<double>()),
-                      g["planner_ms_mean"].get<double>(), g["stack_ms_per_cycle_mean"].get<double>(),
-                      g["realtime_factor"].get<double>());
+    md += fmt::format(
+        "| {} | {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {} | {:.2f} | {:.3f} | {:.1f} | {:.1f} |\n", kind,
+        variant, g["trials"].get<int>(), g["success_rate"].get<double>(), g["collision_rate"].get<double>(),
+        g["tracking_rmse_m"].get<double>(), g["max_spin_rad_s"].get<double>(),
+        g["mission_time_s"].is_null() ? std::string("–") : fmt::format("{:.1f}", g["mission_time_s"].get<double>()),
+        g["planner_ms_mean"].get<double>(), g["stack_ms_per_cycle_mean"].get<double>(),
+        g["realtime_factor"].get<double>(), g["trial_realtime_factor"].get<double>());
   };
   for (const auto& [kind, variants] : r["groups"].items()) {
     for (const char* v : kVariants) row(kind, v, variants[v]);
   }
   for (const char* v : kVariants) row("all", v, r[v]);
-  // Where the wall-clock time goes (all trials): the parts add up to 1000 / real-time factor.
+  // Where the wall-clock time goes (all trials): the parts add up to 1000 / trial real-time factor,
+  // the stack's (all but simulator and runner) to 1000 / real-time factor.
   md += "\nWall-clock time per simulated second [ms], all trials:\n\n| variant |";
   for (const RunCost::Part& p : RunCost::kParts) md += fmt::format(" {} |", p.name);
   md += " total |\n|---|";

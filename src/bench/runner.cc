@@ -103,6 +103,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["sim_time_s"] = sim_time_s;
   j["wall_time_s"] = wall_time_s;
   j["realtime_factor"] = realtime_factor;
+  j["stack_realtime_factor"] = stack_realtime_factor;
   j["tracking_rmse_m"] = tracking_rmse_m;
   j["tracking_rmse_eq37_m"] = tracking_rmse_eq37_m;
   j["max_position_error_m"] = max_position_error_m;
@@ -401,6 +402,8 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
           ? 1e3 * std::chrono::duration<double>(stack_time).count() / static_cast<double>(summary.control_cycles)
           : 0.0;
   summary.realtime_factor = summary.wall_time_s > 0.0 ? summary.sim_time_s / summary.wall_time_s : 0.0;
+  const double stack_s = std::chrono::duration<double>(stack_time).count();
+  summary.stack_realtime_factor = stack_s > 0.0 ? summary.sim_time_s / stack_s : 0.0;
   if (summary.sim_time_s > 0.0) {
     const auto per_sim_s = [&](double wall_s) { return 1e3 * wall_s / summary.sim_time_s; };
     const auto seconds = [](std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); };

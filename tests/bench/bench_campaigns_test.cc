@@ -117,9 +117,11 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
   EXPECT_EQ(c.parameters(0).at("seed"), c.parameters(1).at("seed"));  // both variants fly one world
   EXPECT_NE(c.parameters(0).at("seed"), c.parameters(2).at("seed"));
   const auto metrics = [](bool success, bool collision, double rmse, nlohmann::json time) {
-    nlohmann::json m{{"success", success}, {"crashed", collision}, {"collision", collision},
-                     {"tracking_rmse_m", rmse}, {"max_spin_rad_s", 11.0}, {"mission_time_s", time},
-                     {"planner_ms_mean", 2.0}, {"stack_ms_per_cycle_mean", 0.5}, {"realtime_factor", 4.0}};
+    nlohmann::json m{{"success", success},      {"crashed", collision},
+                     {"collision", collision},  {"tracking_rmse_m", rmse},
+                     {"max_spin_rad_s", 11.0},  {"mission_time_s", time},
+                     {"planner_ms_mean", 2.0},  {"stack_ms_per_cycle_mean", 0.5},
+                     {"realtime_factor", 10.0}, {"trial_realtime_factor", rmse * 100.0}};
     // The wall-clock parts of a run (ms per simulated second), the simulator's differing by trial.
     for (const char* part : {"mapper", "planner", "controller", "stack_other", "runner"}) {
       m[fmt::format("cost_{}_ms_per_sim_s", part)] = 10.0;
@@ -138,6 +140,8 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
   EXPECT_NEAR(r["rotorguard"]["mission_time_s"].get<double>(), 32.0, 1e-12);
   EXPECT_NEAR(r["rotorguard"]["cost_ms_per_sim_s"]["simulator"].get<double>(), 60.0, 1e-9);  // (50 + 70) / 2
   EXPECT_NEAR(r["rotorguard"]["cost_ms_per_sim_s"]["runner"].get<double>(), 10.0, 1e-12);
+  EXPECT_NEAR(r["rotorguard"]["realtime_factor"].get<double>(), 10.0, 1e-12);       // the stack's
+  EXPECT_NEAR(r["rotorguard"]["trial_realtime_factor"].get<double>(), 6.0, 1e-12);  // (5 + 7) / 2
   EXPECT_EQ(r["failure_unaware"]["success_rate"], 0.0);
   EXPECT_EQ(r["failure_unaware"]["collision_rate"], 0.5);   // the diverged trial did not report one
   EXPECT_TRUE(r["failure_unaware"]["mission_time_s"].is_null());  // neither completed

@@ -196,6 +196,12 @@ TEST(NavigationClosedLoop, FliesTheRoomsWaypointsOnItsLidarMap) {
   EXPECT_EQ(r.waypoints_total, 2);
   EXPECT_GE(r.plans, 5) << "replanned as the map filled in";
   EXPECT_GT(r.cost_ms_per_sim_s.planner, 0.0) << "the planning is timed";
+  // The stack's real-time factor is the simulated time over the stack's parts of the wall-clock
+  // time (the simulator and the runner left out), so it is the larger of the two factors.
+  const RunCost& c = r.cost_ms_per_sim_s;
+  EXPECT_NEAR(r.stack_realtime_factor, 1e3 / (c.mapper + c.planner + c.controller + c.stack_other),
+              1e-9 * r.stack_realtime_factor);
+  EXPECT_GT(r.stack_realtime_factor, r.realtime_factor);
   EXPECT_GT(closest, s.vehicle.collision_radius_m) << "the reference kept the vehicle's radius from the furniture";
   EXPECT_LT(r.tracking_rmse_m, 0.1);
 }

@@ -223,8 +223,8 @@ TEST_F(CliTest, HoverRunSucceedsAndWritesLogAndSummary) {
   EXPECT_NE(r.out.find("success"), std::string::npos);
   const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
   for (const char* key : {"scenario", "seed", "success", "crashed", "crash_reason", "sim_time_s", "wall_time_s",
-                          "realtime_factor", "tracking_rmse_m", "max_position_error_m", "min_altitude_m",
-                          "max_spin_rad_s", "faults", "fdd"}) {
+                          "realtime_factor", "stack_realtime_factor", "tracking_rmse_m", "max_position_error_m",
+                          "min_altitude_m", "max_spin_rad_s", "faults", "fdd"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["seed"], 3);

@@ -43,7 +43,9 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
 /// Runs NavCampaign on `jobs` threads in a temporary folder:
 /// {"rotorguard": {...}, "failure_unaware": {...}, "groups": {kind: {variant: {...}}}, ...} with
 /// success_rate, collision_rate, tracking_rmse_m, max_spin_rad_s, mission_time_s,
-/// planner_ms_mean, stack_ms_per_cycle_mean, realtime_factor and the first failures' seeds.
+/// planner_ms_mean, stack_ms_per_cycle_mean, realtime_factor (the whole stack's, the simulator
+/// left out: RunSummary::stack_realtime_factor), trial_realtime_factor (the simulator included)
+/// and the first failures' seeds. Each factor is the mean of the trials' factors.
 nlohmann::json RunNavBenchmark(const NavBenchOptions& options);
 std::string NavMarkdown(const nlohmann::json& result);
 

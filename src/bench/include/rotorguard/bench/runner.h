@@ -64,7 +64,11 @@ struct RunSummary {
   std::string failure_reason;
   double sim_time_s = 0.0;
   double wall_time_s = 0.0;
-  double realtime_factor = 0.0;
+  double realtime_factor = 0.0;  ///< sim_time_s / wall_time_s: the whole run, the simulator included
+  /// Simulated time per second of the flight stack's own wall-clock time (stack_ms_per_cycle_mean's
+  /// total): how much faster than real time the whole stack (estimator, FDD, mapper, planner,
+  /// controller) runs on one core, the simulator not counted. bench nav's `realtime_factor`.
+  double stack_realtime_factor = 0.0;
   double tracking_rmse_m = 0.0;
   double tracking_rmse_eq37_m = 0.0;  ///< paper 000's eq. (37), for comparison with its figures
   double max_position_error_m = 0.0;
