@@ -92,7 +92,7 @@ void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKe
   map.Recenter(PoseAt(0).p_W);
   TimeNs t = 0;
   std::size_t frames = 0, points = 0;
-  double steps = 0.0, updated = 0.0, settled = 0.0;
+  double steps = 0.0, updated = 0.0, skipped = 0.0;
   std::vector<Eigen::Vector3f> world;
   for (auto _ : state) {
     state.PauseTiming();
@@ -112,7 +112,7 @@ void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKe
     map.Recenter(origin);
     const perception::MapUpdateSummary s = map.Insert(origin, world);
     steps += s.voxels_traversed;
-    settled += s.voxels_settled_skipped;
+    skipped += s.voxels_skipped;
     updated += s.voxels_updated;
     points += world.size();
     ++frames;
@@ -121,7 +121,7 @@ void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKe
   state.counters["points_per_frame"] = benchmark::Counter(static_cast<double>(points) / n);
   state.counters["ray_steps_per_frame"] = benchmark::Counter(steps / n);
   state.counters["voxels_updated_per_frame"] = benchmark::Counter(updated / n);
-  state.counters["settled_step_share"] = benchmark::Counter(steps > 0.0 ? settled / steps : 0.0);
+  state.counters["skipped_step_share"] = benchmark::Counter(steps > 0.0 ? skipped / steps : 0.0);
 }
 void BM_MapInsertFrame(benchmark::State& state) {
   MapInsertFrame(state, perception::VoxelMapOptions::WalkKernel::kAuto);

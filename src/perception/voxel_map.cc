@@ -331,7 +331,8 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // Pass 1: the returns' voxels, hit once each, and one ray per hit voxel (from the same origin
   // the other returns in it crossed nearly the same voxels; ego-planner's per-frame voxel cache
   // makes the same trade). Returns outside the window still clear the window along their rays.
-  // A hit voxel is not settled free afterwards, so pass 2 looks at its cell and finds the stamp.
+  // A hit voxel is not missed in the same frame: its skip bit is set until the frame is done, so
+  // that pass 2's walks do not list it (MarkHandled).
   std::vector<Vector3>& rays = ray_ends_;
   rays.clear();
   int hits = 0;
@@ -352,6 +353,7 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     if (cells_[address].stamp == hit) continue;
     cells_[address].stamp = hit;
     Observe(address, hit_q_);
+    MarkHandled(static_cast<std::uint32_t>(address));
     ++hits;
     rays.push_back(p);
   }
@@ -407,12 +409,17 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
       if (c.stamp < miss) {
         c.stamp = miss;
         Observe(address, miss_q_);
+        MarkHandled(address);
         ++missed;
       }
     }
   }
+  // The frame is done: the voxels it marked handled get back their settled bits (clear: the
+  // settled ones were never marked).
+  for (const std::uint32_t address : handled_) SetSettledFree(address, false);
+  handled_.clear();
   summary.voxels_traversed = steps;
-  summary.voxels_settled_skipped = steps - listed_total;
+  summary.voxels_skipped = steps - listed_total;
   summary.voxels_updated = hits + missed;
   return summary;
 }
