@@ -112,9 +112,9 @@ void CondensingQpSolver::Condense(const OcpQp& qp) {
   for (int m = N - 1; m >= 1; --m) {
     tmp.noalias() = W(m + 1) * A(m);
     W(m) = Q(m);
-    // A coefficient-based product (lazyProduct) for A' (W A), which beats Eigen's GEMM path at
-    // this size (measured: docs/control.md).
-    W(m).noalias() += A(m).transpose().lazyProduct(tmp);
+    // Eigen's product evaluator, not lazyProduct: with AVX2 it runs A' (W A) in 12 µs per
+    // condensing where lazyProduct's dot products took 21 (docs/control.md).
+    W(m).noalias() += A(m).transpose() * tmp;
     wv(m) = Eigen::Map<const VecX>(qp.q[m].data(), nx);
     wv(m).noalias() += Q(m) * xb(m) + A(m).transpose() * wv(m + 1);
   }
