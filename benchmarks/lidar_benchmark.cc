@@ -3,6 +3,7 @@
 // pulses); items per second are pulses simulated per second (target >= 2 M/s).
 // CastForestRays/<kernel>: the ray caster alone on those pulses, per cylinder kernel, with the
 // trunks tested per ray (RayCaster::cylinder_tests).
+// BM_DeskewFrame: one forest frame's points moved to the sensor frame at its end.
 // BM_MapInsertFrame/N: one iteration inserts one 10 Hz frame of a sensor sending N pulses per
 // second into the occupancy map (target <= 5 ms for a 20k-point frame): the MID-360's 200 000
 // (about 15 500 returns per frame in the forest, the rest sky) and 260 000 (about 20 000
@@ -13,6 +14,7 @@
 
 #include "rotorguard/bench/perception_bench.h"
 #include "rotorguard/bench/planner_bench.h"
+#include "rotorguard/perception/deskew.h"
 #include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/sim/lidar.h"
 
@@ -131,5 +133,30 @@ BENCHMARK(BM_MapInsertFrame)->Arg(200000)->Arg(260000)->Unit(benchmark::kMillise
 BENCHMARK_CAPTURE(MapInsertFrame, portable_kernel, perception::VoxelMapOptions::WalkKernel::kPortable)
     ->Arg(200000)
     ->Unit(benchmark::kMillisecond);
+
+// One forest frame of the MID-360 (200 000 pulses/s) deskewed with a 333 Hz gyro history of
+// the 11 rad/s spin: per frame, and per point as items.
+void BM_DeskewFrame(benchmark::State& state) {
+  sim::LidarOptions o;
+  o.enabled = true;
+  sim::LidarSimulator lidar(o, Forest(), 1);
+  std::optional<LidarFrame> f;
+  TimeNs t = 0;
+  for (; !f || f->t_start_ns == 0; t += 1'000'000) f = lidar.Step(t, PoseAt(t), t + 1'000'000, PoseAt(t + 1'000'000));
+  perception::Deskewer deskewer{perception::DeskewOptions{}};
+  for (TimeNs s = 0; s <= f->t_end_ns; s += 3'000'000) {
+    ImuSample imu;
+    imu.t_ns = s;
+    imu.w_B = Vector3(0.0, 0.0, 11.0);
+    deskewer.OnImu(imu);
+  }
+  std::vector<Eigen::Vector3f> out;
+  for (auto _ : state) {
+    deskewer.Deskew(*f, Vector3(1.0, 0.0, 0.0), PoseAt(f->t_end_ns).q_WB, &out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * f->points_S.size()));
+}
+BENCHMARK(BM_DeskewFrame)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

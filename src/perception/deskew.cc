@@ -66,14 +66,27 @@ DeskewSummary Deskewer::Deskew(const LidarFrame& frame, const Vector3& v_W, cons
   const Vector3 v_end_B = R_end_T * v_W;
   const Vector3& l = options_.sensor_position_m;
   const TimeNs oldest = gyro_.empty() ? t_end : gyro_.front().t_ns;
+  // The first knot at or before t, from 1 (knots are newest first), or knots.size() if none: the
+  // previous point's, or the one before it, when they fit (a frame's points come in time order,
+  // so k only steps down now and then), else a binary search.
+  const std::size_t n = knots.size();
+  const auto fits = [&](std::size_t k, TimeNs t) {
+    return (k == n || knots[k].t <= t) && (k == 1 || knots[k - 1].t > t);
+  };
+  std::size_t k = n;
   for (std::size_t i = 0; i < frame.points_S.size(); ++i) {
     const TimeNs t = frame.t_start_ns + frame.offset_ns[i];
     const Vector3 p_S = frame.points_S[i].cast<double>();
     if (!p_S.allFinite()) continue;
-    // The first knot at or before t (knots are newest first); rotate from t up to the knot just
-    // after it, then on to t_end.
-    const std::size_t k = static_cast<std::size_t>(
-        std::partition_point(knots.begin() + 1, knots.end(), [t](const Knot& kn) { return kn.t > t; }) - knots.begin());
+    // Rotate from t up to the knot just after it, then on to t_end.
+    if (fits(k, t)) {
+    } else if (k > 1 && fits(k - 1, t)) {
+      --k;
+    } else {
+      k = static_cast<std::size_t>(
+          std::partition_point(knots.begin() + 1, knots.end(), [t](const Knot& kn) { return kn.t > t; }) -
+          knots.begin());
+    }
     const Knot& after = knots[k - 1];
     const Vector3 w = k < knots.size() ? knots[k].w : rate_before(t);
     const Vector3 p_end_B =
