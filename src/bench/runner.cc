@@ -397,24 +397,22 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     summary.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
   }
   summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  summary.stack_ms_per_cycle_mean =
-      summary.control_cycles > 0
-          ? 1e3 * std::chrono::duration<double>(stack_time).count() / static_cast<double>(summary.control_cycles)
-          : 0.0;
-  summary.realtime_factor = summary.wall_time_s > 0.0 ? summary.sim_time_s / summary.wall_time_s : 0.0;
   const double stack_s = std::chrono::duration<double>(stack_time).count();
+  const double simulator_s = std::chrono::duration<double>(sim_time).count();
+  summary.stack_ms_per_cycle_mean =
+      summary.control_cycles > 0 ? 1e3 * stack_s / static_cast<double>(summary.control_cycles) : 0.0;
+  summary.realtime_factor = summary.wall_time_s > 0.0 ? summary.sim_time_s / summary.wall_time_s : 0.0;
   summary.stack_realtime_factor = stack_s > 0.0 ? summary.sim_time_s / stack_s : 0.0;
   if (summary.sim_time_s > 0.0) {
     const auto per_sim_s = [&](double wall_s) { return 1e3 * wall_s / summary.sim_time_s; };
-    const auto seconds = [](std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); };
     const stack::StackCost& c = st.cost();
     RunCost& cost = summary.cost_ms_per_sim_s;
-    cost.simulator = per_sim_s(seconds(sim_time));
+    cost.simulator = per_sim_s(simulator_s);
     cost.mapper = per_sim_s(c.mapper_s);
     cost.planner = per_sim_s(c.planner_s);
     cost.controller = per_sim_s(c.controller_s);
-    cost.stack_other = per_sim_s(std::max(0.0, seconds(stack_time) - c.mapper_s - c.planner_s - c.controller_s));
-    cost.runner = per_sim_s(std::max(0.0, summary.wall_time_s - seconds(stack_time) - seconds(sim_time)));
+    cost.stack_other = per_sim_s(std::max(0.0, stack_s - c.mapper_s - c.planner_s - c.controller_s));
+    cost.runner = per_sim_s(std::max(0.0, summary.wall_time_s - stack_s - simulator_s));
   }
   if (record) {
     flight.summary = summary.ToJson();

@@ -78,17 +78,17 @@ DeskewSummary Deskewer::Deskew(const LidarFrame& frame, const Vector3& v_W, cons
     const TimeNs t = frame.t_start_ns + frame.offset_ns[i];
     const Vector3 p_S = frame.points_S[i].cast<double>();
     if (!p_S.allFinite()) continue;
-    // Rotate from t up to the knot just after it, then on to t_end.
-    if (fits(k, t)) {
-    } else if (k > 1 && fits(k - 1, t)) {
-      --k;
-    } else {
-      k = static_cast<std::size_t>(
-          std::partition_point(knots.begin() + 1, knots.end(), [t](const Knot& kn) { return kn.t > t; }) -
-          knots.begin());
+    if (!fits(k, t)) {
+      if (k > 1 && fits(k - 1, t)) {
+        --k;
+      } else {
+        const auto later = [t](const Knot& kn) { return kn.t > t; };
+        k = static_cast<std::size_t>(std::partition_point(knots.begin() + 1, knots.end(), later) - knots.begin());
+      }
     }
+    // Rotate from t up to the knot just after it, then on to t_end.
     const Knot& after = knots[k - 1];
-    const Vector3 w = k < knots.size() ? knots[k].w : rate_before(t);
+    const Vector3 w = k < n ? knots[k].w : rate_before(t);
     const Vector3 p_end_B =
         after.R_end_from_t * ExpSO3Times(-w * ToSeconds(after.t - t), l + p_S) - v_end_B * ToSeconds(t_end - t);
     out->push_back((p_end_B - l).cast<float>());
