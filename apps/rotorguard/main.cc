@@ -136,7 +136,15 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
   fmt::print("outcome           {}\n", s.success ? "success" : "FAILED: " + s.failure_reason);
   fmt::print("simulated         {:.2f} s in {:.2f} s wall ({:.0f}x real time)\n", s.sim_time_s, s.wall_time_s,
              s.realtime_factor);
-  fmt::print("tracking RMSE     {:.3f} m (max error {:.3f} m)\n", s.tracking_rmse_m, s.max_position_error_m);
+  // The window when it is not the whole flight, and the wreck's share when the flight crashed.
+  const bool whole = s.tracking_start_s == 0.0 && s.tracking_end_s >= s.sim_time_s && !s.crashed;
+  fmt::print(
+      "tracking RMSE     {:.3f} m (max error {:.3f} m){}\n", s.tracking_rmse_m, s.max_position_error_m,
+      whole ? "" : fmt::format(" over {:.2f}-{:.2f} s", s.tracking_start_s, std::min(s.tracking_end_s, s.sim_time_s)));
+  if (s.crashed) {
+    fmt::print("                  {:.3f} m over {:.2f}-{:.2f} s, the wreck held where it crashed\n",
+               s.tracking_rmse_window_m, s.tracking_start_s, s.tracking_end_s);
+  }
   fmt::print("min altitude      {:.3f} m\n", s.min_altitude_m);
   fmt::print("max spin          {:.2f} rad/s\n", s.max_spin_rad_s);
   if (s.waypoints_total >= 0) {

@@ -1,9 +1,10 @@
 #include "rotorguard/bench/assembly_mission.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
-
-#include <fmt/format.h>
+#include <stdexcept>
 
 #include "rotorguard/bench/planner_bench.h"
 #include "rotorguard/perception/voxel_map.h"
@@ -85,6 +86,12 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
   r.trajectory = std::move(traj);
   r.ok = true;
   return r;
+}
+
+void FlyAssemblyPlan(const AssemblyPlanResult& plan, Scenario* s) {
+  if (!plan.ok) throw std::invalid_argument("FlyAssemblyPlan: the plan failed: " + plan.message);
+  s->reference = plan.trajectory;
+  if (!s->tracking_end_s) s->tracking_end_s = std::min(plan.trajectory->duration(), s->duration_s);
 }
 
 }  // namespace rotorguard::bench

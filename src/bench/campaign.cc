@@ -33,11 +33,26 @@ namespace {
 
 /// RunSummary keys a trial may record: deterministic for a scenario and seed (wall-clock figures
 /// such as wall_time_s would make merged summaries depend on the machine and the load).
-const std::vector<std::string> kRecordable = {
-    "success", "crashed", "sim_time_s", "tracking_rmse_m", "tracking_rmse_eq37_m", "max_position_error_m",
-    "min_altitude_m", "max_spin_rad_s", "max_tilt_rad", "tilt_recovery_s", "map_voxels_occupied",
-    "lidar_points_dropped", "physics_steps", "control_cycles", "fdd.detected", "fdd.correct", "fdd.false_alarm",
-    "fdd.latency_s", "fdd.detection_s"};
+const std::vector<std::string> kRecordable = {"success",
+                                              "crashed",
+                                              "sim_time_s",
+                                              "tracking_rmse_m",
+                                              "tracking_rmse_window_m",
+                                              "tracking_rmse_eq37_m",
+                                              "max_position_error_m",
+                                              "min_altitude_m",
+                                              "max_spin_rad_s",
+                                              "max_tilt_rad",
+                                              "tilt_recovery_s",
+                                              "map_voxels_occupied",
+                                              "lidar_points_dropped",
+                                              "physics_steps",
+                                              "control_cycles",
+                                              "fdd.detected",
+                                              "fdd.correct",
+                                              "fdd.false_alarm",
+                                              "fdd.latency_s",
+                                              "fdd.detection_s"};
 const std::vector<std::string> kDefaultMetrics = {"success",        "crashed",      "tracking_rmse_m",
                                                   "max_position_error_m", "min_altitude_m", "max_tilt_rad",
                                                   "tilt_recovery_s"};

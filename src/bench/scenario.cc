@@ -811,6 +811,14 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   }
   if (const auto metrics = root.Optional("metrics")) {
     if (const auto t = metrics->Optional("tracking_start_s")) s.tracking_start_s = t->AsDoubleIn(0.0, s.duration_s);
+    if (const auto t = metrics->Optional("tracking_end_s")) {
+      s.tracking_end_s = t->AsDoubleIn(s.tracking_start_s, s.duration_s);
+      if (*s.tracking_end_s <= s.tracking_start_s) {
+        t->Fail(
+            fmt::format("metrics.tracking_end_s = {:g} is invalid; expected more than metrics.tracking_start_s = {:g}",
+                        *s.tracking_end_s, s.tracking_start_s));
+      }
+    }
     if (const auto e = metrics->Optional("success_error_m")) s.success_error_m = e->AsPositive();
     if (const auto h = metrics->Optional("success_hold_s")) s.success_hold_s = h->AsDoubleIn(0.0, s.duration_s);
     if (const auto r = metrics->Optional("recovered_tilt_rad")) s.recovered_tilt_rad = r->AsDoubleIn(1e-3, 1.5);
@@ -827,7 +835,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   if (s.assembly_plan) {
     const AssemblyPlanResult plan = PlanAssemblyMission(s);
     if (!plan.ok) root.Required("mission").Fail("cannot plan the assembly's path: " + plan.message);
-    s.reference = plan.trajectory;
+    FlyAssemblyPlan(plan, &s);
   }
   CheckReferenceAboveGround(root.Required("mission"), s);
   return s;

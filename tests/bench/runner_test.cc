@@ -3,8 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "rotorguard/bench/perception_bench.h"
 #include "rotorguard/bench/scenario.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/io/csv.h"
+#include "test_util.h"
 
 namespace rotorguard::bench {
 namespace {
@@ -55,6 +60,65 @@ TEST(Runner, NominalControllerCrashesAfterAMotorStop) {
   ASSERT_EQ(r.faults.size(), 1u);
   EXPECT_EQ(r.faults[0].kind, "motor_stop");
   EXPECT_GT(r.sim_time_s, 2.0);  // it was flying until the failure
+}
+
+class RunnerWindowTest : public rotorguard::testing::TempFolderTest {};
+
+TEST_F(RunnerWindowTest, ACrashedVehicleIsHeldAtItsCrashSiteForTheRestOfTheWindow) {
+  // The hover reference stays at the start, [0, 0, 2]; the wreck lies where log.csv's last row
+  // (the final state) puts it. Over [0, T] the window's mean square error is the flown part's
+  // plus the wreck's constant distance over (t_crash, T]:
+  //   rmse_window^2 T = rmse_flown^2 t_crash + |wreck - p_ref|^2 (T - t_crash).
+  const Scenario s = LoadScenario(Config("hover_motor_stop_nominal.yaml"));
+  RunOptions o;
+  o.out_dir = dir_.string();
+  const RunSummary r = RunScenario(s, o);
+  ASSERT_TRUE(r.crashed);
+  const io::NumericTable log = io::ReadNumericCsv((dir_ / "log.csv").string());
+  const std::size_t last = log.rows() - 1;
+  const Vector3 wreck(log.Column("p_x")[last], log.Column("p_y")[last], log.Column("p_z")[last]);
+  const double d2 = (wreck - s.initial_position_m).squaredNorm();
+  const double T = s.duration_s, t_crash = r.sim_time_s;
+  const double expected = std::sqrt((r.tracking_rmse_m * r.tracking_rmse_m * t_crash + d2 * (T - t_crash)) / T);
+  EXPECT_NEAR(r.tracking_rmse_window_m, expected, 1e-6);  // the log's 9 significant digits
+  EXPECT_GT(r.tracking_rmse_window_m, 2.0 * r.tracking_rmse_m);
+}
+
+TEST(RunnerWindow, AFlightThatDoesNotCrashHasOneError) {
+  const RunSummary r = RunScenario(LoadScenario(Config("hover.yaml")));
+  ASSERT_FALSE(r.crashed);
+  EXPECT_EQ(r.tracking_rmse_window_m, r.tracking_rmse_m);
+}
+
+TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
+  // The scenario with a metrics block, its vehicle named by an absolute path.
+  std::string text = io::ReadInputFile(Config("hover_motor_stop_nominal.yaml"));
+  text.replace(text.find("../vehicles/"), 12, std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/");
+  const auto with_metrics = [&](const std::string& metrics) {
+    return Write("s.yaml", text + "metrics: " + metrics + "\n");
+  };
+  // The motor stops at 2 s: a window that ends at 1.5 s holds only the steady hover, and the
+  // crash after it adds nothing to the window.
+  const Scenario whole = LoadScenario(Config("hover_motor_stop_nominal.yaml"));
+  const Scenario early = LoadScenario(with_metrics("{tracking_end_s: 1.5}"));
+  ASSERT_TRUE(early.tracking_end_s.has_value());
+  const RunSummary a = RunScenario(whole), b = RunScenario(early);
+  ASSERT_TRUE(b.crashed);
+  EXPECT_EQ(a.sim_time_s, b.sim_time_s);  // the same flight
+  EXPECT_LT(b.tracking_rmse_m, 0.02);
+  EXPECT_GT(a.tracking_rmse_m, 10.0 * b.tracking_rmse_m);
+  EXPECT_EQ(b.tracking_rmse_window_m, b.tracking_rmse_m);
+  EXPECT_LT(b.max_position_error_m, 0.05);
+  // A window that ends before it starts, or after the flight, names the file and the key.
+  for (const char* metrics : {"{tracking_start_s: 2, tracking_end_s: 2}", "{tracking_end_s: 9}"}) {
+    try {
+      LoadScenario(with_metrics(metrics));
+      ADD_FAILURE() << "an empty or too long tracking window was accepted: " << metrics;
+    } catch (const io::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("s.yaml"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("metrics.tracking_end_s"), std::string::npos) << e.what();
+    }
+  }
 }
 
 // Closed-loop NMPC flights (paper 000, Sec. VI-A/B), the failure handed to the controller.

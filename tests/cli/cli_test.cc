@@ -222,9 +222,10 @@ TEST_F(CliTest, HoverRunSucceedsAndWritesLogAndSummary) {
   ASSERT_EQ(r.exit_code, 0) << r.out;
   EXPECT_NE(r.out.find("success"), std::string::npos);
   const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
-  for (const char* key : {"scenario", "seed", "success", "crashed", "crash_reason", "sim_time_s", "wall_time_s",
-                          "realtime_factor", "stack_realtime_factor", "tracking_rmse_m", "max_position_error_m",
-                          "min_altitude_m", "max_spin_rad_s", "faults", "fdd"}) {
+  for (const char* key :
+       {"scenario", "seed", "success", "crashed", "crash_reason", "sim_time_s", "wall_time_s", "realtime_factor",
+        "stack_realtime_factor", "tracking_rmse_m", "tracking_rmse_window_m", "tracking_window_s",
+        "max_position_error_m", "min_altitude_m", "max_spin_rad_s", "faults", "fdd"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["seed"], 3);

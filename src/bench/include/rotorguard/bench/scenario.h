@@ -63,7 +63,10 @@ struct Scenario {
   sim::SimulatorOptions sim;
   stack::FlightStackOptions stack;
   double log_rate_hz = 100.0;       ///< rows per second in log.csv
-  double tracking_start_s = 0.0;    ///< tracking metrics cover [tracking_start_s, end]
+  double tracking_start_s = 0.0;    ///< tracking metrics cover [tracking_start_s, tracking_end_s]
+  /// The tracking window's end: the flight's end when unset; an assembly_plan mission sets it to
+  /// its plan's duration (the trajectory is what Table II compares, not the hover after it).
+  std::optional<double> tracking_end_s;
   /// A run succeeds when it does not crash and its position error stays at or below
   /// success_error_m over the last success_hold_s of the flight (DESIGN.md's SucR: back under
   /// 0.5 m and held to the end).
