@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <stdexcept>
 
 #include "rotorguard/bench/planner_bench.h"
 #include "rotorguard/perception/voxel_map.h"
@@ -86,12 +85,6 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
   r.trajectory = std::move(traj);
   r.ok = true;
   return r;
-}
-
-void FlyAssemblyPlan(const AssemblyPlanResult& plan, Scenario* s) {
-  if (!plan.ok) throw std::invalid_argument("FlyAssemblyPlan: the plan failed: " + plan.message);
-  s->reference = plan.trajectory;
-  if (!s->tracking_end_s) s->tracking_end_s = std::min(plan.trajectory->duration(), s->duration_s);
 }
 
 }  // namespace rotorguard::bench

@@ -207,7 +207,11 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   const TimeNs control_period = st.control_period_ns();
   const TimeNs log_period = PeriodFromRate(sc.log_rate_hz);
   const TimeNs tracking_start = FromSeconds(sc.tracking_start_s);
-  const TimeNs tracking_end = sc.tracking_end_s ? FromSeconds(*sc.tracking_end_s) : steps * dt_ns;
+  const TimeNs tracking_end = std::min(FromSeconds(TrackingEndS(sc)), steps * dt_ns);
+  if (tracking_end <= tracking_start) {
+    ThrowInvalidArgument("RunScenario", "tracking_start_s", sc.tracking_start_s,
+                         fmt::format("before the tracking window's end, {:g} s", ToSeconds(tracking_end)));
+  }
   TimeNs next_control = 0, next_log = 0;
   std::int64_t next_progress = 0;
   const std::int64_t progress_stride = std::max<std::int64_t>(1, steps / 100);
@@ -395,7 +399,9 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   }
   summary.tracking_rmse_window_m = Finite(tracking.rmse());
   summary.tracking_start_s = sc.tracking_start_s;
-  summary.tracking_end_s = ToSeconds(tracking_end);
+  // A flight that stopped early without a crash (its mission done) was tracked up to its stop.
+  summary.tracking_end_s =
+      summary.crashed ? ToSeconds(tracking_end) : std::min(ToSeconds(tracking_end), summary.sim_time_s);
   summary.min_altitude_m = Finite(sim.fault_events().empty() ? min_alt_all : min_alt_after_fault);
   if (!sim.fault_events().empty() && !summary.crashed) {
     const double onset = sim.fault_events().front().onset_s;

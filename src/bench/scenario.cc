@@ -812,16 +812,20 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   if (const auto metrics = root.Optional("metrics")) {
     if (const auto t = metrics->Optional("tracking_start_s")) s.tracking_start_s = t->AsDoubleIn(0.0, s.duration_s);
     if (const auto t = metrics->Optional("tracking_end_s")) {
-      s.tracking_end_s = t->AsDoubleIn(s.tracking_start_s, s.duration_s);
+      s.tracking_end_s = t->AsDoubleIn(0.0, s.duration_s);
       if (*s.tracking_end_s <= s.tracking_start_s) {
-        t->Fail(
-            fmt::format("metrics.tracking_end_s = {:g} is invalid; expected more than metrics.tracking_start_s = {:g}",
-                        *s.tracking_end_s, s.tracking_start_s));
+        t->Fail(fmt::format("tracking_end_s = {:g} is invalid; expected more than metrics.tracking_start_s = {:g}",
+                            *s.tracking_end_s, s.tracking_start_s));
       }
     }
     if (const auto e = metrics->Optional("success_error_m")) s.success_error_m = e->AsPositive();
     if (const auto h = metrics->Optional("success_hold_s")) s.success_hold_s = h->AsDoubleIn(0.0, s.duration_s);
     if (const auto r = metrics->Optional("recovered_tilt_rad")) s.recovered_tilt_rad = r->AsDoubleIn(1e-3, 1.5);
+    if (!s.assembly_plan && TrackingEndS(s) <= s.tracking_start_s) {  // a plan's window is checked once planned
+      metrics->Required("tracking_start_s")
+          .Fail(fmt::format("tracking_start_s = {:g} is invalid; expected less than the tracking window's end, {:g} s",
+                            s.tracking_start_s, TrackingEndS(s)));
+    }
     metrics->RejectUnknownKeys();
   }
   root.RejectUnknownKeys();
@@ -835,10 +839,24 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   if (s.assembly_plan) {
     const AssemblyPlanResult plan = PlanAssemblyMission(s);
     if (!plan.ok) root.Required("mission").Fail("cannot plan the assembly's path: " + plan.message);
-    FlyAssemblyPlan(plan, &s);
+    s.reference = plan.trajectory;
+    if (TrackingEndS(s) <= s.tracking_start_s) {
+      root.Required("metrics")
+          .Required("tracking_start_s")
+          .Fail(
+              fmt::format("tracking_start_s = {:g} is invalid; expected less than the plan's duration, {:.3f} s, which "
+                          "ends the tracking window of mission assembly_plan (or set metrics.tracking_end_s)",
+                          s.tracking_start_s, plan.trajectory->duration()));
+    }
   }
   CheckReferenceAboveGround(root.Required("mission"), s);
   return s;
+}
+
+double TrackingEndS(const Scenario& s) {
+  if (s.tracking_end_s) return *s.tracking_end_s;
+  if (s.assembly_plan && s.reference) return std::min(s.reference->duration(), s.duration_s);
+  return s.duration_s;
 }
 
 ValidationReport ValidateConfigFile(const std::string& path) {

@@ -80,8 +80,8 @@ TEST(MarsScenario, APlannedRowPassesTheDoorLengthwiseAndFliesItWithoutTouching) 
   const auto* plan = dynamic_cast<const modular::AssemblyTrajectory*>(s.reference.get());
   ASSERT_NE(plan, nullptr);
   // The tracking error is measured while the plan is flown, not over the hover after it.
-  ASSERT_TRUE(s.tracking_end_s.has_value());
-  EXPECT_EQ(*s.tracking_end_s, plan->duration());
+  EXPECT_FALSE(s.tracking_end_s.has_value());
+  EXPECT_EQ(TrackingEndS(s), plan->duration());
   EXPECT_LT(plan->duration(), s.duration_s);
   // The truth geometry (not the planner's map): every unit's sphere clear of every obstacle along
   // the plan, and the row lengthwise (within 20 degrees of x) where it crosses the wall at x = 0.
@@ -102,6 +102,43 @@ TEST(MarsScenario, APlannedRowPassesTheDoorLengthwiseAndFliesItWithoutTouching) 
   const RunSummary r = RunScenario(s, RunOptions{});
   EXPECT_TRUE(r.success) << r.failure_reason;  // the simulator checks every unit's sphere
   EXPECT_LT(r.tracking_rmse_m, 0.03);
+}
+
+TEST(MarsScenario, AReplannedReferenceBringsItsOwnTrackingWindow) {
+  // bench mars loads the scene once and swaps in each method's plan: each flight must be scored
+  // over its own plan, not over the plan the scene was loaded with.
+  Scenario s = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  const double ours = s.reference->duration();
+  Scenario b = s;
+  b.assembly_plan->method = "baseline";
+  const AssemblyPlanResult plan = PlanAssemblyMission(b);
+  ASSERT_TRUE(plan.ok) << plan.message;
+  s.reference = plan.trajectory;
+  const double baseline = plan.trajectory->duration();
+  ASSERT_GT(std::abs(baseline - ours), 0.1);  // the two plans differ, so the check below can fail
+  EXPECT_EQ(TrackingEndS(s), baseline);
+  const RunSummary r = RunScenario(s, RunOptions{});
+  ASSERT_FALSE(r.crashed) << r.failure_reason;
+  EXPECT_NEAR(r.tracking_end_s, baseline, 1e-3);  // to the physics step
+}
+
+class MarsScenarioFile : public rotorguard::testing::TempFolderTest {};
+
+TEST_F(MarsScenarioFile, ATrackingWindowThatStartsAfterThePlanIsAnErrorNamingTheKey) {
+  std::string text = io::ReadInputFile(Config("scenarios/mars_plan_4x1.yaml"));
+  text.replace(text.find("../assemblies/"), 14, Config("assemblies/"));
+  try {
+    LoadScenario(Write("s.yaml", text + "metrics: {tracking_start_s: 15}\n"));
+    ADD_FAILURE() << "a tracking window after the plan was accepted";
+  } catch (const io::ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("s.yaml"), std::string::npos) << m;
+    EXPECT_NE(m.find("metrics.tracking_start_s"), std::string::npos) << m;
+    EXPECT_NE(m.find("the plan's duration"), std::string::npos) << m;
+  }
+  // With its own end the window may lie after the plan (the hover at the goal).
+  const Scenario s = LoadScenario(Write("s.yaml", text + "metrics: {tracking_start_s: 15, tracking_end_s: 20}\n"));
+  EXPECT_EQ(TrackingEndS(s), 20.0);
 }
 
 TEST(MarsScenario, AnUnplannableAssemblyMissionIsAConfigErrorNamingTheMission) {

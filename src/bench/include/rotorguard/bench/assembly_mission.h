@@ -27,9 +27,4 @@ struct AssemblyPlanResult {
 /// the result says why. The map holds the world's boxes and cylinders, not its moving boxes.
 AssemblyPlanResult PlanAssemblyMission(const Scenario& scenario);
 
-/// Makes `plan` (ok) the scenario's reference, and its duration the end of the tracking window
-/// unless metrics.tracking_end_s set one: a plan's tracking error is measured while it is flown
-/// (paper 002's Table II), not over the hover that the scenario's duration adds after it.
-void FlyAssemblyPlan(const AssemblyPlanResult& plan, Scenario* scenario);
-
 }  // namespace rotorguard::bench

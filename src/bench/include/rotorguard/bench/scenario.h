@@ -63,10 +63,9 @@ struct Scenario {
   sim::SimulatorOptions sim;
   stack::FlightStackOptions stack;
   double log_rate_hz = 100.0;       ///< rows per second in log.csv
-  double tracking_start_s = 0.0;    ///< tracking metrics cover [tracking_start_s, tracking_end_s]
-  /// The tracking window's end: the flight's end when unset; an assembly_plan mission sets it to
-  /// its plan's duration (the trajectory is what Table II compares, not the hover after it).
-  std::optional<double> tracking_end_s;
+  /// Tracking metrics cover [tracking_start_s, TrackingEndS(scenario)].
+  double tracking_start_s = 0.0;
+  std::optional<double> tracking_end_s;  ///< metrics.tracking_end_s; see TrackingEndS
   /// A run succeeds when it does not crash and its position error stays at or below
   /// success_error_m over the last success_hold_s of the flight (DESIGN.md's SucR: back under
   /// 0.5 m and held to the end).
@@ -87,6 +86,12 @@ void FitStackToHardware(Scenario* scenario);
 /// Loads and validates a scenario file. Throws io::ConfigError (bad content, with file, line and
 /// key path) or io::InputFileError (a file that cannot be read).
 Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides = {});
+
+/// The end of the tracking window [s]: metrics.tracking_end_s when set; else, for an assembly_plan
+/// mission, its plan's duration (the plan's tracking error while it is flown, paper 002's Table II,
+/// not the hover that the scenario's duration adds after it), read from the reference so that a
+/// re-planned reference brings its own window; else the flight's end, duration_s.
+double TrackingEndS(const Scenario& scenario);
 
 /// The options of controller `assembly` in `scenario`: stack.nominal's cascade and stack.assembly's
 /// reallocation.
