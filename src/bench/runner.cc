@@ -393,7 +393,9 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     // crashed, so that crashing early does not shorten the error's window (paper 002's Table II
     // counts its collided flights' errors).
     const Vector3 wreck = StateView(sim.state()).p_W();
-    for (TimeNs t = std::max(sim.time_ns(), tracking_start); t < tracking_end; t += dt_ns) {
+    TimeNs t = sim.time_ns();  // the physics steps' grid, as the flown samples
+    if (t < tracking_start) t += (tracking_start - t + dt_ns - 1) / dt_ns * dt_ns;
+    for (; t < tracking_end; t += dt_ns) {
       tracking.Add(dt, wreck, st.reference().Evaluate(ToSeconds(t)).p_W);
     }
   }

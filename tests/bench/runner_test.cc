@@ -62,7 +62,15 @@ TEST(Runner, NominalControllerCrashesAfterAMotorStop) {
   EXPECT_GT(r.sim_time_s, 2.0);  // it was flying until the failure
 }
 
-class RunnerWindowTest : public rotorguard::testing::TempFolderTest {};
+class RunnerWindowTest : public rotorguard::testing::TempFolderTest {
+ protected:
+  /// hover_motor_stop_nominal.yaml with a metrics block, its vehicle named by an absolute path.
+  std::string WithMetrics(const std::string& metrics) {
+    std::string text = io::ReadInputFile(Config("hover_motor_stop_nominal.yaml"));
+    text.replace(text.find("../vehicles/"), 12, std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/");
+    return Write("s.yaml", text + "metrics: " + metrics + "\n");
+  }
+};
 
 TEST_F(RunnerWindowTest, ACrashedVehicleIsHeldAtItsCrashSiteForTheRestOfTheWindow) {
   // The hover reference stays at the start, [0, 0, 2]; the wreck lies where log.csv's last row
@@ -82,6 +90,11 @@ TEST_F(RunnerWindowTest, ACrashedVehicleIsHeldAtItsCrashSiteForTheRestOfTheWindo
   const double expected = std::sqrt((r.tracking_rmse_m * r.tracking_rmse_m * t_crash + d2 * (T - t_crash)) / T);
   EXPECT_NEAR(r.tracking_rmse_window_m, expected, 1e-6);  // the log's 9 significant digits
   EXPECT_GT(r.tracking_rmse_window_m, 2.0 * r.tracking_rmse_m);
+  // A window that opens after the crash holds the wreck only: its error is the constant distance.
+  const RunSummary late = RunScenario(LoadScenario(WithMetrics("{tracking_start_s: 4.0005}")));
+  ASSERT_TRUE(late.crashed);
+  EXPECT_EQ(late.tracking_rmse_m, 0.0);  // nothing flown inside the window
+  EXPECT_NEAR(late.tracking_rmse_window_m, std::sqrt(d2), 1e-6);
 }
 
 TEST(RunnerWindow, AFlightThatDoesNotCrashHasOneError) {
@@ -91,16 +104,10 @@ TEST(RunnerWindow, AFlightThatDoesNotCrashHasOneError) {
 }
 
 TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
-  // The scenario with a metrics block, its vehicle named by an absolute path.
-  std::string text = io::ReadInputFile(Config("hover_motor_stop_nominal.yaml"));
-  text.replace(text.find("../vehicles/"), 12, std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/");
-  const auto with_metrics = [&](const std::string& metrics) {
-    return Write("s.yaml", text + "metrics: " + metrics + "\n");
-  };
   // The motor stops at 2 s: a window that ends at 1.5 s holds only the steady hover, and the
   // crash after it adds nothing to the window.
   const Scenario whole = LoadScenario(Config("hover_motor_stop_nominal.yaml"));
-  const Scenario early = LoadScenario(with_metrics("{tracking_end_s: 1.5}"));
+  const Scenario early = LoadScenario(WithMetrics("{tracking_end_s: 1.5}"));
   ASSERT_TRUE(early.tracking_end_s.has_value());
   const RunSummary a = RunScenario(whole), b = RunScenario(early);
   ASSERT_TRUE(b.crashed);
@@ -112,7 +119,7 @@ TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
   // A window that ends before it starts, or after the flight, names the file and the key.
   for (const char* metrics : {"{tracking_start_s: 2, tracking_end_s: 2}", "{tracking_end_s: 9}"}) {
     try {
-      LoadScenario(with_metrics(metrics));
+      LoadScenario(WithMetrics(metrics));
       ADD_FAILURE() << "an empty or too long tracking window was accepted: " << metrics;
     } catch (const io::ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find("s.yaml"), std::string::npos) << e.what();
