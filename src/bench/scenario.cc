@@ -636,6 +636,27 @@ void CheckFaultsAgainstScenario(const ConfigNode& root, const Scenario& s) {
   }
 }
 
+/// The tracking window must hold at least one physics step's sample. The error names the key that
+/// closes it: tracking_end_s when set, else tracking_start_s against what ends the window.
+void CheckTrackingWindow(const ConfigNode& metrics, const Scenario& s) {
+  const double dt = 1.0 / s.sim.physics_rate_hz, end = TrackingEndS(s);
+  if (end - s.tracking_start_s >= dt * (1.0 - 1e-9)) return;
+  if (s.tracking_end_s) {
+    metrics.Required("tracking_end_s")
+        .Fail(fmt::format("tracking_end_s = {:g} is invalid; expected at least one physics step ({:g} s) after "
+                          "metrics.tracking_start_s = {:g}",
+                          end, dt, s.tracking_start_s));
+  }
+  const bool plan_ends = s.assembly_plan && s.reference && s.reference->duration() < s.duration_s;
+  metrics.Required("tracking_start_s")
+      .Fail(fmt::format("tracking_start_s = {:g} is invalid; expected at least one physics step ({:g} s) before the "
+                        "tracking window's end, {:.3f} s ({})",
+                        s.tracking_start_s, dt, end,
+                        plan_ends ? "the plan's duration, which ends the window of mission assembly_plan; or set "
+                                    "metrics.tracking_end_s"
+                                  : "duration_s"));
+}
+
 /// The mission must keep the reference above the ground (z >= 0) over the flight: a reference
 /// below ground cannot be flown and is a configuration mistake.
 void CheckReferenceAboveGround(const ConfigNode& mission, const Scenario& s) {
@@ -813,19 +834,10 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     if (const auto t = metrics->Optional("tracking_start_s")) s.tracking_start_s = t->AsDoubleIn(0.0, s.duration_s);
     if (const auto t = metrics->Optional("tracking_end_s")) {
       s.tracking_end_s = t->AsDoubleIn(0.0, s.duration_s);
-      if (*s.tracking_end_s <= s.tracking_start_s) {
-        t->Fail(fmt::format("tracking_end_s = {:g} is invalid; expected more than metrics.tracking_start_s = {:g}",
-                            *s.tracking_end_s, s.tracking_start_s));
-      }
     }
     if (const auto e = metrics->Optional("success_error_m")) s.success_error_m = e->AsPositive();
     if (const auto h = metrics->Optional("success_hold_s")) s.success_hold_s = h->AsDoubleIn(0.0, s.duration_s);
     if (const auto r = metrics->Optional("recovered_tilt_rad")) s.recovered_tilt_rad = r->AsDoubleIn(1e-3, 1.5);
-    if (!s.assembly_plan && TrackingEndS(s) <= s.tracking_start_s) {  // a plan's window is checked once planned
-      metrics->Required("tracking_start_s")
-          .Fail(fmt::format("tracking_start_s = {:g} is invalid; expected less than the tracking window's end, {:g} s",
-                            s.tracking_start_s, TrackingEndS(s)));
-    }
     metrics->RejectUnknownKeys();
   }
   root.RejectUnknownKeys();
@@ -840,15 +852,9 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     const AssemblyPlanResult plan = PlanAssemblyMission(s);
     if (!plan.ok) root.Required("mission").Fail("cannot plan the assembly's path: " + plan.message);
     s.reference = plan.trajectory;
-    if (TrackingEndS(s) <= s.tracking_start_s) {
-      root.Required("metrics")
-          .Required("tracking_start_s")
-          .Fail(
-              fmt::format("tracking_start_s = {:g} is invalid; expected less than the plan's duration, {:.3f} s, which "
-                          "ends the tracking window of mission assembly_plan (or set metrics.tracking_end_s)",
-                          s.tracking_start_s, plan.trajectory->duration()));
-    }
   }
+  if (const auto metrics = root.Optional("metrics"))
+    CheckTrackingWindow(*metrics, s);  // after planning: a plan ends it
   CheckReferenceAboveGround(root.Required("mission"), s);
   return s;
 }

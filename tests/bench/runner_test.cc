@@ -117,15 +117,24 @@ TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
   EXPECT_EQ(b.tracking_rmse_window_m, b.tracking_rmse_m);
   EXPECT_LT(b.max_position_error_m, 0.05);
   // A window that ends before it starts, or after the flight, names the file and the key.
-  for (const char* metrics : {"{tracking_start_s: 2, tracking_end_s: 2}", "{tracking_end_s: 9}"}) {
+  // A window that holds no physics step's sample (the physics runs at 1 kHz), or ends after the
+  // flight, names the file and the key that closes it.
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"{tracking_start_s: 2, tracking_end_s: 2}", "metrics.tracking_end_s"},
+      {"{tracking_start_s: 1.0001, tracking_end_s: 1.0002}", "metrics.tracking_end_s"},
+      {"{tracking_end_s: 9}", "metrics.tracking_end_s"},
+      {"{tracking_start_s: 7.9999}", "metrics.tracking_start_s"}};
+  for (const auto& [metrics, key] : bad) {
     try {
       LoadScenario(WithMetrics(metrics));
-      ADD_FAILURE() << "an empty or too long tracking window was accepted: " << metrics;
+      ADD_FAILURE() << "a tracking window without a sample was accepted: " << metrics;
     } catch (const io::ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find("s.yaml"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find("metrics.tracking_end_s"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   }
+  // One step's window is enough.
+  EXPECT_NO_THROW(LoadScenario(WithMetrics("{tracking_start_s: 1, tracking_end_s: 1.001}")));
 }
 
 // Closed-loop NMPC flights (paper 000, Sec. VI-A/B), the failure handed to the controller.
