@@ -156,6 +156,34 @@ bool Succeeded(const nlohmann::json& record) {
   return record["status"] == "ok" && record["metrics"].value("success", false);
 }
 
+/// A table cell from its flights, records[first, first + trials): the mean error over the window
+/// (a wreck held) and up to the crash, the largest error, the success rate, the first failure.
+struct Cell {
+  double error_m = 0.0, error_to_crash_m = 0.0, max_error_m = 0.0, success_rate = 0.0;
+  std::string first_failure;
+};
+Cell CellOf(const std::vector<const nlohmann::json*>& records, std::size_t first, int trials) {
+  Cell c;
+  int success = 0;
+  for (int t = 0; t < trials; ++t) {
+    const nlohmann::json& f = *records[first + static_cast<std::size_t>(t)];
+    c.error_m += MetricOr(f, "rmse_m", 0.0) / trials;
+    c.error_to_crash_m += MetricOr(f, "rmse_flown_m", 0.0) / trials;
+    c.max_error_m = std::max(c.max_error_m, MetricOr(f, "max_error_m", 0.0));
+    success += Succeeded(f);
+    if (!Succeeded(f) && c.first_failure.empty()) c.first_failure = TrialFailure(f);
+  }
+  c.success_rate = static_cast<double>(success) / trials;
+  return c;
+}
+/// The cell's figures as row[name + "_error_m"], ..._error_to_crash_m, ..._max_error_m, ..._success_rate.
+void WriteCell(const Cell& c, const std::string& name, nlohmann::json* row) {
+  (*row)[name + "_error_m"] = c.error_m;
+  (*row)[name + "_error_to_crash_m"] = c.error_to_crash_m;
+  (*row)[name + "_max_error_m"] = c.max_error_m;
+  (*row)[name + "_success_rate"] = c.success_rate;
+}
+
 }  // namespace
 
 void MarsBenchOptions::Validate() const {
@@ -336,21 +364,10 @@ nlohmann::json TableOne(const std::vector<const nlohmann::json*>& records, int t
     for (const auto& [rotor, loss] : cases[row].rotors) faults.push_back({{"rotor", rotor}, {"loss", loss}});
     r["faults"] = faults;
     for (int m = 0; m < methods; ++m) {
-      double rmse = 0.0, rmse_flown = 0.0, max_error = 0.0;
-      int success = 0;
-      for (int t = 0; t < trials; ++t) {
-        const nlohmann::json& f = *records[(row * static_cast<std::size_t>(methods) + static_cast<std::size_t>(m)) *
-                                               static_cast<std::size_t>(trials) + static_cast<std::size_t>(t)];
-        rmse += MetricOr(f, "rmse_m", 0.0) / trials;
-        rmse_flown += MetricOr(f, "rmse_flown_m", 0.0) / trials;
-        max_error = std::max(max_error, MetricOr(f, "max_error_m", 0.0));
-        success += Succeeded(f);
-      }
-      const std::string name(modular::ToString(kMethods[static_cast<std::size_t>(m)]));
-      r[name + "_error_m"] = rmse;
-      r[name + "_error_to_crash_m"] = rmse_flown;
-      r[name + "_max_error_m"] = max_error;
-      r[name + "_success_rate"] = static_cast<double>(success) / trials;
+      const std::size_t first =
+          (row * static_cast<std::size_t>(methods) + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials);
+      WriteCell(CellOf(records, first, trials), std::string(modular::ToString(kMethods[static_cast<std::size_t>(m)])),
+                &r);
     }
     if (row == 0) fault_free = r["full_error_m"].get<double>();
     r["full_over_fault_free"] = fault_free > 0.0 ? r["full_error_m"].get<double>() / fault_free : 0.0;
@@ -423,22 +440,12 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
         both_planned = false;
         continue;
       }
-      int success = 0;
-      double max_error = 0.0, error_flown = 0.0;
-      std::string failure;
-      for (int t = 0; t < trials; ++t) {
-        error[m] += MetricOr(at(t), "rmse_m", 0.0) / trials;
-        error_flown += MetricOr(at(t), "rmse_flown_m", 0.0) / trials;
-        max_error = std::max(max_error, MetricOr(at(t), "max_error_m", 0.0));
-        success += Succeeded(at(t));
-        if (!Succeeded(at(t)) && failure.empty()) failure = TrialFailure(at(t));
-      }
-      r[name + "_error_m"] = error[m];
-      r[name + "_error_to_crash_m"] = error_flown;
-      r[name + "_max_error_m"] = max_error;
-      r[name + "_success_rate"] = static_cast<double>(success) / trials;
-      r[name + "_first_failure"] = failure;
-      to_crash[m] = error_flown;
+      const Cell c =
+          CellOf(records, (2 * row + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials), trials);
+      WriteCell(c, name, &r);
+      r[name + "_first_failure"] = c.first_failure;
+      error[m] = c.error_m;
+      to_crash[m] = c.error_to_crash_m;
       const nlohmann::json& x = (*plan)["metrics"];
       r[name + "_duration_s"] = x["duration_s"];
       r[name + "_attitude_deviation_deg"] = x["attitude_deviation_deg"];

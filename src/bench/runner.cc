@@ -208,8 +208,9 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
   const TimeNs log_period = PeriodFromRate(sc.log_rate_hz);
   const TimeNs tracking_start = FromSeconds(sc.tracking_start_s);
   // A window to duration_s ends with the last physics step (steps * dt may round past duration_s).
+  const double tracking_end_s = TrackingEndS(sc);
   const TimeNs tracking_end =
-      TrackingEndS(sc) >= sc.duration_s ? steps * dt_ns : std::min(FromSeconds(TrackingEndS(sc)), steps * dt_ns);
+      tracking_end_s >= sc.duration_s ? steps * dt_ns : std::min(FromSeconds(tracking_end_s), steps * dt_ns);
   if (tracking_end <= tracking_start) {
     ThrowInvalidArgument("RunScenario", "tracking_start_s", sc.tracking_start_s,
                          fmt::format("before the tracking window's end, {:g} s", ToSeconds(tracking_end)));

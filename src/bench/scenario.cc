@@ -647,7 +647,7 @@ void CheckTrackingWindow(const ConfigNode& metrics, const Scenario& s) {
                           "metrics.tracking_start_s = {:g}",
                           end, dt, s.tracking_start_s));
   }
-  const bool plan_ends = s.assembly_plan && s.reference && s.reference->duration() < s.duration_s;
+  const bool plan_ends = end < s.duration_s;  // without tracking_end_s only a plan ends it early (TrackingEndS)
   metrics.Required("tracking_start_s")
       .Fail(fmt::format("tracking_start_s = {:g} is invalid; expected at least one physics step ({:g} s) before the "
                         "tracking window's end, {:.3f} s ({})",
@@ -830,11 +830,10 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
                             "sim.physics_rate_hz = {:g} Hz",
                             s.stack.control_rate_hz, s.sim.physics_rate_hz));
   }
-  if (const auto metrics = root.Optional("metrics")) {
+  const std::optional<ConfigNode> metrics = root.Optional("metrics");
+  if (metrics) {
     if (const auto t = metrics->Optional("tracking_start_s")) s.tracking_start_s = t->AsDoubleIn(0.0, s.duration_s);
-    if (const auto t = metrics->Optional("tracking_end_s")) {
-      s.tracking_end_s = t->AsDoubleIn(0.0, s.duration_s);
-    }
+    if (const auto t = metrics->Optional("tracking_end_s")) s.tracking_end_s = t->AsDoubleIn(0.0, s.duration_s);
     if (const auto e = metrics->Optional("success_error_m")) s.success_error_m = e->AsPositive();
     if (const auto h = metrics->Optional("success_hold_s")) s.success_hold_s = h->AsDoubleIn(0.0, s.duration_s);
     if (const auto r = metrics->Optional("recovered_tilt_rad")) s.recovered_tilt_rad = r->AsDoubleIn(1e-3, 1.5);
@@ -853,8 +852,7 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     if (!plan.ok) root.Required("mission").Fail("cannot plan the assembly's path: " + plan.message);
     s.reference = plan.trajectory;
   }
-  if (const auto metrics = root.Optional("metrics"))
-    CheckTrackingWindow(*metrics, s);  // after planning: a plan ends it
+  if (metrics) CheckTrackingWindow(*metrics, s);  // after planning: a plan ends the window
   CheckReferenceAboveGround(root.Required("mission"), s);
   return s;
 }

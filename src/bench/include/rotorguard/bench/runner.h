@@ -69,14 +69,14 @@ struct RunSummary {
   /// total): how much faster than real time the whole stack (estimator, FDD, mapper, planner,
   /// controller) runs on one core, the simulator not counted. bench nav's `realtime_factor`.
   double stack_realtime_factor = 0.0;
-  /// Over the tracking window (Scenario::tracking_start_s to tracking_end_s), up to the crash for a
+  /// Over the tracking window (Scenario::tracking_start_s to TrackingEndS), up to the crash for a
   /// crashed flight.
   double tracking_rmse_m = 0.0;
   /// Over the whole tracking window, a crashed vehicle held where it crashed for the rest of it:
   /// tracking_rmse_m when the flight did not crash. What paper 002's tables compare.
   double tracking_rmse_window_m = 0.0;
-  /// The tracking window [s]: the scenario's metrics.tracking_start_s and tracking_end_s (the end
-  /// of the flight when it has none; an assembly_plan mission's plan duration).
+  /// The tracking window [s]: the scenario's tracking_start_s and TrackingEndS, the end at the
+  /// flight's stop when it stopped early without a crash.
   double tracking_start_s = 0.0, tracking_end_s = 0.0;
   double tracking_rmse_eq37_m = 0.0;  ///< paper 000's eq. (37), for comparison with its figures
   double max_position_error_m = 0.0;
