@@ -150,6 +150,10 @@ void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out
   if (s.waypoints_total >= 0) {
     fmt::print("navigation        {} of {} waypoints, {} plans ({} failed)\n", s.waypoints_reached, s.waypoints_total,
                s.plans, s.plans_failed);
+    if (s.plans_fine_search > 0 || s.plans_rest_to_rest > 0) {
+      fmt::print("planner fallbacks {} searched at the map's resolution, {} flown from rest to rest\n",
+                 s.plans_fine_search, s.plans_rest_to_rest);
+    }
   }
   if (s.tilt_recovery_s >= 0.0) fmt::print("tilt recovery     {:.2f} s after the first fault\n", s.tilt_recovery_s);
   fmt::print("faults            {}\n", faults.empty() ? "none" : faults);

@@ -34,6 +34,8 @@ struct Group {
   std::vector<double> plan_ms;
   double search_ms = 0.0, optimize_ms = 0.0, iterations = 0.0, rounds = 0.0, pieces = 0.0;
   int attempted = 0, no_path = 0, succeeded = 0;
+  /// Successful plans that needed the planner's fallbacks (PlanSummary::fine_search, rest_to_rest).
+  int fine_search = 0, rest_to_rest = 0;
   double duration_sum = 0.0, max_violation = 0.0;
   std::map<std::string, int> failures;
 };
@@ -76,6 +78,8 @@ nlohmann::json GroupJson(const Group& g) {
           {"clearance_rounds_mean", g.attempted > 0 ? g.rounds / g.attempted : 0.0},
           {"pieces_mean", g.attempted > 0 ? g.pieces / g.attempted : 0.0},
           {"max_limit_violation", g.max_violation},
+          {"plans_fine_search", g.fine_search},
+          {"plans_rest_to_rest", g.rest_to_rest},
           {"failures", failures}};
 }
 
@@ -206,6 +210,8 @@ nlohmann::json RunPlannerBenchmark(const PlannerBenchOptions& options) {
             for (Group* x : {&g, &all}) {
               if (good) {
                 ++x->succeeded;
+                x->fine_search += s.fine_search;
+                x->rest_to_rest += s.rest_to_rest;
                 x->duration_sum += traj.total_duration();
               } else {
                 ++x->failures[clearance < kVehicleRadius ? "true_collision" : "limit_exceeded"];
@@ -246,6 +252,9 @@ std::string PlannerMarkdown(const nlohmann::json& r) {
   };
   for (const auto& [name, g] : r["groups"].items()) row(name, g);
   row("all", r);
+  md += fmt::format("\nOf the successful plans, {} needed the search at the map's resolution and {} were flown from "
+                    "rest to rest (the planner's fallbacks).\n",
+                    r["plans_fine_search"].get<int>(), r["plans_rest_to_rest"].get<int>());
   md += fmt::format("\nTargets (plan_ms_mean <= 5, success_rate >= 0.98, within limits): {}.\n",
                     r["meets_targets"].get<bool>() ? "met" : "NOT met");
   return md;

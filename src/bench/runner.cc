@@ -138,6 +138,8 @@ nlohmann::json RunSummary::ToJson() const {
                        {"waypoints_total", waypoints_total},
                        {"plans", plans},
                        {"plans_failed", plans_failed},
+                       {"plans_fine_search", plans_fine_search},
+                       {"plans_rest_to_rest", plans_rest_to_rest},
                        {"plans_by_reason", plans_by_reason},
                        {"mission_time_s", mission_time_s >= 0.0 ? nlohmann::json(mission_time_s) : nlohmann::json(nullptr)},
                        {"planner_ms_mean", planner_ms_mean},
@@ -324,7 +326,11 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     for (const planning::Replanner::Event& e : nav->events()) {
       ++summary.plans_by_reason[e.reason];
       summary.planner_ms_mean += e.plan_ms / static_cast<double>(nav->events().size());
-      if (e.status == planning::PlanSummary::Status::kSuccess) continue;
+      if (e.status == planning::PlanSummary::Status::kSuccess) {
+        summary.plans_fine_search += e.fine_search;
+        summary.plans_rest_to_rest += e.rest_to_rest;
+        continue;
+      }
       ++summary.plans_failed;
       summary.failed_plans.push_back(fmt::format("{:.2f} s {}: {}", e.t, e.reason, planning::ToString(e.status)));
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace rotorguard::planning {
 
@@ -94,6 +95,30 @@ bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, co
   return true;
 }
 
+bool MinimumJerkTrajectory::BuildRestToRest(const Eigen::Matrix3Xd& points, const Eigen::VectorXd& durations) {
+  durations_.resize(0);
+  coefficients_.resize(0, 3);
+  system_ = BandedMatrix(0, 4, 3);  // no system: the pieces do not come from Build's
+  const int m = static_cast<int>(durations.size());
+  if (m < 1 || points.cols() != m + 1 || !points.allFinite() || !durations.allFinite() || (durations.array() <= 0.0).any()) {
+    return false;
+  }
+  // p(t) = a + (b - a) (10 s^3 - 15 s^4 + 6 s^5), s = t / T: in powers of t, c3 = 10 d / T^3,
+  // c4 = -15 d / T^4, c5 = 6 d / T^5 with d = b - a.
+  coefficients_.setZero(kC * m, 3);
+  for (int i = 0; i < m; ++i) {
+    const double t = durations(i);
+    const Eigen::RowVector3d d = (points.col(i + 1) - points.col(i)).transpose();
+    coefficients_.row(kC * i) = points.col(i).transpose();
+    coefficients_.row(kC * i + 3) = (10.0 / (t * t * t)) * d;
+    coefficients_.row(kC * i + 4) = (-15.0 / (t * t * t * t)) * d;
+    coefficients_.row(kC * i + 5) = (6.0 / (t * t * t * t * t)) * d;
+  }
+  durations_ = durations;
+  total_duration_ = durations.sum();
+  return true;
+}
+
 double MinimumJerkTrajectory::Energy() const {
   // The integral over [0, T] of |6 c3 + 24 c4 t + 60 c5 t^2|^2.
   double e = 0.0;
@@ -127,6 +152,9 @@ void MinimumJerkTrajectory::PropagateGradient(const Eigen::MatrixX3d& d_coeffici
   // G . (dA/dT_i c), where (dA/dT_i c) in a row that evaluates derivative d of piece i at T_i is
   // derivative d + 1 there.
   const int m = pieces();
+  if (system_.size() != kC * m) {
+    throw std::logic_error("MinimumJerkTrajectory::PropagateGradient: the trajectory does not come from Build");
+  }
   Eigen::MatrixXd g = d_coefficients;
   system_.SolveTransposed(g);
   d_waypoints->resize(3, m - 1);

@@ -61,6 +61,16 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     return summary;
   };
   summary.path = FindPath(map, start.col(0), goal, options_.search);
+  if (summary.path.status == PathStatus::kNoPath && options_.fine_search_fallback &&
+      options_.search.resolution_m > map.resolution()) {
+    // The coarse cells may see no way out of a pocket that the map's voxels leave open (a vehicle
+    // stopped among three trunks whose gaps are narrower than two cells): the same search on the
+    // map's own voxels, eight times as many cells, only when the coarse one has failed.
+    AStarOptions fine = options_.search;
+    fine.resolution_m = map.resolution();
+    summary.path = FindPath(map, start.col(0), goal, fine);
+    summary.fine_search = true;
+  }
   summary.search_ms = MsSince(t0);
   switch (summary.path.status) {
     case PathStatus::kFound: break;
@@ -77,7 +87,52 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
   if (status == Status::kCollision) {
     status = Refine(start, goal, limits, map, 0.5 * options_.max_piece_length_m, &summary, out);
   }
+  // From rest, the path itself (a replanner that holds after failed plans asks from rest).
+  constexpr double kRestSpeed = 1e-3, kRestAcceleration = 1e-2;  // [m/s], [m/s²]
+  if (status != Status::kSuccess && options_.rest_to_rest_fallback && start.col(1).norm() <= kRestSpeed &&
+      start.col(2).norm() <= kRestAcceleration && FlyPathFromRest(limits, map, &summary, out)) {
+    summary.rest_to_rest = true;
+    return finish(Status::kSuccess, std::string("the back end failed (") + ToString(status) + ": " + summary.message +
+                                        "): the path is flown from rest to rest");
+  }
   return finish(status, summary.message);
+}
+
+bool Planner::FlyPathFromRest(const DynamicLimits& limits, const perception::VoxelMap& map, PlanSummary* summary,
+                              MinimumJerkTrajectory* out) const {
+  // The corners, repeated points dropped (the search keeps a start and goal that share a cell).
+  const std::vector<Vector3>& pts = summary->path.points;
+  std::vector<Vector3> corners;
+  for (const Vector3& p : pts) {
+    if (corners.empty() || (p - corners.back()).norm() > 1e-9) corners.push_back(p);
+  }
+  if (corners.size() < 2) return false;
+  const int m = static_cast<int>(corners.size()) - 1;
+  Eigen::Matrix3Xd points(3, m + 1);
+  Eigen::VectorXd durations(m);
+  for (int i = 0; i <= m; ++i) points.col(i) = corners[static_cast<std::size_t>(i)];
+  for (int i = 0; i < m; ++i) {
+    // The rest-to-rest quintic over length L in T peaks at 1.875 L / T (speed), 10 / sqrt(3) L / T^2
+    // (acceleration) and 60 L / T^3 (jerk, at the ends).
+    const double length = (points.col(i + 1) - points.col(i)).norm();
+    durations(i) = std::max({1.875 * length / limits.v_max, std::sqrt(10.0 / std::sqrt(3.0) * length / limits.a_max),
+                             std::cbrt(60.0 * length / limits.j_max)});
+  }
+  MinimumJerkTrajectory traj;
+  if (!traj.BuildRestToRest(points, durations)) return false;
+  summary->pieces = m;
+  summary->min_clearance_m = options_.plane_search_m;
+  for (int i = 0; i < m; ++i) {
+    const Vector3 a = points.col(i), b = points.col(i + 1);
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / options_.check_step_m)));
+    for (int k = 0; k <= steps; ++k) {
+      if (const auto o = map.Nearest(a + (b - a) * k / steps, options_.plane_search_m)) {
+        summary->min_clearance_m = std::min(summary->min_clearance_m, o->distance_m);
+      }
+    }
+  }
+  *out = std::move(traj);
+  return true;
 }
 
 PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, const DynamicLimits& limits,

@@ -202,7 +202,8 @@ void Replanner::Update(double t, const perception::VoxelMap& map) {
     if (!keep && mode_ != Mode::kHolding && mode_ != Mode::kIdle) Brake(t, map);
     if (!keep && (mode_ == Mode::kIdle || mode_ == Mode::kHolding)) mode_ = Mode::kHolding;
   }
-  events_.push_back({t, reason, last_plan_.status, mode_, last_plan_.total_ms});
+  events_.push_back(
+      {t, reason, last_plan_.status, mode_, last_plan_.total_ms, last_plan_.fine_search, last_plan_.rest_to_rest});
 }
 
 }  // namespace rotorguard::planning

@@ -62,6 +62,12 @@ TEST(PlannerBench, SmallRunReportsEveryGroup) {
   EXPECT_LT(r["limits_post_failure"]["a_max"].get<double>(), r["limits_nominal"]["a_max"].get<double>());
   EXPECT_GE(r["groups"]["room_nominal"]["success_rate"].get<double>(), 2.0 / 3.0);
   EXPECT_NE(PlannerMarkdown(r).find("room_post_failure"), std::string::npos);
+  // The fallbacks are counted among the successes, never beyond them.
+  for (const char* k : {"plans_fine_search", "plans_rest_to_rest"}) {
+    ASSERT_TRUE(r.contains(k)) << k;
+    EXPECT_GE(r[k].get<int>(), 0) << k;
+    EXPECT_LE(r[k].get<double>(), r["success_rate"].get<double>() * r["pairs"].get<int>() + 1e-9) << k;
+  }
 }
 
 TEST(PlannerBench, BadOptionsAreNamed) {

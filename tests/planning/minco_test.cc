@@ -1,6 +1,7 @@
 #include "rotorguard/planning/minco.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <gtest/gtest.h>
 
@@ -93,6 +94,54 @@ TEST(MinimumJerkTrajectory, RestToRestIsTheClosedForm) {
     EXPECT_LT((traj.Evaluate(t).p_W - expected).norm(), 1e-12);
   }
   EXPECT_NEAR(traj.Energy(), 720.0 * (tail.col(0) - head.col(0)).squaredNorm() / std::pow(T, 5), 1e-9);
+}
+
+// A chain from rest to rest: each piece is the one-piece Build between its corners at rest (the
+// closed form above), so the chain stops at every corner, stays on the segments, peaks at 1.875
+// L / T in speed, and its energy is the pieces' 720 L^2 / T^5. It has no adjoint system.
+TEST(MinimumJerkTrajectory, ARestToRestChainIsOneRestToRestPiecePerSegment) {
+  Eigen::Matrix3Xd points(3, 4);
+  points << 0.0, 2.0, 2.0, -1.0,  //
+      0.0, 0.0, 1.5, 3.0,         //
+      1.0, 1.2, 1.2, 0.8;
+  const Eigen::Vector3d durations(2.0, 1.5, 3.0);
+  MinimumJerkTrajectory chain;
+  ASSERT_TRUE(chain.BuildRestToRest(points, durations));
+  ASSERT_EQ(chain.pieces(), 3);
+  double start = 0.0, energy = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    PvaState head = PvaState::Zero(), tail = PvaState::Zero();
+    head.col(0) = points.col(i);
+    tail.col(0) = points.col(i + 1);
+    MinimumJerkTrajectory one;
+    ASSERT_TRUE(one.Build(head, tail, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, durations(i))));
+    const double length = (points.col(i + 1) - points.col(i)).norm();
+    for (double t = 0.0; t <= durations(i); t += 0.05) {
+      const ReferencePoint a = chain.Evaluate(start + t), b = one.Evaluate(t);
+      EXPECT_LT((a.p_W - b.p_W).norm(), 1e-12) << "piece " << i << " t " << t;
+      EXPECT_LT((a.v_W - b.v_W).norm(), 1e-12) << "piece " << i << " t " << t;
+      EXPECT_LT((a.a_W - b.a_W).norm(), 1e-12) << "piece " << i << " t " << t;
+      // On the segment: the offset from its start is parallel to it.
+      EXPECT_LT((a.p_W - points.col(i)).cross(points.col(i + 1) - points.col(i)).norm(), 1e-12);
+    }
+    EXPECT_LT(chain.Evaluate(start).v_W.norm(), 1e-12) << "at rest at corner " << i;
+    EXPECT_NEAR(chain.PieceDerivative(i, 0.5 * durations(i), 1).norm(), 1.875 * length / durations(i), 1e-12);
+    energy += 720.0 * length * length / std::pow(durations(i), 5);
+    start += durations(i);
+  }
+  EXPECT_NEAR(chain.Energy(), energy, 1e-9 * energy);
+  EXPECT_LT((chain.Evaluate(1e9).p_W - points.col(3)).norm(), 1e-12);
+  Eigen::Matrix3Xd dq;
+  Eigen::VectorXd dt;
+  EXPECT_THROW(chain.PropagateGradient(Eigen::MatrixX3d::Zero(18, 3), Eigen::VectorXd::Zero(3), &dq, &dt),
+               std::logic_error);
+  EXPECT_FALSE(chain.BuildRestToRest(points, Eigen::Vector3d(1.0, 0.0, 1.0))) << "a zero duration";
+  EXPECT_TRUE(chain.empty());
+  EXPECT_FALSE(chain.BuildRestToRest(points, Eigen::Vector2d(1.0, 1.0))) << "sizes";
+  EXPECT_FALSE(chain.BuildRestToRest(points.leftCols(1), Eigen::VectorXd(0))) << "one point";
+  Eigen::Matrix3Xd bad = points;
+  bad(1, 2) = std::nan("");
+  EXPECT_FALSE(chain.BuildRestToRest(bad, durations)) << "a NaN point";
 }
 
 // The energy's total gradient with respect to waypoints and durations (partials propagated

@@ -171,5 +171,83 @@ TEST_F(PlannerAtTheWall, FailuresHaveAStatusAndNoTrajectory) {
   EXPECT_TRUE(traj.empty());
 }
 
+// A wall 1 m thick across the whole window and altitude band, pierced by a tunnel one voxel
+// across (y in [0, 0.1), z in [1.5, 1.6)), no inflation: with 0.5 m cells, whose centres lie at
+// x.x5 m and never in the tunnel's row, no segment between centres can cross the wall (the
+// longest, 0.87 m, is shorter than it is thick), so the coarse search finds no path. The same
+// search on the map's voxels goes through the tunnel, and the plan never meets the wall.
+TEST(PlannerFallbacks, NoPathOnTheCoarseCellsIsSearchedAgainAtTheMapsResolution) {
+  perception::VoxelMapOptions o;
+  o.window_size_m = Vector3(12.8, 12.8, 6.4);
+  o.inflation_radius_m = 0.0;
+  perception::VoxelMap map(o);
+  for (double x = 2.05; x < 3.0; x += 0.1) {
+    for (double y = -6.35; y < 6.4; y += 0.1) {
+      for (double z = 0.05; z < 3.0; z += 0.1) {
+        if (y > 0.0 && y < 0.1 && z > 1.5 && z < 1.6) continue;  // the tunnel
+        map.MarkOccupied(Vector3(x, y, z));
+      }
+    }
+  }
+  PlannerOptions coarse_only;
+  coarse_only.search.resolution_m = 0.5;
+  coarse_only.fine_search_fallback = false;
+  PvaState start = PvaState::Zero();
+  start.col(0) = Vector3(0.0, 0.05, 1.55);
+  const Vector3 goal(4.0, 0.05, 1.55);
+  MinimumJerkTrajectory traj;
+  const PlanSummary without = Planner(coarse_only).Plan(start, goal, DynamicLimits{}, map, &traj);
+  EXPECT_EQ(without.status, PlanSummary::Status::kNoPath);
+  EXPECT_FALSE(without.fine_search);
+  PlannerOptions with = coarse_only;
+  with.fine_search_fallback = true;
+  const PlanSummary s = Planner(with).Plan(start, goal, DynamicLimits{}, map, &traj);
+  ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
+  EXPECT_TRUE(s.fine_search);
+  ASSERT_EQ(s.path.status, PathStatus::kFound);
+  for (std::size_t k = 0; k + 1 < s.path.points.size(); ++k) {
+    EXPECT_FALSE(map.SegmentCollides(s.path.points[k], s.path.points[k + 1])) << "segment " << k;
+  }
+  EXPECT_FALSE(EverInflated(traj, map));
+  EXPECT_LT((traj.Evaluate(1e9).p_W - goal).norm(), 1e-9);
+}
+
+// Without its collision term and re-optimisations the back end cuts the corner into the wall
+// (kCollision). From rest the planner then flies the front end's path itself: every corner at
+// rest, the limits held, never in an inflated voxel, at rest at the goal. From a moving start it
+// cannot (the first segment would begin with a jump in velocity), and the failure stands.
+TEST_F(PlannerAtTheWall, ABackEndThatFailsFromRestFliesThePathFromRestToRest) {
+  PlannerOptions o;
+  o.optimizer.weight_collision = 0.0;
+  o.clearance_rounds = 0;
+  o.rest_to_rest_fallback = false;
+  const Vector3 goal(4, 0, 1.5);
+  const DynamicLimits limits{1.0, 0.8, 6.0};
+  MinimumJerkTrajectory traj;
+  EXPECT_EQ(Planner(o).Plan(start_, goal, limits, map_, &traj).status, PlanSummary::Status::kCollision);
+  o.rest_to_rest_fallback = true;
+  const Planner planner(o);
+  const PlanSummary s = planner.Plan(start_, goal, limits, map_, &traj);
+  ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
+  EXPECT_TRUE(s.rest_to_rest);
+  EXPECT_NE(s.message.find("collision"), std::string::npos) << s.message;
+  ASSERT_EQ(traj.pieces() + 1, static_cast<int>(s.path.points.size()));
+  double t = 0.0;
+  for (int i = 0; i < traj.pieces(); ++i) {
+    EXPECT_LT((traj.Evaluate(t).p_W - s.path.points[static_cast<std::size_t>(i)]).norm(), 1e-9) << "corner " << i;
+    EXPECT_LT(traj.Evaluate(t).v_W.norm(), 1e-9) << "corner " << i;
+    t += traj.durations()(i);
+  }
+  EXPECT_FALSE(EverInflated(traj, map_));
+  EXPECT_LE(traj.MaxNorm(1, 2000), limits.v_max * 1.001);
+  EXPECT_LE(traj.MaxNorm(2, 2000), limits.a_max * 1.001);
+  EXPECT_LE(traj.MaxNorm(3, 2000), limits.j_max * 1.001);
+  EXPECT_LT((traj.Evaluate(1e9).p_W - goal).norm(), 1e-9);
+  EXPECT_GT(s.min_clearance_m, 0.2);
+  PvaState moving = start_;
+  moving.col(1) = Vector3(0.5, 0.0, 0.0);
+  EXPECT_EQ(planner.Plan(moving, goal, limits, map_, &traj).status, PlanSummary::Status::kCollision);
+}
+
 }  // namespace
 }  // namespace rotorguard::planning

@@ -102,6 +102,9 @@ struct RunSummary {
   int waypoints_total = -1;
   /// Planning queries and their results in the navigate mission (the replanner's events).
   int plans = 0, plans_failed = 0;
+  /// Of the successful ones, those that needed the planner's fallbacks: the search at the map's
+  /// resolution, and the path flown from rest to rest (PlanSummary::fine_search, rest_to_rest).
+  int plans_fine_search = 0, plans_rest_to_rest = 0;
   /// Planning queries by what started them: "goal", "failure", "obstacle ahead", "periodic".
   std::map<std::string, int> plans_by_reason;
   /// When the navigate mission reached its last waypoint [s]; -1 when it did not (or another mission).

@@ -31,6 +31,15 @@ class MinimumJerkTrajectory final : public ReferenceTrajectory {
   bool Build(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
              const Eigen::VectorXd& durations);
 
+  /// A chain of straight pieces, each flown from rest to rest: piece i runs from points.col(i) to
+  /// points.col(i + 1) in durations(i) along the quintic 10s^3 - 15s^4 + 6s^5 of s = t / T_i (the
+  /// minimum-jerk profile between rest states), so that the trajectory never leaves the polyline.
+  /// Velocity and acceleration are continuous (zero at every corner), the jerk is not, unlike
+  /// Build's. For a path that must be flown exactly (the planner's fallback); PropagateGradient
+  /// does not apply to it. Returns false (leaving the trajectory empty) on fewer than two points,
+  /// a duration that is not positive and finite, a point that is not finite or mismatched sizes.
+  bool BuildRestToRest(const Eigen::Matrix3Xd& points, const Eigen::VectorXd& durations);
+
   int pieces() const { return static_cast<int>(durations_.size()); }
   bool empty() const { return durations_.size() == 0; }
   const Eigen::VectorXd& durations() const { return durations_; }

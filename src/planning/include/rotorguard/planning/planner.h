@@ -5,6 +5,13 @@
 /// against the map: where it passes through an inflated voxel, planes are added where it does
 /// and the optimisation runs again from its last result, a bounded number of times; if it still
 /// collides, the whole back end once more with pieces half as long.
+///
+/// Two fallbacks keep a vehicle that has stopped from staying stuck where the fast path fails:
+/// a search that finds no path on its cells is repeated at the map's resolution (a passage that
+/// no coarse cell's centre fits through), and when the back end fails from a start at rest the
+/// front end's path itself is flown, corner to corner, stopping at each (its segments are clear of
+/// the inflated map by the search's own test, and a trajectory from rest to rest along a segment
+/// never leaves it).
 #include <string>
 
 #include "rotorguard/perception/voxel_map.h"
@@ -21,6 +28,10 @@ struct PlannerOptions {
   double plane_search_m = 0.5;      ///< a sample gets the plane of an obstacle within this [m], >= clearance
   int clearance_rounds = 8;         ///< re-optimisations with planes added where the result collides, >= 0
   double check_step_m = 0.05;       ///< spacing of the collision check along the result [m], > 0
+  /// On no path at search.resolution_m, search again at the map's resolution.
+  bool fine_search_fallback = true;
+  /// When the back end fails from a start at rest, fly the front end's path from rest to rest.
+  bool rest_to_rest_fallback = true;
   void Validate() const;
 };
 
@@ -44,6 +55,8 @@ struct PlanSummary {
   int clearance_rounds = 0;  ///< re-optimisations for clearance
   double search_ms = 0.0, optimize_ms = 0.0, total_ms = 0.0;
   double min_clearance_m = 0.0; ///< the smallest distance to an occupied voxel centre along the result (capped at plane_search_m)
+  bool fine_search = false;   ///< the path comes from the search at the map's resolution
+  bool rest_to_rest = false;  ///< the result is the path flown from rest to rest (the back end failed: `message` says how)
   bool ok() const { return status == Status::kSuccess; }
 };
 const char* ToString(PlanSummary::Status status);
@@ -64,6 +77,11 @@ class Planner {
   PlanSummary::Status Refine(const PvaState& start, const Vector3& goal, const DynamicLimits& limits,
                              const perception::VoxelMap& map, double piece_length, PlanSummary* summary,
                              MinimumJerkTrajectory* out) const;
+
+  /// The path in `summary->path` as a trajectory from rest to rest at every corner, each segment
+  /// as short in time as `limits` allow; fills min_clearance_m. False if the path has no length.
+  bool FlyPathFromRest(const DynamicLimits& limits, const perception::VoxelMap& map, PlanSummary* summary,
+                       MinimumJerkTrajectory* out) const;
 
   PlannerOptions options_;
   TrajectoryOptimizer optimizer_;

@@ -58,6 +58,8 @@ class Replanner final : public ReferenceTrajectory {
     PlanSummary::Status status = PlanSummary::Status::kSuccess;
     Mode mode_after = Mode::kIdle;
     double plan_ms = 0.0;  ///< the query's wall-clock time (search and optimisation)
+    bool fine_search = false;   ///< PlanSummary::fine_search: the path came from the search at the map's resolution
+    bool rest_to_rest = false;  ///< PlanSummary::rest_to_rest: the path flown from rest to rest
   };
 
   /// Throws ValidationError on invalid options. Holds `hold_position` until given a goal; every
