@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "rotorguard/bench/failure_list.h"
 #include "rotorguard/bench/parallel.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/sim_bench.h"
@@ -95,7 +96,7 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
   std::vector<double> w, settle, detect, ts, ts_nominal, act, act_nominal, tilt, tilt_free;
   int success = 0, replanned = 0;
   std::map<std::string, int> decisions, bindings;
-  nlohmann::json failures = nlohmann::json::array();
+  FailureList failures(10);
   for (std::size_t i = 0; i < flights.size(); ++i) {
     const Fig2Flight& f = flights[i];
     success += f.success;
@@ -104,7 +105,7 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
     w.push_back(f.w_estimate);
     if (f.settle_s >= 0.0) settle.push_back(f.settle_s);
     if (f.detect_s >= 0.0) detect.push_back(f.detect_s);
-    if (!f.success && failures.size() < 10) failures.push_back({{"seed", o.seed + i}, {"reason", f.failure}});
+    if (!f.success) failures.Add({{"seed", o.seed + i}, {"reason", f.failure}});
     if (!f.replanned) continue;
     ++replanned;
     ++decisions[f.decision];
@@ -122,7 +123,7 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
   const double truth = o.fig2.faults.front().eta;
   int identified = 0;
   for (const double e : w) identified += std::abs(e - truth) <= 0.05;
-  return {{"benchmark", "flatness"},
+  nlohmann::json result = {{"benchmark", "flatness"},
           {"ts_envelope_s", fig1.envelope_s},
           {"ts_actuator_s", fig1b.actuator_s},
           {"ts_plan_s", fig1.t_s},
@@ -148,9 +149,10 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
           {"max_pitch_deg", Median(tilt_free)},
           {"max_pitch_deg_range", range(tilt_free)},
           {"max_tilt_deg_with_fault", Median(tilt)},
-          {"failures", failures},
           {"options", {{"seeds", o.seeds}, {"seed", o.seed}, {"jobs", o.jobs}, {"scenario", o.fig2.name}}},
           {"host", HostInfo()}};
+  failures.WriteTo(&result);
+  return result;
 }
 
 std::string FlatnessMarkdown(const nlohmann::json& r) {
@@ -179,6 +181,7 @@ std::string FlatnessMarkdown(const nlohmann::json& r) {
   for (const auto& f : r["failures"]) {
     md += fmt::format("failed: seed {}: {}\n", f["seed"].get<std::uint64_t>(), f["reason"].get<std::string>());
   }
+  if (const std::string more = FailureList::NotListedLine(r, ""); !more.empty()) md += more + "\n";
   return md;
 }
 

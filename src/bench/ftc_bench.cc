@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "rotorguard/bench/campaign.h"
+#include "rotorguard/bench/failure_list.h"
 #include "rotorguard/bench/runner.h"
 #include "rotorguard/bench/scenario.h"
 #include "rotorguard/bench/sim_bench.h"
@@ -123,11 +124,11 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
   std::vector<double> latencies;
   int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
   double min_alt = std::numeric_limits<double>::infinity();
-  nlohmann::json failures = nlohmann::json::array();  // the first few, to reproduce them
+  FailureList failures(5);  // the first few, to reproduce them
   for (std::size_t t = 0; t < trials.size(); ++t) {
     const FtcTrial& r = trials[t];
     success += r.success ? 1 : 0;
-    if (!r.success && failures.size() < 5) failures.push_back({{"trial", t}, {"seed", r.seed}, {"reason", r.failure}});
+    if (!r.success) failures.Add({{"trial", t}, {"seed", r.seed}, {"reason", r.failure}});
     min_alt = std::min(min_alt, r.min_altitude_m);
     if (!r.has_fdd) continue;
     ++with_fdd;
@@ -138,15 +139,16 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
   }
   const double n = static_cast<double>(trials.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  return {{"trials", trials.size()},
+  nlohmann::json result = {{"trials", trials.size()},
           {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
           {"fdd_latency_s_max", NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
           {"sucr", n > 0 ? success / n : 0.0},
           {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
           {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
           {"mini_alt_m", NullIfNan(min_alt)},
-          {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
-          {"failures", failures}};
+          {"fdd_latencies_s", latencies}};  // every correct detection's latency: the distribution
+  failures.WriteTo(&result);
+  return result;
 }
 
 std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "ukf", "indi", "passive", "none"}; }

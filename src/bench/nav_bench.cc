@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "rotorguard/bench/failure_list.h"
 #include "rotorguard/bench/metrics.h"
 #include "rotorguard/bench/planner_bench.h"
 #include "rotorguard/bench/runner.h"
@@ -51,7 +52,7 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
          time = 0;
   int completed = 0;
   std::map<std::string, double> cost;
-  nlohmann::json failures = nlohmann::json::array();
+  FailureList failures(10);  // each with its seed for --replay
   for (std::size_t i = 0; i < trials.size(); ++i) {
     const NavTrial& t = *trials[i];
     success += t.success;
@@ -65,9 +66,9 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
     trial_rtf += t.trial_realtime_factor / n;
     for (const auto& [part, ms] : t.cost_ms_per_sim_s) cost[part] += ms / n;
     if (t.mission_time_s >= 0.0) time += t.mission_time_s, ++completed;
-    if (!t.success && failures.size() < 10) failures.push_back({{"kind", kinds[i]}, {"seed", seeds[i]}, {"reason", t.failure}});
+    if (!t.success) failures.Add({{"kind", kinds[i]}, {"seed", seeds[i]}, {"reason", t.failure}});
   }
-  return {{"trials", trials.size()},
+  nlohmann::json result = {{"trials", trials.size()},
           {"success_rate", success / n},
           {"collision_rate", collision / n},
           {"crash_rate", crash / n},
@@ -78,8 +79,9 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
           {"stack_ms_per_cycle_mean", stack},
           {"realtime_factor", rtf},
           {"trial_realtime_factor", trial_rtf},
-          {"cost_ms_per_sim_s", cost},
-          {"failures", failures}};
+          {"cost_ms_per_sim_s", cost}};
+  failures.WriteTo(&result);
+  return result;
 }
 
 }  // namespace
@@ -286,6 +288,7 @@ std::string NavMarkdown(const nlohmann::json& r) {
       md += fmt::format("\n{} failed: {} seed {}: {}", v, f["kind"].get<std::string>(), f["seed"].get<std::uint64_t>(),
                         f["reason"].get<std::string>());
     }
+    if (const std::string more = FailureList::NotListedLine(r[v], v); !more.empty()) md += "\n" + more;
   }
   return md + "\n";
 }

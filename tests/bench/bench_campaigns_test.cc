@@ -150,6 +150,26 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
   EXPECT_EQ(r["groups"]["room"]["rotorguard"], r["rotorguard"]);
 }
 
+// Thirteen failed flights of one variant: ten are listed with their seeds, the other three are
+// counted, in the JSON and in the Markdown, rather than dropped.
+TEST_F(BenchCampaigns, NavResultCountsTheFailuresItDoesNotList) {
+  NavBenchOptions o;
+  o.trials = 13;
+  o.kinds = {"room"};
+  o.base = LoadScenario(kConfigs + "/scenarios/forest.yaml");
+  const Campaign c = NavCampaign(o);
+  ASSERT_EQ(c.trials, 26);
+  std::vector<nlohmann::json> records;
+  for (int i = 0; i < c.trials; ++i) records.push_back(Record(i, c.parameters(i), nullptr, "error", "boom"));
+  const nlohmann::json r = NavResult(c.bench["options"], records);
+  EXPECT_EQ(r["rotorguard"]["failures"].size(), 10u);
+  EXPECT_EQ(r["rotorguard"]["failures_not_listed"], 3);
+  EXPECT_EQ(r["failure_unaware"]["failures_not_listed"], 3);
+  const std::string md = NavMarkdown(r);
+  EXPECT_NE(md.find("rotorguard failed: 3 more, not listed"), std::string::npos) << md;
+  EXPECT_NE(md.find("failure_unaware failed: 3 more, not listed"), std::string::npos) << md;
+}
+
 TEST_F(BenchCampaigns, BadBenchmarkSpecsNameTheKey) {
   const std::string vehicle = "vehicle: " + kConfigs + "/vehicles/zhou2025_quad.yaml\n";
   RG_EXPECT_THROW_WITH(LoadCampaign(Write("a.yaml", "name: a\nbench: hover\ntrials: 1\n")), io::ConfigError, "bench");
