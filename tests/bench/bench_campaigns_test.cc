@@ -107,12 +107,17 @@ TEST_F(BenchCampaigns, FtcResultCountsAnErroredTrialAsAFailure) {
   RG_EXPECT_THROW_WITH(FtcResult(c.bench["options"], records), std::invalid_argument, "8 trial records");
 }
 
-TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
+/// The nav benchmark's campaign of `trials` rooms, each flown by both variants.
+Campaign RoomNavCampaign(int trials) {
   NavBenchOptions o;
-  o.trials = 2;
+  o.trials = trials;
   o.kinds = {"room"};
   o.base = LoadScenario(kConfigs + "/scenarios/forest.yaml");
-  const Campaign c = NavCampaign(o);
+  return NavCampaign(o);
+}
+
+TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
+  const Campaign c = RoomNavCampaign(2);
   ASSERT_EQ(c.trials, 4);  // (trial, variant): rotorguard, failure_unaware, rotorguard, failure_unaware
   EXPECT_EQ(c.parameters(0).at("seed"), c.parameters(1).at("seed"));  // both variants fly one world
   EXPECT_NE(c.parameters(0).at("seed"), c.parameters(2).at("seed"));
@@ -153,11 +158,7 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
 // Thirteen failed flights of one variant: ten are listed with their seeds, the other three are
 // counted, in the JSON and in the Markdown, rather than dropped.
 TEST_F(BenchCampaigns, NavResultCountsTheFailuresItDoesNotList) {
-  NavBenchOptions o;
-  o.trials = 13;
-  o.kinds = {"room"};
-  o.base = LoadScenario(kConfigs + "/scenarios/forest.yaml");
-  const Campaign c = NavCampaign(o);
+  const Campaign c = RoomNavCampaign(13);
   ASSERT_EQ(c.trials, 26);
   std::vector<nlohmann::json> records;
   for (int i = 0; i < c.trials; ++i) records.push_back(Record(i, c.parameters(i), nullptr, "error", "boom"));
