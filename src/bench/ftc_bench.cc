@@ -139,16 +139,16 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
   }
   const double n = static_cast<double>(trials.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  nlohmann::json result = {{"trials", trials.size()},
+  return {{"trials", trials.size()},
           {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
           {"fdd_latency_s_max", NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
           {"sucr", n > 0 ? success / n : 0.0},
           {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
           {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
           {"mini_alt_m", NullIfNan(min_alt)},
-          {"fdd_latencies_s", latencies}};  // every correct detection's latency: the distribution
-  failures.WriteTo(&result);
-  return result;
+          {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
+          {"failures", failures.listed()},
+          {"failures_not_listed", failures.not_listed()}};
 }
 
 std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "ukf", "indi", "passive", "none"}; }

@@ -68,7 +68,7 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
     if (t.mission_time_s >= 0.0) time += t.mission_time_s, ++completed;
     if (!t.success) failures.Add({{"kind", kinds[i]}, {"seed", seeds[i]}, {"reason", t.failure}});
   }
-  nlohmann::json result = {{"trials", trials.size()},
+  return {{"trials", trials.size()},
           {"success_rate", success / n},
           {"collision_rate", collision / n},
           {"crash_rate", crash / n},
@@ -79,9 +79,9 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
           {"stack_ms_per_cycle_mean", stack},
           {"realtime_factor", rtf},
           {"trial_realtime_factor", trial_rtf},
-          {"cost_ms_per_sim_s", cost}};
-  failures.WriteTo(&result);
-  return result;
+          {"cost_ms_per_sim_s", cost},
+          {"failures", failures.listed()},
+          {"failures_not_listed", failures.not_listed()}};
 }
 
 }  // namespace

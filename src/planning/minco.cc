@@ -95,7 +95,8 @@ bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, co
   return true;
 }
 
-bool MinimumJerkTrajectory::BuildRestToRest(const Eigen::Matrix3Xd& points, const Eigen::VectorXd& durations) {
+bool MinimumJerkTrajectory::BuildRestToRest(const Eigen::Ref<const Eigen::Matrix3Xd>& points,
+                                            const Eigen::VectorXd& durations) {
   durations_.resize(0);
   coefficients_.resize(0, 3);
   system_ = BandedMatrix(0, 4, 3);  // no system: the pieces do not come from Build's

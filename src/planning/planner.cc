@@ -108,9 +108,8 @@ bool Planner::FlyPathFromRest(const DynamicLimits& limits, const perception::Vox
   }
   if (corners.size() < 2) return false;
   const int m = static_cast<int>(corners.size()) - 1;
-  Eigen::Matrix3Xd points(3, m + 1);
+  const Eigen::Map<const Eigen::Matrix3Xd> points(corners.front().data(), 3, m + 1);
   Eigen::VectorXd durations(m);
-  for (int i = 0; i <= m; ++i) points.col(i) = corners[static_cast<std::size_t>(i)];
   for (int i = 0; i < m; ++i) {
     // The rest-to-rest quintic over length L in T peaks at 1.875 L / T (speed), 10 / sqrt(3) L / T^2
     // (acceleration) and 60 L / T^3 (jerk, at the ends).

@@ -23,13 +23,11 @@ class FailureList {
     }
   }
 
-  /// Writes `failures` (the listed ones) and `failures_not_listed` (the count of the others).
-  void WriteTo(nlohmann::json* result) const {
-    (*result)["failures"] = listed_;
-    (*result)["failures_not_listed"] = not_listed_;
-  }
+  /// The listed failures (a result's `failures`) and the count of the others (`failures_not_listed`).
+  const nlohmann::json& listed() const { return listed_; }
+  int not_listed() const { return not_listed_; }
 
-  /// A Markdown line (without its newline) for the failures of `result` (as WriteTo wrote them)
+  /// A Markdown line (without its newline) for the failures of `result` (its `failures_not_listed`)
   /// that are not listed, prefixed by `who`; empty when every failure is listed.
   static std::string NotListedLine(const nlohmann::json& result, const std::string& who) {
     const int more = result.value("failures_not_listed", 0);

@@ -38,7 +38,7 @@ class MinimumJerkTrajectory final : public ReferenceTrajectory {
   /// Build's. For a path that must be flown exactly (the planner's fallback); PropagateGradient
   /// does not apply to it. Returns false (leaving the trajectory empty) on fewer than two points,
   /// a duration that is not positive and finite, a point that is not finite or mismatched sizes.
-  bool BuildRestToRest(const Eigen::Matrix3Xd& points, const Eigen::VectorXd& durations);
+  bool BuildRestToRest(const Eigen::Ref<const Eigen::Matrix3Xd>& points, const Eigen::VectorXd& durations);
 
   int pieces() const { return static_cast<int>(durations_.size()); }
   bool empty() const { return durations_.size() == 0; }
