@@ -72,6 +72,11 @@ const char* ToString(Replanner::Mode mode) {
 Replanner::Replanner(const ReplannerOptions& options, const Vector3& hold_position, double yaw)
     : options_(options), planner_(options.planner), limits_(options.nominal), hold_(hold_position), yaw_(yaw) {
   options_.Validate();
+  if (options_.post_failure_clearance_m) {
+    PlannerOptions o = options_.planner;
+    o.optimizer.clearance_m = *options_.post_failure_clearance_m;
+    post_failure_planner_.emplace(o);
+  }
 }
 
 void Replanner::SetGoal(const Vector3& goal_W) {
@@ -84,13 +89,10 @@ void Replanner::OnFailure() {
   if (failed_) return;  // already
   failed_ = true;
   limits_.a_max = std::min(limits_.a_max, options_.post_failure_a_max);
-  if (options_.post_failure_clearance_m) {
-    PlannerOptions o = options_.planner;
-    o.optimizer.clearance_m = *options_.post_failure_clearance_m;
-    planner_ = Planner(o);
-  }
   failure_pending_ = true;
 }
+
+void Replanner::OnRecovered() { recovered_ = failed_; }
 
 ReferencePoint Replanner::Reference(double t) const {
   if (!trajectory_.empty()) return trajectory_.Evaluate(t);
@@ -116,9 +118,14 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   // A goal beyond the window is approached through a local goal at its edge (receding horizon);
   // when the whole way there is blocked, the planner is asked for the goal itself and says why.
   planned_goal_ = LocalGoal(map, start.col(0), goal_, options_.local_goal_margin_m).value_or(goal_);
-  last_plan_ = planner_.Plan(start, planned_goal_, limits_, map, &traj);
+  bool ok = false;
+  double spent_ms = 0.0;
+  for (const Planner* planner : PlannerChain()) {
+    ok = PlanWith(*planner, start, map, spent_ms, &traj);
+    if (ok) break;
+    spent_ms = last_plan_.total_ms;
+  }
   last_plan_t_ = t;
-  const bool ok = last_plan_.ok();
   if (ok) {
     traj.set_start_time(t);
     traj.set_yaw(yaw_);
@@ -126,6 +133,23 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
     mode_ = Mode::kFollowing;
   }
   return ok;
+}
+
+std::vector<const Planner*> Replanner::PlannerChain() const {
+  // After a failure the vehicle may lurch off its reference until the attitude has recovered (up
+  // to about 0.5 m, docs/navigation.md): the pre-failure clearance is tried first and the
+  // post-failure one only when that fails; after the recovery, the latter alone.
+  if (!failed_ || !post_failure_planner_) return {&planner_};
+  if (recovered_) return {&*post_failure_planner_};
+  return {&planner_, &*post_failure_planner_};
+}
+
+bool Replanner::PlanWith(const Planner& planner, const PvaState& start, const perception::VoxelMap& map,
+                         double earlier_ms, MinimumJerkTrajectory* out) {
+  last_plan_ = planner.Plan(start, planned_goal_, limits_, map, out);
+  last_plan_.total_ms += earlier_ms;
+  last_clearance_m_ = planner.options().optimizer.clearance_m;
+  return last_plan_.ok();
 }
 
 void Replanner::Brake(double t, const perception::VoxelMap& map) {
@@ -203,7 +227,8 @@ void Replanner::Update(double t, const perception::VoxelMap& map) {
     if (!keep && (mode_ == Mode::kIdle || mode_ == Mode::kHolding)) mode_ = Mode::kHolding;
   }
   events_.push_back(
-      {t, reason, last_plan_.status, mode_, last_plan_.total_ms, last_plan_.fine_search, last_plan_.rest_to_rest});
+      {t, reason, last_plan_.status, mode_, last_plan_.total_ms, last_plan_.fine_search, last_plan_.rest_to_rest,
+       last_clearance_m_});
 }
 
 }  // namespace rotorguard::planning

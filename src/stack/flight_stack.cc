@@ -236,6 +236,7 @@ void FlightStack::Navigate(double t, FlightMode mode) {
   // The waypoints in turn, each once the last was reached; the planner at its own rate. While the
   // attitude recovers from a failure the mission waits: no new waypoint.
   next_plan_s_ = t + 1.0 / options_.navigation.planner_rate_hz;
+  if (mode == FlightMode::kDegradedNavigation) navigator_->OnRecovered();  // the failure's transient is over
   const std::vector<Vector3>& w = options_.navigation.waypoints;
   const int total = static_cast<int>(w.size()) * options_.navigation.rounds;
   if (mode != FlightMode::kFailureRecovery && next_waypoint_ < total && (next_waypoint_ == 0 || navigator_->arrived())) {

@@ -27,9 +27,16 @@ Scenario ShortIndoor(int waypoints, double duration_s) {
 TEST(Navigation, AShortIndoorMissionWithAFailureSucceedsAndNeverCommandsANonFiniteThrust) {
   Scenario s = ShortIndoor(2, 16.0);
   s.faults[0].onset.value = 4.0;  // mid-way to the first waypoint
+  planning::ReplannerOptions& replanner = s.stack.navigation.replanner;
+  replanner.planner.optimizer.clearance_m = 0.4;
+  replanner.post_failure_clearance_m = 0.3;
   bool finite = true;
+  std::vector<planning::Replanner::Event> plans;
   RunOptions o;
-  o.on_control_cycle = [&](const stack::FlightStack& st) { finite = finite && st.command().thrust_n.allFinite(); };
+  o.on_control_cycle = [&](const stack::FlightStack& st) {
+    finite = finite && st.command().thrust_n.allFinite();
+    if (st.navigator()->events().size() != plans.size()) plans = st.navigator()->events();
+  };
   const RunSummary r = RunScenario(s, o);
   EXPECT_TRUE(r.success) << r.failure_reason;
   EXPECT_TRUE(finite);
@@ -43,6 +50,15 @@ TEST(Navigation, AShortIndoorMissionWithAFailureSucceedsAndNeverCommandsANonFini
   EXPECT_EQ(r.final_mode, "degraded_navigation");
   EXPECT_GE(r.plans_by_reason.at("failure"), 1);
   EXPECT_GT(r.max_spin_rad_s, 8.0);
+  // The plans keep the pre-failure clearance until the attitude has recovered (the plans in the
+  // failure's transient could give it up only by failing), the post-failure one after.
+  const double recovered_s = r.mode_transitions[1].t;
+  int after = 0;
+  for (const planning::Replanner::Event& e : plans) {
+    after += e.t >= recovered_s;
+    EXPECT_EQ(e.clearance_m, e.t >= recovered_s ? 0.3 : 0.4) << "t = " << e.t << " " << e.reason;
+  }
+  EXPECT_GT(after, 0);
 }
 
 class NavigationWithFiles : public rotorguard::testing::TempFolderTest {};

@@ -160,10 +160,12 @@ TEST(Replanner, AFailureReplansWithThePostFailureAccelerationLimit) {
   EXPECT_LT((r.Reference(25.0).p_W - Vector3(6, 0, 1.5)).norm(), 1e-6);
 }
 
-// The clearance kept before a failure holds the failure's transient; after it the post-failure
-// clearance applies. A pillar 0.55 m beside the straight way: planned for 0.9 m of clearance the
-// trajectory swings wide of it, replanned after a failure for 0.3 m it passes close.
-TEST(Replanner, AFailureSwitchesToThePostFailureClearance) {
+// The clearance kept before a failure holds the failure's transient, which lasts until the
+// attitude has recovered; after that the post-failure clearance applies. A pillar 0.55 m beside
+// the straight way: planned for 0.9 m of clearance the trajectory swings wide of it, and so it
+// does when replanned after a failure, until the recovery; replanned after the recovery for 0.3 m
+// it passes close.
+TEST(Replanner, AFailureSwitchesToThePostFailureClearanceOnceRecovered) {
   perception::VoxelMap map = EmptyMap();
   for (double x = 2.95; x < 3.1; x += 0.1) {
     for (double y = 0.55; y < 0.7; y += 0.1) {
@@ -174,10 +176,11 @@ TEST(Replanner, AFailureSwitchesToThePostFailureClearance) {
   o.planner.optimizer.clearance_m = 0.9;
   o.planner.plane_search_m = 1.0;
   o.post_failure_clearance_m = 0.3;
-  const auto closest = [&](bool failed) {
+  const auto closest = [&](bool failed, bool recovered, double expected_clearance) {
     Replanner r(o, Vector3(0, 0, 1.5));
     r.SetGoal(Vector3(6, 0, 1.5));
     if (failed) r.OnFailure();
+    if (recovered) r.OnRecovered();
     double d = 1e9;  // the reference's least distance to the pillar, sampled as it is flown
     Fly(&r, map, 0.0, 20.0, [&](double t) {
       for (double s = t - 0.1; s < t; s += 0.01) {
@@ -185,11 +188,13 @@ TEST(Replanner, AFailureSwitchesToThePostFailureClearance) {
       }
     });
     EXPECT_TRUE(r.arrived());
+    for (const Replanner::Event& e : r.events()) EXPECT_EQ(e.clearance_m, expected_clearance) << "t = " << e.t;
     return d;
   };
-  const double wide = closest(false), close = closest(true);
-  EXPECT_GT(wide, 0.85);  // about the 0.9 m asked for
-  EXPECT_LT(close, 0.6);  // the straight way, 0.55 m from the voxels
+  EXPECT_GT(closest(false, false, 0.9), 0.85);  // about the 0.9 m asked for
+  EXPECT_GT(closest(false, true, 0.9), 0.85);   // no failure: nothing to recover from
+  EXPECT_GT(closest(true, false, 0.9), 0.85);   // failed, still in the transient
+  EXPECT_LT(closest(true, true, 0.3), 0.6);     // recovered: the straight way, 0.55 m from the voxels
   o.post_failure_clearance_m = 1.5;  // beyond the planes' search radius
   RG_EXPECT_THROW_WITH(Replanner(o, Vector3::Zero()), std::invalid_argument, "post_failure_clearance_m");
 }

@@ -27,8 +27,10 @@ struct ReplannerOptions {
   /// C_o of eq. (36) after a failure [m], >= 0; unset: planner.optimizer.clearance_m throughout.
   /// Before a failure the clearance has to hold the failure's own transient (the vehicle lurches
   /// up to about 0.5 m off its reference in the 0.8 s after a propeller is lost, docs/navigation.md);
-  /// once it is isolated that transient is behind, and the slower post-failure flight can pass
-  /// closer, where the larger clearance would leave no feasible trajectory.
+  /// once the attitude has recovered (OnRecovered) that transient is behind, and the slower
+  /// post-failure flight can pass closer, where the larger clearance would leave no feasible
+  /// trajectory. Between the isolation and the recovery, while the vehicle still lurches, a plan
+  /// is made with the larger clearance first and with this one only when that fails.
   std::optional<double> post_failure_clearance_m;
   double replan_period_s = 1.0;     ///< periodic replanning [s], > 0
   double check_horizon_s = 3.0;     ///< how far ahead the trajectory is checked against the map [s], > 0
@@ -60,6 +62,7 @@ class Replanner final : public ReferenceTrajectory {
     double plan_ms = 0.0;  ///< the query's wall-clock time (search and optimisation)
     bool fine_search = false;   ///< PlanSummary::fine_search: the path came from the search at the map's resolution
     bool rest_to_rest = false;  ///< PlanSummary::rest_to_rest: the path flown from rest to rest
+    double clearance_m = 0.0;   ///< C_o of the query whose result this is (the last one tried)
   };
 
   /// Throws ValidationError on invalid options. Holds `hold_position` until given a goal; every
@@ -67,8 +70,12 @@ class Replanner final : public ReferenceTrajectory {
   Replanner(const ReplannerOptions& options, const Vector3& hold_position, double yaw = 0.0);
 
   void SetGoal(const Vector3& goal_W);
-  /// FDD isolated a failure: the post-failure limits (and clearance) from now on.
+  /// FDD isolated a failure: the post-failure limits from now on, and the post-failure clearance
+  /// as a fallback until OnRecovered (ReplannerOptions::post_failure_clearance_m).
   void OnFailure();
+  /// The attitude has recovered from the failure (the supervisor's degraded navigation): the
+  /// post-failure clearance alone from now on. Nothing before a failure.
+  void OnRecovered();
   /// Runs the state machine at time t [s] on the current map (at the planner's rate).
   void Update(double t, const perception::VoxelMap& map);
 
@@ -92,6 +99,11 @@ class Replanner final : public ReferenceTrajectory {
  private:
   /// Plans from the reference state at t; on success switches to the new trajectory.
   bool Replan(double t, const perception::VoxelMap& map);
+  /// The planners to try in turn now, each with its clearance (the first success is flown).
+  std::vector<const Planner*> PlannerChain() const;
+  /// One query of `planner` from `start` (into last_plan_), its time added to `earlier_ms`.
+  bool PlanWith(const Planner& planner, const PvaState& start, const perception::VoxelMap& map, double earlier_ms,
+                MinimumJerkTrajectory* out);
   /// Whether the trajectory from t to t + check_horizon meets an inflated voxel.
   bool UnsafeAhead(double t, const perception::VoxelMap& map) const;
   /// A one-piece trajectory from the reference state at t to rest, stretched until within limits;
@@ -100,7 +112,8 @@ class Replanner final : public ReferenceTrajectory {
   void Brake(double t, const perception::VoxelMap& map);
 
   ReplannerOptions options_;
-  Planner planner_;
+  Planner planner_;  // planner.optimizer.clearance_m
+  std::optional<Planner> post_failure_planner_;  // post_failure_clearance_m, when set
   DynamicLimits limits_;
   Mode mode_ = Mode::kIdle;
   MinimumJerkTrajectory trajectory_;
@@ -108,8 +121,10 @@ class Replanner final : public ReferenceTrajectory {
   double yaw_ = 0.0;
   Vector3 goal_ = Vector3::Zero(), planned_goal_ = Vector3::Zero();
   bool new_goal_ = false, failure_pending_ = false, failed_ = false, has_goal_ = false, arrived_ = false;
+  bool recovered_ = false;  // OnRecovered after the failure
   double last_plan_t_ = -1e9;
   PlanSummary last_plan_;
+  double last_clearance_m_ = 0.0;  // C_o of last_plan_'s query
   std::vector<Event> events_;
 };
 
