@@ -72,7 +72,7 @@ const char* ToString(Replanner::Mode mode) {
 Replanner::Replanner(const ReplannerOptions& options, const Vector3& hold_position, double yaw)
     : options_(options), planner_(options.planner), limits_(options.nominal), hold_(hold_position), yaw_(yaw) {
   options_.Validate();
-  if (options_.post_failure_clearance_m) {
+  if (options_.post_failure_clearance_m && *options_.post_failure_clearance_m != options_.planner.optimizer.clearance_m) {
     PlannerOptions o = options_.planner;
     o.optimizer.clearance_m = *options_.post_failure_clearance_m;
     post_failure_planner_.emplace(o);
@@ -118,13 +118,24 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   // A goal beyond the window is approached through a local goal at its edge (receding horizon);
   // when the whole way there is blocked, the planner is asked for the goal itself and says why.
   planned_goal_ = LocalGoal(map, start.col(0), goal_, options_.local_goal_margin_m).value_or(goal_);
-  bool ok = false;
-  double spent_ms = 0.0;
+  last_plan_ms_ = 0.0;
+  last_attempts_ = 0;
   for (const Planner* planner : PlannerChain()) {
-    ok = PlanWith(*planner, start, map, spent_ms, &traj);
-    if (ok) break;
-    spent_ms = last_plan_.total_ms;
+    if (planner == nullptr) break;
+    last_plan_ = planner->Plan(start, planned_goal_, limits_, map, &traj);
+    last_clearance_m_ = planner->options().optimizer.clearance_m;
+    last_plan_ms_ += last_plan_.total_ms;
+    ++last_attempts_;
+    // The search does not depend on the clearance: what it could not find, another clearance
+    // would not find either.
+    const PlanSummary::Status s = last_plan_.status;
+    if (last_plan_.ok() || s == PlanSummary::Status::kStartOutOfBounds || s == PlanSummary::Status::kGoalOutOfBounds ||
+        s == PlanSummary::Status::kGoalBlocked || s == PlanSummary::Status::kNoPath ||
+        s == PlanSummary::Status::kSearchLimit) {
+      break;
+    }
   }
+  const bool ok = last_plan_.ok();
   last_plan_t_ = t;
   if (ok) {
     traj.set_start_time(t);
@@ -135,21 +146,13 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   return ok;
 }
 
-std::vector<const Planner*> Replanner::PlannerChain() const {
+std::array<const Planner*, 2> Replanner::PlannerChain() const {
   // After a failure the vehicle may lurch off its reference until the attitude has recovered (up
   // to about 0.5 m, docs/navigation.md): the pre-failure clearance is tried first and the
   // post-failure one only when that fails; after the recovery, the latter alone.
-  if (!failed_ || !post_failure_planner_) return {&planner_};
-  if (recovered_) return {&*post_failure_planner_};
+  if (!failed_ || !post_failure_planner_) return {&planner_, nullptr};
+  if (recovered_) return {&*post_failure_planner_, nullptr};
   return {&planner_, &*post_failure_planner_};
-}
-
-bool Replanner::PlanWith(const Planner& planner, const PvaState& start, const perception::VoxelMap& map,
-                         double earlier_ms, MinimumJerkTrajectory* out) {
-  last_plan_ = planner.Plan(start, planned_goal_, limits_, map, out);
-  last_plan_.total_ms += earlier_ms;
-  last_clearance_m_ = planner.options().optimizer.clearance_m;
-  return last_plan_.ok();
 }
 
 void Replanner::Brake(double t, const perception::VoxelMap& map) {
@@ -227,8 +230,8 @@ void Replanner::Update(double t, const perception::VoxelMap& map) {
     if (!keep && (mode_ == Mode::kIdle || mode_ == Mode::kHolding)) mode_ = Mode::kHolding;
   }
   events_.push_back(
-      {t, reason, last_plan_.status, mode_, last_plan_.total_ms, last_plan_.fine_search, last_plan_.rest_to_rest,
-       last_clearance_m_});
+      {t, reason, last_plan_.status, mode_, last_plan_ms_, last_plan_.fine_search, last_plan_.rest_to_rest,
+       last_clearance_m_, last_attempts_});
 }
 
 }  // namespace rotorguard::planning

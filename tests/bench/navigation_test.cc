@@ -27,16 +27,9 @@ Scenario ShortIndoor(int waypoints, double duration_s) {
 TEST(Navigation, AShortIndoorMissionWithAFailureSucceedsAndNeverCommandsANonFiniteThrust) {
   Scenario s = ShortIndoor(2, 16.0);
   s.faults[0].onset.value = 4.0;  // mid-way to the first waypoint
-  planning::ReplannerOptions& replanner = s.stack.navigation.replanner;
-  replanner.planner.optimizer.clearance_m = 0.4;
-  replanner.post_failure_clearance_m = 0.3;
   bool finite = true;
-  std::vector<planning::Replanner::Event> plans;
   RunOptions o;
-  o.on_control_cycle = [&](const stack::FlightStack& st) {
-    finite = finite && st.command().thrust_n.allFinite();
-    if (st.navigator()->events().size() != plans.size()) plans = st.navigator()->events();
-  };
+  o.on_control_cycle = [&](const stack::FlightStack& st) { finite = finite && st.command().thrust_n.allFinite(); };
   const RunSummary r = RunScenario(s, o);
   EXPECT_TRUE(r.success) << r.failure_reason;
   EXPECT_TRUE(finite);
@@ -50,14 +43,43 @@ TEST(Navigation, AShortIndoorMissionWithAFailureSucceedsAndNeverCommandsANonFini
   EXPECT_EQ(r.final_mode, "degraded_navigation");
   EXPECT_GE(r.plans_by_reason.at("failure"), 1);
   EXPECT_GT(r.max_spin_rad_s, 8.0);
-  // The plans keep the pre-failure clearance until the attitude has recovered (the plans in the
-  // failure's transient could give it up only by failing), the post-failure one after.
-  const double recovered_s = r.mode_transitions[1].t;
-  int after = 0;
+}
+
+// In the loop, the stack tells the planner of the recovery: the plans keep the pre-failure
+// clearance until the supervisor's degraded navigation (or, in the failure's transient, give it up
+// for the post-failure one in a second attempt when it finds no plan), the post-failure one after.
+TEST(Navigation, ThePlansKeepThePreFailureClearanceUntilTheAttitudeHasRecovered) {
+  Scenario s = ShortIndoor(2, 12.0);
+  s.faults[0].onset.value = 4.0;
+  planning::ReplannerOptions& replanner = s.stack.navigation.replanner;
+  replanner.planner.optimizer.clearance_m = 0.4;  // within the planes' default 0.5 m search
+  replanner.post_failure_clearance_m = 0.3;
+  std::vector<planning::Replanner::Event> plans;
+  RunOptions o;
+  o.on_control_cycle = [&](const stack::FlightStack& st) {
+    if (st.navigator()->events().size() != plans.size()) plans = st.navigator()->events();
+  };
+  const RunSummary r = RunScenario(s, o);
+  ASSERT_GE(r.mode_transitions.size(), 2u);
+  ASSERT_EQ(r.mode_transitions[1].to, "degraded_navigation");
+  const double failed_s = r.mode_transitions[0].t, recovered_s = r.mode_transitions[1].t;
+  int before = 0, transient = 0, after = 0;
   for (const planning::Replanner::Event& e : plans) {
-    after += e.t >= recovered_s;
-    EXPECT_EQ(e.clearance_m, e.t >= recovered_s ? 0.3 : 0.4) << "t = " << e.t << " " << e.reason;
+    if (e.t >= recovered_s) {
+      ++after;
+      EXPECT_EQ(e.clearance_m, 0.3) << "t = " << e.t << " " << e.reason;
+      EXPECT_EQ(e.attempts, 1) << "t = " << e.t;
+    } else if (e.t >= failed_s) {
+      ++transient;
+      EXPECT_TRUE((e.clearance_m == 0.4 && e.attempts == 1) || (e.clearance_m == 0.3 && e.attempts == 2))
+          << "t = " << e.t << ": " << e.clearance_m << " m in " << e.attempts << " attempts";
+    } else {
+      ++before;
+      EXPECT_EQ(e.clearance_m, 0.4) << "t = " << e.t;
+    }
   }
+  EXPECT_GT(before, 0);
+  EXPECT_GT(transient, 0);  // the failure's own replan at least
   EXPECT_GT(after, 0);
 }
 

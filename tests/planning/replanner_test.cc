@@ -1,6 +1,7 @@
 #include "rotorguard/planning/replanner.h"
 
 #include <cmath>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -164,7 +165,7 @@ TEST(Replanner, AFailureReplansWithThePostFailureAccelerationLimit) {
 // attitude has recovered; after that the post-failure clearance applies. A pillar 0.55 m beside
 // the straight way: planned for 0.9 m of clearance the trajectory swings wide of it, and so it
 // does when replanned after a failure, until the recovery; replanned after the recovery for 0.3 m
-// it passes close.
+// it passes close. A recovery reported before the failure is no recovery from it.
 TEST(Replanner, AFailureSwitchesToThePostFailureClearanceOnceRecovered) {
   perception::VoxelMap map = EmptyMap();
   for (double x = 2.95; x < 3.1; x += 0.1) {
@@ -176,25 +177,45 @@ TEST(Replanner, AFailureSwitchesToThePostFailureClearanceOnceRecovered) {
   o.planner.optimizer.clearance_m = 0.9;
   o.planner.plane_search_m = 1.0;
   o.post_failure_clearance_m = 0.3;
-  const auto closest = [&](bool failed, bool recovered, double expected_clearance) {
+  // `events` is called at every update ahead of Update; recovered_s is when OnRecovered is (never
+  // when negative), from when the events must have 0.3 m, before it 0.9 m, each in one attempt.
+  const auto closest = [&](const std::function<void(Replanner&, double)>& events, double recovered_s) {
     Replanner r(o, Vector3(0, 0, 1.5));
     r.SetGoal(Vector3(6, 0, 1.5));
-    if (failed) r.OnFailure();
-    if (recovered) r.OnRecovered();
     double d = 1e9;  // the reference's least distance to the pillar, sampled as it is flown
     Fly(&r, map, 0.0, 20.0, [&](double t) {
+      events(r, t);
       for (double s = t - 0.1; s < t; s += 0.01) {
         if (const auto n = map.Nearest(r.Reference(s).p_W, 2.0)) d = std::min(d, n->distance_m);
       }
     });
     EXPECT_TRUE(r.arrived());
-    for (const Replanner::Event& e : r.events()) EXPECT_EQ(e.clearance_m, expected_clearance) << "t = " << e.t;
+    for (const Replanner::Event& e : r.events()) {
+      const bool after = recovered_s >= 0.0 && e.t >= recovered_s - 1e-9;
+      EXPECT_EQ(e.clearance_m, after ? 0.3 : 0.9) << "t = " << e.t;
+      EXPECT_EQ(e.attempts, 1) << "t = " << e.t;
+    }
     return d;
   };
-  EXPECT_GT(closest(false, false, 0.9), 0.85);  // about the 0.9 m asked for
-  EXPECT_GT(closest(false, true, 0.9), 0.85);   // no failure: nothing to recover from
-  EXPECT_GT(closest(true, false, 0.9), 0.85);   // failed, still in the transient
-  EXPECT_LT(closest(true, true, 0.3), 0.6);     // recovered: the straight way, 0.55 m from the voxels
+  const auto at_start = [](bool fail, bool recover) {
+    return [=](Replanner& r, double t) {
+      if (t > 0.0) return;
+      if (recover) r.OnRecovered();
+      if (fail) r.OnFailure();
+    };
+  };
+  EXPECT_GT(closest(at_start(false, false), -1.0), 0.85);  // about the 0.9 m asked for
+  EXPECT_GT(closest(at_start(false, true), -1.0), 0.85);   // no failure: nothing to recover from
+  EXPECT_GT(closest(at_start(true, true), -1.0), 0.85);    // a recovery before the failure is none
+  EXPECT_GT(closest(at_start(true, false), -1.0), 0.85);   // failed, still in the transient
+  const auto recovered_at = [](double recovery_s) {
+    return [=](Replanner& r, double t) {
+      if (t == 0.0) r.OnFailure();
+      if (std::abs(t - recovery_s) < 1e-9) r.OnRecovered();
+    };
+  };
+  EXPECT_LT(closest(recovered_at(0.0), 0.0), 0.6);  // recovered: the straight way, 0.55 m from the voxels
+  EXPECT_LT(closest(recovered_at(1.0), 1.0), 0.7);  // recovered on the way: well inside the 0.9 m
   o.post_failure_clearance_m = 1.5;  // beyond the planes' search radius
   RG_EXPECT_THROW_WITH(Replanner(o, Vector3::Zero()), std::invalid_argument, "post_failure_clearance_m");
 }

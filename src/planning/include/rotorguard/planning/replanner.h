@@ -8,6 +8,7 @@
 /// trajectory starts from the old one's state at the switching instant. When no plan can be made
 /// and the trajectory ahead is unsafe, it brakes to rest within the limits, holds, and keeps
 /// trying.
+#include <array>
 #include <limits>
 #include <optional>
 #include <string>
@@ -30,7 +31,8 @@ struct ReplannerOptions {
   /// once the attitude has recovered (OnRecovered) that transient is behind, and the slower
   /// post-failure flight can pass closer, where the larger clearance would leave no feasible
   /// trajectory. Between the isolation and the recovery, while the vehicle still lurches, a plan
-  /// is made with the larger clearance first and with this one only when that fails.
+  /// is made with the larger clearance first and with this one only when that fails. (A second
+  /// failure after the recovery is planned with this one: the replanner knows of one failure.)
   std::optional<double> post_failure_clearance_m;
   double replan_period_s = 1.0;     ///< periodic replanning [s], > 0
   double check_horizon_s = 3.0;     ///< how far ahead the trajectory is checked against the map [s], > 0
@@ -59,10 +61,11 @@ class Replanner final : public ReferenceTrajectory {
     std::string reason;   ///< "goal", "failure", "obstacle ahead", "periodic"
     PlanSummary::Status status = PlanSummary::Status::kSuccess;
     Mode mode_after = Mode::kIdle;
-    double plan_ms = 0.0;  ///< the query's wall-clock time (search and optimisation)
+    double plan_ms = 0.0;  ///< the queries' wall-clock time (search and optimisation), all attempts
     bool fine_search = false;   ///< PlanSummary::fine_search: the path came from the search at the map's resolution
     bool rest_to_rest = false;  ///< PlanSummary::rest_to_rest: the path flown from rest to rest
     double clearance_m = 0.0;   ///< C_o of the query whose result this is (the last one tried)
+    int attempts = 1;           ///< queries made: 2 when the post-failure clearance stood in for the other
   };
 
   /// Throws ValidationError on invalid options. Holds `hold_position` until given a goal; every
@@ -99,11 +102,9 @@ class Replanner final : public ReferenceTrajectory {
  private:
   /// Plans from the reference state at t; on success switches to the new trajectory.
   bool Replan(double t, const perception::VoxelMap& map);
-  /// The planners to try in turn now, each with its clearance (the first success is flown).
-  std::vector<const Planner*> PlannerChain() const;
-  /// One query of `planner` from `start` (into last_plan_), its time added to `earlier_ms`.
-  bool PlanWith(const Planner& planner, const PvaState& start, const perception::VoxelMap& map, double earlier_ms,
-                MinimumJerkTrajectory* out);
+  /// The planners to try in turn now, each with its clearance (the first success is flown); the
+  /// entries after the last are null.
+  std::array<const Planner*, 2> PlannerChain() const;
   /// Whether the trajectory from t to t + check_horizon meets an inflated voxel.
   bool UnsafeAhead(double t, const perception::VoxelMap& map) const;
   /// A one-piece trajectory from the reference state at t to rest, stretched until within limits;
@@ -113,7 +114,7 @@ class Replanner final : public ReferenceTrajectory {
 
   ReplannerOptions options_;
   Planner planner_;  // planner.optimizer.clearance_m
-  std::optional<Planner> post_failure_planner_;  // post_failure_clearance_m, when set
+  std::optional<Planner> post_failure_planner_;  // post_failure_clearance_m, when set and different
   DynamicLimits limits_;
   Mode mode_ = Mode::kIdle;
   MinimumJerkTrajectory trajectory_;
@@ -125,6 +126,8 @@ class Replanner final : public ReferenceTrajectory {
   double last_plan_t_ = -1e9;
   PlanSummary last_plan_;
   double last_clearance_m_ = 0.0;  // C_o of last_plan_'s query
+  double last_plan_ms_ = 0.0;      // the last Replan's queries, all attempts [ms]
+  int last_attempts_ = 0;          // and their number
   std::vector<Event> events_;
 };
 
