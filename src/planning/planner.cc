@@ -14,6 +14,18 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// PlanSummary::min_clearance_m: the smallest distance to an occupied voxel centre over the
+/// positions that for_each_position(f) hands to f (f returns true to go on), capped at `cap`.
+template <typename ForEachPosition>
+double MinClearance(const perception::VoxelMap& map, double cap, ForEachPosition&& for_each_position) {
+  double clearance = cap;
+  for_each_position([&](const Vector3& p) {
+    if (const auto o = map.Nearest(p, cap)) clearance = std::min(clearance, o->distance_m);
+    return true;
+  });
+  return clearance;
+}
+
 }  // namespace
 
 void PlannerOptions::Validate() const {
@@ -120,16 +132,13 @@ bool Planner::FlyPathFromRest(const DynamicLimits& limits, const perception::Vox
   MinimumJerkTrajectory traj;
   if (!traj.BuildRestToRest(points, durations)) return false;
   summary->pieces = m;
-  summary->min_clearance_m = options_.plane_search_m;
-  for (int i = 0; i < m; ++i) {
-    const Vector3 a = points.col(i), b = points.col(i + 1);
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / options_.check_step_m)));
-    for (int k = 0; k <= steps; ++k) {
-      if (const auto o = map.Nearest(a + (b - a) * k / steps, options_.plane_search_m)) {
-        summary->min_clearance_m = std::min(summary->min_clearance_m, o->distance_m);
-      }
+  summary->min_clearance_m = MinClearance(map, options_.plane_search_m, [&](auto&& f) {
+    for (int i = 0; i < m; ++i) {
+      const Vector3 a = points.col(i), b = points.col(i + 1);
+      const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / options_.check_step_m)));
+      for (int k = 0; k <= steps; ++k) f(Vector3(a + (b - a) * k / steps));
     }
-  }
+  });
   *out = std::move(traj);
   return true;
 }
@@ -228,13 +237,7 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     if (!collides) {
       // The clearance the summary reports, at the same spacing (once: a nearest-voxel search
       // costs as much as hundreds of inflation lookups).
-      summary.min_clearance_m = options_.plane_search_m;
-      for_each_position([&](const Vector3& p) {
-        if (const auto o = map.Nearest(p, options_.plane_search_m)) {
-          summary.min_clearance_m = std::min(summary.min_clearance_m, o->distance_m);
-        }
-        return true;
-      });
+      summary.min_clearance_m = MinClearance(map, options_.plane_search_m, for_each_position);
       break;
     }
     if (round == options_.clearance_rounds) {

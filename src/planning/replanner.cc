@@ -128,12 +128,7 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
     ++last_attempts_;
     // The search does not depend on the clearance: what it could not find, another clearance
     // would not find either.
-    const PlanSummary::Status s = last_plan_.status;
-    if (last_plan_.ok() || s == PlanSummary::Status::kStartOutOfBounds || s == PlanSummary::Status::kGoalOutOfBounds ||
-        s == PlanSummary::Status::kGoalBlocked || s == PlanSummary::Status::kNoPath ||
-        s == PlanSummary::Status::kSearchLimit) {
-      break;
-    }
+    if (last_plan_.ok() || last_plan_.path.status != PathStatus::kFound) break;
   }
   const bool ok = last_plan_.ok();
   last_plan_t_ = t;
