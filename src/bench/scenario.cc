@@ -488,6 +488,7 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o, modular::A
     ReadOptional(*n, "r_input", &m.r_input);
     ReadOptional(*n, "max_rate_rad_s", &m.max_rate_rad_s);
     if (const auto v = n->Optional("max_sqp_iterations")) m.max_sqp_iterations = static_cast<int>(v->AsIntIn(1, 1000));
+    if (const auto v = n->Optional("relinearise_every")) m.relinearise_every = static_cast<int>(v->AsIntIn(1, 20));
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { m.Validate(); });
   }

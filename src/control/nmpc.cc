@@ -71,6 +71,9 @@ void NmpcOptions::Validate() const {
   if (!(sqp_tolerance > 0.0) || !std::isfinite(sqp_tolerance)) {
     ThrowValidation("NmpcOptions", "sqp_tolerance", sqp_tolerance, "a value > 0");
   }
+  if (relinearise_every < 1 || relinearise_every > 20) {
+    ThrowValidation("NmpcOptions", "relinearise_every", relinearise_every, "an integer in [1, 20]");
+  }
   qp.Validate();
 }
 
@@ -111,6 +114,7 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
 void NmpcController::Reset() {
   initialised_ = false;
   prepared_for_t_.reset();
+  reused_since_linearisation_ = -1;
   summary_ = NmpcSummary{};
 }
 
@@ -120,6 +124,7 @@ void NmpcController::SetRotorFailed(int rotor) {
   }
   if (failed_[rotor]) return;  // already reconfigured
   failed_[rotor] = true;
+  reused_since_linearisation_ = -1;  // the weights change: Q_k with them
   u_max_[rotor] = 0.0;  // u_bar_i = 0 (paper 000, Sec. V-A)
   UpdateThrustSplit();
   weights_[StateIndex::kQuaternion + 3] = 0.0;  // yaw is given up
@@ -285,25 +290,32 @@ void NmpcController::ShiftBy(double elapsed) {
   for (int k = 0; k <= N_; ++k) x_[k].segment<4>(StateIndex::kQuaternion).normalize();
 }
 
-bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, double t) {
+bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, double t, bool reuse) {
   const auto start = Clock::now();
-  // Linearise the dynamics (exact RK4 sensitivities) and the cost (Gauss-Newton) along the plan.
+  // Linearise the dynamics (exact RK4 sensitivities) and the cost (Gauss-Newton) along the plan;
+  // or, reusing the last linearisation, only the shooting gaps and the residuals' gradients.
   double gap = 0.0;
   for (int k = 0; k < N_; ++k) {
-    integrator_.Step(x_[k], u_[k], &x_next_, &qp_.A[k], &qp_.B[k]);
+    if (reuse) {
+      integrator_.Step(x_[k], u_[k], &x_next_);
+    } else {
+      integrator_.Step(x_[k], u_[k], &x_next_, &qp_.A[k], &qp_.B[k]);
+    }
     qp_.c[k] = x_next_ - x_[k + 1];
     gap = std::max(gap, qp_.c[k].cwiseAbs().maxCoeff());
   }
   for (int k = 0; k <= N_; ++k) {
     const ReferencePoint ref = reference.Evaluate(t + k * options_.step_s);
     Residual(x_[k], ref, &y_, &dy_);
-    // Gauss-Newton Hessian dy' W dy: dy is the identity but for the 4x4 attitude block, so only
-    // that block is a product.
-    qp_.Q[k].setZero();
-    qp_.Q[k].diagonal() = weights_;
-    const auto d_att = dy_.block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion);
-    qp_.Q[k].block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion).noalias() =
-        d_att.transpose() * weights_.segment<4>(StateIndex::kQuaternion).asDiagonal() * d_att;
+    if (!reuse) {
+      // Gauss-Newton Hessian dy' W dy: dy is the identity but for the 4x4 attitude block, so only
+      // that block is a product.
+      qp_.Q[k].setZero();
+      qp_.Q[k].diagonal() = weights_;
+      const auto d_att = dy_.block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion);
+      qp_.Q[k].block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion).noalias() =
+          d_att.transpose() * weights_.segment<4>(StateIndex::kQuaternion).asDiagonal() * d_att;
+    }
     weighted_y_ = weights_.cwiseProduct(y_);
     qp_.q[k].noalias() = dy_.transpose() * weighted_y_;
     if (k < N_) {
@@ -322,7 +334,9 @@ bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, doub
   }
   qp_.x0.setZero();  // condensed around the plan's own first node; the measurement comes later
   gap_ = gap;
-  const OcpQpSummary& qs = qp_solver_.Prepare(qp_);
+  const OcpQpSummary& qs = reuse ? qp_solver_.PrepareVectors(qp_) : qp_solver_.Prepare(qp_);
+  ++(reuse ? summary_.linearisations_reused : summary_.linearisations);
+  reused_since_linearisation_ = reuse ? reused_since_linearisation_ + 1 : 0;
   summary_.prepare_time_s += Seconds(start, Clock::now());
   return qs.status != QpStatus::kNumericalFailure;
 }
@@ -454,7 +468,17 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   // (the stack's control period) and linearise and condense around it.
   if (options_.max_sqp_iterations == 1 && dt > 0.0 && std::isfinite(dt) && ok) {
     ShiftBy(dt);
-    if (PrepareIteration(reference, t + dt)) prepared_for_t_ = t + dt;
+    // The linearisation is reused while it is younger than relinearise_every preparations and
+    // this call's own QP came from it unchanged (no relaxed rate bounds, no fallback).
+    const bool reuse = summary_.rate_bounds_relaxed == 0 && reused_since_linearisation_ >= 0 &&
+                       reused_since_linearisation_ + 1 < options_.relinearise_every;
+    if (PrepareIteration(reference, t + dt, reuse)) {
+      prepared_for_t_ = t + dt;
+    } else {
+      reused_since_linearisation_ = -1;
+    }
+  } else {
+    reused_since_linearisation_ = -1;
   }
   summary_.solve_time_s = Seconds(start, Clock::now());
 }

@@ -13,6 +13,16 @@ namespace rotorguard::control {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A stage's A_k, B_k and Q_k as fixed-size maps (NX, NU when known at compile time, else Dynamic).
+template <int NX, int NU>
+struct StageMaps {
+  const OcpQp& qp;
+  int nx, nu;
+  Eigen::Map<const Eigen::Matrix<double, NX, NX>> A(int k) const { return {qp.A[k].data(), nx, nx}; }
+  Eigen::Map<const Eigen::Matrix<double, NX, NU>> B(int k) const { return {qp.B[k].data(), nx, nu}; }
+  Eigen::Map<const Eigen::Matrix<double, NX, NX>> Q(int k) const { return {qp.Q[k].data(), nx, nx}; }
+};
 }  // namespace
 
 void OcpQpDims::Validate() const {
@@ -77,71 +87,88 @@ CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptio
 }
 
 template <int NX, int NU>
-void CondensingQpSolver::Condense(const OcpQp& qp) {
+void CondensingQpSolver::CondenseMatrices(const OcpQp& qp) {
   using MatXX = Eigen::Matrix<double, NX, NX>;
   using MatXU = Eigen::Matrix<double, NX, NU>;
   using MatUU = Eigen::Matrix<double, NU, NU>;
-  using VecX = Eigen::Matrix<double, NX, 1>;
-  using VecU = Eigen::Matrix<double, NU, 1>;
   const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
   const std::vector<int>& idx = dims_.state_bound_index;
   const int nbx = static_cast<int>(idx.size());
-  const auto A = [&](int k) { return Eigen::Map<const MatXX>(qp.A[k].data(), nx, nx); };
-  const auto B = [&](int k) { return Eigen::Map<const MatXU>(qp.B[k].data(), nx, nu); };
-  const auto Q = [&](int k) { return Eigen::Map<const MatXX>(qp.Q[k].data(), nx, nx); };
+  const StageMaps<NX, NU> stage{qp, nx, nu};
+  const auto A = [&](int k) { return stage.A(k); };
+  const auto B = [&](int k) { return stage.B(k); };
+  const auto Q = [&](int k) { return stage.Q(k); };
   using MatXN = Eigen::Matrix<double, NX, Eigen::Dynamic>;
   const auto Srow = [&](int k) { return Eigen::Map<MatXN>(s_rows_[k].data(), nx, k * nu); };
   const auto W = [&](int k) { return Eigen::Map<MatXX>(w_matrix_[k].data(), nx, nx); };
   const auto Y = [&](int k) { return Eigen::Map<MatXU>(y_[k].data(), nx, nu); };
-  const auto xb = [&](int k) { return Eigen::Map<VecX>(x_bar_[k].data(), nx); };
-  const auto wv = [&](int k) { return Eigen::Map<VecX>(w_vector_[k].data(), nx); };
   Eigen::Map<MatXX> tmp(tmp_.data(), nx, nx);
 
-  // Free response x_bar (u = 0) and sensitivities S_kj = A_{k-1} ... A_{j+1} B_j, a stage's row
-  // [S_k0 ... S_k,k-2] = A_{k-1} [S_{k-1,0} ... S_{k-1,k-2}] as one product (faster than k-1
-  // products of 17 x 17 by 17 x 4: docs/control.md, "Condensing a stage at a time").
-  xb(0) = qp.x0;
-  for (int k = 0; k < N; ++k) xb(k + 1).noalias() = A(k) * xb(k) + Eigen::Map<const VecX>(qp.c[k].data(), nx);
+  // Sensitivities S_kj = A_{k-1} ... A_{j+1} B_j, a stage's row [S_k0 ... S_k,k-2] = A_{k-1}
+  // [S_{k-1,0} ... S_{k-1,k-2}] as one product (faster than k-1 products of 17 x 17 by 17 x 4:
+  // docs/control.md, "Condensing a stage at a time").
   for (int k = 1; k <= N; ++k) {
     if (k > 1) Srow(k).leftCols((k - 1) * nu).noalias() = A(k - 1) * Srow(k - 1);
     Srow(k).rightCols(nu) = B(k - 1);
   }
-  // Backward: W_m = Q_m + A_m' W_{m+1} A_m, w_m = Q_m x_bar_m + q_m + A_m' w_{m+1}.
+  // Backward: W_m = Q_m + A_m' W_{m+1} A_m.
   W(N) = Q(N);
-  wv(N).noalias() = Q(N) * xb(N) + Eigen::Map<const VecX>(qp.q[N].data(), nx);
   for (int m = N - 1; m >= 1; --m) {
     tmp.noalias() = W(m + 1) * A(m);
     W(m) = Q(m);
     // Eigen's product evaluator, not lazyProduct: with AVX2 it runs A' (W A) in 12 µs per
     // condensing where lazyProduct's dot products took 21 (docs/control.md).
     W(m).noalias() += A(m).transpose() * tmp;
-    wv(m) = Eigen::Map<const VecX>(qp.q[m].data(), nx);
-    wv(m).noalias() += Q(m) * xb(m) + A(m).transpose() * wv(m + 1);
   }
-  // Hessian blocks H_ij = S_{j+1,i}' W_{j+1} B_j (i <= j) plus R_j, gradient g_j = r_j + B_j' w_{j+1}:
-  // input j's column of blocks is one product, [S_{j+1,0} ... S_{j+1,j}]' Y_j, mirrored into its row.
+  // Hessian blocks H_ij = S_{j+1,i}' W_{j+1} B_j (i <= j) plus R_j: input j's column of blocks is
+  // one product, [S_{j+1,0} ... S_{j+1,j}]' Y_j, mirrored into its row.
   for (int j = 0; j < N; ++j) {
     Y(j).noalias() = W(j + 1) * B(j);
     auto column = dense_.H.block(0, j * nu, (j + 1) * nu, nu);
     column.noalias() = Srow(j + 1).transpose() * Y(j);
     dense_.H.block(j * nu, 0, nu, j * nu) = column.topRows(j * nu).transpose();
     dense_.H.block(j * nu, j * nu, nu, nu) += Eigen::Map<const MatUU>(qp.R[j].data(), nu, nu);
-    VecU g(nu);
-    g.noalias() = B(j).transpose() * wv(j + 1);
-    dense_.g.segment(j * nu, nu) = g + qp.r[j];
-    dense_.lb.segment(j * nu, nu) = qp.u_lower[j];
-    dense_.ub.segment(j * nu, nu) = qp.u_upper[j];
   }
   // State bounds become rows of C: x_k[idx] = x_bar_k[idx] + sum_{j<k} S_kj[idx, :] u_j.
   if (nbx > 0) {
     dense_.C.setZero();
     for (int k = 1; k <= N; ++k) {
-      for (int b = 0; b < nbx; ++b) {
-        const int row = (k - 1) * nbx + b;
-        dense_.C.block(row, 0, 1, k * nu) = Srow(k).row(idx[b]);
-        dense_.lc[row] = qp.x_lower[k][b] - x_bar_[k][idx[b]];
-        dense_.uc[row] = qp.x_upper[k][b] - x_bar_[k][idx[b]];
-      }
+      for (int b = 0; b < nbx; ++b) dense_.C.block((k - 1) * nbx + b, 0, 1, k * nu) = Srow(k).row(idx[b]);
+    }
+  }
+}
+
+template <int NX, int NU>
+void CondensingQpSolver::CondenseVectors(const OcpQp& qp) {
+  using VecX = Eigen::Matrix<double, NX, 1>;
+  using VecU = Eigen::Matrix<double, NU, 1>;
+  const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
+  const StageMaps<NX, NU> stage{qp, nx, nu};
+  const auto xb = [&](int k) { return Eigen::Map<VecX>(x_bar_[k].data(), nx); };
+  const auto wv = [&](int k) { return Eigen::Map<VecX>(w_vector_[k].data(), nx); };
+
+  // Free response x_bar (u = 0), then backward w_m = Q_m x_bar_m + q_m + A_m' w_{m+1} and the
+  // gradient g_j = r_j + B_j' w_{j+1}.
+  xb(0) = qp.x0;
+  for (int k = 0; k < N; ++k) xb(k + 1).noalias() = stage.A(k) * xb(k) + Eigen::Map<const VecX>(qp.c[k].data(), nx);
+  wv(N).noalias() = stage.Q(N) * xb(N) + Eigen::Map<const VecX>(qp.q[N].data(), nx);
+  for (int m = N - 1; m >= 1; --m) {
+    wv(m) = Eigen::Map<const VecX>(qp.q[m].data(), nx);
+    wv(m).noalias() += stage.Q(m) * xb(m) + stage.A(m).transpose() * wv(m + 1);
+  }
+  for (int j = 0; j < N; ++j) {
+    VecU g(nu);
+    g.noalias() = stage.B(j).transpose() * wv(j + 1);
+    dense_.g.segment(j * nu, nu) = g + qp.r[j];
+    dense_.lb.segment(j * nu, nu) = qp.u_lower[j];
+    dense_.ub.segment(j * nu, nu) = qp.u_upper[j];
+  }
+  const std::vector<int>& idx = dims_.state_bound_index;
+  for (int k = 1; k <= N; ++k) {
+    for (int b = 0; b < static_cast<int>(idx.size()); ++b) {
+      const int row = (k - 1) * static_cast<int>(idx.size()) + b;
+      dense_.lc[row] = qp.x_lower[k][b] - x_bar_[k][idx[b]];
+      dense_.uc[row] = qp.x_upper[k][b] - x_bar_[k][idx[b]];
     }
   }
 }
@@ -155,35 +182,68 @@ const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
 const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp) {
   const auto start = std::chrono::steady_clock::now();
   summary_ = OcpQpSummary{};
+  RequireSameDims(qp);
+  // Sizes known at compile time make Eigen's small products several times faster: the NMPC's
+  // quadrotor (nx = 17, nu = 4) gets its own instantiation (measured: docs/control.md).
+  if (dims_.nx == 17 && dims_.nu == 4) {
+    CondenseMatrices<17, 4>(qp);
+    CondenseVectors<17, 4>(qp);
+  } else {
+    CondenseMatrices<Eigen::Dynamic, Eigen::Dynamic>(qp);
+    CondenseVectors<Eigen::Dynamic, Eigen::Dynamic>(qp);
+  }
+  KeepPreparedVectors(qp);
+  if (!PrepareReduced()) summary_.status = QpStatus::kNumericalFailure;
+  summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary_;
+}
+
+const OcpQpSummary& CondensingQpSolver::PrepareVectors(const OcpQp& qp) {
+  if (prepared_ == nullptr || summary_.status == QpStatus::kNumericalFailure) return Prepare(qp);
+  const auto start = std::chrono::steady_clock::now();
+  summary_ = OcpQpSummary{};
+  RequireSameDims(qp);
+  if (dims_.nx == 17 && dims_.nu == 4) {
+    CondenseVectors<17, 4>(qp);
+  } else {
+    CondenseVectors<Eigen::Dynamic, Eigen::Dynamic>(qp);
+  }
+  // Inputs newly fixed or freed change the reduced QP's Hessian: that takes a whole preparation.
+  FindFixedInputs();
+  if (pattern_fixed_ != fixed_ || (reduced_ == nullptr) != fixed_.empty()) return Prepare(qp);
+  KeepPreparedVectors(qp);
+  if (reduced_) ReducedVectors();
+  summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary_;
+}
+
+void CondensingQpSolver::RequireSameDims(const OcpQp& qp) const {
   if (qp.dims.horizon != dims_.horizon || qp.dims.nx != dims_.nx || qp.dims.nu != dims_.nu ||
       qp.dims.state_bound_index != dims_.state_bound_index) {
     throw std::invalid_argument("CondensingQpSolver: the problem's dimensions differ from the solver's");
   }
-  // Sizes known at compile time make Eigen's small products several times faster: the NMPC's
-  // quadrotor (nx = 17, nu = 4) gets its own instantiation (measured: docs/control.md).
-  if (dims_.nx == 17 && dims_.nu == 4) {
-    Condense<17, 4>(qp);
-  } else {
-    Condense<Eigen::Dynamic, Eigen::Dynamic>(qp);
-  }
+}
+
+void CondensingQpSolver::KeepPreparedVectors(const OcpQp& qp) {
   g0_ = dense_.g;
   lc0_ = dense_.lc;
   uc0_ = dense_.uc;
   prepared_x0_ = qp.x0;
   prepared_ = &qp;
-  if (!PrepareReduced()) summary_.status = QpStatus::kNumericalFailure;
-  summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return summary_;
+}
+
+void CondensingQpSolver::FindFixedInputs() {
+  pattern_fixed_.clear();
+  for (int i = 0; i < dense_.num_variables(); ++i) {
+    if (dense_.lb[i] == dense_.ub[i]) pattern_fixed_.push_back(i);
+  }
 }
 
 bool CondensingQpSolver::PrepareReduced() {
   // Allocation-free after the first call for a pattern (the real-time iteration's rule): the
   // pattern is built in scratch reserved at construction, the products written out.
   const int n = dense_.num_variables(), m = dense_.num_constraints();
-  pattern_fixed_.clear();
-  for (int i = 0; i < n; ++i) {
-    if (dense_.lb[i] == dense_.ub[i]) pattern_fixed_.push_back(i);
-  }
+  FindFixedInputs();
   const int nF = static_cast<int>(pattern_fixed_.size()), nf = n - nF;
   if (nF == 0 || nf == 0) {  // nothing to eliminate, or nothing left: the whole QP
     fixed_.clear();
@@ -206,17 +266,23 @@ bool CondensingQpSolver::PrepareReduced() {
     g_fixed_.resize(nf);
     c_fixed_.resize(m);
   }
-  // Indexed views copy coefficient by coefficient; the fixed inputs' shares are coefficient-based
-  // products (lazyProduct), which need no temporary.
+  // Indexed views copy coefficient by coefficient.
+  const IndexList free = FreeInputs();
+  reduced_->H = dense_.H(free, free);
+  reduced_->C = dense_.C(Eigen::all, free);
+  ReducedVectors();
+  return reduced_solver_->Factorize(reduced_->H);
+}
+
+void CondensingQpSolver::ReducedVectors() {
+  // The fixed inputs' shares are coefficient-based products (lazyProduct), which need no
+  // temporary.
   const IndexList free = FreeInputs(), fixed = FixedInputs();
   z_fixed_ = dense_.lb(fixed);
-  reduced_->H = dense_.H(free, free);
   g_fixed_.noalias() = dense_.H(free, fixed).lazyProduct(z_fixed_);
   reduced_->lb = dense_.lb(free);
   reduced_->ub = dense_.ub(free);
-  reduced_->C = dense_.C(Eigen::all, free);
   c_fixed_.noalias() = dense_.C(Eigen::all, fixed).lazyProduct(z_fixed_);
-  return reduced_solver_->Factorize(reduced_->H);
 }
 
 const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {

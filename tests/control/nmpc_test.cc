@@ -1,6 +1,8 @@
 #include "rotorguard/control/nmpc.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -182,6 +184,45 @@ TEST(Nmpc, AllRotorsFailedStillCommandsFiniteZeros) {
   EXPECT_EQ(cmd.cwiseAbs().maxCoeff(), 0.0);
 }
 
+// NmpcOptions::relinearise_every: of the real-time iteration's preparations (one per call, for the
+// next), every third linearises and the two between reuse it; the first call's own SQP iterations
+// and a rotor reconfiguration (its weights change the Hessians) linearise. Before the failure the
+// commands stay within 0.05 N of a controller's that linearises every time.
+TEST(Nmpc, ReusesTheLinearisationForTheConfiguredNumberOfPreparations) {
+  NmpcOptions every_third;
+  every_third.relinearise_every = 3;
+  NmpcController reusing(ReferenceQuad(), every_third), linearising(ReferenceQuad(), {});
+  const auto ref = HoverAt(1.5);  // 0.5 m below it, drifting, tilted: the plans move
+  StateEstimate est = HoverEstimate(1.0);
+  est.v_W = Vector3(0.5, -0.3, 0.0);
+  est.q_WB = Quaternion(Eigen::AngleAxisd(0.15, Vector3::UnitX()));
+  std::string pattern;
+  double largest_difference = 0.0;
+  for (int i = 0; i < 12; ++i) {
+    if (i == 7) {
+      reusing.SetRotorFailed(0);
+      linearising.SetRotorFailed(0);
+    }
+    RotorVector a, b;
+    reusing.Compute(est, ref, 0.005 * i, 0.005, &a);
+    linearising.Compute(est, ref, 0.005 * i, 0.005, &b);
+    const NmpcSummary& s = reusing.summary();
+    ASSERT_TRUE(s.IsSolutionUsable()) << "call " << i << ": " << s.BriefReport();
+    EXPECT_EQ(linearising.summary().linearisations_reused, 0);
+    if (i == 0) {
+      EXPECT_EQ(s.linearisations, 3) << "the first plan's own iterations";
+    }
+    pattern += s.linearisations_reused == 1 ? 'r' : (s.linearisations == (i == 0 ? 3 : 1) ? 'L' : '?');
+    // Before the failure (after it, this open loop's fixed state holds the rotors saturated).
+    if (i < 7) largest_difference = std::max(largest_difference, (a - b).cwiseAbs().maxCoeff());
+    est.p_W += 0.005 * est.v_W;
+  }
+  // Calls 0-6: the first's SQP linearised, then r r L r r L; call 7 reconfigures: L, then r r L.
+  EXPECT_EQ(pattern, "rrLrrLrLrrLr");
+  EXPECT_GT(largest_difference, 0.0) << "the reused linearisation changes the plans";
+  EXPECT_LT(largest_difference, 0.05) << "of thrusts of 4 to 9 N";
+}
+
 TEST(Nmpc, OptionsValidationNamesTheField) {
   NmpcOptions o;
   o.horizon_steps = 0;
@@ -189,6 +230,9 @@ TEST(Nmpc, OptionsValidationNamesTheField) {
   o = NmpcOptions{};
   o.step_s = std::nan("");
   RG_EXPECT_THROW_WITH(NmpcController(ReferenceQuad(), o), ValidationError, "step_s");
+  o = NmpcOptions{};
+  o.relinearise_every = 0;
+  RG_EXPECT_THROW_WITH(NmpcController(ReferenceQuad(), o), ValidationError, "relinearise_every = 0");
 }
 
 }  // namespace

@@ -291,6 +291,69 @@ TEST(CondensingQp, InputsFixedByEqualBoundsGiveTheSolutionOfTheWholeQp) {
   EXPECT_EQ(compared, 32);
 }
 
+// The mixed-level iteration's cheap preparation: a QP whose matrices are the last prepared ones and
+// whose vectors (x0, c, q, r, input and state bounds) are new. The oracle is a fresh solver that
+// condenses and factorises the new QP whole. The same solver runs through: a plain update, an
+// update with a fixed input (the reduced QP's shares), a change of the fixed pattern (which takes a
+// whole preparation), and an update after it, each fed back at a measured state.
+TEST(CondensingQp, PreparingOnlyTheVectorsEqualsAWholePreparation) {
+  Rng rng(47);
+  const OcpQp base = OcpPulledAgainstItsStateBounds(8, 17, 4, {0, 3}, rng);
+  CondensingQpSolver reusing(base.dims);
+  ASSERT_NE(reusing.Prepare(base).status, QpStatus::kNumericalFailure);
+  OcpQp qp = base;
+  for (int step = 0; step < 4; ++step) {
+    // New vectors; the matrices stay.
+    qp.x0 = base.x0 + 0.05 * RandomMatrix(17, 1, rng);
+    for (int k = 0; k < 8; ++k) {
+      qp.c[k] = RandomMatrix(17, 1, rng, 0.05);
+      qp.r[k] = RandomMatrix(4, 1, rng, 0.3);
+      qp.u_lower[k].setConstant(-0.6 + 0.1 * rng.Uniform());
+      qp.u_upper[k].setConstant(0.6 - 0.1 * rng.Uniform());
+      if (step >= 1) qp.u_lower[k][1] = qp.u_upper[k][1] = 0.2;  // input 1 held from step 1
+      if (step >= 2 && k % 2 == 0) qp.u_lower[k][3] = qp.u_upper[k][3] = -0.1;  // a new pattern at step 2
+    }
+    for (int k = 0; k <= 8; ++k) {
+      qp.q[k] = base.q[k] + RandomMatrix(17, 1, rng, 0.3);
+      qp.x_lower[k].setConstant(step == 3 ? -1.5 : -1.5 - 0.2 * rng.Uniform());  // step 3: back at +-1.5
+      qp.x_upper[k].setConstant(step == 3 ? 1.5 : 1.5 + 0.2 * rng.Uniform());
+    }
+    const OcpQpSummary& prepared = reusing.PrepareVectors(qp);
+    ASSERT_NE(prepared.status, QpStatus::kNumericalFailure) << "step " << step;
+    const Eigen::VectorXd measured = qp.x0 + 0.02 * RandomMatrix(17, 1, rng);
+    const OcpQpSummary& s = reusing.Feedback(measured);
+    ASSERT_TRUE(s.IsSolutionUsable()) << "step " << step << ": " << s.BriefReport();
+    OcpQp measured_qp = qp;
+    measured_qp.x0 = measured;
+    CondensingQpSolver fresh(qp.dims);
+    ASSERT_TRUE(fresh.Solve(measured_qp).IsSolutionUsable()) << "step " << step;
+    EXPECT_TRUE(MatricesNear(reusing.condensed().g, fresh.condensed().g, 1e-9)) << "step " << step;
+    EXPECT_TRUE(MatricesNear(reusing.condensed().lc, fresh.condensed().lc, 1e-10)) << "step " << step;
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_TRUE(MatricesNear(reusing.u()[k], fresh.u()[k], 1e-9)) << "step " << step << " u_" << k;
+      if (step >= 1) {
+        EXPECT_EQ(reusing.u()[k][1], 0.2);
+      }
+    }
+    EXPECT_TRUE(MatricesNear(reusing.x()[8], fresh.x()[8], 1e-9)) << "step " << step;
+    if (step == 3) {
+      EXPECT_GT(StateBoundsAtTheirLimit(fresh.x(), {0, 3}), 0) << "the state bounds take part";
+    }
+  }
+}
+
+TEST(CondensingQp, PreparingOnlyTheVectorsWithoutAPreparationPreparesWhole) {
+  Rng rng(48);
+  const OcpQp qp = OcpPulledAgainstItsStateBounds(6, 6, 2, {0}, rng);
+  CondensingQpSolver first(qp.dims), whole(qp.dims);
+  ASSERT_NE(first.PrepareVectors(qp).status, QpStatus::kNumericalFailure);
+  whole.Prepare(qp);
+  EXPECT_TRUE(MatricesNear(first.condensed().H, whole.condensed().H, 0.0));
+  ASSERT_TRUE(first.Feedback(qp.x0).IsSolutionUsable());
+  ASSERT_TRUE(whole.Feedback(qp.x0).IsSolutionUsable());
+  for (int k = 0; k < 6; ++k) EXPECT_TRUE(MatricesNear(first.u()[k], whole.u()[k], 0.0)) << "u_" << k;
+}
+
 TEST(CondensingQp, RejectsMismatchedDimensionsAndBadDims) {
   Rng rng(1);
   const OcpQp qp = RandomOcp(4, 3, 1, {}, rng);

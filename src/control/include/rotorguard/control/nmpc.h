@@ -35,6 +35,14 @@ struct NmpcOptions {
   int max_sqp_iterations = 1;
   /// Converge mode stops when the largest step in (x, u) is below this, > 0.
   double sqp_tolerance = 1e-8;
+  /// Real-time iteration only: linearise the dynamics and the cost every this many preparations,
+  /// in [1, 20]. In between (a mixed-level iteration, after Bock et al.'s multi-level scheme) the
+  /// previous preparation's Jacobians A_k, B_k and Gauss-Newton Hessians Q_k are reused with the
+  /// shifted plan's own shooting gaps, residual gradients, input and rate bounds, so that the
+  /// condensed Hessian and its factorisation are kept: an RK4 step without sensitivities and
+  /// O(N nx^2) condensing instead of sensitivities, O(N^2) condensing and a factorisation. 1 is
+  /// the paper's scheme; a rotor reconfiguration always re-linearises (docs/control.md).
+  int relinearise_every = 1;
   DenseQpOptions qp;
   void Validate() const;
 };
@@ -65,6 +73,10 @@ struct NmpcSummary {
   double solve_time_s = 0.0;    ///< the whole call, preparation for the next call included
   long fallbacks = 0;           ///< cumulative count since construction
   int rate_bounds_relaxed = 0;  ///< QPs of this call re-solved without rate bounds (infeasible with them)
+  /// Preparations of this call that linearised, and that reused the last linearisation
+  /// (NmpcOptions::relinearise_every).
+  int linearisations = 0;
+  int linearisations_reused = 0;
   bool IsSolutionUsable() const { return status == NmpcStatus::kSolved || status == NmpcStatus::kMaxIterations; }
   std::string BriefReport() const;
 };
@@ -106,7 +118,8 @@ class NmpcController final : public Controller {
   void ShiftBy(double elapsed_s);
   bool SqpIteration(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t);
   /// Linearisation, condensing and factorisation around the current plan (no measurement needed).
-  bool PrepareIteration(const ReferenceTrajectory& reference, double t);
+  /// `reuse`: keep the last linearisation's A_k, B_k and Q_k (NmpcOptions::relinearise_every).
+  bool PrepareIteration(const ReferenceTrajectory& reference, double t, bool reuse = false);
   /// The prepared QP for the measured state, and the plan update.
   bool FeedbackIteration(const Eigen::VectorXd& x0);
   Eigen::Quaterniond ReferenceAttitude(const ReferencePoint& ref) const;
@@ -133,6 +146,9 @@ class NmpcController final : public Controller {
   bool initialised_ = false;
   double last_t_ = 0.0;
   std::optional<double> prepared_for_t_;  // time the prepared QP is for, in RTI mode
+  // RTI preparations since the last linearisation; -1 forces the next one to linearise (the
+  // weights or bounds' pattern changed, or there is no linearisation to reuse).
+  int reused_since_linearisation_ = -1;
   double gap_ = 0.0;
   Eigen::VectorXd x0_delta_;
   NmpcSummary summary_;

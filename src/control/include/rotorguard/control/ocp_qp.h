@@ -67,6 +67,13 @@ class CondensingQpSolver {
   /// active-set changes for bounds that hold by construction). `qp` must outlive the following
   /// Feedback calls and stay unchanged.
   const OcpQpSummary& Prepare(const OcpQp& qp);
+  /// Preparation for a `qp` whose matrices (A, B, Q, R) are those of the last Prepare, its vectors
+  /// (x0, c, q, r and the bounds) new: the condensed Hessian, the state-bound rows and the
+  /// factorisation are kept, and only the condensed gradient and bounds are recomputed, O(N nx^2)
+  /// instead of O(N^2 nx^2 nu) plus a factorisation. The mixed-level real-time iteration's cheap
+  /// step (NmpcOptions::relinearise_every). The caller vouches for the matrices; a change in which
+  /// inputs are fixed by equal bounds, or no usable preparation before, falls back to Prepare.
+  const OcpQpSummary& PrepareVectors(const OcpQp& qp);
   /// Feedback phase: the QP for the measured initial state x0 (only the gradient and bounds move,
   /// linearly in x0 - prepared x0, by one forward pass through the A_k), solved on the prepared
   /// factorisation, and the trajectory.
@@ -78,13 +85,23 @@ class CondensingQpSolver {
   const DenseQp& condensed() const { return dense_; }
 
  private:
-  /// Fills dense_ from qp; NX and NU are the sizes when known at compile time, else Dynamic.
+  /// Fill dense_ from qp: its Hessian and state-bound rows, and its gradient and bounds. NX and NU
+  /// are the sizes when known at compile time, else Dynamic.
   template <int NX, int NU>
-  void Condense(const OcpQp& qp);
+  void CondenseMatrices(const OcpQp& qp);
+  template <int NX, int NU>
+  void CondenseVectors(const OcpQp& qp);
+  void RequireSameDims(const OcpQp& qp) const;
+  /// The prepared gradient and bounds, from which Feedback shifts by the measured x0.
+  void KeepPreparedVectors(const OcpQp& qp);
+  /// pattern_fixed_: the inputs whose bounds in dense_ coincide.
+  void FindFixedInputs();
 
   /// Finds the inputs fixed by equal bounds in dense_ and, when there are any, builds and
   /// factorises the QP over the others (reduced_); false when its Hessian cannot be factorised.
   bool PrepareReduced();
+  /// The reduced QP's bounds and the fixed inputs' shares of its gradient and constraint rows.
+  void ReducedVectors();
 
   OcpQpDims dims_;
   DenseQpOptions options_;
