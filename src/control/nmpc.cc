@@ -462,14 +462,16 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     HoverCommand(thrust_command);
     summary_.status = NmpcStatus::kFallback;
     ++summary_.fallbacks;
+    reused_since_linearisation_ = -1;  // a fallback: the next preparation linearises
   }
   summary_.command_latency_s = Seconds(start, Clock::now());
   // Preparation for the next call, after the command is out: shift the plan by this call's period
   // (the stack's control period) and linearise and condense around it.
   if (options_.max_sqp_iterations == 1 && dt > 0.0 && std::isfinite(dt) && ok) {
     ShiftBy(dt);
-    // The linearisation is reused while it is younger than relinearise_every preparations and
-    // this call's own QP came from it unchanged (no relaxed rate bounds, no fallback).
+    // The linearisation is reused while it is younger than relinearise_every preparations. A call
+    // that had to drop its rate bounds met a large disturbance: fresh Jacobians then (a choice,
+    // not a need: the relaxed QP kept the same matrices).
     const bool reuse = summary_.rate_bounds_relaxed == 0 && reused_since_linearisation_ >= 0 &&
                        reused_since_linearisation_ + 1 < options_.relinearise_every;
     if (PrepareIteration(reference, t + dt, reuse)) {

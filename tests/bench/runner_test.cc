@@ -159,7 +159,9 @@ TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverSpinningNearElevenRadPerSe
 // against the paper's every-call linearisation, through a motor stop and its spin-up to 11 rad/s:
 // the same recovery, to within a few percent of the error.
 TEST(NmpcClosedLoop, ReusingTheLinearisationBetweenEveryThirdPreparationFliesTheSameFailure) {
+  EXPECT_EQ(LoadScenario(Config("forest.yaml")).stack.nmpc.relinearise_every, 3) << "the key is read";
   Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"));
+  EXPECT_EQ(s.stack.nmpc.relinearise_every, 1) << "the default";
   const RunSummary every = RunScenario(s);
   s.stack.nmpc.relinearise_every = 3;
   const RunSummary third = RunScenario(s);

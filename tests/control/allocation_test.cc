@@ -56,8 +56,11 @@ TEST(Allocation, TheCounterSeesAllocations) {
 }
 
 TEST(Allocation, NmpcRealTimeIterationsAllocateNothing) {
-  for (int failed : {-1, 0}) {
-    NmpcController nmpc(rotorguard::testing::ReferenceQuad(), {});
+  // Every call linearising (the paper's RTI) and every third (the navigation scenarios').
+  for (int failed : {-1, 0}) for (int every : {1, 3}) {
+    NmpcOptions options;
+    options.relinearise_every = every;
+    NmpcController nmpc(rotorguard::testing::ReferenceQuad(), options);
     planning::LemniscateOptions lo;
     lo.center_m = Vector3(0, 0, 1.5);
     const planning::LemniscateReference ref(lo);
@@ -74,7 +77,7 @@ TEST(Allocation, NmpcRealTimeIterationsAllocateNothing) {
     const long n = CountAllocations([&] {
       for (int k = 0; k < 50; ++k) nmpc.Compute(est, ref, t += 0.005, 0.005, &cmd);
     });
-    EXPECT_EQ(n, 0) << (failed >= 0 ? "after a failure" : "nominal");
+    EXPECT_EQ(n, 0) << (failed >= 0 ? "after a failure" : "nominal") << ", relinearise_every " << every;
     EXPECT_TRUE(nmpc.summary().IsSolutionUsable());
   }
 }

@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -293,33 +294,40 @@ TEST(CondensingQp, InputsFixedByEqualBoundsGiveTheSolutionOfTheWholeQp) {
 
 // The mixed-level iteration's cheap preparation: a QP whose matrices are the last prepared ones and
 // whose vectors (x0, c, q, r, input and state bounds) are new. The oracle is a fresh solver that
-// condenses and factorises the new QP whole. The same solver runs through: a plain update, an
-// update with a fixed input (the reduced QP's shares), a change of the fixed pattern (which takes a
-// whole preparation), and an update after it, each fed back at a measured state.
+// condenses and factorises the new QP whole. One solver runs through the steps below, each fed
+// back at a measured state: updates of the whole QP and of the reduced one (fixed inputs at new
+// values: their shares of the gradient and constraint rows change), and the pattern changes in
+// between (an input fixed, another fixed, one freed), which take a whole preparation.
 TEST(CondensingQp, PreparingOnlyTheVectorsEqualsAWholePreparation) {
   Rng rng(47);
   const OcpQp base = OcpPulledAgainstItsStateBounds(8, 17, 4, {0, 3}, rng);
+  struct Step {
+    double held1, held3;  // input 1 at every stage and input 3 at even ones, NaN: free
+  };
+  const double kFree = std::nan("");
+  const Step steps[] = {{kFree, kFree}, {0.2, kFree}, {0.35, kFree}, {0.35, -0.1},
+                        {0.2, -0.25},   {0.2, kFree}, {0.3, kFree}};
   CondensingQpSolver reusing(base.dims);
   ASSERT_NE(reusing.Prepare(base).status, QpStatus::kNumericalFailure);
   OcpQp qp = base;
-  for (int step = 0; step < 4; ++step) {
-    // New vectors; the matrices stay.
+  int step = 0;
+  for (const Step& st : steps) {
     qp.x0 = base.x0 + 0.05 * RandomMatrix(17, 1, rng);
     for (int k = 0; k < 8; ++k) {
       qp.c[k] = RandomMatrix(17, 1, rng, 0.05);
       qp.r[k] = RandomMatrix(4, 1, rng, 0.3);
       qp.u_lower[k].setConstant(-0.6 + 0.1 * rng.Uniform());
       qp.u_upper[k].setConstant(0.6 - 0.1 * rng.Uniform());
-      if (step >= 1) qp.u_lower[k][1] = qp.u_upper[k][1] = 0.2;  // input 1 held from step 1
-      if (step >= 2 && k % 2 == 0) qp.u_lower[k][3] = qp.u_upper[k][3] = -0.1;  // a new pattern at step 2
+      if (!std::isnan(st.held1)) qp.u_lower[k][1] = qp.u_upper[k][1] = st.held1;
+      if (!std::isnan(st.held3) && k % 2 == 0) qp.u_lower[k][3] = qp.u_upper[k][3] = st.held3;
     }
+    const bool last = step + 1 == static_cast<int>(std::size(steps));
     for (int k = 0; k <= 8; ++k) {
       qp.q[k] = base.q[k] + RandomMatrix(17, 1, rng, 0.3);
-      qp.x_lower[k].setConstant(step == 3 ? -1.5 : -1.5 - 0.2 * rng.Uniform());  // step 3: back at +-1.5
-      qp.x_upper[k].setConstant(step == 3 ? 1.5 : 1.5 + 0.2 * rng.Uniform());
+      qp.x_lower[k].setConstant(last ? -1.5 : -1.5 - 0.2 * rng.Uniform());  // the last: back at +-1.5
+      qp.x_upper[k].setConstant(last ? 1.5 : 1.5 + 0.2 * rng.Uniform());
     }
-    const OcpQpSummary& prepared = reusing.PrepareVectors(qp);
-    ASSERT_NE(prepared.status, QpStatus::kNumericalFailure) << "step " << step;
+    ASSERT_NE(reusing.PrepareVectors(qp).status, QpStatus::kNumericalFailure) << "step " << step;
     const Eigen::VectorXd measured = qp.x0 + 0.02 * RandomMatrix(17, 1, rng);
     const OcpQpSummary& s = reusing.Feedback(measured);
     ASSERT_TRUE(s.IsSolutionUsable()) << "step " << step << ": " << s.BriefReport();
@@ -331,15 +339,34 @@ TEST(CondensingQp, PreparingOnlyTheVectorsEqualsAWholePreparation) {
     EXPECT_TRUE(MatricesNear(reusing.condensed().lc, fresh.condensed().lc, 1e-10)) << "step " << step;
     for (int k = 0; k < 8; ++k) {
       EXPECT_TRUE(MatricesNear(reusing.u()[k], fresh.u()[k], 1e-9)) << "step " << step << " u_" << k;
-      if (step >= 1) {
-        EXPECT_EQ(reusing.u()[k][1], 0.2);
+      if (!std::isnan(st.held1)) {
+        EXPECT_EQ(reusing.u()[k][1], st.held1) << "step " << step;
       }
     }
     EXPECT_TRUE(MatricesNear(reusing.x()[8], fresh.x()[8], 1e-9)) << "step " << step;
-    if (step == 3) {
+    if (last) {
       EXPECT_GT(StateBoundsAtTheirLimit(fresh.x(), {0, 3}), 0) << "the state bounds take part";
     }
+    ++step;
   }
+}
+
+// What the cheap preparation keeps: handed other matrices (against its contract), it leaves the
+// condensed Hessian bit for bit as prepared, where a whole preparation changes it; a change of the
+// fixed inputs makes it prepare whole.
+TEST(CondensingQp, PreparingOnlyTheVectorsKeepsTheCondensedHessian) {
+  Rng rng(49);
+  const OcpQp qp = OcpPulledAgainstItsStateBounds(6, 6, 2, {0}, rng);
+  CondensingQpSolver solver(qp.dims);
+  solver.Prepare(qp);
+  const Eigen::MatrixXd prepared = solver.condensed().H;
+  OcpQp other = qp;
+  other.A[2] += 0.1 * RandomMatrix(6, 6, rng);
+  solver.PrepareVectors(other);
+  EXPECT_TRUE(MatricesNear(solver.condensed().H, prepared, 0.0)) << "the Hessian was not condensed again";
+  other.u_lower[0][1] = other.u_upper[0][1] = 0.1;  // an input fixed: a whole preparation
+  solver.PrepareVectors(other);
+  EXPECT_FALSE(MatricesNear(solver.condensed().H, prepared, 1e-6)) << "condensed with the new matrices";
 }
 
 TEST(CondensingQp, PreparingOnlyTheVectorsWithoutAPreparationPreparesWhole) {
