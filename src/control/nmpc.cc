@@ -474,14 +474,9 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     // not a need: the relaxed QP kept the same matrices).
     const bool reuse = summary_.rate_bounds_relaxed == 0 && reused_since_linearisation_ >= 0 &&
                        reused_since_linearisation_ + 1 < options_.relinearise_every;
-    if (PrepareIteration(reference, t + dt, reuse)) {
-      prepared_for_t_ = t + dt;
-    } else {
-      reused_since_linearisation_ = -1;
-    }
-  } else {
-    reused_since_linearisation_ = -1;
+    if (PrepareIteration(reference, t + dt, reuse)) prepared_for_t_ = t + dt;
   }
+  // Unprepared, the next call iterates from scratch: its own preparation linearises.
   summary_.solve_time_s = Seconds(start, Clock::now());
 }
 

@@ -176,40 +176,40 @@ const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
   return Feedback(qp.x0);
 }
 
-const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp) {
+const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp) { return Prepare(qp, /*whole=*/true); }
+
+const OcpQpSummary& CondensingQpSolver::PrepareVectors(const OcpQp& qp) {
+  return Prepare(qp, /*whole=*/prepared_ == nullptr || summary_.status == QpStatus::kNumericalFailure);
+}
+
+const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp, bool whole) {
   const auto start = std::chrono::steady_clock::now();
   summary_ = OcpQpSummary{};
   RequireSameDims(qp);
   // Sizes known at compile time make Eigen's small products several times faster: the NMPC's
   // quadrotor (nx = 17, nu = 4) gets its own instantiation (measured: docs/control.md).
-  if (dims_.nx == 17 && dims_.nu == 4) {
+  const bool nmpc_sizes = dims_.nx == 17 && dims_.nu == 4;
+  if (nmpc_sizes) {
+    CondenseVectors<17, 4>(qp);
+  } else {
+    CondenseVectors<Eigen::Dynamic, Eigen::Dynamic>(qp);
+  }
+  if (!whole) {
+    // Inputs newly fixed or freed change the reduced QP's Hessian: that takes a whole preparation.
+    FindFixedInputs();
+    whole = pattern_fixed_ != fixed_;
+  }
+  if (whole && nmpc_sizes) {
     CondenseMatrices<17, 4>(qp);
-    CondenseVectors<17, 4>(qp);
-  } else {
+  } else if (whole) {
     CondenseMatrices<Eigen::Dynamic, Eigen::Dynamic>(qp);
-    CondenseVectors<Eigen::Dynamic, Eigen::Dynamic>(qp);
   }
   KeepPreparedVectors(qp);
-  if (!PrepareReduced()) summary_.status = QpStatus::kNumericalFailure;
-  summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return summary_;
-}
-
-const OcpQpSummary& CondensingQpSolver::PrepareVectors(const OcpQp& qp) {
-  if (prepared_ == nullptr || summary_.status == QpStatus::kNumericalFailure) return Prepare(qp);
-  const auto start = std::chrono::steady_clock::now();
-  summary_ = OcpQpSummary{};
-  RequireSameDims(qp);
-  if (dims_.nx == 17 && dims_.nu == 4) {
-    CondenseVectors<17, 4>(qp);
-  } else {
-    CondenseVectors<Eigen::Dynamic, Eigen::Dynamic>(qp);
+  if (!whole) {
+    if (reduced_) ReducedVectors();
+  } else if (!PrepareReduced()) {
+    summary_.status = QpStatus::kNumericalFailure;
   }
-  // Inputs newly fixed or freed change the reduced QP's Hessian: that takes a whole preparation.
-  FindFixedInputs();
-  if (pattern_fixed_ != fixed_) return Prepare(qp);
-  KeepPreparedVectors(qp);
-  if (reduced_) ReducedVectors();
   summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary_;
 }

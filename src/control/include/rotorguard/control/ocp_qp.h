@@ -85,6 +85,9 @@ class CondensingQpSolver {
   const DenseQp& condensed() const { return dense_; }
 
  private:
+  /// Prepare and PrepareVectors: the vectors always, the matrices and factorisation when `whole`
+  /// or when the fixed inputs changed.
+  const OcpQpSummary& Prepare(const OcpQp& qp, bool whole);
   /// Fill dense_ from qp: its Hessian and state-bound rows, and its gradient and bounds. NX and NU
   /// are the sizes when known at compile time, else Dynamic.
   template <int NX, int NU>
