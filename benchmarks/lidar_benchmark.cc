@@ -8,7 +8,7 @@
 // second into the occupancy map (target <= 5 ms for a 20k-point frame): the MID-360's 200 000
 // (about 15 500 returns per frame in the forest, the rest sky) and 260 000 (about 20 000
 // returns); MapInsertFrame/portable_kernel/N the same with the portable walk kernel instead of
-// the AVX2 one.
+// the AVX2 one, MapInsertFrame/clearing_stride_2/N with every other ray walked.
 // Run: build/bin/lidar_benchmark
 #include <benchmark/benchmark.h>
 
@@ -81,7 +81,7 @@ BENCHMARK_CAPTURE(CastForestRays, nav_forest_auto_kernel, bench::PlannerForest(2
 BENCHMARK_CAPTURE(CastForestRays, nav_forest_portable_kernel, bench::PlannerForest(22),
                   sim::RayCasterOptions::CylinderKernel::kPortable);
 
-void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKernel kernel) {
+void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKernel kernel, int clearing_stride = 1) {
   // Frames of the flight above in the world frame (each point placed with its true pose),
   // simulated between timed iterations so that the window moves as in flight.
   sim::LidarOptions o;
@@ -90,6 +90,7 @@ void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKe
   sim::LidarSimulator lidar(o, Forest(), 1);
   perception::VoxelMapOptions map_options;
   map_options.walk_kernel = kernel;
+  map_options.clearing_stride = clearing_stride;
   perception::VoxelMap map(map_options);
   map.Recenter(PoseAt(0).p_W);
   TimeNs t = 0;
@@ -131,6 +132,10 @@ void BM_MapInsertFrame(benchmark::State& state) {
 BENCHMARK(BM_MapInsertFrame)->Arg(200000)->Arg(260000)->Unit(benchmark::kMillisecond);
 // The same with the portable walk kernel (two interleaved rays instead of four in a vector).
 BENCHMARK_CAPTURE(MapInsertFrame, portable_kernel, perception::VoxelMapOptions::WalkKernel::kPortable)
+    ->Arg(200000)
+    ->Unit(benchmark::kMillisecond);
+// The same with clearing_stride 2, as the navigation scenarios map: half the rays walked.
+BENCHMARK_CAPTURE(MapInsertFrame, clearing_stride_2, perception::VoxelMapOptions::WalkKernel::kAuto, 2)
     ->Arg(200000)
     ->Unit(benchmark::kMillisecond);
 

@@ -40,6 +40,7 @@ void VoxelMapOptions::Validate() const {
           "inflation_radius_m", inflation_radius_m, "a radius in [0, 100 voxels]");
   require(std::isfinite(max_clearing_range_m) && max_clearing_range_m > 0.0, "max_clearing_range_m",
           max_clearing_range_m, "a range > 0 m");
+  require(clearing_stride >= 1 && clearing_stride <= 16, "clearing_stride", clearing_stride, "an integer in [1, 16]");
   require(std::isfinite(recenter_hysteresis_m) && recenter_hysteresis_m >= 0.0 &&
               recenter_hysteresis_m <= 0.25 * window_size_m.minCoeff(),
           "recenter_hysteresis_m", recenter_hysteresis_m, "a distance in [0, a quarter of the smallest window extent] m");
@@ -369,6 +370,15 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // each prefetched ahead, so that the memory latencies of a window larger than the caches
   // overlap. The order of the list changes nothing: a frame misses a voxel at most once, and what
   // a miss changes besides the cell (the counts, the settled bit, the inflation's +-1) commutes.
+  // The rays this frame walks (clearing_stride): the others' returns were hit all the same.
+  const auto stride = static_cast<std::size_t>(options_.clearing_stride);
+  if (stride > 1) {
+    std::size_t kept = 0;
+    for (std::size_t i = frames_inserted_ % stride; i < rays.size(); i += stride) rays[kept++] = rays[i];
+    rays.resize(kept);
+  }
+  ++frames_inserted_;
+  summary.rays_walked = static_cast<int>(rays.size());
   const double inv_res = 1.0 / res_;
   const Vector3 o = origin_W * inv_res;
   const double max_cells = options_.max_clearing_range_m / res_;

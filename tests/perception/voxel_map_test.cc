@@ -13,6 +13,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/sim/lidar.h"
+#include "test_util.h"
 
 namespace rotorguard::perception {
 namespace {
@@ -46,19 +47,43 @@ TEST(VoxelMap, AWallIsOccupiedTheSpaceBeforeItFreeAndBehindItUnknown) {
   EXPECT_EQ(map.occupied_count(), 20 * 10) << "one layer of 2 x 1 m at 0.1 m";
 }
 
+/// Frames of a wall at x = 4.05 m inserted until the voxel at (2.05, 0, 1) m, of a nearer wall
+/// that moved away, is no longer occupied (at most 50).
+int FramesUntilTheNearWallClears(VoxelMap* map) {
+  int frames = 0;
+  while (map->IsOccupied(Vector3(2.05, 0, 1)) && frames < 50) {
+    map->Insert(Vector3(0, 0, 1), Wall(4.05));
+    ++frames;
+  }
+  return frames;
+}
+
 TEST(VoxelMap, AnObstacleThatMovedAwayIsClearedByTheRaysThroughIt) {
   VoxelMap map(Small());
   for (int f = 0; f < 3; ++f) map.Insert(Vector3(0, 0, 1), Wall(2.05));
   ASSERT_TRUE(map.IsOccupied(Vector3(2.05, 0, 1)));
-  int frames = 0;
-  while (map.IsOccupied(Vector3(2.05, 0, 1)) && frames < 50) {
-    map.Insert(Vector3(0, 0, 1), Wall(4.05));
-    ++frames;
-  }
   // From 3 hits (2.55) to below 0.7 takes 5 misses of 0.4.
-  EXPECT_EQ(frames, 5);
+  EXPECT_EQ(FramesUntilTheNearWallClears(&map), 5);
   EXPECT_TRUE(map.IsOccupied(Vector3(4.05, 0, 1)));
   EXPECT_FALSE(map.IsInflated(Vector3(2.05, 0, 1)));
+}
+
+// clearing_stride 2 on the same walls: each frame walks half of the rays (every other hit voxel's,
+// 100 of the far wall's 200), and the near wall still clears in five frames, because four rays
+// cross each of its voxels (it is half as far: rays to 2 x 2 neighbouring voxels of the far wall,
+// of indices j, j + 1, j + 10 and j + 11, both parities).
+TEST(VoxelMap, AClearingStrideOfTwoWalksHalfTheRaysAndStillClearsTheMovedWallInFiveFrames) {
+  VoxelMapOptions o = Small();
+  o.clearing_stride = 2;
+  VoxelMap map(o);
+  for (int f = 0; f < 3; ++f) {
+    const MapUpdateSummary s = map.Insert(Vector3(0, 0, 1), Wall(2.05));
+    EXPECT_EQ(s.rays_walked, 100) << "frame " << f;
+    EXPECT_EQ(s.points_used, static_cast<int>(Wall(2.05).size())) << "every return is still hit";
+  }
+  EXPECT_EQ(map.occupied_count(), 20 * 10);
+  EXPECT_EQ(FramesUntilTheNearWallClears(&map), 5);
+  EXPECT_TRUE(map.IsOccupied(Vector3(4.05, 0, 1)));
 }
 
 // Inflation by the vehicle radius: every voxel whose centre is within the radius of an occupied
@@ -229,9 +254,11 @@ TEST(VoxelMap, SegmentCollidesExactlyWhenItCrossesAnOccupiedVoxel) {
 // wrap) must not change a voxel's known or occupied state. Most points crowd a small region so
 // that voxels go back and forth between hit and missed; the others cross the window's faces,
 // where slots are reused as it moves.
-TEST_P(VoxelMapWalk, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
+void ExpectManyFramesToMatchTheReference(VoxelMapOptions::WalkKernel kernel, int clearing_stride) {
+  SCOPED_TRACE("clearing_stride " + std::to_string(clearing_stride));
   VoxelMapOptions o;
-  o.walk_kernel = GetParam();
+  o.walk_kernel = kernel;
+  o.clearing_stride = clearing_stride;
   o.window_size_m = Vector3(1.6, 1.6, 0.8);
   o.recenter_hysteresis_m = 0.0;
   o.log_odds_min = -0.8;  // two misses settle a voxel free, so the walk skips many
@@ -262,7 +289,7 @@ TEST_P(VoxelMapWalk, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
       const double r = far ? 1.5 : 0.3;
       points.push_back((center + Vector3(rng.Uniform(-r, r), rng.Uniform(-r, r), rng.Uniform(-r / 2, r / 2))).cast<float>());
     }
-    map.Insert(origin, points);
+    const MapUpdateSummary summary = map.Insert(origin, points);
     // The reference update.
     std::set<Key> hit;
     std::vector<Vector3> rays;
@@ -274,8 +301,14 @@ TEST_P(VoxelMapWalk, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
         rays.push_back(p);
       }
     }
+    // clearing_stride: the frame walks the rays of index = frame (mod stride).
+    std::vector<Vector3> walked;
+    for (std::size_t i = static_cast<std::size_t>(frame % clearing_stride); i < rays.size();
+         i += static_cast<std::size_t>(clearing_stride)) {
+      walked.push_back(rays[i]);
+    }
     std::set<Key> missed;
-    for (const Vector3& end : rays) {
+    for (const Vector3& end : walked) {
       const Key a = key_of(lo + Vector3::Constant(0.05)), b = key_of(hi - Vector3::Constant(0.05));
       for (int x = a[0]; x <= b[0]; ++x) {
         for (int y = a[1]; y <= b[1]; ++y) {
@@ -288,6 +321,7 @@ TEST_P(VoxelMapWalk, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
         }
       }
     }
+    ASSERT_EQ(summary.rays_walked, static_cast<int>(walked.size())) << "frame " << frame;
     for (const Key& v : hit) reference[v] = std::min(o.log_odds_max, reference[v] + o.log_odds_hit);
     for (const Key& v : missed) reference[v] = std::max(o.log_odds_min, reference[v] + o.log_odds_miss);
     // Every voxel of the window, against the reference.
@@ -327,6 +361,11 @@ TEST_P(VoxelMapWalk, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
   EXPECT_GT(compared, 60 * 2000);  // of the window's 16 x 16 x 8, all but the undecided
   EXPECT_GT(occupied_seen, 2000);
   EXPECT_LT(undecided.size(), 50u);
+}
+
+TEST_P(VoxelMapWalk, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
+  ExpectManyFramesToMatchTheReference(GetParam(), 1);
+  ExpectManyFramesToMatchTheReference(GetParam(), 3);
 }
 
 // Nearest against a brute-force search over the list of occupied voxels, for radii that take the
@@ -525,6 +564,11 @@ TEST(VoxelMapOptions, ValidationNamesTheField) {
     ADD_FAILURE();
   } catch (const ValidationError& e) {
     EXPECT_EQ(e.field(), "recenter_hysteresis_m");
+  }
+  for (const int stride : {0, 17}) {
+    o = {};
+    o.clearing_stride = stride;
+    RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "clearing_stride = " + std::to_string(stride));
   }
 }
 

@@ -36,6 +36,12 @@ struct VoxelMapOptions {
   double inflation_radius_m = 0.2;  ///< the vehicle's radius [m], >= 0
   /// Rays longer than this only clear up to it (and still mark their return) [m], > 0.
   double max_clearing_range_m = 20.0;
+  /// A frame walks one in this many of its rays, in [1, 16]: the n-th frame given to Insert (n
+  /// from 0) those of index i = n (mod stride) in the frame's list of rays (one per hit voxel and
+  /// one per return outside the window, in the returns' order). Every return is still hit. The
+  /// walks are most of a frame's cost, and most of their steps cross space already settled free
+  /// by earlier frames; 1 walks every ray.
+  int clearing_stride = 1;
   /// The window follows its centre along an axis only once the centre is more than this from the
   /// window's centre there [m], in [0, a quarter of the smallest extent]. Without it a centre on a
   /// voxel boundary (a level flight at z = 1.5 m) moves the window back and forth with the
@@ -53,6 +59,7 @@ struct VoxelMapOptions {
 struct MapUpdateSummary {
   int points_used = 0;
   int points_dropped = 0;  ///< non-finite, or their voxel outside the window
+  int rays_walked = 0;     ///< the frame's rays whose free space was walked (clearing_stride)
   int voxels_updated = 0;
   long voxels_traversed = 0;  ///< voxels the rays' walks visited, each ray's last included (the update's cost)
   /// Of those, the visits the update skipped: to settled-free voxels (known and at the lower
@@ -255,6 +262,7 @@ class VoxelMap {
   /// (the report's map snapshots call it twice a second).
   std::vector<std::uint64_t> occupied_;
   std::uint32_t frame_ = 0;
+  std::uint64_t frames_inserted_ = 0;  // Insert's calls, for clearing_stride's choice of rays
   std::vector<Index> stencil_;            // offsets within the inflation radius
   /// The stencil as columns along z, the address' fastest axis: a column's voxels are one run of
   /// consecutive addresses (but where z wraps around the ring), so Inflate computes an (x, y) base
