@@ -317,6 +317,7 @@ void VoxelMap::Recenter(const Vector3& center_W) {
 
 MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eigen::Vector3f>& points_W) {
   MapUpdateSummary summary;
+  const std::uint64_t frame_index = frames_inserted_++;  // clearing_stride counts every frame given
   if (!origin_W.allFinite()) {
     summary.points_dropped = static_cast<int>(points_W.size());
     return summary;
@@ -358,13 +359,15 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
     ++hits;
     rays.push_back(p);
   }
-  // Pass 2: free space along each ray, up to the clearing range. A voxel hit in this frame is not
+  // Pass 2: free space along each ray the frame walks (every ray, or one in clearing_stride, a
+  // different residue each frame), up to the clearing range. A voxel hit in this frame is not
   // missed; one missed already is not missed twice; a settled free one is left alone (its miss
   // would change nothing). The whole walk: stopping where another ray already passed leaves gaps
   // between converging rays, and obstacles that moved away with them (even only within 2 m of the
   // sensor, where the rays are denser than the voxels: a repeated frame then never clears 14 of a
-  // moved wall's 382 voxels).
-  // The walks are the cost (a forest frame takes some 800 000 steps): a batch of rays is started,
+  // moved wall's 382 voxels). The stride instead thins the rays evenly and moves its choice every
+  // frame, so a voxel that rays of every residue cross is still missed every frame.
+  // The walks are the cost (a forest frame takes some 800 000 steps with every ray): a batch of rays is started,
   // then walked by a kernel that lists each voxel whose settled bit is clear (see
   // ListUnsettledPortable and ListUnsettledAvx2). The voxels a batch lists are updated after,
   // each prefetched ahead, so that the memory latencies of a window larger than the caches
@@ -374,10 +377,9 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   const auto stride = static_cast<std::size_t>(options_.clearing_stride);
   if (stride > 1) {
     std::size_t kept = 0;
-    for (std::size_t i = frames_inserted_ % stride; i < rays.size(); i += stride) rays[kept++] = rays[i];
+    for (std::size_t i = frame_index % stride; i < rays.size(); i += stride) rays[kept++] = rays[i];
     rays.resize(kept);
   }
-  ++frames_inserted_;
   summary.rays_walked = static_cast<int>(rays.size());
   const double inv_res = 1.0 / res_;
   const Vector3 o = origin_W * inv_res;

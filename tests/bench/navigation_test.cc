@@ -27,7 +27,6 @@ Scenario ShortIndoor(int waypoints, double duration_s) {
 TEST(Navigation, AShortIndoorMissionWithAFailureSucceedsAndNeverCommandsANonFiniteThrust) {
   Scenario s = ShortIndoor(2, 16.0);
   s.faults[0].onset.value = 4.0;  // mid-way to the first waypoint
-  EXPECT_EQ(s.stack.lidar.map.clearing_stride, 2) << "the navigation scenarios' map walks every other ray";
   bool finite = true;
   RunOptions o;
   o.on_control_cycle = [&](const stack::FlightStack& st) { finite = finite && st.command().thrust_n.allFinite(); };

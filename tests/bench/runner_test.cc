@@ -160,6 +160,7 @@ TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverSpinningNearElevenRadPerSe
 // the same recovery, to within a few percent of the error.
 TEST(NmpcClosedLoop, ReusingTheLinearisationBetweenEveryThirdPreparationFliesTheSameFailure) {
   EXPECT_EQ(LoadScenario(Config("forest.yaml")).stack.nmpc.relinearise_every, 3) << "the key is read";
+  EXPECT_EQ(LoadScenario(Config("forest.yaml")).stack.lidar.map.clearing_stride, 2) << "and the map's";
   Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"));
   EXPECT_EQ(s.stack.nmpc.relinearise_every, 1) << "the default";
   const RunSummary every = RunScenario(s);
