@@ -40,7 +40,10 @@ void VoxelMapOptions::Validate() const {
           "inflation_radius_m", inflation_radius_m, "a radius in [0, 100 voxels]");
   require(std::isfinite(max_clearing_range_m) && max_clearing_range_m > 0.0, "max_clearing_range_m",
           max_clearing_range_m, "a range > 0 m");
-  require(clearing_stride >= 1 && clearing_stride <= 16, "clearing_stride", clearing_stride, "an integer in [1, 16]");
+  if (clearing_stride < 1 || clearing_stride > kMaxClearingStride) {
+    ThrowValidation("VoxelMapOptions", "clearing_stride", clearing_stride,
+                    fmt::format("an integer in [1, {}]", kMaxClearingStride));
+  }
   require(std::isfinite(recenter_hysteresis_m) && recenter_hysteresis_m >= 0.0 &&
               recenter_hysteresis_m <= 0.25 * window_size_m.minCoeff(),
           "recenter_hysteresis_m", recenter_hysteresis_m, "a distance in [0, a quarter of the smallest window extent] m");
@@ -367,8 +370,8 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // sensor, where the rays are denser than the voxels: a repeated frame then never clears 14 of a
   // moved wall's 382 voxels). The stride instead thins the rays evenly and moves its choice every
   // frame, so a voxel that rays of every residue cross is still missed every frame.
-  // The walks are the cost (a forest frame takes some 800 000 steps with every ray): a batch of rays is started,
-  // then walked by a kernel that lists each voxel whose settled bit is clear (see
+  // The walks are the cost (a forest frame takes some 800 000 steps with every ray): a batch of
+  // rays is started, then walked by a kernel that lists each voxel whose settled bit is clear (see
   // ListUnsettledPortable and ListUnsettledAvx2). The voxels a batch lists are updated after,
   // each prefetched ahead, so that the memory latencies of a window larger than the caches
   // overlap. The order of the list changes nothing: a frame misses a voxel at most once, and what

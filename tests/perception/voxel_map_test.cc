@@ -570,7 +570,7 @@ TEST(VoxelMapOptions, ValidationNamesTheField) {
   } catch (const ValidationError& e) {
     EXPECT_EQ(e.field(), "recenter_hysteresis_m");
   }
-  for (const int stride : {0, 17}) {
+  for (const int stride : {0, VoxelMapOptions::kMaxClearingStride + 1}) {
     o = {};
     o.clearing_stride = stride;
     RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "clearing_stride = " + std::to_string(stride));

@@ -5,8 +5,9 @@
 /// Each frame updates log-odds (Thrun, Burgard, Fox, Probabilistic Robotics, Sec. 9.2): the voxel
 /// of every return is hit, the voxels its ray crossed are missed (of every ray, or of one in
 /// clearing_stride), each voxel updated at most once per frame (hits win), so that an obstacle
-/// that moved away is cleared by the rays that now pass through it. Occupied voxels are inflated by the vehicle radius in a second layer kept up to
-/// date incrementally, which the planner's queries read.
+/// that moved away is cleared by the rays that now pass through it. Occupied voxels are inflated
+/// by the vehicle radius in a second layer kept up to date incrementally, which the planner's
+/// queries read.
 #include <algorithm>
 #include <cstdint>
 #include <optional>
@@ -36,13 +37,15 @@ struct VoxelMapOptions {
   double inflation_radius_m = 0.2;  ///< the vehicle's radius [m], >= 0
   /// Rays longer than this only clear up to it (and still mark their return) [m], > 0.
   double max_clearing_range_m = 20.0;
-  /// A frame walks one in this many of its rays, in [1, 16]: the n-th frame given to Insert (n
-  /// from 0, a frame dropped for a non-finite origin included) those of index i = n (mod stride)
-  /// in the frame's list of rays (one per hit voxel and one per return outside the window, in the
-  /// returns' order). Every return is still hit. The walks are most of a frame's cost, and most of
-  /// their steps cross space already settled free by earlier frames; 1 walks every ray. (The bound
-  /// keeps every ray walked at least once in 1.6 s at 10 Hz.)
+  /// A frame walks one in this many of its rays, in [1, kMaxClearingStride]: the n-th frame given
+  /// to Insert (n from 0, a frame dropped for a non-finite origin included) those of index
+  /// i = n (mod stride) in the frame's list of rays (one per hit voxel and one per return outside
+  /// the window, in the returns' order). Every return is still hit. The walks are most of a
+  /// frame's cost, and most of their steps cross space already settled free by earlier frames;
+  /// 1 walks every ray.
   int clearing_stride = 1;
+  /// At 10 Hz each residue's rays are then walked at least every 1.6 s.
+  static constexpr int kMaxClearingStride = 16;
   /// The window follows its centre along an axis only once the centre is more than this from the
   /// window's centre there [m], in [0, a quarter of the smallest extent]. Without it a centre on a
   /// voxel boundary (a level flight at z = 1.5 m) moves the window back and forth with the
