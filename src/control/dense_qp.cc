@@ -43,10 +43,20 @@ std::string_view ToString(QpStatus status) {
   return "unknown";
 }
 
+std::string_view ToString(QpStart start) {
+  switch (start) {
+    case QpStart::kCold: return "cold";
+    case QpStart::kWarm: return "warm";
+    case QpStart::kHot: return "hot";
+  }
+  return "unknown";
+}
+
 std::string DenseQpSummary::BriefReport() const {
-  return fmt::format("QP {}: {} iterations, {} active, objective {:.6g}, max violation {:.2e}, {:.1f} us",
-                     ToString(status), iterations, active_constraints, objective, max_violation,
-                     solve_time_s * 1e6);
+  return fmt::format("QP {}: {} start from {} active, {} iterations, {} active, objective {:.6g}, max violation "
+                     "{:.2e}, {:.1f} us",
+                     ToString(status), ToString(start), start_active_constraints, iterations, active_constraints,
+                     objective, max_violation, solve_time_s * 1e6);
 }
 
 void DenseQpOptions::Validate() const {
@@ -71,6 +81,8 @@ DenseQpSolver::DenseQpSolver(int n, int m, const DenseQpOptions& options)
       options_(options),
       chol_(n, n),
       J0_(n, n),
+      order_(static_cast<std::size_t>(std::max(n, 0))),
+      placed_mark_(static_cast<std::size_t>(std::max(n, 0)), 0),
       J_(n, n),
       height_(static_cast<std::size_t>(std::max(n, 0)), 0),
       R_(Eigen::MatrixXd::Zero(n, n)),
@@ -82,20 +94,24 @@ DenseQpSolver::DenseQpSolver(int n, int m, const DenseQpOptions& options)
       cz_(m),
       y_bound_(n),
       y_constraint_(m),
-      is_active_(2 * static_cast<std::size_t>(n + m), 0) {
+      is_active_(2 * static_cast<std::size_t>(n + m), 0),
+      previous_rows_(n, n) {
   if (n < 1 || m < 0) ThrowInvalidArgument("DenseQpSolver", "n, m", fmt::format("{}, {}", n, m), "n >= 1, m >= 0");
   options_.Validate();
   active_.reserve(static_cast<std::size_t>(n));
+  previous_.reserve(static_cast<std::size_t>(n));
+  placed_.reserve(static_cast<std::size_t>(n));
+}
+
+double DenseQpSolver::SignedBound(const DenseQp& qp, const Side& c) const {
+  if (c.index < n_) return c.sign * (c.sign > 0 ? qp.lb[c.index] : qp.ub[c.index]);
+  const int row = c.index - n_;
+  return c.sign * (c.sign > 0 ? qp.lc[row] : qp.uc[row]);
 }
 
 double DenseQpSolver::Slack(const DenseQp& qp, const Side& c) const {
-  if (c.index < n_) {
-    const double bound = c.sign > 0 ? qp.lb[c.index] : qp.ub[c.index];
-    return c.sign * (z_[c.index] - bound);
-  }
-  const int row = c.index - n_;
-  const double bound = c.sign > 0 ? qp.lc[row] : qp.uc[row];
-  return c.sign * (qp.C.row(row).dot(z_) - bound);
+  const double sz = c.index < n_ ? c.sign * z_[c.index] : c.sign * qp.C.row(c.index - n_).dot(z_);
+  return sz - SignedBound(qp, c);
 }
 
 void DenseQpSolver::ComputeD(const DenseQp& qp, const Side& c) {
@@ -165,22 +181,54 @@ void DenseQpSolver::DropFromActiveSet(int position) {
   --q_;
 }
 
+void DenseQpSolver::OrderVariables() {
+  // The bounds active at the last solve go last, in reverse order of activation, so that J0's
+  // trailing columns factorise them as they stand (StartActiveSet); the other variables keep
+  // their order.
+  placed_.clear();
+  if (options_.warm_start) {
+    for (const Side& c : previous_) {
+      if (c.index < n_) placed_.push_back(c);
+    }
+  }
+  std::vector<char>& last = placed_mark_;
+  std::fill(last.begin(), last.end(), 0);
+  for (const Side& c : placed_) last[static_cast<std::size_t>(c.index)] = 1;
+  int k = 0;
+  for (int i = 0; i < n_; ++i) {
+    if (!last[static_cast<std::size_t>(i)]) order_[static_cast<std::size_t>(k++)] = i;
+  }
+  for (auto c = placed_.rbegin(); c != placed_.rend(); ++c) order_[static_cast<std::size_t>(k++)] = c->index;
+}
+
 bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
   factorized_ = false;
+  hot_startable_ = false;  // J and R were built on the previous factorisation
   if (H.rows() != n_ || H.cols() != n_ || !H.allFinite()) return false;
-  chol_ = H;
+  OrderVariables();
+  const bool permuted = !placed_.empty();
+  const IndexList order(order_.data(), n_);
+  if (permuted) {
+    chol_ = H(order, order);  // P H P', the variables in order_
+  } else {
+    chol_ = H;
+  }
   Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(chol_);
   if (llt.info() != Eigen::Success) return false;
-  // J0 = L^-T, upper triangular: column j solves L' x = e_j and needs only the leading (j+1) x
-  // (j+1) block, so the columns are solved in panels against growing leading blocks. That is a
-  // third of the work of solving against the whole identity (measured: docs/control.md).
+  // L^-T of the ordered Hessian, upper triangular: column j solves L' x = e_j and needs only the
+  // leading (j+1) x (j+1) block, so the columns are solved in panels against growing leading
+  // blocks. That is a third of the work of solving against the whole identity (measured:
+  // docs/control.md). J_ is free to serve as scratch: a new factorisation ends the hot starts.
+  Eigen::MatrixXd& ordered = permuted ? J_ : J0_;
   constexpr int kPanel = 8;
-  J0_.setZero();
+  ordered.setZero();
   for (int j0 = 0; j0 < n_; j0 += kPanel) {
     const int j1 = std::min(n_, j0 + kPanel), w = j1 - j0;
-    J0_.block(j0, j0, w, w).setIdentity();
-    chol_.topLeftCorner(j1, j1).triangularView<Eigen::Lower>().transpose().solveInPlace(J0_.block(0, j0, j1, w));
+    ordered.block(j0, j0, w, w).setIdentity();
+    chol_.topLeftCorner(j1, j1).triangularView<Eigen::Lower>().transpose().solveInPlace(ordered.block(0, j0, j1, w));
   }
+  // J0 = P' L^-T factorises H^-1 = J0 J0' in the variables' own order; the rows move back to it.
+  if (permuted) J0_(order, Eigen::all) = J_;
   factorized_ = true;
   return true;
 }
@@ -200,6 +248,107 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
   SolveFactorized(qp);
   summary_.solve_time_s += factorize_s;
   return summary_;
+}
+
+void DenseQpSolver::ClearActiveSet() {
+  J_ = J0_;
+  // Column j of L^-T is zero below row j; with the rows moved back to the variables' order the
+  // zeros are scattered, and the rotations run over whole columns.
+  const bool permuted = !placed_.empty();
+  for (int j = 0; j < n_; ++j) height_[static_cast<std::size_t>(j)] = permuted ? n_ : j + 1;
+  q_ = 0;
+  active_.clear();
+  std::fill(is_active_.begin(), is_active_.end(), 0);
+  R_.setZero();
+}
+
+QpStart DenseQpSolver::StartActiveSet(const DenseQp& qp) {
+  // A hot start needs J, R to factorise the same normals in the same metric: no Factorize since
+  // (hot_startable_), the active rows of C as they were, and a bounded number of hot starts in a
+  // row, since each adds its rotations' rounding to J and R (a rebuild from J0 every
+  // kMaxHotStartsInARow solves costs one warm start).
+  constexpr int kMaxHotStartsInARow = 50;
+  bool hot = options_.warm_start && hot_startable_ && hot_starts_in_a_row_ < kMaxHotStartsInARow;
+  for (int j = 0; hot && j < q_; ++j) {
+    const Side& c = active_[j];
+    hot = c.index < n_ || qp.C.row(c.index - n_) == previous_rows_.row(j);
+  }
+  hot_startable_ = false;  // until this solve succeeds
+  QpStart start = QpStart::kHot;
+  if (hot) {
+    ++hot_starts_in_a_row_;
+  } else {
+    hot_starts_in_a_row_ = 0;
+    ClearActiveSet();
+    start = options_.warm_start && (!placed_.empty() || !previous_.empty()) ? QpStart::kWarm : QpStart::kCold;
+  }
+  if (start == QpStart::kWarm) {
+    PlaceOrderedBounds();
+    for (const Side& c : previous_) {
+      if (is_active_[2 * c.index + (c.sign < 0)] || !std::isfinite(SignedBound(qp, c))) continue;
+      ComputeD(qp, c);
+      // A normal (nearly) in the span of those already added would make R singular: left to the
+      // iterations, which add it only if it is violated and independent.
+      constexpr double kIndependence = 1e-8;
+      if (d_.tail(n_ - q_).norm() <= kIndependence * d_.norm()) continue;
+      AddToActiveSet(c);
+    }
+  }
+  // A side whose bound is now infinite binds no more.
+  for (int j = q_ - 1; j >= 0; --j) {
+    if (!std::isfinite(SignedBound(qp, active_[j]))) DropFromActiveSet(j);
+  }
+  return start;
+}
+
+void DenseQpSolver::PlaceOrderedBounds() {
+  // Factorize put the k placed bounds' variables last, the c-th at position n - 1 - c, so J0 = P'
+  // L^-T with L^-T upper triangular: for the normals N = [s_c e_(variable c)], J0's column n - 1
+  // - a has N' J0[:, n - 1 - a] = 0 for a > c, and its first n - k columns are orthogonal to all of
+  // N. J = [J0's columns n - 1, ..., n - k, then 0, ..., n - k - 1] and R(a, c) = s_c J0(variable c,
+  // n - 1 - a) are therefore the factorisation of the active set N: no rotation is needed.
+  const int k = static_cast<int>(placed_.size());
+  if (k == 0) return;
+  for (int a = 0; a < k; ++a) J_.col(a) = J0_.col(n_ - 1 - a);
+  J_.rightCols(n_ - k) = J0_.leftCols(n_ - k);
+  for (int c = 0; c < k; ++c) {
+    const Side& side = placed_[static_cast<std::size_t>(c)];
+    for (int a = 0; a <= c; ++a) R_(a, c) = side.sign * J0_(side.index, n_ - 1 - a);
+    active_.push_back(side);
+    is_active_[2 * side.index + (side.sign < 0)] = 1;
+  }
+  q_ = k;
+}
+
+void DenseQpSolver::MinimiseOnActiveSet(const DenseQp& qp) {
+  // With J' N = [R; 0] for the active normals N and J J' = H^-1, the minimum on N' z = b is
+  // z = J1 R^-T b - J2 J2' g, and its multipliers (H z + g = N u) u = R^-1 (R^-T b + J1' g).
+  while (true) {
+    for (int j = 0; j < q_; ++j) r_[j] = SignedBound(qp, active_[j]);
+    auto R = R_.topLeftCorner(q_, q_).triangularView<Eigen::Upper>();
+    R.transpose().solveInPlace(r_.head(q_));  // R^-T b
+    d_.noalias() = J_.transpose() * qp.g;       // [J1' g; J2' g]
+    u_.head(q_) = r_.head(q_) + d_.head(q_);
+    R.solveInPlace(u_.head(q_));
+    d_.head(q_) = r_.head(q_);
+    d_.tail(n_ - q_) *= -1.0;
+    z_.noalias() = J_ * d_;
+    // Drop the most negative multiplier and minimise again; at most q rounds.
+    int most_negative = -1;
+    for (int j = 0; j < q_; ++j) {
+      if (u_[j] < 0.0 && (most_negative < 0 || u_[j] < u_[most_negative])) most_negative = j;
+    }
+    if (most_negative < 0) return;
+    DropFromActiveSet(most_negative);
+  }
+}
+
+void DenseQpSolver::KeepForWarmStart(const DenseQp& qp) {
+  previous_.assign(active_.begin(), active_.end());
+  for (int j = 0; j < q_; ++j) {
+    if (active_[j].index >= n_) previous_rows_.row(j) = qp.C.row(active_[j].index - n_);
+  }
+  hot_startable_ = true;
 }
 
 const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
@@ -228,34 +377,40 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
       }
       summary_.max_violation = std::max(0.0, violation);
     }
+    if (status == QpStatus::kSolved) {
+      KeepForWarmStart(qp);
+    } else {
+      previous_.clear();  // the next solve starts cold
+    }
     summary_.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return summary_;
   };
 
-  q_ = 0;
-  active_.clear();
-  std::fill(is_active_.begin(), is_active_.end(), 0);
-  R_.setZero();
+  // Data the method cannot start from: no active set is returned, and the next solve starts cold.
+  const auto reject = [&](QpStatus status) -> const DenseQpSummary& {
+    hot_startable_ = false;
+    q_ = 0;
+    active_.clear();
+    std::fill(is_active_.begin(), is_active_.end(), 0);
+    if (status == QpStatus::kNumericalFailure) z_.setZero();
+    return finish(status);
+  };
   // Bounds may be infinite but never NaN (a NaN bound would be silently ignored by comparisons).
   const bool nan_bound = qp.lb.array().isNaN().any() || qp.ub.array().isNaN().any() ||
                          qp.lc.array().isNaN().any() || qp.uc.array().isNaN().any();
   if (!factorized_ || qp.num_variables() != n_ || qp.num_constraints() != m_ || !qp.g.allFinite() ||
       (m_ > 0 && !qp.C.allFinite()) || nan_bound) {
-    z_.setZero();
-    return finish(QpStatus::kNumericalFailure);
+    return reject(QpStatus::kNumericalFailure);
   }
-  for (int i = 0; i < n_; ++i) {
-    if (qp.lb[i] > qp.ub[i]) return finish(QpStatus::kInfeasible);
-  }
-  for (int i = 0; i < m_; ++i) {
-    if (qp.lc[i] > qp.uc[i]) return finish(QpStatus::kInfeasible);
+  if ((qp.lb.array() > qp.ub.array()).any() || (m_ > 0 && (qp.lc.array() > qp.uc.array()).any())) {
+    return reject(QpStatus::kInfeasible);
   }
 
-  // Unconstrained minimum from the factorisation H = L L', J = L^-T: z = -J J' g.
-  J_ = J0_;
-  for (int j = 0; j < n_; ++j) height_[static_cast<std::size_t>(j)] = j + 1;
-  d_.noalias() = J_.transpose() * qp.g;
-  z_.noalias() = -J_ * d_;
+  // The start: the minimum on the kept or rebuilt active set, or the unconstrained minimum
+  // z = -J J' g (H = L L', J = L^-T) when the set is empty.
+  summary_.start = StartActiveSet(qp);
+  MinimiseOnActiveSet(qp);
+  summary_.start_active_constraints = q_;
 
   const double tol = options_.feasibility_tolerance;
   while (true) {

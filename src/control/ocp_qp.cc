@@ -52,9 +52,10 @@ OcpQp::OcpQp(const OcpQpDims& d) : dims(d) {
 }
 
 std::string OcpQpSummary::BriefReport() const {
-  return fmt::format("OCP QP {}: {} iterations, {} active, objective {:.6g}, condense {:.1f} us, solve {:.1f} us",
-                     ToString(status), iterations, active_constraints, objective, condense_time_s * 1e6,
-                     dense_solve_time_s * 1e6);
+  return fmt::format("OCP QP {}: {} start, {} iterations, {} active, objective {:.6g}, condense {:.1f} us, solve "
+                     "{:.1f} us",
+                     ToString(status), ToString(start), iterations, active_constraints, objective,
+                     condense_time_s * 1e6, dense_solve_time_s * 1e6);
 }
 
 CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options)
@@ -324,6 +325,7 @@ const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
     z_ = dense_solver_.z();
   }
   summary_.status = ds->status;
+  summary_.start = ds->start;
   summary_.iterations = ds->iterations;
   summary_.active_constraints = ds->active_constraints + static_cast<int>(reduced_ ? fixed_.size() : 0);
   summary_.max_violation = ds->max_violation;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -142,6 +143,193 @@ TEST(DenseQp, SatisfiesKktOnLargeProblemsWithManyActiveConstraints) {
     ASSERT_EQ(s.status, QpStatus::kSolved) << s.BriefReport();
     EXPECT_GT(s.active_constraints, 5);
     ExpectKkt(qp, solver, 1e-7);
+  }
+}
+
+/// A problem near `qp`: its gradient and bounds moved by up to `scale` (what changes between two
+/// NMPC calls that share a factorisation).
+DenseQp Perturbed(const DenseQp& qp, double scale, Rng& rng) {
+  DenseQp next = qp;
+  for (int i = 0; i < qp.num_variables(); ++i) {
+    next.g[i] += scale * rng.Normal();
+    const double shift = 0.1 * scale * rng.Normal();
+    next.lb[i] += shift;  // an infinite side stays infinite
+    next.ub[i] += shift;
+  }
+  for (int r = 0; r < qp.num_constraints(); ++r) {
+    const double shift = 0.1 * scale * rng.Normal();
+    next.lc[r] += shift;
+    next.uc[r] += shift;
+  }
+  return next;
+}
+
+// Sequences of nearby problems, solved by one solver that starts from its previous active set and
+// checked against the brute-force oracle; every few problems a new Hessian is factorised, so both
+// the hot start (kept factorisation) and the warm start (rebuilt on the new one) are exercised.
+TEST(DenseQp, WarmAndHotStartsMatchBruteForceOnSequencesOfNearbyProblems) {
+  Rng rng(99);
+  int hot = 0, warm = 0, hot_with_drops = 0;
+  for (int sequence = 0; sequence < 40; ++sequence) {
+    const int n = 2 + sequence % 4, m = sequence % 3;
+    DenseQp qp = RandomQp(n, m, rng);
+    DenseQpSolver solver(n, m);
+    ASSERT_TRUE(solver.Factorize(qp.H));
+    int previous_active = 0;
+    for (int step = 0; step < 8; ++step) {
+      if (step == 4) {
+        const DenseQp other = RandomQp(n, m, rng);
+        qp.H = 0.8 * qp.H + 0.2 * other.H;
+        ASSERT_TRUE(solver.Factorize(qp.H));
+      }
+      const DenseQpSummary& s = solver.SolveFactorized(qp);
+      ASSERT_EQ(s.status, QpStatus::kSolved) << "sequence " << sequence << " step " << step << ": " << s.BriefReport();
+      const Eigen::VectorXd oracle = BruteForce(qp);
+      ASSERT_EQ(oracle.size(), n);
+      EXPECT_LT((solver.z() - oracle).cwiseAbs().maxCoeff(), 1e-8) << "sequence " << sequence << " step " << step;
+      // The first solve has no previous set, and one from an empty set is cold.
+      const QpStart expected = step == 0                      ? QpStart::kCold
+                               : step != 4                    ? QpStart::kHot
+                               : previous_active > 0 ? QpStart::kWarm
+                                                              : QpStart::kCold;
+      EXPECT_EQ(s.start, expected) << "sequence " << sequence << " step " << step;
+      hot += s.start == QpStart::kHot;
+      warm += s.start == QpStart::kWarm;
+      hot_with_drops += s.start == QpStart::kHot && s.start_active_constraints < previous_active;
+      previous_active = s.active_constraints;
+      qp = Perturbed(qp, 1.0, rng);
+    }
+  }
+  EXPECT_EQ(hot, 40 * 6);
+  EXPECT_GT(warm, 30);
+  EXPECT_GT(hot_with_drops, 10);  // the start dropped constraints whose multipliers turned negative
+}
+
+// The NMPC's size: 80 variables, 60 general constraints, many active. Warm and hot starts give the
+// cold solver's solution and satisfy the KKT conditions, in fewer active-set changes.
+TEST(DenseQp, WarmAndHotStartsMatchColdStartsOnLargeProblemsInFewerIterations) {
+  Rng rng(11);
+  DenseQp qp = RandomQp(80, 60, rng);
+  DenseQpOptions cold_options;
+  cold_options.warm_start = false;
+  DenseQpSolver warm(80, 60), cold(80, 60, cold_options);
+  ASSERT_TRUE(warm.Factorize(qp.H));
+  ASSERT_TRUE(cold.Factorize(qp.H));
+  int warm_iterations = 0, cold_iterations = 0;
+  for (int step = 0; step < 30; ++step) {
+    if (step % 10 == 5) {  // a new Hessian: the warm start rebuilds the active set on it
+      qp.H += 0.1 * RandomQp(80, 60, rng).H;
+      ASSERT_TRUE(warm.Factorize(qp.H));
+      ASSERT_TRUE(cold.Factorize(qp.H));
+    }
+    const DenseQpSummary& w = warm.SolveFactorized(qp);
+    const DenseQpSummary& c = cold.SolveFactorized(qp);
+    ASSERT_EQ(w.status, QpStatus::kSolved) << w.BriefReport();
+    ASSERT_EQ(c.status, QpStatus::kSolved) << c.BriefReport();
+    EXPECT_EQ(c.start, QpStart::kCold);
+    EXPECT_GT(c.active_constraints, 3);
+    EXPECT_LT((warm.z() - cold.z()).cwiseAbs().maxCoeff(), 1e-8) << "step " << step << ": " << w.BriefReport();
+    ExpectKkt(qp, warm, 1e-7);
+    if (step > 0) {
+      warm_iterations += w.iterations;
+      cold_iterations += c.iterations;
+    }
+    qp = Perturbed(qp, 0.05, rng);
+  }
+  EXPECT_LT(warm_iterations, cold_iterations / 3) << warm_iterations << " against " << cold_iterations;
+}
+
+// min 1/2 |z|^2 + g'z subject to z >= 0 has z = max(0, -g) (a closed form), and the multipliers
+// of the bounds are max(0, g).
+TEST(DenseQp, AHotStartDropsTheConstraintsWhoseMultipliersTurnNegative) {
+  DenseQp qp(3, 0);
+  qp.lb.setZero();
+  qp.g << 1.0, 2.0, 3.0;
+  DenseQpSolver solver(3, 0);
+  ASSERT_TRUE(solver.Solve(qp).IsSolutionUsable());
+  EXPECT_EQ(solver.summary().active_constraints, 3);
+  EXPECT_LT(solver.z().norm(), 1e-15);
+  qp.g << 1.0, -2.0, -4.0;
+  const DenseQpSummary& s = solver.SolveFactorized(qp);
+  ASSERT_TRUE(s.IsSolutionUsable());
+  EXPECT_EQ(s.start, QpStart::kHot);
+  EXPECT_EQ(s.start_active_constraints, 1);  // variables 1 and 2 left their bounds
+  EXPECT_EQ(s.iterations, 0);                // and the start was the solution
+  EXPECT_LT((solver.z() - Eigen::Vector3d(0.0, 2.0, 4.0)).norm(), 1e-14);
+  EXPECT_LT((solver.bound_multipliers() - Eigen::Vector3d(1.0, 0.0, 0.0)).norm(), 1e-14);
+  // A bound that became infinite binds no more.
+  qp.lb[0] = -kInf;
+  ASSERT_TRUE(solver.SolveFactorized(qp).IsSolutionUsable());
+  EXPECT_EQ(solver.summary().start_active_constraints, 0);
+  EXPECT_LT((solver.z() - Eigen::Vector3d(-1.0, 2.0, 4.0)).norm(), 1e-14);
+}
+
+TEST(DenseQp, TheSameProblemAgainHotStartsAtItsSolution) {
+  Rng rng(5);
+  int lower = 0, upper = 0;  // active bounds of either side, placed by the warm start
+  for (const auto& [n, m] : {std::pair{80, 60}, std::pair{60, 0}}) {
+    const DenseQp qp = RandomQp(n, m, rng);
+    DenseQpSolver solver(n, m);
+    ASSERT_TRUE(solver.Solve(qp).IsSolutionUsable());
+    const Eigen::VectorXd first = solver.z();
+    const int active = solver.summary().active_constraints;
+    ASSERT_GT(active, 5);
+    const DenseQpSummary& again = solver.SolveFactorized(qp);
+    ASSERT_TRUE(again.IsSolutionUsable());
+    EXPECT_EQ(again.start, QpStart::kHot);
+    EXPECT_EQ(again.start_active_constraints, active);
+    EXPECT_EQ(again.iterations, 0);
+    EXPECT_LT((solver.z() - first).cwiseAbs().maxCoeff(), 1e-12);
+    // Factorised anew, with the active bounds ordered last: the warm start is the solution too.
+    ASSERT_TRUE(solver.Factorize(qp.H));
+    const DenseQpSummary& warm = solver.SolveFactorized(qp);
+    ASSERT_TRUE(warm.IsSolutionUsable());
+    EXPECT_EQ(warm.start, QpStart::kWarm);
+    EXPECT_EQ(warm.start_active_constraints, active);
+    EXPECT_EQ(warm.iterations, 0);
+    EXPECT_LT((solver.z() - first).cwiseAbs().maxCoeff(), 1e-10);
+    lower += (solver.bound_multipliers().array() > 0.0).count();
+    upper += (solver.bound_multipliers().array() < 0.0).count();
+  }
+  EXPECT_GT(lower, 0);
+  EXPECT_GT(upper, 0);
+}
+
+// A hot start needs the factorisation of the same normals in the same metric: a changed row of an
+// active constraint, or a new factorisation, rebuilds the set (a warm start); a failed solve, or
+// warm_start off, starts cold.
+TEST(DenseQp, AChangedActiveRowANewFactorisationOrAFailureEndsTheHotStarts) {
+  DenseQp qp(2, 1);
+  qp.g << -1.0, -1.0;
+  qp.C << 1.0, 1.0;
+  qp.uc << 1.0;  // z1 + z2 <= 1 binds: z = (0.5, 0.5)
+  DenseQpSolver solver(2, 1);
+  ASSERT_TRUE(solver.Solve(qp).IsSolutionUsable());
+  EXPECT_EQ(solver.summary().start, QpStart::kCold);
+  ASSERT_EQ(solver.summary().active_constraints, 1);
+  // z1 + 3 z2 <= 1: z = (1, 1) - mu (1, 3) with 4 - 10 mu = 1, so mu = 0.3 and z = (0.7, 0.1).
+  qp.C << 1.0, 3.0;
+  ASSERT_TRUE(solver.SolveFactorized(qp).IsSolutionUsable());
+  EXPECT_EQ(solver.summary().start, QpStart::kWarm);
+  EXPECT_EQ(solver.summary().iterations, 0);
+  EXPECT_LT((solver.z() - Eigen::Vector2d(0.7, 0.1)).norm(), 1e-14);
+  ASSERT_TRUE(solver.SolveFactorized(qp).IsSolutionUsable());
+  EXPECT_EQ(solver.summary().start, QpStart::kHot);
+  ASSERT_TRUE(solver.Factorize(qp.H));
+  ASSERT_TRUE(solver.SolveFactorized(qp).IsSolutionUsable());
+  EXPECT_EQ(solver.summary().start, QpStart::kWarm);
+  DenseQp crossed = qp;
+  crossed.lc << 2.0;  // lc > uc
+  EXPECT_EQ(solver.SolveFactorized(crossed).status, QpStatus::kInfeasible);
+  EXPECT_EQ(solver.summary().active_constraints, 0);
+  ASSERT_TRUE(solver.SolveFactorized(qp).IsSolutionUsable());
+  EXPECT_EQ(solver.summary().start, QpStart::kCold);
+  DenseQpOptions options;
+  options.warm_start = false;
+  DenseQpSolver cold(2, 1, options);
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_TRUE(cold.Solve(qp).IsSolutionUsable());
+    EXPECT_EQ(cold.summary().start, QpStart::kCold);
   }
 }
 

@@ -331,6 +331,10 @@ TEST(CondensingQp, PreparingOnlyTheVectorsEqualsAWholePreparation) {
     const Eigen::VectorXd measured = qp.x0 + 0.02 * RandomMatrix(17, 1, rng);
     const OcpQpSummary& s = reusing.Feedback(measured);
     ASSERT_TRUE(s.IsSolutionUsable()) << "step " << step << ": " << s.BriefReport();
+    // The steps that keep the last one's fixed inputs keep its factorisation, and the dense
+    // solver starts from its last active set with that set's factorisation; a new pattern is a
+    // new reduced solver, which starts cold.
+    EXPECT_EQ(s.start, step == 2 || step == 4 || step == 6 ? QpStart::kHot : QpStart::kCold) << "step " << step;
     OcpQp measured_qp = qp;
     measured_qp.x0 = measured;
     CondensingQpSolver fresh(qp.dims);

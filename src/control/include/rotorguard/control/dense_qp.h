@@ -9,6 +9,12 @@
 /// metric of H (J = L^-T Q, R) updated by Givens rotations. A bound is a constraint with a unit
 /// normal, so adding one costs O(n (n - q)) and needs no product with C. It suits the condensed
 /// NMPC QP (80 variables) where few constraints are active, as qpOASES does for ACADO (paper 000).
+///
+/// A sequence of similar QPs (the NMPC's calls at 200 Hz) starts each solve from the previous
+/// solve's active set (DenseQpOptions::warm_start): the method may start from any active set whose
+/// equality-constrained minimum has non-negative multipliers (Goldfarb and Idnani's S-pair), so the
+/// previous set is taken, its minimum for the new g and bounds computed from the factorisation, and
+/// constraints whose multipliers turn negative dropped before the usual iterations.
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +29,12 @@ struct DenseQpOptions {
   double feasibility_tolerance = 1e-9;
   /// Cap on active-set changes (adds plus drops); >= 1.
   int max_iterations = 1000;
+  /// Start from the previous solve's active set (after a solve that succeeded): with its
+  /// factorisation J, R kept when no Factorize came in between and the active constraints' rows
+  /// of C are unchanged (a hot start: no Givens sweep for the constraints that stay), else rebuilt
+  /// by adding those constraints to the new factorisation (a warm start). The solution is the same
+  /// as from the unconstrained minimum; only the work to reach it differs (docs/control.md).
+  bool warm_start = true;
   void Validate() const;
 };
 
@@ -35,9 +47,21 @@ enum class QpStatus {
 };
 std::string_view ToString(QpStatus status);
 
+/// How a solve started (DenseQpOptions::warm_start).
+enum class QpStart {
+  kCold,  ///< from the unconstrained minimum
+  kWarm,  ///< from the previous active set, refactorised for the new Hessian
+  kHot,   ///< from the previous active set and its kept factorisation
+};
+std::string_view ToString(QpStart start);
+
 struct DenseQpSummary {
   QpStatus status = QpStatus::kNotSolved;
-  int iterations = 0;          ///< active-set changes
+  QpStart start = QpStart::kCold;
+  /// Active constraints the iterations started from: the previous solve's that kept a
+  /// non-negative multiplier (0 for a cold start).
+  int start_active_constraints = 0;
+  int iterations = 0;          ///< active-set changes after the start
   int active_constraints = 0;  ///< at the returned point
   double objective = 0.0;      ///< 1/2 z'Hz + g'z
   double max_violation = 0.0;  ///< largest constraint violation at the returned point
@@ -84,7 +108,25 @@ class DenseQpSolver {
     int index;
     double sign;
   };
+  /// The side's bound in the form s' z >= b: b = sign * (lower or upper bound).
+  double SignedBound(const DenseQp& qp, const Side& c) const;
   double Slack(const DenseQp& qp, const Side& c) const;
+  /// order_ and placed_ for the next factorisation: the bounds of the last solve's active set
+  /// (a warm start's guess) last.
+  void OrderVariables();
+  /// The empty active set on the factorised Hessian: J = J0, no R.
+  void ClearActiveSet();
+  /// The bounds Factorize ordered last made active with no rotation (their factorisation is in
+  /// J0's structure).
+  void PlaceOrderedBounds();
+  /// The start of the iterations: the kept active set (hot), the previous one added to the new
+  /// factorisation (warm) or none (cold); returns which.
+  QpStart StartActiveSet(const DenseQp& qp);
+  /// z and u, the minimum on the active constraints held as equalities and its multipliers;
+  /// constraints with a negative multiplier are dropped until none is left.
+  void MinimiseOnActiveSet(const DenseQp& qp);
+  /// Keeps what a later hot start needs: the active set of a successful solve and its rows of C.
+  void KeepForWarmStart(const DenseQp& qp);
   void ComputeD(const DenseQp& qp, const Side& c);  // d_ = J' n_c
   double NormalDotStep(const DenseQp& qp, const Side& c) const;
   void AddToActiveSet(const Side& c);
@@ -94,8 +136,14 @@ class DenseQpSolver {
 
   int n_, m_;
   DenseQpOptions options_;
-  Eigen::MatrixXd chol_;   // L with H = L L'
-  Eigen::MatrixXd J0_;     // L^-T of the factorised H
+  Eigen::MatrixXd chol_;   // L with P H P' = L L'
+  // J0 = P' L^-T: H^-1 = J0 J0' with the rows in the variables' order. P orders the variables as
+  // order_ (position -> variable), with the bounds in placed_ last (OrderVariables).
+  Eigen::MatrixXd J0_;
+  std::vector<int> order_;
+  std::vector<Side> placed_;
+  std::vector<char> placed_mark_;  // scratch: per variable, whether it is placed last
+  using IndexList = Eigen::Map<const Eigen::ArrayXi>;
   bool factorized_ = false;
   Eigen::MatrixXd J_;      // L^-T Q
   // Column j of J_ is zero below row height_[j] - 1: L^-T is upper triangular, and a rotation of
@@ -107,6 +155,13 @@ class DenseQpSolver {
   std::vector<Side> active_;
   std::vector<char> is_active_;  // per side: 2 * index + (sign < 0)
   int q_ = 0;
+  // The last successful solve's active set (a warm start's guess), and whether J_, R_ still hold
+  // its factorisation for the factorised Hessian (a hot start's condition), with its rows of C
+  // (a hot start needs them unchanged) and the hot starts since the set was last built from J0.
+  std::vector<Side> previous_;
+  bool hot_startable_ = false;
+  Eigen::MatrixXd previous_rows_;
+  int hot_starts_in_a_row_ = 0;
   DenseQpSummary summary_;
 };
 

@@ -45,6 +45,7 @@ struct OcpQp {
 
 struct OcpQpSummary {
   QpStatus status = QpStatus::kNotSolved;
+  QpStart start = QpStart::kCold;  ///< how the dense solver started (DenseQpOptions::warm_start)
   int iterations = 0;           ///< active-set changes of the dense solver
   int active_constraints = 0;
   double objective = 0.0;
