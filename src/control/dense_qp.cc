@@ -1,6 +1,7 @@
 #include "rotorguard/control/dense_qp.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -191,12 +192,15 @@ void DenseQpSolver::OrderVariables() {
       if (c.index < n_) placed_.push_back(c);
     }
   }
-  std::vector<char>& last = placed_mark_;
-  std::fill(last.begin(), last.end(), 0);
-  for (const Side& c : placed_) last[static_cast<std::size_t>(c.index)] = 1;
+  std::fill(placed_mark_.begin(), placed_mark_.end(), 0);
+  for (const Side& c : placed_) {
+    // Both sides of one variable are never active together (their normals are dependent).
+    assert(!placed_mark_[static_cast<std::size_t>(c.index)]);
+    placed_mark_[static_cast<std::size_t>(c.index)] = 1;
+  }
   int k = 0;
   for (int i = 0; i < n_; ++i) {
-    if (!last[static_cast<std::size_t>(i)]) order_[static_cast<std::size_t>(k++)] = i;
+    if (!placed_mark_[static_cast<std::size_t>(i)]) order_[static_cast<std::size_t>(k++)] = i;
   }
   for (auto c = placed_.rbegin(); c != placed_.rend(); ++c) order_[static_cast<std::size_t>(k++)] = c->index;
 }
@@ -206,9 +210,9 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
   hot_startable_ = false;  // J and R were built on the previous factorisation
   if (H.rows() != n_ || H.cols() != n_ || !H.allFinite()) return false;
   OrderVariables();
-  const bool permuted = !placed_.empty();
+  permuted_ = !placed_.empty();
   const IndexList order(order_.data(), n_);
-  if (permuted) {
+  if (permuted_) {
     chol_ = H(order, order);  // P H P', the variables in order_
   } else {
     chol_ = H;
@@ -219,7 +223,7 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
   // leading (j+1) x (j+1) block, so the columns are solved in panels against growing leading
   // blocks. That is a third of the work of solving against the whole identity (measured:
   // docs/control.md). J_ is free to serve as scratch: a new factorisation ends the hot starts.
-  Eigen::MatrixXd& ordered = permuted ? J_ : J0_;
+  Eigen::MatrixXd& ordered = permuted_ ? J_ : J0_;
   constexpr int kPanel = 8;
   ordered.setZero();
   for (int j0 = 0; j0 < n_; j0 += kPanel) {
@@ -228,7 +232,7 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
     chol_.topLeftCorner(j1, j1).triangularView<Eigen::Lower>().transpose().solveInPlace(ordered.block(0, j0, j1, w));
   }
   // J0 = P' L^-T factorises H^-1 = J0 J0' in the variables' own order; the rows move back to it.
-  if (permuted) J0_(order, Eigen::all) = J_;
+  if (permuted_) J0_(order, Eigen::all) = J_;
   factorized_ = true;
   return true;
 }
@@ -239,8 +243,11 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
   const double factorize_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!ok) {
     summary_ = DenseQpSummary{};
-    q_ = 0;
+    ResetActiveSet();
+    previous_.clear();
     z_.setZero();
+    y_bound_.setZero();
+    y_constraint_.setZero();
     summary_.status = QpStatus::kNumericalFailure;
     summary_.solve_time_s = factorize_s;
     return summary_;
@@ -250,15 +257,19 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
   return summary_;
 }
 
-void DenseQpSolver::ClearActiveSet() {
-  J_ = J0_;
-  // Column j of L^-T is zero below row j; with the rows moved back to the variables' order the
-  // zeros are scattered, and the rotations run over whole columns.
-  const bool permuted = !placed_.empty();
-  for (int j = 0; j < n_; ++j) height_[static_cast<std::size_t>(j)] = permuted ? n_ : j + 1;
+void DenseQpSolver::ResetActiveSet() {
+  hot_startable_ = false;
   q_ = 0;
   active_.clear();
   std::fill(is_active_.begin(), is_active_.end(), 0);
+}
+
+void DenseQpSolver::ClearActiveSet() {
+  ResetActiveSet();
+  J_ = J0_;
+  // Column j of L^-T is zero below row j; with the rows moved back to the variables' order the
+  // zeros are scattered, and the rotations run over whole columns.
+  for (int j = 0; j < n_; ++j) height_[static_cast<std::size_t>(j)] = permuted_ ? n_ : j + 1;
   R_.setZero();
 }
 
@@ -344,6 +355,7 @@ void DenseQpSolver::MinimiseOnActiveSet(const DenseQp& qp) {
 }
 
 void DenseQpSolver::KeepForWarmStart(const DenseQp& qp) {
+  if (!options_.warm_start) return;
   previous_.assign(active_.begin(), active_.end());
   for (int j = 0; j < q_; ++j) {
     if (active_[j].index >= n_) previous_rows_.row(j) = qp.C.row(active_[j].index - n_);
@@ -380,7 +392,9 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
     if (status == QpStatus::kSolved) {
       KeepForWarmStart(qp);
     } else {
-      previous_.clear();  // the next solve starts cold
+      // The next solve starts without this one's set: from the bounds the factorisation placed
+      // last (still a valid start), or cold.
+      previous_.clear();
     }
     summary_.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return summary_;
@@ -388,10 +402,7 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
 
   // Data the method cannot start from: no active set is returned, and the next solve starts cold.
   const auto reject = [&](QpStatus status) -> const DenseQpSummary& {
-    hot_startable_ = false;
-    q_ = 0;
-    active_.clear();
-    std::fill(is_active_.begin(), is_active_.end(), 0);
+    ResetActiveSet();
     if (status == QpStatus::kNumericalFailure) z_.setZero();
     return finish(status);
   };
@@ -411,6 +422,8 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
   summary_.start = StartActiveSet(qp);
   MinimiseOnActiveSet(qp);
   summary_.start_active_constraints = q_;
+  // A start on a nearly dependent set with huge finite bounds could overflow.
+  if (!z_.allFinite()) return reject(QpStatus::kNumericalFailure);
 
   const double tol = options_.feasibility_tolerance;
   while (true) {

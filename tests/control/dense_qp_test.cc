@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -188,10 +189,9 @@ TEST(DenseQp, WarmAndHotStartsMatchBruteForceOnSequencesOfNearbyProblems) {
       ASSERT_EQ(oracle.size(), n);
       EXPECT_LT((solver.z() - oracle).cwiseAbs().maxCoeff(), 1e-8) << "sequence " << sequence << " step " << step;
       // The first solve has no previous set, and one from an empty set is cold.
-      const QpStart expected = step == 0                      ? QpStart::kCold
-                               : step != 4                    ? QpStart::kHot
-                               : previous_active > 0 ? QpStart::kWarm
-                                                              : QpStart::kCold;
+      QpStart expected = QpStart::kHot;
+      if (step == 0 || (step == 4 && previous_active == 0)) expected = QpStart::kCold;
+      if (step == 4 && previous_active > 0) expected = QpStart::kWarm;
       EXPECT_EQ(s.start, expected) << "sequence " << sequence << " step " << step;
       hot += s.start == QpStart::kHot;
       warm += s.start == QpStart::kWarm;
@@ -237,6 +237,51 @@ TEST(DenseQp, WarmAndHotStartsMatchColdStartsOnLargeProblemsInFewerIterations) {
     qp = Perturbed(qp, 0.05, rng);
   }
   EXPECT_LT(warm_iterations, cold_iterations / 3) << warm_iterations << " against " << cold_iterations;
+}
+
+// Hot starts on one factorisation are rebuilt from J0 every 50 solves, so that the rotations'
+// rounding cannot pile up; a failed solve leaves only the bounds the factorisation placed as the
+// next start. Every solve is checked against a cold solver.
+TEST(DenseQp, HotStartsAreRebuiltEveryFiftySolvesAndAFailureLeavesThePlacedBounds) {
+  Rng rng(23);
+  DenseQp qp = RandomQp(30, 10, rng);
+  DenseQpOptions cold_options;
+  cold_options.warm_start = false;
+  DenseQpSolver solver(30, 10), cold(30, 10, cold_options);
+  ASSERT_TRUE(solver.Factorize(qp.H));
+  ASSERT_TRUE(cold.Factorize(qp.H));
+  std::vector<int> warm_steps;
+  for (int step = 0; step < 120; ++step) {
+    const DenseQpSummary& s = solver.SolveFactorized(qp);
+    ASSERT_TRUE(s.IsSolutionUsable()) << s.BriefReport();
+    ASSERT_TRUE(cold.SolveFactorized(qp).IsSolutionUsable());
+    EXPECT_LT((solver.z() - cold.z()).cwiseAbs().maxCoeff(), 1e-8) << "step " << step;
+    if (s.start == QpStart::kWarm) warm_steps.push_back(step);
+    EXPECT_EQ(s.start == QpStart::kCold, step == 0) << "step " << step;
+    qp = Perturbed(qp, 0.05, rng);
+  }
+  EXPECT_EQ(warm_steps, (std::vector<int>{51, 102}));
+  ASSERT_TRUE(solver.Factorize(qp.H));  // places the active bounds last
+  ASSERT_TRUE(cold.Factorize(qp.H));
+  ASSERT_TRUE(solver.SolveFactorized(qp).IsSolutionUsable());
+  ASSERT_GT(solver.summary().start_active_constraints, 0);
+  DenseQp crossed = qp;
+  crossed.lb[0] = 1.0;  // above its upper bound
+  crossed.ub[0] = 0.0;
+  EXPECT_EQ(solver.SolveFactorized(crossed).status, QpStatus::kInfeasible);
+  EXPECT_EQ(solver.summary().active_constraints, 0);
+  EXPECT_EQ(solver.bound_multipliers().cwiseAbs().maxCoeff(), 0.0);
+  const DenseQpSummary& after = solver.SolveFactorized(qp);
+  ASSERT_TRUE(after.IsSolutionUsable());
+  EXPECT_EQ(after.start, QpStart::kWarm);
+  ASSERT_TRUE(cold.SolveFactorized(qp).IsSolutionUsable());
+  EXPECT_LT((solver.z() - cold.z()).cwiseAbs().maxCoeff(), 1e-8);
+  // A factorisation that fails leaves no active set and no multipliers behind.
+  DenseQp indefinite = qp;
+  indefinite.H(0, 0) = -1.0;
+  EXPECT_EQ(solver.Solve(indefinite).status, QpStatus::kNumericalFailure);
+  EXPECT_EQ(solver.bound_multipliers().cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(solver.z().cwiseAbs().maxCoeff(), 0.0);
 }
 
 // min 1/2 |z|^2 + g'z subject to z >= 0 has z = max(0, -g) (a closed form), and the multipliers
@@ -296,8 +341,8 @@ TEST(DenseQp, TheSameProblemAgainHotStartsAtItsSolution) {
 }
 
 // A hot start needs the factorisation of the same normals in the same metric: a changed row of an
-// active constraint, or a new factorisation, rebuilds the set (a warm start); a failed solve, or
-// warm_start off, starts cold.
+// active constraint, or a new factorisation, rebuilds the set (a warm start); a failed solve (with
+// no bound placed by the factorisation), or warm_start off, starts cold.
 TEST(DenseQp, AChangedActiveRowANewFactorisationOrAFailureEndsTheHotStarts) {
   DenseQp qp(2, 1);
   qp.g << -1.0, -1.0;

@@ -4,7 +4,7 @@
 ///
 ///   minimise  1/2 z' H z + g' z   subject to  lb <= z <= ub,  lc <= C z <= uc,
 ///
-/// with H symmetric positive definite. The method starts from the unconstrained minimum and adds
+/// with H symmetric positive definite. A cold solve starts from the unconstrained minimum and adds
 /// violated constraints one at a time, keeping a QR factorisation of the active constraints in the
 /// metric of H (J = L^-T Q, R) updated by Givens rotations. A bound is a constraint with a unit
 /// normal, so adding one costs O(n (n - q)) and needs no product with C. It suits the condensed
@@ -32,8 +32,10 @@ struct DenseQpOptions {
   /// Start from the previous solve's active set (after a solve that succeeded): with its
   /// factorisation J, R kept when no Factorize came in between and the active constraints' rows
   /// of C are unchanged (a hot start: no Givens sweep for the constraints that stay), else rebuilt
-  /// by adding those constraints to the new factorisation (a warm start). The solution is the same
-  /// as from the unconstrained minimum; only the work to reach it differs (docs/control.md).
+  /// from J0 (a warm start: the bounds active when Factorize ran were ordered last and need no
+  /// rotation, the set's other constraints are added). The solution is a cold start's up to
+  /// feasibility_tolerance (the iterations stop at the first point within it); only the work to
+  /// reach it differs (docs/control.md).
   bool warm_start = true;
   void Validate() const;
 };
@@ -50,7 +52,7 @@ std::string_view ToString(QpStatus status);
 /// How a solve started (DenseQpOptions::warm_start).
 enum class QpStart {
   kCold,  ///< from the unconstrained minimum
-  kWarm,  ///< from the previous active set, refactorised for the new Hessian
+  kWarm,  ///< from the previous active set rebuilt on J0 (after a Factorize, a changed row of C)
   kHot,   ///< from the previous active set and its kept factorisation
 };
 std::string_view ToString(QpStart start);
@@ -58,8 +60,9 @@ std::string_view ToString(QpStart start);
 struct DenseQpSummary {
   QpStatus status = QpStatus::kNotSolved;
   QpStart start = QpStart::kCold;
-  /// Active constraints the iterations started from: the previous solve's that kept a
-  /// non-negative multiplier (0 for a cold start).
+  /// Active constraints the iterations started from: those of the guessed set (the previous
+  /// solve's, and for a warm start the bounds Factorize placed) that are independent, finite and
+  /// kept a non-negative multiplier (0 for a cold start).
   int start_active_constraints = 0;
   int iterations = 0;          ///< active-set changes after the start
   int active_constraints = 0;  ///< at the returned point
@@ -114,6 +117,8 @@ class DenseQpSolver {
   /// order_ and placed_ for the next factorisation: the bounds of the last solve's active set
   /// (a warm start's guess) last.
   void OrderVariables();
+  /// No active constraint, and no hot start next (the bookkeeping only; J and R are left).
+  void ResetActiveSet();
   /// The empty active set on the factorised Hessian: J = J0, no R.
   void ClearActiveSet();
   /// The bounds Factorize ordered last made active with no rotation (their factorisation is in
@@ -143,6 +148,7 @@ class DenseQpSolver {
   std::vector<int> order_;
   std::vector<Side> placed_;
   std::vector<char> placed_mark_;  // scratch: per variable, whether it is placed last
+  bool permuted_ = false;          // order_ is not the identity: J0's rows are permuted
   using IndexList = Eigen::Map<const Eigen::ArrayXi>;
   bool factorized_ = false;
   Eigen::MatrixXd J_;      // L^-T Q
