@@ -165,6 +165,13 @@ DenseQp Perturbed(const DenseQp& qp, double scale, Rng& rng) {
   return next;
 }
 
+/// Options of a solver that starts every solve from the unconstrained minimum: the comparison.
+DenseQpOptions ColdStarts() {
+  DenseQpOptions options;
+  options.warm_start = false;
+  return options;
+}
+
 // Sequences of nearby problems, solved by one solver that starts from its previous active set and
 // checked against the brute-force oracle; every few problems a new Hessian is factorised, so both
 // the hot start (kept factorisation) and the warm start (rebuilt on the new one) are exercised.
@@ -210,11 +217,8 @@ TEST(DenseQp, WarmAndHotStartsMatchBruteForceOnSequencesOfNearbyProblems) {
 TEST(DenseQp, WarmAndHotStartsMatchColdStartsOnLargeProblemsInFewerIterations) {
   Rng rng(11);
   DenseQp qp = RandomQp(80, 60, rng);
-  DenseQpOptions cold_options;
-  cold_options.warm_start = false;
-  DenseQpSolver warm(80, 60), cold(80, 60, cold_options);
-  ASSERT_TRUE(warm.Factorize(qp.H));
-  ASSERT_TRUE(cold.Factorize(qp.H));
+  DenseQpSolver warm(80, 60), cold(80, 60, ColdStarts());
+  ASSERT_TRUE(warm.Factorize(qp.H) && cold.Factorize(qp.H));
   int warm_iterations = 0, cold_iterations = 0;
   for (int step = 0; step < 30; ++step) {
     if (step % 10 == 5) {  // a new Hessian: the warm start rebuilds the active set on it
@@ -245,11 +249,8 @@ TEST(DenseQp, WarmAndHotStartsMatchColdStartsOnLargeProblemsInFewerIterations) {
 TEST(DenseQp, HotStartsAreRebuiltEveryFiftySolvesAndAFailureLeavesThePlacedBounds) {
   Rng rng(23);
   DenseQp qp = RandomQp(30, 10, rng);
-  DenseQpOptions cold_options;
-  cold_options.warm_start = false;
-  DenseQpSolver solver(30, 10), cold(30, 10, cold_options);
-  ASSERT_TRUE(solver.Factorize(qp.H));
-  ASSERT_TRUE(cold.Factorize(qp.H));
+  DenseQpSolver solver(30, 10), cold(30, 10, ColdStarts());
+  ASSERT_TRUE(solver.Factorize(qp.H) && cold.Factorize(qp.H));
   std::vector<int> warm_steps;
   for (int step = 0; step < 120; ++step) {
     const DenseQpSummary& s = solver.SolveFactorized(qp);
@@ -369,9 +370,7 @@ TEST(DenseQp, AChangedActiveRowANewFactorisationOrAFailureEndsTheHotStarts) {
   EXPECT_EQ(solver.summary().active_constraints, 0);
   ASSERT_TRUE(solver.SolveFactorized(qp).IsSolutionUsable());
   EXPECT_EQ(solver.summary().start, QpStart::kCold);
-  DenseQpOptions options;
-  options.warm_start = false;
-  DenseQpSolver cold(2, 1, options);
+  DenseQpSolver cold(2, 1, ColdStarts());
   for (int i = 0; i < 2; ++i) {
     ASSERT_TRUE(cold.Solve(qp).IsSolutionUsable());
     EXPECT_EQ(cold.summary().start, QpStart::kCold);
