@@ -599,7 +599,9 @@ void ParseStack(const ConfigNode& node, stack::FlightStackOptions* o, modular::A
     ReadOptional(*n, "log_odds_max", &m.log_odds_max);
     ReadOptional(*n, "occupied_threshold", &m.occupied_threshold);
     ReadOptional(*n, "max_clearing_range_m", &m.max_clearing_range_m);
-    if (const auto v = n->Optional("clearing_stride")) m.clearing_stride = static_cast<int>(v->AsIntIn(1, perception::VoxelMapOptions::kMaxClearingStride));
+    if (const auto v = n->Optional("clearing_stride")) {
+      m.clearing_stride = static_cast<int>(v->AsIntIn(1, perception::VoxelMapOptions::kMaxClearingStride));
+    }
     ReadOptional(*n, "recenter_hysteresis_m", &m.recenter_hysteresis_m);
     n->RejectUnknownKeys();
     ValidateAt(*n, [&] { o->lidar.Validate(); });

@@ -187,10 +187,8 @@ void DenseQpSolver::OrderVariables() {
   // trailing columns factorise them as they stand (StartActiveSet); the other variables keep
   // their order.
   placed_.clear();
-  if (options_.warm_start) {
-    for (const Side& c : previous_) {
-      if (c.index < n_) placed_.push_back(c);
-    }
+  for (const Side& c : previous_) {
+    if (c.index < n_) placed_.push_back(c);
   }
   std::fill(placed_mark_.begin(), placed_mark_.end(), 0);
   for (const Side& c : placed_) {
@@ -239,19 +237,8 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
 
 const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
   const auto start = std::chrono::steady_clock::now();
-  const bool ok = Factorize(qp.H);
+  Factorize(qp.H);  // when it fails, SolveFactorized reports the numerical failure
   const double factorize_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!ok) {
-    summary_ = DenseQpSummary{};
-    ResetActiveSet();
-    previous_.clear();
-    z_.setZero();
-    y_bound_.setZero();
-    y_constraint_.setZero();
-    summary_.status = QpStatus::kNumericalFailure;
-    summary_.solve_time_s = factorize_s;
-    return summary_;
-  }
   SolveFactorized(qp);
   summary_.solve_time_s += factorize_s;
   return summary_;
@@ -278,8 +265,9 @@ QpStart DenseQpSolver::StartActiveSet(const DenseQp& qp) {
   // (hot_startable_), the active rows of C as they were, and a bounded number of hot starts in a
   // row, since each adds its rotations' rounding to J and R (a rebuild from J0 every
   // kMaxHotStartsInARow solves costs one warm start).
+  // (With warm_start off nothing is ever kept: KeepForWarmStart is where the option acts.)
   constexpr int kMaxHotStartsInARow = 50;
-  bool hot = options_.warm_start && hot_startable_ && hot_starts_in_a_row_ < kMaxHotStartsInARow;
+  bool hot = hot_startable_ && hot_starts_in_a_row_ < kMaxHotStartsInARow;
   for (int j = 0; hot && j < q_; ++j) {
     const Side& c = active_[j];
     hot = c.index < n_ || qp.C.row(c.index - n_) == previous_rows_.row(j);
@@ -291,7 +279,7 @@ QpStart DenseQpSolver::StartActiveSet(const DenseQp& qp) {
   } else {
     hot_starts_in_a_row_ = 0;
     ClearActiveSet();
-    start = options_.warm_start && (!placed_.empty() || !previous_.empty()) ? QpStart::kWarm : QpStart::kCold;
+    start = !placed_.empty() || !previous_.empty() ? QpStart::kWarm : QpStart::kCold;
   }
   if (start == QpStart::kWarm) {
     PlaceOrderedBounds();
@@ -379,7 +367,7 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
         y_constraint_[c.index - n_] += c.sign * u_[j];
       }
     }
-    if (z_.allFinite()) {
+    if (status != QpStatus::kNumericalFailure && z_.allFinite()) {  // the data may hold NaN
       step_.noalias() = qp.H * z_;
       summary_.objective = 0.5 * z_.dot(step_) + qp.g.dot(z_);
       double violation = ((qp.lb - z_).cwiseMax(z_ - qp.ub)).maxCoeff();
@@ -400,7 +388,8 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
     return summary_;
   };
 
-  // Data the method cannot start from: no active set is returned, and the next solve starts cold.
+  // Data the method cannot start from (or a start that overflowed): no active set and no
+  // multipliers are returned, z is zero for a numerical failure, and finish forgets the guess.
   const auto reject = [&](QpStatus status) -> const DenseQpSummary& {
     ResetActiveSet();
     if (status == QpStatus::kNumericalFailure) z_.setZero();

@@ -320,20 +320,19 @@ TEST(DenseQp, TheSameProblemAgainHotStartsAtItsSolution) {
     const Eigen::VectorXd first = solver.z();
     const int active = solver.summary().active_constraints;
     ASSERT_GT(active, 5);
-    const DenseQpSummary& again = solver.SolveFactorized(qp);
-    ASSERT_TRUE(again.IsSolutionUsable());
-    EXPECT_EQ(again.start, QpStart::kHot);
-    EXPECT_EQ(again.start_active_constraints, active);
-    EXPECT_EQ(again.iterations, 0);
-    EXPECT_LT((solver.z() - first).cwiseAbs().maxCoeff(), 1e-12);
+    // Solved again, the problem starts at its solution: all its constraints, no iteration.
+    const auto expect_start_at_solution = [&](QpStart start, double tolerance) {
+      const DenseQpSummary& s = solver.SolveFactorized(qp);
+      ASSERT_TRUE(s.IsSolutionUsable());
+      EXPECT_EQ(s.start, start);
+      EXPECT_EQ(s.start_active_constraints, active);
+      EXPECT_EQ(s.iterations, 0);
+      EXPECT_LT((solver.z() - first).cwiseAbs().maxCoeff(), tolerance);
+    };
+    expect_start_at_solution(QpStart::kHot, 1e-12);
     // Factorised anew, with the active bounds ordered last: the warm start is the solution too.
     ASSERT_TRUE(solver.Factorize(qp.H));
-    const DenseQpSummary& warm = solver.SolveFactorized(qp);
-    ASSERT_TRUE(warm.IsSolutionUsable());
-    EXPECT_EQ(warm.start, QpStart::kWarm);
-    EXPECT_EQ(warm.start_active_constraints, active);
-    EXPECT_EQ(warm.iterations, 0);
-    EXPECT_LT((solver.z() - first).cwiseAbs().maxCoeff(), 1e-10);
+    expect_start_at_solution(QpStart::kWarm, 1e-10);
     lower += (solver.bound_multipliers().array() > 0.0).count();
     upper += (solver.bound_multipliers().array() < 0.0).count();
   }
@@ -408,6 +407,7 @@ TEST(DenseQp, NonFiniteOrIndefiniteDataIsANumericalFailureNotACrash) {
   DenseQpSolver solver(2, 0);
   EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure);
   EXPECT_TRUE(solver.z().allFinite());
+  EXPECT_EQ(solver.summary().objective, 0.0);  // not a product with the NaN data
   qp.g << 0.0, 1.0;
   qp.H << 1.0, 0.0, 0.0, -1.0;
   EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure);
