@@ -6,35 +6,13 @@
 
 namespace rotorguard {
 
-namespace {
-/// a = sin|θ| / |θ| and b = (1 - cos|θ|) / |θ|^2 of Rodrigues' formula from t2 = |θ|^2; below
-/// 0.05 rad the series to |θ|^6, which leaves terms below 1e-16.
-void RodriguesCoefficients(double t2, double* a, double* b) {
-  if (t2 < 0.05 * 0.05) {
-    *a = 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0));
-    *b = 0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0)));
-  } else {
-    const double angle = std::sqrt(t2);
-    *a = std::sin(angle) / angle;
-    *b = (1.0 - std::cos(angle)) / t2;
-  }
-}
-}  // namespace
 
 Matrix3 ExpSO3(const Vector3& theta) {
   // R = I + a K + b K^2, K = Skew(theta).
   double a, b;
-  RodriguesCoefficients(theta.squaredNorm(), &a, &b);
+  internal::RodriguesCoefficients(theta.squaredNorm(), &a, &b);
   const Matrix3 K = Skew(theta);
   return Matrix3::Identity() + a * K + b * (K * K);
-}
-
-Vector3 ExpSO3Times(const Vector3& theta, const Vector3& v) {
-  // R v = v + a θ x v + b θ x (θ x v).
-  double a, b;
-  RodriguesCoefficients(theta.squaredNorm(), &a, &b);
-  const Vector3 c = theta.cross(v);
-  return v + a * c + b * theta.cross(c);
 }
 
 void SinCosOfTurns(double u, double* sin_out, double* cos_out) {

@@ -119,6 +119,26 @@ TEST(VoxelMap, InflationMatchesBruteForceAlsoAfterTheWindowMoves) {
     }
   };
   check("after insertion");
+  // A frame that frees voxels and occupies others: the same returns seen from another origin, so
+  // that rays through earlier returns miss them (the layer is updated after the frame's updates,
+  // InflateFlipped, with several voxels flipping each way in one frame).
+  {
+    const std::vector<Vector3> before = map.OccupiedVoxels();
+    std::vector<Eigen::Vector3f> moved;
+    for (int k = 0; k < 300; ++k) moved.emplace_back(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(0.1, 1.9));
+    for (int repeat = 0; repeat < 3; ++repeat) map.Insert(Vector3(0.3, -0.2, 1.1), moved);
+    const std::vector<Vector3> after = map.OccupiedVoxels();
+    const auto count_missing = [](const std::vector<Vector3>& from, const std::vector<Vector3>& in) {
+      int missing = 0;
+      for (const Vector3& v : from) {
+        missing += std::none_of(in.begin(), in.end(), [&](const Vector3& w) { return (v - w).norm() < 1e-9; });
+      }
+      return missing;
+    };
+    ASSERT_GT(count_missing(before, after), 10) << "voxels freed";
+    ASSERT_GT(count_missing(after, before), 10) << "voxels occupied";
+  }
+  check("after frames that freed and occupied voxels");
   map.Recenter(Vector3(1.37, -0.82, 0.3));
   check("after a small move");
   map.Recenter(Vector3(4.9, 3.1, 0.6));
