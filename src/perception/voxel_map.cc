@@ -74,22 +74,23 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   max_q_ = fixed(options_.log_odds_max);
   occupied_q_ = fixed(options_.occupied_threshold);
   cells_.assign(n, Cell{});
-  inflation_.assign(n, 0);
   settled_free_.assign(n / 64, 0);  // n is a multiple of 512 (at least 8 voxels per axis)
   occupied_.assign(n / 64, 0);
+  inflated_known_.assign(n / 64, 0);
+  inflated_.assign(n / 64, 0);
   // Offsets whose voxel centres lie within the radius of the centre voxel's.
   const int r = static_cast<int>(std::ceil(options_.inflation_radius_m / res_));
-  stencil_radius_ = r;
   const double r2 = std::pow(options_.inflation_radius_m / res_ + 1e-9, 2);
+  std::vector<Index> stencil;
   for (int x = -r; x <= r; ++x) {
     for (int y = -r; y <= r; ++y) {
       for (int z = -r; z <= r; ++z) {
-        if (x * x + y * y + z * z <= r2) stencil_.emplace_back(x, y, z);
+        if (x * x + y * y + z * z <= r2) stencil.emplace_back(x, y, z);
       }
     }
   }
   // Each (x, y) of the stencil holds a symmetric run of z (the ball's section), in order.
-  for (const Index& o : stencil_) {
+  for (const Index& o : stencil) {
     if (stencil_columns_.empty() || stencil_columns_.back().dx != o.x() || stencil_columns_.back().dy != o.y()) {
       stencil_columns_.push_back({o.x(), o.y(), o.z(), o.z()});
     }
@@ -214,39 +215,36 @@ VoxelMap::Index VoxelMap::IndexOf(std::size_t address) const {
                          PositiveMod(w.z() - origin_.z(), size_.z()));
 }
 
-template <typename F>
-void VoxelMap::ForEachStencilColumn(const Index& i, F&& f) const {
+bool VoxelMap::AnyOccupiedWithinRadius(const Index& i) const {
   const int z_min = origin_.z(), z_max = origin_.z() + size_.z() - 1, z_mask = size_.z() - 1;
   for (const StencilColumn& c : stencil_columns_) {
     const Index bottom(i.x() + c.dx, i.y() + c.dy, z_min);  // the column's (x, y) at the window's floor
     if (!InWindow(bottom)) continue;
     const std::size_t base = Address(bottom) & ~static_cast<std::size_t>(z_mask);  // its (x, y) fields
-    f(base, std::max(i.z() + c.z_lo, z_min), std::min(i.z() + c.z_hi, z_max));
+    // The column's bits in runs of consecutive addresses, each up to the end of a word or to where
+    // z wraps around the ring: one or two words for the default window (64 voxels tall).
+    const int z1 = std::min(i.z() + c.z_hi, z_max);
+    for (int z = std::max(i.z() + c.z_lo, z_min); z <= z1;) {
+      const std::size_t address = base | static_cast<std::size_t>(z & z_mask);
+      const int run = std::min({z1 - z + 1, 64 - static_cast<int>(address & 63), size_.z() - (z & z_mask)});
+      const std::uint64_t mask = run == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << run) - 1;
+      if ((occupied_[address >> 6] >> (address & 63)) & mask) return true;
+      z += run;
+    }
   }
+  return false;
 }
 
-void VoxelMap::Inflate(const Index& i, int delta) {
-  const int z_mask = size_.z() - 1;
-  ForEachStencilColumn(i, [&](std::size_t base, int z0, int z1) {
-    for (int z = z0; z <= z1; ++z) {
-      std::uint16_t& count = inflation_[base | static_cast<std::size_t>(z & z_mask)];
-      count = static_cast<std::uint16_t>(count + delta);
-    }
-  });
-}
-
-void VoxelMap::InflateFlipped() {
-  constexpr std::size_t kPrefetchAhead = 4;
-  const int z_mask = size_.z() - 1;
-  for (std::size_t k = 0; k < flipped_.size(); ++k) {
-    if (k + kPrefetchAhead < flipped_.size()) {
-      ForEachStencilColumn(IndexOf(flipped_[k + kPrefetchAhead].address), [&](std::size_t base, int z0, int z1) {
-        if (z0 <= z1) __builtin_prefetch(inflation_.data() + (base | static_cast<std::size_t>(z0 & z_mask)), 1);
-      });
-    }
-    Inflate(IndexOf(flipped_[k].address), flipped_[k].delta);
+bool VoxelMap::Inflated(std::size_t address) const {
+  if (!inflated_memo_valid_) {
+    std::fill(inflated_known_.begin(), inflated_known_.end(), 0);
+    inflated_memo_valid_ = true;
   }
-  flipped_.clear();
+  if (GetBit(inflated_known_.data(), address)) return GetBit(inflated_.data(), address);
+  const bool inflated = AnyOccupiedWithinRadius(IndexOf(address));
+  SetBit(&inflated_known_, address, true);
+  SetBit(&inflated_, address, inflated);
+  return inflated;
 }
 
 void VoxelMap::Recenter(const Vector3& center_W) {
@@ -257,10 +255,10 @@ void VoxelMap::Recenter(const Vector3& center_W) {
     if (std::abs(target[k] - origin_[k]) > hysteresis_voxels_) new_origin[k] = target[k];
   }
   if (new_origin == origin_) return;
+  inflated_memo_valid_ = false;  // its addresses hold other voxels now
   const Index shift = new_origin - origin_;
   if ((shift.cwiseAbs().array() >= size_.array()).any()) {  // nothing stays
     for (Cell& c : cells_) c = Cell{0, c.stamp, 0};  // the frame stamps stay valid
-    std::fill(inflation_.begin(), inflation_.end(), 0);
     std::fill(settled_free_.begin(), settled_free_.end(), 0);
     std::fill(occupied_.begin(), occupied_.end(), 0);
     occupied_count_ = 0;
@@ -287,56 +285,15 @@ void VoxelMap::Recenter(const Vector3& center_W) {
       }
     }
   };
-  // Forget them (the occupied ones' inflation of the voxels that stay goes too), then free their
-  // slots.
-  for_each_leaving([&](const Index& i) {
-    if (!Occupied(cells_[Address(i)])) return;
-    --occupied_count_;
-    Inflate(i, -1);
-  });
+  // Forget them: free their slots.
   for_each_leaving([&](const Index& i) {
     const std::size_t address = Address(i);
+    occupied_count_ -= Occupied(cells_[address]) ? 1 : 0;
     cells_[address] = Cell{0, cells_[address].stamp, 0};
-    inflation_[address] = 0;
     SetSettledFree(address, false);
     SetBit(&occupied_, address, false);
   });
-  const Index old_origin = origin_;
   SetOrigin(new_origin);
-  // The voxels that entered (in the freed slots, all unknown) get the inflation of the occupied
-  // voxels within the radius of them. Those lie in the part of the window that stayed, in a band
-  // of the radius along each entering face; each is visited once (corners belong to the first
-  // axis' band).
-  const Index keep_lo = old_origin.cwiseMax(new_origin), keep_hi = (old_origin + size_).cwiseMin(new_origin + size_);
-  const auto band = [&](int k, Eigen::Vector2i* range) {
-    (*range)[0] = shift[k] > 0 ? std::max(keep_lo[k], keep_hi[k] - stencil_radius_) : keep_lo[k];
-    (*range)[1] = shift[k] > 0 ? keep_hi[k] : std::min(keep_hi[k], keep_lo[k] + stencil_radius_);
-  };
-  for (int k = 0; k < 3; ++k) {
-    if (shift[k] == 0) continue;
-    Eigen::Vector2i range;
-    band(k, &range);
-    const int a = (k + 1) % 3, b = (k + 2) % 3;
-    Index v;
-    for (v[k] = range[0]; v[k] < range[1]; ++v[k]) {
-      for (v[a] = keep_lo[a]; v[a] < keep_hi[a]; ++v[a]) {
-        for (v[b] = keep_lo[b]; v[b] < keep_hi[b]; ++v[b]) {
-          if (!Occupied(cells_[Address(v)])) continue;
-          bool earlier = false;
-          for (int j = 0; j < k && !earlier; ++j) {
-            Eigen::Vector2i other;
-            band(j, &other);
-            earlier = shift[j] != 0 && v[j] >= other[0] && v[j] < other[1];
-          }
-          if (earlier) continue;
-          for (const Index& o : stencil_) {
-            const Index e = v + o;
-            if (InWindow(e) && !InWindowAt(e, old_origin)) ++inflation_[Address(e)];
-          }
-        }
-      }
-    }
-  }
 }
 
 MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eigen::Vector3f>& points_W) {
@@ -412,7 +369,7 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // ListUnsettledPortable and ListUnsettledAvx2). The voxels a batch lists are updated after,
   // each prefetched ahead, so that the memory latencies of a window larger than the caches
   // overlap. The order of the list changes nothing: a frame misses a voxel at most once, and what
-  // a miss changes besides the cell (the counts, the settled bit, the inflation's +-1) commutes.
+  // a miss changes besides the cell (the count, the settled and occupied bits) commutes.
   // The rays this frame walks (clearing_stride): the others' returns were hit all the same.
   const auto stride = static_cast<std::size_t>(options_.clearing_stride);
   if (stride > 1) {
@@ -470,7 +427,6 @@ MapUpdateSummary VoxelMap::Insert(const Vector3& origin_W, const std::vector<Eig
   // settled ones were never marked).
   for (const std::uint32_t address : handled_) SetSettledFree(address, false);
   handled_.clear();
-  InflateFlipped();
   summary.voxels_traversed = steps;
   summary.voxels_skipped = steps - listed_total;
   summary.voxels_updated = hits + missed;
@@ -622,7 +578,6 @@ void VoxelMap::MarkOccupied(const Vector3& p) {
   if (!InWindow(p)) return;
   const std::size_t address = Address(ToIndex(p));
   Observe(address, max_q_ - min_q_);  // from anywhere to the upper clamp
-  InflateFlipped();
 }
 
 bool VoxelMap::IsOccupied(const Vector3& p) const {
@@ -632,7 +587,7 @@ bool VoxelMap::IsOccupied(const Vector3& p) const {
 
 bool VoxelMap::IsKnown(const Vector3& p) const { return InWindow(p) && cells_[Address(ToIndex(p))].known != 0; }
 
-bool VoxelMap::IsInflated(const Vector3& p) const { return InWindow(p) && inflation_[Address(ToIndex(p))] > 0; }
+bool VoxelMap::IsInflated(const Vector3& p) const { return InWindow(p) && Inflated(Address(ToIndex(p))); }
 
 std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius_m) const {
   if (!p.allFinite() || !(radius_m >= 0.0)) return std::nullopt;
@@ -643,7 +598,7 @@ std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius
   const double half_diagonal = 0.5 * std::sqrt(3.0) * res_;
   std::optional<NearestObstacle> best;
   const auto consider = [&](const Index& i) {
-    if (!InWindow(i) || !Occupied(cells_[Address(i)])) return;
+    if (!InWindow(i) || !OccupiedBit(Address(i))) return;
     const Vector3 q = Center(i);
     const double d = (p - q).norm();
     if (d > radius_m || (best && d >= best->distance_m)) return;
@@ -671,7 +626,7 @@ bool VoxelMap::SegmentCollides(const Vector3& a, const Vector3& b) const {
   if (!a.allFinite() || !b.allFinite()) return true;  // a corrupt query is never declared safe
   bool collides = false;
   TraverseWindow(a / res_, b / res_, [&](std::uint32_t address) {
-    if (inflation_[address] > 0) {
+    if (Inflated(address)) {
       collides = true;
       return false;
     }

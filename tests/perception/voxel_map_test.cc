@@ -92,20 +92,34 @@ TEST(VoxelMap, AClearingStrideWalksOneRayInStrideAndClearsWhereThoseRaysPass) {
 }
 
 // Inflation by the vehicle radius: every voxel whose centre is within the radius of an occupied
-// voxel's centre, checked exhaustively against the list of occupied voxels, also after the window
-// has moved (the layer is kept incrementally and across recentring).
-TEST(VoxelMap, InflationMatchesBruteForceAlsoAfterTheWindowMoves) {
+// voxel's centre, checked exhaustively against the list of occupied voxels, after frames that
+// occupy and free voxels and after the window has moved (queries read the occupied bits a column
+// at a time and remember their answers until the map changes). Per window height: 8 voxels (a
+// word of bits holds 8 columns, z wraps around the ring within a stencil), 64 (a column per word)
+// and 256 (a column spans 4 words, runs cross them).
+class VoxelMapInflation : public ::testing::TestWithParam<double> {};
+
+TEST_P(VoxelMapInflation, MatchesBruteForceAlsoAfterChangesAndWindowMoves) {
   VoxelMapOptions o = Small();
+  o.window_size_m.z() = GetParam();
   o.inflation_radius_m = 0.25;
   o.recenter_hysteresis_m = 0.0;  // every move below shifts all three axes
   VoxelMap map(o);
+  // Returns in a layer at most 1.8 m thick around the sensor (denser rays free more voxels).
+  const Vector3 sensor(0, 0, 0.5 * (map.window_min_W().z() + map.window_max_W().z()));
+  const double half_layer = std::min(0.9, 0.5 * GetParam() - 0.05);
+  const double z_lo = sensor.z() - half_layer, z_hi = sensor.z() + half_layer;
   Rng rng(4);
-  std::vector<Eigen::Vector3f> pts;
-  for (int k = 0; k < 300; ++k) pts.emplace_back(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(0.1, 1.9));
-  map.Insert(Vector3(0, 0, 1), pts);
+  const auto random_returns = [&] {
+    std::vector<Eigen::Vector3f> pts;
+    for (int k = 0; k < 300; ++k) pts.emplace_back(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(z_lo, z_hi));
+    return pts;
+  };
+  map.Insert(sensor, random_returns());
   const auto check = [&](const char* when) {
     const std::vector<Vector3> occ = map.OccupiedVoxels();
     ASSERT_EQ(static_cast<int>(occ.size()), map.occupied_count()) << when;
+    ASSERT_FALSE(occ.empty()) << when;
     Rng q(8);
     for (int k = 0; k < 4000; ++k) {
       // Voxel centres around the occupied ones.
@@ -116,17 +130,19 @@ TEST(VoxelMap, InflationMatchesBruteForceAlsoAfterTheWindowMoves) {
       bool truth = false;
       for (const Vector3& v : occ) truth |= (v - c).norm() <= 0.25 + 1e-9;
       ASSERT_EQ(map.IsInflated(p), truth) << when << " at " << p.transpose();
+      // A segment of one voxel's length there collides when either end's voxel is inflated.
+      if (truth) {
+        ASSERT_TRUE(map.SegmentCollides(c, c + Vector3(0.01, 0.0, 0.0))) << when << " at " << p.transpose();
+      }
     }
   };
   check("after insertion");
-  // A frame that frees voxels and occupies others: the same returns seen from another origin, so
-  // that rays through earlier returns miss them (the layer is updated after the frame's updates,
-  // InflateFlipped, with several voxels flipping each way in one frame).
+  // Frames that free voxels and occupy others: other returns seen from another origin, so that
+  // rays through earlier returns miss them.
   {
     const std::vector<Vector3> before = map.OccupiedVoxels();
-    std::vector<Eigen::Vector3f> moved;
-    for (int k = 0; k < 300; ++k) moved.emplace_back(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(0.1, 1.9));
-    for (int repeat = 0; repeat < 3; ++repeat) map.Insert(Vector3(0.3, -0.2, 1.1), moved);
+    const std::vector<Eigen::Vector3f> moved = random_returns();
+    for (int repeat = 0; repeat < 3; ++repeat) map.Insert(sensor + Vector3(0.3, -0.2, 0.05), moved);
     const std::vector<Vector3> after = map.OccupiedVoxels();
     const auto count_missing = [](const std::vector<Vector3>& from, const std::vector<Vector3>& in) {
       int missing = 0;
@@ -139,13 +155,49 @@ TEST(VoxelMap, InflationMatchesBruteForceAlsoAfterTheWindowMoves) {
     ASSERT_GT(count_missing(after, before), 10) << "voxels occupied";
   }
   check("after frames that freed and occupied voxels");
-  map.Recenter(Vector3(1.37, -0.82, 0.3));
+  const double h = GetParam();  // moves in z scaled to the window's height, so that part stays
+  map.Recenter(sensor + Vector3(1.37, -0.82, 0.1 * h));
   check("after a small move");
-  map.Recenter(Vector3(4.9, 3.1, 0.6));
+  map.Recenter(sensor + Vector3(4.9, 3.1, -0.15 * h));
   check("after a larger move");
+  map.MarkOccupied(sensor + Vector3(4.9, 3.1, -0.1 * h));
+  check("after a voxel marked occupied");
   map.Recenter(Vector3(100, 0, 0));
   EXPECT_EQ(map.occupied_count(), 0) << "everything left";
   EXPECT_TRUE(map.OccupiedVoxels().empty());
+  EXPECT_FALSE(map.IsInflated(Vector3(100, 0, sensor.z())));
+}
+
+INSTANTIATE_TEST_SUITE_P(WindowHeights, VoxelMapInflation, ::testing::Values(0.8, 4.0, 25.6));
+
+// Hand-made cases for the queries' column runs (a word's end, the ring's wrap): one occupied voxel
+// at each height of the window in turn, so at every position of its bit in a word and around the
+// ring, and every voxel of the columns around it checked against the radius (2.5 voxels).
+TEST_P(VoxelMapInflation, OneOccupiedVoxelAtEveryHeight) {
+  VoxelMapOptions o;
+  o.window_size_m = Vector3(1.6, 1.6, GetParam());
+  o.recenter_hysteresis_m = 0.0;  // (at most a quarter of the window)
+  o.inflation_radius_m = 0.25;
+  const auto centre = [](const Vector3& lo, const Eigen::Vector3i& i) {
+    return Vector3(lo + (i.cast<double>() + Vector3::Constant(0.5)) * 0.1);
+  };
+  const int height = VoxelMap(o).size_voxels().z();
+  for (int oz = 0; oz < height; ++oz) {
+    VoxelMap map(o);
+    const Vector3 lo = map.window_min_W();
+    const Eigen::Vector3i occupied(8, 8, oz);
+    map.MarkOccupied(centre(lo, occupied));
+    ASSERT_EQ(map.occupied_count(), 1);
+    for (int x = 5; x <= 11; ++x) {
+      for (int y = 5; y <= 11; ++y) {
+        for (int z = 0; z < height; ++z) {
+          const Eigen::Vector3i q(x, y, z);
+          const bool truth = (q - occupied).cast<double>().norm() <= 2.5 + 1e-9;
+          ASSERT_EQ(map.IsInflated(centre(lo, q)), truth) << "occupied z " << oz << ", query " << q.transpose();
+        }
+      }
+    }
+  }
 }
 
 TEST(VoxelMap, NearestObstacleAndSegmentQueries) {

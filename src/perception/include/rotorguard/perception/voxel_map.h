@@ -5,14 +5,16 @@
 /// Each frame updates log-odds (Thrun, Burgard, Fox, Probabilistic Robotics, Sec. 9.2): the voxel
 /// of every return is hit, the voxels its ray crossed are missed (of every ray, or of one in
 /// clearing_stride), each voxel updated at most once per frame (hits win), so that an obstacle
-/// that moved away is cleared by the rays that now pass through it. Occupied voxels are inflated
-/// by the vehicle radius in a second layer kept up to date incrementally, which the planner's
-/// queries read.
+/// that moved away is cleared by the rays that now pass through it. The planner's queries see
+/// occupied voxels inflated by the vehicle radius, read from a bit per voxel at query time: a
+/// layer of inflation counts kept up to date instead cost a dozen scattered cache lines per voxel
+/// that changed state, a fifth of the map's update.
 #include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
 
+#include "rotorguard/core/huge_pages.h"
 #include "rotorguard/core/types.h"
 
 namespace rotorguard::perception {
@@ -167,9 +169,7 @@ class VoxelMap {
   /// spares the first touch of the cell's line in a window larger than the caches.
   bool SettledFree(std::size_t address) const { return SettledFree(settled_free_.data(), address); }
   /// The same bit read through a pointer the hot loop keeps in a register.
-  static bool SettledFree(const std::uint64_t* bits, std::size_t address) {
-    return (bits[address >> 6] >> (address & 63)) & 1U;
-  }
+  static bool SettledFree(const std::uint64_t* bits, std::size_t address) { return GetBit(bits, address); }
   /// The walk kernels' listing: `address` written at `out`, kept (the end moved past it) unless
   /// its settled bit is set; without a branch, as which voxels are settled is unpredictable.
   static std::uint32_t* ListUnlessSettled(std::uint32_t address, const std::uint64_t* settled, std::uint32_t* out) {
@@ -187,26 +187,24 @@ class VoxelMap {
     handled_.push_back(address);
   }
   /// Bit `address` of a set of bits kept in 64-bit words.
-  static void SetBit(std::vector<std::uint64_t>* bits, std::size_t address, bool value) {
+  static bool GetBit(const std::uint64_t* bits, std::size_t address) { return (bits[address >> 6] >> (address & 63)) & 1U; }
+  static void SetBit(HugePageVector<std::uint64_t>* bits, std::size_t address, bool value) {
     const std::uint64_t bit = std::uint64_t{1} << (address & 63);
     std::uint64_t& word = (*bits)[address >> 6];
     word = value ? word | bit : word & ~bit;
   }
   bool Occupied(const Cell& c) const { return c.log_odds > occupied_q_; }
-  /// Calls f(base, z0, z1) for each column of the inflation stencil around voxel i that meets the
-  /// window: its voxels are the addresses base | (z & z_mask) for z in [z0, z1].
-  template <typename F>
-  void ForEachStencilColumn(const Index& i, F&& f) const;
-  /// Adds delta to the inflation count of every voxel within the radius of voxel i.
-  void Inflate(const Index& i, int delta);
-  /// Applies the inflation of the voxels Observe found flipped (flipped_), a few voxels' stencils
-  /// prefetched ahead: each stencil is a dozen cache lines far apart in a window larger than the
-  /// caches, whose misses serialised when Observe inflated at once (a sixth of the forest's map
-  /// updates). The counts are sums, so their order changes nothing.
-  void InflateFlipped();
+  /// The same, from the occupied bit at this address (kept equal to Occupied of its cell).
+  bool OccupiedBit(std::size_t address) const { return GetBit(occupied_.data(), address); }
+  /// Whether an occupied voxel of the window lies within the inflation radius of voxel i: the
+  /// stencil's columns read as runs of the occupied bits.
+  bool AnyOccupiedWithinRadius(const Index& i) const;
+  /// AnyOccupiedWithinRadius of the voxel at this address, remembered until the occupied bits
+  /// change: the planner's search asks for the same voxels many times (every segment out of a
+  /// cell starts in it), a dozen words each.
+  bool Inflated(std::size_t address) const;
   /// A hit or a miss: the voxel is known and its log-odds move by the step (fixed point),
-  /// clamped; the occupied count follows a change of state, which is queued for the inflation
-  /// layer (InflateFlipped, which every caller runs before it returns).
+  /// clamped; the occupied count and bit follow a change of state.
   void Observe(std::size_t address, int log_odds_step) {
     Cell& cell = cells_[address];
     cell.known = 1;
@@ -217,7 +215,7 @@ class VoxelMap {
     if (was == now) return;
     occupied_count_ += now ? 1 : -1;
     SetBit(&occupied_, address, now);
-    flipped_.push_back({static_cast<std::uint32_t>(address), now ? 1 : -1});
+    inflated_memo_valid_ = false;
   }
   /// One segment's walk through the window's voxels (Amanatides and Woo 1987), in fixed point:
   /// the parameters of the next boundary along each axis and their increments (2^-32 of the
@@ -269,25 +267,23 @@ class VoxelMap {
   Index size_;            // voxels per axis
   Index origin_;          // global index of the window's lower corner
   int hit_q_, miss_q_, min_q_, max_q_, occupied_q_;  // the options' log-odds in fixed point
-  std::vector<Cell> cells_;
-  std::vector<std::uint16_t> inflation_;  // occupied voxels within the radius
-  std::vector<std::uint64_t> settled_free_;  // SettledFree, a bit per address (and MarkHandled's in Insert)
+  HugePageVector<Cell> cells_;
+  HugePageVector<std::uint64_t> settled_free_;  // SettledFree, a bit per address (and MarkHandled's in Insert)
   std::vector<std::uint32_t> handled_;       // the bits MarkHandled set in this frame
-  /// A voxel whose state Observe flipped, not inflated yet: +1 when it became occupied, -1 free.
-  struct Flip {
-    std::uint32_t address;
-    int delta;
-  };
-  std::vector<Flip> flipped_;
-  /// Occupied, a bit per address: OccupiedVoxels reads these 512 KB instead of the 16 MB of cells
-  /// (the report's map snapshots call it twice a second).
-  std::vector<std::uint64_t> occupied_;
+  /// Occupied, a bit per address: the planner's queries (IsInflated, SegmentCollides, Nearest)
+  /// and OccupiedVoxels read these 512 KB instead of the 16 MB of cells.
+  HugePageVector<std::uint64_t> occupied_;
+  /// Inflated's memo, a bit per address: whether it is known, and its value. Cleared on the first
+  /// query after a change of the occupied bits or of the window (a 512 KB fill, at most once a
+  /// frame): queries fill it, so a map must not be queried from two threads at once.
+  mutable HugePageVector<std::uint64_t> inflated_known_, inflated_;
+  mutable bool inflated_memo_valid_ = false;
   std::uint32_t frame_ = 0;
   std::uint64_t frames_inserted_ = 0;  // Insert's calls, for clearing_stride's choice of rays
-  std::vector<Index> stencil_;            // offsets within the inflation radius
-  /// The stencil as columns along z, the address' fastest axis: a column's voxels are one run of
-  /// consecutive addresses (but where z wraps around the ring), so Inflate computes an (x, y) base
-  /// and a window test once per column rather than per voxel.
+  /// The inflation stencil (the offsets whose voxel centres lie within the radius) as columns
+  /// along z, the address' fastest axis: a column's voxels are one run of consecutive addresses
+  /// (but where z wraps around the ring), so a query computes an (x, y) base and a window test
+  /// once per column and reads its occupied bits a word at a time.
   struct StencilColumn {
     int dx, dy, z_lo, z_hi;  // offsets (dx, dy, z) for z in [z_lo, z_hi]
   };
@@ -300,7 +296,6 @@ class VoxelMap {
     double distance;  // [voxels]
   };
   std::vector<SortedOffset> sorted_offsets_;
-  int stencil_radius_ = 0;                // the stencil's extent along each axis [voxels]
   int hysteresis_voxels_ = 0;             // recenter_hysteresis_m in whole voxels
   /// A frame's returns' addresses, in order; the two codes above any address (a window holds at
   /// most 2^29 voxels: 64 million, each axis rounded up to a power of two) mark a non-finite return and one outside the window.

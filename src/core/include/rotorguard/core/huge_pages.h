@@ -1,0 +1,35 @@
+#pragma once
+/// Storage for large arrays read at random, in 2 MB pages where the kernel grants transparent
+/// huge pages on request (Linux's "madvise" mode, Debian's default). In 4 KB pages each random
+/// access to an array larger than the TLB's reach (a few MB) is also a page-table walk: the
+/// occupancy map's 16 MB of cells and 8 MB of inflation counts, which every LiDAR frame touches
+/// tens of thousands of times at scattered addresses. Elsewhere, or below a huge page, the
+/// storage is ordinary; the contents never differ.
+#include <cstddef>
+#include <vector>
+
+namespace rotorguard {
+
+namespace internal {
+/// `bytes` of storage, aligned to a huge page and advised into them when at least one; throws
+/// std::bad_alloc when none is left.
+void* AllocateHugePageBacked(std::size_t bytes);
+void FreeHugePageBacked(void* p, std::size_t bytes) noexcept;
+}  // namespace internal
+
+/// A standard allocator over AllocateHugePageBacked (stateless: any two compare equal).
+template <typename T>
+struct HugePageAllocator {
+  using value_type = T;
+  HugePageAllocator() = default;
+  template <typename U>
+  explicit HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) { return static_cast<T*>(internal::AllocateHugePageBacked(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t n) noexcept { internal::FreeHugePageBacked(p, n * sizeof(T)); }
+  friend bool operator==(const HugePageAllocator&, const HugePageAllocator&) { return true; }
+};
+
+template <typename T>
+using HugePageVector = std::vector<T, HugePageAllocator<T>>;
+
+}  // namespace rotorguard
