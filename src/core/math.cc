@@ -6,7 +6,6 @@
 
 namespace rotorguard {
 
-
 Matrix3 ExpSO3(const Vector3& theta) {
   // R = I + a K + b K^2, K = Skew(theta).
   double a, b;

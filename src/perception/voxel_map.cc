@@ -222,7 +222,8 @@ bool VoxelMap::AnyOccupiedWithinRadius(const Index& i) const {
     if (!InWindow(bottom)) continue;
     const std::size_t base = Address(bottom) & ~static_cast<std::size_t>(z_mask);  // its (x, y) fields
     // The column's bits in runs of consecutive addresses, each up to the end of a word or to where
-    // z wraps around the ring: one or two words for the default window (64 voxels tall).
+    // z wraps around the ring: in the default window (64 voxels tall) one or two runs of the
+    // column's one word.
     const int z1 = std::min(i.z() + c.z_hi, z_max);
     for (int z = std::max(i.z() + c.z_lo, z_min); z <= z1;) {
       const std::size_t address = base | static_cast<std::size_t>(z & z_mask);

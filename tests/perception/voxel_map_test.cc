@@ -130,10 +130,8 @@ TEST_P(VoxelMapInflation, MatchesBruteForceAlsoAfterChangesAndWindowMoves) {
       bool truth = false;
       for (const Vector3& v : occ) truth |= (v - c).norm() <= 0.25 + 1e-9;
       ASSERT_EQ(map.IsInflated(p), truth) << when << " at " << p.transpose();
-      // A segment of one voxel's length there collides when either end's voxel is inflated.
-      if (truth) {
-        ASSERT_TRUE(map.SegmentCollides(c, c + Vector3(0.01, 0.0, 0.0))) << when << " at " << p.transpose();
-      }
+      // A segment within that voxel collides exactly when the voxel is inflated.
+      ASSERT_EQ(map.SegmentCollides(c, c + Vector3(0.01, 0.0, 0.0)), truth) << when << " at " << p.transpose();
     }
   };
   check("after insertion");
@@ -162,10 +160,24 @@ TEST_P(VoxelMapInflation, MatchesBruteForceAlsoAfterChangesAndWindowMoves) {
   check("after a larger move");
   map.MarkOccupied(sensor + Vector3(4.9, 3.1, -0.1 * h));
   check("after a voxel marked occupied");
-  map.Recenter(Vector3(100, 0, 0));
+  // A move of exactly one window along x: nothing stays, and every voxel takes the address of
+  // one that was there before, whose remembered answers must be gone.
+  std::vector<Vector3> inflated_before;
+  for (const Vector3& v : map.OccupiedVoxels()) {
+    if (map.IsInflated(v)) inflated_before.push_back(v);  // queried: in the memo
+  }
+  ASSERT_FALSE(inflated_before.empty());
+  const double window_x = map.window_max_W().x() - map.window_min_W().x();
+  // The centre voxel's centre (the window's centre is a voxel corner, which rounding may tip).
+  const Vector3 centre = 0.5 * (map.window_min_W() + map.window_max_W()) + Vector3::Constant(0.05);
+  map.Recenter(centre + Vector3(window_x, 0.0, 0.0));
   EXPECT_EQ(map.occupied_count(), 0) << "everything left";
   EXPECT_TRUE(map.OccupiedVoxels().empty());
-  EXPECT_FALSE(map.IsInflated(Vector3(100, 0, sensor.z())));
+  for (const Vector3& v : inflated_before) {
+    const Vector3 same_address = v + Vector3(window_x, 0.0, 0.0);
+    ASSERT_TRUE(map.InWindow(same_address));
+    ASSERT_FALSE(map.IsInflated(same_address)) << same_address.transpose();
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(WindowHeights, VoxelMapInflation, ::testing::Values(0.8, 4.0, 25.6));

@@ -2,10 +2,12 @@
 /// Storage for large arrays read at random, in 2 MB pages where the kernel grants transparent
 /// huge pages on request (Linux's "madvise" mode, Debian's default). In 4 KB pages each random
 /// access to an array larger than the TLB's reach (a few MB) is also a page-table walk: the
-/// occupancy map's 16 MB of cells and 8 MB of inflation counts, which every LiDAR frame touches
-/// tens of thousands of times at scattered addresses. Elsewhere, or below a huge page, the
-/// storage is ordinary; the contents never differ.
+/// occupancy map's 16 MB of cells, which every LiDAR frame touches tens of thousands of times at
+/// scattered addresses. Elsewhere (a build without MADV_HUGEPAGE, or the kernel's huge pages
+/// off), or below a huge page, the storage is ordinary; the contents never differ.
 #include <cstddef>
+#include <cstdint>
+#include <new>
 #include <vector>
 
 namespace rotorguard {
@@ -21,12 +23,20 @@ void FreeHugePageBacked(void* p, std::size_t bytes) noexcept;
 template <typename T>
 struct HugePageAllocator {
   using value_type = T;
+  // The storage is aligned for operator new's default (or a huge page): no over-aligned types.
+  static_assert(alignof(T) <= __STDCPP_DEFAULT_NEW_ALIGNMENT__, "HugePageAllocator: over-aligned type");
   HugePageAllocator() = default;
   template <typename U>
-  explicit HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
-  T* allocate(std::size_t n) { return static_cast<T*>(internal::AllocateHugePageBacked(n * sizeof(T))); }
+  HugePageAllocator(const HugePageAllocator<U>&) noexcept {}  // NOLINT(google-explicit-constructor): as std::allocator
+  T* allocate(std::size_t n) {
+    if (n > SIZE_MAX / sizeof(T)) throw std::bad_array_new_length();
+    return static_cast<T*>(internal::AllocateHugePageBacked(n * sizeof(T)));
+  }
   void deallocate(T* p, std::size_t n) noexcept { internal::FreeHugePageBacked(p, n * sizeof(T)); }
-  friend bool operator==(const HugePageAllocator&, const HugePageAllocator&) { return true; }
+  template <typename U>
+  friend bool operator==(const HugePageAllocator&, const HugePageAllocator<U>&) {
+    return true;
+  }
 };
 
 template <typename T>

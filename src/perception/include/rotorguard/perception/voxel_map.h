@@ -80,6 +80,7 @@ struct NearestObstacle {
   Vector3 normal_W;  ///< unit vector from the obstacle towards the query (the obstacle's outward normal there)
 };
 
+/// Threads: a map may be read from one thread at a time only; its inflation queries fill a memo.
 class VoxelMap {
  public:
   explicit VoxelMap(const VoxelMapOptions& options);
@@ -106,12 +107,14 @@ class VoxelMap {
   bool IsOccupied(const Vector3& p_W) const;
   /// Observed at least once (hit or missed). Outside the window: false.
   bool IsKnown(const Vector3& p_W) const;
-  /// Within the inflation radius of an occupied voxel. Outside the window: false.
+  /// Within the inflation radius of an occupied voxel. Outside the window: false. Not safe to
+  /// call from two threads at once on one map, nor with SegmentCollides: both fill a memo.
   bool IsInflated(const Vector3& p_W) const;
   /// The nearest occupied voxel within `radius_m` of p, if any.
   std::optional<NearestObstacle> Nearest(const Vector3& p_W, double radius_m) const;
   /// Whether the segment a-b passes through an inflated voxel (unknown and outside-window space
-  /// count as free: the planner is optimistic about what it has not seen).
+  /// count as free: the planner is optimistic about what it has not seen). Fills the same memo
+  /// as IsInflated (one thread at a time).
   bool SegmentCollides(const Vector3& a_W, const Vector3& b_W) const;
 
   /// Centres of all occupied voxels (for scoring and display), in no particular order.
@@ -201,7 +204,7 @@ class VoxelMap {
   bool AnyOccupiedWithinRadius(const Index& i) const;
   /// AnyOccupiedWithinRadius of the voxel at this address, remembered until the occupied bits
   /// change: the planner's search asks for the same voxels many times (every segment out of a
-  /// cell starts in it), a dozen words each.
+  /// cell starts in it), a few dozen words each (29 columns at the stack's 0.3 m).
   bool Inflated(std::size_t address) const;
   /// A hit or a miss: the voxel is known and its log-odds move by the step (fixed point),
   /// clamped; the occupied count and bit follow a change of state.
@@ -274,8 +277,8 @@ class VoxelMap {
   /// and OccupiedVoxels read these 512 KB instead of the 16 MB of cells.
   HugePageVector<std::uint64_t> occupied_;
   /// Inflated's memo, a bit per address: whether it is known, and its value. Cleared on the first
-  /// query after a change of the occupied bits or of the window (a 512 KB fill, at most once a
-  /// frame): queries fill it, so a map must not be queried from two threads at once.
+  /// query after a change of the occupied bits or of the window (a 512 KB fill, once a frame when
+  /// queries follow a frame's updates): queries fill it (see the class' thread note).
   mutable HugePageVector<std::uint64_t> inflated_known_, inflated_;
   mutable bool inflated_memo_valid_ = false;
   std::uint32_t frame_ = 0;
