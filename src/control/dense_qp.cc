@@ -208,9 +208,8 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
   hot_startable_ = false;  // J and R were built on the previous factorisation
   if (H.rows() != n_ || H.cols() != n_ || !H.allFinite()) return false;
   OrderVariables();
-  permuted_ = !placed_.empty();
   const IndexList order(order_.data(), n_);
-  if (permuted_) {
+  if (permuted()) {
     chol_ = H(order, order);  // P H P', the variables in order_
   } else {
     chol_ = H;
@@ -221,7 +220,7 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
   // leading (j+1) x (j+1) block, so the columns are solved in panels against growing leading
   // blocks. That is a third of the work of solving against the whole identity (measured:
   // docs/control.md). J_ is free to serve as scratch: a new factorisation ends the hot starts.
-  Eigen::MatrixXd& ordered = permuted_ ? J_ : J0_;
+  Eigen::MatrixXd& ordered = permuted() ? J_ : J0_;
   constexpr int kPanel = 8;
   ordered.setZero();
   for (int j0 = 0; j0 < n_; j0 += kPanel) {
@@ -230,7 +229,7 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
     chol_.topLeftCorner(j1, j1).triangularView<Eigen::Lower>().transpose().solveInPlace(ordered.block(0, j0, j1, w));
   }
   // J0 = P' L^-T factorises H^-1 = J0 J0' in the variables' own order; the rows move back to it.
-  if (permuted_) J0_(order, Eigen::all) = J_;
+  if (permuted()) J0_(order, Eigen::all) = J_;
   factorized_ = true;
   return true;
 }
@@ -256,7 +255,7 @@ void DenseQpSolver::ClearActiveSet() {
   J_ = J0_;
   // Column j of L^-T is zero below row j; with the rows moved back to the variables' order the
   // zeros are scattered, and the rotations run over whole columns.
-  for (int j = 0; j < n_; ++j) height_[static_cast<std::size_t>(j)] = permuted_ ? n_ : j + 1;
+  for (int j = 0; j < n_; ++j) height_[static_cast<std::size_t>(j)] = permuted() ? n_ : j + 1;
   R_.setZero();
 }
 

@@ -148,7 +148,8 @@ class DenseQpSolver {
   std::vector<int> order_;
   std::vector<Side> placed_;
   std::vector<char> placed_mark_;  // scratch: per variable, whether it is placed last
-  bool permuted_ = false;          // order_ is not the identity: J0's rows are permuted
+  /// order_ is not the identity (some bound is placed last): J0's rows are permuted.
+  bool permuted() const { return !placed_.empty(); }
   using IndexList = Eigen::Map<const Eigen::ArrayXi>;
   bool factorized_ = false;
   Eigen::MatrixXd J_;      // L^-T Q

@@ -1,7 +1,7 @@
 #pragma once
 /// Storage for large arrays read at random, in 2 MB pages where the kernel grants transparent
-/// huge pages on request (Linux's "madvise" mode, Debian's default). In 4 KB pages each random
-/// access to an array larger than the TLB's reach (a few MB) is also a page-table walk: the
+/// huge pages on request (Linux's "madvise" mode; "always" gives them unasked). In 4 KB pages
+/// each random access to an array larger than the TLB's reach (a few MB) is a page-table walk: the
 /// occupancy map's 16 MB of cells, which every LiDAR frame touches tens of thousands of times at
 /// scattered addresses. Elsewhere (a build without MADV_HUGEPAGE, or the kernel's huge pages
 /// off), or below a huge page, the storage is ordinary; the contents never differ.
@@ -27,7 +27,7 @@ struct HugePageAllocator {
   static_assert(alignof(T) <= __STDCPP_DEFAULT_NEW_ALIGNMENT__, "HugePageAllocator: over-aligned type");
   HugePageAllocator() = default;
   template <typename U>
-  HugePageAllocator(const HugePageAllocator<U>&) noexcept {}  // NOLINT(google-explicit-constructor): as std::allocator
+  HugePageAllocator(const HugePageAllocator<U>&) noexcept {}  // implicit, as std::allocator's
   T* allocate(std::size_t n) {
     if (n > SIZE_MAX / sizeof(T)) throw std::bad_array_new_length();
     return static_cast<T*>(internal::AllocateHugePageBacked(n * sizeof(T)));
