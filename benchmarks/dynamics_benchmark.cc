@@ -2,7 +2,7 @@
 // with every sensor. Run: build/bin/dynamics_benchmark
 #include <benchmark/benchmark.h>
 
-#include "rotorguard/bench/scenario.h"
+#include "rotorguard/harness/scenario.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -11,7 +11,7 @@ namespace {
 using namespace rotorguard;
 
 vehicle::VehicleParams ReferenceVehicle() {
-  return bench::LoadVehicle(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml");
+  return harness::LoadVehicle(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml");
 }
 
 void BM_Derivative(benchmark::State& state) {

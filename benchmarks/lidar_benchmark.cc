@@ -12,8 +12,8 @@
 // Run: build/bin/lidar_benchmark
 #include <benchmark/benchmark.h>
 
-#include "rotorguard/bench/perception_bench.h"
-#include "rotorguard/bench/planner_bench.h"
+#include "rotorguard/benchmarks/perception_bench.h"
+#include "rotorguard/benchmarks/planner_bench.h"
 #include "rotorguard/perception/deskew.h"
 #include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/sim/lidar.h"
@@ -22,7 +22,7 @@ namespace {
 
 using namespace rotorguard;
 
-sim::World Forest() { return bench::PerceptionForest(11); }
+sim::World Forest() { return benchmarks::PerceptionForest(11); }
 
 sim::BodyPose PoseAt(TimeNs t) {
   const double s = ToSeconds(t);
@@ -76,9 +76,9 @@ void CastForestRays(benchmark::State& state, const sim::World& forest, sim::RayC
 BENCHMARK_CAPTURE(CastForestRays, auto_kernel, Forest(), sim::RayCasterOptions::CylinderKernel::kAuto);
 BENCHMARK_CAPTURE(CastForestRays, portable_kernel, Forest(), sim::RayCasterOptions::CylinderKernel::kPortable);
 // The same in a forest of `rotorguard bench nav` (fewer, thicker trees).
-BENCHMARK_CAPTURE(CastForestRays, nav_forest_auto_kernel, bench::PlannerForest(22),
+BENCHMARK_CAPTURE(CastForestRays, nav_forest_auto_kernel, benchmarks::PlannerForest(22),
                   sim::RayCasterOptions::CylinderKernel::kAuto);
-BENCHMARK_CAPTURE(CastForestRays, nav_forest_portable_kernel, bench::PlannerForest(22),
+BENCHMARK_CAPTURE(CastForestRays, nav_forest_portable_kernel, benchmarks::PlannerForest(22),
                   sim::RayCasterOptions::CylinderKernel::kPortable);
 
 void MapInsertFrame(benchmark::State& state, perception::VoxelMapOptions::WalkKernel kernel, int clearing_stride = 1) {

@@ -4,11 +4,11 @@
 // Run: build/bin/nmpc_benchmark
 #include <benchmark/benchmark.h>
 
-#include "rotorguard/bench/scenario.h"
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/control/nmpc_model.h"
 #include "rotorguard/control/ocp_qp.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/harness/scenario.h"
 #include "rotorguard/planning/references.h"
 
 namespace {
@@ -16,7 +16,7 @@ namespace {
 using namespace rotorguard;
 
 vehicle::VehicleParams ReferenceVehicle() {
-  return bench::LoadVehicle(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml");
+  return harness::LoadVehicle(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml");
 }
 
 Eigen::VectorXd SpinningState() {

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "rotorguard/bench/scenario.h"
+#include "rotorguard/harness/scenario.h"
 #include "rotorguard/planning/references.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/stack/flight_stack.h"
@@ -12,7 +12,7 @@
 int main() {
   using namespace rotorguard;
   const vehicle::VehicleParams params =
-      bench::LoadVehicle(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml");
+      harness::LoadVehicle(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml");
   const vehicle::MultirotorModel truth(params);
 
   // The simulator starts the vehicle hovering at 1 m; the stack is asked to hold 1.5 m.

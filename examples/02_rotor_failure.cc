@@ -2,17 +2,17 @@
 // the composite FDD + NMPC stack loses propeller 2 instead of 0. Prints each run's outcome.
 #include <cstdio>
 
-#include "rotorguard/bench/runner.h"
-#include "rotorguard/bench/scenario.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
 
 int main() {
   using namespace rotorguard;
   const std::string file = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/fdd_hover_propeller_loss.yaml";
-  bench::Scenario scenario = bench::LoadScenario(file);
+  harness::Scenario scenario = harness::LoadScenario(file);
   int failures = 0;
   for (int rotor : {0, 2}) {
     scenario.faults.at(0).rotor = rotor;
-    const bench::RunSummary r = bench::RunScenario(scenario);
+    const harness::RunSummary r = harness::RunScenario(scenario);
     std::printf("rotor %d: %s, detected %s on rotor %d after %.3f s, spin %.1f rad/s\n", rotor,
                 r.success ? "success" : r.failure_reason.c_str(), r.fdd && r.fdd->detected ? r.fdd->kind.c_str() : "nothing",
                 r.fdd ? r.fdd->rotor : -1, r.fdd ? r.fdd->latency_s : -1.0, r.max_spin_rad_s);

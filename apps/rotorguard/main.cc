@@ -19,29 +19,34 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include "rotorguard/bench/fdd_calibration.h"
-#include "rotorguard/bench/ftc_bench.h"
-#include "rotorguard/bench/flatness_bench.h"
-#include "rotorguard/bench/bench_campaigns.h"
-#include "rotorguard/bench/campaign.h"
-#include "rotorguard/bench/mars_bench.h"
-#include "rotorguard/bench/nav_bench.h"
-#include "rotorguard/bench/nmpc_bench.h"
-#include "rotorguard/bench/perception_bench.h"
-#include "rotorguard/bench/planner_bench.h"
-#include "rotorguard/bench/qp_bench.h"
-#include "rotorguard/bench/report.h"
-#include "rotorguard/bench/runner.h"
-#include "rotorguard/bench/scenario.h"
-#include "rotorguard/bench/sim_bench.h"
+#include "rotorguard/benchmarks/campaign_bench.h"
+#include "rotorguard/benchmarks/config_files.h"
+#include "rotorguard/benchmarks/fdd_calibration.h"
+#include "rotorguard/benchmarks/flatness_bench.h"
+#include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/benchmarks/mars_bench.h"
+#include "rotorguard/benchmarks/nav_bench.h"
+#include "rotorguard/benchmarks/nmpc_bench.h"
+#include "rotorguard/benchmarks/perception_bench.h"
+#include "rotorguard/benchmarks/planner_bench.h"
+#include "rotorguard/benchmarks/qp_bench.h"
+#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/benchmarks/sim_bench.h"
+#include "rotorguard/buildinfo/build_info.h"
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/campaign/merge.h"
+#include "rotorguard/campaign/slurm.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/io/report_html.h"
+#include "rotorguard/record/report.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-using rotorguard::bench::Override;
+using rotorguard::harness::Override;
 
 enum ExitCode : int { kOk = 0, kRunFailed = 1, kUsage = 2, kUnreadable = 3, kInfeasible = 4 };
 
@@ -127,7 +132,7 @@ std::function<void(int, int)> EtaProgress(const char* what) {
   };
 }
 
-void PrintSummary(const rotorguard::bench::RunSummary& s, const std::string& out_dir, bool csv, bool mcap, bool report) {
+void PrintSummary(const rotorguard::harness::RunSummary& s, const std::string& out_dir, bool csv, bool mcap, bool report) {
   std::string faults;
   for (const auto& f : s.faults) {
     faults += fmt::format("{}rotor {} {} at {:.3f} s", faults.empty() ? "" : "; ", f.rotor, f.kind, f.onset_s);
@@ -202,15 +207,15 @@ int ParseJobs(const std::string& text) {
 }
 
 /// The version recorded in and checked against campaign manifests: the release and the revision.
-std::string ProgramVersion() { return fmt::format("{} ({})", ROTORGUARD_VERSION, rotorguard::bench::GitRevision()); }
+std::string ProgramVersion() { return rotorguard::buildinfo::ProgramVersion(); }
 
 /// A campaign run's options from the command line (shared by `campaign run` and the benchmarks).
-rotorguard::bench::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,
+rotorguard::campaign::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,
                                                            const std::string& shard, bool resume) {
-  rotorguard::bench::CampaignRunOptions o;
+  rotorguard::campaign::CampaignRunOptions o;
   o.out_dir = out;
   o.jobs = ParseJobs(jobs_text);
-  o.shard = rotorguard::bench::Shard::Parse(shard);
+  o.shard = rotorguard::campaign::Shard::Parse(shard);
   o.resume = resume;
   o.version = ProgramVersion();
   return o;
@@ -387,7 +392,7 @@ int main(int argc, char** argv) {
   bench_mars->add_option("--jobs", mars_jobs_text, "Worker threads (default: the number of cores)");
   bench_mars->add_flag("--json", mars_json, "Print JSON instead of Markdown");
 
-  // The campaign benchmarks run on the campaign engine (bench_campaigns.h): their trials can be
+  // The campaign benchmarks run on the campaign engine (benchmarks/registry.h): their trials can be
   // kept, resumed, sharded and merged like a campaign's.
   std::string bench_out, bench_shard = "0/1";
   bool bench_resume = false;
@@ -454,28 +459,28 @@ int main(int argc, char** argv) {
   }
   const auto write_bench_html = [&bench_html](const char* name, const nlohmann::json& result) {
     if (bench_html.empty()) return;
-    rotorguard::bench::WriteBenchReport(name, result, bench_html);
+    rotorguard::record::WriteBenchReport(name, result, bench_html);
     fmt::print(stderr, "report: {}\n", bench_html);
   };
 
   // A benchmark's campaign: its trials in --out (or a temporary folder), then its result printed
   // and, with --out, written as bench.json and bench.md. A shard of several only records its trials.
-  const auto run_bench_campaign = [&](const rotorguard::bench::Campaign& c, const std::string& jobs_text, bool as_json,
+  const auto run_bench_campaign = [&](const rotorguard::campaign::Campaign& c, const std::string& jobs_text, bool as_json,
                                       const char* name) -> std::optional<nlohmann::json> {
-    rotorguard::bench::CampaignRunOptions o = CampaignRunOptionsOf(bench_out, jobs_text, bench_shard, bench_resume);
+    rotorguard::campaign::CampaignRunOptions o = CampaignRunOptionsOf(bench_out, jobs_text, bench_shard, bench_resume);
     if ((o.resume || o.shard.count > 1) && o.out_dir.empty()) {
       throw UsageError(fmt::format("{} needs --out: the folder that keeps the trials", o.resume ? "--resume" : "--shard"));
     }
     o.progress = EtaProgress("trials");
-    const std::optional<std::vector<nlohmann::json>> records = rotorguard::bench::RunCampaignRecords(c, o);
+    const std::optional<std::vector<nlohmann::json>> records = rotorguard::campaign::RunCampaignRecords(c, o);
     if (!records) {
       fmt::print("shard {} of {} done in {}; when every shard is: rotorguard campaign merge {} ...\n", o.shard.index,
                  o.shard.count, o.out_dir, o.out_dir);
       return std::nullopt;
     }
-    const rotorguard::bench::BenchReport r = rotorguard::bench::BenchResult(c.bench, *records);
+    const rotorguard::campaign::BenchReport r = rotorguard::campaign::CampaignResult(c.bench, *records, rotorguard::benchmarks::CampaignKinds());
     write_bench_html(name, r.result);
-    if (!bench_out.empty()) rotorguard::bench::WriteBenchFiles(r, bench_out);
+    if (!bench_out.empty()) rotorguard::campaign::WriteBenchFiles(r, bench_out);
     fmt::print("{}", as_json ? r.result.dump(2) + "\n" : r.markdown);
     return r.result;
   };
@@ -494,15 +499,15 @@ int main(int argc, char** argv) {
       std::vector<Override> overrides = ParseOverrides(sets);
       std::optional<std::uint64_t> seed;
       if (run->count("--seed") > 0) seed = ParseUnsigned("--seed", seed_text, 0, UINT64_MAX);
-      rotorguard::bench::Scenario scenario = rotorguard::bench::LoadScenario(scenario_path, overrides);
+      rotorguard::harness::Scenario scenario = rotorguard::harness::LoadScenario(scenario_path, overrides);
       if (seed) scenario.seed = *seed;
-      rotorguard::bench::RunOptions options;
+      rotorguard::harness::RunOptions options;
       if (log_format == "csv") {
-        options.log_format = rotorguard::bench::LogFormat::kCsv;
+        options.log_format = rotorguard::harness::LogFormat::kCsv;
       } else if (log_format == "mcap") {
-        options.log_format = rotorguard::bench::LogFormat::kMcap;
+        options.log_format = rotorguard::harness::LogFormat::kMcap;
       } else if (log_format == "both") {
-        options.log_format = rotorguard::bench::LogFormat::kBoth;
+        options.log_format = rotorguard::harness::LogFormat::kBoth;
       } else {
         throw UsageError(fmt::format("--log-format: '{}' is invalid; expected csv, mcap or both", log_format));
       }
@@ -519,36 +524,36 @@ int main(int argc, char** argv) {
       ProgressBar bar(!quiet && ::isatty(STDERR_FILENO), scenario.duration_s);
       options.out_dir = out_dir;
       options.progress = [&bar](double f) { bar(f); };
-      const rotorguard::bench::RunSummary summary = rotorguard::bench::RunScenario(scenario, options);
+      const rotorguard::harness::RunSummary summary = rotorguard::harness::RunScenario(scenario, options);
       if (!quiet) {
-        PrintSummary(summary, out_dir, options.log_format != rotorguard::bench::LogFormat::kMcap,
-                     options.log_format != rotorguard::bench::LogFormat::kCsv, options.report);
+        PrintSummary(summary, out_dir, options.log_format != rotorguard::harness::LogFormat::kMcap,
+                     options.log_format != rotorguard::harness::LogFormat::kCsv, options.report);
       }
       if (summary.infeasible_request) return kInfeasible;
       return summary.success ? kOk : kRunFailed;
     }
     if (*report) {
-      const rotorguard::bench::FlightLog log = rotorguard::bench::ReadFlightLog(report_dir);
+      const rotorguard::record::FlightLog log = rotorguard::record::ReadFlightLog(report_dir);
       const std::string path = report_out.empty() ? (fs::path(report_dir) / "report.html").string() : report_out;
-      rotorguard::bench::WriteFlightReport(log, path);
+      rotorguard::record::WriteFlightReport(log, path);
       fmt::print("{}\n", path);
       return kOk;
     }
     if (*validate) {
-      const rotorguard::bench::ValidationReport r = rotorguard::bench::ValidateConfigFile(validate_path);
+      const rotorguard::benchmarks::ValidationReport r = rotorguard::benchmarks::ValidateConfigFile(validate_path);
       fmt::print("{}: valid {} ({})\n", validate_path, r.kind, r.summary);
       return kOk;
     }
     if (*calibrate) {
-      rotorguard::bench::FddCalibrationOptions o;
+      rotorguard::benchmarks::FddCalibrationOptions o;
       o.margin = ParseFinite("--margin", margin_text, 1.0 + 1e-9, 1e6);
-      std::vector<rotorguard::bench::CalibrationLog> logs;
-      for (const std::string& d : calibrate_dirs) logs.push_back(rotorguard::bench::LoadCalibrationLog(d));
+      std::vector<rotorguard::benchmarks::CalibrationLog> logs;
+      for (const std::string& d : calibrate_dirs) logs.push_back(rotorguard::benchmarks::LoadCalibrationLog(d));
       std::string note;
-      o.fdd = rotorguard::bench::RecordedFddOptions(logs, &note);
+      o.fdd = rotorguard::benchmarks::RecordedFddOptions(logs, &note);
       if (!note.empty()) fmt::print(stderr, "note: {}\n", note);
-      const nlohmann::json r = rotorguard::bench::CalibrateCompositeFdd(logs, o);
-      const std::string md = rotorguard::bench::CalibrationMarkdown(r);
+      const nlohmann::json r = rotorguard::benchmarks::CalibrateCompositeFdd(logs, o);
+      const std::string md = rotorguard::benchmarks::CalibrationMarkdown(r);
       if (!calibrate_out.empty()) {
         std::error_code ec;
         fs::create_directories(calibrate_out, ec);
@@ -562,11 +567,11 @@ int main(int argc, char** argv) {
       return kOk;
     }
     if (*bench_sim) {
-      rotorguard::bench::SimBenchOptions o;
+      rotorguard::benchmarks::SimBenchOptions o;
       o.duration_s = ParseFinite("--duration", duration_text, 1e-3, 1e5);
       o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", repetitions_text, 1, 1000));
       const std::string path = bench_scenario.empty() ? DefaultBenchScenario() : bench_scenario;
-      const nlohmann::json result = rotorguard::bench::RunSimBenchmark(rotorguard::bench::LoadScenario(path), o);
+      const nlohmann::json result = rotorguard::benchmarks::RunSimBenchmark(rotorguard::harness::LoadScenario(path), o);
       write_bench_html("sim", result);
       if (json) {
         fmt::print("{}\n", result.dump(2));
@@ -579,11 +584,11 @@ int main(int argc, char** argv) {
       return result["crashed"].get<bool>() ? kRunFailed : kOk;
     }
     if (*bench_ftc) {
-      rotorguard::bench::FtcBenchOptions o;
+      rotorguard::benchmarks::FtcBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_text, 1, 1'000'000));
       o.seed = ParseUnsigned("--seed", ftc_seed_text, 0, UINT64_MAX);
       o.methods.clear();
-      const std::vector<std::string> known = rotorguard::bench::FtcMethods();
+      const std::vector<std::string> known = rotorguard::benchmarks::FtcMethods();
       for (std::size_t start = 0; start <= ftc_methods.size();) {
         const std::size_t comma = std::min(ftc_methods.find(',', start), ftc_methods.size());
         const std::string m = ftc_methods.substr(start, comma - start);
@@ -594,33 +599,33 @@ int main(int argc, char** argv) {
         start = comma + 1;
       }
       const std::string dir = fs::path(DefaultBenchScenario()).parent_path().parent_path().string();
-      o.vehicle = rotorguard::bench::LoadVehicle(dir + "/vehicles/zhou2025_quad.yaml");
-      const std::optional<nlohmann::json> r = run_bench_campaign(rotorguard::bench::FtcCampaign(o), ftc_jobs_text, ftc_json, "ftc");
+      o.vehicle = rotorguard::harness::LoadVehicle(dir + "/vehicles/zhou2025_quad.yaml");
+      const std::optional<nlohmann::json> r = run_bench_campaign(rotorguard::benchmarks::FtcCampaign(o), ftc_jobs_text, ftc_json, "ftc");
       return r && (*r)["errors"].get<int>() > 0 ? kRunFailed : kOk;
     }
     if (*bench_perception) {
-      rotorguard::bench::PerceptionBenchOptions o;
+      rotorguard::benchmarks::PerceptionBenchOptions o;
       o.duration_s = ParseFinite("--duration", perception_duration_text, 1e-3, 600.0);
       o.seed = ParseUnsigned("--seed", perception_seed_text, 0, UINT64_MAX);
       o.progress = CountProgress("runs");
-      const nlohmann::json r = rotorguard::bench::RunPerceptionBenchmark(o);
+      const nlohmann::json r = rotorguard::benchmarks::RunPerceptionBenchmark(o);
       write_bench_html("perception", r);
-      fmt::print("{}", perception_json ? r.dump(2) + "\n" : rotorguard::bench::PerceptionMarkdown(r));
+      fmt::print("{}", perception_json ? r.dump(2) + "\n" : rotorguard::benchmarks::PerceptionMarkdown(r));
       return kOk;
     }
     if (*bench_planner) {
-      rotorguard::bench::PlannerBenchOptions o;
+      rotorguard::benchmarks::PlannerBenchOptions o;
       o.pairs = static_cast<int>(ParseUnsigned("--pairs", planner_pairs_text, 1, 100000));
       o.worlds = static_cast<int>(ParseUnsigned("--worlds", planner_worlds_text, 1, static_cast<std::uint64_t>(o.pairs)));
       o.seed = ParseUnsigned("--seed", planner_seed_text, 0, UINT64_MAX);
       o.progress = CountProgress("plans");
-      const nlohmann::json r = rotorguard::bench::RunPlannerBenchmark(o);
+      const nlohmann::json r = rotorguard::benchmarks::RunPlannerBenchmark(o);
       write_bench_html("planner", r);
-      fmt::print("{}", planner_json ? r.dump(2) + "\n" : rotorguard::bench::PlannerMarkdown(r));
+      fmt::print("{}", planner_json ? r.dump(2) + "\n" : rotorguard::benchmarks::PlannerMarkdown(r));
       return kOk;
     }
     if (*bench_nav) {
-      rotorguard::bench::NavBenchOptions o;
+      rotorguard::benchmarks::NavBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", nav_trials_text, 1, 100000));
       o.seed = ParseUnsigned("--seed", nav_seed_text, 0, UINT64_MAX);
       o.kinds.clear();
@@ -633,7 +638,7 @@ int main(int argc, char** argv) {
         o.kinds.push_back(k);
         start = comma + 1;
       }
-      o.base = rotorguard::bench::LoadScenario(fs::path(DefaultBenchScenario()).parent_path().string() + "/forest.yaml");
+      o.base = rotorguard::harness::LoadScenario(fs::path(DefaultBenchScenario()).parent_path().string() + "/forest.yaml");
       if (!nav_replay.empty()) {
         // KIND:SEED[:unaware]
         const std::size_t a = nav_replay.find(':');
@@ -644,38 +649,39 @@ int main(int argc, char** argv) {
           throw UsageError(fmt::format("--replay: '{}' is invalid; expected KIND:SEED or KIND:SEED:unaware, KIND forest or room", nav_replay));
         }
         const std::uint64_t seed = ParseUnsigned("--replay", nav_replay.substr(a + 1, b == std::string::npos ? b : b - a - 1), 0, UINT64_MAX);
-        const rotorguard::bench::Scenario trial = rotorguard::bench::MakeNavTrial(o.base, kind, seed, variant.empty());
-        rotorguard::bench::RunOptions replay;
+        const rotorguard::harness::Scenario trial = rotorguard::benchmarks::MakeNavTrial(o.base, kind, seed, variant.empty());
+        rotorguard::harness::RunOptions replay;
         replay.out_dir = bench_out.empty() ? (fs::path("out") / trial.name).string() : bench_out;
         replay.report = rotorguard::io::HasViewer();
-        const rotorguard::bench::RunSummary s = rotorguard::bench::RunScenario(trial, replay);
+        const rotorguard::harness::RunSummary s = rotorguard::harness::RunScenario(trial, replay);
         PrintSummary(s, replay.out_dir, true, false, replay.report);
         return s.success ? kOk : kRunFailed;
       }
-      run_bench_campaign(rotorguard::bench::NavCampaign(o), nav_jobs_text, nav_json, "nav");
+      run_bench_campaign(rotorguard::benchmarks::NavCampaign(o), nav_jobs_text, nav_json, "nav");
       return kOk;
     }
     if (*bench_flatness) {
-      rotorguard::bench::FlatnessBenchOptions o;
+      rotorguard::benchmarks::FlatnessBenchOptions o;
       o.seeds = static_cast<int>(ParseUnsigned("--seeds", flat_seeds_text, 1, 10000));
       o.seed = ParseUnsigned("--seed", flat_seed_text, 0, UINT64_MAX);
       o.jobs = ParseJobs(flat_jobs_text);
-      o.fig2 = rotorguard::bench::LoadScenario(fs::path(DefaultBenchScenario()).parent_path().string() + "/flatness_fig2.yaml");
+      o.fig2 = rotorguard::harness::LoadScenario(fs::path(DefaultBenchScenario()).parent_path().string() + "/flatness_fig2.yaml");
       o.progress = CountProgress("flights");
-      const nlohmann::json r = rotorguard::bench::RunFlatnessBenchmark(o);
+      const nlohmann::json r = rotorguard::benchmarks::RunFlatnessBenchmark(o);
       write_bench_html("flatness", r);
-      fmt::print("{}", flat_json ? r.dump(2) + "\n" : rotorguard::bench::FlatnessMarkdown(r));
+      fmt::print("{}", flat_json ? r.dump(2) + "\n" : rotorguard::benchmarks::FlatnessMarkdown(r));
       return kOk;
     }
     if (*bench_campaign) {
       const fs::path configs = fs::path(DefaultBenchScenario()).parent_path().parent_path();
       const std::string spec_path =
           bcamp_spec.empty() ? (configs / "campaigns" / "bench_campaign.yaml").string() : bcamp_spec;
-      const rotorguard::bench::Campaign spec = rotorguard::bench::LoadCampaign(spec_path);
+      const rotorguard::campaign::Campaign spec = rotorguard::campaign::LoadCampaign(spec_path, rotorguard::benchmarks::CampaignKinds());
       std::optional<rotorguard::io::TemporaryFolder> temporary;  // removed after, also on an error
       if (bcamp_dir.empty()) temporary.emplace("rotorguard-bench-campaign");
       const nlohmann::json r =
-          rotorguard::bench::RunCampaignBenchmark(spec, temporary ? temporary->path() : bcamp_dir, ProgramVersion());
+          rotorguard::benchmarks::RunCampaignBenchmark(spec, temporary ? temporary->path() : bcamp_dir, ProgramVersion(),
+                                                       rotorguard::benchmarks::CampaignKinds());
       write_bench_html("campaign", r);
       if (bcamp_json) {
         fmt::print("{}\n", r.dump(2));
@@ -692,11 +698,11 @@ int main(int argc, char** argv) {
       return same ? kOk : kRunFailed;
     }
     if (*campaign_run) {
-      const rotorguard::bench::Campaign spec = rotorguard::bench::LoadCampaign(campaign_spec);
-      rotorguard::bench::CampaignRunOptions o =
+      const rotorguard::campaign::Campaign spec = rotorguard::campaign::LoadCampaign(campaign_spec, rotorguard::benchmarks::CampaignKinds());
+      rotorguard::campaign::CampaignRunOptions o =
           CampaignRunOptionsOf(campaign_out, campaign_jobs_text, campaign_shard, campaign_resume);
       if (!campaign_quiet) o.progress = EtaProgress("trials");
-      const rotorguard::bench::CampaignRunSummary r = rotorguard::bench::RunCampaign(spec, o);
+      const rotorguard::campaign::CampaignRunSummary r = rotorguard::campaign::RunCampaign(spec, o);
       fmt::print("campaign          {} (spec {})\n", spec.name, spec.hash);
       fmt::print("shard             {}/{}: {} trials, {} already done, {} run, {} error or diverged\n", o.shard.index,
                  o.shard.count, r.trials, r.skipped, r.ran, r.errors);
@@ -704,15 +710,15 @@ int main(int argc, char** argv) {
       return kOk;
     }
     if (*campaign_slurm) {
-      const rotorguard::bench::Campaign spec = rotorguard::bench::LoadCampaign(campaign_spec);
-      rotorguard::bench::SlurmScriptOptions o;
+      const rotorguard::campaign::Campaign spec = rotorguard::campaign::LoadCampaign(campaign_spec, rotorguard::benchmarks::CampaignKinds());
+      rotorguard::campaign::SlurmScriptOptions o;
       o.shards = static_cast<int>(ParseUnsigned("--shards", slurm_shards_text, 1, 1'000'000));
       o.cpus_per_task = static_cast<int>(ParseUnsigned("--cpus-per-task", slurm_cpus_text, 1, 256));
       o.out_dir = campaign_out;
       o.rotorguard = fs::read_symlink("/proc/self/exe").string();
       o.partition = slurm_partition;
       o.time_limit = slurm_time;
-      const std::string script = rotorguard::bench::SlurmArrayScript(spec, o);
+      const std::string script = rotorguard::campaign::SlurmArrayScript(spec, o);
       fs::create_directories(campaign_out);
       const std::string path = (fs::path(campaign_out) / "campaign.sbatch").string();
       rotorguard::io::WriteFileAtomically(path, script);
@@ -724,7 +730,7 @@ int main(int argc, char** argv) {
     }
     if (*campaign_merge) {
       const std::string out = merge_out.empty() ? merge_dirs.front() : merge_out;
-      const nlohmann::json s = rotorguard::bench::MergeCampaign(merge_dirs, out);
+      const nlohmann::json s = rotorguard::campaign::MergeCampaign(merge_dirs, out, rotorguard::benchmarks::CampaignKinds());
       fmt::print("campaign          {}: {} trials merged\n", s["campaign"].get<std::string>(), s["trials"].get<int>());
       fmt::print("summary           {}\n", (fs::path(out) / "summary.json").string());
       fmt::print("                  {}\n", (fs::path(out) / "summary.md").string());
@@ -735,32 +741,32 @@ int main(int argc, char** argv) {
       if (rotorguard::io::HasViewer()) {  // the report viewer's page of any benchmark result
         const std::string html = (fs::path(out) / "summary.html").string();
         if (s.contains("bench")) {
-          rotorguard::bench::WriteBenchReport(s["bench"]["benchmark"].get<std::string>(), s["bench"], html);
+          rotorguard::record::WriteBenchReport(s["bench"]["benchmark"].get<std::string>(), s["bench"], html);
         } else {
-          rotorguard::bench::WriteBenchReport("campaign " + s["campaign"].get<std::string>(), s, html);
+          rotorguard::record::WriteBenchReport("campaign " + s["campaign"].get<std::string>(), s, html);
         }
         fmt::print("                  {}\n", html);
       }
       return kOk;
     }
     if (*bench_mars) {
-      rotorguard::bench::MarsBenchOptions o;
+      rotorguard::benchmarks::MarsBenchOptions o;
       o.trials = static_cast<int>(ParseUnsigned("--trials", mars_trials_text, 1, 10000));
       o.seed = ParseUnsigned("--seed", mars_seed_text, 0, UINT64_MAX);
       const fs::path configs = fs::path(DefaultBenchScenario()).parent_path().parent_path();
-      o.spiral = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_spiral_3x2.yaml").string());
-      o.nine_units = rotorguard::bench::LoadAssembly((configs / "assemblies" / "3x3.yaml").string());
-      o.reconfigure = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_reconfigure_3x1.yaml").string());
-      o.plan_4x1 = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_plan_4x1.yaml").string());
-      o.plan_3x2 = rotorguard::bench::LoadScenario((configs / "scenarios" / "mars_plan_3x2.yaml").string());
-      run_bench_campaign(rotorguard::bench::MarsCampaign(o), mars_jobs_text, mars_json, "mars");
+      o.spiral = rotorguard::harness::LoadScenario((configs / "scenarios" / "mars_spiral_3x2.yaml").string());
+      o.nine_units = rotorguard::harness::LoadAssembly((configs / "assemblies" / "3x3.yaml").string());
+      o.reconfigure = rotorguard::harness::LoadScenario((configs / "scenarios" / "mars_reconfigure_3x1.yaml").string());
+      o.plan_4x1 = rotorguard::harness::LoadScenario((configs / "scenarios" / "mars_plan_4x1.yaml").string());
+      o.plan_3x2 = rotorguard::harness::LoadScenario((configs / "scenarios" / "mars_plan_3x2.yaml").string());
+      run_bench_campaign(rotorguard::benchmarks::MarsCampaign(o), mars_jobs_text, mars_json, "mars");
       return kOk;
     }
     if (*bench_nmpc) {
       const std::string dir = fs::path(DefaultBenchScenario()).parent_path().string();
-      const nlohmann::json r = rotorguard::bench::RunNmpcBenchmark(
-          rotorguard::bench::LoadScenario(dir + "/lemniscate_2ms.yaml", {{"stack.controller", "nmpc"}}),
-          rotorguard::bench::LoadScenario(dir + "/nmpc_lemniscate_1ms_rotor0_failed.yaml"));
+      const nlohmann::json r = rotorguard::benchmarks::RunNmpcBenchmark(
+          rotorguard::harness::LoadScenario(dir + "/lemniscate_2ms.yaml", {{"stack.controller", "nmpc"}}),
+          rotorguard::harness::LoadScenario(dir + "/nmpc_lemniscate_1ms_rotor0_failed.yaml"));
       write_bench_html("nmpc", r);
       if (nmpc_json) {
         fmt::print("{}\n", r.dump(2));
@@ -776,9 +782,9 @@ int main(int argc, char** argv) {
       return r["success_nominal"].get<bool>() && r["success_failed"].get<bool>() ? kOk : kRunFailed;
     }
     if (*bench_qp) {
-      rotorguard::bench::QpBenchOptions o;
+      rotorguard::benchmarks::QpBenchOptions o;
       o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", qp_repetitions_text, 1, 1000));
-      const nlohmann::json r = rotorguard::bench::RunQpBenchmark(qp_instance, o);
+      const nlohmann::json r = rotorguard::benchmarks::RunQpBenchmark(qp_instance, o);
       write_bench_html("qp", r);
       if (qp_json) {
         fmt::print("{}\n", r.dump(2));

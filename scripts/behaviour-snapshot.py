@@ -1,0 +1,295 @@
+#!/usr/bin/python3
+"""What a rotorguard build does, minus its timings: a folder to diff against another build's.
+
+Restructuring the code must not change what it computes. This script flies every scenario in
+configs/scenarios/, runs every benchmark at a small size with --json, validates every config file,
+and tries a list of bad command lines, with the build given; it writes what came out, with the
+wall-clock figures removed, into one folder. Two folders made by two builds are then compared with
+`diff -r`: an empty diff means the same flights (log.csv, scene.json, sensors.csv, vehicle.yaml
+byte for byte, the NMPC's solve-time column aside), the same summaries and benchmark figures (timing
+keys aside), and the same error messages and exit codes.
+
+    scripts/behaviour-snapshot.py build/bin/rotorguard /tmp/snap-after [--qp-instance FILE]
+    diff -r /tmp/snap-before /tmp/snap-after
+
+Runs on one core for about ten minutes. Standard library only (Debian's python3).
+"""
+import argparse
+import hashlib
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+# Keys whose values are wall-clock measurements or facts of the machine and the build: left out of
+# the comparison. Everything else a summary or a benchmark reports must be the same.
+TIMING_KEY = re.compile(
+    r"(_ms($|_)|_us($|_)|^wall|realtime|per_s|_per_sim_s|^cost|^host$|^cpu$|^git_revision$|^version$|"
+    r"^started$|^finished$|^date$|scaling_efficiency|^elapsed|^time_s$|_time_s_mean$|solve_time|^meets_.*speed|^meets_targets$)")
+# Output lines that carry timings (the run's table) or the program's own paths.
+TIMING_LINE = re.compile(r"^(simulated |report: |trials/s )")
+# The log's only wall-clock column.
+TIMING_COLUMNS = {"nmpc_ms"}
+
+
+def strip_timing(value, dropped, path=""):
+    if isinstance(value, dict):
+        out = {}
+        for k, v in value.items():
+            if TIMING_KEY.search(k):
+                dropped.add(re.sub(r"\.\d+", ".N", f"{path}.{k}".lstrip(".")))
+                continue
+            out[k] = strip_timing(v, dropped, f"{path}.{k}")
+        return out
+    if isinstance(value, list):
+        return [strip_timing(v, dropped, f"{path}.{i}") for i, v in enumerate(value)]
+    return value
+
+
+def normalised_json(text, dropped, work=None):
+    if work:
+        text = text.replace(work, "WORK")
+    return json.dumps(strip_timing(json.loads(text), dropped), indent=1, sort_keys=True) + "\n"
+
+
+def normalised_csv(text):
+    lines = text.splitlines()
+    header = lines[0].split(",")
+    keep = [i for i, name in enumerate(header) if name not in TIMING_COLUMNS]
+    return "\n".join(",".join(cells[i] for i in keep) for cells in (line.split(",") for line in lines)) + "\n"
+
+
+def digest(text):
+    return hashlib.sha256(text.encode()).hexdigest() + "\n"
+
+
+class Snapshot:
+    def __init__(self, exe, out):
+        self.exe = os.path.abspath(exe)
+        self.out = out
+        self.work = tempfile.mkdtemp(prefix="rotorguard-snapshot-")
+        self.dropped = set()
+
+    def write(self, rel, text):
+        path = os.path.join(self.out, rel)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w") as f:
+            f.write(text)
+
+    def run(self, args, timeout=3600):
+        r = subprocess.run([self.exe] + args, cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+        return r.returncode, r.stdout, r.stderr
+
+    def stdout_lines(self, text):
+        text = text.replace(self.work, "WORK")
+        return "".join(line + "\n" for line in text.splitlines() if not TIMING_LINE.match(line))
+
+    def scenarios(self):
+        folder = os.path.join(ROOT, "configs", "scenarios")
+        for name in sorted(os.listdir(folder)):
+            if not name.endswith(".yaml"):
+                continue
+            stem = name[:-5]
+            run_dir = os.path.join(self.work, "runs", stem)
+            print(f"  run {name}", file=sys.stderr, flush=True)
+            code, out, err = self.run(["run", f"configs/scenarios/{name}", "--out", run_dir, "--no-report"])
+            base = f"scenarios/{stem}/"
+            self.write(base + "exit", f"{code}\n{err}")
+            self.write(base + "stdout", self.stdout_lines(out))
+            for f in ["summary.json", "log.csv", "scene.json", "sensors.csv", "vehicle.yaml"]:
+                path = os.path.join(run_dir, f)
+                if not os.path.exists(path):
+                    self.write(base + f + ".missing", "")
+                    continue
+                text = open(path).read()
+                if f == "summary.json":
+                    self.write(base + f, normalised_json(text, self.dropped))
+                elif f == "log.csv":
+                    self.write(base + f + ".sha256", digest(normalised_csv(text)))
+                else:
+                    self.write(base + f + ".sha256", digest(text))
+
+    def benches(self, qp_instance):
+        runs = os.path.join(self.work, "runs")
+        calibration_runs = [os.path.join(runs, s) for s in
+                            ("hover", "fdd_hover_motor_stop", "fdd_hover_propeller_loss", "takeoff",
+                             "fdd_takeoff_propeller_loss")]
+        cases = {
+            "sim": ["bench", "sim", "--duration", "3", "--repetitions", "1", "--json"],
+            "nmpc": ["bench", "nmpc", "--json"],
+            "ftc": ["bench", "ftc", "--trials", "2", "--json", "--jobs", "2"],
+            "perception": ["bench", "perception", "--duration", "1", "--json"],
+            "planner": ["bench", "planner", "--pairs", "10", "--worlds", "2", "--json"],
+            "nav": ["bench", "nav", "--trials", "1", "--json", "--jobs", "2"],
+            "flatness": ["bench", "flatness", "--seeds", "2", "--json", "--jobs", "2"],
+            "mars": ["bench", "mars", "--trials", "1", "--json", "--jobs", "2"],
+            "campaign": ["bench", "campaign", "--json"],
+            "fdd-calibrate": ["fdd-calibrate", "--json"] + calibration_runs,
+        }
+        if qp_instance:
+            cases["qp"] = ["bench", "qp", "--instance", os.path.abspath(qp_instance), "--repetitions", "1", "--json"]
+        for name, args in cases.items():
+            print(f"  {' '.join(args[:2])}", file=sys.stderr, flush=True)
+            code, out, err = self.run(args)
+            self.write(f"bench/{name}/exit", f"{code}\n{self.stdout_lines(err)}")
+            try:
+                self.write(f"bench/{name}/result.json", normalised_json(out, self.dropped, self.work))
+            except json.JSONDecodeError:
+                self.write(f"bench/{name}/stdout", self.stdout_lines(out))
+
+    def campaigns(self):
+        spec = "configs/campaigns/fdd_hover.yaml"
+        out = os.path.join(self.work, "campaign")
+        code, stdout, err = self.run(["campaign", "run", spec, "--out", out, "--jobs", "2", "--quiet"])
+        self.write("campaign/run", f"{code}\n{self.stdout_lines(stdout)}{err}")
+        code, stdout, err = self.run(["campaign", "merge", out])
+        self.write("campaign/merge", f"{code}\n{self.stdout_lines(stdout)}{err}")
+        if os.path.exists(os.path.join(out, "summary.json")):
+            self.write("campaign/summary.json",
+                       normalised_json(open(os.path.join(out, "summary.json")).read(), self.dropped))
+        slurm = os.path.join(self.work, "slurm")
+        code, stdout, err = self.run(["campaign", "slurm", spec, "--shards", "3", "--out", slurm])
+        self.write("campaign/slurm", f"{code}\n{self.stdout_lines(stdout)}{err}")
+
+    def validations(self):
+        for kind in ("vehicles", "scenarios", "assemblies", "campaigns"):
+            folder = os.path.join(ROOT, "configs", kind)
+            for name in sorted(os.listdir(folder)):
+                code, out, err = self.run(["validate", f"configs/{kind}/{name}"])
+                self.write(f"validate/{kind}/{name}", f"{code}\n{out}{err}")
+
+    def bad_inputs(self):
+        """Command lines and files a user gets wrong: each one's exit code and message."""
+        bad = os.path.join(self.work, "bad")
+        os.makedirs(bad, exist_ok=True)
+        hover = open(os.path.join(ROOT, "configs", "scenarios", "hover.yaml")).read()
+        no_stack = hover.replace("stack:\n  controller: nominal\n", "")
+        vehicle = open(os.path.join(ROOT, "configs", "vehicles", "zhou2025_quad.yaml")).read()
+        files = {
+            "typo_key.yaml": hover.replace("duration_s:", "duration_sec:"),
+            "duplicate_key.yaml": hover + "\nduration_s: 3\n",
+            "unit_string.yaml": hover.replace("duration_s: 10.0", "duration_s: 10s"),
+            "nan.yaml": hover.replace("duration_s: 10.0", "duration_s: .nan"),
+            "no_mission.yaml": re.sub(r"(?ms)^mission:.*?(?=^\S)", "", hover),
+            "bad_fault_rotor.yaml": hover + "\nfaults:\n  - {rotor: 7, kind: motor_stop, onset: {at_time_s: 1.0}}\n",
+            "bad_controller.yaml": no_stack + "\nstack:\n  controller: pid\n",
+            "bad_nmpc.yaml": no_stack + "\nstack:\n  controller: nmpc\n  nmpc: {horizon_steps: 0}\n",
+            "bad_composite.yaml": no_stack + "\nstack:\n  fdd: composite\n  composite_fdd: {motor_index_threshold: -1}\n",
+            "bad_planner.yaml": no_stack + "\nstack:\n  planner: {v_max: -1}\n",
+            "bad_map.yaml": no_stack + "\nstack:\n  map: {resolution_m: 0}\n",
+            "bad_supervisor.yaml": no_stack + "\nstack:\n  supervisor: {max_speed_m_s: 0}\n",
+            "not_yaml.yaml": "a: [1, 2\n",
+            "empty.yaml": "",
+            "list_top.yaml": "- 1\n- 2\n",
+            "negative_mass.yaml": vehicle.replace("mass_kg: 1.15", "mass_kg: -1.15"),
+            "weak_vehicle.yaml": re.sub(r"max_thrust_n: [0-9.]+", "max_thrust_n: 2.0", vehicle),
+        }
+        for name, text in files.items():
+            with open(os.path.join(bad, name), "w") as f:
+                f.write(text)
+        # A vehicle file that points a scenario at the bad vehicles.
+        with open(os.path.join(bad, "weak_scenario.yaml"), "w") as f:
+            f.write(hover.replace("../vehicles/zhou2025_quad.yaml", "weak_vehicle.yaml"))
+        os.makedirs(os.path.join(bad, "empty_dir"), exist_ok=True)
+        cases = [
+            [],
+            ["frobnicate"],
+            ["run"],
+            ["run", "no/such/file.yaml"],
+            ["run", bad],
+            ["run", "configs/scenarios/hover.yaml", "--set", "duration_s=nan"],
+            ["run", "configs/scenarios/hover.yaml", "--set", "duration_s=1e999"],
+            ["run", "configs/scenarios/hover.yaml", "--set", "nosuch.key=1"],
+            ["run", "configs/scenarios/hover.yaml", "--set", "vehicle.mass_kg=-1"],
+            ["run", "configs/scenarios/hover.yaml", "--set", "vehicle.nosuch=1"],
+            ["run", "configs/scenarios/hover.yaml", "--set", "novalue"],
+            ["run", "configs/scenarios/hover.yaml", "--seed", "-1"],
+            ["run", "configs/scenarios/hover.yaml", "--seed", "1e3"],
+            ["run", "configs/scenarios/hover.yaml", "--log-format", "xml"],
+            ["run", "configs/scenarios/hover.yaml", "--bogus"],
+            ["report"],
+            ["report", os.path.join(bad, "empty_dir")],
+            ["report", "no/such/dir"],
+            ["validate", "no/such/file.yaml"],
+            ["fdd-calibrate", os.path.join(bad, "empty_dir")],
+            ["fdd-calibrate", "--margin", "1", os.path.join(bad, "empty_dir")],
+            ["fdd-calibrate", "--margin", "nan", os.path.join(bad, "empty_dir")],
+            ["bench"],
+            ["bench", "sim", "--duration", "inf"],
+            ["bench", "sim", "--duration", "0"],
+            ["bench", "sim", "--repetitions", "0"],
+            ["bench", "sim", "--scenario", "no/such.yaml"],
+            ["bench", "qp"],
+            ["bench", "qp", "--instance", "no/such.json"],
+            ["bench", "qp", "--instance", os.path.join(bad, "not_yaml.yaml")],
+            ["bench", "ftc", "--trials", "0"],
+            ["bench", "ftc", "--methods", "rotorguard,pid"],
+            ["bench", "ftc", "--jobs", "0"],
+            ["bench", "ftc", "--resume"],
+            ["bench", "ftc", "--shard", "1/2"],
+            ["bench", "ftc", "--shard", "2/2", "--out", os.path.join(bad, "shard_out")],
+            ["bench", "nav", "--kinds", "desert"],
+            ["bench", "nav", "--replay", "forest"],
+            ["bench", "nav", "--replay", "desert:1"],
+            ["bench", "nav", "--replay", "forest:x"],
+            ["bench", "mars", "--trials", "0"],
+            ["bench", "planner", "--pairs", "2", "--worlds", "3"],
+            ["bench", "perception", "--duration", "-1"],
+            ["bench", "flatness", "--seeds", "0"],
+            ["bench", "campaign", "--work", ROOT],
+            ["bench", "campaign", "--spec", "no/such.yaml"],
+            ["campaign"],
+            ["campaign", "run", "configs/campaigns/fdd_hover.yaml"],
+            ["campaign", "run", "no/such.yaml", "--out", os.path.join(bad, "c")],
+            ["campaign", "run", "configs/campaigns/fdd_hover.yaml", "--out", os.path.join(bad, "c"), "--shard", "3/2"],
+            ["campaign", "slurm", "configs/campaigns/fdd_hover.yaml", "--shards", "0", "--out", os.path.join(bad, "s")],
+            ["campaign", "merge", os.path.join(bad, "empty_dir")],
+            ["campaign", "merge", "no/such/dir"],
+        ]
+        for name in list(files) + ["weak_scenario.yaml"]:
+            cases.append(["validate", os.path.join(bad, name)])
+            if not name.startswith(("negative_mass", "weak_vehicle")):
+                cases.append(["run", os.path.join(bad, name), "--out", os.path.join(bad, "out")])
+        lines = []
+        for args in cases:
+            code, out, err = self.run(args, timeout=600)
+            shown = " ".join(a.replace(self.work, "WORK") for a in args)
+            err = err.replace(self.work, "WORK")
+            # CLI11's usage text follows its one-line error; the first line is what differs between builds.
+            lines.append(f"$ rotorguard {shown}\nexit {code}\n{err.strip().splitlines()[0] if err.strip() else ''}\n")
+        self.write("errors.txt", "\n".join(lines))
+
+    def make(self, qp_instance):
+        if os.path.exists(self.out):
+            shutil.rmtree(self.out)
+        os.makedirs(self.out)
+        try:
+            print("scenarios", file=sys.stderr)
+            self.scenarios()
+            print("benchmarks", file=sys.stderr)
+            self.benches(qp_instance)
+            print("campaigns, validation, bad input", file=sys.stderr)
+            self.campaigns()
+            self.validations()
+            self.bad_inputs()
+            self.write("timing_keys_ignored.txt", "".join(k + "\n" for k in sorted(self.dropped)))
+        finally:
+            shutil.rmtree(self.work, ignore_errors=True)
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("rotorguard", help="the program to snapshot, e.g. build/bin/rotorguard")
+    p.add_argument("out", help="the snapshot's folder (replaced)")
+    p.add_argument("--qp-instance", help="an OCP QP instance for `bench qp` (skipped without one)")
+    a = p.parse_args()
+    Snapshot(a.rotorguard, a.out).make(a.qp_instance)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,51 @@
+#include "rotorguard/benchmarks/config_files.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/campaign/registry.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/config_node.h"
+
+namespace rotorguard::benchmarks {
+
+ValidationReport ValidateConfigFile(const std::string& path) {
+  const io::ConfigDocument doc = io::ConfigDocument::LoadFile(path);
+  const io::ConfigNode root = doc.root();
+  const std::vector<std::string> keys = root.Keys();
+  const auto has = [&](const char* k) { return std::find(keys.begin(), keys.end(), k) != keys.end(); };
+  if (has("rotors") || has("mass_kg")) {
+    const vehicle::VehicleParams v = harness::LoadVehicle(path);
+    return {"vehicle", fmt::format("vehicle '{}': {} rotors, {:g} kg, thrust-to-weight {:.2f}", v.name,
+                                   v.num_rotors(), v.mass_kg, v.total_max_thrust_n() / v.weight_n())};
+  }
+  if (has("unit") && has("spacing_m")) {
+    const modular::Assembly a = harness::LoadAssembly(path);
+    return {"assembly", fmt::format("assembly '{}': {} units, {} rotors, {:g} kg, thrust-to-weight {:.2f}", a.name,
+                                    a.num_units, a.vehicle.num_rotors(), a.vehicle.mass_kg,
+                                    a.vehicle.total_max_thrust_n() / a.vehicle.weight_n())};
+  }
+  if (has("bench") && !has("mission")) {
+    const campaign::Campaign c = campaign::LoadCampaign(path, CampaignKinds());
+    return {"campaign", fmt::format("campaign '{}': {} trials of benchmark {}, spec {}", c.name, c.trials,
+                                    c.bench["name"].get<std::string>(), c.hash)};
+  }
+  if (has("scenario") && !has("mission")) {
+    const CampaignSpec c = LoadCampaignSpec(path);
+    return {"campaign", fmt::format("campaign '{}': {} trials of {} ({} grid key(s), {} random), spec {}", c.name,
+                                    c.trials(), c.scenario, c.grid.size(), c.random.size(), c.hash)};
+  }
+  if (has("mission") || has("vehicle") || has("assembly")) {
+    const harness::Scenario s = harness::LoadScenario(path);
+    return {"scenario", fmt::format("scenario '{}': {} mission, {:g} s, {} fault(s), vehicle {}", s.name,
+                                    s.mission_type, s.duration_s, s.faults.size(), s.vehicle_file)};
+  }
+  root.Fail("cannot tell the kind of this file; expected a scenario (with 'mission' and 'vehicle') or "
+            "a vehicle (with 'mass_kg' and 'rotors')");
+}
+
+}  // namespace rotorguard::benchmarks

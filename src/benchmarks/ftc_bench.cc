@@ -1,0 +1,334 @@
+#include "rotorguard/benchmarks/ftc_bench.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "rotorguard/buildinfo/build_info.h"
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/campaign/failure_list.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/planning/references.h"
+
+namespace rotorguard::benchmarks {
+
+namespace {
+
+struct Cell {
+  const char* test;   // the paper's test number, "-" for fault-free trials
+  const char* phase;  // hover, tracking, takeoff
+  const char* fault;  // propeller_loss, motor_stop, none
+};
+
+constexpr Cell kCells[] = {
+    {"#1", "hover", "propeller_loss"},    {"#2", "hover", "motor_stop"},
+    {"#1", "tracking", "propeller_loss"}, {"#2", "tracking", "motor_stop"},
+    {"#3", "takeoff", "propeller_loss"},  {"#4", "takeoff", "motor_stop"},
+    {"-", "hover", "none"},               {"-", "tracking", "none"},
+    {"-", "takeoff", "none"},
+};
+constexpr int kNumCells = sizeof(kCells) / sizeof(kCells[0]);
+
+/// A trial's scenario: the phase's mission, the drawn fault, gust and noise seed, the method's stack.
+harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOptions& o, std::uint64_t trial_seed) {
+  Rng rng(trial_seed);
+  const int rotor = std::min(o.vehicle.num_rotors() - 1, static_cast<int>(rng.Uniform() * o.vehicle.num_rotors()));
+  const double gust = rng.Uniform(0.0, 0.3);
+  const double draw = rng.Uniform();
+  harness::Scenario s;
+  s.name = fmt::format("ftc_{}_{}_{}", cell.phase, cell.fault, method);
+  s.vehicle = o.vehicle;
+  s.seed = trial_seed;
+  s.sim.wind.gust_std_m_s = gust;
+  s.sim.wind.gust_time_constant_s = 2.0;
+  const std::string phase = cell.phase;
+  sim::FaultOnset onset;
+  if (phase == "hover") {
+    s.duration_s = 8.0;
+    s.initial_position_m = Vector3(0, 0, 2.0);
+    s.mission_type = "hover";
+    planning::HoverOptions h;
+    h.position_m = s.initial_position_m;
+    s.reference = std::make_shared<planning::HoverReference>(h);
+    onset = {sim::FaultOnset::Kind::kAtTime, 1.5 + 1.5 * draw};
+  } else if (phase == "tracking") {
+    s.duration_s = 14.0;
+    s.initial_position_m = Vector3(0, 0, 1.5);
+    s.mission_type = "lemniscate";
+    planning::LemniscateOptions l;  // the paper's 6 x 3 x 1 m at 2 m/s
+    l.center_m = s.initial_position_m;
+    l.max_speed_m_s = 2.0;
+    s.reference = std::make_shared<planning::LemniscateReference>(l);
+    onset = {sim::FaultOnset::Kind::kAtTime, 4.0 + 4.0 * draw};
+  } else {
+    s.duration_s = 8.0;
+    s.initial_position_m = Vector3::Zero();
+    s.mission_type = "takeoff";
+    planning::TakeoffOptions t;
+    t.altitude_m = 1.5;
+    s.reference = std::make_shared<planning::TakeoffReference>(t);
+    // On the climb, 2-50 cm above the ground (the take-off detector's domain, paper 000 Sec. V-B3).
+    // Not earlier: with the landing gear still on the ground, the ground carries the lost thrust
+    // and torque and no inertial detector can see the loss (docs/benchmarks.md).
+    onset = {sim::FaultOnset::Kind::kAtAltitude, 0.02 + 0.48 * draw};
+  }
+  if (std::string(cell.fault) != "none") {
+    sim::FaultSpec f;
+    f.rotor = rotor;
+    f.kind = *vehicle::ParseFaultKind(cell.fault);
+    f.onset = onset;
+    s.faults.push_back(f);
+  }
+  harness::FitStackToHardware(&s);
+  if (method == "rotorguard") {
+    s.stack.controller = "nmpc";
+    s.stack.fdd = "composite";
+  } else if (method == "fixedtime") {  // FixedA: the fixed-time observer driving the same NMPC
+    s.stack.controller = "nmpc";
+    s.stack.fdd = "fixedtime";
+  } else if (method == "ukf") {  // paper 004's UKF loss estimation driving the same NMPC
+    s.stack.controller = "nmpc";
+    s.stack.fdd = "ukf";
+  } else if (method == "indi") {  // the composite FDD's isolation handed to the INDI controller
+    s.stack.controller = "indi";
+    s.stack.fdd = "composite";
+  } else if (method == "passive") {  // UnifP: one passive fault-tolerant controller, no FDD
+    s.stack.controller = "passive";
+    s.stack.fdd = "none";
+  } else {  // none: the nominal controller without fault detection
+    s.stack.controller = "nominal";
+    s.stack.fdd = "none";
+  }
+  s.log_rate_hz = 10.0;
+  return s;
+}
+
+double Mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+
+nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty) {
+  std::vector<double> latencies;
+  int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
+  double min_alt = std::numeric_limits<double>::infinity();
+  campaign::FailureList failures(5);  // the first few, to reproduce them
+  for (std::size_t t = 0; t < trials.size(); ++t) {
+    const FtcTrial& r = trials[t];
+    success += r.success ? 1 : 0;
+    if (!r.success) failures.Add({{"trial", t}, {"seed", r.seed}, {"reason", r.failure}});
+    min_alt = std::min(min_alt, r.min_altitude_m);
+    if (!r.has_fdd) continue;
+    ++with_fdd;
+    false_alarms += r.false_alarm ? 1 : 0;
+    // A missed detection: no correct isolation within 1 s of the onset (DESIGN.md, MDR).
+    if (faulty && (!r.correct || r.latency_s > 1.0)) ++missed;
+    if (r.correct) latencies.push_back(r.latency_s);
+  }
+  const double n = static_cast<double>(trials.size());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return {{"trials", trials.size()},
+          {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
+          {"fdd_latency_s_max", NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
+          {"sucr", n > 0 ? success / n : 0.0},
+          {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
+          {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
+          {"mini_alt_m", NullIfNan(min_alt)},
+          {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
+          {"failures", failures.listed()},
+          {"failures_not_listed", failures.not_listed()}};
+}
+
+std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "ukf", "indi", "passive", "none"}; }
+
+void FtcBenchOptions::Validate() const {
+  if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
+  if (jobs < 1 || jobs > 256) ThrowInvalidArgument("FtcBenchOptions", "jobs", jobs, "a count in [1, 256]");
+  if (methods.empty()) ThrowInvalidArgument("FtcBenchOptions", "methods", "(none)", "at least one method");
+  const std::vector<std::string> known = FtcMethods();
+  for (const std::string& m : methods) {
+    if (std::find(known.begin(), known.end(), m) == known.end()) {
+      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, ukf, indi, passive, none");
+    }
+  }
+  vehicle.Validate();
+}
+
+campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
+  o.Validate();
+  const int methods = static_cast<int>(o.methods.size());
+  campaign::Campaign c;
+  c.name = "bench_ftc";
+  c.seed = o.seed;
+  c.trials = kNumCells * methods * o.trials;
+  c.group_keys = {"phase", "fault", "method"};
+  c.metrics = {"success", "correct", "false_alarm", "latency_s", "min_altitude_m"};
+  const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"methods", o.methods},
+                                  {"vehicle", o.vehicle.name}};
+  c.bench = {{"name", "ftc"}, {"options", options}};
+  c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::VehicleToYaml(o.vehicle));
+  // Trial index = (cell, method, trial), the trial fastest. Every method flies the same draws: the
+  // seed depends on the cell and trial only.
+  const auto decompose = [o, methods](int index) {
+    return std::array<int, 3>{index / (o.trials * methods), (index / o.trials) % methods, index % o.trials};
+  };
+  c.parameters = [o, decompose](int index) {
+    const auto [cell, method, trial] = decompose(index);
+    const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
+    return std::map<std::string, std::string>{{"test", kCells[cell].test},   {"phase", kCells[cell].phase},
+                                              {"fault", kCells[cell].fault}, {"method", o.methods[method]},
+                                              {"trial", std::to_string(trial)}, {"seed", std::to_string(seed)}};
+  };
+  c.run = [o, decompose](int index, const std::map<std::string, std::string>& params) {
+    const auto [cell, method, trial] = decompose(index);
+    const harness::RunSummary s = harness::RunScenario(MakeTrial(kCells[cell], o.methods[method], o, std::stoull(params.at("seed"))));
+    campaign::TrialOutcome out;
+    out.metrics = {{"success", s.success}, {"min_altitude_m", s.min_altitude_m}};
+    if (s.fdd) {
+      out.metrics["correct"] = s.fdd->correct;
+      out.metrics["false_alarm"] = s.fdd->false_alarm;
+      out.metrics["latency_s"] = s.fdd->correct ? nlohmann::json(s.fdd->latency_s) : nlohmann::json(nullptr);
+    }
+    out.message = s.failure_reason;
+    return out;
+  };
+  return c;
+}
+
+nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
+  const std::vector<std::string> methods = options.at("methods").get<std::vector<std::string>>();
+  const int trials = options.at("trials").get<int>();
+  const int m_count = static_cast<int>(methods.size());
+  if (static_cast<int>(records.size()) != kNumCells * m_count * trials) {
+    throw std::invalid_argument(fmt::format("ftc: {} trial records for {} cells x {} methods x {} trials",
+                                            records.size(), kNumCells, m_count, trials));
+  }
+  nlohmann::json cells = nlohmann::json::array();
+  int errors = 0;
+  for (int c = 0; c < kNumCells; ++c) {
+    for (int m = 0; m < m_count; ++m) {
+      std::vector<FtcTrial> cell_trials;
+      for (int t = 0; t < trials; ++t) {
+        const nlohmann::json& r = records[static_cast<std::size_t>((c * m_count + m) * trials + t)];
+        FtcTrial trial;
+        trial.seed = std::stoull(r["params"]["seed"].get<std::string>());
+        trial.failure = campaign::TrialFailure(r);
+        if (r["status"] != "ok") {  // an error or a non-finite metric: the trial failed
+          ++errors;
+          cell_trials.push_back(trial);
+          continue;
+        }
+        const nlohmann::json& x = r["metrics"];
+        trial.success = x["success"].get<bool>();
+        trial.min_altitude_m = x["min_altitude_m"].get<double>();
+        if (x.contains("correct")) {
+          trial.has_fdd = true;
+          trial.correct = x["correct"].get<bool>();
+          trial.false_alarm = x["false_alarm"].get<bool>();
+          trial.latency_s = x["latency_s"].is_null() ? -1.0 : x["latency_s"].get<double>();
+        }
+        cell_trials.push_back(trial);
+      }
+      nlohmann::json cell = AggregateFtcCell(cell_trials, std::string(kCells[c].fault) != "none");
+      cell["test"] = kCells[c].test;
+      cell["phase"] = kCells[c].phase;
+      cell["fault"] = kCells[c].fault;
+      cell["method"] = methods[static_cast<std::size_t>(m)];
+      cells.push_back(cell);
+    }
+  }
+  return {{"benchmark", "ftc"}, {"cells", cells}, {"errors", errors}, {"options", options}, {"host", buildinfo::HostInfo()}};
+}
+
+nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {
+  const campaign::Campaign c = FtcCampaign(o);
+  return FtcResult(c.bench["options"], campaign::RunWholeCampaign(c, o.jobs, o.progress));
+}
+
+namespace {
+std::string Fmt(const nlohmann::json& v, const char* format, double scale = 1.0) {
+  if (v.is_null()) return "/";
+  return fmt::format(fmt::runtime(format), v.get<double>() * scale);
+}
+
+/// The paper's figures (DESIGN.md, "Reference numbers"): "ours / FixedA" where it gives both.
+std::string Paper(const std::string& phase, const std::string& fault, const std::string& metric) {
+  if (metric == "latency") {
+    if (phase == "hover") return fault == "propeller_loss" ? "0.105" : "0.032";
+    if (phase == "tracking") return fault == "propeller_loss" ? "0.184 / 0.253" : "0.028 / 0.225";
+    return "0.020";
+  }
+  if (metric == "sucr") {
+    if (phase == "tracking") return fault == "propeller_loss" ? "90 / 60" : "100 / 70";
+    if (phase == "hover") return "100";
+    return "ok / crash";
+  }
+  if (metric == "none") return "";
+  if (metric == "mini_alt") return phase == "takeoff" ? (fault == "propeller_loss" ? "0 (UnifP -0.262, FixedA -9.278)" : "0 (UnifP -0.228)") : "";
+  return "0";
+}
+}  // namespace
+
+std::string FtcMarkdown(const nlohmann::json& result) {
+  std::vector<std::string> methods;
+  for (const auto& m : result["options"]["methods"]) methods.push_back(m.get<std::string>());
+  std::string out = fmt::format("FTC benchmark, {} trials per cell, seed {}\n\n", result["options"]["trials"].get<int>(),
+                                result["options"]["seed"].get<std::uint64_t>());
+  std::string header = "| test | phase | fault | metric |";
+  std::string rule = "|---|---|---|---|";
+  for (const auto& m : methods) {
+    header += " " + m + " |";
+    rule += "---|";
+  }
+  out += header + " paper (ours / FixedA) |\n" + rule + "---|\n";
+  const auto cell = [&](const std::string& phase, const std::string& fault, const std::string& method) {
+    for (const auto& c : result["cells"]) {
+      if (c["phase"] == phase && c["fault"] == fault && c["method"] == method) return c;
+    }
+    return nlohmann::json();
+  };
+  for (const auto& c0 : result["cells"]) {
+    if (c0["method"] != methods.front()) continue;
+    const std::string phase = c0["phase"], fault = c0["fault"], test = c0["test"];
+    struct Row {
+      const char* name;
+      const char* key;
+      const char* format;
+      double scale;
+      const char* paper;
+    };
+    const Row rows[] = {{"FDD latency mean (s)", "fdd_latency_s_mean", "{:.3f}", 1.0, "latency"},
+                        {"FDD latency max (s)", "fdd_latency_s_max", "{:.3f}", 1.0, "none"},
+                        {"SucR (%)", "sucr", "{:.1f}", 100.0, "sucr"},
+                        {"MDR (%)", "mdr", "{:.1f}", 100.0, "rate"},
+                        {"FAR (%)", "far", "{:.1f}", 100.0, "rate"},
+                        {"MiniA (m)", "mini_alt_m", "{:.3f}", 1.0, "mini_alt"}};
+    for (const Row& row : rows) {
+      if (fault == "none" && (std::string(row.key) == "fdd_latency_s_mean" || std::string(row.key) == "fdd_latency_s_max" ||
+                              std::string(row.key) == "mdr")) {
+        continue;
+      }
+      if (std::string(row.key) == "mini_alt_m" && phase != "takeoff") continue;
+      std::string line = fmt::format("| {} | {} | {} | {} |", test, phase, fault, row.name);
+      for (const auto& m : methods) line += fmt::format(" {} |", Fmt(cell(phase, fault, m)[row.key], row.format, row.scale));
+      const std::string paper = fault == "none" ? (std::string(row.key) == "far" ? "0" : "") : Paper(phase, fault, row.paper);
+      out += line + " " + paper + " |\n";
+    }
+  }
+  return out;
+}
+
+}  // namespace rotorguard::benchmarks

@@ -1,0 +1,93 @@
+#pragma once
+/// Threshold calibration of the composite FDD from saved runs (rotorguard fdd-calibrate): the
+/// sensor logs of fault-free and faulty flights are replayed offline through the real detector
+/// while one threshold sweeps, giving per value the detection latency, the misses and the false
+/// alarms (an ROC-style table), and the margin to the most alarming value the indices reached in
+/// fault-free flight. A suggestion picks the fastest value that keeps a stated margin.
+///
+/// A replay is exact up to the first isolation of the recorded flight (the detector sees what the
+/// stack saw). After it the recorded stack had reconfigured, so a threshold that detects later
+/// than the recorded one is scored on a flight that already flew reconfigured.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/record/sensor_log.h"
+#include "rotorguard/sim/fault_injector.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::benchmarks {
+
+/// A saved run, as `rotorguard run --out DIR` leaves it: sensors.csv, vehicle.yaml, summary.json.
+struct CalibrationLog {
+  std::string dir;
+  vehicle::VehicleParams vehicle;
+  double imu_rate_hz = 0.0;
+  Vector3 imu_position_m = Vector3::Zero();
+  std::vector<harness::FaultRecord> faults;  ///< the injected faults (ground truth for scoring)
+  /// The composite FDD's settings in the recorded flight (summary.json "composite_fdd"), when the
+  /// stack ran it.
+  std::optional<fdd::CompositeFddOptions> recorded_fdd;
+  std::vector<record::SensorRecord> records;
+};
+
+/// Loads a run folder. Throws io::InputFileError for a missing or malformed file (naming it, and
+/// the line and byte for sensors.csv), an invalid vehicle.yaml included.
+CalibrationLog LoadCalibrationLog(const std::string& dir);
+
+/// The settings to replay with: those the first log recorded, else the defaults. When logs
+/// recorded different settings, `note` (if given) says so.
+fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& logs, std::string* note);
+
+/// The log's injected faults as the simulator reports them, for ScoreFdd.
+std::vector<sim::FaultEvent> FaultEvents(const CalibrationLog& log);
+
+struct ReplayOutcome {
+  /// The first rotor isolated as failed (motor or propeller), if any; its diagnosis, detector and
+  /// time are in `statuses`.
+  std::optional<int> isolated_rotor;
+  /// The most alarming values the indices took in fault-free flight (the whole log without
+  /// faults, the part before the first onset with): the lowest motor index M_i, the highest
+  /// propeller index P_i, the highest take-off statistic.
+  double min_motor_index = 1.0;
+  double max_propeller_index = 0.0;
+  double max_takeoff_alpha = 0.0;
+  /// The detector's per-rotor statuses when the replay stopped (after the onset, once a rotor was
+  /// isolated; else at the end of the log), for ScoreFdd.
+  std::vector<fdd::RotorStatus> statuses;
+};
+
+/// Replays a log through a CompositeFdd built with `options` (the log's IMU rate and position
+/// are filled in).
+ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::CompositeFddOptions& options);
+
+struct FddCalibrationOptions {
+  fdd::CompositeFddOptions fdd;  ///< the thresholds not being swept
+  /// Required margin to the fault-free extreme: gamma_P and the take-off threshold at least
+  /// `margin` times the largest fault-free value, gamma_M at most the smallest fault-free M_i
+  /// divided by it. > 1.
+  double margin = 1.5;
+  void Validate() const;
+};
+
+/// Runs the three sweeps (motor_index_threshold, propeller_index_threshold,
+/// takeoff_angular_acceleration_rad_s2) over the logs. The document:
+/// {"logs": [{"dir", "faulty", "fault": {...}|null, "with_configured_thresholds": {...}}],
+///  "fault_free_extremes": {"min_motor_index", "max_propeller_index", "max_takeoff_alpha"} (null:
+///  no fault-free flight moved the index),
+///  "sweeps": [{"threshold", "configured", "rows": [{"value", "detected", "missed", "false_alarms",
+///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null, "note"}]}
+/// A value that is not valid with the other thresholds (gamma_P at or below the degraded
+/// threshold) is left out.
+/// Throws std::invalid_argument when `logs` is empty.
+nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, const FddCalibrationOptions& options);
+
+/// The calibration as Markdown tables with the suggestions.
+std::string CalibrationMarkdown(const nlohmann::json& calibration);
+
+}  // namespace rotorguard::benchmarks

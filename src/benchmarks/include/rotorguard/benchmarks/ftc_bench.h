@@ -1,0 +1,73 @@
+#pragma once
+/// `rotorguard bench ftc`: paper 000's FTC benchmark (Sec. VI-A, Tables III and IV) as Monte Carlo
+/// trials. Test #1 propeller and Test #2 motor failure while hovering and while tracking the 2 m/s
+/// lemniscate, Tests #3 / #4 the same during take-off, plus fault-free trials of every phase for the
+/// false-alarm rate. Each trial draws its onset, rotor, noise seed and a light gust from a seed
+/// derived from the benchmark seed and the trial index, so results do not depend on the job count.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::benchmarks {
+
+/// The method names RunFtcBenchmark knows.
+std::vector<std::string> FtcMethods();
+
+struct FtcBenchOptions {
+  int trials = 20;                 ///< per cell (the paper's count), >= 1
+  std::uint64_t seed = 1;
+  /// Methods by name: rotorguard (composite FDD + NMPC), fixedtime (FixedA: fixed-time observer
+  /// + the same NMPC), ukf (paper 004's UKF loss estimation + the same NMPC), indi (composite FDD
+  /// + incremental nonlinear dynamic inversion), passive (UnifP: reduced-attitude control with yaw
+  /// free, no FDD), none (nominal controller, no FDD). All of them by default.
+  std::vector<std::string> methods = FtcMethods();
+  int jobs = 1;                    ///< worker threads, >= 1
+  vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
+  /// Called after each finished trial with (done, total).
+  std::function<void(int, int)> progress;
+  void Validate() const;
+};
+
+/// One trial's outcome, as the cells aggregate it.
+struct FtcTrial {
+  bool success = false;
+  bool has_fdd = false;      ///< the method runs fault detection
+  bool correct = false;      ///< right rotor and kind, at or after the onset
+  bool false_alarm = false;  ///< a diagnosis without a fault, or before the onset
+  double latency_s = -1.0;   ///< when correct
+  double min_altitude_m = 0.0;
+  std::string failure;       ///< why it failed (run failure or error), "" on success
+  std::uint64_t seed = 0;
+};
+
+/// A cell's metrics (DESIGN.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty
+/// cells: no correct isolation within 1 s), far, mini_alt_m (least altitude after the fault), and
+/// the first failures. Null where a metric does not apply (no FDD; MDR of fault-free cells).
+nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty);
+
+/// The benchmark as a campaign (campaign.h), so that it shards, resumes and merges like any other:
+/// trial index = (cell, method, trial), the trial fastest; parameters {test, phase, fault, method,
+/// trial, seed}. Its hash covers the options and the vehicle. Throws std::invalid_argument for bad
+/// options.
+campaign::Campaign FtcCampaign(const FtcBenchOptions& options);
+/// RunFtcBenchmark's result from the campaign's records (in trial order) and its options
+/// (`Campaign::bench["options"]`). A trial recorded as error or diverged counts as a failure and in
+/// "errors".
+nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records);
+
+/// Runs every cell and method (FtcCampaign, on `jobs` threads in a temporary folder); returns
+/// {"cells": [...], "options": {...}, "errors": n, "host": {...}} with, per cell, test, phase,
+/// fault, method, trials, fdd_latency_s_mean, fdd_latency_s_max, sucr, mdr, far and mini_alt_m
+/// (DESIGN.md, Metrics).
+nlohmann::json RunFtcBenchmark(const FtcBenchOptions& options);
+
+/// Markdown tables shaped like the paper's Tables III and IV, the paper's figures beside ours.
+std::string FtcMarkdown(const nlohmann::json& result);
+
+}  // namespace rotorguard::benchmarks

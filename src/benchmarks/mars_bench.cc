@@ -1,0 +1,606 @@
+#include "rotorguard/benchmarks/mars_bench.h"
+
+#include <algorithm>
+#include <array>
+#include <mutex>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "rotorguard/benchmarks/reconfiguration.h"
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/campaign/statistics.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/harness/assembly_mission.h"
+#include "rotorguard/harness/flight_metrics.h"
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/modular/allocation.h"
+
+namespace rotorguard::benchmarks {
+
+namespace {
+
+/// A row of Table I (or Fig. 3): what each faulty rotor keeps of its thrust, rotor by rotor.
+struct FaultCase {
+  std::string name;
+  std::vector<std::pair<int, double>> rotors;  ///< (rotor, loss); loss 1 is a stopped motor
+};
+
+std::vector<FaultCase> TableOneCases() {
+  // Unit No. k is index k - 1, its rotor j is index 4 (k - 1) + j - 1 (modular::Assembly).
+  const auto unit = [](int k) {
+    std::vector<std::pair<int, double>> r;
+    for (int j = 0; j < 4; ++j) r.emplace_back(4 * (k - 1) + j, 1.0);
+    return r;
+  };
+  std::vector<std::pair<int, double>> two_units = unit(1);
+  for (const auto& r : unit(6)) two_units.push_back(r);
+  std::vector<std::pair<int, double>> same_row = unit(1);
+  for (const auto& r : unit(3)) same_row.push_back(r);
+  return {{"no failure", {}},
+          {"eta_2,2 = 0.5", {{5, 0.5}}},
+          {"eta_2,1 = eta_2,2 = 0.5", {{4, 0.5}, {5, 0.5}}},
+          {"unit No. 1 dead", unit(1)},
+          {"units No. 1 and 6 dead (diagonal)", two_units},
+          {"units No. 1 and 3 dead (one row)", same_row}};
+}
+
+const std::vector<modular::Reallocation> kMethods = {modular::Reallocation::kNone, modular::Reallocation::kPartial,
+                                                     modular::Reallocation::kFull};
+
+harness::Scenario WithFaults(const harness::Scenario& base, const FaultCase& c, modular::Reallocation method, std::uint64_t seed) {
+  harness::Scenario s = base;
+  s.seed = seed;
+  s.allocation.method = method;
+  s.faults.clear();
+  s.stack.known_faults.clear();
+  for (const auto& [rotor, loss] : c.rotors) {
+    sim::FaultSpec f;
+    f.rotor = rotor;
+    f.kind = loss >= 1.0 ? vehicle::FaultKind::kMotorStop : vehicle::FaultKind::kLossOfEffectiveness;
+    f.eta = loss >= 1.0 ? 0.0 : loss;
+    f.onset.value = 0.0;
+    s.faults.push_back(f);
+    s.stack.known_faults.push_back({rotor, 0.0, loss});
+  }
+  return s;
+}
+
+/// Mean and 99th percentile [us] of the full reallocation on `a` with a dead unit and random
+/// partial losses, for random wrenches around hover.
+std::pair<double, double> TimeAllocation(const modular::Assembly& a, int samples, std::uint64_t seed) {
+  modular::AssemblyAllocator alloc(a, {});
+  Rng rng(seed);
+  const int n = a.vehicle.num_rotors();
+  RotorVector eta = RotorVector::Ones(n);
+  eta.segment(0, a.rotors_per_unit).setZero();  // unit No. 1 dead
+  for (int k = a.rotors_per_unit; k < n; ++k) eta[k] = rng.Uniform() < 0.15 ? rng.Uniform(0.3, 0.9) : 1.0;
+  alloc.SetEffectiveness(eta);
+  std::vector<double> us;
+  us.reserve(static_cast<std::size_t>(samples));
+  RotorVector u;
+  const double w = a.vehicle.weight_n();
+  for (int i = 0; i < samples; ++i) {
+    const Eigen::Vector4d wrench(w * rng.Uniform(0.7, 1.4), rng.Uniform(-0.5, 0.5), rng.Uniform(-0.5, 0.5),
+                                 rng.Uniform(-0.1, 0.1));
+    us.push_back(1e6 * alloc.Allocate(wrench, &u).solve_time_s);  // the allocator times itself
+  }
+  double mean = 0.0;
+  for (const double v : us) mean += v / samples;
+  return {mean, campaign::Percentile(us, 99.0)};
+}
+
+/// The rotors of unit No. k (index k - 1), all stopped.
+std::vector<std::pair<int, double>> DeadUnit(int k) {
+  std::vector<std::pair<int, double>> r;
+  for (int j = 0; j < 4; ++j) r.emplace_back(4 * (k - 1) + j, 1.0);
+  return r;
+}
+
+/// What a plan asks of the assembly, sampled every millisecond (finer than the planner's checks):
+/// the largest acceleration, thrust per kilogram |a + g e_z| and yaw acceleration.
+struct PlanDemands {
+  double accel = 0.0, thrust_accel = 0.0, yaw_accel = 0.0;
+};
+PlanDemands DemandsOf(const modular::AssemblyTrajectory& t) {
+  PlanDemands d;
+  for (double time = 0.0; time <= t.duration(); time += 1e-3) {
+    Vector3 a = t.Evaluate(time).a_W;
+    d.accel = std::max(d.accel, a.norm());
+    a.z() += kGravity;
+    d.thrust_accel = std::max(d.thrust_accel, a.norm());
+    d.yaw_accel = std::max(d.yaw_accel, std::abs(t.yaw().Evaluate(time).a_W.x()));
+  }
+  return d;
+}
+
+/// A row of Table II: a scene and the unit that is dead in it.
+struct PlanRow {
+  const harness::Scenario* scene;
+  std::string fault;
+  int dead_unit;  ///< paper's No.; 0: none
+};
+constexpr int kTableTwoRows = 5;
+std::array<PlanRow, kTableTwoRows> TableTwoRows(const MarsBenchOptions& o) {
+  return {{{&o.plan_4x1, "normal", 0}, {&o.plan_4x1, "No. 3", 3}, {&o.plan_4x1, "No. 4", 4},
+           {&o.plan_3x2, "normal", 0}, {&o.plan_3x2, "No. 2", 2}}};
+}
+constexpr const char* kPlanners[2] = {"baseline", "ours"};
+constexpr int kPlanSlots = 2 * kTableTwoRows;  ///< a plan per row and planner
+constexpr const char* kSwitches[2] = {"prepared", "naive"};
+
+/// Table II's plans, made once per process on first use (planning is deterministic) and shared by
+/// the flights that fly them: slot = row * 2 + planner.
+struct PlanCache {
+  std::array<std::once_flag, kPlanSlots> once;
+  std::array<harness::Scenario, kPlanSlots> scenes;  ///< the row's scenario flying the plan
+  std::array<harness::AssemblyPlanResult, kPlanSlots> plans;
+  std::array<PlanDemands, kPlanSlots> demands;  ///< what each plan asks of the assembly
+};
+
+/// The records of `part`, in trial order.
+std::vector<const nlohmann::json*> PartOf(const std::vector<nlohmann::json>& records, const std::string& part) {
+  std::vector<const nlohmann::json*> r;
+  for (const nlohmann::json& x : records) {
+    if (x["params"]["part"] == part) r.push_back(&x);
+  }
+  return r;
+}
+
+/// A record's metric, or `fallback` when the trial did not record it (an error).
+double MetricOr(const nlohmann::json& record, const char* key, double fallback) {
+  const nlohmann::json& m = record["metrics"];
+  return m.is_object() && m.contains(key) && m[key].is_number() ? m[key].get<double>() : fallback;
+}
+bool Succeeded(const nlohmann::json& record) {
+  return record["status"] == "ok" && record["metrics"].value("success", false);
+}
+
+/// A table cell from its flights, records[first, first + trials): the mean error over the window
+/// (a wreck held) and up to the crash, the largest error, the success rate, the first failure.
+struct Cell {
+  double error_m = 0.0, error_to_crash_m = 0.0, max_error_m = 0.0, success_rate = 0.0;
+  std::string first_failure;
+};
+Cell CellOf(const std::vector<const nlohmann::json*>& records, std::size_t first, int trials) {
+  Cell c;
+  int success = 0;
+  for (int t = 0; t < trials; ++t) {
+    const nlohmann::json& f = *records[first + static_cast<std::size_t>(t)];
+    c.error_m += MetricOr(f, "rmse_m", 0.0) / trials;
+    c.error_to_crash_m += MetricOr(f, "rmse_flown_m", 0.0) / trials;
+    c.max_error_m = std::max(c.max_error_m, MetricOr(f, "max_error_m", 0.0));
+    success += Succeeded(f);
+    if (!Succeeded(f) && c.first_failure.empty()) c.first_failure = campaign::TrialFailure(f);
+  }
+  c.success_rate = static_cast<double>(success) / trials;
+  return c;
+}
+/// The cell's figures as row[name + "_error_m"], ..._error_to_crash_m, ..._max_error_m, ..._success_rate.
+void WriteCell(const Cell& c, const std::string& name, nlohmann::json* row) {
+  (*row)[name + "_error_m"] = c.error_m;
+  (*row)[name + "_error_to_crash_m"] = c.error_to_crash_m;
+  (*row)[name + "_max_error_m"] = c.max_error_m;
+  (*row)[name + "_success_rate"] = c.success_rate;
+}
+
+}  // namespace
+
+void MarsBenchOptions::Validate() const {
+  if (trials < 1 || trials > 10000) ThrowInvalidArgument("MarsBenchOptions", "trials", trials, "a count in [1, 10000]");
+  if (jobs < 1 || jobs > 256) ThrowInvalidArgument("MarsBenchOptions", "jobs", jobs, "a count in [1, 256]");
+  if (alloc_samples < 100 || alloc_samples > 10'000'000) {
+    ThrowInvalidArgument("MarsBenchOptions", "alloc_samples", alloc_samples, "a count in [100, 10^7]");
+  }
+  if (!spiral.assembly || spiral.stack.controller != "assembly") {
+    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "an assembly scenario flown by controller assembly");
+  }
+  if (spiral.assembly->num_units != 6) {
+    ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "the 3x2 assembly of Table I (six units)");
+  }
+}
+
+campaign::Campaign MarsCampaign(const MarsBenchOptions& o) {
+  o.Validate();
+  const std::vector<FaultCase> cases = TableOneCases();
+  const bool reconfig = o.reconfigure.assembly != nullptr;
+  const bool table2 = o.plan_4x1.assembly_plan && o.plan_3x2.assembly_plan;
+  // Parts in trial order: the allocation's timing (one trial), Table I (case, method, trial), the
+  // self-reconfiguration (trial, switch) and Table II (row, planner, trial).
+  const int n1 = static_cast<int>(cases.size() * kMethods.size()) * o.trials;
+  const int n2 = reconfig ? 2 * o.trials : 0;
+  const int n3 = table2 ? kPlanSlots * o.trials : 0;
+  campaign::Campaign c;
+  c.name = "bench_mars";
+  c.seed = o.seed;
+  c.trials = 1 + n1 + n2 + n3;
+  c.group_keys = {"part", "case", "shape", "fault", "method", "variant"};
+  c.metrics = {"success", "rmse_m", "max_error_m", "separation_max_attitude_deg", "docking_max_attitude_deg",
+               "alloc_us_mean"};
+  const nlohmann::json options = {{"trials", o.trials},
+                                  {"seed", o.seed},
+                                  {"alloc_samples", o.alloc_samples},
+                                  {"assembly", o.spiral.assembly->name},
+                                  {"alloc_units", o.nine_units.num_units},
+                                  {"reconfigure", reconfig},
+                                  {"table2", table2}};
+  // Records version 3: rmse_m covers each plan's window, a crashed flight's wreck held (v1: to the crash;
+  // v2: Table II flights scored over the window of the plan the scene was loaded with).
+  c.bench = {{"name", "mars"}, {"records", 3}, {"options", options}};
+  std::string inputs = c.bench.dump() + "\n" + harness::ScenarioFingerprint(o.spiral) + harness::VehicleToYaml(o.nine_units.vehicle);
+  if (reconfig) inputs += harness::ScenarioFingerprint(o.reconfigure);
+  if (table2) inputs += harness::ScenarioFingerprint(o.plan_4x1) + harness::ScenarioFingerprint(o.plan_3x2);
+  c.hash = campaign::Fingerprint(inputs);
+  const int trials = o.trials;
+  c.parameters = [o, cases, n1, n2, trials](int index) -> std::map<std::string, std::string> {
+    if (index == 0) return {{"part", "alloc"}, {"seed", std::to_string(o.seed)}};
+    int k = index - 1;
+    // Every row and method flies the same seeds: the rows differ by their faults only.
+    const auto seed = [&](int trial) { return std::to_string(o.seed + static_cast<std::uint64_t>(trial)); };
+    if (k < n1) {
+      const int trial = k % trials, method = (k / trials) % static_cast<int>(kMethods.size());
+      const int row = k / (trials * static_cast<int>(kMethods.size()));
+      return {{"part", "table1"}, {"case", cases[static_cast<std::size_t>(row)].name},
+              {"method", std::string(modular::ToString(kMethods[static_cast<std::size_t>(method)]))},
+              {"trial", std::to_string(trial)}, {"seed", seed(trial)}};
+    }
+    k -= n1;
+    if (k < n2) return {{"part", "reconfig"}, {"variant", kSwitches[k % 2]}, {"trial", std::to_string(k / 2)}, {"seed", seed(k / 2)}};
+    k -= n2;
+    const PlanRow row = TableTwoRows(o)[static_cast<std::size_t>(k / (2 * trials))];
+    return {{"part", "table2"}, {"shape", row.scene->assembly->name}, {"fault", row.fault},
+            {"method", kPlanners[(k / trials) % 2]}, {"trial", std::to_string(k % trials)}, {"seed", seed(k % trials)}};
+  };
+  const auto cache = std::make_shared<PlanCache>();
+  c.run = [o, cases, n1, n2, trials, cache](int index, const std::map<std::string, std::string>& params) {
+    campaign::TrialOutcome out;
+    const std::uint64_t seed = std::stoull(params.at("seed"));
+    const std::string part = params.at("part");
+    if (part == "alloc") {
+      const auto [mean, p99] = TimeAllocation(o.nine_units, o.alloc_samples, seed);
+      out.metrics = {{"alloc_us_mean", mean}, {"alloc_us_p99", p99}};
+      return out;
+    }
+    harness::RunSummary r;
+    if (part == "table1") {
+      const int k = index - 1;
+      const FaultCase& fault = cases[static_cast<std::size_t>(k / (trials * static_cast<int>(kMethods.size())))];
+      // Whether the rotors that still deliver can hold the assembly's weight at all (the
+      // allocator's exact QP): a case that cannot hover is reported, not held against the target.
+      modular::AssemblyAllocator check(*o.spiral.assembly, {});
+      RotorVector eta = RotorVector::Ones(o.spiral.vehicle.num_rotors());
+      for (const auto& [rotor, loss] : fault.rotors) eta[rotor] = 1.0 - loss;
+      check.SetEffectiveness(eta);
+      RotorVector hover;
+      out.metrics["hover_attainable"] =
+          check.Allocate(Eigen::Vector4d(o.spiral.vehicle.weight_n(), 0, 0, 0), &hover).attainable;
+      r = harness::RunScenario(WithFaults(o.spiral, fault, kMethods[static_cast<std::size_t>((k / trials) % 3)], seed), harness::RunOptions{});
+    } else if (part == "reconfig") {
+      ReconfigurationOptions ro;
+      ro.base = o.reconfigure;
+      ro.base.seed = seed;
+      ro.naive = params.at("variant") == kSwitches[1];
+      const ReconfigurationResult x = RunReconfiguration(ro);
+      out.metrics = {{"success", x.success},
+                     {"separation_max_attitude_deg", x.separation_max_attitude_deg},
+                     {"docking_max_attitude_deg", x.docking_max_attitude_deg},
+                     {"separation_max_accel_m_s2", x.separation_max_accel_m_s2},
+                     {"docking_max_accel_m_s2", x.docking_max_accel_m_s2},
+                     {"unit_max_tilt_deg", x.unit_max_tilt_deg},
+                     {"steady_max_attitude_deg", x.steady_max_attitude_deg}};
+      out.message = x.failure;
+      return out;
+    } else {
+      const int k = index - 1 - n1 - n2;
+      const std::size_t slot = static_cast<std::size_t>(k / trials);
+      std::call_once(cache->once[slot], [&] {
+        const PlanRow row = TableTwoRows(o)[slot / 2];
+        const FaultCase fault{row.fault, row.dead_unit > 0 ? DeadUnit(row.dead_unit) : std::vector<std::pair<int, double>>{}};
+        harness::Scenario s = WithFaults(*row.scene, fault, modular::Reallocation::kFull, o.seed);
+        s.assembly_plan->method = kPlanners[slot % 2];
+        cache->plans[slot] = harness::PlanAssemblyMission(s);  // never throws: a failure is the row's
+        if (cache->plans[slot].ok) {
+          s.reference = cache->plans[slot].trajectory;
+          cache->demands[slot] = DemandsOf(*cache->plans[slot].trajectory);
+        }
+        cache->scenes[slot] = std::move(s);
+      });
+      const harness::AssemblyPlanResult& plan = cache->plans[slot];
+      out.metrics["planned"] = plan.ok;
+      if (!plan.ok) {
+        out.message = plan.message;
+        return out;
+      }
+      // What the plan asks of the assembly, beside what it can give (the mechanism of the rows).
+      const PlanDemands& demands = cache->demands[slot];
+      out.metrics["duration_s"] = plan.trajectory_summary.duration_s;
+      out.metrics["attitude_deviation_deg"] = plan.trajectory_summary.attitude_deviation_rad * 180.0 / std::numbers::pi;
+      out.metrics["plan_ms"] = plan.astar_ms + plan.trajectory_summary.solve_ms;
+      out.metrics["max_accel_m_s2"] = demands.accel;
+      out.metrics["max_thrust_accel_m_s2"] = demands.thrust_accel;
+      out.metrics["max_yaw_accel_rad_s2"] = demands.yaw_accel;
+      out.metrics["capacity_accel_m_s2"] = plan.capacity.max_acceleration_m_s2;
+      out.metrics["capacity_thrust_accel_m_s2"] = plan.capacity.max_thrust_n / cache->scenes[slot].vehicle.mass_kg;
+      out.metrics["capacity_yaw_accel_rad_s2"] = plan.capacity.max_yaw_acceleration_rad_s2;
+      harness::Scenario s = cache->scenes[slot];
+      s.seed = seed;
+      r = harness::RunScenario(s, harness::RunOptions{});
+    }
+    out.metrics["success"] = r.success;
+    out.metrics["rmse_m"] = r.tracking_rmse_window_m;  // a crashed flight's wreck counts to the window's end
+    out.metrics["rmse_flown_m"] = r.tracking_rmse_m;
+    out.metrics["max_error_m"] = r.max_position_error_m;
+    out.message = r.failure_reason;
+    return out;
+  };
+  return c;
+}
+
+namespace {
+
+/// Table I from its records: (case, method, trial), the trial fastest.
+nlohmann::json TableOne(const std::vector<const nlohmann::json*>& records, int trials, bool* within) {
+  nlohmann::json table1 = nlohmann::json::array();
+  const std::vector<FaultCase> cases = TableOneCases();
+  const int methods = static_cast<int>(kMethods.size());
+  if (records.size() != cases.size() * static_cast<std::size_t>(methods * trials)) {
+    throw std::invalid_argument(fmt::format("mars: {} Table I records for {} cases x {} methods x {} trials",
+                                            records.size(), cases.size(), methods, trials));
+  }
+  double fault_free = 0.0;
+  *within = true;
+  for (std::size_t row = 0; row < cases.size(); ++row) {
+    // Every trial of the row records the allocator's verdict; one that threw records nothing.
+    bool can_hover = false;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(methods * trials); ++k) {
+      const nlohmann::json& m = (*records[row * static_cast<std::size_t>(methods * trials) + k])["metrics"];
+      if (m.is_object() && m.contains("hover_attainable")) {
+        can_hover = m["hover_attainable"].get<bool>();
+        break;
+      }
+    }
+    nlohmann::json r = {{"case", cases[row].name}, {"hover_attainable", can_hover}};
+    nlohmann::json faults = nlohmann::json::array();
+    for (const auto& [rotor, loss] : cases[row].rotors) faults.push_back({{"rotor", rotor}, {"loss", loss}});
+    r["faults"] = faults;
+    for (int m = 0; m < methods; ++m) {
+      const std::size_t first =
+          (row * static_cast<std::size_t>(methods) + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials);
+      WriteCell(CellOf(records, first, trials), std::string(modular::ToString(kMethods[static_cast<std::size_t>(m)])),
+                &r);
+    }
+    if (row == 0) fault_free = r["full_error_m"].get<double>();
+    r["full_over_fault_free"] = fault_free > 0.0 ? r["full_error_m"].get<double>() / fault_free : 0.0;
+    if (can_hover) {
+      *within = *within && r["full_over_fault_free"].get<double>() <= 1.5 && r["full_success_rate"].get<double>() == 1.0;
+    }
+    table1.push_back(r);
+  }
+  return table1;
+}
+
+/// The self-reconfiguration from its records: (trial, switch), the switch fastest; the largest
+/// figures over the trials.
+nlohmann::json Reconfiguration(const std::vector<const nlohmann::json*>& records, int trials) {
+  if (records.size() != static_cast<std::size_t>(2 * trials)) {
+    throw std::invalid_argument(fmt::format("mars: {} reconfiguration records for {} trials x 2", records.size(), trials));
+  }
+  nlohmann::json variants;
+  for (int v = 0; v < 2; ++v) {
+    nlohmann::json x = {{"success_rate", 0.0}, {"first_failure", ""}};
+    int success = 0;
+    for (const char* key : {"separation_max_attitude_deg", "docking_max_attitude_deg", "separation_max_accel_m_s2",
+                            "docking_max_accel_m_s2", "unit_max_tilt_deg", "steady_max_attitude_deg"}) {
+      double worst = 0.0;
+      for (int t = 0; t < trials; ++t) worst = std::max(worst, MetricOr(*records[static_cast<std::size_t>(2 * t + v)], key, 0.0));
+      x[key] = worst;
+    }
+    for (int t = 0; t < trials; ++t) {
+      const nlohmann::json& r = *records[static_cast<std::size_t>(2 * t + v)];
+      success += Succeeded(r);
+      if (!Succeeded(r) && x["first_failure"] == "") x["first_failure"] = campaign::TrialFailure(r);
+    }
+    x["success_rate"] = static_cast<double>(success) / trials;
+    variants[kSwitches[v]] = x;
+  }
+  return variants;
+}
+
+/// Table II from its records: (row, planner, trial), the trial fastest.
+nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int trials) {
+  nlohmann::json table = nlohmann::json::array();
+  double sum[2] = {0.0, 0.0}, sum_to_crash[2] = {0.0, 0.0}, improvement_sum = 0.0;
+  int compared = 0;
+  bool all_better = true;
+  if (records.size() != static_cast<std::size_t>(kPlanSlots * trials)) {
+    throw std::invalid_argument(fmt::format("mars: {} Table II records for {} rows x 2 planners x {} trials",
+                                            records.size(), kTableTwoRows, trials));
+  }
+  const std::size_t rows = kTableTwoRows;
+  for (std::size_t row = 0; row < rows; ++row) {
+    const nlohmann::json& head = *records[row * static_cast<std::size_t>(2 * trials)];
+    nlohmann::json r = {{"shape", head["params"]["shape"]}, {"fault", head["params"]["fault"]}};
+    double error[2] = {0.0, 0.0}, to_crash[2] = {0.0, 0.0};
+    bool both_planned = true;
+    for (int m = 0; m < 2; ++m) {
+      const auto at = [&](int t) -> const nlohmann::json& {
+        return *records[(2 * row + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials) + static_cast<std::size_t>(t)];
+      };
+      const std::string name = kPlanners[m];
+      // The plan's figures, from the first flight that recorded them (every flight flies one plan).
+      const nlohmann::json* plan = nullptr;
+      for (int t = 0; t < trials && plan == nullptr; ++t) {
+        if (at(t)["status"] == "ok") plan = &at(t);
+      }
+      const bool planned = plan != nullptr && (*plan)["metrics"]["planned"].get<bool>();
+      r[name + "_planned"] = planned;
+      if (!planned) {
+        r[name + "_plan_failure"] = plan != nullptr ? (*plan)["message"].get<std::string>()
+                                                    : "every flight failed; the first: " + campaign::TrialFailure(at(0));
+        both_planned = false;
+        continue;
+      }
+      const Cell c =
+          CellOf(records, (2 * row + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials), trials);
+      WriteCell(c, name, &r);
+      r[name + "_first_failure"] = c.first_failure;
+      error[m] = c.error_m;
+      to_crash[m] = c.error_to_crash_m;
+      const nlohmann::json& x = (*plan)["metrics"];
+      r[name + "_duration_s"] = x["duration_s"];
+      r[name + "_attitude_deviation_deg"] = x["attitude_deviation_deg"];
+      r[name + "_plan_ms"] = x["plan_ms"];
+      r[name + "_max_accel_m_s2"] = x["max_accel_m_s2"];
+      r[name + "_max_thrust_accel_m_s2"] = x["max_thrust_accel_m_s2"];
+      r[name + "_max_yaw_accel_rad_s2"] = x["max_yaw_accel_rad_s2"];
+      r["capacity_accel_m_s2"] = x["capacity_accel_m_s2"];
+      r["capacity_thrust_accel_m_s2"] = x["capacity_thrust_accel_m_s2"];
+      r["capacity_yaw_accel_rad_s2"] = x["capacity_yaw_accel_rad_s2"];
+    }
+    // A row that either method could not plan has no comparison: null, left out of the averages.
+    all_better = all_better && both_planned && error[1] < error[0];
+    if (both_planned && error[0] > 0.0) {
+      r["improvement"] = 1.0 - error[1] / error[0];
+      improvement_sum += r["improvement"].get<double>();
+      ++compared;
+      for (int m = 0; m < 2; ++m) sum[m] += error[m], sum_to_crash[m] += to_crash[m];
+    } else {
+      r["improvement"] = nullptr;
+    }
+    table.push_back(r);
+  }
+  return {{"table2", table},
+          {"table2_rows_compared", compared},
+          {"table2_improvement_average", sum[0] > 0.0 ? nlohmann::json(1.0 - sum[1] / sum[0]) : nlohmann::json()},
+          {"table2_improvement_row_mean", compared > 0 ? nlohmann::json(improvement_sum / compared) : nlohmann::json()},
+          // The average as it would be if a crashed flight's error stopped at the crash.
+          {"table2_improvement_average_to_crash",
+           sum_to_crash[0] > 0.0 ? nlohmann::json(1.0 - sum_to_crash[1] / sum_to_crash[0]) : nlohmann::json()},
+          {"table2_ours_better_in_every_row", all_better}};
+}
+
+}  // namespace
+
+nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
+  const int trials = options.at("trials").get<int>();
+  const std::vector<const nlohmann::json*> alloc = PartOf(records, "alloc"), t1 = PartOf(records, "table1"),
+                                           rc = PartOf(records, "reconfig"), t2 = PartOf(records, "table2");
+  if (alloc.size() != 1) throw std::invalid_argument(fmt::format("mars: {} allocation timings; expected 1", alloc.size()));
+  bool within = true;
+  const nlohmann::json table1 = TableOne(t1, trials, &within);
+  const nlohmann::json reconfig =
+      options.at("reconfigure").get<bool>() ? Reconfiguration(rc, trials) : nlohmann::json();
+  const nlohmann::json table2 = options.at("table2").get<bool>() ? TableTwo(t2, trials) : nlohmann::json();
+  nlohmann::json failures = nlohmann::json::array();
+  for (const nlohmann::json* f : t1) {
+    if (failures.size() >= 10) break;
+    if (Succeeded(*f) || (*f)["params"]["method"] == "none") continue;
+    failures.push_back({{"case", (*f)["params"]["case"]},
+                        {"method", (*f)["params"]["method"]},
+                        {"seed", std::stoull((*f)["params"]["seed"].get<std::string>())},
+                        {"reason", campaign::TrialFailure(*f)}});
+  }
+  const auto worst = [&](const char* variant) {
+    return reconfig.is_null() ? nlohmann::json(nullptr)
+                              : nlohmann::json(std::max(reconfig[variant]["separation_max_attitude_deg"].get<double>(),
+                                                        reconfig[variant]["docking_max_attitude_deg"].get<double>()));
+  };
+  nlohmann::json result = {{"benchmark", "mars"},
+                           {"assembly", options.at("assembly")},
+                           {"trials", trials},
+                           {"table1", table1},
+                           {"table1_full_within_1_5x_fault_free", within},
+                           {"alloc_units", options.at("alloc_units")},
+                           // Null when the timing trial failed (never a figure that passes the target).
+                           {"alloc_us_mean", (*alloc[0])["status"] == "ok" ? (*alloc[0])["metrics"]["alloc_us_mean"] : nlohmann::json()},
+                           {"alloc_us_p99", (*alloc[0])["status"] == "ok" ? (*alloc[0])["metrics"]["alloc_us_p99"] : nlohmann::json()},
+                           {"reconfig", reconfig},
+                           {"reconfig_max_attitude_deg", worst("prepared")},
+                           {"reconfig_max_attitude_deg_naive", worst("naive")},
+                           {"failures", failures},
+                           {"options", options}};
+  for (const char* key : {"table2", "table2_rows_compared", "table2_improvement_average", "table2_improvement_row_mean",
+                          "table2_improvement_average_to_crash", "table2_ours_better_in_every_row"}) {
+    result[key] = table2.is_null() ? nlohmann::json(nullptr) : table2[key];
+  }
+  return result;
+}
+
+nlohmann::json RunMarsBenchmark(const MarsBenchOptions& o) {
+  const campaign::Campaign c = MarsCampaign(o);
+  return MarsResult(c.bench["options"], campaign::RunWholeCampaign(c, o.jobs, o.progress));
+}
+
+namespace {
+/// A table cell's note when some of its flights crashed: their error up to the crash, beside the
+/// window's (where the wreck is held to the window's end).
+std::string ToCrash(const nlohmann::json& row, const std::string& method) {
+  const double to_crash = row.value(method + "_error_to_crash_m", 0.0);
+  if (to_crash == row[method + "_error_m"].get<double>()) return "";
+  return fmt::format("; {:.3f} m to the crash", to_crash);
+}
+}  // namespace
+
+std::string MarsMarkdown(const nlohmann::json& r) {
+  std::string s = fmt::format("Table I ({} assembly on the spiral, {} flights per cell: mean tracking RMSE, "
+                              "success rate)\n\n",
+                              r["assembly"].get<std::string>(), r["trials"].get<int>());
+  s += "| case | without FTC | partial (eqs. 3-5) | full (eq. 6) | full / fault-free |\n|---|---|---|---|---|\n";
+  for (const auto& row : r["table1"]) {
+    const auto cell = [&](const char* m) {
+      return fmt::format("{:.3f} m ({:.0f} %{})", row[std::string(m) + "_error_m"].get<double>(),
+                         100.0 * row[std::string(m) + "_success_rate"].get<double>(), ToCrash(row, m));
+    };
+    const bool hover = row["hover_attainable"].get<bool>();  // a ratio only where the target applies
+    s += fmt::format("| {}{} | {} | {} | {} | {} |\n", row["case"].get<std::string>(),
+                     hover ? "" : " (cannot hover: beyond the rotors' reach)", cell("none"), cell("partial"),
+                     cell("full"), hover ? fmt::format("{:.2f}", row["full_over_fault_free"].get<double>()) : "-");
+  }
+  s += r["alloc_us_mean"].is_null()
+           ? std::string("\nallocation: the timing trial failed (see the campaign's errors)\n")
+           : fmt::format("\nallocation ({} units, full reallocation with a dead unit): {:.1f} us mean, {:.1f} us p99\n",
+                         r["alloc_units"].get<int>(), r["alloc_us_mean"].get<double>(), r["alloc_us_p99"].get<double>());
+  if (!r["reconfig"].is_null()) {
+    s += "\nSelf-reconfiguration (largest over the trials)\n\n| switch | success | steady hover | separation | docking | "
+         "unit's tilt |\n|---|---|---|---|---|---|\n";
+    for (const char* v : {"prepared", "naive"}) {
+      const nlohmann::json& x = r["reconfig"][v];
+      s += fmt::format("| {} | {:.0f} % | {:.2f} deg | {:.2f} deg, {:.2f} m/s^2 | {:.2f} deg, {:.2f} m/s^2 | {:.1f} deg |\n", v,
+                       100.0 * x["success_rate"].get<double>(), x["steady_max_attitude_deg"].get<double>(),
+                       x["separation_max_attitude_deg"].get<double>(),
+                       x["separation_max_accel_m_s2"].get<double>(), x["docking_max_attitude_deg"].get<double>(),
+                       x["docking_max_accel_m_s2"].get<double>(), x["unit_max_tilt_deg"].get<double>());
+    }
+  }
+  if (!r["table2"].is_null()) {
+    s += "\nTable II (planned by each method, flown with the full reallocation: mean tracking RMSE, success rate, "
+         "the trajectory's duration)\n\n| shape | fault | baseline (SVSDF) | ours | improvement |\n|---|---|---|---|---|\n";
+    for (const auto& row : r["table2"]) {
+      const auto cell = [&](const std::string& m) {
+        if (!row[m + "_planned"].get<bool>()) return "no plan: " + row[m + "_plan_failure"].get<std::string>();
+        return fmt::format("{:.3f} m ({:.0f} %, {:.1f} s{})", row[m + "_error_m"].get<double>(),
+                           100.0 * row[m + "_success_rate"].get<double>(), row[m + "_duration_s"].get<double>(),
+                           ToCrash(row, m));
+      };
+      s += fmt::format("| {} | {} | {} | {} | {} |\n", row["shape"].get<std::string>(),
+                       row["fault"].get<std::string>(), cell("baseline"), cell("ours"),
+                       row["improvement"].is_null() ? std::string("-")
+                                                    : fmt::format("{:.1f} %", 100.0 * row["improvement"].get<double>()));
+    }
+    const auto percent = [](const nlohmann::json& v) {
+      return v.is_null() ? std::string("-") : fmt::format("{:.1f} %", 100.0 * v.get<double>());
+    };
+    s += fmt::format(
+        "\naverage improvement {} (1 - mean ours / mean baseline, the paper's Average row; {} as the "
+        "mean of the rows', {} with the errors to the crash); ours better in every row: {}\n",
+        percent(r["table2_improvement_average"]), percent(r["table2_improvement_row_mean"]),
+        percent(r["table2_improvement_average_to_crash"]),
+        r["table2_ours_better_in_every_row"].get<bool>() ? "yes" : "no");
+  }
+  return s;
+}
+
+}  // namespace rotorguard::benchmarks

@@ -1,0 +1,308 @@
+#include "rotorguard/benchmarks/reconfiguration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/modular/assembly_controller.h"
+#include "rotorguard/planning/references.h"
+#include "rotorguard/sim/simulator.h"
+#include "rotorguard/stack/flight_stack.h"
+
+namespace rotorguard::benchmarks {
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+/// One rigid body in flight: its truth (model, simulator) and its stack. `origin[k]` is the rotor
+/// of the original assembly that rotor k of this body is, so faults follow their rotors.
+struct Body {
+  std::vector<int> origin;
+  vehicle::VehicleParams params;
+  std::unique_ptr<vehicle::MultirotorModel> model;
+  std::unique_ptr<sim::Simulator> sim;
+  std::unique_ptr<stack::FlightStack> stack;
+  modular::AssemblyController* controller = nullptr;  // owned by the stack, when an assembly
+  RotorCommand command;
+  TimeNs next_control = 0;
+
+  void Step() {
+    const TimeNs t = sim->time_ns();
+    if (t >= next_control) {
+      command = stack->Update(t);
+      next_control += stack->control_period_ns();
+    }
+    harness::DeliverToStack(sim->Step(command), stack.get());
+  }
+  vehicle::StateView state() const { return vehicle::StateView(sim->state()); }
+};
+
+/// A body of `params` starting in `x`, holding `reference`, flown by the assembly controller of
+/// `assembly` (or, when null, by the nominal controller: a lone unit).
+std::unique_ptr<Body> MakeBody(const harness::Scenario& base, const vehicle::VehicleParams& params,
+                               const modular::Assembly* assembly, std::vector<int> origin,
+                               const vehicle::StateVector& x, std::shared_ptr<const ReferenceTrajectory> reference,
+                               std::uint64_t seed) {
+  auto b = std::make_unique<Body>();
+  b->origin = std::move(origin);
+  b->params = params;
+  b->model = std::make_unique<vehicle::MultirotorModel>(params);
+  const auto index_of = [&](int original) {
+    const auto it = std::find(b->origin.begin(), b->origin.end(), original);
+    return it == b->origin.end() ? -1 : static_cast<int>(it - b->origin.begin());
+  };
+  std::vector<sim::FaultSpec> faults;
+  for (sim::FaultSpec f : base.faults) {
+    f.rotor = index_of(f.rotor);
+    if (f.rotor < 0) continue;
+    f.onset.kind = sim::FaultOnset::Kind::kAtTime;
+    f.onset.value = 0.0;  // it has happened already
+    faults.push_back(f);
+  }
+  stack::FlightStackOptions o = base.stack;
+  o.known_faults.clear();
+  std::unique_ptr<control::Controller> controller;
+  if (assembly) {
+    for (stack::KnownFault k : base.stack.known_faults) {
+      k.rotor = index_of(k.rotor);
+      k.at_time_s = 0.0;
+      if (k.rotor >= 0) o.known_faults.push_back(k);
+    }
+    o.supervisor.max_failed_rotors = assembly->FailedRotorAllowance();
+    auto c = std::make_unique<modular::AssemblyController>(*assembly, harness::AssemblyControllerOptionsOf(base));
+    b->controller = c.get();
+    controller = std::move(c);
+  } else {
+    o.controller = "nominal";
+    o.supervisor.max_failed_rotors = 1;
+  }
+  b->sim = std::make_unique<sim::Simulator>(*b->model, base.world, faults, base.sim, seed, x);
+  b->stack = std::make_unique<stack::FlightStack>(params, std::move(reference), o, std::move(controller));
+  harness::DeliverToStack(b->sim->outputs(), b->stack.get());
+  b->command = b->stack->command();
+  return b;
+}
+
+std::shared_ptr<const ReferenceTrajectory> Hold(const Vector3& p, double yaw) {
+  planning::HoverOptions h;
+  h.position_m = p;
+  h.yaw_rad = yaw;
+  return std::make_shared<planning::HoverReference>(h);
+}
+
+/// The state of a part of a rigid body whose centre of mass is `r_B` from the body's (body frame),
+/// with the rotors `rotors` of the body.
+vehicle::StateVector PartState(const vehicle::StateVector& x, const Vector3& r_B, const std::vector<int>& rotors) {
+  const vehicle::StateView s(x);
+  const Matrix3 R = s.q_WB().normalized().toRotationMatrix();
+  vehicle::StateVector y(13 + static_cast<int>(rotors.size()));
+  y.segment<3>(vehicle::StateIndex::kPosition) = s.p_W() + R * r_B;
+  y.segment<4>(vehicle::StateIndex::kQuaternion) = x.segment<4>(vehicle::StateIndex::kQuaternion);
+  y.segment<3>(vehicle::StateIndex::kVelocity) = s.v_W() + R * s.w_B().cross(r_B);
+  y.segment<3>(vehicle::StateIndex::kBodyRate) = s.w_B();
+  for (std::size_t k = 0; k < rotors.size(); ++k) y[vehicle::StateIndex::kMotor + static_cast<int>(k)] = s.motor(rotors[k]);
+  return y;
+}
+
+/// Samples of the assembly (whichever body it is at the time) for the event windows.
+struct Sample {
+  double t;
+  int body;
+  Vector3 z_W, v_W;
+};
+
+struct EventFigures {
+  double max_attitude_deg = 0.0, max_accel = 0.0;
+};
+
+EventFigures Measure(const std::vector<Sample>& samples, double from, double to) {
+  EventFigures f;
+  const Sample* first = nullptr;
+  const Sample* previous = nullptr;
+  for (const Sample& s : samples) {
+    if (s.t < from || s.t > to) {
+      previous = nullptr;
+      continue;
+    }
+    if (!first) first = &s;
+    f.max_attitude_deg = std::max(f.max_attitude_deg, std::acos(std::clamp(s.z_W.dot(first->z_W), -1.0, 1.0)) / kDeg);
+    if (previous && previous->body == s.body && s.t > previous->t) {
+      f.max_accel = std::max(f.max_accel, ((s.v_W - previous->v_W) / (s.t - previous->t)).norm());
+    }
+    previous = &s;
+  }
+  return f;
+}
+
+}  // namespace
+
+void ReconfigurationOptions::Validate() const {
+  const auto fail = [](const char* field, double v, const char* rule) {
+    ThrowInvalidArgument("ReconfigurationOptions", field, v, rule);
+  };
+  if (!base.assembly || base.stack.controller != "assembly") {
+    ThrowInvalidArgument("ReconfigurationOptions", "base", base.name, "an assembly scenario flown by controller assembly");
+  }
+  const modular::Assembly& a = *base.assembly;
+  if (unit < 0 || unit >= a.num_units) fail("unit", unit, "a unit of the assembly");
+  if (a.num_units < 2) fail("unit", unit, "an assembly of at least two units");
+  for (const Eigen::Vector2i& s : a.slots) {
+    if (s == target_slot) {
+      ThrowInvalidArgument("ReconfigurationOptions", "target_slot", fmt::format("[{}, {}]", s.x(), s.y()), "a free grid cell");
+    }
+  }
+  for (const sim::FaultSpec& f : base.faults) {
+    if (a.UnitOfRotor(f.rotor) == unit) fail("unit", unit, "a healthy unit (it flies alone with the nominal controller)");
+  }
+  if (!(blend_s > 0.0 && separate_s > 2.0 * blend_s + window_s + 1.0)) {
+    fail("separate_s", separate_s, "a time > 2 blend_s + window_s + 1 s (a steady window, then the separation)");
+  }
+  if (!(transfer_speed_m_s > 0.0)) fail("transfer_speed_m_s", transfer_speed_m_s, "> 0");
+  if (!(climb_m > 0.0)) fail("climb_m", climb_m, "> 0");
+  if (!(dock_tolerance_m > 0.0)) fail("dock_tolerance_m", dock_tolerance_m, "> 0");
+  if (!(dock_speed_m_s > 0.0)) fail("dock_speed_m_s", dock_speed_m_s, "> 0");
+  if (!(hold_s > 0.0)) fail("hold_s", hold_s, "> 0");
+  if (!(window_s > 0.0 && window_s <= hold_s)) fail("window_s", window_s, "in (0, hold_s]");
+}
+
+ReconfigurationResult RunReconfiguration(const ReconfigurationOptions& o) {
+  o.Validate();
+  ReconfigurationResult result;
+  const harness::Scenario& base = o.base;
+  const modular::Assembly& A = *base.assembly;
+  const int per_unit = A.rotors_per_unit;
+  const double yaw = base.initial_yaw_rad;
+  std::vector<Sample> samples;
+  const auto record = [&](double t, int id, const Body& b) {
+    samples.push_back({t, id, b.state().q_WB().normalized().toRotationMatrix().col(2), b.state().v_W()});
+  };
+  const auto crashed = [&](const Body& b, const char* who) {
+    if (!b.sim->crashed()) return false;
+    result.failure = fmt::format("{} crashed: {}", who, b.sim->crash_reason().value_or("?"));
+    return true;
+  };
+
+  // Docked: the whole assembly holds the start.
+  std::vector<int> all(static_cast<std::size_t>(A.vehicle.num_rotors()));
+  for (int k = 0; k < A.vehicle.num_rotors(); ++k) all[static_cast<std::size_t>(k)] = k;
+  const vehicle::MultirotorModel a_model(A.vehicle);
+  std::unique_ptr<Body> a = MakeBody(base, A.vehicle, &A, all,
+                                     a_model.MakeState(base.initial_position_m, yaw, a_model.HoverThrusts()),
+                                     Hold(base.initial_position_m, yaw), base.seed);
+  const double blend_start = o.separate_s - o.blend_s;
+  while (a->sim->time_s() < o.separate_s) {
+    const double t = a->sim->time_s();
+    if (!o.naive && t >= blend_start) a->controller->SetDetaching(o.unit, std::min(1.0, (t - blend_start) / o.blend_s));
+    record(t, 0, *a);
+    a->Step();
+    if (crashed(*a, "the assembly")) return result;
+  }
+  result.separation_s = a->sim->time_s();
+
+  // Separation: the remaining assembly B and the unit U, each from its part of A's state.
+  modular::AssemblySpec b_spec;
+  b_spec.name = A.name + "_without_unit";
+  b_spec.unit = A.unit;
+  b_spec.spacing_m = A.spacing_m;
+  std::vector<int> b_rotors, u_rotors;
+  Vector3 r_b = Vector3::Zero();
+  for (int u = 0; u < A.num_units; ++u) {
+    for (int j = 0; j < per_unit; ++j) (u == o.unit ? u_rotors : b_rotors).push_back(A.FirstRotor(u) + j);
+    if (u == o.unit) continue;
+    b_spec.slots.push_back(A.slots[static_cast<std::size_t>(u)]);
+    r_b += A.unit_position_B[static_cast<std::size_t>(u)] / (A.num_units - 1);
+  }
+  const modular::Assembly B = modular::BuildAssembly(b_spec);
+  const vehicle::StateVector x_a = a->sim->state();
+  const vehicle::StateVector x_b = PartState(x_a, r_b, b_rotors);
+  const vehicle::StateVector x_u = PartState(x_a, A.unit_position_B[static_cast<std::size_t>(o.unit)], u_rotors);
+  const Vector3 p_b0 = x_b.segment<3>(vehicle::StateIndex::kPosition);
+  // The slot in B's frame, and in the world while B holds p_b0 at the yaw.
+  Vector3 grid_com = Vector3::Zero();
+  for (const Eigen::Vector2i& s : b_spec.slots) grid_com += Vector3(s.x(), s.y(), 0.0) * b_spec.spacing_m / b_spec.slots.size();
+  const Vector3 slot_B = Vector3(o.target_slot.x(), o.target_slot.y(), 0.0) * b_spec.spacing_m - grid_com;
+  const Matrix3 R_yaw = Eigen::AngleAxisd(yaw, Vector3::UnitZ()).toRotationMatrix();
+  const Vector3 p_u0 = x_u.segment<3>(vehicle::StateIndex::kPosition), target = p_b0 + R_yaw * slot_B;
+  planning::WaypointOptions path;
+  path.waypoints_m = {p_u0, p_u0 + Vector3(0, 0, o.climb_m), target + Vector3(0, 0, o.climb_m), target};
+  path.max_speed_m_s = o.transfer_speed_m_s;
+  path.max_accel_m_s2 = 0.5;
+  path.yaw_rad = yaw;
+  auto way = std::make_shared<planning::WaypointReference>(path);
+  const double transfer_s = way->duration();
+  a.reset();
+  std::unique_ptr<Body> b = MakeBody(base, B.vehicle, &B, b_rotors, x_b, Hold(p_b0, yaw), base.seed + 1);
+  std::unique_ptr<Body> u = MakeBody(base, A.unit, nullptr, u_rotors, x_u, way, base.seed + 2);
+  while (true) {
+    const double t_local = b->sim->time_s(), t = o.separate_s + t_local;
+    record(t, 1, *b);
+    result.unit_max_tilt_deg = std::max(result.unit_max_tilt_deg, TiltOf(u->state().q_WB()) / kDeg);
+    if (t_local >= transfer_s) {
+      const Matrix3 R_b = b->state().q_WB().normalized().toRotationMatrix();
+      const Vector3 slot_now = b->state().p_W() + R_b * slot_B;
+      if ((u->state().p_W() - slot_now).norm() < o.dock_tolerance_m &&
+          (u->state().v_W() - b->state().v_W()).norm() < o.dock_speed_m_s) {
+        break;
+      }
+      if (t_local > transfer_s + 5.0) {
+        result.failure = fmt::format("the unit did not reach its slot within 5 s of its path's end (off by {:.3f} m)",
+                                     (u->state().p_W() - slot_now).norm());
+        return result;
+      }
+    }
+    b->Step();
+    u->Step();
+    if (crashed(*b, "the assembly") || crashed(*u, "the unit")) return result;
+  }
+  result.docking_s = o.separate_s + b->sim->time_s();
+
+  // Docking: one body again, its state from the two (momentum conserved; the latch aligns the
+  // unit's attitude with the assembly's).
+  modular::AssemblySpec c_spec = b_spec;
+  c_spec.name = A.name + "_reconfigured";
+  c_spec.slots.push_back(o.target_slot);
+  const modular::Assembly C = modular::BuildAssembly(c_spec);
+  const double m_b = B.vehicle.mass_kg, m_u = A.unit.mass_kg, m = m_b + m_u;
+  vehicle::StateVector x_c(13 + C.vehicle.num_rotors());
+  x_c.segment<3>(vehicle::StateIndex::kPosition) = (m_b * b->state().p_W() + m_u * u->state().p_W()) / m;
+  x_c.segment<4>(vehicle::StateIndex::kQuaternion) = b->sim->state().segment<4>(vehicle::StateIndex::kQuaternion);
+  x_c.segment<3>(vehicle::StateIndex::kVelocity) = (m_b * b->state().v_W() + m_u * u->state().v_W()) / m;
+  x_c.segment<3>(vehicle::StateIndex::kBodyRate) = b->state().w_B();
+  std::vector<int> c_rotors = b_rotors;
+  for (int k = 0; k < B.vehicle.num_rotors(); ++k) x_c[vehicle::StateIndex::kMotor + k] = b->state().motor(k);
+  for (int j = 0; j < per_unit; ++j) {
+    x_c[vehicle::StateIndex::kMotor + B.vehicle.num_rotors() + j] = u->state().motor(j);
+    c_rotors.push_back(u_rotors[static_cast<std::size_t>(j)]);
+  }
+  const Vector3 p_c = x_c.segment<3>(vehicle::StateIndex::kPosition);
+  b.reset();
+  u.reset();
+  std::unique_ptr<Body> c = MakeBody(base, C.vehicle, &C, c_rotors, x_c, Hold(p_c, yaw), base.seed + 3);
+  while (c->sim->time_s() < o.hold_s) {
+    record(result.docking_s + c->sim->time_s(), 2, *c);
+    c->Step();
+    if (crashed(*c, "the docked assembly")) return result;
+  }
+  const EventFigures sep = Measure(samples, o.naive ? o.separate_s - 0.01 : blend_start - 0.01, o.separate_s + o.window_s);
+  const EventFigures dock = Measure(samples, result.docking_s - 0.01, result.docking_s + o.window_s);
+  result.steady_max_attitude_deg =
+      Measure(samples, blend_start - 0.5 - (o.separate_s + o.window_s - blend_start), blend_start - 0.5).max_attitude_deg;
+  result.separation_max_attitude_deg = sep.max_attitude_deg;
+  result.separation_max_accel_m_s2 = sep.max_accel;
+  result.docking_max_attitude_deg = dock.max_attitude_deg;
+  result.docking_max_accel_m_s2 = dock.max_accel;
+  result.success = (c->state().p_W() - p_c).norm() < 0.1;
+  if (!result.success) result.failure = "the docked assembly did not hold its position within 0.1 m";
+  return result;
+}
+
+}  // namespace rotorguard::benchmarks

@@ -1,0 +1,309 @@
+#include "rotorguard/campaign/campaign.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "rotorguard/campaign/parallel.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/io/files.h"
+#include "results_file.h"
+
+namespace rotorguard::campaign {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::uint64_t Fnv1a(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string Hex(std::uint64_t v) { return fmt::format("{:016x}", v); }
+
+std::string Host() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof(name) - 1) != 0) return "unknown";
+  return name;
+}
+
+std::string UtcNow() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+
+/// One whole line appended and synced: after a kill the file holds whole lines, at most the last
+/// one cut short.
+class AppendFile {
+ public:
+  explicit AppendFile(const std::string& path) : path_(path) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw std::runtime_error(fmt::format("{}: cannot open for appending", path));
+  }
+  ~AppendFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  AppendFile(const AppendFile&) = delete;
+  AppendFile& operator=(const AppendFile&) = delete;
+  void AppendLine(const std::string& line) {
+    const std::string text = line + "\n";
+    std::size_t done = 0;
+    while (done < text.size()) {
+      const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+      if (n < 0) throw std::runtime_error(fmt::format("{}: write failed", path_));
+      done += static_cast<std::size_t>(n);
+    }
+    if (::fsync(fd_) != 0) throw std::runtime_error(fmt::format("{}: fsync failed", path_));
+  }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
+
+/// An exclusive lock on a shard for the life of a run: a second run of the same shard (a resubmitted
+/// task whose first copy still runs) is refused instead of appending the same trials twice.
+class ShardLock {
+ public:
+  explicit ShardLock(const std::string& path) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw io::InputFileError(path, "cannot open the shard's lock file");
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw std::invalid_argument(fmt::format("{} is held: this shard is already running (wait for it, or stop "
+                                              "it, then --resume)", path));
+    }
+  }
+  ~ShardLock() { ::close(fd_); }  // closing releases the lock
+  ShardLock(const ShardLock&) = delete;
+  ShardLock& operator=(const ShardLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
+bool IsValidCampaignName(const std::string& name) {
+  return !name.empty() &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") == std::string::npos;
+}
+
+std::string TrialId(const std::map<std::string, std::string>& parameters) {
+  std::string text;
+  for (const auto& [key, value] : parameters) text += key + "=" + value + "\n";
+  return Fingerprint(text);
+}
+
+std::string Fingerprint(const std::string& text) { return Hex(Fnv1a(text)); }
+
+std::string TrialFailure(const nlohmann::json& record) {
+  const std::string message = record.value("message", "");
+  return record.value("status", "") == "ok" ? message : record.value("status", "") + ": " + message;
+}
+
+Shard Shard::Parse(const std::string& text) {
+  const std::size_t slash = text.find('/');
+  Shard s;
+  try {
+    if (slash == std::string::npos) throw std::invalid_argument("no slash");
+    std::size_t used = 0;
+    s.index = std::stoi(text.substr(0, slash), &used);
+    if (used != slash) throw std::invalid_argument("trailing text");
+    const std::string count = text.substr(slash + 1);
+    s.count = std::stoi(count, &used);
+    if (used != count.size()) throw std::invalid_argument("trailing text");
+  } catch (const std::exception&) {
+    throw std::invalid_argument(fmt::format("--shard '{}' is invalid; expected i/N with 0 <= i < N", text));
+  }
+  if (s.count < 1 || s.index < 0 || s.index >= s.count) {
+    throw std::invalid_argument(fmt::format("--shard '{}' is invalid; expected i/N with 0 <= i < N (shards count from 0)", text));
+  }
+  return s;
+}
+
+std::string Shard::ResultsFileName() const {
+  return count == 1 ? "results.jsonl" : fmt::format("results.shard-{}.jsonl", index);
+}
+
+std::string Shard::ManifestFileName() const {
+  return count == 1 ? "manifest.json" : fmt::format("manifest.shard-{}.json", index);
+}
+
+std::pair<int, int> Shard::Range(int trials) const {
+  const auto at = [&](int k) { return static_cast<int>(static_cast<long long>(trials) * k / count); };
+  return {at(index), at(index + 1)};
+}
+
+CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOptions& options) {
+  if (options.jobs < 1 || options.jobs > 256) {
+    throw std::invalid_argument(fmt::format("--jobs {} is invalid; expected a count in [1, 256]", options.jobs));
+  }
+  if (options.shard.count > campaign.trials) {
+    throw std::invalid_argument(fmt::format("--shard {}/{}: more shards than the campaign's {} trials",
+                                            options.shard.index, options.shard.count, campaign.trials));
+  }
+  std::error_code ec;
+  fs::create_directories(options.out_dir, ec);
+  if (ec || !fs::is_directory(options.out_dir)) {
+    throw std::invalid_argument(fmt::format("--out: cannot create the folder '{}'{}", options.out_dir,
+                                            ec ? ": " + ec.message() : ""));
+  }
+  CampaignRunSummary summary;
+  summary.results_file = (fs::path(options.out_dir) / options.shard.ResultsFileName()).string();
+  summary.manifest_file = (fs::path(options.out_dir) / options.shard.ManifestFileName()).string();
+  const auto [first, last] = options.shard.Range(campaign.trials);
+  summary.trials = last - first;
+  nlohmann::json manifest = {{"campaign", campaign.name},
+                             {"spec", campaign.file},
+                             {"spec_hash", campaign.hash},
+                             {"version", options.version},
+                             {"seed", campaign.seed},
+                             {"trials_total", campaign.trials},
+                             {"shard", fmt::format("{}/{}", options.shard.index, options.shard.count)},
+                             {"trial_range", {first, last}},
+                             {"grid_keys", campaign.group_keys},
+                             {"metrics", campaign.metrics},
+                             {"host", Host()},
+                             {"started", UtcNow()},
+                             {"finished", nullptr}};
+  if (!campaign.bench.is_null()) manifest["bench"] = campaign.bench;
+
+  const ShardLock lock(summary.manifest_file + ".lock");
+  const bool exists = fs::exists(summary.results_file) || fs::exists(summary.manifest_file);
+  std::map<int, nlohmann::json> done;
+  if (exists && !options.resume) {
+    throw std::invalid_argument(fmt::format("{} already holds this shard's results; pass --resume to continue "
+                                            "it, or choose another --out", options.out_dir));
+  }
+  if (exists) {
+    if (!fs::exists(summary.manifest_file)) {
+      throw io::CorruptFileError(summary.manifest_file, 0, "missing: the results cannot be matched to a spec");
+    }
+    const nlohmann::json old = ReadJsonFile(summary.manifest_file);
+    for (const char* key : {"spec_hash", "version", "shard"}) {
+      if (!old.contains(key) || old[key] != manifest[key]) {
+        throw std::invalid_argument(fmt::format(
+            "--resume: {} records {} {}, this run has {}; resume only the same spec with the same program",
+            summary.manifest_file, key, old.contains(key) ? old[key].dump() : "(none)", manifest[key].dump()));
+      }
+    }
+    manifest["started"] = old.value("started", manifest["started"]);
+    Recorded recorded = ReadResults(summary.results_file);
+    for (const auto& [index, line] : recorded.trials) {
+      if (index < first || index >= last || line["id"].get<std::string>() != TrialId(campaign.parameters(index))) {
+        throw io::CorruptFileError(summary.results_file, 0,
+                                   fmt::format("trial {} does not belong to this shard of this spec", index));
+      }
+    }
+    // Only now, with every check passed, cut the line a kill left unfinished.
+    if (recorded.cut) fs::resize_file(summary.results_file, recorded.whole_size);
+    done = std::move(recorded.trials);
+  }
+  io::WriteFileAtomically(summary.manifest_file, manifest.dump(2) + "\n");
+
+  std::vector<int> todo;
+  for (int i = first; i < last; ++i) {
+    if (!done.count(i)) todo.push_back(i);
+  }
+  summary.skipped = summary.trials - static_cast<int>(todo.size());
+  AppendFile results(summary.results_file);
+  std::mutex mutex;
+  int errors = 0;
+  std::exception_ptr write_error;
+  ParallelFor(static_cast<int>(todo.size()), options.jobs, [&](int task) {
+    const int index = todo[static_cast<std::size_t>(task)];
+    const std::map<std::string, std::string> params = campaign.parameters(index);
+    nlohmann::json line = {{"trial", index}, {"id", TrialId(params)}, {"params", params}};
+    try {
+      TrialOutcome r = campaign.run(index, params);
+      bool finite = true;
+      for (auto& [name, value] : r.metrics.items()) {
+        if (value.is_number_float() && !std::isfinite(value.get<double>())) {
+          finite = false;
+          value = nullptr;  // JSON has no NaN
+        }
+      }
+      line["status"] = finite ? "ok" : "diverged";
+      line["message"] = finite ? r.message : "a metric is not finite" + (r.message.empty() ? "" : "; " + r.message);
+      line["metrics"] = std::move(r.metrics);
+    } catch (const std::exception& e) {
+      line["status"] = "error";
+      line["message"] = e.what();
+      line["metrics"] = nullptr;
+    } catch (...) {
+      line["status"] = "error";
+      line["message"] = "an exception of unknown type";
+      line["metrics"] = nullptr;
+    }
+    // Invalid UTF-8 in a message is replaced rather than thrown: the trial is recorded either way.
+    const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    const std::lock_guard<std::mutex> guard(mutex);
+    if (line["status"] != "ok") ++errors;
+    if (write_error) return;  // the disk failed: no more lines; the run reports it below
+    try {
+      results.AppendLine(text);
+    } catch (...) {
+      write_error = std::current_exception();
+    }
+  }, options.progress);
+  if (write_error) std::rethrow_exception(write_error);  // the manifest stays unfinished: resume later
+  summary.ran = static_cast<int>(todo.size());
+  summary.errors = errors;
+  manifest["finished"] = UtcNow();
+  io::WriteFileAtomically(summary.manifest_file, manifest.dump(2) + "\n");
+  return summary;
+}
+
+std::optional<std::vector<nlohmann::json>> RunCampaignRecords(const Campaign& campaign, CampaignRunOptions options) {
+  std::optional<io::TemporaryFolder> temporary;  // removed on return and on an exception
+  if (options.out_dir.empty()) {
+    temporary.emplace("rotorguard-" + campaign.name);
+    options.out_dir = temporary->path();
+    options.resume = false;
+  }
+  const CampaignRunSummary run = RunCampaign(campaign, options);
+  if (options.shard.count > 1) return std::nullopt;
+  // This run's results only: the folder may also hold another sharding's files.
+  Recorded recorded = ReadResults(run.results_file);
+  if (recorded.cut || static_cast<int>(recorded.trials.size()) != campaign.trials) {
+    throw io::CorruptFileError(run.results_file, recorded.whole_size,
+                               fmt::format("{} of {} trials recorded after the run", recorded.trials.size(),
+                                           campaign.trials));
+  }
+  std::vector<nlohmann::json> records;
+  records.reserve(recorded.trials.size());
+  for (auto& [index, line] : recorded.trials) records.push_back(std::move(line));
+  return records;
+}
+
+std::vector<nlohmann::json> RunWholeCampaign(const Campaign& campaign, int jobs,
+                                             const std::function<void(int, int)>& progress) {
+  CampaignRunOptions o;
+  o.jobs = jobs;
+  o.progress = progress;
+  return *RunCampaignRecords(campaign, o);
+}
+
+}  // namespace rotorguard::campaign

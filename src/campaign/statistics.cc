@@ -1,0 +1,25 @@
+#include "rotorguard/campaign/statistics.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rotorguard::campaign {
+
+std::pair<double, double> WilsonInterval(int successes, int n) {
+  if (n <= 0) return {0.0, 1.0};
+  const double z = 1.959963984540054, p = static_cast<double>(successes) / n, z2 = z * z;
+  const double denom = 1.0 + z2 / n;
+  const double centre = (p + z2 / (2.0 * n)) / denom;
+  const double half = z * std::sqrt(p * (1.0 - p) / n + z2 / (4.0 * n * n)) / denom;
+  // At 0 (or n) successes the bound is exactly 0 (or 1); the formula leaves rounding there.
+  return {successes == 0 ? 0.0 : std::max(0.0, centre - half), successes == n ? 1.0 : std::min(1.0, centre + half)};
+}
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(i, v.size() - 1)];
+}
+
+}  // namespace rotorguard::campaign

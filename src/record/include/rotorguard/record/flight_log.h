@@ -1,0 +1,42 @@
+#pragma once
+/// The record of one flight, as the run folder keeps it and as reports and log viewers read it:
+///   summary.json  the outcome and metrics (RunSummary::ToJson),
+///   log.csv       truth, reference, estimate, commands, rotors and FDD indices at the log rate,
+///   scene.json    what the replay draws: vehicle geometry, the world's obstacles (moving boxes
+///                 sampled over time), every plan the navigator adopted and the LiDAR map's
+///                 changes, all in the world frame (docs/report.md, "Files").
+/// flight.mcap (flight_mcap.h) holds the same record for Foxglove and PlotJuggler.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/io/csv.h"
+
+namespace rotorguard::record {
+
+struct FlightLog {
+  nlohmann::json summary;  ///< summary.json
+  nlohmann::json scene;    ///< scene.json
+  io::NumericTable table;  ///< log.csv
+};
+
+/// The names of the log's columns for a vehicle of n rotors (`mode` is the supervisor's flight
+/// mode, stack::FlightMode's code), with the FDD columns (motor index
+/// mi_i, propeller index pi_i, diagnosed health code health_i) when the stack runs fault
+/// detection, and nmpc_ms (the NMPC's last solve time) when it flies the NMPC.
+std::vector<std::string> LogColumns(int num_rotors, bool with_fdd, bool with_nmpc);
+
+/// The log's text: the header, then one line per row, every number in %.9g.
+std::string FormatLogCsv(const io::NumericTable& table);
+
+/// Writes log.csv and scene.json into `dir` atomically (summary.json is the runner's).
+void WriteFlightLogFiles(const FlightLog& log, const std::string& dir);
+
+/// Reads a run folder: summary.json and either log.csv with scene.json or, when those are absent,
+/// flight.mcap. Throws io::InputFileError (a file missing or unreadable) or io::CorruptFileError
+/// (damaged content, with its byte offset).
+FlightLog ReadFlightLog(const std::string& dir);
+
+}  // namespace rotorguard::record

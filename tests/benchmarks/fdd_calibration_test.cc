@@ -1,0 +1,229 @@
+// The sensor log (write, read back, reject corruption) and the offline FDD calibration, checked
+// against the live runs that recorded the logs.
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "rotorguard/benchmarks/fdd_calibration.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/harness/flight_metrics.h"
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/record/sensor_log.h"
+#include "test_util.h"
+#include "vehicle/vehicle_fixture.h"
+
+namespace rotorguard::benchmarks {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Config(const std::string& name) {
+  return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
+}
+
+class TempFolder : public rotorguard::testing::TempFolderTest {
+ protected:
+  /// The reason of the InputFileError that reading `text` as a sensor log gives ("" if none).
+  std::string ReadError(const std::string& text) {
+    try {
+      record::ReadSensorLog(Write("sensors.csv", text), 4);
+    } catch (const io::InputFileError& e) {
+      return e.reason();
+    }
+    return "";
+  }
+};
+
+using SensorLog = TempFolder;
+
+TEST_F(SensorLog, RoundTripsEveryMessageExactly) {
+  std::string text(record::kSensorLogHeader);
+  ImuSample imu{123, Vector3(0.1, -0.2, 9.81), Vector3(1.0 / 3.0, 2e-7, -5.5)};
+  EscTelemetry esc{124, RotorVector(4)};
+  esc.motor_speed_rad_s << 1480.123456789, 0.0, 1e3 / 7.0, 2000.0;
+  OdometrySample odom{125, Vector3(1, 2, 3), Quaternion(0.9, 0.1, -0.3, 0.2).normalized(), Vector3(-1, 0.5, 0)};
+  RotorCommand cmd{126, RotorVector(4)};
+  cmd.thrust_n << 2.8, 0.0, 11.5, std::nextafter(3.0, 4.0);
+  record::AppendImu(imu, &text);
+  record::AppendEsc(esc, &text);
+  record::AppendOdometry(odom, &text);
+  record::AppendCommand(cmd, &text);
+  const std::vector<record::SensorRecord> r = record::ReadSensorLog(Write("sensors.csv", text), 4);
+  ASSERT_EQ(r.size(), 4u);
+  EXPECT_EQ(std::get<ImuSample>(r[0]).t_ns, 123);
+  EXPECT_EQ(std::get<ImuSample>(r[0]).specific_force_B, imu.specific_force_B);
+  EXPECT_EQ(std::get<ImuSample>(r[0]).w_B, imu.w_B);
+  EXPECT_EQ(std::get<EscTelemetry>(r[1]).motor_speed_rad_s, esc.motor_speed_rad_s);
+  EXPECT_EQ(std::get<OdometrySample>(r[2]).p_W, odom.p_W);
+  EXPECT_EQ(std::get<OdometrySample>(r[2]).q_WB.coeffs(), odom.q_WB.coeffs());
+  EXPECT_EQ(std::get<OdometrySample>(r[2]).v_W, odom.v_W);
+  EXPECT_EQ(std::get<RotorCommand>(r[3]).t_ns, 126);
+  EXPECT_EQ(std::get<RotorCommand>(r[3]).thrust_n, cmd.thrust_n);
+}
+
+TEST_F(SensorLog, RejectsCorruptionNamingTheLineAndByte) {
+  const std::string header(record::kSensorLogHeader);
+  const std::string imu = "imu,0,0,0,9.8,0,0,0\n";
+  // The byte offset is where the bad line starts.
+  EXPECT_EQ(ReadError(header + imu + "imu,1,0,0,9.8,0,0"),
+            fmt::format("line 3 (byte {}): truncated: the last line has no end of line", header.size() + imu.size()));
+  EXPECT_EQ(ReadError(header + imu + "imu,1,0,0,9.8,0,0\n"),
+            fmt::format("line 3 (byte {}): imu has 5 values; expected 6", header.size() + imu.size()));
+  EXPECT_EQ(ReadError(header + "gps,0,1\n"),
+            fmt::format("line 2 (byte {}): unknown message type 'gps'; expected imu, esc, odom or cmd", header.size()));
+  EXPECT_EQ(ReadError(header + "esc,0,1,2,1.5x,4\n"),
+            fmt::format("line 2 (byte {}): value 3 is not a number", header.size()));
+  EXPECT_EQ(ReadError(header + "esc,0,1,2,nan,inf\n"), "") << "non-finite values are kept for the replay";
+  EXPECT_EQ(ReadError(header + "esc,x,1,2,3,4\n"), fmt::format("line 2 (byte {}): t_ns is not an integer", header.size()));
+  EXPECT_EQ(ReadError(header + "imu,5,0,0,9.8,0,0,0\n" + imu),
+            fmt::format("line 3 (byte {}): imu time stamp 0 ns is before the previous one (5 ns)",
+                        header.size() + imu.size()));
+  EXPECT_NE(ReadError("t,p_x\n" + imu).find("line 1 (byte 0): expected the header"), std::string::npos);
+  EXPECT_NE(ReadError("").find("empty file"), std::string::npos);
+}
+
+TEST_F(TempFolder, VehicleYamlRoundTripsThroughTheLoader) {
+  vehicle::VehicleParams v = rotorguard::testing::ReferenceQuad();
+  // Collision spheres as an assembly has them (one per unit), within the bounding radius.
+  v.collision_spheres = {{Vector3(0.08, -0.04, 0.0), 0.1}, {Vector3(-0.1, 0.05, 0.0), 0.1 / 3.0}};
+  const vehicle::VehicleParams back = harness::LoadVehicle(Write("vehicle.yaml", harness::VehicleToYaml(v)));
+  EXPECT_EQ(back.name, v.name);
+  EXPECT_EQ(back.mass_kg, v.mass_kg);
+  EXPECT_EQ(back.inertia_kg_m2, v.inertia_kg_m2);
+  EXPECT_EQ(back.rotor_drag_kg_s, v.rotor_drag_kg_s);
+  EXPECT_EQ(back.yaw_damping_n_m_s, v.yaw_damping_n_m_s);
+  EXPECT_NEAR(back.thrust_coefficient_n_s2, v.thrust_coefficient_n_s2, 1e-15 * v.thrust_coefficient_n_s2);
+  EXPECT_EQ(back.motor_time_constant_s, v.motor_time_constant_s);
+  EXPECT_EQ(back.motor_stop_time_constant_s, v.motor_stop_time_constant_s);
+  EXPECT_EQ(back.unloaded_speed_ratio, v.unloaded_speed_ratio);
+  EXPECT_EQ(back.collision_radius_m, v.collision_radius_m);
+  ASSERT_EQ(back.collision_spheres.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back.collision_spheres[i].centre_B, v.collision_spheres[i].centre_B);
+    EXPECT_EQ(back.collision_spheres[i].radius_m, v.collision_spheres[i].radius_m);
+  }
+  ASSERT_EQ(back.rotors.size(), v.rotors.size());
+  for (std::size_t i = 0; i < v.rotors.size(); ++i) {
+    EXPECT_EQ(back.rotors[i].p_B, v.rotors[i].p_B);
+    EXPECT_EQ(back.rotors[i].direction, v.rotors[i].direction);
+    EXPECT_EQ(back.rotors[i].max_thrust_n, v.rotors[i].max_thrust_n);
+    EXPECT_EQ(back.rotors[i].yaw_coefficient_m, v.rotors[i].yaw_coefficient_m);
+  }
+}
+
+using FddReplay = TempFolder;
+
+// The replay is the detector of the live run: the same diagnosis, to the sample, for a motor
+// failure, a propeller loss in hover and one during take-off, and no diagnosis for a fault-free
+// flight.
+TEST_F(FddReplay, FindsTheLiveRunsDiagnosisExactly) {
+  const std::vector<std::pair<std::string, std::vector<harness::Override>>> runs = {
+      {"fdd_hover_motor_stop.yaml", {{"faults.0.rotor", "2"}}},
+      {"fdd_hover_propeller_loss.yaml", {{"faults.0.rotor", "1"}}},
+      {"fdd_takeoff_propeller_loss.yaml", {{"faults.0.rotor", "3"}}},
+      {"lemniscate_2ms.yaml", {{"stack.controller", "nmpc"}, {"stack.fdd", "composite"}, {"duration_s", "8"}}},
+  };
+  for (const auto& [file, overrides] : runs) {
+    const harness::Scenario s = harness::LoadScenario(Config(file), overrides);
+    const fs::path out = dir_ / s.name;
+    harness::RunOptions o;
+    o.out_dir = out.string();
+    const harness::RunSummary live = harness::RunScenario(s, o);
+    ASSERT_TRUE(live.fdd.has_value()) << file;
+    const CalibrationLog log = LoadCalibrationLog(out.string());
+    ASSERT_EQ(log.faults.size(), s.faults.size());
+    ASSERT_TRUE(log.recorded_fdd.has_value());
+    const ReplayOutcome replay = ReplayCompositeFdd(log, *log.recorded_fdd);
+    const harness::FddRecord scored = harness::ScoreFdd(replay.statuses, FaultEvents(log));
+    EXPECT_EQ(scored.detected, live.fdd->detected) << file;
+    EXPECT_EQ(scored.rotor, live.fdd->rotor) << file;
+    EXPECT_EQ(scored.kind, live.fdd->kind) << file;
+    EXPECT_EQ(scored.detector, live.fdd->detector) << file;
+    EXPECT_EQ(scored.detection_s, live.fdd->detection_s) << file;
+    EXPECT_EQ(scored.correct, live.fdd->correct) << file;
+    EXPECT_EQ(scored.false_alarm, live.fdd->false_alarm) << file;
+  }
+}
+
+// The sweep on two fault-free flights (a take-off among them) and two faulty ones: the configured thresholds detect both
+// faults without a false alarm; without debounce, every motor-index threshold above the lowest
+// fault-free M_i (margin < 1) must false-alarm, since the index reached it; the suggestion keeps
+// the margin and is no slower than the configured value.
+TEST_F(FddReplay, CalibrationTableAndSuggestionAreConsistent) {
+  std::vector<CalibrationLog> logs;
+  const std::vector<std::pair<std::string, std::vector<harness::Override>>> runs = {
+      {"lemniscate_2ms.yaml", {{"duration_s", "12"}}},
+      {"takeoff.yaml", {{"stack.controller", "nmpc"}, {"stack.fdd", "composite"}}},
+      {"fdd_hover_motor_stop.yaml", {}},
+      {"fdd_hover_propeller_loss.yaml", {}},
+  };
+  for (const auto& [file, overrides] : runs) {
+    const harness::Scenario s = harness::LoadScenario(Config(file), overrides);
+    harness::RunOptions o;
+    o.out_dir = (dir_ / s.name).string();
+    harness::RunScenario(s, o);
+    logs.push_back(LoadCalibrationLog(o.out_dir));
+  }
+  FddCalibrationOptions options;
+  options.fdd.motor_index_samples = 1;
+  const nlohmann::json c = CalibrateCompositeFdd(logs, options);
+  for (const auto& l : c["logs"]) {
+    EXPECT_FALSE(l["with_configured_thresholds"]["false_alarm"].get<bool>()) << l["dir"];
+    EXPECT_EQ(l["with_configured_thresholds"]["correct"].get<bool>(), l["faulty"].get<bool>()) << l["dir"];
+  }
+  const double min_m = c["fault_free_extremes"]["min_motor_index"].get<double>();
+  EXPECT_GT(min_m, 0.8);
+  EXPECT_LT(min_m, 1.0);
+  bool saw_false_alarm = false;
+  for (const auto& sw : c["sweeps"]) {
+    for (const auto& r : sw["rows"]) {
+      if (sw["threshold"] == "motor_index_threshold" && r["value"].get<double>() > min_m) {
+        EXPECT_GT(r["false_alarms"].get<int>(), 0) << r["value"];
+        saw_false_alarm = true;
+      }
+    }
+    ASSERT_FALSE(sw["suggested"].is_null()) << sw["threshold"] << ": " << sw["note"];
+    ASSERT_TRUE(sw["suggested"]["margin"].is_number());
+    EXPECT_GE(sw["suggested"]["margin"].get<double>(), options.margin);
+    // At the suggested value the replays detect both faults, with no false alarm.
+    fdd::CompositeFddOptions at = options.fdd;
+    const double suggested = sw["suggested"]["value"].get<double>();
+    if (sw["threshold"] == "motor_index_threshold") at.motor_index_threshold = suggested;
+    if (sw["threshold"] == "propeller_index_threshold") at.propeller_index_threshold = suggested;
+    if (sw["threshold"] == "takeoff_angular_acceleration_rad_s2") at.takeoff_angular_acceleration_rad_s2 = suggested;
+    for (const CalibrationLog& log : logs) {
+      const ReplayOutcome r = ReplayCompositeFdd(log, at);
+      EXPECT_EQ(r.isolated_rotor.has_value(), !log.faults.empty()) << sw["threshold"] << " " << log.dir;
+      if (r.isolated_rotor) {
+        EXPECT_EQ(*r.isolated_rotor, log.faults.front().rotor);
+      }
+    }
+    const double configured = sw["configured"].get<double>();
+    for (const auto& r : sw["rows"]) {
+      if (r["value"].get<double>() == configured && r["margin"].is_number() &&
+          r["margin"].get<double>() >= options.margin && r["latency_s_mean"].is_number()) {
+        EXPECT_LE(sw["suggested"]["latency_s_mean"].get<double>(), r["latency_s_mean"].get<double>() + 1e-12);
+      }
+    }
+  }
+  EXPECT_TRUE(saw_false_alarm) << "the sweep reaches above the fault-free minimum of M_i";
+  EXPECT_NE(CalibrationMarkdown(c).find("Suggested: motor_index_threshold ="), std::string::npos);
+}
+
+TEST(FddCalibration, RejectsNoLogsAndABadMargin) {
+  EXPECT_THROW(CalibrateCompositeFdd({}, FddCalibrationOptions{}), std::invalid_argument);
+  FddCalibrationOptions o;
+  o.margin = 1.0;
+  EXPECT_THROW(o.Validate(), ValidationError);
+}
+
+}  // namespace
+}  // namespace rotorguard::benchmarks

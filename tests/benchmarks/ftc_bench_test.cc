@@ -1,0 +1,42 @@
+// The FTC benchmark's cell metrics (docs/metrics.md) on hand-made trials.
+#include "rotorguard/benchmarks/ftc_bench.h"
+
+#include <gtest/gtest.h>
+
+namespace rotorguard::benchmarks {
+namespace {
+
+TEST(FtcCell, MetricArithmeticOnHandMadeTrials) {
+  // Four faulty trials: two correct isolations (0.02 s, 0.04 s), one detected 1.5 s late (counts as
+  // missed), one false alarm before the onset; three successes; least altitude -0.2 m.
+  std::vector<FtcTrial> t(4);
+  for (auto& x : t) x.has_fdd = true;
+  t[0] = {true, true, true, false, 0.02, 1.9, "", 11};
+  t[1] = {true, true, true, false, 0.04, 1.8, "", 12};
+  t[2] = {true, true, true, false, 1.5, 1.5, "", 13};
+  t[3] = {false, true, false, true, -1.0, -0.2, "crash: ground impact at 3.00 m/s", 14};
+  const nlohmann::json c = AggregateFtcCell(t, /*faulty=*/true);
+  EXPECT_EQ(c["trials"], 4);
+  EXPECT_NEAR(c["fdd_latency_s_mean"].get<double>(), (0.02 + 0.04 + 1.5) / 3.0, 1e-12);
+  EXPECT_NEAR(c["fdd_latency_s_max"].get<double>(), 1.5, 1e-12);
+  EXPECT_NEAR(c["sucr"].get<double>(), 0.75, 1e-12);
+  EXPECT_NEAR(c["mdr"].get<double>(), 0.5, 1e-12);  // the late one and the false alarm
+  EXPECT_NEAR(c["far"].get<double>(), 0.25, 1e-12);
+  EXPECT_NEAR(c["mini_alt_m"].get<double>(), -0.2, 1e-12);
+  ASSERT_EQ(c["failures"].size(), 1u);
+  EXPECT_EQ(c["failures"][0]["seed"], 14);
+}
+
+TEST(FtcCell, MetricsWithoutFaultDetectionAreNull) {
+  std::vector<FtcTrial> t(2);
+  t[0].success = true;
+  const nlohmann::json c = AggregateFtcCell(t, /*faulty=*/true);
+  EXPECT_TRUE(c["mdr"].is_null());
+  EXPECT_TRUE(c["far"].is_null());
+  EXPECT_TRUE(c["fdd_latency_s_mean"].is_null());
+  EXPECT_NEAR(c["sucr"].get<double>(), 0.5, 1e-12);
+  EXPECT_TRUE(AggregateFtcCell({FtcTrial{true, true, false, false, -1.0, 1.0, "", 1}}, false)["mdr"].is_null());
+}
+
+}  // namespace
+}  // namespace rotorguard::benchmarks

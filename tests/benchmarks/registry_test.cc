@@ -1,0 +1,209 @@
+// The benchmarks on the campaign engine (bench/bench_campaigns.h): a benchmark run whole, in
+// shards merged by `MergeCampaign`, or from its spec file gives one result; the results are built
+// from the records as hand-made records say they must be; bad specs name the key.
+
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/benchmarks/nav_bench.h"
+#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/campaign/merge.h"
+#include "rotorguard/campaign/registry.h"
+#include "rotorguard/campaign/slurm.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/io/files.h"
+#include "test_util.h"
+
+namespace rotorguard::benchmarks {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kConfigs = std::string(ROTORGUARD_SOURCE_DIR) + "/configs";
+
+/// The FTC benchmark at its smallest: one trial per cell, the project's method and the nominal
+/// controller (18 flights of a few seconds each).
+FtcBenchOptions SmallFtc() {
+  FtcBenchOptions o;
+  o.trials = 1;
+  o.seed = 5;
+  o.methods = {"rotorguard", "none"};
+  o.vehicle = harness::LoadVehicle(kConfigs + "/vehicles/zhou2025_quad.yaml");
+  return o;
+}
+
+/// A record as RunCampaign writes it.
+nlohmann::json Record(int trial, std::map<std::string, std::string> params, nlohmann::json metrics,
+                      const std::string& status = "ok", const std::string& message = "") {
+  return {{"trial", trial}, {"id", campaign::TrialId(params)}, {"params", params}, {"status", status}, {"message", message},
+          {"metrics", metrics}};
+}
+
+class BenchCampaigns : public testing::TempFolderTest {};
+
+TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSameCampaign) {
+  const campaign::Campaign c = FtcCampaign(SmallFtc());
+  ASSERT_EQ(c.trials, 9 * 2);
+  // Whole, on two threads, in a temporary folder.
+  campaign::CampaignRunOptions whole;
+  whole.jobs = 2;
+  const nlohmann::json direct = FtcResult(c.bench["options"], *campaign::RunCampaignRecords(c, whole));
+  // In three shards in two folders, then merged: the merge writes the same benchmark result.
+  for (int i = 0; i < 3; ++i) {
+    campaign::CampaignRunOptions o;
+    o.out_dir = (dir_ / (i < 2 ? "a" : "b")).string();
+    o.shard = campaign::Shard{i, 3};
+    o.version = "test";
+    EXPECT_FALSE(campaign::RunCampaignRecords(c, o).has_value());  // one shard of several: nothing to report yet
+  }
+  const nlohmann::json merged = campaign::MergeCampaign({(dir_ / "a").string(), (dir_ / "b").string()}, (dir_ / "m").string(), CampaignKinds());
+  ASSERT_TRUE(merged.contains("bench"));
+  // The generic summary counts only the trials that record a metric: `none` runs no FDD.
+  for (const auto& g : merged["by_grid_point"]) {
+    EXPECT_EQ(g["metrics"]["correct"]["n"], g["grid"]["method"] == "none" ? 0 : 1) << g.dump();
+  }
+  EXPECT_EQ(merged["bench"]["cells"], direct["cells"]);
+  EXPECT_EQ(io::ReadFile((dir_ / "m" / "bench.md").string()), FtcMarkdown(direct));
+  // The benchmark's own figures: the project's method isolates every fault and flies every cell.
+  for (const auto& cell : direct["cells"]) {
+    if (cell["method"] != "rotorguard") continue;
+    EXPECT_EQ(cell["sucr"], 1.0) << cell.dump();
+    if (cell["fault"] != "none") {
+      EXPECT_EQ(cell["mdr"], 0.0) << cell.dump();
+    }
+  }
+  // The same options written as a spec are the same campaign: the same trials and hash, so shards
+  // run from the spec and from `bench ftc` merge together.
+  const std::string spec = Write("ftc.yaml", "name: small_ftc\nbench: ftc\ntrials: 1\nseed: 5\n"
+                                             "methods: [rotorguard, none]\nvehicle: " + kConfigs +
+                                             "/vehicles/zhou2025_quad.yaml\n");
+  const campaign::Campaign from_file = campaign::LoadCampaign(spec, CampaignKinds());
+  EXPECT_EQ(from_file.hash, c.hash);
+  EXPECT_EQ(from_file.trials, c.trials);
+  EXPECT_EQ(from_file.name, "small_ftc");
+  for (int i = 0; i < c.trials; ++i) EXPECT_EQ(from_file.parameters(i), c.parameters(i));
+  // Any change of what the trials depend on is another campaign.
+  FtcBenchOptions heavier = SmallFtc();
+  heavier.vehicle.mass_kg *= 1.01;
+  EXPECT_NE(FtcCampaign(heavier).hash, c.hash);
+}
+
+TEST_F(BenchCampaigns, FtcResultCountsAnErroredTrialAsAFailure) {
+  FtcBenchOptions o = SmallFtc();
+  o.methods = {"none"};
+  const campaign::Campaign c = FtcCampaign(o);
+  std::vector<nlohmann::json> records;
+  for (int i = 0; i < c.trials; ++i) {
+    records.push_back(Record(i, c.parameters(i), {{"success", true}, {"min_altitude_m", 1.0}}));
+  }
+  records[0] = Record(0, c.parameters(0), nullptr, "error", "boom");
+  const nlohmann::json r = FtcResult(c.bench["options"], records);
+  EXPECT_EQ(r["errors"], 1);
+  EXPECT_EQ(r["cells"][0]["sucr"], 0.0);  // cell 0 is its one trial, the errored one
+  EXPECT_EQ(r["cells"][0]["failures"][0]["reason"], "error: boom");
+  EXPECT_EQ(r["cells"][1]["sucr"], 1.0);
+  records.pop_back();
+  RG_EXPECT_THROW_WITH(FtcResult(c.bench["options"], records), std::invalid_argument, "8 trial records");
+}
+
+/// The nav benchmark's campaign of `trials` rooms, each flown by both variants.
+campaign::Campaign RoomNavCampaign(int trials) {
+  NavBenchOptions o;
+  o.trials = trials;
+  o.kinds = {"room"};
+  o.base = harness::LoadScenario(kConfigs + "/scenarios/forest.yaml");
+  return NavCampaign(o);
+}
+
+TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
+  const campaign::Campaign c = RoomNavCampaign(2);
+  ASSERT_EQ(c.trials, 4);  // (trial, variant): rotorguard, failure_unaware, rotorguard, failure_unaware
+  EXPECT_EQ(c.parameters(0).at("seed"), c.parameters(1).at("seed"));  // both variants fly one world
+  EXPECT_NE(c.parameters(0).at("seed"), c.parameters(2).at("seed"));
+  const auto metrics = [](bool success, bool collision, double rmse, nlohmann::json time) {
+    nlohmann::json m{{"success", success},      {"crashed", collision},
+                     {"collision", collision},  {"tracking_rmse_m", rmse},
+                     {"max_spin_rad_s", 11.0},  {"mission_time_s", time},
+                     {"planner_ms_mean", 2.0},  {"stack_ms_per_cycle_mean", 0.5},
+                     {"realtime_factor", 10.0}, {"trial_realtime_factor", rmse * 100.0}};
+    // The wall-clock parts of a run (ms per simulated second), the simulator's differing by trial.
+    for (const char* part : {"mapper", "planner", "controller", "stack_other", "runner"}) {
+      m[fmt::format("cost_{}_ms_per_sim_s", part)] = 10.0;
+    }
+    m["cost_simulator_ms_per_sim_s"] = rmse * 1000.0;
+    return m;
+  };
+  const std::vector<nlohmann::json> records = {
+      Record(0, c.parameters(0), metrics(true, false, 0.05, 30.0)),
+      Record(1, c.parameters(1), metrics(false, true, 0.20, nullptr), "ok", "crash: collision with a box"),
+      Record(2, c.parameters(2), metrics(true, false, 0.07, 34.0)),
+      Record(3, c.parameters(3), nullptr, "diverged", "a metric is not finite")};
+  const nlohmann::json r = NavResult(c.bench["options"], records);
+  EXPECT_EQ(r["rotorguard"]["success_rate"], 1.0);
+  EXPECT_NEAR(r["rotorguard"]["tracking_rmse_m"].get<double>(), 0.06, 1e-12);
+  EXPECT_NEAR(r["rotorguard"]["mission_time_s"].get<double>(), 32.0, 1e-12);
+  EXPECT_NEAR(r["rotorguard"]["cost_ms_per_sim_s"]["simulator"].get<double>(), 60.0, 1e-9);  // (50 + 70) / 2
+  EXPECT_NEAR(r["rotorguard"]["cost_ms_per_sim_s"]["runner"].get<double>(), 10.0, 1e-12);
+  EXPECT_NEAR(r["rotorguard"]["realtime_factor"].get<double>(), 10.0, 1e-12);       // the stack's
+  EXPECT_NEAR(r["rotorguard"]["trial_realtime_factor"].get<double>(), 6.0, 1e-12);  // (5 + 7) / 2
+  EXPECT_EQ(r["failure_unaware"]["success_rate"], 0.0);
+  EXPECT_EQ(r["failure_unaware"]["collision_rate"], 0.5);   // the diverged trial did not report one
+  EXPECT_TRUE(r["failure_unaware"]["mission_time_s"].is_null());  // neither completed
+  ASSERT_EQ(r["failure_unaware"]["failures"].size(), 2u);
+  EXPECT_EQ(r["failure_unaware"]["failures"][1]["reason"], "diverged: a metric is not finite");
+  EXPECT_EQ(r["groups"]["room"]["rotorguard"], r["rotorguard"]);
+}
+
+// Thirteen failed flights of one variant: ten are listed with their seeds, the other three are
+// counted, in the JSON and in the Markdown, rather than dropped.
+TEST_F(BenchCampaigns, NavResultCountsTheFailuresItDoesNotList) {
+  const campaign::Campaign c = RoomNavCampaign(13);
+  ASSERT_EQ(c.trials, 26);
+  std::vector<nlohmann::json> records;
+  for (int i = 0; i < c.trials; ++i) records.push_back(Record(i, c.parameters(i), nullptr, "error", "boom"));
+  const nlohmann::json r = NavResult(c.bench["options"], records);
+  EXPECT_EQ(r["rotorguard"]["failures"].size(), 10u);
+  EXPECT_EQ(r["rotorguard"]["failures_not_listed"], 3);
+  EXPECT_EQ(r["failure_unaware"]["failures_not_listed"], 3);
+  const std::string md = NavMarkdown(r);
+  EXPECT_NE(md.find("rotorguard failed: 3 more, not listed"), std::string::npos) << md;
+  EXPECT_NE(md.find("failure_unaware failed: 3 more, not listed"), std::string::npos) << md;
+}
+
+TEST_F(BenchCampaigns, BadBenchmarkSpecsNameTheKey) {
+  const std::string vehicle = "vehicle: " + kConfigs + "/vehicles/zhou2025_quad.yaml\n";
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("a.yaml", "name: a\nbench: hover\ntrials: 1\n"), CampaignKinds()), io::ConfigError, "bench");
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("b.yaml", "name: b\nbench: ftc\ntrials: 0\n" + vehicle), CampaignKinds()), io::ConfigError,
+                       "trials");
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("c.yaml", "name: c\nbench: ftc\ntrials: 1\nmethods: [rotorguard, magic]\n" +
+                                                        vehicle), CampaignKinds()),
+                       io::ConfigError, "magic");
+  // A key of another benchmark is unknown here.
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("d.yaml", "name: d\nbench: ftc\ntrials: 1\nkinds: [room]\n" + vehicle), CampaignKinds()),
+                       io::ConfigError, "kinds");
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("e.yaml", "name: e\nbench: ftc\ntrials: 1\n"), CampaignKinds()), io::ConfigError, "vehicle");
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("f.yaml", "name: a b\nbench: ftc\ntrials: 1\n" + vehicle), CampaignKinds()), io::ConfigError,
+                       "name");
+  // A file that cannot be read is reported at the key that names it.
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("g.yaml", "name: g\nbench: nav\ntrials: 1\nbase: no_such.yaml\n"), CampaignKinds()),
+                       io::ConfigError, "base");
+  // Table II needs both of its scenes.
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("h.yaml", "name: h\nbench: mars\ntrials: 1\nspiral: " + kConfigs +
+                                                        "/scenarios/mars_spiral_3x2.yaml\nnine_units: " + kConfigs +
+                                                        "/assemblies/3x3.yaml\nplan_4x1: " + kConfigs +
+                                                        "/scenarios/mars_plan_4x1.yaml\n"), CampaignKinds()),
+                       io::ConfigError, "plan_3x2");
+  // A spec without a file cannot make a Slurm script.
+  campaign::SlurmScriptOptions s;
+  s.out_dir = dir_.string();
+  s.rotorguard = "/bin/true";
+  RG_EXPECT_THROW_WITH(campaign::SlurmArrayScript(FtcCampaign(SmallFtc()), s), std::invalid_argument, "no spec file");
+}
+
+}  // namespace
+}  // namespace rotorguard::benchmarks

@@ -1,0 +1,267 @@
+// Paper 002's assemblies in the closed loop (configs/scenarios/mars_spiral_3x2.yaml): the assembly
+// flies as one multirotor of 24 rotors in the simulator, the stack's assembly controller
+// reallocates over the rotors it knows to be degraded.
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/benchmarks/mars_bench.h"
+#include "rotorguard/benchmarks/reconfiguration.h"
+#include "rotorguard/harness/assembly_mission.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/config_node.h"
+#include "test_util.h"
+
+namespace rotorguard::harness {
+namespace {
+
+std::string Config(const std::string& path) { return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/" + path; }
+
+/// Unit No. 1 (rotors 0-3) dead from the start, known to the controller.
+const std::vector<Override> kDeadUnit = {
+    {"faults", "[{rotor: 0, kind: motor_stop, onset: {at_time_s: 0}}, {rotor: 1, kind: motor_stop, onset: "
+               "{at_time_s: 0}}, {rotor: 2, kind: motor_stop, onset: {at_time_s: 0}}, {rotor: 3, kind: motor_stop, "
+               "onset: {at_time_s: 0}}]"},
+    {"stack.known_faults", "[{rotor: 0, at_time_s: 0}, {rotor: 1, at_time_s: 0}, {rotor: 2, at_time_s: 0}, "
+                           "{rotor: 3, at_time_s: 0}]"},
+    {"duration_s", "20"}};
+
+RunSummary Fly(std::vector<Override> overrides, const std::string& reallocation) {
+  overrides.emplace_back("stack.assembly.reallocation", reallocation);
+  return RunScenario(LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), overrides), RunOptions{});
+}
+
+TEST(MarsScenario, TheAssemblyTracksTheSpiralWithAHalfThrustRotor) {
+  const Scenario s = LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), {{"duration_s", "20"}});
+  ASSERT_TRUE(s.assembly);
+  EXPECT_EQ(s.vehicle.num_rotors(), 24);
+  EXPECT_DOUBLE_EQ(s.vehicle.mass_kg, 3.0);
+  const RunSummary r = RunScenario(s, RunOptions{});
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_LT(r.tracking_rmse_m, 0.05);
+}
+
+TEST(MarsScenario, ReallocationCarriesADeadUnitThatTheFaultBlindAllocationCannot) {
+  const RunSummary full = Fly(kDeadUnit, "full");
+  const RunSummary none = Fly(kDeadUnit, "none");
+  EXPECT_TRUE(full.success) << full.failure_reason;
+  EXPECT_NE(full.final_mode, "emergency_landing") << "four failed rotors are within an assembly's allowance";
+  EXPECT_NE(full.final_mode, "landed");
+  EXPECT_LT(full.tracking_rmse_m, 0.03);
+  EXPECT_GT(none.tracking_rmse_m, 4.0 * full.tracking_rmse_m);
+}
+
+TEST(MarsScenario, AssemblyKeysAreCheckedNamingTheKey) {
+  const auto message = [](const std::string& file, const std::vector<Override>& o) {
+    try {
+      LoadScenario(Config(file), o);
+    } catch (const io::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  std::string m = message("scenarios/hover.yaml", {{"stack.controller", "assembly"}});
+  EXPECT_NE(m.find("controller assembly flies an assembly"), std::string::npos) << m;
+  m = message("scenarios/mars_spiral_3x2.yaml", {{"stack.assembly.reallocation", "hybrid"}});
+  EXPECT_NE(m.find("stack.assembly.reallocation"), std::string::npos) << m;
+  m = message("scenarios/mars_spiral_3x2.yaml", {{"stack.known_faults.0.loss", "1.5"}});
+  EXPECT_NE(m.find("known_faults.0.loss"), std::string::npos) << m;
+  m = message("scenarios/nmpc_hover_motor_stop_known.yaml",
+              {{"stack.known_faults", "[{rotor: 0, at_time_s: 1, loss: 0.5}]"}});
+  EXPECT_NE(m.find("1 unless the controller is assembly"), std::string::npos) << m;
+}
+
+TEST(MarsScenario, APlannedRowPassesTheDoorLengthwiseAndFliesItWithoutTouching) {
+  const Scenario s = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  ASSERT_TRUE(s.assembly_plan);
+  const auto* plan = dynamic_cast<const modular::AssemblyTrajectory*>(s.reference.get());
+  ASSERT_NE(plan, nullptr);
+  // The tracking error is measured while the plan is flown, not over the hover after it.
+  EXPECT_FALSE(s.tracking_end_s.has_value());
+  EXPECT_EQ(TrackingEndS(s), plan->duration());
+  EXPECT_LT(plan->duration(), s.duration_s);
+  // The truth geometry (not the planner's map): every unit's sphere clear of every obstacle along
+  // the plan, and the row lengthwise (within 20 degrees of x) where it crosses the wall at x = 0.
+  bool crossed = false;
+  for (double t = 0.0; t <= plan->duration(); t += 0.01) {
+    const modular::AssemblyPose pose = plan->PoseAt(t);
+    const double c = std::cos(pose.yaw_rad), sn = std::sin(pose.yaw_rad);
+    for (const Vector3& u : s.assembly->unit_position_B) {
+      const Vector3 p = pose.p_W + Vector3(c * u.x() - sn * u.y(), sn * u.x() + c * u.y(), 0.0);
+      ASSERT_GE(s.world.DistanceToObstacles(p, t), s.assembly->unit_radius_m) << "t = " << t;
+    }
+    if (std::abs(pose.p_W.x()) < 0.05) {
+      crossed = true;
+      EXPECT_LT(std::abs(sn), std::sin(20.0 * std::numbers::pi / 180.0)) << "t = " << t;
+    }
+  }
+  EXPECT_TRUE(crossed);
+  const RunSummary r = RunScenario(s, RunOptions{});
+  EXPECT_TRUE(r.success) << r.failure_reason;  // the simulator checks every unit's sphere
+  EXPECT_LT(r.tracking_rmse_m, 0.03);
+}
+
+TEST(MarsScenario, AReplannedReferenceBringsItsOwnTrackingWindow) {
+  // bench mars loads the scene once and swaps in each method's plan: each flight must be scored
+  // over its own plan, not over the plan the scene was loaded with.
+  Scenario s = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  const double ours = s.reference->duration();
+  Scenario b = s;
+  b.assembly_plan->method = "baseline";
+  const AssemblyPlanResult plan = PlanAssemblyMission(b);
+  ASSERT_TRUE(plan.ok) << plan.message;
+  s.reference = plan.trajectory;
+  const double baseline = plan.trajectory->duration();
+  ASSERT_GT(std::abs(baseline - ours), 0.1);  // the two plans differ, so the check below can fail
+  EXPECT_EQ(TrackingEndS(s), baseline);
+  const RunSummary r = RunScenario(s, RunOptions{});
+  ASSERT_FALSE(r.crashed) << r.failure_reason;
+  EXPECT_NEAR(r.tracking_end_s, baseline, 1e-3);  // to the physics step
+}
+
+class MarsScenarioFile : public rotorguard::testing::TempFolderTest {};
+
+TEST_F(MarsScenarioFile, ATrackingWindowThatStartsAfterThePlanIsAnErrorNamingTheKey) {
+  std::string text = io::ReadInputFile(Config("scenarios/mars_plan_4x1.yaml"));
+  text.replace(text.find("../assemblies/"), 14, Config("assemblies/"));
+  const std::string late = Write("late.yaml", text + "metrics: {tracking_start_s: 15}\n");
+  for (const char* part : {"late.yaml", "metrics.tracking_start_s", "the plan's duration"}) {
+    RG_EXPECT_THROW_WITH(LoadScenario(late), io::ConfigError, part);
+  }
+  // With its own end the window may lie after the plan (the hover at the goal).
+  const Scenario s = LoadScenario(Write("s.yaml", text + "metrics: {tracking_start_s: 15, tracking_end_s: 20}\n"));
+  EXPECT_EQ(TrackingEndS(s), 20.0);
+}
+
+TEST(MarsScenario, AnUnplannableAssemblyMissionIsAConfigErrorNamingTheMission) {
+  const auto message = [](const std::vector<Override>& o) {
+    try {
+      LoadScenario(Config("scenarios/mars_plan_4x1.yaml"), o);
+    } catch (const io::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  std::string m = message({{"mission.goal_m", "[0.0, -2.0, 1.2]"}});  // inside the wall
+  EXPECT_NE(m.find("cannot plan the assembly's path: A*: goal_blocked"), std::string::npos) << m;
+  EXPECT_NE(m.find("mission"), std::string::npos) << m;
+  m = message({{"mission.method", "fastest"}});
+  EXPECT_NE(m.find("mission.method"), std::string::npos) << m;
+  m = message({{"mission.safety_factor", "1.5"}});
+  EXPECT_NE(m.find("mission.safety_factor"), std::string::npos) << m;
+  try {
+    LoadScenario(Config("scenarios/hover.yaml"), {{"mission", "{type: assembly_plan, goal_m: [1, 0, 1]}"}});
+    ADD_FAILURE() << "a single vehicle accepted mission assembly_plan";
+  } catch (const io::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("plans for an assembly"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError) {
+  benchmarks::MarsBenchOptions o;
+  o.trials = 1;
+  o.jobs = 2;
+  o.alloc_samples = 1000;
+  o.spiral = LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), {{"duration_s", "15"}});
+  o.nine_units = LoadAssembly(Config("assemblies/3x3.yaml"));
+  o.reconfigure = LoadScenario(Config("scenarios/mars_reconfigure_3x1.yaml"));
+  o.plan_4x1 = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  o.plan_3x2 = LoadScenario(Config("scenarios/mars_plan_3x2.yaml"));
+  const nlohmann::json r = benchmarks::RunMarsBenchmark(o);
+  // Table II: ours plans every row and flies it, each plan within what the known rotors can give.
+  ASSERT_EQ(r["table2"].size(), 5u);
+  for (const auto& row : r["table2"]) {
+    SCOPED_TRACE(row["shape"].get<std::string>() + " " + row["fault"].get<std::string>());
+    ASSERT_TRUE(row["ours_planned"].get<bool>());
+    EXPECT_EQ(row["ours_success_rate"].get<double>(), 1.0) << row["ours_first_failure"];
+    // Ours asks no more of the assembly than its rotors can give (sampled every millisecond against
+    // the allocator's capacity, not the planner's own limits).
+    EXPECT_LT(row["ours_max_thrust_accel_m_s2"].get<double>(), row["capacity_thrust_accel_m_s2"].get<double>());
+    EXPECT_LT(row["ours_max_yaw_accel_rad_s2"].get<double>(), row["capacity_yaw_accel_rad_s2"].get<double>());
+  }
+  // The baseline plans the same trajectory whatever the fault: with the end unit No. 4 dead it asks
+  // for more yaw acceleration than the row can give, and the row falls.
+  const nlohmann::json& dead_end = r["table2"][2];
+  ASSERT_EQ(dead_end["fault"].get<std::string>(), "No. 4");
+  ASSERT_TRUE(dead_end["baseline_planned"].get<bool>());
+  EXPECT_GT(dead_end["baseline_max_yaw_accel_rad_s2"].get<double>(), dead_end["capacity_yaw_accel_rad_s2"].get<double>());
+  EXPECT_EQ(dead_end["baseline_success_rate"].get<double>(), 0.0);
+  EXPECT_LT(dead_end["ours_error_m"].get<double>(), dead_end["baseline_error_m"].get<double>());
+  // Its wreck lies at the wall while the plan goes on to the goal beyond: the error over the plan's
+  // window is far above the error up to the crash. Ours does not crash: one error.
+  EXPECT_GT(dead_end["baseline_error_m"].get<double>(), 10.0 * dead_end["baseline_error_to_crash_m"].get<double>());
+  EXPECT_EQ(dead_end["ours_error_m"].get<double>(), dead_end["ours_error_to_crash_m"].get<double>());
+  ASSERT_EQ(r["table1"].size(), 6u);
+  for (const auto& row : r["table1"]) {
+    SCOPED_TRACE(row["case"].get<std::string>());
+    // Units No. 1 and 3 dead leave unit No. 2 alone on its side of the roll axis: it would have to
+    // carry half the weight (14.7 N), four rotors of 2.6 N give 10.4 N. Every other case can hover.
+    const bool one_row = row["case"].get<std::string>().find("No. 1 and 3") != std::string::npos;
+    EXPECT_EQ(row["hover_attainable"].get<bool>(), !one_row);
+    if (one_row) continue;
+    EXPECT_EQ(row["full_success_rate"].get<double>(), 1.0);
+    EXPECT_LE(row["full_over_fault_free"].get<double>(), 1.5);
+  }
+  // A dead unit: the fault-blind allocation errs far more than the reallocation.
+  EXPECT_GT(r["table1"][3]["none_error_m"].get<double>(), 4.0 * r["table1"][3]["full_error_m"].get<double>());
+  EXPECT_TRUE(r["table1_full_within_1_5x_fault_free"].get<bool>());
+  EXPECT_GT(r["alloc_us_mean"].get<double>(), 0.0);
+  EXPECT_EQ(r["alloc_units"].get<int>(), 9);
+  EXPECT_LT(r["reconfig_max_attitude_deg"].get<double>(), 1.0);
+  EXPECT_EQ(r["reconfig"]["prepared"]["success_rate"].get<double>(), 1.0);
+  o.trials = 0;
+  RG_EXPECT_THROW_WITH(benchmarks::RunMarsBenchmark(o), std::invalid_argument, "trials = 0");
+}
+
+TEST(Reconfiguration, AUnitSeparatesFliesOverAndDocksWhileTheAssemblyStaysLevel) {
+  benchmarks::ReconfigurationOptions o;
+  o.base = LoadScenario(Config("scenarios/mars_reconfigure_3x1.yaml"));
+  const benchmarks::ReconfigurationResult prepared = benchmarks::RunReconfiguration(o);
+  ASSERT_TRUE(prepared.success) << prepared.failure;
+  EXPECT_GT(prepared.docking_s, prepared.separation_s + 3.0);  // up, across and down at 0.3 m/s
+  EXPECT_LT(prepared.separation_max_attitude_deg, 1.0);        // paper: at most about 1 degree
+  EXPECT_LT(prepared.docking_max_attitude_deg, 1.0);
+  o.naive = true;
+  const benchmarks::ReconfigurationResult naive = benchmarks::RunReconfiguration(o);
+  ASSERT_TRUE(naive.success) << naive.failure;
+  // Prepared, nothing acts through the latch when it opens: the assembly's acceleration does not
+  // jump as it does when the unit is let go carrying its share of the fault's compensation.
+  EXPECT_LT(prepared.separation_max_accel_m_s2, naive.separation_max_accel_m_s2);
+  o.target_slot = Eigen::Vector2i(1, 0);  // occupied
+  RG_EXPECT_THROW_WITH(benchmarks::RunReconfiguration(o), std::invalid_argument, "target_slot");
+}
+
+class AssemblyFile : public testing::TempFolderTest {};
+
+TEST_F(AssemblyFile, BadSlotsNameFileLineAndKey) {
+  const std::string unit = Config("vehicles/mars_unit.yaml");
+  const std::string path = Write("bad.yaml", "unit: " + unit + "\nspacing_m: 0.25\nslots:\n  - [0, 0]\n  - [0, 0]\n");
+  try {
+    LoadAssembly(path);
+    ADD_FAILURE() << "expected an error";
+  } catch (const io::ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("bad.yaml"), std::string::npos) << m;
+    EXPECT_NE(m.find("slots.1"), std::string::npos) << m;
+    EXPECT_NE(m.find("a grid cell no other unit occupies"), std::string::npos) << m;
+  }
+  const std::string close = Write("close.yaml", "unit: " + unit + "\nspacing_m: 0.1\nshape: 3x2\n");
+  RG_EXPECT_THROW_WITH(LoadAssembly(close), io::ConfigError, "spacing_m");
+  const std::string both = Write("both.yaml", "unit: " + unit + "\nspacing_m: 0.25\nshape: 3x2\nslots: [[0, 0]]\n");
+  RG_EXPECT_THROW_WITH(LoadAssembly(both), io::ConfigError, "exactly one of 'shape' and 'slots'");
+  const modular::Assembly a = LoadAssembly(Config("assemblies/3x3_plus.yaml"));
+  EXPECT_EQ(a.num_units, 5);
+}
+
+TEST_F(AssemblyFile, AScenarioNamesEitherAVehicleOrAnAssembly) {
+  const std::string path = Write("both.yaml", "vehicle: " + Config("vehicles/mars_unit.yaml") + "\nassembly: " +
+                                                  Config("assemblies/3x2.yaml") +
+                                                  "\nduration_s: 1\nmission: {type: hover}\n");
+  RG_EXPECT_THROW_WITH(LoadScenario(path), io::ConfigError, "exactly one of 'vehicle' (a vehicle file) and 'assembly'");
+}
+
+}  // namespace
+}  // namespace rotorguard::harness

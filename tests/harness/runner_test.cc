@@ -1,0 +1,307 @@
+// Closed-loop flights of the shipped scenarios: the nominal stack through sensors only.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rotorguard/benchmarks/perception_bench.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/io/csv.h"
+#include "test_util.h"
+
+namespace rotorguard::harness {
+namespace {
+
+std::string Config(const std::string& name) {
+  return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
+}
+
+TEST(Runner, NominalControllerTracksThe2msLemniscateWithinTenCentimetres) {
+  const Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"));
+  const RunSummary r = RunScenario(s);
+  EXPECT_TRUE(r.success) << r.crash_reason;
+  EXPECT_LT(r.tracking_rmse_m, 0.10);
+  EXPECT_NEAR(r.sim_time_s, s.duration_s, 1e-6);
+}
+
+TEST(Runner, NominalControllerTracksTheLemniscateOverManySeeds) {
+  // Sensor noise and gusts differ per seed; the bound must hold for each, not on average.
+  for (std::uint64_t seed = 10; seed < 16; ++seed) {
+    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"duration_s", "20"}});
+    s.seed = seed;
+    const RunSummary r = RunScenario(s);
+    EXPECT_TRUE(r.success) << "seed " << seed;
+    EXPECT_LT(r.tracking_rmse_m, 0.10) << "seed " << seed;
+  }
+}
+
+TEST(Runner, HoverHoldsPosition) {
+  const RunSummary r = RunScenario(LoadScenario(Config("hover.yaml")));
+  EXPECT_TRUE(r.success);
+  EXPECT_LT(r.max_position_error_m, 0.05);
+  EXPECT_GT(r.min_altitude_m, 0.95);
+}
+
+TEST(Runner, TakesOffFromTheGroundAndSettlesAtAltitude) {
+  const Scenario s = LoadScenario(Config("takeoff.yaml"));
+  ASSERT_EQ(s.initial_position_m.z(), 0.0);
+  const RunSummary r = RunScenario(s);
+  EXPECT_TRUE(r.success) << r.crash_reason;
+  EXPECT_GE(r.min_altitude_m, 0.0);
+  EXPECT_LT(r.tracking_rmse_m, 0.05);
+}
+
+TEST(Runner, NominalControllerCrashesAfterAMotorStop) {
+  const RunSummary r = RunScenario(LoadScenario(Config("hover_motor_stop_nominal.yaml")));
+  EXPECT_TRUE(r.crashed);
+  EXPECT_FALSE(r.success);
+  ASSERT_EQ(r.faults.size(), 1u);
+  EXPECT_EQ(r.faults[0].kind, "motor_stop");
+  EXPECT_GT(r.sim_time_s, 2.0);  // it was flying until the failure
+}
+
+class RunnerWindowTest : public rotorguard::testing::TempFolderTest {
+ protected:
+  /// hover_motor_stop_nominal.yaml with a metrics block, its vehicle named by an absolute path.
+  std::string WithMetrics(const std::string& metrics) {
+    std::string text = io::ReadInputFile(Config("hover_motor_stop_nominal.yaml"));
+    text.replace(text.find("../vehicles/"), 12, std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/");
+    return Write("s.yaml", text + "metrics: " + metrics + "\n");
+  }
+};
+
+TEST_F(RunnerWindowTest, ACrashedVehicleIsHeldAtItsCrashSiteForTheRestOfTheWindow) {
+  // The hover reference stays at the start, [0, 0, 2]; the wreck lies where log.csv's last row
+  // (the final state) puts it. Over [0, T] the window's mean square error is the flown part's
+  // plus the wreck's constant distance over (t_crash, T]:
+  //   rmse_window^2 T = rmse_flown^2 t_crash + |wreck - p_ref|^2 (T - t_crash).
+  const Scenario s = LoadScenario(Config("hover_motor_stop_nominal.yaml"));
+  RunOptions o;
+  o.out_dir = dir_.string();
+  const RunSummary r = RunScenario(s, o);
+  ASSERT_TRUE(r.crashed);
+  const io::NumericTable log = io::ReadNumericCsv((dir_ / "log.csv").string());
+  const std::size_t last = log.rows() - 1;
+  const Vector3 wreck(log.Column("p_x")[last], log.Column("p_y")[last], log.Column("p_z")[last]);
+  const double d2 = (wreck - s.initial_position_m).squaredNorm();
+  const double T = s.duration_s, t_crash = r.sim_time_s;
+  const double expected = std::sqrt((r.tracking_rmse_m * r.tracking_rmse_m * t_crash + d2 * (T - t_crash)) / T);
+  EXPECT_NEAR(r.tracking_rmse_window_m, expected, 1e-6);  // the log's 9 significant digits
+  EXPECT_GT(r.tracking_rmse_window_m, 2.0 * r.tracking_rmse_m);
+  // A window that opens after the crash holds the wreck only: its error is the constant distance.
+  const RunSummary late = RunScenario(LoadScenario(WithMetrics("{tracking_start_s: 4.0005}")));
+  ASSERT_TRUE(late.crashed);
+  EXPECT_EQ(late.tracking_rmse_m, 0.0);  // nothing flown inside the window
+  EXPECT_NEAR(late.tracking_rmse_window_m, std::sqrt(d2), 1e-6);
+}
+
+TEST(RunnerWindow, AFlightThatDoesNotCrashHasOneError) {
+  const RunSummary r = RunScenario(LoadScenario(Config("hover.yaml")));
+  ASSERT_FALSE(r.crashed);
+  EXPECT_EQ(r.tracking_rmse_window_m, r.tracking_rmse_m);
+}
+
+TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
+  // The motor stops at 2 s: a window that ends at 1.5 s holds only the steady hover, and the
+  // crash after it adds nothing to the window.
+  const Scenario whole = LoadScenario(Config("hover_motor_stop_nominal.yaml"));
+  const Scenario early = LoadScenario(WithMetrics("{tracking_end_s: 1.5}"));
+  ASSERT_TRUE(early.tracking_end_s.has_value());
+  const RunSummary a = RunScenario(whole), b = RunScenario(early);
+  ASSERT_TRUE(b.crashed);
+  EXPECT_EQ(a.sim_time_s, b.sim_time_s);  // the same flight
+  EXPECT_LT(b.tracking_rmse_m, 0.02);
+  EXPECT_GT(a.tracking_rmse_m, 10.0 * b.tracking_rmse_m);
+  EXPECT_EQ(b.tracking_rmse_window_m, b.tracking_rmse_m);
+  EXPECT_LT(b.max_position_error_m, 0.05);
+  // A window that holds no physics step's sample (the physics runs at 1 kHz), or ends after the
+  // flight, names the file and the key that closes it.
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"{tracking_start_s: 2, tracking_end_s: 2}", "metrics.tracking_end_s"},
+      {"{tracking_start_s: 1.0001, tracking_end_s: 1.0002}", "metrics.tracking_end_s"},
+      {"{tracking_end_s: 9}", "metrics.tracking_end_s"},
+      {"{tracking_start_s: 7.9999}", "metrics.tracking_start_s"}};
+  for (const auto& [metrics, key] : bad) {
+    SCOPED_TRACE(metrics);
+    const std::string path = WithMetrics(metrics);
+    RG_EXPECT_THROW_WITH(LoadScenario(path), io::ConfigError, "s.yaml");
+    RG_EXPECT_THROW_WITH(LoadScenario(path), io::ConfigError, key);
+  }
+  // One step's window is enough.
+  EXPECT_NO_THROW(LoadScenario(WithMetrics("{tracking_start_s: 1, tracking_end_s: 1.001}")));
+}
+
+// Closed-loop NMPC flights (paper 000, Sec. VI-A/B), the failure handed to the controller.
+
+TEST(NmpcClosedLoop, HoversAndTracksTheNominal2msLemniscate) {
+  const RunSummary hover = RunScenario(LoadScenario(Config("hover.yaml"), {{"stack.controller", "nmpc"}}));
+  EXPECT_TRUE(hover.success) << hover.failure_reason;
+  EXPECT_LT(hover.max_position_error_m, 0.05);
+  const RunSummary lem = RunScenario(
+      LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}, {"duration_s", "20"}}));
+  EXPECT_TRUE(lem.success) << lem.failure_reason;
+  EXPECT_LT(lem.tracking_rmse_m, 0.10);
+}
+
+TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverSpinningNearElevenRadPerSecond) {
+  const Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"));
+  const RunSummary r = RunScenario(s);
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_GT(r.min_altitude_m, 2.0 - 0.2);  // altitude within 0.2 m of the hover height
+  EXPECT_NEAR(r.max_spin_rad_s, 11.0, 1.0);
+  EXPECT_GE(r.tilt_recovery_s, 0.0);
+  EXPECT_LE(r.tilt_recovery_s, 3.0);  // roll and pitch recovered within 3 s (paper: about 3 s)
+}
+
+// The mixed-level iteration (NmpcOptions::relinearise_every = 3, as the navigation scenarios fly)
+// against the paper's every-call linearisation, through a motor stop and its spin-up to 11 rad/s:
+// the same recovery, to within a few percent of the error.
+TEST(NmpcClosedLoop, ReusingTheLinearisationBetweenEveryThirdPreparationFliesTheSameFailure) {
+  EXPECT_EQ(LoadScenario(Config("forest.yaml")).stack.nmpc.relinearise_every, 3) << "the key is read";
+  EXPECT_EQ(LoadScenario(Config("forest.yaml")).stack.lidar.map.clearing_stride, 2) << "and the map's";
+  Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"));
+  EXPECT_EQ(s.stack.nmpc.relinearise_every, 1) << "the default";
+  const RunSummary every = RunScenario(s);
+  s.stack.nmpc.relinearise_every = 3;
+  const RunSummary third = RunScenario(s);
+  ASSERT_TRUE(every.success) << every.failure_reason;
+  EXPECT_TRUE(third.success) << third.failure_reason;
+  EXPECT_NE(third.tracking_rmse_m, every.tracking_rmse_m) << "the option reached the controller";
+  EXPECT_NEAR(third.tracking_rmse_m, every.tracking_rmse_m, 0.05 * every.tracking_rmse_m);
+  EXPECT_NEAR(third.max_position_error_m, every.max_position_error_m, 0.05 * every.max_position_error_m);
+  EXPECT_NEAR(third.max_spin_rad_s, every.max_spin_rad_s, 0.1);
+  EXPECT_NEAR(third.tilt_recovery_s, every.tilt_recovery_s, 0.05);
+  EXPECT_GT(third.min_altitude_m, 2.0 - 0.2);
+}
+
+TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {
+  const RunSummary r = RunScenario(LoadScenario(Config("nmpc_lemniscate_1ms_rotor0_failed.yaml")));
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_LE(r.tracking_rmse_m, 0.15);  // paper 000's hardware: 0.14-0.15 m
+  EXPECT_GT(r.max_spin_rad_s, 9.0);
+}
+
+// Composite FDD + NMPC in closed loop: the stack discovers the failure from its sensors.
+
+TEST(FddClosedLoop, IsolatesAndSurvivesEachFaultKindInHover) {
+  for (const char* kind : {"propeller_loss", "motor_stop"}) {
+    const RunSummary r = RunScenario(LoadScenario(Config(std::string("fdd_hover_") + kind + ".yaml")));
+    EXPECT_TRUE(r.success) << kind << ": " << r.failure_reason;
+    ASSERT_TRUE(r.fdd.has_value());
+    EXPECT_TRUE(r.fdd->correct) << kind << ": " << r.fdd->kind << " on rotor " << r.fdd->rotor;
+    EXPECT_FALSE(r.fdd->false_alarm);
+    EXPECT_LT(r.fdd->latency_s, std::string(kind) == "motor_stop" ? 0.028 : 0.10) << kind;
+    EXPECT_GT(r.min_altitude_m, 1.8) << kind;
+  }
+}
+
+TEST(FddClosedLoop, NoFalseAlarmOnTheAggressiveNominalLemniscate) {
+  for (std::uint64_t seed : {21u, 22u}) {
+    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}, {"stack.fdd", "composite"}});
+    s.seed = seed;
+    const RunSummary r = RunScenario(s);
+    ASSERT_TRUE(r.fdd.has_value());
+    EXPECT_FALSE(r.fdd->detected) << "seed " << seed << ": " << r.fdd->kind << " on rotor " << r.fdd->rotor
+                                  << " by " << r.fdd->detector << " at " << r.fdd->detection_s;
+  }
+}
+
+TEST(FddClosedLoop, AFaultDuringTakeoffOnEachRotorEndsInAStableHover) {
+  for (int rotor = 0; rotor < 4; ++rotor) {
+    for (const char* kind : {"propeller_loss", "motor_stop"}) {
+      const Scenario s = LoadScenario(Config("fdd_takeoff_propeller_loss.yaml"),
+                                      {{"faults.0.rotor", std::to_string(rotor)}, {"faults.0.kind", kind}});
+      const RunSummary r = RunScenario(s);
+      EXPECT_TRUE(r.success) << "rotor " << rotor << " " << kind << ": " << r.failure_reason;
+      ASSERT_TRUE(r.fdd.has_value());
+      EXPECT_TRUE(r.fdd->correct) << "rotor " << rotor << " " << kind;
+      EXPECT_LT(r.fdd->latency_s, 0.025) << "rotor " << rotor << " " << kind;
+      EXPECT_GE(r.min_altitude_m, 0.0);  // MiniA: no altitude lost at take-off
+    }
+  }
+}
+
+TEST(PassiveClosedLoop, TracksTheNominalLemniscateWithYawLeftFree) {
+  const RunSummary r = RunScenario(
+      LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "passive"}, {"duration_s", "20"}}));
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_LT(r.tracking_rmse_m, 0.10);
+}
+
+// The INDI baseline, driven by the composite FDD's isolation, keeps a hover through either fault
+// kind on every rotor (the reconfiguration path through the stack for the second FTC controller).
+TEST(IndiClosedLoop, KeepsHoveringAfterEitherFaultOnEveryRotor) {
+  for (int rotor = 0; rotor < 4; ++rotor) {
+    for (const char* kind : {"propeller_loss", "motor_stop"}) {
+      const RunSummary r = RunScenario(LoadScenario(
+          Config("fdd_hover_propeller_loss.yaml"),
+          {{"stack.controller", "indi"}, {"faults.0.rotor", std::to_string(rotor)}, {"faults.0.kind", kind}}));
+      EXPECT_TRUE(r.success) << "rotor " << rotor << " " << kind << ": " << r.failure_reason;
+      ASSERT_TRUE(r.fdd.has_value());
+      EXPECT_TRUE(r.fdd->correct) << "rotor " << rotor << " " << kind;
+      EXPECT_GT(r.max_spin_rad_s, 9.0) << "yaw is given up: the vehicle spins";
+      EXPECT_GT(r.min_altitude_m, 1.0);
+    }
+  }
+}
+
+// The whole LiDAR path in the loop: a vehicle spinning at about 11 rad/s after a propeller loss
+// maps the room's walls, ground and pillar from deskewed frames; without deskewing the same frames
+// smear into free space.
+TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
+  double precision[2] = {0.0, 0.0};
+  const Scenario s = LoadScenario(Config("room_lidar_propeller_loss.yaml"));
+  for (int deskew = 0; deskew < 2; ++deskew) {
+    Scenario variant = s;
+    variant.stack.lidar.deskew_frames = deskew == 1;
+    RunOptions o;
+    double p = 0.0;
+    o.on_control_cycle = [&](const stack::FlightStack& st) {
+      if (st.map() && st.command().t_ns == FromSeconds(s.duration_s) - st.control_period_ns()) {
+        p = benchmarks::MapPrecision(*st.map(), s.world);
+      }
+    };
+    const RunSummary r = RunScenario(variant, o);
+    EXPECT_TRUE(r.success) << r.failure_reason;
+    EXPECT_GT(r.max_spin_rad_s, 9.0);
+    EXPECT_GT(r.map_voxels_occupied, 5000);
+    EXPECT_GT(r.lidar_points_dropped, 0) << "pulses into the open sky";
+    EXPECT_GT(r.cost_ms_per_sim_s.mapper, 0.0) << "the stack's LiDAR frames are timed";
+    precision[deskew] = p;
+  }
+  EXPECT_GT(precision[1], 0.95) << "deskewed";    // measured 1.000
+  EXPECT_LT(precision[0], 0.9) << "raw frames";  // measured 0.70
+}
+
+// Navigation on the stack's own map: the room's furniture is only ever seen by the simulated
+// LiDAR, the planner flies both waypoints around it, and the vehicle keeps its radius from every
+// true surface (checked here against the world at each control cycle, beside the simulator's crash
+// detection).
+TEST(NavigationClosedLoop, FliesTheRoomsWaypointsOnItsLidarMap) {
+  const Scenario s = LoadScenario(Config("room_navigate.yaml"));
+  double closest = 1e9;
+  RunOptions o;
+  o.on_control_cycle = [&](const stack::FlightStack& st) {
+    // The planned reference, as flown, against the furniture and walls (not the floor).
+    closest = std::min(closest, s.world.DistanceToObstacles(st.reference_point().p_W, 0.0));
+  };
+  const RunSummary r = RunScenario(s, o);
+  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_EQ(r.waypoints_reached, 2);
+  EXPECT_EQ(r.waypoints_total, 2);
+  EXPECT_GE(r.plans, 5) << "replanned as the map filled in";
+  EXPECT_GT(r.cost_ms_per_sim_s.planner, 0.0) << "the planning is timed";
+  // The stack's real-time factor is the simulated time over the stack's parts of the wall-clock
+  // time (the simulator and the runner left out), so it is the larger of the two factors.
+  const RunCost& c = r.cost_ms_per_sim_s;
+  EXPECT_NEAR(r.stack_realtime_factor, 1e3 / (c.mapper + c.planner + c.controller + c.stack_other),
+              1e-9 * r.stack_realtime_factor);
+  EXPECT_GT(r.stack_realtime_factor, r.realtime_factor);
+  EXPECT_GT(closest, s.vehicle.collision_radius_m) << "the reference kept the vehicle's radius from the furniture";
+  EXPECT_LT(r.tracking_rmse_m, 0.1);
+}
+
+}  // namespace
+}  // namespace rotorguard::harness
