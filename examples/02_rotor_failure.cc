@@ -13,9 +13,11 @@ int main() {
   for (int rotor : {0, 2}) {
     scenario.faults.at(0).rotor = rotor;
     const harness::RunSummary r = harness::RunScenario(scenario);
+    const bool detected = r.fdd && r.fdd->detected();
     std::printf("rotor %d: %s, detected %s on rotor %d after %.3f s, spin %.1f rad/s\n", rotor,
-                r.success ? "success" : r.failure_reason.c_str(), r.fdd && r.fdd->detected ? r.fdd->kind.c_str() : "nothing",
-                r.fdd ? r.fdd->rotor : -1, r.fdd ? r.fdd->latency_s : -1.0, r.max_spin_rad_s);
+                r.success ? "success" : r.failure_reason.value_or("").c_str(),
+                detected ? r.fdd->diagnosis->kind.c_str() : "nothing", detected ? r.fdd->diagnosis->rotor : -1,
+                r.fdd ? r.fdd->latency_s.value_or(-1.0) : -1.0, r.max_spin_rad_s);
     failures += r.success && r.fdd && r.fdd->correct ? 0 : 1;
   }
   return failures == 0 ? 0 : 1;

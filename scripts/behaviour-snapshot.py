@@ -248,6 +248,17 @@ class Snapshot:
             ["campaign", "run", "no/such.yaml", "--out", os.path.join(bad, "c")],
             ["campaign", "run", "configs/campaigns/fdd_hover.yaml", "--out", os.path.join(bad, "c"), "--shard", "3/2"],
             ["campaign", "slurm", "configs/campaigns/fdd_hover.yaml", "--shards", "0", "--out", os.path.join(bad, "s")],
+            ["campaign", "slurm", "configs/campaigns/fdd_hover.yaml", "--shards", "100000", "--out", os.path.join(bad, "s")],
+            ["campaign", "slurm", "configs/campaigns/fdd_hover.yaml", "--shards", "2", "--out", os.path.join(bad, "a b")],
+            ["campaign", "slurm", "configs/campaigns/fdd_hover.yaml", "--shards", "2", "--out", os.path.join(bad, "s"),
+             "--partition", "a b"],
+            # A shard run twice into one folder: the second needs --resume.
+            ["bench", "ftc", "--trials", "1", "--methods", "none", "--out", os.path.join(bad, "twice"), "--shard", "0/9"],
+            ["bench", "ftc", "--trials", "1", "--methods", "none", "--out", os.path.join(bad, "twice"), "--shard", "0/9"],
+            ["bench", "ftc", "--trials", "1", "--methods", "none", "--out", os.path.join(bad, "twice"), "--shard", "9/10"],
+            ["bench", "ftc", "--trials", "1", "--methods", "none", "--out", os.path.join(bad, "twice"), "--shard", "a/2"],
+            ["bench", "ftc", "--trials", "1", "--methods", "none", "--out", os.path.join(bad, "many"), "--shard", "0/99"],
+            ["campaign", "merge", os.path.join(bad, "twice")],
             ["campaign", "merge", os.path.join(bad, "empty_dir")],
             ["campaign", "merge", "no/such/dir"],
         ]

@@ -209,11 +209,11 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
                         {"faulty", !log.faults.empty()},
                         {"fault", fault},
                         {"with_configured_thresholds",
-                         {{"detected", recorded.record.detected},
+                         {{"detected", recorded.record.detected()},
                           {"correct", recorded.record.correct},
                           {"false_alarm", recorded.record.false_alarm},
-                          {"latency_s", recorded.record.correct ? nlohmann::json(recorded.record.latency_s)
-                                                                : nlohmann::json(nullptr)}}}});
+                          {"latency_s", recorded.record.latency_s ? nlohmann::json(*recorded.record.latency_s)
+                                                                  : nlohmann::json(nullptr)}}}});
   }
   const std::vector<Sweep> sweeps = {
       {"motor_index_threshold", &fdd::CompositeFddOptions::motor_index_threshold, &ReplayOutcome::min_motor_index,
@@ -248,9 +248,9 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
         false_alarms += s.record.false_alarm ? 1 : 0;
         if (log.faults.empty()) continue;
         // Missed: no correct diagnosis within 1 s of the onset (DESIGN.md, MDR).
-        if (s.record.correct && s.record.latency_s <= 1.0) {
+        if (s.record.latency_s && *s.record.latency_s <= 1.0) {
           ++detected;
-          latencies.push_back(s.record.latency_s);
+          latencies.push_back(*s.record.latency_s);
         } else {
           ++missed;
         }

@@ -72,20 +72,21 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
       }
       const harness::RunSummary r = harness::RunScenario(s, harness::RunOptions{});
       f.success = r.success;
-      f.failure = r.failure_reason;
+      f.failure = r.failure_reason.value_or("");
       f.max_tilt_deg = r.max_tilt_rad / kDeg;
-      if (faulty < static_cast<int>(r.ukf_w_hat.size())) f.w_estimate = r.ukf_w_hat[static_cast<std::size_t>(faulty)];
-      if (r.fdd) f.detect_s = r.fdd->detected ? r.fdd->detection_s - onset : -1.0;
-      if (r.ukf_settled_s >= 0.0) f.settle_s = r.ukf_settled_s - onset;
-      for (const nlohmann::json& d : r.flatness_decisions) {
-        const std::string kind = d["kind"].get<std::string>();
-        if (kind != "continue" && kind != "return" && kind != "land") continue;
+      if (const std::optional<stack::UkfSummary>& ukf = r.stack.ukf) {
+        if (faulty < static_cast<int>(ukf->w_hat.size())) f.w_estimate = ukf->w_hat[static_cast<std::size_t>(faulty)];
+        if (ukf->settled_s) f.settle_s = *ukf->settled_s - onset;
+      }
+      if (r.fdd) f.detect_s = r.fdd->diagnosis ? r.fdd->diagnosis->detection_s - onset : -1.0;
+      for (const planning::FlatnessDecision& d : r.stack.flatness_decisions) {
+        if (d.kind != "continue" && d.kind != "return" && d.kind != "land") continue;
         f.replanned = true;
-        f.decision = kind;
-        f.replan_ts_s = d["t_s"].get<double>();
-        f.binding = d["binding"].get<std::string>();
-        f.replan_actuator_s = d["actuator_s"].get<double>();
-        const Eigen::Vector2d delta(d["delta_m"][0].get<double>(), d["delta_m"][1].get<double>());
+        f.decision = d.kind;
+        f.replan_ts_s = d.t_s;
+        f.binding = d.binding;
+        f.replan_actuator_s = d.actuator_s;
+        const Eigen::Vector2d delta(d.delta_m.x(), d.delta_m.y());
         const planning::SettlingTime nominal = planning::PlanSettlingTime(model, limits, delta);
         f.replan_nominal_ts_s = std::max(nominal.t_s, o.fig2.stack.navigation.flatness.min_t_s);
         f.replan_nominal_actuator_s = nominal.actuator_s;

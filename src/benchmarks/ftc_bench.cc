@@ -200,9 +200,9 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
     if (s.fdd) {
       out.metrics["correct"] = s.fdd->correct;
       out.metrics["false_alarm"] = s.fdd->false_alarm;
-      out.metrics["latency_s"] = s.fdd->correct ? nlohmann::json(s.fdd->latency_s) : nlohmann::json(nullptr);
+      out.metrics["latency_s"] = s.fdd->latency_s ? nlohmann::json(*s.fdd->latency_s) : nlohmann::json(nullptr);
     }
-    out.message = s.failure_reason;
+    out.message = s.failure_reason.value_or("");
     return out;
   };
   return c;

@@ -333,7 +333,7 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& o) {
     out.metrics["rmse_m"] = r.tracking_rmse_window_m;  // a crashed flight's wreck counts to the window's end
     out.metrics["rmse_flown_m"] = r.tracking_rmse_m;
     out.metrics["max_error_m"] = r.max_position_error_m;
-    out.message = r.failure_reason;
+    out.message = r.failure_reason.value_or("");
     return out;
   };
   return c;

@@ -175,16 +175,16 @@ campaign::Campaign NavCampaign(const NavBenchOptions& o) {
     campaign::TrialOutcome out;
     out.metrics = {{"success", s.success},
                    {"crashed", s.crashed},
-                   {"collision", s.crashed && s.crash_reason.rfind("collision", 0) == 0},
+                   {"collision", s.crashed && s.crash_reason.value_or("").rfind("collision", 0) == 0},
                    {"tracking_rmse_m", s.tracking_rmse_m},
                    {"max_spin_rad_s", s.max_spin_rad_s},
-                   {"mission_time_s", s.mission_time_s >= 0.0 ? nlohmann::json(s.mission_time_s) : nlohmann::json()},
-                   {"planner_ms_mean", s.planner_ms_mean},
+                   {"mission_time_s", s.mission_time_s ? nlohmann::json(*s.mission_time_s) : nlohmann::json()},
+                   {"planner_ms_mean", s.stack.navigation ? s.stack.navigation->planner_ms_mean : 0.0},
                    {"stack_ms_per_cycle_mean", s.stack_ms_per_cycle_mean},
                    {"realtime_factor", s.stack_realtime_factor},
                    {"trial_realtime_factor", s.realtime_factor}};
     for (const harness::RunCost::Part& p : harness::RunCost::kParts) out.metrics[CostMetric(p.name)] = s.cost_ms_per_sim_s.*p.field;
-    out.message = s.failure_reason;
+    out.message = s.failure_reason.value_or("");
     return out;
   };
   return c;

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "rotorguard/campaign/parallel.h"
+#include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
 #include "results_file.h"
@@ -123,26 +124,6 @@ std::string TrialFailure(const nlohmann::json& record) {
   return record.value("status", "") == "ok" ? message : record.value("status", "") + ": " + message;
 }
 
-Shard Shard::Parse(const std::string& text) {
-  const std::size_t slash = text.find('/');
-  Shard s;
-  try {
-    if (slash == std::string::npos) throw std::invalid_argument("no slash");
-    std::size_t used = 0;
-    s.index = std::stoi(text.substr(0, slash), &used);
-    if (used != slash) throw std::invalid_argument("trailing text");
-    const std::string count = text.substr(slash + 1);
-    s.count = std::stoi(count, &used);
-    if (used != count.size()) throw std::invalid_argument("trailing text");
-  } catch (const std::exception&) {
-    throw std::invalid_argument(fmt::format("--shard '{}' is invalid; expected i/N with 0 <= i < N", text));
-  }
-  if (s.count < 1 || s.index < 0 || s.index >= s.count) {
-    throw std::invalid_argument(fmt::format("--shard '{}' is invalid; expected i/N with 0 <= i < N (shards count from 0)", text));
-  }
-  return s;
-}
-
 std::string Shard::ResultsFileName() const {
   return count == 1 ? "results.jsonl" : fmt::format("results.shard-{}.jsonl", index);
 }
@@ -157,18 +138,22 @@ std::pair<int, int> Shard::Range(int trials) const {
 }
 
 CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOptions& options) {
+  const std::string shard_text = fmt::format("{}/{}", options.shard.index, options.shard.count);
   if (options.jobs < 1 || options.jobs > 256) {
-    throw std::invalid_argument(fmt::format("--jobs {} is invalid; expected a count in [1, 256]", options.jobs));
+    ThrowValidation("CampaignRunOptions", "jobs", options.jobs, "a count in [1, 256]");
+  }
+  if (options.shard.count < 1 || options.shard.index < 0 || options.shard.index >= options.shard.count) {
+    ThrowValidation("CampaignRunOptions", "shard", shard_text, "i/N with 0 <= i < N (shards count from 0)");
   }
   if (options.shard.count > campaign.trials) {
-    throw std::invalid_argument(fmt::format("--shard {}/{}: more shards than the campaign's {} trials",
-                                            options.shard.index, options.shard.count, campaign.trials));
+    ThrowValidation("CampaignRunOptions", "shard", shard_text,
+                    fmt::format("at most as many shards as the campaign's {} trials", campaign.trials));
   }
   std::error_code ec;
   fs::create_directories(options.out_dir, ec);
   if (ec || !fs::is_directory(options.out_dir)) {
-    throw std::invalid_argument(fmt::format("--out: cannot create the folder '{}'{}", options.out_dir,
-                                            ec ? ": " + ec.message() : ""));
+    throw ValidationError("out_dir", fmt::format("CampaignRunOptions::out_dir: cannot create the folder '{}'{}",
+                                                 options.out_dir, ec ? ": " + ec.message() : ""));
   }
   CampaignRunSummary summary;
   summary.results_file = (fs::path(options.out_dir) / options.shard.ResultsFileName()).string();
@@ -181,7 +166,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
                              {"version", options.version},
                              {"seed", campaign.seed},
                              {"trials_total", campaign.trials},
-                             {"shard", fmt::format("{}/{}", options.shard.index, options.shard.count)},
+                             {"shard", shard_text},
                              {"trial_range", {first, last}},
                              {"grid_keys", campaign.group_keys},
                              {"metrics", campaign.metrics},
@@ -194,8 +179,10 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
   const bool exists = fs::exists(summary.results_file) || fs::exists(summary.manifest_file);
   std::map<int, nlohmann::json> done;
   if (exists && !options.resume) {
-    throw std::invalid_argument(fmt::format("{} already holds this shard's results; pass --resume to continue "
-                                            "it, or choose another --out", options.out_dir));
+    throw ValidationError("resume", fmt::format("CampaignRunOptions::out_dir '{}' already holds this shard's results; "
+                                                "set CampaignRunOptions::resume to continue it, or choose another "
+                                                "CampaignRunOptions::out_dir",
+                                                options.out_dir));
   }
   if (exists) {
     if (!fs::exists(summary.manifest_file)) {
@@ -204,8 +191,9 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
     const nlohmann::json old = ReadJsonFile(summary.manifest_file);
     for (const char* key : {"spec_hash", "version", "shard"}) {
       if (!old.contains(key) || old[key] != manifest[key]) {
-        throw std::invalid_argument(fmt::format(
-            "--resume: {} records {} {}, this run has {}; resume only the same spec with the same program",
+        throw ValidationError("resume", fmt::format(
+            "CampaignRunOptions::resume: {} records {} {}, this run has {}; resume only the same spec with the same "
+            "program",
             summary.manifest_file, key, old.contains(key) ? old[key].dump() : "(none)", manifest[key].dump()));
       }
     }

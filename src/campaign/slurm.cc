@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "rotorguard/core/error.h"
+
 namespace rotorguard::campaign {
 
 namespace fs = std::filesystem;
@@ -26,22 +28,23 @@ std::string SlurmArrayScript(const Campaign& campaign, const SlurmScriptOptions&
                                             "spec (docs/campaigns.md)", campaign.name));
   }
   if (o.shards < 1 || o.shards > campaign.trials) {
-    throw std::invalid_argument(fmt::format("--shards {} is invalid; expected a count in [1, {}] (the campaign's "
-                                            "trials)", o.shards, campaign.trials));
+    ThrowValidation("SlurmScriptOptions", "shards", o.shards,
+                    fmt::format("a count in [1, {}] (the campaign's trials)", campaign.trials));
   }
   if (o.cpus_per_task < 1 || o.cpus_per_task > 256) {
-    throw std::invalid_argument(fmt::format("--cpus-per-task {} is invalid; expected a count in [1, 256]", o.cpus_per_task));
+    ThrowValidation("SlurmScriptOptions", "cpus_per_task", o.cpus_per_task, "a count in [1, 256]");
   }
-  if (o.out_dir.empty() || o.rotorguard.empty()) throw std::invalid_argument("the script needs --out and the program");
-  for (const std::string* v : {&o.partition, &o.time_limit}) {
+  if (o.out_dir.empty()) ThrowValidation("SlurmScriptOptions", "out_dir", "''", "the results folder");
+  if (o.rotorguard.empty()) ThrowValidation("SlurmScriptOptions", "rotorguard", "''", "the program's path");
+  for (const auto& [field, v] : {std::pair{"partition", &o.partition}, std::pair{"time_limit", &o.time_limit}}) {
     if (v->find_first_of(" \t\n'\"\\$`") != std::string::npos) {
-      throw std::invalid_argument(fmt::format("'{}' is invalid; expected a Slurm name without spaces or quotes", *v));
+      ThrowValidation("SlurmScriptOptions", field, fmt::format("'{}'", *v), "a Slurm name without spaces or quotes");
     }
   }
   const std::string out = fs::absolute(o.out_dir).lexically_normal().string();
   if (out.find_first_of(" \t\n%") != std::string::npos) {
-    throw std::invalid_argument(fmt::format("--out '{}' is invalid; expected a folder without spaces or '%' (an "
-                                            "#SBATCH line cannot quote them)", o.out_dir));
+    ThrowValidation("SlurmScriptOptions", "out_dir", fmt::format("'{}'", o.out_dir),
+                    "a folder without spaces or '%' (an #SBATCH line cannot quote them)");
   }
   const std::string spec_path = fs::absolute(campaign.file).lexically_normal().string();
   std::string s = fmt::format(

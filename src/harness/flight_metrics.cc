@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rotorguard/core/math.h"
+
 namespace rotorguard::harness {
 
 void TrackingErrorAccumulator::Add(double dt, const Vector3& p, const Vector3& p_ref) {
@@ -20,41 +22,61 @@ double TrackingErrorAccumulator::rmse_eq37() const {
   return duration_ > 0.0 ? std::sqrt(integral_) / duration_ : 0.0;
 }
 
-bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis) {
-  switch (truth) {
-    // kFailed: a method that cannot tell the motor from the propeller isolates either correctly.
-    case vehicle::FaultKind::kMotorStop:
-      return diagnosis == fdd::RotorHealth::kMotorFailed || diagnosis == fdd::RotorHealth::kFailed;
-    case vehicle::FaultKind::kPropellerLoss:
-      return diagnosis == fdd::RotorHealth::kPropellerFailed || diagnosis == fdd::RotorHealth::kFailed;
-    case vehicle::FaultKind::kLossOfEffectiveness: return diagnosis == fdd::RotorHealth::kDegraded;
-    case vehicle::FaultKind::kStuck: return diagnosis != fdd::RotorHealth::kOk;
-    case vehicle::FaultKind::kNone: return false;
+namespace {
+double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
+}  // namespace
+
+FlightMetrics::FlightMetrics(const FlightMetricsOptions& options) : options_(options) {}
+
+void FlightMetrics::OnStep(TimeNs t, const vehicle::StateView& s, const Vector3& p_ref, bool after_fault) {
+  const double t_s = ToSeconds(t);
+  if (t >= options_.tracking_start_ns && t < options_.tracking_end_ns) {
+    tracking_.Add(ToSeconds(options_.step_ns), s.p_W(), p_ref);
   }
-  return false;
+  const double error = (s.p_W() - p_ref).norm();
+  if (!(error <= options_.success_error_m)) last_violation_ = Violation{t_s, error};
+  const double altitude = s.p_W().z();
+  min_altitude_all_ = std::min(min_altitude_all_, altitude);
+  if (after_fault) min_altitude_after_fault_ = std::min(min_altitude_after_fault_, altitude);
+  max_spin_rad_s_ = std::max(max_spin_rad_s_, std::abs(s.w_B().z()));
+  const double tilt = TiltOf(s.q_WB());
+  if (after_fault && tilt > options_.recovered_tilt_rad) last_tilted_s_ = t_s;
+  max_tilt_rad_ = std::max(max_tilt_rad_, tilt);
 }
 
-FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vector<sim::FaultEvent>& events) {
-  FddRecord r;
-  for (int i = 0; i < static_cast<int>(rotors.size()); ++i) {
-    if (!rotors[i].detected_s) continue;
-    if (!r.detected || *rotors[i].detected_s < r.detection_s) {
-      r.detected = true;
-      r.rotor = i;
-      r.detection_s = *rotors[i].detected_s;
-      r.kind = std::string(fdd::ToString(rotors[i].health));
-      r.detector = rotors[i].detector;
-    }
+void FlightMetrics::Finish(const FlightEnd& end, const std::function<Vector3(double)>& reference_at,
+                           RunSummary* summary) {
+  const bool after_fault = end.first_onset_s.has_value();
+  min_altitude_all_ = std::min(min_altitude_all_, end.p_W.z());  // the final state (or the crash site)
+  if (after_fault) min_altitude_after_fault_ = std::min(min_altitude_after_fault_, end.p_W.z());
+  summary->tracking_rmse_m = Finite(tracking_.rmse());
+  summary->tracking_rmse_eq37_m = Finite(tracking_.rmse_eq37());
+  summary->max_position_error_m = Finite(tracking_.max_error());
+  const TimeNs dt_ns = options_.step_ns;
+  if (end.crashed) {
+    // A wreck does not follow the reference: over the rest of the window the vehicle is where it
+    // crashed, so that crashing early does not shorten the error's window (paper 002's Table II
+    // counts its collided flights' errors). Sampled on the physics steps' grid, as the flight was.
+    TimeNs t = end.t_ns;
+    if (t < options_.tracking_start_ns) t += (options_.tracking_start_ns - t + dt_ns - 1) / dt_ns * dt_ns;
+    for (; t < options_.tracking_end_ns; t += dt_ns) tracking_.Add(ToSeconds(dt_ns), end.p_W, reference_at(ToSeconds(t)));
   }
-  if (!r.detected) return r;
-  if (events.empty() || r.detection_s < events.front().onset_s) {
-    r.false_alarm = true;
-    return r;
+  summary->tracking_rmse_window_m = Finite(tracking_.rmse());
+  const double end_s = ToSeconds(end.t_ns);
+  summary->tracking_start_s = options_.tracking_start_s;
+  // A flight that stopped early without a crash (its mission done) was tracked up to its stop.
+  summary->tracking_end_s =
+      end.crashed ? ToSeconds(options_.tracking_end_ns) : std::min(ToSeconds(options_.tracking_end_ns), end_s);
+  summary->min_altitude_m = Finite(after_fault ? min_altitude_after_fault_ : min_altitude_all_);
+  summary->max_spin_rad_s = max_spin_rad_s_;
+  summary->max_tilt_rad = max_tilt_rad_;
+  summary->tilt_recovery_s.reset();
+  if (after_fault && !end.crashed) {
+    const double onset = *end.first_onset_s;
+    const double settle = last_tilted_s_.value_or(onset);
+    // Still tilted at the very end: it never settled.
+    if (settle < end_s - 2.0 * ToSeconds(dt_ns)) summary->tilt_recovery_s = std::max(0.0, settle - onset);
   }
-  const sim::FaultEvent& first = events.front();
-  r.correct = r.rotor == first.rotor && KindMatches(first.kind, rotors[r.rotor].health);
-  if (r.correct) r.latency_s = r.detection_s - first.onset_s;
-  return r;
 }
 
 }  // namespace rotorguard::harness

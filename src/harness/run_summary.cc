@@ -8,14 +8,85 @@ nlohmann::json RunCost::ToJson() const {
   return j;
 }
 
+namespace {
+
+/// The value, or null.
+template <typename T>
+nlohmann::json OrNull(const std::optional<T>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json Vec(const Vector3& v) { return {v.x(), v.y(), v.z()}; }
+
+nlohmann::json FddJson(const FddRecord& f) {
+  const std::optional<FddRecord::Diagnosis>& d = f.diagnosis;
+  return {{"detected", f.detected()},
+          {"rotor", d ? nlohmann::json(d->rotor) : nlohmann::json(nullptr)},
+          {"kind", d ? nlohmann::json(d->kind) : nlohmann::json(nullptr)},
+          {"detector", d ? nlohmann::json(d->detector) : nlohmann::json(nullptr)},
+          {"detection_s", d ? nlohmann::json(d->detection_s) : nlohmann::json(nullptr)},
+          {"correct", f.correct},
+          {"false_alarm", f.false_alarm},
+          {"latency_s", OrNull(f.latency_s)}};
+}
+
+nlohmann::json NavigationJson(const stack::NavigationSummary& n, const std::optional<double>& mission_time_s,
+                              bool infeasible_request) {
+  return {{"waypoints_reached", n.waypoints_reached},
+          {"waypoints_total", n.waypoints_total},
+          {"plans", n.plans},
+          {"plans_failed", n.plans_failed},
+          {"plans_fine_search", n.plans_fine_search},
+          {"plans_rest_to_rest", n.plans_rest_to_rest},
+          {"plans_by_reason", n.plans_by_reason},
+          {"mission_time_s", OrNull(mission_time_s)},
+          {"planner_ms_mean", n.planner_ms_mean},
+          {"failed_plans", n.failed_plans},
+          {"infeasible_request", infeasible_request}};
+}
+
+nlohmann::json FlatnessDecisionJson(const planning::FlatnessDecision& d) {
+  return {{"t", d.t},
+          {"kind", d.kind},
+          {"t_s", d.t_s},
+          {"binding", d.binding},
+          {"w_hat", {d.w_hat[0], d.w_hat[1], d.w_hat[2], d.w_hat[3]}},
+          {"reason", d.reason},
+          {"delta_m", Vec(d.delta_m)},
+          {"envelope_s", d.envelope_s},
+          {"actuator_s", d.actuator_s}};
+}
+
+/// The stack's account (RunSummary::stack) at summary.json's top level.
+void AddStackJson(const RunSummary& r, nlohmann::json* j) {
+  const stack::FlightStackSummary& s = r.stack;
+  (*j)["map_voxels_occupied"] = OrNull(s.map_voxels_occupied);
+  if (s.navigation) (*j)["navigation"] = NavigationJson(*s.navigation, r.mission_time_s, r.infeasible_request);
+  if (!s.flatness_decisions.empty()) {
+    nlohmann::json decisions = nlohmann::json::array();
+    for (const planning::FlatnessDecision& d : s.flatness_decisions) decisions.push_back(FlatnessDecisionJson(d));
+    (*j)["flatness"] = {{"decisions", decisions}};
+  }
+  if (s.ukf) (*j)["ukf"] = {{"w_hat", s.ukf->w_hat}, {"settled_s", OrNull(s.ukf->settled_s)}};
+  (*j)["lidar_points_dropped"] = s.lidar_points_dropped;
+  nlohmann::json transitions = nlohmann::json::array();
+  for (const stack::ModeTransition& m : s.transitions) {
+    transitions.push_back(
+        {{"t", m.t}, {"from", stack::ToString(m.from)}, {"to", stack::ToString(m.to)}, {"reason", m.reason}});
+  }
+  (*j)["supervisor"] = {{"final_mode", stack::ToString(s.final_mode)}, {"transitions", transitions}};
+}
+
+}  // namespace
+
 nlohmann::json RunSummary::ToJson() const {
   nlohmann::json j;
   j["scenario"] = scenario;
   j["seed"] = seed;
   j["success"] = success;
   j["crashed"] = crashed;
-  j["crash_reason"] = crashed ? nlohmann::json(crash_reason) : nlohmann::json(nullptr);
-  j["failure_reason"] = success ? nlohmann::json(nullptr) : nlohmann::json(failure_reason);
+  j["crash_reason"] = OrNull(crash_reason);
+  j["failure_reason"] = OrNull(failure_reason);
   j["sim_time_s"] = sim_time_s;
   j["wall_time_s"] = wall_time_s;
   j["realtime_factor"] = realtime_factor;
@@ -28,49 +99,15 @@ nlohmann::json RunSummary::ToJson() const {
   j["min_altitude_m"] = min_altitude_m;
   j["max_spin_rad_s"] = max_spin_rad_s;
   j["max_tilt_rad"] = max_tilt_rad;
-  j["tilt_recovery_s"] = tilt_recovery_s >= 0.0 ? nlohmann::json(tilt_recovery_s) : nlohmann::json(nullptr);
+  j["tilt_recovery_s"] = OrNull(tilt_recovery_s);
   j["faults"] = nlohmann::json::array();
   for (const FaultRecord& f : faults) {
     j["faults"].push_back({{"rotor", f.rotor}, {"kind", f.kind}, {"onset_s", f.onset_s}});
   }
-  if (fdd) {
-    j["fdd"] = {{"detected", fdd->detected},
-                {"rotor", fdd->detected ? nlohmann::json(fdd->rotor) : nlohmann::json(nullptr)},
-                {"kind", fdd->detected ? nlohmann::json(fdd->kind) : nlohmann::json(nullptr)},
-                {"detector", fdd->detected ? nlohmann::json(fdd->detector) : nlohmann::json(nullptr)},
-                {"detection_s", fdd->detected ? nlohmann::json(fdd->detection_s) : nlohmann::json(nullptr)},
-                {"correct", fdd->correct},
-                {"false_alarm", fdd->false_alarm},
-                {"latency_s", fdd->correct ? nlohmann::json(fdd->latency_s) : nlohmann::json(nullptr)}};
-  } else {
-    j["fdd"] = nullptr;  // the stack ran no fault detection
-  }
+  j["fdd"] = fdd ? FddJson(*fdd) : nlohmann::json(nullptr);  // null: the stack ran no fault detection
   j["composite_fdd"] = composite_fdd ? CompositeFddOptionsToJson(*composite_fdd) : nlohmann::json(nullptr);
-  j["sensors"] = {{"imu_rate_hz", imu_rate_hz},
-                  {"imu_position_m", {imu_position_m.x(), imu_position_m.y(), imu_position_m.z()}}};
-  j["map_voxels_occupied"] = map_voxels_occupied >= 0 ? nlohmann::json(map_voxels_occupied) : nlohmann::json(nullptr);
-  if (waypoints_total >= 0) {
-    j["navigation"] = {{"waypoints_reached", waypoints_reached},
-                       {"waypoints_total", waypoints_total},
-                       {"plans", plans},
-                       {"plans_failed", plans_failed},
-                       {"plans_fine_search", plans_fine_search},
-                       {"plans_rest_to_rest", plans_rest_to_rest},
-                       {"plans_by_reason", plans_by_reason},
-                       {"mission_time_s", mission_time_s >= 0.0 ? nlohmann::json(mission_time_s) : nlohmann::json(nullptr)},
-                       {"planner_ms_mean", planner_ms_mean},
-                       {"failed_plans", failed_plans},
-                       {"infeasible_request", infeasible_request}};
-  }
-  if (!flatness_decisions.empty()) j["flatness"] = {{"decisions", flatness_decisions}};
-  if (!ukf_w_hat.empty()) {
-    j["ukf"] = {{"w_hat", ukf_w_hat}, {"settled_s", ukf_settled_s >= 0.0 ? nlohmann::json(ukf_settled_s) : nlohmann::json(nullptr)}};
-  }
-  j["lidar_points_dropped"] = lidar_points_dropped;
-  j["supervisor"] = {{"final_mode", final_mode}, {"transitions", nlohmann::json::array()}};
-  for (const ModeRecord& m : mode_transitions) {
-    j["supervisor"]["transitions"].push_back({{"t", m.t}, {"from", m.from}, {"to", m.to}, {"reason", m.reason}});
-  }
+  j["sensors"] = {{"imu_rate_hz", sensors.imu_rate_hz}, {"imu_position_m", Vec(sensors.imu_position_m)}};
+  AddStackJson(*this, &j);
   j["stack_ms_per_cycle_mean"] = stack_ms_per_cycle_mean;
   j["cost_ms_per_sim_s"] = cost_ms_per_sim_s.ToJson();
   j["physics_steps"] = physics_steps;

@@ -316,4 +316,49 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   return command_;
 }
 
+NavigationSummary FlightStack::SummarizeNavigation() const {
+  const std::vector<Vector3>& w = options_.navigation.waypoints;
+  NavigationSummary n;
+  n.waypoints_reached = waypoints_reached();
+  n.waypoints_total = static_cast<int>(w.size()) * options_.navigation.rounds;
+  if (!navigator_) return n;
+  const std::vector<planning::Replanner::Event>& events = navigator_->events();
+  n.plans = static_cast<int>(events.size());
+  for (const planning::Replanner::Event& e : events) {
+    ++n.plans_by_reason[e.reason];
+    n.planner_ms_mean += e.plan_ms / static_cast<double>(events.size());
+    if (e.status == planning::PlanSummary::Status::kSuccess) {
+      n.plans_fine_search += e.fine_search;
+      n.plans_rest_to_rest += e.rest_to_rest;
+      continue;
+    }
+    ++n.plans_failed;
+    n.failed_plans.push_back(fmt::format("{:.2f} s {}: {}", e.t, e.reason, planning::ToString(e.status)));
+  }
+  using Status = planning::PlanSummary::Status;
+  const Status last = navigator_->last_plan().status;
+  if (n.waypoints_reached < n.waypoints_total && !events.empty() &&
+      (last == Status::kGoalBlocked || last == Status::kGoalOutOfBounds || last == Status::kNoPath)) {
+    const Vector3& goal = w[static_cast<std::size_t>(n.waypoints_reached) % w.size()];
+    n.unreachable = fmt::format("waypoint {} at [{:g}, {:g}, {:g}] is unreachable: {} ({})", n.waypoints_reached + 1,
+                                goal.x(), goal.y(), goal.z(), planning::ToString(last), navigator_->last_plan().message);
+  }
+  return n;
+}
+
+FlightStackSummary FlightStack::Summarize() const {
+  FlightStackSummary s;
+  if (navigator_ || flatness_) s.navigation = SummarizeNavigation();
+  if (flatness_) s.flatness_decisions = flatness_->decisions();
+  if (const auto* ukf = dynamic_cast<const fdd::UkfFdd*>(fdd_.get())) {
+    const Eigen::VectorXd w = ukf->loss();
+    s.ukf = UkfSummary{std::vector<double>(w.data(), w.data() + w.size()), ukf->settled_after_detection_s()};
+  }
+  s.final_mode = supervisor_.mode();
+  s.transitions = supervisor_.transitions();
+  if (const perception::VoxelMap* m = map()) s.map_voxels_occupied = m->occupied_count();
+  s.lidar_points_dropped = lidar_points_dropped_;
+  return s;
+}
+
 }  // namespace rotorguard::stack

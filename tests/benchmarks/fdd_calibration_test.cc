@@ -18,7 +18,7 @@
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/record/sensor_log.h"
 #include "test_util.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::benchmarks {
 namespace {
@@ -143,11 +143,13 @@ TEST_F(FddReplay, FindsTheLiveRunsDiagnosisExactly) {
     ASSERT_TRUE(log.recorded_fdd.has_value());
     const ReplayOutcome replay = ReplayCompositeFdd(log, *log.recorded_fdd);
     const harness::FddRecord scored = harness::ScoreFdd(replay.statuses, FaultEvents(log));
-    EXPECT_EQ(scored.detected, live.fdd->detected) << file;
-    EXPECT_EQ(scored.rotor, live.fdd->rotor) << file;
-    EXPECT_EQ(scored.kind, live.fdd->kind) << file;
-    EXPECT_EQ(scored.detector, live.fdd->detector) << file;
-    EXPECT_EQ(scored.detection_s, live.fdd->detection_s) << file;
+    ASSERT_EQ(scored.detected(), live.fdd->detected()) << file;
+    if (scored.detected()) {
+      EXPECT_EQ(scored.diagnosis->rotor, live.fdd->diagnosis->rotor) << file;
+      EXPECT_EQ(scored.diagnosis->kind, live.fdd->diagnosis->kind) << file;
+      EXPECT_EQ(scored.diagnosis->detector, live.fdd->diagnosis->detector) << file;
+      EXPECT_EQ(scored.diagnosis->detection_s, live.fdd->diagnosis->detection_s) << file;
+    }
     EXPECT_EQ(scored.correct, live.fdd->correct) << file;
     EXPECT_EQ(scored.false_alarm, live.fdd->false_alarm) << file;
   }

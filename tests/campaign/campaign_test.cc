@@ -20,6 +20,7 @@
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/slurm.h"
 #include "rotorguard/campaign/statistics.h"
+#include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
@@ -163,15 +164,19 @@ TEST_F(Campaigns, BadInputIsRejectedNamingTheKeyAndNothingIsOverwritten) {
   RG_EXPECT_THROW_WITH(LoadCampaignSpec(Write("m.yaml", "name: m\nscenario: " + ScenarioPath("hover.yaml") +
                                                              "\nmetrics: [wall_time_s]\n")),
                        io::ConfigError, "not a recorded metric");
-  RG_EXPECT_THROW_WITH(campaign::Shard::Parse("4/4"), std::invalid_argument, "0 <= i < N");
-  RG_EXPECT_THROW_WITH(campaign::Shard::Parse("0/0"), std::invalid_argument, "0 <= i < N");
-  RG_EXPECT_THROW_WITH(campaign::Shard::Parse("a/2"), std::invalid_argument, "--shard 'a/2'");
+  for (const campaign::Shard bad : {campaign::Shard{4, 4}, campaign::Shard{0, 0}, campaign::Shard{-1, 2}}) {
+    campaign::CampaignRunOptions o;
+    o.out_dir = (dir_ / "bad_shard").string();
+    o.shard = bad;
+    RG_EXPECT_THROW_WITH(campaign::RunCampaign(ScenarioCampaign(LoadCampaignSpec(Spec())), o), ValidationError,
+                         "CampaignRunOptions::shard");
+  }
 
   const CampaignSpec spec = LoadCampaignSpec(Spec());
   Run(spec, "out");
   const std::string results = (dir_ / "out" / "results.jsonl").string();
   const std::string before = io::ReadFile(results);
-  RG_EXPECT_THROW_WITH(Run(spec, "out"), std::invalid_argument, "--resume");
+  RG_EXPECT_THROW_WITH(Run(spec, "out"), ValidationError, "set CampaignRunOptions::resume");
   // Another spec (another seed) cannot resume these results, nor merge with them.
   std::string text = io::ReadFile((dir_ / "spec.yaml").string());
   text.replace(text.find("seed: 7"), 7, "seed: 8");
@@ -262,7 +267,7 @@ TEST_F(Campaigns, TheSlurmScriptRunsOneResumableShardPerArrayTask) {
     EXPECT_NE(script.find(needle), std::string::npos) << needle << " not in\n" << script;
   }
   o.shards = 7;  // more than the 6 trials
-  RG_EXPECT_THROW_WITH(campaign::SlurmArrayScript(ScenarioCampaign(spec), o), std::invalid_argument, "--shards 7");
+  RG_EXPECT_THROW_WITH(campaign::SlurmArrayScript(ScenarioCampaign(spec), o), ValidationError, "SlurmScriptOptions::shards = 7");
   o.shards = 3;
   o.partition = "a b";
   RG_EXPECT_THROW_WITH(campaign::SlurmArrayScript(ScenarioCampaign(spec), o), std::invalid_argument, "'a b'");

@@ -9,7 +9,7 @@
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/planning/references.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 extern "C" {
 void* __libc_malloc(std::size_t size);

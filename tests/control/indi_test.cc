@@ -1,13 +1,13 @@
-#include "rotorguard/control/indi_controller.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
+#include "rotorguard/control/indi_controller.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/planning/references.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::control {
 namespace {

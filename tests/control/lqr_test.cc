@@ -1,4 +1,3 @@
-#include "rotorguard/control/lqr.h"
 
 #include <cmath>
 #include <complex>
@@ -11,10 +10,11 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include "rotorguard/control/lqr.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/planning/flatness.h"
 #include "rotorguard/vehicle/multirotor.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::control {
 namespace {

@@ -11,9 +11,9 @@
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/core/rng.h"
-#include "rotorguard/vehicle/multirotor.h"
 #include "rotorguard/planning/references.h"
-#include "vehicle/vehicle_fixture.h"
+#include "rotorguard/vehicle/multirotor.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::control {
 namespace {

@@ -1,4 +1,3 @@
-#include "rotorguard/control/nmpc_model.h"
 
 #include <gtest/gtest.h>
 
@@ -6,10 +5,11 @@
 #include <numbers>
 #include <utility>
 
+#include "rotorguard/control/nmpc_model.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/vehicle/multirotor.h"
 #include "test_util.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::control {
 namespace {

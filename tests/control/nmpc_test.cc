@@ -1,4 +1,3 @@
-#include "rotorguard/control/nmpc.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,12 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include "rotorguard/control/nmpc.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/planning/references.h"
 #include "test_util.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::control {
 namespace {

@@ -1,8 +1,6 @@
 // The composite FDD on synthetic sensor streams of a hovering reference quadrotor, where the truth
 // is known exactly: speeds from the drive thrusts, specific force and rates from the thrusts that
 // actually act.
-#include "rotorguard/fdd/composite_fdd.h"
-#include "rotorguard/fdd/fixed_time_fdd.h"
 
 #include <cmath>
 
@@ -10,8 +8,10 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/fdd/fixed_time_fdd.h"
 #include "rotorguard/vehicle/effectiveness.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::fdd {
 namespace {

@@ -1,7 +1,6 @@
 // Paper 004's UKF fault estimation on a closed-loop flight of the Qball-X4-like vehicle: the full
 // nonlinear model (motor lag, rotor drag) flown by the LQR baseline, with IMU noise; the truth is
 // the loss injected into the model.
-#include "rotorguard/fdd/ukf_fdd.h"
 
 #include <cmath>
 
@@ -10,10 +9,11 @@
 #include "rotorguard/control/lqr.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/fdd/ukf_fdd.h"
 #include "rotorguard/planning/references.h"
 #include "rotorguard/vehicle/multirotor.h"
 #include "rotorguard/vehicle/pwm_model.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::fdd {
 namespace {

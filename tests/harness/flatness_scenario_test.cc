@@ -20,32 +20,35 @@ std::string Config(const std::string& name) { return std::string(ROTORGUARD_SOUR
 TEST(FlatnessScenario, Fig2DetectsIdentifiesHoldsAndReplans) {
   const Scenario s = LoadScenario(Config("flatness_fig2.yaml"));
   const RunSummary r = RunScenario(s, RunOptions{});
-  EXPECT_TRUE(r.success) << r.failure_reason;
-  ASSERT_TRUE(r.fdd && r.fdd->detected);
-  EXPECT_EQ(r.fdd->rotor, 1);          // the paper's motor 2
-  EXPECT_EQ(r.fdd->kind, "degraded");
+  EXPECT_TRUE(r.success) << r.failure_reason.value_or("");
+  ASSERT_TRUE(r.fdd && r.fdd->detected());
+  EXPECT_EQ(r.fdd->diagnosis->rotor, 1);  // the paper's motor 2
+  EXPECT_EQ(r.fdd->diagnosis->kind, "degraded");
   EXPECT_TRUE(r.fdd->correct);
-  EXPECT_LT(r.fdd->latency_s, 1.0);
-  ASSERT_EQ(r.ukf_w_hat.size(), 4u);
-  EXPECT_NEAR(1.0 - r.ukf_w_hat[1], 0.6, 0.05);  // Fig. 2(b)
-  for (const int healthy : {0, 2, 3}) EXPECT_LT(r.ukf_w_hat[static_cast<std::size_t>(healthy)], 0.05);
+  EXPECT_LT(r.fdd->latency_s.value_or(1e9), 1.0);
+  ASSERT_TRUE(r.stack.ukf.has_value());
+  ASSERT_EQ(r.stack.ukf->w_hat.size(), 4u);
+  EXPECT_NEAR(1.0 - r.stack.ukf->w_hat[1], 0.6, 0.05);  // Fig. 2(b)
+  for (const int healthy : {0, 2, 3}) EXPECT_LT(r.stack.ukf->w_hat[static_cast<std::size_t>(healthy)], 0.05);
   // plan (5.46 s at 10 deg), hold after the detection, continue once the estimate settled.
-  ASSERT_EQ(r.flatness_decisions.size(), 3u);
-  EXPECT_EQ(r.flatness_decisions[0]["kind"], "plan");
-  EXPECT_NEAR(r.flatness_decisions[0]["t_s"].get<double>(), 5.46, 0.01);
-  EXPECT_EQ(r.flatness_decisions[1]["kind"], "hold");
-  EXPECT_GE(r.flatness_decisions[1]["t"].get<double>(), r.fdd->detection_s);
-  EXPECT_EQ(r.flatness_decisions[2]["kind"], "continue");
-  EXPECT_GE(r.flatness_decisions[2]["t"].get<double>(), r.ukf_settled_s);
+  const std::vector<planning::FlatnessDecision>& decisions = r.stack.flatness_decisions;
+  ASSERT_EQ(decisions.size(), 3u);
+  EXPECT_EQ(decisions[0].kind, "plan");
+  EXPECT_NEAR(decisions[0].t_s, 5.46, 0.01);
+  EXPECT_EQ(decisions[1].kind, "hold");
+  EXPECT_GE(decisions[1].t, r.fdd->diagnosis->detection_s);
+  EXPECT_EQ(decisions[2].kind, "continue");
+  ASSERT_TRUE(r.stack.ukf->settled_s.has_value());
+  EXPECT_GE(decisions[2].t, *r.stack.ukf->settled_s);
   // The re-plan is bound by the damaged motor 2 and slower than a fault-free re-plan of the same
   // remaining distance, by eqs. (16)-(23) evaluated here without the fault.
-  const nlohmann::json& replan = r.flatness_decisions[2];
-  EXPECT_EQ(replan["binding"], "motor 2");
-  const Eigen::Vector2d delta(replan["delta_m"][0].get<double>(), replan["delta_m"][1].get<double>());
+  const planning::FlatnessDecision& replan = decisions[2];
+  EXPECT_EQ(replan.binding, "motor 2");
+  const Eigen::Vector2d delta(replan.delta_m.x(), replan.delta_m.y());
   const planning::SettlingTime fault_free = planning::PlanSettlingTime(
       vehicle::PwmQuadModel::FromVehicle(s.vehicle), s.stack.navigation.flatness.limits, delta);
-  EXPECT_GT(replan["t_s"].get<double>(), fault_free.t_s + 0.2);
-  EXPECT_EQ(r.waypoints_reached, 1);
+  EXPECT_GT(replan.t_s, fault_free.t_s + 0.2);
+  EXPECT_EQ(r.stack.navigation.value().waypoints_reached, 1);
   // The pitch the plan allows, within the LQR's tracking of its steps.
   EXPECT_LT(r.max_tilt_rad, 11.0 * 3.14159265358979 / 180.0);
 }

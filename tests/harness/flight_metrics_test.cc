@@ -1,8 +1,11 @@
-#include "rotorguard/harness/flight_metrics.h"
 
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "rotorguard/harness/failure_diagnosis.h"
+#include "rotorguard/harness/flight_metrics.h"
 
 namespace rotorguard::harness {
 namespace {
@@ -24,35 +27,127 @@ TEST(TrackingError, EmptyIsZeroNotNan) {
   EXPECT_EQ(acc.rmse_eq37(), 0.0);
 }
 
-fdd::RotorStatus Diagnosed(fdd::RotorHealth h, double t) {
-  fdd::RotorStatus s;
-  s.health = h;
-  s.detected_s = t;
-  s.detector = "test";
-  return s;
+/// A quadrotor's state at p_W, tilted by `tilt` about x, spinning at `yaw_rate` about body z.
+vehicle::StateVector State(const Vector3& p_W, double tilt = 0.0, double yaw_rate = 0.0) {
+  vehicle::StateVector x = vehicle::StateVector::Zero(13 + 4);
+  x.segment<3>(vehicle::StateIndex::kPosition) = p_W;
+  const Quaternion q(Eigen::AngleAxisd(tilt, Vector3::UnitX()));
+  x.segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
+  x[vehicle::StateIndex::kBodyRate + 2] = yaw_rate;
+  return x;
 }
 
-TEST(ScoreFdd, CorrectLateWrongAndFalseDiagnosesOnHandMadeCases) {
-  const std::vector<sim::FaultEvent> prop0 = {{0, vehicle::FaultKind::kPropellerLoss, 2.0}};
-  std::vector<fdd::RotorStatus> rotors(4);
-  EXPECT_FALSE(ScoreFdd(rotors, prop0).detected);  // missed
-  rotors[0] = Diagnosed(fdd::RotorHealth::kPropellerFailed, 2.04);
-  FddRecord r = ScoreFdd(rotors, prop0);
-  EXPECT_TRUE(r.correct);
-  EXPECT_NEAR(r.latency_s, 0.04, 1e-12);
-  rotors[0] = Diagnosed(fdd::RotorHealth::kMotorFailed, 2.04);  // right rotor, wrong kind
-  EXPECT_FALSE(ScoreFdd(rotors, prop0).correct);
-  rotors[0] = fdd::RotorStatus{};
-  rotors[2] = Diagnosed(fdd::RotorHealth::kPropellerFailed, 2.1);  // wrong rotor
-  r = ScoreFdd(rotors, prop0);
-  EXPECT_FALSE(r.correct);
-  EXPECT_FALSE(r.false_alarm);
-  rotors[2] = Diagnosed(fdd::RotorHealth::kPropellerFailed, 1.5);  // before the onset
-  EXPECT_TRUE(ScoreFdd(rotors, prop0).false_alarm);
-  EXPECT_TRUE(ScoreFdd(rotors, {}).false_alarm);  // no fault at all
-  // The earliest diagnosis counts.
-  rotors[1] = Diagnosed(fdd::RotorHealth::kMotorFailed, 1.0);
-  EXPECT_EQ(ScoreFdd(rotors, prop0).rotor, 1);
+constexpr TimeNs kStep = 10'000'000;  // 10 ms
+
+FlightMetricsOptions Options(TimeNs start, TimeNs end) {
+  FlightMetricsOptions o;
+  o.step_ns = kStep;
+  o.tracking_start_ns = start;
+  o.tracking_end_ns = end;
+  o.tracking_start_s = ToSeconds(start);
+  o.success_error_m = 0.5;
+  o.recovered_tilt_rad = 0.1;
+  return o;
+}
+
+// A hand-made flight of 4 s at 10 ms steps: 0.3 m off the reference for its first second, 0.1 m
+// after; a fault at 1 s tilts it 0.3 rad until 2.5 s and drops it to 0.4 m; it spins at 11 rad/s
+// after the fault. The window [0.5, 3.5) s holds 0.5 s at 0.3 m and 2.5 s at 0.1 m.
+TEST(FlightMetrics, HandMadeFlightGivesEveryMetricByHand) {
+  FlightMetrics m(Options(500'000'000, 3'500'000'000));
+  const Vector3 ref(0.0, 0.0, 1.0);
+  for (TimeNs t = 0; t < 4'000'000'000; t += kStep) {
+    const bool fault = t >= 1'000'000'000;
+    const bool tilted = fault && t < 2'500'000'000;
+    const Vector3 p = ref + Vector3(t < 1'000'000'000 ? 0.3 : 0.1, 0.0, 0.0) - Vector3(0, 0, t == 2'000'000'000 ? 0.6 : 0.0);
+    m.OnStep(t, vehicle::StateView(State(p, tilted ? 0.3 : 0.0, fault ? 11.0 : 0.0)), ref, fault);
+  }
+  RunSummary s;
+  const vehicle::StateVector end = State(ref + Vector3(0.1, 0, 0));
+  m.Finish({4'000'000'000, false, vehicle::StateView(end).p_W(), 1.0}, [&](double) { return ref; }, &s);
+  // 0.5 s at 0.09 m^2, then 2.5 s at 0.01 m^2 but for the step at 2.0 s, 0.6 m low as well:
+  // its error is sqrt(0.01 + 0.36) m.
+  const double integral = 0.5 * 0.09 + (2.5 - 0.01) * 0.01 + 0.01 * (0.01 + 0.36);
+  EXPECT_NEAR(s.tracking_rmse_m, std::sqrt(integral / 3.0), 1e-9);
+  EXPECT_NEAR(s.tracking_rmse_eq37_m, std::sqrt(integral) / 3.0, 1e-9);
+  EXPECT_NEAR(s.tracking_rmse_window_m, s.tracking_rmse_m, 1e-15) << "no crash: the same window";
+  EXPECT_NEAR(s.max_position_error_m, std::sqrt(0.37), 1e-12);
+  EXPECT_NEAR(s.min_altitude_m, 0.4, 1e-12) << "after the fault";
+  EXPECT_NEAR(s.max_spin_rad_s, 11.0, 1e-12);
+  EXPECT_NEAR(s.max_tilt_rad, 0.3, 1e-9);
+  ASSERT_TRUE(s.tilt_recovery_s.has_value());
+  EXPECT_NEAR(*s.tilt_recovery_s, 2.49 - 1.0, 1e-9) << "the last tilted step is 2.49 s";
+  EXPECT_EQ(s.tracking_start_s, 0.5);
+  EXPECT_EQ(s.tracking_end_s, 3.5);
+  ASSERT_TRUE(m.last_violation().has_value());
+  EXPECT_NEAR(m.last_violation()->t_s, 2.0, 1e-12) << "0.61 m > 0.5 m at 2.0 s only";
+}
+
+// A crash at 2 s: the wreck is held where it fell over the rest of the window [0, 4) s, against a
+// reference 1 m above it: the window's RMSE counts 2 s at 0 m and 2 s at 1 m.
+TEST(FlightMetrics, ACrashedVehicleIsHeldWhereItCrashedOverTheRestOfTheWindow) {
+  FlightMetrics m(Options(0, 4'000'000'000));
+  const Vector3 ref(0.0, 0.0, 1.0);
+  for (TimeNs t = 0; t < 2'000'000'000; t += kStep) m.OnStep(t, vehicle::StateView(State(ref)), ref, false);
+  RunSummary s;
+  m.Finish({2'000'000'000, true, Vector3::Zero(), std::nullopt}, [&](double) { return ref; }, &s);
+  EXPECT_NEAR(s.tracking_rmse_m, 0.0, 1e-15) << "up to the crash";
+  EXPECT_NEAR(s.tracking_rmse_window_m, std::sqrt(0.5), 1e-9);
+  EXPECT_NEAR(s.min_altitude_m, 0.0, 1e-15) << "the crash site counts";
+  EXPECT_EQ(s.tracking_end_s, 4.0) << "a crashed flight's window is the scenario's";
+  EXPECT_FALSE(s.tilt_recovery_s.has_value());
+}
+
+TEST(FlightMetrics, TiltThatNeverSettlesHasNoRecoveryTime) {
+  FlightMetrics m(Options(0, 1'000'000'000));
+  for (TimeNs t = 0; t < 1'000'000'000; t += kStep) {
+    m.OnStep(t, vehicle::StateView(State(Vector3::Zero(), 0.5)), Vector3::Zero(), true);
+  }
+  RunSummary s;
+  m.Finish({1'000'000'000, false, Vector3::Zero(), 0.0}, [](double) { return Vector3::Zero(); }, &s);
+  EXPECT_FALSE(s.tilt_recovery_s.has_value());
+}
+
+// The success rule's verdicts, the most fundamental first, on hand-made summaries.
+TEST(DiagnoseFailure, TheMostFundamentalReasonWins) {
+  const SuccessRule rule{0.5, 2.0};
+  RunSummary s;
+  s.sim_time_s = 10.0;
+  DiagnoseFailure(std::nullopt, rule, &s);
+  EXPECT_TRUE(s.success);
+  EXPECT_FALSE(s.failure_reason.has_value());
+
+  // A breach 2.5 s before the end is outside the last 2 s: still a success; at 8.5 s it is not.
+  DiagnoseFailure(FlightMetrics::Violation{7.5, 0.8}, rule, &s);
+  EXPECT_TRUE(s.success);
+  DiagnoseFailure(FlightMetrics::Violation{8.5, 0.8}, rule, &s);
+  EXPECT_EQ(s.failure_reason.value_or(""), "position error 0.80 m > 0.5 m at t = 8.50 s, within the last 2 s");
+
+  // Waypoints missed, and the planner's verdict on the pending one: an infeasible request.
+  s.stack.navigation = stack::NavigationSummary{};
+  s.stack.navigation->waypoints_reached = 1;
+  s.stack.navigation->waypoints_total = 3;
+  DiagnoseFailure(std::nullopt, rule, &s);
+  EXPECT_EQ(s.failure_reason.value_or(""), "navigation reached 1 of 3 waypoints");
+  EXPECT_FALSE(s.infeasible_request);
+  s.stack.navigation->unreachable = "waypoint 2 at [1, 2, 3] is unreachable: no_path (enclosed)";
+  DiagnoseFailure(std::nullopt, rule, &s);
+  EXPECT_TRUE(s.infeasible_request);
+  EXPECT_EQ(s.failure_reason.value_or(""),
+            "navigation reached 1 of 3 waypoints; waypoint 2 at [1, 2, 3] is unreachable: no_path (enclosed)");
+
+  // An emergency landing outranks the position error and the waypoints ...
+  s.stack.transitions = {{4.0, stack::FlightMode::kNominal, stack::FlightMode::kEmergencyLanding, "no plan for 10 s"}};
+  s.stack.final_mode = stack::FlightMode::kLanded;
+  DiagnoseFailure(FlightMetrics::Violation{9.9, 3.0}, rule, &s);
+  EXPECT_EQ(s.failure_reason.value_or(""), "emergency landing at t = 4.00 s: no plan for 10 s (landed)");
+  EXPECT_FALSE(s.infeasible_request);
+  // ... and a crash outranks everything.
+  s.crashed = true;
+  s.crash_reason = "ground impact at 5.56 m/s";
+  DiagnoseFailure(FlightMetrics::Violation{9.9, 3.0}, rule, &s);
+  EXPECT_EQ(s.failure_reason.value_or(""), "crash: ground impact at 5.56 m/s");
+  EXPECT_FALSE(s.success);
 }
 
 }  // namespace

@@ -31,17 +31,17 @@ TEST(Navigation, AShortIndoorMissionWithAFailureSucceedsAndNeverCommandsANonFini
   RunOptions o;
   o.on_control_cycle = [&](const stack::FlightStack& st) { finite = finite && st.command().thrust_n.allFinite(); };
   const RunSummary r = RunScenario(s, o);
-  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_TRUE(r.success) << r.failure_reason.value_or("");
   EXPECT_TRUE(finite);
-  EXPECT_EQ(r.waypoints_reached, 2);
+  EXPECT_EQ(r.stack.navigation.value().waypoints_reached, 2);
   ASSERT_TRUE(r.fdd.has_value());
   EXPECT_TRUE(r.fdd->correct);
   // The mission carried on after the isolation: recovery, then degraded navigation to the end.
-  ASSERT_GE(r.mode_transitions.size(), 2u);
-  EXPECT_EQ(r.mode_transitions[0].to, "failure_recovery");
-  EXPECT_EQ(r.mode_transitions[1].to, "degraded_navigation");
-  EXPECT_EQ(r.final_mode, "degraded_navigation");
-  EXPECT_GE(r.plans_by_reason.at("failure"), 1);
+  ASSERT_GE(r.stack.transitions.size(), 2u);
+  EXPECT_EQ(r.stack.transitions[0].to, stack::FlightMode::kFailureRecovery);
+  EXPECT_EQ(r.stack.transitions[1].to, stack::FlightMode::kDegradedNavigation);
+  EXPECT_EQ(r.stack.final_mode, stack::FlightMode::kDegradedNavigation);
+  EXPECT_GE(r.stack.navigation.value().plans_by_reason.at("failure"), 1);
   EXPECT_GT(r.max_spin_rad_s, 8.0);
 }
 
@@ -60,9 +60,9 @@ TEST(Navigation, ThePlansKeepThePreFailureClearanceUntilTheAttitudeHasRecovered)
     if (st.navigator()->events().size() != plans.size()) plans = st.navigator()->events();
   };
   const RunSummary r = RunScenario(s, o);
-  ASSERT_GE(r.mode_transitions.size(), 2u);
-  ASSERT_EQ(r.mode_transitions[1].to, "degraded_navigation");
-  const double failed_s = r.mode_transitions[0].t, recovered_s = r.mode_transitions[1].t;
+  ASSERT_GE(r.stack.transitions.size(), 2u);
+  ASSERT_EQ(r.stack.transitions[1].to, stack::FlightMode::kDegradedNavigation);
+  const double failed_s = r.stack.transitions[0].t, recovered_s = r.stack.transitions[1].t;
   int before = 0, transient = 0, after = 0;
   for (const planning::Replanner::Event& e : plans) {
     if (e.t >= recovered_s) {
@@ -99,7 +99,7 @@ TEST_F(NavigationWithFiles, AnObstacleMovedOntoThePathIsSeenAndFlownAround) {
   RunOptions o;
   o.out_dir = dir_.string();
   const RunSummary r = RunScenario(s, o);
-  EXPECT_TRUE(r.success) << r.failure_reason;
+  EXPECT_TRUE(r.success) << r.failure_reason.value_or("");
   const record::FlightLog log = record::ReadFlightLog(dir_.string());
   // Where the box came to rest, grown by the vehicle's radius: the first plan (made before the
   // box moved) crosses it, so the stack had to see it and plan anew ...
@@ -145,14 +145,14 @@ TEST(Navigation, LosingOdometryLandsAndTheLandingCompletesWhenItReturns) {
   Scenario s = LoadScenario(Config("hover.yaml"), {{"duration_s", "14"}, {"stack.controller", "nmpc"}});
   s.sim.odometry.outages.push_back({2.0, 1.0});  // 0.5 s without odometry is a lost estimator
   const RunSummary r = RunScenario(s);
-  EXPECT_FALSE(r.crashed) << r.crash_reason;
+  EXPECT_FALSE(r.crashed) << r.crash_reason.value_or("");
   EXPECT_FALSE(r.success);
-  ASSERT_EQ(r.mode_transitions.size(), 2u);
-  EXPECT_EQ(r.mode_transitions[0].to, "emergency_landing");
-  EXPECT_NEAR(r.mode_transitions[0].t, 2.5, 0.01);
-  EXPECT_EQ(r.mode_transitions[1].to, "landed");
-  EXPECT_EQ(r.final_mode, "landed");
-  EXPECT_NE(r.failure_reason.find("emergency landing"), std::string::npos);
+  ASSERT_EQ(r.stack.transitions.size(), 2u);
+  EXPECT_EQ(r.stack.transitions[0].to, stack::FlightMode::kEmergencyLanding);
+  EXPECT_NEAR(r.stack.transitions[0].t, 2.5, 0.01);
+  EXPECT_EQ(r.stack.transitions[1].to, stack::FlightMode::kLanded);
+  EXPECT_EQ(r.stack.final_mode, stack::FlightMode::kLanded);
+  EXPECT_NE(r.failure_reason.value_or("").find("emergency landing"), std::string::npos);
 }
 
 }  // namespace

@@ -1,4 +1,3 @@
-#include "rotorguard/modular/allocation.h"
 
 #include <cmath>
 
@@ -7,9 +6,10 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/modular/allocation.h"
 #include "rotorguard/vehicle/effectiveness.h"
+#include "assembly_fixture.h"
 #include "test_util.h"
-#include "modular/assembly_fixture.h"
 
 namespace rotorguard::modular {
 namespace {

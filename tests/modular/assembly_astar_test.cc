@@ -1,13 +1,13 @@
-#include "rotorguard/modular/assembly_astar.h"
 
 #include <cmath>
 #include <numbers>
 
 #include <gtest/gtest.h>
 
-#include "modular/assembly_fixture.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
+#include "rotorguard/modular/assembly_astar.h"
+#include "assembly_fixture.h"
 #include "test_util.h"
 
 namespace rotorguard::modular {

@@ -1,11 +1,11 @@
-#include "rotorguard/modular/assembly.h"
 
 #include <gtest/gtest.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/modular/assembly.h"
 #include "rotorguard/vehicle/effectiveness.h"
+#include "assembly_fixture.h"
 #include "test_util.h"
-#include "modular/assembly_fixture.h"
 
 namespace rotorguard::modular {
 namespace {

@@ -1,4 +1,3 @@
-#include "rotorguard/perception/deskew.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include "rotorguard/perception/deskew.h"
 #include "rotorguard/sim/lidar.h"
-#include "sim/room_fixture.h"
+#include "room_fixture.h"
 
 namespace rotorguard::perception {
 namespace {

@@ -1,5 +1,3 @@
-#include "rotorguard/planning/flatness.h"
-#include "rotorguard/planning/flatness_navigator.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +9,10 @@
 #include <gtest/gtest.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/planning/flatness.h"
+#include "rotorguard/planning/flatness_navigator.h"
 #include "rotorguard/vehicle/pwm_model.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::planning {
 namespace {

@@ -69,7 +69,7 @@ TEST_F(FlightLogTest, CsvAndMcapHoldTheSameFlightAndTheMapsChangesRebuildTheStac
     t += 1.0 / s.stack.control_rate_hz;
   };
   const harness::RunSummary summary = harness::RunScenario(s, o);
-  ASSERT_TRUE(summary.success) << summary.failure_reason;
+  ASSERT_TRUE(summary.success) << summary.failure_reason.value_or("");
 
   const FlightLog csv = ReadFlightLog(dir_.string());
   const FlightLog mcap = ReadFlightMcap((dir_ / "flight.mcap").string());

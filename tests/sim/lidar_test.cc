@@ -1,4 +1,3 @@
-#include "rotorguard/sim/lidar.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "rotorguard/core/error.h"
-#include "sim/room_fixture.h"
+#include "rotorguard/sim/lidar.h"
+#include "room_fixture.h"
 
 namespace rotorguard::sim {
 namespace {

@@ -1,10 +1,10 @@
-#include "rotorguard/sim/simulator.h"
 
 #include <gtest/gtest.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/sim/simulator.h"
 #include "rotorguard/vehicle/vehicle_params.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::sim {
 namespace {

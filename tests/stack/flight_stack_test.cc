@@ -1,4 +1,3 @@
-#include "rotorguard/stack/flight_stack.h"
 
 #include <type_traits>
 
@@ -6,8 +5,9 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/planning/references.h"
+#include "rotorguard/stack/flight_stack.h"
 #include "test_util.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::stack {
 namespace {

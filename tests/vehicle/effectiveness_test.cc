@@ -1,12 +1,12 @@
-#include "rotorguard/vehicle/effectiveness.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/vehicle/effectiveness.h"
 #include "test_util.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::vehicle {
 namespace {

@@ -65,8 +65,6 @@ struct Campaign {
 struct Shard {
   int index = 0;
   int count = 1;
-  /// "i/N" with 0 <= i < N. Throws std::invalid_argument naming the text.
-  static Shard Parse(const std::string& text);
   std::pair<int, int> Range(int trials) const;  ///< [first, last)
   /// The shard's files in its folder: results.jsonl and manifest.json for the whole campaign,
   /// results.shard-i.jsonl and manifest.shard-i.json for one of several.
@@ -75,10 +73,10 @@ struct Shard {
 };
 
 struct CampaignRunOptions {
-  std::string out_dir;
-  int jobs = 1;
-  Shard shard;
-  bool resume = false;
+  std::string out_dir;  ///< the shard's folder, created when missing
+  int jobs = 1;         ///< worker threads, in [1, 256]
+  Shard shard;          ///< 0 <= index < count <= the campaign's trials
+  bool resume = false;  ///< continue the results already in out_dir (else they are an error)
   std::string version;  ///< the program's version and revision, recorded and checked
   std::function<void(int done, int total)> progress;
 };
@@ -91,9 +89,9 @@ struct CampaignRunSummary {
   std::string results_file, manifest_file;
 };
 
-/// Runs the shard's trials not yet recorded. Throws std::invalid_argument for a bad request (an
-/// existing results file without `resume`, a resume against another spec or version, the shard
-/// already running in another process), io::InputFileError or io::CorruptFileError for unreadable
+/// Runs the shard's trials not yet recorded. Throws ValidationError naming the option (a bad count
+/// or shard, an existing results file without `resume`, a resume against another spec or
+/// version), std::invalid_argument when the shard is already running in another process, io::InputFileError or io::CorruptFileError for unreadable
 /// or damaged results, and leaves every existing file as it was; an I/O failure while appending
 /// is rethrown once the trials in flight are done (the manifest stays unfinished: resume later).
 CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOptions& options);

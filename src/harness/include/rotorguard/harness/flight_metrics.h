@@ -1,12 +1,14 @@
 #pragma once
-/// Flight metrics as defined in DESIGN.md ("Metrics"), accumulated sample by sample.
+/// Flight metrics as defined in docs/metrics.md, accumulated sample by sample.
+#include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rotorguard/core/types.h"
-#include "rotorguard/fdd/composite_fdd.h"
-#include "rotorguard/sim/fault_injector.h"
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::harness {
 
@@ -27,24 +29,60 @@ class TrackingErrorAccumulator {
   double max_error_ = 0.0;
 };
 
-/// What fault detection concluded, scored against the injected faults (DESIGN.md, Metrics).
-struct FddRecord {
-  bool detected = false;      ///< some rotor left the ok state
-  int rotor = -1;             ///< the first rotor diagnosed
-  std::string kind;           ///< motor_failed, propeller_failed or degraded
-  std::string detector;       ///< motor_index, thrust_loss_observer or takeoff
-  double detection_s = 0.0;
-  bool correct = false;       ///< right rotor and kind, at or after the first onset
-  bool false_alarm = false;   ///< a diagnosis without a fault, or before the first onset
-  double latency_s = -1.0;    ///< detection - onset when correct, else negative
+/// What a flight metric needs to know of the scenario: the tracking window, the success rule's
+/// bound and the tilt that counts as recovered (docs/metrics.md).
+struct FlightMetricsOptions {
+  TimeNs step_ns = 1'000'000;   ///< the physics step at which the flight is sampled
+  /// The tracking window [start, end) on the physics steps' grid; tracking_start_s is the
+  /// scenario's value as written (summary.json "tracking_window_s").
+  TimeNs tracking_start_ns = 0, tracking_end_ns = 0;
+  double tracking_start_s = 0.0;
+  double success_error_m = 0.5;       ///< the success rule's bound on |p - p_ref| [m]
+  double recovered_tilt_rad = 0.0873;  ///< roll and pitch count as recovered below this tilt [rad]
 };
 
-/// Whether a diagnosis names the injected fault kind (stuck: any diagnosis of the rotor).
-bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis);
+/// How a flight ended.
+struct FlightEnd {
+  TimeNs t_ns = 0;          ///< the simulated time at the end
+  bool crashed = false;
+  Vector3 p_W = Vector3::Zero();   ///< the final position (the crash site)
+  std::optional<double> first_onset_s;  ///< the first fault's onset, when one happened
+};
 
-/// Scores the detector's per-rotor statuses against the injected fault events: the earliest
-/// diagnosis counts; it is a false alarm without a fault or before the first onset, and correct
-/// when it names the first fault's rotor and kind.
-FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vector<sim::FaultEvent>& events);
+/// A flight's metrics (docs/metrics.md), accumulated from the true state at every physics step:
+/// the tracking error over the window, the last breach of the success rule's bound, the lowest
+/// altitude (after the first fault when there is one), the largest spin and tilt, and when the
+/// tilt last exceeded the recovered bound after a fault.
+class FlightMetrics {
+ public:
+  explicit FlightMetrics(const FlightMetricsOptions& options);
+
+  /// The state at time t, before the step from t; p_ref is the reference the stack followed at t,
+  /// and after_fault whether a fault has begun.
+  void OnStep(TimeNs t, const vehicle::StateView& state, const Vector3& p_ref, bool after_fault);
+
+  /// The last time the position error exceeded the success bound, and by how much.
+  struct Violation {
+    double t_s = 0.0;
+    double error_m = 0.0;
+  };
+  const std::optional<Violation>& last_violation() const { return last_violation_; }
+
+  /// Fills `summary`'s metrics: tracking_* and max_position_error_m (a crashed vehicle held at its
+  /// crash site over the rest of the window for tracking_rmse_window_m, against `reference_at`,
+  /// the position the stack's reference gives at a time), min_altitude_m (the final state
+  /// counted), max_spin_rad_s, max_tilt_rad and tilt_recovery_s.
+  void Finish(const FlightEnd& end, const std::function<Vector3(double t_s)>& reference_at, RunSummary* summary);
+
+ private:
+  FlightMetricsOptions options_;
+  TrackingErrorAccumulator tracking_;
+  std::optional<Violation> last_violation_;
+  std::optional<double> last_tilted_s_;  // after a fault
+  double min_altitude_all_ = std::numeric_limits<double>::infinity();
+  double min_altitude_after_fault_ = std::numeric_limits<double>::infinity();
+  double max_spin_rad_s_ = 0.0;
+  double max_tilt_rad_ = 0.0;
+};
 
 }  // namespace rotorguard::harness

@@ -9,17 +9,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rotorguard/core/types.h"
 #include "rotorguard/fdd/composite_fdd.h"
-#include "rotorguard/harness/flight_metrics.h"
+#include "rotorguard/harness/fdd_score.h"
+#include "rotorguard/stack/flight_stack.h"
 
 namespace rotorguard::harness {
 
-/// A flight-mode transition of the stack's supervisor (stack/supervisor.h).
-struct ModeRecord {
-  double t = 0.0;
-  std::string from, to, reason;
-};
-
+/// An injected fault as it happened.
 struct FaultRecord {
   int rotor = 0;
   std::string kind;
@@ -49,30 +46,46 @@ struct RunCost {
   nlohmann::json ToJson() const;
 };
 
-/// The outcome of one run; the fields of summary.json (DESIGN.md keys; later features add keys).
+/// The IMU the stack read: what a replay of sensors.csv needs (summary.json "sensors").
+struct SensorsRecord {
+  double imu_rate_hz = 0.0;
+  Vector3 imu_position_m = Vector3::Zero();
+};
+
+/// The outcome of one run: summary.json's fields, nested as it nests them (docs/scenarios.md,
+/// "summary.json"; the metrics are defined in docs/metrics.md). Absent values are empty optionals,
+/// written as null (or, for the stack's parts, left out).
 struct RunSummary {
   std::string scenario;
   std::uint64_t seed = 0;
-  bool success = false;  ///< no crash and position error held within the scenario's bound at the end
+  /// No crash, no emergency landing, the position error held within the scenario's bound over the
+  /// end of the flight, and every waypoint reached (docs/metrics.md, "SucR").
+  bool success = false;
   bool crashed = false;
-  std::string crash_reason;     ///< "" when not crashed
-  /// Why the run failed: "crash: ..." or the position error that broke the success rule; "" on success.
-  std::string failure_reason;
+  std::optional<std::string> crash_reason;    ///< "ground impact at 5.56 m/s"; none without a crash
+  std::optional<std::string> failure_reason;  ///< why the run failed; none on success
+
   double sim_time_s = 0.0;
   double wall_time_s = 0.0;
   double realtime_factor = 0.0;  ///< sim_time_s / wall_time_s: the whole run, the simulator included
-  /// Simulated time per second of the flight stack's own wall-clock time (stack_ms_per_cycle_mean's
-  /// total): how much faster than real time the whole stack (estimator, FDD, mapper, planner,
-  /// controller) runs on one core, the simulator not counted. bench nav's `realtime_factor`.
+  /// Simulated time per second of the flight stack's own wall-clock time: how much faster than
+  /// real time the whole stack (estimator, FDD, mapper, planner, controller) runs on one core, the
+  /// simulator not counted. bench nav's `realtime_factor`.
   double stack_realtime_factor = 0.0;
-  /// Over the tracking window (Scenario::tracking_start_s to TrackingEndS), up to the crash for a
-  /// crashed flight.
+  /// Wall-clock time the flight stack took per control cycle, its sensor callbacks (mapping
+  /// included) counted [ms].
+  double stack_ms_per_cycle_mean = 0.0;
+  RunCost cost_ms_per_sim_s;
+  std::uint64_t physics_steps = 0;
+  std::uint64_t control_cycles = 0;
+
+  /// Over the tracking window, up to the crash for a crashed flight.
   double tracking_rmse_m = 0.0;
   /// Over the whole tracking window, a crashed vehicle held where it crashed for the rest of it:
   /// tracking_rmse_m when the flight did not crash. What paper 002's tables compare.
   double tracking_rmse_window_m = 0.0;
-  /// The tracking window [s]: the scenario's tracking_start_s and TrackingEndS, the end at the
-  /// flight's stop when it stopped early without a crash.
+  /// The tracking window [s] (summary.json "tracking_window_s"): the scenario's tracking_start_s
+  /// and TrackingEndS, the end at the flight's stop when it stopped early without a crash.
   double tracking_start_s = 0.0, tracking_end_s = 0.0;
   double tracking_rmse_eq37_m = 0.0;  ///< paper 000's eq. (37), for comparison with its figures
   double max_position_error_m = 0.0;
@@ -80,53 +93,26 @@ struct RunSummary {
   double max_spin_rad_s = 0.0;  ///< largest |yaw rate| of the body
   double max_tilt_rad = 0.0;    ///< largest tilt of the body z axis from the vertical
   /// Time from the first fault onset until the tilt stays below metrics.recovered_tilt_rad to the
-  /// end (paper 000: roll and pitch recovered in about 3 s); negative when there is no fault or
-  /// the tilt never settles.
-  double tilt_recovery_s = -1.0;
+  /// end (paper 000: roll and pitch recovered in about 3 s); none without a fault, after a crash,
+  /// or when the tilt never settles.
+  std::optional<double> tilt_recovery_s;
+
   std::vector<FaultRecord> faults;
   std::optional<FddRecord> fdd;  ///< present when the stack runs fault detection
-  /// The IMU the stack read (summary.json "sensors"): what a replay of sensors.csv needs.
-  double imu_rate_hz = 0.0;
-  Vector3 imu_position_m = Vector3::Zero();
   /// The composite FDD's thresholds when the stack ran it (summary.json "composite_fdd").
   std::optional<fdd::CompositeFddOptions> composite_fdd;
-  /// Occupied voxels of the stack's map at the end; -1 without a LiDAR (null in summary.json).
-  int map_voxels_occupied = -1;
-  long lidar_points_dropped = 0;  ///< LiDAR pulses that gave no map point (FlightStack)
-  /// The navigate mission: waypoints reached of those to fly (x rounds); -1 for other missions.
-  int waypoints_reached = -1;
-  int waypoints_total = -1;
-  /// Planning queries and their results in the navigate mission (the replanner's events).
-  int plans = 0, plans_failed = 0;
-  /// Of the successful ones, those that needed the planner's fallbacks: the search at the map's
-  /// resolution, and the path flown from rest to rest (PlanSummary::fine_search, rest_to_rest).
-  int plans_fine_search = 0, plans_rest_to_rest = 0;
-  /// Planning queries by what started them: "goal", "failure", "obstacle ahead", "periodic".
-  std::map<std::string, int> plans_by_reason;
-  /// When the navigate mission reached its last waypoint [s]; -1 when it did not (or another mission).
-  double mission_time_s = -1.0;
-  double planner_ms_mean = 0.0;  ///< wall-clock time of a planning query, mean (0 without queries)
-  /// Wall-clock time the flight stack took per control cycle, its sensor callbacks (mapping
-  /// included) counted: the whole stack's cost [ms].
-  double stack_ms_per_cycle_mean = 0.0;
-  RunCost cost_ms_per_sim_s;
-  /// Each failed planning query: time [s], reason and status ("12.30 s periodic: no_path").
-  std::vector<std::string> failed_plans;
-  /// The navigate mission asked for a waypoint the planner found unreachable at the end (inside an
-  /// obstacle's inflation, outside the map, or enclosed): an infeasible request (CLI exit 4).
+  SensorsRecord sensors;
+
+  /// The stack's own account (FlightStack::Summarize), written at summary.json's top level:
+  /// "navigation" (with the two keys below), "flatness" {"decisions"}, "ukf", "supervisor",
+  /// "map_voxels_occupied" and "lidar_points_dropped".
+  stack::FlightStackSummary stack;
+  /// summary.json navigation.mission_time_s: when the navigate mission reached its last waypoint
+  /// [s], by the runner's clock; none when it did not.
+  std::optional<double> mission_time_s;
+  /// summary.json navigation.infeasible_request: the mission ended with its pending waypoint found
+  /// unreachable (NavigationSummary::unreachable), an infeasible request (CLI exit 4).
   bool infeasible_request = false;
-  /// The supervisor's transitions and the mode the flight ended in (summary.json "supervisor").
-  std::vector<ModeRecord> mode_transitions;
-  /// Paper 004's planner: each decision {t, kind (plan, hold, continue, return, land), t_s,
-  /// binding, w_hat, reason} (summary.json "flatness").
-  std::vector<nlohmann::json> flatness_decisions;
-  /// With fdd: ukf, its final loss estimates and when it first settled after a detection (-1:
-  /// never; summary.json "ukf").
-  std::vector<double> ukf_w_hat;
-  double ukf_settled_s = -1.0;
-  std::string final_mode = "nominal";
-  std::uint64_t physics_steps = 0;
-  std::uint64_t control_cycles = 0;
 
   nlohmann::json ToJson() const;
 };

@@ -1,32 +1,18 @@
 #pragma once
 /// Flies a scenario: the simulator and the flight stack in closed loop, exchanging only sensor
-/// messages and rotor commands. Given an output folder it writes the flight's record
-/// (flight_log.h: log.csv and scene.json, or flight.mcap), sensors.csv (every message the stack
-/// received; sensor_log.h), vehicle.yaml (the vehicle flown), summary.json and, when asked,
-/// report.html.
-#include <array>
+/// messages and rotor commands. Given an output folder it writes the run's files
+/// (flight_recorder.h).
 #include <functional>
-#include <map>
-#include <optional>
 #include <string>
-#include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "rotorguard/harness/flight_recorder.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
 
 namespace rotorguard::harness {
 
-/// What a run folder holds besides summary.json (flight_log.h): kCsv log.csv, scene.json and
-/// sensors.csv; kMcap flight.mcap (flight_mcap.h); kBoth all of them.
-enum class LogFormat { kCsv, kMcap, kBoth };
-
-struct RunOptions {
-  std::string out_dir;  ///< "" writes nothing
-  LogFormat log_format = LogFormat::kCsv;
-  /// Also write report.html (report.h); needs a program built with the viewer (io::HasViewer).
-  bool report = false;
+/// The recorder's options (out_dir "" writes nothing, log_format, report), and how the run goes.
+struct RunOptions : FlightRecorderOptions {
   /// Called about every 1 % of simulated time with the completed fraction in [0, 1].
   std::function<void(double)> progress;
   /// Called after every control cycle with the stack (benchmarks read solver statistics).
@@ -37,8 +23,9 @@ struct RunOptions {
   bool stop_when_mission_complete = false;
 };
 
-/// Runs the scenario to its duration or to a crash. Throws std::runtime_error when an output
-/// file cannot be written (nothing half-written is left behind).
+/// Runs the scenario to its duration or to a crash. Throws std::invalid_argument for a scenario
+/// the loop cannot run (a control rate above the physics rate, an empty tracking window) and
+/// std::runtime_error when an output file cannot be written (nothing half-written is left behind).
 RunSummary RunScenario(const Scenario& scenario, const RunOptions& options = {});
 
 /// Hands a simulator step's sensor messages to the stack (the only way the truth reaches it), and

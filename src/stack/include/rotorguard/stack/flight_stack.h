@@ -3,6 +3,7 @@
 /// its own copy of the vehicle parameters (the stack's model, not the simulator's truth) and a
 /// mission reference.
 #include <algorithm>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,8 +22,8 @@
 #include "rotorguard/fdd/ukf_fdd.h"
 #include "rotorguard/perception/lidar_mapper.h"
 #include "rotorguard/planning/flatness_navigator.h"
-#include "rotorguard/planning/replanner.h"
 #include "rotorguard/planning/references.h"
+#include "rotorguard/planning/replanner.h"
 #include "rotorguard/stack/estimator.h"
 #include "rotorguard/stack/supervisor.h"
 #include "rotorguard/vehicle/multirotor.h"
@@ -110,6 +111,43 @@ struct StackCost {
   double controller_s = 0.0;  ///< the controller's Compute (the NMPC's solve)
 };
 
+/// The navigate mission as the stack flew it (FlightStack::Summarize).
+struct NavigationSummary {
+  int waypoints_reached = 0;  ///< counting repeats over the rounds
+  int waypoints_total = 0;    ///< waypoints x rounds
+  /// The replanner's planning queries (method minco; all zero for flatness): how many, how many
+  /// failed, how many of the successful ones needed the planner's fallbacks (the search at the
+  /// map's resolution, the path flown from rest to rest), and by what started them ("goal",
+  /// "failure", "obstacle ahead", "periodic").
+  int plans = 0, plans_failed = 0, plans_fine_search = 0, plans_rest_to_rest = 0;
+  std::map<std::string, int> plans_by_reason;
+  double planner_ms_mean = 0.0;  ///< wall-clock time of a query, mean (0 without queries)
+  /// Each failed query: time, reason and status ("12.30 s periodic: no_path").
+  std::vector<std::string> failed_plans;
+  /// When the mission is incomplete and its last plan found the pending waypoint unreachable
+  /// (inside an obstacle's inflation, outside the map or the altitude band, enclosed): which
+  /// waypoint and why, "waypoint 3 at [1, 2, 1] is unreachable: no_path (...)". Empty otherwise.
+  std::string unreachable;
+};
+
+/// What the UKF fault estimator concluded (fdd ukf).
+struct UkfSummary {
+  std::vector<double> w_hat;        ///< its final loss-of-effectiveness estimates, per rotor
+  std::optional<double> settled_s;  ///< when it first settled after a detection [s]; none: never
+};
+
+/// What the stack did over a flight, taken from its parts: the run summary's account of the stack.
+struct FlightStackSummary {
+  std::optional<NavigationSummary> navigation;  ///< mission navigate
+  /// Paper 004's planner's decisions: plan, hold, continue, return, land (navigation method flatness).
+  std::vector<planning::FlatnessDecision> flatness_decisions;
+  std::optional<UkfSummary> ukf;                ///< fdd ukf
+  FlightMode final_mode = FlightMode::kNominal;  ///< the supervisor's mode at the end ...
+  std::vector<ModeTransition> transitions;       ///< ... and its transitions
+  std::optional<int> map_voxels_occupied;       ///< the LiDAR map's occupied voxels; none without a LiDAR
+  long lidar_points_dropped = 0;                ///< as lidar_points_dropped()
+};
+
 class FlightStack {
  public:
   /// `controller`, when given, is flown instead of one built from options.controller (which must
@@ -166,6 +204,9 @@ class FlightStack {
   const Supervisor& supervisor() const { return supervisor_; }
   /// Rotors the stack treats as failed (isolated by its FDD or handed over as known faults).
   int isolated_rotors() const { return static_cast<int>(isolated_.size()); }
+  /// What the stack did so far: navigation, re-planning decisions, fault estimates, flight modes,
+  /// the map.
+  FlightStackSummary Summarize() const;
 
  private:
   /// One rotor found failed (FDD) or handed over (known fault): the controller reconfigures and,
@@ -177,6 +218,8 @@ class FlightStack {
   /// The flatness navigator's part: waypoints in turn once each leg settled, hold on a detection,
   /// re-plan once the estimate settled.
   void NavigateFlatness(double t);
+  /// Summarize's account of the navigate mission.
+  NavigationSummary SummarizeNavigation() const;
 
   vehicle::MultirotorModel model_;
   std::shared_ptr<const ReferenceTrajectory> reference_;

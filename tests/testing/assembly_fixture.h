@@ -8,7 +8,7 @@
 #include "rotorguard/modular/assembly.h"
 #include "rotorguard/modular/assembly_astar.h"
 #include "rotorguard/perception/voxel_map.h"
-#include "vehicle/vehicle_fixture.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::testing {
 

@@ -1,0 +1,404 @@
+// rotorguard bench NAME: the papers' benchmarks and the project's own, as tables or JSON.
+#include <filesystem>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "rotorguard/benchmarks/campaign_bench.h"
+#include "rotorguard/benchmarks/flatness_bench.h"
+#include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/benchmarks/mars_bench.h"
+#include "rotorguard/benchmarks/nav_bench.h"
+#include "rotorguard/benchmarks/nmpc_bench.h"
+#include "rotorguard/benchmarks/perception_bench.h"
+#include "rotorguard/benchmarks/planner_bench.h"
+#include "rotorguard/benchmarks/qp_bench.h"
+#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/benchmarks/sim_bench.h"
+#include "rotorguard/buildinfo/build_info.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/io/files.h"
+#include "rotorguard/io/report_html.h"
+#include "rotorguard/record/report.h"
+#include "cli.h"
+
+namespace rotorguard::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class BenchCommand final : public Command {
+ public:
+  CLI::App* Register(CLI::App* app) override {
+    CLI::App* bench = app->add_subcommand("bench", "Benchmarks; results as a table or JSON.");
+    bench->require_subcommand(1);
+    RegisterSim(bench);
+    RegisterQp(bench);
+    RegisterNmpc(bench);
+    RegisterFtc(bench);
+    RegisterPerception(bench);
+    RegisterPlanner(bench);
+    RegisterNav(bench);
+    RegisterFlatness(bench);
+    RegisterMars(bench);
+    // The benchmarks that run on the campaign engine (benchmarks/registry.h): their trials can be
+    // kept, resumed, sharded and merged like a campaign's.
+    for (CLI::App* b : {ftc_, nav_, mars_}) {
+      b->add_option("--out", out_,
+                    b == nav_ ? "The trials' records and the result (bench.json, bench.md); with --replay: the\n"
+                                "run folder (default out/nav_KIND_SEED)"
+                              : "Keep the trials' records (results.jsonl, manifest.json) and the result\n"
+                                "(bench.json, bench.md) in this folder (default: a temporary folder)");
+      b->add_option("--shard", shard_, "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
+                                       "with `campaign merge` when all are done");
+      b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
+    }
+    RegisterCampaign(bench);
+    // Every benchmark can also write its page: tables and distributions (record/report.h).
+    for (CLI::App* b : {sim_, qp_, nmpc_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
+      b->add_option("--html", html_, "Also write the result as an HTML page to this file");
+      b->add_flag("--json", json_, b == sim_ || b == qp_ || b == nmpc_ || b == campaign_
+                                       ? "Print JSON instead of a table"
+                                       : "Print JSON instead of Markdown");
+    }
+    return bench;
+  }
+
+  int Execute() override {
+    if (*sim_) return Sim();
+    if (*qp_) return Qp();
+    if (*nmpc_) return Nmpc();
+    if (*ftc_) return Ftc();
+    if (*perception_) return Perception();
+    if (*planner_) return Planner();
+    if (*nav_) return Nav();
+    if (*flatness_) return Flatness();
+    if (*mars_) return Mars();
+    return Campaign();
+  }
+
+ private:
+  void RegisterSim(CLI::App* bench) {
+    sim_ = bench->add_subcommand(
+        "sim", "Closed-loop simulation speed: the 2 m/s lemniscate with all sensors and the nominal "
+               "controller. Reports the median realtime_factor and steps_per_s (target >= 200x real time).");
+    sim_->add_option("--scenario", sim_scenario_, "Scenario to fly (default: configs/scenarios/lemniscate_2ms.yaml)");
+    sim_->add_option("--duration", sim_duration_, "Simulated seconds per repetition (default 60)");
+    sim_->add_option("--repetitions", sim_repetitions_, "Repetitions; the median is reported (default 5)");
+  }
+  void RegisterQp(CLI::App* bench) {
+    qp_ = bench->add_subcommand(
+        "qp", "The NMPC's QP solver (condensing + dual active set) on a reference OCP QP instance:\n"
+              "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
+              "iterations_mean and max_u0_error against the instance's optimal u_0.");
+    qp_->add_option("--instance", qp_instance_, "Instance file (JSON), e.g. a copy of qp_hover_n20.json")->required();
+    qp_->add_option("--repetitions", qp_repetitions_, "Solves per case; the median time counts (default 3)");
+  }
+  void RegisterNmpc(CLI::App* bench) {
+    nmpc_ = bench->add_subcommand(
+        "nmpc", "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
+                "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
+  }
+  void RegisterFtc(CLI::App* bench) {
+    ftc_ = bench->add_subcommand(
+        "ftc", "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
+               "tracking the 2 m/s lemniscate and during take-off, plus fault-free trials for the false-alarm rate.\n"
+               "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).");
+    ftc_->add_option("--trials", ftc_trials_, "Trials per cell (default 20, the paper's count)");
+    ftc_->add_option("--seed", seed_, "Benchmark seed (default 1); trial seeds derive from it");
+    ftc_->add_option("--methods", ftc_methods_,
+                     "Comma-separated methods: rotorguard, fixedtime, ukf, indi, passive, none (default all)");
+    ftc_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
+  }
+  void RegisterPerception(CLI::App* bench) {
+    perception_ = bench->add_subcommand(
+        "perception", "The simulated MID-360 on a vehicle spinning at 11 rad/s and flying 1 m/s through a 500-tree\n"
+                      "forest and around a room, deskewing on and off: points_per_s_simulated, map_update_ms_mean\n"
+                      "per frame, map precision and recall against the world within one voxel.");
+    perception_->add_option("--duration", perception_duration_, "Simulated seconds per run (default 10)");
+    perception_->add_option("--seed", seed_, "Sensor noise and forest layout (default 1)");
+  }
+  void RegisterPlanner(CLI::App* bench) {
+    planner_ = bench->add_subcommand(
+        "planner", "The trajectory planner (A*, MINCO, L-BFGS) on random forests (30 x 20 m) and rooms (10 x 8 m),\n"
+                   "random start/goal pairs, nominal and post-failure limits, on the map of the true world:\n"
+                   "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.");
+    planner_->add_option("--pairs", planner_pairs_, "Start/goal pairs per world kind (default 100)");
+    planner_->add_option("--worlds", planner_worlds_, "Distinct worlds per kind (default 10, at most --pairs)");
+    planner_->add_option("--seed", seed_, "Worlds and pairs (default 1)");
+  }
+  void RegisterNav(CLI::App* bench) {
+    nav_ = bench->add_subcommand(
+        "nav",
+        "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
+        "mid-flight on a random rotor, flown by rotorguard and by its failure-unaware variant:\n"
+        "success_rate, collision_rate, tracking_rmse_m, max_spin_rad_s, mission_time_s, planner_ms_mean,\n"
+        "stack_ms_per_cycle_mean, realtime_factor (the stack's, on one core) and trial_realtime_factor\n"
+        "(the simulator included).");
+    nav_->add_option("--trials", nav_trials_, "Random worlds per kind, each flown by both variants (default 100)");
+    nav_->add_option("--seed", seed_, "Benchmark seed (default 1); trial seeds derive from it");
+    nav_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
+    nav_->add_option("--kinds", nav_kinds_, "Comma-separated world kinds: forest, room (default both)");
+    nav_->add_option("--replay", nav_replay_,
+                     "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out");
+  }
+  void RegisterFlatness(CLI::App* bench) {
+    flatness_ = bench->add_subcommand(
+        "flatness", "Paper 004: closed-form settling times of Fig. 1 (ts_envelope_s, ts_actuator_s) and the Fig. 2\n"
+                    "flight (configs/scenarios/flatness_fig2.yaml) over many seeds: ukf_w_estimate, ukf_settle_s,\n"
+                    "replan_ts_s against a fault-free re-plan, max_pitch_deg against theta_max.");
+    flatness_->add_option("--seeds", flatness_seeds_, "Flights of the Fig. 2 scenario (default 20)");
+    flatness_->add_option("--seed", seed_, "The first flight's seed (default 1)");
+    flatness_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
+  }
+  void RegisterMars(CLI::App* bench) {
+    mars_ = bench->add_subcommand(
+        "mars",
+        "Paper 002: the 3x2 assembly on Table I's spiral (configs/scenarios/mars_spiral_3x2.yaml) with the\n"
+        "paper's rotor faults and Fig. 3's dead units, without reallocation, partial and full: table1\n"
+        "(mean tracking RMSE, a crashed flight's wreck held where it crashed; success rate); alloc_us_mean\n"
+        "for nine units (configs/assemblies/3x3.yaml); the self-reconfiguration (mars_reconfigure_3x1.yaml);\n"
+        "table2: the 4x1 and 3x2 assemblies planned through a door by ours and the baseline\n"
+        "(mars_plan_4x1.yaml, mars_plan_3x2.yaml) and flown, the error over each plan's duration.");
+    mars_->add_option("--trials", mars_trials_, "Flights per case and method (default 10, the paper's)");
+    mars_->add_option("--seed", seed_, "The first flight's seed (default 1)");
+    mars_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
+  }
+  void RegisterCampaign(CLI::App* bench) {
+    campaign_ = bench->add_subcommand(
+        "campaign", "The campaign engine (docs/campaigns.md): a spec run with one worker and with two\n"
+                    "(trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency), killed and resumed, and\n"
+                    "in 4 shards; each merged summary compared byte for byte with the uninterrupted one.");
+    campaign_->add_option("--spec", campaign_spec_, "Campaign spec (default configs/campaigns/bench_campaign.yaml)");
+    campaign_->add_option("--work", campaign_work_, "A new folder for the runs (default: a temporary one, removed after)");
+  }
+
+  /// Writes the result's page when --html asked for one.
+  void WriteHtml(const char* name, const nlohmann::json& result) const {
+    if (html_.empty()) return;
+    record::WriteBenchReport(name, result, html_);
+    fmt::print(stderr, "report: {}\n", html_);
+  }
+  /// Prints a benchmark whose tables are Markdown: its JSON with --json.
+  void PrintMarkdownResult(const char* name, const nlohmann::json& result, const std::string& markdown) const {
+    WriteHtml(name, result);
+    fmt::print("{}", json_ ? result.dump(2) + "\n" : markdown);
+  }
+
+  /// A benchmark's campaign: its trials in --out (or a temporary folder), then its result printed
+  /// and, with --out, written as bench.json and bench.md. A shard of several only records its
+  /// trials; nullopt then.
+  std::optional<nlohmann::json> RunBenchCampaign(const campaign::Campaign& c, const char* name) const {
+    campaign::CampaignRunOptions o = CampaignRunOptionsOf(out_, jobs_, shard_, resume_);
+    if ((o.resume || o.shard.count > 1) && o.out_dir.empty()) {
+      throw UsageError(fmt::format("{} needs --out: the folder that keeps the trials", o.resume ? "--resume" : "--shard"));
+    }
+    o.progress = EtaProgress("trials");
+    const std::optional<std::vector<nlohmann::json>> records = campaign::RunCampaignRecords(c, o);
+    if (!records) {
+      fmt::print("shard {} of {} done in {}; when every shard is: rotorguard campaign merge {} ...\n", o.shard.index,
+                 o.shard.count, o.out_dir, o.out_dir);
+      return std::nullopt;
+    }
+    const campaign::BenchReport r = campaign::CampaignResult(c.bench, *records, benchmarks::CampaignKinds());
+    WriteHtml(name, r.result);
+    if (!out_.empty()) campaign::WriteBenchFiles(r, out_);
+    fmt::print("{}", json_ ? r.result.dump(2) + "\n" : r.markdown);
+    return r.result;
+  }
+
+  std::uint64_t Seed() const { return ParseUnsigned("--seed", seed_, 0, UINT64_MAX); }
+
+  int Sim() const {
+    benchmarks::SimBenchOptions o;
+    o.duration_s = ParseFinite("--duration", sim_duration_, 1e-3, 1e5);
+    o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", sim_repetitions_, 1, 1000));
+    const std::string path = sim_scenario_.empty() ? ConfigPath("scenarios/lemniscate_2ms.yaml") : sim_scenario_;
+    const nlohmann::json r = benchmarks::RunSimBenchmark(harness::LoadScenario(path), o);
+    WriteHtml("sim", r);
+    if (json_) {
+      fmt::print("{}\n", r.dump(2));
+    } else {
+      fmt::print("scenario          {}\n", r["scenario"].get<std::string>());
+      fmt::print("realtime_factor   {:.1f}x (median of {})\n", r["realtime_factor"].get<double>(), o.repetitions);
+      fmt::print("steps_per_s       {:.0f}\n", r["steps_per_s"].get<double>());
+      fmt::print("cpu               {}\n", r["host"]["cpu"].get<std::string>());
+    }
+    return r["crashed"].get<bool>() ? kRunFailed : kOk;
+  }
+
+  int Qp() const {
+    benchmarks::QpBenchOptions o;
+    o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", qp_repetitions_, 1, 1000));
+    const nlohmann::json r = benchmarks::RunQpBenchmark(qp_instance_, o);
+    WriteHtml("qp", r);
+    if (json_) {
+      fmt::print("{}\n", r.dump(2));
+    } else {
+      fmt::print("cases             {} stress, {} track\n", r["cases_stress"].get<int>(), r["cases_track"].get<int>());
+      fmt::print("stress            {:.1f} us median, {:.1f} us p99\n", r["stress_us_median"].get<double>(),
+                 r["stress_us_p99"].get<double>());
+      fmt::print("track             {:.1f} us median, {:.1f} us p99\n", r["track_us_median"].get<double>(),
+                 r["track_us_p99"].get<double>());
+      fmt::print("iterations_mean   {:.2f}\n", r["iterations_mean"].get<double>());
+      fmt::print("u0 error          {:.2e} median, {:.2e} p99, {:.2e} max\n", r["u0_error_median"].get<double>(),
+                 r["u0_error_p99"].get<double>(), r["max_u0_error"].get<double>());
+      fmt::print("reference u0      not optimal in {} cases (pinning it raises the objective by up to {:.1e})\n",
+                 r["cases_reference_u0_suboptimal"].get<int>(), r["worst_reference_relative_gap"].get<double>());
+      fmt::print("failures          {}\n", r["failures"].get<int>());
+    }
+    return r["failures"].get<int>() > 0 ? kRunFailed : kOk;
+  }
+
+  int Nmpc() const {
+    const nlohmann::json r = benchmarks::RunNmpcBenchmark(
+        harness::LoadScenario(ConfigPath("scenarios/lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}}),
+        harness::LoadScenario(ConfigPath("scenarios/nmpc_lemniscate_1ms_rotor0_failed.yaml")));
+    WriteHtml("nmpc", r);
+    if (json_) {
+      fmt::print("{}\n", r.dump(2));
+    } else {
+      fmt::print("solve time        {:.3f} ms mean, {:.3f} ms p99, {:.3f} ms max over {} calls\n",
+                 r["solve_ms_mean"].get<double>(), r["solve_ms_p99"].get<double>(), r["solve_ms_max"].get<double>(),
+                 r["calls"].get<int>());
+      fmt::print("qp_iterations     {:.2f} mean\n", r["qp_iterations_mean"].get<double>());
+      fmt::print("fallbacks         {}\n", r["fallbacks"].get<long>());
+      fmt::print("tracking RMSE     {:.3f} m nominal, {:.3f} m with a failed rotor\n",
+                 r["tracking_rmse_m_nominal"].get<double>(), r["tracking_rmse_m_failed"].get<double>());
+    }
+    return r["success_nominal"].get<bool>() && r["success_failed"].get<bool>() ? kOk : kRunFailed;
+  }
+
+  int Ftc() const {
+    benchmarks::FtcBenchOptions o;
+    o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_, 1, 1'000'000));
+    o.seed = Seed();
+    o.methods = ParseWordList("--methods", ftc_methods_, benchmarks::FtcMethods());
+    o.vehicle = harness::LoadVehicle(ConfigPath("vehicles/zhou2025_quad.yaml"));
+    const std::optional<nlohmann::json> r = RunBenchCampaign(benchmarks::FtcCampaign(o), "ftc");
+    return r && (*r)["errors"].get<int>() > 0 ? kRunFailed : kOk;
+  }
+
+  int Perception() const {
+    benchmarks::PerceptionBenchOptions o;
+    o.duration_s = ParseFinite("--duration", perception_duration_, 1e-3, 600.0);
+    o.seed = Seed();
+    o.progress = CountProgress("runs");
+    const nlohmann::json r = benchmarks::RunPerceptionBenchmark(o);
+    PrintMarkdownResult("perception", r, benchmarks::PerceptionMarkdown(r));
+    return kOk;
+  }
+
+  int Planner() const {
+    benchmarks::PlannerBenchOptions o;
+    o.pairs = static_cast<int>(ParseUnsigned("--pairs", planner_pairs_, 1, 100000));
+    o.worlds = static_cast<int>(ParseUnsigned("--worlds", planner_worlds_, 1, static_cast<std::uint64_t>(o.pairs)));
+    o.seed = Seed();
+    o.progress = CountProgress("plans");
+    const nlohmann::json r = benchmarks::RunPlannerBenchmark(o);
+    PrintMarkdownResult("planner", r, benchmarks::PlannerMarkdown(r));
+    return kOk;
+  }
+
+  int Nav() const {
+    benchmarks::NavBenchOptions o;
+    o.trials = static_cast<int>(ParseUnsigned("--trials", nav_trials_, 1, 100000));
+    o.seed = Seed();
+    o.kinds = ParseWordList("--kinds", nav_kinds_, {"forest", "room"});
+    o.base = harness::LoadScenario(ConfigPath("scenarios/forest.yaml"));
+    if (!nav_replay_.empty()) return ReplayNavTrial(o.base);
+    RunBenchCampaign(benchmarks::NavCampaign(o), "nav");
+    return kOk;
+  }
+
+  /// --replay KIND:SEED[:unaware]: one trial of bench nav, flown into a run folder.
+  int ReplayNavTrial(const harness::Scenario& base) const {
+    const std::size_t a = nav_replay_.find(':');
+    const std::size_t b = a == std::string::npos ? a : nav_replay_.find(':', a + 1);
+    const std::string kind = nav_replay_.substr(0, a);
+    const std::string variant = b == std::string::npos ? "" : nav_replay_.substr(b + 1);
+    if (a == std::string::npos || (kind != "forest" && kind != "room") || (!variant.empty() && variant != "unaware")) {
+      throw UsageError(fmt::format(
+          "--replay: '{}' is invalid; expected KIND:SEED or KIND:SEED:unaware, KIND forest or room", nav_replay_));
+    }
+    const std::uint64_t seed =
+        ParseUnsigned("--replay", nav_replay_.substr(a + 1, b == std::string::npos ? b : b - a - 1), 0, UINT64_MAX);
+    const harness::Scenario trial = benchmarks::MakeNavTrial(base, kind, seed, variant.empty());
+    harness::RunOptions replay;
+    replay.out_dir = out_.empty() ? (fs::path("out") / trial.name).string() : out_;
+    replay.report = io::HasViewer();
+    const harness::RunSummary s = harness::RunScenario(trial, replay);
+    PrintRunSummary(s, replay.out_dir, replay);
+    return s.success ? kOk : kRunFailed;
+  }
+
+  int Flatness() const {
+    benchmarks::FlatnessBenchOptions o;
+    o.seeds = static_cast<int>(ParseUnsigned("--seeds", flatness_seeds_, 1, 10000));
+    o.seed = Seed();
+    o.jobs = ParseJobs(jobs_);
+    o.fig2 = harness::LoadScenario(ConfigPath("scenarios/flatness_fig2.yaml"));
+    o.progress = CountProgress("flights");
+    const nlohmann::json r = benchmarks::RunFlatnessBenchmark(o);
+    PrintMarkdownResult("flatness", r, benchmarks::FlatnessMarkdown(r));
+    return kOk;
+  }
+
+  int Mars() const {
+    benchmarks::MarsBenchOptions o;
+    o.trials = static_cast<int>(ParseUnsigned("--trials", mars_trials_, 1, 10000));
+    o.seed = Seed();
+    o.spiral = harness::LoadScenario(ConfigPath("scenarios/mars_spiral_3x2.yaml"));
+    o.nine_units = harness::LoadAssembly(ConfigPath("assemblies/3x3.yaml"));
+    o.reconfigure = harness::LoadScenario(ConfigPath("scenarios/mars_reconfigure_3x1.yaml"));
+    o.plan_4x1 = harness::LoadScenario(ConfigPath("scenarios/mars_plan_4x1.yaml"));
+    o.plan_3x2 = harness::LoadScenario(ConfigPath("scenarios/mars_plan_3x2.yaml"));
+    RunBenchCampaign(benchmarks::MarsCampaign(o), "mars");
+    return kOk;
+  }
+
+  int Campaign() const {
+    const std::string spec_path = campaign_spec_.empty() ? ConfigPath("campaigns/bench_campaign.yaml") : campaign_spec_;
+    const campaign::Campaign spec = campaign::LoadCampaign(spec_path, benchmarks::CampaignKinds());
+    std::optional<io::TemporaryFolder> temporary;  // removed after, also on an error
+    if (campaign_work_.empty()) temporary.emplace("rotorguard-bench-campaign");
+    const nlohmann::json r = benchmarks::RunCampaignBenchmark(spec, temporary ? temporary->path() : campaign_work_,
+                                                              buildinfo::ProgramVersion(), benchmarks::CampaignKinds());
+    WriteHtml("campaign", r);
+    if (json_) {
+      fmt::print("{}\n", r.dump(2));
+    } else {
+      fmt::print("campaign          {} ({} trials)\n", r["campaign"].get<std::string>(), r["trials"].get<int>());
+      fmt::print("trials/s          {:.2f} with 1 worker, {:.2f} with 2 (scaling efficiency {:.2f})\n",
+                 r["trials_per_s_1worker"].get<double>(), r["trials_per_s_2workers"].get<double>(),
+                 r["scaling_efficiency"].get<double>());
+      fmt::print("identical         jobs {}, kill and resume {}, 4 shards {}\n", r["jobs_identical"].get<bool>(),
+                 r["resume_identical"].get<bool>(), r["shards_identical"].get<bool>());
+    }
+    const bool same = r["jobs_identical"].get<bool>() && r["resume_identical"].get<bool>() &&
+                      r["shards_identical"].get<bool>();
+    return same ? kOk : kRunFailed;
+  }
+
+  CLI::App *sim_ = nullptr, *qp_ = nullptr, *nmpc_ = nullptr, *ftc_ = nullptr, *perception_ = nullptr,
+           *planner_ = nullptr, *nav_ = nullptr, *flatness_ = nullptr, *mars_ = nullptr, *campaign_ = nullptr;
+  // Options several benchmarks share (one of them runs per invocation).
+  std::string seed_ = "1", jobs_, out_, shard_ = "0/1", html_;
+  bool resume_ = false, json_ = false;
+  std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
+  std::string qp_instance_, qp_repetitions_ = "3";
+  std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none";
+  std::string perception_duration_ = "10";
+  std::string planner_pairs_ = "100", planner_worlds_ = "10";
+  std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;
+  std::string flatness_seeds_ = "20";
+  std::string mars_trials_ = "10";
+  std::string campaign_spec_, campaign_work_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeBenchCommand() { return std::make_unique<BenchCommand>(); }
+
+}  // namespace rotorguard::cli

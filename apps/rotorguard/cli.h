@@ -1,0 +1,86 @@
+#pragma once
+// The command line's shared parts: exit codes, strict argument parsing, progress lines, and the
+// Command interface each subcommand file implements (run, report, validate, fdd-calibrate, bench,
+// campaign). Commands parse, call the libraries and print; no algorithm lives here.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/harness/flight_recorder.h"
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/harness/scenario.h"
+
+namespace rotorguard::cli {
+
+/// The documented exit codes (docs/cli.md).
+enum ExitCode : int { kOk = 0, kRunFailed = 1, kUsage = 2, kUnreadable = 3, kInfeasible = 4 };
+
+/// A command-line value that is not acceptable: exit 2 with this message.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A subcommand: it adds itself and its options to the parser, and runs once the parser chose it.
+class Command {
+ public:
+  virtual ~Command() = default;
+  /// Adds the command to `app`; returns its subcommand, which the parser marks as chosen.
+  virtual CLI::App* Register(CLI::App* app) = 0;
+  /// Runs the parsed command; returns its exit code. Throws for errors (ExitCodeOf maps them).
+  virtual int Execute() = 0;
+};
+
+std::unique_ptr<Command> MakeRunCommand();
+std::unique_ptr<Command> MakeReportCommand();
+std::unique_ptr<Command> MakeValidateCommand();
+std::unique_ptr<Command> MakeFddCalibrateCommand();
+std::unique_ptr<Command> MakeBenchCommand();
+std::unique_ptr<Command> MakeCampaignCommand();
+
+/// The exit code of an error, by its type (UsageError, io::ConfigError: 2; io::InputFileError,
+/// io::CorruptFileError: 3; std::invalid_argument: 2; anything else: 1), and its message with the
+/// option fields library errors name turned into the flags that set them.
+int ExitCodeOf(const std::exception& error);
+std::string MessageOf(const std::exception& error);
+
+// ---- Strict argument parsing: each throws UsageError naming the option, the text and what was expected.
+/// An unsigned integer in [lo, hi]: digits only, no sign, no exponent.
+std::uint64_t ParseUnsigned(const std::string& option, const std::string& text, std::uint64_t lo, std::uint64_t hi);
+/// A finite number in [lo, hi]; rejects nan, inf, 1e999 (overflow) and trailing text.
+double ParseFinite(const std::string& option, const std::string& text, double lo, double hi);
+/// --jobs: worker threads, the number of cores when `text` is empty.
+int ParseJobs(const std::string& text);
+/// --shard "i/N" with 0 <= i < N.
+campaign::Shard ParseShard(const std::string& text);
+/// A comma-separated list of words, each one of `allowed`.
+std::vector<std::string> ParseWordList(const std::string& option, const std::string& text,
+                                       const std::vector<std::string>& allowed);
+/// --set key.path=value, repeatable.
+std::vector<harness::Override> ParseOverrides(const std::vector<std::string>& sets);
+
+/// The campaign options a command line gives (campaign run and the benchmarks that run as campaigns).
+campaign::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,
+                                                  const std::string& shard, bool resume);
+
+/// A configs/ file: relative to the working directory when it has one, else the source tree's.
+std::string ConfigPath(const std::string& relative);
+
+// ---- Progress on a terminal's stderr (nothing when stderr is not a terminal).
+/// "\r[####    ]  42%  t = 4.2 / 10.0 s" for a flight of `duration_s`.
+std::function<void(double)> FlightProgress(bool enabled, double duration_s);
+/// "\r<what> done / total", for benchmarks that report whole units of work.
+std::function<void(int, int)> CountProgress(const char* what);
+/// "\r<what> done / total, elapsed, ETA", for long runs of equal units of work.
+std::function<void(int, int)> EtaProgress(const char* what);
+
+/// The run's table: outcome, metrics, faults, detection, re-planning, flight modes and the files.
+void PrintRunSummary(const harness::RunSummary& summary, const std::string& out_dir,
+                     const harness::FlightRecorderOptions& files);
+
+}  // namespace rotorguard::cli

@@ -1,0 +1,63 @@
+// rotorguard fdd-calibrate RUNS...: sweep the composite FDD's thresholds over saved runs.
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "rotorguard/benchmarks/fdd_calibration.h"
+#include "rotorguard/io/files.h"
+#include "cli.h"
+
+namespace rotorguard::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class FddCalibrateCommand final : public Command {
+ public:
+  CLI::App* Register(CLI::App* app) override {
+    CLI::App* calibrate = app->add_subcommand(
+        "fdd-calibrate",
+        "Replay saved runs (folders written by 'rotorguard run --out DIR', fault-free and faulty) through the\n"
+        "composite FDD offline while each threshold sweeps (gamma_M, gamma_P, take-off): detection latency,\n"
+        "misses and false alarms per value, the margin to the fault-free extremes, and a suggested value.");
+    calibrate->add_option("runs", dirs_, "Run folders (each with sensors.csv, vehicle.yaml, summary.json)")->required();
+    calibrate->add_option("--margin", margin_text_,
+                          "Required margin to the fault-free extreme of each index (default 1.5, > 1)");
+    calibrate->add_option("--out", out_, "Folder for calibration.json and calibration.md");
+    calibrate->add_flag("--json", json_, "Print JSON instead of Markdown");
+    return calibrate;
+  }
+
+  int Execute() override {
+    benchmarks::FddCalibrationOptions o;
+    o.margin = ParseFinite("--margin", margin_text_, 1.0 + 1e-9, 1e6);
+    std::vector<benchmarks::CalibrationLog> logs;
+    for (const std::string& d : dirs_) logs.push_back(benchmarks::LoadCalibrationLog(d));
+    std::string note;
+    o.fdd = benchmarks::RecordedFddOptions(logs, &note);
+    if (!note.empty()) fmt::print(stderr, "note: {}\n", note);
+    const nlohmann::json r = benchmarks::CalibrateCompositeFdd(logs, o);
+    const std::string md = benchmarks::CalibrationMarkdown(r);
+    if (!out_.empty()) {
+      std::error_code ec;
+      fs::create_directories(out_, ec);
+      if (ec || !fs::is_directory(out_)) throw UsageError(fmt::format("--out: cannot create folder '{}'", out_));
+      io::WriteFileAtomically((fs::path(out_) / "calibration.json").string(), r.dump(2) + "\n");
+      io::WriteFileAtomically((fs::path(out_) / "calibration.md").string(), md);
+    }
+    fmt::print("{}", json_ ? r.dump(2) + "\n" : md);
+    return kOk;
+  }
+
+ private:
+  std::vector<std::string> dirs_;
+  std::string margin_text_ = "1.5", out_;
+  bool json_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> MakeFddCalibrateCommand() { return std::make_unique<FddCalibrateCommand>(); }
+
+}  // namespace rotorguard::cli

@@ -1,0 +1,150 @@
+// rotorguard run SCENARIO: fly a scenario and write its folder.
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/io/report_html.h"
+#include "cli.h"
+
+namespace rotorguard::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class RunCommand final : public Command {
+ public:
+  CLI::App* Register(CLI::App* app) override {
+    CLI::App* run = app->add_subcommand(
+        "run",
+        "Fly a scenario; write DIR/summary.json, DIR/report.html, the flight's log\n"
+        "(DIR/log.csv and DIR/scene.json, and/or DIR/flight.mcap), DIR/sensors.csv\n"
+        "and DIR/vehicle.yaml.\n"
+        "Exit 0 when the mission succeeds, 1 when it fails (crash), 4 when a\n"
+        "waypoint is unreachable.");
+    run->add_option("scenario", scenario_path_, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
+    run->add_option("--out", out_dir_, "Output folder (default: out/<scenario name>)");
+    run->add_option("--set", sets_,
+                    "Override a value: key.path=value (e.g. duration_s=5, faults.0.rotor=2, vehicle.mass_kg=1.2); "
+                    "the key must exist in the file. Repeatable.");
+    run->add_option("--seed", seed_text_, "Random seed, an integer in [0, 2^64-1] (overrides the file's seed)");
+    run->add_flag("--quiet,-q", quiet_, "No progress bar and no summary table");
+    run->add_option("--log-format", log_format_,
+                    "csv (log.csv, scene.json, sensors.csv; the default), mcap (flight.mcap, for Foxglove and "
+                    "PlotJuggler) or both");
+    run->add_flag("--no-report", no_report_, "Do not write report.html");
+    app_ = run;
+    return run;
+  }
+
+  int Execute() override {
+    const std::vector<harness::Override> overrides = ParseOverrides(sets_);
+    std::optional<std::uint64_t> seed;
+    if (app_->count("--seed") > 0) seed = ParseUnsigned("--seed", seed_text_, 0, UINT64_MAX);
+    harness::Scenario scenario = harness::LoadScenario(scenario_path_, overrides);
+    if (seed) scenario.seed = *seed;
+    harness::RunOptions options;
+    options.log_format = ParseLogFormat();
+    options.report = !no_report_ && io::HasViewer();
+    if (!no_report_ && !options.report) {
+      fmt::print(stderr, "note: no report.html: this rotorguard was built without the report viewer (npm)\n");
+    }
+    options.out_dir = out_dir_.empty() ? (fs::path("out") / scenario.name).string() : out_dir_;
+    std::error_code ec;
+    fs::create_directories(options.out_dir, ec);
+    if (ec || !fs::is_directory(options.out_dir)) {
+      throw UsageError(fmt::format("--out: cannot create folder '{}'{}", options.out_dir, ec ? ": " + ec.message() : ""));
+    }
+    options.progress = FlightProgress(!quiet_, scenario.duration_s);
+    const harness::RunSummary summary = harness::RunScenario(scenario, options);
+    if (!quiet_) PrintRunSummary(summary, options.out_dir, options);
+    if (summary.infeasible_request) return kInfeasible;
+    return summary.success ? kOk : kRunFailed;
+  }
+
+ private:
+  harness::LogFormat ParseLogFormat() const {
+    if (log_format_ == "csv") return harness::LogFormat::kCsv;
+    if (log_format_ == "mcap") return harness::LogFormat::kMcap;
+    if (log_format_ == "both") return harness::LogFormat::kBoth;
+    throw UsageError(fmt::format("--log-format: '{}' is invalid; expected csv, mcap or both", log_format_));
+  }
+
+  CLI::App* app_ = nullptr;
+  std::string scenario_path_, out_dir_, seed_text_, log_format_ = "csv";
+  std::vector<std::string> sets_;
+  bool quiet_ = false, no_report_ = false;
+};
+
+/// Paper 004's re-planning decisions, one a line: hold, then continue, return or land.
+void PrintFlatnessDecisions(const std::vector<planning::FlatnessDecision>& decisions) {
+  for (std::size_t i = 0; i < decisions.size(); ++i) {
+    const planning::FlatnessDecision& d = decisions[i];
+    std::string what = fmt::format("{} at {:.2f} s", d.kind, d.t);
+    if (d.kind != "land") what += fmt::format(", t_s {:.2f} s", d.t_s);
+    if (!d.binding.empty()) what += fmt::format(" ({})", d.binding);
+    if (d.kind == "continue" || d.kind == "return" || d.kind == "land") {
+      what += fmt::format(", w_hat [{:.2f}, {:.2f}, {:.2f}, {:.2f}]", d.w_hat[0], d.w_hat[1], d.w_hat[2], d.w_hat[3]);
+    }
+    fmt::print("{}{}: {}\n", i == 0 ? "re-planning       " : "                  ", what, d.reason);
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<Command> MakeRunCommand() { return std::make_unique<RunCommand>(); }
+
+void PrintRunSummary(const harness::RunSummary& s, const std::string& out_dir,
+                     const harness::FlightRecorderOptions& files) {
+  std::string faults;
+  for (const auto& f : s.faults) {
+    faults += fmt::format("{}rotor {} {} at {:.3f} s", faults.empty() ? "" : "; ", f.rotor, f.kind, f.onset_s);
+  }
+  fmt::print("scenario          {}\n", s.scenario);
+  fmt::print("outcome           {}\n", s.success ? "success" : "FAILED: " + s.failure_reason.value_or(""));
+  fmt::print("simulated         {:.2f} s in {:.2f} s wall ({:.0f}x real time)\n", s.sim_time_s, s.wall_time_s,
+             s.realtime_factor);
+  // The window when it is not the whole flight, and the wreck's share when the flight crashed.
+  const bool whole = s.tracking_start_s == 0.0 && s.tracking_end_s >= s.sim_time_s && !s.crashed;
+  fmt::print("tracking RMSE     {:.3f} m (max error {:.3f} m){}\n", s.tracking_rmse_m, s.max_position_error_m,
+             whole ? ""
+                   : fmt::format(" over {:.2f}-{:.2f} s", s.tracking_start_s, std::min(s.tracking_end_s, s.sim_time_s)));
+  if (s.crashed) {
+    fmt::print("                  {:.3f} m over {:.2f}-{:.2f} s, the wreck held where it crashed\n",
+               s.tracking_rmse_window_m, s.tracking_start_s, s.tracking_end_s);
+  }
+  fmt::print("min altitude      {:.3f} m\n", s.min_altitude_m);
+  fmt::print("max spin          {:.2f} rad/s\n", s.max_spin_rad_s);
+  if (const std::optional<stack::NavigationSummary>& n = s.stack.navigation) {
+    fmt::print("navigation        {} of {} waypoints, {} plans ({} failed)\n", n->waypoints_reached, n->waypoints_total,
+               n->plans, n->plans_failed);
+    if (n->plans_fine_search > 0 || n->plans_rest_to_rest > 0) {
+      fmt::print("planner fallbacks {} searched at the map's resolution, {} flown from rest to rest\n",
+                 n->plans_fine_search, n->plans_rest_to_rest);
+    }
+  }
+  if (s.tilt_recovery_s) fmt::print("tilt recovery     {:.2f} s after the first fault\n", *s.tilt_recovery_s);
+  fmt::print("faults            {}\n", faults.empty() ? "none" : faults);
+  if (s.fdd && !s.fdd->diagnosis) fmt::print("fault detection   nothing detected\n");
+  if (s.fdd && s.fdd->diagnosis) {
+    const harness::FddRecord::Diagnosis& d = *s.fdd->diagnosis;
+    fmt::print("fault detection   rotor {} {} by {} at {:.3f} s{}\n", d.rotor, d.kind, d.detector, d.detection_s,
+               s.fdd->latency_s ? fmt::format(" (correct, {:.3f} s after onset)", *s.fdd->latency_s)
+                                : (s.fdd->false_alarm ? " (false alarm)" : " (wrong rotor or kind)"));
+  }
+  PrintFlatnessDecisions(s.stack.flatness_decisions);
+  for (std::size_t i = 0; i < s.stack.transitions.size(); ++i) {
+    const stack::ModeTransition& m = s.stack.transitions[i];
+    fmt::print("{}{} -> {} at {:.2f} s: {}\n", i == 0 ? "flight modes      " : "                  ",
+               stack::ToString(m.from), stack::ToString(m.to), m.t, m.reason);
+  }
+  fmt::print("seed              {}\n", s.seed);
+  if (out_dir.empty()) return;
+  if (files.log_format != harness::LogFormat::kMcap) fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());
+  if (files.log_format != harness::LogFormat::kCsv) fmt::print("mcap              {}\n", (fs::path(out_dir) / "flight.mcap").string());
+  fmt::print("summary           {}\n", (fs::path(out_dir) / "summary.json").string());
+  if (files.report) fmt::print("report            {}\n", (fs::path(out_dir) / "report.html").string());
+}
+
+}  // namespace rotorguard::cli

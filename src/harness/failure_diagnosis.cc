@@ -1,0 +1,45 @@
+#include "rotorguard/harness/failure_diagnosis.h"
+
+#include <fmt/format.h>
+
+namespace rotorguard::harness {
+
+namespace {
+
+/// "emergency landing at t = 12.34 s: REASON (landed)" for the first emergency landing, if any.
+std::optional<std::string> EmergencyLanding(const stack::FlightStackSummary& stack) {
+  for (const stack::ModeTransition& m : stack.transitions) {
+    if (m.to != stack::FlightMode::kEmergencyLanding) continue;
+    return fmt::format("emergency landing at t = {:.2f} s: {}{}", m.t, m.reason,
+                       stack.final_mode == stack::FlightMode::kLanded ? " (landed)" : "");
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+void DiagnoseFailure(const std::optional<FlightMetrics::Violation>& last_violation, const SuccessRule& rule,
+                     RunSummary* summary) {
+  RunSummary& s = *summary;
+  s.failure_reason.reset();
+  s.infeasible_request = false;
+  if (s.crashed) {
+    s.failure_reason = "crash: " + s.crash_reason.value_or("");
+  } else if (std::optional<std::string> landing = EmergencyLanding(s.stack)) {
+    s.failure_reason = std::move(landing);
+  } else if (last_violation && last_violation->t_s >= s.sim_time_s - rule.hold_s) {
+    s.failure_reason = fmt::format("position error {:.2f} m > {:g} m at t = {:.2f} s, within the last {:g} s",
+                                   last_violation->error_m, rule.error_m, last_violation->t_s, rule.hold_s);
+  } else if (const std::optional<stack::NavigationSummary>& n = s.stack.navigation;
+             n && n->waypoints_reached < n->waypoints_total) {
+    std::string reason = fmt::format("navigation reached {} of {} waypoints", n->waypoints_reached, n->waypoints_total);
+    if (!n->unreachable.empty()) {
+      s.infeasible_request = true;
+      reason += "; " + n->unreachable;
+    }
+    s.failure_reason = std::move(reason);
+  }
+  s.success = !s.failure_reason.has_value();
+}
+
+}  // namespace rotorguard::harness

@@ -1,0 +1,130 @@
+#include "rotorguard/harness/flight_recorder.h"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/record/flight_mcap.h"
+#include "rotorguard/record/report.h"
+#include "rotorguard/record/sensor_log.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace rotorguard::harness {
+
+namespace {
+
+namespace fs = std::filesystem;
+using vehicle::StateView;
+
+/// One row of log.csv (record/flight_log.h, LogColumns): the truth, the stack's reference,
+/// estimate and outputs, the rotors, and the FDD indices and NMPC solve time when the stack has them.
+void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::NumericTable* table) {
+  const StateView s(sim.state());
+  std::size_t c = 0;
+  const auto put = [&](double v) { table->values[c++].push_back(v); };
+  const auto v3 = [&](const Vector3& v) { put(v.x()), put(v.y()), put(v.z()); };
+  const auto q4 = [&](const Quaternion& q) { put(q.w()), put(q.x()), put(q.y()), put(q.z()); };
+  put(sim.time_s());
+  v3(s.p_W());
+  q4(s.q_WB());
+  v3(s.v_W());
+  v3(s.w_B());
+  const ReferencePoint& r = st.reference_point();
+  v3(r.p_W);
+  v3(r.v_W);
+  put(r.yaw);
+  const StateEstimate& e = st.estimate();
+  v3(e.p_W);
+  q4(e.q_WB);
+  v3(e.v_W);
+  v3(e.w_B);
+  v3(sim.wind());
+  put(sim.landed() ? 1.0 : 0.0);
+  put(static_cast<int>(st.supervisor().mode()));
+  const int n = sim.model().num_rotors();
+  for (int i = 0; i < n; ++i) put(sim.applied_command()[i]);
+  for (int i = 0; i < n; ++i) put(sim.rotor_thrusts()[i]);
+  for (int i = 0; i < n; ++i) put(vehicle::RadPerSecondToRpm(sim.motor_speeds()[i]));
+  for (int i = 0; i < n; ++i) put(static_cast<int>(sim.faults()[i].kind));  // docs/scenarios.md, "Outputs"
+  if (const fdd::FaultDetector* detector = st.fault_detector()) {
+    const std::vector<fdd::RotorStatus>& rotors = detector->rotors();
+    for (int i = 0; i < n; ++i) put(rotors[i].motor_index);
+    for (int i = 0; i < n; ++i) put(rotors[i].propeller_index);
+    for (int i = 0; i < n; ++i) put(static_cast<int>(rotors[i].health));
+  }
+  if (const control::NmpcController* nmpc = st.nmpc()) put(1e3 * nmpc->summary().solve_time_s);
+  RG_INVARIANT(c == table->columns.size(), "log row and LogColumns disagree");
+}
+
+std::string InFolder(const std::string& dir, const char* name) { return (fs::path(dir) / name).string(); }
+
+}  // namespace
+
+FlightRecorder::FlightRecorder(const FlightRecorderOptions& options, const Scenario& scenario)
+    : options_(options),
+      scenario_(&scenario),
+      log_period_ns_(PeriodFromRate(scenario.log_rate_hz)),
+      scene_(scenario.vehicle, scenario.world, {}, scenario.assembly.get()) {
+  if (!enabled()) return;
+  std::error_code ec;
+  fs::create_directories(options_.out_dir, ec);
+  if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", options_.out_dir, ec.message()));
+  // A summary left by an earlier run must not pass for this run's, nor its files mix with these.
+  for (const char* name : {"summary.json", "report.html", "flight.mcap", "log.csv", "scene.json", "sensors.csv"}) {
+    fs::remove(InFolder(options_.out_dir, name), ec);
+  }
+  if (options_.log_format != LogFormat::kMcap) {
+    sensors_.emplace(InFolder(options_.out_dir, "sensors.csv"));
+    sensor_buffer_ = record::kSensorLogHeader;
+  }
+}
+
+void FlightRecorder::Begin(const stack::FlightStack& st, int num_rotors) {
+  flight_.table.columns = record::LogColumns(num_rotors, st.fault_detector() != nullptr, st.nmpc() != nullptr);
+  flight_.table.values.resize(flight_.table.columns.size());
+}
+
+void FlightRecorder::OnControlCycle(TimeNs t, const stack::FlightStack& st, const RotorCommand& command) {
+  if (!enabled()) return;
+  if (sensors_) record::AppendCommand(command, &sensor_buffer_);
+  scene_.OnControlCycle(ToSeconds(t), st);
+}
+
+void FlightRecorder::OnStep(TimeNs t, const sim::Simulator& sim, const stack::FlightStack& st) {
+  if (!enabled() || t < next_log_ns_) return;
+  AppendRow(sim, st, &flight_.table);
+  scene_.OnTime(ToSeconds(t));
+  next_log_ns_ += log_period_ns_;
+}
+
+void FlightRecorder::AfterStep() {
+  if (sensors_ && sensor_buffer_.size() > (1u << 20)) {
+    sensors_->Write(sensor_buffer_);
+    sensor_buffer_.clear();
+  }
+}
+
+void FlightRecorder::WriteFlight(const sim::Simulator& sim, const stack::FlightStack& st) {
+  if (!enabled()) return;
+  AppendRow(sim, st, &flight_.table);
+  flight_.scene = scene_.ToJson();
+  if (options_.log_format != LogFormat::kMcap) {
+    record::WriteFlightLogFiles(flight_, options_.out_dir);
+    sensors_->Write(sensor_buffer_);
+    sensors_->Commit();
+  }
+  // The vehicle the stack flew, so that the run's folder is enough to replay its sensor log.
+  io::WriteFileAtomically(InFolder(options_.out_dir, "vehicle.yaml"), VehicleToYaml(scenario_->vehicle));
+}
+
+void FlightRecorder::WriteSummary(const RunSummary& summary) {
+  if (!enabled()) return;
+  flight_.summary = summary.ToJson();
+  if (options_.log_format != LogFormat::kCsv) record::WriteFlightMcap(flight_, InFolder(options_.out_dir, "flight.mcap"));
+  io::WriteFileAtomically(InFolder(options_.out_dir, "summary.json"), flight_.summary.dump(2) + "\n");
+  if (options_.report) record::WriteFlightReport(flight_, InFolder(options_.out_dir, "report.html"));
+}
+
+}  // namespace rotorguard::harness

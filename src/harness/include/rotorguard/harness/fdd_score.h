@@ -1,0 +1,39 @@
+#pragma once
+/// Fault detection scored against the faults that were injected (docs/metrics.md, "FDD latency,
+/// MDR and FAR"): the run summary's `fdd` and the offline calibration's score.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rotorguard/fdd/composite_fdd.h"  // RotorStatus, RotorHealth
+#include "rotorguard/sim/fault_injector.h"
+
+namespace rotorguard::harness {
+
+/// What fault detection concluded.
+struct FddRecord {
+  /// The earliest diagnosis: of which rotor, what (motor_failed, propeller_failed, degraded,
+  /// failed), by which detector (motor_index, thrust_loss_observer, takeoff, ...), when [s].
+  struct Diagnosis {
+    int rotor = 0;
+    std::string kind;
+    std::string detector;
+    double detection_s = 0.0;
+  };
+  std::optional<Diagnosis> diagnosis;  ///< none: no rotor left the ok state
+  bool correct = false;      ///< right rotor and kind, at or after the first onset
+  bool false_alarm = false;  ///< a diagnosis without a fault, or before the first onset
+  std::optional<double> latency_s;  ///< detection - onset, when correct
+
+  bool detected() const { return diagnosis.has_value(); }
+};
+
+/// Whether a diagnosis names the injected fault kind (stuck: any diagnosis of the rotor).
+bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis);
+
+/// Scores the detector's per-rotor statuses against the injected fault events: the earliest
+/// diagnosis counts; it is a false alarm without a fault or before the first onset, and correct
+/// when it names the first fault's rotor and kind.
+FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vector<sim::FaultEvent>& events);
+
+}  // namespace rotorguard::harness

@@ -1,0 +1,68 @@
+#pragma once
+/// The files of a run folder (docs/scenarios.md, "Outputs"), written as the flight goes and at its
+/// end: log.csv and scene.json and/or flight.mcap, sensors.csv (every message the stack received
+/// and every command it sent), vehicle.yaml (the vehicle the stack flew), summary.json and, when
+/// asked, report.html. summary.json comes last, so that a folder with one holds a whole run.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "rotorguard/core/types.h"
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/harness/scene_recorder.h"
+#include "rotorguard/io/files.h"
+#include "rotorguard/record/flight_log.h"
+#include "rotorguard/sim/simulator.h"
+#include "rotorguard/stack/flight_stack.h"
+
+namespace rotorguard::harness {
+
+/// What a run folder holds besides summary.json: kCsv log.csv, scene.json and sensors.csv; kMcap
+/// flight.mcap (record/flight_mcap.h); kBoth all of them.
+enum class LogFormat { kCsv, kMcap, kBoth };
+
+struct FlightRecorderOptions {
+  std::string out_dir;  ///< "" records nothing
+  LogFormat log_format = LogFormat::kCsv;
+  /// Also write report.html (record/report.h); needs a program built with the viewer (io::HasViewer).
+  bool report = false;
+};
+
+class FlightRecorder {
+ public:
+  /// Creates the folder and removes the files an earlier run left in it (nothing of two runs may
+  /// mix); opens sensors.csv. Throws std::runtime_error when the folder cannot be made.
+  FlightRecorder(const FlightRecorderOptions& options, const Scenario& scenario);
+
+  bool enabled() const { return !options_.out_dir.empty(); }
+  /// The sensor log's text to append to (sensors.csv's format), null when it is not written.
+  std::string* sensor_log() { return sensors_ ? &sensor_buffer_ : nullptr; }
+
+  /// The stack is built: the log's columns follow what it runs (its FDD, the NMPC).
+  void Begin(const stack::FlightStack& stack, int num_rotors);
+  /// After each control cycle at time t: its command and what the scene draws of the stack.
+  void OnControlCycle(TimeNs t, const stack::FlightStack& stack, const RotorCommand& command);
+  /// Before each physics step: a log row when one is due.
+  void OnStep(TimeNs t, const sim::Simulator& sim, const stack::FlightStack& stack);
+  /// After each physics step: the sensor log goes to its file in chunks of about 1 MB.
+  void AfterStep();
+  /// At the flight's end: its last row, then log.csv, scene.json, sensors.csv and vehicle.yaml.
+  void WriteFlight(const sim::Simulator& sim, const stack::FlightStack& stack);
+  /// Then flight.mcap, summary.json and report.html, as asked. Throws std::runtime_error when a
+  /// file cannot be written.
+  void WriteSummary(const RunSummary& summary);
+
+ private:
+  FlightRecorderOptions options_;
+  const Scenario* scenario_;
+  TimeNs log_period_ns_;
+  TimeNs next_log_ns_ = 0;
+  std::optional<io::AtomicFileWriter> sensors_;
+  std::string sensor_buffer_;
+  record::FlightLog flight_;
+  SceneRecorder scene_;
+};
+
+}  // namespace rotorguard::harness
