@@ -167,34 +167,93 @@ class Snapshot:
         """Command lines and files a user gets wrong: each one's exit code and message."""
         bad = os.path.join(self.work, "bad")
         os.makedirs(bad, exist_ok=True)
-        hover = open(os.path.join(ROOT, "configs", "scenarios", "hover.yaml")).read()
+        vehicle_file = os.path.join(ROOT, "configs", "vehicles", "zhou2025_quad.yaml")
+        hover = open(os.path.join(ROOT, "configs", "scenarios", "hover.yaml")).read().replace(
+            "../vehicles/zhou2025_quad.yaml", vehicle_file)
         no_stack = hover.replace("stack:\n  controller: nominal\n", "")
-        vehicle = open(os.path.join(ROOT, "configs", "vehicles", "zhou2025_quad.yaml")).read()
+        no_mission = no_stack.replace("mission:\n  type: hover\n", "")
+        vehicle = open(vehicle_file).read()
         files = {
             "typo_key.yaml": hover.replace("duration_s:", "duration_sec:"),
             "duplicate_key.yaml": hover + "\nduration_s: 3\n",
             "unit_string.yaml": hover.replace("duration_s: 10.0", "duration_s: 10s"),
             "nan.yaml": hover.replace("duration_s: 10.0", "duration_s: .nan"),
-            "no_mission.yaml": re.sub(r"(?ms)^mission:.*?(?=^\S)", "", hover),
+            "no_mission.yaml": no_mission,
             "bad_fault_rotor.yaml": hover + "\nfaults:\n  - {rotor: 7, kind: motor_stop, onset: {at_time_s: 1.0}}\n",
-            "bad_controller.yaml": no_stack + "\nstack:\n  controller: pid\n",
-            "bad_nmpc.yaml": no_stack + "\nstack:\n  controller: nmpc\n  nmpc: {horizon_steps: 0}\n",
-            "bad_composite.yaml": no_stack + "\nstack:\n  fdd: composite\n  composite_fdd: {motor_index_threshold: -1}\n",
-            "bad_planner.yaml": no_stack + "\nstack:\n  planner: {v_max: -1}\n",
-            "bad_map.yaml": no_stack + "\nstack:\n  map: {resolution_m: 0}\n",
-            "bad_supervisor.yaml": no_stack + "\nstack:\n  supervisor: {max_speed_m_s: 0}\n",
             "not_yaml.yaml": "a: [1, 2\n",
             "empty.yaml": "",
             "list_top.yaml": "- 1\n- 2\n",
             "negative_mass.yaml": vehicle.replace("mass_kg: 1.15", "mass_kg: -1.15"),
             "weak_vehicle.yaml": re.sub(r"max_thrust_n: [0-9.]+", "max_thrust_n: 2.0", vehicle),
         }
+        # One bad key a file: the stack's blocks, the sensors, the simulation, the metrics, the
+        # missions, the world, the faults and the start.
+        stack_cases = {
+            "controller": "controller: pid", "nmpc_horizon": "controller: nmpc\n  nmpc: {horizon_steps: 0}",
+            "nmpc_horizon_big": "nmpc: {horizon_steps: 500}", "nmpc_q_attitude": "nmpc: {q_attitude: [1, 2, 3]}",
+            "nmpc_step": "nmpc: {step_s: -0.05}", "nmpc_typo": "nmpc: {horizon: 20}",
+            "nominal_kp": "nominal: {kp_position: -1}", "nominal_tilt": "nominal: {max_tilt_rad: 3}",
+            "passive_nan": "passive: {k_tilt: .nan}", "indi_cutoff": "controller: indi\n  indi: {filter_cutoff_hz: 150}",
+            "indi_cutoff_rate": "controller: indi\n  control_rate_hz: 100\n  indi: {filter_cutoff_hz: 60}",
+            "fdd": "fdd: magic", "composite": "fdd: composite\n  composite_fdd: {motor_index_threshold: -1}",
+            "composite_samples": "composite_fdd: {motor_index_samples: 0}",
+            "composite_typo": "composite_fdd: {gamma_m: 0.2}",
+            "supervisor": "supervisor: {max_speed_m_s: 0}", "supervisor_rotors": "supervisor: {max_failed_rotors: 99}",
+            "planner_rate": "planner: {rate_hz: -1}", "planner_weights": "planner: {weights: {time: 1, speed: 2}}",
+            "planner_band": "planner: {altitude_band_m: [2, 1]}", "planner_word": "planner: magic",
+            "planner_method": "planner: {method: astar}", "planner_clearance": "planner: {post_failure_clearance_m: -1}",
+            "planner_factor": "planner: {post_failure_safety_factor: 2}",
+            "flatness_angle": "flatness: {theta_max_deg: 95}", "flatness_hold": "flatness: {min_hold_s: 40, max_hold_s: 30}",
+            "map_stride": "map: {clearing_stride: 99}", "map_resolution": "map: {resolution_m: 0}",
+            "map_odds": "map: {log_odds_hit: -1}", "known_fault_rotor": "known_faults: [{rotor: 9, at_time_s: 1}]",
+            "known_fault_time": "known_faults: [{rotor: 1, at_time_s: -1}]", "known_faults_map": "known_faults: {rotor: 1}",
+            "control_rate": "control_rate_hz: 5000", "control_rate_nan": "control_rate_hz: .inf",
+            "assembly_realloc": "assembly: {reallocation: some}", "typo": "nmcp: {}", "deskew": "deskew_frames: maybe",
+        }
+        for key, text in stack_cases.items():
+            files[f"stack_{key}.yaml"] = no_stack + "\nstack:\n  " + text + "\n"
+        other_cases = {
+            "imu_rate": "sensors:\n  imu: {rate_hz: 0}", "imu_typo": "sensors:\n  imu: {rate: 100}",
+            "esc_rate": "sensors:\n  esc: {rate_hz: 5000}", "lidar_rate": "sensors:\n  lidar: {frame_rate_hz: -1}",
+            "lidar_off": "sensors:\n  lidar: {enabled: false, points_per_s: 0}",
+            "outage": "sensors:\n  odometry: {outages: [{start_s: -1, duration_s: 1}]}",
+            "sensor_typo": "sensors:\n  gps: {}", "physics": "sim: {physics_rate_hz: 10}",
+            "log_rate": "sim: {log_rate_hz: 5000}", "wind_typo": "wind: {gusts: 1}",
+            "tracking_start": "metrics: {tracking_start_s: 20}",
+            "tracking_window": "metrics: {tracking_start_s: 5, tracking_end_s: 5}",
+            "success_error": "metrics: {success_error_m: 0}", "tilt": "metrics: {recovered_tilt_rad: 2}",
+            "box": "world:\n  boxes: [{center_m: [1, 1, 1], size_m: [1, 0, 1]}]",
+            "cylinder": "world:\n  cylinders: [{center_m: [1, 1, 1], radius_m: 0.2, height_m: 2}]",
+            "moving": "world:\n  moving_boxes: [{size_m: [1, 1, 1], waypoints_m: [], speed_m_s: 1}]",
+            "world_typo": "world:\n  trees: []",
+            "fault_kind": "faults: [{rotor: 0, kind: melted, onset: {at_time_s: 1}}]",
+            "fault_eta": "faults: [{rotor: 0, kind: motor_stop, eta: 0.5, onset: {at_time_s: 1}}]",
+            "fault_onset": "faults: [{rotor: 0, kind: motor_stop, onset: {at_time_s: 1, at_altitude_m: 2}}]",
+            "fault_takeoff": "faults: [{rotor: 0, kind: motor_stop, onset: {during_takeoff_s: 0.1}}]",
+            "fault_late": "faults: [{rotor: 0, kind: motor_stop, onset: {at_time_s: 99}}]",
+            "fault_intermittent": "faults: [{rotor: 0, kind: motor_stop, onset: {at_time_s: 1}, intermittent: {on_s: 0.0001, off_s: 1}}]",
+        }
+        for key, text in other_cases.items():
+            files[f"other_{key}.yaml"] = hover + "\n" + text + "\n"
+        mission_cases = {
+            "type": "type: cruise", "lemniscate": "type: lemniscate\n  size_m: [6, 3, 1]",
+            "lemniscate_low": "type: lemniscate\n  max_speed_m_s: 1\n  center_m: [0, 0, 0.2]",
+            "circle": "type: circle\n  center_m: [0, 0, 1]\n  radius_m: 1", "takeoff": "type: takeoff\n  altitude_m: -1",
+            "waypoints": "type: waypoints\n  waypoints_m: []\n  max_speed_m_s: 1",
+            "navigate": "type: navigate\n  waypoints_m: [[1, 0, 1]]",
+            "navigate_rounds": "type: navigate\n  waypoints_m: [[1, 0, 1]]\n  rounds: 0",
+            "assembly_plan": "type: assembly_plan\n  goal_m: [1, 0, 1]", "typo": "type: hover\n  positon_m: [0, 0, 1]",
+        }
+        for key, text in mission_cases.items():
+            files[f"mission_{key}.yaml"] = no_mission + "\nmission:\n  " + text + "\n"
+        files["initial_below.yaml"] = hover.replace("position_m: [0.0, 0.0, 1.0]", "position_m: [0.0, 0.0, -1.0]")
+        files["both_vehicle_assembly.yaml"] = hover + "\nassembly: x.yaml\n"
         for name, text in files.items():
             with open(os.path.join(bad, name), "w") as f:
                 f.write(text)
         # A vehicle file that points a scenario at the bad vehicles.
         with open(os.path.join(bad, "weak_scenario.yaml"), "w") as f:
-            f.write(hover.replace("../vehicles/zhou2025_quad.yaml", "weak_vehicle.yaml"))
+            f.write(hover.replace(vehicle_file, "weak_vehicle.yaml"))
         os.makedirs(os.path.join(bad, "empty_dir"), exist_ok=True)
         cases = [
             [],
@@ -270,7 +329,7 @@ class Snapshot:
         for args in cases:
             code, out, err = self.run(args, timeout=600)
             shown = " ".join(a.replace(self.work, "WORK") for a in args)
-            err = err.replace(self.work, "WORK")
+            err = err.replace(self.work, "WORK").replace(ROOT, "ROOT")
             # CLI11's usage text follows its one-line error; the first line is what differs between builds.
             lines.append(f"$ rotorguard {shown}\nexit {code}\n{err.strip().splitlines()[0] if err.strip() else ''}\n")
         self.write("errors.txt", "\n".join(lines))

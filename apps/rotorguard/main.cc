@@ -1,5 +1,5 @@
 // rotorguard: the command-line interface. Each command lives in its own file (run, report,
-// validate, fdd-calibrate, bench, campaign) and parses, calls the libraries and prints; here the
+// validate, keys, fdd-calibrate, bench, campaign) and parses, calls the libraries and prints; here the
 // commands are registered, the chosen one runs, and its errors become the documented exit codes
 // (docs/cli.md): 0 success; 1 the run failed; 2 usage or invalid config; 3 an input file is
 // unreadable or damaged; 4 an infeasible request.
@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   commands.push_back(cli::MakeRunCommand());
   commands.push_back(cli::MakeReportCommand());
   commands.push_back(cli::MakeValidateCommand());
+  commands.push_back(cli::MakeKeysCommand());
   commands.push_back(cli::MakeFddCalibrateCommand());
   commands.push_back(cli::MakeBenchCommand());
   commands.push_back(cli::MakeCampaignCommand());

@@ -8,6 +8,7 @@
 #include "rotorguard/benchmarks/scenario_sweep.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/registry.h"
+#include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
 
@@ -40,9 +41,10 @@ ValidationReport ValidateConfigFile(const std::string& path) {
                                     c.trials(), c.scenario, c.grid.size(), c.random.size(), c.hash)};
   }
   if (has("mission") || has("vehicle") || has("assembly")) {
-    const harness::Scenario s = harness::LoadScenario(path);
+    harness::Scenario s = harness::LoadScenario(path);
+    harness::PlanMission(&s);  // a mission that cannot be planned is an invalid file
     return {"scenario", fmt::format("scenario '{}': {} mission, {:g} s, {} fault(s), vehicle {}", s.name,
-                                    s.mission_type, s.duration_s, s.faults.size(), s.vehicle_file)};
+                                    ToName(s.mission_kind), s.duration_s, s.faults.size(), s.vehicle_file)};
   }
   root.Fail("cannot tell the kind of this file; expected a scenario (with 'mission' and 'vehicle') or "
             "a vehicle (with 'mass_kg' and 'rotors')");

@@ -14,6 +14,7 @@
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/json_archive.h"
 #include "rotorguard/record/sensor_log.h"
 #include "rotorguard/stack/estimator.h"
 
@@ -97,7 +98,9 @@ CalibrationLog LoadCalibrationLog(const std::string& dir) {
       log.faults.push_back({f.at("rotor").get<int>(), f.at("kind").get<std::string>(), f.at("onset_s").get<double>()});
     }
     if (summary.contains("composite_fdd") && !summary["composite_fdd"].is_null()) {
-      log.recorded_fdd = harness::CompositeFddOptionsFromJson(summary["composite_fdd"]);
+      fdd::CompositeFddOptions recorded;
+      io::FromJson(summary["composite_fdd"], &recorded);
+      log.recorded_fdd = recorded;
     }
     // The IMU setup must be one the detector accepts.
     WithLogImu(log.recorded_fdd.value_or(fdd::CompositeFddOptions{}), log).Validate();
@@ -121,7 +124,7 @@ fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& l
     if (!log.recorded_fdd) continue;
     if (!first) {
       first = &log;
-    } else if (harness::CompositeFddOptionsToJson(*log.recorded_fdd) != harness::CompositeFddOptionsToJson(*first->recorded_fdd)) {
+    } else if (io::ToJson(*log.recorded_fdd) != io::ToJson(*first->recorded_fdd)) {
       if (note) {
         *note = fmt::format("{} and {} were flown with different FDD settings; all are replayed with those of {}",
                             first->dir, log.dir, first->dir);

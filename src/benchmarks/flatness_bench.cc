@@ -41,7 +41,7 @@ double Median(std::vector<double> v) {
 void FlatnessBenchOptions::Validate() const {
   if (seeds < 1 || seeds > 10000) ThrowInvalidArgument("FlatnessBenchOptions", "seeds", seeds, "a count in [1, 10000]");
   if (jobs < 1 || jobs > 256) ThrowInvalidArgument("FlatnessBenchOptions", "jobs", jobs, "a count in [1, 256]");
-  if (fig2.stack.navigation.method != "flatness" || fig2.faults.empty() || fig2.stack.navigation.waypoints.empty()) {
+  if (fig2.stack.navigation.method != stack::NavigationMethod::kFlatness || fig2.faults.empty() || fig2.stack.navigation.waypoints.empty()) {
     ThrowInvalidArgument("FlatnessBenchOptions", "fig2", fig2.name, "a flatness navigate scenario with a fault");
   }
 }

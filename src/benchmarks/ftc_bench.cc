@@ -37,6 +37,28 @@ constexpr Cell kCells[] = {
 };
 constexpr int kNumCells = sizeof(kCells) / sizeof(kCells[0]);
 
+/// The methods compared, each a controller and a fault detector of the stack.
+struct FtcMethod {
+  const char* name;
+  stack::ControllerKind controller;
+  stack::FddKind fdd;
+};
+constexpr FtcMethod kMethods[] = {
+    {"rotorguard", stack::ControllerKind::kNmpc, stack::FddKind::kComposite},  // composite FDD + NMPC
+    {"fixedtime", stack::ControllerKind::kNmpc, stack::FddKind::kFixedTime},   // FixedA: fixed-time observer, same NMPC
+    {"ukf", stack::ControllerKind::kNmpc, stack::FddKind::kUkf},               // paper 004's UKF, same NMPC
+    {"indi", stack::ControllerKind::kIndi, stack::FddKind::kComposite},        // the composite FDD's isolation to INDI
+    {"passive", stack::ControllerKind::kPassive, stack::FddKind::kNone},       // UnifP: one passive FTC, no FDD
+    {"none", stack::ControllerKind::kNominal, stack::FddKind::kNone},          // the nominal controller, no FDD
+};
+
+const FtcMethod& FtcMethodNamed(const std::string& name) {
+  for (const FtcMethod& m : kMethods) {
+    if (name == m.name) return m;
+  }
+  throw std::invalid_argument("ftc: no method named '" + name + "'");
+}
+
 /// A trial's scenario: the phase's mission, the drawn fault, gust and noise seed, the method's stack.
 harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOptions& o, std::uint64_t trial_seed) {
   Rng rng(trial_seed);
@@ -54,7 +76,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
   if (phase == "hover") {
     s.duration_s = 8.0;
     s.initial_position_m = Vector3(0, 0, 2.0);
-    s.mission_type = "hover";
+    s.mission_kind = harness::MissionKind::kHover;
     planning::HoverOptions h;
     h.position_m = s.initial_position_m;
     s.reference = std::make_shared<planning::HoverReference>(h);
@@ -62,7 +84,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
   } else if (phase == "tracking") {
     s.duration_s = 14.0;
     s.initial_position_m = Vector3(0, 0, 1.5);
-    s.mission_type = "lemniscate";
+    s.mission_kind = harness::MissionKind::kLemniscate;
     planning::LemniscateOptions l;  // the paper's 6 x 3 x 1 m at 2 m/s
     l.center_m = s.initial_position_m;
     l.max_speed_m_s = 2.0;
@@ -71,7 +93,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
   } else {
     s.duration_s = 8.0;
     s.initial_position_m = Vector3::Zero();
-    s.mission_type = "takeoff";
+    s.mission_kind = harness::MissionKind::kTakeoff;
     planning::TakeoffOptions t;
     t.altitude_m = 1.5;
     s.reference = std::make_shared<planning::TakeoffReference>(t);
@@ -88,25 +110,9 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     s.faults.push_back(f);
   }
   harness::FitStackToHardware(&s);
-  if (method == "rotorguard") {
-    s.stack.controller = "nmpc";
-    s.stack.fdd = "composite";
-  } else if (method == "fixedtime") {  // FixedA: the fixed-time observer driving the same NMPC
-    s.stack.controller = "nmpc";
-    s.stack.fdd = "fixedtime";
-  } else if (method == "ukf") {  // paper 004's UKF loss estimation driving the same NMPC
-    s.stack.controller = "nmpc";
-    s.stack.fdd = "ukf";
-  } else if (method == "indi") {  // the composite FDD's isolation handed to the INDI controller
-    s.stack.controller = "indi";
-    s.stack.fdd = "composite";
-  } else if (method == "passive") {  // UnifP: one passive fault-tolerant controller, no FDD
-    s.stack.controller = "passive";
-    s.stack.fdd = "none";
-  } else {  // none: the nominal controller without fault detection
-    s.stack.controller = "nominal";
-    s.stack.fdd = "none";
-  }
+  const FtcMethod& m = FtcMethodNamed(method);
+  s.stack.controller = m.controller;
+  s.stack.fdd = m.fdd;
   s.log_rate_hz = 10.0;
   return s;
 }
@@ -152,7 +158,11 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
           {"failures_not_listed", failures.not_listed()}};
 }
 
-std::vector<std::string> FtcMethods() { return {"rotorguard", "fixedtime", "ukf", "indi", "passive", "none"}; }
+std::vector<std::string> FtcMethods() {
+  std::vector<std::string> names;
+  for (const FtcMethod& m : kMethods) names.emplace_back(m.name);
+  return names;
+}
 
 void FtcBenchOptions::Validate() const {
   if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
@@ -161,7 +171,7 @@ void FtcBenchOptions::Validate() const {
   const std::vector<std::string> known = FtcMethods();
   for (const std::string& m : methods) {
     if (std::find(known.begin(), known.end(), m) == known.end()) {
-      ThrowInvalidArgument("FtcBenchOptions", "methods", m, "one of: rotorguard, fixedtime, ukf, indi, passive, none");
+      ThrowInvalidArgument("FtcBenchOptions", "methods", m, fmt::format("one of: {}", fmt::join(known, ", ")));
     }
   }
   vehicle.Validate();

@@ -128,7 +128,8 @@ std::array<PlanRow, kTableTwoRows> TableTwoRows(const MarsBenchOptions& o) {
   return {{{&o.plan_4x1, "normal", 0}, {&o.plan_4x1, "No. 3", 3}, {&o.plan_4x1, "No. 4", 4},
            {&o.plan_3x2, "normal", 0}, {&o.plan_3x2, "No. 2", 2}}};
 }
-constexpr const char* kPlanners[2] = {"baseline", "ours"};
+constexpr harness::AssemblyPlanMethod kPlanners[2] = {harness::AssemblyPlanMethod::kBaseline,
+                                                      harness::AssemblyPlanMethod::kOurs};
 constexpr int kPlanSlots = 2 * kTableTwoRows;  ///< a plan per row and planner
 constexpr const char* kSwitches[2] = {"prepared", "naive"};
 
@@ -195,7 +196,7 @@ void MarsBenchOptions::Validate() const {
   if (alloc_samples < 100 || alloc_samples > 10'000'000) {
     ThrowInvalidArgument("MarsBenchOptions", "alloc_samples", alloc_samples, "a count in [100, 10^7]");
   }
-  if (!spiral.assembly || spiral.stack.controller != "assembly") {
+  if (!spiral.assembly || spiral.stack.controller != stack::ControllerKind::kAssembly) {
     ThrowInvalidArgument("MarsBenchOptions", "spiral", spiral.name, "an assembly scenario flown by controller assembly");
   }
   if (spiral.assembly->num_units != 6) {
@@ -244,7 +245,7 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& o) {
       const int trial = k % trials, method = (k / trials) % static_cast<int>(kMethods.size());
       const int row = k / (trials * static_cast<int>(kMethods.size()));
       return {{"part", "table1"}, {"case", cases[static_cast<std::size_t>(row)].name},
-              {"method", std::string(modular::ToString(kMethods[static_cast<std::size_t>(method)]))},
+              {"method", std::string(ToName(kMethods[static_cast<std::size_t>(method)]))},
               {"trial", std::to_string(trial)}, {"seed", seed(trial)}};
     }
     k -= n1;
@@ -252,7 +253,7 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& o) {
     k -= n2;
     const PlanRow row = TableTwoRows(o)[static_cast<std::size_t>(k / (2 * trials))];
     return {{"part", "table2"}, {"shape", row.scene->assembly->name}, {"fault", row.fault},
-            {"method", kPlanners[(k / trials) % 2]}, {"trial", std::to_string(k % trials)}, {"seed", seed(k % trials)}};
+            {"method", ToName(kPlanners[(k / trials) % 2])}, {"trial", std::to_string(k % trials)}, {"seed", seed(k % trials)}};
   };
   const auto cache = std::make_shared<PlanCache>();
   c.run = [o, cases, n1, n2, trials, cache](int index, const std::map<std::string, std::string>& params) {
@@ -369,7 +370,7 @@ nlohmann::json TableOne(const std::vector<const nlohmann::json*>& records, int t
     for (int m = 0; m < methods; ++m) {
       const std::size_t first =
           (row * static_cast<std::size_t>(methods) + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials);
-      WriteCell(CellOf(records, first, trials), std::string(modular::ToString(kMethods[static_cast<std::size_t>(m)])),
+      WriteCell(CellOf(records, first, trials), std::string(ToName(kMethods[static_cast<std::size_t>(m)])),
                 &r);
     }
     if (row == 0) fault_free = r["full_error_m"].get<double>();
@@ -429,7 +430,7 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
       const auto at = [&](int t) -> const nlohmann::json& {
         return *records[(2 * row + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials) + static_cast<std::size_t>(t)];
       };
-      const std::string name = kPlanners[m];
+      const std::string name = ToName(kPlanners[m]);
       // The plan's figures, from the first flight that recorded them (every flight flies one plan).
       const nlohmann::json* plan = nullptr;
       for (int t = 0; t < trials && plan == nullptr; ++t) {

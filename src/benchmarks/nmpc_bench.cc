@@ -23,8 +23,8 @@ struct Flight {
 };
 
 Flight Fly(const harness::Scenario& s) {
-  if (s.stack.controller != "nmpc") {
-    ThrowInvalidArgument("RunNmpcBenchmark", "stack.controller", s.stack.controller, "nmpc");
+  if (s.stack.controller != stack::ControllerKind::kNmpc) {
+    ThrowInvalidArgument("RunNmpcBenchmark", "stack.controller", ToName(s.stack.controller), "nmpc");
   }
   Flight f;
   harness::RunOptions o;

@@ -82,7 +82,7 @@ std::unique_ptr<Body> MakeBody(const harness::Scenario& base, const vehicle::Veh
     b->controller = c.get();
     controller = std::move(c);
   } else {
-    o.controller = "nominal";
+    o.controller = stack::ControllerKind::kNominal;
     o.supervisor.max_failed_rotors = 1;
   }
   b->sim = std::make_unique<sim::Simulator>(*b->model, base.world, faults, base.sim, seed, x);
@@ -149,7 +149,7 @@ void ReconfigurationOptions::Validate() const {
   const auto fail = [](const char* field, double v, const char* rule) {
     ThrowInvalidArgument("ReconfigurationOptions", field, v, rule);
   };
-  if (!base.assembly || base.stack.controller != "assembly") {
+  if (!base.assembly || base.stack.controller != stack::ControllerKind::kAssembly) {
     ThrowInvalidArgument("ReconfigurationOptions", "base", base.name, "an assembly scenario flown by controller assembly");
   }
   const modular::Assembly& a = *base.assembly;

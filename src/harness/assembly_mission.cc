@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/perception/voxel_map.h"
@@ -18,7 +19,7 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
   }
   const AssemblyPlanSpec& spec = *s.assembly_plan;
   const modular::Assembly& a = *s.assembly;
-  const bool ours = spec.method == "ours";
+  const bool ours = spec.method == AssemblyPlanMethod::kOurs;
   // What the stack knows of its rotors (the paper plans for the known faults, as FTC flies them).
   RotorVector eta = RotorVector::Ones(a.vehicle.num_rotors());
   // Faults the stack learns later in the flight are not known when it plans, at the start.
@@ -85,6 +86,18 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
   r.trajectory = std::move(traj);
   r.ok = true;
   return r;
+}
+
+void PlanMission(Scenario* s) {
+  if (!s->assembly_plan || s->reference) return;
+  const AssemblyPlanResult plan = PlanAssemblyMission(*s);
+  if (!plan.ok) {
+    const std::string message = "cannot plan the assembly's path: " + plan.message;
+    if (s->source.mission) s->source.mission->Fail(message);
+    throw std::invalid_argument("PlanMission: " + message);
+  }
+  s->reference = plan.trajectory;
+  CheckPlannedMission(*s);
 }
 
 }  // namespace rotorguard::harness

@@ -1,5 +1,7 @@
 #include "rotorguard/harness/run_summary.h"
 
+#include "rotorguard/io/json_archive.h"
+
 namespace rotorguard::harness {
 
 nlohmann::json RunCost::ToJson() const {
@@ -105,7 +107,7 @@ nlohmann::json RunSummary::ToJson() const {
     j["faults"].push_back({{"rotor", f.rotor}, {"kind", f.kind}, {"onset_s", f.onset_s}});
   }
   j["fdd"] = fdd ? FddJson(*fdd) : nlohmann::json(nullptr);  // null: the stack ran no fault detection
-  j["composite_fdd"] = composite_fdd ? CompositeFddOptionsToJson(*composite_fdd) : nlohmann::json(nullptr);
+  j["composite_fdd"] = composite_fdd ? io::ToJson(*composite_fdd) : nlohmann::json(nullptr);
   j["sensors"] = {{"imu_rate_hz", sensors.imu_rate_hz}, {"imu_position_m", Vec(sensors.imu_position_m)}};
   AddStackJson(*this, &j);
   j["stack_ms_per_cycle_mean"] = stack_ms_per_cycle_mean;
@@ -113,38 +115,6 @@ nlohmann::json RunSummary::ToJson() const {
   j["physics_steps"] = physics_steps;
   j["control_cycles"] = control_cycles;
   return j;
-}
-
-nlohmann::json CompositeFddOptionsToJson(const fdd::CompositeFddOptions& o) {
-  return {{"motor_index_threshold", o.motor_index_threshold},
-          {"motor_index_samples", o.motor_index_samples},
-          {"motor_index_min_thrust_n", o.motor_index_min_thrust_n},
-          {"propeller_index_threshold", o.propeller_index_threshold},
-          {"propeller_persistence_s", o.propeller_persistence_s},
-          {"degraded_threshold", o.degraded_threshold},
-          {"degraded_persistence_s", o.degraded_persistence_s},
-          {"filter_cutoff_hz", o.filter_cutoff_hz},
-          {"takeoff_max_altitude_m", o.takeoff_max_altitude_m},
-          {"takeoff_window_s", o.takeoff_window_s},
-          {"takeoff_angular_acceleration_rad_s2", o.takeoff_angular_acceleration_rad_s2},
-          {"takeoff_direction_cosine", o.takeoff_direction_cosine}};
-}
-
-fdd::CompositeFddOptions CompositeFddOptionsFromJson(const nlohmann::json& j) {
-  fdd::CompositeFddOptions o;
-  o.motor_index_threshold = j.at("motor_index_threshold").get<double>();
-  o.motor_index_samples = j.at("motor_index_samples").get<int>();
-  o.motor_index_min_thrust_n = j.at("motor_index_min_thrust_n").get<double>();
-  o.propeller_index_threshold = j.at("propeller_index_threshold").get<double>();
-  o.propeller_persistence_s = j.at("propeller_persistence_s").get<double>();
-  o.degraded_threshold = j.at("degraded_threshold").get<double>();
-  o.degraded_persistence_s = j.at("degraded_persistence_s").get<double>();
-  o.filter_cutoff_hz = j.at("filter_cutoff_hz").get<double>();
-  o.takeoff_max_altitude_m = j.at("takeoff_max_altitude_m").get<double>();
-  o.takeoff_window_s = j.at("takeoff_window_s").get<double>();
-  o.takeoff_angular_acceleration_rad_s2 = j.at("takeoff_angular_acceleration_rad_s2").get<double>();
-  o.takeoff_direction_cosine = j.at("takeoff_direction_cosine").get<double>();
-  return o;
 }
 
 }  // namespace rotorguard::harness

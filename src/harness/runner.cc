@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/failure_diagnosis.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/record/sensor_log.h"
@@ -52,7 +53,7 @@ sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel&
 
 /// The controller the stack cannot build itself (it lives in a module above it), when asked for.
 std::unique_ptr<control::Controller> ExternalController(const Scenario& sc) {
-  if (sc.stack.controller != "assembly") return nullptr;
+  if (sc.stack.controller != stack::ControllerKind::kAssembly) return nullptr;
   if (!sc.assembly) throw std::invalid_argument("RunScenario: controller assembly needs the scenario's assembly");
   return std::make_unique<modular::AssemblyController>(*sc.assembly, AssemblyControllerOptionsOf(sc));
 }
@@ -104,7 +105,7 @@ class ClosedLoop {
     s.stack = stack_.Summarize();
     s.mission_time_s = mission_time_s_;
     s.sensors = {sc_.sim.imu.rate_hz, sc_.sim.imu.position_m};
-    if (sc_.stack.fdd == "composite") s.composite_fdd = sc_.stack.composite_fdd;
+    if (sc_.stack.fdd == stack::FddKind::kComposite) s.composite_fdd = sc_.stack.composite_fdd;
     if (const fdd::FaultDetector* detector = stack_.fault_detector()) {
       s.fdd = ScoreFdd(detector->rotors(), sim_.fault_events());
     }
@@ -210,6 +211,11 @@ void DeliverToStack(const sim::SensorOutputs& o, stack::FlightStack* st, std::st
 }
 
 RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
+  if (!sc.reference && sc.assembly_plan) {  // an assembly's plan is made before it flies
+    Scenario planned = sc;
+    PlanMission(&planned);
+    return RunScenario(planned, options);
+  }
   if (sc.stack.control_rate_hz > sc.sim.physics_rate_hz) {
     ThrowInvalidArgument("RunScenario", "stack.control_rate_hz", sc.stack.control_rate_hz,
                          "at most sim.physics_rate_hz (the runner polls the stack at physics steps)");

@@ -9,22 +9,6 @@
 
 namespace rotorguard::modular {
 
-std::string_view ToString(Reallocation method) {
-  switch (method) {
-    case Reallocation::kNone: return "none";
-    case Reallocation::kPartial: return "partial";
-    case Reallocation::kFull: return "full";
-  }
-  return "?";
-}
-
-std::optional<Reallocation> ParseReallocation(std::string_view name) {
-  for (const Reallocation m : {Reallocation::kNone, Reallocation::kPartial, Reallocation::kFull}) {
-    if (name == ToString(m)) return m;
-  }
-  return std::nullopt;
-}
-
 void AllocatorOptions::Validate() const {
   if (!(priority.allFinite() && priority.minCoeff() > 0.0)) {
     ThrowValidation("AllocatorOptions", "priority", "(a non-positive or non-finite weight)", "four weights > 0");

@@ -43,9 +43,9 @@ void TrajectoryOptimizerOptions::Validate() const {
   const auto require = [](bool ok, const char* field, double v, const char* rule) {
     if (!ok) ThrowValidation("TrajectoryOptimizerOptions", field, v, rule);
   };
-  for (const auto& [v, f] : {std::pair{weight_time, "weight_time"}, std::pair{weight_smoothness, "weight_smoothness"},
-                             std::pair{weight_feasibility, "weight_feasibility"},
-                             std::pair{weight_collision, "weight_collision"}}) {
+  for (const auto& [v, f] : {std::pair{weights.time, "weights.time"}, std::pair{weights.smoothness, "weights.smoothness"},
+                             std::pair{weights.feasibility, "weights.feasibility"},
+                             std::pair{weights.collision, "weights.collision"}}) {
     require(std::isfinite(v) && v >= 0.0, f, v, "a finite weight >= 0");
   }
   require(std::isfinite(clearance_m) && clearance_m >= 0.0, "clearance_m", clearance_m, "a distance >= 0 m");
@@ -97,9 +97,9 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   Eigen::MatrixX3d dc;
   Eigen::VectorXd dt;
   traj.EnergyPartials(&dc, &dt);
-  double cost = o.weight_time * t.sum() + o.weight_smoothness * traj.Energy();
-  dc *= o.weight_smoothness;
-  dt = dt * o.weight_smoothness + Eigen::VectorXd::Constant(pieces, o.weight_time);
+  double cost = o.weights.time * t.sum() + o.weights.smoothness * traj.Energy();
+  dc *= o.weights.smoothness;
+  dt = dt * o.weights.smoothness + Eigen::VectorXd::Constant(pieces, o.weights.time);
   // Sampled penalties, cubed throughout (the paper cubes the clearance term only). A sample at
   // t = s T_i moves with T_i: its explicit derivative is the next derivative of the sampled
   // quantity times s.
@@ -120,12 +120,12 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
         double slope;
         const double pen = CubicPenalty(der.row(d).squaredNorm() - limit2[d - 1], &slope);
         if (slope == 0.0) continue;
-        cost += o.weight_feasibility * pen;
-        const Eigen::RowVector3d dp = o.weight_feasibility * slope * 2.0 * der.row(d);  // d cost / d derivative
+        cost += o.weights.feasibility * pen;
+        const Eigen::RowVector3d dp = o.weights.feasibility * slope * 2.0 * der.row(d);  // d cost / d derivative
         dc.middleRows<kC>(kC * i) += basis.row(d).transpose() * dp;
         dt(i) += dp.dot(der.row(d + 1)) * s;
       }
-      if (!planes.empty() && o.weight_collision > 0.0) {  // J_c (eqs. 34-36)
+      if (!planes.empty() && o.weights.collision > 0.0) {  // J_c (eqs. 34-36)
         const Vector3 p = der.row(0).transpose();
         const std::vector<SamplePlane>& list = planes[static_cast<std::size_t>(i)];
         for (std::size_t k = cursor; k < list.size() && list[k].sample == j; ++k) {
@@ -133,8 +133,8 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
           double slope;
           const double pen = CubicPenalty(o.clearance_m - (p - plane.point).dot(plane.normal), &slope);
           if (slope == 0.0) continue;  // (a NaN plane makes the cost NaN: a failed evaluation, not a skip)
-          cost += o.weight_collision * pen;
-          const Eigen::RowVector3d dp = -o.weight_collision * slope * plane.normal.transpose();
+          cost += o.weights.collision * pen;
+          const Eigen::RowVector3d dp = -o.weights.collision * slope * plane.normal.transpose();
           dc.middleRows<kC>(kC * i) += basis.row(0).transpose() * dp;
           dt(i) += dp.dot(der.row(1)) * s;
         }
@@ -154,7 +154,6 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   }
   return cost;
 }
-
 
 TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, const PvaState& tail,
                                                          const Eigen::Matrix3Xd& waypoints,

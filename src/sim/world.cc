@@ -1,5 +1,7 @@
 #include "rotorguard/sim/world.h"
 
+#include "rotorguard/core/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,6 +9,14 @@
 #include <fmt/format.h>
 
 namespace rotorguard::sim {
+
+void Box::Validate() const {
+  if (!(size_m.minCoeff() > 0.0)) throw ValidationError("size_m", "box sizes must be > 0 m");
+}
+
+void MovingBox::Validate() const {
+  if (!(size_m.minCoeff() > 0.0)) throw ValidationError("size_m", "box sizes must be > 0 m");
+}
 
 double Box::Distance(const Vector3& p) const {
   // Rotate the point into the box frame, then clamp to the half extents.

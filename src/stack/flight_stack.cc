@@ -49,9 +49,6 @@ void NavigationOptions::Validate() const {
     ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", post_failure_safety_factor,
                     "in (0, 1]");
   }
-  if (method != "minco" && method != "flatness") {
-    ThrowValidation("FlightStackOptions", "navigation.method", method, "minco or flatness");
-  }
   if (!(std::isfinite(start_s) && start_s >= 0.0)) {
     ThrowValidation("FlightStackOptions", "navigation.start_s", start_s, "a time >= 0 s");
   }
@@ -63,15 +60,10 @@ void FlightStackOptions::Validate() const {
   if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > 10000.0) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
   }
-  if (controller != "nominal" && controller != "nmpc" && controller != "passive" && controller != "indi" &&
-      controller != "lqr" && controller != "assembly") {
-    ThrowValidation("FlightStackOptions", "controller", controller,
-                    "one of: nominal, nmpc, passive, indi, lqr, assembly");
-  }
   nominal.Validate();
   passive.Validate();
   nmpc.Validate();
-  if (controller == "indi") IndiOptionsInStack(*this).Validate();  // its filters depend on the rate
+  if (controller == ControllerKind::kIndi) IndiOptionsInStack(*this).Validate();  // its filters depend on the rate
   lqr.Validate();
   for (std::size_t i = 0; i < known_faults.size(); ++i) {
     if (!std::isfinite(known_faults[i].at_time_s) || known_faults[i].at_time_s < 0.0) {
@@ -82,13 +74,10 @@ void FlightStackOptions::Validate() const {
       ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.loss", i), known_faults[i].loss,
                       "a fraction in (0, 1] (1: the rotor failed)");
     }
-    if (known_faults[i].loss < 1.0 && controller != "assembly") {
+    if (known_faults[i].loss < 1.0 && controller != ControllerKind::kAssembly) {
       ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.loss", i), known_faults[i].loss,
                       "1 unless the controller is assembly (the one that reallocates a partial loss)");
     }
-  }
-  if (fdd != "none" && fdd != "composite" && fdd != "fixedtime" && fdd != "ukf") {
-    ThrowValidation("FlightStackOptions", "fdd", fdd, "one of: none, composite, fixedtime, ukf");
   }
   composite_fdd.Validate();
   fixed_time_fdd.Validate();
@@ -103,8 +92,9 @@ void FlightStackOptions::Validate() const {
                       "a rate in (0, control_rate_hz]");
     }
   }
-  if (!known_faults.empty() && controller != "nmpc" && controller != "indi" && controller != "assembly") {
-    ThrowValidation("FlightStackOptions", "known_faults", controller,
+  if (!known_faults.empty() && controller != ControllerKind::kNmpc && controller != ControllerKind::kIndi &&
+      controller != ControllerKind::kAssembly) {
+    ThrowValidation("FlightStackOptions", "known_faults", ToName(controller),
                     "controller nmpc, indi or assembly (the controllers that reconfigure)");
   }
 }
@@ -121,25 +111,25 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
   if (controller) {
-    if (controller->name() != options_.controller) {
-      ThrowValidation("FlightStackOptions", "controller", options_.controller,
+    if (controller->name() != ToName(options_.controller)) {
+      ThrowValidation("FlightStackOptions", "controller", ToName(options_.controller),
                       fmt::format("the name of the controller handed in ({})", controller->name()));
     }
     controller_ = std::move(controller);
-  } else if (options_.controller == "assembly") {
-    ThrowValidation("FlightStackOptions", "controller", options_.controller,
+  } else if (options_.controller == ControllerKind::kAssembly) {
+    ThrowValidation("FlightStackOptions", "controller", ToName(options_.controller),
                     "a controller built by the caller (the assembly controller lives in the modular module)");
-  } else if (options_.controller == "nmpc") {
+  } else if (options_.controller == ControllerKind::kNmpc) {
     auto nmpc = std::make_unique<control::NmpcController>(model_.params(), options_.nmpc);
     nmpc_ = nmpc.get();
     controller_ = std::move(nmpc);
-  } else if (options_.controller == "indi") {
+  } else if (options_.controller == ControllerKind::kIndi) {
     controller_ = std::make_unique<control::IndiController>(model_, IndiOptionsInStack(options_));
-  } else if (options_.controller == "lqr") {
+  } else if (options_.controller == ControllerKind::kLqr) {
     control::LqrControllerOptions lqr = options_.lqr;
     lqr.sample_hz = options_.control_rate_hz;
     controller_ = std::make_unique<control::LqrController>(vehicle::PwmQuadModel::FromVehicle(model_.params()), lqr);
-  } else if (options_.controller == "passive") {
+  } else if (options_.controller == ControllerKind::kPassive) {
     controller_ = std::make_unique<control::PassiveController>(model_, options_.passive);
   } else {
     controller_ = std::make_unique<control::NominalController>(model_, options_.nominal);
@@ -152,12 +142,22 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     }
   }
   known_fault_applied_.assign(options_.known_faults.size(), false);
-  if (options_.fdd == "composite") fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
-  if (options_.fdd == "fixedtime") fdd_ = std::make_unique<fdd::FixedTimeFdd>(model_.params(), options_.fixed_time_fdd);
-  if (options_.fdd == "ukf") fdd_ = std::make_unique<fdd::UkfFdd>(model_.params(), options_.ukf_fdd);
+  switch (options_.fdd) {
+    case FddKind::kComposite:
+      fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
+      break;
+    case FddKind::kFixedTime:
+      fdd_ = std::make_unique<fdd::FixedTimeFdd>(model_.params(), options_.fixed_time_fdd);
+      break;
+    case FddKind::kUkf:
+      fdd_ = std::make_unique<fdd::UkfFdd>(model_.params(), options_.ukf_fdd);
+      break;
+    case FddKind::kNone:
+      break;
+  }
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
-  if (!options_.navigation.waypoints.empty() && options_.navigation.method == "flatness") {
+  if (!options_.navigation.waypoints.empty() && options_.navigation.method == NavigationMethod::kFlatness) {
     const ReferencePoint start = reference_->Evaluate(0.0);
     flatness_ = std::make_unique<planning::FlatnessNavigator>(vehicle::PwmQuadModel::FromVehicle(model_.params()),
                                                               options_.navigation.flatness, start.p_W, start.yaw);

@@ -74,9 +74,19 @@ TEST(MarsScenario, AssemblyKeysAreCheckedNamingTheKey) {
   EXPECT_NE(m.find("1 unless the controller is assembly"), std::string::npos) << m;
 }
 
+/// A scenario loaded, then its assembly's mission planned.
+Scenario LoadPlanned(const std::string& path, const std::vector<Override>& overrides = {}) {
+  Scenario s = LoadScenario(path, overrides);
+  PlanMission(&s);
+  return s;
+}
+
 TEST(MarsScenario, APlannedRowPassesTheDoorLengthwiseAndFliesItWithoutTouching) {
-  const Scenario s = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
-  ASSERT_TRUE(s.assembly_plan);
+  const Scenario loaded = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  ASSERT_TRUE(loaded.assembly_plan);
+  EXPECT_EQ(loaded.reference, nullptr) << "the loader reads; it does not plan";
+  Scenario s = loaded;
+  PlanMission(&s);
   const auto* plan = dynamic_cast<const modular::AssemblyTrajectory*>(s.reference.get());
   ASSERT_NE(plan, nullptr);
   // The tracking error is measured while the plan is flown, not over the hover after it.
@@ -107,10 +117,10 @@ TEST(MarsScenario, APlannedRowPassesTheDoorLengthwiseAndFliesItWithoutTouching) 
 TEST(MarsScenario, AReplannedReferenceBringsItsOwnTrackingWindow) {
   // bench mars loads the scene once and swaps in each method's plan: each flight must be scored
   // over its own plan, not over the plan the scene was loaded with.
-  Scenario s = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  Scenario s = LoadPlanned(Config("scenarios/mars_plan_4x1.yaml"));
   const double ours = s.reference->duration();
   Scenario b = s;
-  b.assembly_plan->method = "baseline";
+  b.assembly_plan->method = AssemblyPlanMethod::kBaseline;
   const AssemblyPlanResult plan = PlanAssemblyMission(b);
   ASSERT_TRUE(plan.ok) << plan.message;
   s.reference = plan.trajectory;
@@ -129,17 +139,17 @@ TEST_F(MarsScenarioFile, ATrackingWindowThatStartsAfterThePlanIsAnErrorNamingThe
   text.replace(text.find("../assemblies/"), 14, Config("assemblies/"));
   const std::string late = Write("late.yaml", text + "metrics: {tracking_start_s: 15}\n");
   for (const char* part : {"late.yaml", "metrics.tracking_start_s", "the plan's duration"}) {
-    RG_EXPECT_THROW_WITH(LoadScenario(late), io::ConfigError, part);
+    RG_EXPECT_THROW_WITH(LoadPlanned(late), io::ConfigError, part);
   }
   // With its own end the window may lie after the plan (the hover at the goal).
-  const Scenario s = LoadScenario(Write("s.yaml", text + "metrics: {tracking_start_s: 15, tracking_end_s: 20}\n"));
+  const Scenario s = LoadPlanned(Write("s.yaml", text + "metrics: {tracking_start_s: 15, tracking_end_s: 20}\n"));
   EXPECT_EQ(TrackingEndS(s), 20.0);
 }
 
 TEST(MarsScenario, AnUnplannableAssemblyMissionIsAConfigErrorNamingTheMission) {
   const auto message = [](const std::vector<Override>& o) {
     try {
-      LoadScenario(Config("scenarios/mars_plan_4x1.yaml"), o);
+      LoadPlanned(Config("scenarios/mars_plan_4x1.yaml"), o);
     } catch (const io::ConfigError& e) {
       return std::string(e.what());
     }

@@ -233,8 +233,9 @@ TEST(AssemblyAllocator, BadInputIsAClearErrorOrAFiniteFallback) {
   AllocatorOptions o;
   o.priority[2] = 0.0;
   RG_EXPECT_THROW_WITH(AssemblyAllocator(a, o), ValidationError, "priority");
-  EXPECT_EQ(ParseReallocation("partial"), Reallocation::kPartial);
-  EXPECT_FALSE(ParseReallocation("hybrid").has_value());
+  EXPECT_EQ(FromName<Reallocation>("partial"), Reallocation::kPartial);
+  EXPECT_FALSE(FromName<Reallocation>("hybrid").has_value());
+  EXPECT_STREQ(ToName(Reallocation::kNone), "none");
 }
 
 }  // namespace

@@ -1,10 +1,10 @@
-#include "rotorguard/planning/planner.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
 #include "rotorguard/planning/astar.h"
+#include "rotorguard/planning/planner.h"
 
 namespace rotorguard::planning {
 namespace {
@@ -218,7 +218,7 @@ TEST(PlannerFallbacks, NoPathOnTheCoarseCellsIsSearchedAgainAtTheMapsResolution)
 // cannot (the first segment would begin with a jump in velocity), and the failure stands.
 TEST_F(PlannerAtTheWall, ABackEndThatFailsFromRestFliesThePathFromRestToRest) {
   PlannerOptions o;
-  o.optimizer.weight_collision = 0.0;
+  o.optimizer.weights.collision = 0.0;
   o.clearance_rounds = 0;
   o.rest_to_rest_fallback = false;
   const Vector3 goal(4, 0, 1.5);

@@ -1,4 +1,3 @@
-#include "rotorguard/planning/trajectory_optimizer.h"
 
 #include <cmath>
 
@@ -6,6 +5,7 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/planning/trajectory_optimizer.h"
 
 namespace rotorguard::planning {
 namespace {
@@ -36,13 +36,12 @@ void StraightGuess(const Vector3& a, const Vector3& b, int pieces, double speed,
   *t = Eigen::VectorXd::Constant(pieces, (b - a).norm() / pieces / speed);
 }
 
-
 // The objective's gradient (time, energy, the three limits and the clearance all active) against
 // central differences, in waypoints and in the duration parameters.
 TEST(TrajectoryOptimizer, ObjectiveGradientMatchesFiniteDifferences) {
   TrajectoryOptimizerOptions o;
-  o.weight_feasibility = 10.0;
-  o.weight_collision = 10.0;
+  o.weights.feasibility = 10.0;
+  o.weights.collision = 10.0;
   o.clearance_m = 0.5;
   const TrajectoryOptimizer optimizer(o);
   DynamicLimits limits{0.5, 0.4, 0.6};  // tight: every penalty active somewhere

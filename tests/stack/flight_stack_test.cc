@@ -62,10 +62,25 @@ TEST(FlightStack, CorruptSensorDataNeverReachesTheMotorsAsNan) {
   EXPECT_TRUE(st.estimate().p_W.allFinite());  // the corrupt sample was dropped
 }
 
-TEST(FlightStack, RejectsUnknownControllerNames) {
+TEST(FlightStack, RejectsAHandedInControllerOfAnotherKind) {
   FlightStackOptions o;
-  o.controller = "magic";
-  RG_EXPECT_THROW_WITH(FlightStack(ReferenceQuad(), HoverAt(1.0), o), ValidationError, "controller = magic");
+  o.controller = ControllerKind::kNmpc;
+  const vehicle::MultirotorModel model(ReferenceQuad());
+  RG_EXPECT_THROW_WITH(
+      FlightStack(ReferenceQuad(), HoverAt(1.0), o, std::make_unique<control::NominalController>(model, o.nominal)),
+      ValidationError, "controller = nmpc");
+  o.controller = ControllerKind::kAssembly;  // built by its module: the stack cannot make it
+  RG_EXPECT_THROW_WITH(FlightStack(ReferenceQuad(), HoverAt(1.0), o), ValidationError, "controller = assembly");
+}
+
+// Every kind's name is written once and reads back to the same kind.
+TEST(FlightStack, KindNamesRoundTrip) {
+  for (const auto& n : EnumNames<ControllerKind>()) EXPECT_EQ(FromName<ControllerKind>(n.name), n.value);
+  for (const auto& n : EnumNames<FddKind>()) EXPECT_EQ(FromName<FddKind>(n.name), n.value);
+  for (const auto& n : EnumNames<NavigationMethod>()) EXPECT_EQ(FromName<NavigationMethod>(n.name), n.value);
+  EXPECT_EQ(EnumNames<ControllerKind>().size(), 6u);
+  EXPECT_STREQ(ToName(FddKind::kFixedTime), "fixedtime");
+  EXPECT_FALSE(FromName<ControllerKind>("magic").has_value());
 }
 
 }  // namespace

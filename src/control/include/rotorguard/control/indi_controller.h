@@ -23,6 +23,7 @@
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/nominal_controller.h"
 #include "rotorguard/control/position_loop.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/filters.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -43,6 +44,15 @@ struct IndiControllerOptions {
   double sample_hz = 200.0;  ///< rate at which Compute is called [Hz], > 0
   NominalControllerOptions nominal;  ///< before any failure
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    position.Serialize(a);  // used after a failure; before it, stack.nominal flies
+    a->Visit("k_h", &k_h, {.meaning = "reduced-attitude stiffness [1/s²]"});
+    a->Visit("d_h", &d_h, {.meaning = "reduced-attitude damping [1/s]"});
+    a->Visit("opposite_ratio", &opposite_ratio, {.meaning = "relaxed hover: the failed rotor's twin's thrust relative to its neighbours, in [0, 1)"});
+    a->Visit("filter_cutoff_hz", &filter_cutoff_hz, {.meaning = "cut-off of the angular-acceleration and thrust filters [Hz], below half of stack.control_rate_hz"});
+  }
 };
 
 /// The relaxed-hover equilibrium of a quadrotor with one failed rotor: the spin axis n_B (unit, body

@@ -15,6 +15,7 @@
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/nmpc_model.h"
 #include "rotorguard/control/ocp_qp.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::control {
@@ -45,6 +46,22 @@ struct NmpcOptions {
   int relinearise_every = 1;
   DenseQpOptions qp;
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("horizon_steps", &horizon_steps, {.meaning = "N, the shooting nodes", .min = 1, .max = 200});
+    a->Visit("step_s", &step_s, {.meaning = "time between nodes [s], in (0, 1]"});
+    a->Visit("integrator_substeps", &integrator_substeps, {.meaning = "RK4 sub-steps per node", .min = 1, .max = 20});
+    a->Visit("q_position", &q_position, {.meaning = "Q_p of eq. (10)"});
+    a->Visit("q_attitude", &q_attitude, {.meaning = "Q_q of eq. (10): tilt x, tilt y, tilt², yaw"});
+    a->Visit("q_velocity", &q_velocity, {.meaning = "Q_v of eq. (10)"});
+    a->Visit("q_rate", &q_rate, {.meaning = "Q_ω of eq. (10)"});
+    a->Visit("q_thrust", &q_thrust, {.meaning = "Q_t of eq. (10) on the motor thrusts"});
+    a->Visit("r_input", &r_input, {.meaning = "R of eq. (10) on the commands, > 0"});
+    a->Visit("max_rate_rad_s", &max_rate_rad_s, {.meaning = "body-rate bounds [rad/s]"});
+    a->Visit("max_sqp_iterations", &max_sqp_iterations, {.meaning = "SQP iterations a cycle (1: the real-time iteration)", .min = 1, .max = 1000});
+    a->Visit("relinearise_every", &relinearise_every, {.meaning = "a full linearisation every this many preparations (docs/control.md)", .min = 1, .max = 20});
+  }
 };
 
 enum class NmpcStatus {

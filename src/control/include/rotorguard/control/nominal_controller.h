@@ -5,6 +5,7 @@
 #include "rotorguard/control/allocation.h"
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/position_loop.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::control {
@@ -16,6 +17,14 @@ struct NominalControllerOptions {
   double max_rate_rad_s = 8.0;        ///< commanded body-rate limit [rad/s], > 0
   /// Throws ValidationError naming the field.
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    position.Serialize(a);
+    a->Visit("k_attitude", &k_attitude, {.meaning = "attitude error to body rate [1/s]"});
+    a->Visit("k_rate", &k_rate, {.meaning = "rate error to angular acceleration [1/s]"});
+    a->Visit("max_rate_rad_s", &max_rate_rad_s, {.meaning = "commanded body-rate limit [rad/s]"});
+  }
 };
 
 /// The cascade of NominalController up to the wrench: position loop -> thrust vector -> attitude ->

@@ -7,6 +7,7 @@
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/dense_qp.h"
 #include "rotorguard/control/position_loop.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::control {
@@ -19,6 +20,14 @@ struct PassiveControllerOptions {
   /// unique), relative to the thrust weight, > 0.
   double regularisation = 1e-3;
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    position.Serialize(a);
+    a->Visit("k_tilt", &k_tilt, {.meaning = "reduced-attitude error to roll/pitch rate [1/s]"});
+    a->Visit("k_rate", &k_rate, {.meaning = "roll/pitch rate error to angular acceleration [1/s]"});
+    a->Visit("regularisation", &regularisation, {.meaning = "weight towards equal rotor thrusts, relative to the thrust's"});
+  }
 };
 
 class PassiveController final : public Controller {

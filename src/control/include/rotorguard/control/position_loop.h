@@ -4,6 +4,7 @@
 /// vector (gravity and the model's rotor drag compensated), with its tilt limited.
 #include <string>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/vehicle/vehicle_params.h"
@@ -18,6 +19,15 @@ struct PositionLoopOptions {
   double max_tilt_rad = 0.7;          ///< thrust vector tilt limit [rad], in (0, pi/2)
   /// Throws ValidationError naming `owner` and the field.
   void Validate(const std::string& owner) const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("kp_position", &kp_position, {.meaning = "position gain [1/s²]"});
+    a->Visit("kd_velocity", &kd_velocity, {.meaning = "velocity gain [1/s]"});
+    a->Visit("ki_position", &ki_position, {.meaning = "integral gain [1/s³]"});
+    a->Visit("integral_limit_m_s2", &integral_limit_m_s2, {.meaning = "clamp on the integral's acceleration [m/s²]"});
+    a->Visit("max_tilt_rad", &max_tilt_rad, {.meaning = "tilt limit of the thrust vector [rad], in (0, π/2)"});
+  }
 };
 
 class PositionLoop {

@@ -27,4 +27,10 @@ struct AssemblyPlanResult {
 /// the result says why. The map holds the world's boxes and cylinders, not its moving boxes.
 AssemblyPlanResult PlanAssemblyMission(const Scenario& scenario);
 
+/// Plans `scenario`'s assembly_plan mission when it has one that is not planned yet (its
+/// reference is null), makes the plan its reference and runs the checks that need it
+/// (CheckPlannedMission). Throws io::ConfigError at the file's mission block (std::invalid_argument
+/// for a scenario built in code) when the mission cannot be planned. RunScenario calls it.
+void PlanMission(Scenario* scenario);
+
 }  // namespace rotorguard::harness

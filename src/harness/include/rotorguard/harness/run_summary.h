@@ -99,7 +99,8 @@ struct RunSummary {
 
   std::vector<FaultRecord> faults;
   std::optional<FddRecord> fdd;  ///< present when the stack runs fault detection
-  /// The composite FDD's thresholds when the stack ran it (summary.json "composite_fdd").
+  /// The composite FDD's thresholds when the stack ran it (summary.json "composite_fdd", its keys
+  /// those of stack.composite_fdd: io::ToJson).
   std::optional<fdd::CompositeFddOptions> composite_fdd;
   SensorsRecord sensors;
 
@@ -116,10 +117,5 @@ struct RunSummary {
 
   nlohmann::json ToJson() const;
 };
-
-/// The composite FDD's thresholds as summary.json records them ("composite_fdd"), and back (throws
-/// nlohmann::json::exception for a missing or mistyped key).
-nlohmann::json CompositeFddOptionsToJson(const fdd::CompositeFddOptions& options);
-fdd::CompositeFddOptions CompositeFddOptionsFromJson(const nlohmann::json& json);
 
 }  // namespace rotorguard::harness

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "rotorguard/core/trajectory.h"
+#include "rotorguard/harness/mission.h"
+#include "rotorguard/io/config_node.h"
 #include "rotorguard/modular/allocation.h"
 #include "rotorguard/modular/assembly.h"
 #include "rotorguard/modular/assembly_controller.h"
@@ -20,26 +22,6 @@
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::harness {
-
-/// Mission `assembly_plan` (paper 002, Sec. III): the assembly plans from its initial pose to
-/// `goal_m` on the world's geometry (a known map, the paper's setting) with the dynamically
-/// feasible A* and the shape-aware trajectory optimisation (modular/assembly_trajectory.h), for the
-/// rotors the stack knows of (stack.known_faults), and flies the result.
-struct AssemblyPlanSpec {
-  Vector3 goal_m = Vector3::Zero();
-  /// "ours" (eqs. 9 and 11-12 with the assembly's dynamics) or "baseline" (Table II's SVSDF row:
-  /// kinematic limits only, no attitude terms).
-  std::string method = "ours";
-  double max_speed_m_s = 1.0;
-  double max_accel_m_s2 = 2.0;
-  double max_jerk_m_s3 = 6.0;
-  double max_yaw_rate_rad_s = 1.0;  ///< ours: the yaw's rate limit [rad/s]
-  double safety_factor = 0.7;       ///< ours: the share of the assembly's capacity planned for, in (0, 1]
-  double attitude_weight = 0.3;     ///< ours: L_Phi of the A* (eq. 9b) [m/rad]
-  /// λ_t of eq. (11) for both methods: the larger, the more agile (closer to the limits) the plan.
-  double time_weight = 10.0;
-  double map_resolution_m = 0.1;
-};
 
 struct Scenario {
   std::string name;
@@ -56,7 +38,10 @@ struct Scenario {
   sim::World world;
   Vector3 initial_position_m = Vector3::Zero();
   double initial_yaw_rad = 0.0;
-  std::string mission_type;   ///< hover, takeoff, lemniscate, circle, waypoints, navigate, assembly_plan
+  MissionKind mission_kind = MissionKind::kHover;
+  /// What the stack follows (Mission::reference); for an assembly_plan mission, null until
+  /// PlanMission (assembly_mission.h) has planned it. A navigate mission's waypoints and rounds are
+  /// in stack.navigation.
   std::shared_ptr<const ReferenceTrajectory> reference;
   std::optional<AssemblyPlanSpec> assembly_plan;  ///< mission assembly_plan
   std::vector<sim::FaultSpec> faults;
@@ -67,12 +52,16 @@ struct Scenario {
   double tracking_start_s = 0.0;
   std::optional<double> tracking_end_s;  ///< metrics.tracking_end_s; see TrackingEndS
   /// A run succeeds when it does not crash and its position error stays at or below
-  /// success_error_m over the last success_hold_s of the flight (DESIGN.md's SucR: back under
-  /// 0.5 m and held to the end).
+  /// success_error_m over the last success_hold_s of the flight (docs/metrics.md, "SucR").
   double success_error_m = 0.5;
   double success_hold_s = 2.0;
   /// Roll and pitch count as recovered after a fault once the tilt stays below this [rad].
   double recovered_tilt_rad = 0.0873;  // 5 degrees
+  /// Where the file put the keys that are checked only once the mission is planned
+  /// (PlanMission): the mission and metrics blocks, when they came from a file.
+  struct Source {
+    std::optional<io::ConfigNode> mission, metrics;
+  } source;
 };
 
 /// A `--set key.path=value` override. Paths starting with "vehicle." apply to the vehicle file.
@@ -86,6 +75,12 @@ void FitStackToHardware(Scenario* scenario);
 /// Loads and validates a scenario file. Throws io::ConfigError (bad content, with file, line and
 /// key path) or io::InputFileError (a file that cannot be read).
 Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides = {});
+
+/// The rules that need the mission's reference, reported at the file's keys (Scenario::source):
+/// the tracking window holds at least one physics step; the reference stays above the ground.
+/// LoadScenario runs them; for an assembly_plan mission, PlanMission does once it has planned.
+/// Throws io::ConfigError.
+void CheckPlannedMission(const Scenario& scenario);
 
 /// The end of the tracking window [s]: metrics.tracking_end_s when set; else, for an assembly_plan
 /// mission, its plan's duration (the plan's tracking error while it is flown, paper 002's Table II,

@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 
 #include "rotorguard/control/dense_qp.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
 #include "rotorguard/modular/assembly.h"
 
@@ -37,9 +38,9 @@ enum class Reallocation {
   /// the wrench with minimum variance of the delivered thrusts.
   kFull,
 };
-std::string_view ToString(Reallocation method);
-/// "none", "partial", "full".
-std::optional<Reallocation> ParseReallocation(std::string_view name);
+inline constexpr EnumName<Reallocation> kReallocationNames[] = {
+    {Reallocation::kNone, "none"}, {Reallocation::kPartial, "partial"}, {Reallocation::kFull, "full"}};
+constexpr std::span<const EnumName<Reallocation>> NamesOf(const Reallocation*) { return kReallocationNames; }
 
 struct AllocatorOptions {
   Reallocation method = Reallocation::kFull;
@@ -54,6 +55,11 @@ struct AllocatorOptions {
   control::DenseQpOptions qp;
   /// Throws ValidationError naming the field.
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("reallocation", &method, {.meaning = "full: min-variance over every rotor that delivers; partial: eqs. 3-5 of paper 002; none: the fault-blind pseudo-inverse"});
+  }
 };
 
 struct AllocationSummary {

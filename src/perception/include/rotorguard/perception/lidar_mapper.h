@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/perception/deskew.h"
 #include "rotorguard/perception/voxel_map.h"
@@ -25,6 +26,12 @@ struct LidarMapperOptions {
   double inflation_margin_m = 0.1;
   /// Throws ValidationError naming the field.
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("inflation_margin_m", &inflation_margin_m, {.meaning = "obstacles are inflated by the vehicle's collision_radius_m plus this [m]"});
+    map.Serialize(a);
+  }
 };
 
 struct LidarFrameSummary {

@@ -7,6 +7,7 @@
 /// "<Options>::<field> = <value> is invalid; expected <rule>".
 #include <vector>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/core/types.h"
 
@@ -18,6 +19,12 @@ namespace rotorguard::planning {
 struct HoverOptions {
   Vector3 position_m = Vector3::Zero();  ///< point to hold, world frame [m]; finite
   double yaw_rad = 0.0;                  ///< heading to hold [rad]; finite
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("position_m", &position_m, {.meaning = "the point to hold [m]", .default_text = "the initial position"});
+    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+  }
 };
 
 /// Holds one point at rest forever (duration() = 0).
@@ -42,6 +49,13 @@ struct TakeoffOptions {
   double altitude_m = 1.0;            ///< climb above start_m [m]; finite, nonzero (< 0: a descent)
   double max_speed_m_s = 0.5;         ///< peak climb speed [m/s]; finite, > 0
   double yaw_rad = 0.0;               ///< heading held throughout [rad]; finite
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("altitude_m", &altitude_m, {.meaning = "the climb above the start [m] (a minimum-jerk climb)", .positive = true, .required = true});
+    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "peak climb speed [m/s]"});
+    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+  }
 };
 
 /// Vertical climb (or, with a negative altitude, descent) from rest to rest along the minimum-jerk quintic
@@ -121,6 +135,15 @@ struct LemniscateOptions {
   double max_speed_m_s = 2.0;          ///< top speed once ramped up [m/s]; finite, > 0
   double ramp_s = 3.0;                 ///< time to full phase rate from rest [s]; finite, >= 0
   double yaw_rad = 0.0;                ///< heading held throughout [rad]; finite
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("center_m", &center_m, {.meaning = "centre of the figure eight x = sx/2 sin θ, y = sy/2 sin 2θ, z = sz/2 sin θ [m]", .default_text = "the initial position"});
+    a->Visit("size_m", TripleOf{&size_x_m, &size_y_m, &size_z_m}, {.meaning = "its full extent [sx, sy, sz] [m]"});
+    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "top speed once ramped up [m/s]", .required = true});
+    a->Visit("ramp_s", &ramp_s, {.meaning = "time to full phase rate from rest [s]"});
+    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+  }
 };
 
 /// Figure eight c(theta) = center + [sx/2 sin(theta), sy/2 sin(2 theta), sz/2 sin(theta)]
@@ -152,6 +175,17 @@ struct CircleOptions {
   /// Vertical speed once ramped up [m/s]: non-zero makes the circle a helix (paper 002's spiral),
   /// z = center.z + climb_m_s * theta / Omega; finite.
   double climb_m_s = 0.0;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("center_m", &center_m, {.meaning = "centre; the circle starts at centre + [radius, 0, 0] [m]", .required = true});
+    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .required = true});
+    a->Visit("speed_m_s", &speed_m_s, {.meaning = "tangential speed once ramped up [m/s]", .required = true});
+    a->Visit("ramp_s", &ramp_s, {.meaning = "time to full speed from rest [s]"});
+    a->Visit("clockwise", &clockwise, {.meaning = "seen from above"});
+    a->Visit("climb_m_s", &climb_m_s, {.meaning = "vertical speed: non-zero makes the circle a helix (paper 002's spiral) [m/s]"});
+    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+  }
 };
 
 /// Horizontal circle c(theta) = center + radius [cos(theta), +-sin(theta), 0] (minus when
@@ -179,6 +213,15 @@ struct WaypointOptions {
   double max_accel_m_s2 = 1.0;       ///< acceleration limit on every segment [m/s^2]; finite, > 0
   double dwell_s = 0.0;              ///< pause at each intermediate waypoint [s]; finite, >= 0
   double yaw_rad = 0.0;              ///< heading held throughout [rad]; finite
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("waypoints_m", &waypoints_m, {.meaning = "the points flown to from the start, in turn, stopping at each [m]", .required = true});
+    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "speed limit of the trapezoidal profile [m/s]", .required = true});
+    a->Visit("max_accel_m_s2", &max_accel_m_s2, {.meaning = "its acceleration limit [m/s²]"});
+    a->Visit("dwell_s", &dwell_s, {.meaning = "pause at each intermediate waypoint [s]"});
+    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+  }
 };
 
 /// Straight segments between consecutive waypoints, each flown from rest to rest with a

@@ -8,6 +8,7 @@
 /// trajectory starts from the old one's state at the switching instant. When no plan can be made
 /// and the trajectory ahead is unsafe, it brakes to rest within the limits, holds, and keeps
 /// trying.
+#include <algorithm>
 #include <array>
 #include <limits>
 #include <optional>
@@ -41,6 +42,12 @@ struct ReplannerOptions {
   /// the straight line towards it that lies this far inside the window [m], >= 0. Replanning as
   /// the window follows the vehicle moves the local goal on (receding horizon).
   double local_goal_margin_m = 1.0;
+  /// Widens planner.plane_search_m to the clearances kept (a guide sample looks for its obstacle
+  /// plane at least as far as that): what a scenario's planner block implies when it sets them.
+  void WidenPlaneSearch() {
+    planner.plane_search_m =
+        std::max({planner.plane_search_m, planner.optimizer.clearance_m, post_failure_clearance_m.value_or(0.0)});
+  }
   void Validate() const;
 };
 

@@ -15,6 +15,7 @@
 #include <vector>
 #include <string>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
 #include "rotorguard/planning/minco.h"
 
@@ -61,12 +62,24 @@ using NearestPlane = std::function<std::optional<ObstaclePlane>(const Vector3& p
 /// places them), each sample's nearest obstacle where `nearest` finds one.
 PlaneSet BuildSamplePlanes(const MinimumJerkTrajectory& traj, int samples_per_piece, const NearestPlane& nearest);
 
+/// Eq. (22)'s weights λ = [λ_t, λ_s, λ_d, λ_c] (paper 000 Sec. VI: [10, 1, 1e4, 1e4]), each >= 0.
+struct CostWeights {
+  double time = 10.0;
+  double smoothness = 1.0;
+  double feasibility = 1e4;
+  double collision = 1e4;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("time", &time, {.meaning = "λ_t, on the trajectory's duration"});
+    a->Visit("smoothness", &smoothness, {.meaning = "λ_s, on the integrated squared jerk"});
+    a->Visit("feasibility", &feasibility, {.meaning = "λ_d, on speed, acceleration and jerk beyond the limits"});
+    a->Visit("collision", &collision, {.meaning = "λ_c, on points closer than the clearance to an obstacle"});
+  }
+};
+
 struct TrajectoryOptimizerOptions {
-  // Eq. (22)'s weights λ = [λ_t, λ_s, λ_d, λ_c]; paper 000 Sec. VI uses [10, 1, 1e4, 1e4].
-  double weight_time = 10.0;
-  double weight_smoothness = 1.0;
-  double weight_feasibility = 1e4;
-  double weight_collision = 1e4;
+  CostWeights weights;
   double clearance_m = 0.3;      ///< C_o of eq. (36), the safe distance [m], >= 0
   int samples_per_piece = 16;    ///< penalty samples per piece (κ / M), >= 2
   int max_iterations = 200;      ///< L-BFGS iterations, >= 1

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/sim/raycast.h"
@@ -33,6 +34,21 @@ struct LidarOptions {
   double grid_cell_m = 1.0;                      ///< the boxes' ray-casting grid cell [m], > 0
   /// Throws ValidationError naming the field (SimulatorOptions prefixes "sensors.lidar.").
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("enabled", &enabled, {.meaning = "a lidar block switches the sensor on unless this says false", .default_text = "true"});
+    a->Visit("frame_rate_hz", &frame_rate_hz, {.meaning = "frames per second"});
+    a->Visit("points_per_s", &points_per_s, {.meaning = "pulses per second"});
+    a->Visit("min_range_m", &min_range_m, {.meaning = "closer returns are dropped [m]"});
+    a->Visit("max_range_m", &max_range_m, {.meaning = "[m]"});
+    a->Visit("min_elevation_rad", &min_elevation_rad, {.meaning = "the field of view's lower edge [rad] (-7°)"});
+    a->Visit("max_elevation_rad", &max_elevation_rad, {.meaning = "its upper edge [rad] (52°)"});
+    a->Visit("range_noise_m", &range_noise_m, {.meaning = "1-σ range noise [m]"});
+    a->Visit("dropout_probability", &dropout_probability, {.meaning = "chance a return is lost, in [0, 1)"});
+    a->Visit("position_m", &position_m, {.meaning = "mounting point, body frame [m]"});
+    a->Visit("grid_cell_m", &grid_cell_m, {.meaning = "the boxes' ray-casting grid cell [m]"});
+  }
 };
 
 /// A body pose: position and attitude of the body frame in the world.

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/core/types.h"
@@ -21,6 +22,18 @@ struct ImuOptions {
   double accel_bias_initial = 0.02;          ///< std of the bias at start [m/s^2], >= 0
   double gyro_bias_initial = 2.0e-3;         ///< std of the bias at start [rad/s], >= 0
   void Validate(double physics_rate_hz) const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("rate_hz", &rate_hz, {.meaning = "sample rate [Hz], at most the physics rate"});
+    a->Visit("position_m", &position_m, {.meaning = "mounting point from the centre of gravity, body frame [m]"});
+    a->Visit("accel_noise_density", &accel_noise_density, {.meaning = "accelerometer white noise [m/s²/√Hz]"});
+    a->Visit("gyro_noise_density", &gyro_noise_density, {.meaning = "gyro white noise [rad/s/√Hz]"});
+    a->Visit("accel_bias_random_walk", &accel_bias_random_walk, {.meaning = "accelerometer bias diffusion [m/s³/√Hz]"});
+    a->Visit("gyro_bias_random_walk", &gyro_bias_random_walk, {.meaning = "gyro bias diffusion [rad/s²/√Hz]"});
+    a->Visit("accel_bias_initial", &accel_bias_initial, {.meaning = "std of the accelerometer bias at the start [m/s²]"});
+    a->Visit("gyro_bias_initial", &gyro_bias_initial, {.meaning = "std of the gyro bias at the start [rad/s]"});
+  }
 };
 
 struct EscOptions {
@@ -29,6 +42,14 @@ struct EscOptions {
   double quantization_rpm = 10.0;  ///< reported resolution [rpm], >= 0 (0: none)
   double delay_s = 0.001;       ///< transport delay, >= 0 and < 0.5 s
   void Validate(double physics_rate_hz) const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("rate_hz", &rate_hz, {.meaning = "telemetry rate [Hz], at most the physics rate"});
+    a->Visit("noise_rpm", &noise_rpm, {.meaning = "white measurement noise [rpm]"});
+    a->Visit("quantization_rpm", &quantization_rpm, {.meaning = "reported resolution [rpm] (0: none)"});
+    a->Visit("delay_s", &delay_s, {.meaning = "transport delay [s], below 0.5 s"});
+  }
 };
 
 struct OdometryOptions {
@@ -43,11 +64,27 @@ struct OdometryOptions {
   struct Outage {
     double start_s = 0.0;
     double duration_s = 0.0;
+
+    template <typename Archive>
+    void Serialize(Archive* a) {
+      a->Visit("start_s", &start_s, {.meaning = "when the front end loses track [s]", .min = 0.0, .required = true});
+      a->Visit("duration_s", &duration_s, {.meaning = "for how long [s]", .min = 0.0, .required = true});
+    }
   };
   std::vector<Outage> outages;
   /// Whether time t [s] lies in an outage.
   bool InOutage(double t) const;
   void Validate(double physics_rate_hz) const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("rate_hz", &rate_hz, {.meaning = "rate [Hz], at most the physics rate"});
+    a->Visit("position_noise_m", &position_noise_m, {.meaning = "position std at rest [m]"});
+    a->Visit("velocity_noise_m_s", &velocity_noise_m_s, {.meaning = "velocity std at rest [m/s]"});
+    a->Visit("attitude_noise_rad", &attitude_noise_rad, {.meaning = "attitude std at rest, per small-angle component [rad]"});
+    a->Visit("rate_noise_gain", &rate_noise_gain, {.meaning = "the stds grow as (1 + gain·|ω|) [per rad/s]"});
+    a->Visit("outages", &outages, {.meaning = "intervals without odometry (the front end lost track)"});
+  }
 };
 
 /// What a sensor sees of the truth at one instant.

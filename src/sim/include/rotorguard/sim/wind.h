@@ -2,6 +2,7 @@
 /// Wind: a constant mean plus first-order Gauss-Markov gusts on each axis.
 #include <cstdint>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/core/types.h"
 
@@ -12,6 +13,13 @@ struct WindOptions {
   double gust_std_m_s = 0.0;           ///< stationary std of each gust component [m/s], >= 0
   double gust_time_constant_s = 1.0;   ///< correlation time of gusts [s], > 0
   void Validate() const;
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("mean_m_s", &mean_m_s, {.meaning = "mean wind, world frame [m/s]"});
+    a->Visit("gust_std_m_s", &gust_std_m_s, {.meaning = "stationary std of each Gauss-Markov gust component [m/s]"});
+    a->Visit("gust_time_constant_s", &gust_time_constant_s, {.meaning = "the gusts' correlation time [s]"});
+  }
 };
 
 class WindModel {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
 
 namespace rotorguard::sim {
@@ -15,6 +16,15 @@ struct Box {
   Vector3 center_m = Vector3::Zero();
   Vector3 size_m = Vector3::Ones();
   double yaw_rad = 0.0;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("center_m", &center_m, {.meaning = "[m]", .required = true});
+    a->Visit("size_m", &size_m, {.meaning = "full extents along its axes [m], each > 0", .required = true});
+    a->Visit("yaw_rad", &yaw_rad, {.meaning = "rotation about z [rad]"});
+  }
+  /// Throws ValidationError when an extent is not > 0.
+  void Validate() const;
   /// Euclidean distance from `p` to the box (0 inside).
   double Distance(const Vector3& p) const;
 };
@@ -24,6 +34,13 @@ struct Cylinder {
   Eigen::Vector2d center_m = Eigen::Vector2d::Zero();
   double radius_m = 0.1;
   double height_m = 5.0;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("center_m", &center_m, {.meaning = "[x, y] of its axis [m]", .required = true});
+    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .positive = true, .required = true});
+    a->Visit("height_m", &height_m, {.meaning = "standing on the ground [m]", .positive = true, .required = true});
+  }
   double Distance(const Vector3& p) const;
 };
 
@@ -35,6 +52,17 @@ struct MovingBox {
   double speed_m_s = 0.5;
   bool loop = true;
   double start_s = 0.0;  ///< it rests at its first waypoint until then [s] (an obstacle moved mid-flight)
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("size_m", &size_m, {.meaning = "full extents [m], each > 0", .required = true});
+    a->Visit("waypoints_m", &waypoints_m, {.meaning = "the centre's polyline [m]", .required = true});
+    a->Visit("speed_m_s", &speed_m_s, {.meaning = "[m/s]", .min = 0.0, .required = true});
+    a->Visit("loop", &loop, {.meaning = "back to the first waypoint after the last (else it stops there)"});
+    a->Visit("start_s", &start_s, {.meaning = "it rests at its first waypoint until then [s]", .min = 0.0});
+  }
+  /// Throws ValidationError when an extent is not > 0.
+  void Validate() const;
   /// The box's pose at time t [s].
   Box At(double t) const;
 };
@@ -44,6 +72,14 @@ class World {
   std::vector<Box> boxes;
   std::vector<Cylinder> cylinders;
   std::vector<MovingBox> moving_boxes;
+
+  /// The keys of a scenario's `world`.
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("boxes", &boxes, {.meaning = "walls, furniture"});
+    a->Visit("cylinders", &cylinders, {.meaning = "trees"});
+    a->Visit("moving_boxes", &moving_boxes, {.meaning = "boxes moving along a polyline"});
+  }
 
   /// Name of the first obstacle a sphere at `p` of `radius` intersects at time t, if any
   /// ("box 3", "cylinder 12", "moving box 0"). The ground is handled by the simulator.

@@ -9,12 +9,15 @@
 #include <string>
 #include <vector>
 
+#include <span>
+
 #include "rotorguard/control/controller.h"
 #include "rotorguard/control/indi_controller.h"
 #include "rotorguard/control/lqr.h"
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/control/nominal_controller.h"
 #include "rotorguard/control/passive_controller.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/fdd/composite_fdd.h"
@@ -39,7 +42,50 @@ struct KnownFault {
   /// Fraction of the rotor's thrust lost, in (0, 1]: 1 is a failure (isolated as FDD would), less
   /// a partial loss handed to controllers that reallocate (the sim's loss_of_effectiveness eta).
   double loss = 1.0;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("rotor", &rotor, {.meaning = "the rotor handed over as failed", .min = 0, .max = kMaxRotors - 1, .required = true});
+    a->Visit("at_time_s", &at_time_s, {.meaning = "when [s]", .min = 0.0, .required = true});
+    a->Visit("loss", &loss, {.meaning = "1: failed; below 1 a partial loss of thrust (controller assembly only)"});
+  }
 };
+
+/// How the navigate mission plans (key stack.planner.method).
+enum class NavigationMethod {
+  kMinco,     ///< paper 000's failure-aware MINCO planner on the LiDAR map (the Replanner)
+  kFlatness,  ///< paper 004's closed-form critically damped legs, hold-then-replan after a detected fault
+};
+inline constexpr EnumName<NavigationMethod> kNavigationMethodNames[] = {{NavigationMethod::kMinco, "minco"},
+                                                                        {NavigationMethod::kFlatness, "flatness"}};
+constexpr std::span<const EnumName<NavigationMethod>> NamesOf(const NavigationMethod*) { return kNavigationMethodNames; }
+
+/// The stack's controller (key stack.controller).
+enum class ControllerKind {
+  kNominal,   ///< the geometric cascade, not fault tolerant
+  kNmpc,      ///< paper 000's NMPC (docs/control.md)
+  kPassive,   ///< the UnifP-style baseline: reduced attitude with yaw free, never reconfigured
+  kIndi,      ///< incremental nonlinear dynamic inversion after an isolation, the nominal cascade before
+  kLqr,       ///< paper 004's LQR on the vehicle's PWM model
+  kAssembly,  ///< an assembly's reallocating controller, built by the caller (modular module)
+};
+inline constexpr EnumName<ControllerKind> kControllerKindNames[] = {
+    {ControllerKind::kNominal, "nominal"}, {ControllerKind::kNmpc, "nmpc"}, {ControllerKind::kPassive, "passive"},
+    {ControllerKind::kIndi, "indi"},       {ControllerKind::kLqr, "lqr"},   {ControllerKind::kAssembly, "assembly"}};
+constexpr std::span<const EnumName<ControllerKind>> NamesOf(const ControllerKind*) { return kControllerKindNames; }
+
+/// The stack's fault detection (key stack.fdd).
+enum class FddKind {
+  kNone,
+  kComposite,  ///< paper 000's composite FDD (docs/fdd.md)
+  kFixedTime,  ///< the FixedA baseline's fixed-time observer
+  kUkf,        ///< paper 004's loss-of-effectiveness UKF
+};
+inline constexpr EnumName<FddKind> kFddKindNames[] = {{FddKind::kNone, "none"},
+                                                      {FddKind::kComposite, "composite"},
+                                                      {FddKind::kFixedTime, "fixedtime"},
+                                                      {FddKind::kUkf, "ukf"}};
+constexpr std::span<const EnumName<FddKind>> NamesOf(const FddKind*) { return kFddKindNames; }
 
 /// Navigation among obstacles (mission type navigate; docs/planning.md): the waypoints flown in
 /// order, `rounds` times, each planned on the LiDAR map by the replanner at `planner_rate_hz`.
@@ -53,10 +99,8 @@ struct NavigationOptions {
   /// false: the failure-unaware variant, whose planner keeps its nominal acceleration limit after
   /// a failure (the NMPC still reconfigures): the comparison row of `rotorguard bench nav`.
   bool failure_aware = true;
-  /// "minco": paper 000's failure-aware MINCO planner on the LiDAR map (the Replanner);
-  /// "flatness": paper 004's closed-form critically damped legs with hold-then-replan after a
-  /// detected fault (FlatnessNavigator; no map, no obstacles; needs a vehicle with a PWM model).
-  std::string method = "minco";
+  /// The flatness method needs no map and sees no obstacles, and needs a vehicle with a PWM model.
+  NavigationMethod method = NavigationMethod::kMinco;
   planning::ReplannerOptions replanner;      ///< its post_failure_a_max is set from eq. (33)
   planning::FlatnessNavigatorOptions flatness;
   /// The mission starts at this time [s] (the vehicle holds its start until then), >= 0.
@@ -64,13 +108,36 @@ struct NavigationOptions {
   /// Throws ValidationError naming the field ("navigation.rounds"); the rate is checked against
   /// the control rate by FlightStackOptions.
   void Validate() const;
+
+  /// The keys of stack.planner (the waypoints and rounds are the mission's).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    planning::ReplannerOptions& r = replanner;
+    a->Visit("method", &method, {.meaning = "minco, or flatness: paper 004's legs without a map (docs/flatness.md)"});
+    a->Visit("start_s", &start_s, {.meaning = "the mission starts then; the vehicle holds its start until [s]"});
+    a->Visit("rate_hz", &planner_rate_hz, {.meaning = "the planner's rate [Hz], at most the control rate"});
+    a->Visit("v_max", &r.nominal.v_max, {.meaning = "nominal speed limit [m/s]"});
+    a->Visit("a_max", &r.nominal.a_max, {.meaning = "nominal acceleration limit a_max,n [m/s²]"});
+    a->Visit("j_max", &r.nominal.j_max, {.meaning = "nominal jerk limit [m/s³]"});
+    a->Visit("post_failure_safety_factor", &post_failure_safety_factor,
+             {.meaning = "γ_a,f of eq. (33): with the vehicle's mass, rotor thrust and drag it gives a_max,f after a failure"});
+    a->Visit("replan_period_s", &r.replan_period_s, {.meaning = "periodic replanning [s]"});
+    a->Visit("clearance_m", &r.planner.optimizer.clearance_m, {.meaning = "C_o of eq. (36), the distance kept from obstacles [m]"});
+    a->Visit("post_failure_clearance_m", &r.post_failure_clearance_m,
+             {.meaning = "unset: clearance_m throughout; else C_o once the attitude recovered from a failure, and the one "
+                         "tried when clearance_m finds no plan before (docs/navigation.md)",
+              .min = 0.0});
+    a->Visit("failure_aware", &failure_aware, {.meaning = "false: the failure-unaware variant keeps the nominal limits after a failure"});
+    a->Visit("altitude_band_m", PairOf{&r.planner.search.z_min_m, &r.planner.search.z_max_m},
+             {.meaning = "[z_min, z_max], the altitudes the search may use [m]"});
+    a->Visit("weights", &r.planner.optimizer.weights, {.meaning = "eq. (22)'s weights"});
+  }
 };
 
 struct FlightStackOptions {
   double control_rate_hz = 200.0;    ///< controller rate (paper 000: 200 Hz), in (0, 10000]
-  /// Controller name; one of: nominal, nmpc, passive, indi, lqr, or assembly (the modular
-  /// controller, built by the caller and handed to the FlightStack).
-  std::string controller = "nominal";
+  /// The assembly controller is built by the caller and handed to the FlightStack.
+  ControllerKind controller = ControllerKind::kNominal;
   control::NominalControllerOptions nominal;
   control::PassiveControllerOptions passive;
   control::NmpcOptions nmpc;
@@ -79,11 +146,9 @@ struct FlightStackOptions {
   /// Paper 004's LQR baseline (vehicles with a PWM model); the stack sets its sample_hz.
   control::LqrControllerOptions lqr;
   std::vector<KnownFault> known_faults;  ///< handed to the controller at their times (nmpc, indi)
-  /// Fault detection: "none", "composite" (paper 000, Sec. V-B), "fixedtime" (the FixedA
-  /// baseline) or "ukf" (paper 004's loss-of-effectiveness UKF). On isolation the NMPC or INDI is
-  /// reconfigured (the nominal, passive and LQR controllers cannot be); the flatness planner holds
-  /// and re-plans on any detection.
-  std::string fdd = "none";
+  /// On isolation the NMPC or INDI is reconfigured (the nominal, passive and LQR controllers cannot
+  /// be); the flatness planner holds and re-plans on any detection.
+  FddKind fdd = FddKind::kNone;
   fdd::CompositeFddOptions composite_fdd;
   fdd::FixedTimeFddOptions fixed_time_fdd;
   fdd::UkfFddOptions ukf_fdd;
@@ -96,11 +161,41 @@ struct FlightStackOptions {
   SupervisorOptions supervisor;
   /// Throws ValidationError naming the field.
   void Validate() const;
+
+  /// The keys of a scenario's `stack` (docs/scenarios.md). The fault detectors' IMU and the
+  /// mapper's LiDAR mount and inflation radius are hardware facts, set from the sensors, not keys.
+  template <typename Archive>
+  void Serialize(Archive* a);
 };
 
 /// The INDI options as the stack builds the controller: sampled at control_rate_hz, flying with
 /// the `nominal` gains until a failure.
 control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& options);
+
+template <typename Archive>
+void FlightStackOptions::Serialize(Archive* a) {
+  a->Visit("controller", &controller, {.meaning = "the controller (docs/control.md)"});
+  a->Visit("control_rate_hz", &control_rate_hz, {.meaning = "the controller's rate [Hz], at most sim.physics_rate_hz"});
+  a->Visit("nominal", &nominal, {.meaning = "the nominal cascade's gains"});
+  a->Visit("passive", &passive, {.meaning = "the passive controller: stack.nominal's position gains and its own"});
+  // INDI's filters are checked against the control rate it samples at.
+  a->Visit("indi", &indi, {.meaning = "the INDI baseline: position gains after a failure and its own"},
+           [this] { IndiOptionsInStack(*this).Validate(); });
+  a->Visit("nmpc", &nmpc, {.meaning = "the NMPC (docs/control.md)"});
+  a->Visit("fdd", &fdd, {.meaning = "fault detection; an isolation reconfigures the NMPC or INDI (docs/fdd.md)"});
+  a->Visit("composite_fdd", &composite_fdd, {.meaning = "the composite FDD's thresholds (paper 000, eqs. 13-18)"});
+  a->Visit("deskew_frames", &lidar.deskew_frames, {.meaning = "deskew each LiDAR frame to its end pose before mapping"});
+  a->Visit("supervisor", &supervisor, {.meaning = "flight modes and emergency landing (docs/navigation.md)"});
+  a->Visit("planner", &navigation, {.meaning = "the navigate mission's planner (docs/planning.md)", .shorthand = "method"},
+           [this] {
+             navigation.replanner.WidenPlaneSearch();
+             navigation.Validate();
+           });
+  a->Visit("flatness", &navigation.flatness, {.meaning = "paper 004's planner (docs/flatness.md)"});
+  a->Visit("map", &lidar, {.meaning = "the LiDAR occupancy map (docs/perception.md)"});
+  a->Visit("known_faults", &known_faults,
+           {.meaning = "failures handed to the NMPC, INDI or assembly controller at their times, without detection"});
+}
 
 /// Wall-clock time the stack's parts have taken so far [s]: where a flight's computation goes
 /// (the on-board budget, and the Monte Carlo one). The rest of the stack (estimator, FDD,

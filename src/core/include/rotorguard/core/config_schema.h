@@ -1,0 +1,112 @@
+#pragma once
+/// Config keys declared once, next to the fields they set (Drake's `Serialize(Archive*)`): an
+/// options struct lists its keys in a member template
+///
+///     template <typename Archive>
+///     void Serialize(Archive* a) {
+///       a->Visit("horizon_steps", &horizon_steps, {.meaning = "N: prediction steps", .min = 1, .max = 200});
+///       a->Visit("q_position", &q_position, {.meaning = "Q_p of eq. (10)"});
+///     }
+///
+/// and every archive walks that one list: the strict YAML reader (io/config_archive.h), the JSON
+/// reader and writer, and the writer of the documentation's key tables. The modules that declare
+/// keys know no archive and no file format: this header is all they include.
+///
+/// Enums that config files name (controller, fault detection, planner, mission) declare their
+/// names once too, as a table found by `NamesOf`, from which parsing, printing and the list of
+/// accepted words all come.
+#include <array>
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rotorguard {
+
+/// What a key means and accepts: its row in the documentation and the loader's range check.
+struct KeyInfo {
+  /// The documentation's "meaning" column (units in the key's name or here).
+  const char* meaning = "";
+  /// Numbers (and each element of a vector of numbers) must lie in [min, max] ...
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  /// ... and, when set, be > 0 (min is then not used).
+  bool positive = false;
+  /// The key must be present (the loader reports it missing); else absent keys keep the default.
+  bool required = false;
+  /// For a block: the key a plain scalar in place of the block sets (`planner: flatness` for
+  /// `planner: {method: flatness}`); none when the block must be a map.
+  const char* shorthand = nullptr;
+  /// The documentation's default and rule, when the value's own would mislead (a default that
+  /// depends on another key, a range that does); none: written from the value and the range.
+  const char* default_text = nullptr;
+  const char* rule_text = nullptr;
+};
+
+/// A name of an enum's value, as config files write it.
+template <typename E>
+struct EnumName {
+  E value;
+  const char* name;
+};
+
+/// The names of E's values, in the order shown to users: an ADL-found `NamesOf(const E*)` that
+/// returns a span of EnumName<E>, declared next to the enum.
+template <typename E>
+std::span<const EnumName<E>> EnumNames() {
+  return NamesOf(static_cast<const E*>(nullptr));
+}
+
+/// Whether E declares its names (NamesOf).
+template <typename E>
+concept NamedEnum = requires { NamesOf(static_cast<const E*>(nullptr)); };
+
+/// The name of `value`; "" for a value without one (never for a table that lists them all).
+template <NamedEnum E>
+const char* ToName(E value) {
+  for (const EnumName<E>& n : EnumNames<E>()) {
+    if (n.value == value) return n.name;
+  }
+  return "";
+}
+
+/// The value named `name`, if any.
+template <NamedEnum E>
+std::optional<E> FromName(std::string_view name) {
+  for (const EnumName<E>& n : EnumNames<E>()) {
+    if (name == n.name) return n.value;
+  }
+  return std::nullopt;
+}
+
+/// Every name, in order.
+template <NamedEnum E>
+std::vector<std::string> NameList() {
+  std::vector<std::string> names;
+  for (const EnumName<E>& n : EnumNames<E>()) names.emplace_back(n.name);
+  return names;
+}
+
+/// An angle kept in radians but written in degrees in config files (`theta_max_deg`): the reader
+/// converts, the documentation shows degrees.
+struct DegreesOf {
+  double* radians;
+};
+
+/// Two numbers written as one key's list [lo, hi] (`altitude_band_m: [0.5, 2.5]`).
+struct PairOf {
+  double* first;
+  double* second;
+};
+
+/// Three numbers written as one key's list [x, y, z] (`size_m: [6, 3, 1]`).
+struct TripleOf {
+  double* x;
+  double* y;
+  double* z;
+};
+
+}  // namespace rotorguard

@@ -1,0 +1,109 @@
+#pragma once
+/// The keys that are a scenario's own, each declared once (core/config_schema.h): views that point
+/// into a Scenario. The other sections' keys are declared by the options structs of the modules
+/// they configure (stack::FlightStackOptions, sim::ImuOptions, planning::LemniscateOptions, ...).
+/// The loader reads through these declarations and docs/scenarios.md's key tables are written
+/// from them (ScenarioKeyTables).
+#include <filesystem>
+#include <string>
+
+#include "rotorguard/core/config_schema.h"
+#include "rotorguard/harness/scenario.h"
+
+namespace rotorguard::harness {
+
+/// The top level's scalars.
+struct HeaderKeys {
+  Scenario* s;
+  std::string description;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("name", &s->name, {.meaning = "label used in outputs", .default_text = "the file's name"});
+    a->Visit("description", &description, {.meaning = "free text"});
+    a->Visit("duration_s", &s->duration_s, {.meaning = "simulated time [s]", .min = 1e-3, .max = 1e6, .required = true});
+    a->Visit("seed", &s->seed, {.meaning = "the same seed gives the same log.csv, byte for byte"});
+  }
+};
+
+/// `initial`: where the flight starts.
+struct InitialKeys {
+  Scenario* s;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("position_m", &s->initial_position_m,
+             {.meaning = "start position [m]; z = 0 starts landed (motors idle), z > 0 in hover", .rule_text = "z ≥ 0"});
+    a->Visit("yaw_rad", &s->initial_yaw_rad, {.meaning = "start heading [rad]"});
+  }
+};
+
+/// `sim`: the simulation's own settings.
+struct SimKeys {
+  Scenario* s;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("physics_rate_hz", &s->sim.physics_rate_hz,
+             {.meaning = "RK4 rate [Hz]; the step must be at most half the fastest motor time constant"});
+    a->Visit("log_rate_hz", &s->log_rate_hz, {.meaning = "rows per second in log.csv, at most the physics rate"});
+    a->Visit("crash_speed_m_s", &s->sim.crash_speed_m_s, {.meaning = "touching the ground faster is a crash [m/s]"});
+    a->Visit("crash_tilt_rad", &s->sim.crash_tilt_rad, {.meaning = "touching the ground more tilted is a crash [rad]"});
+  }
+};
+
+/// `sensors`: what the stack receives (docs/perception.md for the LiDAR).
+struct SensorsKeys {
+  sim::SimulatorOptions* o;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("imu", &o->imu, {.meaning = "the IMU"});
+    a->Visit("esc", &o->esc, {.meaning = "the ESCs' speed telemetry"});
+    a->Visit("odometry", &o->odometry, {.meaning = "the odometry front end"});
+    // A LiDAR is checked with the simulation, and only when it is on (SimulatorOptions::Validate).
+    a->Visit("lidar", &o->lidar, {.meaning = "the simulated Livox MID-360; off without this block"}, [] {});
+  }
+};
+
+/// `metrics`: the tracking window and the success rule (docs/metrics.md).
+struct MetricsKeys {
+  Scenario* s;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("tracking_start_s", &s->tracking_start_s,
+             {.meaning = "tracking metrics cover [tracking_start_s, tracking_end_s]", .min = 0.0, .max = s->duration_s,
+              .rule_text = "in [0, duration_s]"});
+    a->Visit("tracking_end_s", &s->tracking_end_s,
+             {.meaning = "the window's end, at least one physics step after tracking_start_s", .min = 0.0,
+              .max = s->duration_s, .default_text = "the flight's end; an assembly_plan's: its plan's duration",
+              .rule_text = "in [0, duration_s]"});
+    a->Visit("success_error_m", &s->success_error_m,
+             {.meaning = "a run succeeds when |p - p_ref| stays at or below this [m] ...", .positive = true});
+    a->Visit("success_hold_s", &s->success_hold_s,
+             {.meaning = "... over the flight's last success_hold_s [s]", .min = 0.0, .max = s->duration_s,
+              .rule_text = "in [0, duration_s]"});
+    a->Visit("recovered_tilt_rad", &s->recovered_tilt_rad,
+             {.meaning = "roll and pitch count as recovered once the tilt stays below this [rad] (tilt_recovery_s)",
+              .min = 1e-3, .max = 1.5});
+  }
+};
+
+/// `stack`: the flight stack's keys and the assembly controller's reallocation.
+struct StackKeys {
+  Scenario* s;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    s->stack.Serialize(a);
+    a->Visit("assembly", &s->allocation, {.meaning = "controller assembly's reallocation (docs/modular.md)"});
+  }
+};
+
+/// docs/scenarios.md's key tables: a Markdown section per block (the top level, initial, sim,
+/// sensors, wind, world, metrics, each mission type, stack), every key with its default, what it
+/// accepts and its meaning, written from the declarations above and the modules' own.
+std::string ScenarioKeyTables();
+
+}  // namespace rotorguard::harness

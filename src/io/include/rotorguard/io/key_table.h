@@ -1,0 +1,164 @@
+#pragma once
+/// The documentation's key tables, written from the keys options structs declare
+/// (core/config_schema.h): one row per key with its path, its default (the struct's value), the
+/// values it accepts and its meaning, so that docs/scenarios.md cannot drift from the loader.
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <Eigen/Core>
+#include <fmt/format.h>
+
+#include "rotorguard/core/config_schema.h"
+
+namespace rotorguard::io {
+
+/// One key of a table.
+struct KeyRow {
+  std::string key;      ///< dotted path below the table's section, "weights.time", "known_faults[].rotor"
+  std::string value;    ///< the default, as a file would write it ("" for none) ...
+  bool value_is_prose = false;  ///< ... or in words (a default that depends on other keys)
+  std::string rule;     ///< what it accepts
+  std::string meaning;
+};
+
+/// Collects a struct's rows: `value.Serialize(&writer)`, nested blocks and lists of blocks
+/// flattened into dotted paths.
+class KeyTableWriter {
+ public:
+  explicit KeyTableWriter(std::string prefix = "") : prefix_(std::move(prefix)) {}
+
+  template <typename T, typename... Rest>
+  void Visit(const char* key, T* value, const KeyInfo& info = {}, Rest&&...) {
+    const std::string path = prefix_ + key;
+    if constexpr (requires { value->Serialize(this); }) {
+      if (info.shorthand != nullptr) {
+        Add(path, "", fmt::format("a map, or the value of `{}` alone", info.shorthand), info.meaning);
+      }
+      KeyTableWriter nested(path + ".");
+      value->Serialize(&nested);
+      rows_.insert(rows_.end(), nested.rows_.begin(), nested.rows_.end());
+    } else if constexpr (IsBlockList<T>::value) {
+      Add(path, "none", "a list of maps", info.meaning);
+      typename T::value_type item{};
+      KeyTableWriter nested(path + "[].");
+      item.Serialize(&nested);
+      rows_.insert(rows_.end(), nested.rows_.begin(), nested.rows_.end());
+    } else {
+      Add(path, info.default_text ? info.default_text : Text(*value), RuleOf(*value, info), info.meaning,
+          info.default_text != nullptr);
+    }
+  }
+  void Visit(const char* key, DegreesOf angle, const KeyInfo& info) {
+    Add(prefix_ + key, Number(*angle.radians * 180.0 / 3.14159265358979323846),
+        info.rule_text ? info.rule_text : fmt::format("in ({}, {}) deg", Number(info.min), Number(info.max)),
+        info.meaning);
+  }
+  void Visit(const char* key, TripleOf t, const KeyInfo& info) {
+    Add(prefix_ + key, fmt::format("[{}, {}, {}]", Number(*t.x), Number(*t.y), Number(*t.z)),
+        info.rule_text ? info.rule_text : "three numbers", info.meaning);
+  }
+  void Visit(const char* key, PairOf pair, const KeyInfo& info) {
+    Add(prefix_ + key, fmt::format("[{}, {}]", Number(*pair.first), Number(*pair.second)),
+        info.rule_text ? info.rule_text : "two numbers", info.meaning);
+  }
+
+  const std::vector<KeyRow>& rows() const { return rows_; }
+
+ private:
+  template <typename T>
+  struct IsBlockList : std::false_type {};
+  template <typename T>
+  struct IsBlockList<std::vector<T>> : std::bool_constant<requires(T* t, KeyTableWriter* w) { t->Serialize(w); }> {};
+
+  void Add(std::string key, std::string value, std::string rule, const char* meaning, bool prose = false) {
+    rows_.push_back({std::move(key), std::move(value), prose, std::move(rule), meaning});
+  }
+
+  static std::string Number(double v) {
+    if (v == std::numeric_limits<double>::infinity()) return "inf";
+    return fmt::format("{}", v);
+  }
+  static std::string Text(double v) { return Number(v); }
+  static std::string Text(const std::optional<double>& v) { return v ? Number(*v) : "unset"; }
+  static std::string Text(int v) { return std::to_string(v); }
+  static std::string Text(std::uint64_t v) { return std::to_string(v); }
+  static std::string Text(bool v) { return v ? "true" : "false"; }
+  static std::string Text(const std::string& v) { return v; }
+  template <int N>
+  static std::string Text(const Eigen::Matrix<double, N, 1>& v) {
+    std::vector<std::string> items;
+    for (int i = 0; i < v.size(); ++i) items.push_back(Number(v[i]));
+    return fmt::format("[{}]", fmt::join(items, ", "));
+  }
+  static std::string Text(const std::vector<Eigen::Vector3d>& v) { return v.empty() ? "none" : "a list"; }
+  template <NamedEnum E>
+  static std::string Text(E v) {
+    return ToName(v);
+  }
+
+  template <typename T>
+  static std::string RuleOf(const T&, const KeyInfo& info) {
+    std::string rule;
+    if (info.rule_text != nullptr) {
+      rule = info.rule_text;
+    } else if constexpr (NamedEnum<T>) {
+      std::vector<std::string> names;
+      for (const std::string& n : NameList<T>()) names.push_back("`" + n + "`");
+      rule = fmt::format("one of {}", fmt::join(names, ", "));
+    } else if constexpr (std::is_same_v<T, bool>) {
+      rule = "true or false";
+    } else if constexpr (std::is_same_v<T, std::vector<Eigen::Vector3d>>) {
+      rule = "a non-empty list of [x, y, z]";
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      rule = "text";
+    } else if constexpr (std::is_same_v<T, Eigen::Vector2d>) {
+      rule = "[x, y]";
+    } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+      rule = "[x, y, z]";
+    } else if constexpr (std::is_same_v<T, Eigen::Vector4d>) {
+      rule = "four numbers";
+    } else {
+      constexpr double kInf = std::numeric_limits<double>::infinity();
+      const bool integer = std::is_integral_v<T>;
+      if (info.positive) {
+        rule = "> 0";
+      } else if (info.min > -kInf && info.max < kInf) {
+        rule = fmt::format("in [{}, {}]", Number(info.min), Number(info.max));
+      } else if (info.min > -kInf) {
+        rule = fmt::format("≥ {}", Number(info.min));
+      } else if (info.max < kInf) {
+        rule = fmt::format("≤ {}", Number(info.max));
+      }
+      if (integer) {
+        rule = rule.empty() ? "an integer" : "an integer " + rule;
+      } else if (rule.empty()) {
+        rule = "a number";
+      }
+    }
+    return info.required ? (rule.empty() ? "**required**" : "**required**, " + rule) : rule;
+  }
+
+  std::string prefix_;
+  std::vector<KeyRow> rows_;
+};
+
+/// A Markdown table of `rows`, each key prefixed by `section` ("stack.nmpc."): | key | default | rule | meaning |.
+inline std::string KeyTableMarkdown(const std::vector<KeyRow>& rows, const std::string& section) {
+  const auto cell = [](std::string text) {  // a '|' would end the cell
+    for (std::size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2)) text.insert(at, "\\");
+    return text;
+  };
+  std::string md = "| key | default | accepts | meaning |\n|---|---|---|---|\n";
+  for (const KeyRow& r : rows) {
+    const std::string value = r.value.empty() || r.value_is_prose ? r.value : "`" + r.value + "`";
+    md += fmt::format("| `{}{}` | {} | {} | {} |\n", section, r.key, cell(value), cell(r.rule), cell(r.meaning));
+  }
+  return md;
+}
+
+}  // namespace rotorguard::io

@@ -1,0 +1,253 @@
+// The scenario loader on hand-written files: every section's keys land in the fields they name
+// (the oracle is the file's own numbers), absent keys keep the options structs' defaults, errors
+// name the file, line and key, the mission comes back as a value, and docs/scenarios.md's key
+// tables are the ones the loader reads.
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "rotorguard/harness/assembly_mission.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/harness/scenario_keys.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/io/json_archive.h"
+#include "rotorguard/planning/references.h"
+#include "test_util.h"
+
+namespace rotorguard::harness {
+namespace {
+
+const std::string kVehicle = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml";
+
+class ScenarioLoader : public testing::TempFolderTest {
+ protected:
+  /// A scenario file of the reference vehicle with `body` after its first lines.
+  std::string File(const std::string& body, const std::string& name = "s.yaml") {
+    return Write(name, "vehicle: " + kVehicle + "\nduration_s: 10\n" + body);
+  }
+  /// The message of the ConfigError loading `body` raises ("(no error)" without one).
+  std::string Error(const std::string& body) {
+    try {
+      LoadScenario(File(body));
+    } catch (const io::ConfigError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+};
+
+TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
+  const Scenario s = LoadScenario(File("mission: {type: hover}\n"));
+  EXPECT_EQ(s.name, "s");  // the file's name
+  EXPECT_EQ(s.seed, 1u);
+  EXPECT_EQ(s.mission_kind, MissionKind::kHover);
+  // Every stack key at its default: compared through the keys' own JSON, so a new key counts too.
+  stack::FlightStackOptions defaults;
+  EXPECT_EQ(io::ToJson(s.stack), io::ToJson(defaults));
+  EXPECT_EQ(io::ToJson(s.sim.imu), io::ToJson(sim::ImuOptions{}));
+  EXPECT_FALSE(s.sim.lidar.enabled);
+  EXPECT_EQ(s.success_error_m, 0.5);
+  EXPECT_FALSE(s.tracking_end_s.has_value());
+}
+
+TEST_F(ScenarioLoader, EverySectionsKeysLandInTheirFields) {
+  const Scenario s = LoadScenario(File(R"(seed: 42
+initial: {position_m: [1, 2, 3], yaw_rad: 0.5}
+sim: {physics_rate_hz: 2000, log_rate_hz: 50}
+sensors:
+  imu: {rate_hz: 400}
+  odometry: {outages: [{start_s: 2, duration_s: 0.5}]}
+  lidar: {frame_rate_hz: 5}
+wind: {gust_std_m_s: 0.2}
+world:
+  cylinders: [{center_m: [4, 5], radius_m: 0.2, height_m: 3}]
+mission: {type: navigate, waypoints_m: [[3, 0, 1], [6, 0, 1]], rounds: 2}
+stack:
+  controller: nmpc
+  fdd: composite
+  nmpc: {horizon_steps: 15, q_attitude: [1, 2, 3, 4]}
+  composite_fdd: {motor_index_samples: 3}
+  planner: {rate_hz: 5, v_max: 1.5, altitude_band_m: [0.8, 2.0], weights: {time: 20}, clearance_m: 0.8}
+  flatness: {theta_max_deg: 15}
+  map: {clearing_stride: 2, inflation_margin_m: 0.2}
+  deskew_frames: false
+  known_faults: [{rotor: 2, at_time_s: 1.5}]
+metrics: {tracking_start_s: 1, success_hold_s: 3}
+)"));
+  EXPECT_EQ(s.seed, 42u);
+  EXPECT_EQ(s.initial_position_m, Vector3(1, 2, 3));
+  EXPECT_EQ(s.initial_yaw_rad, 0.5);
+  EXPECT_EQ(s.sim.physics_rate_hz, 2000.0);
+  EXPECT_EQ(s.log_rate_hz, 50.0);
+  EXPECT_EQ(s.sim.imu.rate_hz, 400.0);
+  ASSERT_EQ(s.sim.odometry.outages.size(), 1u);
+  EXPECT_EQ(s.sim.odometry.outages[0].duration_s, 0.5);
+  EXPECT_TRUE(s.sim.lidar.enabled) << "a lidar block switches the sensor on";
+  EXPECT_EQ(s.sim.lidar.frame_rate_hz, 5.0);
+  EXPECT_EQ(s.sim.wind.gust_std_m_s, 0.2);
+  ASSERT_EQ(s.world.cylinders.size(), 1u);
+  EXPECT_EQ(s.world.cylinders[0].center_m, Eigen::Vector2d(4, 5));
+  // The mission's waypoints are what the stack's navigation flies.
+  EXPECT_EQ(s.mission_kind, MissionKind::kNavigate);
+  EXPECT_EQ(s.stack.navigation.waypoints.size(), 2u);
+  EXPECT_EQ(s.stack.navigation.rounds, 2);
+  EXPECT_EQ(s.stack.controller, stack::ControllerKind::kNmpc);
+  EXPECT_EQ(s.stack.fdd, stack::FddKind::kComposite);
+  EXPECT_EQ(s.stack.nmpc.horizon_steps, 15);
+  EXPECT_EQ(s.stack.nmpc.q_attitude, Eigen::Vector4d(1, 2, 3, 4));
+  EXPECT_EQ(s.stack.composite_fdd.motor_index_samples, 3);
+  EXPECT_EQ(s.stack.navigation.planner_rate_hz, 5.0);
+  EXPECT_EQ(s.stack.navigation.replanner.nominal.v_max, 1.5);
+  EXPECT_EQ(s.stack.navigation.replanner.planner.search.z_min_m, 0.8);
+  EXPECT_EQ(s.stack.navigation.replanner.planner.search.z_max_m, 2.0);
+  EXPECT_EQ(s.stack.navigation.replanner.planner.optimizer.weights.time, 20.0);
+  EXPECT_EQ(s.stack.navigation.replanner.planner.optimizer.weights.smoothness, 1.0) << "the others keep theirs";
+  EXPECT_EQ(s.stack.navigation.replanner.planner.plane_search_m, 0.8) << "widened to the clearance kept";
+  EXPECT_NEAR(s.stack.navigation.flatness.limits.theta_max_rad, 15.0 * std::numbers::pi / 180.0, 1e-15);
+  EXPECT_EQ(s.stack.lidar.map.clearing_stride, 2);
+  EXPECT_FALSE(s.stack.lidar.deskew_frames);
+  // The inflation radius follows the vehicle's collision radius (0.2 m) and the margin.
+  EXPECT_NEAR(s.stack.lidar.map.inflation_radius_m, 0.4, 1e-15);
+  ASSERT_EQ(s.stack.known_faults.size(), 1u);
+  EXPECT_EQ(s.stack.known_faults[0].rotor, 2);
+  EXPECT_EQ(s.stack.known_faults[0].at_time_s, 1.5);
+  EXPECT_EQ(s.stack.known_faults[0].loss, 1.0);
+  // The fault detectors know the IMU that the sensors section describes.
+  EXPECT_EQ(s.stack.composite_fdd.imu_rate_hz, 400.0);
+  EXPECT_EQ(s.tracking_start_s, 1.0);
+  EXPECT_EQ(s.success_hold_s, 3.0);
+}
+
+TEST_F(ScenarioLoader, APlannerWordIsShortForItsMethod) {
+  // Paper 004's planner needs a vehicle with a PWM model.
+  const Scenario s = LoadScenario(Write("q.yaml", "vehicle: " + std::string(ROTORGUARD_SOURCE_DIR) +
+                                                      "/configs/vehicles/qball_x4.yaml\nduration_s: 10\n"
+                                                      "mission: {type: hover}\nstack: {planner: flatness}\n"));
+  EXPECT_EQ(s.stack.navigation.method, stack::NavigationMethod::kFlatness);
+  EXPECT_NE(Error("mission: {type: hover}\nstack: {planner: astar}\n").find("expected one of: minco, flatness"),
+            std::string::npos);
+}
+
+TEST_F(ScenarioLoader, TheMissionComesBackAsAValue) {
+  const io::ConfigDocument doc =
+      io::ConfigDocument::LoadString("type: lemniscate\nmax_speed_m_s: 1.5\nsize_m: [4, 2, 0]\n", "m.yaml");
+  const Mission m = ParseMission(doc.root(), Vector3(0, 0, 2), 0.3);
+  EXPECT_EQ(m.kind, MissionKind::kLemniscate);
+  const auto* lemniscate = dynamic_cast<const planning::LemniscateReference*>(m.reference.get());
+  ASSERT_NE(lemniscate, nullptr);
+  EXPECT_EQ(lemniscate->options().center_m, Vector3(0, 0, 2)) << "the centre defaults to the start";
+  EXPECT_EQ(lemniscate->options().yaw_rad, 0.3) << "the heading too";
+  EXPECT_EQ(lemniscate->options().size_x_m, 4.0);
+  EXPECT_EQ(lemniscate->options().size_z_m, 0.0);
+  EXPECT_FALSE(m.navigate.has_value());
+  // Waypoints start where the vehicle does.
+  const io::ConfigDocument w = io::ConfigDocument::LoadString("type: waypoints\nwaypoints_m: [[1, 0, 2]]\nmax_speed_m_s: 1\n", "w.yaml");
+  const Mission waypoints = ParseMission(w.root(), Vector3(0, 0, 2), 0.0);
+  const auto* legs = dynamic_cast<const planning::WaypointReference*>(waypoints.reference.get());
+  ASSERT_NE(legs, nullptr);
+  ASSERT_EQ(legs->options().waypoints_m.size(), 2u);
+  EXPECT_EQ(legs->options().waypoints_m.front(), Vector3(0, 0, 2));
+}
+
+TEST_F(ScenarioLoader, AnAssemblysPlanIsMadeAfterLoadingNotInIt) {
+  std::string text = io::ReadInputFile(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/mars_plan_4x1.yaml");
+  text.replace(text.find("../assemblies/"), 14, std::string(ROTORGUARD_SOURCE_DIR) + "/configs/assemblies/");
+  Scenario s = LoadScenario(Write("plan.yaml", text));
+  ASSERT_TRUE(s.assembly_plan.has_value());
+  EXPECT_EQ(s.reference, nullptr);
+  EXPECT_EQ(s.assembly_plan->method, AssemblyPlanMethod::kOurs);
+  PlanMission(&s);
+  ASSERT_NE(s.reference, nullptr);
+  EXPECT_GT(s.reference->duration(), 1.0);
+  const std::shared_ptr<const ReferenceTrajectory> plan = s.reference;
+  PlanMission(&s);  // planned once
+  EXPECT_EQ(s.reference, plan);
+}
+
+TEST_F(ScenarioLoader, ErrorsNameTheFileLineAndKey) {
+  std::string m = Error("mission: {type: hover}\nstack:\n  nmpc: {horizon_steps: 0}\n");
+  EXPECT_NE(m.find("s.yaml:5:"), std::string::npos) << m;
+  EXPECT_NE(m.find("stack.nmpc.horizon_steps"), std::string::npos) << m;
+  EXPECT_NE(m.find("[1, 200]"), std::string::npos) << m;
+  // A block's own rule, found after reading it, at the key that broke it.
+  m = Error("mission: {type: hover}\nstack:\n  fdd: composite\n  composite_fdd: {motor_index_threshold: -1}\n");
+  EXPECT_NE(m.find("s.yaml:6:"), std::string::npos) << m;
+  EXPECT_NE(m.find("stack.composite_fdd.motor_index_threshold"), std::string::npos) << m;
+  m = Error("mission: {type: hover}\nstack:\n  planner: {weights: {time: 1, speed: 2}}\n");
+  EXPECT_NE(m.find("stack.planner.weights.speed: unknown key 'speed'; expected one of: time, smoothness, "
+                   "feasibility, collision"),
+            std::string::npos)
+      << m;
+  m = Error("mission: {type: cruise}\n");
+  EXPECT_NE(m.find("hover, takeoff, lemniscate, circle, waypoints, navigate, assembly_plan"), std::string::npos) << m;
+  m = Error("mission: {type: lemniscate}\n");
+  EXPECT_NE(m.find("missing required key 'max_speed_m_s'"), std::string::npos) << m;
+  m = Error("mission: {type: hover}\nstack: {known_faults: [{rotor: 1}]}\n");
+  EXPECT_NE(m.find("missing required key 'at_time_s'"), std::string::npos) << m;
+  m = Error("mission: {type: hover}\nstack: {known_faults: {rotor: 1}}\n");
+  EXPECT_NE(m.find("expected a list of {rotor, at_time_s, loss}"), std::string::npos) << m;
+  m = Error("mission: {type: hover}\nstack: {flatness: {theta_max_deg: 95}}\n");
+  EXPECT_NE(m.find("theta_max_deg = 95 is invalid; expected an angle in (0, 90) deg"), std::string::npos) << m;
+  m = Error("mission: {type: hover}\nworld: {boxes: [{center_m: [0, 0, 1], size_m: [1, 0, 1]}]}\n");
+  EXPECT_NE(m.find("world.boxes.0.size_m: box sizes must be > 0 m"), std::string::npos) << m;
+}
+
+TEST_F(ScenarioLoader, VehicleOverridesApplyToTheVehicleFile) {
+  const Scenario s = LoadScenario(File("mission: {type: hover}\n"), {{"vehicle.mass_kg", "1.3"}});
+  EXPECT_EQ(s.vehicle.mass_kg, 1.3);
+  RG_EXPECT_THROW_WITH(LoadScenario(File("mission: {type: hover}\n"), {{"vehicle.mass", "1.3"}}), io::ConfigError,
+                       "vehicle.mass");
+}
+
+/// The keys a block's unknown-key error lists, from its message.
+std::vector<std::string> ListedKeys(const std::string& message) {
+  std::vector<std::string> keys;
+  std::stringstream list(message.substr(message.find("expected one of: ") + 17));
+  for (std::string k; std::getline(list, k, ',');) keys.push_back(k.substr(k.find_first_not_of(' ')));
+  return keys;
+}
+
+// The tables cover exactly the keys the loader takes: a block's unknown-key error lists them.
+TEST_F(ScenarioLoader, KeyTablesListEveryKeyTheLoaderTakes) {
+  const std::string tables = ScenarioKeyTables();
+  for (const std::string block : {"stack", "stack.nmpc", "stack.planner", "sensors.lidar", "metrics", "initial"}) {
+    std::string yaml = "mission: {type: hover}\n";
+    std::string indent;
+    std::size_t start = 0;
+    for (std::size_t dot = block.find('.'); ; dot = block.find('.', start)) {
+      yaml += indent + block.substr(start, dot == std::string::npos ? std::string::npos : dot - start) + ":\n";
+      indent += "  ";
+      if (dot == std::string::npos) break;
+      start = dot + 1;
+    }
+    yaml += indent + "no_such_key: 1\n";
+    const std::vector<std::string> keys = ListedKeys(Error(yaml));
+    ASSERT_FALSE(keys.empty()) << block;
+    for (const std::string& k : keys) {
+      EXPECT_NE(tables.find("`" + block + "." + k), std::string::npos) << block << "." << k << " is not documented";
+    }
+  }
+}
+
+// docs/scenarios.md holds the tables the code writes (`rotorguard keys`), unedited.
+TEST(ScenarioDocs, TheKeyTablesAreTheCodes) {
+  std::ifstream in(std::string(ROTORGUARD_SOURCE_DIR) + "/docs/scenarios.md");
+  std::stringstream doc;
+  doc << in.rdbuf();
+  const std::string text = doc.str();
+  const std::string begin = "<!-- BEGIN rotorguard keys: generated, do not edit by hand -->\n";
+  const std::string end = "<!-- END rotorguard keys -->";
+  const std::size_t a = text.find(begin), b = text.find(end);
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  EXPECT_EQ(text.substr(a + begin.size(), b - a - begin.size()), ScenarioKeyTables())
+      << "docs/scenarios.md's key tables are out of date: replace the lines between the markers with the output "
+         "of `rotorguard keys`";
+}
+
+}  // namespace
+}  // namespace rotorguard::harness
