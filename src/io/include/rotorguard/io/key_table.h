@@ -149,9 +149,13 @@ class KeyTableWriter {
 
 /// A Markdown table of `rows`, each key prefixed by `section` ("stack.nmpc."): | key | default | rule | meaning |.
 inline std::string KeyTableMarkdown(const std::vector<KeyRow>& rows, const std::string& section) {
-  const auto cell = [](std::string text) {  // a '|' would end the cell
-    for (std::size_t at = text.find('|'); at != std::string::npos; at = text.find('|', at + 2)) text.insert(at, "\\");
-    return text;
+  const auto cell = [](const std::string& text) {  // a '|' would end the cell
+    std::string escaped;
+    for (const char c : text) {
+      if (c == '|') escaped.push_back('\\');
+      escaped.push_back(c);
+    }
+    return escaped;
   };
   std::string md = "| key | default | accepts | meaning |\n|---|---|---|---|\n";
   for (const KeyRow& r : rows) {
