@@ -1,7 +1,7 @@
 # rotorguard_module(NAME SOURCES ... DEPENDS ... [PRIVATE_DEPENDS ...])
 # One static library per module, target rotorguard_<name> with alias rotorguard::<name>.
 # Public headers live in src/<name>/include/rotorguard/<name>/; a module sees another module's
-# headers only if it links that module, so the layering of DESIGN.md is enforced by the build.
+# headers only if it links that module, so the layering of docs/architecture.md is enforced by the build.
 set(ROTORGUARD_MODULES "" CACHE INTERNAL "")
 function(rotorguard_module name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS;PRIVATE_DEPENDS" ${ARGN})

@@ -18,6 +18,7 @@ packages=(
   chromium             # headless browser of the report's browser test (viewer/test)
   slurm-wlm munge      # campaigns as Slurm job arrays; a single-node cluster in tests (scripts/local-slurm.sh)
   parallel             # GNU parallel: campaign shards across machines over ssh
+  python3              # scripts/: the layering check (a test) and the behaviour snapshot
 )
 # Node.js and npm build the report viewer (viewer/); a machine that has them already keeps its own.
 if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then

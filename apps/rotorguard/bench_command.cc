@@ -1,9 +1,10 @@
 // rotorguard bench NAME: the papers' benchmarks and the project's own, as tables or JSON.
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <optional>
 
-#include <fmt/format.h>
-
+#include "cli.h"
 #include "rotorguard/benchmarks/campaign_bench.h"
 #include "rotorguard/benchmarks/flatness_bench.h"
 #include "rotorguard/benchmarks/ftc_bench.h"
@@ -20,7 +21,6 @@
 #include "rotorguard/io/files.h"
 #include "rotorguard/io/report_html.h"
 #include "rotorguard/record/report.h"
-#include "cli.h"
 
 namespace rotorguard::cli {
 
@@ -50,17 +50,18 @@ class BenchCommand final : public Command {
                                 "run folder (default out/nav_KIND_SEED)"
                               : "Keep the trials' records (results.jsonl, manifest.json) and the result\n"
                                 "(bench.json, bench.md) in this folder (default: a temporary folder)");
-      b->add_option("--shard", shard_, "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
-                                       "with `campaign merge` when all are done");
+      b->add_option("--shard", shard_,
+                    "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
+                    "with `campaign merge` when all are done");
       b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
     }
     RegisterCampaign(bench);
     // Every benchmark can also write its page: tables and distributions (record/report.h).
     for (CLI::App* b : {sim_, qp_, nmpc_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
       b->add_option("--html", html_, "Also write the result as an HTML page to this file");
-      b->add_flag("--json", json_, b == sim_ || b == qp_ || b == nmpc_ || b == campaign_
-                                       ? "Print JSON instead of a table"
-                                       : "Print JSON instead of Markdown");
+      b->add_flag("--json", json_,
+                  b == sim_ || b == qp_ || b == nmpc_ || b == campaign_ ? "Print JSON instead of a table"
+                                                                        : "Print JSON instead of Markdown");
     }
     return bench;
   }
@@ -81,30 +82,33 @@ class BenchCommand final : public Command {
  private:
   void RegisterSim(CLI::App* bench) {
     sim_ = bench->add_subcommand(
-        "sim", "Closed-loop simulation speed: the 2 m/s lemniscate with all sensors and the nominal "
-               "controller. Reports the median realtime_factor and steps_per_s (target >= 200x real time).");
+        "sim",
+        "Closed-loop simulation speed: the 2 m/s lemniscate with all sensors and the nominal "
+        "controller. Reports the median realtime_factor and steps_per_s (target >= 200x real time).");
     sim_->add_option("--scenario", sim_scenario_, "Scenario to fly (default: configs/scenarios/lemniscate_2ms.yaml)");
     sim_->add_option("--duration", sim_duration_, "Simulated seconds per repetition (default 60)");
     sim_->add_option("--repetitions", sim_repetitions_, "Repetitions; the median is reported (default 5)");
   }
   void RegisterQp(CLI::App* bench) {
-    qp_ = bench->add_subcommand(
-        "qp", "The NMPC's QP solver (condensing + dual active set) on a reference OCP QP instance:\n"
-              "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
-              "iterations_mean and max_u0_error against the instance's optimal u_0.");
+    qp_ = bench->add_subcommand("qp",
+                                "The NMPC's QP solver (condensing + dual active set) on a reference OCP QP instance:\n"
+                                "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
+                                "iterations_mean and max_u0_error against the instance's optimal u_0.");
     qp_->add_option("--instance", qp_instance_, "Instance file (JSON), e.g. a copy of qp_hover_n20.json")->required();
     qp_->add_option("--repetitions", qp_repetitions_, "Solves per case; the median time counts (default 3)");
   }
   void RegisterNmpc(CLI::App* bench) {
     nmpc_ = bench->add_subcommand(
-        "nmpc", "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
-                "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
+        "nmpc",
+        "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
+        "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
   }
   void RegisterFtc(CLI::App* bench) {
     ftc_ = bench->add_subcommand(
-        "ftc", "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
-               "tracking the 2 m/s lemniscate and during take-off, plus fault-free trials for the false-alarm rate.\n"
-               "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).");
+        "ftc",
+        "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
+        "tracking the 2 m/s lemniscate and during take-off, plus fault-free trials for the false-alarm rate.\n"
+        "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).");
     ftc_->add_option("--trials", ftc_trials_, "Trials per cell (default 20, the paper's count)");
     ftc_->add_option("--seed", seed_, "Benchmark seed (default 1); trial seeds derive from it");
     ftc_->add_option("--methods", ftc_methods_,
@@ -113,17 +117,19 @@ class BenchCommand final : public Command {
   }
   void RegisterPerception(CLI::App* bench) {
     perception_ = bench->add_subcommand(
-        "perception", "The simulated MID-360 on a vehicle spinning at 11 rad/s and flying 1 m/s through a 500-tree\n"
-                      "forest and around a room, deskewing on and off: points_per_s_simulated, map_update_ms_mean\n"
-                      "per frame, map precision and recall against the world within one voxel.");
+        "perception",
+        "The simulated MID-360 on a vehicle spinning at 11 rad/s and flying 1 m/s through a 500-tree\n"
+        "forest and around a room, deskewing on and off: points_per_s_simulated, map_update_ms_mean\n"
+        "per frame, map precision and recall against the world within one voxel.");
     perception_->add_option("--duration", perception_duration_, "Simulated seconds per run (default 10)");
     perception_->add_option("--seed", seed_, "Sensor noise and forest layout (default 1)");
   }
   void RegisterPlanner(CLI::App* bench) {
     planner_ = bench->add_subcommand(
-        "planner", "The trajectory planner (A*, MINCO, L-BFGS) on random forests (30 x 20 m) and rooms (10 x 8 m),\n"
-                   "random start/goal pairs, nominal and post-failure limits, on the map of the true world:\n"
-                   "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.");
+        "planner",
+        "The trajectory planner (A*, MINCO, L-BFGS) on random forests (30 x 20 m) and rooms (10 x 8 m),\n"
+        "random start/goal pairs, nominal and post-failure limits, on the map of the true world:\n"
+        "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.");
     planner_->add_option("--pairs", planner_pairs_, "Start/goal pairs per world kind (default 100)");
     planner_->add_option("--worlds", planner_worlds_, "Distinct worlds per kind (default 10, at most --pairs)");
     planner_->add_option("--seed", seed_, "Worlds and pairs (default 1)");
@@ -145,9 +151,10 @@ class BenchCommand final : public Command {
   }
   void RegisterFlatness(CLI::App* bench) {
     flatness_ = bench->add_subcommand(
-        "flatness", "Paper 004: closed-form settling times of Fig. 1 (ts_envelope_s, ts_actuator_s) and the Fig. 2\n"
-                    "flight (configs/scenarios/flatness_fig2.yaml) over many seeds: ukf_w_estimate, ukf_settle_s,\n"
-                    "replan_ts_s against a fault-free re-plan, max_pitch_deg against theta_max.");
+        "flatness",
+        "Paper 004: closed-form settling times of Fig. 1 (ts_envelope_s, ts_actuator_s) and the Fig. 2\n"
+        "flight (configs/scenarios/flatness_fig2.yaml) over many seeds: ukf_w_estimate, ukf_settle_s,\n"
+        "replan_ts_s against a fault-free re-plan, max_pitch_deg against theta_max.");
     flatness_->add_option("--seeds", flatness_seeds_, "Flights of the Fig. 2 scenario (default 20)");
     flatness_->add_option("--seed", seed_, "The first flight's seed (default 1)");
     flatness_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
@@ -167,11 +174,13 @@ class BenchCommand final : public Command {
   }
   void RegisterCampaign(CLI::App* bench) {
     campaign_ = bench->add_subcommand(
-        "campaign", "The campaign engine (docs/campaigns.md): a spec run with one worker and with two\n"
-                    "(trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency), killed and resumed, and\n"
-                    "in 4 shards; each merged summary compared byte for byte with the uninterrupted one.");
+        "campaign",
+        "The campaign engine (docs/campaigns.md): a spec run with one worker and with two\n"
+        "(trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency), killed and resumed, and\n"
+        "in 4 shards; each merged summary compared byte for byte with the uninterrupted one.");
     campaign_->add_option("--spec", campaign_spec_, "Campaign spec (default configs/campaigns/bench_campaign.yaml)");
-    campaign_->add_option("--work", campaign_work_, "A new folder for the runs (default: a temporary one, removed after)");
+    campaign_->add_option("--work", campaign_work_,
+                          "A new folder for the runs (default: a temporary one, removed after)");
   }
 
   /// Writes the result's page when --html asked for one.
@@ -192,7 +201,8 @@ class BenchCommand final : public Command {
   std::optional<nlohmann::json> RunBenchCampaign(const campaign::Campaign& c, const char* name) const {
     campaign::CampaignRunOptions o = CampaignRunOptionsOf(out_, jobs_, shard_, resume_);
     if ((o.resume || o.shard.count > 1) && o.out_dir.empty()) {
-      throw UsageError(fmt::format("{} needs --out: the folder that keeps the trials", o.resume ? "--resume" : "--shard"));
+      throw UsageError(
+          fmt::format("{} needs --out: the folder that keeps the trials", o.resume ? "--resume" : "--shard"));
     }
     o.progress = EtaProgress("trials");
     const std::optional<std::vector<nlohmann::json>> records = campaign::RunCampaignRecords(c, o);
@@ -376,8 +386,8 @@ class BenchCommand final : public Command {
       fmt::print("identical         jobs {}, kill and resume {}, 4 shards {}\n", r["jobs_identical"].get<bool>(),
                  r["resume_identical"].get<bool>(), r["shards_identical"].get<bool>());
     }
-    const bool same = r["jobs_identical"].get<bool>() && r["resume_identical"].get<bool>() &&
-                      r["shards_identical"].get<bool>();
+    const bool same =
+        r["jobs_identical"].get<bool>() && r["resume_identical"].get<bool>() && r["shards_identical"].get<bool>();
     return same ? kOk : kRunFailed;
   }
 

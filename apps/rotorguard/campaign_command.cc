@@ -1,8 +1,9 @@
 // rotorguard campaign run|slurm|merge: Monte Carlo campaigns in crash-safe, resumable shards.
-#include <filesystem>
-
 #include <fmt/format.h>
 
+#include <filesystem>
+
+#include "cli.h"
 #include "rotorguard/benchmarks/registry.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/registry.h"
@@ -10,7 +11,6 @@
 #include "rotorguard/io/files.h"
 #include "rotorguard/io/report_html.h"
 #include "rotorguard/record/report.h"
-#include "cli.h"
 
 namespace rotorguard::cli {
 
@@ -26,9 +26,10 @@ class CampaignCommand final : public Command {
                                              "crash-safe, resumable shards and merged (docs/campaigns.md).");
     campaign->require_subcommand(1);
     run_ = campaign->add_subcommand(
-        "run", "Run a campaign spec's trials (or one shard of them): each finished trial appends a line to\n"
-               "DIR/results.jsonl (results.shard-i.jsonl), synced; DIR/manifest.json records the run.\n"
-               "Exit 0 when every trial ran (a trial's crash or error is recorded, not fatal).");
+        "run",
+        "Run a campaign spec's trials (or one shard of them): each finished trial appends a line to\n"
+        "DIR/results.jsonl (results.shard-i.jsonl), synced; DIR/manifest.json records the run.\n"
+        "Exit 0 when every trial ran (a trial's crash or error is recorded, not fatal).");
     run_->add_option("spec", spec_, "Campaign spec (YAML), e.g. configs/campaigns/ftc_demo.yaml")->required();
     run_->add_option("--out", out_, "Results folder")->required();
     run_->add_option("--jobs", jobs_text_, "Worker threads (default: the number of cores)");
@@ -36,9 +37,10 @@ class CampaignCommand final : public Command {
     run_->add_flag("--resume", resume_, "Continue the results in --out: skip finished trials");
     run_->add_flag("--quiet,-q", quiet_, "No progress line");
     slurm_ = campaign->add_subcommand(
-        "slurm", "Write DIR/campaign.sbatch: a Slurm job array whose task i runs shard i/N of the spec into DIR\n"
-                 "(with --resume, so resubmitting it or its failed tasks is safe). Submit it with sbatch;\n"
-                 "merge DIR when every task is done.");
+        "slurm",
+        "Write DIR/campaign.sbatch: a Slurm job array whose task i runs shard i/N of the spec into DIR\n"
+        "(with --resume, so resubmitting it or its failed tasks is safe). Submit it with sbatch;\n"
+        "merge DIR when every task is done.");
     slurm_->add_option("spec", spec_, "Campaign spec (YAML)")->required();
     slurm_->add_option("--shards", shards_text_, "Array tasks, one shard each")->required();
     slurm_->add_option("--out", out_, "Results folder (on a file system every node sees)")->required();
@@ -46,8 +48,9 @@ class CampaignCommand final : public Command {
     slurm_->add_option("--partition", partition_, "Slurm partition (default: the cluster's)");
     slurm_->add_option("--time", time_, "Slurm time limit per task, e.g. 02:00:00");
     merge_ = campaign->add_subcommand(
-        "merge", "Join the shards in the given folders (every trial exactly once, one spec, one program) and\n"
-                 "write summary.json, summary.md and (with the report viewer) summary.html.");
+        "merge",
+        "Join the shards in the given folders (every trial exactly once, one spec, one program) and\n"
+        "write summary.json, summary.md and (with the report viewer) summary.html.");
     merge_->add_option("dirs", merge_dirs_, "Results folders")->required();
     merge_->add_option("--out", merge_out_, "Where to write the summary (default: the first folder)");
     return campaign;

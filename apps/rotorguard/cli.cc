@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,8 +11,6 @@
 #include <filesystem>
 #include <thread>
 #include <utility>
-
-#include <fmt/format.h>
 
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/io/config_node.h"
@@ -25,16 +24,11 @@ namespace {
 /// Library errors name the option fields they reject ("CampaignRunOptions::jobs = 0 is invalid");
 /// on the command line the user set them with these flags.
 constexpr std::pair<const char*, const char*> kFlagOfField[] = {
-    {"CampaignRunOptions::out_dir", "--out"},
-    {"CampaignRunOptions::resume", "--resume"},
-    {"CampaignRunOptions::jobs", "--jobs"},
-    {"CampaignRunOptions::shard", "--shard"},
-    {"SlurmScriptOptions::shards", "--shards"},
-    {"SlurmScriptOptions::cpus_per_task", "--cpus-per-task"},
-    {"SlurmScriptOptions::out_dir", "--out"},
-    {"SlurmScriptOptions::partition", "--partition"},
-    {"SlurmScriptOptions::time_limit", "--time"},
-    {"FddCalibrationOptions::margin", "--margin"},
+    {"CampaignRunOptions::out_dir", "--out"},     {"CampaignRunOptions::resume", "--resume"},
+    {"CampaignRunOptions::jobs", "--jobs"},       {"CampaignRunOptions::shard", "--shard"},
+    {"SlurmScriptOptions::shards", "--shards"},   {"SlurmScriptOptions::cpus_per_task", "--cpus-per-task"},
+    {"SlurmScriptOptions::out_dir", "--out"},     {"SlurmScriptOptions::partition", "--partition"},
+    {"SlurmScriptOptions::time_limit", "--time"}, {"FddCalibrationOptions::margin", "--margin"},
 };
 
 }  // namespace
@@ -75,8 +69,7 @@ std::uint64_t ParseUnsigned(const std::string& option, const std::string& text, 
 double ParseFinite(const std::string& option, const std::string& text, double lo, double hi) {
   double v = 0.0;
   const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(v) || v < lo ||
-      v > hi) {
+  if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(v) || v < lo || v > hi) {
     throw UsageError(
         fmt::format("{}: '{}' is invalid; expected a finite number in [{:g}, {:g}]", option, text, lo, hi));
   }
@@ -100,8 +93,7 @@ campaign::Shard ParseShard(const std::string& text) {
     throw UsageError(fmt::format("--shard '{}' is invalid; expected i/N with 0 <= i < N", text));
   }
   if (s.count < 1 || s.index < 0 || s.index >= s.count) {
-    throw UsageError(
-        fmt::format("--shard '{}' is invalid; expected i/N with 0 <= i < N (shards count from 0)", text));
+    throw UsageError(fmt::format("--shard '{}' is invalid; expected i/N with 0 <= i < N (shards count from 0)", text));
   }
   return s;
 }

@@ -2,14 +2,13 @@
 // The command line's shared parts: exit codes, strict argument parsing, progress lines, and the
 // Command interface each subcommand file implements (run, report, validate, fdd-calibrate, bench,
 // campaign). Commands parse, call the libraries and print; no algorithm lives here.
+#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/harness/flight_recorder.h"

@@ -1,11 +1,11 @@
 // rotorguard fdd-calibrate RUNS...: sweep the composite FDD's thresholds over saved runs.
-#include <filesystem>
-
 #include <fmt/format.h>
 
+#include <filesystem>
+
+#include "cli.h"
 #include "rotorguard/benchmarks/fdd_calibration.h"
 #include "rotorguard/io/files.h"
-#include "cli.h"
 
 namespace rotorguard::cli {
 

@@ -1,8 +1,8 @@
 // rotorguard keys: every key a scenario file accepts, with its default, what it accepts and its meaning.
 #include <fmt/format.h>
 
-#include "rotorguard/harness/scenario_keys.h"
 #include "cli.h"
+#include "rotorguard/harness/scenario_keys.h"
 
 namespace rotorguard::cli {
 

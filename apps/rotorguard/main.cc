@@ -3,22 +3,23 @@
 // commands are registered, the chosen one runs, and its errors become the documented exit codes
 // (docs/cli.md): 0 success; 1 the run failed; 2 usage or invalid config; 3 an input file is
 // unreadable or damaged; 4 an infeasible request.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
 #include <exception>
 #include <memory>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-#include <fmt/format.h>
-
-#include "rotorguard/buildinfo/build_info.h"
 #include "cli.h"
+#include "rotorguard/buildinfo/build_info.h"
 
 int main(int argc, char** argv) {
   namespace cli = rotorguard::cli;
-  CLI::App app{"rotorguard: multirotor flight stack and simulator that keeps flying after rotor failures.\n"
-               "Exit codes: 0 success; 1 the run failed (crash); 2 usage or invalid config;\n"
-               "3 an input file is unreadable; 4 an infeasible request.",
-               "rotorguard"};
+  CLI::App app{
+      "rotorguard: multirotor flight stack and simulator that keeps flying after rotor failures.\n"
+      "Exit codes: 0 success; 1 the run failed (crash); 2 usage or invalid config;\n"
+      "3 an input file is unreadable; 4 an infeasible request.",
+      "rotorguard"};
   app.set_version_flag("--version", rotorguard::buildinfo::Version());
   app.require_subcommand(1);
 

@@ -1,11 +1,11 @@
 // rotorguard report DIR: rebuild a saved run's report.html.
-#include <filesystem>
-
 #include <fmt/format.h>
 
+#include <filesystem>
+
+#include "cli.h"
 #include "rotorguard/record/flight_log.h"
 #include "rotorguard/record/report.h"
-#include "cli.h"
 
 namespace rotorguard::cli {
 

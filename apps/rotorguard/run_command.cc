@@ -1,11 +1,11 @@
 // rotorguard run SCENARIO: fly a scenario and write its folder.
-#include <filesystem>
-
 #include <fmt/format.h>
 
+#include <filesystem>
+
+#include "cli.h"
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/io/report_html.h"
-#include "cli.h"
 
 namespace rotorguard::cli {
 
@@ -16,13 +16,12 @@ namespace {
 class RunCommand final : public Command {
  public:
   CLI::App* Register(CLI::App* app) override {
-    CLI::App* run = app->add_subcommand(
-        "run",
-        "Fly a scenario; write DIR/summary.json, DIR/report.html, the flight's log\n"
-        "(DIR/log.csv and DIR/scene.json, and/or DIR/flight.mcap), DIR/sensors.csv\n"
-        "and DIR/vehicle.yaml.\n"
-        "Exit 0 when the mission succeeds, 1 when it fails (crash), 4 when a\n"
-        "waypoint is unreachable.");
+    CLI::App* run = app->add_subcommand("run",
+                                        "Fly a scenario; write DIR/summary.json, DIR/report.html, the flight's log\n"
+                                        "(DIR/log.csv and DIR/scene.json, and/or DIR/flight.mcap), DIR/sensors.csv\n"
+                                        "and DIR/vehicle.yaml.\n"
+                                        "Exit 0 when the mission succeeds, 1 when it fails (crash), 4 when a\n"
+                                        "waypoint is unreachable.");
     run->add_option("scenario", scenario_path_, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
     run->add_option("--out", out_dir_, "Output folder (default: out/<scenario name>)");
     run->add_option("--set", sets_,
@@ -54,7 +53,8 @@ class RunCommand final : public Command {
     std::error_code ec;
     fs::create_directories(options.out_dir, ec);
     if (ec || !fs::is_directory(options.out_dir)) {
-      throw UsageError(fmt::format("--out: cannot create folder '{}'{}", options.out_dir, ec ? ": " + ec.message() : ""));
+      throw UsageError(
+          fmt::format("--out: cannot create folder '{}'{}", options.out_dir, ec ? ": " + ec.message() : ""));
     }
     options.progress = FlightProgress(!quiet_, scenario.duration_s);
     const harness::RunSummary summary = harness::RunScenario(scenario, options);
@@ -107,9 +107,9 @@ void PrintRunSummary(const harness::RunSummary& s, const std::string& out_dir,
              s.realtime_factor);
   // The window when it is not the whole flight, and the wreck's share when the flight crashed.
   const bool whole = s.tracking_start_s == 0.0 && s.tracking_end_s >= s.sim_time_s && !s.crashed;
-  fmt::print("tracking RMSE     {:.3f} m (max error {:.3f} m){}\n", s.tracking_rmse_m, s.max_position_error_m,
-             whole ? ""
-                   : fmt::format(" over {:.2f}-{:.2f} s", s.tracking_start_s, std::min(s.tracking_end_s, s.sim_time_s)));
+  fmt::print(
+      "tracking RMSE     {:.3f} m (max error {:.3f} m){}\n", s.tracking_rmse_m, s.max_position_error_m,
+      whole ? "" : fmt::format(" over {:.2f}-{:.2f} s", s.tracking_start_s, std::min(s.tracking_end_s, s.sim_time_s)));
   if (s.crashed) {
     fmt::print("                  {:.3f} m over {:.2f}-{:.2f} s, the wreck held where it crashed\n",
                s.tracking_rmse_window_m, s.tracking_start_s, s.tracking_end_s);
@@ -141,8 +141,10 @@ void PrintRunSummary(const harness::RunSummary& s, const std::string& out_dir,
   }
   fmt::print("seed              {}\n", s.seed);
   if (out_dir.empty()) return;
-  if (files.log_format != harness::LogFormat::kMcap) fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());
-  if (files.log_format != harness::LogFormat::kCsv) fmt::print("mcap              {}\n", (fs::path(out_dir) / "flight.mcap").string());
+  if (files.log_format != harness::LogFormat::kMcap)
+    fmt::print("log               {}\n", (fs::path(out_dir) / "log.csv").string());
+  if (files.log_format != harness::LogFormat::kCsv)
+    fmt::print("mcap              {}\n", (fs::path(out_dir) / "flight.mcap").string());
   fmt::print("summary           {}\n", (fs::path(out_dir) / "summary.json").string());
   if (files.report) fmt::print("report            {}\n", (fs::path(out_dir) / "report.html").string());
 }

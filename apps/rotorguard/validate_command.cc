@@ -1,8 +1,8 @@
 // rotorguard validate FILE: check a config file without using it.
 #include <fmt/format.h>
 
-#include "rotorguard/benchmarks/config_files.h"
 #include "cli.h"
+#include "rotorguard/benchmarks/config_files.h"
 
 namespace rotorguard::cli {
 

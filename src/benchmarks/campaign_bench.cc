@@ -1,10 +1,10 @@
 #include "rotorguard/benchmarks/campaign_bench.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <filesystem>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/merge.h"
@@ -16,8 +16,8 @@ namespace rotorguard::benchmarks {
 namespace fs = std::filesystem;
 using campaign::Campaign;
 
-nlohmann::json RunCampaignBenchmark(const campaign::Campaign& spec, const std::string& work_dir, const std::string& version,
-                                    const campaign::CampaignRegistry& kinds) {
+nlohmann::json RunCampaignBenchmark(const campaign::Campaign& spec, const std::string& work_dir,
+                                    const std::string& version, const campaign::CampaignRegistry& kinds) {
   if (fs::exists(work_dir) && !fs::is_empty(work_dir)) {
     throw std::invalid_argument(fmt::format("bench campaign: '{}' is not empty; expected a new folder", work_dir));
   }

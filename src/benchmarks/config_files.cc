@@ -1,8 +1,8 @@
 #include "rotorguard/benchmarks/config_files.h"
 
-#include <algorithm>
-
 #include <fmt/format.h>
+
+#include <algorithm>
 
 #include "rotorguard/benchmarks/registry.h"
 #include "rotorguard/benchmarks/scenario_sweep.h"
@@ -21,8 +21,8 @@ ValidationReport ValidateConfigFile(const std::string& path) {
   const auto has = [&](const char* k) { return std::find(keys.begin(), keys.end(), k) != keys.end(); };
   if (has("rotors") || has("mass_kg")) {
     const vehicle::VehicleParams v = harness::LoadVehicle(path);
-    return {"vehicle", fmt::format("vehicle '{}': {} rotors, {:g} kg, thrust-to-weight {:.2f}", v.name,
-                                   v.num_rotors(), v.mass_kg, v.total_max_thrust_n() / v.weight_n())};
+    return {"vehicle", fmt::format("vehicle '{}': {} rotors, {:g} kg, thrust-to-weight {:.2f}", v.name, v.num_rotors(),
+                                   v.mass_kg, v.total_max_thrust_n() / v.weight_n())};
   }
   if (has("unit") && has("spacing_m")) {
     const modular::Assembly a = harness::LoadAssembly(path);
@@ -46,8 +46,9 @@ ValidationReport ValidateConfigFile(const std::string& path) {
     return {"scenario", fmt::format("scenario '{}': {} mission, {:g} s, {} fault(s), vehicle {}", s.name,
                                     ToName(s.mission_kind), s.duration_s, s.faults.size(), s.vehicle_file)};
   }
-  root.Fail("cannot tell the kind of this file; expected a scenario (with 'mission' and 'vehicle') or "
-            "a vehicle (with 'mass_kg' and 'rotors')");
+  root.Fail(
+      "cannot tell the kind of this file; expected a scenario (with 'mission' and 'vehicle') or "
+      "a vehicle (with 'mass_kg' and 'rotors')");
 }
 
 }  // namespace rotorguard::benchmarks

@@ -250,7 +250,7 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
         const Scored s = ReplayAndScore(log, o);
         false_alarms += s.record.false_alarm ? 1 : 0;
         if (log.faults.empty()) continue;
-        // Missed: no correct diagnosis within 1 s of the onset (DESIGN.md, MDR).
+        // Missed: no correct diagnosis within 1 s of the onset (docs/metrics.md, MDR).
         if (s.record.latency_s && *s.record.latency_s <= 1.0) {
           ++detected;
           latencies.push_back(*s.record.latency_s);

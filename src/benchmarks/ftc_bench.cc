@@ -140,7 +140,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
     if (!r.has_fdd) continue;
     ++with_fdd;
     false_alarms += r.false_alarm ? 1 : 0;
-    // A missed detection: no correct isolation within 1 s of the onset (DESIGN.md, MDR).
+    // A missed detection: no correct isolation within 1 s of the onset (docs/metrics.md, MDR).
     if (faulty && (!r.correct || r.latency_s > 1.0)) ++missed;
     if (r.correct) latencies.push_back(r.latency_s);
   }
@@ -274,7 +274,7 @@ std::string Fmt(const nlohmann::json& v, const char* format, double scale = 1.0)
   return fmt::format(fmt::runtime(format), v.get<double>() * scale);
 }
 
-/// The paper's figures (DESIGN.md, "Reference numbers"): "ours / FixedA" where it gives both.
+/// Paper 000's figures (Tables III and IV): "ours / FixedA" where it gives both.
 std::string Paper(const std::string& phase, const std::string& fault, const std::string& metric) {
   if (metric == "latency") {
     if (phase == "hover") return fault == "propeller_loss" ? "0.105" : "0.032";

@@ -1,9 +1,9 @@
 #include "rotorguard/benchmarks/registry.h"
 
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "rotorguard/benchmarks/ftc_bench.h"
 #include "rotorguard/benchmarks/mars_bench.h"
@@ -63,13 +63,19 @@ class SpecFiles {
   std::string path_;
 };
 
-std::uint64_t SeedOf(const io::ConfigNode& root) { return root.Has("seed") ? root.Required("seed").AsUint64() : 1; }
+/// The keys every benchmark's spec has, read before its own (unknown-key messages list the keys in
+/// the order they were read).
+template <typename Options>
+Options SeedAndTrials(const io::ConfigNode& root, int max_trials) {
+  Options o;
+  o.seed = root.Has("seed") ? root.Required("seed").AsUint64() : 1;
+  o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, max_trials));
+  return o;
+}
 
 campaign::Campaign LoadFtc(const io::ConfigNode& root, const std::string& path) {
   const SpecFiles files(root, path);
-  FtcBenchOptions o;
-  o.seed = SeedOf(root);  // read before the kind's keys: unknown-key messages list keys as read
-  o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, 1'000'000));
+  FtcBenchOptions o = SeedAndTrials<FtcBenchOptions>(root, 1'000'000);
   if (root.Has("methods")) o.methods = WordList(root.Required("methods"), FtcMethods());
   o.vehicle = files.Load("vehicle", [](const std::string& p) { return harness::LoadVehicle(p); });
   return Checked(root, [&] { return FtcCampaign(o); });
@@ -77,9 +83,7 @@ campaign::Campaign LoadFtc(const io::ConfigNode& root, const std::string& path) 
 
 campaign::Campaign LoadNav(const io::ConfigNode& root, const std::string& path) {
   const SpecFiles files(root, path);
-  NavBenchOptions o;
-  o.seed = SeedOf(root);  // read before the kind's keys: unknown-key messages list keys as read
-  o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, 100'000));
+  NavBenchOptions o = SeedAndTrials<NavBenchOptions>(root, 100'000);
   if (root.Has("kinds")) o.kinds = WordList(root.Required("kinds"), {"forest", "room"});
   o.base = files.ScenarioAt("base");
   return Checked(root, [&] { return NavCampaign(o); });
@@ -87,10 +91,9 @@ campaign::Campaign LoadNav(const io::ConfigNode& root, const std::string& path) 
 
 campaign::Campaign LoadMars(const io::ConfigNode& root, const std::string& path) {
   const SpecFiles files(root, path);
-  MarsBenchOptions o;
-  o.seed = SeedOf(root);  // read before the kind's keys: unknown-key messages list keys as read
-  o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, 10'000));
-  if (root.Has("alloc_samples")) o.alloc_samples = static_cast<int>(root.Required("alloc_samples").AsIntIn(100, 10'000'000));
+  MarsBenchOptions o = SeedAndTrials<MarsBenchOptions>(root, 10'000);
+  if (root.Has("alloc_samples"))
+    o.alloc_samples = static_cast<int>(root.Required("alloc_samples").AsIntIn(100, 10'000'000));
   o.spiral = files.ScenarioAt("spiral");
   o.nine_units = files.Load("nine_units", [](const std::string& p) { return harness::LoadAssembly(p); });
   if (root.Has("reconfigure")) o.reconfigure = files.ScenarioAt("reconfigure");
@@ -106,7 +109,8 @@ campaign::Campaign LoadMars(const io::ConfigNode& root, const std::string& path)
 
 campaign::CampaignRegistry MakeKinds() {
   campaign::CampaignRegistry kinds;
-  kinds.Add({"", [](const io::ConfigNode& root, const std::string& path) {
+  kinds.Add({"",
+             [](const io::ConfigNode& root, const std::string& path) {
                return ScenarioCampaign(LoadCampaignSpec(root, path));
              },
              {}});

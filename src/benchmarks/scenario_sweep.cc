@@ -1,9 +1,9 @@
 #include "rotorguard/benchmarks/scenario_sweep.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <filesystem>
-
-#include <fmt/format.h>
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/core/rng.h"
@@ -40,9 +40,9 @@ const std::vector<std::string> kRecordable = {"success",
                                               "fdd.false_alarm",
                                               "fdd.latency_s",
                                               "fdd.detection_s"};
-const std::vector<std::string> kDefaultMetrics = {"success",        "crashed",      "tracking_rmse_m",
-                                                  "max_position_error_m", "min_altitude_m", "max_tilt_rad",
-                                                  "tilt_recovery_s"};
+const std::vector<std::string> kDefaultMetrics = {
+    "success",        "crashed",      "tracking_rmse_m", "max_position_error_m",
+    "min_altitude_m", "max_tilt_rad", "tilt_recovery_s"};
 
 /// The value at a dotted path of `j` ("fdd.latency_s"), null when absent.
 nlohmann::json AtPath(const nlohmann::json& j, const std::string& path) {
@@ -83,7 +83,8 @@ CampaignSpec LoadCampaignSpec(const io::ConfigNode& root, const std::string& pat
   spec.name = root.Required("name").AsString();
   if (!campaign::IsValidCampaignName(spec.name)) {
     root.FailAt("name", fmt::format("'{}' is invalid; expected letters, digits, '_', '.' or '-' (it names files and "
-                                    "Slurm jobs)", spec.name));
+                                    "Slurm jobs)",
+                                    spec.name));
   }
   const io::ConfigNode scenario = root.Required("scenario");
   // Canonical, so that every machine and every way of naming the spec records the same path (it
@@ -130,17 +131,18 @@ CampaignSpec LoadCampaignSpec(const io::ConfigNode& root, const std::string& pat
       }
       if (key == "seed") random->FailAt(key, "the seed is the campaign's (key seed): each trial derives its own");
       spec.random.emplace_back(key, r);
-      canonical["random"].push_back({key, r.kind == RandomSweep::Kind::kUniform ? nlohmann::json({r.lo, r.hi})
-                                                                                  : nlohmann::json(r.choices)});
+      canonical["random"].push_back(
+          {key, r.kind == RandomSweep::Kind::kUniform ? nlohmann::json({r.lo, r.hi}) : nlohmann::json(r.choices)});
     }
   }
   if (const auto metrics_node = root.Optional("metrics")) {
-    if (!metrics_node->IsSequence() || metrics_node->size() == 0) metrics_node->Fail("expected a non-empty list of metrics");
+    if (!metrics_node->IsSequence() || metrics_node->size() == 0)
+      metrics_node->Fail("expected a non-empty list of metrics");
     for (std::size_t i = 0; i < metrics_node->size(); ++i) {
       const std::string m = metrics_node->At(i).AsString();
       if (std::find(kRecordable.begin(), kRecordable.end(), m) == kRecordable.end()) {
-        metrics_node->At(i).Fail(fmt::format("'{}' is not a recorded metric; expected one of {}", m,
-                                             fmt::join(kRecordable, ", ")));
+        metrics_node->At(i).Fail(
+            fmt::format("'{}' is not a recorded metric; expected one of {}", m, fmt::join(kRecordable, ", ")));
       }
       spec.metrics.push_back(m);
     }
@@ -212,7 +214,8 @@ campaign::Campaign ScenarioCampaign(const CampaignSpec& spec) {
   c.metrics = spec.metrics;
   c.parameters = [spec](int index) { return TrialParameters(spec, index); };
   c.run = [spec](int, const std::map<std::string, std::string>& params) {
-    const nlohmann::json r = harness::RunScenario(harness::LoadScenario(spec.scenario, OverridesOf(params)), harness::RunOptions{}).ToJson();
+    const nlohmann::json r =
+        harness::RunScenario(harness::LoadScenario(spec.scenario, OverridesOf(params)), harness::RunOptions{}).ToJson();
     campaign::TrialOutcome out;
     for (const std::string& m : spec.metrics) out.metrics[m] = AtPath(r, m);
     return out;

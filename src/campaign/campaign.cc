@@ -1,6 +1,7 @@
 #include "rotorguard/campaign/campaign.h"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -14,13 +15,11 @@
 #include <set>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
+#include "results_file.h"
 #include "rotorguard/campaign/parallel.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
-#include "results_file.h"
 
 namespace rotorguard::campaign {
 
@@ -92,8 +91,10 @@ class ShardLock {
     if (fd_ < 0) throw io::InputFileError(path, "cannot open the shard's lock file");
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       ::close(fd_);
-      throw std::invalid_argument(fmt::format("{} is held: this shard is already running (wait for it, or stop "
-                                              "it, then --resume)", path));
+      throw std::invalid_argument(
+          fmt::format("{} is held: this shard is already running (wait for it, or stop "
+                      "it, then --resume)",
+                      path));
     }
   }
   ~ShardLock() { ::close(fd_); }  // closing releases the lock
@@ -107,8 +108,8 @@ class ShardLock {
 }  // namespace
 
 bool IsValidCampaignName(const std::string& name) {
-  return !name.empty() &&
-         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") == std::string::npos;
+  return !name.empty() && name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") ==
+                              std::string::npos;
 }
 
 std::string TrialId(const std::map<std::string, std::string>& parameters) {
@@ -191,10 +192,12 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
     const nlohmann::json old = ReadJsonFile(summary.manifest_file);
     for (const char* key : {"spec_hash", "version", "shard"}) {
       if (!old.contains(key) || old[key] != manifest[key]) {
-        throw ValidationError("resume", fmt::format(
-            "CampaignRunOptions::resume: {} records {} {}, this run has {}; resume only the same spec with the same "
-            "program",
-            summary.manifest_file, key, old.contains(key) ? old[key].dump() : "(none)", manifest[key].dump()));
+        throw ValidationError("resume",
+                              fmt::format("CampaignRunOptions::resume: {} records {} {}, this run has {}; resume only "
+                                          "the same spec with the same "
+                                          "program",
+                                          summary.manifest_file, key, old.contains(key) ? old[key].dump() : "(none)",
+                                          manifest[key].dump()));
       }
     }
     manifest["started"] = old.value("started", manifest["started"]);
@@ -220,42 +223,45 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
   std::mutex mutex;
   int errors = 0;
   std::exception_ptr write_error;
-  ParallelFor(static_cast<int>(todo.size()), options.jobs, [&](int task) {
-    const int index = todo[static_cast<std::size_t>(task)];
-    const std::map<std::string, std::string> params = campaign.parameters(index);
-    nlohmann::json line = {{"trial", index}, {"id", TrialId(params)}, {"params", params}};
-    try {
-      TrialOutcome r = campaign.run(index, params);
-      bool finite = true;
-      for (auto& [name, value] : r.metrics.items()) {
-        if (value.is_number_float() && !std::isfinite(value.get<double>())) {
-          finite = false;
-          value = nullptr;  // JSON has no NaN
+  ParallelFor(
+      static_cast<int>(todo.size()), options.jobs,
+      [&](int task) {
+        const int index = todo[static_cast<std::size_t>(task)];
+        const std::map<std::string, std::string> params = campaign.parameters(index);
+        nlohmann::json line = {{"trial", index}, {"id", TrialId(params)}, {"params", params}};
+        try {
+          TrialOutcome r = campaign.run(index, params);
+          bool finite = true;
+          for (auto& [name, value] : r.metrics.items()) {
+            if (value.is_number_float() && !std::isfinite(value.get<double>())) {
+              finite = false;
+              value = nullptr;  // JSON has no NaN
+            }
+          }
+          line["status"] = finite ? "ok" : "diverged";
+          line["message"] = finite ? r.message : "a metric is not finite" + (r.message.empty() ? "" : "; " + r.message);
+          line["metrics"] = std::move(r.metrics);
+        } catch (const std::exception& e) {
+          line["status"] = "error";
+          line["message"] = e.what();
+          line["metrics"] = nullptr;
+        } catch (...) {
+          line["status"] = "error";
+          line["message"] = "an exception of unknown type";
+          line["metrics"] = nullptr;
         }
-      }
-      line["status"] = finite ? "ok" : "diverged";
-      line["message"] = finite ? r.message : "a metric is not finite" + (r.message.empty() ? "" : "; " + r.message);
-      line["metrics"] = std::move(r.metrics);
-    } catch (const std::exception& e) {
-      line["status"] = "error";
-      line["message"] = e.what();
-      line["metrics"] = nullptr;
-    } catch (...) {
-      line["status"] = "error";
-      line["message"] = "an exception of unknown type";
-      line["metrics"] = nullptr;
-    }
-    // Invalid UTF-8 in a message is replaced rather than thrown: the trial is recorded either way.
-    const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-    const std::lock_guard<std::mutex> guard(mutex);
-    if (line["status"] != "ok") ++errors;
-    if (write_error) return;  // the disk failed: no more lines; the run reports it below
-    try {
-      results.AppendLine(text);
-    } catch (...) {
-      write_error = std::current_exception();
-    }
-  }, options.progress);
+        // Invalid UTF-8 in a message is replaced rather than thrown: the trial is recorded either way.
+        const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+        const std::lock_guard<std::mutex> guard(mutex);
+        if (line["status"] != "ok") ++errors;
+        if (write_error) return;  // the disk failed: no more lines; the run reports it below
+        try {
+          results.AppendLine(text);
+        } catch (...) {
+          write_error = std::current_exception();
+        }
+      },
+      options.progress);
   if (write_error) std::rethrow_exception(write_error);  // the manifest stays unfinished: resume later
   summary.ran = static_cast<int>(todo.size());
   summary.errors = errors;
@@ -276,9 +282,9 @@ std::optional<std::vector<nlohmann::json>> RunCampaignRecords(const Campaign& ca
   // This run's results only: the folder may also hold another sharding's files.
   Recorded recorded = ReadResults(run.results_file);
   if (recorded.cut || static_cast<int>(recorded.trials.size()) != campaign.trials) {
-    throw io::CorruptFileError(run.results_file, recorded.whole_size,
-                               fmt::format("{} of {} trials recorded after the run", recorded.trials.size(),
-                                           campaign.trials));
+    throw io::CorruptFileError(
+        run.results_file, recorded.whole_size,
+        fmt::format("{} of {} trials recorded after the run", recorded.trials.size(), campaign.trials));
   }
   std::vector<nlohmann::json> records;
   records.reserve(recorded.trials.size());

@@ -1,17 +1,17 @@
 #include "rotorguard/campaign/merge.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
+#include "results_file.h"
 #include "rotorguard/campaign/statistics.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
-#include "results_file.h"
 
 namespace rotorguard::campaign {
 
@@ -112,18 +112,19 @@ std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& 
       if (!manifests.empty()) {
         for (const char* key : {"spec_hash", "version"}) {
           if (manifest[key] != manifests.front()[key]) {
-            throw std::invalid_argument(fmt::format("campaign merge: {} has {} {} but {} has {}; merge only shards "
-                                                    "of one spec run by one program", m.string(), key,
-                                                    manifest[key].dump(), manifest_files.front(),
-                                                    manifests.front()[key].dump()));
+            throw std::invalid_argument(fmt::format(
+                "campaign merge: {} has {} {} but {} has {}; merge only shards "
+                "of one spec run by one program",
+                m.string(), key, manifest[key].dump(), manifest_files.front(), manifests.front()[key].dump()));
           }
         }
       }
       if (manifest["finished"].is_null()) {
-        throw std::invalid_argument(fmt::format("campaign merge: {} is unfinished (shard {} was stopped before its "
-                                                "last trial); resume it with `campaign run ... --shard {} --resume` "
-                                                "first", m.string(), manifest["shard"].dump(),
-                                                manifest["shard"].dump()));
+        throw std::invalid_argument(
+            fmt::format("campaign merge: {} is unfinished (shard {} was stopped before its "
+                        "last trial); resume it with `campaign run ... --shard {} --resume` "
+                        "first",
+                        m.string(), manifest["shard"].dump(), manifest["shard"].dump()));
       }
       const std::string shard = manifest["shard"].get<std::string>();
       const std::string results =
@@ -137,8 +138,8 @@ std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& 
       }
       for (auto& [index, line] : recorded.trials) {
         if (trials.count(index)) {
-          throw std::invalid_argument(fmt::format("campaign merge: trial {} is in both {} and {}", index,
-                                                  source[index], results));
+          throw std::invalid_argument(
+              fmt::format("campaign merge: trial {} is in both {} and {}", index, source[index], results));
         }
         source[index] = results;
         trials.emplace(index, std::move(line));
@@ -154,8 +155,10 @@ std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& 
   }
   if (!missing.empty()) {
     std::vector<int> first(missing.begin(), missing.begin() + std::min<std::size_t>(missing.size(), 10));
-    throw std::invalid_argument(fmt::format("campaign merge: {} of {} trials are missing (first: {}); run or resume "
-                                            "the shards that hold them", missing.size(), total, fmt::join(first, ", ")));
+    throw std::invalid_argument(
+        fmt::format("campaign merge: {} of {} trials are missing (first: {}); run or resume "
+                    "the shards that hold them",
+                    missing.size(), total, fmt::join(first, ", ")));
   }
   if (static_cast<int>(trials.size()) != total) {
     throw std::invalid_argument(fmt::format("campaign merge: trials beyond the campaign's {}", total));
@@ -203,7 +206,8 @@ nlohmann::json MergeCampaign(const std::vector<std::string>& dirs, const std::st
   // summary.md: the same figures as a table, one row per grid point.
   std::string md = fmt::format("# Campaign {}\n\n{} trials (spec {}, {}): ", head["campaign"].get<std::string>(), total,
                                head["spec_hash"].get<std::string>(), head["version"].get<std::string>());
-  for (const auto& [status, n] : summary["overall"]["status"].items()) md += fmt::format("{} {}; ", status, n.get<int>());
+  for (const auto& [status, n] : summary["overall"]["status"].items())
+    md += fmt::format("{} {}; ", status, n.get<int>());
   md += "\nRates: value [Wilson 95 % interval]; numbers: mean ± 95 % half-width (normal approximation).\n\n|";
   for (const std::string& k : grid_keys) md += fmt::format(" {} |", k);
   md += " trials |";

@@ -1,10 +1,10 @@
 #include "rotorguard/campaign/registry.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "rotorguard/io/files.h"
 
@@ -46,7 +46,8 @@ Campaign LoadCampaign(const std::string& path, const CampaignRegistry& kinds) {
   const std::string name = root.Required("name").AsString();
   if (!IsValidCampaignName(name)) {
     root.FailAt("name", fmt::format("'{}' is invalid; expected letters, digits, '_', '.' or '-' (it names files and "
-                                    "Slurm jobs)", name));
+                                    "Slurm jobs)",
+                                    name));
   }
   const CampaignKind& kind = *kinds.Find(bench.AsEnum(kinds.names()));
   Campaign c = kind.load(root, path);

@@ -1,8 +1,8 @@
 #include "results_file.h"
 
-#include <filesystem>
-
 #include <fmt/format.h>
+
+#include <filesystem>
 
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
@@ -27,8 +27,9 @@ Recorded ReadResults(const std::string& path) {
                        j["message"].is_string() && j.contains("metrics") &&
                        (j["metrics"].is_object() || j["metrics"].is_null());
     if (!valid) {
-      throw io::CorruptFileError(path, offset, "expected one trial record per line: {trial, id, params, status, "
-                                               "message, metrics}");
+      throw io::CorruptFileError(path, offset,
+                                 "expected one trial record per line: {trial, id, params, status, "
+                                 "message, metrics}");
     }
     const int index = j["trial"].get<int>();
     if (r.trials.count(index)) throw io::CorruptFileError(path, offset, fmt::format("trial {} recorded twice", index));

@@ -3,9 +3,8 @@
 // is one trial's record, and JSON manifests.
 #include <cstddef>
 #include <map>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rotorguard::campaign {
 

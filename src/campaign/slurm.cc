@@ -1,9 +1,9 @@
 #include "rotorguard/campaign/slurm.h"
 
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "rotorguard/core/error.h"
 
@@ -24,8 +24,10 @@ std::string ShellQuote(const std::string& text) {
 
 std::string SlurmArrayScript(const Campaign& campaign, const SlurmScriptOptions& o) {
   if (campaign.file.empty()) {
-    throw std::invalid_argument(fmt::format("campaign '{}' has no spec file for the tasks to run; write it as a "
-                                            "spec (docs/campaigns.md)", campaign.name));
+    throw std::invalid_argument(
+        fmt::format("campaign '{}' has no spec file for the tasks to run; write it as a "
+                    "spec (docs/campaigns.md)",
+                    campaign.name));
   }
   if (o.shards < 1 || o.shards > campaign.trials) {
     ThrowValidation("SlurmScriptOptions", "shards", o.shards,
@@ -64,10 +66,11 @@ std::string SlurmArrayScript(const Campaign& campaign, const SlurmScriptOptions&
       fmt::arg("cpus", o.cpus_per_task), fmt::arg("out", out));
   if (!o.partition.empty()) s += "#SBATCH --partition=" + o.partition + "\n";
   if (!o.time_limit.empty()) s += "#SBATCH --time=" + o.time_limit + "\n";
-  s += fmt::format("set -euo pipefail\n"
-                   "exec {} campaign run {} --out {} --shard \"${{SLURM_ARRAY_TASK_ID}}/{}\" "
-                   "--jobs \"${{SLURM_CPUS_PER_TASK:-{}}}\" --resume --quiet\n",
-                   ShellQuote(o.rotorguard), ShellQuote(spec_path), ShellQuote(out), o.shards, o.cpus_per_task);
+  s += fmt::format(
+      "set -euo pipefail\n"
+      "exec {} campaign run {} --out {} --shard \"${{SLURM_ARRAY_TASK_ID}}/{}\" "
+      "--jobs \"${{SLURM_CPUS_PER_TASK:-{}}}\" --resume --quiet\n",
+      ShellQuote(o.rotorguard), ShellQuote(spec_path), ShellQuote(out), o.shards, o.cpus_per_task);
   return s;
 }
 

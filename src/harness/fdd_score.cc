@@ -9,9 +9,12 @@ bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis) {
       return diagnosis == fdd::RotorHealth::kMotorFailed || diagnosis == fdd::RotorHealth::kFailed;
     case vehicle::FaultKind::kPropellerLoss:
       return diagnosis == fdd::RotorHealth::kPropellerFailed || diagnosis == fdd::RotorHealth::kFailed;
-    case vehicle::FaultKind::kLossOfEffectiveness: return diagnosis == fdd::RotorHealth::kDegraded;
-    case vehicle::FaultKind::kStuck: return diagnosis != fdd::RotorHealth::kOk;
-    case vehicle::FaultKind::kNone: return false;
+    case vehicle::FaultKind::kLossOfEffectiveness:
+      return diagnosis == fdd::RotorHealth::kDegraded;
+    case vehicle::FaultKind::kStuck:
+      return diagnosis != fdd::RotorHealth::kOk;
+    case vehicle::FaultKind::kNone:
+      return false;
   }
   return false;
 }
@@ -22,7 +25,8 @@ FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vecto
     const fdd::RotorStatus& status = rotors[static_cast<std::size_t>(i)];
     if (!status.detected_s) continue;
     if (!r.diagnosis || *status.detected_s < r.diagnosis->detection_s) {
-      r.diagnosis = FddRecord::Diagnosis{i, std::string(fdd::ToString(status.health)), status.detector, *status.detected_s};
+      r.diagnosis =
+          FddRecord::Diagnosis{i, std::string(fdd::ToString(status.health)), status.detector, *status.detected_s};
     }
   }
   if (!r.diagnosis) return r;

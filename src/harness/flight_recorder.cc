@@ -1,9 +1,9 @@
 #include "rotorguard/harness/flight_recorder.h"
 
+#include <fmt/format.h>
+
 #include <filesystem>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/record/flight_mcap.h"
@@ -122,7 +122,8 @@ void FlightRecorder::WriteFlight(const sim::Simulator& sim, const stack::FlightS
 void FlightRecorder::WriteSummary(const RunSummary& summary) {
   if (!enabled()) return;
   flight_.summary = summary.ToJson();
-  if (options_.log_format != LogFormat::kCsv) record::WriteFlightMcap(flight_, InFolder(options_.out_dir, "flight.mcap"));
+  if (options_.log_format != LogFormat::kCsv)
+    record::WriteFlightMcap(flight_, InFolder(options_.out_dir, "flight.mcap"));
   io::WriteFileAtomically(InFolder(options_.out_dir, "summary.json"), flight_.summary.dump(2) + "\n");
   if (options_.report) record::WriteFlightReport(flight_, InFolder(options_.out_dir, "report.html"));
 }

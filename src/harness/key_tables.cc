@@ -1,8 +1,8 @@
+#include <fmt/format.h>
+
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "rotorguard/harness/scenario_keys.h"
 #include "rotorguard/io/key_table.h"

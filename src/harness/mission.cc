@@ -34,33 +34,21 @@ Mission ParseMission(const io::ConfigNode& node, const Vector3& start_m, double 
   Mission m;
   m.kind = *FromName<MissionKind>(node.Required("type").AsEnum(NameList<MissionKind>()));
   switch (m.kind) {
-    case MissionKind::kHover: {
-      planning::HoverOptions o;
-      o.position_m = start_m;
-      o.yaw_rad = start_yaw_rad;
-      m.reference = Build<planning::HoverReference>(node, o);
+    case MissionKind::kHover:
+      m.reference = Build<planning::HoverReference>(
+          node, planning::HoverOptions{.position_m = start_m, .yaw_rad = start_yaw_rad});
       break;
-    }
-    case MissionKind::kTakeoff: {
-      planning::TakeoffOptions o;
-      o.start_m = start_m;
-      o.yaw_rad = start_yaw_rad;
-      m.reference = Build<planning::TakeoffReference>(node, o);
+    case MissionKind::kTakeoff:
+      m.reference = Build<planning::TakeoffReference>(
+          node, planning::TakeoffOptions{.start_m = start_m, .yaw_rad = start_yaw_rad});
       break;
-    }
-    case MissionKind::kLemniscate: {
-      planning::LemniscateOptions o;
-      o.center_m = start_m;
-      o.yaw_rad = start_yaw_rad;
-      m.reference = Build<planning::LemniscateReference>(node, o);
+    case MissionKind::kLemniscate:
+      m.reference = Build<planning::LemniscateReference>(
+          node, planning::LemniscateOptions{.center_m = start_m, .yaw_rad = start_yaw_rad});
       break;
-    }
-    case MissionKind::kCircle: {
-      planning::CircleOptions o;
-      o.yaw_rad = start_yaw_rad;
-      m.reference = Build<planning::CircleReference>(node, o);
+    case MissionKind::kCircle:
+      m.reference = Build<planning::CircleReference>(node, planning::CircleOptions{.yaw_rad = start_yaw_rad});
       break;
-    }
     case MissionKind::kWaypoints: {
       planning::WaypointOptions o;
       o.yaw_rad = start_yaw_rad;

@@ -1,10 +1,10 @@
 #include "rotorguard/harness/runner.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cmath>
 #include <memory>
-
-#include <fmt/format.h>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/assembly_mission.h"
@@ -114,7 +114,8 @@ class ClosedLoop {
     }
     FlightEnd end{sim_.time_ns(), sim_.crashed(), vehicle::StateView(sim_.state()).p_W(), std::nullopt};
     if (!sim_.fault_events().empty()) end.first_onset_s = sim_.fault_events().front().onset_s;
-    metrics_.Finish(end, [this](double t) { return stack_.reference().Evaluate(t).p_W; }, &s);
+    metrics_.Finish(
+        end, [this](double t) { return stack_.reference().Evaluate(t).p_W; }, &s);
     DiagnoseFailure(metrics_.last_violation(), {sc_.success_error_m, sc_.success_hold_s}, &s);
     AddTimes(wall_start, &s);
     recorder_.WriteSummary(s);

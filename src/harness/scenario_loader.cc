@@ -1,19 +1,19 @@
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
 #include <type_traits>
 
-#include <fmt/format.h>
-
+#include "loader_internal.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/harness/scenario_keys.h"
 #include "rotorguard/io/config_archive.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/vehicle/pwm_model.h"
-#include "loader_internal.h"
 
 namespace rotorguard::harness {
 
@@ -41,8 +41,7 @@ sim::FaultSpec ParseFault(const ConfigNode& f) {
   // The range is checked against the vehicle's rotor count by FaultSpec::Validate.
   spec.rotor = static_cast<int>(f.Required("rotor").AsIntIn(-1'000'000, 1'000'000));
   const ConfigNode kind = f.Required("kind");
-  spec.kind = *vehicle::ParseFaultKind(
-      kind.AsEnum({"motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck"}));
+  spec.kind = *vehicle::ParseFaultKind(kind.AsEnum({"motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck"}));
   if (spec.kind == vehicle::FaultKind::kLossOfEffectiveness) {
     spec.eta = f.Required("eta").AsDouble();
   } else if (f.Has("eta")) {
@@ -125,9 +124,10 @@ void CheckReferenceAboveGround(const ConfigNode& mission, const Scenario& s) {
     const double t = std::min(static_cast<double>(k) * step, end);
     const double z = s.reference->Evaluate(t).p_W.z();
     if (z < -1e-9) {
-      mission.Fail(fmt::format("the {} reference goes below the ground (z = {:.3f} m at t = {:.2f} s); raise "
-                               "its centre or the initial position",
-                               ToName(s.mission_kind), z, t));
+      mission.Fail(
+          fmt::format("the {} reference goes below the ground (z = {:.3f} m at t = {:.2f} s); raise "
+                      "its centre or the initial position",
+                      ToName(s.mission_kind), z, t));
     }
   }
 }
@@ -135,8 +135,7 @@ void CheckReferenceAboveGround(const ConfigNode& mission, const Scenario& s) {
 /// `vehicle` (a vehicle file) or `assembly` (an assembly file): the vehicle flown, and the
 /// assembly's geometry when it is one. A file that cannot be read is still an unreadable input
 /// (exit 3), with the scenario line that names it.
-void ReadVehicle(const ConfigNode& root, const std::string& path, const std::vector<Override>& overrides,
-                 Scenario* s) {
+void ReadVehicle(const ConfigNode& root, const std::string& path, const std::vector<Override>& overrides, Scenario* s) {
   if (root.Has("assembly") == root.Has("vehicle")) {
     root.Fail("expected exactly one of 'vehicle' (a vehicle file) and 'assembly' (an assembly file)");
   }
@@ -152,8 +151,8 @@ void ReadVehicle(const ConfigNode& root, const std::string& path, const std::vec
       s->vehicle = LoadVehicle(s->vehicle_file, overrides);
     }
   } catch (const io::InputFileError& e) {
-    throw io::InputFileError(e.path(), fmt::format("{} (named by '{}' at {})", e.reason(), vehicle_key,
-                                                   vehicle_node.Location()));
+    throw io::InputFileError(e.path(),
+                             fmt::format("{} (named by '{}' at {})", e.reason(), vehicle_key, vehicle_node.Location()));
   }
 }
 
@@ -257,9 +256,11 @@ void CheckAcrossSections(const ConfigNode& root, const Scenario& s) {
       !s.sim.lidar.enabled) {
     root.Required("mission").Fail("the navigate mission plans on the LiDAR map; expected sensors.lidar");
   }
-  if (s.stack.navigation.method == stack::NavigationMethod::kFlatness || s.stack.controller == stack::ControllerKind::kLqr) {
+  if (s.stack.navigation.method == stack::NavigationMethod::kFlatness ||
+      s.stack.controller == stack::ControllerKind::kLqr) {
     // Paper 004's planner and controller work on the vehicle's PWM model: its layout is checked now.
-    ValidateAt(root.Required(s.assembly ? "assembly" : "vehicle"), [&] { vehicle::PwmQuadModel::FromVehicle(s.vehicle); });
+    ValidateAt(root.Required(s.assembly ? "assembly" : "vehicle"),
+               [&] { vehicle::PwmQuadModel::FromVehicle(s.vehicle); });
   }
 }
 

@@ -1,16 +1,16 @@
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <iterator>
-
-#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "loader_internal.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_archive.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/vehicle/multirotor.h"
-#include "loader_internal.h"
 
 // Vehicle and assembly files, and the overrides and paths every loader shares.
 namespace rotorguard::harness {
@@ -56,9 +56,8 @@ vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
     const ConfigNode r = rotors.At(i);
     vehicle::Rotor rotor;
     rotor.p_B = r.Required("position_m").AsVector3();
-    rotor.direction = r.Required("direction").AsEnum({"ccw", "cw"}) == "cw"
-                          ? vehicle::SpinDirection::kClockwise
-                          : vehicle::SpinDirection::kCounterClockwise;
+    rotor.direction = r.Required("direction").AsEnum({"ccw", "cw"}) == "cw" ? vehicle::SpinDirection::kClockwise
+                                                                            : vehicle::SpinDirection::kCounterClockwise;
     rotor.yaw_coefficient_m = r.Required("yaw_coefficient_m").AsDouble();
     rotor.max_thrust_n = r.Required("max_thrust_n").AsDouble();
     r.RejectUnknownKeys();
@@ -89,8 +88,7 @@ void ApplyOverrides(ConfigDocument* doc, const std::vector<Override>& overrides,
       doc->ApplyOverride(path.substr(kVehiclePrefix.size()), value);
     } catch (const io::ConfigError& e) {
       // Report the path as the user wrote it, with its prefix.
-      throw io::ConfigError(e.file(), e.line(), e.column(), std::string(kVehiclePrefix) + e.key_path(),
-                            e.message());
+      throw io::ConfigError(e.file(), e.line(), e.column(), std::string(kVehiclePrefix) + e.key_path(), e.message());
     }
   }
 }
@@ -128,7 +126,8 @@ modular::Assembly LoadAssembly(const std::string& path) {
     for (std::size_t k = 0; k < slots.size(); ++k) {
       const ConfigNode cell = slots.At(k);
       if (!cell.IsSequence() || cell.size() != 2) cell.Fail("expected a grid cell [i, j] of two integers");
-      spec.slots.emplace_back(static_cast<int>(cell.At(0).AsIntIn(-64, 64)), static_cast<int>(cell.At(1).AsIntIn(-64, 64)));
+      spec.slots.emplace_back(static_cast<int>(cell.At(0).AsIntIn(-64, 64)),
+                              static_cast<int>(cell.At(1).AsIntIn(-64, 64)));
     }
   }
   root.RejectUnknownKeys();
@@ -147,7 +146,8 @@ std::string VehicleToYaml(const vehicle::VehicleParams& v) {
   fmt::format_to(it, "name: {}\nmass_kg: {}\ninertia_kg_m2:\n", nlohmann::json(v.name).dump(), v.mass_kg);
   for (int r = 0; r < 3; ++r) fmt::format_to(it, "  - {}\n", vec(v.inertia_kg_m2.row(r).transpose()));
   fmt::format_to(it, "rotor_drag_kg_s: {}\nyaw_damping_n_m_s: {}\n", vec(v.rotor_drag_kg_s), v.yaw_damping_n_m_s);
-  fmt::format_to(it, "thrust_coefficient_n_per_rpm2: {}\n", v.thrust_coefficient_n_s2 / (rpm_per_rad_s * rpm_per_rad_s));
+  fmt::format_to(it, "thrust_coefficient_n_per_rpm2: {}\n",
+                 v.thrust_coefficient_n_s2 / (rpm_per_rad_s * rpm_per_rad_s));
   fmt::format_to(it, "motor_time_constant_s: {}\nmotor_stop_time_constant_s: {}\n", v.motor_time_constant_s,
                  v.motor_stop_time_constant_s);
   fmt::format_to(it, "unloaded_rpm_ratio: {}\ncollision_radius_m: {}\n", v.unloaded_speed_ratio, v.collision_radius_m);
@@ -160,8 +160,8 @@ std::string VehicleToYaml(const vehicle::VehicleParams& v) {
   }
   fmt::format_to(it, "rotors:\n");
   for (const vehicle::Rotor& r : v.rotors) {
-    fmt::format_to(it, "  - {{position_m: {}, direction: {}, yaw_coefficient_m: {}, max_thrust_n: {}}}\n",
-                   vec(r.p_B), r.direction == vehicle::SpinDirection::kClockwise ? "cw" : "ccw", r.yaw_coefficient_m,
+    fmt::format_to(it, "  - {{position_m: {}, direction: {}, yaw_coefficient_m: {}, max_thrust_n: {}}}\n", vec(r.p_B),
+                   r.direction == vehicle::SpinDirection::kClockwise ? "cw" : "ccw", r.yaw_coefficient_m,
                    r.max_thrust_n);
   }
   return fmt::to_string(out);

@@ -1,9 +1,9 @@
 // Statistics of campaigns and benchmarks against closed forms and hand-made samples.
 #include "rotorguard/campaign/statistics.h"
 
-#include <vector>
-
 #include <gtest/gtest.h>
+
+#include <vector>
 
 namespace rotorguard::campaign {
 namespace {

@@ -1,11 +1,12 @@
 
-#include <cmath>
-#include <vector>
+#include "rotorguard/harness/flight_metrics.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "rotorguard/harness/failure_diagnosis.h"
-#include "rotorguard/harness/flight_metrics.h"
 
 namespace rotorguard::harness {
 namespace {
@@ -59,12 +60,14 @@ TEST(FlightMetrics, HandMadeFlightGivesEveryMetricByHand) {
   for (TimeNs t = 0; t < 4'000'000'000; t += kStep) {
     const bool fault = t >= 1'000'000'000;
     const bool tilted = fault && t < 2'500'000'000;
-    const Vector3 p = ref + Vector3(t < 1'000'000'000 ? 0.3 : 0.1, 0.0, 0.0) - Vector3(0, 0, t == 2'000'000'000 ? 0.6 : 0.0);
+    const Vector3 p =
+        ref + Vector3(t < 1'000'000'000 ? 0.3 : 0.1, 0.0, 0.0) - Vector3(0, 0, t == 2'000'000'000 ? 0.6 : 0.0);
     m.OnStep(t, vehicle::StateView(State(p, tilted ? 0.3 : 0.0, fault ? 11.0 : 0.0)), ref, fault);
   }
   RunSummary s;
   const vehicle::StateVector end = State(ref + Vector3(0.1, 0, 0));
-  m.Finish({4'000'000'000, false, vehicle::StateView(end).p_W(), 1.0}, [&](double) { return ref; }, &s);
+  m.Finish(
+      {4'000'000'000, false, vehicle::StateView(end).p_W(), 1.0}, [&](double) { return ref; }, &s);
   // 0.5 s at 0.09 m^2, then 2.5 s at 0.01 m^2 but for the step at 2.0 s, 0.6 m low as well:
   // its error is sqrt(0.01 + 0.36) m.
   const double integral = 0.5 * 0.09 + (2.5 - 0.01) * 0.01 + 0.01 * (0.01 + 0.36);
@@ -90,7 +93,8 @@ TEST(FlightMetrics, ACrashedVehicleIsHeldWhereItCrashedOverTheRestOfTheWindow) {
   const Vector3 ref(0.0, 0.0, 1.0);
   for (TimeNs t = 0; t < 2'000'000'000; t += kStep) m.OnStep(t, vehicle::StateView(State(ref)), ref, false);
   RunSummary s;
-  m.Finish({2'000'000'000, true, Vector3::Zero(), std::nullopt}, [&](double) { return ref; }, &s);
+  m.Finish(
+      {2'000'000'000, true, Vector3::Zero(), std::nullopt}, [&](double) { return ref; }, &s);
   EXPECT_NEAR(s.tracking_rmse_m, 0.0, 1e-15) << "up to the crash";
   EXPECT_NEAR(s.tracking_rmse_window_m, std::sqrt(0.5), 1e-9);
   EXPECT_NEAR(s.min_altitude_m, 0.0, 1e-15) << "the crash site counts";
@@ -104,7 +108,8 @@ TEST(FlightMetrics, TiltThatNeverSettlesHasNoRecoveryTime) {
     m.OnStep(t, vehicle::StateView(State(Vector3::Zero(), 0.5)), Vector3::Zero(), true);
   }
   RunSummary s;
-  m.Finish({1'000'000'000, false, Vector3::Zero(), 0.0}, [](double) { return Vector3::Zero(); }, &s);
+  m.Finish(
+      {1'000'000'000, false, Vector3::Zero(), 0.0}, [](double) { return Vector3::Zero(); }, &s);
   EXPECT_FALSE(s.tilt_recovery_s.has_value());
 }
 

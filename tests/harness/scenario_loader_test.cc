@@ -3,12 +3,12 @@
 // name the file, line and key, the mission comes back as a value, and docs/scenarios.md's key
 // tables are the ones the loader reads.
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <sstream>
-
-#include <gtest/gtest.h>
 
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/scenario.h"
@@ -145,7 +145,8 @@ TEST_F(ScenarioLoader, TheMissionComesBackAsAValue) {
   EXPECT_EQ(lemniscate->options().size_z_m, 0.0);
   EXPECT_FALSE(m.navigate.has_value());
   // Waypoints start where the vehicle does.
-  const io::ConfigDocument w = io::ConfigDocument::LoadString("type: waypoints\nwaypoints_m: [[1, 0, 2]]\nmax_speed_m_s: 1\n", "w.yaml");
+  const io::ConfigDocument w =
+      io::ConfigDocument::LoadString("type: waypoints\nwaypoints_m: [[1, 0, 2]]\nmax_speed_m_s: 1\n", "w.yaml");
   const Mission waypoints = ParseMission(w.root(), Vector3(0, 0, 2), 0.0);
   const auto* legs = dynamic_cast<const planning::WaypointReference*>(waypoints.reference.get());
   ASSERT_NE(legs, nullptr);
@@ -218,7 +219,7 @@ TEST_F(ScenarioLoader, KeyTablesListEveryKeyTheLoaderTakes) {
     std::string yaml = "mission: {type: hover}\n";
     std::string indent;
     std::size_t start = 0;
-    for (std::size_t dot = block.find('.'); ; dot = block.find('.', start)) {
+    for (std::size_t dot = block.find('.');; dot = block.find('.', start)) {
       yaml += indent + block.substr(start, dot == std::string::npos ? std::string::npos : dot - start) + ":\n";
       indent += "  ";
       if (dot == std::string::npos) break;

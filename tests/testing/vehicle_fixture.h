@@ -1,5 +1,5 @@
 #pragma once
-/// The reference vehicle of paper 000 (Table II and DESIGN.md), built in code for unit tests that
+/// The reference vehicle of paper 000 (Table II and configs/vehicles/zhou2025_quad.yaml), built in code for unit tests that
 /// must not depend on config files.
 #include "rotorguard/vehicle/vehicle_params.h"
 

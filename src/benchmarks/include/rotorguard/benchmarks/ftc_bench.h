@@ -46,7 +46,7 @@ struct FtcTrial {
   std::uint64_t seed = 0;
 };
 
-/// A cell's metrics (DESIGN.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty
+/// A cell's metrics (docs/metrics.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty
 /// cells: no correct isolation within 1 s), far, mini_alt_m (least altitude after the fault), and
 /// the first failures. Null where a metric does not apply (no FDD; MDR of fault-free cells).
 nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty);
@@ -64,7 +64,7 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
 /// Runs every cell and method (FtcCampaign, on `jobs` threads in a temporary folder); returns
 /// {"cells": [...], "options": {...}, "errors": n, "host": {...}} with, per cell, test, phase,
 /// fault, method, trials, fdd_latency_s_mean, fdd_latency_s_max, sucr, mdr, far and mini_alt_m
-/// (DESIGN.md, Metrics).
+/// (docs/metrics.md).
 nlohmann::json RunFtcBenchmark(const FtcBenchOptions& options);
 
 /// Markdown tables shaped like the paper's Tables III and IV, the paper's figures beside ours.

@@ -1,9 +1,8 @@
 #pragma once
 /// Facts about this program and the machine it runs on, recorded with every benchmark result and
 /// campaign manifest so that a figure can be traced to the build and the host that produced it.
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 namespace rotorguard::buildinfo {
 

@@ -12,11 +12,10 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace rotorguard::campaign {
 
@@ -82,18 +81,18 @@ struct CampaignRunOptions {
 };
 
 struct CampaignRunSummary {
-  int trials = 0;    ///< in the shard
-  int skipped = 0;   ///< already done (resume)
+  int trials = 0;   ///< in the shard
+  int skipped = 0;  ///< already done (resume)
   int ran = 0;
-  int errors = 0;    ///< status error or diverged
+  int errors = 0;  ///< status error or diverged
   std::string results_file, manifest_file;
 };
 
 /// Runs the shard's trials not yet recorded. Throws ValidationError naming the option (a bad count
 /// or shard, an existing results file without `resume`, a resume against another spec or
-/// version), std::invalid_argument when the shard is already running in another process, io::InputFileError or io::CorruptFileError for unreadable
-/// or damaged results, and leaves every existing file as it was; an I/O failure while appending
-/// is rethrown once the trials in flight are done (the manifest stays unfinished: resume later).
+/// version), std::invalid_argument when the shard is already running in another process, io::InputFileError or
+/// io::CorruptFileError for unreadable or damaged results, and leaves every existing file as it was; an I/O failure
+/// while appending is rethrown once the trials in flight are done (the manifest stays unfinished: resume later).
 CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOptions& options);
 
 /// Runs `options.shard` of `campaign` (RunCampaign) and, when that is the whole campaign, returns

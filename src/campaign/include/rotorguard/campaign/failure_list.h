@@ -1,12 +1,12 @@
 #pragma once
 /// The failed trials a benchmark's result names: the first few listed with what reproduces each
 /// (a seed for --replay), the rest counted, so that a report never drops one silently.
+#include <fmt/format.h>
+
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
-
-#include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 namespace rotorguard::campaign {
 

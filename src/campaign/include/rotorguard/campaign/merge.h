@@ -1,10 +1,9 @@
 #pragma once
 /// Joining a campaign's shards: every trial exactly once, one spec, one program; then the
 /// statistics of its metrics per grid point (summary.json, summary.md) and its kind's own result.
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "rotorguard/campaign/registry.h"
 

@@ -6,10 +6,9 @@
 /// A spec names its kind with the key `bench` (docs/campaigns.md, "Benchmarks as campaigns"); a
 /// spec without that key is read by the kind registered without a name (the scenario sweep).
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/io/config_node.h"

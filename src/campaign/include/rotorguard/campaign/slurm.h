@@ -7,12 +7,12 @@
 namespace rotorguard::campaign {
 
 struct SlurmScriptOptions {
-  int shards = 1;              ///< array tasks, one shard each, in [1, trials]
-  int cpus_per_task = 1;       ///< --cpus-per-task, and each task's --jobs, in [1, 256]
-  std::string out_dir;         ///< the results folder (made absolute in the script)
-  std::string rotorguard;      ///< the program each task runs (absolute path)
-  std::string partition;       ///< "" for the cluster's default
-  std::string time_limit;      ///< Slurm's --time ("" for the partition's default)
+  int shards = 1;          ///< array tasks, one shard each, in [1, trials]
+  int cpus_per_task = 1;   ///< --cpus-per-task, and each task's --jobs, in [1, 256]
+  std::string out_dir;     ///< the results folder (made absolute in the script)
+  std::string rotorguard;  ///< the program each task runs (absolute path)
+  std::string partition;   ///< "" for the cluster's default
+  std::string time_limit;  ///< Slurm's --time ("" for the partition's default)
 };
 
 /// An `sbatch --array` script: task i runs `campaign run SPEC --shard i/N --resume` into the

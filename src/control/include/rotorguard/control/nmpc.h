@@ -59,8 +59,10 @@ struct NmpcOptions {
     a->Visit("q_thrust", &q_thrust, {.meaning = "Q_t of eq. (10) on the motor thrusts"});
     a->Visit("r_input", &r_input, {.meaning = "R of eq. (10) on the commands, > 0"});
     a->Visit("max_rate_rad_s", &max_rate_rad_s, {.meaning = "body-rate bounds [rad/s]"});
-    a->Visit("max_sqp_iterations", &max_sqp_iterations, {.meaning = "SQP iterations a cycle (1: the real-time iteration)", .min = 1, .max = 1000});
-    a->Visit("relinearise_every", &relinearise_every, {.meaning = "a full linearisation every this many preparations (docs/control.md)", .min = 1, .max = 20});
+    a->Visit("max_sqp_iterations", &max_sqp_iterations,
+             {.meaning = "SQP iterations a cycle (1: the real-time iteration)", .min = 1, .max = 1000});
+    a->Visit("relinearise_every", &relinearise_every,
+             {.meaning = "a full linearisation every this many preparations (docs/control.md)", .min = 1, .max = 20});
   }
 };
 

@@ -26,7 +26,8 @@ struct PassiveControllerOptions {
     position.Serialize(a);
     a->Visit("k_tilt", &k_tilt, {.meaning = "reduced-attitude error to roll/pitch rate [1/s]"});
     a->Visit("k_rate", &k_rate, {.meaning = "roll/pitch rate error to angular acceleration [1/s]"});
-    a->Visit("regularisation", &regularisation, {.meaning = "weight towards equal rotor thrusts, relative to the thrust's"});
+    a->Visit("regularisation", &regularisation,
+             {.meaning = "weight towards equal rotor thrusts, relative to the thrust's"});
   }
 };
 

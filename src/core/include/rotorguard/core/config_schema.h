@@ -62,7 +62,9 @@ std::span<const EnumName<E>> EnumNames() {
 
 /// Whether E declares its names (NamesOf).
 template <typename E>
-concept NamedEnum = requires { NamesOf(static_cast<const E*>(nullptr)); };
+concept NamedEnum = requires {
+  NamesOf(static_cast<const E*>(nullptr));
+};
 
 /// The name of `value`; "" for a value without one (never for a table that lists them all).
 template <NamedEnum E>

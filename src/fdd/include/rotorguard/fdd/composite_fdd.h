@@ -55,18 +55,27 @@ struct CompositeFddOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("motor_index_threshold", &motor_index_threshold, {.meaning = "γ_M: a motor index M_i (eq. 13) at or below it isolates a motor failure, in (0, 1)"});
-    a->Visit("motor_index_samples", &motor_index_samples, {.meaning = "consecutive telemetry samples the index must stay low", .min = 1, .max = 1000});
-    a->Visit("motor_index_min_thrust_n", &motor_index_min_thrust_n, {.meaning = "the index is evaluated only while the expected thrust exceeds this [N]"});
-    a->Visit("propeller_index_threshold", &propeller_index_threshold, {.meaning = "γ_P: a propeller index P_i (eq. 17) above it isolates a propeller failure, in (0, 1]"});
+    a->Visit("motor_index_threshold", &motor_index_threshold,
+             {.meaning = "γ_M: a motor index M_i (eq. 13) at or below it isolates a motor failure, in (0, 1)"});
+    a->Visit("motor_index_samples", &motor_index_samples,
+             {.meaning = "consecutive telemetry samples the index must stay low", .min = 1, .max = 1000});
+    a->Visit("motor_index_min_thrust_n", &motor_index_min_thrust_n,
+             {.meaning = "the index is evaluated only while the expected thrust exceeds this [N]"});
+    a->Visit("propeller_index_threshold", &propeller_index_threshold,
+             {.meaning = "γ_P: a propeller index P_i (eq. 17) above it isolates a propeller failure, in (0, 1]"});
     a->Visit("propeller_persistence_s", &propeller_persistence_s, {.meaning = "P_i must stay above γ_P this long [s]"});
-    a->Visit("degraded_threshold", &degraded_threshold, {.meaning = "P_i between this and γ_P for degraded_persistence_s is a partial loss"});
+    a->Visit("degraded_threshold", &degraded_threshold,
+             {.meaning = "P_i between this and γ_P for degraded_persistence_s is a partial loss"});
     a->Visit("degraded_persistence_s", &degraded_persistence_s, {.meaning = "how long a partial loss must last [s]"});
-    a->Visit("filter_cutoff_hz", &filter_cutoff_hz, {.meaning = "cut-off of the observer's low-pass filters [Hz], below the IMU's Nyquist frequency"});
-    a->Visit("takeoff_max_altitude_m", &takeoff_max_altitude_m, {.meaning = "the take-off detector (eq. 18) runs below this altitude [m] ..."});
+    a->Visit("filter_cutoff_hz", &filter_cutoff_hz,
+             {.meaning = "cut-off of the observer's low-pass filters [Hz], below the IMU's Nyquist frequency"});
+    a->Visit("takeoff_max_altitude_m", &takeoff_max_altitude_m,
+             {.meaning = "the take-off detector (eq. 18) runs below this altitude [m] ..."});
     a->Visit("takeoff_window_s", &takeoff_window_s, {.meaning = "... and within this long of lift-off [s]"});
-    a->Visit("takeoff_angular_acceleration_rad_s2", &takeoff_angular_acceleration_rad_s2, {.meaning = "roll/pitch angular acceleration that fires it [rad/s²] ..."});
-    a->Visit("takeoff_direction_cosine", &takeoff_direction_cosine, {.meaning = "... pointing within this cosine of the loss of one rotor"});
+    a->Visit("takeoff_angular_acceleration_rad_s2", &takeoff_angular_acceleration_rad_s2,
+             {.meaning = "roll/pitch angular acceleration that fires it [rad/s²] ..."});
+    a->Visit("takeoff_direction_cosine", &takeoff_direction_cosine,
+             {.meaning = "... pointing within this cosine of the loss of one rotor"});
   }
 };
 

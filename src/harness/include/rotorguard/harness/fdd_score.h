@@ -21,9 +21,9 @@ struct FddRecord {
     double detection_s = 0.0;
   };
   std::optional<Diagnosis> diagnosis;  ///< none: no rotor left the ok state
-  bool correct = false;      ///< right rotor and kind, at or after the first onset
-  bool false_alarm = false;  ///< a diagnosis without a fault, or before the first onset
-  std::optional<double> latency_s;  ///< detection - onset, when correct
+  bool correct = false;                ///< right rotor and kind, at or after the first onset
+  bool false_alarm = false;            ///< a diagnosis without a fault, or before the first onset
+  std::optional<double> latency_s;     ///< detection - onset, when correct
 
   bool detected() const { return diagnosis.has_value(); }
 };

@@ -24,11 +24,13 @@ enum class MissionKind {
   kNavigate,      ///< waypoints planned on the stack's LiDAR map (docs/planning.md)
   kAssemblyPlan,  ///< an assembly's plan to a goal on a known map (paper 002; assembly_mission.h)
 };
-inline constexpr EnumName<MissionKind> kMissionKindNames[] = {
-    {MissionKind::kHover, "hover"},         {MissionKind::kTakeoff, "takeoff"},
-    {MissionKind::kLemniscate, "lemniscate"}, {MissionKind::kCircle, "circle"},
-    {MissionKind::kWaypoints, "waypoints"}, {MissionKind::kNavigate, "navigate"},
-    {MissionKind::kAssemblyPlan, "assembly_plan"}};
+inline constexpr EnumName<MissionKind> kMissionKindNames[] = {{MissionKind::kHover, "hover"},
+                                                              {MissionKind::kTakeoff, "takeoff"},
+                                                              {MissionKind::kLemniscate, "lemniscate"},
+                                                              {MissionKind::kCircle, "circle"},
+                                                              {MissionKind::kWaypoints, "waypoints"},
+                                                              {MissionKind::kNavigate, "navigate"},
+                                                              {MissionKind::kAssemblyPlan, "assembly_plan"}};
 constexpr std::span<const EnumName<MissionKind>> NamesOf(const MissionKind*) { return kMissionKindNames; }
 
 /// How an assembly plans (key mission.method).
@@ -36,8 +38,8 @@ enum class AssemblyPlanMethod {
   kOurs,      ///< eqs. 9 and 11-12 with the assembly's dynamics
   kBaseline,  ///< Table II's SVSDF-style row: kinematic limits only, no attitude terms
 };
-inline constexpr EnumName<AssemblyPlanMethod> kAssemblyPlanMethodNames[] = {{AssemblyPlanMethod::kOurs, "ours"},
-                                                                            {AssemblyPlanMethod::kBaseline, "baseline"}};
+inline constexpr EnumName<AssemblyPlanMethod> kAssemblyPlanMethodNames[] = {
+    {AssemblyPlanMethod::kOurs, "ours"}, {AssemblyPlanMethod::kBaseline, "baseline"}};
 constexpr std::span<const EnumName<AssemblyPlanMethod>> NamesOf(const AssemblyPlanMethod*) {
   return kAssemblyPlanMethodNames;
 }
@@ -61,16 +63,22 @@ struct AssemblyPlanSpec {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("goal_m", &goal_m, {.meaning = "where the assembly plans to, from its initial pose [m]", .required = true});
+    a->Visit("goal_m", &goal_m,
+             {.meaning = "where the assembly plans to, from its initial pose [m]", .required = true});
     a->Visit("method", &method, {.meaning = "ours, or baseline: Table II's SVSDF-style row"});
     a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "speed limit [m/s]", .positive = true});
     a->Visit("max_accel_m_s2", &max_accel_m_s2, {.meaning = "acceleration limit [m/s²]", .positive = true});
     a->Visit("max_jerk_m_s3", &max_jerk_m_s3, {.meaning = "jerk limit [m/s³]", .positive = true});
-    a->Visit("max_yaw_rate_rad_s", &max_yaw_rate_rad_s, {.meaning = "ours: the yaw's rate limit [rad/s]", .positive = true});
-    a->Visit("safety_factor", &safety_factor, {.meaning = "ours: the share of the assembly's capacity planned for", .min = 0.01, .max = 1.0});
-    a->Visit("attitude_weight", &attitude_weight, {.meaning = "ours: L_Φ of the A* (eq. 9b) [m/rad]", .min = 0.0, .max = 100.0});
-    a->Visit("time_weight", &time_weight, {.meaning = "λ_t of eq. (11): the larger, the more agile the plan", .min = 0.0, .max = 1e6});
-    a->Visit("map_resolution_m", &map_resolution_m, {.meaning = "voxel edge of the known map [m]", .min = 0.02, .max = 1.0});
+    a->Visit("max_yaw_rate_rad_s", &max_yaw_rate_rad_s,
+             {.meaning = "ours: the yaw's rate limit [rad/s]", .positive = true});
+    a->Visit("safety_factor", &safety_factor,
+             {.meaning = "ours: the share of the assembly's capacity planned for", .min = 0.01, .max = 1.0});
+    a->Visit("attitude_weight", &attitude_weight,
+             {.meaning = "ours: L_Φ of the A* (eq. 9b) [m/rad]", .min = 0.0, .max = 100.0});
+    a->Visit("time_weight", &time_weight,
+             {.meaning = "λ_t of eq. (11): the larger, the more agile the plan", .min = 0.0, .max = 1e6});
+    a->Visit("map_resolution_m", &map_resolution_m,
+             {.meaning = "voxel edge of the known map [m]", .min = 0.02, .max = 1.0});
   }
 };
 

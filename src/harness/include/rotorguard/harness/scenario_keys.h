@@ -21,7 +21,8 @@ struct HeaderKeys {
   void Serialize(Archive* a) {
     a->Visit("name", &s->name, {.meaning = "label used in outputs", .default_text = "the file's name"});
     a->Visit("description", &description, {.meaning = "free text"});
-    a->Visit("duration_s", &s->duration_s, {.meaning = "simulated time [s]", .min = 1e-3, .max = 1e6, .required = true});
+    a->Visit("duration_s", &s->duration_s,
+             {.meaning = "simulated time [s]", .min = 1e-3, .max = 1e6, .required = true});
     a->Visit("seed", &s->seed, {.meaning = "the same seed gives the same log.csv, byte for byte"});
   }
 };
@@ -32,8 +33,9 @@ struct InitialKeys {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("position_m", &s->initial_position_m,
-             {.meaning = "start position [m]; z = 0 starts landed (motors idle), z > 0 in hover", .rule_text = "z ≥ 0"});
+    a->Visit(
+        "position_m", &s->initial_position_m,
+        {.meaning = "start position [m]; z = 0 starts landed (motors idle), z > 0 in hover", .rule_text = "z ≥ 0"});
     a->Visit("yaw_rad", &s->initial_yaw_rad, {.meaning = "start heading [rad]"});
   }
 };
@@ -73,20 +75,27 @@ struct MetricsKeys {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("tracking_start_s", &s->tracking_start_s,
-             {.meaning = "tracking metrics cover [tracking_start_s, tracking_end_s]", .min = 0.0, .max = s->duration_s,
+             {.meaning = "tracking metrics cover [tracking_start_s, tracking_end_s]",
+              .min = 0.0,
+              .max = s->duration_s,
               .rule_text = "in [0, duration_s]"});
     a->Visit("tracking_end_s", &s->tracking_end_s,
-             {.meaning = "the window's end, at least one physics step after tracking_start_s", .min = 0.0,
-              .max = s->duration_s, .default_text = "the flight's end; an assembly_plan's: its plan's duration",
+             {.meaning = "the window's end, at least one physics step after tracking_start_s",
+              .min = 0.0,
+              .max = s->duration_s,
+              .default_text = "the flight's end; an assembly_plan's: its plan's duration",
               .rule_text = "in [0, duration_s]"});
     a->Visit("success_error_m", &s->success_error_m,
              {.meaning = "a run succeeds when |p - p_ref| stays at or below this [m] ...", .positive = true});
     a->Visit("success_hold_s", &s->success_hold_s,
-             {.meaning = "... over the flight's last success_hold_s [s]", .min = 0.0, .max = s->duration_s,
+             {.meaning = "... over the flight's last success_hold_s [s]",
+              .min = 0.0,
+              .max = s->duration_s,
               .rule_text = "in [0, duration_s]"});
     a->Visit("recovered_tilt_rad", &s->recovered_tilt_rad,
              {.meaning = "roll and pitch count as recovered once the tilt stays below this [rad] (tilt_recovery_s)",
-              .min = 1e-3, .max = 1.5});
+              .min = 1e-3,
+              .max = 1.5});
   }
 };
 

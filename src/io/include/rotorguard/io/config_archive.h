@@ -7,15 +7,15 @@
 ///
 ///     stack::FlightStackOptions o;
 ///     io::ReadConfig(doc.root().Required("stack"), &o);
+#include <fmt/format.h>
+
+#include <Eigen/Core>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
-
-#include <Eigen/Core>
-#include <fmt/format.h>
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/error.h"
@@ -40,7 +40,9 @@ class ConfigReader;
 
 /// A struct that declares its keys.
 template <typename T>
-concept DeclaresKeys = requires(T* t, ConfigReader* a) { t->Serialize(a); };
+concept DeclaresKeys = requires(T* t, ConfigReader* a) {
+  t->Serialize(a);
+};
 
 /// Reads the keys `value` declares from the map `node` and rejects the others; no validation.
 template <DeclaresKeys T>
@@ -107,7 +109,8 @@ class ConfigReader {
     if (const std::optional<ConfigNode> n = Find(key, info)) {
       const double deg = n->AsDouble();
       if (!(deg > info.min && deg < info.max)) {
-        n->Fail(fmt::format("{} = {:g} is invalid; expected an angle in ({:g}, {:g}) deg", key, deg, info.min, info.max));
+        n->Fail(
+            fmt::format("{} = {:g} is invalid; expected an angle in ({:g}, {:g}) deg", key, deg, info.min, info.max));
       }
       *angle.radians = deg * 3.14159265358979323846 / 180.0;
     }

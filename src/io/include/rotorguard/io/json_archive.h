@@ -1,14 +1,13 @@
 #pragma once
 /// The keys an options struct declares (core/config_schema.h) as a JSON object, and back: what
 /// summary.json records of a run's settings, in the same keys as the scenario file.
+#include <Eigen/Core>
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
-
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
 
 #include "rotorguard/core/config_schema.h"
 
@@ -22,7 +21,9 @@ class JsonWriter {
   void Visit(const char* key, T* value, const KeyInfo& = {}, Rest&&...) {
     json_[key] = ToValue(*value);
   }
-  void Visit(const char* key, DegreesOf angle, const KeyInfo&) { json_[key] = *angle.radians * 180.0 / 3.14159265358979323846; }
+  void Visit(const char* key, DegreesOf angle, const KeyInfo&) {
+    json_[key] = *angle.radians * 180.0 / 3.14159265358979323846;
+  }
   void Visit(const char* key, PairOf pair, const KeyInfo&) { json_[key] = {*pair.first, *pair.second}; }
   void Visit(const char* key, TripleOf t, const KeyInfo&) { json_[key] = {*t.x, *t.y, *t.z}; }
   nlohmann::json& json() { return json_; }
@@ -30,17 +31,25 @@ class JsonWriter {
  private:
   template <typename T>
   static nlohmann::json ToValue(T& value) {
-    if constexpr (requires(JsonWriter* w) { value.Serialize(w); }) {
+    if constexpr (requires(JsonWriter * w) { value.Serialize(w); }) {
       JsonWriter nested;
       value.Serialize(&nested);
       return nested.json_;
     } else if constexpr (NamedEnum<T>) {
       return ToName(value);
-    } else if constexpr (requires { value.data(); value.size(); typename T::Scalar; }) {  // an Eigen vector
+    } else if constexpr (requires {
+                           value.data();
+                           value.size();
+                           typename T::Scalar;
+                         }) {  // an Eigen vector
       return std::vector<double>(value.data(), value.data() + value.size());
     } else if constexpr (requires { value.has_value(); }) {
       return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-    } else if constexpr (requires { value.begin(); typename T::value_type; } && !std::is_same_v<T, std::string>) {
+    } else if constexpr (requires {
+                           value.begin();
+                           typename T::value_type;
+                         } &&
+                         !std::is_same_v<T, std::string>) {
       nlohmann::json list = nlohmann::json::array();
       for (auto& item : value) list.push_back(ToValue(item));
       return list;
@@ -77,7 +86,7 @@ class JsonReader {
  private:
   template <typename T>
   static void FromValue(const nlohmann::json& j, T* value) {
-    if constexpr (requires(JsonReader* r) { value->Serialize(r); }) {
+    if constexpr (requires(JsonReader * r) { value->Serialize(r); }) {
       JsonReader nested(j);
       value->Serialize(&nested);
     } else if constexpr (NamedEnum<T>) {
@@ -85,7 +94,11 @@ class JsonReader {
       const std::optional<T> parsed = FromName<T>(name);
       if (!parsed) throw nlohmann::json::other_error::create(501, "unknown name '" + name + "'", &j);
       *value = *parsed;
-    } else if constexpr (requires { value->data(); value->size(); typename T::Scalar; }) {  // an Eigen vector
+    } else if constexpr (requires {
+                           value->data();
+                           value->size();
+                           typename T::Scalar;
+                         }) {  // an Eigen vector
       const std::vector<double> v = j.get<std::vector<double>>();
       if (static_cast<Eigen::Index>(v.size()) != value->size()) {
         throw nlohmann::json::other_error::create(502, "wrong number of elements", &j);
@@ -97,7 +110,11 @@ class JsonReader {
       } else {
         *value = j.get<typename T::value_type>();
       }
-    } else if constexpr (requires { value->begin(); typename T::value_type; } && !std::is_same_v<T, std::string>) {
+    } else if constexpr (requires {
+                           value->begin();
+                           typename T::value_type;
+                         } &&
+                         !std::is_same_v<T, std::string>) {
       value->clear();
       for (const nlohmann::json& item : j) {
         typename T::value_type v{};

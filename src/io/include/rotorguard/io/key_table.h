@@ -2,6 +2,9 @@
 /// The documentation's key tables, written from the keys options structs declare
 /// (core/config_schema.h): one row per key with its path, its default (the struct's value), the
 /// values it accepts and its meaning, so that docs/scenarios.md cannot drift from the loader.
+#include <fmt/format.h>
+
+#include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -10,19 +13,16 @@
 #include <type_traits>
 #include <vector>
 
-#include <Eigen/Core>
-#include <fmt/format.h>
-
 #include "rotorguard/core/config_schema.h"
 
 namespace rotorguard::io {
 
 /// One key of a table.
 struct KeyRow {
-  std::string key;      ///< dotted path below the table's section, "weights.time", "known_faults[].rotor"
-  std::string value;    ///< the default, as a file would write it ("" for none) ...
+  std::string key;              ///< dotted path below the table's section, "weights.time", "known_faults[].rotor"
+  std::string value;            ///< the default, as a file would write it ("" for none) ...
   bool value_is_prose = false;  ///< ... or in words (a default that depends on other keys)
-  std::string rule;     ///< what it accepts
+  std::string rule;             ///< what it accepts
   std::string meaning;
 };
 
@@ -73,7 +73,9 @@ class KeyTableWriter {
   template <typename T>
   struct IsBlockList : std::false_type {};
   template <typename T>
-  struct IsBlockList<std::vector<T>> : std::bool_constant<requires(T* t, KeyTableWriter* w) { t->Serialize(w); }> {};
+      struct IsBlockList<std::vector<T>> : std::bool_constant < requires(T* t, KeyTableWriter* w) {
+    t->Serialize(w);
+  } > {};
 
   void Add(std::string key, std::string value, std::string rule, const char* meaning, bool prose = false) {
     rows_.push_back({std::move(key), std::move(value), prose, std::move(rule), meaning});

@@ -58,7 +58,9 @@ struct AllocatorOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("reallocation", &method, {.meaning = "full: min-variance over every rotor that delivers; partial: eqs. 3-5 of paper 002; none: the fault-blind pseudo-inverse"});
+    a->Visit("reallocation", &method,
+             {.meaning = "full: min-variance over every rotor that delivers; partial: eqs. 3-5 of paper 002; none: the "
+                         "fault-blind pseudo-inverse"});
   }
 };
 

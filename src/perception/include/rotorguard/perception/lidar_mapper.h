@@ -29,7 +29,8 @@ struct LidarMapperOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("inflation_margin_m", &inflation_margin_m, {.meaning = "obstacles are inflated by the vehicle's collision_radius_m plus this [m]"});
+    a->Visit("inflation_margin_m", &inflation_margin_m,
+             {.meaning = "obstacles are inflated by the vehicle's collision_radius_m plus this [m]"});
     map.Serialize(a);
   }
 };

@@ -66,15 +66,20 @@ struct VoxelMapOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("resolution_m", &resolution_m, {.meaning = "voxel edge [m]"});
-    a->Visit("window_size_m", &window_size_m, {.meaning = "the map's window around the vehicle [m], rounded up to a power of two voxels per axis"});
+    a->Visit("window_size_m", &window_size_m,
+             {.meaning = "the map's window around the vehicle [m], rounded up to a power of two voxels per axis"});
     a->Visit("log_odds_hit", &log_odds_hit, {.meaning = "log-odds added by a return (within ±30)"});
     a->Visit("log_odds_miss", &log_odds_miss, {.meaning = "log-odds added by a ray passing through"});
     a->Visit("log_odds_min", &log_odds_min, {.meaning = "lower clamp of a voxel's log-odds"});
     a->Visit("log_odds_max", &log_odds_max, {.meaning = "upper clamp of a voxel's log-odds"});
     a->Visit("occupied_threshold", &occupied_threshold, {.meaning = "log-odds above which a voxel is occupied"});
     a->Visit("max_clearing_range_m", &max_clearing_range_m, {.meaning = "rays clear free space up to this range [m]"});
-    a->Visit("clearing_stride", &clearing_stride, {.meaning = "a frame walks one in this many of its rays (every return is still hit)", .min = 1, .max = kMaxClearingStride});
-    a->Visit("recenter_hysteresis_m", &recenter_hysteresis_m, {.meaning = "the window follows an axis once the vehicle is this far from its centre along it [m]"});
+    a->Visit("clearing_stride", &clearing_stride,
+             {.meaning = "a frame walks one in this many of its rays (every return is still hit)",
+              .min = 1,
+              .max = kMaxClearingStride});
+    a->Visit("recenter_hysteresis_m", &recenter_hysteresis_m,
+             {.meaning = "the window follows an axis once the vehicle is this far from its centre along it [m]"});
   }
 };
 

@@ -31,15 +31,18 @@ struct FlatnessNavigatorOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("theta_max_deg", DegreesOf{&limits.theta_max_rad}, {.meaning = "pitch bound θ_max of eq. (16) [deg]", .min = 0.0, .max = 90.0});
-    a->Visit("phi_max_deg", DegreesOf{&limits.phi_max_rad}, {.meaning = "roll bound φ_max [deg]", .min = 0.0, .max = 90.0});
+    a->Visit("theta_max_deg", DegreesOf{&limits.theta_max_rad},
+             {.meaning = "pitch bound θ_max of eq. (16) [deg]", .min = 0.0, .max = 90.0});
+    a->Visit("phi_max_deg", DegreesOf{&limits.phi_max_rad},
+             {.meaning = "roll bound φ_max [deg]", .min = 0.0, .max = 90.0});
     a->Visit("rho_angle", &limits.rho_angle, {.meaning = "ρ_θ = ρ_φ, the model's safety margin, in (0, 1]"});
     a->Visit("u_max", &limits.u_max, {.meaning = "the largest PWM input a plan may ask of a motor (0: the vehicle's)"});
     a->Visit("rho_u", &limits.rho_u, {.meaning = "ρ_u of eq. (23), in (0, 1]"});
     a->Visit("hold_t_s", &hold_t_s, {.meaning = "settling time of the slow trajectory held after a detection [s]"});
     a->Visit("min_hold_s", &min_hold_s, {.meaning = "the shortest hold [s]"});
     a->Visit("max_hold_s", &max_hold_s, {.meaning = "re-plan after this even if the estimate has not settled [s]"});
-    a->Visit("time_budget_s", &time_budget_s, {.meaning = "the longest re-planned leg accepted [s]; beyond it: return home, or land"});
+    a->Visit("time_budget_s", &time_budget_s,
+             {.meaning = "the longest re-planned leg accepted [s]; beyond it: return home, or land"});
     a->Visit("min_t_s", &min_t_s, {.meaning = "settling time of a leg without a horizontal move [s]"});
   }
 };

@@ -37,7 +37,7 @@ struct LbfgsSummary {
 };
 
 /// Minimises f from *x in place. Ceres' glog warnings (its line search's harmless ones) are kept
-/// to errors: a library does not print (DESIGN.md).
+/// to errors: a library does not print.
 LbfgsSummary MinimizeLbfgs(const GradientObjective& f, const LbfgsOptions& options, Eigen::VectorXd* x);
 
 }  // namespace rotorguard::planning

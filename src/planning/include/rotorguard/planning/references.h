@@ -52,7 +52,8 @@ struct TakeoffOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("altitude_m", &altitude_m, {.meaning = "the climb above the start [m] (a minimum-jerk climb)", .positive = true, .required = true});
+    a->Visit("altitude_m", &altitude_m,
+             {.meaning = "the climb above the start [m] (a minimum-jerk climb)", .positive = true, .required = true});
     a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "peak climb speed [m/s]"});
     a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
   }
@@ -138,7 +139,9 @@ struct LemniscateOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("center_m", &center_m, {.meaning = "centre of the figure eight x = sx/2 sin θ, y = sy/2 sin 2θ, z = sz/2 sin θ [m]", .default_text = "the initial position"});
+    a->Visit("center_m", &center_m,
+             {.meaning = "centre of the figure eight x = sx/2 sin θ, y = sy/2 sin 2θ, z = sz/2 sin θ [m]",
+              .default_text = "the initial position"});
     a->Visit("size_m", TripleOf{&size_x_m, &size_y_m, &size_z_m}, {.meaning = "its full extent [sx, sy, sz] [m]"});
     a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "top speed once ramped up [m/s]", .required = true});
     a->Visit("ramp_s", &ramp_s, {.meaning = "time to full phase rate from rest [s]"});
@@ -178,12 +181,14 @@ struct CircleOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("center_m", &center_m, {.meaning = "centre; the circle starts at centre + [radius, 0, 0] [m]", .required = true});
+    a->Visit("center_m", &center_m,
+             {.meaning = "centre; the circle starts at centre + [radius, 0, 0] [m]", .required = true});
     a->Visit("radius_m", &radius_m, {.meaning = "[m]", .required = true});
     a->Visit("speed_m_s", &speed_m_s, {.meaning = "tangential speed once ramped up [m/s]", .required = true});
     a->Visit("ramp_s", &ramp_s, {.meaning = "time to full speed from rest [s]"});
     a->Visit("clockwise", &clockwise, {.meaning = "seen from above"});
-    a->Visit("climb_m_s", &climb_m_s, {.meaning = "vertical speed: non-zero makes the circle a helix (paper 002's spiral) [m/s]"});
+    a->Visit("climb_m_s", &climb_m_s,
+             {.meaning = "vertical speed: non-zero makes the circle a helix (paper 002's spiral) [m/s]"});
     a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
   }
 };
@@ -216,8 +221,10 @@ struct WaypointOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("waypoints_m", &waypoints_m, {.meaning = "the points flown to from the start, in turn, stopping at each [m]", .required = true});
-    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "speed limit of the trapezoidal profile [m/s]", .required = true});
+    a->Visit("waypoints_m", &waypoints_m,
+             {.meaning = "the points flown to from the start, in turn, stopping at each [m]", .required = true});
+    a->Visit("max_speed_m_s", &max_speed_m_s,
+             {.meaning = "speed limit of the trapezoidal profile [m/s]", .required = true});
     a->Visit("max_accel_m_s2", &max_accel_m_s2, {.meaning = "its acceleration limit [m/s²]"});
     a->Visit("dwell_s", &dwell_s, {.meaning = "pause at each intermediate waypoint [s]"});
     a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});

@@ -37,7 +37,8 @@ struct LidarOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("enabled", &enabled, {.meaning = "a lidar block switches the sensor on unless this says false", .default_text = "true"});
+    a->Visit("enabled", &enabled,
+             {.meaning = "a lidar block switches the sensor on unless this says false", .default_text = "true"});
     a->Visit("frame_rate_hz", &frame_rate_hz, {.meaning = "frames per second"});
     a->Visit("points_per_s", &points_per_s, {.meaning = "pulses per second"});
     a->Visit("min_range_m", &min_range_m, {.meaning = "closer returns are dropped [m]"});

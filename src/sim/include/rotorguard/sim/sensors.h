@@ -31,7 +31,8 @@ struct ImuOptions {
     a->Visit("gyro_noise_density", &gyro_noise_density, {.meaning = "gyro white noise [rad/s/√Hz]"});
     a->Visit("accel_bias_random_walk", &accel_bias_random_walk, {.meaning = "accelerometer bias diffusion [m/s³/√Hz]"});
     a->Visit("gyro_bias_random_walk", &gyro_bias_random_walk, {.meaning = "gyro bias diffusion [rad/s²/√Hz]"});
-    a->Visit("accel_bias_initial", &accel_bias_initial, {.meaning = "std of the accelerometer bias at the start [m/s²]"});
+    a->Visit("accel_bias_initial", &accel_bias_initial,
+             {.meaning = "std of the accelerometer bias at the start [m/s²]"});
     a->Visit("gyro_bias_initial", &gyro_bias_initial, {.meaning = "std of the gyro bias at the start [rad/s]"});
   }
 };
@@ -81,7 +82,8 @@ struct OdometryOptions {
     a->Visit("rate_hz", &rate_hz, {.meaning = "rate [Hz], at most the physics rate"});
     a->Visit("position_noise_m", &position_noise_m, {.meaning = "position std at rest [m]"});
     a->Visit("velocity_noise_m_s", &velocity_noise_m_s, {.meaning = "velocity std at rest [m/s]"});
-    a->Visit("attitude_noise_rad", &attitude_noise_rad, {.meaning = "attitude std at rest, per small-angle component [rad]"});
+    a->Visit("attitude_noise_rad", &attitude_noise_rad,
+             {.meaning = "attitude std at rest, per small-angle component [rad]"});
     a->Visit("rate_noise_gain", &rate_noise_gain, {.meaning = "the stds grow as (1 + gain·|ω|) [per rad/s]"});
     a->Visit("outages", &outages, {.meaning = "intervals without odometry (the front end lost track)"});
   }

@@ -45,7 +45,8 @@ struct KnownFault {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("rotor", &rotor, {.meaning = "the rotor handed over as failed", .min = 0, .max = kMaxRotors - 1, .required = true});
+    a->Visit("rotor", &rotor,
+             {.meaning = "the rotor handed over as failed", .min = 0, .max = kMaxRotors - 1, .required = true});
     a->Visit("at_time_s", &at_time_s, {.meaning = "when [s]", .min = 0.0, .required = true});
     a->Visit("loss", &loss, {.meaning = "1: failed; below 1 a partial loss of thrust (controller assembly only)"});
   }
@@ -119,15 +120,20 @@ struct NavigationOptions {
     a->Visit("v_max", &r.nominal.v_max, {.meaning = "nominal speed limit [m/s]"});
     a->Visit("a_max", &r.nominal.a_max, {.meaning = "nominal acceleration limit a_max,n [m/s²]"});
     a->Visit("j_max", &r.nominal.j_max, {.meaning = "nominal jerk limit [m/s³]"});
-    a->Visit("post_failure_safety_factor", &post_failure_safety_factor,
-             {.meaning = "γ_a,f of eq. (33): with the vehicle's mass, rotor thrust and drag it gives a_max,f after a failure"});
+    a->Visit(
+        "post_failure_safety_factor", &post_failure_safety_factor,
+        {.meaning =
+             "γ_a,f of eq. (33): with the vehicle's mass, rotor thrust and drag it gives a_max,f after a failure"});
     a->Visit("replan_period_s", &r.replan_period_s, {.meaning = "periodic replanning [s]"});
-    a->Visit("clearance_m", &r.planner.optimizer.clearance_m, {.meaning = "C_o of eq. (36), the distance kept from obstacles [m]"});
-    a->Visit("post_failure_clearance_m", &r.post_failure_clearance_m,
-             {.meaning = "unset: clearance_m throughout; else C_o once the attitude recovered from a failure, and the one "
-                         "tried when clearance_m finds no plan before (docs/navigation.md)",
-              .min = 0.0});
-    a->Visit("failure_aware", &failure_aware, {.meaning = "false: the failure-unaware variant keeps the nominal limits after a failure"});
+    a->Visit("clearance_m", &r.planner.optimizer.clearance_m,
+             {.meaning = "C_o of eq. (36), the distance kept from obstacles [m]"});
+    a->Visit(
+        "post_failure_clearance_m", &r.post_failure_clearance_m,
+        {.meaning = "unset: clearance_m throughout; else C_o once the attitude recovered from a failure, and the one "
+                    "tried when clearance_m finds no plan before (docs/navigation.md)",
+         .min = 0.0});
+    a->Visit("failure_aware", &failure_aware,
+             {.meaning = "false: the failure-unaware variant keeps the nominal limits after a failure"});
     a->Visit("altitude_band_m", PairOf{&r.planner.search.z_min_m, &r.planner.search.z_max_m},
              {.meaning = "[z_min, z_max], the altitudes the search may use [m]"});
     a->Visit("weights", &r.planner.optimizer.weights, {.meaning = "eq. (22)'s weights"});
@@ -184,10 +190,11 @@ void FlightStackOptions::Serialize(Archive* a) {
   a->Visit("nmpc", &nmpc, {.meaning = "the NMPC (docs/control.md)"});
   a->Visit("fdd", &fdd, {.meaning = "fault detection; an isolation reconfigures the NMPC or INDI (docs/fdd.md)"});
   a->Visit("composite_fdd", &composite_fdd, {.meaning = "the composite FDD's thresholds (paper 000, eqs. 13-18)"});
-  a->Visit("deskew_frames", &lidar.deskew_frames, {.meaning = "deskew each LiDAR frame to its end pose before mapping"});
+  a->Visit("deskew_frames", &lidar.deskew_frames,
+           {.meaning = "deskew each LiDAR frame to its end pose before mapping"});
   a->Visit("supervisor", &supervisor, {.meaning = "flight modes and emergency landing (docs/navigation.md)"});
-  a->Visit("planner", &navigation, {.meaning = "the navigate mission's planner (docs/planning.md)", .shorthand = "method"},
-           [this] {
+  a->Visit("planner", &navigation,
+           {.meaning = "the navigate mission's planner (docs/planning.md)", .shorthand = "method"}, [this] {
              navigation.replanner.WidenPlaneSearch();
              navigation.Validate();
            });
@@ -236,11 +243,11 @@ struct FlightStackSummary {
   std::optional<NavigationSummary> navigation;  ///< mission navigate
   /// Paper 004's planner's decisions: plan, hold, continue, return, land (navigation method flatness).
   std::vector<planning::FlatnessDecision> flatness_decisions;
-  std::optional<UkfSummary> ukf;                ///< fdd ukf
+  std::optional<UkfSummary> ukf;                 ///< fdd ukf
   FlightMode final_mode = FlightMode::kNominal;  ///< the supervisor's mode at the end ...
   std::vector<ModeTransition> transitions;       ///< ... and its transitions
-  std::optional<int> map_voxels_occupied;       ///< the LiDAR map's occupied voxels; none without a LiDAR
-  long lidar_points_dropped = 0;                ///< as lidar_points_dropped()
+  std::optional<int> map_voxels_occupied;        ///< the LiDAR map's occupied voxels; none without a LiDAR
+  long lidar_points_dropped = 0;                 ///< as lidar_points_dropped()
 };
 
 class FlightStack {

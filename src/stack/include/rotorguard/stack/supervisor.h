@@ -47,16 +47,23 @@ struct SupervisorOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("recovery_tilt_rad", &recovery_tilt_rad, {.meaning = "recovery from a failure ends once roll and pitch stay below this [rad] ..."});
+    a->Visit("recovery_tilt_rad", &recovery_tilt_rad,
+             {.meaning = "recovery from a failure ends once roll and pitch stay below this [rad] ..."});
     a->Visit("recovery_hold_s", &recovery_hold_s, {.meaning = "... for this long [s]"});
-    a->Visit("no_plan_timeout_s", &no_plan_timeout_s, {.meaning = "a goal without a successful plan for this long [s] lands the vehicle"});
+    a->Visit("no_plan_timeout_s", &no_plan_timeout_s,
+             {.meaning = "a goal without a successful plan for this long [s] lands the vehicle"});
     a->Visit("odometry_timeout_s", &odometry_timeout_s, {.meaning = "odometry older than this [s] lands the vehicle"});
-    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "a speed estimate above this [m/s] (a diverged estimator) lands the vehicle"});
+    a->Visit("max_speed_m_s", &max_speed_m_s,
+             {.meaning = "a speed estimate above this [m/s] (a diverged estimator) lands the vehicle"});
     a->Visit("landing_speed_m_s", &landing_speed_m_s, {.meaning = "peak descent rate of an emergency landing [m/s]"});
     a->Visit("landing_depth_m", &landing_depth_m, {.meaning = "how far below the ground the descent aims [m]"});
-    a->Visit("touchdown_thrust_ratio", &touchdown_thrust_ratio, {.meaning = "collective command over weight below which ..."});
+    a->Visit("touchdown_thrust_ratio", &touchdown_thrust_ratio,
+             {.meaning = "collective command over weight below which ..."});
     a->Visit("touchdown_hold_s", &touchdown_hold_s, {.meaning = "... for this long [s] is a touchdown"});
-    a->Visit("max_failed_rotors", &max_failed_rotors, {.meaning = "failed rotors the vehicle flies on; one more lands it (an assembly of n units: 4n - 4)", .min = 0, .max = kMaxRotors});
+    a->Visit("max_failed_rotors", &max_failed_rotors,
+             {.meaning = "failed rotors the vehicle flies on; one more lands it (an assembly of n units: 4n - 4)",
+              .min = 0,
+              .max = kMaxRotors});
   }
 };
 

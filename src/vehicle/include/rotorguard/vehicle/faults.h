@@ -1,5 +1,5 @@
 #pragma once
-/// Rotor fault kinds and how each changes a rotor (DESIGN.md, "Faults").
+/// Rotor fault kinds and how each changes a rotor (docs/scenarios.md, "Faults").
 #include <optional>
 #include <string>
 #include <string_view>
