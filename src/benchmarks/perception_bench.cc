@@ -12,6 +12,7 @@
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/harness/world_raster.h"
 #include "rotorguard/perception/lidar_mapper.h"
 #include "rotorguard/sim/lidar.h"
 #include "rotorguard/sim/sensors.h"
@@ -166,7 +167,7 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
           {"map_update_ms_max", frame_ms.empty() ? 0.0 : frame_ms.back()},
           {"map_voxels_occupied", map ? map->occupied_count() : 0},
           {"truth_voxels_in_window", truth_voxels},
-          {"map_precision", map ? MapPrecision(*map, scene.world) : 0.0},
+          {"map_precision", map ? harness::MapPrecision(*map, scene.world) : 0.0},
           {"map_recall", recall}};
 }
 
@@ -200,14 +201,6 @@ sim::World PerceptionRoom() {
              {Vector3(-3.7, 1.5, 1.0), Vector3(0.4, 1.6, 2.0), 0.0}};  // a shelf against a wall
   w.cylinders = {{Eigen::Vector2d(1.5, 1.0), 0.2, 3.0}};
   return w;
-}
-
-double MapPrecision(const perception::VoxelMap& map, const sim::World& world) {
-  const std::vector<Vector3> occupied = map.OccupiedVoxels();
-  const double tolerance = map.resolution() * (0.5 * std::sqrt(3.0) + 1.0);
-  long good = 0;
-  for (const Vector3& c : occupied) good += world.DistanceToSurface(c, 0.0) <= tolerance ? 1 : 0;
-  return occupied.empty() ? 0.0 : static_cast<double>(good) / static_cast<double>(occupied.size());
 }
 
 nlohmann::json RunPerceptionBenchmark(const PerceptionBenchOptions& options) {

@@ -170,7 +170,7 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   const std::string before = ReadText(results);
   EXPECT_EQ(Cli("campaign run " + spec + " --out " + killed).exit_code, 2);
   EXPECT_EQ(ReadText(results), before);
-  for (const char* shard : {"4/4", "0/0", "-1/2"}) {
+  for (const char* shard : {"4/4", "0/0", "-1/2", "a/2", "1/2x", "3"}) {
     const Result r = Cli("campaign run " + spec + " --out " + (dir_ / "s").string() + " --shard=" + shard);
     EXPECT_EQ(r.exit_code, 2) << shard << ": " << r.out;
     EXPECT_NE(r.out.find("--shard"), std::string::npos) << r.out;
@@ -193,7 +193,9 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
 TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
   const Result r = Cli("--help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* s : {"run", "validate", "bench", "campaign", "fdd-calibrate", "report", "Exit codes"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  for (const char* s : {"run", "validate", "keys", "bench", "campaign", "fdd-calibrate", "report", "Exit codes"}) {
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  }
   const Result run = Cli("run --help");
   EXPECT_EQ(run.exit_code, 0);
   for (const char* s : {"--out", "--set", "--seed", "--quiet", "--log-format", "--no-report"}) EXPECT_NE(run.out.find(s), std::string::npos) << s;
@@ -207,6 +209,14 @@ TEST_F(CliTest, HelpListsEveryCommandAndExitCodes) {
   EXPECT_EQ(planner.exit_code, 0);
   for (const char* s : {"--pairs", "--worlds", "--seed", "--json"}) EXPECT_NE(planner.out.find(s), std::string::npos) << s;
   EXPECT_EQ(Cli("validate --help").exit_code, 0);
+}
+
+// `keys` prints every scenario key with its default: the stack's NMPC horizon (20, paper 000) among them.
+TEST_F(CliTest, KeysPrintsEveryScenarioKeyWithItsDefault) {
+  const Result r = Cli("keys");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("| `stack.nmpc.horizon_steps` | `20` | an integer in [1, 200] |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("`mission` with `type: lemniscate`"), std::string::npos);
 }
 
 TEST_F(CliTest, UsageErrorsExitTwo) {

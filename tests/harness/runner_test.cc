@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "rotorguard/benchmarks/perception_bench.h"
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/harness/world_raster.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/csv.h"
 #include "test_util.h"
@@ -262,7 +262,7 @@ TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
     double p = 0.0;
     o.on_control_cycle = [&](const stack::FlightStack& st) {
       if (st.map() && st.command().t_ns == FromSeconds(s.duration_s) - st.control_period_ns()) {
-        p = benchmarks::MapPrecision(*st.map(), s.world);
+        p = MapPrecision(*st.map(), s.world);
       }
     };
     const RunSummary r = RunScenario(variant, o);

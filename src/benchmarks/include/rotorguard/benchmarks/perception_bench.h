@@ -36,10 +36,6 @@ sim::World PerceptionForest(std::uint64_t seed);
 /// An 8 x 6 m room (walls 3 m high, no ceiling) with a pillar, a table-sized box and a shelf.
 sim::World PerceptionRoom();
 
-/// Share of the map's occupied voxels within one voxel of a true surface: the voxel's centre at
-/// most half a diagonal plus one edge from it. 0 for an empty map.
-double MapPrecision(const perception::VoxelMap& map, const sim::World& world);
-
 nlohmann::json RunPerceptionBenchmark(const PerceptionBenchOptions& options);
 /// The result as a Markdown table.
 std::string PerceptionMarkdown(const nlohmann::json& result);

@@ -1,7 +1,7 @@
 #pragma once
-/// A known map: the world's geometry written into a voxel map, for planning on the truth (paper
-/// 002's setting, and the planner benchmark's), where the flight stack would otherwise build its
-/// map from LiDAR returns.
+/// Voxel maps and the world's truth: the world's geometry written into a map, for planning on the
+/// truth (paper 002's setting, and the planner benchmark's), where the flight stack would otherwise
+/// build its map from LiDAR returns; and a map the stack built scored against the world.
 #include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/sim/world.h"
 
@@ -10,5 +10,9 @@ namespace rotorguard::harness {
 /// Marks occupied every voxel of `map`'s window whose centre lies within half a voxel diagonal of
 /// a box or cylinder of `world` (the ground is left out: the planner keeps an altitude band).
 void RasterizeWorld(const sim::World& world, perception::VoxelMap* map);
+
+/// Share of the map's occupied voxels within one voxel of a true surface: the voxel's centre at
+/// most half a diagonal plus one edge from it. 0 for an empty map.
+double MapPrecision(const perception::VoxelMap& map, const sim::World& world);
 
 }  // namespace rotorguard::harness
