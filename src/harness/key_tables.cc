@@ -72,4 +72,11 @@ std::string ScenarioKeyTables() {
   return md;
 }
 
+std::string VehicleKeyTable() {
+  io::KeyTableWriter writer;
+  vehicle::VehicleParams defaults;
+  defaults.Serialize(&writer);
+  return io::KeyTableMarkdown(writer.rows(), "");
+}
+
 }  // namespace rotorguard::harness

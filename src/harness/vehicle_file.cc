@@ -1,16 +1,14 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <filesystem>
-#include <iterator>
-#include <nlohmann/json.hpp>
 
-#include "loader_internal.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_archive.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/yaml_writer.h"
 #include "rotorguard/vehicle/multirotor.h"
+#include "loader_internal.h"
 
 // Vehicle and assembly files, and the overrides and paths every loader shares.
 namespace rotorguard::harness {
@@ -21,62 +19,29 @@ using io::ValidateAt;
 
 namespace {
 
-vehicle::VehicleParams ParseVehicle(const ConfigNode& root) {
-  vehicle::VehicleParams v;
-  v.name = root.Has("name") ? root.Required("name").AsString() : "vehicle";
-  v.mass_kg = root.Required("mass_kg").AsDouble();
-  const ConfigNode inertia = root.Required("inertia_kg_m2");
-  if (!inertia.IsSequence() || inertia.size() != 3) {
-    inertia.Fail("expected a 3x3 matrix written as three rows of three numbers");
-  }
-  for (std::size_t r = 0; r < 3; ++r) {
-    const std::vector<double> row = inertia.At(r).AsDoubleList(3);
-    for (int c = 0; c < 3; ++c) v.inertia_kg_m2(static_cast<int>(r), c) = row[c];
-  }
-  v.rotor_drag_kg_s = root.Required("rotor_drag_kg_s").AsVector3();
-  v.yaw_damping_n_m_s = root.Required("yaw_damping_n_m_s").AsDouble();
-  v.thrust_coefficient_n_s2 =
-      vehicle::ThrustCoefficientFromRpm(root.Required("thrust_coefficient_n_per_rpm2").AsPositive());
-  v.motor_time_constant_s = root.Required("motor_time_constant_s").AsDouble();
-  v.motor_stop_time_constant_s = root.Required("motor_stop_time_constant_s").AsDouble();
-  v.unloaded_speed_ratio = root.Required("unloaded_rpm_ratio").AsDouble();
-  v.collision_radius_m = root.Required("collision_radius_m").AsDouble();
-  if (root.Has("pwm_gain_n")) v.pwm_gain_n = root.Required("pwm_gain_n").AsPositive();
-  if (const auto spheres = root.Optional("collision_spheres")) {
-    if (!spheres->IsSequence() || spheres->size() == 0) spheres->Fail("expected a non-empty list of spheres");
-    for (std::size_t i = 0; i < spheres->size(); ++i) {
-      const ConfigNode c = spheres->At(i);
-      v.collision_spheres.push_back({c.Required("centre_m").AsVector3(), c.Required("radius_m").AsPositive()});
-      c.RejectUnknownKeys();
-    }
-  }
-  const ConfigNode rotors = root.Required("rotors");
-  if (!rotors.IsSequence() || rotors.size() == 0) rotors.Fail("expected a non-empty list of rotors");
-  for (std::size_t i = 0; i < rotors.size(); ++i) {
-    const ConfigNode r = rotors.At(i);
-    vehicle::Rotor rotor;
-    rotor.p_B = r.Required("position_m").AsVector3();
-    rotor.direction = r.Required("direction").AsEnum({"ccw", "cw"}) == "cw" ? vehicle::SpinDirection::kClockwise
-                                                                            : vehicle::SpinDirection::kCounterClockwise;
-    rotor.yaw_coefficient_m = r.Required("yaw_coefficient_m").AsDouble();
-    rotor.max_thrust_n = r.Required("max_thrust_n").AsDouble();
-    r.RejectUnknownKeys();
-    v.rotors.push_back(rotor);
-  }
-  root.RejectUnknownKeys();
-  ValidateAt(root, [&] { v.Validate(); });
-  return v;
+constexpr std::string_view kVehiclePrefix = "vehicle.";
+
+/// An error at a `--set vehicle.KEY=...` value, named as the user wrote it.
+io::ConfigError WithVehiclePrefix(const io::ConfigError& e) {
+  if (e.file() != io::kOverrideSource) return e;
+  return io::ConfigError(e.file(), e.line(), e.column(), std::string(kVehiclePrefix) + e.key_path(), e.message());
 }
 
 vehicle::VehicleParams LoadVehicleDocument(ConfigDocument doc, const std::vector<Override>& overrides) {
   ApplyOverrides(&doc, overrides, /*vehicle_part=*/true);
-  return ParseVehicle(doc.root());
+  vehicle::VehicleParams v;
+  v.name = "vehicle";
+  try {
+    io::ReadConfig(doc.root(), &v);
+  } catch (const io::ConfigError& e) {
+    throw WithVehiclePrefix(e);
+  }
+  return v;
 }
 
 }  // namespace
 
 void ApplyOverrides(ConfigDocument* doc, const std::vector<Override>& overrides, bool vehicle_part) {
-  constexpr std::string_view kVehiclePrefix = "vehicle.";
   for (const auto& [path, value] : overrides) {
     const bool is_vehicle = path.rfind(kVehiclePrefix, 0) == 0;
     if (is_vehicle != vehicle_part) continue;
@@ -87,8 +52,7 @@ void ApplyOverrides(ConfigDocument* doc, const std::vector<Override>& overrides,
     try {
       doc->ApplyOverride(path.substr(kVehiclePrefix.size()), value);
     } catch (const io::ConfigError& e) {
-      // Report the path as the user wrote it, with its prefix.
-      throw io::ConfigError(e.file(), e.line(), e.column(), std::string(kVehiclePrefix) + e.key_path(), e.message());
+      throw WithVehiclePrefix(e);
     }
   }
 }
@@ -137,34 +101,10 @@ modular::Assembly LoadAssembly(const std::string& path) {
 }
 
 std::string VehicleToYaml(const vehicle::VehicleParams& v) {
-  auto out = fmt::memory_buffer();
-  auto it = std::back_inserter(out);
-  const auto vec = [](const Vector3& x) { return fmt::format("[{}, {}, {}]", x.x(), x.y(), x.z()); };
-  const double rpm_per_rad_s = vehicle::RadPerSecondToRpm(1.0);
-  fmt::format_to(it, "# Written by rotorguard: the vehicle a run flew (the format of configs/vehicles/).\n");
-  // A JSON string is a valid YAML double-quoted scalar.
-  fmt::format_to(it, "name: {}\nmass_kg: {}\ninertia_kg_m2:\n", nlohmann::json(v.name).dump(), v.mass_kg);
-  for (int r = 0; r < 3; ++r) fmt::format_to(it, "  - {}\n", vec(v.inertia_kg_m2.row(r).transpose()));
-  fmt::format_to(it, "rotor_drag_kg_s: {}\nyaw_damping_n_m_s: {}\n", vec(v.rotor_drag_kg_s), v.yaw_damping_n_m_s);
-  fmt::format_to(it, "thrust_coefficient_n_per_rpm2: {}\n",
-                 v.thrust_coefficient_n_s2 / (rpm_per_rad_s * rpm_per_rad_s));
-  fmt::format_to(it, "motor_time_constant_s: {}\nmotor_stop_time_constant_s: {}\n", v.motor_time_constant_s,
-                 v.motor_stop_time_constant_s);
-  fmt::format_to(it, "unloaded_rpm_ratio: {}\ncollision_radius_m: {}\n", v.unloaded_speed_ratio, v.collision_radius_m);
-  if (v.pwm_gain_n > 0.0) fmt::format_to(it, "pwm_gain_n: {}\n", v.pwm_gain_n);
-  if (!v.collision_spheres.empty()) {  // an assembly's footprint, unit by unit
-    fmt::format_to(it, "collision_spheres:\n");
-    for (const vehicle::CollisionSphere& c : v.collision_spheres) {
-      fmt::format_to(it, "  - {{centre_m: {}, radius_m: {}}}\n", vec(c.centre_B), c.radius_m);
-    }
-  }
-  fmt::format_to(it, "rotors:\n");
-  for (const vehicle::Rotor& r : v.rotors) {
-    fmt::format_to(it, "  - {{position_m: {}, direction: {}, yaw_coefficient_m: {}, max_thrust_n: {}}}\n", vec(r.p_B),
-                   r.direction == vehicle::SpinDirection::kClockwise ? "cw" : "ccw", r.yaw_coefficient_m,
-                   r.max_thrust_n);
-  }
-  return fmt::to_string(out);
+  io::YamlWriter writer;
+  vehicle::VehicleParams copy = v;
+  copy.Serialize(&writer);
+  return "# Written by rotorguard: the vehicle a run flew (the format of configs/vehicles/).\n" + writer.text();
 }
 
 std::string ScenarioFingerprint(const Scenario& scenario) {

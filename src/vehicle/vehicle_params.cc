@@ -26,6 +26,7 @@ void RequireNonNegative(const std::string& field, double value) {
 double ThrustCoefficientFromRpm(double k) { return k * kRpmPerRadPerSecond * kRpmPerRadPerSecond; }
 double RadPerSecondToRpm(double w) { return w * kRpmPerRadPerSecond; }
 double RpmToRadPerSecond(double rpm) { return rpm / kRpmPerRadPerSecond; }
+double ThrustCoefficientToRpm(double k) { return k / (kRpmPerRadPerSecond * kRpmPerRadPerSecond); }
 
 double VehicleParams::total_max_thrust_n() const {
   double sum = 0.0;

@@ -202,6 +202,11 @@ TEST_F(ScenarioLoader, VehicleOverridesApplyToTheVehicleFile) {
   EXPECT_EQ(s.vehicle.mass_kg, 1.3);
   RG_EXPECT_THROW_WITH(LoadScenario(File("mission: {type: hover}\n"), {{"vehicle.mass", "1.3"}}), io::ConfigError,
                        "vehicle.mass");
+  // A value the vehicle's rules reject is named as it was written, prefix included.
+  RG_EXPECT_THROW_WITH(LoadScenario(File("mission: {type: hover}\n"), {{"vehicle.mass_kg", "-1"}}), io::ConfigError,
+                       "--set: vehicle.mass_kg: '-1' is out of range");
+  RG_EXPECT_THROW_WITH(LoadScenario(File("mission: {type: hover}\n"), {{"vehicle.rotors.0.max_thrust_n", "0.1"}}),
+                       io::ConfigError, "vehicle.rotors.0.max_thrust_n: VehicleParams::rotors.0.max_thrust_n = 0.1");
 }
 
 /// The keys a block's unknown-key error lists, from its message.
@@ -234,20 +239,27 @@ TEST_F(ScenarioLoader, KeyTablesListEveryKeyTheLoaderTakes) {
   }
 }
 
-// docs/scenarios.md holds the tables the code writes (`rotorguard keys`), unedited.
-TEST(ScenarioDocs, TheKeyTablesAreTheCodes) {
+/// The text between `begin` and `end` in docs/scenarios.md.
+std::string DocsRegion(const std::string& begin, const std::string& end) {
   std::ifstream in(std::string(ROTORGUARD_SOURCE_DIR) + "/docs/scenarios.md");
   std::stringstream doc;
   doc << in.rdbuf();
   const std::string text = doc.str();
-  const std::string begin = "<!-- BEGIN rotorguard keys: generated, do not edit by hand -->\n";
-  const std::string end = "<!-- END rotorguard keys -->";
   const std::size_t a = text.find(begin), b = text.find(end);
-  ASSERT_NE(a, std::string::npos);
-  ASSERT_NE(b, std::string::npos);
-  EXPECT_EQ(text.substr(a + begin.size(), b - a - begin.size()), ScenarioKeyTables())
+  if (a == std::string::npos || b == std::string::npos) return "(markers not found)";
+  return text.substr(a + begin.size(), b - a - begin.size());
+}
+
+// docs/scenarios.md holds the tables the code writes (`rotorguard keys`), unedited.
+TEST(ScenarioDocs, TheKeyTablesAreTheCodes) {
+  EXPECT_EQ(DocsRegion("<!-- BEGIN rotorguard keys: generated, do not edit by hand -->\n", "<!-- END rotorguard keys -->"),
+            ScenarioKeyTables())
       << "docs/scenarios.md's key tables are out of date: replace the lines between the markers with the output "
          "of `rotorguard keys`";
+  EXPECT_EQ(DocsRegion("<!-- BEGIN rotorguard keys --vehicle: generated, do not edit by hand -->\n",
+                       "<!-- END rotorguard keys --vehicle -->"),
+            VehicleKeyTable())
+      << "docs/scenarios.md's vehicle table is out of date: replace it with the output of `rotorguard keys --vehicle`";
 }
 
 }  // namespace

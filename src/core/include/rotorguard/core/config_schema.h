@@ -30,7 +30,7 @@ namespace rotorguard {
 struct KeyInfo {
   /// The documentation's "meaning" column (units in the key's name or here).
   const char* meaning = "";
-  /// Numbers (and each element of a vector of numbers) must lie in [min, max] ...
+  /// Numbers must lie in [min, max] (a list of blocks: have at least `min` items) ...
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   /// ... and, when set, be > 0 (min is then not used).
@@ -102,6 +102,14 @@ struct DegreesOf {
 struct PairOf {
   double* first;
   double* second;
+};
+
+/// A number kept in one unit and written in another (`thrust_coefficient_n_per_rpm2`, kept per
+/// (rad/s)²): `from_file` converts what a file says, `to_file` converts back.
+struct ConvertedOf {
+  double* value;
+  double (*from_file)(double);
+  double (*to_file)(double);
 };
 
 /// Three numbers written as one key's list [x, y, z] (`size_m: [6, 3, 1]`).

@@ -115,4 +115,7 @@ struct StackKeys {
 /// accepts and its meaning, written from the declarations above and the modules' own.
 std::string ScenarioKeyTables();
 
+/// docs/scenarios.md's table of a vehicle file's keys (vehicle::VehicleParams's declaration).
+std::string VehicleKeyTable();
+
 }  // namespace rotorguard::harness

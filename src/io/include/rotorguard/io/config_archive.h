@@ -115,6 +115,14 @@ class ConfigReader {
       *angle.radians = deg * 3.14159265358979323846 / 180.0;
     }
   }
+  /// A number in a file's unit, kept in another.
+  void Visit(const char* key, ConvertedOf number, const KeyInfo& info) {
+    if (const std::optional<ConfigNode> n = Find(key, info)) {
+      double x = 0.0;
+      Read(*n, &x, info);
+      *number.value = number.from_file(x);
+    }
+  }
   /// Three numbers as one list.
   void Visit(const char* key, TripleOf triple, const KeyInfo& info) {
     if (const std::optional<ConfigNode> n = Find(key, info)) {
@@ -196,6 +204,13 @@ class ConfigReader {
     const std::vector<double> x = n.AsDoubleList(2);
     *v = Eigen::Vector2d(x[0], x[1]);
   }
+  static void Read(const ConfigNode& n, Eigen::Matrix3d* m, const KeyInfo&) {
+    if (!n.IsSequence() || n.size() != 3) n.Fail("expected a 3x3 matrix written as three rows of three numbers");
+    for (std::size_t r = 0; r < 3; ++r) {
+      const std::vector<double> row = n.At(r).AsDoubleList(3);
+      for (int c = 0; c < 3; ++c) (*m)(static_cast<int>(r), c) = row[static_cast<std::size_t>(c)];
+    }
+  }
   static void Read(const ConfigNode& n, Eigen::Vector4d* v, const KeyInfo&) {
     const std::vector<double> x = n.AsDoubleList(4);
     *v = Eigen::Vector4d(x[0], x[1], x[2], x[3]);
@@ -210,8 +225,9 @@ class ConfigReader {
     *v = *FromName<E>(n.AsEnum(NameList<E>()));
   }
   template <DeclaresKeys T>
-  static void Read(const ConfigNode& n, std::vector<T>* v, const KeyInfo&) {
+  static void Read(const ConfigNode& n, std::vector<T>* v, const KeyInfo& info) {
     if (!n.IsSequence()) n.Fail("expected a list of " + KeyListOf<T>());
+    if (info.min >= 1.0 && n.size() == 0) n.Fail("expected a non-empty list of " + KeyListOf<T>());
     v->clear();
     for (std::size_t i = 0; i < n.size(); ++i) {
       T item{};

@@ -25,6 +25,7 @@ class JsonWriter {
     json_[key] = *angle.radians * 180.0 / 3.14159265358979323846;
   }
   void Visit(const char* key, PairOf pair, const KeyInfo&) { json_[key] = {*pair.first, *pair.second}; }
+  void Visit(const char* key, ConvertedOf number, const KeyInfo&) { json_[key] = number.to_file(*number.value); }
   void Visit(const char* key, TripleOf t, const KeyInfo&) { json_[key] = {*t.x, *t.y, *t.z}; }
   nlohmann::json& json() { return json_; }
 
@@ -72,6 +73,9 @@ class JsonReader {
   }
   void Visit(const char* key, DegreesOf angle, const KeyInfo&) {
     *angle.radians = json_.at(key).get<double>() * 3.14159265358979323846 / 180.0;
+  }
+  void Visit(const char* key, ConvertedOf number, const KeyInfo&) {
+    *number.value = number.from_file(json_.at(key).get<double>());
   }
   void Visit(const char* key, PairOf pair, const KeyInfo&) {
     *pair.first = json_.at(key).at(0).get<double>();

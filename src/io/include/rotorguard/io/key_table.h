@@ -43,20 +43,26 @@ class KeyTableWriter {
       value->Serialize(&nested);
       rows_.insert(rows_.end(), nested.rows_.begin(), nested.rows_.end());
     } else if constexpr (IsBlockList<T>::value) {
-      Add(path, "none", "a list of maps", info.meaning);
+      std::string rule = info.min >= 1.0 ? "a non-empty list of maps" : "a list of maps";
+      if (info.required) rule = "**required**, " + rule;
+      Add(path, info.required ? "" : "none", info.rule_text ? info.rule_text : rule, info.meaning);
       typename T::value_type item{};
       KeyTableWriter nested(path + "[].");
       item.Serialize(&nested);
       rows_.insert(rows_.end(), nested.rows_.begin(), nested.rows_.end());
     } else {
-      Add(path, info.default_text ? info.default_text : Text(*value), RuleOf(*value, info), info.meaning,
-          info.default_text != nullptr);
+      // A required key has no default to show.
+      Add(path, info.required ? "" : (info.default_text ? info.default_text : Text(*value)), RuleOf(*value, info),
+          info.meaning, info.default_text != nullptr);
     }
   }
   void Visit(const char* key, DegreesOf angle, const KeyInfo& info) {
     Add(prefix_ + key, Number(*angle.radians * 180.0 / 3.14159265358979323846),
         info.rule_text ? info.rule_text : fmt::format("in ({}, {}) deg", Number(info.min), Number(info.max)),
         info.meaning);
+  }
+  void Visit(const char* key, ConvertedOf number, const KeyInfo& info) {
+    Add(prefix_ + key, info.required ? "" : Number(number.to_file(*number.value)), RuleOf(0.0, info), info.meaning);
   }
   void Visit(const char* key, TripleOf t, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}, {}]", Number(*t.x), Number(*t.y), Number(*t.z)),
@@ -91,6 +97,11 @@ class KeyTableWriter {
   static std::string Text(std::uint64_t v) { return std::to_string(v); }
   static std::string Text(bool v) { return v ? "true" : "false"; }
   static std::string Text(const std::string& v) { return v; }
+  static std::string Text(const Eigen::Matrix3d& m) {
+    std::vector<std::string> rows;
+    for (int r = 0; r < 3; ++r) rows.push_back(Text(Eigen::Vector3d(m.row(r).transpose())));
+    return fmt::format("[{}]", fmt::join(rows, ", "));
+  }
   template <int N>
   static std::string Text(const Eigen::Matrix<double, N, 1>& v) {
     std::vector<std::string> items;
@@ -105,10 +116,9 @@ class KeyTableWriter {
 
   template <typename T>
   static std::string RuleOf(const T&, const KeyInfo& info) {
+    if (info.rule_text != nullptr) return info.rule_text;  // as written, "**required**" included
     std::string rule;
-    if (info.rule_text != nullptr) {
-      rule = info.rule_text;
-    } else if constexpr (NamedEnum<T>) {
+    if constexpr (NamedEnum<T>) {
       std::vector<std::string> names;
       for (const std::string& n : NameList<T>()) names.push_back("`" + n + "`");
       rule = fmt::format("one of {}", fmt::join(names, ", "));
