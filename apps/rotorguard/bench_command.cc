@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "cli.h"
 #include "rotorguard/benchmarks/campaign_bench.h"
@@ -33,15 +35,13 @@ class BenchCommand final : public Command {
   CLI::App* Register(CLI::App* app) override {
     CLI::App* bench = app->add_subcommand("bench", "Benchmarks; results as a table or JSON.");
     bench->require_subcommand(1);
-    RegisterSim(bench);
-    RegisterQp(bench);
-    RegisterNmpc(bench);
-    RegisterFtc(bench);
-    RegisterPerception(bench);
-    RegisterPlanner(bench);
-    RegisterNav(bench);
-    RegisterFlatness(bench);
-    RegisterMars(bench);
+    for (const Benchmark& b : Benchmarks()) {
+      *b.app = bench->add_subcommand(b.name, b.description);
+      for (const Flag& f : b.flags) {
+        CLI::Option* option = (*b.app)->add_option(f.name, *f.value, f.help);
+        if (f.required) option->required();
+      }
+    }
     // The benchmarks that run on the campaign engine (benchmarks/registry.h): their trials can be
     // kept, resumed, sharded and merged like a campaign's.
     for (CLI::App* b : {ftc_, nav_, mars_}) {
@@ -55,7 +55,6 @@ class BenchCommand final : public Command {
                     "with `campaign merge` when all are done");
       b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
     }
-    RegisterCampaign(bench);
     // Every benchmark can also write its page: tables and distributions (record/report.h).
     for (CLI::App* b : {sim_, qp_, nmpc_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
       b->add_option("--html", html_, "Also write the result as an HTML page to this file");
@@ -80,107 +79,106 @@ class BenchCommand final : public Command {
   }
 
  private:
-  void RegisterSim(CLI::App* bench) {
-    sim_ = bench->add_subcommand(
-        "sim",
-        "Closed-loop simulation speed: the 2 m/s lemniscate with all sensors and the nominal "
-        "controller. Reports the median realtime_factor and steps_per_s (target >= 200x real time).");
-    sim_->add_option("--scenario", sim_scenario_, "Scenario to fly (default: configs/scenarios/lemniscate_2ms.yaml)");
-    sim_->add_option("--duration", sim_duration_, "Simulated seconds per repetition (default 60)");
-    sim_->add_option("--repetitions", sim_repetitions_, "Repetitions; the median is reported (default 5)");
-  }
-  void RegisterQp(CLI::App* bench) {
-    qp_ = bench->add_subcommand("qp",
-                                "The NMPC's QP solver (condensing + dual active set) on a reference OCP QP instance:\n"
-                                "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
-                                "iterations_mean and max_u0_error against the instance's optimal u_0.");
-    qp_->add_option("--instance", qp_instance_, "Instance file (JSON), e.g. a copy of qp_hover_n20.json")->required();
-    qp_->add_option("--repetitions", qp_repetitions_, "Solves per case; the median time counts (default 3)");
-  }
-  void RegisterNmpc(CLI::App* bench) {
-    nmpc_ = bench->add_subcommand(
-        "nmpc",
-        "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
-        "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.");
-  }
-  void RegisterFtc(CLI::App* bench) {
-    ftc_ = bench->add_subcommand(
-        "ftc",
-        "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
-        "tracking the 2 m/s lemniscate and during take-off, plus fault-free trials for the false-alarm rate.\n"
-        "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).");
-    ftc_->add_option("--trials", ftc_trials_, "Trials per cell (default 20, the paper's count)");
-    ftc_->add_option("--seed", seed_, "Benchmark seed (default 1); trial seeds derive from it");
-    ftc_->add_option("--methods", ftc_methods_,
-                     "Comma-separated methods: rotorguard, fixedtime, ukf, indi, passive, none (default all)");
-    ftc_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
-  }
-  void RegisterPerception(CLI::App* bench) {
-    perception_ = bench->add_subcommand(
-        "perception",
-        "The simulated MID-360 on a vehicle spinning at 11 rad/s and flying 1 m/s through a 500-tree\n"
-        "forest and around a room, deskewing on and off: points_per_s_simulated, map_update_ms_mean\n"
-        "per frame, map precision and recall against the world within one voxel.");
-    perception_->add_option("--duration", perception_duration_, "Simulated seconds per run (default 10)");
-    perception_->add_option("--seed", seed_, "Sensor noise and forest layout (default 1)");
-  }
-  void RegisterPlanner(CLI::App* bench) {
-    planner_ = bench->add_subcommand(
-        "planner",
-        "The trajectory planner (A*, MINCO, L-BFGS) on random forests (30 x 20 m) and rooms (10 x 8 m),\n"
-        "random start/goal pairs, nominal and post-failure limits, on the map of the true world:\n"
-        "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.");
-    planner_->add_option("--pairs", planner_pairs_, "Start/goal pairs per world kind (default 100)");
-    planner_->add_option("--worlds", planner_worlds_, "Distinct worlds per kind (default 10, at most --pairs)");
-    planner_->add_option("--seed", seed_, "Worlds and pairs (default 1)");
-  }
-  void RegisterNav(CLI::App* bench) {
-    nav_ = bench->add_subcommand(
-        "nav",
-        "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
-        "mid-flight on a random rotor, flown by rotorguard and by its failure-unaware variant:\n"
-        "success_rate, collision_rate, tracking_rmse_m, max_spin_rad_s, mission_time_s, planner_ms_mean,\n"
-        "stack_ms_per_cycle_mean, realtime_factor (the stack's, on one core) and trial_realtime_factor\n"
-        "(the simulator included).");
-    nav_->add_option("--trials", nav_trials_, "Random worlds per kind, each flown by both variants (default 100)");
-    nav_->add_option("--seed", seed_, "Benchmark seed (default 1); trial seeds derive from it");
-    nav_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
-    nav_->add_option("--kinds", nav_kinds_, "Comma-separated world kinds: forest, room (default both)");
-    nav_->add_option("--replay", nav_replay_,
-                     "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out");
-  }
-  void RegisterFlatness(CLI::App* bench) {
-    flatness_ = bench->add_subcommand(
-        "flatness",
-        "Paper 004: closed-form settling times of Fig. 1 (ts_envelope_s, ts_actuator_s) and the Fig. 2\n"
-        "flight (configs/scenarios/flatness_fig2.yaml) over many seeds: ukf_w_estimate, ukf_settle_s,\n"
-        "replan_ts_s against a fault-free re-plan, max_pitch_deg against theta_max.");
-    flatness_->add_option("--seeds", flatness_seeds_, "Flights of the Fig. 2 scenario (default 20)");
-    flatness_->add_option("--seed", seed_, "The first flight's seed (default 1)");
-    flatness_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
-  }
-  void RegisterMars(CLI::App* bench) {
-    mars_ = bench->add_subcommand(
-        "mars",
-        "Paper 002: the 3x2 assembly on Table I's spiral (configs/scenarios/mars_spiral_3x2.yaml) with the\n"
-        "paper's rotor faults and Fig. 3's dead units, without reallocation, partial and full: table1\n"
-        "(mean tracking RMSE, a crashed flight's wreck held where it crashed; success rate); alloc_us_mean\n"
-        "for nine units (configs/assemblies/3x3.yaml); the self-reconfiguration (mars_reconfigure_3x1.yaml);\n"
-        "table2: the 4x1 and 3x2 assemblies planned through a door by ours and the baseline\n"
-        "(mars_plan_4x1.yaml, mars_plan_3x2.yaml) and flown, the error over each plan's duration.");
-    mars_->add_option("--trials", mars_trials_, "Flights per case and method (default 10, the paper's)");
-    mars_->add_option("--seed", seed_, "The first flight's seed (default 1)");
-    mars_->add_option("--jobs", jobs_, "Worker threads (default: the number of cores)");
-  }
-  void RegisterCampaign(CLI::App* bench) {
-    campaign_ = bench->add_subcommand(
-        "campaign",
-        "The campaign engine (docs/campaigns.md): a spec run with one worker and with two\n"
-        "(trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency), killed and resumed, and\n"
-        "in 4 shards; each merged summary compared byte for byte with the uninterrupted one.");
-    campaign_->add_option("--spec", campaign_spec_, "Campaign spec (default configs/campaigns/bench_campaign.yaml)");
-    campaign_->add_option("--work", campaign_work_,
-                          "A new folder for the runs (default: a temporary one, removed after)");
+  /// A benchmark's own options, as CLI text (parsed and checked when it runs).
+  struct Flag {
+    const char* name;
+    std::string* value;
+    const char* help;
+    bool required = false;
+  };
+  struct Benchmark {
+    CLI::App** app;
+    const char* name;
+    const char* description;
+    std::vector<Flag> flags;
+  };
+
+  /// Every benchmark with its description and options, in the order of `rotorguard bench --help`.
+  std::vector<Benchmark> Benchmarks() {
+    const Flag jobs{"--jobs", &jobs_, "Worker threads (default: the number of cores)"};
+    const Flag trial_seed{"--seed", &seed_, "Benchmark seed (default 1); trial seeds derive from it"};
+    const Flag first_seed{"--seed", &seed_, "The first flight's seed (default 1)"};
+    return {
+        {&sim_,
+         "sim",
+         "Closed-loop simulation speed: the 2 m/s lemniscate with all sensors and the nominal "
+         "controller. Reports the median realtime_factor and steps_per_s (target >= 200x real time).",
+         {{"--scenario", &sim_scenario_, "Scenario to fly (default: configs/scenarios/lemniscate_2ms.yaml)"},
+          {"--duration", &sim_duration_, "Simulated seconds per repetition (default 60)"},
+          {"--repetitions", &sim_repetitions_, "Repetitions; the median is reported (default 5)"}}},
+        {&qp_,
+         "qp",
+         "The NMPC's QP solver (condensing + dual active set) on a reference OCP QP instance:\n"
+         "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
+         "iterations_mean and max_u0_error against the instance's optimal u_0.",
+         {{"--instance", &qp_instance_, "Instance file (JSON), e.g. a copy of qp_hover_n20.json", true},
+          {"--repetitions", &qp_repetitions_, "Solves per case; the median time counts (default 3)"}}},
+        {&nmpc_,
+         "nmpc",
+         "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
+         "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.",
+         {}},
+        {&ftc_,
+         "ftc",
+         "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
+         "tracking the 2 m/s lemniscate and during take-off, plus fault-free trials for the false-alarm rate.\n"
+         "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).",
+         {{"--trials", &ftc_trials_, "Trials per cell (default 20, the paper's count)"},
+          trial_seed,
+          {"--methods", &ftc_methods_,
+           "Comma-separated methods: rotorguard, fixedtime, ukf, indi, passive, none (default all)"},
+          jobs}},
+        {&perception_,
+         "perception",
+         "The simulated MID-360 on a vehicle spinning at 11 rad/s and flying 1 m/s through a 500-tree\n"
+         "forest and around a room, deskewing on and off: points_per_s_simulated, map_update_ms_mean\n"
+         "per frame, map precision and recall against the world within one voxel.",
+         {{"--duration", &perception_duration_, "Simulated seconds per run (default 10)"},
+          {"--seed", &seed_, "Sensor noise and forest layout (default 1)"}}},
+        {&planner_,
+         "planner",
+         "The trajectory planner (A*, MINCO, L-BFGS) on random forests (30 x 20 m) and rooms (10 x 8 m),\n"
+         "random start/goal pairs, nominal and post-failure limits, on the map of the true world:\n"
+         "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.",
+         {{"--pairs", &planner_pairs_, "Start/goal pairs per world kind (default 100)"},
+          {"--worlds", &planner_worlds_, "Distinct worlds per kind (default 10, at most --pairs)"},
+          {"--seed", &seed_, "Worlds and pairs (default 1)"}}},
+        {&nav_,
+         "nav",
+         "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
+         "mid-flight on a random rotor, flown by rotorguard and by its failure-unaware variant:\n"
+         "success_rate, collision_rate, tracking_rmse_m, max_spin_rad_s, mission_time_s, planner_ms_mean,\n"
+         "stack_ms_per_cycle_mean, realtime_factor (the stack's, on one core) and trial_realtime_factor\n"
+         "(the simulator included).",
+         {{"--trials", &nav_trials_, "Random worlds per kind, each flown by both variants (default 100)"},
+          trial_seed,
+          jobs,
+          {"--kinds", &nav_kinds_, "Comma-separated world kinds: forest, room (default both)"},
+          {"--replay", &nav_replay_,
+           "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out"}}},
+        {&flatness_,
+         "flatness",
+         "Paper 004: closed-form settling times of Fig. 1 (ts_envelope_s, ts_actuator_s) and the Fig. 2\n"
+         "flight (configs/scenarios/flatness_fig2.yaml) over many seeds: ukf_w_estimate, ukf_settle_s,\n"
+         "replan_ts_s against a fault-free re-plan, max_pitch_deg against theta_max.",
+         {{"--seeds", &flatness_seeds_, "Flights of the Fig. 2 scenario (default 20)"}, first_seed, jobs}},
+        {&mars_,
+         "mars",
+         "Paper 002: the 3x2 assembly on Table I's spiral (configs/scenarios/mars_spiral_3x2.yaml) with the\n"
+         "paper's rotor faults and Fig. 3's dead units, without reallocation, partial and full: table1\n"
+         "(mean tracking RMSE, a crashed flight's wreck held where it crashed; success rate); alloc_us_mean\n"
+         "for nine units (configs/assemblies/3x3.yaml); the self-reconfiguration (mars_reconfigure_3x1.yaml);\n"
+         "table2: the 4x1 and 3x2 assemblies planned through a door by ours and the baseline\n"
+         "(mars_plan_4x1.yaml, mars_plan_3x2.yaml) and flown, the error over each plan's duration.",
+         {{"--trials", &mars_trials_, "Flights per case and method (default 10, the paper's)"}, first_seed, jobs}},
+        {&campaign_,
+         "campaign",
+         "The campaign engine (docs/campaigns.md): a spec run with one worker and with two\n"
+         "(trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency), killed and resumed, and\n"
+         "in 4 shards; each merged summary compared byte for byte with the uninterrupted one.",
+         {{"--spec", &campaign_spec_, "Campaign spec (default configs/campaigns/bench_campaign.yaml)"},
+          {"--work", &campaign_work_, "A new folder for the runs (default: a temporary one, removed after)"}}},
+    };
   }
 
   /// Writes the result's page when --html asked for one.

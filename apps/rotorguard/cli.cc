@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <charconv>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +12,7 @@
 #include <utility>
 
 #include "rotorguard/buildinfo/build_info.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/io/config_node.h"
 
 namespace rotorguard::cli {
@@ -166,10 +166,10 @@ std::function<void(int, int)> CountProgress(const char* what) {
 
 std::function<void(int, int)> EtaProgress(const char* what) {
   const bool tty = ::isatty(STDERR_FILENO);
-  const auto start = std::chrono::steady_clock::now();
-  return [tty, what, start](int done, int total) {
+  const Stopwatch clock;
+  return [tty, what, clock](int done, int total) {
     if (!tty) return;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double elapsed = clock.seconds();
     const double eta = done > 0 ? elapsed * (total - done) / done : 0.0;
     std::fprintf(stderr, "\r%s %d / %d, %.0f s elapsed, ETA %.0f s   ", what, done, total, elapsed, eta);
     if (done == total) std::fprintf(stderr, "\n");

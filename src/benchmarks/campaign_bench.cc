@@ -1,14 +1,14 @@
-#include "rotorguard/benchmarks/campaign_bench.h"
 
 #include <fmt/format.h>
 
-#include <chrono>
 #include <filesystem>
 #include <stdexcept>
 
+#include "rotorguard/benchmarks/campaign_bench.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/registry.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/io/files.h"
 
 namespace rotorguard::benchmarks {
@@ -28,9 +28,9 @@ nlohmann::json RunCampaignBenchmark(const campaign::Campaign& spec, const std::s
     o.shard = shard;
     o.resume = resume;
     o.version = version;
-    const auto t0 = std::chrono::steady_clock::now();
+    const Stopwatch clock;
     campaign::RunCampaign(spec, o);
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return clock.seconds();
   };
   const auto summary = [&](const std::string& name) {
     const fs::path dir = fs::path(work_dir) / name;

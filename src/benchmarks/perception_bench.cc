@@ -1,7 +1,5 @@
-#include "rotorguard/benchmarks/perception_bench.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <unordered_set>
@@ -9,9 +7,11 @@
 
 #include <fmt/format.h>
 
+#include "rotorguard/benchmarks/perception_bench.h"
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/perception/lidar_mapper.h"
 #include "rotorguard/sim/lidar.h"
@@ -21,10 +21,6 @@
 namespace rotorguard::benchmarks {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 /// The prescribed motion: level, yawing at the spin rate, along a line (forest) or a circle (room).
 struct Path {
@@ -116,18 +112,18 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
       mapper.OnImu(s);
     }
     if (odometry_timer.Due(t)) estimator.OnOdometry(odometry.Sample(truth));
-    const Clock::time_point c0 = Clock::now();
+    const Stopwatch lidar_clock;
     const std::optional<LidarFrame> frame = lidar.Step(t - step, pose_at(t - step), t, pose_at(t));
-    lidar_s += Since(c0);
+    lidar_s += lidar_clock.seconds();
     if (!frame) continue;
     for (std::size_t i = 0; i < frame->points_S.size(); ++i) {
       const sim::BodyPose p = pose_at(frame->t_start_ns + frame->offset_ns[i]);
       seen.insert(VoxelKey(p.p_W + p.q_WB * (lidar_options.position_m + frame->points_S[i].cast<double>()), res));
     }
     const StateEstimate estimate = estimator.Estimate(frame->t_end_ns);
-    const Clock::time_point m0 = Clock::now();
+    const Stopwatch map_clock;
     mapper.OnFrame(*frame, estimate);
-    const double dt = Since(m0);
+    const double dt = map_clock.seconds();
     // The first frame also allocates the map (tens of MB, once per flight): reported apart.
     if (frames == 0) {
       first_frame_ms = 1e3 * dt;

@@ -1,15 +1,15 @@
-#include "rotorguard/control/dense_qp.h"
 
 #include <algorithm>
 #include <cassert>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
 
+#include "rotorguard/control/dense_qp.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
 
 namespace rotorguard::control {
 
@@ -235,9 +235,9 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
 }
 
 const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   Factorize(qp.H);  // when it fails, SolveFactorized reports the numerical failure
-  const double factorize_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double factorize_s = clock.seconds();
   SolveFactorized(qp);
   summary_.solve_time_s += factorize_s;
   return summary_;
@@ -351,7 +351,7 @@ void DenseQpSolver::KeepForWarmStart(const DenseQp& qp) {
 }
 
 const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   summary_ = DenseQpSummary{};
   const auto finish = [&](QpStatus status) -> const DenseQpSummary& {
     summary_.status = status;
@@ -383,7 +383,7 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
       // last (still a valid start), or cold.
       previous_.clear();
     }
-    summary_.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary_.solve_time_s = clock.seconds();
     return summary_;
   };
 

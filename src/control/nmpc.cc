@@ -1,27 +1,24 @@
-#include "rotorguard/control/nmpc.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 #include <fmt/format.h>
 
+#include "rotorguard/control/nmpc.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/vehicle/effectiveness.h"
 #include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::control {
 
 namespace {
-using Clock = std::chrono::steady_clock;
 using vehicle::StateIndex;
 
 // Regularises the reduced-attitude decomposition at a 180 degree tilt (where w^2 + z^2 = 0).
 constexpr double kDecompositionEpsilon = 1e-9;
-
-double Seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
 void RequireNonNegative(const char* field, const Eigen::VectorXd& v) {
   if (!v.allFinite() || v.minCoeff() < 0.0) {
@@ -291,7 +288,7 @@ void NmpcController::ShiftBy(double elapsed) {
 }
 
 bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, double t, bool reuse) {
-  const auto start = Clock::now();
+  const Stopwatch clock;
   // Linearise the dynamics (exact RK4 sensitivities) and the cost (Gauss-Newton) along the plan;
   // or, reusing the last linearisation, only the shooting gaps and the residuals' gradients.
   double gap = 0.0;
@@ -337,12 +334,12 @@ bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, doub
   const OcpQpSummary& qs = reuse ? qp_solver_.PrepareVectors(qp_) : qp_solver_.Prepare(qp_);
   ++(reuse ? summary_.linearisations_reused : summary_.linearisations);
   reused_since_linearisation_ = reuse ? reused_since_linearisation_ + 1 : 0;
-  summary_.prepare_time_s += Seconds(start, Clock::now());
+  summary_.prepare_time_s += clock.seconds();
   return qs.status != QpStatus::kNumericalFailure;
 }
 
 bool NmpcController::FeedbackIteration(const Eigen::VectorXd& x0) {
-  auto start = Clock::now();
+  Stopwatch clock;
   x0_delta_ = x0 - x_[0];
   const OcpQpSummary* qs = &qp_solver_.Feedback(x0_delta_);
   if (qs->status == QpStatus::kInfeasible) {
@@ -355,11 +352,9 @@ bool NmpcController::FeedbackIteration(const Eigen::VectorXd& x0) {
       qp_.x_upper[k].setConstant(std::numeric_limits<double>::infinity());
     }
     ++summary_.rate_bounds_relaxed;
-    summary_.feedback_time_s += Seconds(start, Clock::now());
-    const auto prepare = Clock::now();
+    summary_.feedback_time_s += clock.Restart();
     qp_solver_.Prepare(qp_);
-    summary_.prepare_time_s += Seconds(prepare, Clock::now());
-    start = Clock::now();
+    summary_.prepare_time_s += clock.Restart();
     qs = &qp_solver_.Feedback(x0_delta_);
   }
   const OcpQpSummary& q = *qs;
@@ -381,7 +376,7 @@ bool NmpcController::FeedbackIteration(const Eigen::VectorXd& x0) {
   }
   summary_.step_norm = step;
   summary_.kkt_residual = std::max(step, gap_);
-  summary_.feedback_time_s += Seconds(start, Clock::now());
+  summary_.feedback_time_s += clock.seconds();
   return ok;
 }
 
@@ -391,7 +386,7 @@ bool NmpcController::SqpIteration(const Eigen::VectorXd& x0, const ReferenceTraj
 
 void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory& reference, double t, double dt,
                              RotorVector* thrust_command) {
-  const auto start = Clock::now();
+  const Stopwatch clock;
   const long fallbacks = summary_.fallbacks;
   summary_ = NmpcSummary{};
   summary_.fallbacks = fallbacks;
@@ -407,7 +402,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     } else {
       HoverCommand(thrust_command);
     }
-    summary_.solve_time_s = Seconds(start, Clock::now());
+    summary_.solve_time_s = clock.seconds();
     return;
   }
   // The measured state: pose and velocity from the estimator, motor thrusts from telemetry when
@@ -464,7 +459,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     ++summary_.fallbacks;
     reused_since_linearisation_ = -1;  // a fallback: the next preparation linearises
   }
-  summary_.command_latency_s = Seconds(start, Clock::now());
+  summary_.command_latency_s = clock.seconds();
   // Preparation for the next call, after the command is out: shift the plan by this call's period
   // (the stack's control period) and linearise and condense around it.
   if (options_.max_sqp_iterations == 1 && dt > 0.0 && std::isfinite(dt) && ok) {
@@ -477,7 +472,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     if (PrepareIteration(reference, t + dt, reuse)) prepared_for_t_ = t + dt;
   }
   // Unprepared, the next call iterates from scratch: its own preparation linearises.
-  summary_.solve_time_s = Seconds(start, Clock::now());
+  summary_.solve_time_s = clock.seconds();
 }
 
 }  // namespace rotorguard::control

@@ -1,13 +1,13 @@
-#include "rotorguard/control/ocp_qp.h"
 
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "rotorguard/control/ocp_qp.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
 
 namespace rotorguard::control {
 
@@ -184,7 +184,7 @@ const OcpQpSummary& CondensingQpSolver::PrepareVectors(const OcpQp& qp) {
 }
 
 const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp, bool whole) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   summary_ = OcpQpSummary{};
   RequireSameDims(qp);
   // Sizes known at compile time make Eigen's small products several times faster: the NMPC's
@@ -211,7 +211,7 @@ const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp, bool whole) {
   } else if (!PrepareReduced()) {
     summary_.status = QpStatus::kNumericalFailure;
   }
-  summary_.condense_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary_.condense_time_s = clock.seconds();
   return summary_;
 }
 
@@ -285,7 +285,7 @@ void CondensingQpSolver::ReducedVectors() {
 
 const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
   if (prepared_ == nullptr) throw std::logic_error("CondensingQpSolver::Feedback called before Prepare");
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   const OcpQp& qp = *prepared_;
   const int N = dims_.horizon, nu = dims_.nu;
   if (summary_.status == QpStatus::kNumericalFailure || x0.size() != dims_.nx || !x0.allFinite()) {
@@ -349,7 +349,7 @@ const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
     }
   }
   summary_.objective = objective;
-  summary_.dense_solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary_.dense_solve_time_s = clock.seconds();
   summary_.total_time_s = summary_.condense_time_s + summary_.dense_solve_time_s;
   return summary_;
 }

@@ -1,11 +1,11 @@
-#include "rotorguard/harness/assembly_mission.h"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 
+#include "rotorguard/core/stopwatch.h"
+#include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/perception/voxel_map.h"
 
@@ -61,10 +61,10 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
     to.weight_attitude = 0.0;
   }
 
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   const modular::AssemblyPath path =
       modular::FindAssemblyPath(map, a, eta, {s.initial_position_m, s.initial_yaw_rad}, spec.goal_m, ao);
-  r.astar_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  r.astar_ms = clock.milliseconds();
   r.path_status = path.status;
   r.astar_attitude_deviation_rad = path.attitude_deviation_rad;
   if (path.status != modular::AssemblyPathStatus::kFound) {

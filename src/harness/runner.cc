@@ -1,15 +1,15 @@
-#include "rotorguard/harness/runner.h"
 
 #include <fmt/format.h>
 
-#include <chrono>
 #include <cmath>
 #include <memory>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/failure_diagnosis.h"
 #include "rotorguard/harness/flight_metrics.h"
+#include "rotorguard/harness/runner.h"
 #include "rotorguard/record/sensor_log.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/stack/flight_stack.h"
@@ -18,10 +18,6 @@
 namespace rotorguard::harness {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 /// The flight metrics' settings: the tracking window on the physics steps' grid (a window to
 /// duration_s ends with the last step, as steps * dt may round past it). Throws
@@ -92,8 +88,8 @@ class ClosedLoop {
     if (options_.progress) options_.progress(1.0);
   }
 
-  /// The run's summary, judged and timed (wall clock from `wall_start`), and written when recording.
-  RunSummary Summarize(Clock::time_point wall_start) {
+  /// The run's summary, judged and timed (wall clock from `wall`'s start), and written when recording.
+  RunSummary Summarize(const Stopwatch& wall) {
     RunSummary s;
     s.scenario = sc_.name;
     s.seed = sc_.seed;
@@ -117,7 +113,7 @@ class ClosedLoop {
     metrics_.Finish(
         end, [this](double t) { return stack_.reference().Evaluate(t).p_W; }, &s);
     DiagnoseFailure(metrics_.last_violation(), {sc_.success_error_m, sc_.success_hold_s}, &s);
-    AddTimes(wall_start, &s);
+    AddTimes(wall, &s);
     recorder_.WriteSummary(s);
     return s;
   }
@@ -127,9 +123,9 @@ class ClosedLoop {
   void Step() {
     const TimeNs t = sim_.time_ns();
     if (t >= next_control_) {
-      const auto start = Clock::now();
+      const Stopwatch clock;
       command_ = stack_.Update(t);
-      stack_time_ += Clock::now() - start;
+      stack_s_ += clock.seconds();
       next_control_ += stack_.control_period_ns();
       ++control_cycles_;
       if (options_.on_control_cycle) options_.on_control_cycle(stack_);
@@ -138,12 +134,11 @@ class ClosedLoop {
     const Vector3 p_ref = stack_.reference().Evaluate(ToSeconds(t)).p_W;  // the planner's when navigating
     metrics_.OnStep(t, vehicle::StateView(sim_.state()), p_ref, !sim_.fault_events().empty());
     recorder_.OnStep(t, sim_, stack_);
-    const auto sim_start = Clock::now();
+    Stopwatch clock;
     const sim::SensorOutputs& outputs = sim_.Step(command_);
-    const auto deliver_start = Clock::now();
-    sim_time_ += deliver_start - sim_start;
+    simulator_s_ += clock.Restart();
     DeliverToStack(outputs, &stack_, recorder_.sensor_log());
-    stack_time_ += Clock::now() - deliver_start;
+    stack_s_ += clock.seconds();
     recorder_.AfterStep();
     ++physics_steps_;
   }
@@ -160,22 +155,21 @@ class ClosedLoop {
   }
 
   /// Where the wall-clock time went (summary.json "cost_ms_per_sim_s" and the real-time factors).
-  void AddTimes(Clock::time_point wall_start, RunSummary* s) const {
-    s->wall_time_s = Seconds(Clock::now() - wall_start);
-    const double stack_s = Seconds(stack_time_), simulator_s = Seconds(sim_time_);
-    s->stack_ms_per_cycle_mean = s->control_cycles > 0 ? 1e3 * stack_s / static_cast<double>(s->control_cycles) : 0.0;
+  void AddTimes(const Stopwatch& wall, RunSummary* s) const {
+    s->wall_time_s = wall.seconds();
+    s->stack_ms_per_cycle_mean = s->control_cycles > 0 ? 1e3 * stack_s_ / static_cast<double>(s->control_cycles) : 0.0;
     s->realtime_factor = s->wall_time_s > 0.0 ? s->sim_time_s / s->wall_time_s : 0.0;
-    s->stack_realtime_factor = stack_s > 0.0 ? s->sim_time_s / stack_s : 0.0;
+    s->stack_realtime_factor = stack_s_ > 0.0 ? s->sim_time_s / stack_s_ : 0.0;
     if (s->sim_time_s <= 0.0) return;
     const auto per_sim_s = [&](double wall_s) { return 1e3 * wall_s / s->sim_time_s; };
     const stack::StackCost& c = stack_.cost();
     RunCost& cost = s->cost_ms_per_sim_s;
-    cost.simulator = per_sim_s(simulator_s);
+    cost.simulator = per_sim_s(simulator_s_);
     cost.mapper = per_sim_s(c.mapper_s);
     cost.planner = per_sim_s(c.planner_s);
     cost.controller = per_sim_s(c.controller_s);
-    cost.stack_other = per_sim_s(std::max(0.0, stack_s - c.mapper_s - c.planner_s - c.controller_s));
-    cost.runner = per_sim_s(std::max(0.0, s->wall_time_s - stack_s - simulator_s));
+    cost.stack_other = per_sim_s(std::max(0.0, stack_s_ - c.mapper_s - c.planner_s - c.controller_s));
+    cost.runner = per_sim_s(std::max(0.0, s->wall_time_s - stack_s_ - simulator_s_));
   }
 
   const Scenario& sc_;
@@ -188,7 +182,7 @@ class ClosedLoop {
   FlightMetrics metrics_;
   RotorCommand command_;
   TimeNs next_control_ = 0;
-  Clock::duration stack_time_{}, sim_time_{};
+  double stack_s_ = 0.0, simulator_s_ = 0.0;  // wall-clock time in each [s]
   std::uint64_t physics_steps_ = 0, control_cycles_ = 0;
   std::optional<double> mission_time_s_;
 };
@@ -221,10 +215,10 @@ RunSummary RunScenario(const Scenario& sc, const RunOptions& options) {
     ThrowInvalidArgument("RunScenario", "stack.control_rate_hz", sc.stack.control_rate_hz,
                          "at most sim.physics_rate_hz (the runner polls the stack at physics steps)");
   }
-  const auto wall_start = Clock::now();
+  const Stopwatch wall;
   ClosedLoop loop(sc, options);
   loop.Fly();
-  return loop.Summarize(wall_start);
+  return loop.Summarize(wall);
 }
 
 }  // namespace rotorguard::harness

@@ -1,10 +1,10 @@
-#include "rotorguard/modular/allocation.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
+#include "rotorguard/modular/allocation.h"
 #include "rotorguard/vehicle/effectiveness.h"
 
 namespace rotorguard::modular {
@@ -138,12 +138,12 @@ Eigen::VectorXd AssemblyAllocator::SolveSubset(Subset* s, const Eigen::Vector4d&
 }
 
 const AllocationSummary& AssemblyAllocator::Allocate(const Eigen::Vector4d& wrench, RotorVector* command) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   const int n = assembly_.vehicle.num_rotors();
   summary_ = AllocationSummary{};
   command->setZero(n);
   if (!wrench.allFinite()) {
-    summary_.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary_.solve_time_s = clock.seconds();
     return summary_;
   }
   Reallocation method = options_.method;
@@ -191,7 +191,7 @@ const AllocationSummary& AssemblyAllocator::Allocate(const Eigen::Vector4d& wren
   }
   summary_.residual = B_ * eta_.cwiseProduct(*command) - wrench;
   if (!command->allFinite()) command->setZero(n);
-  summary_.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary_.solve_time_s = clock.seconds();
   return summary_;
 }
 

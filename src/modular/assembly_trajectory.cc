@@ -1,7 +1,5 @@
-#include "rotorguard/modular/assembly_trajectory.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -10,7 +8,9 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/modular/allocation.h"
+#include "rotorguard/modular/assembly_trajectory.h"
 #include "rotorguard/planning/lbfgs.h"
 
 namespace rotorguard::modular {
@@ -358,19 +358,15 @@ AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception
                                                                 const AssemblyLimits& limits,
                                                                 AssemblyTrajectory* out) const {
   using Status = AssemblyTrajectorySummary::Status;
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   AssemblyTrajectorySummary summary;
   const auto finish = [&](Status status, std::string message) {
     summary.status = status;
     summary.message = std::move(message);
-    summary.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    summary.solve_ms = clock.milliseconds();
     return summary;
   };
-  try {
-    limits.Validate();
-  } catch (const ValidationError& e) {
-    return finish(Status::kInvalidInput, e.what());
-  }
+  if (const auto broken = BrokenRule([&] { limits.Validate(); })) return finish(Status::kInvalidInput, *broken);
   if (path.status != AssemblyPathStatus::kFound || path.poses.size() < 2) {
     return finish(Status::kInvalidInput, "need a found A* path of at least two poses");
   }

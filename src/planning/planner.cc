@@ -1,18 +1,14 @@
-#include "rotorguard/planning/planner.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
+#include "rotorguard/planning/planner.h"
 
 namespace rotorguard::planning {
 
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// PlanSummary::min_clearance_m: the smallest distance to an occupied voxel centre over the
 /// positions that for_each_position(f) hands to f (f returns true to go on), capped at `cap`.
@@ -64,12 +60,12 @@ Planner::Planner(const PlannerOptions& options) : options_(options), optimizer_(
 PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const DynamicLimits& limits,
                           const perception::VoxelMap& map, MinimumJerkTrajectory* out) const {
   using Status = PlanSummary::Status;
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   PlanSummary summary;
   const auto finish = [&](Status status, std::string message) {
     summary.status = status;
     summary.message = std::move(message);
-    summary.total_ms = MsSince(t0);
+    summary.total_ms = clock.milliseconds();
     return summary;
   };
   summary.path = FindPath(map, start.col(0), goal, options_.search);
@@ -83,7 +79,7 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     summary.path = FindPath(map, start.col(0), goal, fine);
     summary.fine_search = true;
   }
-  summary.search_ms = MsSince(t0);
+  summary.search_ms = clock.milliseconds();
   switch (summary.path.status) {
     case PathStatus::kFound: break;
     case PathStatus::kStartOutOfBounds: return finish(Status::kStartOutOfBounds, "the start lies outside the map");
@@ -205,11 +201,11 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
           {j, ObstaclePlane{Vector3(0, 0, options_.search.z_max_m + c_o), -Vector3::UnitZ()}});
     }
   }
-  const auto t_opt = std::chrono::steady_clock::now();
+  const Stopwatch optimize_clock;
   for (int round = 0;; ++round) {
     summary.optimizer = optimizer_.Optimize(start, tail, q, t, limits, planes, &traj);
     if (!summary.optimizer.ok()) {
-      summary.optimize_ms += MsSince(t_opt);
+      summary.optimize_ms += optimize_clock.milliseconds();
       return fail(summary.optimizer.status == TrajectoryOptimizerSummary::Status::kInfeasible ? Status::kInfeasible
                                                                                              : Status::kOptimizerFailed,
                   summary.optimizer.message);
@@ -241,7 +237,7 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
       break;
     }
     if (round == options_.clearance_rounds) {
-      summary.optimize_ms += MsSince(t_opt);
+      summary.optimize_ms += optimize_clock.milliseconds();
       return fail(Status::kCollision, "the trajectory still meets an inflated voxel after " +
                                             std::to_string(round) + " re-optimisations");
     }
@@ -268,7 +264,7 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     t = traj.durations();
     for (int i = 0; i + 1 < pieces; ++i) q.col(i) = traj.PieceDerivative(i, t(i), 0);
   }
-  summary.optimize_ms += MsSince(t_opt);
+  summary.optimize_ms += optimize_clock.milliseconds();
   summary.message.clear();
   *out = std::move(traj);
   return Status::kSuccess;

@@ -1,11 +1,11 @@
-#include "rotorguard/planning/trajectory_optimizer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <limits>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/planning/lbfgs.h"
+#include "rotorguard/planning/trajectory_optimizer.h"
 
 namespace rotorguard::planning {
 
@@ -161,20 +161,16 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
                                                          const PlaneSet& planes,
                                                          MinimumJerkTrajectory* out) const {
   using Status = TrajectoryOptimizerSummary::Status;
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   TrajectoryOptimizerSummary summary;
   const int pieces = static_cast<int>(durations.size());
   const auto fail = [&](Status status, std::string message) {
     summary.status = status;
     summary.message = std::move(message);
-    summary.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    summary.solve_ms = clock.milliseconds();
     return summary;
   };
-  try {
-    limits.Validate();
-  } catch (const ValidationError& e) {
-    return fail(Status::kInvalidInput, e.what());
-  }
+  if (const auto broken = BrokenRule([&] { limits.Validate(); })) return fail(Status::kInvalidInput, *broken);
   if (pieces < 1 || waypoints.cols() != pieces - 1 || !waypoints.allFinite() || !durations.allFinite() ||
       (durations.array() <= 0.0).any() || !head.allFinite() || !tail.allFinite() ||
       (!planes.empty() && static_cast<int>(planes.size()) != pieces)) {
@@ -231,7 +227,7 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   *out = std::move(traj);
   summary.status = Status::kSuccess;
   summary.message = lbfgs.message;
-  summary.solve_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  summary.solve_ms = clock.milliseconds();
   return summary;
 }
 

@@ -1,13 +1,13 @@
-#include "rotorguard/stack/flight_stack.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
 #include <fmt/format.h>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
+#include "rotorguard/stack/flight_stack.h"
 
 namespace rotorguard::stack {
 
@@ -16,14 +16,14 @@ namespace {
 /// Adds the wall-clock time of its scope to *total [s].
 class ScopedCost {
  public:
-  explicit ScopedCost(double* total) : total_(total), start_(std::chrono::steady_clock::now()) {}
+  explicit ScopedCost(double* total) : total_(total) {}
   ScopedCost(const ScopedCost&) = delete;
   ScopedCost& operator=(const ScopedCost&) = delete;
-  ~ScopedCost() { *total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  ~ScopedCost() { *total_ += clock_.seconds(); }
 
  private:
   double* total_;
-  std::chrono::steady_clock::time_point start_;
+  Stopwatch clock_;
 };
 
 }  // namespace

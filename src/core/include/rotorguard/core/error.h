@@ -1,5 +1,6 @@
 #pragma once
 /// Error helpers. User input errors are exceptions with context; broken internal invariants abort.
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -35,6 +36,18 @@ template <typename T>
                                   const T& value, const std::string& expected) {
   throw ValidationError(field, fmt::format("{}::{} = {} is invalid; expected {}", owner, field,
                                            value, expected));
+}
+
+/// The message of the rule `validate` finds broken (it throws ValidationError), or nullopt: for a
+/// solver that reports bad input in its summary rather than throwing.
+template <typename F>
+std::optional<std::string> BrokenRule(F&& validate) {
+  try {
+    validate();
+  } catch (const ValidationError& e) {
+    return e.what();
+  }
+  return std::nullopt;
 }
 
 /// Throws std::invalid_argument "<api>: <parameter> = <value> is invalid; expected <rule>".
