@@ -26,7 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string Config(const std::string& name) {
-  return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
+  return testing::SourcePath("configs/scenarios/" + name);
 }
 
 class TempFolder : public rotorguard::testing::TempFolderTest {

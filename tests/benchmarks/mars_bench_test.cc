@@ -14,7 +14,7 @@
 namespace rotorguard::benchmarks {
 namespace {
 
-std::string Config(const std::string& path) { return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/" + path; }
+std::string Config(const std::string& path) { return testing::SourcePath("configs/" + path); }
 
 TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError) {
   MarsBenchOptions o;

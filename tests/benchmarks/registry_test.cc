@@ -24,7 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kConfigs = std::string(ROTORGUARD_SOURCE_DIR) + "/configs";
+const std::string kConfigs = testing::SourcePath("configs");
 
 /// The FTC benchmark at its smallest: one trial per cell, the project's method and the nominal
 /// controller (18 flights of a few seconds each).

@@ -34,7 +34,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string ScenarioPath(const std::string& name) {
-  return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
+  return testing::SourcePath("configs/scenarios/" + name);
 }
 
 class Campaigns : public testing::TempFolderTest {

@@ -49,7 +49,7 @@ std::string ReadText(const fs::path& p) {
   return ss.str();
 }
 
-const std::string kVehicle = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml";
+const std::string kVehicle = rotorguard::testing::SourcePath("configs/vehicles/zhou2025_quad.yaml");
 
 /// A short valid hover scenario; `extra` is appended (YAML) to it.
 std::string Scenario(const std::string& vehicle, const std::string& extra = "") {
@@ -124,8 +124,9 @@ TEST_F(CliTest, ABenchmarkInShardsMergesToTheTablesOfOneRun) {
 /// through (docs/campaigns.md).
 TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   const std::string spec = Write("c.yaml", "name: kill_test\n"
-                                           "scenario: " + std::string(ROTORGUARD_SOURCE_DIR) +
-                                               "/configs/scenarios/fdd_hover_motor_stop.yaml\n"
+                                           "scenario: " +
+                                               rotorguard::testing::SourcePath("configs/scenarios/fdd_hover_motor_stop.yaml") +
+                                               "\n"
                                            "repeats: 4\n"
                                            "grid:\n"
                                            "  duration_s: [3.0]\n"
@@ -313,7 +314,7 @@ TEST_F(CliTest, UnreachableWaypointExitsFourNamingIt) {
 }
 
 TEST_F(CliTest, NominalControllerLosingAMotorCrashesAndExitsOne) {
-  const std::string s = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/hover_motor_stop_nominal.yaml";
+  const std::string s = rotorguard::testing::SourcePath("configs/scenarios/hover_motor_stop_nominal.yaml");
   const Result r = Cli("run " + s + " --quiet --out " + Out());
   EXPECT_EQ(r.exit_code, 1) << r.out;
   const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
@@ -487,7 +488,7 @@ TEST_F(CliTest, UnreadableInputExitsThree) {
 }
 
 TEST_F(CliTest, ValidateChecksScenariosAndVehiclesWithoutFlying) {
-  const Result ok = Cli("validate " + std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/lemniscate_2ms.yaml");
+  const Result ok = Cli("validate " + rotorguard::testing::SourcePath("configs/scenarios/lemniscate_2ms.yaml"));
   EXPECT_EQ(ok.exit_code, 0) << ok.out;
   EXPECT_NE(ok.out.find("valid scenario"), std::string::npos) << ok.out;
   const Result veh = Cli("validate " + kVehicle);
@@ -498,7 +499,7 @@ TEST_F(CliTest, ValidateChecksScenariosAndVehiclesWithoutFlying) {
 }
 
 TEST_F(CliTest, EveryShippedConfigValidates) {
-  for (const auto& e : fs::recursive_directory_iterator(std::string(ROTORGUARD_SOURCE_DIR) + "/configs")) {
+  for (const auto& e : fs::recursive_directory_iterator(rotorguard::testing::SourcePath("configs"))) {
     if (e.path().extension() != ".yaml") continue;
     const Result r = Cli("validate " + e.path().string());
     EXPECT_EQ(r.exit_code, 0) << e.path() << ": " << r.out;

@@ -11,11 +11,12 @@
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/planning/flatness.h"
 #include "rotorguard/vehicle/pwm_model.h"
+#include "test_util.h"
 
 namespace rotorguard::harness {
 namespace {
 
-std::string Config(const std::string& name) { return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name; }
+std::string Config(const std::string& name) { return testing::SourcePath("configs/scenarios/" + name); }
 
 TEST(FlatnessScenario, Fig2DetectsIdentifiesHoldsAndReplans) {
   const Scenario s = LoadScenario(Config("flatness_fig2.yaml"));

@@ -16,7 +16,7 @@
 namespace rotorguard::harness {
 namespace {
 
-std::string Config(const std::string& path) { return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/" + path; }
+std::string Config(const std::string& path) { return testing::SourcePath("configs/" + path); }
 
 /// Unit No. 1 (rotors 0-3) dead from the start, known to the controller.
 const std::vector<Override> kDeadUnit = {

@@ -13,7 +13,7 @@ namespace rotorguard::harness {
 namespace {
 
 std::string Config(const std::string& name) {
-  return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
+  return testing::SourcePath("configs/scenarios/" + name);
 }
 
 /// The indoor scenario cut to its first `waypoints` waypoints, flown once.

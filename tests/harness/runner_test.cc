@@ -15,7 +15,7 @@ namespace rotorguard::harness {
 namespace {
 
 std::string Config(const std::string& name) {
-  return std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/" + name;
+  return testing::SourcePath("configs/scenarios/" + name);
 }
 
 TEST(Runner, NominalControllerTracksThe2msLemniscateWithinTenCentimetres) {
@@ -67,7 +67,7 @@ class RunnerWindowTest : public rotorguard::testing::TempFolderTest {
   /// hover_motor_stop_nominal.yaml with a metrics block, its vehicle named by an absolute path.
   std::string WithMetrics(const std::string& metrics) {
     std::string text = io::ReadInputFile(Config("hover_motor_stop_nominal.yaml"));
-    text.replace(text.find("../vehicles/"), 12, std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/");
+    text.replace(text.find("../vehicles/"), 12, testing::SourcePath("configs/vehicles/"));
     return Write("s.yaml", text + "metrics: " + metrics + "\n");
   }
 };

@@ -21,7 +21,7 @@
 namespace rotorguard::harness {
 namespace {
 
-const std::string kVehicle = std::string(ROTORGUARD_SOURCE_DIR) + "/configs/vehicles/zhou2025_quad.yaml";
+const std::string kVehicle = testing::SourcePath("configs/vehicles/zhou2025_quad.yaml");
 
 class ScenarioLoader : public testing::TempFolderTest {
  protected:
@@ -124,8 +124,8 @@ metrics: {tracking_start_s: 1, success_hold_s: 3}
 
 TEST_F(ScenarioLoader, APlannerWordIsShortForItsMethod) {
   // Paper 004's planner needs a vehicle with a PWM model.
-  const Scenario s = LoadScenario(Write("q.yaml", "vehicle: " + std::string(ROTORGUARD_SOURCE_DIR) +
-                                                      "/configs/vehicles/qball_x4.yaml\nduration_s: 10\n"
+  const Scenario s = LoadScenario(Write("q.yaml", "vehicle: " + testing::SourcePath("configs/vehicles/qball_x4.yaml") +
+                                                      "\nduration_s: 10\n"
                                                       "mission: {type: hover}\nstack: {planner: flatness}\n"));
   EXPECT_EQ(s.stack.navigation.method, stack::NavigationMethod::kFlatness);
   EXPECT_NE(Error("mission: {type: hover}\nstack: {planner: astar}\n").find("expected one of: minco, flatness"),
@@ -155,8 +155,8 @@ TEST_F(ScenarioLoader, TheMissionComesBackAsAValue) {
 }
 
 TEST_F(ScenarioLoader, AnAssemblysPlanIsMadeAfterLoadingNotInIt) {
-  std::string text = io::ReadInputFile(std::string(ROTORGUARD_SOURCE_DIR) + "/configs/scenarios/mars_plan_4x1.yaml");
-  text.replace(text.find("../assemblies/"), 14, std::string(ROTORGUARD_SOURCE_DIR) + "/configs/assemblies/");
+  std::string text = io::ReadInputFile(testing::SourcePath("configs/scenarios/mars_plan_4x1.yaml"));
+  text.replace(text.find("../assemblies/"), 14, testing::SourcePath("configs/assemblies/"));
   Scenario s = LoadScenario(Write("plan.yaml", text));
   ASSERT_TRUE(s.assembly_plan.has_value());
   EXPECT_EQ(s.reference, nullptr);
@@ -241,7 +241,7 @@ TEST_F(ScenarioLoader, KeyTablesListEveryKeyTheLoaderTakes) {
 
 /// The text between `begin` and `end` in docs/scenarios.md.
 std::string DocsRegion(const std::string& begin, const std::string& end) {
-  std::ifstream in(std::string(ROTORGUARD_SOURCE_DIR) + "/docs/scenarios.md");
+  std::ifstream in(testing::SourcePath("docs/scenarios.md"));
   std::stringstream doc;
   doc << in.rdbuf();
   const std::string text = doc.str();

@@ -14,6 +14,13 @@
 
 namespace rotorguard::testing {
 
+/// A file of the source tree by its path from the root ("configs/scenarios/hover.yaml"). Joined
+/// as paths at run time: GCC 12 misreads the inlined concatenation of a string literal this long
+/// as an out-of-bounds copy (-Warray-bounds) when the standard headers come precompiled.
+inline std::string SourcePath(const std::string& relative) {
+  return (std::filesystem::path(ROTORGUARD_SOURCE_DIR) / relative).string();
+}
+
 /// Passes when |a - b| <= tol elementwise; prints both matrices otherwise.
 template <typename A, typename B>
 ::testing::AssertionResult MatricesNear(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b,
