@@ -5,8 +5,8 @@ Restructuring the code must not change what it computes. This script flies every
 configs/scenarios/, runs every benchmark at a small size with --json, validates every config file,
 and tries a list of bad command lines, with the build given; it writes what came out, with the
 wall-clock figures removed, into one folder. Two folders made by two builds are then compared with
-`diff -r`: an empty diff means the same flights (log.csv, scene.json, sensors.csv, vehicle.yaml
-byte for byte, the NMPC's solve-time column aside), the same summaries and benchmark figures (timing
+`diff -r`: an empty diff means the same flights (log.csv, scene.json, sensors.csv, vehicle.yaml and
+truth_vehicle.yaml byte for byte, the NMPC's solve-time column aside), the same summaries and benchmark figures (timing
 keys aside), and the same error messages and exit codes.
 
     scripts/behaviour-snapshot.py build/bin/rotorguard /tmp/snap-after [--qp-instance FILE]
@@ -102,7 +102,8 @@ class Snapshot:
             base = f"scenarios/{stem}/"
             self.write(base + "exit", f"{code}\n{err}")
             self.write(base + "stdout", self.stdout_lines(out))
-            for f in ["summary.json", "log.csv", "scene.json", "sensors.csv", "vehicle.yaml"]:
+            for f in ["summary.json", "log.csv", "scene.json", "sensors.csv", "vehicle.yaml",
+                      "truth_vehicle.yaml"]:
                 path = os.path.join(run_dir, f)
                 if not os.path.exists(path):
                     self.write(base + f + ".missing", "")

@@ -89,6 +89,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["crashed"] = crashed;
   j["crash_reason"] = OrNull(crash_reason);
   j["failure_reason"] = OrNull(failure_reason);
+  j["truth"] = io::ToJson(truth);
   j["sim_time_s"] = sim_time_s;
   j["wall_time_s"] = wall_time_s;
   j["realtime_factor"] = realtime_factor;

@@ -12,6 +12,7 @@
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/record/sensor_log.h"
 #include "rotorguard/sim/simulator.h"
+#include "rotorguard/sim/truth.h"
 #include "rotorguard/stack/flight_stack.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -38,12 +39,16 @@ FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int
   return o;
 }
 
-/// The simulator of `truth` (which it keeps a reference to), starting hovering when the start is in
-/// the air, idle on the ground.
-sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel& truth) {
+/// The simulator of `truth` (which it keeps a reference to) and the rest of `draw` (the IMU where
+/// it really is about the true centre of gravity, the external torque), starting hovering when the
+/// start is in the air, idle on the ground.
+sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel& truth, const sim::TruthDraw& draw) {
   const RotorVector motors =
       sc.initial_position_m.z() > 0.0 ? truth.HoverThrusts() : RotorVector::Zero(truth.num_rotors());
-  return sim::Simulator(truth, sc.world, sc.faults, sc.sim, sc.seed,
+  sim::SimulatorOptions options = sc.sim;
+  options.imu.position_m = sc.sim.imu.position_m - draw.cog_offset_m + draw.imu_offset_m;
+  options.external_torque_n_m = draw.external_torque_n_m;
+  return sim::Simulator(truth, sc.world, sc.faults, options, sc.seed,
                         truth.MakeState(sc.initial_position_m, sc.initial_yaw_rad, motors));
 }
 
@@ -62,8 +67,9 @@ class ClosedLoop {
       : sc_(sc),
         options_(options),
         recorder_(options, sc),
-        truth_(sc.vehicle),
-        sim_(MakeSimulator(sc, truth_)),
+        draw_(sim::DrawTruth(sc.truth, sc.vehicle, sc.seed)),
+        truth_(sim::TruthVehicle(sc.vehicle, draw_), sim::ThrustRatios(draw_)),
+        sim_(MakeSimulator(sc, truth_, draw_)),
         stack_(sc.vehicle, sc.reference, sc.stack, ExternalController(sc)),
         steps_(std::llround(sc.duration_s / ToSeconds(sim_.step_ns()))),
         metrics_(MetricsOptionsOf(sc, sim_.step_ns(), steps_)),
@@ -93,6 +99,7 @@ class ClosedLoop {
     RunSummary s;
     s.scenario = sc_.name;
     s.seed = sc_.seed;
+    s.truth = draw_;
     s.sim_time_s = sim_.time_s();
     s.physics_steps = physics_steps_;
     s.control_cycles = control_cycles_;
@@ -175,6 +182,7 @@ class ClosedLoop {
   const Scenario& sc_;
   const RunOptions& options_;
   FlightRecorder recorder_;
+  sim::TruthDraw draw_;             // how the simulated vehicle departs from the file
   vehicle::MultirotorModel truth_;  // the simulator's vehicle; the stack builds its own from the file
   sim::Simulator sim_;
   stack::FlightStack stack_;

@@ -96,6 +96,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world,
   UpdateOutputs();
   vehicle::Disturbance still_air;
   still_air.wind_W = wind_.velocity();
+  still_air.torque_B = options_.external_torque_n_m;
   SampleSensors(still_air);
 }
 
@@ -174,6 +175,7 @@ const SensorOutputs& Simulator::Step(const RotorCommand& command) {
   injector_.Update(t_ns_, x_[StateIndex::kPosition + 2], !landed_, &faults_);
   vehicle::Disturbance disturbance;
   disturbance.wind_W = wind_.Step(dt);
+  disturbance.torque_B = options_.external_torque_n_m;
   x_before_ = x_;
   integrator_.Step(command_, faults_, disturbance, dt, &x_);
   t_ns_ += dt_ns_;

@@ -2,14 +2,24 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 #include "rotorguard/core/math.h"
 #include "rotorguard/vehicle/effectiveness.h"
 
 namespace rotorguard::vehicle {
 
-MultirotorModel::MultirotorModel(VehicleParams params) : params_(std::move(params)) {
+MultirotorModel::MultirotorModel(VehicleParams params, RotorVector thrust_ratio)
+    : params_(std::move(params)), thrust_ratio_(std::move(thrust_ratio)) {
   params_.Validate();
+  if (thrust_ratio_.size() == 0) thrust_ratio_ = RotorVector::Ones(num_rotors());
+  if (thrust_ratio_.size() != num_rotors() || !(thrust_ratio_.array() > 0.0).all() || !thrust_ratio_.allFinite()) {
+    throw std::invalid_argument(
+        fmt::format("MultirotorModel: thrust_ratio has {} entries; expected {} positive finite ratios, one per rotor",
+                    thrust_ratio_.size(), num_rotors()));
+  }
   effectiveness_ = ComputeEffectivenessMatrix(params_.rotors);
   max_thrust_.resize(num_rotors());
   for (int i = 0; i < num_rotors(); ++i) max_thrust_[i] = params_.rotors[i].max_thrust_n;
@@ -18,7 +28,8 @@ MultirotorModel::MultirotorModel(VehicleParams params) : params_(std::move(param
 
 RotorVector MultirotorModel::HoverThrusts() const {
   const AllocationMatrix pinv = PseudoInverse(effectiveness_);
-  return pinv * Eigen::Vector4d(params_.weight_n(), 0.0, 0.0, 0.0);
+  const RotorVector applied = pinv * Eigen::Vector4d(params_.weight_n(), 0.0, 0.0, 0.0);
+  return applied.cwiseQuotient(thrust_ratio_);
 }
 
 StateVector MultirotorModel::MakeState(const Vector3& p_W, double yaw,
@@ -41,12 +52,12 @@ void MultirotorModel::RotorThrusts(const StateVector& x, const RotorFaults& faul
         (*thrust)[i] = 0.0;
         break;
       case FaultKind::kLossOfEffectiveness:
-        (*thrust)[i] = (1.0 - faults[i].eta) * drive;
+        (*thrust)[i] = (1.0 - faults[i].eta) * thrust_ratio_[i] * drive;
         break;
       case FaultKind::kNone:
       case FaultKind::kMotorStop:
       case FaultKind::kStuck:
-        (*thrust)[i] = drive;
+        (*thrust)[i] = thrust_ratio_[i] * drive;
         break;
     }
   }

@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/csv.h"
+#include "rotorguard/sim/truth.h"
 #include "test_util.h"
 
 namespace rotorguard::harness {
@@ -42,6 +44,45 @@ TEST(Runner, HoverHoldsPosition) {
   EXPECT_TRUE(r.success);
   EXPECT_LT(r.max_position_error_m, 0.05);
   EXPECT_GT(r.min_altitude_m, 0.95);
+}
+
+/// Runs that write their files into a fresh folder.
+class RunnerFiles : public testing::TempFolderTest {};
+
+TEST_F(RunnerFiles, TheStackFliesTheVehicleFileWhileTheSimulatorFliesTheDraw) {
+  Scenario s = LoadScenario(Config("hover.yaml"), {{"duration_s", "3"}});
+  s.truth.preset = sim::TruthPreset::kRealistic;
+  RunOptions o;
+  o.out_dir = dir_.string();
+  const RunSummary r = RunScenario(s, o);
+  const auto read = [&](const char* name) { return io::ReadInputFile((dir_ / name).string()); };
+  // What the stack was told: the file's vehicle and the file's IMU mounting point ...
+  EXPECT_EQ(read("vehicle.yaml"), VehicleToYaml(s.vehicle));
+  EXPECT_EQ(r.sensors.imu_position_m, s.sim.imu.position_m);
+  // ... what the simulator flew: the draw the summary records, which differs from the file.
+  EXPECT_EQ(r.truth.preset, sim::TruthPreset::kRealistic);
+  EXPECT_EQ(read("truth_vehicle.yaml"), VehicleToYaml(sim::TruthVehicle(s.vehicle, r.truth)));
+  EXPECT_NE(read("truth_vehicle.yaml"), read("vehicle.yaml"));
+  const nlohmann::json summary = nlohmann::json::parse(read("summary.json"));
+  EXPECT_EQ(summary["truth"]["preset"], "realistic");
+  EXPECT_EQ(summary["truth"]["mass_ratio"].get<double>(), r.truth.mass_ratio);
+}
+
+TEST_F(RunnerFiles, TheSameSeedFliesTheSameDrawAndAnotherSeedAnother) {
+  Scenario s = LoadScenario(Config("hover.yaml"), {{"duration_s", "2"}});
+  s.truth.preset = sim::TruthPreset::kRealistic;
+  const auto fly = [&](std::uint64_t seed) {
+    Scenario t = s;
+    t.seed = seed;
+    RunOptions o;
+    o.out_dir = (dir_ / std::to_string(seed)).string();
+    const RunSummary r = RunScenario(t, o);
+    return std::make_pair(r.truth.mass_ratio, io::ReadInputFile((dir_ / std::to_string(seed) / "log.csv").string()));
+  };
+  const auto a = fly(3), b = fly(3), c = fly(4);
+  EXPECT_EQ(a.first, b.first);
+  EXPECT_EQ(a.second, b.second) << "two runs of one seed must log the same bytes";
+  EXPECT_NE(a.first, c.first);
 }
 
 TEST(Runner, TakesOffFromTheGroundAndSettlesAtAltitude) {

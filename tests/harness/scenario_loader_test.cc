@@ -54,6 +54,23 @@ TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
   EXPECT_FALSE(s.tracking_end_s.has_value());
 }
 
+TEST_F(ScenarioLoader, TruthIsAPresetWordOrABlockThatOverridesItsRanges) {
+  EXPECT_EQ(LoadScenario(File("mission: {type: hover}\n")).truth.preset, sim::TruthPreset::kIdeal);
+  EXPECT_EQ(LoadScenario(File("truth: realistic\nmission: {type: hover}\n")).truth.preset,
+            sim::TruthPreset::kRealistic);
+  const Scenario s = LoadScenario(File("truth: {preset: realistic, mass_fraction: 0.02}\nmission: {type: hover}\n"));
+  EXPECT_EQ(s.truth.Ranges().mass_fraction, 0.02);
+  EXPECT_EQ(s.truth.Ranges().inertia_fraction, sim::RangesOf(sim::TruthPreset::kRealistic).inertia_fraction);
+  const std::string f = (dir_ / "s.yaml").string();
+  EXPECT_EQ(Error("truth: exact\nmission: {type: hover}\n"),
+            f + ":3:8: truth: 'exact' is not allowed; expected one of: ideal, realistic");
+  EXPECT_EQ(Error("truth: {mass_fraction: 0.9}\nmission: {type: hover}\n"),
+            f + ":3:24: truth.mass_fraction: '0.9' is out of range; expected a number in [0, 0.5]");
+  EXPECT_EQ(Error("truth: {motor_stop_time_constant_min_s: 0.01}\nmission: {type: hover}\n"),
+            f + ":3:8: truth.motor_stop_time_constant_max_s: motor_stop_time_constant_max_s is missing; expected both "
+                "ends of the stop time constant's range or neither");
+}
+
 TEST_F(ScenarioLoader, EverySectionsKeysLandInTheirFields) {
   const Scenario s = LoadScenario(File(R"(seed: 42
 initial: {position_m: [1, 2, 3], yaw_rad: 0.5}

@@ -48,7 +48,8 @@ class FlightRecorder {
   void OnStep(TimeNs t, const sim::Simulator& sim, const stack::FlightStack& stack);
   /// After each physics step: the sensor log goes to its file in chunks of about 1 MB.
   void AfterStep();
-  /// At the flight's end: its last row, then log.csv, scene.json, sensors.csv and vehicle.yaml.
+  /// At the flight's end: its last row, then log.csv, scene.json, sensors.csv, vehicle.yaml (the
+  /// stack's) and truth_vehicle.yaml (the simulator's).
   void WriteFlight(const sim::Simulator& sim, const stack::FlightStack& stack);
   /// Then flight.mcap, summary.json and report.html, as asked. Throws std::runtime_error when a
   /// file cannot be written.

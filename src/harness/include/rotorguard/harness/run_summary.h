@@ -12,6 +12,7 @@
 #include "rotorguard/core/types.h"
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/harness/fdd_score.h"
+#include "rotorguard/sim/truth.h"
 #include "rotorguard/stack/flight_stack.h"
 
 namespace rotorguard::harness {
@@ -64,6 +65,8 @@ struct RunSummary {
   bool crashed = false;
   std::optional<std::string> crash_reason;    ///< "ground impact at 5.56 m/s"; none without a crash
   std::optional<std::string> failure_reason;  ///< why the run failed; none on success
+  /// The simulated vehicle's departure from the vehicle file (summary.json "truth").
+  sim::TruthDraw truth;
 
   double sim_time_s = 0.0;
   double wall_time_s = 0.0;

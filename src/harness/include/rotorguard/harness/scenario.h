@@ -17,6 +17,7 @@
 #include "rotorguard/modular/assembly_controller.h"
 #include "rotorguard/sim/fault_injector.h"
 #include "rotorguard/sim/simulator.h"
+#include "rotorguard/sim/truth.h"
 #include "rotorguard/sim/world.h"
 #include "rotorguard/stack/flight_stack.h"
 #include "rotorguard/vehicle/vehicle_params.h"
@@ -34,7 +35,10 @@ struct Scenario {
   modular::AllocatorOptions allocation;
   double duration_s = 10.0;
   std::uint64_t seed = 1;
+  /// The vehicle file the stack reads; the simulator flies a draw from `truth` about it.
   vehicle::VehicleParams vehicle;
+  /// How the simulated vehicle departs from `vehicle` (key `truth`; sim/truth.h).
+  sim::TruthOptions truth;
   sim::World world;
   Vector3 initial_position_m = Vector3::Zero();
   double initial_yaw_rad = 0.0;

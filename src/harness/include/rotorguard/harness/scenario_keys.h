@@ -24,6 +24,9 @@ struct HeaderKeys {
     a->Visit("duration_s", &s->duration_s,
              {.meaning = "simulated time [s]", .min = 1e-3, .max = 1e6, .required = true});
     a->Visit("seed", &s->seed, {.meaning = "the same seed gives the same log.csv, byte for byte"});
+    a->Visit("truth", &s->truth,
+             {.meaning = "how the simulated vehicle departs from the vehicle file the stack reads (docs/truth.md)",
+              .shorthand = "preset"});
   }
 };
 

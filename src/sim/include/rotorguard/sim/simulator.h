@@ -24,6 +24,9 @@ struct SimulatorOptions {
   OdometryOptions odometry;
   LidarOptions lidar;  ///< off by default
   WindOptions wind;
+  /// A constant torque on the airframe, body frame [N*m]: a payload or cable the stack is not told
+  /// of. Not a scenario key: the scenario's truth draws it (truth.h).
+  Vector3 external_torque_n_m = Vector3::Zero();
   /// Touching the ground faster than this (any direction) is a crash [m/s], > 0.
   double crash_speed_m_s = 1.0;
   /// Touching the ground tilted more than this is a crash [rad], in (0, pi].

@@ -52,8 +52,10 @@ struct Accelerations {
 
 class MultirotorModel {
  public:
-  /// Validates `params` (throws ValidationError).
-  explicit MultirotorModel(VehicleParams params);
+  /// Validates `params` (throws ValidationError). `thrust_ratio` (simulated vehicles only): each
+  /// rotor's thrust relative to what params' k_n gives at the same motor speed, a propeller's
+  /// spread that the vehicle file does not know; empty: 1 for every rotor.
+  explicit MultirotorModel(VehicleParams params, RotorVector thrust_ratio = {});
 
   const VehicleParams& params() const { return params_; }
   int num_rotors() const { return params_.num_rotors(); }
@@ -61,8 +63,10 @@ class MultirotorModel {
   const EffectivenessMatrix& effectiveness() const { return effectiveness_; }
   const RotorVector& max_thrust() const { return max_thrust_; }
 
-  /// Minimum-norm rotor thrusts that hold hover (total thrust m*g, zero torque).
+  /// Minimum-norm rotor thrusts that hold hover (total thrust m*g, zero torque), as motor states
+  /// (commands): the thrust each applies is thrust_ratio times it.
   RotorVector HoverThrusts() const;
+  const RotorVector& thrust_ratio() const { return thrust_ratio_; }
   /// A state at rest at `p_W` with yaw `yaw`, motors at `motor_thrust`.
   StateVector MakeState(const Vector3& p_W, double yaw, const RotorVector& motor_thrust) const;
 
@@ -84,6 +88,7 @@ class MultirotorModel {
   VehicleParams params_;
   EffectivenessMatrix effectiveness_;
   RotorVector max_thrust_;
+  RotorVector thrust_ratio_;
   Matrix3 inertia_inv_;
 };
 

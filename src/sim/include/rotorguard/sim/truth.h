@@ -1,0 +1,142 @@
+#pragma once
+/// The truth is not the model: how the simulated vehicle departs from the vehicle file the flight
+/// stack reads. A scenario's `truth` block names a preset (`ideal`: the file is exact; `realistic`:
+/// the spread a careful experimenter would defend for a 1 kg class quadrotor) and may override any
+/// range; each flight draws its own vehicle from the ranges with a seed derived from the scenario's,
+/// so every method compared on a trial flies the same draw. docs/truth.md gives each range's reason.
+///
+/// Only the simulator is built from the draw: the stack keeps the file's vehicle and the file's
+/// IMU mounting point, and the `stack` module cannot include this header (it does not link `sim`).
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "rotorguard/core/config_schema.h"
+#include "rotorguard/core/types.h"
+#include "rotorguard/vehicle/vehicle_params.h"
+
+namespace rotorguard::sim {
+
+enum class TruthPreset { kIdeal, kRealistic };
+inline constexpr EnumName<TruthPreset> kTruthPresetNames[] = {{TruthPreset::kIdeal, "ideal"},
+                                                              {TruthPreset::kRealistic, "realistic"}};
+constexpr std::span<const EnumName<TruthPreset>> NamesOf(const TruthPreset*) { return kTruthPresetNames; }
+
+/// The half-widths of the uniform draws (relative ones as fractions of the file's value), and the
+/// range of the motor-stop time constant. All zero: the file's vehicle exactly.
+struct TruthRanges {
+  double mass_fraction = 0.0;                 ///< m = m_file (1 + U(-a, a))
+  double inertia_fraction = 0.0;              ///< each principal axis of the body frame independently
+  double cog_offset_m = 0.0;                  ///< each axis of the centre of gravity's offset, U(-a, a)
+  double thrust_coefficient_fraction = 0.0;   ///< each rotor's k_n (thrust per speed squared)
+  double yaw_coefficient_fraction = 0.0;      ///< each rotor's κ_t
+  double motor_time_constant_fraction = 0.0;  ///< σ of all motors (one ESC firmware, one motor type)
+  double rotor_drag_fraction = 0.0;           ///< each axis of D
+  double imu_offset_m = 0.0;                  ///< each axis of the IMU's mounting point, U(-a, a)
+  double external_torque_n_m = 0.0;           ///< roll and pitch of a constant torque, U(-a, a)
+  /// Motor-stop time constant drawn log-uniformly in [min, max] [s]; unset: the file's value.
+  std::optional<double> motor_stop_time_constant_min_s, motor_stop_time_constant_max_s;
+};
+
+/// The ranges of a preset.
+TruthRanges RangesOf(TruthPreset preset);
+
+/// The scenario's `truth` block: a preset, and any of its ranges overridden.
+struct TruthOptions {
+  TruthPreset preset = TruthPreset::kIdeal;
+  std::optional<double> mass_fraction, inertia_fraction, cog_offset_m, thrust_coefficient_fraction,
+      yaw_coefficient_fraction, motor_time_constant_fraction, rotor_drag_fraction, imu_offset_m, external_torque_n_m,
+      motor_stop_time_constant_min_s, motor_stop_time_constant_max_s;
+
+  /// The preset's ranges with the overrides applied.
+  TruthRanges Ranges() const;
+  /// Throws ValidationError naming the key ("motor_stop_time_constant_max_s") and the rule.
+  void Validate() const;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("preset", &preset, {.meaning = "`realistic`: the spread of docs/truth.md; `ideal`: the file is exact"});
+    constexpr const char* kPresets = "the preset's";
+    a->Visit("mass_fraction", &mass_fraction,
+             {.meaning = "mass drawn in m (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
+    a->Visit("inertia_fraction", &inertia_fraction,
+             {.meaning = "each principal moment drawn in I (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
+    a->Visit("cog_offset_m", &cog_offset_m,
+             {.meaning = "each axis of the centre of gravity's offset drawn in ± a [m]",
+              .min = 0,
+              .max = 0.05,
+              .default_text = kPresets});
+    a->Visit("thrust_coefficient_fraction", &thrust_coefficient_fraction,
+             {.meaning = "each rotor's k_n drawn in k_n (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
+    a->Visit("yaw_coefficient_fraction", &yaw_coefficient_fraction,
+             {.meaning = "each rotor's κ_t drawn in κ_t (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
+    a->Visit("motor_time_constant_fraction", &motor_time_constant_fraction,
+             {.meaning = "the motors' σ drawn in σ (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
+    a->Visit(
+        "rotor_drag_fraction", &rotor_drag_fraction,
+        {.meaning = "each axis of the rotor drag D drawn in D (1 ± a)", .min = 0, .max = 1, .default_text = kPresets});
+    a->Visit("imu_offset_m", &imu_offset_m,
+             {.meaning = "each axis of the IMU's mounting point drawn in ± a about the sensors.imu position [m]",
+              .min = 0,
+              .max = 0.05,
+              .default_text = kPresets});
+    a->Visit(
+        "external_torque_n_m", &external_torque_n_m,
+        {.meaning = "a constant roll and pitch torque the stack is not told of (payload, cable), each in ± a [N·m]",
+         .min = 0,
+         .max = 1,
+         .default_text = kPresets});
+    a->Visit("motor_stop_time_constant_min_s", &motor_stop_time_constant_min_s,
+             {.meaning = "a stopped motor's time constant drawn log-uniformly in [min, max] [s]",
+              .positive = true,
+              .default_text = kPresets});
+    a->Visit("motor_stop_time_constant_max_s", &motor_stop_time_constant_max_s,
+             {.meaning = "(set both or neither)", .positive = true, .default_text = kPresets});
+  }
+};
+
+/// One flight's vehicle as drawn: ratios to the file's values, offsets, the external torque.
+struct TruthDraw {
+  TruthPreset preset = TruthPreset::kIdeal;
+  double mass_ratio = 1.0;
+  Vector3 inertia_ratio = Vector3::Ones();  ///< of the body-frame principal moments
+  Vector3 cog_offset_m = Vector3::Zero();   ///< the true centre of gravity in the file's body frame
+  std::vector<double> thrust_coefficient_ratio, yaw_coefficient_ratio;  ///< per rotor
+  double motor_time_constant_ratio = 1.0;
+  double motor_stop_time_constant_s = 0.0;  ///< the true value [s]
+  Vector3 rotor_drag_ratio = Vector3::Ones();
+  Vector3 imu_offset_m = Vector3::Zero();         ///< added to the IMU's mounting point
+  Vector3 external_torque_n_m = Vector3::Zero();  ///< body frame
+
+  /// summary.json's "truth" object.
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("preset", &preset, {.meaning = "the scenario's truth preset"});
+    a->Visit("mass_ratio", &mass_ratio, {.meaning = "true mass / the file's"});
+    a->Visit("inertia_ratio", &inertia_ratio, {.meaning = "true principal moments / the file's, body x, y, z"});
+    a->Visit("cog_offset_m", &cog_offset_m, {.meaning = "the true centre of gravity in the file's body frame [m]"});
+    a->Visit("thrust_coefficient_ratio", &thrust_coefficient_ratio, {.meaning = "per rotor: true k_n / the file's"});
+    a->Visit("yaw_coefficient_ratio", &yaw_coefficient_ratio, {.meaning = "per rotor: true κ_t / the file's"});
+    a->Visit("motor_time_constant_ratio", &motor_time_constant_ratio, {.meaning = "true σ / the file's"});
+    a->Visit("motor_stop_time_constant_s", &motor_stop_time_constant_s, {.meaning = "the true value [s]"});
+    a->Visit("rotor_drag_ratio", &rotor_drag_ratio, {.meaning = "true D / the file's, per axis"});
+    a->Visit("imu_offset_m", &imu_offset_m, {.meaning = "the IMU's true mounting point minus sensors.imu's [m]"});
+    a->Visit("external_torque_n_m", &external_torque_n_m, {.meaning = "constant torque, body frame [N·m]"});
+  }
+};
+
+/// The draw of `ranges` for `vehicle` with `seed`: a pure function of its arguments. Zero ranges
+/// give the identity (ratios 1, offsets 0, the file's stop time constant) without drawing.
+TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& vehicle, std::uint64_t seed);
+
+/// The simulated vehicle of `draw`: the file's with its mass, moments, drag, yaw coefficients and
+/// time constants scaled, and its rotors placed about the true centre of gravity. The per-rotor
+/// thrust coefficients are not a vehicle-file quantity: they go to the model (ThrustRatios).
+vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const TruthDraw& draw);
+
+/// The per-rotor thrust of the simulated motors relative to what the file's k_n gives for the
+/// same speed (MultirotorModel's thrust_ratio).
+RotorVector ThrustRatios(const TruthDraw& draw);
+
+}  // namespace rotorguard::sim

@@ -1,0 +1,130 @@
+#include "rotorguard/sim/truth.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+
+namespace rotorguard::sim {
+
+TruthRanges RangesOf(TruthPreset preset) {
+  TruthRanges r;
+  if (preset == TruthPreset::kIdeal) return r;
+  // docs/truth.md gives the reason for each.
+  r.mass_fraction = 0.07;
+  r.inertia_fraction = 0.15;
+  r.cog_offset_m = 0.007;  // per axis: at most 1 cm horizontally
+  r.thrust_coefficient_fraction = 0.05;
+  r.yaw_coefficient_fraction = 0.10;
+  r.motor_time_constant_fraction = 0.20;
+  r.rotor_drag_fraction = 0.30;
+  r.imu_offset_m = 0.005;
+  r.external_torque_n_m = 0.01;
+  r.motor_stop_time_constant_min_s = 0.005;
+  r.motor_stop_time_constant_max_s = 0.050;
+  return r;
+}
+
+TruthRanges TruthOptions::Ranges() const {
+  TruthRanges r = RangesOf(preset);
+  const auto take = [](const std::optional<double>& override, double* range) {
+    if (override) *range = *override;
+  };
+  take(mass_fraction, &r.mass_fraction);
+  take(inertia_fraction, &r.inertia_fraction);
+  take(cog_offset_m, &r.cog_offset_m);
+  take(thrust_coefficient_fraction, &r.thrust_coefficient_fraction);
+  take(yaw_coefficient_fraction, &r.yaw_coefficient_fraction);
+  take(motor_time_constant_fraction, &r.motor_time_constant_fraction);
+  take(rotor_drag_fraction, &r.rotor_drag_fraction);
+  take(imu_offset_m, &r.imu_offset_m);
+  take(external_torque_n_m, &r.external_torque_n_m);
+  if (motor_stop_time_constant_min_s) {
+    r.motor_stop_time_constant_min_s = motor_stop_time_constant_min_s;
+    r.motor_stop_time_constant_max_s = motor_stop_time_constant_max_s;
+  }
+  return r;
+}
+
+void TruthOptions::Validate() const {
+  if (motor_stop_time_constant_min_s.has_value() != motor_stop_time_constant_max_s.has_value()) {
+    const char* missing =
+        motor_stop_time_constant_min_s ? "motor_stop_time_constant_max_s" : "motor_stop_time_constant_min_s";
+    throw ValidationError(missing, fmt::format("{} is missing; expected both ends of the stop time constant's "
+                                               "range or neither",
+                                               missing));
+  }
+  if (motor_stop_time_constant_min_s && *motor_stop_time_constant_max_s < *motor_stop_time_constant_min_s) {
+    ThrowValidation("TruthOptions", "motor_stop_time_constant_max_s", *motor_stop_time_constant_max_s,
+                    fmt::format("at least motor_stop_time_constant_min_s = {}", *motor_stop_time_constant_min_s));
+  }
+}
+
+namespace {
+
+/// 1 + U(-a, a), or exactly 1 without drawing when a = 0.
+double Ratio(double a, Rng* rng) { return a > 0.0 ? 1.0 + rng->Uniform(-a, a) : 1.0; }
+
+Vector3 Ratios(double a, Rng* rng) {
+  const double x = Ratio(a, rng), y = Ratio(a, rng), z = Ratio(a, rng);
+  return {x, y, z};
+}
+
+Vector3 Offset(double a, Rng* rng) { return Ratios(a, rng) - Vector3::Ones(); }
+
+}  // namespace
+
+TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& vehicle, std::uint64_t seed) {
+  const TruthRanges r = options.Ranges();
+  // The draw's own stream: what it draws never shifts the sensors' or the wind's noise.
+  Rng rng(DeriveSeed(seed, 0x7472757468ULL));  // "truth"
+  TruthDraw d;
+  d.preset = options.preset;
+  d.mass_ratio = Ratio(r.mass_fraction, &rng);
+  d.inertia_ratio = Ratios(r.inertia_fraction, &rng);
+  d.cog_offset_m = Offset(r.cog_offset_m, &rng);
+  for (int i = 0; i < vehicle.num_rotors(); ++i) {
+    d.thrust_coefficient_ratio.push_back(Ratio(r.thrust_coefficient_fraction, &rng));
+    d.yaw_coefficient_ratio.push_back(Ratio(r.yaw_coefficient_fraction, &rng));
+  }
+  d.motor_time_constant_ratio = Ratio(r.motor_time_constant_fraction, &rng);
+  d.motor_stop_time_constant_s = vehicle.motor_stop_time_constant_s;
+  if (r.motor_stop_time_constant_min_s) {
+    const double lo = std::log(*r.motor_stop_time_constant_min_s), hi = std::log(*r.motor_stop_time_constant_max_s);
+    d.motor_stop_time_constant_s = hi > lo ? std::exp(rng.Uniform(lo, hi)) : *r.motor_stop_time_constant_min_s;
+  }
+  d.rotor_drag_ratio = Ratios(r.rotor_drag_fraction, &rng);
+  d.imu_offset_m = Offset(r.imu_offset_m, &rng);
+  const Vector3 torque = Offset(r.external_torque_n_m, &rng);
+  d.external_torque_n_m = Vector3(torque.x(), torque.y(), 0.0);
+  return d;
+}
+
+vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const TruthDraw& d) {
+  vehicle::VehicleParams v = file;
+  v.mass_kg = file.mass_kg * d.mass_ratio;
+  // I' = S I S with S = diag(sqrt(ratio)): the principal moments of a diagonal I scale by the
+  // ratios, and I' stays symmetric positive definite for any I.
+  const Vector3 s = d.inertia_ratio.cwiseSqrt();
+  v.inertia_kg_m2 = s.asDiagonal() * file.inertia_kg_m2 * s.asDiagonal();
+  v.rotor_drag_kg_s = file.rotor_drag_kg_s.cwiseProduct(d.rotor_drag_ratio);
+  v.motor_time_constant_s = file.motor_time_constant_s * d.motor_time_constant_ratio;
+  v.motor_stop_time_constant_s = d.motor_stop_time_constant_s;
+  // Rotor positions are relative to the centre of gravity: a CoG at c moves every hub by -c.
+  for (std::size_t i = 0; i < v.rotors.size(); ++i) {
+    v.rotors[i].p_B = file.rotors[i].p_B - d.cog_offset_m;
+    if (i < d.yaw_coefficient_ratio.size()) v.rotors[i].yaw_coefficient_m *= d.yaw_coefficient_ratio[i];
+  }
+  for (vehicle::CollisionSphere& c : v.collision_spheres) c.centre_B -= d.cog_offset_m;
+  return v;
+}
+
+RotorVector ThrustRatios(const TruthDraw& draw) {
+  RotorVector r(static_cast<Eigen::Index>(draw.thrust_coefficient_ratio.size()));
+  for (std::size_t i = 0; i < draw.thrust_coefficient_ratio.size(); ++i) r[i] = draw.thrust_coefficient_ratio[i];
+  return r;
+}
+
+}  // namespace rotorguard::sim
