@@ -54,6 +54,9 @@ class BenchCommand final : public Command {
                     "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
                     "with `campaign merge` when all are done");
       b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
+      b->add_option("--truth", truth_,
+                    "The simulated vehicles: ideal (the vehicle file exactly) or realistic (each trial\n"
+                    "draws its own about the file; docs/truth.md) (default ideal)");
     }
     // Every benchmark can also write its page: tables and distributions (record/report.h).
     for (CLI::App* b : {sim_, qp_, nmpc_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
@@ -278,12 +281,20 @@ class BenchCommand final : public Command {
     return r["success_nominal"].get<bool>() && r["success_failed"].get<bool>() ? kOk : kRunFailed;
   }
 
+  /// --truth: the world the campaign benchmarks fly.
+  sim::TruthPreset Truth() const {
+    if (const std::optional<sim::TruthPreset> p = FromName<sim::TruthPreset>(truth_)) return *p;
+    throw UsageError(fmt::format("--truth '{}' is invalid; expected one of: {}", truth_,
+                                 fmt::join(NameList<sim::TruthPreset>(), ", ")));
+  }
+
   int Ftc() const {
     benchmarks::FtcBenchOptions o;
     o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_, 1, 1'000'000));
     o.seed = Seed();
     o.methods = ParseWordList("--methods", ftc_methods_, benchmarks::FtcMethods());
     o.vehicle = harness::LoadVehicle(ConfigPath("vehicles/zhou2025_quad.yaml"));
+    o.truth = Truth();
     const std::optional<nlohmann::json> r = RunBenchCampaign(benchmarks::FtcCampaign(o), "ftc");
     return r && (*r)["errors"].get<int>() > 0 ? kRunFailed : kOk;
   }
@@ -315,6 +326,8 @@ class BenchCommand final : public Command {
     o.seed = Seed();
     o.kinds = ParseWordList("--kinds", nav_kinds_, {"forest", "room"});
     o.base = harness::LoadScenario(ConfigPath("scenarios/forest.yaml"));
+    o.truth = Truth();
+    o.base.truth.preset = o.truth;  // a replayed trial flies the same world
     if (!nav_replay_.empty()) return ReplayNavTrial(o.base);
     RunBenchCampaign(benchmarks::NavCampaign(o), "nav");
     return kOk;
@@ -362,6 +375,7 @@ class BenchCommand final : public Command {
     o.reconfigure = harness::LoadScenario(ConfigPath("scenarios/mars_reconfigure_3x1.yaml"));
     o.plan_4x1 = harness::LoadScenario(ConfigPath("scenarios/mars_plan_4x1.yaml"));
     o.plan_3x2 = harness::LoadScenario(ConfigPath("scenarios/mars_plan_3x2.yaml"));
+    o.truth = Truth();
     RunBenchCampaign(benchmarks::MarsCampaign(o), "mars");
     return kOk;
   }
@@ -396,6 +410,7 @@ class BenchCommand final : public Command {
   bool resume_ = false, json_ = false;
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3";
+  std::string truth_ = "ideal";
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none";
   std::string perception_duration_ = "10";
   std::string planner_pairs_ = "100", planner_worlds_ = "10";

@@ -69,6 +69,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
   s.name = fmt::format("ftc_{}_{}_{}", cell.phase, cell.fault, method);
   s.vehicle = o.vehicle;
   s.seed = trial_seed;
+  s.truth.preset = o.truth;
   s.sim.wind.gust_std_m_s = gust;
   s.sim.wind.gust_time_constant_s = 2.0;
   const std::string phase = cell.phase;
@@ -186,8 +187,9 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   c.trials = kNumCells * methods * o.trials;
   c.group_keys = {"phase", "fault", "method"};
   c.metrics = {"success", "correct", "false_alarm", "latency_s", "min_altitude_m"};
-  const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"methods", o.methods},
-                                  {"vehicle", o.vehicle.name}};
+  const nlohmann::json options = {{"trials", o.trials},   {"seed", o.seed},
+                                  {"methods", o.methods}, {"vehicle", o.vehicle.name},
+                                  {"truth", ToName(o.truth)}};
   c.bench = {{"name", "ftc"}, {"options", options}};
   c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::VehicleToYaml(o.vehicle));
   // Trial index = (cell, method, trial), the trial fastest. Every method flies the same draws: the
@@ -260,7 +262,8 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
       cells.push_back(cell);
     }
   }
-  return {{"benchmark", "ftc"}, {"cells", cells}, {"errors", errors}, {"options", options}, {"host", buildinfo::HostInfo()}};
+  return {{"benchmark", "ftc"}, {"truth", options.value("truth", "ideal")}, {"cells", cells},
+          {"errors", errors},     {"options", options},             {"host", buildinfo::HostInfo()}};
 }
 
 nlohmann::json RunFtcBenchmark(const FtcBenchOptions& o) {

@@ -152,7 +152,8 @@ campaign::Campaign NavCampaign(const NavBenchOptions& o) {
   c.group_keys = {"kind", "variant"};
   c.metrics = {"success",        "collision",       "tracking_rmse_m",      "max_spin_rad_s",
                "mission_time_s", "realtime_factor", "trial_realtime_factor"};
-  const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"kinds", o.kinds}, {"base", o.base.name}};
+  const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"kinds", o.kinds}, {"base", o.base.name},
+                                  {"truth", ToName(o.truth)}};
   // "records": what a trial records. Version 2 made realtime_factor the stack's and added
   // trial_realtime_factor; the hash then refuses to resume or merge the folders of version 1.
   c.bench = {{"name", "nav"}, {"records", 2}, {"options", options}};
@@ -167,7 +168,9 @@ campaign::Campaign NavCampaign(const NavBenchOptions& o) {
                                               {"trial", std::to_string(trial)},
                                               {"seed", std::to_string(seed)}};
   };
-  c.run = [base = o.base](int, const std::map<std::string, std::string>& params) {
+  harness::Scenario base = o.base;
+  base.truth.preset = o.truth;
+  c.run = [base](int, const std::map<std::string, std::string>& params) {
     harness::RunOptions run;
     run.stop_when_mission_complete = true;
     const harness::RunSummary s = harness::RunScenario(MakeNavTrial(base, params.at("kind"), std::stoull(params.at("seed")),
@@ -241,6 +244,7 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
   }
   result["groups"] = groups;
   result["options"] = options;
+  result["truth"] = options.value("truth", "ideal");  // records made before the key: the ideal world
   result["host"] = buildinfo::HostInfo();
   return result;
 }

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include "rotorguard/harness/scenario.h"
+#include "test_util.h"
+
 namespace rotorguard::benchmarks {
 namespace {
 
@@ -36,6 +39,25 @@ TEST(FtcCell, MetricsWithoutFaultDetectionAreNull) {
   EXPECT_TRUE(c["fdd_latency_s_mean"].is_null());
   EXPECT_NEAR(c["sucr"].get<double>(), 0.5, 1e-12);
   EXPECT_TRUE(AggregateFtcCell({FtcTrial{true, true, false, false, -1.0, 1.0, "", 1}}, false)["mdr"].is_null());
+}
+
+TEST(FtcBenchmark, TheRealisticWorldFliesOtherVehiclesUnderItsOwnHash) {
+  // One trial of one method in each world: the same index, the same seed and fault, another
+  // vehicle. A campaign of one world cannot resume or merge into the other's (hash).
+  FtcBenchOptions o;
+  o.trials = 1;
+  o.methods = {"rotorguard"};
+  o.vehicle = harness::LoadVehicle(testing::SourcePath("configs/vehicles/zhou2025_quad.yaml"));
+  const campaign::Campaign ideal = FtcCampaign(o);
+  o.truth = sim::TruthPreset::kRealistic;
+  const campaign::Campaign realistic = FtcCampaign(o);
+  EXPECT_EQ(ideal.bench["options"]["truth"], "ideal");
+  EXPECT_EQ(realistic.bench["options"]["truth"], "realistic");
+  EXPECT_NE(ideal.hash, realistic.hash);
+  EXPECT_EQ(ideal.parameters(0), realistic.parameters(0));
+  const campaign::TrialOutcome a = ideal.run(0, ideal.parameters(0));
+  const campaign::TrialOutcome b = realistic.run(0, realistic.parameters(0));
+  EXPECT_NE(a.metrics["min_altitude_m"], b.metrics["min_altitude_m"]);
 }
 
 }  // namespace

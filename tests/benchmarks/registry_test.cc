@@ -1,4 +1,4 @@
-// The benchmarks on the campaign engine (bench/bench_campaigns.h): a benchmark run whole, in
+// The benchmarks on the campaign engine (benchmarks/registry.h): a benchmark run whole, in
 // shards merged by `MergeCampaign`, or from its spec file gives one result; the results are built
 // from the records as hand-made records say they must be; bad specs name the key.
 

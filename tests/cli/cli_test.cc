@@ -86,6 +86,17 @@ class CliTest : public rotorguard::testing::TempFolderTest {
   std::string Out() const { return (dir_ / "out").string(); }
 };
 
+/// The campaign benchmarks fly the world --truth names and say which in their JSON.
+TEST_F(CliTest, ABenchmarksWorldIsNamedByTruthAndRecordedInItsJson) {
+  const Result r = Cli("bench ftc --trials 1 --methods none --seed 3 --jobs 1 --truth realistic --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(nlohmann::json::parse(r.out.substr(r.out.find('{')))["truth"], "realistic");
+  const Result bad = Cli("bench nav --truth perfect");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.out.find("--truth 'perfect' is invalid; expected one of: ideal, realistic"), std::string::npos)
+      << bad.out;
+}
+
 /// A benchmark run in two shards and merged prints the same tables as one run of it, and its
 /// campaign flags are checked (docs/campaigns.md, "Benchmarks as campaigns").
 TEST_F(CliTest, ABenchmarkInShardsMergesToTheTablesOfOneRun) {

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotorguard/campaign/campaign.h"
+#include "rotorguard/sim/truth.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::benchmarks {
@@ -29,6 +30,9 @@ struct FtcBenchOptions {
   std::vector<std::string> methods = FtcMethods();
   int jobs = 1;                    ///< worker threads, >= 1
   vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
+  /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
+  /// vehicle file the stack reads; every method flies the same draw of a trial.
+  sim::TruthPreset truth = sim::TruthPreset::kIdeal;
   /// Called after each finished trial with (done, total).
   std::function<void(int, int)> progress;
   void Validate() const;

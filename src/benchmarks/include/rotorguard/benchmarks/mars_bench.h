@@ -12,6 +12,7 @@
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/sim/truth.h"
 
 namespace rotorguard::benchmarks {
 
@@ -33,6 +34,9 @@ struct MarsBenchOptions {
   /// assembly_plan), each planned by ours and by the baseline for every row's fault and flown over
   /// `trials` seeds. Table II is skipped when either has no assembly_plan mission.
   harness::Scenario plan_4x1, plan_3x2;
+  /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
+  /// vehicle file the stack reads; every method flies the same draw of a trial.
+  sim::TruthPreset truth = sim::TruthPreset::kIdeal;
   std::function<void(int, int)> progress;
   /// Throws std::invalid_argument naming the field.
   void Validate() const;

@@ -13,6 +13,7 @@
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/sim/truth.h"
 
 namespace rotorguard::benchmarks {
 
@@ -24,6 +25,9 @@ struct NavBenchOptions {
   /// The vehicle, sensors and stack every trial flies (configs/scenarios/forest.yaml); its world,
   /// waypoints, faults, wind and seed are replaced per trial.
   harness::Scenario base;
+  /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
+  /// vehicle file the stack reads; every method flies the same draw of a trial.
+  sim::TruthPreset truth = sim::TruthPreset::kIdeal;
   std::function<void(int, int)> progress;  ///< (flights done, flights in all)
   /// Throws std::invalid_argument naming the field.
   void Validate() const;
