@@ -90,7 +90,7 @@ std::pair<double, double> TimeAllocation(const modular::Assembly& a, int samples
   }
   double mean = 0.0;
   for (const double v : us) mean += v / samples;
-  return {mean, campaign::Percentile(us, 99.0)};
+  return {mean, campaign::Percentile(us, 0.99)};
 }
 
 /// The rotors of unit No. k (index k - 1), all stopped.

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "rotorguard/buildinfo/build_info.h"
+#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/control/ocp_qp.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
@@ -17,15 +18,6 @@ namespace rotorguard::benchmarks {
 
 namespace {
 using nlohmann::json;
-
-double InterpolatedPercentile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  if (v.empty()) return 0.0;
-  const double pos = p * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
 
 Eigen::VectorXd Vector(const json& j, const std::string& what, int size) {
   if (!j.is_array() || static_cast<int>(j.size()) != size) {
@@ -129,7 +121,7 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
     for (const Case& c : cases) {
       qp->x0 = c.x0;
       for (int r = 0; r < options.repetitions; ++r) reps[r] = solver.Solve(*qp).total_time_s * 1e6;
-      g.times_us.push_back(InterpolatedPercentile(reps, 0.5));
+      g.times_us.push_back(campaign::Percentile(reps, 0.5));
       const control::OcpQpSummary& s = solver.summary();
       if (!s.IsSolutionUsable()) ++g.failures;
       g.iterations_sum += s.iterations;
@@ -162,14 +154,14 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
           {"cases_stress", stress.size()},
           {"cases_track", track.size()},
           {"repetitions", options.repetitions},
-          {"stress_us_median", InterpolatedPercentile(st.times_us, 0.5)},
-          {"stress_us_p99", InterpolatedPercentile(st.times_us, 0.99)},
-          {"track_us_median", InterpolatedPercentile(tr.times_us, 0.5)},
-          {"track_us_p99", InterpolatedPercentile(tr.times_us, 0.99)},
+          {"stress_us_median", campaign::Percentile(st.times_us, 0.5)},
+          {"stress_us_p99", campaign::Percentile(st.times_us, 0.99)},
+          {"track_us_median", campaign::Percentile(tr.times_us, 0.5)},
+          {"track_us_p99", campaign::Percentile(tr.times_us, 0.99)},
           {"iterations_mean", cases > 0 ? (st.iterations_sum + tr.iterations_sum) / cases : 0.0},
-          {"max_u0_error", std::max(InterpolatedPercentile(st.u0_errors, 1.0), InterpolatedPercentile(tr.u0_errors, 1.0))},
-          {"u0_error_median", InterpolatedPercentile(all_errors, 0.5)},
-          {"u0_error_p99", InterpolatedPercentile(all_errors, 0.99)},
+          {"max_u0_error", std::max(campaign::Percentile(st.u0_errors, 1.0), campaign::Percentile(tr.u0_errors, 1.0))},
+          {"u0_error_median", campaign::Percentile(all_errors, 0.5)},
+          {"u0_error_p99", campaign::Percentile(all_errors, 0.99)},
           {"cases_u0_error_above_1e-4", std::count_if(all_errors.begin(), all_errors.end(),
                                                       [](double e) { return e > 1e-4; })},
           {"cases_reference_u0_suboptimal", st.reference_suboptimal + tr.reference_suboptimal},
