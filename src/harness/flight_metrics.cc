@@ -37,7 +37,10 @@ void FlightMetrics::OnStep(TimeNs t, const vehicle::StateView& s, const Vector3&
   if (!(error <= options_.success_error_m)) last_violation_ = Violation{t_s, error};
   const double altitude = s.p_W().z();
   min_altitude_all_ = std::min(min_altitude_all_, altitude);
-  if (after_fault) min_altitude_after_fault_ = std::min(min_altitude_after_fault_, altitude);
+  if (after_fault) {
+    if (!onset_altitude_) onset_altitude_ = altitude;
+    min_altitude_after_fault_ = std::min(min_altitude_after_fault_, altitude);
+  }
   max_spin_rad_s_ = std::max(max_spin_rad_s_, std::abs(s.w_B().z()));
   const double tilt = TiltOf(s.q_WB());
   if (after_fault && tilt > options_.recovered_tilt_rad) last_tilted_s_ = t_s;
@@ -48,7 +51,10 @@ void FlightMetrics::Finish(const FlightEnd& end, const std::function<Vector3(dou
                            RunSummary* summary) {
   const bool after_fault = end.first_onset_s.has_value();
   min_altitude_all_ = std::min(min_altitude_all_, end.p_W.z());  // the final state (or the crash site)
-  if (after_fault) min_altitude_after_fault_ = std::min(min_altitude_after_fault_, end.p_W.z());
+  if (after_fault) {
+    if (!onset_altitude_) onset_altitude_ = end.p_W.z();  // a fault at the flight's very end
+    min_altitude_after_fault_ = std::min(min_altitude_after_fault_, end.p_W.z());
+  }
   summary->tracking_rmse_m = Finite(tracking_.rmse());
   summary->tracking_rmse_eq37_m = Finite(tracking_.rmse_eq37());
   summary->max_position_error_m = Finite(tracking_.max_error());
@@ -68,6 +74,9 @@ void FlightMetrics::Finish(const FlightEnd& end, const std::function<Vector3(dou
   summary->tracking_end_s =
       end.crashed ? ToSeconds(options_.tracking_end_ns) : std::min(ToSeconds(options_.tracking_end_ns), end_s);
   summary->min_altitude_m = Finite(after_fault ? min_altitude_after_fault_ : min_altitude_all_);
+  // MiniA (docs/metrics.md): the lowest altitude after the onset relative to the onset's; <= 0.
+  summary->altitude_change_m.reset();
+  if (after_fault) summary->altitude_change_m = Finite(min_altitude_after_fault_ - *onset_altitude_);
   summary->max_spin_rad_s = max_spin_rad_s_;
   summary->max_tilt_rad = max_tilt_rad_;
   summary->tilt_recovery_s.reset();

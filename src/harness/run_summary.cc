@@ -100,6 +100,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["tracking_rmse_eq37_m"] = tracking_rmse_eq37_m;
   j["max_position_error_m"] = max_position_error_m;
   j["min_altitude_m"] = min_altitude_m;
+  j["altitude_change_m"] = OrNull(altitude_change_m);
   j["max_spin_rad_s"] = max_spin_rad_s;
   j["max_tilt_rad"] = max_tilt_rad;
   j["tilt_recovery_s"] = OrNull(tilt_recovery_s);

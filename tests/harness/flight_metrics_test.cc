@@ -76,6 +76,8 @@ TEST(FlightMetrics, HandMadeFlightGivesEveryMetricByHand) {
   EXPECT_NEAR(s.tracking_rmse_window_m, s.tracking_rmse_m, 1e-15) << "no crash: the same window";
   EXPECT_NEAR(s.max_position_error_m, std::sqrt(0.37), 1e-12);
   EXPECT_NEAR(s.min_altitude_m, 0.4, 1e-12) << "after the fault";
+  ASSERT_TRUE(s.altitude_change_m.has_value());
+  EXPECT_NEAR(*s.altitude_change_m, -0.6, 1e-12) << "from 1.0 m at the onset down to 0.4 m";
   EXPECT_NEAR(s.max_spin_rad_s, 11.0, 1e-12);
   EXPECT_NEAR(s.max_tilt_rad, 0.3, 1e-9);
   ASSERT_TRUE(s.tilt_recovery_s.has_value());
@@ -98,8 +100,28 @@ TEST(FlightMetrics, ACrashedVehicleIsHeldWhereItCrashedOverTheRestOfTheWindow) {
   EXPECT_NEAR(s.tracking_rmse_m, 0.0, 1e-15) << "up to the crash";
   EXPECT_NEAR(s.tracking_rmse_window_m, std::sqrt(0.5), 1e-9);
   EXPECT_NEAR(s.min_altitude_m, 0.0, 1e-15) << "the crash site counts";
+  EXPECT_FALSE(s.altitude_change_m.has_value()) << "no fault, no MiniA";
   EXPECT_EQ(s.tracking_end_s, 4.0) << "a crashed flight's window is the scenario's";
   EXPECT_FALSE(s.tilt_recovery_s.has_value());
+}
+
+// MiniA at take-off: a fault at 0.3 m while climbing 1 m/s; the vehicle sinks to 0.22 m, then climbs
+// on. The change is measured from the onset's altitude (-0.08 m), not from the ground: the lowest
+// altitude alone (0.22 m) would pass any test of "no ground contact".
+TEST(FlightMetrics, AltitudeChangeIsMeasuredFromTheOnsetsAltitude) {
+  FlightMetrics m(Options(0, 2'000'000'000));
+  double z = 0.0;
+  for (TimeNs t = 0; t < 2'000'000'000; t += kStep) {
+    const bool fault = t >= 300'000'000;
+    const double ts = ToSeconds(t);
+    z = !fault ? ts : (ts < 0.7 ? 0.3 - 0.2 * (ts - 0.3) : 0.22 + 0.5 * (ts - 0.7));
+    m.OnStep(t, vehicle::StateView(State(Vector3(0, 0, z))), Vector3(0, 0, z), fault);
+  }
+  RunSummary s;
+  m.Finish({2'000'000'000, false, Vector3(0, 0, z), 0.3}, [&](double) { return Vector3(0, 0, z); }, &s);
+  ASSERT_TRUE(s.altitude_change_m.has_value());
+  EXPECT_NEAR(*s.altitude_change_m, -0.08, 1e-9);
+  EXPECT_NEAR(s.min_altitude_m, 0.22, 1e-9);
 }
 
 TEST(FlightMetrics, TiltThatNeverSettlesHasNoRecoveryTime) {

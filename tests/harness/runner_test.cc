@@ -90,7 +90,7 @@ TEST(Runner, TakesOffFromTheGroundAndSettlesAtAltitude) {
   ASSERT_EQ(s.initial_position_m.z(), 0.0);
   const RunSummary r = RunScenario(s);
   EXPECT_TRUE(r.success) << r.crash_reason.value_or("");
-  EXPECT_GE(r.min_altitude_m, 0.0);
+  EXPECT_FALSE(r.altitude_change_m.has_value()) << "no fault";
   EXPECT_LT(r.tracking_rmse_m, 0.05);
 }
 
@@ -261,7 +261,9 @@ TEST(FddClosedLoop, AFaultDuringTakeoffOnEachRotorEndsInAStableHover) {
       ASSERT_TRUE(r.fdd.has_value());
       EXPECT_TRUE(r.fdd->correct) << "rotor " << rotor << " " << kind;
       EXPECT_LT(r.fdd->latency_s, 0.025) << "rotor " << rotor << " " << kind;
-      EXPECT_GE(r.min_altitude_m, 0.0);  // MiniA: no altitude lost at take-off
+      // MiniA: at most 5 cm lost from the altitude of the onset (docs/metrics.md).
+      ASSERT_TRUE(r.altitude_change_m.has_value());
+      EXPECT_GE(*r.altitude_change_m, -0.05) << "rotor " << rotor << " " << kind;
     }
   }
 }

@@ -81,6 +81,7 @@ class FlightMetrics {
   std::optional<double> last_tilted_s_;  // after a fault
   double min_altitude_all_ = std::numeric_limits<double>::infinity();
   double min_altitude_after_fault_ = std::numeric_limits<double>::infinity();
+  std::optional<double> onset_altitude_;  ///< at the first step after the first fault's onset
   double max_spin_rad_s_ = 0.0;
   double max_tilt_rad_ = 0.0;
 };

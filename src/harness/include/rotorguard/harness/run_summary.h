@@ -93,6 +93,9 @@ struct RunSummary {
   double tracking_rmse_eq37_m = 0.0;  ///< paper 000's eq. (37), for comparison with its figures
   double max_position_error_m = 0.0;
   double min_altitude_m = 0.0;  ///< after the first fault onset when there is one, else whole run
+  /// MiniA: the lowest altitude after the first fault's onset minus the altitude at the onset
+  /// (negative: altitude lost; never below minus the onset altitude); none without a fault.
+  std::optional<double> altitude_change_m;
   double max_spin_rad_s = 0.0;  ///< largest |yaw rate| of the body
   double max_tilt_rad = 0.0;    ///< largest tilt of the body z axis from the vertical
   /// Time from the first fault onset until the tilt stays below metrics.recovered_tilt_rad to the
