@@ -137,7 +137,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
     const FtcTrial& r = trials[t];
     success += r.success ? 1 : 0;
     if (!r.success) failures.Add({{"trial", t}, {"seed", r.seed}, {"reason", r.failure}});
-    min_alt = std::min(min_alt, r.min_altitude_m);
+    if (!r.errored) min_alt = std::min(min_alt, r.min_altitude_m);
     if (!r.has_fdd) continue;
     ++with_fdd;
     false_alarms += r.false_alarm ? 1 : 0;
@@ -240,6 +240,9 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         trial.failure = campaign::TrialFailure(r);
         if (r["status"] != "ok") {  // an error or a non-finite metric: the trial failed
           ++errors;
+          trial.errored = true;
+          // It isolated nothing: for a method that detects faults, a missed detection.
+          trial.has_fdd = FtcMethodNamed(methods[static_cast<std::size_t>(m)]).fdd != stack::FddKind::kNone;
           cell_trials.push_back(trial);
           continue;
         }

@@ -5,6 +5,7 @@
 
 #include "rotorguard/harness/scenario.h"
 #include "test_util.h"
+#include "vehicle_fixture.h"
 
 namespace rotorguard::benchmarks {
 namespace {
@@ -28,6 +29,52 @@ TEST(FtcCell, MetricArithmeticOnHandMadeTrials) {
   EXPECT_NEAR(c["mini_alt_m"].get<double>(), -0.2, 1e-12);
   ASSERT_EQ(c["failures"].size(), 1u);
   EXPECT_EQ(c["failures"][0]["seed"], 14);
+}
+
+TEST(FtcCell, AnErroredTrialIsAFailureAndAMissedDetection) {
+  // Two faulty trials of a method with FDD: one correct isolation, one that errored (it reported no
+  // metrics). MDR counts the errored one; the least altitude comes from the finished one alone.
+  std::vector<FtcTrial> t(2);
+  t[0] = {true, true, true, false, 0.02, 1.9, "", 11};
+  t[1].has_fdd = true;
+  t[1].errored = true;
+  t[1].failure = "error: diverged";
+  const nlohmann::json c = AggregateFtcCell(t, /*faulty=*/true);
+  EXPECT_NEAR(c["mdr"].get<double>(), 0.5, 1e-12);
+  EXPECT_NEAR(c["sucr"].get<double>(), 0.5, 1e-12);
+  EXPECT_NEAR(c["mini_alt_m"].get<double>(), 1.9, 1e-12);
+  EXPECT_NEAR(c["far"].get<double>(), 0.0, 1e-12);
+}
+
+TEST(FtcResult, TrialsThatErroredAreMissedDetectionsOfAMethodWithFdd) {
+  // Every trial of rotorguard (composite FDD) errored: every faulty cell misses all its faults,
+  // and the fault-free cell has no MDR to report. Without FDD (none) MDR stays null.
+  for (const char* method : {"rotorguard", "none"}) {
+    const nlohmann::json options = {{"trials", 1}, {"seed", 1}, {"methods", {method}}, {"vehicle", "v"}};
+    std::vector<nlohmann::json> records;
+    const int cells = static_cast<int>(FtcCampaign([&] {
+                                         FtcBenchOptions o;
+                                         o.trials = 1;
+                                         o.methods = {method};
+                                         o.vehicle = testing::ReferenceQuad();
+                                         return o;
+                                       }())
+                                           .trials);
+    for (int i = 0; i < cells; ++i) {
+      records.push_back({{"status", "error"}, {"message", "diverged"}, {"params", {{"seed", "7"}}}});
+    }
+    const nlohmann::json r = FtcResult(options, records);
+    EXPECT_EQ(r["errors"], cells);
+    for (const nlohmann::json& c : r["cells"]) {
+      EXPECT_EQ(c["sucr"], 0.0);
+      const bool faulty = c["fault"] != "none";
+      if (faulty && std::string(method) == "rotorguard") {
+        EXPECT_EQ(c["mdr"], 1.0) << c["phase"] << " " << c["fault"];
+      } else {
+        EXPECT_TRUE(c["mdr"].is_null()) << method << " " << c["phase"] << " " << c["fault"];
+      }
+    }
+  }
 }
 
 TEST(FtcCell, MetricsWithoutFaultDetectionAreNull) {

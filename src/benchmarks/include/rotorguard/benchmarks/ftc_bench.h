@@ -48,10 +48,14 @@ struct FtcTrial {
   double min_altitude_m = 0.0;
   std::string failure;       ///< why it failed (run failure or error), "" on success
   std::uint64_t seed = 0;
+  /// The trial did not finish (an error or a non-finite metric): a failure, a missed detection
+  /// when the method detects faults, and no altitude to count.
+  bool errored = false;
 };
 
 /// A cell's metrics (docs/metrics.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty
-/// cells: no correct isolation within 1 s), far, mini_alt_m (least altitude after the fault), and
+/// cells: no correct isolation within 1 s, errored trials included), far, mini_alt_m (least altitude
+/// after the fault, over the trials that finished), and
 /// the first failures. Null where a metric does not apply (no FDD; MDR of fault-free cells).
 nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty);
 
