@@ -41,4 +41,16 @@ FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vecto
   return r;
 }
 
+void AddReconfigurationLatency(const std::vector<stack::RotorReconfiguration>& reconfigurations,
+                               const std::vector<sim::FaultEvent>& events, FddRecord* record) {
+  record->reconfiguration_latency_s.reset();
+  if (!record->correct || events.empty()) return;
+  for (const stack::RotorReconfiguration& c : reconfigurations) {
+    if (c.rotor == record->diagnosis->rotor) {
+      record->reconfiguration_latency_s = c.t_s - events.front().onset_s;
+      return;
+    }
+  }
+}
+
 }  // namespace rotorguard::harness

@@ -29,7 +29,8 @@ nlohmann::json FddJson(const FddRecord& f) {
           {"detection_s", d ? nlohmann::json(d->detection_s) : nlohmann::json(nullptr)},
           {"correct", f.correct},
           {"false_alarm", f.false_alarm},
-          {"latency_s", OrNull(f.latency_s)}};
+          {"latency_s", OrNull(f.latency_s)},
+          {"reconfiguration_latency_s", OrNull(f.reconfiguration_latency_s)}};
 }
 
 nlohmann::json NavigationJson(const stack::NavigationSummary& n, const std::optional<double>& mission_time_s,

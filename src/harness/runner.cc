@@ -111,6 +111,7 @@ class ClosedLoop {
     if (sc_.stack.fdd == stack::FddKind::kComposite) s.composite_fdd = sc_.stack.composite_fdd;
     if (const fdd::FaultDetector* detector = stack_.fault_detector()) {
       s.fdd = ScoreFdd(detector->rotors(), sim_.fault_events());
+      AddReconfigurationLatency(s.stack.reconfigurations, sim_.fault_events(), &*s.fdd);
     }
     for (const sim::FaultEvent& e : sim_.fault_events()) {
       s.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});

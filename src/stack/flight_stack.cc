@@ -195,9 +195,10 @@ void FlightStack::OnLidar(const LidarFrame& frame) {
   lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_.Estimate(frame.t_end_ns)).points_dropped;
 }
 
-void FlightStack::OnRotorFailed(int rotor) {
+void FlightStack::OnRotorFailed(int rotor, double t) {
   if (std::find(isolated_.begin(), isolated_.end(), rotor) != isolated_.end()) return;
   isolated_.push_back(rotor);
+  reconfigurations_.push_back({rotor, t});
   controller_->SetRotorFailed(rotor);
   if (navigator_ && options_.navigation.failure_aware) navigator_->OnFailure();
 }
@@ -261,7 +262,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
       if (!known_fault_applied_[i] && ts >= options_.known_faults[i].at_time_s) {
         const KnownFault& k = options_.known_faults[i];
         if (k.loss >= 1.0) {
-          OnRotorFailed(k.rotor);
+          OnRotorFailed(k.rotor, ts);
         } else {
           controller_->SetRotorEffectiveness(k.rotor, 1.0 - k.loss);
         }
@@ -272,7 +273,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
       fdd_->SetEstimate(estimate_);
       // Isolation reconfigures the controller (the NMPC: u_bar_i = 0, yaw given up, post-failure
       // thrust reference; controllers that cannot reconfigure ignore it) and the planner.
-      for (int rotor : fdd_->TakeNewIsolations()) OnRotorFailed(rotor);
+      for (int rotor : fdd_->TakeNewIsolations()) OnRotorFailed(rotor, ts);
     }
   }
   SupervisorInputs in;
@@ -358,6 +359,7 @@ FlightStackSummary FlightStack::Summarize() const {
   s.transitions = supervisor_.transitions();
   if (const perception::VoxelMap* m = map()) s.map_voxels_occupied = m->occupied_count();
   s.lidar_points_dropped = lidar_points_dropped_;
+  s.reconfigurations = reconfigurations_;
   return s;
 }
 

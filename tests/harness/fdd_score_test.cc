@@ -37,5 +37,22 @@ TEST(ScoreFdd, CorrectLateWrongAndFalseDiagnosesOnHandMadeCases) {
   EXPECT_EQ(ScoreFdd(rotors, prop0).diagnosis->rotor, 1);
 }
 
+TEST(ScoreFdd, ReconfigurationLatencyIsTheFirstControlCycleWithoutTheDiagnosedRotor) {
+  // Propeller 0 lost at 2.0 s, isolated at 2.04 s; the controller flew without rotor 3 (a known
+  // fault) from 1.0 s and without rotor 0 from the cycle at 2.045 s.
+  const std::vector<sim::FaultEvent> prop0 = {{0, vehicle::FaultKind::kPropellerLoss, 2.0}};
+  std::vector<fdd::RotorStatus> rotors(4);
+  rotors[0] = Diagnosed(fdd::RotorHealth::kPropellerFailed, 2.04);
+  FddRecord r = ScoreFdd(rotors, prop0);
+  AddReconfigurationLatency({{3, 1.0}, {0, 2.045}}, prop0, &r);
+  EXPECT_NEAR(r.reconfiguration_latency_s.value_or(-1.0), 0.045, 1e-12);
+  AddReconfigurationLatency({{3, 1.0}}, prop0, &r);  // never reconfigured for rotor 0
+  EXPECT_FALSE(r.reconfiguration_latency_s.has_value());
+  rotors[0] = Diagnosed(fdd::RotorHealth::kMotorFailed, 2.04);  // wrong kind: no latency of either sort
+  r = ScoreFdd(rotors, prop0);
+  AddReconfigurationLatency({{0, 2.045}}, prop0, &r);
+  EXPECT_FALSE(r.reconfiguration_latency_s.has_value());
+}
+
 }  // namespace
 }  // namespace rotorguard::harness

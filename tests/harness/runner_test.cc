@@ -195,6 +195,18 @@ TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverAndRecoversRollAndPitch) {
   EXPECT_LE(r.tilt_recovery_s.value_or(-1.0), 3.0);  // roll and pitch recovered within 3 s (paper: about 3 s)
 }
 
+TEST(FddClosedLoop, TheControllerIsReconfiguredAtTheFirstControlCycleAfterTheIsolation) {
+  // The isolation is taken by the next control cycle: the reconfiguration follows the detection by
+  // at most one control period (both include the ESC telemetry's delay).
+  const Scenario s = LoadScenario(Config("fdd_hover_motor_stop.yaml"));
+  const RunSummary r = RunScenario(s);
+  ASSERT_TRUE(r.fdd.has_value());
+  ASSERT_TRUE(r.fdd->correct);
+  ASSERT_TRUE(r.fdd->reconfiguration_latency_s.has_value());
+  EXPECT_GE(*r.fdd->reconfiguration_latency_s, *r.fdd->latency_s);
+  EXPECT_LE(*r.fdd->reconfiguration_latency_s, *r.fdd->latency_s + 1.0 / s.stack.control_rate_hz + 1e-9);
+}
+
 TEST(NmpcClosedLoop, TheSpinAfterAMotorStopIsWhereYawDampingBalancesTheReactionTorque) {
   // With a motor stopped and its twin idle, the two rotors left carry the weight and both push the
   // body the same way about z: in steady spin κ_t m g = k_dψ r (paper 000, eq. 3), so r = κ_t m g /

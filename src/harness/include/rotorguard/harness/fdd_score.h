@@ -7,6 +7,7 @@
 
 #include "rotorguard/fdd/composite_fdd.h"  // RotorStatus, RotorHealth
 #include "rotorguard/sim/fault_injector.h"
+#include "rotorguard/stack/flight_stack.h"
 
 namespace rotorguard::harness {
 
@@ -24,6 +25,9 @@ struct FddRecord {
   bool correct = false;                ///< right rotor and kind, at or after the first onset
   bool false_alarm = false;            ///< a diagnosis without a fault, or before the first onset
   std::optional<double> latency_s;     ///< detection - onset, when correct
+  /// When correct: the first control cycle that flew without the diagnosed rotor - onset. It adds
+  /// to latency_s the wait for the next control cycle (the telemetry's delay is in both).
+  std::optional<double> reconfiguration_latency_s;
 
   bool detected() const { return diagnosis.has_value(); }
 };
@@ -35,5 +39,10 @@ bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis);
 /// diagnosis counts; it is a false alarm without a fault or before the first onset, and correct
 /// when it names the first fault's rotor and kind.
 FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vector<sim::FaultEvent>& events);
+
+/// Sets `record`'s reconfiguration_latency_s from the stack's reconfigurations when the diagnosis
+/// is correct and the controller was reconfigured for its rotor.
+void AddReconfigurationLatency(const std::vector<stack::RotorReconfiguration>& reconfigurations,
+                               const std::vector<sim::FaultEvent>& events, FddRecord* record);
 
 }  // namespace rotorguard::harness

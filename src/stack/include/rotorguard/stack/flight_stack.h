@@ -239,6 +239,13 @@ struct UkfSummary {
 };
 
 /// What the stack did over a flight, taken from its parts: the run summary's account of the stack.
+/// A rotor the controller was reconfigured for (FDD isolation or known fault), and the time of the
+/// control cycle whose command first flew without it [s].
+struct RotorReconfiguration {
+  int rotor = 0;
+  double t_s = 0.0;
+};
+
 struct FlightStackSummary {
   std::optional<NavigationSummary> navigation;  ///< mission navigate
   /// Paper 004's planner's decisions: plan, hold, continue, return, land (navigation method flatness).
@@ -248,6 +255,7 @@ struct FlightStackSummary {
   std::vector<ModeTransition> transitions;       ///< ... and its transitions
   std::optional<int> map_voxels_occupied;        ///< the LiDAR map's occupied voxels; none without a LiDAR
   long lidar_points_dropped = 0;                 ///< as lidar_points_dropped()
+  std::vector<RotorReconfiguration> reconfigurations;  ///< in the order they happened
 };
 
 class FlightStack {
@@ -313,7 +321,7 @@ class FlightStack {
  private:
   /// One rotor found failed (FDD) or handed over (known fault): the controller reconfigures and,
   /// unless the failure-unaware variant flies, the planner switches to the post-failure limit.
-  void OnRotorFailed(int rotor);
+  void OnRotorFailed(int rotor, double t);
   /// The navigator's part of a control cycle: the next waypoint when due (not while recovering
   /// from a failure), the planner at its rate, the time of its last success.
   void Navigate(double t, FlightMode mode);
@@ -329,6 +337,7 @@ class FlightStack {
   OdometryImuEstimator estimator_;
   Supervisor supervisor_;
   std::vector<int> isolated_;            // rotors treated as failed, in the order they failed
+  std::vector<RotorReconfiguration> reconfigurations_;  // ... and the control cycles that took them
   std::optional<planning::TakeoffReference> landing_;  // the emergency landing's descent ...
   std::optional<TimeShiftedReference> descent_;         // ... from the time it started
   std::size_t plan_events_seen_ = 0;
