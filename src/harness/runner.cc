@@ -48,6 +48,11 @@ sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel&
   sim::SimulatorOptions options = sc.sim;
   options.imu.position_m = sc.sim.imu.position_m - draw.cog_offset_m + draw.imu_offset_m;
   options.external_torque_n_m = draw.external_torque_n_m;
+  options.imu.vibration_m_s2 = draw.imu_vibration_m_s2;
+  // The vibration's amplitude is given at the file's hover speed: T = m g / n = k_n ω².
+  const vehicle::VehicleParams& file = sc.vehicle;
+  options.imu.vibration_reference_speed_rad_s =
+      std::sqrt(file.weight_n() / file.num_rotors() / file.thrust_coefficient_n_s2);
   return sim::Simulator(truth, sc.world, sc.faults, options, sc.seed,
                         truth.MakeState(sc.initial_position_m, sc.initial_yaw_rad, motors));
 }

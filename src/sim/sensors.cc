@@ -1,6 +1,7 @@
 #include "rotorguard/sim/sensors.h"
 
 #include <cmath>
+#include <numbers>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
@@ -33,6 +34,13 @@ void ImuOptions::Validate(double physics_rate_hz) const {
   RequireNonNegative("ImuOptions", "gyro_bias_random_walk", gyro_bias_random_walk);
   RequireNonNegative("ImuOptions", "accel_bias_initial", accel_bias_initial);
   RequireNonNegative("ImuOptions", "gyro_bias_initial", gyro_bias_initial);
+  if (!(accel_range_m_s2 > 0.0)) ThrowValidation("ImuOptions", "accel_range_m_s2", accel_range_m_s2, "a range > 0");
+  if (!(gyro_range_rad_s > 0.0)) ThrowValidation("ImuOptions", "gyro_range_rad_s", gyro_range_rad_s, "a range > 0");
+  RequireNonNegative("ImuOptions", "vibration_m_s2", vibration_m_s2);
+  if (!(vibration_reference_speed_rad_s > 0.0)) {
+    ThrowValidation("ImuOptions", "vibration_reference_speed_rad_s", vibration_reference_speed_rad_s, "a speed > 0");
+  }
+  RequireNonNegative("ImuOptions", "vibration_fault_factor", vibration_fault_factor);
 }
 
 void EscOptions::Validate(double physics_rate_hz) const {
@@ -85,7 +93,34 @@ ImuSample ImuModel::Sample(const TruthSample& truth) {
   out.specific_force_B =
       f_B + accel_bias_ + NormalVector(rng_, options_.accel_noise_density / std::sqrt(dt_));
   out.w_B = w + gyro_bias_ + NormalVector(rng_, options_.gyro_noise_density / std::sqrt(dt_));
+  if (options_.vibration_m_s2 > 0.0) out.specific_force_B += Vibration(truth);
+  // A MEMS sensor saturates: each axis reads at most its range.
+  const double a = options_.accel_range_m_s2, g = options_.gyro_range_rad_s;
+  out.specific_force_B = out.specific_force_B.cwiseMax(Vector3::Constant(-a)).cwiseMin(Vector3::Constant(a));
+  out.w_B = out.w_B.cwiseMax(Vector3::Constant(-g)).cwiseMin(Vector3::Constant(g));
   return out;
+}
+
+Vector3 ImuModel::Vibration(const TruthSample& truth) {
+  const RotorVector& speed = truth.motor_speed_rad_s;
+  rotor_phase_.resize(static_cast<std::size_t>(speed.size()), 0.0);
+  Vector3 v = Vector3::Zero();
+  for (int i = 0; i < speed.size(); ++i) {
+    double& phase = rotor_phase_[static_cast<std::size_t>(i)];
+    // The phase advances by ω dt between samples: at the IMU's rate the rotor's frequency aliases,
+    // as it does on a sensor without an anti-aliasing filter.
+    phase = std::fmod(phase + speed[i] * dt_, 2.0 * std::numbers::pi);
+    const double ratio = speed[i] / options_.vibration_reference_speed_rad_s;
+    double amplitude = options_.vibration_m_s2 * ratio * ratio;
+    if (truth.faults != nullptr && i < static_cast<int>(truth.faults->size())) {
+      const vehicle::FaultKind kind = (*truth.faults)[static_cast<std::size_t>(i)].kind;
+      if (kind == vehicle::FaultKind::kPropellerLoss || kind == vehicle::FaultKind::kLossOfEffectiveness) {
+        amplitude *= options_.vibration_fault_factor;
+      }
+    }
+    v += amplitude * Vector3(std::cos(phase), std::sin(phase), 0.0);
+  }
+  return v;
 }
 
 EscModel::EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed)

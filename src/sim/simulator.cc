@@ -114,6 +114,7 @@ void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
   truth.x = &x_;
   if (!landed_) truth.acc = model_.ComputeAccelerations(x_, faults_, disturbance);
   truth.motor_speed_rad_s = speed_;
+  truth.faults = &faults_;
   if (imu_due) outputs_.imu = imu_.Sample(truth);
   if (esc_due) esc_.Measure(truth);
   if (odom_due && !options_.odometry.InOutage(ToSeconds(t_ns_))) outputs_.odometry = odometry_.Sample(truth);

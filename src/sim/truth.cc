@@ -24,6 +24,7 @@ TruthRanges RangesOf(TruthPreset preset) {
   r.external_torque_n_m = 0.01;
   r.motor_stop_time_constant_min_s = 0.005;
   r.motor_stop_time_constant_max_s = 0.050;
+  r.imu_vibration_m_s2 = 0.8;
   return r;
 }
 
@@ -41,6 +42,7 @@ TruthRanges TruthOptions::Ranges() const {
   take(rotor_drag_fraction, &r.rotor_drag_fraction);
   take(imu_offset_m, &r.imu_offset_m);
   take(external_torque_n_m, &r.external_torque_n_m);
+  take(imu_vibration_m_s2, &r.imu_vibration_m_s2);
   if (motor_stop_time_constant_min_s) {
     r.motor_stop_time_constant_min_s = motor_stop_time_constant_min_s;
     r.motor_stop_time_constant_max_s = motor_stop_time_constant_max_s;
@@ -99,6 +101,8 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   d.imu_offset_m = Offset(r.imu_offset_m, &rng);
   const Vector3 torque = Offset(r.external_torque_n_m, &rng);
   d.external_torque_n_m = Vector3(torque.x(), torque.y(), 0.0);
+  // Drawn last, so that the draws above keep their values when this range changes.
+  if (r.imu_vibration_m_s2 > 0.0) d.imu_vibration_m_s2 = rng.Uniform(0.5, 1.0) * r.imu_vibration_m_s2;
   return d;
 }
 

@@ -48,6 +48,65 @@ TEST(Imu, TangentialAccelerationFromAngularAcceleration) {
   EXPECT_NEAR(imu.Sample(truth).specific_force_B.y(), 0.5, 1e-12);
 }
 
+/// A noiseless IMU at the centre of gravity, vibrating `amplitude` per rotor at `reference` rad/s.
+ImuOptions VibratingImu(double amplitude, double reference) {
+  ImuOptions o;
+  o.position_m.setZero();
+  o.accel_noise_density = o.gyro_noise_density = o.accel_bias_random_walk = 0.0;
+  o.gyro_bias_random_walk = o.accel_bias_initial = o.gyro_bias_initial = 0.0;
+  o.vibration_m_s2 = amplitude;
+  o.vibration_reference_speed_rad_s = reference;
+  return o;
+}
+
+/// RMS of the accelerometer's x and y over n samples, the specific force of gravity removed.
+double VibrationRms(ImuModel* imu, const RotorVector& speeds, const vehicle::RotorFaults* faults, int n) {
+  const vehicle::StateVector x = SpinningState(0.0);
+  TruthSample truth;
+  truth.x = &x;
+  truth.motor_speed_rad_s = speeds;
+  truth.faults = faults;
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const Vector3 f = imu->Sample(truth).specific_force_B;
+    sum += f.x() * f.x() + f.y() * f.y();
+  }
+  return std::sqrt(sum / n);
+}
+
+TEST(Imu, ARotorsImbalanceShakesItWithAmplitudeGrowingAsSpeedSquared) {
+  // One rotor at the reference speed: a vector of length A rotating in the rotor plane, so the
+  // in-plane RMS is A whatever the aliasing. At twice the speed the centrifugal force is four
+  // times larger; a propeller lost multiplies it by the fault factor (10).
+  ImuModel at_reference(VibratingImu(0.8, 900.0), 1);
+  EXPECT_NEAR(VibrationRms(&at_reference, RotorVector::Constant(1, 900.0), nullptr, 3000), 0.8, 1e-9);
+  ImuModel twice(VibratingImu(0.8, 900.0), 1);
+  EXPECT_NEAR(VibrationRms(&twice, RotorVector::Constant(1, 1800.0), nullptr, 3000), 3.2, 1e-9);
+  vehicle::RotorFaults lost(1);
+  lost[0].kind = vehicle::FaultKind::kPropellerLoss;
+  ImuModel damaged(VibratingImu(0.8, 900.0), 1);
+  EXPECT_NEAR(VibrationRms(&damaged, RotorVector::Constant(1, 900.0), &lost, 3000), 8.0, 1e-9);
+  // A stopped rotor does not shake it; two rotors at incommensurate speeds add in power.
+  ImuModel two(VibratingImu(0.8, 900.0), 1);
+  RotorVector speeds(3);
+  speeds << 900.0, 0.0, 900.0 * std::sqrt(2.0);
+  EXPECT_NEAR(VibrationRms(&two, speeds, nullptr, 200000), std::sqrt(0.8 * 0.8 + 1.6 * 1.6), 0.01);
+}
+
+TEST(Imu, EachAxisSaturatesAtItsRange) {
+  ImuOptions o = VibratingImu(0.0, 1.0);
+  o.accel_range_m_s2 = 5.0;
+  o.gyro_range_rad_s = 3.0;
+  ImuModel imu(o, 1);
+  const vehicle::StateVector x = SpinningState(-11.0);  // spinning past the gyro's range
+  TruthSample truth;
+  truth.x = &x;
+  const ImuSample s = imu.Sample(truth);
+  EXPECT_EQ(s.specific_force_B.z(), 5.0) << "gravity (9.81) clips at the range";
+  EXPECT_EQ(s.w_B.z(), -3.0);
+  EXPECT_EQ(s.specific_force_B.x(), 0.0);
+}
+
 TEST(Imu, WhiteNoiseHasTheConfiguredDensity) {
   ImuOptions o;
   o.position_m.setZero();

@@ -21,6 +21,15 @@ struct ImuOptions {
   double gyro_bias_random_walk = 2.0e-5;     ///< bias diffusion [rad/s^2/sqrt(Hz)], >= 0
   double accel_bias_initial = 0.02;          ///< std of the bias at start [m/s^2], >= 0
   double gyro_bias_initial = 2.0e-3;         ///< std of the bias at start [rad/s], >= 0
+  double accel_range_m_s2 = 16.0 * kGravity;  ///< each accelerometer axis saturates at ± this, > 0
+  double gyro_range_rad_s = 34.906585039886590;  ///< each gyro axis saturates at ± this (2000 °/s), > 0
+  /// The airframe's vibration at the accelerometer (truth side: set from the scenario's truth, not
+  /// a sensor key). Each rotor's imbalance shakes the body in the rotor plane at the rotor's speed
+  /// ω, with amplitude vibration_m_s2 (ω / vibration_reference_speed_rad_s)² (a centrifugal
+  /// force), vibration_fault_factor times larger for a rotor whose propeller is lost or damaged.
+  double vibration_m_s2 = 0.0;
+  double vibration_reference_speed_rad_s = 1.0;
+  double vibration_fault_factor = 10.0;
   void Validate(double physics_rate_hz) const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
@@ -34,6 +43,10 @@ struct ImuOptions {
     a->Visit("accel_bias_initial", &accel_bias_initial,
              {.meaning = "std of the accelerometer bias at the start [m/s²]"});
     a->Visit("gyro_bias_initial", &gyro_bias_initial, {.meaning = "std of the gyro bias at the start [rad/s]"});
+    a->Visit("accel_range_m_s2", &accel_range_m_s2,
+             {.meaning = "each accelerometer axis saturates at ± this [m/s²] (16 g)", .positive = true});
+    a->Visit("gyro_range_rad_s", &gyro_range_rad_s,
+             {.meaning = "each gyro axis saturates at ± this [rad/s] (2000 °/s)", .positive = true});
   }
 };
 
@@ -95,6 +108,7 @@ struct TruthSample {
   const vehicle::StateVector* x = nullptr;
   vehicle::Accelerations acc;
   RotorVector motor_speed_rad_s;
+  const vehicle::RotorFaults* faults = nullptr;  ///< none: every rotor healthy
 };
 
 class ImuModel {
@@ -105,10 +119,14 @@ class ImuModel {
   const Vector3& gyro_bias() const { return gyro_bias_; }
 
  private:
+  /// The vibration at the accelerometer now, each rotor's phase advanced by one sample.
+  Vector3 Vibration(const TruthSample& truth);
+
   ImuOptions options_;
   Rng rng_;
   double dt_;
   Vector3 accel_bias_, gyro_bias_;
+  std::vector<double> rotor_phase_;  ///< each rotor's angle [rad], for the vibration
 };
 
 /// ESC telemetry with noise, quantisation and a transport delay (a ring buffer of samples).

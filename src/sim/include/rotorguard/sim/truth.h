@@ -35,6 +35,9 @@ struct TruthRanges {
   double rotor_drag_fraction = 0.0;           ///< each axis of D
   double imu_offset_m = 0.0;                  ///< each axis of the IMU's mounting point, U(-a, a)
   double external_torque_n_m = 0.0;           ///< roll and pitch of a constant torque, U(-a, a)
+  /// Each healthy rotor's vibration at the accelerometer at hover speed, drawn in [a/2, a] [m/s²]
+  /// (ImuOptions::vibration_m_s2; ten times more on a rotor whose propeller is lost or damaged).
+  double imu_vibration_m_s2 = 0.0;
   /// Motor-stop time constant drawn log-uniformly in [min, max] [s]; unset: the file's value.
   std::optional<double> motor_stop_time_constant_min_s, motor_stop_time_constant_max_s;
 };
@@ -47,7 +50,7 @@ struct TruthOptions {
   TruthPreset preset = TruthPreset::kIdeal;
   std::optional<double> mass_fraction, inertia_fraction, cog_offset_m, thrust_coefficient_fraction,
       yaw_coefficient_fraction, motor_time_constant_fraction, rotor_drag_fraction, imu_offset_m, external_torque_n_m,
-      motor_stop_time_constant_min_s, motor_stop_time_constant_max_s;
+      motor_stop_time_constant_min_s, motor_stop_time_constant_max_s, imu_vibration_m_s2;
 
   /// The preset's ranges with the overrides applied.
   TruthRanges Ranges() const;
@@ -93,6 +96,12 @@ struct TruthOptions {
               .default_text = kPresets});
     a->Visit("motor_stop_time_constant_max_s", &motor_stop_time_constant_max_s,
              {.meaning = "(set both or neither)", .positive = true, .default_text = kPresets});
+    a->Visit("imu_vibration_m_s2", &imu_vibration_m_s2,
+             {.meaning = "each healthy rotor's vibration at the accelerometer at hover speed, drawn in [a/2, a] "
+                         "[m/s²]; ten times more after a propeller loss or damage",
+              .min = 0,
+              .max = 20,
+              .default_text = kPresets});
   }
 };
 
@@ -108,6 +117,7 @@ struct TruthDraw {
   Vector3 rotor_drag_ratio = Vector3::Ones();
   Vector3 imu_offset_m = Vector3::Zero();         ///< added to the IMU's mounting point
   Vector3 external_torque_n_m = Vector3::Zero();  ///< body frame
+  double imu_vibration_m_s2 = 0.0;                ///< ImuOptions::vibration_m_s2
 
   /// summary.json's "truth" object.
   template <typename Archive>
@@ -123,6 +133,8 @@ struct TruthDraw {
     a->Visit("rotor_drag_ratio", &rotor_drag_ratio, {.meaning = "true D / the file's, per axis"});
     a->Visit("imu_offset_m", &imu_offset_m, {.meaning = "the IMU's true mounting point minus sensors.imu's [m]"});
     a->Visit("external_torque_n_m", &external_torque_n_m, {.meaning = "constant torque, body frame [N·m]"});
+    a->Visit("imu_vibration_m_s2", &imu_vibration_m_s2,
+             {.meaning = "a healthy rotor's vibration at hover speed [m/s²]"});
   }
 };
 
