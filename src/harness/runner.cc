@@ -49,6 +49,8 @@ sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel&
   options.imu.position_m = sc.sim.imu.position_m - draw.cog_offset_m + draw.imu_offset_m;
   options.external_torque_n_m = draw.external_torque_n_m;
   options.imu.vibration_m_s2 = draw.imu_vibration_m_s2;
+  options.esc.gain = draw.esc_gain;
+  options.esc.dropout_probability = draw.esc_dropout_probability;
   // The vibration's amplitude is given at the file's hover speed: T = m g / n = k_n ω².
   const vehicle::VehicleParams& file = sc.vehicle;
   options.imu.vibration_reference_speed_rad_s =

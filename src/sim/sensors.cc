@@ -1,5 +1,7 @@
 #include "rotorguard/sim/sensors.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <numbers>
 
@@ -49,6 +51,14 @@ void EscOptions::Validate(double physics_rate_hz) const {
   RequireNonNegative("EscOptions", "quantization_rpm", quantization_rpm);
   if (!std::isfinite(delay_s) || delay_s < 0.0 || delay_s >= 0.5) {
     ThrowValidation("EscOptions", "delay_s", delay_s, "a value in [0, 0.5) s");
+  }
+  for (std::size_t k = 0; k < gain.size(); ++k) {
+    if (!(gain[k] > 0.0) || !std::isfinite(gain[k])) {
+      ThrowValidation("EscOptions", fmt::format("gain.{}", k), gain[k], "a positive finite ratio");
+    }
+  }
+  if (!(dropout_probability >= 0.0 && dropout_probability < 1.0)) {
+    ThrowValidation("EscOptions", "dropout_probability", dropout_probability, "a probability in [0, 1)");
   }
 }
 
@@ -125,6 +135,10 @@ Vector3 ImuModel::Vibration(const TruthSample& truth) {
 
 EscModel::EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed)
     : options_(options), rng_(seed), num_rotors_(num_rotors), delay_ns_(FromSeconds(options.delay_s)) {
+  if (!options_.gain.empty() && static_cast<int>(options_.gain.size()) != num_rotors) {
+    ThrowInvalidArgument("EscModel", "gain", fmt::format("{} entries", options_.gain.size()),
+                         fmt::format("one per motor ({})", num_rotors));
+  }
   // Enough slots for every sample in flight during the delay, plus margin.
   const auto slots = static_cast<std::size_t>(std::ceil(options.delay_s * options.rate_hz)) + 2;
   ring_.resize(slots);
@@ -132,6 +146,8 @@ EscModel::EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed
 }
 
 void EscModel::Measure(const TruthSample& truth) {
+  // A lost frame never arrives (drawn only when frames can be lost: no other noise moves).
+  if (options_.dropout_probability > 0.0 && rng_.Uniform() < options_.dropout_probability) return;
   if (count_ == ring_.size()) {  // full: drop the oldest (cannot happen with the sizing above)
     head_ = (head_ + 1) % ring_.size();
     --count_;
@@ -139,8 +155,8 @@ void EscModel::Measure(const TruthSample& truth) {
   EscTelemetry& m = ring_[(head_ + count_) % ring_.size()];
   m.t_ns = truth.t_ns;
   for (int i = 0; i < num_rotors_; ++i) {
-    double rpm = vehicle::RadPerSecondToRpm(truth.motor_speed_rad_s[i]) +
-                 options_.noise_rpm * rng_.Normal();
+    const double gain = options_.gain.empty() ? 1.0 : options_.gain[static_cast<std::size_t>(i)];
+    double rpm = vehicle::RadPerSecondToRpm(gain * truth.motor_speed_rad_s[i]) + options_.noise_rpm * rng_.Normal();
     if (options_.quantization_rpm > 0.0) {
       rpm = options_.quantization_rpm * std::round(rpm / options_.quantization_rpm);
     }

@@ -25,6 +25,8 @@ TruthRanges RangesOf(TruthPreset preset) {
   r.motor_stop_time_constant_min_s = 0.005;
   r.motor_stop_time_constant_max_s = 0.050;
   r.imu_vibration_m_s2 = 0.8;
+  r.esc_gain_fraction = 0.01;
+  r.esc_dropout_probability = 0.01;
   return r;
 }
 
@@ -43,6 +45,8 @@ TruthRanges TruthOptions::Ranges() const {
   take(imu_offset_m, &r.imu_offset_m);
   take(external_torque_n_m, &r.external_torque_n_m);
   take(imu_vibration_m_s2, &r.imu_vibration_m_s2);
+  take(esc_gain_fraction, &r.esc_gain_fraction);
+  take(esc_dropout_probability, &r.esc_dropout_probability);
   if (motor_stop_time_constant_min_s) {
     r.motor_stop_time_constant_min_s = motor_stop_time_constant_min_s;
     r.motor_stop_time_constant_max_s = motor_stop_time_constant_max_s;
@@ -103,6 +107,8 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   d.external_torque_n_m = Vector3(torque.x(), torque.y(), 0.0);
   // Drawn last, so that the draws above keep their values when this range changes.
   if (r.imu_vibration_m_s2 > 0.0) d.imu_vibration_m_s2 = rng.Uniform(0.5, 1.0) * r.imu_vibration_m_s2;
+  for (int i = 0; i < vehicle.num_rotors(); ++i) d.esc_gain.push_back(Ratio(r.esc_gain_fraction, &rng));
+  d.esc_dropout_probability = r.esc_dropout_probability;
   return d;
 }
 

@@ -55,6 +55,11 @@ struct EscOptions {
   double noise_rpm = 20.0;      ///< white measurement noise [rpm], >= 0
   double quantization_rpm = 10.0;  ///< reported resolution [rpm], >= 0 (0: none)
   double delay_s = 0.001;       ///< transport delay, >= 0 and < 0.5 s
+  /// Truth side (set from the scenario's truth, not sensor keys): each motor's reported speed
+  /// relative to its true speed (empty: 1 for every motor), and the probability that a telemetry
+  /// frame is lost (a CRC error on the wire), in [0, 1).
+  std::vector<double> gain;
+  double dropout_probability = 0.0;
   void Validate(double physics_rate_hz) const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>

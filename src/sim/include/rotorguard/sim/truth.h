@@ -38,6 +38,8 @@ struct TruthRanges {
   /// Each healthy rotor's vibration at the accelerometer at hover speed, drawn in [a/2, a] [m/s²]
   /// (ImuOptions::vibration_m_s2; ten times more on a rotor whose propeller is lost or damaged).
   double imu_vibration_m_s2 = 0.0;
+  double esc_gain_fraction = 0.0;        ///< each motor's reported speed, ω (1 ± a)
+  double esc_dropout_probability = 0.0;  ///< each telemetry frame lost with this probability
   /// Motor-stop time constant drawn log-uniformly in [min, max] [s]; unset: the file's value.
   std::optional<double> motor_stop_time_constant_min_s, motor_stop_time_constant_max_s;
 };
@@ -50,7 +52,8 @@ struct TruthOptions {
   TruthPreset preset = TruthPreset::kIdeal;
   std::optional<double> mass_fraction, inertia_fraction, cog_offset_m, thrust_coefficient_fraction,
       yaw_coefficient_fraction, motor_time_constant_fraction, rotor_drag_fraction, imu_offset_m, external_torque_n_m,
-      motor_stop_time_constant_min_s, motor_stop_time_constant_max_s, imu_vibration_m_s2;
+      motor_stop_time_constant_min_s, motor_stop_time_constant_max_s, imu_vibration_m_s2, esc_gain_fraction,
+      esc_dropout_probability;
 
   /// The preset's ranges with the overrides applied.
   TruthRanges Ranges() const;
@@ -102,6 +105,13 @@ struct TruthOptions {
               .min = 0,
               .max = 20,
               .default_text = kPresets});
+    a->Visit("esc_gain_fraction", &esc_gain_fraction,
+             {.meaning = "each motor's telemetry reports ω (1 ± a)", .min = 0, .max = 0.2, .default_text = kPresets});
+    a->Visit("esc_dropout_probability", &esc_dropout_probability,
+             {.meaning = "each ESC telemetry frame is lost with this probability",
+              .min = 0,
+              .max = 0.5,
+              .default_text = kPresets});
   }
 };
 
@@ -118,6 +128,8 @@ struct TruthDraw {
   Vector3 imu_offset_m = Vector3::Zero();         ///< added to the IMU's mounting point
   Vector3 external_torque_n_m = Vector3::Zero();  ///< body frame
   double imu_vibration_m_s2 = 0.0;                ///< ImuOptions::vibration_m_s2
+  std::vector<double> esc_gain;                   ///< per motor: reported / true speed (EscOptions::gain)
+  double esc_dropout_probability = 0.0;           ///< EscOptions::dropout_probability
 
   /// summary.json's "truth" object.
   template <typename Archive>
@@ -135,6 +147,8 @@ struct TruthDraw {
     a->Visit("external_torque_n_m", &external_torque_n_m, {.meaning = "constant torque, body frame [N·m]"});
     a->Visit("imu_vibration_m_s2", &imu_vibration_m_s2,
              {.meaning = "a healthy rotor's vibration at hover speed [m/s²]"});
+    a->Visit("esc_gain", &esc_gain, {.meaning = "per motor: reported / true speed"});
+    a->Visit("esc_dropout_probability", &esc_dropout_probability, {.meaning = "a telemetry frame's loss probability"});
   }
 };
 
