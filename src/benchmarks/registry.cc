@@ -64,12 +64,15 @@ class SpecFiles {
 };
 
 /// The keys every benchmark's spec has, read before its own (unknown-key messages list the keys in
-/// the order they were read).
+/// the order they were read): seed, trials and the world they fly (`truth`, as --truth).
 template <typename Options>
 Options SeedAndTrials(const io::ConfigNode& root, int max_trials) {
   Options o;
   o.seed = root.Has("seed") ? root.Required("seed").AsUint64() : 1;
   o.trials = static_cast<int>(root.Required("trials").AsIntIn(1, max_trials));
+  if (root.Has("truth")) {
+    o.truth = *FromName<sim::TruthPreset>(root.Required("truth").AsEnum(NameList<sim::TruthPreset>()));
+  }
   return o;
 }
 

@@ -175,6 +175,19 @@ TEST_F(BenchCampaigns, NavResultCountsTheFailuresItDoesNotList) {
   EXPECT_NE(md.find("failure_unaware failed: 3 more, not listed"), std::string::npos) << md;
 }
 
+TEST_F(BenchCampaigns, ASpecsTruthIsTheSameCampaignAsTheFlag) {
+  // `truth: realistic` in a spec is `bench ftc --truth realistic`: the same options, the same hash.
+  const std::string spec = "name: t\nbench: ftc\ntrials: 1\nseed: 5\nmethods: [rotorguard, none]\nvehicle: " + kConfigs +
+                           "/vehicles/zhou2025_quad.yaml\n";
+  FtcBenchOptions o = SmallFtc();
+  o.truth = sim::TruthPreset::kRealistic;
+  const campaign::Campaign from_spec = campaign::LoadCampaign(Write("t.yaml", spec + "truth: realistic\n"), CampaignKinds());
+  EXPECT_EQ(from_spec.hash, FtcCampaign(o).hash);
+  EXPECT_EQ(from_spec.bench["options"]["truth"], "realistic");
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("u.yaml", spec + "truth: perfect\n"), CampaignKinds()),
+                       io::ConfigError, "truth: 'perfect' is not allowed; expected one of: ideal, realistic");
+}
+
 TEST_F(BenchCampaigns, BadBenchmarkSpecsNameTheKey) {
   const std::string vehicle = "vehicle: " + kConfigs + "/vehicles/zhou2025_quad.yaml\n";
   RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("a.yaml", "name: a\nbench: hover\ntrials: 1\n"), CampaignKinds()), io::ConfigError, "bench");
