@@ -116,7 +116,7 @@ void FlightRecorder::WriteFlight(const sim::Simulator& sim, const stack::FlightS
     sensors_->Commit();
   }
   // The vehicle the stack flew, so that the run's folder is enough to replay its sensor log.
-  io::WriteFileAtomically(InFolder(options_.out_dir, "vehicle.yaml"), VehicleToYaml(scenario_->vehicle));
+  io::WriteFileAtomically(InFolder(options_.out_dir, "vehicle.yaml"), VehicleToYaml(st.model().params()));
   // The vehicle the simulator flew (summary.json's "truth" has the per-rotor thrust ratios, the
   // IMU's offset and the external torque, which a vehicle file does not hold).
   io::WriteFileAtomically(InFolder(options_.out_dir, "truth_vehicle.yaml"), VehicleToYaml(sim.model().params()));

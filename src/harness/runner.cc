@@ -114,7 +114,8 @@ class ClosedLoop {
     s.crash_reason = sim_.crash_reason();
     s.stack = stack_.Summarize();
     s.mission_time_s = mission_time_s_;
-    s.sensors = {sc_.sim.imu.rate_hz, sc_.sim.imu.position_m};
+    // The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
+    s.sensors = {sc_.sim.imu.rate_hz, stack_.options().estimator.imu_position_m};
     if (sc_.stack.fdd == stack::FddKind::kComposite) s.composite_fdd = sc_.stack.composite_fdd;
     if (const fdd::FaultDetector* detector = stack_.fault_detector()) {
       s.fdd = ScoreFdd(detector->rotors(), sim_.fault_events());

@@ -288,6 +288,8 @@ class FlightStack {
   }
   const RotorCommand& command() const { return command_; }
   const vehicle::MultirotorModel& model() const { return model_; }
+  /// What the stack was configured with (the vehicle's sensors as it believes them).
+  const FlightStackOptions& options() const { return options_; }
   const control::Controller& controller() const { return *controller_; }
   /// The NMPC, when it is the controller (for its solve statistics); else null.
   const control::NmpcController* nmpc() const { return nmpc_; }
