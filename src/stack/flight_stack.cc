@@ -196,8 +196,10 @@ void FlightStack::OnLidar(const LidarFrame& frame) {
 }
 
 void FlightStack::OnRotorFailed(int rotor, double t) {
-  if (std::find(isolated_.begin(), isolated_.end(), rotor) != isolated_.end()) return;
-  isolated_.push_back(rotor);
+  if (std::any_of(reconfigurations_.begin(), reconfigurations_.end(),
+                  [rotor](const RotorReconfiguration& r) { return r.rotor == rotor; })) {
+    return;
+  }
   reconfigurations_.push_back({rotor, t});
   controller_->SetRotorFailed(rotor);
   if (navigator_ && options_.navigation.failure_aware) navigator_->OnFailure();
@@ -280,7 +282,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   in.t = ts;
   in.estimate = estimate_;
   in.odometry_age_s = estimator_.odometry_age_s(t);
-  in.isolated_rotors = static_cast<int>(isolated_.size());
+  in.isolated_rotors = isolated_rotors();
   in.navigating = navigator_ && next_waypoint_ > 0 && !navigator_->arrived();
   in.since_last_plan_s = ts - last_plan_ok_s_;
   in.thrust_ratio = command_.thrust_n.sum() / model_.params().weight_n();

@@ -315,7 +315,7 @@ class FlightStack {
   /// The supervisor: the flight mode and its logged transitions.
   const Supervisor& supervisor() const { return supervisor_; }
   /// Rotors the stack treats as failed (isolated by its FDD or handed over as known faults).
-  int isolated_rotors() const { return static_cast<int>(isolated_.size()); }
+  int isolated_rotors() const { return static_cast<int>(reconfigurations_.size()); }
   /// What the stack did so far: navigation, re-planning decisions, fault estimates, flight modes,
   /// the map.
   FlightStackSummary Summarize() const;
@@ -338,8 +338,7 @@ class FlightStack {
   FlightStackOptions options_;
   OdometryImuEstimator estimator_;
   Supervisor supervisor_;
-  std::vector<int> isolated_;            // rotors treated as failed, in the order they failed
-  std::vector<RotorReconfiguration> reconfigurations_;  // ... and the control cycles that took them
+  std::vector<RotorReconfiguration> reconfigurations_;  // rotors treated as failed, in order, and when
   std::optional<planning::TakeoffReference> landing_;  // the emergency landing's descent ...
   std::optional<TimeShiftedReference> descent_;         // ... from the time it started
   std::size_t plan_events_seen_ = 0;
