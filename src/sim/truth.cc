@@ -32,21 +32,9 @@ TruthRanges RangesOf(TruthPreset preset) {
 
 TruthRanges TruthOptions::Ranges() const {
   TruthRanges r = RangesOf(preset);
-  const auto take = [](const std::optional<double>& override, double* range) {
-    if (override) *range = *override;
-  };
-  take(mass_fraction, &r.mass_fraction);
-  take(inertia_fraction, &r.inertia_fraction);
-  take(cog_offset_m, &r.cog_offset_m);
-  take(thrust_coefficient_fraction, &r.thrust_coefficient_fraction);
-  take(yaw_coefficient_fraction, &r.yaw_coefficient_fraction);
-  take(motor_time_constant_fraction, &r.motor_time_constant_fraction);
-  take(rotor_drag_fraction, &r.rotor_drag_fraction);
-  take(imu_offset_m, &r.imu_offset_m);
-  take(external_torque_n_m, &r.external_torque_n_m);
-  take(imu_vibration_m_s2, &r.imu_vibration_m_s2);
-  take(esc_gain_fraction, &r.esc_gain_fraction);
-  take(esc_dropout_probability, &r.esc_dropout_probability);
+  for (const TruthOverrideKey& k : kTruthOverrideKeys) {
+    if (k.range != nullptr && this->*k.override) r.*k.range = *(this->*k.override);
+  }
   if (motor_stop_time_constant_min_s) {
     r.motor_stop_time_constant_min_s = motor_stop_time_constant_min_s;
     r.motor_stop_time_constant_max_s = motor_stop_time_constant_max_s;

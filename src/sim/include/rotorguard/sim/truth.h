@@ -61,59 +61,94 @@ struct TruthOptions {
   void Validate() const;
 
   template <typename Archive>
-  void Serialize(Archive* a) {
-    a->Visit("preset", &preset, {.meaning = "`realistic`: the spread of docs/truth.md; `ideal`: the file is exact"});
-    constexpr const char* kPresets = "the preset's";
-    a->Visit("mass_fraction", &mass_fraction,
-             {.meaning = "mass drawn in m (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
-    a->Visit("inertia_fraction", &inertia_fraction,
-             {.meaning = "each principal moment drawn in I (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
-    a->Visit("cog_offset_m", &cog_offset_m,
-             {.meaning = "each axis of the centre of gravity's offset drawn in ± a [m]",
-              .min = 0,
-              .max = 0.05,
-              .default_text = kPresets});
-    a->Visit("thrust_coefficient_fraction", &thrust_coefficient_fraction,
-             {.meaning = "each rotor's k_n drawn in k_n (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
-    a->Visit("yaw_coefficient_fraction", &yaw_coefficient_fraction,
-             {.meaning = "each rotor's κ_t drawn in κ_t (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
-    a->Visit("motor_time_constant_fraction", &motor_time_constant_fraction,
-             {.meaning = "the motors' σ drawn in σ (1 ± a)", .min = 0, .max = 0.5, .default_text = kPresets});
-    a->Visit(
-        "rotor_drag_fraction", &rotor_drag_fraction,
-        {.meaning = "each axis of the rotor drag D drawn in D (1 ± a)", .min = 0, .max = 1, .default_text = kPresets});
-    a->Visit("imu_offset_m", &imu_offset_m,
-             {.meaning = "each axis of the IMU's mounting point drawn in ± a about the sensors.imu position [m]",
-              .min = 0,
-              .max = 0.05,
-              .default_text = kPresets});
-    a->Visit(
-        "external_torque_n_m", &external_torque_n_m,
-        {.meaning = "a constant roll and pitch torque the stack is not told of (payload, cable), each in ± a [N·m]",
-         .min = 0,
-         .max = 1,
-         .default_text = kPresets});
-    a->Visit("motor_stop_time_constant_min_s", &motor_stop_time_constant_min_s,
-             {.meaning = "a stopped motor's time constant drawn log-uniformly in [min, max] [s]",
-              .positive = true,
-              .default_text = kPresets});
-    a->Visit("motor_stop_time_constant_max_s", &motor_stop_time_constant_max_s,
-             {.meaning = "(set both or neither)", .positive = true, .default_text = kPresets});
-    a->Visit("imu_vibration_m_s2", &imu_vibration_m_s2,
-             {.meaning = "each healthy rotor's vibration at the accelerometer at hover speed, drawn in [a/2, a] "
-                         "[m/s²]; ten times more after a propeller loss or damage",
-              .min = 0,
-              .max = 20,
-              .default_text = kPresets});
-    a->Visit("esc_gain_fraction", &esc_gain_fraction,
-             {.meaning = "each motor's telemetry reports ω (1 ± a)", .min = 0, .max = 0.2, .default_text = kPresets});
-    a->Visit("esc_dropout_probability", &esc_dropout_probability,
-             {.meaning = "each ESC telemetry frame is lost with this probability",
-              .min = 0,
-              .max = 0.5,
-              .default_text = kPresets});
-  }
+  void Serialize(Archive* a);
 };
+
+/// One override of the truth block: its key (the field's name), what it accepts and means, and
+/// the range it replaces; none for the stop time constant's two ends, which replace their
+/// range together (TruthOptions::Ranges). The keys, the loader and Ranges() all follow this list.
+struct TruthOverrideKey {
+  const char* key;
+  std::optional<double> TruthOptions::*override;
+  double TruthRanges::*range;
+  KeyInfo info;
+};
+
+inline constexpr TruthOverrideKey kTruthOverrideKeys[] = {
+    {"mass_fraction",
+     &TruthOptions::mass_fraction,
+     &TruthRanges::mass_fraction,
+     {.meaning = "mass drawn in m (1 ± a)", .min = 0, .max = 0.5}},
+    {"inertia_fraction",
+     &TruthOptions::inertia_fraction,
+     &TruthRanges::inertia_fraction,
+     {.meaning = "each principal moment drawn in I (1 ± a)", .min = 0, .max = 0.5}},
+    {"cog_offset_m",
+     &TruthOptions::cog_offset_m,
+     &TruthRanges::cog_offset_m,
+     {.meaning = "each axis of the centre of gravity's offset drawn in ± a [m]", .min = 0, .max = 0.05}},
+    {"thrust_coefficient_fraction",
+     &TruthOptions::thrust_coefficient_fraction,
+     &TruthRanges::thrust_coefficient_fraction,
+     {.meaning = "each rotor's k_n drawn in k_n (1 ± a)", .min = 0, .max = 0.5}},
+    {"yaw_coefficient_fraction",
+     &TruthOptions::yaw_coefficient_fraction,
+     &TruthRanges::yaw_coefficient_fraction,
+     {.meaning = "each rotor's κ_t drawn in κ_t (1 ± a)", .min = 0, .max = 0.5}},
+    {"motor_time_constant_fraction",
+     &TruthOptions::motor_time_constant_fraction,
+     &TruthRanges::motor_time_constant_fraction,
+     {.meaning = "the motors' σ drawn in σ (1 ± a)", .min = 0, .max = 0.5}},
+    {"rotor_drag_fraction",
+     &TruthOptions::rotor_drag_fraction,
+     &TruthRanges::rotor_drag_fraction,
+     {.meaning = "each axis of the rotor drag D drawn in D (1 ± a)", .min = 0, .max = 1}},
+    {"imu_offset_m",
+     &TruthOptions::imu_offset_m,
+     &TruthRanges::imu_offset_m,
+     {.meaning = "each axis of the IMU's mounting point drawn in ± a about the sensors.imu position [m]",
+      .min = 0,
+      .max = 0.05}},
+    {"external_torque_n_m",
+     &TruthOptions::external_torque_n_m,
+     &TruthRanges::external_torque_n_m,
+     {.meaning = "a constant roll and pitch torque the stack is not told of (payload, cable), each in ± a [N·m]",
+      .min = 0,
+      .max = 1}},
+    {"motor_stop_time_constant_min_s",
+     &TruthOptions::motor_stop_time_constant_min_s,
+     nullptr,
+     {.meaning = "a stopped motor's time constant drawn log-uniformly in [min, max] [s]", .positive = true}},
+    {"motor_stop_time_constant_max_s",
+     &TruthOptions::motor_stop_time_constant_max_s,
+     nullptr,
+     {.meaning = "(set both or neither)", .positive = true}},
+    {"imu_vibration_m_s2",
+     &TruthOptions::imu_vibration_m_s2,
+     &TruthRanges::imu_vibration_m_s2,
+     {.meaning = "each healthy rotor's vibration at the accelerometer at hover speed, drawn in [a/2, a] [m/s²]; ten "
+                 "times more after a propeller loss or damage",
+      .min = 0,
+      .max = 20}},
+    {"esc_gain_fraction",
+     &TruthOptions::esc_gain_fraction,
+     &TruthRanges::esc_gain_fraction,
+     {.meaning = "each motor's telemetry reports ω (1 ± a)", .min = 0, .max = 0.2}},
+    {"esc_dropout_probability",
+     &TruthOptions::esc_dropout_probability,
+     &TruthRanges::esc_dropout_probability,
+     {.meaning = "each ESC telemetry frame is lost with this probability", .min = 0, .max = 0.5}},
+};
+
+template <typename Archive>
+void TruthOptions::Serialize(Archive* a) {
+  a->Visit("preset", &preset, {.meaning = "`realistic`: the spread of docs/truth.md; `ideal`: the file is exact"});
+  for (const TruthOverrideKey& k : kTruthOverrideKeys) {
+    KeyInfo info = k.info;
+    info.default_text = "the preset's";
+    a->Visit(k.key, &(this->*k.override), info);
+  }
+}
 
 /// One flight's vehicle as drawn: ratios to the file's values, offsets, the external torque.
 struct TruthDraw {
