@@ -232,6 +232,7 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
   int errors = 0;
   for (int c = 0; c < kNumCells; ++c) {
     for (int m = 0; m < m_count; ++m) {
+      const bool method_has_fdd = FtcMethodNamed(methods[static_cast<std::size_t>(m)]).fdd != stack::FddKind::kNone;
       std::vector<FtcTrial> cell_trials;
       for (int t = 0; t < trials; ++t) {
         const nlohmann::json& r = records[static_cast<std::size_t>((c * m_count + m) * trials + t)];
@@ -242,7 +243,7 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
           ++errors;
           trial.errored = true;
           // It isolated nothing: for a method that detects faults, a missed detection.
-          trial.has_fdd = FtcMethodNamed(methods[static_cast<std::size_t>(m)]).fdd != stack::FddKind::kNone;
+          trial.has_fdd = method_has_fdd;
           cell_trials.push_back(trial);
           continue;
         }
