@@ -72,7 +72,7 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
   const sim::OdometryOptions odometry_options;
   sim::LidarSimulator lidar(lidar_options, scene.world, DeriveSeed(options.seed, 1));
   sim::ImuModel imu(imu_options, DeriveSeed(options.seed, 2));
-  sim::OdometryModel odometry(odometry_options, DeriveSeed(options.seed, 3));
+  sim::OdometryModel odometry(odometry_options, scene.world, DeriveSeed(options.seed, 3));
   sim::RateTimer imu_timer(imu_options.rate_hz), odometry_timer(odometry_options.rate_hz);
   stack::OdometryImuEstimator estimator(1.0);  // no ESC telemetry here: the coefficient is unused
   perception::LidarMapperOptions mapper_options;
@@ -111,7 +111,8 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
       estimator.OnImu(s);
       mapper.OnImu(s);
     }
-    if (odometry_timer.Due(t)) estimator.OnOdometry(odometry.Sample(truth));
+    if (odometry_timer.Due(t)) odometry.Measure(truth);
+    if (OdometrySample o; odometry.Deliver(t, &o)) estimator.OnOdometry(o);
     const Stopwatch lidar_clock;
     const std::optional<LidarFrame> frame = lidar.Step(t - step, pose_at(t - step), t, pose_at(t));
     lidar_s += lidar_clock.seconds();

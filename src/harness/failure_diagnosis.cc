@@ -16,6 +16,15 @@ std::optional<std::string> EmergencyLanding(const stack::FlightStackSummary& sta
   return std::nullopt;
 }
 
+/// By when the position error must be back under the bound for good: recovery_s after the first
+/// fault's correct isolation, or after its onset when nothing isolated it correctly; none without
+/// a fault.
+std::optional<double> RecoveryDeadline(const RunSummary& s, const SuccessRule& rule) {
+  if (s.faults.empty()) return std::nullopt;
+  const double latency = s.fdd && s.fdd->latency_s ? *s.fdd->latency_s : 0.0;
+  return s.faults.front().onset_s + latency + rule.recovery_s;
+}
+
 }  // namespace
 
 void DiagnoseFailure(const std::optional<FlightMetrics::Violation>& last_violation, const SuccessRule& rule,
@@ -27,9 +36,19 @@ void DiagnoseFailure(const std::optional<FlightMetrics::Violation>& last_violati
     s.failure_reason = "crash: " + s.crash_reason.value_or("");
   } else if (std::optional<std::string> landing = EmergencyLanding(s.stack)) {
     s.failure_reason = std::move(landing);
+  } else if (rule.max_altitude_loss_m && s.altitude_change_m && -*s.altitude_change_m > *rule.max_altitude_loss_m) {
+    s.failure_reason = fmt::format("lost {:.3f} m of altitude after the fault, more than {:g} m", -*s.altitude_change_m,
+                                   *rule.max_altitude_loss_m);
   } else if (last_violation && last_violation->t_s >= s.sim_time_s - rule.hold_s) {
     s.failure_reason = fmt::format("position error {:.2f} m > {:g} m at t = {:.2f} s, within the last {:g} s",
                                    last_violation->error_m, rule.error_m, last_violation->t_s, rule.hold_s);
+  } else if (const std::optional<double> recovered_by = RecoveryDeadline(s, rule);
+             last_violation && recovered_by && last_violation->t_s > *recovered_by) {
+    s.failure_reason = fmt::format(
+        "position error {:.2f} m > {:g} m at t = {:.2f} s, later than {:g} s after the {} "
+        "(t = {:.2f} s)",
+        last_violation->error_m, rule.error_m, last_violation->t_s, rule.recovery_s,
+        s.fdd && s.fdd->latency_s ? "isolation" : "fault's onset", *recovered_by - rule.recovery_s);
   } else if (const std::optional<stack::NavigationSummary>& n = s.stack.navigation;
              n && n->waypoints_reached < n->waypoints_total) {
     std::string reason = fmt::format("navigation reached {} of {} waypoints", n->waypoints_reached, n->waypoints_total);

@@ -34,7 +34,7 @@ FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int
     ThrowInvalidArgument("RunScenario", "tracking_start_s", sc.tracking_start_s,
                          fmt::format("before the tracking window's end, {:g} s", ToSeconds(o.tracking_end_ns)));
   }
-  o.success_error_m = sc.success_error_m;
+  o.success_error_m = sc.success.error_m;
   o.recovered_tilt_rad = sc.recovered_tilt_rad;
   return o;
 }
@@ -51,6 +51,11 @@ sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel&
   options.imu.vibration_m_s2 = draw.imu_vibration_m_s2;
   options.esc.gain = draw.esc_gain;
   options.esc.dropout_probability = draw.esc_dropout_probability;
+  options.odometry.latency_s = draw.odometry_latency_s;
+  options.odometry.drift_m_per_sqrt_s = draw.odometry_drift_m_per_sqrt_s;
+  options.odometry.yaw_drift_rad_per_sqrt_s = draw.odometry_yaw_drift_rad_per_sqrt_s;
+  options.odometry.few_features_gain = draw.odometry_few_features_gain;
+  options.odometry.outage_rate_hz = draw.odometry_outage_rate_hz;
   // The vibration's amplitude is given at the file's hover speed: T = m g / n = k_n ω².
   const vehicle::VehicleParams& file = sc.vehicle;
   options.imu.vibration_reference_speed_rad_s =
@@ -128,7 +133,7 @@ class ClosedLoop {
     if (!sim_.fault_events().empty()) end.first_onset_s = sim_.fault_events().front().onset_s;
     metrics_.Finish(
         end, [this](double t) { return stack_.reference().Evaluate(t).p_W; }, &s);
-    DiagnoseFailure(metrics_.last_violation(), {sc_.success_error_m, sc_.success_hold_s}, &s);
+    DiagnoseFailure(metrics_.last_violation(), sc_.success, &s);
     AddTimes(wall, &s);
     recorder_.WriteSummary(s);
     return s;
@@ -167,7 +172,7 @@ class ClosedLoop {
       if (stack_.waypoints_reached() >= total) mission_time_s_ = sim_.time_s();
     }
     return options_.stop_when_mission_complete && mission_time_s_ &&
-           sim_.time_s() >= *mission_time_s_ + 3.0 + sc_.success_hold_s;
+           sim_.time_s() >= *mission_time_s_ + 3.0 + sc_.success.hold_s;
   }
 
   /// Where the wall-clock time went (summary.json "cost_ms_per_sim_s" and the real-time factors).

@@ -72,6 +72,21 @@ void OdometryOptions::Validate(double physics_rate_hz) const {
     RequireNonNegative("OdometryOptions", fmt::format("outages.{}.start_s", i), outages[i].start_s);
     RequireNonNegative("OdometryOptions", fmt::format("outages.{}.duration_s", i), outages[i].duration_s);
   }
+  if (!std::isfinite(latency_s) || latency_s < 0.0 || latency_s >= 0.5) {
+    ThrowValidation("OdometryOptions", "latency_s", latency_s, "a value in [0, 0.5) s");
+  }
+  RequireNonNegative("OdometryOptions", "drift_m_per_sqrt_s", drift_m_per_sqrt_s);
+  RequireNonNegative("OdometryOptions", "yaw_drift_rad_per_sqrt_s", yaw_drift_rad_per_sqrt_s);
+  RequireNonNegative("OdometryOptions", "few_features_gain", few_features_gain);
+  if (features_reference < 1)
+    ThrowValidation("OdometryOptions", "features_reference", features_reference, "a count >= 1");
+  RequireNonNegative("OdometryOptions", "feature_range_m", feature_range_m);
+  RequireNonNegative("OdometryOptions", "outage_rate_hz", outage_rate_hz);
+  RequireNonNegative("OdometryOptions", "outage_min_s", outage_min_s);
+  if (!(outage_max_s >= outage_min_s) || !std::isfinite(outage_max_s)) {
+    ThrowValidation("OdometryOptions", "outage_max_s", outage_max_s,
+                    fmt::format("a time >= outage_min_s = {}", outage_min_s));
+  }
 }
 
 bool OdometryOptions::InOutage(double t) const {
@@ -177,12 +192,48 @@ bool EscModel::Deliver(TimeNs t, EscTelemetry* delivered) {
   return found;
 }
 
-OdometryModel::OdometryModel(const OdometryOptions& options, std::uint64_t seed)
-    : options_(options), rng_(seed) {}
+namespace {
+// The odometry model's streams beside its noise: drawing drift or outages never shifts the noise.
+constexpr std::uint64_t kDriftStream = 1, kOutageStream = 2;
+}  // namespace
 
-OdometrySample OdometryModel::Sample(const TruthSample& truth) {
+OdometryModel::OdometryModel(const OdometryOptions& options, const World& world, std::uint64_t seed)
+    : options_(options),
+      world_(world),
+      rng_(seed),
+      drift_rng_(DeriveSeed(seed, kDriftStream)),
+      outage_rng_(DeriveSeed(seed, kOutageStream)),
+      dt_(1.0 / options.rate_hz) {}
+
+double OdometryModel::FewFeaturesFactor(const Vector3& p_W, double t) const {
+  if (options_.few_features_gain <= 0.0) return 1.0;
+  // Obstacles within range are the structure a LiDAR front end registers its scans against; the
+  // ground alone leaves the horizontal position and the yaw unobserved.
+  int n = 0;
+  const double range = options_.feature_range_m;
+  for (const Box& b : world_.boxes) n += b.Distance(p_W) < range;
+  for (const Cylinder& c : world_.cylinders) n += c.Distance(p_W) < range;
+  for (const MovingBox& m : world_.moving_boxes) n += m.At(t).Distance(p_W) < range;
+  const double missing = 1.0 - std::min(1.0, static_cast<double>(n) / options_.features_reference);
+  return 1.0 + options_.few_features_gain * missing;
+}
+
+bool OdometryModel::InOutage(TimeNs t_ns) {
+  if (options_.InOutage(ToSeconds(t_ns))) return true;
+  if (options_.outage_rate_hz <= 0.0) return false;
+  if (t_ns < random_outage_end_ns_) return true;
+  // A Poisson process sampled once per odometry period: P(an outage starts) = 1 - exp(-rate dt).
+  if (outage_rng_.Uniform(0.0, 1.0) < 1.0 - std::exp(-options_.outage_rate_hz * dt_)) {
+    random_outage_end_ns_ = t_ns + FromSeconds(outage_rng_.Uniform(options_.outage_min_s, options_.outage_max_s));
+    return true;
+  }
+  return false;
+}
+
+void OdometryModel::Measure(const TruthSample& truth) {
   const vehicle::StateView s(*truth.x);
-  const double scale = 1.0 + options_.rate_noise_gain * s.w_B().norm();
+  const double t = ToSeconds(truth.t_ns);
+  const double scale = (1.0 + options_.rate_noise_gain * s.w_B().norm()) * FewFeaturesFactor(s.p_W(), t);
   OdometrySample out;
   out.t_ns = truth.t_ns;
   out.p_W = s.p_W() + NormalVector(rng_, options_.position_noise_m * scale);
@@ -192,7 +243,25 @@ OdometrySample OdometryModel::Sample(const TruthSample& truth) {
   const Quaternion dq = angle > 0.0 ? Quaternion(Eigen::AngleAxisd(angle, dtheta / angle))
                                     : Quaternion::Identity();
   out.q_WB = (s.q_WB() * dq).normalized();
-  return out;
+  if (options_.drift_m_per_sqrt_s > 0.0 || options_.yaw_drift_rad_per_sqrt_s > 0.0) {
+    // The front end's frame wanders from the world's (a random walk in position and yaw): what it
+    // reports is the truth seen in that frame, p' = R_z(ψ_d) p + d, v' = R_z(ψ_d) v.
+    const double root_dt = std::sqrt(dt_) * scale;
+    drift_p_ += NormalVector(drift_rng_, options_.drift_m_per_sqrt_s * root_dt);
+    drift_yaw_ += options_.yaw_drift_rad_per_sqrt_s * root_dt * drift_rng_.Normal();
+    const Quaternion r(Eigen::AngleAxisd(drift_yaw_, Vector3::UnitZ()));
+    out.p_W = r * out.p_W + drift_p_;
+    out.v_W = r * out.v_W;
+    out.q_WB = (r * out.q_WB).normalized();
+  }
+  pending_.push_back(out);
+}
+
+bool OdometryModel::Deliver(TimeNs t, OdometrySample* delivered) {
+  if (pending_.empty() || pending_.front().t_ns + FromSeconds(options_.latency_s) > t) return false;
+  *delivered = pending_.front();
+  pending_.pop_front();
+  return true;
 }
 
 }  // namespace rotorguard::sim

@@ -65,9 +65,8 @@ void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
   }
 }
 
-Simulator::Simulator(const vehicle::MultirotorModel& model, World world,
-                     std::vector<FaultSpec> faults, const SimulatorOptions& options,
-                     std::uint64_t seed, const vehicle::StateVector& initial)
+Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::vector<FaultSpec> faults,
+                     const SimulatorOptions& options, std::uint64_t seed, const vehicle::StateVector& initial)
     : model_(model),
       world_(std::move(world)),
       options_(Validated(options, model.params())),
@@ -75,7 +74,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world,
       integrator_(model),
       imu_(options_.imu, DeriveSeed(seed, kImuStream)),
       esc_(options_.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
-      odometry_(options_.odometry, DeriveSeed(seed, kOdometryStream)),
+      odometry_(options_.odometry, world_, DeriveSeed(seed, kOdometryStream)),
       wind_(options_.wind, DeriveSeed(seed, kWindStream)),
       imu_timer_(options_.imu.rate_hz),
       esc_timer_(options_.esc.rate_hz),
@@ -117,13 +116,15 @@ void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
   truth.faults = &faults_;
   if (imu_due) outputs_.imu = imu_.Sample(truth);
   if (esc_due) esc_.Measure(truth);
-  if (odom_due && !options_.odometry.InOutage(ToSeconds(t_ns_))) outputs_.odometry = odometry_.Sample(truth);
+  if (odom_due && !odometry_.InOutage(t_ns_)) odometry_.Measure(truth);
   DeliverTelemetry();
 }
 
 void Simulator::DeliverTelemetry() {
   EscTelemetry telemetry;
   if (esc_.Deliver(t_ns_, &telemetry)) outputs_.esc = telemetry;
+  OdometrySample odometry;
+  if (odometry_.Deliver(t_ns_, &odometry)) outputs_.odometry = odometry;
 }
 
 void Simulator::UpdateOutputs() {

@@ -27,6 +27,12 @@ TruthRanges RangesOf(TruthPreset preset) {
   r.imu_vibration_m_s2 = 0.8;
   r.esc_gain_fraction = 0.01;
   r.esc_dropout_probability = 0.01;
+  r.odometry_latency_min_s = 0.010;
+  r.odometry_latency_max_s = 0.030;
+  r.odometry_drift_m_per_sqrt_s = 0.01;
+  r.odometry_yaw_drift_rad_per_sqrt_s = 0.001;
+  r.odometry_few_features_gain = 1.0;
+  r.odometry_outage_rate_hz = 1.0 / 60.0;
   return r;
 }
 
@@ -39,21 +45,33 @@ TruthRanges TruthOptions::Ranges() const {
     r.motor_stop_time_constant_min_s = motor_stop_time_constant_min_s;
     r.motor_stop_time_constant_max_s = motor_stop_time_constant_max_s;
   }
+  if (odometry_latency_min_s) {
+    r.odometry_latency_min_s = *odometry_latency_min_s;
+    r.odometry_latency_max_s = *odometry_latency_max_s;
+  }
   return r;
 }
 
+namespace {
+
+/// An interval given by two keys must be given whole and in order.
+void ValidateInterval(const std::optional<double>& min, const char* min_key, const std::optional<double>& max,
+                      const char* max_key) {
+  if (min.has_value() != max.has_value()) {
+    const char* missing = min ? max_key : min_key;
+    throw ValidationError(missing,
+                          fmt::format("{} is missing; expected both {} and {} or neither", missing, min_key, max_key));
+  }
+  if (min && *max < *min)
+    ThrowValidation("TruthOptions", max_key, *max, fmt::format("at least {} = {}", min_key, *min));
+}
+
+}  // namespace
+
 void TruthOptions::Validate() const {
-  if (motor_stop_time_constant_min_s.has_value() != motor_stop_time_constant_max_s.has_value()) {
-    const char* missing =
-        motor_stop_time_constant_min_s ? "motor_stop_time_constant_max_s" : "motor_stop_time_constant_min_s";
-    throw ValidationError(missing, fmt::format("{} is missing; expected both ends of the stop time constant's "
-                                               "range or neither",
-                                               missing));
-  }
-  if (motor_stop_time_constant_min_s && *motor_stop_time_constant_max_s < *motor_stop_time_constant_min_s) {
-    ThrowValidation("TruthOptions", "motor_stop_time_constant_max_s", *motor_stop_time_constant_max_s,
-                    fmt::format("at least motor_stop_time_constant_min_s = {}", *motor_stop_time_constant_min_s));
-  }
+  ValidateInterval(motor_stop_time_constant_min_s, "motor_stop_time_constant_min_s", motor_stop_time_constant_max_s,
+                   "motor_stop_time_constant_max_s");
+  ValidateInterval(odometry_latency_min_s, "odometry_latency_min_s", odometry_latency_max_s, "odometry_latency_max_s");
 }
 
 namespace {
@@ -97,6 +115,15 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   if (r.imu_vibration_m_s2 > 0.0) d.imu_vibration_m_s2 = rng.Uniform(0.5, 1.0) * r.imu_vibration_m_s2;
   for (int i = 0; i < vehicle.num_rotors(); ++i) d.esc_gain.push_back(Ratio(r.esc_gain_fraction, &rng));
   d.esc_dropout_probability = r.esc_dropout_probability;
+  if (r.odometry_latency_max_s > 0.0)
+    d.odometry_latency_s = rng.Uniform(r.odometry_latency_min_s, r.odometry_latency_max_s);
+  if (r.odometry_drift_m_per_sqrt_s > 0.0)
+    d.odometry_drift_m_per_sqrt_s = rng.Uniform(0.5, 1.0) * r.odometry_drift_m_per_sqrt_s;
+  if (r.odometry_yaw_drift_rad_per_sqrt_s > 0.0) {
+    d.odometry_yaw_drift_rad_per_sqrt_s = rng.Uniform(0.5, 1.0) * r.odometry_yaw_drift_rad_per_sqrt_s;
+  }
+  d.odometry_few_features_gain = r.odometry_few_features_gain;
+  d.odometry_outage_rate_hz = r.odometry_outage_rate_hz;
   return d;
 }
 

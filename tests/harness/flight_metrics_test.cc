@@ -137,7 +137,7 @@ TEST(FlightMetrics, TiltThatNeverSettlesHasNoRecoveryTime) {
 
 // The success rule's verdicts, the most fundamental first, on hand-made summaries.
 TEST(DiagnoseFailure, TheMostFundamentalReasonWins) {
-  const SuccessRule rule{0.5, 2.0};
+  const SuccessRule rule;  // 0.5 m over the last 2 s
   RunSummary s;
   s.sim_time_s = 10.0;
   DiagnoseFailure(std::nullopt, rule, &s);
@@ -175,6 +175,47 @@ TEST(DiagnoseFailure, TheMostFundamentalReasonWins) {
   DiagnoseFailure(FlightMetrics::Violation{9.9, 3.0}, rule, &s);
   EXPECT_EQ(s.failure_reason.value_or(""), "crash: ground impact at 5.56 m/s");
   EXPECT_FALSE(s.success);
+}
+
+// After a fault the error must be back under the bound within recovery_s of the correct isolation
+// (of the onset when nothing isolated it) and stay there: hand-made timelines on a 20 s flight.
+TEST(DiagnoseFailure, AfterAFaultTheErrorMustRecoverWithinTheWindowOfTheIsolation) {
+  const SuccessRule rule;  // 0.5 m, the last 2 s, 5 s after the isolation
+  RunSummary s;
+  s.sim_time_s = 20.0;
+  s.faults = {{0, "motor_stop", 4.0}};
+  s.fdd = FddRecord{};
+  s.fdd->latency_s = 0.1;  // isolated at 4.1 s: back under 0.5 m by 9.1 s
+  DiagnoseFailure(FlightMetrics::Violation{9.0, 0.7}, rule, &s);
+  EXPECT_TRUE(s.success) << s.failure_reason.value_or("");
+  DiagnoseFailure(FlightMetrics::Violation{9.2, 0.7}, rule, &s);
+  EXPECT_EQ(s.failure_reason.value_or(""),
+            "position error 0.70 m > 0.5 m at t = 9.20 s, later than 5 s after the isolation (t = 4.10 s)");
+  // Nothing isolated correctly: the window starts at the onset.
+  s.fdd->latency_s.reset();
+  DiagnoseFailure(FlightMetrics::Violation{9.05, 0.7}, rule, &s);
+  EXPECT_EQ(s.failure_reason.value_or(""),
+            "position error 0.70 m > 0.5 m at t = 9.05 s, later than 5 s after the fault's onset (t = 4.00 s)");
+  // Without a fault the old rule alone: the last 2 s.
+  s.faults.clear();
+  DiagnoseFailure(FlightMetrics::Violation{15.0, 0.7}, rule, &s);
+  EXPECT_TRUE(s.success);
+}
+
+TEST(DiagnoseFailure, AFaultCostingMoreAltitudeThanTheBoundFails) {
+  SuccessRule rule;
+  RunSummary s;
+  s.sim_time_s = 5.0;
+  s.faults = {{1, "propeller_loss", 1.0}};
+  s.altitude_change_m = -0.08;
+  DiagnoseFailure(std::nullopt, rule, &s);
+  EXPECT_TRUE(s.success) << "no bound unless the scenario states one";
+  rule.max_altitude_loss_m = 0.05;
+  DiagnoseFailure(std::nullopt, rule, &s);
+  EXPECT_EQ(s.failure_reason.value_or(""), "lost 0.080 m of altitude after the fault, more than 0.05 m");
+  s.altitude_change_m = -0.04;
+  DiagnoseFailure(std::nullopt, rule, &s);
+  EXPECT_TRUE(s.success);
 }
 
 }  // namespace

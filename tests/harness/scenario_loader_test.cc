@@ -50,7 +50,7 @@ TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
   EXPECT_EQ(io::ToJson(s.stack), io::ToJson(defaults));
   EXPECT_EQ(io::ToJson(s.sim.imu), io::ToJson(sim::ImuOptions{}));
   EXPECT_FALSE(s.sim.lidar.enabled);
-  EXPECT_EQ(s.success_error_m, 0.5);
+  EXPECT_EQ(s.success.error_m, 0.5);
   EXPECT_FALSE(s.tracking_end_s.has_value());
 }
 
@@ -68,7 +68,7 @@ TEST_F(ScenarioLoader, TruthIsAPresetWordOrABlockThatOverridesItsRanges) {
             f + ":3:24: truth.mass_fraction: '0.9' is out of range; expected a number in [0, 0.5]");
   EXPECT_EQ(Error("truth: {motor_stop_time_constant_min_s: 0.01}\nmission: {type: hover}\n"),
             f + ":3:8: truth.motor_stop_time_constant_max_s: motor_stop_time_constant_max_s is missing; expected both "
-                "ends of the stop time constant's range or neither");
+                "motor_stop_time_constant_min_s and motor_stop_time_constant_max_s or neither");
 }
 
 TEST_F(ScenarioLoader, EverySectionsKeysLandInTheirFields) {
@@ -136,7 +136,7 @@ metrics: {tracking_start_s: 1, success_hold_s: 3}
   // The fault detectors know the IMU that the sensors section describes.
   EXPECT_EQ(s.stack.composite_fdd.imu_rate_hz, 400.0);
   EXPECT_EQ(s.tracking_start_s, 1.0);
-  EXPECT_EQ(s.success_hold_s, 3.0);
+  EXPECT_EQ(s.success.hold_s, 3.0);
 }
 
 TEST_F(ScenarioLoader, APlannerWordIsShortForItsMethod) {

@@ -16,6 +16,14 @@ vehicle::StateVector SpinningState(double r) {
   return x;
 }
 
+/// A sample captured now and delivered at once (the model's latency must be zero).
+OdometrySample MeasureNow(OdometryModel* odometry, const TruthSample& truth) {
+  odometry->Measure(truth);
+  OdometrySample out;
+  EXPECT_TRUE(odometry->Deliver(truth.t_ns, &out));
+  return out;
+}
+
 TEST(Imu, SeesCentrifugalAccelerationWhileSpinning) {
   ImuOptions o;
   o.position_m = Vector3(0.02, -0.01, 0.03);
@@ -176,18 +184,147 @@ TEST(Esc, EachMotorsGainScalesWhatItReportsAndLostFramesNeverArrive) {
 TEST(Odometry, NoiseGrowsWithBodyRate) {
   OdometryOptions o;
   o.rate_noise_gain = 0.2;
-  OdometryModel still(o, 5), spinning(o, 5);
+  const World empty;
+  OdometryModel still(o, empty, 5), spinning(o, empty, 5);
   const vehicle::StateVector x0 = SpinningState(0.0), x1 = SpinningState(10.0);
   TruthSample t0, t1;
   t0.x = &x0;
   t1.x = &x1;
   double e0 = 0.0, e1 = 0.0;
   for (int i = 0; i < 5000; ++i) {
-    e0 += still.Sample(t0).p_W.squaredNorm();
-    e1 += spinning.Sample(t1).p_W.squaredNorm();
+    e0 += MeasureNow(&still, t0).p_W.squaredNorm();
+    e1 += MeasureNow(&spinning, t1).p_W.squaredNorm();
   }
   // Same random stream, std scaled by (1 + 0.2 * 10) = 3.
   EXPECT_NEAR(std::sqrt(e1 / e0), 3.0, 1e-9);
+}
+
+TEST(Odometry, ArrivesLateStampedAtCapture) {
+  OdometryOptions o;
+  o.latency_s = 0.023;
+  const World empty;
+  OdometryModel odometry(o, empty, 5);
+  const vehicle::StateVector x = SpinningState(0.0);
+  TruthSample truth;
+  truth.x = &x;
+  OdometrySample out;
+  std::vector<TimeNs> captured, arrived;
+  // Captured every 10 ms, polled every 1 ms: each arrives at the first poll 23 ms after capture.
+  for (TimeNs t = 0; t <= 100'000'000; t += 1'000'000) {
+    truth.t_ns = t;
+    if (t % 10'000'000 == 0) odometry.Measure(truth);
+    if (odometry.Deliver(t, &out)) {
+      captured.push_back(out.t_ns);
+      arrived.push_back(t);
+    }
+  }
+  ASSERT_EQ(captured.size(), 8u);  // captures at 0..70 ms arrive by 100 ms; 80..100 ms are in flight
+  for (std::size_t i = 0; i < captured.size(); ++i) {
+    EXPECT_EQ(captured[i], static_cast<TimeNs>(i) * 10'000'000);
+    EXPECT_EQ(arrived[i], captured[i] + 23'000'000);
+  }
+}
+
+TEST(Odometry, DriftIsARandomWalkOfTheStatedDiffusion) {
+  OdometryOptions o;
+  o.position_noise_m = o.velocity_noise_m_s = o.attitude_noise_rad = 0.0;
+  o.drift_m_per_sqrt_s = 0.02;
+  o.yaw_drift_rad_per_sqrt_s = 0.003;
+  const World empty;
+  const vehicle::StateVector x = SpinningState(0.0);
+  TruthSample truth;
+  truth.x = &x;
+  // After T seconds each axis of a random walk has variance σ² T: over many flights of 4 s the
+  // mean squared drift is 3 σ² T in position and σ² T in yaw.
+  const int flights = 400;
+  const double seconds = 4.0;
+  double p2 = 0.0, yaw2 = 0.0;
+  for (int f = 0; f < flights; ++f) {
+    OdometryModel odometry(o, empty, DeriveSeed(11, static_cast<std::uint64_t>(f)));
+    OdometrySample out;
+    for (int k = 0; k < static_cast<int>(seconds * o.rate_hz); ++k) out = MeasureNow(&odometry, truth);
+    // The vehicle sits at the origin, so what the front end reports is its frame's drift.
+    EXPECT_NEAR((out.p_W - odometry.drift_m()).norm(), 0.0, 1e-12);
+    p2 += out.p_W.squaredNorm();
+    yaw2 += odometry.drift_yaw_rad() * odometry.drift_yaw_rad();
+  }
+  // Relative std of a mean of 400 χ² values: sqrt(2 / (3·400)) = 4 % and sqrt(2/400) = 7 %.
+  EXPECT_NEAR(p2 / flights / (3.0 * o.drift_m_per_sqrt_s * o.drift_m_per_sqrt_s * seconds), 1.0, 0.15);
+  EXPECT_NEAR(yaw2 / flights / (o.yaw_drift_rad_per_sqrt_s * o.yaw_drift_rad_per_sqrt_s * seconds), 1.0, 0.25);
+}
+
+TEST(Odometry, DriftRotatesTheReportedFrame) {
+  OdometryOptions o;
+  o.position_noise_m = o.velocity_noise_m_s = o.attitude_noise_rad = 0.0;
+  o.yaw_drift_rad_per_sqrt_s = 0.5;
+  const World empty;
+  OdometryModel odometry(o, empty, 3);
+  vehicle::StateVector x = SpinningState(0.0);
+  x.segment<3>(vehicle::StateIndex::kPosition) = Vector3(2.0, 0.0, 1.0);
+  x.segment<3>(vehicle::StateIndex::kVelocity) = Vector3(0.0, 1.0, 0.0);
+  TruthSample truth;
+  truth.x = &x;
+  const OdometrySample out = MeasureNow(&odometry, truth);
+  const double yaw = odometry.drift_yaw_rad();
+  ASSERT_GT(std::abs(yaw), 1e-3);
+  EXPECT_NEAR(out.p_W.x(), 2.0 * std::cos(yaw), 1e-12);
+  EXPECT_NEAR(out.p_W.y(), 2.0 * std::sin(yaw), 1e-12);
+  EXPECT_NEAR(out.p_W.z(), 1.0, 1e-12);
+  EXPECT_NEAR(out.v_W.x(), -std::sin(yaw), 1e-12);
+  // The attitude turns with the frame: the body's x axis points at the drifted yaw.
+  const Vector3 x_axis = out.q_WB * Vector3::UnitX();
+  EXPECT_NEAR(std::atan2(x_axis.y(), x_axis.x()), yaw, 1e-12);
+}
+
+TEST(Odometry, NoiseGrowsWhereFewObstaclesAreInView) {
+  OdometryOptions o;
+  o.rate_noise_gain = 0.0;
+  o.few_features_gain = 2.0;
+  o.features_reference = 4;
+  o.feature_range_m = 10.0;
+  World empty, sparse, dense;
+  for (int i = 0; i < 8; ++i) {
+    const Cylinder c{.center_m = Eigen::Vector2d(3.0 + i, 0.0), .radius_m = 0.2, .height_m = 5.0};
+    dense.cylinders.push_back(c);
+    if (i == 0) sparse.cylinders.push_back(c);
+    if (i == 7) sparse.cylinders.push_back({.center_m = Eigen::Vector2d(30.0, 0.0), .radius_m = 0.2, .height_m = 5.0});
+  }
+  OdometryModel a(o, empty, 5), b(o, sparse, 5), c(o, dense, 5);
+  const vehicle::StateVector x = SpinningState(0.0);
+  TruthSample truth;
+  truth.x = &x;
+  double ea = 0.0, eb = 0.0, ec = 0.0;
+  for (int i = 0; i < 100; ++i) {
+    ea += MeasureNow(&a, truth).p_W.squaredNorm();
+    eb += MeasureNow(&b, truth).p_W.squaredNorm();
+    ec += MeasureNow(&c, truth).p_W.squaredNorm();
+  }
+  // Same stream; factors 1 + 2 (1 - n/4): none in view 3, one in view (the other is 30 m away) 2.5,
+  // eight in view 1.
+  EXPECT_NEAR(std::sqrt(ea / ec), 3.0, 1e-9);
+  EXPECT_NEAR(std::sqrt(eb / ec), 2.5, 1e-9);
+}
+
+TEST(Odometry, LosesTrackAtTheStatedRate) {
+  OdometryOptions o;
+  o.outage_rate_hz = 0.5;
+  o.outage_min_s = 0.1;
+  o.outage_max_s = 0.3;
+  const World empty;
+  OdometryModel odometry(o, empty, 9);
+  const TimeNs period = PeriodFromRate(o.rate_hz);
+  int outages = 0, lost = 0;
+  bool was_lost = false;
+  const int samples = 200'000;  // 2000 s
+  for (int k = 0; k < samples; ++k) {
+    const bool now = odometry.InOutage(k * period);
+    outages += now && !was_lost;
+    lost += now;
+    was_lost = now;
+  }
+  // About rate · (time tracking) outages of 0.2 s mean: 2000 s · 0.5 Hz / (1 + 0.5 · 0.2) = 909 ± 30.
+  EXPECT_NEAR(outages, 909, 100);
+  EXPECT_NEAR(lost * 0.01 / outages, 0.2, 0.02);
 }
 
 TEST(RateTimer, FiresOnItsGridFromPhysicsSteps) {

@@ -63,7 +63,7 @@ TEST(Truth, ADrawIsAPureFunctionOfItsSeed) {
 TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   const vehicle::VehicleParams file = ReferenceQuad();
   const TruthRanges r = RangesOf(TruthPreset::kRealistic);
-  std::vector<double> mass, kn, stop, torque, cog;
+  std::vector<double> mass, kn, stop, torque, cog, latency;
   for (std::uint64_t seed = 0; seed < 4000; ++seed) {
     const TruthDraw d = DrawTruth(Realistic(), file, seed);
     mass.push_back(d.mass_ratio - 1.0);
@@ -71,6 +71,9 @@ TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
     stop.push_back(d.motor_stop_time_constant_s);
     torque.push_back(d.external_torque_n_m.x());
     cog.push_back(d.cog_offset_m.y());
+    latency.push_back(d.odometry_latency_s);
+    EXPECT_GE(d.odometry_drift_m_per_sqrt_s, 0.5 * r.odometry_drift_m_per_sqrt_s);
+    EXPECT_LE(d.odometry_drift_m_per_sqrt_s, r.odometry_drift_m_per_sqrt_s);
     EXPECT_EQ(d.external_torque_n_m.z(), 0.0);
   }
   // Uniform on [-a, a]: 4000 draws come within 0.5 % of a of both ends with probability > 1 - 1e-8.
@@ -85,6 +88,8 @@ TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   fills(kn, 1.0, r.thrust_coefficient_fraction);
   fills(torque, 0.0, r.external_torque_n_m);
   fills(cog, 0.0, r.cog_offset_m);
+  const double half_width = 0.5 * (r.odometry_latency_max_s - r.odometry_latency_min_s);
+  fills(latency, r.odometry_latency_min_s + half_width, half_width);
   // Log-uniform on [5, 50] ms: inside, and its median the geometric mean sqrt(5 * 50) = 15.8 ms
   // (the standard error of a median of 4000 draws is about 2 % of it).
   const auto [lo, hi] = std::minmax_element(stop.begin(), stop.end());
@@ -105,12 +110,15 @@ TEST(Truth, AnOverrideReplacesOneRangeOfThePreset) {
   EXPECT_NE(d.inertia_ratio, Vector3::Ones());  // the rest keeps the preset's spread
 }
 
-TEST(Truth, TheStopTimeConstantsRangeNeedsBothEndsInOrder) {
+TEST(Truth, AnIntervalNeedsBothEndsInOrder) {
   TruthOptions o;
   o.motor_stop_time_constant_min_s = 0.01;
   RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "motor_stop_time_constant_max_s is missing");
   o.motor_stop_time_constant_max_s = 0.005;
   RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "at least motor_stop_time_constant_min_s = 0.01");
+  o = TruthOptions();
+  o.odometry_latency_max_s = 0.02;
+  RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "odometry_latency_min_s is missing");
 }
 
 TEST(Truth, TheDrawnVehicleMovesItsRotorsAboutTheTrueCentreOfGravity) {

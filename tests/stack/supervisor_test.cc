@@ -199,6 +199,31 @@ TEST(OdometryImuEstimator, DeadReckonsThroughAnOdometryGapExactlyEnoughForConsta
   EXPECT_EQ(e.Estimate(2'000'000'000).p_W, Vector3(9, 9, 9));
 }
 
+// A late sample against the closed form: the vehicle climbs at a constant 1 m/s² while its
+// odometry arrives 30 ms after capture. On arrival the estimate is the sample carried over the
+// IMU samples since its capture, p = p0 + v0 τ + a τ²/2, not the sample as it was 30 ms before.
+TEST(OdometryImuEstimator, CarriesALateSampleFromItsCaptureToItsArrival) {
+  OdometryImuEstimator e(1e-6);
+  const Vector3 p0(1, 2, 3), v0(0.5, 0, 0.2), a(0, 0, 1.0);
+  const TimeNs capture = 1'000'000'000, latency = 30'000'000;
+  for (TimeNs t = capture - 60'000'000; t <= capture + latency; t += 3'000'000) {
+    ImuSample imu;
+    imu.t_ns = t;
+    imu.specific_force_B = a + Vector3(0, 0, kGravity);
+    e.OnImu(imu);
+  }
+  OdometrySample odom;
+  odom.t_ns = capture;
+  odom.p_W = p0;
+  odom.v_W = v0;
+  e.OnOdometry(odom);
+  const double tau = ToSeconds(latency);
+  const StateEstimate s = e.Estimate(capture + latency);
+  EXPECT_NEAR((s.p_W - (p0 + v0 * tau + 0.5 * a * tau * tau)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((s.v_W - (v0 + a * tau)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(e.odometry_age_s(capture + latency), tau, 1e-12) << "the age counts from the capture";
+}
+
 TEST(OdometryImuEstimator, TheDeadReckonedEstimateStopsAtTheGround) {
   OdometryImuEstimator e(1e-6);
   OdometrySample odom;

@@ -18,7 +18,7 @@ struct RunOptions : FlightRecorderOptions {
   /// Called after every control cycle with the stack (benchmarks read solver statistics).
   std::function<void(const stack::FlightStack&)> on_control_cycle;
   /// End the run once a navigate mission has reached its last waypoint, settled there for 3 s and
-  /// held it for the scenario's success_hold_s (Monte Carlo trials need not fly out their whole
+  /// held it for the scenario's success.hold_s (Monte Carlo trials need not fly out their whole
   /// duration).
   bool stop_when_mission_complete = false;
 };

@@ -24,6 +24,16 @@
 
 namespace rotorguard::harness {
 
+/// The success rule a scenario states (its `metrics` keys success_error_m, success_hold_s,
+/// success_recovery_s, max_altitude_loss_m; docs/metrics.md, "SucR").
+struct SuccessRule {
+  double error_m = 0.5;     ///< the bound on |p - p_ref| [m] ...
+  double hold_s = 2.0;      ///< ... held over the flight's last hold_s [s] ...
+  double recovery_s = 5.0;  ///< ... and from recovery_s after a fault's correct isolation [s]
+  /// A fault costing more altitude than this fails the run [m] (at take-off: 0.05 m).
+  std::optional<double> max_altitude_loss_m;
+};
+
 struct Scenario {
   std::string name;
   std::string file;           ///< the scenario file it came from ("" when built in code)
@@ -55,10 +65,7 @@ struct Scenario {
   /// Tracking metrics cover [tracking_start_s, TrackingEndS(scenario)].
   double tracking_start_s = 0.0;
   std::optional<double> tracking_end_s;  ///< metrics.tracking_end_s; see TrackingEndS
-  /// A run succeeds when it does not crash and its position error stays at or below
-  /// success_error_m over the last success_hold_s of the flight (docs/metrics.md, "SucR").
-  double success_error_m = 0.5;
-  double success_hold_s = 2.0;
+  SuccessRule success;
   /// Roll and pitch count as recovered after a fault once the tilt stays below this [rad].
   double recovered_tilt_rad = 0.0873;  // 5 degrees
   /// Where the file put the keys that are checked only once the mission is planned

@@ -88,13 +88,21 @@ struct MetricsKeys {
               .max = s->duration_s,
               .default_text = "the flight's end; an assembly_plan's: its plan's duration",
               .rule_text = "in [0, duration_s]"});
-    a->Visit("success_error_m", &s->success_error_m,
+    a->Visit("success_error_m", &s->success.error_m,
              {.meaning = "a run succeeds when |p - p_ref| stays at or below this [m] ...", .positive = true});
-    a->Visit("success_hold_s", &s->success_hold_s,
-             {.meaning = "... over the flight's last success_hold_s [s]",
+    a->Visit("success_hold_s", &s->success.hold_s,
+             {.meaning = "... over the flight's last success_hold_s [s] ...",
               .min = 0.0,
               .max = s->duration_s,
               .rule_text = "in [0, duration_s]"});
+    a->Visit("success_recovery_s", &s->success.recovery_s,
+             {.meaning = "... and from success_recovery_s after the fault's correct isolation (its onset when "
+                         "none) to the end [s]",
+              .min = 0.0});
+    a->Visit("max_altitude_loss_m", &s->success.max_altitude_loss_m,
+             {.meaning = "a fault costing more altitude than this fails the run [m] (take-off: 0.05)",
+              .min = 0.0,
+              .default_text = "no bound"});
     a->Visit("recovered_tilt_rad", &s->recovered_tilt_rad,
              {.meaning = "roll and pitch count as recovered once the tilt stays below this [rad] (tilt_recovery_s)",
               .min = 1e-3,

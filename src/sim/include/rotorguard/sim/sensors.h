@@ -2,12 +2,14 @@
 /// Sensor models: IMU, ESC telemetry, odometry. Each owns its random stream (derived from the run
 /// seed) so that adding or retuning one sensor does not change the noise of another.
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/core/types.h"
+#include "rotorguard/sim/world.h"
 #include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::sim {
@@ -91,6 +93,21 @@ struct OdometryOptions {
     }
   };
   std::vector<Outage> outages;
+  /// Truth side (set from the scenario's truth, not sensor keys): how a LiDAR-inertial front end
+  /// departs from the truth. Each sample is stamped when its scan was captured and arrives
+  /// latency_s later. Its frame drifts from the world's by a random walk in position and yaw.
+  /// Noise and drift grow with the body rate (rate_noise_gain) and where the front end sees few
+  /// features: by 1 + few_features_gain (1 - n / features_reference) when only n < reference
+  /// obstacles lie within feature_range_m. It loses track at random (a Poisson process of
+  /// outage_rate_hz), each time for a duration drawn uniformly in [outage_min_s, outage_max_s].
+  double latency_s = 0.0;
+  double drift_m_per_sqrt_s = 0.0;
+  double yaw_drift_rad_per_sqrt_s = 0.0;
+  double few_features_gain = 0.0;
+  int features_reference = 8;
+  double feature_range_m = 20.0;
+  double outage_rate_hz = 0.0;
+  double outage_min_s = 0.05, outage_max_s = 0.3;
   /// Whether time t [s] lies in an outage.
   bool InOutage(double t) const;
   void Validate(double physics_rate_hz) const;
@@ -153,14 +170,35 @@ class EscModel {
   std::size_t head_ = 0, count_ = 0;
 };
 
+/// A LiDAR-inertial front end's odometry: noise, drift, a latency, outages (OdometryOptions).
 class OdometryModel {
  public:
-  OdometryModel(const OdometryOptions& options, std::uint64_t seed);
-  OdometrySample Sample(const TruthSample& truth);
+  /// Keeps a reference to `world` (its obstacles are the front end's features).
+  OdometryModel(const OdometryOptions& options, const World& world, std::uint64_t seed);
+  /// Captures a sample now (call at the odometry rate); it is delivered `latency_s` later, unless
+  /// the front end has lost track.
+  void Measure(const TruthSample& truth);
+  /// The oldest captured sample whose latency has elapsed at time t, if one is waiting (call every
+  /// physics step).
+  bool Deliver(TimeNs t, OdometrySample* delivered);
+  /// Whether the front end has lost track at time t: a scheduled outage or a random one.
+  bool InOutage(TimeNs t);
+  /// The drift of the front end's frame: position [m] and yaw [rad] of the world in it.
+  const Vector3& drift_m() const { return drift_p_; }
+  double drift_yaw_rad() const { return drift_yaw_; }
 
  private:
+  /// The factor by which noise and drift grow where few obstacles are in view, >= 1.
+  double FewFeaturesFactor(const Vector3& p_W, double t) const;
+
   OdometryOptions options_;
-  Rng rng_;
+  const World& world_;
+  Rng rng_, drift_rng_, outage_rng_;
+  double dt_;
+  Vector3 drift_p_ = Vector3::Zero();
+  double drift_yaw_ = 0.0;
+  TimeNs random_outage_end_ns_ = -1;
+  std::deque<OdometrySample> pending_;
 };
 
 /// Fires every `period` on an integer-nanosecond grid; polled at physics steps.

@@ -42,6 +42,14 @@ struct TruthRanges {
   double esc_dropout_probability = 0.0;  ///< each telemetry frame lost with this probability
   /// Motor-stop time constant drawn log-uniformly in [min, max] [s]; unset: the file's value.
   std::optional<double> motor_stop_time_constant_min_s, motor_stop_time_constant_max_s;
+  /// The odometry front end (OdometryOptions): its latency drawn uniformly in [min, max] [s]; the
+  /// random walks of its frame's position [m/√s] and yaw [rad/√s] each drawn in [a/2, a]; how much
+  /// its noise and drift grow with no obstacle in view; how often it loses track [1/s].
+  double odometry_latency_min_s = 0.0, odometry_latency_max_s = 0.0;
+  double odometry_drift_m_per_sqrt_s = 0.0;
+  double odometry_yaw_drift_rad_per_sqrt_s = 0.0;
+  double odometry_few_features_gain = 0.0;
+  double odometry_outage_rate_hz = 0.0;
 };
 
 /// The ranges of a preset.
@@ -53,7 +61,8 @@ struct TruthOptions {
   std::optional<double> mass_fraction, inertia_fraction, cog_offset_m, thrust_coefficient_fraction,
       yaw_coefficient_fraction, motor_time_constant_fraction, rotor_drag_fraction, imu_offset_m, external_torque_n_m,
       motor_stop_time_constant_min_s, motor_stop_time_constant_max_s, imu_vibration_m_s2, esc_gain_fraction,
-      esc_dropout_probability;
+      esc_dropout_probability, odometry_latency_min_s, odometry_latency_max_s, odometry_drift_m_per_sqrt_s,
+      odometry_yaw_drift_rad_per_sqrt_s, odometry_few_features_gain, odometry_outage_rate_hz;
 
   /// The preset's ranges with the overrides applied.
   TruthRanges Ranges() const;
@@ -65,8 +74,9 @@ struct TruthOptions {
 };
 
 /// One override of the truth block: its key (the field's name), what it accepts and means, and
-/// the range it replaces; none for the stop time constant's two ends, which replace their
-/// range together (TruthOptions::Ranges). The keys, the loader and Ranges() all follow this list.
+/// the range it replaces; none for the two ends of the stop time constant's and of the odometry
+/// latency's interval, which replace their interval together (TruthOptions::Ranges). The keys, the
+/// loader and Ranges() all follow this list.
 struct TruthOverrideKey {
   const char* key;
   std::optional<double> TruthOptions::*override;
@@ -138,6 +148,34 @@ inline constexpr TruthOverrideKey kTruthOverrideKeys[] = {
      &TruthOptions::esc_dropout_probability,
      &TruthRanges::esc_dropout_probability,
      {.meaning = "each ESC telemetry frame is lost with this probability", .min = 0, .max = 0.5}},
+    {"odometry_latency_min_s",
+     &TruthOptions::odometry_latency_min_s,
+     nullptr,
+     {.meaning = "the odometry arrives this much after its capture, drawn uniformly in [min, max] [s]",
+      .min = 0,
+      .max = 0.4}},
+    {"odometry_latency_max_s",
+     &TruthOptions::odometry_latency_max_s,
+     nullptr,
+     {.meaning = "(set both or neither)", .min = 0, .max = 0.4}},
+    {"odometry_drift_m_per_sqrt_s",
+     &TruthOptions::odometry_drift_m_per_sqrt_s,
+     &TruthRanges::odometry_drift_m_per_sqrt_s,
+     {.meaning = "the odometry frame's position random walk, each axis, drawn in [a/2, a] [m/√s]", .min = 0, .max = 1}},
+    {"odometry_yaw_drift_rad_per_sqrt_s",
+     &TruthOptions::odometry_yaw_drift_rad_per_sqrt_s,
+     &TruthRanges::odometry_yaw_drift_rad_per_sqrt_s,
+     {.meaning = "the odometry frame's yaw random walk, drawn in [a/2, a] [rad/√s]", .min = 0, .max = 0.1}},
+    {"odometry_few_features_gain",
+     &TruthOptions::odometry_few_features_gain,
+     &TruthRanges::odometry_few_features_gain,
+     {.meaning = "odometry noise and drift grow by 1 + a (1 - n/8) with n < 8 obstacles within 20 m",
+      .min = 0,
+      .max = 10}},
+    {"odometry_outage_rate_hz",
+     &TruthOptions::odometry_outage_rate_hz,
+     &TruthRanges::odometry_outage_rate_hz,
+     {.meaning = "the odometry loses track for 0.05-0.3 s this often on average [1/s]", .min = 0, .max = 1}},
 };
 
 template <typename Archive>
@@ -165,6 +203,11 @@ struct TruthDraw {
   double imu_vibration_m_s2 = 0.0;                ///< ImuOptions::vibration_m_s2
   std::vector<double> esc_gain;                   ///< per motor: reported / true speed (EscOptions::gain)
   double esc_dropout_probability = 0.0;           ///< EscOptions::dropout_probability
+  double odometry_latency_s = 0.0;                ///< OdometryOptions::latency_s
+  double odometry_drift_m_per_sqrt_s = 0.0;       ///< OdometryOptions::drift_m_per_sqrt_s
+  double odometry_yaw_drift_rad_per_sqrt_s = 0.0;  ///< OdometryOptions::yaw_drift_rad_per_sqrt_s
+  double odometry_few_features_gain = 0.0;         ///< OdometryOptions::few_features_gain
+  double odometry_outage_rate_hz = 0.0;            ///< OdometryOptions::outage_rate_hz
 
   /// summary.json's "truth" object.
   template <typename Archive>
@@ -184,6 +227,16 @@ struct TruthDraw {
              {.meaning = "a healthy rotor's vibration at hover speed [m/s²]"});
     a->Visit("esc_gain", &esc_gain, {.meaning = "per motor: reported / true speed"});
     a->Visit("esc_dropout_probability", &esc_dropout_probability, {.meaning = "a telemetry frame's loss probability"});
+    a->Visit("odometry_latency_s", &odometry_latency_s,
+             {.meaning = "from an odometry sample's capture to its arrival [s]"});
+    a->Visit("odometry_drift_m_per_sqrt_s", &odometry_drift_m_per_sqrt_s,
+             {.meaning = "the odometry frame's position random walk [m/√s]"});
+    a->Visit("odometry_yaw_drift_rad_per_sqrt_s", &odometry_yaw_drift_rad_per_sqrt_s,
+             {.meaning = "the odometry frame's yaw random walk [rad/√s]"});
+    a->Visit("odometry_few_features_gain", &odometry_few_features_gain,
+             {.meaning = "growth of odometry noise and drift with no obstacle in view"});
+    a->Visit("odometry_outage_rate_hz", &odometry_outage_rate_hz,
+             {.meaning = "how often the odometry loses track [1/s]"});
   }
 };
 

@@ -1,5 +1,7 @@
 #pragma once
 /// State estimators of the flight stack. They see sensor messages only.
+#include <deque>
+
 #include "rotorguard/core/messages.h"
 
 namespace rotorguard::stack {
@@ -20,12 +22,17 @@ struct EstimatorOptions {
   Vector3 imu_position_m = Vector3::Zero();
   /// Odometry older than this [s] is carried forward by integrating the IMU, > 0.
   double dead_reckoning_after_s = 0.05;
+  /// IMU samples kept to carry a late odometry sample from its capture to its arrival [s], > 0:
+  /// longer than the odometry's latency.
+  double imu_history_s = 0.25;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
 
 /// Pose and velocity from the latest odometry (assumed to be LiDAR-inertial odometry's output),
-/// body rates from the latest gyro sample, motor thrusts from ESC telemetry through k_n. When the
+/// body rates from the latest gyro sample, motor thrusts from ESC telemetry through k_n. Odometry
+/// arrives late, stamped when its scan was captured: on arrival it is carried to the newest IMU
+/// sample by integrating the IMU samples since its capture (kept for imu_history_s). When the
 /// odometry stops (its front end lost track), the last odometry is carried forward by strapdown
 /// integration of the IMU: attitude by the gyro, velocity and position by the specific force
 /// rotated to the world with gravity added (the IMU's lever arm removed), never below the ground
@@ -44,6 +51,15 @@ class OdometryImuEstimator final : public Estimator {
   double odometry_age_s(TimeNs t) const;
 
  private:
+  /// A strapdown state: pose and velocity at an instant.
+  struct Strapdown {
+    TimeNs t_ns = 0;
+    Vector3 p = Vector3::Zero(), v = Vector3::Zero();
+    Quaternion q = Quaternion::Identity();
+  };
+  /// Carries `s` to the instant of `imu` (a later one).
+  void Integrate(const ImuSample& imu, Strapdown* s) const;
+
   EstimatorOptions options_;
   bool have_odometry_ = false;
   bool have_imu_ = false;
@@ -51,10 +67,9 @@ class OdometryImuEstimator final : public Estimator {
   Vector3 w_B_ = Vector3::Zero();
   double thrust_coefficient_;
   RotorVector motor_thrust_;
-  // Dead-reckoned state, restarted at every odometry sample.
-  TimeNs dr_t_ns_ = 0;
-  Vector3 dr_p_ = Vector3::Zero(), dr_v_ = Vector3::Zero();
-  Quaternion dr_q_ = Quaternion::Identity();
+  std::deque<ImuSample> imu_history_;  ///< the last imu_history_s of valid samples, oldest first
+  Strapdown arrived_;                  ///< the latest odometry carried to its arrival
+  Strapdown dead_reckoned_;            ///< restarted at every odometry sample, then integrated
 };
 
 }  // namespace rotorguard::stack
