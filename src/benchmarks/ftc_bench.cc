@@ -98,6 +98,8 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     planning::TakeoffOptions t;
     t.altitude_m = 1.5;
     s.reference = std::make_shared<planning::TakeoffReference>(t);
+    // A take-off may lose at most 5 cm to the fault (docs/metrics.md, SucR).
+    s.success.max_altitude_loss_m = 0.05;
     // On the climb, 2-50 cm above the ground (the take-off detector's domain, paper 000 Sec. V-B3).
     // Not earlier: with the landing gear still on the ground, the ground carries the lost thrust
     // and torque and no inertial detector can see the loss (docs/benchmarks.md).
@@ -137,7 +139,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
     const FtcTrial& r = trials[t];
     success += r.success ? 1 : 0;
     if (!r.success) failures.Add({{"trial", t}, {"seed", r.seed}, {"reason", r.failure}});
-    if (!r.errored) min_alt = std::min(min_alt, r.min_altitude_m);
+    if (!r.errored && std::isfinite(r.altitude_change_m)) min_alt = std::min(min_alt, r.altitude_change_m);
     if (!r.has_fdd) continue;
     ++with_fdd;
     false_alarms += r.false_alarm ? 1 : 0;
@@ -186,7 +188,7 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   c.seed = o.seed;
   c.trials = kNumCells * methods * o.trials;
   c.group_keys = {"phase", "fault", "method"};
-  c.metrics = {"success", "correct", "false_alarm", "latency_s", "min_altitude_m"};
+  c.metrics = {"success", "correct", "false_alarm", "latency_s", "altitude_change_m"};
   const nlohmann::json options = {{"trials", o.trials},   {"seed", o.seed},
                                   {"methods", o.methods}, {"vehicle", o.vehicle.name},
                                   {"truth", ToName(o.truth)}};
@@ -208,7 +210,9 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
     const auto [cell, method, trial] = decompose(index);
     const harness::RunSummary s = harness::RunScenario(MakeTrial(kCells[cell], o.methods[method], o, std::stoull(params.at("seed"))));
     campaign::TrialOutcome out;
-    out.metrics = {{"success", s.success}, {"min_altitude_m", s.min_altitude_m}};
+    out.metrics = {
+        {"success", s.success},
+        {"altitude_change_m", s.altitude_change_m ? nlohmann::json(*s.altitude_change_m) : nlohmann::json(nullptr)}};
     if (s.fdd) {
       out.metrics["correct"] = s.fdd->correct;
       out.metrics["false_alarm"] = s.fdd->false_alarm;
@@ -249,7 +253,8 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         }
         const nlohmann::json& x = r["metrics"];
         trial.success = x["success"].get<bool>();
-        trial.min_altitude_m = x["min_altitude_m"].get<double>();
+        trial.altitude_change_m = x["altitude_change_m"].is_null() ? std::numeric_limits<double>::quiet_NaN()
+                                                                   : x["altitude_change_m"].get<double>();
         if (x.contains("correct")) {
           trial.has_fdd = true;
           trial.correct = x["correct"].get<bool>();
@@ -338,7 +343,7 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                               std::string(row.key) == "mdr")) {
         continue;
       }
-      if (std::string(row.key) == "mini_alt_m" && phase != "takeoff") continue;
+      if (std::string(row.key) == "mini_alt_m" && (phase != "takeoff" || fault == "none")) continue;
       std::string line = fmt::format("| {} | {} | {} | {} |", test, phase, fault, row.name);
       for (const auto& m : methods) line += fmt::format(" {} |", Fmt(cell(phase, fault, m)[row.key], row.format, row.scale));
       const std::string paper = fault == "none" ? (std::string(row.key) == "far" ? "0" : "") : Paper(phase, fault, row.paper);

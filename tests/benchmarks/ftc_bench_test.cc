@@ -12,7 +12,8 @@ namespace {
 
 TEST(FtcCell, MetricArithmeticOnHandMadeTrials) {
   // Four faulty trials: two correct isolations (0.02 s, 0.04 s), one detected 1.5 s late (counts as
-  // missed), one false alarm before the onset; three successes; least altitude -0.2 m.
+  // missed), one false alarm before the onset; three successes; altitude changes 1.9, 1.8, 1.5 and
+  // -0.2 m, whose least is MiniA.
   std::vector<FtcTrial> t(4);
   for (auto& x : t) x.has_fdd = true;
   t[0] = {true, true, true, false, 0.02, 1.9, "", 11};
@@ -33,7 +34,7 @@ TEST(FtcCell, MetricArithmeticOnHandMadeTrials) {
 
 TEST(FtcCell, AnErroredTrialIsAFailureAndAMissedDetection) {
   // Two faulty trials of a method with FDD: one correct isolation, one that errored (it reported no
-  // metrics). MDR counts the errored one; the least altitude comes from the finished one alone.
+  // metrics). MDR counts the errored one; MiniA comes from the finished one alone.
   std::vector<FtcTrial> t(2);
   t[0] = {true, true, true, false, 0.02, 1.9, "", 11};
   t[1].has_fdd = true;
@@ -88,6 +89,11 @@ TEST(FtcCell, MetricsWithoutFaultDetectionAreNull) {
   EXPECT_TRUE(AggregateFtcCell({FtcTrial{true, true, false, false, -1.0, 1.0, "", 1}}, false)["mdr"].is_null());
 }
 
+TEST(FtcCell, FaultFreeTrialsHaveNoAltitudeChange) {
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(AggregateFtcCell({FtcTrial{true, true, false, false, -1.0, none, "", 1}}, false)["mini_alt_m"].is_null());
+}
+
 TEST(FtcBenchmark, TheRealisticWorldFliesOtherVehiclesUnderItsOwnHash) {
   // One trial of one method in each world: the same index, the same seed and fault, another
   // vehicle. A campaign of one world cannot resume or merge into the other's (hash).
@@ -104,7 +110,7 @@ TEST(FtcBenchmark, TheRealisticWorldFliesOtherVehiclesUnderItsOwnHash) {
   EXPECT_EQ(ideal.parameters(0), realistic.parameters(0));
   const campaign::TrialOutcome a = ideal.run(0, ideal.parameters(0));
   const campaign::TrialOutcome b = realistic.run(0, realistic.parameters(0));
-  EXPECT_NE(a.metrics["min_altitude_m"], b.metrics["min_altitude_m"]);
+  EXPECT_NE(a.metrics["altitude_change_m"], b.metrics["altitude_change_m"]);
 }
 
 }  // namespace

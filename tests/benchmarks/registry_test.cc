@@ -99,7 +99,7 @@ TEST_F(BenchCampaigns, FtcResultCountsAnErroredTrialAsAFailure) {
   const campaign::Campaign c = FtcCampaign(o);
   std::vector<nlohmann::json> records;
   for (int i = 0; i < c.trials; ++i) {
-    records.push_back(Record(i, c.parameters(i), {{"success", true}, {"min_altitude_m", 1.0}}));
+    records.push_back(Record(i, c.parameters(i), {{"success", true}, {"altitude_change_m", -0.01}}));
   }
   records[0] = Record(0, c.parameters(0), nullptr, "error", "boom");
   const nlohmann::json r = FtcResult(c.bench["options"], records);

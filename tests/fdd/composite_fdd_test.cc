@@ -186,6 +186,11 @@ TEST(FixedTimeFdd, IsolatesEveryRotorFromTheObserverWithoutTelemetry) {
   EXPECT_FALSE(quiet.Run(5.0));  // noise only
 }
 
+TEST(FixedTimeFdd, FiltersAtTheCompositeFddsCutOff) {
+  // A fair comparison: the baseline's filters pass what ours pass.
+  EXPECT_EQ(FixedTimeFddOptions{}.estimate_cutoff_hz, CompositeFddOptions{}.filter_cutoff_hz);
+}
+
 TEST(CompositeFdd, OptionsValidationNamesTheField) {
   CompositeFddOptions o;
   o.motor_index_threshold = 1.5;

@@ -45,7 +45,9 @@ struct FtcTrial {
   bool correct = false;      ///< right rotor and kind, at or after the onset
   bool false_alarm = false;  ///< a diagnosis without a fault, or before the onset
   double latency_s = -1.0;   ///< when correct
-  double min_altitude_m = 0.0;
+  /// The altitude change from the fault's onset to the lowest point after it [m] (negative: lost;
+  /// NaN without a fault): docs/metrics.md, MiniA.
+  double altitude_change_m = 0.0;
   std::string failure;       ///< why it failed (run failure or error), "" on success
   std::uint64_t seed = 0;
   /// The trial did not finish (an error or a non-finite metric): a failure, a missed detection

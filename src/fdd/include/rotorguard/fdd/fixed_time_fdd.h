@@ -19,7 +19,10 @@ struct FixedTimeFddOptions {
   /// the low-power terms converge in finite time near the origin, the high-power ones bound the
   /// convergence time from any initial error (fixed time). All > 0.
   double k1 = 30.0, k1_fast = 10.0, k2 = 400.0, k2_fast = 50.0;
-  double estimate_cutoff_hz = 10.0;  ///< low-pass on the fault estimates (chattering), > 0
+  /// Low-pass on the fault estimates (chattering) and the measurements, > 0: the composite FDD's
+  /// cut-off (CompositeFddOptions::filter_cutoff_hz), as paper 000 gives FixedA's none, so that
+  /// the comparison does not turn on the filters.
+  double estimate_cutoff_hz = 20.0;
   /// Loss of effectiveness above this isolates the rotor, in (0, 1] ...
   double loss_threshold = 0.8;
   double persistence_s = 0.02;  ///< ... when it persists this long [s], >= 0
