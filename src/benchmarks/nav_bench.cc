@@ -1,15 +1,16 @@
 #include "rotorguard/benchmarks/nav_bench.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "rotorguard/benchmarks/planner_bench.h"
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/failure_list.h"
+#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/harness/flight_metrics.h"
@@ -71,8 +72,10 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
     if (t.mission_time_s >= 0.0) time += t.mission_time_s, ++completed;
     if (!t.success) failures.Add({{"kind", kinds[i]}, {"seed", seeds[i]}, {"reason", t.failure}});
   }
+  const auto [success_lo, success_hi] = campaign::WilsonInterval(static_cast<int>(success), static_cast<int>(n));
   return {{"trials", trials.size()},
           {"success_rate", success / n},
+          {"success_wilson95", {success_lo, success_hi}},
           {"collision_rate", collision / n},
           {"crash_rate", crash / n},
           {"tracking_rmse_m", rmse},
@@ -85,6 +88,26 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
           {"cost_ms_per_sim_s", cost},
           {"failures", failures.listed()},
           {"failures_not_listed", failures.not_listed()}};
+}
+
+/// The two variants on the same worlds, pair by pair (docs/metrics.md, "Paired comparison"): how
+/// many worlds each alone succeeded in, and the exact McNemar test of that split.
+nlohmann::json Paired(const std::vector<const NavTrial*>& aware, const std::vector<const NavTrial*>& unaware) {
+  int both = 0, only_aware = 0, only_unaware = 0, neither = 0;
+  for (std::size_t i = 0; i < aware.size(); ++i) {
+    const bool a = aware[i]->success, u = unaware[i]->success;
+    both += a && u;
+    only_aware += a && !u;
+    only_unaware += !a && u;
+    neither += !a && !u;
+  }
+  return {{"worlds", aware.size()},
+          {"both_succeeded", both},
+          {"only_rotorguard", only_aware},
+          {"only_failure_unaware", only_unaware},
+          {"both_failed", neither},
+          {"success_difference", aware.empty() ? 0.0 : static_cast<double>(only_aware - only_unaware) / aware.size()},
+          {"mcnemar_exact_p", campaign::McNemarExactP(only_aware, only_unaware)}};
 }
 
 }  // namespace
@@ -222,6 +245,7 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
   }
   nlohmann::json result = {{"benchmark", "nav"}};
   nlohmann::json groups = nlohmann::json::object();
+  std::vector<const NavTrial*> by_variant[2];
   for (int v = 0; v < 2; ++v) {
     std::vector<const NavTrial*> all;
     std::vector<std::uint64_t> all_seeds;
@@ -236,12 +260,18 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
       }
       const std::vector<std::string> group_kinds(group.size(), kinds[k]);
       groups[kinds[k]][kVariants[v]] = Aggregate(group, group_seeds, group_kinds);
+      if (v == 1) {
+        const auto first = by_variant[0].begin() + static_cast<std::ptrdiff_t>(k) * trials;
+        groups[kinds[k]]["paired"] = Paired({first, first + trials}, group);
+      }
       all.insert(all.end(), group.begin(), group.end());
       all_seeds.insert(all_seeds.end(), group_seeds.begin(), group_seeds.end());
       all_kinds.insert(all_kinds.end(), group_kinds.begin(), group_kinds.end());
     }
     result[kVariants[v]] = Aggregate(all, all_seeds, all_kinds);
+    by_variant[v] = std::move(all);
   }
+  result["paired"] = Paired(by_variant[0], by_variant[1]);
   result["groups"] = groups;
   result["options"] = options;
   result["truth"] = options.value("truth", "ideal");  // records made before the key: the ideal world
@@ -272,6 +302,25 @@ std::string NavMarkdown(const nlohmann::json& r) {
     for (const char* v : kVariants) row(kind, v, variants[v]);
   }
   for (const char* v : kVariants) row("all", v, r[v]);
+  // The comparison that matters: the same worlds flown by both.
+  const auto paired = [&](const std::string& kind, const nlohmann::json& p) {
+    md += fmt::format(
+        "\nPaired on the same {} {} worlds: both succeeded in {}, rotorguard alone in {}, "
+        "failure-unaware alone in {}, neither in {}; difference {:+.3f}, exact McNemar p = {:.3g}.",
+        p["worlds"].get<int>(), kind, p["both_succeeded"].get<int>(), p["only_rotorguard"].get<int>(),
+        p["only_failure_unaware"].get<int>(), p["both_failed"].get<int>(), p["success_difference"].get<double>(),
+        p["mcnemar_exact_p"].get<double>());
+  };
+  md += "\nSuccess rates' 95 % Wilson intervals:";
+  for (const char* v : kVariants) {
+    md += fmt::format(" {} [{:.3f}, {:.3f}]", v, r[v]["success_wilson95"][0].get<double>(),
+                      r[v]["success_wilson95"][1].get<double>());
+  }
+  md += ".\n";
+  for (const auto& [kind, variants] : r["groups"].items()) {
+    if (variants.contains("paired")) paired(kind, variants["paired"]);
+  }
+  md += "\n";
   // Where the wall-clock time goes (all trials): the parts add up to 1000 / trial real-time factor,
   // the stack's (all but simulator and runner) to 1000 / real-time factor.
   md += "\nWall-clock time per simulated second [ms], all trials:\n\n| variant |";

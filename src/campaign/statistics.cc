@@ -18,6 +18,21 @@ std::pair<double, double> WilsonInterval(int successes, int n) {
   return {successes == 0 ? 0.0 : std::max(0.0, centre - half), successes == n ? 1.0 : std::min(1.0, centre + half)};
 }
 
+double McNemarExactP(int only_first, int only_second) {
+  if (only_first < 0 || only_second < 0) {
+    throw std::invalid_argument(
+        fmt::format("McNemarExactP: counts {} and {} are invalid; expected counts >= 0", only_first, only_second));
+  }
+  const int n = only_first + only_second, k = std::min(only_first, only_second);
+  if (n == 0) return 1.0;
+  // Σ C(n, i) 2^-n, each term from log-gamma so that thousands of pairs neither overflow nor underflow.
+  double tail = 0.0;
+  for (int i = 0; i <= k; ++i) {
+    tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) - n * std::log(2.0));
+  }
+  return std::min(1.0, 2.0 * tail);
+}
+
 double Percentile(std::vector<double> v, double p) {
   if (!(p >= 0.0 && p <= 1.0)) {
     throw std::invalid_argument(

@@ -55,8 +55,9 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
     r.limits = modular::DynamicsAwareLimits(kinematic, r.capacity, a.vehicle.mass_kg, spec.max_yaw_rate_rad_s,
                                             spec.safety_factor);
     ao.attitude_weight = spec.attitude_weight;
-  } else {  // SVSDF: the footprint and kinematic limits only
+  } else {  // SVSDF: the footprint and kinematic limits only, the yaw rate's among them
     r.limits.kinematic = kinematic;
+    r.limits.yaw_rate_max = spec.max_yaw_rate_rad_s;
     ao.attitude_weight = 0.0;
     to.weight_attitude = 0.0;
   }

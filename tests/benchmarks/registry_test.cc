@@ -2,18 +2,20 @@
 // shards merged by `MergeCampaign`, or from its spec file gives one result; the results are built
 // from the records as hand-made records say they must be; bad specs name the key.
 
-#include <filesystem>
+#include "rotorguard/benchmarks/registry.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "rotorguard/benchmarks/ftc_bench.h"
 #include "rotorguard/benchmarks/nav_bench.h"
-#include "rotorguard/benchmarks/registry.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/registry.h"
 #include "rotorguard/campaign/slurm.h"
+#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
@@ -157,6 +159,13 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
   ASSERT_EQ(r["failure_unaware"]["failures"].size(), 2u);
   EXPECT_EQ(r["failure_unaware"]["failures"][1]["reason"], "diverged: a metric is not finite");
   EXPECT_EQ(r["groups"]["room"]["rotorguard"], r["rotorguard"]);
+  // Paired on the two worlds: rotorguard alone succeeded in both; p = 2 C(2, 0) / 2^2 = 0.5.
+  EXPECT_EQ(r["paired"]["only_rotorguard"], 2);
+  EXPECT_EQ(r["paired"]["only_failure_unaware"], 0);
+  EXPECT_EQ(r["paired"]["success_difference"], 1.0);
+  EXPECT_EQ(r["paired"]["mcnemar_exact_p"], 0.5);
+  EXPECT_EQ(r["groups"]["room"]["paired"], r["paired"]);
+  EXPECT_NEAR(r["rotorguard"]["success_wilson95"][0].get<double>(), campaign::WilsonInterval(2, 2).first, 1e-15);
 }
 
 // Thirteen failed flights of one variant: ten are listed with their seeds, the other three are

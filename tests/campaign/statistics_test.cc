@@ -23,6 +23,20 @@ TEST(WilsonInterval, MatchesTheClosedFormAtKnownPoints) {
 
 // Hand-made samples (unsorted on input) against numpy.percentile's default (linear, type 7):
 // 1..101 shuffled lands on ranks exactly; the others interpolate.
+TEST(McNemarExactP, IsTheTwoSidedBinomialTailOfTheDiscordantPairs) {
+  // Closed forms: 1 vs 9 discordant pairs, 2 (1 + 10) / 2^10; 2 vs 10, 2 (1 + 12 + 66) / 2^12.
+  EXPECT_NEAR(McNemarExactP(1, 9), 22.0 / 1024.0, 1e-14);
+  EXPECT_NEAR(McNemarExactP(10, 2), 158.0 / 4096.0, 1e-14);
+  EXPECT_EQ(McNemarExactP(0, 0), 1.0);
+  EXPECT_EQ(McNemarExactP(5, 5), 1.0);  // an even split: the doubled tail exceeds 1
+  EXPECT_NEAR(McNemarExactP(0, 7), 2.0 / 128.0, 1e-15);
+  // Thousands of pairs: finite, symmetric, and tiny for a lopsided split.
+  EXPECT_EQ(McNemarExactP(1200, 1500), McNemarExactP(1500, 1200));
+  EXPECT_GT(McNemarExactP(1200, 1500), 0.0);
+  EXPECT_LT(McNemarExactP(1200, 1500), 1e-7);
+  EXPECT_THROW(McNemarExactP(-1, 3), std::invalid_argument);
+}
+
 TEST(Percentile, InterpolatesBetweenTheClosestRanksOfTheSortedSample) {
   std::vector<double> v;
   for (int k = 101; k >= 1; --k) v.push_back(k % 2 ? k : 102 - k);  // every value 1..101 once

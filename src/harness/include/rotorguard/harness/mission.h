@@ -54,7 +54,7 @@ struct AssemblyPlanSpec {
   double max_speed_m_s = 1.0;
   double max_accel_m_s2 = 2.0;
   double max_jerk_m_s3 = 6.0;
-  double max_yaw_rate_rad_s = 1.0;  ///< ours: the yaw's rate limit [rad/s]
+  double max_yaw_rate_rad_s = 1.0;  ///< both methods: the yaw's rate limit [rad/s]
   double safety_factor = 0.7;       ///< ours: the share of the assembly's capacity planned for, in (0, 1]
   double attitude_weight = 0.3;     ///< ours: L_Phi of the A* (eq. 9b) [m/rad]
   /// λ_t of eq. (11) for both methods: the larger, the more agile (closer to the limits) the plan.
@@ -70,7 +70,7 @@ struct AssemblyPlanSpec {
     a->Visit("max_accel_m_s2", &max_accel_m_s2, {.meaning = "acceleration limit [m/s²]", .positive = true});
     a->Visit("max_jerk_m_s3", &max_jerk_m_s3, {.meaning = "jerk limit [m/s³]", .positive = true});
     a->Visit("max_yaw_rate_rad_s", &max_yaw_rate_rad_s,
-             {.meaning = "ours: the yaw's rate limit [rad/s]", .positive = true});
+             {.meaning = "both methods: the yaw's rate limit [rad/s]", .positive = true});
     a->Visit("safety_factor", &safety_factor,
              {.meaning = "ours: the share of the assembly's capacity planned for", .min = 0.01, .max = 1.0});
     a->Visit("attitude_weight", &attitude_weight,
