@@ -54,9 +54,11 @@ class BenchCommand final : public Command {
                     "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
                     "with `campaign merge` when all are done");
       b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
+    }
+    for (CLI::App* b : {ftc_, nav_, mars_, flatness_}) {
       b->add_option("--truth", truth_,
-                    "The simulated vehicles: ideal (the vehicle file exactly) or realistic (each trial\n"
-                    "draws its own about the file; docs/truth.md) (default ideal)");
+                    "The simulated vehicles: realistic (each trial draws its own about the file;\n"
+                    "docs/truth.md) or ideal (the vehicle file exactly) (default realistic)");
     }
     // Every benchmark can also write its page: tables and distributions (record/report.h).
     for (CLI::App* b : {sim_, qp_, nmpc_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
@@ -360,6 +362,7 @@ class BenchCommand final : public Command {
     o.seed = Seed();
     o.jobs = ParseJobs(jobs_);
     o.fig2 = harness::LoadScenario(ConfigPath("scenarios/flatness_fig2.yaml"));
+    o.truth = Truth();
     o.progress = CountProgress("flights");
     const nlohmann::json r = benchmarks::RunFlatnessBenchmark(o);
     PrintMarkdownResult("flatness", r, benchmarks::FlatnessMarkdown(r));
@@ -410,7 +413,7 @@ class BenchCommand final : public Command {
   bool resume_ = false, json_ = false;
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3";
-  std::string truth_ = "ideal";
+  std::string truth_ = "realistic";
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none";
   std::string perception_duration_ = "10";
   std::string planner_pairs_ = "100", planner_worlds_ = "10";

@@ -64,6 +64,8 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
     Fig2Flight& f = flights[static_cast<std::size_t>(task / 2)];
     harness::Scenario s = o.fig2;
     s.seed = o.seed + static_cast<std::uint64_t>(task / 2);
+    s.truth = sim::TruthOptions();
+    s.truth.preset = o.truth;
     try {
       if (task % 2 == 1) {  // the same flight without the fault: the pitch the plan asks for
         s.faults.clear();
@@ -126,36 +128,40 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
   const double truth = o.fig2.faults.front().eta;
   int identified = 0;
   for (const double e : w) identified += std::abs(e - truth) <= 0.05;
-  return {{"benchmark", "flatness"},
-          {"ts_envelope_s", fig1.envelope_s},
-          {"ts_actuator_s", fig1b.actuator_s},
-          {"ts_plan_s", fig1.t_s},
-          {"ts_plan_binding", planning::ToString(fig1.binding)},
-          {"flights", o.seeds},
-          {"success_rate", static_cast<double>(success) / o.seeds},
-          {"fault", {{"rotor", faulty}, {"w", truth}, {"onset_s", onset}}},
-          {"ukf_w_estimate", Median(w)},
-          {"ukf_w_estimate_range", range(w)},
-          {"ukf_identified_rate", static_cast<double>(identified) / o.seeds},
-          {"ukf_detect_s", detect.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(detect))},
-          {"ukf_settle_s", settle.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(settle))},
-          {"ukf_settle_s_range", range(settle)},
-          {"replanned_rate", static_cast<double>(replanned) / o.seeds},
-          {"replan_decisions", decisions},
-          {"replan_bindings", bindings},
-          {"replan_ts_s", ts.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(ts))},
-          {"replan_ts_s_range", range(ts)},
-          {"replan_ts_nominal_s", ts_nominal.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(ts_nominal))},
-          {"replan_actuator_s", act.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(act))},
-          {"replan_actuator_nominal_s", act_nominal.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(act_nominal))},
-          {"theta_max_deg", limits.theta_max_rad / kDeg},
-          {"max_pitch_deg", Median(tilt_free)},
-          {"max_pitch_deg_range", range(tilt_free)},
-          {"max_tilt_deg_with_fault", Median(tilt)},
-          {"failures", failures.listed()},
-          {"failures_not_listed", failures.not_listed()},
-          {"options", {{"seeds", o.seeds}, {"seed", o.seed}, {"jobs", o.jobs}, {"scenario", o.fig2.name}}},
-          {"host", buildinfo::HostInfo()}};
+  return {
+      {"benchmark", "flatness"},
+      {"ts_envelope_s", fig1.envelope_s},
+      {"ts_actuator_s", fig1b.actuator_s},
+      {"ts_plan_s", fig1.t_s},
+      {"ts_plan_binding", planning::ToString(fig1.binding)},
+      {"flights", o.seeds},
+      {"success_rate", static_cast<double>(success) / o.seeds},
+      {"fault", {{"rotor", faulty}, {"w", truth}, {"onset_s", onset}}},
+      {"ukf_w_estimate", Median(w)},
+      {"ukf_w_estimate_range", range(w)},
+      {"ukf_identified_rate", static_cast<double>(identified) / o.seeds},
+      {"ukf_detect_s", detect.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(detect))},
+      {"ukf_settle_s", settle.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(settle))},
+      {"ukf_settle_s_range", range(settle)},
+      {"replanned_rate", static_cast<double>(replanned) / o.seeds},
+      {"replan_decisions", decisions},
+      {"replan_bindings", bindings},
+      {"replan_ts_s", ts.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(ts))},
+      {"replan_ts_s_range", range(ts)},
+      {"replan_ts_nominal_s", ts_nominal.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(ts_nominal))},
+      {"replan_actuator_s", act.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(act))},
+      {"replan_actuator_nominal_s",
+       act_nominal.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(act_nominal))},
+      {"theta_max_deg", limits.theta_max_rad / kDeg},
+      {"max_pitch_deg", Median(tilt_free)},
+      {"max_pitch_deg_range", range(tilt_free)},
+      {"max_tilt_deg_with_fault", Median(tilt)},
+      {"failures", failures.listed()},
+      {"failures_not_listed", failures.not_listed()},
+      {"options",
+       {{"seeds", o.seeds}, {"seed", o.seed}, {"jobs", o.jobs}, {"scenario", o.fig2.name}, {"truth", ToName(o.truth)}}},
+      {"truth", ToName(o.truth)},
+      {"host", buildinfo::HostInfo()}};
 }
 
 std::string FlatnessMarkdown(const nlohmann::json& r) {

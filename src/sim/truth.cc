@@ -143,6 +143,9 @@ vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const Tr
     if (i < d.yaw_coefficient_ratio.size()) v.rotors[i].yaw_coefficient_m *= d.yaw_coefficient_ratio[i];
   }
   for (vehicle::CollisionSphere& c : v.collision_spheres) c.centre_B -= d.cog_offset_m;
+  // The spheres, moved, stay within the bound about the true CoG only if it grows by the offset. A
+  // body of one sphere keeps it centred on the CoG (off by the offset, at most 12 mm).
+  if (!v.collision_spheres.empty()) v.collision_radius_m = file.collision_radius_m + d.cog_offset_m.norm();
   return v;
 }
 

@@ -101,6 +101,7 @@ TEST(FtcBenchmark, TheRealisticWorldFliesOtherVehiclesUnderItsOwnHash) {
   o.trials = 1;
   o.methods = {"rotorguard"};
   o.vehicle = harness::LoadVehicle(testing::SourcePath("configs/vehicles/zhou2025_quad.yaml"));
+  o.truth = sim::TruthPreset::kIdeal;
   const campaign::Campaign ideal = FtcCampaign(o);
   o.truth = sim::TruthPreset::kRealistic;
   const campaign::Campaign realistic = FtcCampaign(o);

@@ -36,6 +36,7 @@ FtcBenchOptions SmallFtc() {
   o.seed = 5;
   o.methods = {"rotorguard", "none"};
   o.vehicle = harness::LoadVehicle(kConfigs + "/vehicles/zhou2025_quad.yaml");
+  o.truth = sim::TruthPreset::kIdeal;  // the figures below are the exact model's
   return o;
 }
 
@@ -81,9 +82,10 @@ TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSa
   }
   // The same options written as a spec are the same campaign: the same trials and hash, so shards
   // run from the spec and from `bench ftc` merge together.
-  const std::string spec = Write("ftc.yaml", "name: small_ftc\nbench: ftc\ntrials: 1\nseed: 5\n"
-                                             "methods: [rotorguard, none]\nvehicle: " + kConfigs +
-                                             "/vehicles/zhou2025_quad.yaml\n");
+  const std::string spec = Write("ftc.yaml",
+                                 "name: small_ftc\nbench: ftc\ntrials: 1\nseed: 5\n"
+                                 "methods: [rotorguard, none]\nvehicle: " +
+                                     kConfigs + "/vehicles/zhou2025_quad.yaml\ntruth: ideal\n");
   const campaign::Campaign from_file = campaign::LoadCampaign(spec, CampaignKinds());
   EXPECT_EQ(from_file.hash, c.hash);
   EXPECT_EQ(from_file.trials, c.trials);

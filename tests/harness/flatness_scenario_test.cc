@@ -19,7 +19,7 @@ namespace {
 std::string Config(const std::string& name) { return testing::SourcePath("configs/scenarios/" + name); }
 
 TEST(FlatnessScenario, Fig2DetectsIdentifiesHoldsAndReplans) {
-  const Scenario s = LoadScenario(Config("flatness_fig2.yaml"));
+  const Scenario s = LoadScenario(Config("flatness_fig2.yaml"), {{"truth", "ideal"}});
   const RunSummary r = RunScenario(s, RunOptions{});
   EXPECT_TRUE(r.success) << r.failure_reason.value_or("");
   ASSERT_TRUE(r.fdd && r.fdd->detected());

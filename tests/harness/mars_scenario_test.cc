@@ -29,11 +29,12 @@ const std::vector<Override> kDeadUnit = {
 
 RunSummary Fly(std::vector<Override> overrides, const std::string& reallocation) {
   overrides.emplace_back("stack.assembly.reallocation", reallocation);
+  overrides.emplace_back("truth", "ideal");
   return RunScenario(LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), overrides), RunOptions{});
 }
 
 TEST(MarsScenario, TheAssemblyTracksTheSpiralWithAHalfThrustRotor) {
-  const Scenario s = LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), {{"duration_s", "20"}});
+  const Scenario s = LoadScenario(Config("scenarios/mars_spiral_3x2.yaml"), {{"truth", "ideal"}, {"duration_s", "20"}});
   ASSERT_TRUE(s.assembly);
   EXPECT_EQ(s.vehicle.num_rotors(), 24);
   EXPECT_DOUBLE_EQ(s.vehicle.mass_kg, 3.0);
@@ -73,14 +74,15 @@ TEST(MarsScenario, AssemblyKeysAreCheckedNamingTheKey) {
 }
 
 /// A scenario loaded, then its assembly's mission planned.
-Scenario LoadPlanned(const std::string& path, const std::vector<Override>& overrides = {}) {
+Scenario LoadPlanned(const std::string& path, std::vector<Override> overrides = {}) {
+  overrides.emplace_back("truth", "ideal");
   Scenario s = LoadScenario(path, overrides);
   PlanMission(&s);
   return s;
 }
 
 TEST(MarsScenario, APlannedRowPassesTheDoorLengthwiseAndFliesItWithoutTouching) {
-  const Scenario loaded = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  const Scenario loaded = LoadScenario(Config("scenarios/mars_plan_4x1.yaml"), {{"truth", "ideal"}});
   ASSERT_TRUE(loaded.assembly_plan);
   EXPECT_EQ(loaded.reference, nullptr) << "the loader reads; it does not plan";
   Scenario s = loaded;
@@ -161,7 +163,8 @@ TEST(MarsScenario, AnUnplannableAssemblyMissionIsAConfigErrorNamingTheMission) {
   m = message({{"mission.safety_factor", "1.5"}});
   EXPECT_NE(m.find("mission.safety_factor"), std::string::npos) << m;
   try {
-    LoadScenario(Config("scenarios/hover.yaml"), {{"mission", "{type: assembly_plan, goal_m: [1, 0, 1]}"}});
+    LoadScenario(Config("scenarios/hover.yaml"),
+                 {{"truth", "ideal"}, {"mission", "{type: assembly_plan, goal_m: [1, 0, 1]}"}});
     ADD_FAILURE() << "a single vehicle accepted mission assembly_plan";
   } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("plans for an assembly"), std::string::npos) << e.what();

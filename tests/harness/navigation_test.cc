@@ -18,7 +18,8 @@ std::string Config(const std::string& name) {
 
 /// The indoor scenario cut to its first `waypoints` waypoints, flown once.
 Scenario ShortIndoor(int waypoints, double duration_s) {
-  Scenario s = LoadScenario(Config("indoor_waypoints.yaml"), {{"duration_s", std::to_string(duration_s)}});
+  Scenario s =
+      LoadScenario(Config("indoor_waypoints.yaml"), {{"truth", "ideal"}, {"duration_s", std::to_string(duration_s)}});
   s.stack.navigation.waypoints.resize(static_cast<std::size_t>(waypoints));
   s.stack.navigation.rounds = 1;
   return s;
@@ -86,7 +87,7 @@ TEST(Navigation, ThePlansKeepThePreFailureClearanceUntilTheAttitudeHasRecovered)
 class NavigationWithFiles : public rotorguard::testing::TempFolderTest {};
 
 TEST_F(NavigationWithFiles, AnObstacleMovedOntoThePathIsSeenAndFlownAround) {
-  Scenario s = LoadScenario(Config("room_navigate.yaml"), {{"duration_s", "16"}});
+  Scenario s = LoadScenario(Config("room_navigate.yaml"), {{"truth", "ideal"}, {"duration_s", "16"}});
   s.stack.navigation.waypoints.resize(1);
   // A person-sized box steps into the way near the goal 1 s after the vehicle set off, and stays.
   sim::MovingBox box;
@@ -142,7 +143,8 @@ TEST(Navigation, TheFailureUnawareVariantKeepsItsNominalAccelerationLimit) {
 }
 
 TEST(Navigation, LosingOdometryLandsAndTheLandingCompletesWhenItReturns) {
-  Scenario s = LoadScenario(Config("hover.yaml"), {{"duration_s", "14"}, {"stack.controller", "nmpc"}});
+  Scenario s =
+      LoadScenario(Config("hover.yaml"), {{"truth", "ideal"}, {"duration_s", "14"}, {"stack.controller", "nmpc"}});
   s.sim.odometry.outages.push_back({2.0, 1.0});  // 0.5 s without odometry is a lost estimator
   const RunSummary r = RunScenario(s);
   EXPECT_FALSE(r.crashed) << r.crash_reason.value_or("");

@@ -1,4 +1,6 @@
-// Closed-loop flights of the shipped scenarios: the nominal stack through sensors only.
+// Closed-loop flights of the shipped scenarios: the nominal stack through sensors only. They hold
+// the stack to figures of the world where its model is exact (`truth: ideal`); the realistic
+// world's outcomes are shipped_scenarios_test.cc's and the benchmarks' (docs/benchmarks.md).
 
 #include <gtest/gtest.h>
 
@@ -21,7 +23,7 @@ std::string Config(const std::string& name) {
 }
 
 TEST(Runner, NominalControllerTracksThe2msLemniscateWithinTenCentimetres) {
-  const Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"));
+  const Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"truth", "ideal"}});
   const RunSummary r = RunScenario(s);
   EXPECT_TRUE(r.success) << r.crash_reason.value_or("");
   EXPECT_LT(r.tracking_rmse_m, 0.10);
@@ -31,7 +33,7 @@ TEST(Runner, NominalControllerTracksThe2msLemniscateWithinTenCentimetres) {
 TEST(Runner, NominalControllerTracksTheLemniscateOverManySeeds) {
   // Sensor noise and gusts differ per seed; the bound must hold for each, not on average.
   for (std::uint64_t seed = 10; seed < 16; ++seed) {
-    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"duration_s", "20"}});
+    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"truth", "ideal"}, {"duration_s", "20"}});
     s.seed = seed;
     const RunSummary r = RunScenario(s);
     EXPECT_TRUE(r.success) << "seed " << seed;
@@ -40,7 +42,7 @@ TEST(Runner, NominalControllerTracksTheLemniscateOverManySeeds) {
 }
 
 TEST(Runner, HoverHoldsPosition) {
-  const RunSummary r = RunScenario(LoadScenario(Config("hover.yaml")));
+  const RunSummary r = RunScenario(LoadScenario(Config("hover.yaml"), {{"truth", "ideal"}}));
   EXPECT_TRUE(r.success);
   EXPECT_LT(r.max_position_error_m, 0.05);
   EXPECT_GT(r.min_altitude_m, 0.95);
@@ -50,7 +52,7 @@ TEST(Runner, HoverHoldsPosition) {
 class RunnerFiles : public testing::TempFolderTest {};
 
 TEST_F(RunnerFiles, TheStackFliesTheVehicleFileWhileTheSimulatorFliesTheDraw) {
-  Scenario s = LoadScenario(Config("hover.yaml"), {{"duration_s", "3"}});
+  Scenario s = LoadScenario(Config("hover.yaml"), {{"truth", "ideal"}, {"duration_s", "3"}});
   s.truth.preset = sim::TruthPreset::kRealistic;
   RunOptions o;
   o.out_dir = dir_.string();
@@ -69,7 +71,7 @@ TEST_F(RunnerFiles, TheStackFliesTheVehicleFileWhileTheSimulatorFliesTheDraw) {
 }
 
 TEST_F(RunnerFiles, TheSameSeedFliesTheSameDrawAndAnotherSeedAnother) {
-  Scenario s = LoadScenario(Config("hover.yaml"), {{"duration_s", "2"}});
+  Scenario s = LoadScenario(Config("hover.yaml"), {{"truth", "ideal"}, {"duration_s", "2"}});
   s.truth.preset = sim::TruthPreset::kRealistic;
   const auto fly = [&](std::uint64_t seed) {
     Scenario t = s;
@@ -86,7 +88,7 @@ TEST_F(RunnerFiles, TheSameSeedFliesTheSameDrawAndAnotherSeedAnother) {
 }
 
 TEST(Runner, TakesOffFromTheGroundAndSettlesAtAltitude) {
-  const Scenario s = LoadScenario(Config("takeoff.yaml"));
+  const Scenario s = LoadScenario(Config("takeoff.yaml"), {{"truth", "ideal"}});
   ASSERT_EQ(s.initial_position_m.z(), 0.0);
   const RunSummary r = RunScenario(s);
   EXPECT_TRUE(r.success) << r.crash_reason.value_or("");
@@ -95,7 +97,7 @@ TEST(Runner, TakesOffFromTheGroundAndSettlesAtAltitude) {
 }
 
 TEST(Runner, NominalControllerCrashesAfterAMotorStop) {
-  const RunSummary r = RunScenario(LoadScenario(Config("hover_motor_stop_nominal.yaml")));
+  const RunSummary r = RunScenario(LoadScenario(Config("hover_motor_stop_nominal.yaml"), {{"truth", "ideal"}}));
   EXPECT_TRUE(r.crashed);
   EXPECT_FALSE(r.success);
   ASSERT_EQ(r.faults.size(), 1u);
@@ -109,6 +111,7 @@ class RunnerWindowTest : public rotorguard::testing::TempFolderTest {
   std::string WithMetrics(const std::string& metrics) {
     std::string text = io::ReadInputFile(Config("hover_motor_stop_nominal.yaml"));
     text.replace(text.find("../vehicles/"), 12, testing::SourcePath("configs/vehicles/"));
+    text.replace(text.find("truth: realistic"), 16, "truth: ideal");  // the figures of the exact model
     return Write("s.yaml", text + "metrics: " + metrics + "\n");
   }
 };
@@ -118,7 +121,7 @@ TEST_F(RunnerWindowTest, ACrashedVehicleIsHeldAtItsCrashSiteForTheRestOfTheWindo
   // (the final state) puts it. Over [0, T] the window's mean square error is the flown part's
   // plus the wreck's constant distance over (t_crash, T]:
   //   rmse_window^2 T = rmse_flown^2 t_crash + |wreck - p_ref|^2 (T - t_crash).
-  const Scenario s = LoadScenario(Config("hover_motor_stop_nominal.yaml"));
+  const Scenario s = LoadScenario(Config("hover_motor_stop_nominal.yaml"), {{"truth", "ideal"}});
   RunOptions o;
   o.out_dir = dir_.string();
   const RunSummary r = RunScenario(s, o);
@@ -139,7 +142,7 @@ TEST_F(RunnerWindowTest, ACrashedVehicleIsHeldAtItsCrashSiteForTheRestOfTheWindo
 }
 
 TEST(RunnerWindow, AFlightThatDoesNotCrashHasOneError) {
-  const RunSummary r = RunScenario(LoadScenario(Config("hover.yaml")));
+  const RunSummary r = RunScenario(LoadScenario(Config("hover.yaml"), {{"truth", "ideal"}}));
   ASSERT_FALSE(r.crashed);
   EXPECT_EQ(r.tracking_rmse_window_m, r.tracking_rmse_m);
 }
@@ -147,7 +150,7 @@ TEST(RunnerWindow, AFlightThatDoesNotCrashHasOneError) {
 TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
   // The motor stops at 2 s: a window that ends at 1.5 s holds only the steady hover, and the
   // crash after it adds nothing to the window.
-  const Scenario whole = LoadScenario(Config("hover_motor_stop_nominal.yaml"));
+  const Scenario whole = LoadScenario(Config("hover_motor_stop_nominal.yaml"), {{"truth", "ideal"}});
   const Scenario early = LoadScenario(WithMetrics("{tracking_end_s: 1.5}"));
   ASSERT_TRUE(early.tracking_end_s.has_value());
   const RunSummary a = RunScenario(whole), b = RunScenario(early);
@@ -167,8 +170,8 @@ TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
   for (const auto& [metrics, key] : bad) {
     SCOPED_TRACE(metrics);
     const std::string path = WithMetrics(metrics);
-    RG_EXPECT_THROW_WITH(LoadScenario(path), io::ConfigError, "s.yaml");
-    RG_EXPECT_THROW_WITH(LoadScenario(path), io::ConfigError, key);
+    RG_EXPECT_THROW_WITH(LoadScenario(path, {{"truth", "ideal"}}), io::ConfigError, "s.yaml");
+    RG_EXPECT_THROW_WITH(LoadScenario(path, {{"truth", "ideal"}}), io::ConfigError, key);
   }
   // One step's window is enough.
   EXPECT_NO_THROW(LoadScenario(WithMetrics("{tracking_start_s: 1, tracking_end_s: 1.001}")));
@@ -177,17 +180,18 @@ TEST_F(RunnerWindowTest, TheWindowsEndLeavesOutWhatComesAfterIt) {
 // Closed-loop NMPC flights (paper 000, Sec. VI-A/B), the failure handed to the controller.
 
 TEST(NmpcClosedLoop, HoversAndTracksTheNominal2msLemniscate) {
-  const RunSummary hover = RunScenario(LoadScenario(Config("hover.yaml"), {{"stack.controller", "nmpc"}}));
+  const RunSummary hover =
+      RunScenario(LoadScenario(Config("hover.yaml"), {{"truth", "ideal"}, {"stack.controller", "nmpc"}}));
   EXPECT_TRUE(hover.success) << hover.failure_reason.value_or("");
   EXPECT_LT(hover.max_position_error_m, 0.05);
-  const RunSummary lem = RunScenario(
-      LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}, {"duration_s", "20"}}));
+  const RunSummary lem = RunScenario(LoadScenario(
+      Config("lemniscate_2ms.yaml"), {{"truth", "ideal"}, {"stack.controller", "nmpc"}, {"duration_s", "20"}}));
   EXPECT_TRUE(lem.success) << lem.failure_reason.value_or("");
   EXPECT_LT(lem.tracking_rmse_m, 0.10);
 }
 
 TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverAndRecoversRollAndPitch) {
-  const Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"));
+  const Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"), {{"truth", "ideal"}});
   const RunSummary r = RunScenario(s);
   EXPECT_TRUE(r.success) << r.failure_reason.value_or("");
   EXPECT_GT(r.min_altitude_m, 2.0 - 0.2);  // altitude within 0.2 m of the hover height
@@ -198,7 +202,7 @@ TEST(NmpcClosedLoop, SurvivesAKnownMotorFailureInHoverAndRecoversRollAndPitch) {
 TEST(FddClosedLoop, TheControllerIsReconfiguredAtTheFirstControlCycleAfterTheIsolation) {
   // The isolation is taken by the next control cycle: the reconfiguration follows the detection by
   // at most one control period (both include the ESC telemetry's delay).
-  const Scenario s = LoadScenario(Config("fdd_hover_motor_stop.yaml"));
+  const Scenario s = LoadScenario(Config("fdd_hover_motor_stop.yaml"), {{"truth", "ideal"}});
   const RunSummary r = RunScenario(s);
   ASSERT_TRUE(r.fdd.has_value());
   ASSERT_TRUE(r.fdd->correct);
@@ -213,8 +217,8 @@ TEST(NmpcClosedLoop, TheSpinAfterAMotorStopIsWhereYawDampingBalancesTheReactionT
   // k_dψ. The vehicle file's k_dψ was chosen to give the paper's 11 rad/s; the law must hold for
   // others too, each predicted from the vehicle's κ_t, m and g alone.
   for (const double k_d : {0.0088, 0.011, 0.022}) {
-    const Scenario s =
-        LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"), {{"vehicle.yaw_damping_n_m_s", std::to_string(k_d)}});
+    const Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"),
+                                    {{"truth", "ideal"}, {"vehicle.yaw_damping_n_m_s", std::to_string(k_d)}});
     const RunSummary r = RunScenario(s);
     const double predicted = s.vehicle.rotors[0].yaw_coefficient_m * s.vehicle.weight_n() / k_d;
     EXPECT_TRUE(r.success) << "k_d " << k_d << ": " << r.failure_reason.value_or("");
@@ -226,9 +230,11 @@ TEST(NmpcClosedLoop, TheSpinAfterAMotorStopIsWhereYawDampingBalancesTheReactionT
 // against the paper's every-call linearisation, through a motor stop and its spin-up to 11 rad/s:
 // the same recovery, to within a few percent of the error.
 TEST(NmpcClosedLoop, ReusingTheLinearisationBetweenEveryThirdPreparationFliesTheSameFailure) {
-  EXPECT_EQ(LoadScenario(Config("forest.yaml")).stack.nmpc.relinearise_every, 3) << "the key is read";
-  EXPECT_EQ(LoadScenario(Config("forest.yaml")).stack.lidar.map.clearing_stride, 2) << "and the map's";
-  Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"));
+  EXPECT_EQ(LoadScenario(Config("forest.yaml"), {{"truth", "ideal"}}).stack.nmpc.relinearise_every, 3)
+      << "the key is read";
+  EXPECT_EQ(LoadScenario(Config("forest.yaml"), {{"truth", "ideal"}}).stack.lidar.map.clearing_stride, 2)
+      << "and the map's";
+  Scenario s = LoadScenario(Config("nmpc_hover_motor_stop_known.yaml"), {{"truth", "ideal"}});
   EXPECT_EQ(s.stack.nmpc.relinearise_every, 1) << "the default";
   const RunSummary every = RunScenario(s);
   s.stack.nmpc.relinearise_every = 3;
@@ -244,7 +250,8 @@ TEST(NmpcClosedLoop, ReusingTheLinearisationBetweenEveryThirdPreparationFliesThe
 }
 
 TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {
-  const RunSummary r = RunScenario(LoadScenario(Config("nmpc_lemniscate_1ms_rotor0_failed.yaml")));
+  const RunSummary r =
+      RunScenario(LoadScenario(Config("nmpc_lemniscate_1ms_rotor0_failed.yaml"), {{"truth", "ideal"}}));
   EXPECT_TRUE(r.success) << r.failure_reason.value_or("");
   EXPECT_LE(r.tracking_rmse_m, 0.15);  // paper 000's hardware: 0.14-0.15 m
   EXPECT_GT(r.max_spin_rad_s, 9.0);
@@ -254,7 +261,8 @@ TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {
 
 TEST(FddClosedLoop, IsolatesAndSurvivesEachFaultKindInHover) {
   for (const char* kind : {"propeller_loss", "motor_stop"}) {
-    const RunSummary r = RunScenario(LoadScenario(Config(std::string("fdd_hover_") + kind + ".yaml")));
+    const RunSummary r =
+        RunScenario(LoadScenario(Config(std::string("fdd_hover_") + kind + ".yaml"), {{"truth", "ideal"}}));
     EXPECT_TRUE(r.success) << kind << ": " << r.failure_reason.value_or("");
     ASSERT_TRUE(r.fdd.has_value());
     ASSERT_TRUE(r.fdd->detected()) << kind;
@@ -267,7 +275,8 @@ TEST(FddClosedLoop, IsolatesAndSurvivesEachFaultKindInHover) {
 
 TEST(FddClosedLoop, NoFalseAlarmOnTheAggressiveNominalLemniscate) {
   for (std::uint64_t seed : {21u, 22u}) {
-    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}, {"stack.fdd", "composite"}});
+    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"),
+                              {{"truth", "ideal"}, {"stack.controller", "nmpc"}, {"stack.fdd", "composite"}});
     s.seed = seed;
     const RunSummary r = RunScenario(s);
     ASSERT_TRUE(r.fdd.has_value());
@@ -280,8 +289,9 @@ TEST(FddClosedLoop, NoFalseAlarmOnTheAggressiveNominalLemniscate) {
 TEST(FddClosedLoop, AFaultDuringTakeoffOnEachRotorEndsInAStableHover) {
   for (int rotor = 0; rotor < 4; ++rotor) {
     for (const char* kind : {"propeller_loss", "motor_stop"}) {
-      const Scenario s = LoadScenario(Config("fdd_takeoff_propeller_loss.yaml"),
-                                      {{"faults.0.rotor", std::to_string(rotor)}, {"faults.0.kind", kind}});
+      const Scenario s =
+          LoadScenario(Config("fdd_takeoff_propeller_loss.yaml"),
+                       {{"truth", "ideal"}, {"faults.0.rotor", std::to_string(rotor)}, {"faults.0.kind", kind}});
       const RunSummary r = RunScenario(s);
       EXPECT_TRUE(r.success) << "rotor " << rotor << " " << kind << ": " << r.failure_reason.value_or("");
       ASSERT_TRUE(r.fdd.has_value());
@@ -295,8 +305,8 @@ TEST(FddClosedLoop, AFaultDuringTakeoffOnEachRotorEndsInAStableHover) {
 }
 
 TEST(PassiveClosedLoop, TracksTheNominalLemniscateWithYawLeftFree) {
-  const RunSummary r = RunScenario(
-      LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "passive"}, {"duration_s", "20"}}));
+  const RunSummary r = RunScenario(LoadScenario(
+      Config("lemniscate_2ms.yaml"), {{"truth", "ideal"}, {"stack.controller", "passive"}, {"duration_s", "20"}}));
   EXPECT_TRUE(r.success) << r.failure_reason.value_or("");
   EXPECT_LT(r.tracking_rmse_m, 0.10);
 }
@@ -306,9 +316,11 @@ TEST(PassiveClosedLoop, TracksTheNominalLemniscateWithYawLeftFree) {
 TEST(IndiClosedLoop, KeepsHoveringAfterEitherFaultOnEveryRotor) {
   for (int rotor = 0; rotor < 4; ++rotor) {
     for (const char* kind : {"propeller_loss", "motor_stop"}) {
-      const RunSummary r = RunScenario(LoadScenario(
-          Config("fdd_hover_propeller_loss.yaml"),
-          {{"stack.controller", "indi"}, {"faults.0.rotor", std::to_string(rotor)}, {"faults.0.kind", kind}}));
+      const RunSummary r =
+          RunScenario(LoadScenario(Config("fdd_hover_propeller_loss.yaml"), {{"truth", "ideal"},
+                                                                             {"stack.controller", "indi"},
+                                                                             {"faults.0.rotor", std::to_string(rotor)},
+                                                                             {"faults.0.kind", kind}}));
       EXPECT_TRUE(r.success) << "rotor " << rotor << " " << kind << ": " << r.failure_reason.value_or("");
       ASSERT_TRUE(r.fdd.has_value());
       EXPECT_TRUE(r.fdd->correct) << "rotor " << rotor << " " << kind;
@@ -323,7 +335,7 @@ TEST(IndiClosedLoop, KeepsHoveringAfterEitherFaultOnEveryRotor) {
 // smear into free space.
 TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
   double precision[2] = {0.0, 0.0};
-  const Scenario s = LoadScenario(Config("room_lidar_propeller_loss.yaml"));
+  const Scenario s = LoadScenario(Config("room_lidar_propeller_loss.yaml"), {{"truth", "ideal"}});
   for (int deskew = 0; deskew < 2; ++deskew) {
     Scenario variant = s;
     variant.stack.lidar.deskew_frames = deskew == 1;
@@ -351,7 +363,7 @@ TEST(LidarClosedLoop, MapsTheRoomWhileSpinningAndDeskewingIsWhatKeepsItSharp) {
 // true surface (checked here against the world at each control cycle, beside the simulator's crash
 // detection).
 TEST(NavigationClosedLoop, FliesTheRoomsWaypointsOnItsLidarMap) {
-  const Scenario s = LoadScenario(Config("room_navigate.yaml"));
+  const Scenario s = LoadScenario(Config("room_navigate.yaml"), {{"truth", "ideal"}});
   double closest = 1e9;
   RunOptions o;
   o.on_control_cycle = [&](const stack::FlightStack& st) {

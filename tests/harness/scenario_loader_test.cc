@@ -55,9 +55,8 @@ TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
 }
 
 TEST_F(ScenarioLoader, TruthIsAPresetWordOrABlockThatOverridesItsRanges) {
-  EXPECT_EQ(LoadScenario(File("mission: {type: hover}\n")).truth.preset, sim::TruthPreset::kIdeal);
-  EXPECT_EQ(LoadScenario(File("truth: realistic\nmission: {type: hover}\n")).truth.preset,
-            sim::TruthPreset::kRealistic);
+  EXPECT_EQ(LoadScenario(File("mission: {type: hover}\n")).truth.preset, sim::TruthPreset::kRealistic);
+  EXPECT_EQ(LoadScenario(File("truth: ideal\nmission: {type: hover}\n")).truth.preset, sim::TruthPreset::kIdeal);
   const Scenario s = LoadScenario(File("truth: {preset: realistic, mass_fraction: 0.02}\nmission: {type: hover}\n"));
   EXPECT_EQ(s.truth.Ranges().mass_fraction, 0.02);
   EXPECT_EQ(s.truth.Ranges().inertia_fraction, sim::RangesOf(sim::TruthPreset::kRealistic).inertia_fraction);

@@ -29,7 +29,9 @@ TruthOptions Realistic() {
 
 TEST(Truth, TheIdealWorldIsTheFileExactly) {
   const vehicle::VehicleParams file = ReferenceQuad();
-  const TruthDraw d = DrawTruth(TruthOptions{}, file, 42);
+  TruthOptions ideal;
+  ideal.preset = TruthPreset::kIdeal;
+  const TruthDraw d = DrawTruth(ideal, file, 42);
   EXPECT_EQ(d.mass_ratio, 1.0);
   EXPECT_EQ(d.inertia_ratio, Vector3::Ones());
   EXPECT_EQ(d.cog_offset_m, Vector3::Zero());

@@ -32,7 +32,7 @@ struct FtcBenchOptions {
   vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
   /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
   /// vehicle file the stack reads; every method flies the same draw of a trial.
-  sim::TruthPreset truth = sim::TruthPreset::kIdeal;
+  sim::TruthPreset truth = sim::TruthPreset::kRealistic;
   /// Called after each finished trial with (done, total).
   std::function<void(int, int)> progress;
   void Validate() const;

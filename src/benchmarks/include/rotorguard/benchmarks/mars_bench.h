@@ -36,7 +36,7 @@ struct MarsBenchOptions {
   harness::Scenario plan_4x1, plan_3x2;
   /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
   /// vehicle file the stack reads; every method flies the same draw of a trial.
-  sim::TruthPreset truth = sim::TruthPreset::kIdeal;
+  sim::TruthPreset truth = sim::TruthPreset::kRealistic;
   std::function<void(int, int)> progress;
   /// Throws std::invalid_argument naming the field.
   void Validate() const;

@@ -27,7 +27,7 @@ struct NavBenchOptions {
   harness::Scenario base;
   /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
   /// vehicle file the stack reads; every method flies the same draw of a trial.
-  sim::TruthPreset truth = sim::TruthPreset::kIdeal;
+  sim::TruthPreset truth = sim::TruthPreset::kRealistic;
   std::function<void(int, int)> progress;  ///< (flights done, flights in all)
   /// Throws std::invalid_argument naming the field.
   void Validate() const;

@@ -57,7 +57,7 @@ TruthRanges RangesOf(TruthPreset preset);
 
 /// The scenario's `truth` block: a preset, and any of its ranges overridden.
 struct TruthOptions {
-  TruthPreset preset = TruthPreset::kIdeal;
+  TruthPreset preset = TruthPreset::kRealistic;  ///< a scenario that names none flies a drawn vehicle
   std::optional<double> mass_fraction, inertia_fraction, cog_offset_m, thrust_coefficient_fraction,
       yaw_coefficient_fraction, motor_time_constant_fraction, rotor_drag_fraction, imu_offset_m, external_torque_n_m,
       motor_stop_time_constant_min_s, motor_stop_time_constant_max_s, imu_vibration_m_s2, esc_gain_fraction,
