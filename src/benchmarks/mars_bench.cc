@@ -434,10 +434,11 @@ nlohmann::json Reconfiguration(const std::vector<const nlohmann::json*>& records
   return variants;
 }
 
-/// Table II from its records: (row, planner, trial), the trial fastest. Each trial plans its own
-/// (perturbed) start and goal with both planners; a method's cell is over the flights it could
-/// plan (its plan rate beside), the comparison over the trials both could plan (paired).
-nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int trials) {
+}  // namespace
+
+// Each trial plans its own (perturbed) start and goal with both planners: a method's cell is over
+// the flights it could plan (its plan rate beside), the comparison over the trials both planned.
+nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, int trials) {
   nlohmann::json table = nlohmann::json::array();
   double sum[2] = {0.0, 0.0}, sum_to_crash[2] = {0.0, 0.0}, improvement_sum = 0.0;
   int compared = 0;
@@ -527,8 +528,6 @@ nlohmann::json TableTwo(const std::vector<const nlohmann::json*>& records, int t
           {"table2_ours_better_in_every_row", all_better}};
 }
 
-}  // namespace
-
 nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
   const int trials = options.at("trials").get<int>();
   const std::vector<const nlohmann::json*> alloc = PartOf(records, "alloc"), t1 = PartOf(records, "table1"),
@@ -538,7 +537,7 @@ nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohm
   const nlohmann::json table1 = TableOne(t1, trials, &within);
   const nlohmann::json reconfig =
       options.at("reconfigure").get<bool>() ? Reconfiguration(rc, trials) : nlohmann::json();
-  const nlohmann::json table2 = options.at("table2").get<bool>() ? TableTwo(t2, trials) : nlohmann::json();
+  const nlohmann::json table2 = options.at("table2").get<bool>() ? MarsTableTwo(t2, trials) : nlohmann::json();
   nlohmann::json failures = nlohmann::json::array();
   for (const nlohmann::json* f : t1) {
     if (failures.size() >= 10) break;

@@ -73,6 +73,57 @@ TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError
   RG_EXPECT_THROW_WITH(RunMarsBenchmark(o), std::invalid_argument, "trials = 0");
 }
 
+// Table II on hand-made records: 5 rows x 2 planners (baseline, ours) x 3 trials. In row 0 the
+// baseline plans trials 0 and 1 (errors 0.2, 0.4 m; trial 1 crashed) and not trial 2, ours all three
+// (0.1, 0.1, 0.7 m): the cells are over each method's own plans, the comparison over trials 0 and 1.
+TEST(MarsTableTwo, CellsAreOverEachMethodsPlansAndTheComparisonOverTheTrialsBothPlanned) {
+  const auto flight = [](double rmse, bool success) {
+    return nlohmann::json{{"status", "ok"},
+                          {"message", success ? "" : "crash: collision with box 0"},
+                          {"params", {{"shape", "mars_4x1"}, {"fault", "normal"}}},
+                          {"metrics",
+                           {{"planned", true},
+                            {"success", success},
+                            {"rmse_m", rmse},
+                            {"rmse_flown_m", rmse / 2},
+                            {"max_error_m", 2 * rmse},
+                            {"duration_s", 6.0},
+                            {"attitude_deviation_deg", 1.0},
+                            {"plan_ms", 10.0},
+                            {"max_accel_m_s2", 1.0},
+                            {"max_thrust_accel_m_s2", 11.0},
+                            {"max_yaw_accel_rad_s2", 2.0},
+                            {"capacity_accel_m_s2", 5.0},
+                            {"capacity_thrust_accel_m_s2", 20.0},
+                            {"capacity_yaw_accel_rad_s2", 4.0}}}};
+  };
+  const nlohmann::json no_plan = {{"status", "ok"},
+                                  {"message", "A*: no_path"},
+                                  {"params", {{"shape", "mars_4x1"}, {"fault", "normal"}}},
+                                  {"metrics", {{"planned", false}}}};
+  std::vector<nlohmann::json> records;
+  for (int row = 0; row < 5; ++row) {
+    for (const nlohmann::json& r : {flight(0.2, true), flight(0.4, false), no_plan}) records.push_back(r);  // baseline
+    for (const nlohmann::json& r : {flight(0.1, true), flight(0.1, true), flight(0.7, true)}) records.push_back(r);
+  }
+  std::vector<const nlohmann::json*> pointers;
+  for (const nlohmann::json& r : records) pointers.push_back(&r);
+  const nlohmann::json t = MarsTableTwo(pointers, 3);
+  const nlohmann::json& row = t["table2"][0];
+  EXPECT_NEAR(row["baseline_error_m"].get<double>(), 0.3, 1e-12);             // its two plans
+  EXPECT_NEAR(row["baseline_success_rate"].get<double>(), 1.0 / 3.0, 1e-12);  // of three trials
+  EXPECT_NEAR(row["baseline_plan_rate"].get<double>(), 2.0 / 3.0, 1e-12);
+  EXPECT_EQ(row["baseline_plan_failure"], "A*: no_path");
+  EXPECT_NEAR(row["ours_error_m"].get<double>(), 0.3, 1e-12);  // (0.1 + 0.1 + 0.7) / 3
+  EXPECT_EQ(row["paired_trials"], 2);
+  EXPECT_NEAR(row["improvement"].get<double>(), 1.0 - 0.1 / 0.3, 1e-12);  // trials 0 and 1 only
+  EXPECT_NEAR(t["table2_improvement_average"].get<double>(), 1.0 - 0.1 / 0.3, 1e-12);
+  EXPECT_TRUE(t["table2_ours_better_in_every_row"].get<bool>());
+  records.pop_back();
+  pointers.pop_back();
+  EXPECT_THROW(MarsTableTwo(pointers, 3), std::invalid_argument);
+}
+
 TEST(Reconfiguration, AUnitSeparatesFliesOverAndDocksWhileTheAssemblyStaysLevel) {
   ReconfigurationOptions o;
   o.base = harness::LoadScenario(Config("scenarios/mars_reconfigure_3x1.yaml"));

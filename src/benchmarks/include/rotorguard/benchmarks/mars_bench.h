@@ -44,12 +44,18 @@ struct MarsBenchOptions {
 
 /// The benchmark as a campaign (campaign.h): one trial timing the allocation, then Table I's
 /// flights (part table1: case, method, trial), the self-reconfiguration's (part reconfig: trial,
-/// switch) and Table II's (part table2: row, planner, trial; each plan made once per process).
+/// switch) and Table II's (part table2: row, planner, trial; each trial plans its own perturbed
+/// start and goal).
 /// Its hash covers the options and every scene. Throws std::invalid_argument for bad options.
 campaign::Campaign MarsCampaign(const MarsBenchOptions& options);
 /// RunMarsBenchmark's result from the campaign's records (in trial order) and its options
 /// (`Campaign::bench["options"]`). A trial recorded as error or diverged counts as a failure.
 nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records);
+/// Table II from its records, (row, planner, trial) with the trial fastest, the baseline planner
+/// first (docs/metrics.md, "Table II of bench mars"): {table2: [rows], table2_rows_compared,
+/// table2_improvement_average, table2_improvement_row_mean, table2_improvement_average_to_crash,
+/// table2_ours_better_in_every_row}. Throws std::invalid_argument for a wrong record count.
+nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, int trials);
 
 /// Runs MarsCampaign on `jobs` threads in a temporary folder:
 /// {table1: [{case, faults, hover_attainable, none_error_m, partial_error_m, full_error_m,
