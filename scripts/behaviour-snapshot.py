@@ -9,8 +9,12 @@ wall-clock figures removed, into one folder. Two folders made by two builds are 
 truth_vehicle.yaml byte for byte, the NMPC's solve-time column aside), the same summaries and benchmark figures (timing
 keys aside), and the same error messages and exit codes.
 
-    scripts/behaviour-snapshot.py build/bin/rotorguard /tmp/snap-after [--qp-instance FILE]
+    scripts/behaviour-snapshot.py build/bin/rotorguard /tmp/snap-after [--qp-instance FILE] [--truth ideal]
     diff -r /tmp/snap-before /tmp/snap-after
+
+`--truth ideal` flies every scenario that states a world, and every benchmark that has a world, in
+that one: a snapshot of a build from before the realistic world became the default is compared
+with `--truth ideal` of a later one.
 
 Takes about 80 s on a 2-core machine: the scenarios one after another, the sampled benchmarks with
 --jobs 2. Standard library only (Debian's python3).
@@ -70,8 +74,9 @@ def digest(text):
 
 
 class Snapshot:
-    def __init__(self, exe, out):
+    def __init__(self, exe, out, truth=None):
         self.exe = os.path.abspath(exe)
+        self.truth = truth
         self.out = out
         self.work = tempfile.mkdtemp(prefix="rotorguard-snapshot-")
         self.dropped = set()
@@ -98,7 +103,10 @@ class Snapshot:
             stem = name[:-5]
             run_dir = os.path.join(self.work, "runs", stem)
             print(f"  run {name}", file=sys.stderr, flush=True)
-            code, out, err = self.run(["run", f"configs/scenarios/{name}", "--out", run_dir, "--no-report"])
+            world = []
+            if self.truth and re.search(r"^truth:", open(os.path.join(folder, name)).read(), re.M):
+                world = ["--set", f"truth={self.truth}"]
+            code, out, err = self.run(["run", f"configs/scenarios/{name}", "--out", run_dir, "--no-report"] + world)
             base = f"scenarios/{stem}/"
             self.write(base + "exit", f"{code}\n{err}")
             self.write(base + "stdout", self.stdout_lines(out))
@@ -135,6 +143,9 @@ class Snapshot:
         }
         if qp_instance:
             cases["qp"] = ["bench", "qp", "--instance", os.path.abspath(qp_instance), "--repetitions", "1", "--json"]
+        if self.truth:
+            for name in ("ftc", "nav", "flatness", "mars"):
+                cases[name] = cases[name] + ["--truth", self.truth]
         for name, args in cases.items():
             print(f"  {' '.join(args[:2])}", file=sys.stderr, flush=True)
             code, out, err = self.run(args)
@@ -359,8 +370,10 @@ def main():
     p.add_argument("rotorguard", help="the program to snapshot, e.g. build/bin/rotorguard")
     p.add_argument("out", help="the snapshot's folder (replaced)")
     p.add_argument("--qp-instance", help="an OCP QP instance for `bench qp` (skipped without one)")
+    p.add_argument("--truth", choices=["ideal", "realistic"],
+                   help="fly the scenarios that state a world, and the benchmarks, in this one")
     a = p.parse_args()
-    Snapshot(a.rotorguard, a.out).make(a.qp_instance)
+    Snapshot(a.rotorguard, a.out, a.truth).make(a.qp_instance)
 
 
 if __name__ == "__main__":
