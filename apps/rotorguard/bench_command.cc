@@ -55,7 +55,7 @@ class BenchCommand final : public Command {
                     "with `campaign merge` when all are done");
       b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
     }
-    for (CLI::App* b : {ftc_, nav_, mars_, flatness_}) {
+    for (CLI::App* b : {sim_, nmpc_, ftc_, nav_, mars_, flatness_}) {
       b->add_option("--truth", truth_,
                     "The simulated vehicles: realistic (each trial draws its own about the file;\n"
                     "docs/truth.md) or ideal (the vehicle file exactly) (default realistic)");
@@ -228,7 +228,9 @@ class BenchCommand final : public Command {
     o.duration_s = ParseFinite("--duration", sim_duration_, 1e-3, 1e5);
     o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", sim_repetitions_, 1, 1000));
     const std::string path = sim_scenario_.empty() ? ConfigPath("scenarios/lemniscate_2ms.yaml") : sim_scenario_;
-    const nlohmann::json r = benchmarks::RunSimBenchmark(harness::LoadScenario(path), o);
+    harness::Scenario scenario = harness::LoadScenario(path);
+    scenario.truth = WorldOf(scenario.truth);
+    const nlohmann::json r = benchmarks::RunSimBenchmark(scenario, o);
     WriteHtml("sim", r);
     if (json_) {
       fmt::print("{}\n", r.dump(2));
@@ -265,9 +267,12 @@ class BenchCommand final : public Command {
   }
 
   int Nmpc() const {
-    const nlohmann::json r = benchmarks::RunNmpcBenchmark(
-        harness::LoadScenario(ConfigPath("scenarios/lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}}),
-        harness::LoadScenario(ConfigPath("scenarios/nmpc_lemniscate_1ms_rotor0_failed.yaml")));
+    harness::Scenario nominal =
+        harness::LoadScenario(ConfigPath("scenarios/lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}});
+    harness::Scenario failed = harness::LoadScenario(ConfigPath("scenarios/nmpc_lemniscate_1ms_rotor0_failed.yaml"));
+    nominal.truth = WorldOf(nominal.truth);
+    failed.truth = WorldOf(failed.truth);
+    const nlohmann::json r = benchmarks::RunNmpcBenchmark(nominal, failed);
     WriteHtml("nmpc", r);
     if (json_) {
       fmt::print("{}\n", r.dump(2));
@@ -283,7 +288,13 @@ class BenchCommand final : public Command {
     return r["success_nominal"].get<bool>() && r["success_failed"].get<bool>() ? kOk : kRunFailed;
   }
 
-  /// --truth: the world the campaign benchmarks fly.
+  /// A scenario's truth in the world of --truth: the preset replaced, its overrides kept.
+  sim::TruthOptions WorldOf(sim::TruthOptions truth) const {
+    truth.preset = Truth();
+    return truth;
+  }
+
+  /// --truth: the world the benchmarks fly.
   sim::TruthPreset Truth() const {
     if (const std::optional<sim::TruthPreset> p = FromName<sim::TruthPreset>(truth_)) return *p;
     throw UsageError(fmt::format("--truth '{}' is invalid; expected one of: {}", truth_,
