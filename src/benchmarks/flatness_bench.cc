@@ -64,7 +64,6 @@ nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
     Fig2Flight& f = flights[static_cast<std::size_t>(task / 2)];
     harness::Scenario s = o.fig2;
     s.seed = o.seed + static_cast<std::uint64_t>(task / 2);
-    s.truth = sim::TruthOptions();
     s.truth.preset = o.truth;
     try {
       if (task % 2 == 1) {  // the same flight without the fault: the pitch the plan asks for

@@ -39,28 +39,12 @@ FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int
   return o;
 }
 
-/// The simulator of `truth` (which it keeps a reference to) and the rest of `draw` (the IMU where
-/// it really is about the true centre of gravity, the external torque), starting hovering when the
-/// start is in the air, idle on the ground.
+/// The simulator of `truth` (which it keeps a reference to) with the sensors and disturbances of
+/// `draw`, starting hovering when the start is in the air, idle on the ground.
 sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel& truth, const sim::TruthDraw& draw) {
   const RotorVector motors =
       sc.initial_position_m.z() > 0.0 ? truth.HoverThrusts() : RotorVector::Zero(truth.num_rotors());
-  sim::SimulatorOptions options = sc.sim;
-  options.imu.position_m = sc.sim.imu.position_m - draw.cog_offset_m + draw.imu_offset_m;
-  options.external_torque_n_m = draw.external_torque_n_m;
-  options.imu.vibration_m_s2 = draw.imu_vibration_m_s2;
-  options.esc.gain = draw.esc_gain;
-  options.esc.dropout_probability = draw.esc_dropout_probability;
-  options.odometry.latency_s = draw.odometry_latency_s;
-  options.odometry.drift_m_per_sqrt_s = draw.odometry_drift_m_per_sqrt_s;
-  options.odometry.yaw_drift_rad_per_sqrt_s = draw.odometry_yaw_drift_rad_per_sqrt_s;
-  options.odometry.few_features_gain = draw.odometry_few_features_gain;
-  options.odometry.outage_rate_hz = draw.odometry_outage_rate_hz;
-  // The vibration's amplitude is given at the file's hover speed: T = m g / n = k_n ω².
-  const vehicle::VehicleParams& file = sc.vehicle;
-  options.imu.vibration_reference_speed_rad_s =
-      std::sqrt(file.weight_n() / file.num_rotors() / file.thrust_coefficient_n_s2);
-  return sim::Simulator(truth, sc.world, sc.faults, options, sc.seed,
+  return sim::Simulator(truth, sc.world, sc.faults, sim::TruthSimulatorOptions(sc.sim, sc.vehicle, draw), sc.seed,
                         truth.MakeState(sc.initial_position_m, sc.initial_yaw_rad, motors));
 }
 

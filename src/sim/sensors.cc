@@ -203,7 +203,8 @@ OdometryModel::OdometryModel(const OdometryOptions& options, const World& world,
       rng_(seed),
       drift_rng_(DeriveSeed(seed, kDriftStream)),
       outage_rng_(DeriveSeed(seed, kOutageStream)),
-      dt_(1.0 / options.rate_hz) {}
+      dt_(1.0 / options.rate_hz),
+      latency_ns_(FromSeconds(options.latency_s)) {}
 
 double OdometryModel::FewFeaturesFactor(const Vector3& p_W, double t) const {
   if (options_.few_features_gain <= 0.0) return 1.0;
@@ -258,7 +259,7 @@ void OdometryModel::Measure(const TruthSample& truth) {
 }
 
 bool OdometryModel::Deliver(TimeNs t, OdometrySample* delivered) {
-  if (pending_.empty() || pending_.front().t_ns + FromSeconds(options_.latency_s) > t) return false;
+  if (pending_.empty() || pending_.front().t_ns + latency_ns_ > t) return false;
   *delivered = pending_.front();
   pending_.pop_front();
   return true;

@@ -150,9 +150,26 @@ vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const Tr
 }
 
 RotorVector ThrustRatios(const TruthDraw& draw) {
-  RotorVector r(static_cast<Eigen::Index>(draw.thrust_coefficient_ratio.size()));
-  for (std::size_t i = 0; i < draw.thrust_coefficient_ratio.size(); ++i) r[i] = draw.thrust_coefficient_ratio[i];
-  return r;
+  const std::vector<double>& r = draw.thrust_coefficient_ratio;
+  return Eigen::Map<const RotorVector>(r.data(), static_cast<Eigen::Index>(r.size()));
+}
+
+SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const vehicle::VehicleParams& file,
+                                       const TruthDraw& draw) {
+  SimulatorOptions o = scenario;
+  o.imu.position_m = scenario.imu.position_m - draw.cog_offset_m + draw.imu_offset_m;
+  o.imu.vibration_m_s2 = draw.imu_vibration_m_s2;
+  // The vibration's amplitude is given at the file's hover speed: T = m g / n = k_n ω².
+  o.imu.vibration_reference_speed_rad_s = std::sqrt(file.weight_n() / file.num_rotors() / file.thrust_coefficient_n_s2);
+  o.external_torque_n_m = draw.external_torque_n_m;
+  o.esc.gain = draw.esc_gain;
+  o.esc.dropout_probability = draw.esc_dropout_probability;
+  o.odometry.latency_s = draw.odometry_latency_s;
+  o.odometry.drift_m_per_sqrt_s = draw.odometry_drift_m_per_sqrt_s;
+  o.odometry.yaw_drift_rad_per_sqrt_s = draw.odometry_yaw_drift_rad_per_sqrt_s;
+  o.odometry.few_features_gain = draw.odometry_few_features_gain;
+  o.odometry.outage_rate_hz = draw.odometry_outage_rate_hz;
+  return o;
 }
 
 }  // namespace rotorguard::sim

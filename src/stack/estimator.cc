@@ -21,6 +21,7 @@ void EstimatorOptions::Validate() const {
 OdometryImuEstimator::OdometryImuEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options)
     : options_(options), thrust_coefficient_(thrust_coefficient_n_s2) {
   options_.Validate();
+  imu_history_ns_ = FromSeconds(options_.imu_history_s);
 }
 
 void OdometryImuEstimator::OnEscTelemetry(const EscTelemetry& esc) {
@@ -52,7 +53,7 @@ void OdometryImuEstimator::OnImu(const ImuSample& imu) {
   w_B_ = imu.w_B;
   have_imu_ = true;
   imu_history_.push_back(imu);
-  while (imu_history_.front().t_ns < imu.t_ns - FromSeconds(options_.imu_history_s)) imu_history_.pop_front();
+  while (imu_history_.front().t_ns < imu.t_ns - imu_history_ns_) imu_history_.pop_front();
   if (!have_odometry_ || imu.t_ns <= dead_reckoned_.t_ns) return;
   Integrate(imu, &dead_reckoned_);
 }

@@ -19,7 +19,8 @@ struct FlatnessBenchOptions {
   int jobs = 1;            ///< worker threads, in [1, 256]
   /// configs/scenarios/flatness_fig2.yaml: the vehicle, the move, the fault and the stack.
   harness::Scenario fig2;
-  sim::TruthPreset truth = sim::TruthPreset::kRealistic;  ///< the world every flight flies (the file's is replaced)
+  sim::TruthPreset truth =
+      sim::TruthPreset::kRealistic;  ///< the world every flight flies (the file's preset replaced, its overrides kept)
   std::function<void(int, int)> progress;
   /// Throws std::invalid_argument naming the field.
   void Validate() const;

@@ -195,6 +195,7 @@ class OdometryModel {
   const World& world_;
   Rng rng_, drift_rng_, outage_rng_;
   double dt_;
+  TimeNs latency_ns_;
   Vector3 drift_p_ = Vector3::Zero();
   double drift_yaw_ = 0.0;
   TimeNs random_outage_end_ns_ = -1;

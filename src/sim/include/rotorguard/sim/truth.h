@@ -14,6 +14,7 @@
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
+#include "rotorguard/sim/simulator.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::sim {
@@ -252,5 +253,11 @@ vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const Tr
 /// The per-rotor thrust of the simulated motors relative to what the file's k_n gives for the
 /// same speed (MultirotorModel's thrust_ratio).
 RotorVector ThrustRatios(const TruthDraw& draw);
+
+/// The scenario's simulator options with the sensors and disturbances of `draw`: the IMU where it
+/// really is about the true centre of gravity and its vibration (given at `file`'s hover speed),
+/// the external torque, the ESC's gains and lost frames, the odometry's latency, drift and outages.
+SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const vehicle::VehicleParams& file,
+                                       const TruthDraw& draw);
 
 }  // namespace rotorguard::sim

@@ -67,6 +67,7 @@ class OdometryImuEstimator final : public Estimator {
   Vector3 w_B_ = Vector3::Zero();
   double thrust_coefficient_;
   RotorVector motor_thrust_;
+  TimeNs imu_history_ns_ = 0;          ///< options_.imu_history_s
   std::deque<ImuSample> imu_history_;  ///< the last imu_history_s of valid samples, oldest first
   Strapdown arrived_;                  ///< the latest odometry carried to its arrival
   Strapdown dead_reckoned_;            ///< restarted at every odometry sample, then integrated
