@@ -71,6 +71,7 @@ void NmpcOptions::Validate() const {
   if (relinearise_every < 1 || relinearise_every > 20) {
     ThrowValidation("NmpcOptions", "relinearise_every", relinearise_every, "an integer in [1, 20]");
   }
+  disturbance.Validate();
   qp.Validate();
 }
 
@@ -82,9 +83,12 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
       nx_(model_.nx()),
       nu_(model_.nu()),
       N_(options.horizon_steps),
-      qp_(OcpQpDims{options.horizon_steps, model_.nx(), model_.nu(),
+      qp_(OcpQpDims{options.horizon_steps,
+                    model_.nx(),
+                    model_.nu(),
                     {StateIndex::kBodyRate, StateIndex::kBodyRate + 1, StateIndex::kBodyRate + 2}}),
       qp_solver_(qp_.dims, options.qp),
+      observer_(model_, options.disturbance),
       failed_(static_cast<std::size_t>(model_.nu()), false) {
   weights_.resize(nx_);
   weights_ << options_.q_position, options_.q_attitude, options_.q_velocity, options_.q_rate,
@@ -102,10 +106,9 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
   x0_delta_.resize(nx_);
   weighted_y_.resize(nx_);
   for (int k = 0; k < N_; ++k) qp_.R[k] = options_.r_input * Eigen::MatrixXd::Identity(nu_, nu_);
-  // Minimum-norm split of a unit total thrust with zero torque.
-  hover_split_ = vehicle::PseudoInverse(vehicle::ComputeEffectivenessMatrix(vehicle_.rotors)) *
-                 Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
-  unit_split_ = hover_split_;
+  eta_ = Eigen::VectorXd::Ones(nu_);
+  torque_offset_ = Eigen::VectorXd::Zero(nu_);
+  UpdateThrustSplit();
 }
 
 void NmpcController::Reset() {
@@ -113,6 +116,8 @@ void NmpcController::Reset() {
   prepared_for_t_.reset();
   reused_since_linearisation_ = -1;
   summary_ = NmpcSummary{};
+  observer_.Reset();
+  ApplyCorrection();
 }
 
 void NmpcController::SetRotorFailed(int rotor) {
@@ -121,22 +126,43 @@ void NmpcController::SetRotorFailed(int rotor) {
   }
   if (failed_[rotor]) return;  // already reconfigured
   failed_[rotor] = true;
+  eta_[rotor] = 0.0;
   reused_since_linearisation_ = -1;  // the weights change: Q_k with them
-  u_max_[rotor] = 0.0;  // u_bar_i = 0 (paper 000, Sec. V-A)
-  UpdateThrustSplit();
+  u_max_[rotor] = 0.0;               // u_bar_i = 0 (paper 000, Sec. V-A)
   weights_[StateIndex::kQuaternion + 3] = 0.0;  // yaw is given up
-  // Reference spin: the yaw torque of the post-failure thrust split against the yaw damping.
-  const Eigen::VectorXd t_ref = ThrustReference(vehicle_.weight_n());
-  double yaw_torque = 0.0;
-  for (int i = 0; i < nu_; ++i) yaw_torque += vehicle_.rotors[i].yaw_sign() * vehicle_.rotors[i].yaw_coefficient_m * t_ref[i];
-  spin_reference_ = Eigen::Vector3d(0.0, 0.0, yaw_torque / std::max(vehicle_.yaw_damping_n_m_s, 1e-9));
+  UpdateThrustSplit();
 }
 
-Eigen::VectorXd NmpcController::ThrustReference(double total) const { return total * unit_split_; }
+void NmpcController::SetRotorEffectiveness(int rotor, double effectiveness) {
+  if (rotor < 0 || rotor >= nu_ || !std::isfinite(effectiveness)) {
+    ThrowInvalidArgument("NmpcController::SetRotorEffectiveness", "rotor, effectiveness",
+                         fmt::format("{}, {}", rotor, effectiveness),
+                         fmt::format("an index in [0, {}), a finite value", nu_));
+  }
+  if (effectiveness <= 0.0) return SetRotorFailed(rotor);
+  // Changes below a percent are noise of the estimate; each change re-linearises.
+  constexpr double kChange = 0.01;
+  const double eta = std::min(effectiveness, 1.0);
+  if (failed_[rotor] || std::abs(eta - eta_[rotor]) < kChange) return;
+  eta_[rotor] = eta;
+  reused_since_linearisation_ = -1;
+  UpdateThrustSplit();
+}
+
+Eigen::VectorXd NmpcController::ThrustReference(double total) const { return ThrustReferenceOf(total); }
 
 void NmpcController::UpdateThrustSplit() {
+  ModelCorrection correction = model_.correction();
+  correction.effectiveness = eta_;
+  model_.SetCorrection(correction);
+  const Eigen::MatrixXd E = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors) * eta_.asDiagonal();
+  torque_split_ = Eigen::MatrixXd::Zero(nu_, 3);
   if (std::none_of(failed_.begin(), failed_.end(), [](bool f) { return f; })) {
-    unit_split_ = hover_split_;
+    // Minimum-norm split of a unit total thrust with zero torque, and of unit torques.
+    const Eigen::MatrixXd pinv = E.completeOrthogonalDecomposition().pseudoInverse();
+    unit_split_ = pinv.col(0);
+    torque_split_ = pinv.rightCols<3>();
+    ApplyCorrection();
     return;
   }
   // The exact mirror image of a failed rotor through the centre of gravity (its diagonal twin on a
@@ -152,26 +178,46 @@ void NmpcController::UpdateThrustSplit() {
     }
   }
   // The others carry a unit total thrust with zero roll and pitch torque (least squares when the
-  // torques cannot balance, e.g. two adjacent rotors lost).
+  // torques cannot balance, e.g. two adjacent rotors lost); yaw is not controlled.
   std::vector<int> active;
   for (int i = 0; i < nu_; ++i) {
     if (!idle[i]) active.push_back(i);
   }
   unit_split_ = Eigen::VectorXd::Zero(nu_);
-  if (active.empty()) return;
-  Eigen::MatrixXd E(3, static_cast<int>(active.size()));
-  for (int c = 0; c < static_cast<int>(active.size()); ++c) {
-    const Eigen::Vector3d& p = vehicle_.rotors[active[c]].p_B;
-    E.col(c) << 1.0, p.y(), -p.x();
+  if (!active.empty()) {
+    Eigen::MatrixXd Ea(3, static_cast<int>(active.size()));
+    for (int c = 0; c < static_cast<int>(active.size()); ++c) Ea.col(c) = E.col(active[c]).head<3>();
+    const Eigen::MatrixXd pinv = Ea.completeOrthogonalDecomposition().pseudoInverse();
+    for (int c = 0; c < static_cast<int>(active.size()); ++c) {
+      unit_split_[active[c]] = std::max(0.0, pinv(c, 0));
+      torque_split_.row(active[c]).head<2>() = pinv.row(c).tail<2>();
+    }
   }
-  const Eigen::VectorXd t = E.completeOrthogonalDecomposition().solve(Eigen::VectorXd::Unit(3, 0));  // (1, 0, 0)
-  for (int c = 0; c < static_cast<int>(active.size()); ++c) unit_split_[active[c]] = std::max(0.0, t[c]);
+  ApplyCorrection();
+}
+
+void NmpcController::ApplyCorrection() {
+  const Eigen::Vector3d& alpha = observer_.angular_acceleration_B();
+  model_.SetDisturbance(observer_.acceleration_W(), alpha);
+  // The rotor thrusts whose torque balances the disturbance's: M diag(eta) T = -I alpha_d.
+  const Eigen::Vector3d torque = -(vehicle_.inertia_kg_m2 * alpha);
+  torque_offset_.noalias() = torque_split_ * torque;
+  if (std::none_of(failed_.begin(), failed_.end(), [](bool f) { return f; })) return;
+  // Reference spin: the yaw torque of the post-failure thrust split (and the disturbance's)
+  // against the yaw damping.
+  const double weight = vehicle_.weight_n();
+  double yaw_torque = vehicle_.inertia_kg_m2(2, 2) * alpha.z();
+  for (int i = 0; i < nu_; ++i) {
+    const double t_ref = weight * unit_split_[i] + torque_offset_[i];
+    yaw_torque += vehicle_.rotors[i].yaw_sign() * vehicle_.rotors[i].yaw_coefficient_m * eta_[i] * t_ref;
+  }
+  spin_reference_ = Eigen::Vector3d(0.0, 0.0, yaw_torque / std::max(vehicle_.yaw_damping_n_m_s, 1e-9));
 }
 
 Eigen::Vector3d NmpcController::ReferenceThrustVector(const ReferencePoint& ref) const {
   // Eq. (1) solved for the thrust vector along the reference, with the drag of the reference
   // velocity (body and world frames taken as aligned for the drag term).
-  return vehicle_.mass_kg * (ref.a_W + Eigen::Vector3d(0.0, 0.0, kGravity)) +
+  return vehicle_.mass_kg * (ref.a_W + Eigen::Vector3d(0.0, 0.0, kGravity) - model_.correction().acceleration_W) +
          vehicle_.rotor_drag_kg_s.cwiseProduct(ref.v_W);
 }
 
@@ -199,7 +245,7 @@ void NmpcController::Residual(const Eigen::VectorXd& x, const ReferencePoint& re
   y->segment<3>(0) = x.segment<3>(StateIndex::kPosition) - ref.p_W;
   y->segment<3>(7) = x.segment<3>(StateIndex::kVelocity) - ref.v_W;
   y->segment<3>(10) = x.segment<3>(StateIndex::kBodyRate) - spin_reference_;
-  y->tail(nu_) = x.tail(nu_) - ReferenceTotalThrust(ref) * unit_split_;
+  y->tail(nu_) = x.tail(nu_) - ThrustReferenceOf(ReferenceTotalThrust(ref));
   dy->block<3, 3>(0, 0).setIdentity();
   dy->block<3, 3>(7, 7).setIdentity();
   dy->block<3, 3>(10, 10).setIdentity();
@@ -257,7 +303,7 @@ void NmpcController::HoverCommand(RotorVector* thrust_command) const {
 void NmpcController::Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t) {
   for (int k = 0; k <= N_; ++k) x_[k] = x0;
   for (int k = 0; k < N_; ++k) {
-    u_[k] = (ReferenceTotalThrust(reference.Evaluate(t + k * options_.step_s)) * unit_split_).cwiseMin(u_max_);
+    u_[k] = ThrustReference(ReferenceTotalThrust(reference.Evaluate(t + k * options_.step_s))).cwiseMin(u_max_);
   }
   initialised_ = true;
 }
@@ -316,7 +362,7 @@ bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, doub
     weighted_y_ = weights_.cwiseProduct(y_);
     qp_.q[k].noalias() = dy_.transpose() * weighted_y_;
     if (k < N_) {
-      qp_.r[k] = options_.r_input * (u_[k] - ReferenceTotalThrust(ref) * unit_split_);
+      qp_.r[k] = options_.r_input * (u_[k] - ThrustReferenceOf(ReferenceTotalThrust(ref)));
       qp_.u_lower[k] = -u_[k];
       qp_.u_upper[k] = u_max_ - u_[k];
     }
@@ -419,7 +465,12 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   } else if (initialised_) {
     x0_.tail(nu_) = x_[0].tail(nu_);
   } else {
-    x0_.tail(nu_) = vehicle_.weight_n() * unit_split_;
+    x0_.tail(nu_) = ThrustReferenceOf(vehicle_.weight_n());
+  }
+  // What the model misses, from this measurement, into the prediction.
+  if (options_.disturbance.enabled) {
+    observer_.Update(x0_, t);
+    ApplyCorrection();
   }
 
   int iterations = options_.max_sqp_iterations;

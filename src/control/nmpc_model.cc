@@ -35,24 +35,54 @@ NmpcModel::NmpcModel(const vehicle::VehicleParams& params) : params_(params), nu
   inertia_ = params_.inertia_kg_m2;
   inertia_inv_ = inertia_.inverse();
   torque_map_ = vehicle::ComputeEffectivenessMatrix(params_.rotors).bottomRows<3>();
+  eta_ = Eigen::VectorXd::Ones(nu_);
+  correction_.effectiveness = eta_;
   alpha_map_ = inertia_inv_ * torque_map_;
+}
+
+void NmpcModel::SetCorrection(const ModelCorrection& c) {
+  const Eigen::VectorXd eta = c.effectiveness.size() == 0 ? Eigen::VectorXd::Ones(nu_) : c.effectiveness;
+  if (eta.size() != nu_ || !eta.allFinite() || eta.minCoeff() < 0.0 || eta.maxCoeff() > 1.0) {
+    ThrowInvalidArgument("NmpcModel::SetCorrection", "effectiveness", fmt::format("{} entries", eta.size()),
+                         fmt::format("{} entries in [0, 1]", nu_));
+  }
+  SetDisturbance(c.acceleration_W, c.angular_acceleration_B);
+  correction_.effectiveness = eta;
+  eta_ = eta;
+  alpha_map_ = inertia_inv_ * torque_map_ * eta_.asDiagonal();
+}
+
+void NmpcModel::SetDisturbance(const Eigen::Vector3d& acceleration_W, const Eigen::Vector3d& angular_acceleration_B) {
+  if (!acceleration_W.allFinite() || !angular_acceleration_B.allFinite()) {
+    ThrowInvalidArgument("NmpcModel::SetDisturbance", "acceleration_W, angular_acceleration_B", "(non-finite)",
+                         "finite accelerations");
+  }
+  correction_.acceleration_W = acceleration_W;
+  correction_.angular_acceleration_B = angular_acceleration_B;
+}
+
+void NmpcModel::ModelAccelerations(const Eigen::VectorXd& x, Eigen::Vector3d* a_W, Eigen::Vector3d* alpha_B) const {
+  const Eigen::Matrix3d R = RotationOf(x[3], x[4], x[5], x[6]);
+  const Eigen::Vector3d v = x.segment<3>(StateIndex::kVelocity);
+  const Eigen::Vector3d w = x.segment<3>(StateIndex::kBodyRate);
+  const auto T = x.segment(StateIndex::kMotor, nu_);
+  const Eigen::Vector3d D = params_.rotor_drag_kg_s;
+  *a_W = (R.col(2) * eta_.dot(T) - R * D.asDiagonal() * (R.transpose() * v)) / params_.mass_kg -
+         Eigen::Vector3d(0, 0, kGravity);
+  *alpha_B = alpha_map_ * T -
+             inertia_inv_ * (w.cross(inertia_ * w) + Eigen::Vector3d(0, 0, params_.yaw_damping_n_m_s * w.z()));
 }
 
 void NmpcModel::Dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot) const {
   x_dot->resize(nx());
   const double qw = x[3], qx = x[4], qy = x[5], qz = x[6];
-  const Eigen::Matrix3d R = RotationOf(qw, qx, qy, qz);
-  const Eigen::Vector3d v = x.segment<3>(StateIndex::kVelocity);
-  const Eigen::Vector3d w = x.segment<3>(StateIndex::kBodyRate);
-  const auto T = x.segment(StateIndex::kMotor, nu_);
-  const Eigen::Vector3d D = params_.rotor_drag_kg_s;
-  x_dot->segment<3>(0) = v;
-  x_dot->segment<4>(3) = QuaternionDerivative(Quaternion(qw, qx, qy, qz), w);
-  x_dot->segment<3>(7) = (R.col(2) * T.sum() - R * D.asDiagonal() * (R.transpose() * v)) / params_.mass_kg -
-                         Eigen::Vector3d(0, 0, kGravity);
-  x_dot->segment<3>(10) = inertia_inv_ * (torque_map_ * T - w.cross(inertia_ * w) -
-                                          Eigen::Vector3d(0, 0, params_.yaw_damping_n_m_s * w.z()));
-  x_dot->segment(StateIndex::kMotor, nu_) = (u - T) / params_.motor_time_constant_s;
+  Eigen::Vector3d a_W, alpha_B;
+  ModelAccelerations(x, &a_W, &alpha_B);
+  x_dot->segment<3>(0) = x.segment<3>(StateIndex::kVelocity);
+  x_dot->segment<4>(3) = QuaternionDerivative(Quaternion(qw, qx, qy, qz), x.segment<3>(StateIndex::kBodyRate));
+  x_dot->segment<3>(7) = a_W + correction_.acceleration_W;
+  x_dot->segment<3>(10) = alpha_B + correction_.angular_acceleration_B;
+  x_dot->segment(StateIndex::kMotor, nu_) = (u - x.segment(StateIndex::kMotor, nu_)) / params_.motor_time_constant_s;
 }
 
 void NmpcModel::DynamicsWithJacobians(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot,
@@ -70,7 +100,7 @@ void NmpcModel::UpdateDynamicsWithJacobians(const Eigen::VectorXd& x, const Eige
   Eigen::Matrix3d dR[4];
   RotationDerivatives(qw, qx, qy, qz, dR);
   const Eigen::Vector3d v = x.segment<3>(7), w = x.segment<3>(10);
-  const double thrust = x.segment(StateIndex::kMotor, nu_).sum();
+  const double thrust = eta_.dot(x.segment(StateIndex::kMotor, nu_));
   const Eigen::Matrix3d D = params_.rotor_drag_kg_s.asDiagonal();
   const double inv_m = 1.0 / params_.mass_kg;
 
@@ -88,15 +118,15 @@ void NmpcModel::UpdateDynamicsWithJacobians(const Eigen::VectorXd& x, const Eige
       qz, qw, -qx,      //
       -qy, qx, qw;
   fx->block<4, 3>(3, 10) = 0.5 * xi;
-  // v_dot = (R e3 sum(T) - R D R' v) / m - g e3.
+  // v_dot = (R e3 eta'T - R D R' v) / m - g e3 + a_c.
   const Eigen::Vector3d drag_body = D * (R.transpose() * v);
   for (int i = 0; i < 4; ++i) {
     fx->block<3, 1>(7, 3 + i) =
         inv_m * (dR[i].col(2) * thrust - dR[i] * drag_body - R * D * (dR[i].transpose() * v));
   }
   fx->block<3, 3>(7, 7) = -inv_m * R * D * R.transpose();
-  for (int j = 0; j < nu_; ++j) fx->block<3, 1>(7, StateIndex::kMotor + j) = inv_m * R.col(2);
-  // w_dot = I^-1 (M T - w x I w - k_dpsi r e3).
+  for (int j = 0; j < nu_; ++j) fx->block<3, 1>(7, StateIndex::kMotor + j) = (eta_[j] * inv_m) * R.col(2);
+  // w_dot = I^-1 (M diag(eta) T - w x I w - k_dpsi r e3) + alpha_c.
   const Eigen::Matrix3d gyro = Skew(w) * inertia_ - Skew(inertia_ * w);
   Eigen::Matrix3d damping = Eigen::Matrix3d::Zero();
   damping(2, 2) = params_.yaw_damping_n_m_s;
@@ -127,12 +157,12 @@ void MultiplyBlocks(const Eigen::MatrixXd& fx, const Eigen::MatrixXd& M_in, int 
   out.template middleRows<4>(StateIndex::kQuaternion).noalias() =
       F.template block<4, 4>(StateIndex::kQuaternion, StateIndex::kQuaternion) * Mq +
       F.template block<4, 3>(StateIndex::kQuaternion, StateIndex::kBodyRate) * Mw;
-  // The thrust columns of v_dot are equal (R e3 / m): a rank-one term.
+  // The thrust columns of v_dot are eta_j R e3 / m.
   out.template middleRows<3>(StateIndex::kVelocity).noalias() =
       F.template block<3, 4>(StateIndex::kVelocity, StateIndex::kQuaternion) * Mq +
       F.template block<3, 3>(StateIndex::kVelocity, StateIndex::kVelocity) * Mv;
   out.template middleRows<3>(StateIndex::kVelocity).noalias() +=
-      F.template block<3, 1>(StateIndex::kVelocity, StateIndex::kMotor) * MT.colwise().sum();
+      F.template block<3, NU>(StateIndex::kVelocity, StateIndex::kMotor, 3, nu) * MT;
   out.template middleRows<3>(StateIndex::kBodyRate).noalias() =
       F.template block<3, 3>(StateIndex::kBodyRate, StateIndex::kBodyRate) * Mw +
       F.template block<3, NU>(StateIndex::kBodyRate, StateIndex::kMotor, 3, nu) * MT;

@@ -55,6 +55,7 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   expected_thrust_ = RotorVector::Zero(n_);
   measured_thrust_ = RotorVector::Zero(n_);
   low_index_count_.assign(n_, 0);
+  low_index_since_s_.assign(n_, 0.0);
   above_since_s_.assign(n_, -1.0);
   degraded_since_s_.assign(n_, -1.0);
   degraded_sum_.assign(n_, 0.0);
@@ -74,7 +75,8 @@ std::vector<int> FaultDetectorBase::TakeNewIsolations() {
   return out;
 }
 
-void FaultDetectorBase::Isolate(int rotor, RotorHealth health, double t, const char* detector) {
+void FaultDetectorBase::Isolate(int rotor, RotorHealth health, double t, const char* detector,
+                                std::optional<double> onset) {
   RotorStatus& r = rotors_[rotor];
   if (r.health == RotorHealth::kMotorFailed || r.health == RotorHealth::kPropellerFailed ||
       r.health == RotorHealth::kFailed) {
@@ -82,6 +84,7 @@ void FaultDetectorBase::Isolate(int rotor, RotorHealth health, double t, const c
   }
   r.health = health;
   r.detected_s = t;
+  r.onset_s = onset.value_or(t);
   r.detector = detector;
   if (health != RotorHealth::kDegraded) {
     r.eta = 1.0;
@@ -126,7 +129,10 @@ void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
     const double index = esc.motor_speed_rad_s[i] / std::sqrt(expected_thrust_[i] / kn);
     rotors_[i].motor_index = index;
     low_index_count_[i] = index <= options_.motor_index_threshold ? low_index_count_[i] + 1 : 0;
-    if (low_index_count_[i] >= options_.motor_index_samples) Isolate(i, RotorHealth::kMotorFailed, t, "motor_index");
+    if (low_index_count_[i] == 1) low_index_since_s_[i] = t;
+    if (low_index_count_[i] >= options_.motor_index_samples) {
+      Isolate(i, RotorHealth::kMotorFailed, t, "motor_index", low_index_since_s_[i]);
+    }
   }
   have_esc_ = true;
 }
@@ -216,7 +222,7 @@ void CompositeFdd::RunObserver(double t) {
     if (p > options_.propeller_index_threshold) {
       if (above_since_s_[i] < 0.0) above_since_s_[i] = t;
       if (t - above_since_s_[i] >= options_.propeller_persistence_s) {
-        Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer");
+        Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer", above_since_s_[i]);
       }
     } else {
       above_since_s_[i] = -1.0;
@@ -231,7 +237,7 @@ void CompositeFdd::RunObserver(double t) {
       degraded_sum_[i] += p;
       ++degraded_count_[i];
       if (t - degraded_since_s_[i] >= options_.degraded_persistence_s && rotors_[i].health == RotorHealth::kOk) {
-        Isolate(i, RotorHealth::kDegraded, t, "thrust_loss_observer");
+        Isolate(i, RotorHealth::kDegraded, t, "thrust_loss_observer", degraded_since_s_[i]);
         rotors_[i].eta = degraded_sum_[i] / degraded_count_[i];
       } else if (rotors_[i].health == RotorHealth::kDegraded) {
         rotors_[i].eta = degraded_sum_[i] / degraded_count_[i];

@@ -142,6 +142,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     }
   }
   known_fault_applied_.assign(options_.known_faults.size(), false);
+  degraded_told_.assign(static_cast<std::size_t>(model_.num_rotors()), false);
   switch (options_.fdd) {
     case FddKind::kComposite:
       fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
@@ -195,14 +196,22 @@ void FlightStack::OnLidar(const LidarFrame& frame) {
   lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_.Estimate(frame.t_end_ns)).points_dropped;
 }
 
-void FlightStack::OnRotorFailed(int rotor, double t) {
+void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
   if (std::any_of(reconfigurations_.begin(), reconfigurations_.end(),
                   [rotor](const RotorReconfiguration& r) { return r.rotor == rotor; })) {
     return;
   }
   reconfigurations_.push_back({rotor, t});
+  if (nmpc_) nmpc_->RewindDisturbance(onset);
   controller_->SetRotorFailed(rotor);
   if (navigator_ && options_.navigation.failure_aware) navigator_->OnFailure();
+}
+
+void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset) {
+  auto told = degraded_told_.begin() + rotor;
+  if (!*told && nmpc_) nmpc_->RewindDisturbance(onset);
+  *told = true;
+  controller_->SetRotorEffectiveness(rotor, effectiveness);
 }
 
 void FlightStack::NavigateFlatness(double t) {
@@ -264,9 +273,9 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
       if (!known_fault_applied_[i] && ts >= options_.known_faults[i].at_time_s) {
         const KnownFault& k = options_.known_faults[i];
         if (k.loss >= 1.0) {
-          OnRotorFailed(k.rotor, ts);
+          OnRotorFailed(k.rotor, ts, k.at_time_s);
         } else {
-          controller_->SetRotorEffectiveness(k.rotor, 1.0 - k.loss);
+          OnRotorDegraded(k.rotor, 1.0 - k.loss, k.at_time_s);
         }
         known_fault_applied_[i] = true;
       }
@@ -275,7 +284,15 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
       fdd_->SetEstimate(estimate_);
       // Isolation reconfigures the controller (the NMPC: u_bar_i = 0, yaw given up, post-failure
       // thrust reference; controllers that cannot reconfigure ignore it) and the planner.
-      for (int rotor : fdd_->TakeNewIsolations()) OnRotorFailed(rotor, ts);
+      const std::vector<fdd::RotorStatus>& rotors = fdd_->rotors();
+      for (int rotor : fdd_->TakeNewIsolations()) OnRotorFailed(rotor, ts, rotors[rotor].onset_s.value_or(ts));
+      // A partial loss reaches the controller as the rotor's effectiveness, 1 - eta, updated as
+      // the FDD's estimate of eta improves.
+      for (std::size_t i = 0; i < rotors.size(); ++i) {
+        if (rotors[i].health == fdd::RotorHealth::kDegraded) {
+          OnRotorDegraded(static_cast<int>(i), 1.0 - rotors[i].eta, rotors[i].onset_s.value_or(ts));
+        }
+      }
     }
   }
   SupervisorInputs in;

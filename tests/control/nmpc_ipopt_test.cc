@@ -218,7 +218,7 @@ OracleCase RandomCase(Rng& rng) {
 void ExpectMatchesIpopt(int failed_rotor, std::uint64_t seed) {
   Rng rng(seed);
   const vehicle::VehicleParams vehicle = rotorguard::testing::ReferenceQuad();
-  const NmpcModel model(vehicle);
+  NmpcModel model(vehicle);
   for (int trial = 0; trial < 6; ++trial) {
     const OracleCase c = RandomCase(rng);
     NmpcOptions o;
@@ -229,6 +229,9 @@ void ExpectMatchesIpopt(int failed_rotor, std::uint64_t seed) {
     RotorVector cmd;
     nmpc.Compute(c.estimate, *c.reference, 0.0, 0.0, &cmd);
     ASSERT_EQ(nmpc.summary().status, NmpcStatus::kSolved) << nmpc.summary().BriefReport();
+    // The same prediction model: a failed rotor's effectiveness is 0, and the disturbance
+    // observer's first estimate (zero) is in it.
+    model.SetCorrection(nmpc.model_correction());
 
     // The NMPC's converged objective, from the same node costs.
     const auto& xs = nmpc.planned_states();

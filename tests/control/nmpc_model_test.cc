@@ -1,11 +1,13 @@
 
+#include "rotorguard/control/nmpc_model.h"
+
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <utility>
 
-#include "rotorguard/control/nmpc_model.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/vehicle/multirotor.h"
 #include "test_util.h"
@@ -81,10 +83,59 @@ TEST(NmpcModel, EqualsTheSimulatorModelForHealthyRotorsWithinBounds) {
   }
 }
 
+/// A correction with every rotor partly effective and constant accelerations in every axis.
+ModelCorrection SomeCorrection(Rng& rng, int rotors = 4) {
+  ModelCorrection c;
+  c.effectiveness.resize(rotors);
+  for (int i = 0; i < rotors; ++i) c.effectiveness[i] = rng.Uniform(0.2, 1.0);
+  c.acceleration_W << rng.Normal(), rng.Normal(), rng.Normal();
+  c.angular_acceleration_B << 10.0 * rng.Normal(), 10.0 * rng.Normal(), rng.Normal();
+  return c;
+}
+
+TEST(NmpcModel, WithACorrectionEqualsTheSimulatorModelWithTheSameLossesForceAndTorque) {
+  // The simulator's loss of effectiveness eta (thrust and torque scale by 1 - eta) is the
+  // model's effectiveness 1 - eta; its force and torque disturbances are m a_c and I alpha_c.
+  const vehicle::VehicleParams params = ReferenceQuad();
+  NmpcModel model(params);
+  const vehicle::MultirotorModel truth(params);
+  Rng rng(21);
+  for (int trial = 0; trial < 20; ++trial) {
+    const ModelCorrection c = SomeCorrection(rng);
+    model.SetCorrection(c);
+    vehicle::RotorFaults faults(4);
+    for (int i = 0; i < 4; ++i) faults[i] = {vehicle::FaultKind::kLossOfEffectiveness, 1.0 - c.effectiveness[i]};
+    vehicle::Disturbance d;
+    d.force_W = params.mass_kg * c.acceleration_W;
+    d.torque_B = params.inertia_kg_m2 * c.angular_acceleration_B;
+    const Eigen::VectorXd x = SomeState(rng), u = SomeInput(rng);
+    Eigen::VectorXd f;
+    model.Dynamics(x, u, &f);
+    vehicle::StateVector xs = x, fs;
+    RotorVector us = u;
+    truth.Derivative(xs, us, faults, d, &fs);
+    EXPECT_TRUE(MatricesNear(f, Eigen::VectorXd(fs), 1e-10)) << "trial " << trial;
+  }
+}
+
+TEST(NmpcModel, RejectsABadCorrection) {
+  NmpcModel model(ReferenceQuad());
+  ModelCorrection c;
+  c.effectiveness = Eigen::VectorXd::Constant(3, 1.0);
+  EXPECT_THROW(model.SetCorrection(c), std::invalid_argument);
+  c.effectiveness = Eigen::Vector4d(1.0, 1.0, 1.2, 1.0);
+  EXPECT_THROW(model.SetCorrection(c), std::invalid_argument);
+  c.effectiveness.resize(0);
+  c.acceleration_W.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(model.SetCorrection(c), std::invalid_argument);
+  EXPECT_EQ(model.effectiveness(), Eigen::VectorXd::Ones(4));  // nothing half-applied
+}
+
 TEST(NmpcModel, AnalyticJacobiansMatchFiniteDifferences) {
-  const NmpcModel model(ReferenceQuad());
+  NmpcModel model(ReferenceQuad());
   Rng rng(2);
   for (int trial = 0; trial < 20; ++trial) {
+    if (trial >= 10) model.SetCorrection(SomeCorrection(rng));  // the effectiveness scales columns
     const Eigen::VectorXd x = SomeState(rng), u = SomeInput(rng);
     Eigen::VectorXd f;
     Eigen::MatrixXd fx, fu;
@@ -101,12 +152,13 @@ TEST(NmpcModel, AnalyticJacobiansMatchFiniteDifferences) {
 TEST(Rk4Sensitivity, DiscreteSensitivitiesMatchFiniteDifferences) {
   // The quadrotor (compile-time sized products) and a hexarotor (the generic ones).
   for (const vehicle::VehicleParams& vehicle : {ReferenceQuad(), Hexarotor()}) {
-    const NmpcModel model(vehicle);
+    NmpcModel model(vehicle);
     const int rotors = vehicle.num_rotors();
     for (int substeps : {1, 3}) {
       Rk4Sensitivity rk4(model, 0.05, substeps);
       Rng rng(3 + substeps);
       for (int trial = 0; trial < 10; ++trial) {
+        if (trial == 5) model.SetCorrection(SomeCorrection(rng, rotors));
         const Eigen::VectorXd x = SomeState(rng, rotors), u = SomeInput(rng, rotors);
         Eigen::VectorXd next;
         Eigen::MatrixXd A, B;
@@ -154,8 +206,9 @@ namespace rotorguard::control {
 namespace {
 
 TEST(NmpcModel, StructuredJacobianProductEqualsTheDenseProduct) {
-  const NmpcModel model(rotorguard::testing::ReferenceQuad());
+  NmpcModel model(rotorguard::testing::ReferenceQuad());
   Rng rng(12);
+  model.SetCorrection(SomeCorrection(rng));  // unequal thrust columns
   const Eigen::VectorXd x = SomeState(rng), u = SomeInput(rng);
   Eigen::VectorXd f;
   Eigen::MatrixXd fx, fu, out;

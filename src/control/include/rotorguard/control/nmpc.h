@@ -6,13 +6,15 @@
 /// into preparation and feedback, warm-started from the previous solution shifted by the elapsed
 /// time) or iterated to convergence. A rotor isolated as failed gets u_bar_i = 0 at run time; the
 /// yaw-error weight drops to 0 and the thrust reference switches to the post-failure equilibrium.
+/// Offset-free: a disturbance observer estimates what the model misses, and the model predicts
+/// with it and with each rotor's known effectiveness (docs/control.md).
+#include <Eigen/Core>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "rotorguard/control/controller.h"
+#include "rotorguard/control/disturbance_observer.h"
 #include "rotorguard/control/nmpc_model.h"
 #include "rotorguard/control/ocp_qp.h"
 #include "rotorguard/core/config_schema.h"
@@ -44,6 +46,8 @@ struct NmpcOptions {
   /// O(N nx^2) condensing instead of sensitivities, O(N^2) condensing and a factorisation. 1 is
   /// the paper's scheme; a rotor reconfiguration always re-linearises (docs/control.md).
   int relinearise_every = 1;
+  /// What the model misses, estimated in flight and predicted with (offset-free NMPC).
+  DisturbanceObserverOptions disturbance;
   DenseQpOptions qp;
   void Validate() const;
   /// The keys of this struct in config files (core/config_schema.h).
@@ -63,6 +67,8 @@ struct NmpcOptions {
              {.meaning = "SQP iterations a cycle (1: the real-time iteration)", .min = 1, .max = 1000});
     a->Visit("relinearise_every", &relinearise_every,
              {.meaning = "a full linearisation every this many preparations (docs/control.md)", .min = 1, .max = 20});
+    a->Visit("disturbance", &disturbance,
+             {.meaning = "the disturbance observer that makes the NMPC offset-free (docs/control.md)"});
   }
 };
 
@@ -113,13 +119,23 @@ class NmpcController final : public Controller {
   /// the least-squares sense when that is impossible) and reference spin. No rebuild. Throws
   /// std::invalid_argument for a rotor out of range.
   void SetRotorFailed(int rotor) override;
+  /// A rotor delivers only `effectiveness` of its thrust and torque (a partial loss; <= 0 is a
+  /// failure): its column of the model scales, and the thrust reference reallocates with yaw kept.
+  /// Throws std::invalid_argument for a rotor out of range or a non-finite value.
+  void SetRotorEffectiveness(int rotor, double effectiveness) override;
+  /// The disturbance estimates return to their values at time t [s] (DisturbanceObserver::RewindTo):
+  /// a fault just put into the model was, until then, partly estimated as a disturbance.
+  void RewindDisturbance(double t) { observer_.RewindTo(t); }
   const std::vector<bool>& failed_rotors() const { return failed_; }
+  /// The model's correction in use: rotor effectiveness and the disturbance estimates.
+  const ModelCorrection& model_correction() const { return model_.correction(); }
   const NmpcSummary& summary() const { return summary_; }
   const NmpcOptions& options() const { return options_; }
   /// The current plan: N + 1 states and N inputs (after the last call).
   const std::vector<Eigen::VectorXd>& planned_states() const { return x_; }
   const std::vector<Eigen::VectorXd>& planned_inputs() const { return u_; }
-  /// The thrust reference t_ref in use (hover split, or the post-failure equilibrium).
+  /// The thrust reference t_ref in use for a total thrust (hover split, or the post-failure
+  /// equilibrium), with the rotor thrusts that balance the estimated disturbance torque.
   Eigen::VectorXd ThrustReference(double total_thrust) const;
 
   /// Gauss-Newton cost of one node (for tests): residual y and its Jacobian dy/dx at `x` for the
@@ -142,6 +158,8 @@ class NmpcController final : public Controller {
   /// The prepared QP for the measured state, and the plan update.
   bool FeedbackIteration(const Eigen::VectorXd& x0);
   Eigen::Quaterniond ReferenceAttitude(const ReferencePoint& ref) const;
+  /// ThrustReference as an expression on the members (no allocation on the control-rate path).
+  auto ThrustReferenceOf(double total) const { return total * unit_split_ + torque_offset_; }
   Eigen::Vector3d ReferenceThrustVector(const ReferencePoint& ref) const;
   double ReferenceTotalThrust(const ReferencePoint& ref) const;
   void HoverCommand(RotorVector* thrust_command) const;
@@ -155,9 +173,16 @@ class NmpcController final : public Controller {
   CondensingQpSolver qp_solver_;
   Eigen::VectorXd weights_;          // diagonal of W for y (nx entries)
   Eigen::VectorXd u_max_;
-  Eigen::VectorXd hover_split_;  // minimum-norm rotor thrusts per newton of total thrust
-  Eigen::VectorXd unit_split_;   // the thrust reference per newton: hover_split_ or post-failure
+  DisturbanceObserver observer_;
+  Eigen::VectorXd eta_;            // each rotor's effectiveness (0 once failed)
+  Eigen::VectorXd unit_split_;     // the thrust reference per newton of total thrust
+  Eigen::MatrixXd torque_split_;   // rotor thrusts per N m of roll, pitch, yaw torque (n x 3)
+  Eigen::VectorXd torque_offset_;  // torque_split_ times the torque the disturbance asks for
+  /// The splits for the failed rotors and the effectiveness: the minimum-norm split with yaw
+  /// while every rotor flies; else the post-failure one (SetRotorFailed).
   void UpdateThrustSplit();
+  /// The observer's estimates into the model, the thrust reference and the reference spin.
+  void ApplyCorrection();
   std::vector<bool> failed_;
   Eigen::Vector3d spin_reference_ = Eigen::Vector3d::Zero();
   std::vector<Eigen::VectorXd> x_, u_;  // shooting nodes and inputs

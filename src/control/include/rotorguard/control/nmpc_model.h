@@ -1,12 +1,24 @@
 #pragma once
-/// The NMPC's prediction model: paper 000's eqs. (1)-(3) and (6) for a healthy multirotor without
-/// wind (rotor failures enter the OCP as input bounds, not as model changes), its analytic
-/// Jacobians, and an RK4 discretisation with exact sensitivities (forward mode through the stages).
+/// The NMPC's prediction model: paper 000's eqs. (1)-(3) and (6) for the vehicle file's multirotor
+/// (rotor failures enter the OCP as input bounds), corrected by what the stack has learnt in flight
+/// (ModelCorrection), its analytic Jacobians, and an RK4 discretisation with exact sensitivities
+/// (forward mode through the stages).
 #include <Eigen/Core>
 
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::control {
+
+/// What the model learns in flight, so that its predictions are offset-free where the file is
+/// wrong (docs/control.md, "Offset-free NMPC"): each rotor's effectiveness eta_i (its thrust and
+/// torque are eta_i T_i: a partial loss, or 0 for a rotor given up), and the constant world-frame
+/// acceleration and body-frame angular acceleration the file's model misses (mass, centre of
+/// gravity, thrust coefficients, an external force or torque), added to eqs. (1) and (3).
+struct ModelCorrection {
+  Eigen::VectorXd effectiveness;                                     ///< one entry per rotor in [0, 1]; empty: all 1
+  Eigen::Vector3d acceleration_W = Eigen::Vector3d::Zero();          ///< [m/s²]
+  Eigen::Vector3d angular_acceleration_B = Eigen::Vector3d::Zero();  ///< [rad/s²]
+};
 
 /// State layout as vehicle::StateIndex: [p (3), q (4: w, x, y, z), v (3), w (3), T (n)].
 class NmpcModel {
@@ -15,6 +27,20 @@ class NmpcModel {
   int nx() const { return 13 + nu_; }
   int nu() const { return nu_; }
   const vehicle::VehicleParams& params() const { return params_; }
+
+  /// Throws std::invalid_argument for an effectiveness of the wrong size or outside [0, 1], or a
+  /// non-finite acceleration; nothing changes then.
+  void SetCorrection(const ModelCorrection& correction);
+  /// SetCorrection's accelerations alone, without allocating (every control cycle). Throws
+  /// std::invalid_argument for a non-finite one.
+  void SetDisturbance(const Eigen::Vector3d& acceleration_W, const Eigen::Vector3d& angular_acceleration_B);
+  const ModelCorrection& correction() const { return correction_; }
+  /// The rotor effectiveness in use (all 1 unless corrected).
+  const Eigen::VectorXd& effectiveness() const { return eta_; }
+  /// The uncorrected accelerations of x: v_dot and w_dot of eqs. (1) and (3) with the rotor
+  /// effectiveness but without the constant accelerations (what a disturbance observer compares
+  /// with the measurement).
+  void ModelAccelerations(const Eigen::VectorXd& x, Eigen::Vector3d* a_W, Eigen::Vector3d* alpha_B) const;
 
   /// x_dot = f(x, u); `u` are commanded thrusts (not saturated: the OCP bounds them).
   void Dynamics(const Eigen::VectorXd& x, const Eigen::VectorXd& u, Eigen::VectorXd* x_dot) const;
@@ -36,7 +62,9 @@ class NmpcModel {
   int nu_;
   Eigen::Matrix3d inertia_, inertia_inv_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> torque_map_;  // rows 1..3 of the effectiveness matrix
-  Eigen::Matrix<double, 3, Eigen::Dynamic> alpha_map_;   // I^-1 torque_map_
+  ModelCorrection correction_;
+  Eigen::VectorXd eta_;                                 // the rotor effectiveness
+  Eigen::Matrix<double, 3, Eigen::Dynamic> alpha_map_;  // I^-1 torque_map_ diag(eta)
 };
 
 /// One RK4 step of NmpcModel over `dt` with `substeps` equal sub-steps, input held, and the exact

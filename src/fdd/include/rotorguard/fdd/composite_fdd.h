@@ -89,6 +89,9 @@ struct RotorStatus {
   double motor_index = 1.0;      ///< M_i, latest
   double propeller_index = 0.0;  ///< P_i, latest
   std::optional<double> detected_s;  ///< when the health left kOk
+  /// When the evidence for the diagnosis began: the first sample of the index that crossed its
+  /// threshold (the detection time for detectors that cannot tell).
+  std::optional<double> onset_s;
   std::string detector;          ///< "motor_index", "thrust_loss_observer", "takeoff"
 };
 
@@ -118,9 +121,10 @@ class FaultDetectorBase : public FaultDetector {
 
  protected:
   explicit FaultDetectorBase(int num_rotors);
-  /// Marks a rotor's health at time t; a failure (motor, propeller or unclassified) isolates it
-  /// once. A rotor already isolated keeps its diagnosis.
-  void Isolate(int rotor, RotorHealth health, double t, const char* detector);
+  /// Marks a rotor's health at time t, on evidence that began at `onset` (default t); a failure
+  /// (motor, propeller or unclassified) isolates it once. A rotor already isolated keeps its
+  /// diagnosis.
+  void Isolate(int rotor, RotorHealth health, double t, const char* detector, std::optional<double> onset = {});
 
   std::vector<RotorStatus> rotors_;
   std::vector<int> new_isolations_;
@@ -155,6 +159,7 @@ class CompositeFdd final : public FaultDetectorBase {
   // Motor index.
   RotorVector command_, expected_thrust_;
   std::vector<int> low_index_count_;
+  std::vector<double> low_index_since_s_;
   std::optional<TimeNs> last_esc_ns_;
   RotorVector measured_thrust_;
   bool have_esc_ = false;

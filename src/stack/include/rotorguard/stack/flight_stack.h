@@ -321,9 +321,14 @@ class FlightStack {
   FlightStackSummary Summarize() const;
 
  private:
-  /// One rotor found failed (FDD) or handed over (known fault): the controller reconfigures and,
-  /// unless the failure-unaware variant flies, the planner switches to the post-failure limit.
-  void OnRotorFailed(int rotor, double t);
+  /// One rotor found failed (FDD) or handed over (known fault) at t, the fault's evidence
+  /// beginning at `onset`: the controller reconfigures (the NMPC's disturbance estimate returns to
+  /// its value at the onset: the fault is now in its model) and, unless the failure-unaware
+  /// variant flies, the planner switches to the post-failure limit.
+  void OnRotorFailed(int rotor, double t, double onset);
+  /// A rotor's partial loss, found by the FDD or handed over: its effectiveness reaches the
+  /// controller (the first time, with the disturbance estimate returned to the onset's).
+  void OnRotorDegraded(int rotor, double effectiveness, double onset);
   /// The navigator's part of a control cycle: the next waypoint when due (not while recovering
   /// from a failure), the planner at its rate, the time of its last success.
   void Navigate(double t, FlightMode mode);
@@ -356,6 +361,7 @@ class FlightStack {
   long lidar_points_dropped_ = 0;
   StackCost cost_;
   std::vector<bool> known_fault_applied_;
+  std::vector<bool> degraded_told_;  // per rotor: the controller heard of its partial loss
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
   StateEstimate estimate_;
