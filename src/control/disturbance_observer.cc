@@ -28,6 +28,10 @@ void DisturbanceObserverOptions::Validate() const {
   RequirePositive("force_bandwidth_rad_s", force_bandwidth_rad_s);
   RequirePositive("torque_bandwidth_rad_s", torque_bandwidth_rad_s);
   RequirePositive("max_acceleration_m_s2", max_acceleration_m_s2);
+  if (!std::isfinite(torque_bandwidth_after_failure_rad_s) || torque_bandwidth_after_failure_rad_s < 0.0) {
+    ThrowValidation("DisturbanceObserverOptions", "torque_bandwidth_after_failure_rad_s",
+                    torque_bandwidth_after_failure_rad_s, "a value >= 0");
+  }
   RequirePositive("max_angular_acceleration_rad_s2", max_angular_acceleration_rad_s2);
   if (!std::isfinite(min_altitude_m))
     ThrowValidation("DisturbanceObserverOptions", "min_altitude_m", min_altitude_m, "finite");
@@ -40,6 +44,7 @@ DisturbanceObserver::DisturbanceObserver(const NmpcModel& model, const Disturban
 
 void DisturbanceObserver::Reset() {
   have_prev_ = false;
+  torque_slowed_ = false;
   d_a_.setZero();
   d_alpha_.setZero();
   history_.resize(kHistory);
@@ -65,7 +70,11 @@ void DisturbanceObserver::Update(const Eigen::VectorXd& x, double t) {
       *d += ((1.0 - p) * (1.0 - p) / dt) * e;
     };
     step(options_.force_bandwidth_rad_s, v, a_prev_, &v_hat_, &d_a_);
-    step(options_.torque_bandwidth_rad_s, w, alpha_prev_, &w_hat_, &d_alpha_);
+    if (!torque_slowed_) {
+      step(options_.torque_bandwidth_rad_s, w, alpha_prev_, &w_hat_, &d_alpha_);
+    } else if (options_.torque_bandwidth_after_failure_rad_s > 0.0) {
+      step(options_.torque_bandwidth_after_failure_rad_s, w, alpha_prev_, &w_hat_, &d_alpha_);
+    }
     d_a_ = Clamped(d_a_, options_.max_acceleration_m_s2);
     d_alpha_ = Clamped(d_alpha_, options_.max_angular_acceleration_rad_s2);
   } else {

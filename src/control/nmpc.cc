@@ -127,6 +127,7 @@ void NmpcController::SetRotorFailed(int rotor) {
   if (failed_[rotor]) return;  // already reconfigured
   failed_[rotor] = true;
   eta_[rotor] = 0.0;
+  observer_.SlowTorque();            // the spin that follows is no place for a fast torque observer
   reused_since_linearisation_ = -1;  // the weights change: Q_k with them
   u_max_[rotor] = 0.0;               // u_bar_i = 0 (paper 000, Sec. V-A)
   weights_[StateIndex::kQuaternion + 3] = 0.0;  // yaw is given up

@@ -42,6 +42,8 @@ void CompositeFddOptions::Validate() const {
   RequireIn("takeoff_window_s", takeoff_window_s, 1e-3, 1e3, "a time > 0 s");
   RequireIn("takeoff_angular_acceleration_rad_s2", takeoff_angular_acceleration_rad_s2, 1e-3, 1e6, "a value > 0");
   RequireIn("takeoff_direction_cosine", takeoff_direction_cosine, 1e-6, 1.0, "a value in (0, 1]");
+  RequireIn("takeoff_missing_thrust_fraction", takeoff_missing_thrust_fraction, 0.0, 1.0, "a value in [0, 1]");
+  RequireIn("baseline_time_constant_s", baseline_time_constant_s, 0.0, 100.0, "a time in [0, 100] s");
   if (!imu_position_m.allFinite()) ThrowValidation("CompositeFddOptions", "imu_position_m", "(non-finite)", "finite");
 }
 
@@ -147,10 +149,10 @@ void CompositeFdd::OnImu(const ImuSample& imu) {
   alpha_filter_.Step(imu.w_B, dt);
   Eigen::Vector4d wrench = effectiveness_ * measured_thrust_;
   wrench_filter_.Step(wrench);
-  RunObserver(ToSeconds(imu.t_ns));
+  RunObserver(ToSeconds(imu.t_ns), dt);
 }
 
-void CompositeFdd::RunObserver(double t) {
+void CompositeFdd::RunObserver(double t, double dt) {
   // The observer's force balance holds once the ground no longer carries the vehicle: in the air,
   // or when the rotors (by their measured speeds) lift at least kLiftFraction of the weight. The
   // latter starts the take-off window at lift-off rather than at some altitude.
@@ -184,9 +186,10 @@ void CompositeFdd::RunObserver(double t) {
   const Matrix3& I = vp.inertia_kg_m2;
   const Vector3 torque_loss = wrench.tail<3>() - I * alpha - w.cross(I * w) -
                               Vector3(0.0, 0.0, vp.yaw_damping_n_m_s * w.z());
-  // eq. (16): per-rotor losses.
-  Eigen::Vector4d lost;
-  lost << force_loss, torque_loss;
+  // eq. (16): per-rotor losses, counted from the healthy residual learnt so far.
+  Eigen::Vector4d residual;
+  residual << force_loss, torque_loss;
+  const Eigen::Vector4d lost = residual - baseline_;
   thrust_loss_ = pinv_ * lost;
 
   // Take-off detector (eq. 18): a strong roll/pitch angular acceleration shortly after lift-off,
@@ -206,13 +209,18 @@ void CompositeFdd::RunObserver(double t) {
         best = i;
       }
     }
-    if (best >= 0) {
-      // Telemetry tells the kind: a collapsing speed is the motor, a healthy one the propeller.
-      const bool motor = rotors_[best].motor_index < 0.5;
+    // The rotor it points at must miss thrust: by telemetry, or by the force balance. Which of
+    // the two sees it tells the kind: a slowing motor's loss shows in its telemetry (and so not in
+    // the force balance, which counts measured thrusts); a lost propeller's only in the balance.
+    const double by_telemetry = best < 0 ? 0.0 : expected_thrust_[best] - measured_thrust_[best];
+    if (best >= 0 &&
+        std::max(by_telemetry, lost[0]) >= options_.takeoff_missing_thrust_fraction * expected_thrust_[best]) {
+      const bool motor = by_telemetry > lost[0];
       Isolate(best, motor ? RotorHealth::kMotorFailed : RotorHealth::kPropellerFailed, t, "takeoff");
     }
   }
 
+  const bool learning = t - *airborne_since_s_ < 3.0 * options_.baseline_time_constant_s;
   // eq. (17): P_i = lost thrust / thrust the rotor should give; persistent -> propeller failure.
   const double min_thrust = options_.motor_index_min_thrust_n;
   for (int i = 0; i < n_; ++i) {
@@ -228,7 +236,7 @@ void CompositeFdd::RunObserver(double t) {
       above_since_s_[i] = -1.0;
     }
     // Partial loss: a persistent intermediate index, reported with its mean as eta.
-    if (p > options_.degraded_threshold && p <= options_.propeller_index_threshold) {
+    if (!learning && p > options_.degraded_threshold && p <= options_.propeller_index_threshold) {
       if (degraded_since_s_[i] < 0.0) {
         degraded_since_s_[i] = t;
         degraded_sum_[i] = 0.0;
@@ -245,6 +253,16 @@ void CompositeFdd::RunObserver(double t) {
     } else {
       degraded_since_s_[i] = -1.0;
     }
+  }
+  // The healthy residual: learnt while nothing looks wrong, frozen from the first suspicion on, so
+  // that a fault is measured against the vehicle as it flew before it.
+  // For its first three time constants in the air it learns regardless (the file's errors are
+  // all there is to see), and no partial loss is diagnosed then.
+  const bool quiet = std::all_of(rotors_.begin(), rotors_.end(), [this](const RotorStatus& status) {
+    return status.health == RotorHealth::kOk && std::abs(status.propeller_index) <= options_.degraded_threshold;
+  });
+  if (options_.baseline_time_constant_s > 0.0 && (quiet || learning) && dt > 0.0) {
+    baseline_ += std::min(1.0, dt / options_.baseline_time_constant_s) * (residual - baseline_);
   }
 }
 

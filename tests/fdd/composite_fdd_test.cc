@@ -121,6 +121,9 @@ TEST(CompositeFdd, IsolatesAnEjectedPropellerOfEveryRotorFromTheMotion) {
     EXPECT_EQ(b.fdd_.rotors()[rotor].health, RotorHealth::kPropellerFailed) << "rotor " << rotor;
     EXPECT_EQ(b.fdd_.rotors()[rotor].detector, "thrust_loss_observer");
     EXPECT_LT(*detected - onset, 0.1);
+    ASSERT_TRUE(b.fdd_.rotors()[rotor].onset_s);
+    EXPECT_GE(*b.fdd_.rotors()[rotor].onset_s, onset);
+    EXPECT_LE(*b.fdd_.rotors()[rotor].onset_s, *detected);
     for (int other = 0; other < 4; ++other) {
       if (other != rotor) {
         EXPECT_EQ(b.fdd_.rotors()[other].health, RotorHealth::kOk);
@@ -131,13 +134,64 @@ TEST(CompositeFdd, IsolatesAnEjectedPropellerOfEveryRotorFromTheMotion) {
 
 TEST(CompositeFdd, ReportsAPersistentPartialLossAsDegradationWithItsEta) {
   Bench b(1.0);
-  ASSERT_FALSE(b.Run(1.0));
+  ASSERT_FALSE(b.Run(2.0));  // past the baseline's learning (3 x 0.5 s in the air)
+  const double onset = b.now();
   b.actual_[2] = 0.6 * b.hover_[2];  // eta = 0.4, a ramp-free step
   b.Run(2.0);
   const RotorStatus& r = b.fdd_.rotors()[2];
   EXPECT_EQ(r.health, RotorHealth::kDegraded);
   EXPECT_NEAR(r.eta, 0.4, 0.05);
+  ASSERT_TRUE(r.onset_s);
+  EXPECT_GE(*r.onset_s, onset);                     // dated by the first sample past the threshold ...
+  EXPECT_LT(*r.onset_s, onset + 0.05);              // ... through the observer's 20 Hz filters
   EXPECT_TRUE(b.fdd_.TakeNewIsolations().empty());  // degradation does not isolate the rotor
+}
+
+TEST(CompositeFdd, MeasuresLossesFromTheResidualOfTheVehicleAsItFlies) {
+  // Rotor 0's telemetry reads 25 % more thrust than it gives (a thrust coefficient the file has
+  // wrong): to the file's model rotor 0 loses a fifth of its thrust, from the start. The baseline
+  // learns that residual; a later true partial loss of rotor 2 is measured from it.
+  for (const double time_constant : {0.5, 0.0}) {
+    CompositeFddOptions o;
+    o.baseline_time_constant_s = time_constant;
+    Bench b(1.0, o);
+    b.drive_[0] = 1.25 * b.hover_[0];
+    const auto detected = b.Run(3.0);
+    if (time_constant == 0.0) {  // the file's model alone: a false partial loss
+      EXPECT_EQ(b.fdd_.rotors()[0].health, RotorHealth::kDegraded);
+      continue;
+    }
+    EXPECT_FALSE(detected);
+    // The residual: thrust 0.25 T_h missing along z, and its torque at rotor 0.
+    const Eigen::Vector4d expected = b.effectiveness_.col(0) * 0.25 * b.hover_[0];
+    EXPECT_LT((b.fdd_.baseline() - expected).norm(), 0.05 * expected.norm()) << b.fdd_.baseline().transpose();
+    b.actual_[2] = 0.6 * b.hover_[2];
+    b.Run(2.0);
+    EXPECT_EQ(b.fdd_.rotors()[2].health, RotorHealth::kDegraded);
+    EXPECT_NEAR(b.fdd_.rotors()[2].eta, 0.4, 0.05);
+    EXPECT_EQ(b.fdd_.rotors()[0].health, RotorHealth::kOk);
+  }
+}
+
+TEST(CompositeFdd, TakeoffDetectorIgnoresATurnThatCostsNoThrust) {
+  // Just after lift-off rotor 0 gives 1 N more and rotor 1, its diagonal twin, 1 N less than
+  // their telemetry says (as a centre of gravity off the file's does): the vehicle turns as if
+  // rotor 1 were lost, at 18 rad/s², but no thrust is missing.
+  for (const double fraction : {0.5, 0.0}) {
+    CompositeFddOptions o;
+    o.takeoff_missing_thrust_fraction = fraction;
+    Bench b(1.0, o);
+    ASSERT_FALSE(b.Run(0.2, 0.02));
+    b.actual_[0] += 1.0;
+    b.actual_[1] -= 1.0;
+    const auto detected = b.Run(0.2, 0.02);
+    if (fraction == 0.0) {  // the direction and magnitude alone would isolate rotor 1
+      EXPECT_TRUE(detected);
+      EXPECT_EQ(b.fdd_.rotors()[1].detector, "takeoff");
+    } else {
+      EXPECT_FALSE(detected) << b.fdd_.rotors()[1].detector;
+    }
+  }
 }
 
 TEST(CompositeFdd, ARampLossCrossesIntoPropellerFailure) {

@@ -20,6 +20,9 @@ struct DisturbanceObserverOptions {
   double force_bandwidth_rad_s = 3.0;
   /// The double pole of the body-rate observer's error dynamics [rad/s], > 0.
   double torque_bandwidth_rad_s = 6.0;
+  /// Its double pole once a rotor failed and the vehicle spins [rad/s], >= 0 (0: the estimate
+  /// stays where it was).
+  double torque_bandwidth_after_failure_rad_s = 1.0;
   /// The estimates are clamped to these magnitudes: a world-frame acceleration [m/s²] and a
   /// body-frame angular acceleration [rad/s²], > 0. A constant model error that needs more is
   /// not one the file's vehicle can fly with.
@@ -36,6 +39,8 @@ struct DisturbanceObserverOptions {
              {.meaning = "the velocity observer's double pole [rad/s]", .min = 1e-3, .max = 1e3});
     a->Visit("torque_bandwidth_rad_s", &torque_bandwidth_rad_s,
              {.meaning = "the body-rate observer's double pole [rad/s]", .min = 1e-3, .max = 1e3});
+    a->Visit("torque_bandwidth_after_failure_rad_s", &torque_bandwidth_after_failure_rad_s,
+             {.meaning = "... once a rotor failed and the vehicle spins [rad/s] (0: held)", .min = 0.0, .max = 1e3});
     a->Visit("max_acceleration_m_s2", &max_acceleration_m_s2,
              {.meaning = "the largest acceleration estimated [m/s²]", .min = 1e-6});
     a->Visit("max_angular_acceleration_rad_s2", &max_angular_acceleration_rad_s2,
@@ -58,8 +63,14 @@ class DisturbanceObserver {
   /// (at or below min_altitude_m), restarts the velocity and rate estimates and keeps the
   /// disturbances.
   void Update(const Eigen::VectorXd& x, double t);
-  /// Back to zero disturbances and no measurement.
+  /// Back to zero disturbances and no measurement (and the torque estimate running again).
   void Reset();
+  /// From now on the angular-acceleration estimate moves at torque_bandwidth_after_failure_rad_s
+  /// (the force estimate runs on). For a vehicle spinning after a failure: there the gyroscopic
+  /// coupling of a wrong inertia grows with the spin and is no constant, and a torque observer
+  /// that chases it feeds the precession (docs/control.md).
+  void SlowTorque() { torque_slowed_ = true; }
+  bool torque_slowed() const { return torque_slowed_; }
   /// The disturbances estimated at time `t` or just before it, from the last kHistory updates
   /// (about 5 s at 200 Hz; the oldest one kept when t is older): the value to return to when a
   /// fault found later is put into the model, so that the fault's own transient is not counted
@@ -73,6 +84,7 @@ class DisturbanceObserver {
   const NmpcModel& model_;
   DisturbanceObserverOptions options_;
   bool have_prev_ = false;
+  bool torque_slowed_ = false;
   double t_prev_ = 0.0;
   Eigen::Vector3d a_prev_, alpha_prev_;  // the model's accelerations at the previous measurement
   Eigen::Vector3d v_hat_, w_hat_, d_a_, d_alpha_;

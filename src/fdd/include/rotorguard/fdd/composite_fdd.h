@@ -38,14 +38,24 @@ struct CompositeFddOptions {
   /// Cut-off of the low-pass filters on specific force, body rate, angular acceleration and the
   /// measured wrench [Hz], > 0 and below the IMU's Nyquist frequency.
   double filter_cutoff_hz = 20.0;
+  /// The observer learns the healthy vehicle's residual wrench (what the vehicle file misses: a
+  /// centre-of-gravity offset, mass and thrust-coefficient errors) with this time constant [s]
+  /// while airborne, every rotor healthy and every |P_i| within degraded_threshold, and measures
+  /// losses from it (docs/fdd.md). 0: losses from the file's model alone. In [0, 100].
+  double baseline_time_constant_s = 0.5;
   /// Take-off detector (eq. 18): active while the vehicle is airborne below this altitude [m] and
   /// within takeoff_window_s of lift-off, > 0.
   double takeoff_max_altitude_m = 0.6;
   double takeoff_window_s = 3.0;
   /// Filtered roll/pitch angular acceleration magnitude that fires it [rad/s^2], > 0 ...
   double takeoff_angular_acceleration_rad_s2 = 12.0;
-  /// ... pointing within this cosine of the signature of losing one rotor, in (0, 1].
+  /// ... pointing within this cosine of the signature of losing one rotor, in (0, 1] ...
   double takeoff_direction_cosine = 0.9;
+  /// ... while that rotor misses at least this fraction of its expected thrust, by its telemetry
+  /// (a motor slowing) or by the observer's force balance (a propeller lost), in [0, 1]: a
+  /// centre-of-gravity offset turns the vehicle at lift-off as a lost rotor does, but costs no
+  /// thrust.
+  double takeoff_missing_thrust_fraction = 0.5;
   /// Nominal IMU sample rate [Hz] (filters are designed for it), > 2 * filter_cutoff_hz.
   double imu_rate_hz = 333.0;
   /// IMU mounting point relative to the centre of gravity, body frame [m]: its lever-arm
@@ -75,7 +85,13 @@ struct CompositeFddOptions {
     a->Visit("takeoff_angular_acceleration_rad_s2", &takeoff_angular_acceleration_rad_s2,
              {.meaning = "roll/pitch angular acceleration that fires it [rad/s²] ..."});
     a->Visit("takeoff_direction_cosine", &takeoff_direction_cosine,
-             {.meaning = "... pointing within this cosine of the loss of one rotor"});
+             {.meaning = "... pointing within this cosine of the loss of one rotor ..."});
+    a->Visit("takeoff_missing_thrust_fraction", &takeoff_missing_thrust_fraction,
+             {.meaning = "... while that rotor misses this fraction of its expected thrust", .min = 0.0, .max = 1.0});
+    a->Visit("baseline_time_constant_s", &baseline_time_constant_s,
+             {.meaning = "the healthy residual is learnt with this time constant [s] (0: off; docs/fdd.md)",
+              .min = 0.0,
+              .max = 100.0});
   }
 };
 
@@ -142,14 +158,17 @@ class CompositeFdd final : public FaultDetectorBase {
   void OnEscTelemetry(const EscTelemetry& esc) override;
   /// The commanded thrusts sent to the motors: the motor index's reference.
   void SetCommand(const RotorVector& thrust_command) override;
-  /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16), for inspection.
+  /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16, from the baseline), for
+  /// inspection.
   const Eigen::VectorXd& thrust_loss() const { return thrust_loss_; }
+  /// The healthy residual wrench learnt so far [N, N m]: thrust along body z, then torque.
+  const Eigen::Vector4d& baseline() const { return baseline_; }
   /// The take-off detector's statistic: the filtered roll/pitch angular acceleration magnitude
   /// [rad/s^2] while its window is active, else 0 (for threshold calibration).
   double takeoff_angular_acceleration() const { return takeoff_angular_acceleration_; }
 
  private:
-  void RunObserver(double t);
+  void RunObserver(double t, double dt);
 
   vehicle::VehicleParams vehicle_;
   CompositeFddOptions options_;
@@ -173,6 +192,7 @@ class CompositeFdd final : public FaultDetectorBase {
   std::vector<double> above_since_s_, degraded_since_s_, degraded_sum_;
   std::vector<int> degraded_count_;
   Eigen::VectorXd thrust_loss_;
+  Eigen::Vector4d baseline_ = Eigen::Vector4d::Zero();  // the healthy residual wrench
   double takeoff_angular_acceleration_ = 0.0;
 };
 
