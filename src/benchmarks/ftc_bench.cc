@@ -1,16 +1,17 @@
 #include "rotorguard/benchmarks/ftc_bench.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
 
-#include <fmt/format.h>
-
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/failure_list.h"
+#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/harness/run_summary.h"
@@ -23,16 +24,31 @@ namespace rotorguard::benchmarks {
 namespace {
 
 struct Cell {
-  const char* test;   // the paper's test number, "-" for fault-free trials
+  const char* test;   // the paper's test number, "+" for cells beyond it, "-" for fault-free trials
   const char* phase;  // hover, tracking, takeoff
-  const char* fault;  // propeller_loss, motor_stop, none
+  const char* fault;  // the cell's name: propeller_loss, motor_stop, loe_30, ..., none
+  const char* kind = "none";  // the injected vehicle::FaultKind
+  double eta = 0.0;           // loss_of_effectiveness only
+  bool intermittent = false;  // on 0.5 s, off 0.5 s from the onset
 };
 
 constexpr Cell kCells[] = {
-    {"#1", "hover", "propeller_loss"},    {"#2", "hover", "motor_stop"},
-    {"#1", "tracking", "propeller_loss"}, {"#2", "tracking", "motor_stop"},
-    {"#3", "takeoff", "propeller_loss"},  {"#4", "takeoff", "motor_stop"},
-    {"-", "hover", "none"},               {"-", "tracking", "none"},
+    {"#1", "hover", "propeller_loss", "propeller_loss"},
+    {"#2", "hover", "motor_stop", "motor_stop"},
+    {"#1", "tracking", "propeller_loss", "propeller_loss"},
+    {"#2", "tracking", "motor_stop", "motor_stop"},
+    {"#3", "takeoff", "propeller_loss", "propeller_loss"},
+    {"#4", "takeoff", "motor_stop", "motor_stop"},
+    {"+", "hover", "loe_30", "loss_of_effectiveness", 0.3},
+    {"+", "hover", "loe_50", "loss_of_effectiveness", 0.5},
+    {"+", "hover", "loe_70", "loss_of_effectiveness", 0.7},
+    {"+", "tracking", "loe_30", "loss_of_effectiveness", 0.3},
+    {"+", "tracking", "loe_50", "loss_of_effectiveness", 0.5},
+    {"+", "tracking", "loe_70", "loss_of_effectiveness", 0.7},
+    {"+", "hover", "loe_50_intermittent", "loss_of_effectiveness", 0.5, true},
+    {"+", "hover", "propeller_loss_intermittent", "propeller_loss", 0.0, true},
+    {"-", "hover", "none"},
+    {"-", "tracking", "none"},
     {"-", "takeoff", "none"},
 };
 constexpr int kNumCells = sizeof(kCells) / sizeof(kCells[0]);
@@ -105,11 +121,16 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     // and torque and no inertial detector can see the loss (docs/benchmarks.md).
     onset = {sim::FaultOnset::Kind::kAtAltitude, 0.02 + 0.48 * draw};
   }
-  if (std::string(cell.fault) != "none") {
+  // Where the vehicle settled: the last 3 s, at least 2 s after the latest isolation of a partial
+  // loss (onset + 0.5 s persistence).
+  if (phase != "takeoff") s.tracking_start_s = s.duration_s - 3.0;
+  if (std::string(cell.kind) != "none") {
     sim::FaultSpec f;
     f.rotor = rotor;
-    f.kind = *vehicle::ParseFaultKind(cell.fault);
+    f.kind = *vehicle::ParseFaultKind(cell.kind);
+    f.eta = cell.eta;
     f.onset = onset;
+    if (cell.intermittent) f.intermittent = sim::IntermittentPattern{0.5, 0.5};
     s.faults.push_back(f);
   }
   harness::FitStackToHardware(&s);
@@ -131,7 +152,7 @@ nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v)
 }  // namespace
 
 nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty) {
-  std::vector<double> latencies;
+  std::vector<double> latencies, final_rmse, eta_errors;
   int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
   double min_alt = std::numeric_limits<double>::infinity();
   campaign::FailureList failures(5);  // the first few, to reproduce them
@@ -140,6 +161,8 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
     success += r.success ? 1 : 0;
     if (!r.success) failures.Add({{"trial", t}, {"seed", r.seed}, {"reason", r.failure}});
     if (!r.errored && std::isfinite(r.altitude_change_m)) min_alt = std::min(min_alt, r.altitude_change_m);
+    if (!r.errored && std::isfinite(r.final_rmse_m)) final_rmse.push_back(r.final_rmse_m);
+    if (!r.errored && std::isfinite(r.eta_error)) eta_errors.push_back(r.eta_error);
     if (!r.has_fdd) continue;
     ++with_fdd;
     false_alarms += r.false_alarm ? 1 : 0;
@@ -149,16 +172,20 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
   }
   const double n = static_cast<double>(trials.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  return {{"trials", trials.size()},
-          {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
-          {"fdd_latency_s_max", NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
-          {"sucr", n > 0 ? success / n : 0.0},
-          {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
-          {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
-          {"mini_alt_m", NullIfNan(min_alt)},
-          {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
-          {"failures", failures.listed()},
-          {"failures_not_listed", failures.not_listed()}};
+  return {
+      {"trials", trials.size()},
+      {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
+      {"fdd_latency_s_max", NullIfNan(latencies.empty() ? nan : *std::max_element(latencies.begin(), latencies.end()))},
+      {"sucr", n > 0 ? success / n : 0.0},
+      {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
+      {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
+      {"mini_alt_m", NullIfNan(min_alt)},
+      {"final_rmse_m_median", NullIfNan(final_rmse.empty() ? nan : campaign::Percentile(final_rmse, 0.5))},
+      {"eta_error_mean", NullIfNan(eta_errors.empty() ? nan : Mean(eta_errors))},
+      {"eta_error_max", NullIfNan(eta_errors.empty() ? nan : *std::max_element(eta_errors.begin(), eta_errors.end()))},
+      {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
+      {"failures", failures.listed()},
+      {"failures_not_listed", failures.not_listed()}};
 }
 
 std::vector<std::string> FtcMethods() {
@@ -188,7 +215,7 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   c.seed = o.seed;
   c.trials = kNumCells * methods * o.trials;
   c.group_keys = {"phase", "fault", "method"};
-  c.metrics = {"success", "correct", "false_alarm", "latency_s", "altitude_change_m"};
+  c.metrics = {"success", "correct", "false_alarm", "latency_s", "altitude_change_m", "final_rmse_m", "eta_error"};
   const nlohmann::json options = {{"trials", o.trials},   {"seed", o.seed},
                                   {"methods", o.methods}, {"vehicle", o.vehicle.name},
                                   {"truth", ToName(o.truth)}};
@@ -210,10 +237,15 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
     const auto [cell, method, trial] = decompose(index);
     const harness::RunSummary s = harness::RunScenario(MakeTrial(kCells[cell], o.methods[method], o, std::stoull(params.at("seed"))));
     campaign::TrialOutcome out;
+    const bool takeoff = std::string(kCells[cell].phase) == "takeoff";
     out.metrics = {
         {"success", s.success},
-        {"altitude_change_m", s.altitude_change_m ? nlohmann::json(*s.altitude_change_m) : nlohmann::json(nullptr)}};
+        {"altitude_change_m", s.altitude_change_m ? nlohmann::json(*s.altitude_change_m) : nlohmann::json(nullptr)},
+        {"final_rmse_m", takeoff ? nlohmann::json(nullptr) : nlohmann::json(s.tracking_rmse_m)}};
     if (s.fdd) {
+      const bool partial = s.fdd->correct && s.fdd->diagnosis->kind == "degraded";
+      out.metrics["eta_error"] =
+          partial ? nlohmann::json(std::abs(s.fdd->diagnosis->eta - kCells[cell].eta)) : nlohmann::json(nullptr);
       out.metrics["correct"] = s.fdd->correct;
       out.metrics["false_alarm"] = s.fdd->false_alarm;
       out.metrics["latency_s"] = s.fdd->latency_s ? nlohmann::json(*s.fdd->latency_s) : nlohmann::json(nullptr);
@@ -253,8 +285,12 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         }
         const nlohmann::json& x = r["metrics"];
         trial.success = x["success"].get<bool>();
-        trial.altitude_change_m = x["altitude_change_m"].is_null() ? std::numeric_limits<double>::quiet_NaN()
-                                                                   : x["altitude_change_m"].get<double>();
+        const auto number = [&x](const char* key) {
+          return !x.contains(key) || x[key].is_null() ? std::numeric_limits<double>::quiet_NaN() : x[key].get<double>();
+        };
+        trial.altitude_change_m = number("altitude_change_m");
+        trial.final_rmse_m = number("final_rmse_m");
+        trial.eta_error = number("eta_error");
         if (x.contains("correct")) {
           trial.has_fdd = true;
           trial.correct = x["correct"].get<bool>();
@@ -337,16 +373,23 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                         {"SucR (%)", "sucr", "{:.1f}", 100.0, "sucr"},
                         {"MDR (%)", "mdr", "{:.1f}", 100.0, "rate"},
                         {"FAR (%)", "far", "{:.1f}", 100.0, "rate"},
-                        {"MiniA (m)", "mini_alt_m", "{:.3f}", 1.0, "mini_alt"}};
+                        {"MiniA (m)", "mini_alt_m", "{:.3f}", 1.0, "mini_alt"},
+                        {"final RMSE median (m)", "final_rmse_m_median", "{:.3f}", 1.0, "none"},
+                        {"|η̂ − η| mean", "eta_error_mean", "{:.3f}", 1.0, "none"},
+                        {"|η̂ − η| max", "eta_error_max", "{:.3f}", 1.0, "none"}};
     for (const Row& row : rows) {
       if (fault == "none" && (std::string(row.key) == "fdd_latency_s_mean" || std::string(row.key) == "fdd_latency_s_max" ||
                               std::string(row.key) == "mdr")) {
         continue;
       }
       if (std::string(row.key) == "mini_alt_m" && (phase != "takeoff" || fault == "none")) continue;
+      if (std::string(row.key) == "final_rmse_m_median" && phase == "takeoff") continue;
+      if (std::string(row.key).starts_with("eta_error") && fault.find("loe") == std::string::npos) continue;
       std::string line = fmt::format("| {} | {} | {} | {} |", test, phase, fault, row.name);
       for (const auto& m : methods) line += fmt::format(" {} |", Fmt(cell(phase, fault, m)[row.key], row.format, row.scale));
-      const std::string paper = fault == "none" ? (std::string(row.key) == "far" ? "0" : "") : Paper(phase, fault, row.paper);
+      const std::string paper = fault == "none" ? (std::string(row.key) == "far" ? "0" : "")
+                                : test == "+"   ? ""
+                                                : Paper(phase, fault, row.paper);
       out += line + " " + paper + " |\n";
     }
   }

@@ -25,8 +25,8 @@ FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vecto
     const fdd::RotorStatus& status = rotors[static_cast<std::size_t>(i)];
     if (!status.detected_s) continue;
     if (!r.diagnosis || *status.detected_s < r.diagnosis->detection_s) {
-      r.diagnosis =
-          FddRecord::Diagnosis{i, std::string(fdd::ToString(status.health)), status.detector, *status.detected_s};
+      r.diagnosis = FddRecord::Diagnosis{i, std::string(fdd::ToString(status.health)), status.detector,
+                                         *status.detected_s, status.eta};
     }
   }
   if (!r.diagnosis) return r;

@@ -27,6 +27,7 @@ nlohmann::json FddJson(const FddRecord& f) {
           {"kind", d ? nlohmann::json(d->kind) : nlohmann::json(nullptr)},
           {"detector", d ? nlohmann::json(d->detector) : nlohmann::json(nullptr)},
           {"detection_s", d ? nlohmann::json(d->detection_s) : nlohmann::json(nullptr)},
+          {"eta", d ? nlohmann::json(d->eta) : nlohmann::json(nullptr)},
           {"correct", f.correct},
           {"false_alarm", f.false_alarm},
           {"latency_s", OrNull(f.latency_s)},

@@ -32,6 +32,21 @@ TEST(FtcCell, MetricArithmeticOnHandMadeTrials) {
   EXPECT_EQ(c["failures"][0]["seed"], 14);
 }
 
+TEST(FtcCell, SettledErrorIsTheMedianAndEtaErrorsCountOnlyWhereThereAreAny) {
+  // Three trials settled at 0.1, 0.3 and 0.2 m; two partial losses estimated 0.02 and 0.06 off.
+  std::vector<FtcTrial> t(3);
+  t[0].final_rmse_m = 0.1;
+  t[1].final_rmse_m = 0.3;
+  t[2].final_rmse_m = 0.2;
+  t[0].eta_error = 0.02;
+  t[2].eta_error = 0.06;
+  const nlohmann::json c = AggregateFtcCell(t, /*faulty=*/true);
+  EXPECT_NEAR(c["final_rmse_m_median"].get<double>(), 0.2, 1e-12);
+  EXPECT_NEAR(c["eta_error_mean"].get<double>(), 0.04, 1e-12);
+  EXPECT_NEAR(c["eta_error_max"].get<double>(), 0.06, 1e-12);
+  EXPECT_TRUE(AggregateFtcCell({FtcTrial{}}, true)["eta_error_mean"].is_null());
+}
+
 TEST(FtcCell, AnErroredTrialIsAFailureAndAMissedDetection) {
   // Two faulty trials of a method with FDD: one correct isolation, one that errored (it reported no
   // metrics). MDR counts the errored one; MiniA comes from the finished one alone.

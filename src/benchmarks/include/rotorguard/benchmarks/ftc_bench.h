@@ -6,10 +6,10 @@
 /// derived from the benchmark seed and the trial index, so results do not depend on the job count.
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/sim/truth.h"
@@ -53,6 +53,11 @@ struct FtcTrial {
   /// The trial did not finish (an error or a non-finite metric): a failure, a missed detection
   /// when the method detects faults, and no altitude to count.
   bool errored = false;
+  /// The RMS position error over the last 3 s [m] (hover and tracking; NaN at take-off): where the
+  /// vehicle settled after the fault.
+  double final_rmse_m = std::numeric_limits<double>::quiet_NaN();
+  /// |eta^ - eta| of a correct partial-loss diagnosis (NaN otherwise).
+  double eta_error = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A cell's metrics (docs/metrics.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty

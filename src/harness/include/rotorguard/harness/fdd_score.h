@@ -20,6 +20,7 @@ struct FddRecord {
     std::string kind;
     std::string detector;
     double detection_s = 0.0;
+    double eta = 0.0;  ///< the estimated loss of effectiveness at the end (degraded), else 1
   };
   std::optional<Diagnosis> diagnosis;  ///< none: no rotor left the ok state
   bool correct = false;                ///< right rotor and kind, at or after the first onset
