@@ -92,6 +92,10 @@ void Replanner::OnFailure() {
   failure_pending_ = true;
 }
 
+void Replanner::LimitAcceleration(double a_max) {
+  if (std::isfinite(a_max) && a_max > 0.0) limits_.a_max = std::min(limits_.a_max, a_max);
+}
+
 void Replanner::OnRecovered() { recovered_ = failed_; }
 
 ReferencePoint Replanner::Reference(double t) const {

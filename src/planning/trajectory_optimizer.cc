@@ -39,6 +39,23 @@ double PostFailureAccelerationLimit(double mass_kg, double rotor_max_thrust_n, d
   return safety_factor * std::abs((std::sqrt(thrust * thrust - weight * weight) - f_max) / mass_kg);
 }
 
+double DegradedAccelerationLimit(double nominal_a_max, double weight_n, const std::vector<double>& rotor_max_thrust_n,
+                                 const std::vector<double>& effectiveness) {
+  if (rotor_max_thrust_n.size() != effectiveness.size() || rotor_max_thrust_n.empty()) {
+    ThrowInvalidArgument("DegradedAccelerationLimit", "effectiveness", effectiveness.size(),
+                         fmt::format("{} entries, one per rotor", rotor_max_thrust_n.size()));
+  }
+  double nominal = 0.0, weakest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < effectiveness.size(); ++i) {
+    nominal += rotor_max_thrust_n[i];
+    weakest = std::min(weakest, std::clamp(effectiveness[i], 0.0, 1.0) * rotor_max_thrust_n[i]);
+  }
+  const double degraded = static_cast<double>(effectiveness.size()) * weakest;
+  const double w2 = weight_n * weight_n;
+  if (degraded <= weight_n || nominal <= weight_n) return 0.0;
+  return nominal_a_max * std::sqrt(degraded * degraded - w2) / std::sqrt(nominal * nominal - w2);
+}
+
 void TrajectoryOptimizerOptions::Validate() const {
   const auto require = [](bool ok, const char* field, double v, const char* rule) {
     if (!ok) ThrowValidation("TrajectoryOptimizerOptions", field, v, rule);

@@ -143,6 +143,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
   }
   known_fault_applied_.assign(options_.known_faults.size(), false);
   degraded_told_.assign(static_cast<std::size_t>(model_.num_rotors()), false);
+  effectiveness_.assign(static_cast<std::size_t>(model_.num_rotors()), 1.0);
   switch (options_.fdd) {
     case FddKind::kComposite:
       fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
@@ -212,6 +213,15 @@ void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset)
   if (!*told && nmpc_) nmpc_->RewindDisturbance(onset);
   *told = true;
   controller_->SetRotorEffectiveness(rotor, effectiveness);
+  // The planner keeps to what the weakened vehicle can still accelerate (failure-aware only).
+  effectiveness_[static_cast<std::size_t>(rotor)] = std::clamp(effectiveness, 0.0, 1.0);
+  if (navigator_ && options_.navigation.failure_aware) {
+    std::vector<double> max_thrust;
+    for (const vehicle::Rotor& r : model_.params().rotors) max_thrust.push_back(r.max_thrust_n);
+    navigator_->LimitAcceleration(
+        std::max(0.05, planning::DegradedAccelerationLimit(options_.navigation.replanner.nominal.a_max,
+                                                           model_.params().weight_n(), max_thrust, effectiveness_)));
+  }
 }
 
 void FlightStack::NavigateFlatness(double t) {

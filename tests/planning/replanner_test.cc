@@ -161,6 +161,31 @@ TEST(Replanner, AFailureReplansWithThePostFailureAccelerationLimit) {
   EXPECT_LT((r.Reference(25.0).p_W - Vector3(6, 0, 1.5)).norm(), 1e-6);
 }
 
+// A partial loss lowers the acceleration limit (never raises it); the trajectory being flown is
+// kept, and the next periodic replan keeps to the new limit.
+TEST(Replanner, APartialLossLimitsTheAccelerationFromTheNextReplanOn) {
+  const perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));
+  r.SetGoal(Vector3(6, 0, 1.5));
+  const double nominal = r.limits().a_max;
+  Fly(&r, map, 0.0, 40.0, [&](double t) {
+    if (std::abs(t - 1.0) < 1e-6) {
+      r.LimitAcceleration(0.3);
+      r.LimitAcceleration(2.0 * nominal);  // a higher one changes nothing
+    }
+  });
+  EXPECT_EQ(r.limits().a_max, 0.3);
+  EXPECT_EQ(Count(r, "failure"), 0);
+  const auto next = std::find_if(r.events().begin(), r.events().end(),
+                                 [](const Replanner::Event& e) { return e.t > 1.0 && e.reason == "periodic"; });
+  ASSERT_NE(next, r.events().end());
+  const double head_a = r.Reference(next->t).a_W.norm();
+  double a_max = 0.0;
+  for (double t = next->t; t <= 40.0; t += 0.005) a_max = std::max(a_max, r.Reference(t).a_W.norm());
+  EXPECT_LE(a_max, std::max(0.3, head_a) * 1.001);
+  EXPECT_LT((r.Reference(40.0).p_W - Vector3(6, 0, 1.5)).norm(), 1e-6);
+}
+
 // The clearance kept before a failure holds the failure's transient, which lasts until the
 // attitude has recovered; after that the post-failure clearance applies. A pillar 0.55 m beside
 // the straight way: planned for 0.9 m of clearance the trajectory swings wide of it, and so it

@@ -75,6 +75,17 @@ TEST(TrajectoryOptimizer, ObjectiveGradientMatchesFiniteDifferences) {
 
 // Eq. (33) with the reference vehicle: two rotors of 11.5 N lift 1.15 kg with
 // sqrt(23^2 - (1.15 g)^2) = 20.04 N to spare horizontally, less 0.65 kg/s x 1 m/s of drag.
+TEST(TrajectoryOptimizer, DegradedAccelerationLimitScalesTheNominalByTheHorizontalThrustLeft) {
+  const double w = 1.15 * 9.81;
+  const std::vector<double> max_thrust(4, 11.5);
+  EXPECT_NEAR(DegradedAccelerationLimit(3.0, w, max_thrust, {1, 1, 1, 1}), 3.0, 1e-12);  // nothing lost
+  // Rotor 0 at half: a balanced split gives 4 x 5.75 N = 23 N of the 46 N.
+  EXPECT_NEAR(DegradedAccelerationLimit(3.0, w, max_thrust, {0.5, 1, 1, 1}),
+              3.0 * std::sqrt(23.0 * 23.0 - w * w) / std::sqrt(46.0 * 46.0 - w * w), 1e-12);
+  EXPECT_EQ(DegradedAccelerationLimit(3.0, w, max_thrust, {1, 1, 0.2, 1}), 0.0) << "4 x 2.3 N cannot hold 11.3 N";
+  EXPECT_THROW(DegradedAccelerationLimit(3.0, w, max_thrust, {1, 1}), std::invalid_argument);
+}
+
 TEST(TrajectoryOptimizer, PostFailureAccelerationLimitIsEquation33) {
   const double w = 1.15 * 9.81;
   EXPECT_NEAR(PostFailureAccelerationLimit(1.15, 11.5, 0.65, 1.0, 0.5), 0.5 * (std::sqrt(23.0 * 23.0 - w * w) - 0.65) / 1.15,

@@ -83,6 +83,10 @@ class Replanner final : public ReferenceTrajectory {
   /// FDD isolated a failure: the post-failure limits from now on, and the post-failure clearance
   /// as a fallback until OnRecovered (ReplannerOptions::post_failure_clearance_m).
   void OnFailure();
+  /// A partial loss (the FDD's degraded rotor): plans from now on keep to `a_max` when it is below
+  /// the limit in force (DegradedAccelerationLimit). Every rotor still flies, so the trajectory
+  /// being flown is kept until the next replan (periodic at most replan_period_s later).
+  void LimitAcceleration(double a_max);
   /// The attitude has recovered from the failure (the supervisor's degraded navigation): the
   /// post-failure clearance alone from now on. Nothing before a failure.
   void OnRecovered();

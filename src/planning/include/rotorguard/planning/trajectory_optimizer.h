@@ -36,6 +36,14 @@ struct DynamicLimits {
 double PostFailureAccelerationLimit(double mass_kg, double rotor_max_thrust_n, double max_drag_coefficient_kg_s,
                                     double v_max, double safety_factor);
 
+/// Eq. (33)'s idea for a partial loss, where every rotor still flies and yaw stays controlled: the
+/// nominal limit scaled by the horizontal thrust left, a_n sqrt(T_d² - W²) / sqrt(T_n² - W²), with
+/// T_n = sum of the rotors' max thrusts ū_i and T_d = n min_i(eta_i ū_i), the most a balanced split
+/// (equal effective thrusts, as the NMPC's minimum-norm allocation of a symmetric vehicle) can give.
+/// 0 when T_d cannot hold the weight W. Throws std::invalid_argument for sizes that differ.
+double DegradedAccelerationLimit(double nominal_a_max, double weight_n, const std::vector<double>& rotor_max_thrust_n,
+                                 const std::vector<double>& effectiveness);
+
 /// An obstacle as the plane of eq. (34): through `point`, with unit `normal` pointing to free space;
 /// a position p is at signed distance (p - point) . normal from it (eq. 35).
 struct ObstaclePlane {
