@@ -106,7 +106,6 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
   x0_delta_.resize(nx_);
   weighted_y_.resize(nx_);
   for (int k = 0; k < N_; ++k) qp_.R[k] = options_.r_input * Eigen::MatrixXd::Identity(nu_, nu_);
-  eta_ = Eigen::VectorXd::Ones(nu_);
   torque_offset_ = Eigen::VectorXd::Zero(nu_);
   UpdateThrustSplit();
 }
@@ -126,12 +125,11 @@ void NmpcController::SetRotorFailed(int rotor) {
   }
   if (failed_[rotor]) return;  // already reconfigured
   failed_[rotor] = true;
-  eta_[rotor] = 0.0;
   observer_.SlowTorque();            // the spin that follows is no place for a fast torque observer
   reused_since_linearisation_ = -1;  // the weights change: Q_k with them
   u_max_[rotor] = 0.0;               // u_bar_i = 0 (paper 000, Sec. V-A)
   weights_[StateIndex::kQuaternion + 3] = 0.0;  // yaw is given up
-  UpdateThrustSplit();
+  SetModelEffectiveness(rotor, 0.0);
 }
 
 void NmpcController::SetRotorEffectiveness(int rotor, double effectiveness) {
@@ -141,33 +139,51 @@ void NmpcController::SetRotorEffectiveness(int rotor, double effectiveness) {
                          fmt::format("an index in [0, {}), a finite value", nu_));
   }
   if (effectiveness <= 0.0) return SetRotorFailed(rotor);
-  // Changes below a percent are noise of the estimate; each change re-linearises.
-  constexpr double kChange = 0.01;
   const double eta = std::min(effectiveness, 1.0);
-  if (failed_[rotor] || std::abs(eta - eta_[rotor]) < kChange) return;
-  eta_[rotor] = eta;
-  reused_since_linearisation_ = -1;
+  if (failed_[rotor] || eta == model_.effectiveness()[rotor]) return;
+  reused_since_linearisation_ = -1;  // the model's columns change
+  SetModelEffectiveness(rotor, eta);
+}
+
+void NmpcController::SetModelEffectiveness(int rotor, double eta) {
+  Eigen::VectorXd all = model_.effectiveness();
+  all[rotor] = eta;
+  model_.SetEffectiveness(all);
   UpdateThrustSplit();
 }
 
 Eigen::VectorXd NmpcController::ThrustReference(double total) const { return ThrustReferenceOf(total); }
 
 void NmpcController::UpdateThrustSplit() {
-  ModelCorrection correction = model_.correction();
-  correction.effectiveness = eta_;
-  model_.SetCorrection(correction);
-  const Eigen::MatrixXd E = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors) * eta_.asDiagonal();
+  const Eigen::VectorXd& eta = model_.effectiveness();
+  const Eigen::MatrixXd E = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors) * eta.asDiagonal();
   torque_split_ = Eigen::MatrixXd::Zero(nu_, 3);
-  if (std::none_of(failed_.begin(), failed_.end(), [](bool f) { return f; })) {
+  if (!AnyFailed()) {
     // Minimum-norm split of a unit total thrust with zero torque, and of unit torques.
     const Eigen::MatrixXd pinv = E.completeOrthogonalDecomposition().pseudoInverse();
     unit_split_ = pinv.col(0);
     torque_split_ = pinv.rightCols<3>();
-    ApplyCorrection();
-    return;
+  } else {
+    // The exact mirror image of a failed rotor through the centre of gravity (its diagonal twin
+    // on a quadrotor) idles, so that roll and pitch torques balance; only a healthy twin counts.
+    // The others carry a unit total thrust with zero roll and pitch torque (least squares when the
+    // torques cannot balance, e.g. two adjacent rotors lost); yaw is not controlled.
+    const std::vector<int> active = ActiveRotorsAfterFailure();
+    unit_split_ = Eigen::VectorXd::Zero(nu_);
+    if (!active.empty()) {
+      Eigen::MatrixXd Ea(3, static_cast<int>(active.size()));
+      for (int c = 0; c < static_cast<int>(active.size()); ++c) Ea.col(c) = E.col(active[c]).head<3>();
+      const Eigen::MatrixXd pinv = Ea.completeOrthogonalDecomposition().pseudoInverse();
+      for (int c = 0; c < static_cast<int>(active.size()); ++c) {
+        unit_split_[active[c]] = std::max(0.0, pinv(c, 0));
+        torque_split_.row(active[c]).head<2>() = pinv.row(c).tail<2>();
+      }
+    }
   }
-  // The exact mirror image of a failed rotor through the centre of gravity (its diagonal twin on a
-  // quadrotor) idles, so that roll and pitch torques balance; only a healthy twin counts.
+  ApplyCorrection();
+}
+
+std::vector<int> NmpcController::ActiveRotorsAfterFailure() const {
   std::vector<bool> idle = failed_;
   for (int f = 0; f < nu_; ++f) {
     if (!failed_[f]) continue;
@@ -178,23 +194,11 @@ void NmpcController::UpdateThrustSplit() {
       }
     }
   }
-  // The others carry a unit total thrust with zero roll and pitch torque (least squares when the
-  // torques cannot balance, e.g. two adjacent rotors lost); yaw is not controlled.
   std::vector<int> active;
   for (int i = 0; i < nu_; ++i) {
     if (!idle[i]) active.push_back(i);
   }
-  unit_split_ = Eigen::VectorXd::Zero(nu_);
-  if (!active.empty()) {
-    Eigen::MatrixXd Ea(3, static_cast<int>(active.size()));
-    for (int c = 0; c < static_cast<int>(active.size()); ++c) Ea.col(c) = E.col(active[c]).head<3>();
-    const Eigen::MatrixXd pinv = Ea.completeOrthogonalDecomposition().pseudoInverse();
-    for (int c = 0; c < static_cast<int>(active.size()); ++c) {
-      unit_split_[active[c]] = std::max(0.0, pinv(c, 0));
-      torque_split_.row(active[c]).head<2>() = pinv.row(c).tail<2>();
-    }
-  }
-  ApplyCorrection();
+  return active;
 }
 
 void NmpcController::ApplyCorrection() {
@@ -203,14 +207,15 @@ void NmpcController::ApplyCorrection() {
   // The rotor thrusts whose torque balances the disturbance's: M diag(eta) T = -I alpha_d.
   const Eigen::Vector3d torque = -(vehicle_.inertia_kg_m2 * alpha);
   torque_offset_.noalias() = torque_split_ * torque;
-  if (std::none_of(failed_.begin(), failed_.end(), [](bool f) { return f; })) return;
+  if (!AnyFailed()) return;
   // Reference spin: the yaw torque of the post-failure thrust split (and the disturbance's)
   // against the yaw damping.
   const double weight = vehicle_.weight_n();
   double yaw_torque = vehicle_.inertia_kg_m2(2, 2) * alpha.z();
   for (int i = 0; i < nu_; ++i) {
     const double t_ref = weight * unit_split_[i] + torque_offset_[i];
-    yaw_torque += vehicle_.rotors[i].yaw_sign() * vehicle_.rotors[i].yaw_coefficient_m * eta_[i] * t_ref;
+    yaw_torque +=
+        vehicle_.rotors[i].yaw_sign() * vehicle_.rotors[i].yaw_coefficient_m * model_.effectiveness()[i] * t_ref;
   }
   spin_reference_ = Eigen::Vector3d(0.0, 0.0, yaw_torque / std::max(vehicle_.yaw_damping_n_m_s, 1e-9));
 }
@@ -468,11 +473,9 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   } else {
     x0_.tail(nu_) = ThrustReferenceOf(vehicle_.weight_n());
   }
-  // What the model misses, from this measurement, into the prediction.
-  if (options_.disturbance.enabled) {
-    observer_.Update(x0_, t);
-    ApplyCorrection();
-  }
+  // What the model misses, from this measurement, into the prediction (nothing when disabled).
+  observer_.Update(x0_, t);
+  ApplyCorrection();
 
   int iterations = options_.max_sqp_iterations;
   // Real-time iteration: when the previous call prepared the QP for this very time, only the

@@ -35,28 +35,37 @@ NmpcModel::NmpcModel(const vehicle::VehicleParams& params) : params_(params), nu
   inertia_ = params_.inertia_kg_m2;
   inertia_inv_ = inertia_.inverse();
   torque_map_ = vehicle::ComputeEffectivenessMatrix(params_.rotors).bottomRows<3>();
-  eta_ = Eigen::VectorXd::Ones(nu_);
-  correction_.effectiveness = eta_;
+  correction_.effectiveness = Eigen::VectorXd::Ones(nu_);
   alpha_map_ = inertia_inv_ * torque_map_;
 }
 
-void NmpcModel::SetCorrection(const ModelCorrection& c) {
-  const Eigen::VectorXd eta = c.effectiveness.size() == 0 ? Eigen::VectorXd::Ones(nu_) : c.effectiveness;
-  if (eta.size() != nu_ || !eta.allFinite() || eta.minCoeff() < 0.0 || eta.maxCoeff() > 1.0) {
-    ThrowInvalidArgument("NmpcModel::SetCorrection", "effectiveness", fmt::format("{} entries", eta.size()),
-                         fmt::format("{} entries in [0, 1]", nu_));
-  }
-  SetDisturbance(c.acceleration_W, c.angular_acceleration_B);
-  correction_.effectiveness = eta;
-  eta_ = eta;
-  alpha_map_ = inertia_inv_ * torque_map_ * eta_.asDiagonal();
-}
-
-void NmpcModel::SetDisturbance(const Eigen::Vector3d& acceleration_W, const Eigen::Vector3d& angular_acceleration_B) {
+namespace {
+void RequireFinite(const Eigen::Vector3d& acceleration_W, const Eigen::Vector3d& angular_acceleration_B) {
   if (!acceleration_W.allFinite() || !angular_acceleration_B.allFinite()) {
     ThrowInvalidArgument("NmpcModel::SetDisturbance", "acceleration_W, angular_acceleration_B", "(non-finite)",
                          "finite accelerations");
   }
+}
+}  // namespace
+
+void NmpcModel::SetCorrection(const ModelCorrection& c) {
+  RequireFinite(c.acceleration_W, c.angular_acceleration_B);  // before anything changes
+  SetEffectiveness(c.effectiveness);
+  SetDisturbance(c.acceleration_W, c.angular_acceleration_B);
+}
+
+void NmpcModel::SetEffectiveness(const Eigen::VectorXd& effectiveness) {
+  const Eigen::VectorXd eta = effectiveness.size() == 0 ? Eigen::VectorXd::Ones(nu_) : effectiveness;
+  if (eta.size() != nu_ || !eta.allFinite() || eta.minCoeff() < 0.0 || eta.maxCoeff() > 1.0) {
+    ThrowInvalidArgument("NmpcModel::SetEffectiveness", "effectiveness", fmt::format("{} entries", eta.size()),
+                         fmt::format("{} entries in [0, 1]", nu_));
+  }
+  correction_.effectiveness = eta;
+  alpha_map_ = inertia_inv_ * torque_map_ * eta.asDiagonal();
+}
+
+void NmpcModel::SetDisturbance(const Eigen::Vector3d& acceleration_W, const Eigen::Vector3d& angular_acceleration_B) {
+  RequireFinite(acceleration_W, angular_acceleration_B);
   correction_.acceleration_W = acceleration_W;
   correction_.angular_acceleration_B = angular_acceleration_B;
 }
@@ -67,7 +76,7 @@ void NmpcModel::ModelAccelerations(const Eigen::VectorXd& x, Eigen::Vector3d* a_
   const Eigen::Vector3d w = x.segment<3>(StateIndex::kBodyRate);
   const auto T = x.segment(StateIndex::kMotor, nu_);
   const Eigen::Vector3d D = params_.rotor_drag_kg_s;
-  *a_W = (R.col(2) * eta_.dot(T) - R * D.asDiagonal() * (R.transpose() * v)) / params_.mass_kg -
+  *a_W = (R.col(2) * effectiveness().dot(T) - R * D.asDiagonal() * (R.transpose() * v)) / params_.mass_kg -
          Eigen::Vector3d(0, 0, kGravity);
   *alpha_B = alpha_map_ * T -
              inertia_inv_ * (w.cross(inertia_ * w) + Eigen::Vector3d(0, 0, params_.yaw_damping_n_m_s * w.z()));
@@ -100,7 +109,7 @@ void NmpcModel::UpdateDynamicsWithJacobians(const Eigen::VectorXd& x, const Eige
   Eigen::Matrix3d dR[4];
   RotationDerivatives(qw, qx, qy, qz, dR);
   const Eigen::Vector3d v = x.segment<3>(7), w = x.segment<3>(10);
-  const double thrust = eta_.dot(x.segment(StateIndex::kMotor, nu_));
+  const double thrust = effectiveness().dot(x.segment(StateIndex::kMotor, nu_));
   const Eigen::Matrix3d D = params_.rotor_drag_kg_s.asDiagonal();
   const double inv_m = 1.0 / params_.mass_kg;
 
@@ -125,7 +134,7 @@ void NmpcModel::UpdateDynamicsWithJacobians(const Eigen::VectorXd& x, const Eige
         inv_m * (dR[i].col(2) * thrust - dR[i] * drag_body - R * D * (dR[i].transpose() * v));
   }
   fx->block<3, 3>(7, 7) = -inv_m * R * D * R.transpose();
-  for (int j = 0; j < nu_; ++j) fx->block<3, 1>(7, StateIndex::kMotor + j) = (eta_[j] * inv_m) * R.col(2);
+  for (int j = 0; j < nu_; ++j) fx->block<3, 1>(7, StateIndex::kMotor + j) = (effectiveness()[j] * inv_m) * R.col(2);
   // w_dot = I^-1 (M diag(eta) T - w x I w - k_dpsi r e3) + alpha_c.
   const Eigen::Matrix3d gyro = Skew(w) * inertia_ - Skew(inertia_ * w);
   Eigen::Matrix3d damping = Eigen::Matrix3d::Zero();

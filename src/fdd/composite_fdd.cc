@@ -212,11 +212,11 @@ void CompositeFdd::RunObserver(double t, double dt) {
     // The rotor it points at must miss thrust: by telemetry, or by the force balance. Which of
     // the two sees it tells the kind: a slowing motor's loss shows in its telemetry (and so not in
     // the force balance, which counts measured thrusts); a lost propeller's only in the balance.
-    const double by_telemetry = best < 0 ? 0.0 : expected_thrust_[best] - measured_thrust_[best];
-    if (best >= 0 &&
-        std::max(by_telemetry, lost[0]) >= options_.takeoff_missing_thrust_fraction * expected_thrust_[best]) {
-      const bool motor = by_telemetry > lost[0];
-      Isolate(best, motor ? RotorHealth::kMotorFailed : RotorHealth::kPropellerFailed, t, "takeoff");
+    if (best >= 0) {
+      const double by_telemetry = expected_thrust_[best] - measured_thrust_[best];
+      if (std::max(by_telemetry, lost[0]) >= options_.takeoff_missing_thrust_fraction * expected_thrust_[best]) {
+        Isolate(best, by_telemetry > lost[0] ? RotorHealth::kMotorFailed : RotorHealth::kPropellerFailed, t, "takeoff");
+      }
     }
   }
 

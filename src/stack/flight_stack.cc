@@ -209,12 +209,18 @@ void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
 }
 
 void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset) {
-  auto told = degraded_told_.begin() + rotor;
-  if (!*told && nmpc_) nmpc_->RewindDisturbance(onset);
-  *told = true;
-  controller_->SetRotorEffectiveness(rotor, effectiveness);
+  // The FDD's estimate improves sample by sample: changes below a percent are its noise, and each
+  // one the NMPC takes costs it a re-linearisation and the planner a new limit.
+  constexpr double kChange = 0.01;
+  const double eta = std::clamp(effectiveness, 0.0, 1.0);
+  const auto i = static_cast<std::size_t>(rotor);
+  // A detector's estimate may come back to 1 (the UKF's): "told" is its own flag.
+  if (degraded_told_[i] && std::abs(eta - effectiveness_[i]) < kChange) return;
+  if (!degraded_told_[i] && nmpc_) nmpc_->RewindDisturbance(onset);
+  degraded_told_[i] = true;
+  effectiveness_[i] = eta;
+  controller_->SetRotorEffectiveness(rotor, eta);
   // The planner keeps to what the weakened vehicle can still accelerate (failure-aware only).
-  effectiveness_[static_cast<std::size_t>(rotor)] = std::clamp(effectiveness, 0.0, 1.0);
   if (navigator_ && options_.navigation.failure_aware) {
     std::vector<double> max_thrust;
     for (const vehicle::Rotor& r : model_.params().rotors) max_thrust.push_back(r.max_thrust_n);

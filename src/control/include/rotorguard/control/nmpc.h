@@ -9,6 +9,7 @@
 /// Offset-free: a disturbance observer estimates what the model misses, and the model predicts
 /// with it and with each rotor's known effectiveness (docs/control.md).
 #include <Eigen/Core>
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -173,16 +174,20 @@ class NmpcController final : public Controller {
   CondensingQpSolver qp_solver_;
   Eigen::VectorXd weights_;          // diagonal of W for y (nx entries)
   Eigen::VectorXd u_max_;
-  DisturbanceObserver observer_;
-  Eigen::VectorXd eta_;            // each rotor's effectiveness (0 once failed)
+  DisturbanceObserver observer_;   // the rotors' effectiveness (0 once failed) is model_'s
   Eigen::VectorXd unit_split_;     // the thrust reference per newton of total thrust
   Eigen::MatrixXd torque_split_;   // rotor thrusts per N m of roll, pitch, yaw torque (n x 3)
   Eigen::VectorXd torque_offset_;  // torque_split_ times the torque the disturbance asks for
   /// The splits for the failed rotors and the effectiveness: the minimum-norm split with yaw
   /// while every rotor flies; else the post-failure one (SetRotorFailed).
   void UpdateThrustSplit();
+  /// After a failure: the rotors that carry the weight (not failed, not a failed rotor's twin).
+  std::vector<int> ActiveRotorsAfterFailure() const;
+  /// One rotor's effectiveness into the model, and the splits for it.
+  void SetModelEffectiveness(int rotor, double eta);
   /// The observer's estimates into the model, the thrust reference and the reference spin.
   void ApplyCorrection();
+  bool AnyFailed() const { return std::find(failed_.begin(), failed_.end(), true) != failed_.end(); }
   std::vector<bool> failed_;
   Eigen::Vector3d spin_reference_ = Eigen::Vector3d::Zero();
   std::vector<Eigen::VectorXd> x_, u_;  // shooting nodes and inputs

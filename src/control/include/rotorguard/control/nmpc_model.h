@@ -28,15 +28,18 @@ class NmpcModel {
   int nu() const { return nu_; }
   const vehicle::VehicleParams& params() const { return params_; }
 
-  /// Throws std::invalid_argument for an effectiveness of the wrong size or outside [0, 1], or a
-  /// non-finite acceleration; nothing changes then.
+  /// SetEffectiveness and SetDisturbance together. Throws std::invalid_argument as they do;
+  /// nothing changes then.
   void SetCorrection(const ModelCorrection& correction);
-  /// SetCorrection's accelerations alone, without allocating (every control cycle). Throws
+  /// Each rotor's effectiveness (empty: all 1). Throws std::invalid_argument for the wrong size
+  /// or an entry outside [0, 1].
+  void SetEffectiveness(const Eigen::VectorXd& effectiveness);
+  /// The constant accelerations alone, without allocating (every control cycle). Throws
   /// std::invalid_argument for a non-finite one.
   void SetDisturbance(const Eigen::Vector3d& acceleration_W, const Eigen::Vector3d& angular_acceleration_B);
   const ModelCorrection& correction() const { return correction_; }
   /// The rotor effectiveness in use (all 1 unless corrected).
-  const Eigen::VectorXd& effectiveness() const { return eta_; }
+  const Eigen::VectorXd& effectiveness() const { return correction_.effectiveness; }
   /// The uncorrected accelerations of x: v_dot and w_dot of eqs. (1) and (3) with the rotor
   /// effectiveness but without the constant accelerations (what a disturbance observer compares
   /// with the measurement).
@@ -62,8 +65,7 @@ class NmpcModel {
   int nu_;
   Eigen::Matrix3d inertia_, inertia_inv_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> torque_map_;  // rows 1..3 of the effectiveness matrix
-  ModelCorrection correction_;
-  Eigen::VectorXd eta_;                                 // the rotor effectiveness
+  ModelCorrection correction_;                           // its effectiveness always has nu_ entries
   Eigen::Matrix<double, 3, Eigen::Dynamic> alpha_map_;  // I^-1 torque_map_ diag(eta)
 };
 

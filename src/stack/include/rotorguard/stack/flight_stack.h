@@ -326,10 +326,10 @@ class FlightStack {
   /// its value at the onset: the fault is now in its model) and, unless the failure-unaware
   /// variant flies, the planner switches to the post-failure limit.
   void OnRotorFailed(int rotor, double t, double onset);
-  /// A rotor's partial loss, found by the FDD or handed over: its effectiveness reaches the
-  /// controller (the first time, with the disturbance estimate returned to the onset's) and the
-  /// planner's acceleration limit (DegradedAccelerationLimit), unless the failure-unaware variant
-  /// flies.
+  /// A rotor's partial loss, found by the FDD (every cycle, as its estimate improves) or handed
+  /// over: its effectiveness, when it changed by a percent, reaches the controller (the first
+  /// time, with the disturbance estimate returned to the onset's) and the planner's acceleration
+  /// limit (DegradedAccelerationLimit), unless the failure-unaware variant flies.
   void OnRotorDegraded(int rotor, double effectiveness, double onset);
   /// The navigator's part of a control cycle: the next waypoint when due (not while recovering
   /// from a failure), the planner at its rate, the time of its last success.
@@ -363,8 +363,8 @@ class FlightStack {
   long lidar_points_dropped_ = 0;
   StackCost cost_;
   std::vector<bool> known_fault_applied_;
-  std::vector<bool> degraded_told_;  // per rotor: the controller heard of its partial loss
-  std::vector<double> effectiveness_;  // per rotor: 1 - eta of its partial loss (1: healthy)
+  std::vector<bool> degraded_told_;    // per rotor: the controller heard of its partial loss
+  std::vector<double> effectiveness_;  // per rotor: the effectiveness last handed over (1: healthy)
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
   StateEstimate estimate_;
