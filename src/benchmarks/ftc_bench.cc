@@ -367,6 +367,7 @@ std::string FtcMarkdown(const nlohmann::json& result) {
       const char* format;
       double scale;
       const char* paper;
+      bool where_measured = false;  // shown only when some method has a value
     };
     const Row rows[] = {{"FDD latency mean (s)", "fdd_latency_s_mean", "{:.3f}", 1.0, "latency"},
                         {"FDD latency max (s)", "fdd_latency_s_max", "{:.3f}", 1.0, "none"},
@@ -374,17 +375,20 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                         {"MDR (%)", "mdr", "{:.1f}", 100.0, "rate"},
                         {"FAR (%)", "far", "{:.1f}", 100.0, "rate"},
                         {"MiniA (m)", "mini_alt_m", "{:.3f}", 1.0, "mini_alt"},
-                        {"final RMSE median (m)", "final_rmse_m_median", "{:.3f}", 1.0, "none"},
-                        {"|η̂ − η| mean", "eta_error_mean", "{:.3f}", 1.0, "none"},
-                        {"|η̂ − η| max", "eta_error_max", "{:.3f}", 1.0, "none"}};
+                        {"final RMSE median (m)", "final_rmse_m_median", "{:.3f}", 1.0, "none", true},
+                        {"|η̂ − η| mean", "eta_error_mean", "{:.3f}", 1.0, "none", true},
+                        {"|η̂ − η| max", "eta_error_max", "{:.3f}", 1.0, "none", true}};
     for (const Row& row : rows) {
       if (fault == "none" && (std::string(row.key) == "fdd_latency_s_mean" || std::string(row.key) == "fdd_latency_s_max" ||
                               std::string(row.key) == "mdr")) {
         continue;
       }
       if (std::string(row.key) == "mini_alt_m" && (phase != "takeoff" || fault == "none")) continue;
-      if (std::string(row.key) == "final_rmse_m_median" && phase == "takeoff") continue;
-      if (std::string(row.key).starts_with("eta_error") && fault.find("loe") == std::string::npos) continue;
+      if (row.where_measured && std::all_of(methods.begin(), methods.end(), [&](const std::string& m) {
+            return cell(phase, fault, m)[row.key].is_null();
+          })) {
+        continue;  // the settled error at take-off, the eta error without a partial loss
+      }
       std::string line = fmt::format("| {} | {} | {} | {} |", test, phase, fault, row.name);
       for (const auto& m : methods) line += fmt::format(" {} |", Fmt(cell(phase, fault, m)[row.key], row.format, row.scale));
       const std::string paper = fault == "none" ? (std::string(row.key) == "far" ? "0" : "")
