@@ -125,7 +125,7 @@ TEST(NmpcModel, RejectsABadCorrection) {
   EXPECT_THROW(model.SetCorrection(c), std::invalid_argument);
   c.effectiveness = Eigen::Vector4d(1.0, 1.0, 1.2, 1.0);
   EXPECT_THROW(model.SetCorrection(c), std::invalid_argument);
-  c.effectiveness.resize(0);
+  c.effectiveness = Eigen::Vector4d(1.0, 0.5, 1.0, 1.0);  // valid, with a bad acceleration
   c.acceleration_W.x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(model.SetCorrection(c), std::invalid_argument);
   EXPECT_EQ(model.effectiveness(), Eigen::VectorXd::Ones(4));  // nothing half-applied

@@ -15,8 +15,8 @@ namespace rotorguard::control {
 
 struct DisturbanceObserverOptions {
   bool enabled = true;  ///< false: the model is flown as the file gives it (no disturbance terms)
-  /// The double pole of the velocity observer's error dynamics [rad/s], > 0: slow enough that
-  /// the odometry's corrections and a fault's first 0.2 s barely move the estimate.
+  /// The double pole of the velocity observer's error dynamics [rad/s], > 0: slow, so that a
+  /// fault's first 0.2 s moves the estimate by 12 % of the fault's acceleration (docs/control.md).
   double force_bandwidth_rad_s = 3.0;
   /// The double pole of the body-rate observer's error dynamics [rad/s], > 0.
   double torque_bandwidth_rad_s = 6.0;
@@ -70,7 +70,6 @@ class DisturbanceObserver {
   /// coupling of a wrong inertia grows with the spin and is no constant, and a torque observer
   /// that chases it feeds the precession (docs/control.md).
   void SlowTorque() { torque_slowed_ = true; }
-  bool torque_slowed() const { return torque_slowed_; }
   /// The disturbances estimated at time `t` or just before it, from the last kHistory updates
   /// (about 5 s at 200 Hz; the oldest one kept when t is older): the value to return to when a
   /// fault found later is put into the model, so that the fault's own transient is not counted
