@@ -133,6 +133,13 @@ void PrintRunSummary(const harness::RunSummary& s, const std::string& out_dir,
                s.fdd->latency_s ? fmt::format(" (correct, {:.3f} s after onset)", *s.fdd->latency_s)
                                 : (s.fdd->false_alarm ? " (false alarm)" : " (wrong rotor or kind)"));
   }
+  if (s.fdd && s.fdd->second && !s.fdd->second->isolated) {
+    fmt::print("second failure    rotor {} not isolated\n", s.fdd->second->rotor);
+  } else if (s.fdd && s.fdd->second) {
+    const harness::FddRecord::Second& d = *s.fdd->second;
+    fmt::print("second failure    rotor {} {} by {} at {:.3f} s{}\n", d.rotor, d.kind, d.detector, d.detection_s,
+               d.latency_s ? fmt::format(" (correct, {:.3f} s after onset)", *d.latency_s) : " (wrong kind or early)");
+  }
   PrintFlatnessDecisions(s.stack.flatness_decisions);
   for (std::size_t i = 0; i < s.stack.transitions.size(); ++i) {
     const stack::ModeTransition& m = s.stack.transitions[i];

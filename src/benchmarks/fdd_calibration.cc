@@ -56,7 +56,7 @@ Scored ReplayAndScore(const CalibrationLog& log, const fdd::CompositeFddOptions&
 struct Sweep {
   const char* name;
   double fdd::CompositeFddOptions::*field;
-  double ReplayOutcome::*extreme;  // the statistic it thresholds, at its fault-free extreme
+  double fdd::IndexExtremes::*extreme;  // the statistic it thresholds, at its fault-free extreme
   std::vector<double> values;
   bool alarm_when_low;  // the motor index alarms below its threshold, the others above
 };
@@ -160,17 +160,10 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::Composite
         detector.SetCommand(command.thrust_n);
       }
     }
-    if (detector.first_isolated_rotor()) {
-      if (ToSeconds(record::RecordTime(r)) >= onset) break;  // nothing left to learn
-      continue;  // extremes only from flight the detector still considers healthy
-    }
-    if (ToSeconds(record::RecordTime(r)) < onset) {
-      for (const fdd::RotorStatus& st : detector.rotors()) {
-        out.min_motor_index = std::min(out.min_motor_index, st.motor_index);
-        out.max_propeller_index = std::max(out.max_propeller_index, st.propeller_index);
-      }
-      out.max_takeoff_alpha = std::max(out.max_takeoff_alpha, detector.takeoff_angular_acceleration());
-    }
+    // Extremes from flight before the fault (the detector itself stops at its first isolation).
+    const bool before_onset = ToSeconds(record::RecordTime(r)) < onset;
+    if (before_onset) out.extremes = detector.healthy_extremes();
+    if (detector.first_isolated_rotor() && !before_onset) break;  // nothing left to learn
   }
   out.isolated_rotor = detector.first_isolated_rotor();
   out.statuses = detector.rotors();
@@ -193,14 +186,12 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
   disarmed.propeller_index_threshold = 1.0;
   disarmed.propeller_persistence_s = 10.0;
   disarmed.takeoff_angular_acceleration_rad_s2 = 1e6;
-  ReplayOutcome extremes;  // over all logs
+  fdd::IndexExtremes extremes;  // over all logs
   nlohmann::json log_docs = nlohmann::json::array();
   int faulty_logs = 0;
   for (const CalibrationLog& log : logs) {
     const ReplayOutcome e = ReplayCompositeFdd(log, disarmed);
-    extremes.min_motor_index = std::min(extremes.min_motor_index, e.min_motor_index);
-    extremes.max_propeller_index = std::max(extremes.max_propeller_index, e.max_propeller_index);
-    extremes.max_takeoff_alpha = std::max(extremes.max_takeoff_alpha, e.max_takeoff_alpha);
+    extremes.Merge(e.extremes);
     const Scored recorded = ReplayAndScore(log, options.fdd);
     nlohmann::json fault = nullptr;
     if (!log.faults.empty()) {
@@ -219,14 +210,21 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
                                                                   : nlohmann::json(nullptr)}}}});
   }
   const std::vector<Sweep> sweeps = {
-      {"motor_index_threshold", &fdd::CompositeFddOptions::motor_index_threshold, &ReplayOutcome::min_motor_index,
-       {0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99}, true},
-      {"propeller_index_threshold", &fdd::CompositeFddOptions::propeller_index_threshold,
-       &ReplayOutcome::max_propeller_index,
-       {0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0}, false},
-      {"takeoff_angular_acceleration_rad_s2", &fdd::CompositeFddOptions::takeoff_angular_acceleration_rad_s2,
-       &ReplayOutcome::max_takeoff_alpha,
-       {0.5, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0, 30.0, 40.0}, false},
+      {"motor_index_threshold",
+       &fdd::CompositeFddOptions::motor_index_threshold,
+       &fdd::IndexExtremes::min_motor_index,
+       {0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99},
+       true},
+      {"propeller_index_threshold",
+       &fdd::CompositeFddOptions::propeller_index_threshold,
+       &fdd::IndexExtremes::max_propeller_index,
+       {0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0},
+       false},
+      {"takeoff_angular_acceleration_rad_s2",
+       &fdd::CompositeFddOptions::takeoff_angular_acceleration_rad_s2,
+       &fdd::IndexExtremes::max_takeoff_alpha,
+       {0.5, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0, 30.0, 40.0},
+       false},
   };
   nlohmann::json sweep_docs = nlohmann::json::array();
   for (const Sweep& sw : sweeps) {

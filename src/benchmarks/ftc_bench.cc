@@ -30,6 +30,9 @@ struct Cell {
   const char* kind = "none";  // the injected vehicle::FaultKind
   double eta = 0.0;           // loss_of_effectiveness only
   bool intermittent = false;  // on 0.5 s, off 0.5 s from the onset
+  // A second failure, a propeller loss 2.5-3.5 s after the first: on the first rotor's diagonal
+  // twin ("twin") or on a rotor beside it ("adjacent"); nullptr: none.
+  const char* second = nullptr;
 };
 
 constexpr Cell kCells[] = {
@@ -47,6 +50,8 @@ constexpr Cell kCells[] = {
     {"+", "tracking", "loe_70", "loss_of_effectiveness", 0.7},
     {"+", "hover", "loe_50_intermittent", "loss_of_effectiveness", 0.5, true},
     {"+", "hover", "propeller_loss_intermittent", "propeller_loss", 0.0, true},
+    {"+", "hover", "motor_stop_then_twin", "motor_stop", 0.0, false, "twin"},
+    {"+", "hover", "motor_stop_then_adjacent", "motor_stop", 0.0, false, "adjacent"},
     {"-", "hover", "none"},
     {"-", "tracking", "none"},
     {"-", "takeoff", "none"},
@@ -133,6 +138,26 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     if (cell.intermittent) f.intermittent = sim::IntermittentPattern{0.5, 0.5};
     s.faults.push_back(f);
   }
+  if (cell.second) {
+    // The twin: the rotor mirrored through the centre of gravity; adjacent: the nearest other.
+    const Eigen::Vector2d p = o.vehicle.rotors[rotor].p_B.head<2>();
+    const bool twin = std::string(cell.second) == "twin";
+    int pick = -1;
+    double best = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < o.vehicle.num_rotors(); ++j) {
+      const double d =
+          twin ? (o.vehicle.rotors[j].p_B.head<2>() + p).norm() : (o.vehicle.rotors[j].p_B.head<2>() - p).norm();
+      if (j != rotor && d < best) {
+        best = d;
+        pick = j;
+      }
+    }
+    sim::FaultSpec f;
+    f.rotor = pick;
+    f.kind = vehicle::FaultKind::kPropellerLoss;
+    f.onset = {sim::FaultOnset::Kind::kAtTime, onset.value + 2.5 + rng.Uniform()};
+    s.faults.push_back(f);
+  }
   harness::FitStackToHardware(&s);
   const FtcMethod& m = FtcMethodNamed(method);
   s.stack.controller = m.controller;
@@ -151,8 +176,9 @@ nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v)
 
 }  // namespace
 
-nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty) {
-  std::vector<double> latencies, final_rmse, eta_errors;
+nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty, bool with_second) {
+  std::vector<double> latencies, final_rmse, eta_errors, second_latencies, crash_speeds;
+  int second_correct = 0;
   int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
   double min_alt = std::numeric_limits<double>::infinity();
   campaign::FailureList failures(5);  // the first few, to reproduce them
@@ -163,6 +189,11 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
     if (!r.errored && std::isfinite(r.altitude_change_m)) min_alt = std::min(min_alt, r.altitude_change_m);
     if (!r.errored && std::isfinite(r.final_rmse_m)) final_rmse.push_back(r.final_rmse_m);
     if (!r.errored && std::isfinite(r.eta_error)) eta_errors.push_back(r.eta_error);
+    if (!r.errored && std::isfinite(r.crash_speed_m_s)) crash_speeds.push_back(r.crash_speed_m_s);
+    if (r.second_correct) {
+      ++second_correct;
+      second_latencies.push_back(r.second_latency_s);
+    }
     if (!r.has_fdd) continue;
     ++with_fdd;
     false_alarms += r.false_alarm ? 1 : 0;
@@ -183,6 +214,13 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
       {"final_rmse_m_median", NullIfNan(final_rmse.empty() ? nan : campaign::Percentile(final_rmse, 0.5))},
       {"eta_error_mean", NullIfNan(eta_errors.empty() ? nan : Mean(eta_errors))},
       {"eta_error_max", NullIfNan(eta_errors.empty() ? nan : *std::max_element(eta_errors.begin(), eta_errors.end()))},
+      {"second_isolated", NullIfNan(with_second ? second_correct / n : nan)},
+      {"second_latency_s_median",
+       NullIfNan(second_latencies.empty() ? nan : campaign::Percentile(second_latencies, 0.5))},
+      {"crashes", crash_speeds.size()},
+      {"crash_speed_m_s_median", NullIfNan(crash_speeds.empty() ? nan : campaign::Percentile(crash_speeds, 0.5))},
+      {"crash_speed_m_s_max",
+       NullIfNan(crash_speeds.empty() ? nan : *std::max_element(crash_speeds.begin(), crash_speeds.end()))},
       {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
       {"failures", failures.listed()},
       {"failures_not_listed", failures.not_listed()}};
@@ -215,7 +253,8 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   c.seed = o.seed;
   c.trials = kNumCells * methods * o.trials;
   c.group_keys = {"phase", "fault", "method"};
-  c.metrics = {"success", "correct", "false_alarm", "latency_s", "altitude_change_m", "final_rmse_m", "eta_error"};
+  c.metrics = {"success",      "correct",   "false_alarm",    "latency_s",        "altitude_change_m",
+               "final_rmse_m", "eta_error", "second_correct", "second_latency_s", "crash_speed_m_s"};
   const nlohmann::json options = {{"trials", o.trials},   {"seed", o.seed},
                                   {"methods", o.methods}, {"vehicle", o.vehicle.name},
                                   {"truth", ToName(o.truth)}};
@@ -235,13 +274,15 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   };
   c.run = [o, decompose](int index, const std::map<std::string, std::string>& params) {
     const auto [cell, method, trial] = decompose(index);
-    const harness::RunSummary s = harness::RunScenario(MakeTrial(kCells[cell], o.methods[method], o, std::stoull(params.at("seed"))));
+    const harness::RunSummary s =
+        harness::RunScenario(MakeTrial(kCells[cell], o.methods[method], o, std::stoull(params.at("seed"))));
     campaign::TrialOutcome out;
     const bool takeoff = std::string(kCells[cell].phase) == "takeoff";
     out.metrics = {
         {"success", s.success},
         {"altitude_change_m", s.altitude_change_m ? nlohmann::json(*s.altitude_change_m) : nlohmann::json(nullptr)},
-        {"final_rmse_m", takeoff ? nlohmann::json(nullptr) : nlohmann::json(s.tracking_rmse_m)}};
+        {"final_rmse_m", takeoff ? nlohmann::json(nullptr) : nlohmann::json(s.tracking_rmse_m)},
+        {"crash_speed_m_s", s.crash_speed_m_s ? nlohmann::json(*s.crash_speed_m_s) : nlohmann::json(nullptr)}};
     if (s.fdd) {
       const bool partial = s.fdd->correct && s.fdd->diagnosis->kind == "degraded";
       out.metrics["eta_error"] =
@@ -249,6 +290,11 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
       out.metrics["correct"] = s.fdd->correct;
       out.metrics["false_alarm"] = s.fdd->false_alarm;
       out.metrics["latency_s"] = s.fdd->latency_s ? nlohmann::json(*s.fdd->latency_s) : nlohmann::json(nullptr);
+      if (s.fdd->second) {
+        out.metrics["second_correct"] = s.fdd->second->correct;
+        out.metrics["second_latency_s"] =
+            s.fdd->second->latency_s ? nlohmann::json(*s.fdd->second->latency_s) : nlohmann::json(nullptr);
+      }
     }
     out.message = s.failure_reason.value_or("");
     return out;
@@ -291,6 +337,9 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         trial.altitude_change_m = number("altitude_change_m");
         trial.final_rmse_m = number("final_rmse_m");
         trial.eta_error = number("eta_error");
+        trial.crash_speed_m_s = number("crash_speed_m_s");
+        trial.second_latency_s = number("second_latency_s");
+        if (x.contains("second_correct")) trial.second_correct = x["second_correct"].get<bool>();
         if (x.contains("correct")) {
           trial.has_fdd = true;
           trial.correct = x["correct"].get<bool>();
@@ -299,7 +348,8 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         }
         cell_trials.push_back(trial);
       }
-      nlohmann::json cell = AggregateFtcCell(cell_trials, std::string(kCells[c].fault) != "none");
+      nlohmann::json cell =
+          AggregateFtcCell(cell_trials, std::string(kCells[c].fault) != "none", kCells[c].second != nullptr);
       cell["test"] = kCells[c].test;
       cell["phase"] = kCells[c].phase;
       cell["fault"] = kCells[c].fault;
@@ -377,7 +427,11 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                         {"MiniA (m)", "mini_alt_m", "{:.3f}", 1.0, "mini_alt"},
                         {"final RMSE median (m)", "final_rmse_m_median", "{:.3f}", 1.0, "none", true},
                         {"|η̂ − η| mean", "eta_error_mean", "{:.3f}", 1.0, "none", true},
-                        {"|η̂ − η| max", "eta_error_max", "{:.3f}", 1.0, "none", true}};
+                        {"|η̂ − η| max", "eta_error_max", "{:.3f}", 1.0, "none", true},
+                        {"second failure isolated (%)", "second_isolated", "{:.1f}", 100.0, "none", true},
+                        {"second failure latency median (s)", "second_latency_s_median", "{:.3f}", 1.0, "none", true},
+                        {"impact speed median (m/s)", "crash_speed_m_s_median", "{:.2f}", 1.0, "none", true},
+                        {"impact speed max (m/s)", "crash_speed_m_s_max", "{:.2f}", 1.0, "none", true}};
     for (const Row& row : rows) {
       if (fault == "none" && (std::string(row.key) == "fdd_latency_s_mean" || std::string(row.key) == "fdd_latency_s_max" ||
                               std::string(row.key) == "mdr")) {

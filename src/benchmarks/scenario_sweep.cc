@@ -39,7 +39,10 @@ const std::vector<std::string> kRecordable = {"success",
                                               "fdd.correct",
                                               "fdd.false_alarm",
                                               "fdd.latency_s",
-                                              "fdd.detection_s"};
+                                              "fdd.detection_s",
+                                              "fdd.healthy_extremes.min_motor_index",
+                                              "fdd.healthy_extremes.max_propeller_index",
+                                              "fdd.healthy_extremes.max_takeoff_alpha"};
 const std::vector<std::string> kDefaultMetrics = {
     "success",        "crashed",      "tracking_rmse_m", "max_position_error_m",
     "min_altitude_m", "max_tilt_rad", "tilt_recovery_s"};

@@ -27,6 +27,11 @@ std::string_view ToString(RotorHealth h) {
   return "unknown";
 }
 
+bool IsIsolated(RotorHealth health) {
+  return health == RotorHealth::kMotorFailed || health == RotorHealth::kPropellerFailed ||
+         health == RotorHealth::kFailed;
+}
+
 void CompositeFddOptions::Validate() const {
   RequireIn("motor_index_threshold", motor_index_threshold, 1e-6, 1.0 - 1e-6, "a value in (0, 1)");
   if (motor_index_samples < 1) ThrowValidation("CompositeFddOptions", "motor_index_samples", motor_index_samples, ">= 1");
@@ -43,6 +48,9 @@ void CompositeFddOptions::Validate() const {
   RequireIn("takeoff_angular_acceleration_rad_s2", takeoff_angular_acceleration_rad_s2, 1e-3, 1e6, "a value > 0");
   RequireIn("takeoff_direction_cosine", takeoff_direction_cosine, 1e-6, 1.0, "a value in (0, 1]");
   RequireIn("takeoff_missing_thrust_fraction", takeoff_missing_thrust_fraction, 0.0, 1.0, "a value in [0, 1]");
+  RequireIn("second_failure_missing_thrust_fraction", second_failure_missing_thrust_fraction, 0.0, 1.0,
+            "a value in [0, 1]");
+  RequireIn("post_isolation_relearn_s", post_isolation_relearn_s, 0.0, 100.0, "a time in [0, 100] s");
   RequireIn("baseline_time_constant_s", baseline_time_constant_s, 0.0, 100.0, "a time in [0, 100] s");
   if (!imu_position_m.allFinite()) ThrowValidation("CompositeFddOptions", "imu_position_m", "(non-finite)", "finite");
 }
@@ -56,6 +64,7 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   command_ = RotorVector::Zero(n_);
   expected_thrust_ = RotorVector::Zero(n_);
   measured_thrust_ = RotorVector::Zero(n_);
+  working_ = RotorVector::Ones(n_);
   low_index_count_.assign(n_, 0);
   low_index_since_s_.assign(n_, 0.0);
   above_since_s_.assign(n_, -1.0);
@@ -69,6 +78,12 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   wrench_filter_ = LowPass2<4>(options_.filter_cutoff_hz, options_.imu_rate_hz);
 }
 
+void IndexExtremes::Merge(const IndexExtremes& other) {
+  min_motor_index = std::min(min_motor_index, other.min_motor_index);
+  max_propeller_index = std::max(max_propeller_index, other.max_propeller_index);
+  max_takeoff_alpha = std::max(max_takeoff_alpha, other.max_takeoff_alpha);
+}
+
 FaultDetectorBase::FaultDetectorBase(int num_rotors) : rotors_(static_cast<std::size_t>(num_rotors)) {}
 
 std::vector<int> FaultDetectorBase::TakeNewIsolations() {
@@ -80,10 +95,7 @@ std::vector<int> FaultDetectorBase::TakeNewIsolations() {
 void FaultDetectorBase::Isolate(int rotor, RotorHealth health, double t, const char* detector,
                                 std::optional<double> onset) {
   RotorStatus& r = rotors_[rotor];
-  if (r.health == RotorHealth::kMotorFailed || r.health == RotorHealth::kPropellerFailed ||
-      r.health == RotorHealth::kFailed) {
-    return;
-  }
+  if (IsIsolated(r.health)) return;
   r.health = health;
   r.detected_s = t;
   r.onset_s = onset.value_or(t);
@@ -130,6 +142,7 @@ void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
     // eq. (13): M_i = w_measured / w_expected.
     const double index = esc.motor_speed_rad_s[i] / std::sqrt(expected_thrust_[i] / kn);
     rotors_[i].motor_index = index;
+    if (!first_isolated_) extremes_.min_motor_index = std::min(extremes_.min_motor_index, index);
     low_index_count_[i] = index <= options_.motor_index_threshold ? low_index_count_[i] + 1 : 0;
     if (low_index_count_[i] == 1) low_index_since_s_[i] = t;
     if (low_index_count_[i] >= options_.motor_index_samples) {
@@ -147,7 +160,9 @@ void CompositeFdd::OnImu(const ImuSample& imu) {
   force_filter_.Step(imu.specific_force_B);
   rate_filter_.Step(imu.w_B);
   alpha_filter_.Step(imu.w_B, dt);
-  Eigen::Vector4d wrench = effectiveness_ * measured_thrust_;
+  for (int i = 0; i < n_; ++i) working_[i] = IsIsolated(rotors_[i].health) ? 0.0 : 1.0;
+  // An isolated rotor gives no thrust, whatever its motor's speed (a lost propeller spins freely).
+  Eigen::Vector4d wrench = effectiveness_ * measured_thrust_.cwiseProduct(working_);
   wrench_filter_.Step(wrench);
   RunObserver(ToSeconds(imu.t_ns), dt);
 }
@@ -161,14 +176,23 @@ void CompositeFdd::RunObserver(double t, double dt) {
                                           wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
   if (flying && !airborne_since_s_) airborne_since_s_ = t;
   if (!flying) airborne_since_s_.reset();
-  // The observer and the take-off detector assume one failure in a vehicle that otherwise flies
-  // as modelled (paper 000 treats single failures). After an isolation the reconfigured vehicle
-  // spins, saturates rotors and may touch down, which they would misread as further failures;
-  // the motor index, a direct measurement, keeps watching every motor.
   takeoff_angular_acceleration_ = 0.0;
-  if (!airborne_since_s_ || first_isolated_) {
+  if (!airborne_since_s_) {
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
     return;
+  }
+  // After an isolation the observer keeps watching the rotors still working, for a second complete
+  // loss: the isolated rotors leave its wrench and its allocation, and it learns the reconfigured
+  // vehicle's residual (the spin's) afresh for post_isolation_relearn_s before it judges again.
+  // Partial losses and the take-off detector are single-failure tools (paper 000): they stop.
+  const int isolated = static_cast<int>(n_ - working_.sum());
+  if (isolated != isolated_seen_) {
+    isolated_seen_ = isolated;
+    relearn_since_s_ = t;
+    Eigen::MatrixXd working_effectiveness = effectiveness_ * working_.asDiagonal();
+    pinv_ = working_effectiveness.completeOrthogonalDecomposition().pseudoInverse();
+    std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
+    std::fill(degraded_since_s_.begin(), degraded_since_s_.end(), -1.0);
   }
   const vehicle::VehicleParams& vp = vehicle_;
   const Vector3& w = rate_filter_.value();
@@ -194,9 +218,10 @@ void CompositeFdd::RunObserver(double t, double dt) {
 
   // Take-off detector (eq. 18): a strong roll/pitch angular acceleration shortly after lift-off,
   // pointing like the loss of one rotor's thrust: alpha ~ -I^-1 (r_i x T e3).
-  const bool takeoff = t - *airborne_since_s_ <= options_.takeoff_window_s &&
+  const bool takeoff = isolated == 0 && t - *airborne_since_s_ <= options_.takeoff_window_s &&
                        estimate_.p_W.z() <= options_.takeoff_max_altitude_m;
   if (takeoff) takeoff_angular_acceleration_ = alpha.head<2>().norm();
+  if (isolated == 0) extremes_.max_takeoff_alpha = std::max(extremes_.max_takeoff_alpha, takeoff_angular_acceleration_);
   if (takeoff && alpha.head<2>().norm() > options_.takeoff_angular_acceleration_rad_s2) {
     int best = -1;
     double best_cos = options_.takeoff_direction_cosine;
@@ -220,14 +245,22 @@ void CompositeFdd::RunObserver(double t, double dt) {
     }
   }
 
-  const bool learning = t - *airborne_since_s_ < 3.0 * options_.baseline_time_constant_s;
+  const bool learning = t - *airborne_since_s_ < 3.0 * options_.baseline_time_constant_s ||
+                        (relearn_since_s_ && t - *relearn_since_s_ < options_.post_isolation_relearn_s);
   // eq. (17): P_i = lost thrust / thrust the rotor should give; persistent -> propeller failure.
   const double min_thrust = options_.motor_index_min_thrust_n;
   for (int i = 0; i < n_; ++i) {
     const double p = measured_thrust_[i] > min_thrust ? thrust_loss_[i] / measured_thrust_[i] : 0.0;
     rotors_[i].propeller_index = p;
-    if (rotors_[i].health == RotorHealth::kMotorFailed || rotors_[i].health == RotorHealth::kPropellerFailed) continue;
-    if (p > options_.propeller_index_threshold) {
+    if (isolated == 0) extremes_.max_propeller_index = std::max(extremes_.max_propeller_index, p);
+    if (working_[i] == 0.0) continue;  // isolated already
+    if (learning && isolated > 0) continue;
+    // After an isolation the spinning vehicle's torque residual (inertia errors times the spin)
+    // can point at a rotor; a lost propeller also costs thrust, which the force balance sees
+    // whatever the inertia.
+    const bool costs_thrust =
+        isolated == 0 || lost[0] >= options_.second_failure_missing_thrust_fraction * measured_thrust_[i];
+    if (p > options_.propeller_index_threshold && costs_thrust) {
       if (above_since_s_[i] < 0.0) above_since_s_[i] = t;
       if (t - above_since_s_[i] >= options_.propeller_persistence_s) {
         Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer", above_since_s_[i]);
@@ -236,7 +269,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
       above_since_s_[i] = -1.0;
     }
     // Partial loss: a persistent intermediate index, reported with its mean as eta.
-    if (!learning && p > options_.degraded_threshold && p <= options_.propeller_index_threshold) {
+    if (!learning && isolated == 0 && p > options_.degraded_threshold && p <= options_.propeller_index_threshold) {
       if (degraded_since_s_[i] < 0.0) {
         degraded_since_s_[i] = t;
         degraded_sum_[i] = 0.0;
@@ -258,9 +291,14 @@ void CompositeFdd::RunObserver(double t, double dt) {
   // that a fault is measured against the vehicle as it flew before it.
   // For its first three time constants in the air it learns regardless (the file's errors are
   // all there is to see), and no partial loss is diagnosed then.
-  const bool quiet = std::all_of(rotors_.begin(), rotors_.end(), [this](const RotorStatus& status) {
-    return status.health == RotorHealth::kOk && std::abs(status.propeller_index) <= options_.degraded_threshold;
-  });
+  bool quiet = true;
+  for (int i = 0; i < n_; ++i) {
+    const RotorStatus& status = rotors_[i];
+    if (working_[i] > 0.0 &&
+        (status.health != RotorHealth::kOk || std::abs(status.propeller_index) > options_.degraded_threshold)) {
+      quiet = false;
+    }
+  }
   if (options_.baseline_time_constant_s > 0.0 && (quiet || learning) && dt > 0.0) {
     baseline_ += std::min(1.0, dt / options_.baseline_time_constant_s) * (residual - baseline_);
   }

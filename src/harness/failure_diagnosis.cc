@@ -16,6 +16,16 @@ std::optional<std::string> EmergencyLanding(const stack::FlightStackSummary& sta
   return std::nullopt;
 }
 
+/// " after flight termination at t = 5.04 s (REASON)" when the supervisor stopped the motors.
+std::string Termination(const stack::FlightStackSummary& stack) {
+  for (const stack::ModeTransition& m : stack.transitions) {
+    if (m.to == stack::FlightMode::kFlightTermination) {
+      return fmt::format(" after flight termination at t = {:.2f} s ({})", m.t, m.reason);
+    }
+  }
+  return "";
+}
+
 /// By when the position error must be back under the bound for good: recovery_s after the first
 /// fault's correct isolation, or after its onset when nothing isolated it correctly; none without
 /// a fault.
@@ -33,7 +43,9 @@ void DiagnoseFailure(const std::optional<FlightMetrics::Violation>& last_violati
   s.failure_reason.reset();
   s.infeasible_request = false;
   if (s.crashed) {
-    s.failure_reason = "crash: " + s.crash_reason.value_or("");
+    s.failure_reason = "crash: " + s.crash_reason.value_or("") + Termination(s.stack);
+  } else if (const std::string terminated = Termination(s.stack); !terminated.empty()) {
+    s.failure_reason = "motors stopped" + terminated;
   } else if (std::optional<std::string> landing = EmergencyLanding(s.stack)) {
     s.failure_reason = std::move(landing);
   } else if (rule.max_altitude_loss_m && s.altitude_change_m && -*s.altitude_change_m > *rule.max_altitude_loss_m) {

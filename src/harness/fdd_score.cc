@@ -1,5 +1,7 @@
 #include "rotorguard/harness/fdd_score.h"
 
+#include <algorithm>
+
 namespace rotorguard::harness {
 
 bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis) {
@@ -19,8 +21,32 @@ bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis) {
   return false;
 }
 
+namespace {
+
+std::optional<FddRecord::Second> ScoreSecond(const std::vector<fdd::RotorStatus>& rotors,
+                                             const std::vector<sim::FaultEvent>& events) {
+  if (events.empty()) return std::nullopt;
+  const auto other = std::find_if(events.begin(), events.end(),
+                                  [&events](const sim::FaultEvent& e) { return e.rotor != events.front().rotor; });
+  if (other == events.end() || other->rotor < 0 || other->rotor >= static_cast<int>(rotors.size())) return std::nullopt;
+  const fdd::RotorStatus& status = rotors[static_cast<std::size_t>(other->rotor)];
+  FddRecord::Second second;
+  second.rotor = other->rotor;
+  second.isolated = fdd::IsIsolated(status.health);
+  second.kind = fdd::ToString(status.health);
+  second.detector = status.detector;
+  second.detection_s = status.detected_s.value_or(0.0);
+  second.correct = second.isolated && status.detected_s && *status.detected_s >= other->onset_s &&
+                   KindMatches(other->kind, status.health);
+  if (second.correct) second.latency_s = *status.detected_s - other->onset_s;
+  return second;
+}
+
+}  // namespace
+
 FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vector<sim::FaultEvent>& events) {
   FddRecord r;
+  r.second = ScoreSecond(rotors, events);
   for (int i = 0; i < static_cast<int>(rotors.size()); ++i) {
     const fdd::RotorStatus& status = rotors[static_cast<std::size_t>(i)];
     if (!status.detected_s) continue;

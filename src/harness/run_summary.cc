@@ -20,6 +20,22 @@ nlohmann::json OrNull(const std::optional<T>& value) {
 
 nlohmann::json Vec(const Vector3& v) { return {v.x(), v.y(), v.z()}; }
 
+nlohmann::json ExtremesJson(const fdd::IndexExtremes& e) {
+  return {{"min_motor_index", e.min_motor_index},
+          {"max_propeller_index", e.max_propeller_index},
+          {"max_takeoff_alpha", e.max_takeoff_alpha}};
+}
+
+nlohmann::json SecondJson(const FddRecord::Second& s) {
+  return {{"rotor", s.rotor},
+          {"isolated", s.isolated},
+          {"kind", s.kind},
+          {"detector", s.detector},
+          {"detection_s", s.isolated ? nlohmann::json(s.detection_s) : nlohmann::json(nullptr)},
+          {"correct", s.correct},
+          {"latency_s", OrNull(s.latency_s)}};
+}
+
 nlohmann::json FddJson(const FddRecord& f) {
   const std::optional<FddRecord::Diagnosis>& d = f.diagnosis;
   return {{"detected", f.detected()},
@@ -31,7 +47,9 @@ nlohmann::json FddJson(const FddRecord& f) {
           {"correct", f.correct},
           {"false_alarm", f.false_alarm},
           {"latency_s", OrNull(f.latency_s)},
-          {"reconfiguration_latency_s", OrNull(f.reconfiguration_latency_s)}};
+          {"reconfiguration_latency_s", OrNull(f.reconfiguration_latency_s)},
+          {"healthy_extremes", f.healthy_extremes ? ExtremesJson(*f.healthy_extremes) : nlohmann::json(nullptr)},
+          {"second", f.second ? SecondJson(*f.second) : nlohmann::json(nullptr)}};
 }
 
 nlohmann::json NavigationJson(const stack::NavigationSummary& n, const std::optional<double>& mission_time_s,
@@ -90,6 +108,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["success"] = success;
   j["crashed"] = crashed;
   j["crash_reason"] = OrNull(crash_reason);
+  j["crash_speed_m_s"] = OrNull(crash_speed_m_s);
   j["failure_reason"] = OrNull(failure_reason);
   j["truth"] = io::ToJson(truth);
   j["sim_time_s"] = sim_time_s;

@@ -101,6 +101,7 @@ class ClosedLoop {
     s.control_cycles = control_cycles_;
     s.crashed = sim_.crashed();
     s.crash_reason = sim_.crash_reason();
+    s.crash_speed_m_s = sim_.crash_speed_m_s();
     s.stack = stack_.Summarize();
     s.mission_time_s = mission_time_s_;
     // The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
@@ -109,6 +110,9 @@ class ClosedLoop {
     if (const fdd::FaultDetector* detector = stack_.fault_detector()) {
       s.fdd = ScoreFdd(detector->rotors(), sim_.fault_events());
       AddReconfigurationLatency(s.stack.reconfigurations, sim_.fault_events(), &*s.fdd);
+      if (composite_) {
+        s.fdd->healthy_extremes = sim_.fault_events().empty() ? composite_->healthy_extremes() : healthy_extremes_;
+      }
     }
     for (const sim::FaultEvent& e : sim_.fault_events()) {
       s.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
@@ -127,6 +131,8 @@ class ClosedLoop {
   /// One physics step, and the stack's control cycle when one is due before it.
   void Step() {
     const TimeNs t = sim_.time_ns();
+    // The detector has seen only flight before any fault: its extremes are a healthy flight's.
+    if (composite_ && sim_.fault_events().empty()) healthy_extremes_ = composite_->healthy_extremes();
     if (t >= next_control_) {
       const Stopwatch clock;
       command_ = stack_.Update(t);
@@ -190,6 +196,8 @@ class ClosedLoop {
   TimeNs next_control_ = 0;
   double stack_s_ = 0.0, simulator_s_ = 0.0;  // wall-clock time in each [s]
   std::uint64_t physics_steps_ = 0, control_cycles_ = 0;
+  const fdd::CompositeFdd* composite_ = dynamic_cast<const fdd::CompositeFdd*>(stack_.fault_detector());
+  fdd::IndexExtremes healthy_extremes_;  // the composite detector's, before the first fault
   std::optional<double> mission_time_s_;
 };
 

@@ -150,6 +150,7 @@ void Simulator::ResolveGroundContact(const vehicle::StateVector& before) {
   if (s.p_W().z() > 0.0) return;
   const double speed = s.v_W().norm();
   const double tilt = TiltOf(s.q_WB());
+  if (speed > options_.crash_speed_m_s || tilt > options_.crash_tilt_rad) crash_speed_m_s_ = speed;
   if (speed > options_.crash_speed_m_s) {
     crash_reason_ = fmt::format("ground impact at {:.2f} m/s", speed);
   } else if (tilt > options_.crash_tilt_rad) {

@@ -1,13 +1,16 @@
 
+#include "rotorguard/stack/flight_stack.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include <fmt/format.h>
-
+#include "rotorguard/control/allocation.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/stopwatch.h"
-#include "rotorguard/stack/flight_stack.h"
 
 namespace rotorguard::stack {
 
@@ -203,6 +206,19 @@ void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
     return;
   }
   reconfigurations_.push_back({rotor, t});
+  // Can the rotors left hold the vehicle? The supervisor acts on the answer.
+  std::vector<bool> failed(static_cast<std::size_t>(model_.num_rotors()), false);
+  std::vector<int> failed_rotors;
+  for (const RotorReconfiguration& r : reconfigurations_) {
+    failed[static_cast<std::size_t>(r.rotor)] = true;
+    failed_rotors.push_back(r.rotor);
+  }
+  if (!control::HoverThrustSplit(model_.params(), failed)) {
+    std::sort(failed_rotors.begin(), failed_rotors.end());
+    cannot_hover_ = fmt::format(
+        "rotors {} failed: no thrusts within the limits of the others hold the weight with zero roll and pitch torque",
+        fmt::join(failed_rotors, ", "));
+  }
   if (nmpc_) nmpc_->RewindDisturbance(onset);
   controller_->SetRotorFailed(rotor);
   if (navigator_ && options_.navigation.failure_aware) navigator_->OnFailure();
@@ -319,6 +335,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   in.navigating = navigator_ && next_waypoint_ > 0 && !navigator_->arrived();
   in.since_last_plan_s = ts - last_plan_ok_s_;
   in.thrust_ratio = command_.thrust_n.sum() / model_.params().weight_n();
+  in.cannot_hover = cannot_hover_;
   if (flatness_ && flatness_->land_request()) in.land_request = "re-planning decided to land: " + *flatness_->land_request();
   const FlightMode mode = supervisor_.Update(in);
 
@@ -339,8 +356,9 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   }
   const ReferenceTrajectory& followed = reference();
   reference_point_ = followed.Evaluate(ts);
-  if (!estimate_.valid || mode == FlightMode::kLanded) {
-    // Nothing to act on yet, or on the ground after a landing: motors off.
+  if (!estimate_.valid || mode == FlightMode::kLanded || mode == FlightMode::kFlightTermination) {
+    // Nothing to act on yet, on the ground after a landing, or a vehicle that cannot hover: motors
+    // off.
     command_.thrust_n.setZero();
     return command_;
   }

@@ -16,6 +16,8 @@ const char* ToString(FlightMode mode) {
     case FlightMode::kDegradedNavigation: return "degraded_navigation";
     case FlightMode::kEmergencyLanding: return "emergency_landing";
     case FlightMode::kLanded: return "landed";
+    case FlightMode::kFlightTermination:
+      return "flight_termination";
   }
   return "unknown";
 }
@@ -50,7 +52,11 @@ void Supervisor::Enter(FlightMode to, double t, std::string reason) {
 FlightMode Supervisor::Update(const SupervisorInputs& in) {
   const double t = in.t;
   const StateEstimate& e = in.estimate;
-  if (mode_ == FlightMode::kLanded) return mode_;
+  if (mode_ == FlightMode::kLanded || mode_ == FlightMode::kFlightTermination) return mode_;
+  if (!in.cannot_hover.empty() && options_.terminate_when_uncontrollable) {
+    Enter(FlightMode::kFlightTermination, t, in.cannot_hover);
+    return mode_;
+  }
   if (mode_ == FlightMode::kEmergencyLanding) {
     // A land detector: the ground holds the vehicle up, so the controller chasing a reference
     // below it commands ever less thrust.
@@ -80,6 +86,8 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
                ? fmt::format("a second rotor failed ({} isolated)", in.isolated_rotors)
                : fmt::format("{} rotors failed (the vehicle flies on at most {})", in.isolated_rotors,
                              options_.max_failed_rotors);
+  } else if (!in.cannot_hover.empty()) {
+    land = in.cannot_hover;
   } else if (in.navigating && in.since_last_plan_s > options_.no_plan_timeout_s) {
     land = fmt::format("no feasible trajectory for {:.1f} s", in.since_last_plan_s);
   } else if (!in.land_request.empty()) {

@@ -2,12 +2,14 @@
 // the stack to figures of the world where its model is exact (`truth: ideal`); the realistic
 // world's outcomes are shipped_scenarios_test.cc's and the benchmarks' (docs/benchmarks.md).
 
+#include "rotorguard/harness/runner.h"
+
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/io/config_node.h"
@@ -270,6 +272,47 @@ TEST(FddClosedLoop, IsolatesAndSurvivesEachFaultKindInHover) {
     EXPECT_FALSE(r.fdd->false_alarm);
     EXPECT_LT(r.fdd->latency_s.value_or(1e9), std::string(kind) == "motor_stop" ? 0.028 : 0.10) << kind;
     EXPECT_GT(r.min_altitude_m, 1.8) << kind;
+    // The indices' healthy extremes are those before the onset: the stopped motor's M_i near 0
+    // and the lost propeller's P_i near 1 are not among them.
+    ASSERT_TRUE(r.fdd->healthy_extremes) << kind;
+    EXPECT_GT(r.fdd->healthy_extremes->min_motor_index, 0.8) << kind;
+    EXPECT_LT(r.fdd->healthy_extremes->max_propeller_index, 0.3) << kind;
+  }
+}
+
+TEST(FddClosedLoop, ASecondFailureFliesOnOnTheTwinAndStopsTheMotorsBesideIt) {
+  // Rotor 0's motor stops at 2 s in hover, in the realistic world; at 5 s a propeller is lost on
+  // its idle diagonal twin (1) or on a rotor beside it (2). (Seeds whose drawn vehicle recovers
+  // from the first failure; seed 2 draws one whose spin diverges, docs/benchmarks.md.)
+  for (std::uint64_t seed : {1u, 3u, 4u}) {
+    for (int second : {1, 2}) {
+      Scenario s = LoadScenario(Config("fdd_hover_motor_stop.yaml"), {{"duration_s", "8"}});
+      s.seed = seed;
+      sim::FaultSpec f;
+      f.rotor = second;
+      f.kind = vehicle::FaultKind::kPropellerLoss;
+      f.onset = {sim::FaultOnset::Kind::kAtTime, 5.0};
+      s.faults.push_back(f);
+      const RunSummary r = RunScenario(s);
+      const std::string what = fmt::format("seed {} rotor {}", seed, second);
+      ASSERT_TRUE(r.fdd && r.fdd->second) << what;
+      EXPECT_TRUE(r.fdd->correct) << what;
+      if (second == 1) {
+        // The twin carries nothing: the vehicle flies on as before, and nothing else is isolated.
+        EXPECT_TRUE(r.success) << what << ": " << r.failure_reason.value_or("");
+        EXPECT_NE(r.stack.final_mode, stack::FlightMode::kFlightTermination) << what;
+        EXPECT_EQ(r.stack.reconfigurations.size(), r.fdd->second->isolated ? 2u : 1u) << what;
+      } else {
+        EXPECT_TRUE(r.fdd->second->correct) << what;
+        EXPECT_LT(r.fdd->second->latency_s.value_or(1e9), 0.1) << what;
+        EXPECT_EQ(r.stack.final_mode, stack::FlightMode::kFlightTermination) << what;
+        EXPECT_TRUE(r.crashed) << what;
+        EXPECT_NE(r.failure_reason.value_or("").find("after flight termination"), std::string::npos) << what;
+        ASSERT_TRUE(r.crash_speed_m_s) << what;
+        // Falling from 2 m: at most sqrt(2 g h) = 6.26 m/s, drag only slowing it.
+        EXPECT_LT(*r.crash_speed_m_s, std::sqrt(2.0 * kGravity * 2.0)) << what;
+      }
+    }
   }
 }
 

@@ -54,8 +54,45 @@ TEST(Supervisor, AnIsolationRecoversThenFliesDegradedOnceTheAttitudeHasSettled) 
   EXPECT_EQ(s.transitions()[1].to, FlightMode::kDegradedNavigation);
 }
 
-TEST(Supervisor, ASecondFailureLands) {
+TEST(Supervisor, ASecondFailureTheVehicleFliesOnChangesNoMode) {
+  Supervisor s;  // no count limit by default
+  SupervisorInputs in = Hovering(1.0);
+  in.isolated_rotors = 1;
+  EXPECT_EQ(s.Update(in), FlightMode::kFailureRecovery);
+  in.t = 5.0;
+  in.isolated_rotors = 2;  // the idle diagonal twin: the hover split stands
+  EXPECT_EQ(s.Update(in), FlightMode::kFailureRecovery);
+  EXPECT_EQ(s.transitions().size(), 1u);
+}
+
+TEST(Supervisor, AFailureThatLeavesNoHoverSplitStopsTheMotorsOrLandsWhenTold) {
+  SupervisorInputs in = Hovering(1.0);
+  in.isolated_rotors = 1;
   Supervisor s;
+  s.Update(in);
+  in.t = 5.0;
+  in.isolated_rotors = 2;
+  in.cannot_hover = "rotors 0, 2 failed";
+  EXPECT_EQ(s.Update(in), FlightMode::kFlightTermination);
+  EXPECT_EQ(s.transitions().back().reason, "rotors 0, 2 failed");
+  in.t = 6.0;
+  in.thrust_ratio = 0.0;  // terminal: nothing brings it back
+  in.cannot_hover.clear();
+  EXPECT_EQ(s.Update(in), FlightMode::kFlightTermination);
+  EXPECT_EQ(s.transitions().size(), 2u);
+
+  SupervisorOptions land;
+  land.terminate_when_uncontrollable = false;
+  Supervisor l(land);
+  in.cannot_hover = "rotors 0, 2 failed";
+  EXPECT_EQ(l.Update(in), FlightMode::kEmergencyLanding);
+  EXPECT_EQ(l.transitions().back().reason, "rotors 0, 2 failed");
+}
+
+TEST(Supervisor, ACountLimitLandsTheFailureAfterIt) {
+  SupervisorOptions o;
+  o.max_failed_rotors = 1;
+  Supervisor s(o);
   SupervisorInputs in = Hovering(1.0);
   in.isolated_rotors = 1;
   s.Update(in);
@@ -129,6 +166,7 @@ TEST(Supervisor, TouchdownIsTheThrustHeldDownByTheGround) {
   SupervisorOptions o;
   o.touchdown_thrust_ratio = 0.5;
   o.touchdown_hold_s = 0.3;
+  o.max_failed_rotors = 1;
   Supervisor s(o);
   SupervisorInputs in = Hovering(1.0);
   in.isolated_rotors = 2;

@@ -166,7 +166,9 @@ function plotsSection(app, data, clock) {
   for (const f of summary.faults || []) markers.push({ t: f.onset_s, color: "#d62728", label: `fault r${f.rotor}` });
   if (summary.fdd && summary.fdd.detected) markers.push({ t: summary.fdd.detection_s, color: "#ff7f0e", label: "detected" });
   for (const m of (summary.supervisor && summary.supervisor.transitions) || []) {
-    if (m.to === "emergency_landing" || m.to === "landed") markers.push({ t: m.t, color: "#7f3fbf", label: m.to.replace("_", " ") });
+    if (m.to === "emergency_landing" || m.to === "landed" || m.to === "flight_termination") {
+      markers.push({ t: m.t, color: "#7f3fbf", label: m.to.replace("_", " ") });
+    }
   }
 
   app.appendChild(el("h2", { text: "Rotors (paper 000, Fig. 7)" }));

@@ -52,11 +52,8 @@ struct ReplayOutcome {
   /// time are in `statuses`.
   std::optional<int> isolated_rotor;
   /// The most alarming values the indices took in fault-free flight (the whole log without
-  /// faults, the part before the first onset with): the lowest motor index M_i, the highest
-  /// propeller index P_i, the highest take-off statistic.
-  double min_motor_index = 1.0;
-  double max_propeller_index = 0.0;
-  double max_takeoff_alpha = 0.0;
+  /// faults, the part before the first onset with; the detector's own, CompositeFdd::healthy_extremes).
+  fdd::IndexExtremes extremes;
   /// The detector's per-rotor statuses when the replay stopped (after the onset, once a rotor was
   /// isolated; else at the end of the log), for ScoreFdd.
   std::vector<fdd::RotorStatus> statuses;

@@ -58,13 +58,20 @@ struct FtcTrial {
   double final_rmse_m = std::numeric_limits<double>::quiet_NaN();
   /// |eta^ - eta| of a correct partial-loss diagnosis (NaN otherwise).
   double eta_error = std::numeric_limits<double>::quiet_NaN();
+  /// The speed at a crash's ground contact [m/s] (NaN without a crash).
+  double crash_speed_m_s = std::numeric_limits<double>::quiet_NaN();
+  /// A second failed rotor isolated with its kind, and how long after its onset [s] (NaN if not).
+  bool second_correct = false;
+  double second_latency_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// A cell's metrics (docs/metrics.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty
 /// cells: no correct isolation within 1 s, errored trials included), far, mini_alt_m (least altitude
 /// after the fault, over the trials that finished), and
-/// the first failures. Null where a metric does not apply (no FDD; MDR of fault-free cells).
-nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty);
+/// the first failures; with_second: the share of trials whose second failed rotor was isolated
+/// and the median latency; the crashes and their impact speeds. Null where a metric does not apply
+/// (no FDD; MDR of fault-free cells).
+nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty, bool with_second = false);
 
 /// The benchmark as a campaign (campaign.h), so that it shards, resumes and merges like any other:
 /// trial index = (cell, method, trial), the trial fastest; parameters {test, phase, fault, method,

@@ -1,7 +1,12 @@
 #pragma once
-/// Control allocation by the pseudo-inverse of the effectiveness matrix, with saturation.
+/// Control allocation by the pseudo-inverse of the effectiveness matrix, with saturation; whether
+/// a vehicle can still hover on the rotors it has left.
+#include <optional>
+#include <vector>
+
 #include "rotorguard/core/types.h"
 #include "rotorguard/vehicle/multirotor.h"
+#include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::control {
 
@@ -17,5 +22,13 @@ class PseudoInverseAllocator {
   AllocationMatrix pinv_;
   RotorVector max_thrust_;
 };
+
+/// The minimum-norm rotor thrusts that hold the vehicle's weight with zero roll and pitch torque,
+/// each in [0, max_thrust_n] and zero on a failed rotor, or none when no such split exists: the
+/// vehicle cannot hover on what is left. Yaw is left free (after a failure it is given up and the
+/// spin balances it against the yaw damping). The test is static: a vehicle that could fly only by
+/// balancing a torque gyroscopically while spinning (Mueller and D'Andrea's flight on one
+/// propeller) is judged unable to. `failed` has one entry per rotor.
+std::optional<RotorVector> HoverThrustSplit(const vehicle::VehicleParams& vehicle, const std::vector<bool>& failed);
 
 }  // namespace rotorguard::control

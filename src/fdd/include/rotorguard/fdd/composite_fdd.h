@@ -3,7 +3,9 @@
 /// ESC telemetry, the thrust/torque-loss observer (eqs. 14-17) on filtered IMU data and measured
 /// rotor speeds, and the take-off detector (eq. 18). It sees only sensor messages, the stack's
 /// estimate and its own commands; docs/fdd.md gives the filter design and the measured latencies.
-/// After the first isolation only the motor index keeps watching (single failures, as the paper).
+/// After an isolation the motor index and the observer keep watching the remaining rotors for a
+/// second complete failure; partial losses and the take-off detector assume a single failure, as
+/// the paper does.
 #include <optional>
 #include <string>
 #include <string_view>
@@ -43,6 +45,13 @@ struct CompositeFddOptions {
   /// while airborne, every rotor healthy and every |P_i| within degraded_threshold, and measures
   /// losses from it (docs/fdd.md). 0: losses from the file's model alone. In [0, 100].
   double baseline_time_constant_s = 0.5;
+  /// After an isolation the observer learns the reconfigured vehicle's residual for this long [s]
+  /// and judges nothing meanwhile; then it watches the remaining rotors for a second complete
+  /// loss (docs/fdd.md). In [0, 100].
+  double post_isolation_relearn_s = 2.0;
+  /// ... and isolates a second propeller failure only while the force balance misses at least
+  /// this fraction of that rotor's thrust, in [0, 1].
+  double second_failure_missing_thrust_fraction = 0.5;
   /// Take-off detector (eq. 18): active while the vehicle is airborne below this altitude [m] and
   /// within takeoff_window_s of lift-off, > 0.
   double takeoff_max_altitude_m = 0.6;
@@ -92,12 +101,23 @@ struct CompositeFddOptions {
              {.meaning = "the healthy residual is learnt with this time constant [s] (0: off; docs/fdd.md)",
               .min = 0.0,
               .max = 100.0});
+    a->Visit("post_isolation_relearn_s", &post_isolation_relearn_s,
+             {.meaning = "after an isolation the residual is relearnt this long [s] before a second failure is sought",
+              .min = 0.0,
+              .max = 100.0});
+    a->Visit(
+        "second_failure_missing_thrust_fraction", &second_failure_missing_thrust_fraction,
+        {.meaning = "... and a second propeller failure must miss this fraction of its thrust in the force balance",
+         .min = 0.0,
+         .max = 1.0});
   }
 };
 
 /// kFailed: a rotor isolated as failed by a method that cannot tell the motor from the propeller.
 enum class RotorHealth { kOk, kMotorFailed, kPropellerFailed, kDegraded, kFailed };
 std::string_view ToString(RotorHealth health);
+/// Motor, propeller or unclassified failure: the rotor is out of the vehicle.
+bool IsIsolated(RotorHealth health);
 
 struct RotorStatus {
   RotorHealth health = RotorHealth::kOk;
@@ -109,6 +129,15 @@ struct RotorStatus {
   /// threshold (the detection time for detectors that cannot tell).
   std::optional<double> onset_s;
   std::string detector;          ///< "motor_index", "thrust_loss_observer", "takeoff"
+};
+
+/// The most alarming values a composite FDD's indices took: what a threshold must clear to raise
+/// no alarm on that flight.
+struct IndexExtremes {
+  double min_motor_index = 1.0;      ///< lowest M_i (eq. 13)
+  double max_propeller_index = 0.0;  ///< highest P_i (eq. 17)
+  double max_takeoff_alpha = 0.0;    ///< highest take-off statistic [rad/s^2] (eq. 18's input)
+  void Merge(const IndexExtremes& other);
 };
 
 /// The interface every fault detector implements, so that a stack or a benchmark swaps them by name.
@@ -166,6 +195,9 @@ class CompositeFdd final : public FaultDetectorBase {
   /// The take-off detector's statistic: the filtered roll/pitch angular acceleration magnitude
   /// [rad/s^2] while its window is active, else 0 (for threshold calibration).
   double takeoff_angular_acceleration() const { return takeoff_angular_acceleration_; }
+  /// The indices' extremes over every evaluation before the first isolation: over a healthy
+  /// flight, what the thresholds must clear (fdd-calibrate, docs/fdd.md).
+  const IndexExtremes& healthy_extremes() const { return extremes_; }
 
  private:
   void RunObserver(double t, double dt);
@@ -181,6 +213,9 @@ class CompositeFdd final : public FaultDetectorBase {
   std::vector<double> low_index_since_s_;
   std::optional<TimeNs> last_esc_ns_;
   RotorVector measured_thrust_;
+  RotorVector working_;  // 1 for a rotor not isolated, else 0
+  int isolated_seen_ = 0;
+  std::optional<double> relearn_since_s_;
   bool have_esc_ = false;
   // Observer.
   double imu_rate_hz_ = 0.0;
@@ -194,6 +229,7 @@ class CompositeFdd final : public FaultDetectorBase {
   Eigen::VectorXd thrust_loss_;
   Eigen::Vector4d baseline_ = Eigen::Vector4d::Zero();  // the healthy residual wrench
   double takeoff_angular_acceleration_ = 0.0;
+  IndexExtremes extremes_;
 };
 
 }  // namespace rotorguard::fdd

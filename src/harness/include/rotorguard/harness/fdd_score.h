@@ -29,6 +29,19 @@ struct FddRecord {
   /// When correct: the first control cycle that flew without the diagnosed rotor - onset. It adds
   /// to latency_s the wait for the next control cycle (the telemetry's delay is in both).
   std::optional<double> reconfiguration_latency_s;
+  /// The second failed rotor: the first fault event on another rotor than the first event's.
+  struct Second {
+    int rotor = 0;
+    bool isolated = false;            ///< the detector took it out of the vehicle (any failure kind)
+    std::string kind, detector;       ///< its diagnosis, as Diagnosis's ("ok": none)
+    double detection_s = 0.0;         ///< when isolated
+    bool correct = false;             ///< isolated with the injected kind, at or after the event's onset
+    std::optional<double> latency_s;  ///< detection - onset, when correct
+  };
+  std::optional<Second> second;  ///< none: a single faulty rotor, or none at all
+  /// The composite detector's index extremes before the first fault's onset (over the whole flight
+  /// without one, up to a first isolation): how far a healthy flight pushed its indices.
+  std::optional<fdd::IndexExtremes> healthy_extremes;
 
   bool detected() const { return diagnosis.has_value(); }
 };
@@ -38,7 +51,8 @@ bool KindMatches(vehicle::FaultKind truth, fdd::RotorHealth diagnosis);
 
 /// Scores the detector's per-rotor statuses against the injected fault events: the earliest
 /// diagnosis counts; it is a false alarm without a fault or before the first onset, and correct
-/// when it names the first fault's rotor and kind.
+/// when it names the first fault's rotor and kind. A fault on a second rotor is scored on its own
+/// (FddRecord::second).
 FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vector<sim::FaultEvent>& events);
 
 /// Sets `record`'s reconfiguration_latency_s from the stack's reconfigurations when the diagnosis

@@ -73,6 +73,8 @@ class Simulator {
   bool landed() const { return landed_; }
   bool crashed() const { return crash_reason_.has_value(); }
   const std::optional<std::string>& crash_reason() const { return crash_reason_; }
+  /// The speed [m/s] at the crash's ground contact; none without a crash.
+  std::optional<double> crash_speed_m_s() const { return crash_speed_m_s_; }
 
  private:
   void ResolveGroundContact(const vehicle::StateVector& before);
@@ -101,6 +103,7 @@ class Simulator {
   RotorVector thrust_, speed_, command_;
   bool landed_ = false;
   std::optional<std::string> crash_reason_;
+  std::optional<double> crash_speed_m_s_;
   SensorOutputs outputs_;
 };
 

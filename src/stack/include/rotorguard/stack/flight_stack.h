@@ -345,7 +345,9 @@ class FlightStack {
   FlightStackOptions options_;
   OdometryImuEstimator estimator_;
   Supervisor supervisor_;
-  std::vector<RotorReconfiguration> reconfigurations_;  // rotors treated as failed, in order, and when
+  std::vector<RotorReconfiguration> reconfigurations_;
+  std::string cannot_hover_;  // why the rotors left cannot hold the vehicle ("" = they can)  // rotors treated as
+                              // failed, in order, and when
   std::optional<planning::TakeoffReference> landing_;  // the emergency landing's descent ...
   std::optional<TimeShiftedReference> descent_;         // ... from the time it started
   std::size_t plan_events_seen_ = 0;

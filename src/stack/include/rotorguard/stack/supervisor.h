@@ -4,7 +4,16 @@
 ///
 ///   nominal ──isolation──► failure_recovery ──attitude settled──► degraded_navigation
 ///      │                        │                                        │
-///      └──────── too many failures, no plan for too long, estimator lost ───┴──► emergency_landing ──touchdown──► landed
+///      ├──────── too many failures, no plan for too long, estimator lost ───┴──► emergency_landing ──touchdown──►
+///      landed └──────── a failure that leaves no hover thrust split (any mode in flight) ──► flight_termination
+///
+/// A further isolation the vehicle can fly on (on a quadrotor: the idle diagonal twin of the first
+/// failed rotor) changes no mode. One that leaves it unable to hover (control::HoverThrustSplit:
+/// no thrusts within the limits hold the weight with zero roll and pitch torque, e.g. two adjacent
+/// rotors of a quadrotor) terminates the flight: every motor stops, as PX4's flight termination
+/// does. No descent it can command lands measurably slower than falling (docs/fdd.md, "Second
+/// failures"), and stopped propellers and an untumbling body are the less harmful impact.
+/// `terminate_when_uncontrollable: false` flies the emergency landing instead.
 ///
 /// In failure recovery the NMPC has reconfigured and the planner has replanned with the
 /// post-failure limit; the mission takes no new waypoint until the attitude has settled. An
@@ -21,7 +30,14 @@
 
 namespace rotorguard::stack {
 
-enum class FlightMode { kNominal, kFailureRecovery, kDegradedNavigation, kEmergencyLanding, kLanded };
+enum class FlightMode {
+  kNominal,
+  kFailureRecovery,
+  kDegradedNavigation,
+  kEmergencyLanding,
+  kLanded,
+  kFlightTermination,  ///< motors stopped in the air: the vehicle cannot hover on its remaining rotors
+};
 const char* ToString(FlightMode mode);
 
 struct SupervisorOptions {
@@ -34,10 +50,13 @@ struct SupervisorOptions {
   double odometry_timeout_s = 0.5;
   /// A speed estimate above this [m/s] is a diverged estimator: land. > 0.
   double max_speed_m_s = 15.0;
-  /// Failed rotors the vehicle flies on; one more lands it. A quadrotor flies on one (paper
-  /// 000); an assembly of n units reallocates over its 4n rotors (scenarios with an assembly
-  /// default to 4n - 4). >= 0.
-  int max_failed_rotors = 1;
+  /// Failed rotors the vehicle flies on; one more lands it, >= 0. By default no count limits it:
+  /// whether the rotors left can hold the vehicle decides (SupervisorInputs::cannot_hover).
+  /// Scenarios with an assembly of n units default to 4n - 4.
+  int max_failed_rotors = kMaxRotors;
+  /// A failure that leaves the vehicle unable to hover stops every motor (true) or flies the
+  /// emergency landing (false).
+  bool terminate_when_uncontrollable = true;
   double landing_speed_m_s = 0.4;       ///< peak descent rate of an emergency landing [m/s], > 0
   double landing_depth_m = 0.5;         ///< how far below the ground the descent aims [m], > 0
   double touchdown_thrust_ratio = 0.5;  ///< collective command / weight below which ... (0, 1)
@@ -61,9 +80,12 @@ struct SupervisorOptions {
              {.meaning = "collective command over weight below which ..."});
     a->Visit("touchdown_hold_s", &touchdown_hold_s, {.meaning = "... for this long [s] is a touchdown"});
     a->Visit("max_failed_rotors", &max_failed_rotors,
-             {.meaning = "failed rotors the vehicle flies on; one more lands it (an assembly of n units: 4n - 4)",
+             {.meaning = "failed rotors the vehicle flies on; one more lands it (default: no limit by count; an "
+                         "assembly of n units: 4n - 4)",
               .min = 0,
               .max = kMaxRotors});
+    a->Visit("terminate_when_uncontrollable", &terminate_when_uncontrollable,
+             {.meaning = "a failure that leaves no hover thrust split stops the motors (true) or lands (false)"});
   }
 };
 
@@ -77,6 +99,8 @@ struct SupervisorInputs {
   double since_last_plan_s = 0.0;    ///< time since the planner last succeeded (0 when it just did)
   double thrust_ratio = 1.0;         ///< the last collective thrust command / the vehicle's weight
   std::string land_request;          ///< a planner's decision to land, with its reason ("" = none)
+  /// Why the vehicle cannot hover on the rotors it has left ("" = it can).
+  std::string cannot_hover;
 };
 
 struct ModeTransition {
