@@ -185,7 +185,7 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
   disarmed.motor_index_samples = std::numeric_limits<int>::max();
   disarmed.propeller_index_threshold = 1.0;
   disarmed.propeller_persistence_s = 10.0;
-  disarmed.takeoff_angular_acceleration_rad_s2 = 1e6;
+  disarmed.takeoff_index_threshold = 1e6;
   fdd::IndexExtremes extremes;  // over all logs
   nlohmann::json log_docs = nlohmann::json::array();
   int faulty_logs = 0;
@@ -220,10 +220,10 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
        &fdd::IndexExtremes::max_propeller_index,
        {0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0},
        false},
-      {"takeoff_angular_acceleration_rad_s2",
-       &fdd::CompositeFddOptions::takeoff_angular_acceleration_rad_s2,
-       &fdd::IndexExtremes::max_takeoff_alpha,
-       {0.5, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0, 30.0, 40.0},
+      {"takeoff_index_threshold",
+       &fdd::CompositeFddOptions::takeoff_index_threshold,
+       &fdd::IndexExtremes::max_takeoff_index,
+       {0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.47, 0.6, 0.8, 1.0, 1.2, 1.5},
        false},
   };
   nlohmann::json sweep_docs = nlohmann::json::array();
@@ -308,7 +308,8 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
            {{"min_motor_index", extremes.min_motor_index < 1.0 ? nlohmann::json(extremes.min_motor_index) : nullptr},
             {"max_propeller_index",
              extremes.max_propeller_index > 0.0 ? nlohmann::json(extremes.max_propeller_index) : nullptr},
-            {"max_takeoff_alpha", extremes.max_takeoff_alpha > 0.0 ? nlohmann::json(extremes.max_takeoff_alpha) : nullptr}}},
+            {"max_takeoff_index",
+             extremes.max_takeoff_index > 0.0 ? nlohmann::json(extremes.max_takeoff_index) : nullptr}}},
           {"sweeps", sweep_docs}};
 }
 
@@ -323,9 +324,9 @@ std::string CalibrationMarkdown(const nlohmann::json& c) {
   const auto num = [](const nlohmann::json& v, const char* f) {
     return v.is_null() ? std::string("/") : fmt::format(fmt::runtime(f), v.get<double>());
   };
-  fmt::format_to(it, "Fault-free extremes (/: not exercised): min M_i {}, max P_i {}, max take-off alpha {} rad/s^2\n",
+  fmt::format_to(it, "Fault-free extremes (/: not exercised): min M_i {}, max P_i {}, max take-off index {}\n",
                  num(x["min_motor_index"], "{:.3f}"), num(x["max_propeller_index"], "{:.3f}"),
-                 num(x["max_takeoff_alpha"], "{:.2f}"));
+                 num(x["max_takeoff_index"], "{:.3f}"));
   for (const auto& sw : c["sweeps"]) {
     fmt::format_to(it, "\n### {} (configured {:g})\n\n", sw["threshold"].get<std::string>(), sw["configured"].get<double>());
     fmt::format_to(it, "| value | detected | missed | false alarms | latency mean (s) | latency max (s) | margin |\n");

@@ -1,9 +1,10 @@
 #include "rotorguard/fdd/composite_fdd.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
+#include <limits>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/vehicle/effectiveness.h"
@@ -35,7 +36,7 @@ bool IsIsolated(RotorHealth health) {
 void CompositeFddOptions::Validate() const {
   RequireIn("motor_index_threshold", motor_index_threshold, 1e-6, 1.0 - 1e-6, "a value in (0, 1)");
   if (motor_index_samples < 1) ThrowValidation("CompositeFddOptions", "motor_index_samples", motor_index_samples, ">= 1");
-  RequireIn("motor_index_min_thrust_n", motor_index_min_thrust_n, 1e-6, 1e6, "a thrust > 0 N");
+  RequireIn("min_thrust_fraction", min_thrust_fraction, 1e-6, 1.0, "a fraction in (0, 1]");
   RequireIn("propeller_index_threshold", propeller_index_threshold, 1e-6, 1.0, "a value in (0, 1]");
   RequireIn("propeller_persistence_s", propeller_persistence_s, 0.0, 10.0, "a time in [0, 10] s");
   RequireIn("degraded_threshold", degraded_threshold, 1e-6, propeller_index_threshold - 1e-6,
@@ -45,7 +46,7 @@ void CompositeFddOptions::Validate() const {
   RequireIn("filter_cutoff_hz", filter_cutoff_hz, 1e-3, 0.5 * imu_rate_hz - 1e-6, "a cut-off below half imu_rate_hz");
   RequireIn("takeoff_max_altitude_m", takeoff_max_altitude_m, 1e-3, 100.0, "an altitude > 0 m");
   RequireIn("takeoff_window_s", takeoff_window_s, 1e-3, 1e3, "a time > 0 s");
-  RequireIn("takeoff_angular_acceleration_rad_s2", takeoff_angular_acceleration_rad_s2, 1e-3, 1e6, "a value > 0");
+  RequireIn("takeoff_index_threshold", takeoff_index_threshold, 1e-6, 1e6, "a value > 0");
   RequireIn("takeoff_direction_cosine", takeoff_direction_cosine, 1e-6, 1.0, "a value in (0, 1]");
   RequireIn("takeoff_missing_thrust_fraction", takeoff_missing_thrust_fraction, 0.0, 1.0, "a value in [0, 1]");
   RequireIn("second_failure_missing_thrust_fraction", second_failure_missing_thrust_fraction, 0.0, 1.0,
@@ -76,12 +77,25 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   rate_filter_ = LowPass2<3>(options_.filter_cutoff_hz, options_.imu_rate_hz);
   alpha_filter_ = FilteredDerivative<3>(options_.filter_cutoff_hz, options_.imu_rate_hz);
   wrench_filter_ = LowPass2<4>(options_.filter_cutoff_hz, options_.imu_rate_hz);
+  // The thresholds' units: a rotor's share of the hover thrust, and the roll/pitch angular
+  // acceleration of losing it (eq. 18's signature), the smallest over the rotors.
+  hover_thrust_per_rotor_n_ = vehicle_.weight_n() / n_;
+  one_rotor_alpha_ = std::numeric_limits<double>::infinity();
+  const Matrix3 inverse_inertia = vehicle_.inertia_kg_m2.inverse();
+  for (const vehicle::Rotor& r : vehicle_.rotors) {
+    const Vector3 torque = r.p_B.cross(Vector3(0.0, 0.0, hover_thrust_per_rotor_n_));
+    one_rotor_alpha_ = std::min(one_rotor_alpha_, (inverse_inertia * torque).head<2>().norm());
+  }
+  if (!(one_rotor_alpha_ > 0.0) || !std::isfinite(one_rotor_alpha_)) {
+    ThrowValidation("CompositeFdd", "vehicle.rotors", "(a rotor at the centre of gravity)",
+                    "every rotor off the centre of gravity: losing it must turn the vehicle");
+  }
 }
 
 void IndexExtremes::Merge(const IndexExtremes& other) {
   min_motor_index = std::min(min_motor_index, other.min_motor_index);
   max_propeller_index = std::max(max_propeller_index, other.max_propeller_index);
-  max_takeoff_alpha = std::max(max_takeoff_alpha, other.max_takeoff_alpha);
+  max_takeoff_index = std::max(max_takeoff_index, other.max_takeoff_index);
 }
 
 FaultDetectorBase::FaultDetectorBase(int num_rotors) : rotors_(static_cast<std::size_t>(num_rotors)) {}
@@ -134,7 +148,7 @@ void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
     // The motor model starts where the motors are, then follows the commands.
     if (first) expected_thrust_[i] = measured_thrust_[i];
     expected_thrust_[i] += blend * (command_[i] - expected_thrust_[i]);
-    if (expected_thrust_[i] < options_.motor_index_min_thrust_n) {
+    if (expected_thrust_[i] < options_.min_thrust_fraction * hover_thrust_per_rotor_n_) {
       low_index_count_[i] = 0;
       rotors_[i].motor_index = 1.0;
       continue;
@@ -176,7 +190,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
                                           wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
   if (flying && !airborne_since_s_) airborne_since_s_ = t;
   if (!flying) airborne_since_s_.reset();
-  takeoff_angular_acceleration_ = 0.0;
+  takeoff_index_ = 0.0;
   if (!airborne_since_s_) {
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
     return;
@@ -220,9 +234,9 @@ void CompositeFdd::RunObserver(double t, double dt) {
   // pointing like the loss of one rotor's thrust: alpha ~ -I^-1 (r_i x T e3).
   const bool takeoff = isolated == 0 && t - *airborne_since_s_ <= options_.takeoff_window_s &&
                        estimate_.p_W.z() <= options_.takeoff_max_altitude_m;
-  if (takeoff) takeoff_angular_acceleration_ = alpha.head<2>().norm();
-  if (isolated == 0) extremes_.max_takeoff_alpha = std::max(extremes_.max_takeoff_alpha, takeoff_angular_acceleration_);
-  if (takeoff && alpha.head<2>().norm() > options_.takeoff_angular_acceleration_rad_s2) {
+  if (takeoff) takeoff_index_ = alpha.head<2>().norm() / one_rotor_alpha_;
+  if (isolated == 0) extremes_.max_takeoff_index = std::max(extremes_.max_takeoff_index, takeoff_index_);
+  if (takeoff && takeoff_index_ > options_.takeoff_index_threshold) {
     int best = -1;
     double best_cos = options_.takeoff_direction_cosine;
     for (int i = 0; i < n_; ++i) {
@@ -248,7 +262,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
   const bool learning = t - *airborne_since_s_ < 3.0 * options_.baseline_time_constant_s ||
                         (relearn_since_s_ && t - *relearn_since_s_ < options_.post_isolation_relearn_s);
   // eq. (17): P_i = lost thrust / thrust the rotor should give; persistent -> propeller failure.
-  const double min_thrust = options_.motor_index_min_thrust_n;
+  const double min_thrust = options_.min_thrust_fraction * hover_thrust_per_rotor_n_;
   for (int i = 0; i < n_; ++i) {
     const double p = measured_thrust_[i] > min_thrust ? thrust_loss_[i] / measured_thrust_[i] : 0.0;
     rotors_[i].propeller_index = p;

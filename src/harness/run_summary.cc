@@ -23,7 +23,7 @@ nlohmann::json Vec(const Vector3& v) { return {v.x(), v.y(), v.z()}; }
 nlohmann::json ExtremesJson(const fdd::IndexExtremes& e) {
   return {{"min_motor_index", e.min_motor_index},
           {"max_propeller_index", e.max_propeller_index},
-          {"max_takeoff_alpha", e.max_takeoff_alpha}};
+          {"max_takeoff_index", e.max_takeoff_index}};
 }
 
 nlohmann::json SecondJson(const FddRecord::Second& s) {

@@ -202,7 +202,7 @@ TEST_F(FddReplay, CalibrationTableAndSuggestionAreConsistent) {
     const double suggested = sw["suggested"]["value"].get<double>();
     if (sw["threshold"] == "motor_index_threshold") at.motor_index_threshold = suggested;
     if (sw["threshold"] == "propeller_index_threshold") at.propeller_index_threshold = suggested;
-    if (sw["threshold"] == "takeoff_angular_acceleration_rad_s2") at.takeoff_angular_acceleration_rad_s2 = suggested;
+    if (sw["threshold"] == "takeoff_index_threshold") at.takeoff_index_threshold = suggested;
     for (const CalibrationLog& log : logs) {
       const ReplayOutcome r = ReplayCompositeFdd(log, at);
       EXPECT_EQ(r.isolated_rotor.has_value(), !log.faults.empty()) << sw["threshold"] << " " << log.dir;

@@ -194,7 +194,7 @@ TEST(CompositeFdd, HealthyExtremesAreTheIndicesMostAlarmingValuesUntilTheFirstIs
   EXPECT_GT(healthy.min_motor_index, 0.99);
   EXPECT_GT(healthy.max_propeller_index, 0.0);
   EXPECT_LT(healthy.max_propeller_index, 0.15);
-  EXPECT_EQ(healthy.max_takeoff_alpha, 0.0);  // hovering at 1 m: no take-off
+  EXPECT_EQ(healthy.max_takeoff_index, 0.0);  // hovering at 1 m: no take-off
   b.drive_[1] = b.actual_[1] = 0.0;
   ASSERT_TRUE(b.Run(0.1));
   const IndexExtremes at_isolation = b.fdd_.healthy_extremes();
@@ -202,6 +202,26 @@ TEST(CompositeFdd, HealthyExtremesAreTheIndicesMostAlarmingValuesUntilTheFirstIs
   b.actual_[2] = 0.0;                            // what follows the isolation no longer counts
   b.Run(1.0);
   EXPECT_EQ(b.fdd_.healthy_extremes().max_propeller_index, at_isolation.max_propeller_index);
+}
+
+TEST(CompositeFdd, ThresholdsAreInUnitsOfTheVehiclesHoverThrustAndOneRotorsTurn) {
+  // X layout, arms a along x and y: losing a rotor's W/4 turns the vehicle at a W/4 / I_xx about x
+  // and a W/4 / I_yy about y (eq. 3 at rest).
+  const vehicle::VehicleParams v = ReferenceQuad();
+  const CompositeFdd fdd(v, {});
+  const double a = std::abs(v.rotors[0].p_B.x()), share = v.weight_n() / 4.0;
+  EXPECT_NEAR(fdd.hover_thrust_per_rotor_n(), share, 1e-12);
+  EXPECT_NEAR(fdd.one_rotor_angular_acceleration_rad_s2(),
+              std::hypot(a * share / v.inertia_kg_m2(0, 0), a * share / v.inertia_kg_m2(1, 1)), 1e-9);
+  // Twice as heavy and as stiff, with rotors twice as strong: the same thresholds, in newtons and
+  // rad/s^2 twice and once the reference's.
+  vehicle::VehicleParams heavy = v;
+  heavy.mass_kg *= 2.0;
+  heavy.inertia_kg_m2 *= 2.0;
+  for (vehicle::Rotor& r : heavy.rotors) r.max_thrust_n *= 2.0;
+  const CompositeFdd scaled(heavy, {});
+  EXPECT_NEAR(scaled.hover_thrust_per_rotor_n(), 2.0 * share, 1e-12);
+  EXPECT_NEAR(scaled.one_rotor_angular_acceleration_rad_s2(), fdd.one_rotor_angular_acceleration_rad_s2(), 1e-9);
 }
 
 TEST(CompositeFdd, ReportsAPersistentPartialLossAsDegradationWithItsEta) {

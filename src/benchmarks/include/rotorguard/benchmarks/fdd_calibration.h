@@ -73,9 +73,9 @@ struct FddCalibrationOptions {
 };
 
 /// Runs the three sweeps (motor_index_threshold, propeller_index_threshold,
-/// takeoff_angular_acceleration_rad_s2) over the logs. The document:
+/// takeoff_index_threshold) over the logs. The document:
 /// {"logs": [{"dir", "faulty", "fault": {...}|null, "with_configured_thresholds": {...}}],
-///  "fault_free_extremes": {"min_motor_index", "max_propeller_index", "max_takeoff_alpha"} (null:
+///  "fault_free_extremes": {"min_motor_index", "max_propeller_index", "max_takeoff_index"} (null:
 ///  no fault-free flight moved the index),
 ///  "sweeps": [{"threshold", "configured", "rows": [{"value", "detected", "missed", "false_alarms",
 ///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null, "note"}]}

@@ -25,9 +25,10 @@ struct CompositeFddOptions {
   double motor_index_threshold = 0.2;
   /// Consecutive telemetry samples the index must stay low (debounce), >= 1.
   int motor_index_samples = 2;
-  /// The index is evaluated only while the expected thrust exceeds this [N] (w_expected -> 0
-  /// makes the ratio meaningless), > 0.
-  double motor_index_min_thrust_n = 0.3;
+  /// The indices are evaluated only while the rotor's thrust (expected, for M_i; measured, for
+  /// P_i) exceeds this fraction of its share of the hover thrust, W / n (w_expected -> 0 makes
+  /// the ratios meaningless), in (0, 1].
+  double min_thrust_fraction = 0.1;
   /// Propeller index P_i = thrust lost / thrust the rotor should give (eq. 17) above this isolates
   /// a propeller failure (gamma_P, paper: 0.8), in (0, 1].
   double propeller_index_threshold = 0.8;
@@ -56,8 +57,10 @@ struct CompositeFddOptions {
   /// within takeoff_window_s of lift-off, > 0.
   double takeoff_max_altitude_m = 0.6;
   double takeoff_window_s = 3.0;
-  /// Filtered roll/pitch angular acceleration magnitude that fires it [rad/s^2], > 0 ...
-  double takeoff_angular_acceleration_rad_s2 = 12.0;
+  /// The take-off index: the filtered roll/pitch angular acceleration magnitude over the one that
+  /// losing one rotor's share of the hover thrust causes (the smallest over the rotors,
+  /// |I^-1 (r_i x (W/n) e3)|). Above this it fires, > 0 ...
+  double takeoff_index_threshold = 0.47;
   /// ... pointing within this cosine of the signature of losing one rotor, in (0, 1] ...
   double takeoff_direction_cosine = 0.9;
   /// ... while that rotor misses at least this fraction of its expected thrust, by its telemetry
@@ -78,8 +81,9 @@ struct CompositeFddOptions {
              {.meaning = "γ_M: a motor index M_i (eq. 13) at or below it isolates a motor failure, in (0, 1)"});
     a->Visit("motor_index_samples", &motor_index_samples,
              {.meaning = "consecutive telemetry samples the index must stay low", .min = 1, .max = 1000});
-    a->Visit("motor_index_min_thrust_n", &motor_index_min_thrust_n,
-             {.meaning = "the index is evaluated only while the expected thrust exceeds this [N]"});
+    a->Visit(
+        "min_thrust_fraction", &min_thrust_fraction,
+        {.meaning = "the indices are evaluated only above this fraction of a rotor's hover thrust W/n, in (0, 1]"});
     a->Visit("propeller_index_threshold", &propeller_index_threshold,
              {.meaning = "γ_P: a propeller index P_i (eq. 17) above it isolates a propeller failure, in (0, 1]"});
     a->Visit("propeller_persistence_s", &propeller_persistence_s, {.meaning = "P_i must stay above γ_P this long [s]"});
@@ -91,8 +95,9 @@ struct CompositeFddOptions {
     a->Visit("takeoff_max_altitude_m", &takeoff_max_altitude_m,
              {.meaning = "the take-off detector (eq. 18) runs below this altitude [m] ..."});
     a->Visit("takeoff_window_s", &takeoff_window_s, {.meaning = "... and within this long of lift-off [s]"});
-    a->Visit("takeoff_angular_acceleration_rad_s2", &takeoff_angular_acceleration_rad_s2,
-             {.meaning = "roll/pitch angular acceleration that fires it [rad/s²] ..."});
+    a->Visit("takeoff_index_threshold", &takeoff_index_threshold,
+             {.meaning =
+                  "roll/pitch angular acceleration, over that of losing one rotor's hover thrust, that fires it ..."});
     a->Visit("takeoff_direction_cosine", &takeoff_direction_cosine,
              {.meaning = "... pointing within this cosine of the loss of one rotor ..."});
     a->Visit("takeoff_missing_thrust_fraction", &takeoff_missing_thrust_fraction,
@@ -136,7 +141,7 @@ struct RotorStatus {
 struct IndexExtremes {
   double min_motor_index = 1.0;      ///< lowest M_i (eq. 13)
   double max_propeller_index = 0.0;  ///< highest P_i (eq. 17)
-  double max_takeoff_alpha = 0.0;    ///< highest take-off statistic [rad/s^2] (eq. 18's input)
+  double max_takeoff_index = 0.0;    ///< highest take-off index (eq. 18's statistic, normalised)
   void Merge(const IndexExtremes& other);
 };
 
@@ -192,9 +197,12 @@ class CompositeFdd final : public FaultDetectorBase {
   const Eigen::VectorXd& thrust_loss() const { return thrust_loss_; }
   /// The healthy residual wrench learnt so far [N, N m]: thrust along body z, then torque.
   const Eigen::Vector4d& baseline() const { return baseline_; }
-  /// The take-off detector's statistic: the filtered roll/pitch angular acceleration magnitude
-  /// [rad/s^2] while its window is active, else 0 (for threshold calibration).
-  double takeoff_angular_acceleration() const { return takeoff_angular_acceleration_; }
+  /// The take-off index while its window is active, else 0 (for threshold calibration).
+  double takeoff_index() const { return takeoff_index_; }
+  /// What the indices are normalised by: a rotor's share of the hover thrust W/n [N], and the
+  /// roll/pitch angular acceleration of losing it [rad/s^2] (the smallest over the rotors).
+  double hover_thrust_per_rotor_n() const { return hover_thrust_per_rotor_n_; }
+  double one_rotor_angular_acceleration_rad_s2() const { return one_rotor_alpha_; }
   /// The indices' extremes over every evaluation before the first isolation: over a healthy
   /// flight, what the thresholds must clear (fdd-calibrate, docs/fdd.md).
   const IndexExtremes& healthy_extremes() const { return extremes_; }
@@ -228,7 +236,8 @@ class CompositeFdd final : public FaultDetectorBase {
   std::vector<int> degraded_count_;
   Eigen::VectorXd thrust_loss_;
   Eigen::Vector4d baseline_ = Eigen::Vector4d::Zero();  // the healthy residual wrench
-  double takeoff_angular_acceleration_ = 0.0;
+  double takeoff_index_ = 0.0;
+  double hover_thrust_per_rotor_n_ = 0.0, one_rotor_alpha_ = 0.0;
   IndexExtremes extremes_;
 };
 
