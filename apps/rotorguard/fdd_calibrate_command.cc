@@ -26,6 +26,9 @@ class FddCalibrateCommand final : public Command {
                           "Required margin to the fault-free extreme of each index (default 1.5, > 1)");
     calibrate->add_option("--out", out_, "Folder for calibration.json and calibration.md");
     calibrate->add_flag("--json", json_, "Print JSON instead of Markdown");
+    calibrate->add_option("--write", write_,
+                          "Write the thresholds, with the suggested values, to this YAML file; a vehicle file\n"
+                          "names it with its key `fdd: FILE`");
     return calibrate;
   }
 
@@ -46,13 +49,15 @@ class FddCalibrateCommand final : public Command {
       io::WriteFileAtomically((fs::path(out_) / "calibration.json").string(), r.dump(2) + "\n");
       io::WriteFileAtomically((fs::path(out_) / "calibration.md").string(), md);
     }
+    if (!write_.empty()) io::WriteFileAtomically(write_, benchmarks::CalibratedFddYaml(r, o.fdd));
     fmt::print("{}", json_ ? r.dump(2) + "\n" : md);
+    if (!write_.empty()) fmt::print(stderr, "thresholds written to {}\n", write_);
     return kOk;
   }
 
  private:
   std::vector<std::string> dirs_;
-  std::string margin_text_ = "1.5", out_;
+  std::string margin_text_ = "1.5", out_, write_;
   bool json_ = false;
 };
 

@@ -1,5 +1,7 @@
 #include "rotorguard/benchmarks/fdd_calibration.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -7,14 +9,13 @@
 #include <limits>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/json_archive.h"
+#include "rotorguard/io/yaml_writer.h"
 #include "rotorguard/record/sensor_log.h"
 #include "rotorguard/stack/estimator.h"
 
@@ -339,6 +340,30 @@ std::string CalibrationMarkdown(const nlohmann::json& c) {
     fmt::format_to(it, "\n{}: {}\n", sw["suggested"].is_null() ? "No suggestion" : "Suggested", sw["note"].get<std::string>());
   }
   return out;
+}
+
+std::string CalibratedFddYaml(const nlohmann::json& calibration, fdd::CompositeFddOptions base) {
+  std::string applied;
+  for (const auto& sw : calibration.at("sweeps")) {
+    if (sw["suggested"].is_null()) continue;
+    const std::string name = sw["threshold"];
+    const double value = sw["suggested"]["value"];
+    if (name == "motor_index_threshold") base.motor_index_threshold = value;
+    if (name == "propeller_index_threshold") base.propeller_index_threshold = value;
+    if (name == "takeoff_index_threshold") base.takeoff_index_threshold = value;
+    applied += fmt::format("#   {}\n", sw["note"].get<std::string>());
+  }
+  base.Validate();
+  io::YamlWriter writer;
+  base.Serialize(&writer);
+  int faulty = 0;
+  for (const auto& log : calibration.at("logs")) faulty += log["faulty"].get<bool>() ? 1 : 0;
+  std::string keys = writer.text();
+  if (!keys.empty() && keys.back() != '\n') keys += '\n';
+  return fmt::format(
+      "# Composite FDD thresholds written by rotorguard fdd-calibrate from {} logs ({} faulty); name this\n"
+      "# file from the vehicle file with `fdd: FILE` (docs/fdd.md). Suggested values applied:\n{}{}",
+      calibration.at("logs").size(), faulty, applied.empty() ? "#   none\n" : applied, keys);
 }
 
 }  // namespace rotorguard::benchmarks

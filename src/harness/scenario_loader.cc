@@ -149,6 +149,8 @@ void ReadVehicle(const ConfigNode& root, const std::string& path, const std::vec
       s->assembly = std::move(assembly);
     } else {
       s->vehicle = LoadVehicle(s->vehicle_file, overrides);
+      // The vehicle's own FDD thresholds, which the scenario's stack.composite_fdd may override.
+      if (auto fdd = LoadVehicleFdd(s->vehicle_file)) std::tie(s->stack.composite_fdd, s->vehicle_fdd_file) = *fdd;
     }
   } catch (const io::InputFileError& e) {
     throw io::InputFileError(e.path(),

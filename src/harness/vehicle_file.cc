@@ -31,6 +31,7 @@ vehicle::VehicleParams LoadVehicleDocument(ConfigDocument doc, const std::vector
   ApplyOverrides(&doc, overrides, /*vehicle_part=*/true);
   vehicle::VehicleParams v;
   v.name = "vehicle";
+  doc.root().Optional("fdd");  // the FDD's thresholds: LoadVehicleFdd's
   try {
     io::ReadConfig(doc.root(), &v);
   } catch (const io::ConfigError& e) {
@@ -66,6 +67,23 @@ std::string ResolveRelative(const std::string& base_file, const std::string& pat
 
 vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Override>& overrides) {
   return LoadVehicleDocument(ConfigDocument::LoadFile(path), overrides);
+}
+
+std::optional<std::pair<fdd::CompositeFddOptions, std::string>> LoadVehicleFdd(const std::string& vehicle_path) {
+  const ConfigDocument doc = ConfigDocument::LoadFile(vehicle_path);
+  const std::optional<ConfigNode> key = doc.root().Optional("fdd");
+  if (!key) return std::nullopt;
+  const std::string file = ResolveRelative(vehicle_path, key->AsString());
+  ConfigDocument thresholds = [&] {
+    try {
+      return ConfigDocument::LoadFile(file);
+    } catch (const io::InputFileError& e) {
+      throw io::InputFileError(e.path(), fmt::format("{} (named by 'fdd' at {})", e.reason(), key->Location()));
+    }
+  }();
+  fdd::CompositeFddOptions o;
+  io::ReadConfig(thresholds.root(), &o);
+  return std::pair{o, file};
 }
 
 modular::Assembly LoadAssembly(const std::string& path) {
@@ -109,7 +127,8 @@ std::string VehicleToYaml(const vehicle::VehicleParams& v) {
 
 std::string ScenarioFingerprint(const Scenario& scenario) {
   return (scenario.file.empty() ? std::string() : io::ReadInputFile(scenario.file)) + "\n" +
-         VehicleToYaml(scenario.vehicle);
+         VehicleToYaml(scenario.vehicle) +
+         (scenario.vehicle_fdd_file.empty() ? std::string() : "\n" + io::ReadInputFile(scenario.vehicle_fdd_file));
 }
 
 }  // namespace rotorguard::harness

@@ -283,6 +283,21 @@ TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
   const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "cal" / "calibration.json"));
   EXPECT_EQ(j["sweeps"].size(), 3u);
   EXPECT_EQ(j["logs"][1]["with_configured_thresholds"]["correct"], true);
+  // --write: the thresholds with the suggestions applied, a file a vehicle file names with `fdd:`.
+  const Result w = Cli("fdd-calibrate " + Out() + "/free " + Out() + "/faulty --write " + Out() + "/thresholds.yaml");
+  ASSERT_EQ(w.exit_code, 0) << w.out;
+  const std::string vehicle = Write("calibrated.yaml", ReadText(kVehicle) + "fdd: " + Out() + "/thresholds.yaml\n");
+  const std::string flown =
+      Write("calibrated_run.yaml", Scenario(vehicle, "stack: {controller: nmpc, fdd: composite}\n"));
+  ASSERT_EQ(Cli("run " + flown + " --quiet --no-report --out " + Out() + "/calibrated").exit_code, 0);
+  const nlohmann::json used = nlohmann::json::parse(ReadText(fs::path(Out()) / "calibrated" / "summary.json"));
+  int applied = 0;
+  for (const auto& sw : j["sweeps"]) {
+    if (sw["suggested"].is_null()) continue;
+    EXPECT_EQ(used["composite_fdd"][sw["threshold"].get<std::string>()], sw["suggested"]["value"]) << sw.dump();
+    ++applied;
+  }
+  EXPECT_GT(applied, 0);
 
   EXPECT_EQ(Cli("fdd-calibrate " + Out() + "/free --margin 1").exit_code, 2);
   EXPECT_EQ(Cli("fdd-calibrate").exit_code, 2);

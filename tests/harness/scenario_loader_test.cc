@@ -14,6 +14,7 @@
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/harness/scenario_keys.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/files.h"
 #include "rotorguard/io/json_archive.h"
 #include "rotorguard/planning/references.h"
 #include "test_util.h"
@@ -223,6 +224,29 @@ TEST_F(ScenarioLoader, VehicleOverridesApplyToTheVehicleFile) {
                        "--set: vehicle.mass_kg: '-1' is out of range");
   RG_EXPECT_THROW_WITH(LoadScenario(File("mission: {type: hover}\n"), {{"vehicle.rotors.0.max_thrust_n", "0.1"}}),
                        io::ConfigError, "vehicle.rotors.0.max_thrust_n: VehicleParams::rotors.0.max_thrust_n = 0.1");
+}
+
+TEST_F(ScenarioLoader, AVehiclesFddThresholdsFileIsTheDefaultAScenarioOverrides) {
+  Write("thresholds.yaml", "propeller_index_threshold: 0.7\ntakeoff_index_threshold: 0.6\n");
+  const std::string vehicle = Write("quad.yaml", io::ReadInputFile(kVehicle) + "fdd: thresholds.yaml\n");
+  const auto scenario = [&](const std::string& stack) {
+    return Write("fdd.yaml", "vehicle: quad.yaml\nduration_s: 10\nmission: {type: hover}\n" + stack);
+  };
+  Scenario s = LoadScenario(scenario(""));
+  EXPECT_EQ(s.stack.composite_fdd.propeller_index_threshold, 0.7);
+  EXPECT_EQ(s.stack.composite_fdd.takeoff_index_threshold, 0.6);
+  EXPECT_EQ(s.stack.composite_fdd.motor_index_threshold, fdd::CompositeFddOptions{}.motor_index_threshold);
+  EXPECT_NE(s.vehicle_fdd_file.find("thresholds.yaml"), std::string::npos);
+  s = LoadScenario(scenario("stack: {composite_fdd: {propeller_index_threshold: 0.6}}\n"));
+  EXPECT_EQ(s.stack.composite_fdd.propeller_index_threshold, 0.6);  // the scenario's word is the last
+  EXPECT_EQ(s.stack.composite_fdd.takeoff_index_threshold, 0.6);
+  // A bad key or value in the thresholds file is named there; a missing file where it is named.
+  Write("thresholds.yaml", "propeller_index_threshold: 0.7\ngamma_p: 0.8\n");
+  RG_EXPECT_THROW_WITH(LoadScenario(scenario("")), io::ConfigError, "thresholds.yaml:2:");
+  Write("thresholds.yaml", "propeller_index_threshold: 0.1\n");  // below the partial-loss threshold
+  RG_EXPECT_THROW_WITH(LoadScenario(scenario("")), io::ConfigError, "propeller_index_threshold");
+  Write("quad.yaml", io::ReadInputFile(kVehicle) + "fdd: no_such.yaml\n");
+  RG_EXPECT_THROW_WITH(LoadScenario(scenario("")), io::InputFileError, "named by 'fdd' at");
 }
 
 /// The keys a block's unknown-key error lists, from its message.

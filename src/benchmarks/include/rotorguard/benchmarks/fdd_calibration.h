@@ -87,4 +87,8 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
 /// The calibration as Markdown tables with the suggestions.
 std::string CalibrationMarkdown(const nlohmann::json& calibration);
 
+/// `base` with every threshold the calibration suggests a value for set to it, as the YAML file a
+/// vehicle file names with its key `fdd` (harness::LoadVehicleFdd), headed by what it came from.
+std::string CalibratedFddYaml(const nlohmann::json& calibration, fdd::CompositeFddOptions base);
+
 }  // namespace rotorguard::benchmarks

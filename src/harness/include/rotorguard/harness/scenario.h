@@ -38,6 +38,8 @@ struct Scenario {
   std::string name;
   std::string file;           ///< the scenario file it came from ("" when built in code)
   std::string vehicle_file;   ///< the vehicle's file, or the assembly's (key `assembly`)
+  /// The composite FDD thresholds file the vehicle file names (its key `fdd`), "" when none.
+  std::string vehicle_fdd_file;
   /// An assembly of units (paper 002; key `assembly` in place of `vehicle`): its geometry, with
   /// `vehicle` the combined multirotor. Null for a single vehicle.
   std::shared_ptr<const modular::Assembly> assembly;
@@ -109,6 +111,11 @@ modular::Assembly LoadAssembly(const std::string& path);
 
 /// Loads and validates a vehicle file (same error contract).
 vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Override>& overrides = {});
+/// The composite FDD thresholds a vehicle file names with its key `fdd` (a YAML file of
+/// stack.composite_fdd's keys, relative to the vehicle file; `rotorguard fdd-calibrate --write`
+/// writes one), and that file's path; none when the vehicle file names none. Same error contract,
+/// a missing file named with the vehicle file's line.
+std::optional<std::pair<fdd::CompositeFddOptions, std::string>> LoadVehicleFdd(const std::string& vehicle_path);
 /// The vehicle in the format LoadVehicle reads, every number in its shortest exact form (the
 /// thrust coefficient, converted to per rpm^2, reads back within one part in 1e15).
 std::string VehicleToYaml(const vehicle::VehicleParams& vehicle);
