@@ -306,7 +306,9 @@ class BenchCommand final : public Command {
     o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_, 1, 1'000'000));
     o.seed = Seed();
     o.methods = ParseWordList("--methods", ftc_methods_, benchmarks::FtcMethods());
-    o.vehicle = harness::LoadVehicle(ConfigPath("vehicles/zhou2025_quad.yaml"));
+    const std::string vehicle = ConfigPath("vehicles/zhou2025_quad.yaml");
+    o.vehicle = harness::LoadVehicle(vehicle);
+    if (auto fdd = harness::LoadVehicleFdd(vehicle)) o.fdd = fdd->first;
     o.truth = Truth();
     const std::optional<nlohmann::json> r = RunBenchCampaign(benchmarks::FtcCampaign(o), "ftc");
     return r && (*r)["errors"].get<int>() > 0 ? kRunFailed : kOk;

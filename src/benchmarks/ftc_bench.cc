@@ -17,6 +17,7 @@
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/json_archive.h"
 #include "rotorguard/planning/references.h"
 
 namespace rotorguard::benchmarks {
@@ -158,6 +159,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     f.onset = {sim::FaultOnset::Kind::kAtTime, onset.value + 2.5 + rng.Uniform()};
     s.faults.push_back(f);
   }
+  if (o.fdd) s.stack.composite_fdd = *o.fdd;
   harness::FitStackToHardware(&s);
   const FtcMethod& m = FtcMethodNamed(method);
   s.stack.controller = m.controller;
@@ -255,9 +257,12 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   c.group_keys = {"phase", "fault", "method"};
   c.metrics = {"success",      "correct",   "false_alarm",    "latency_s",        "altitude_change_m",
                "final_rmse_m", "eta_error", "second_correct", "second_latency_s", "crash_speed_m_s"};
-  const nlohmann::json options = {{"trials", o.trials},   {"seed", o.seed},
-                                  {"methods", o.methods}, {"vehicle", o.vehicle.name},
-                                  {"truth", ToName(o.truth)}};
+  nlohmann::json options = {{"trials", o.trials},
+                            {"seed", o.seed},
+                            {"methods", o.methods},
+                            {"vehicle", o.vehicle.name},
+                            {"truth", ToName(o.truth)}};
+  if (o.fdd) options["fdd"] = io::ToJson(*o.fdd);  // the vehicle's own thresholds: another campaign
   c.bench = {{"name", "ftc"}, {"options", options}};
   c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::VehicleToYaml(o.vehicle));
   // Trial index = (cell, method, trial), the trial fastest. Every method flies the same draws: the

@@ -81,6 +81,9 @@ campaign::Campaign LoadFtc(const io::ConfigNode& root, const std::string& path) 
   FtcBenchOptions o = SeedAndTrials<FtcBenchOptions>(root, 1'000'000);
   if (root.Has("methods")) o.methods = WordList(root.Required("methods"), FtcMethods());
   o.vehicle = files.Load("vehicle", [](const std::string& p) { return harness::LoadVehicle(p); });
+  if (auto fdd = files.Load("vehicle", [](const std::string& p) { return harness::LoadVehicleFdd(p); })) {
+    o.fdd = fdd->first;
+  }
   return Checked(root, [&] { return FtcCampaign(o); });
 }
 

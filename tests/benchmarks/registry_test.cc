@@ -103,6 +103,28 @@ TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSa
   EXPECT_NE(FtcCampaign(heavier).hash, c.hash);
 }
 
+TEST_F(BenchCampaigns, FtcFliesTheVehiclesOwnFddThresholds) {
+  // Thresholds nothing can reach: with them, no isolation.
+  Write("disarmed.yaml",
+        "motor_index_threshold: 0.01\nmotor_index_samples: 1000\npropeller_index_threshold: 1.0\n"
+        "propeller_persistence_s: 10\ntakeoff_index_threshold: 1000\n");
+  Write("quad.yaml", io::ReadFile(kConfigs + "/vehicles/zhou2025_quad.yaml") + "fdd: disarmed.yaml\n");
+  const auto spec = [&](const std::string& vehicle) {
+    return Write(
+        "ftc_" + std::to_string(vehicle.size()) + ".yaml",
+        "name: f\nbench: ftc\ntrials: 1\nseed: 5\nmethods: [rotorguard]\nvehicle: " + vehicle + "\ntruth: ideal\n");
+  };
+  const campaign::Campaign own = campaign::LoadCampaign(spec("quad.yaml"), CampaignKinds());
+  const campaign::Campaign shipped =
+      campaign::LoadCampaign(spec(kConfigs + "/vehicles/zhou2025_quad.yaml"), CampaignKinds());
+  EXPECT_NE(own.hash, shipped.hash);
+  EXPECT_EQ(own.bench["options"]["fdd"]["propeller_index_threshold"], 1.0);
+  EXPECT_FALSE(shipped.bench["options"].contains("fdd"));
+  // Trial 0 is a propeller lost in hover: the defaults isolate it, the vehicle's thresholds do not.
+  EXPECT_EQ(shipped.run(0, shipped.parameters(0)).metrics["correct"], true);
+  EXPECT_EQ(own.run(0, own.parameters(0)).metrics["correct"], false);
+}
+
 TEST_F(BenchCampaigns, FtcResultCountsAnErroredTrialAsAFailure) {
   FtcBenchOptions o = SmallFtc();
   o.methods = {"none"};

@@ -8,10 +8,12 @@
 #include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rotorguard/campaign/campaign.h"
+#include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/sim/truth.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
@@ -30,6 +32,9 @@ struct FtcBenchOptions {
   std::vector<std::string> methods = FtcMethods();
   int jobs = 1;                    ///< worker threads, >= 1
   vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
+  /// The composite FDD thresholds its vehicle file names (harness::LoadVehicleFdd), else the
+  /// defaults; every method that runs the composite FDD flies with them.
+  std::optional<fdd::CompositeFddOptions> fdd;
   /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
   /// vehicle file the stack reads; every method flies the same draw of a trial.
   sim::TruthPreset truth = sim::TruthPreset::kRealistic;
