@@ -127,18 +127,19 @@ void PrintRunSummary(const harness::RunSummary& s, const std::string& out_dir,
   if (s.tilt_recovery_s) fmt::print("tilt recovery     {:.2f} s after the first fault\n", *s.tilt_recovery_s);
   fmt::print("faults            {}\n", faults.empty() ? "none" : faults);
   if (s.fdd && !s.fdd->diagnosis) fmt::print("fault detection   nothing detected\n");
+  const auto diagnosis = [](const harness::FddRecord::Diagnosis& d, const std::optional<double>& latency_s) {
+    return fmt::format("rotor {} {} by {} at {:.3f} s{}", d.rotor, d.kind, d.detector, d.detection_s,
+                       latency_s ? fmt::format(" (correct, {:.3f} s after onset)", *latency_s) : "");
+  };
   if (s.fdd && s.fdd->diagnosis) {
-    const harness::FddRecord::Diagnosis& d = *s.fdd->diagnosis;
-    fmt::print("fault detection   rotor {} {} by {} at {:.3f} s{}\n", d.rotor, d.kind, d.detector, d.detection_s,
-               s.fdd->latency_s ? fmt::format(" (correct, {:.3f} s after onset)", *s.fdd->latency_s)
-                                : (s.fdd->false_alarm ? " (false alarm)" : " (wrong rotor or kind)"));
+    fmt::print("fault detection   {}{}\n", diagnosis(*s.fdd->diagnosis, s.fdd->latency_s),
+               s.fdd->latency_s ? "" : (s.fdd->false_alarm ? " (false alarm)" : " (wrong rotor or kind)"));
   }
-  if (s.fdd && s.fdd->second && !s.fdd->second->isolated) {
-    fmt::print("second failure    rotor {} not isolated\n", s.fdd->second->rotor);
-  } else if (s.fdd && s.fdd->second) {
-    const harness::FddRecord::Second& d = *s.fdd->second;
-    fmt::print("second failure    rotor {} {} by {} at {:.3f} s{}\n", d.rotor, d.kind, d.detector, d.detection_s,
-               d.latency_s ? fmt::format(" (correct, {:.3f} s after onset)", *d.latency_s) : " (wrong kind or early)");
+  if (const std::optional<harness::FddRecord::Second> second = s.fdd ? s.fdd->second : std::nullopt; second) {
+    fmt::print("second failure    {}\n", !second->isolated
+                                             ? fmt::format("rotor {} not isolated", second->diagnosis.rotor)
+                                             : diagnosis(second->diagnosis, second->latency_s) +
+                                                   (second->latency_s ? "" : " (wrong kind or early)"));
   }
   PrintFlatnessDecisions(s.stack.flatness_decisions);
   for (std::size_t i = 0; i < s.stack.transitions.size(); ++i) {

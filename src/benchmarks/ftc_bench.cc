@@ -19,6 +19,7 @@
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/json_archive.h"
 #include "rotorguard/planning/references.h"
+#include "rotorguard/vehicle/effectiveness.h"
 
 namespace rotorguard::benchmarks {
 
@@ -141,16 +142,19 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
   }
   if (cell.second) {
     // The twin: the rotor mirrored through the centre of gravity; adjacent: the nearest other.
-    const Eigen::Vector2d p = o.vehicle.rotors[rotor].p_B.head<2>();
-    const bool twin = std::string(cell.second) == "twin";
     int pick = -1;
-    double best = std::numeric_limits<double>::infinity();
-    for (int j = 0; j < o.vehicle.num_rotors(); ++j) {
-      const double d =
-          twin ? (o.vehicle.rotors[j].p_B.head<2>() + p).norm() : (o.vehicle.rotors[j].p_B.head<2>() - p).norm();
-      if (j != rotor && d < best) {
-        best = d;
-        pick = j;
+    if (std::string(cell.second) == "twin") {
+      const std::vector<int> twins = vehicle::DiagonalTwins(o.vehicle.rotors, rotor);
+      if (twins.empty()) ThrowInvalidArgument("ftc", "vehicle", o.vehicle.name, "a vehicle whose rotors have twins");
+      pick = twins.front();
+    } else {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int j = 0; j < o.vehicle.num_rotors(); ++j) {
+        const double d = (o.vehicle.rotors[j].p_B - o.vehicle.rotors[rotor].p_B).head<2>().norm();
+        if (j != rotor && d < nearest) {
+          nearest = d;
+          pick = j;
+        }
       }
     }
     sim::FaultSpec f;

@@ -31,9 +31,7 @@ std::optional<RotorVector> HoverThrustSplit(const vehicle::VehicleParams& vehicl
   }
   // min 1/2 |T|^2  s.t.  [thrust; roll; pitch] rows of the effectiveness matrix T = [W; 0; 0],
   // 0 <= T_i <= max (0 when failed): a strictly convex QP, infeasible exactly when no split exists.
-  DenseQp qp(n, 3);
-  qp.H = Eigen::MatrixXd::Identity(n, n);
-  qp.g.setZero();
+  DenseQp qp(n, 3);  // H = I, g = 0
   qp.lb.setZero();
   for (int i = 0; i < n; ++i) qp.ub[i] = failed[static_cast<std::size_t>(i)] ? 0.0 : vehicle.rotors[i].max_thrust_n;
   qp.C = vehicle::ComputeEffectivenessMatrix(vehicle.rotors).topRows<3>();

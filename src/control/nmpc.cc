@@ -187,12 +187,7 @@ std::vector<int> NmpcController::ActiveRotorsAfterFailure() const {
   std::vector<bool> idle = failed_;
   for (int f = 0; f < nu_; ++f) {
     if (!failed_[f]) continue;
-    const Eigen::Vector3d& pf = vehicle_.rotors[f].p_B;
-    for (int j = 0; j < nu_; ++j) {
-      if (j != f && !failed_[j] && (vehicle_.rotors[j].p_B.head<2>() + pf.head<2>()).norm() < 0.05 * pf.head<2>().norm()) {
-        idle[j] = true;
-      }
-    }
+    for (int j : vehicle::DiagonalTwins(vehicle_.rotors, f)) idle[j] = true;
   }
   std::vector<int> active;
   for (int i = 0; i < nu_; ++i) {

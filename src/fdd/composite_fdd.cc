@@ -77,14 +77,16 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   rate_filter_ = LowPass2<3>(options_.filter_cutoff_hz, options_.imu_rate_hz);
   alpha_filter_ = FilteredDerivative<3>(options_.filter_cutoff_hz, options_.imu_rate_hz);
   wrench_filter_ = LowPass2<4>(options_.filter_cutoff_hz, options_.imu_rate_hz);
-  // The thresholds' units: a rotor's share of the hover thrust, and the roll/pitch angular
-  // acceleration of losing it (eq. 18's signature), the smallest over the rotors.
+  // Eq. (18)'s signatures: the roll/pitch angular acceleration per newton rotor i loses,
+  // -I^-1 (r_i x e3). The thresholds' units: a rotor's share of the hover thrust, and the angular
+  // acceleration of losing it, the smallest over the rotors.
   hover_thrust_per_rotor_n_ = vehicle_.weight_n() / n_;
   one_rotor_alpha_ = std::numeric_limits<double>::infinity();
   const Matrix3 inverse_inertia = vehicle_.inertia_kg_m2.inverse();
   for (const vehicle::Rotor& r : vehicle_.rotors) {
-    const Vector3 torque = r.p_B.cross(Vector3(0.0, 0.0, hover_thrust_per_rotor_n_));
-    one_rotor_alpha_ = std::min(one_rotor_alpha_, (inverse_inertia * torque).head<2>().norm());
+    const Eigen::Vector2d signature = (inverse_inertia * Vector3(-r.p_B.y(), r.p_B.x(), 0.0)).head<2>();
+    loss_signature_.push_back(signature.normalized());
+    one_rotor_alpha_ = std::min(one_rotor_alpha_, hover_thrust_per_rotor_n_ * signature.norm());
   }
   if (!(one_rotor_alpha_ > 0.0) || !std::isfinite(one_rotor_alpha_)) {
     ThrowValidation("CompositeFdd", "vehicle.rotors", "(a rotor at the centre of gravity)",
@@ -240,9 +242,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
     int best = -1;
     double best_cos = options_.takeoff_direction_cosine;
     for (int i = 0; i < n_; ++i) {
-      const Vector3 torque(-vp.rotors[i].p_B.y(), vp.rotors[i].p_B.x(), 0.0);  // losing T e3 at r_i
-      const Eigen::Vector2d signature = (I.inverse() * torque).head<2>();
-      const double c = signature.normalized().dot(alpha.head<2>().normalized());
+      const double c = loss_signature_[static_cast<std::size_t>(i)].dot(alpha.head<2>().normalized());
       if (c > best_cos) {
         best_cos = c;
         best = i;

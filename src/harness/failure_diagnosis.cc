@@ -42,9 +42,10 @@ void DiagnoseFailure(const std::optional<FlightMetrics::Violation>& last_violati
   RunSummary& s = *summary;
   s.failure_reason.reset();
   s.infeasible_request = false;
+  const std::string terminated = Termination(s.stack);
   if (s.crashed) {
-    s.failure_reason = "crash: " + s.crash_reason.value_or("") + Termination(s.stack);
-  } else if (const std::string terminated = Termination(s.stack); !terminated.empty()) {
+    s.failure_reason = "crash: " + s.crash_reason.value_or("") + terminated;
+  } else if (!terminated.empty()) {
     s.failure_reason = "motors stopped" + terminated;
   } else if (std::optional<std::string> landing = EmergencyLanding(s.stack)) {
     s.failure_reason = std::move(landing);

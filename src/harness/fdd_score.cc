@@ -31,11 +31,9 @@ std::optional<FddRecord::Second> ScoreSecond(const std::vector<fdd::RotorStatus>
   if (other == events.end() || other->rotor < 0 || other->rotor >= static_cast<int>(rotors.size())) return std::nullopt;
   const fdd::RotorStatus& status = rotors[static_cast<std::size_t>(other->rotor)];
   FddRecord::Second second;
-  second.rotor = other->rotor;
+  second.diagnosis = {other->rotor, std::string(fdd::ToString(status.health)), status.detector,
+                      status.detected_s.value_or(0.0), status.eta};
   second.isolated = fdd::IsIsolated(status.health);
-  second.kind = fdd::ToString(status.health);
-  second.detector = status.detector;
-  second.detection_s = status.detected_s.value_or(0.0);
   second.correct = second.isolated && status.detected_s && *status.detected_s >= other->onset_s &&
                    KindMatches(other->kind, status.health);
   if (second.correct) second.latency_s = *status.detected_s - other->onset_s;

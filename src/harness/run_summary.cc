@@ -26,30 +26,36 @@ nlohmann::json ExtremesJson(const fdd::IndexExtremes& e) {
           {"max_takeoff_index", e.max_takeoff_index}};
 }
 
+/// A diagnosis's rotor, kind, detector, detection_s and eta; nulls without one.
+nlohmann::json DiagnosisJson(const std::optional<FddRecord::Diagnosis>& d) {
+  if (!d)
+    return {{"rotor", nullptr}, {"kind", nullptr}, {"detector", nullptr}, {"detection_s", nullptr}, {"eta", nullptr}};
+  return {{"rotor", d->rotor},
+          {"kind", d->kind},
+          {"detector", d->detector},
+          {"detection_s", d->detection_s},
+          {"eta", d->eta}};
+}
+
 nlohmann::json SecondJson(const FddRecord::Second& s) {
-  return {{"rotor", s.rotor},
-          {"isolated", s.isolated},
-          {"kind", s.kind},
-          {"detector", s.detector},
-          {"detection_s", s.isolated ? nlohmann::json(s.detection_s) : nlohmann::json(nullptr)},
-          {"correct", s.correct},
-          {"latency_s", OrNull(s.latency_s)}};
+  nlohmann::json j = DiagnosisJson(s.diagnosis);
+  if (!s.isolated) j["detection_s"] = nullptr;
+  j["isolated"] = s.isolated;
+  j["correct"] = s.correct;
+  j["latency_s"] = OrNull(s.latency_s);
+  return j;
 }
 
 nlohmann::json FddJson(const FddRecord& f) {
-  const std::optional<FddRecord::Diagnosis>& d = f.diagnosis;
-  return {{"detected", f.detected()},
-          {"rotor", d ? nlohmann::json(d->rotor) : nlohmann::json(nullptr)},
-          {"kind", d ? nlohmann::json(d->kind) : nlohmann::json(nullptr)},
-          {"detector", d ? nlohmann::json(d->detector) : nlohmann::json(nullptr)},
-          {"detection_s", d ? nlohmann::json(d->detection_s) : nlohmann::json(nullptr)},
-          {"eta", d ? nlohmann::json(d->eta) : nlohmann::json(nullptr)},
-          {"correct", f.correct},
-          {"false_alarm", f.false_alarm},
-          {"latency_s", OrNull(f.latency_s)},
-          {"reconfiguration_latency_s", OrNull(f.reconfiguration_latency_s)},
-          {"healthy_extremes", f.healthy_extremes ? ExtremesJson(*f.healthy_extremes) : nlohmann::json(nullptr)},
-          {"second", f.second ? SecondJson(*f.second) : nlohmann::json(nullptr)}};
+  nlohmann::json j = DiagnosisJson(f.diagnosis);
+  j["detected"] = f.detected();
+  j["correct"] = f.correct;
+  j["false_alarm"] = f.false_alarm;
+  j["latency_s"] = OrNull(f.latency_s);
+  j["reconfiguration_latency_s"] = OrNull(f.reconfiguration_latency_s);
+  j["healthy_extremes"] = f.healthy_extremes ? ExtremesJson(*f.healthy_extremes) : nlohmann::json(nullptr);
+  j["second"] = f.second ? SecondJson(*f.second) : nlohmann::json(nullptr);
+  return j;
 }
 
 nlohmann::json NavigationJson(const stack::NavigationSummary& n, const std::optional<double>& mission_time_s,

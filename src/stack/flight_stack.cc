@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "rotorguard/control/allocation.h"
 #include "rotorguard/core/error.h"
@@ -147,6 +146,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
   known_fault_applied_.assign(options_.known_faults.size(), false);
   degraded_told_.assign(static_cast<std::size_t>(model_.num_rotors()), false);
   effectiveness_.assign(static_cast<std::size_t>(model_.num_rotors()), 1.0);
+  for (const vehicle::Rotor& r : model_.params().rotors) rotor_max_thrust_n_.push_back(r.max_thrust_n);
   switch (options_.fdd) {
     case FddKind::kComposite:
       fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
@@ -171,8 +171,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
     // vehicle whose two remaining rotors cannot hold its weight gets a token limit (it cannot fly
     // on after a failure anyway).
     const vehicle::VehicleParams& p = model_.params();
-    double rotor_thrust = std::numeric_limits<double>::infinity();
-    for (const auto& r : p.rotors) rotor_thrust = std::min(rotor_thrust, r.max_thrust_n);
+    const double rotor_thrust = *std::min_element(rotor_max_thrust_n_.begin(), rotor_max_thrust_n_.end());
     planning::ReplannerOptions r = options_.navigation.replanner;
     r.post_failure_a_max = std::max(0.05, planning::PostFailureAccelerationLimit(
                                               p.mass_kg, rotor_thrust, p.rotor_drag_kg_s.maxCoeff(), r.nominal.v_max,
@@ -238,11 +237,9 @@ void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset)
   controller_->SetRotorEffectiveness(rotor, eta);
   // The planner keeps to what the weakened vehicle can still accelerate (failure-aware only).
   if (navigator_ && options_.navigation.failure_aware) {
-    std::vector<double> max_thrust;
-    for (const vehicle::Rotor& r : model_.params().rotors) max_thrust.push_back(r.max_thrust_n);
-    navigator_->LimitAcceleration(
-        std::max(0.05, planning::DegradedAccelerationLimit(options_.navigation.replanner.nominal.a_max,
-                                                           model_.params().weight_n(), max_thrust, effectiveness_)));
+    navigator_->LimitAcceleration(std::max(
+        0.05, planning::DegradedAccelerationLimit(options_.navigation.replanner.nominal.a_max,
+                                                  model_.params().weight_n(), rotor_max_thrust_n_, effectiveness_)));
   }
 }
 

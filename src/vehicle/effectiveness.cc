@@ -17,6 +17,15 @@ EffectivenessMatrix ComputeEffectivenessMatrix(const std::vector<Rotor>& rotors)
   return m;
 }
 
+std::vector<int> DiagonalTwins(const std::vector<Rotor>& rotors, int rotor) {
+  const Eigen::Vector2d p = rotors.at(static_cast<std::size_t>(rotor)).p_B.head<2>();
+  std::vector<int> twins;
+  for (int j = 0; j < static_cast<int>(rotors.size()); ++j) {
+    if (j != rotor && (rotors[j].p_B.head<2>() + p).norm() < 0.05 * p.norm()) twins.push_back(j);
+  }
+  return twins;
+}
+
 AllocationMatrix PseudoInverse(const EffectivenessMatrix& m) {
   const Eigen::Matrix4d mmt = m * m.transpose();
   Eigen::LDLT<Eigen::Matrix4d> ldlt(mmt);

@@ -238,6 +238,7 @@ class CompositeFdd final : public FaultDetectorBase {
   Eigen::Vector4d baseline_ = Eigen::Vector4d::Zero();  // the healthy residual wrench
   double takeoff_index_ = 0.0;
   double hover_thrust_per_rotor_n_ = 0.0, one_rotor_alpha_ = 0.0;
+  std::vector<Eigen::Vector2d> loss_signature_;  // per rotor: eq. (18)'s direction of losing it
   IndexExtremes extremes_;
 };
 

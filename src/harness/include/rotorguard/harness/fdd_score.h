@@ -31,10 +31,8 @@ struct FddRecord {
   std::optional<double> reconfiguration_latency_s;
   /// The second failed rotor: the first fault event on another rotor than the first event's.
   struct Second {
-    int rotor = 0;
+    Diagnosis diagnosis;              ///< that rotor's ("ok", no detector, time 0: none)
     bool isolated = false;            ///< the detector took it out of the vehicle (any failure kind)
-    std::string kind, detector;       ///< its diagnosis, as Diagnosis's ("ok": none)
-    double detection_s = 0.0;         ///< when isolated
     bool correct = false;             ///< isolated with the injected kind, at or after the event's onset
     std::optional<double> latency_s;  ///< detection - onset, when correct
   };

@@ -345,9 +345,8 @@ class FlightStack {
   FlightStackOptions options_;
   OdometryImuEstimator estimator_;
   Supervisor supervisor_;
-  std::vector<RotorReconfiguration> reconfigurations_;
-  std::string cannot_hover_;  // why the rotors left cannot hold the vehicle ("" = they can)  // rotors treated as
-                              // failed, in order, and when
+  std::vector<RotorReconfiguration> reconfigurations_;  // rotors treated as failed, in order, and when
+  std::string cannot_hover_;                            // why the rotors left cannot hold the vehicle ("" = they can)
   std::optional<planning::TakeoffReference> landing_;  // the emergency landing's descent ...
   std::optional<TimeShiftedReference> descent_;         // ... from the time it started
   std::size_t plan_events_seen_ = 0;
@@ -367,6 +366,7 @@ class FlightStack {
   std::vector<bool> known_fault_applied_;
   std::vector<bool> degraded_told_;    // per rotor: the controller heard of its partial loss
   std::vector<double> effectiveness_;  // per rotor: the effectiveness last handed over (1: healthy)
+  std::vector<double> rotor_max_thrust_n_;  // per rotor: the file's T_bar
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
   StateEstimate estimate_;
