@@ -4,16 +4,19 @@
 ///
 ///   nominal ──isolation──► failure_recovery ──attitude settled──► degraded_navigation
 ///      │                        │                                        │
-///      ├──────── too many failures, no plan for too long, estimator lost ───┴──► emergency_landing ──touchdown──►
-///      landed └──────── a failure that leaves no hover thrust split (any mode in flight) ──► flight_termination
+///      ├── too many failures, no plan for too long, estimator lost ──────┴──► emergency_landing
+///      │                                                                        │ touchdown
+///      │                                                                        ▼
+///      │                                                                      landed
+///      └── a failure that leaves no hover thrust split (any mode in flight) ──► flight_termination
 ///
 /// A further isolation the vehicle can fly on (on a quadrotor: the idle diagonal twin of the first
 /// failed rotor) changes no mode. One that leaves it unable to hover (control::HoverThrustSplit:
 /// no thrusts within the limits hold the weight with zero roll and pitch torque, e.g. two adjacent
 /// rotors of a quadrotor) terminates the flight: every motor stops, as PX4's flight termination
-/// does. No descent it can command lands measurably slower than falling (docs/fdd.md, "Second
-/// failures"), and stopped propellers and an untumbling body are the less harmful impact.
-/// `terminate_when_uncontrollable: false` flies the emergency landing instead.
+/// does: the vehicle lands with its propellers still and nearly level. The NMPC's emergency
+/// landing (`terminate_when_uncontrollable: false`) lands about 5 % slower on average but tumbles
+/// it past 90° half the time (docs/fdd.md, "Second failures").
 ///
 /// In failure recovery the NMPC has reconfigured and the planner has replanned with the
 /// post-failure limit; the mission takes no new waypoint until the attitude has settled. An
