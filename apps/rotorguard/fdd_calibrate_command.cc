@@ -20,8 +20,12 @@ class FddCalibrateCommand final : public Command {
         "fdd-calibrate",
         "Replay saved runs (folders written by 'rotorguard run --out DIR', fault-free and faulty) through the\n"
         "composite FDD offline while each threshold sweeps (gamma_M, gamma_P, take-off): detection latency,\n"
-        "misses and false alarms per value, the margin to the fault-free extremes, and a suggested value.");
-    calibrate->add_option("runs", dirs_, "Run folders (each with sensors.csv, vehicle.yaml, summary.json)")->required();
+        "misses and false alarms per value, the margin to the fault-free extremes (of the runs and of the\n"
+        "flights of --healthy campaigns), and a suggested value with the latency its margin costs.");
+    calibrate->add_option("runs", dirs_, "Run folders (each with sensors.csv, vehicle.yaml, summary.json)");
+    calibrate->add_option("--healthy", campaigns_,
+                          "Campaign folders ('rotorguard campaign run --out DIR') whose flights' recorded\n"
+                          "fdd.healthy_extremes and fdd.false_alarm join the fault-free extremes. Repeatable");
     calibrate->add_option("--margin", margin_text_,
                           "Required margin to the fault-free extreme of each index (default 1.5, > 1)");
     calibrate->add_option("--out", out_, "Folder for calibration.json and calibration.md");
@@ -35,12 +39,15 @@ class FddCalibrateCommand final : public Command {
   int Execute() override {
     benchmarks::FddCalibrationOptions o;
     o.margin = ParseFinite("--margin", margin_text_, 1.0 + 1e-9, 1e6);
+    if (dirs_.empty() && campaigns_.empty()) throw UsageError("give run folders, --healthy campaign folders, or both");
     std::vector<benchmarks::CalibrationLog> logs;
     for (const std::string& d : dirs_) logs.push_back(benchmarks::LoadCalibrationLog(d));
+    std::vector<benchmarks::CampaignFlights> campaigns;
+    for (const std::string& d : campaigns_) campaigns.push_back(benchmarks::LoadCampaignFlights(d));
     std::string note;
     o.fdd = benchmarks::RecordedFddOptions(logs, &note);
     if (!note.empty()) fmt::print(stderr, "note: {}\n", note);
-    const nlohmann::json r = benchmarks::CalibrateCompositeFdd(logs, o);
+    const nlohmann::json r = benchmarks::CalibrateCompositeFdd(logs, campaigns, o);
     const std::string md = benchmarks::CalibrationMarkdown(r);
     if (!out_.empty()) {
       std::error_code ec;
@@ -56,7 +63,7 @@ class FddCalibrateCommand final : public Command {
   }
 
  private:
-  std::vector<std::string> dirs_;
+  std::vector<std::string> dirs_, campaigns_;
   std::string margin_text_ = "1.5", out_, write_;
   bool json_ = false;
 };

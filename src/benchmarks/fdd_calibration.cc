@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "rotorguard/campaign/merge.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/harness/run_summary.h"
@@ -57,9 +58,22 @@ Scored ReplayAndScore(const CalibrationLog& log, const fdd::CompositeFddOptions&
 struct Sweep {
   const char* name;
   double fdd::CompositeFddOptions::*field;
-  double fdd::IndexExtremes::*extreme;  // the statistic it thresholds, at its fault-free extreme
+  double fdd::IndexExtremes::*statistic;  // what the rule compares with the threshold
+  double fdd::IndexExtremes::*raw;        // the index itself: did fault-free flight move it at all?
   std::vector<double> values;
-  bool alarm_when_low;  // the motor index alarms below its threshold, the others above
+  bool alarm_when_low;  // the motor index alarms at or below its threshold, the others above
+
+  /// Would the rule fire at `value` on a flight with these statistics?
+  bool Alarms(const fdd::IndexExtremes& e, double value) const {
+    return alarm_when_low ? e.*statistic <= value : e.*statistic > value;
+  }
+  bool Exercised(const fdd::IndexExtremes& e) const { return alarm_when_low ? e.*raw < 1.0 : e.*raw > 0.0; }
+  /// How far `value` sits beyond the statistic's extreme; infinite when the rule's statistic never
+  /// left its neutral value (no sample passed the take-off gates, say).
+  double Margin(const fdd::IndexExtremes& e, double value) const {
+    if (alarm_when_low) return e.*statistic / value;
+    return e.*statistic > 0.0 ? value / e.*statistic : std::numeric_limits<double>::infinity();
+  }
 };
 
 /// The detector's options with the IMU the log's run read.
@@ -119,6 +133,48 @@ CalibrationLog LoadCalibrationLog(const std::string& dir) {
   return log;
 }
 
+CampaignFlights LoadCampaignFlights(const std::string& dir) {
+  nlohmann::json manifest;
+  const std::vector<nlohmann::json> records = campaign::ReadCampaignRecords({dir}, &manifest);
+  std::vector<std::string> needed = {"fdd.false_alarm"};
+  for (const auto& [name, member] : fdd::kIndexExtremesFields)
+    needed.push_back("fdd.healthy_extremes." + std::string(name));
+  const std::vector<std::string> recorded = manifest.at("metrics").get<std::vector<std::string>>();
+  for (const std::string& m : needed) {
+    if (std::find(recorded.begin(), recorded.end(), m) == recorded.end()) {
+      throw io::InputFileError(dir, fmt::format("the campaign does not record the metric '{}'; fdd-calibrate needs "
+                                                "{} in its spec's metrics: list",
+                                                m, fmt::join(needed, ", ")));
+    }
+  }
+  CampaignFlights out;
+  out.dir = dir;
+  for (const nlohmann::json& r : records) {
+    const int trial = r.at("trial").get<int>();
+    if (r.at("status") != "ok") {
+      throw io::InputFileError(dir, fmt::format("trial {} did not finish ({}: {}); every flight must count", trial,
+                                                r["status"].get<std::string>(), r.value("message", "")));
+    }
+    const nlohmann::json& metrics = r.at("metrics");
+    FlightExtremes f;
+    for (const auto& [name, member] : fdd::kIndexExtremesFields) {
+      const nlohmann::json& v = metrics.at("fdd.healthy_extremes." + std::string(name));
+      if (!v.is_number()) {
+        throw io::InputFileError(dir, fmt::format("trial {} has no fdd.healthy_extremes.{} (flown without the "
+                                                  "composite FDD? set stack.fdd: composite)",
+                                                  trial, name));
+      }
+      f.extremes.*member = v.get<double>();
+    }
+    const nlohmann::json& alarm = metrics.at("fdd.false_alarm");
+    if (!alarm.is_boolean())
+      throw io::InputFileError(dir, fmt::format("trial {}: fdd.false_alarm is not a boolean", trial));
+    f.false_alarm = alarm.get<bool>();
+    out.flights.push_back(f);
+  }
+  return out;
+}
+
 fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& logs, std::string* note) {
   const CalibrationLog* first = nullptr;
   for (const CalibrationLog& log : logs) {
@@ -176,18 +232,23 @@ void FddCalibrationOptions::Validate() const {
   if (!(margin > 1.0) || !std::isfinite(margin)) ThrowValidation("FddCalibrationOptions", "margin", margin, "> 1");
 }
 
-nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, const FddCalibrationOptions& options) {
+nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
+                                     const std::vector<CampaignFlights>& campaigns,
+                                     const FddCalibrationOptions& options) {
   options.Validate();
-  if (logs.empty()) ThrowInvalidArgument("CalibrateCompositeFdd", "logs", "(none)", "at least one run folder");
-  // The fault-free extremes: replays with the detectors disarmed, so that no isolation stops the
-  // statistics early (a false alarm would otherwise hide how far the indices go).
+  std::size_t campaign_flights = 0;
+  for (const CampaignFlights& c : campaigns) campaign_flights += c.flights.size();
+  if (logs.empty() && campaign_flights == 0) {
+    ThrowInvalidArgument("CalibrateCompositeFdd", "logs", "(none)", "at least one run folder or campaign flight");
+  }
+  // The fault-free extremes of the logs: replays with the thresholds out of reach, so that no
+  // isolation stops the statistics early (a false alarm would otherwise hide how far the indices
+  // go). The debounce, the persistence and the take-off gates stay: they define the statistics.
   fdd::CompositeFddOptions disarmed = options.fdd;
   disarmed.motor_index_threshold = 1e-6;
-  disarmed.motor_index_samples = std::numeric_limits<int>::max();
   disarmed.propeller_index_threshold = 1.0;
-  disarmed.propeller_persistence_s = 10.0;
   disarmed.takeoff_index_threshold = 1e6;
-  fdd::IndexExtremes extremes;  // over all logs
+  fdd::IndexExtremes extremes;  // over all logs and campaign flights
   nlohmann::json log_docs = nlohmann::json::array();
   int faulty_logs = 0;
   for (const CalibrationLog& log : logs) {
@@ -210,31 +271,43 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
                           {"latency_s", recorded.record.latency_s ? nlohmann::json(*recorded.record.latency_s)
                                                                   : nlohmann::json(nullptr)}}}});
   }
+  nlohmann::json campaign_docs = nlohmann::json::array();
+  for (const CampaignFlights& c : campaigns) {
+    int alarms = 0;
+    for (const FlightExtremes& f : c.flights) {
+      extremes.Merge(f.extremes);
+      alarms += f.false_alarm ? 1 : 0;
+    }
+    campaign_docs.push_back({{"dir", c.dir}, {"flights", c.flights.size()}, {"false_alarms", alarms}});
+  }
   const std::vector<Sweep> sweeps = {
       {"motor_index_threshold",
        &fdd::CompositeFddOptions::motor_index_threshold,
+       &fdd::IndexExtremes::debounced_motor_index,
        &fdd::IndexExtremes::min_motor_index,
        {0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95, 0.99},
        true},
       {"propeller_index_threshold",
        &fdd::CompositeFddOptions::propeller_index_threshold,
+       &fdd::IndexExtremes::persistent_propeller_index,
        &fdd::IndexExtremes::max_propeller_index,
        {0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0},
        false},
       {"takeoff_index_threshold",
        &fdd::CompositeFddOptions::takeoff_index_threshold,
+       &fdd::IndexExtremes::gated_takeoff_index,
        &fdd::IndexExtremes::max_takeoff_index,
        {0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.47, 0.6, 0.8, 1.0, 1.2, 1.5},
        false},
   };
+  const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   nlohmann::json sweep_docs = nlohmann::json::array();
   for (const Sweep& sw : sweeps) {
-    const double extreme = extremes.*sw.extreme;
     // An index no fault-free flight moved (the motor index stays 1, the others 0) gives no margin.
-    const bool exercised = sw.alarm_when_low ? extreme < 1.0 : extreme > 0.0;
+    const bool exercised = sw.Exercised(extremes);
     nlohmann::json rows = nlohmann::json::array();
-    std::optional<std::size_t> best;
-    double best_latency = std::numeric_limits<double>::infinity();
+    std::optional<std::size_t> best, fastest_clear;
+    double best_latency = std::numeric_limits<double>::infinity(), clear_latency = best_latency;
     for (double value : sw.values) {
       fdd::CompositeFddOptions o = options.fdd;
       o.*sw.field = value;
@@ -257,9 +330,12 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
           ++missed;
         }
       }
-      // Margin: how far the threshold sits beyond the most alarming fault-free value.
-      double margin = std::numeric_limits<double>::quiet_NaN();
-      if (exercised) margin = sw.alarm_when_low ? extreme / value : value / extreme;
+      // A campaign flight alarms at this value when it alarmed as flown (another rule) or when the
+      // rule's statistic passes the value: the statistic is exactly what the rule compares.
+      for (const CampaignFlights& c : campaigns) {
+        for (const FlightExtremes& f : c.flights) false_alarms += f.false_alarm || sw.Alarms(f.extremes, value) ? 1 : 0;
+      }
+      const double margin = exercised ? sw.Margin(extremes, value) : std::numeric_limits<double>::quiet_NaN();
       double mean = std::numeric_limits<double>::quiet_NaN(), max = mean;
       if (!latencies.empty()) {
         mean = 0.0;
@@ -267,7 +343,6 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
         mean /= static_cast<double>(latencies.size());
         max = *std::max_element(latencies.begin(), latencies.end());
       }
-      const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
       rows.push_back({{"value", value},
                       {"detected", detected},
                       {"missed", missed},
@@ -277,22 +352,39 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
                       {"margin", finite_or_null(margin)}});
       // Suggested: the fastest value with the margin, no false alarm and no miss; ties go to the
       // value with the larger margin (earlier in the list for the motor index, later otherwise).
-      const bool acceptable = std::isfinite(margin) && margin >= options.margin && false_alarms == 0 && missed == 0 && !latencies.empty();
+      const bool clear = false_alarms == 0 && missed == 0 && !latencies.empty();
       const bool tie_with_larger_margin = !sw.alarm_when_low && std::abs(mean - best_latency) <= 1e-9;
-      if (acceptable && (mean < best_latency - 1e-9 || tie_with_larger_margin)) {
+      if (clear && exercised && margin >= options.margin && (mean < best_latency - 1e-9 || tie_with_larger_margin)) {
         best_latency = mean;
         best = rows.size() - 1;
       }
+      if (clear && mean < clear_latency - 1e-9) {
+        clear_latency = mean;
+        fastest_clear = rows.size() - 1;
+      }
     }
-    nlohmann::json doc = {{"threshold", sw.name}, {"configured", options.fdd.*sw.field}, {"rows", rows}};
+    const auto brief = [&](std::optional<std::size_t> row) {
+      if (!row) return nlohmann::json(nullptr);
+      const nlohmann::json& r = rows[*row];
+      return nlohmann::json{{"value", r["value"]}, {"margin", r["margin"]}, {"latency_s_mean", r["latency_s_mean"]}};
+    };
+    const auto margin_text = [](const nlohmann::json& m) {
+      return m.is_null() ? std::string("unbounded") : fmt::format("{:.2f}x", m.get<double>());
+    };
+    nlohmann::json doc = {{"threshold", sw.name},     {"configured", options.fdd.*sw.field},
+                          {"exercised", exercised},   {"rows", rows},
+                          {"suggested", brief(best)}, {"fastest_without_alarm", brief(fastest_clear)}};
     if (best) {
       const nlohmann::json& r = rows[*best];
-      doc["suggested"] = {{"value", r["value"]}, {"margin", r["margin"]}, {"latency_s_mean", r["latency_s_mean"]}};
-      doc["note"] = fmt::format("{} = {:g}: {:.2f}x beyond the fault-free extreme {:.3g}, mean latency {:.3f} s over {} faulty logs",
-                                sw.name, r["value"].get<double>(), r["margin"].get<double>(), extreme,
-                                r["latency_s_mean"].get<double>(), faulty_logs);
+      const nlohmann::json& c = rows[*fastest_clear];  // the suggestion is itself clear
+      doc["note"] = fmt::format(
+          "{} = {:g}: {} beyond the fault-free extreme {:.3g}, mean latency {:.3f} s over {} faulty logs; "
+          "the margin costs {:.3f} s against the fastest value without an alarm ({:g}, {})",
+          sw.name, r["value"].get<double>(), margin_text(r["margin"]), extremes.*sw.statistic,
+          r["latency_s_mean"].get<double>(), faulty_logs,
+          r["latency_s_mean"].get<double>() - c["latency_s_mean"].get<double>(), c["value"].get<double>(),
+          margin_text(c["margin"]));
     } else {
-      doc["suggested"] = nullptr;
       doc["note"] = faulty_logs == 0 ? std::string("no faulty logs: latency cannot be measured (add runs with faults)")
                     : !exercised
                         ? std::string("no fault-free flight exercised this index (a take-off, for the take-off "
@@ -303,14 +395,16 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, co
     }
     sweep_docs.push_back(doc);
   }
+  // The statistics' extremes; null for one no fault-free flight moved from its neutral value.
+  nlohmann::json extremes_doc = nlohmann::json::object();
+  const fdd::IndexExtremes neutral;
+  for (const auto& [name, member] : fdd::kIndexExtremesFields) {
+    extremes_doc[std::string(name)] = extremes.*member != neutral.*member ? nlohmann::json(extremes.*member) : nullptr;
+  }
   return {{"logs", log_docs},
+          {"campaigns", campaign_docs},
           {"margin_required", options.margin},
-          {"fault_free_extremes",
-           {{"min_motor_index", extremes.min_motor_index < 1.0 ? nlohmann::json(extremes.min_motor_index) : nullptr},
-            {"max_propeller_index",
-             extremes.max_propeller_index > 0.0 ? nlohmann::json(extremes.max_propeller_index) : nullptr},
-            {"max_takeoff_index",
-             extremes.max_takeoff_index > 0.0 ? nlohmann::json(extremes.max_takeoff_index) : nullptr}}},
+          {"fault_free_extremes", extremes_doc},
           {"sweeps", sweep_docs}};
 }
 
@@ -319,23 +413,32 @@ std::string CalibrationMarkdown(const nlohmann::json& c) {
   auto it = std::back_inserter(out);
   int faulty = 0;
   for (const auto& l : c["logs"]) faulty += l["faulty"].get<bool>() ? 1 : 0;
-  const auto& x = c["fault_free_extremes"];
-  fmt::format_to(it, "FDD threshold calibration: {} logs ({} faulty, {} fault-free)\n\n", c["logs"].size(), faulty,
+  fmt::format_to(it, "FDD threshold calibration: {} logs ({} faulty, {} fault-free)", c["logs"].size(), faulty,
                  c["logs"].size() - static_cast<std::size_t>(faulty));
+  for (const auto& k : c["campaigns"]) {
+    fmt::format_to(it, ", {} flights of {} ({} false alarms as flown)", k["flights"].get<int>(),
+                   k["dir"].get<std::string>(), k["false_alarms"].get<int>());
+  }
   const auto num = [](const nlohmann::json& v, const char* f) {
     return v.is_null() ? std::string("/") : fmt::format(fmt::runtime(f), v.get<double>());
   };
-  fmt::format_to(it, "Fault-free extremes (/: not exercised): min M_i {}, max P_i {}, max take-off index {}\n",
-                 num(x["min_motor_index"], "{:.3f}"), num(x["max_propeller_index"], "{:.3f}"),
-                 num(x["max_takeoff_index"], "{:.3f}"));
+  const auto& x = c["fault_free_extremes"];
+  fmt::format_to(it,
+                 "\n\nFault-free extremes (/: not moved), each rule's statistic (the index itself):\n"
+                 "debounced M_i {} ({}), persistent P_i {} ({}), gated take-off index {} ({})\n",
+                 num(x["debounced_motor_index"], "{:.3f}"), num(x["min_motor_index"], "{:.3f}"),
+                 num(x["persistent_propeller_index"], "{:.3f}"), num(x["max_propeller_index"], "{:.3f}"),
+                 num(x["gated_takeoff_index"], "{:.3f}"), num(x["max_takeoff_index"], "{:.3f}"));
   for (const auto& sw : c["sweeps"]) {
     fmt::format_to(it, "\n### {} (configured {:g})\n\n", sw["threshold"].get<std::string>(), sw["configured"].get<double>());
     fmt::format_to(it, "| value | detected | missed | false alarms | latency mean (s) | latency max (s) | margin |\n");
     fmt::format_to(it, "|---|---|---|---|---|---|---|\n");
+    const bool exercised = sw["exercised"].get<bool>();
     for (const auto& r : sw["rows"]) {
+      const std::string margin = !exercised ? "/" : r["margin"].is_null() ? "unbounded" : num(r["margin"], "{:.2f}x");
       fmt::format_to(it, "| {:g} | {} | {} | {} | {} | {} | {} |\n", r["value"].get<double>(), r["detected"].get<int>(),
                      r["missed"].get<int>(), r["false_alarms"].get<int>(), num(r["latency_s_mean"], "{:.3f}"),
-                     num(r["latency_s_max"], "{:.3f}"), num(r["margin"], "{:.2f}x"));
+                     num(r["latency_s_max"], "{:.3f}"), margin);
     }
     fmt::format_to(it, "\n{}: {}\n", sw["suggested"].is_null() ? "No suggestion" : "Suggested", sw["note"].get<std::string>());
   }
@@ -358,12 +461,15 @@ std::string CalibratedFddYaml(const nlohmann::json& calibration, fdd::CompositeF
   base.Serialize(&writer);
   int faulty = 0;
   for (const auto& log : calibration.at("logs")) faulty += log["faulty"].get<bool>() ? 1 : 0;
+  int flights = 0;
+  for (const auto& k : calibration.at("campaigns")) flights += k["flights"].get<int>();
   std::string keys = writer.text();
   if (!keys.empty() && keys.back() != '\n') keys += '\n';
   return fmt::format(
-      "# Composite FDD thresholds written by rotorguard fdd-calibrate from {} logs ({} faulty); name this\n"
-      "# file from the vehicle file with `fdd: FILE` (docs/fdd.md). Suggested values applied:\n{}{}",
-      calibration.at("logs").size(), faulty, applied.empty() ? "#   none\n" : applied, keys);
+      "# Composite FDD thresholds written by rotorguard fdd-calibrate from {} logs ({} faulty) and {} campaign\n"
+      "# flights; name this file from the vehicle file with `fdd: FILE` (docs/fdd.md). Suggested values\n"
+      "# applied:\n{}{}",
+      calibration.at("logs").size(), faulty, flights, applied.empty() ? "#   none\n" : applied, keys);
 }
 
 }  // namespace rotorguard::benchmarks

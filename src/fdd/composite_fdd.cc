@@ -68,6 +68,8 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   working_ = RotorVector::Ones(n_);
   low_index_count_.assign(n_, 0);
   low_index_since_s_.assign(n_, 0.0);
+  recent_motor_index_.assign(n_, {});
+  recent_propeller_index_.assign(n_, {});
   above_since_s_.assign(n_, -1.0);
   degraded_since_s_.assign(n_, -1.0);
   degraded_sum_.assign(n_, 0.0);
@@ -98,6 +100,9 @@ void IndexExtremes::Merge(const IndexExtremes& other) {
   min_motor_index = std::min(min_motor_index, other.min_motor_index);
   max_propeller_index = std::max(max_propeller_index, other.max_propeller_index);
   max_takeoff_index = std::max(max_takeoff_index, other.max_takeoff_index);
+  debounced_motor_index = std::min(debounced_motor_index, other.debounced_motor_index);
+  persistent_propeller_index = std::max(persistent_propeller_index, other.persistent_propeller_index);
+  gated_takeoff_index = std::max(gated_takeoff_index, other.gated_takeoff_index);
 }
 
 FaultDetectorBase::FaultDetectorBase(int num_rotors) : rotors_(static_cast<std::size_t>(num_rotors)) {}
@@ -152,13 +157,25 @@ void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
     expected_thrust_[i] += blend * (command_[i] - expected_thrust_[i]);
     if (expected_thrust_[i] < options_.min_thrust_fraction * hover_thrust_per_rotor_n_) {
       low_index_count_[i] = 0;
+      recent_motor_index_[i].clear();
       rotors_[i].motor_index = 1.0;
       continue;
     }
     // eq. (13): M_i = w_measured / w_expected.
     const double index = esc.motor_speed_rad_s[i] / std::sqrt(expected_thrust_[i] / kn);
     rotors_[i].motor_index = index;
-    if (!first_isolated_) extremes_.min_motor_index = std::min(extremes_.min_motor_index, index);
+    if (!first_isolated_) {
+      // The rule below fires when motor_index_samples consecutive indices are all at or below
+      // gamma_M, that is when their largest is.
+      std::deque<double>& recent = recent_motor_index_[i];
+      recent.push_back(index);
+      if (static_cast<int>(recent.size()) > options_.motor_index_samples) recent.pop_front();
+      extremes_.min_motor_index = std::min(extremes_.min_motor_index, index);
+      if (static_cast<int>(recent.size()) == options_.motor_index_samples) {
+        extremes_.debounced_motor_index =
+            std::min(extremes_.debounced_motor_index, *std::max_element(recent.begin(), recent.end()));
+      }
+    }
     low_index_count_[i] = index <= options_.motor_index_threshold ? low_index_count_[i] + 1 : 0;
     if (low_index_count_[i] == 1) low_index_since_s_[i] = t;
     if (low_index_count_[i] >= options_.motor_index_samples) {
@@ -195,6 +212,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
   takeoff_index_ = 0.0;
   if (!airborne_since_s_) {
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
+    for (auto& recent : recent_propeller_index_) recent.clear();
     return;
   }
   // After an isolation the observer keeps watching the rotors still working, for a second complete
@@ -236,9 +254,8 @@ void CompositeFdd::RunObserver(double t, double dt) {
   // pointing like the loss of one rotor's thrust: alpha ~ -I^-1 (r_i x T e3).
   const bool takeoff = isolated == 0 && t - *airborne_since_s_ <= options_.takeoff_window_s &&
                        estimate_.p_W.z() <= options_.takeoff_max_altitude_m;
-  if (takeoff) takeoff_index_ = alpha.head<2>().norm() / one_rotor_alpha_;
-  if (isolated == 0) extremes_.max_takeoff_index = std::max(extremes_.max_takeoff_index, takeoff_index_);
-  if (takeoff && takeoff_index_ > options_.takeoff_index_threshold) {
+  if (takeoff) {
+    takeoff_index_ = alpha.head<2>().norm() / one_rotor_alpha_;
     int best = -1;
     double best_cos = options_.takeoff_direction_cosine;
     for (int i = 0; i < n_; ++i) {
@@ -251,11 +268,13 @@ void CompositeFdd::RunObserver(double t, double dt) {
     // The rotor it points at must miss thrust: by telemetry, or by the force balance. Which of
     // the two sees it tells the kind: a slowing motor's loss shows in its telemetry (and so not in
     // the force balance, which counts measured thrusts); a lost propeller's only in the balance.
-    if (best >= 0) {
-      const double by_telemetry = expected_thrust_[best] - measured_thrust_[best];
-      if (std::max(by_telemetry, lost[0]) >= options_.takeoff_missing_thrust_fraction * expected_thrust_[best]) {
-        Isolate(best, by_telemetry > lost[0] ? RotorHealth::kMotorFailed : RotorHealth::kPropellerFailed, t, "takeoff");
-      }
+    const double by_telemetry = best >= 0 ? expected_thrust_[best] - measured_thrust_[best] : 0.0;
+    const bool gates_hold = best >= 0 && std::max(by_telemetry, lost[0]) >=
+                                             options_.takeoff_missing_thrust_fraction * expected_thrust_[best];
+    if (gates_hold) extremes_.gated_takeoff_index = std::max(extremes_.gated_takeoff_index, takeoff_index_);
+    extremes_.max_takeoff_index = std::max(extremes_.max_takeoff_index, takeoff_index_);
+    if (gates_hold && takeoff_index_ > options_.takeoff_index_threshold) {
+      Isolate(best, by_telemetry > lost[0] ? RotorHealth::kMotorFailed : RotorHealth::kPropellerFailed, t, "takeoff");
     }
   }
 
@@ -266,7 +285,19 @@ void CompositeFdd::RunObserver(double t, double dt) {
   for (int i = 0; i < n_; ++i) {
     const double p = measured_thrust_[i] > min_thrust ? thrust_loss_[i] / measured_thrust_[i] : 0.0;
     rotors_[i].propeller_index = p;
-    if (isolated == 0) extremes_.max_propeller_index = std::max(extremes_.max_propeller_index, p);
+    if (isolated == 0) {
+      extremes_.max_propeller_index = std::max(extremes_.max_propeller_index, p);
+      // The rule below fires once P_i has stayed above gamma_P from a sample at least
+      // propeller_persistence_s old to now, that is when the smallest P_i over that span does.
+      auto& recent = recent_propeller_index_[i];
+      recent.emplace_back(t, p);
+      while (recent.size() >= 2 && t - recent[1].first >= options_.propeller_persistence_s) recent.pop_front();
+      if (t - recent.front().first >= options_.propeller_persistence_s) {
+        double held = p;
+        for (const auto& [_, value] : recent) held = std::min(held, value);
+        extremes_.persistent_propeller_index = std::max(extremes_.persistent_propeller_index, held);
+      }
+    }
     if (working_[i] == 0.0) continue;  // isolated already
     if (learning && isolated > 0) continue;
     // After an isolation the spinning vehicle's torque residual (inertia errors times the spin)

@@ -21,9 +21,9 @@ nlohmann::json OrNull(const std::optional<T>& value) {
 nlohmann::json Vec(const Vector3& v) { return {v.x(), v.y(), v.z()}; }
 
 nlohmann::json ExtremesJson(const fdd::IndexExtremes& e) {
-  return {{"min_motor_index", e.min_motor_index},
-          {"max_propeller_index", e.max_propeller_index},
-          {"max_takeoff_index", e.max_takeoff_index}};
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [name, member] : fdd::kIndexExtremesFields) j[std::string(name)] = e.*member;
+  return j;
 }
 
 /// A diagnosis's rotor, kind, detector, detection_s and eta; nulls without one.

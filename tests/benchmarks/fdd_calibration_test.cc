@@ -1,15 +1,18 @@
 // The sensor log (write, read back, reject corruption) and the offline FDD calibration, checked
 // against the live runs that recorded the logs.
 
+#include "rotorguard/benchmarks/fdd_calibration.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 
-#include <fmt/format.h>
-#include <gtest/gtest.h>
-
-#include "rotorguard/benchmarks/fdd_calibration.h"
+#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign/campaign.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/harness/run_summary.h"
@@ -155,10 +158,11 @@ TEST_F(FddReplay, FindsTheLiveRunsDiagnosisExactly) {
   }
 }
 
-// The sweep on two fault-free flights (a take-off among them) and two faulty ones: the configured thresholds detect both
-// faults without a false alarm; without debounce, every motor-index threshold above the lowest
-// fault-free M_i (margin < 1) must false-alarm, since the index reached it; the suggestion keeps
-// the margin and is no slower than the configured value.
+// The sweep on two fault-free flights (a take-off among them) and two faulty ones: the configured
+// thresholds detect both faults without a false alarm. Each rule's statistic is the boundary of its
+// alarms, so a row false-alarms exactly when its value is not beyond the fault-free extreme
+// (margin below 1). The suggestion keeps the margin, detects both faults, and is no slower than the
+// configured value; what the margin costs is its latency over the fastest row without an alarm.
 TEST_F(FddReplay, CalibrationTableAndSuggestionAreConsistent) {
   std::vector<CalibrationLog> logs;
   const std::vector<std::pair<std::string, std::vector<harness::Override>>> runs = {
@@ -177,26 +181,35 @@ TEST_F(FddReplay, CalibrationTableAndSuggestionAreConsistent) {
     logs.push_back(LoadCalibrationLog(o.out_dir));
   }
   FddCalibrationOptions options;
-  options.fdd.motor_index_samples = 1;
-  const nlohmann::json c = CalibrateCompositeFdd(logs, options);
+  const nlohmann::json c = CalibrateCompositeFdd(logs, {}, options);
   for (const auto& l : c["logs"]) {
     EXPECT_FALSE(l["with_configured_thresholds"]["false_alarm"].get<bool>()) << l["dir"];
     EXPECT_EQ(l["with_configured_thresholds"]["correct"].get<bool>(), l["faulty"].get<bool>()) << l["dir"];
   }
-  const double min_m = c["fault_free_extremes"]["min_motor_index"].get<double>();
-  EXPECT_GT(min_m, 0.8);
-  EXPECT_LT(min_m, 1.0);
-  bool saw_false_alarm = false;
+  const double debounced = c["fault_free_extremes"]["debounced_motor_index"].get<double>();
+  EXPECT_GT(debounced, 0.8);
+  EXPECT_LT(debounced, 1.0);
+  EXPECT_GE(debounced, c["fault_free_extremes"]["min_motor_index"].get<double>());
+  int rows_alarming = 0;
   for (const auto& sw : c["sweeps"]) {
+    ASSERT_TRUE(sw["exercised"].get<bool>()) << sw["threshold"];
     for (const auto& r : sw["rows"]) {
-      if (sw["threshold"] == "motor_index_threshold" && r["value"].get<double>() > min_m) {
-        EXPECT_GT(r["false_alarms"].get<int>(), 0) << r["value"];
-        saw_false_alarm = true;
+      if (!r["margin"].is_number()) {  // unbounded: the rule's statistic never moved
+        EXPECT_EQ(r["false_alarms"].get<int>(), 0) << sw["threshold"] << " " << r["value"];
+        continue;
       }
+      const double margin = r["margin"].get<double>();
+      if (std::abs(margin - 1.0) < 1e-9) continue;
+      EXPECT_EQ(r["false_alarms"].get<int>() > 0, margin < 1.0) << sw["threshold"] << " " << r["value"];
+      rows_alarming += margin < 1.0 ? 1 : 0;
     }
     ASSERT_FALSE(sw["suggested"].is_null()) << sw["threshold"] << ": " << sw["note"];
-    ASSERT_TRUE(sw["suggested"]["margin"].is_number());
-    EXPECT_GE(sw["suggested"]["margin"].get<double>(), options.margin);
+    if (sw["suggested"]["margin"].is_number()) {
+      EXPECT_GE(sw["suggested"]["margin"].get<double>(), options.margin);
+    }
+    ASSERT_FALSE(sw["fastest_without_alarm"].is_null());
+    EXPECT_LE(sw["fastest_without_alarm"]["latency_s_mean"].get<double>(),
+              sw["suggested"]["latency_s_mean"].get<double>());
     // At the suggested value the replays detect both faults, with no false alarm.
     fdd::CompositeFddOptions at = options.fdd;
     const double suggested = sw["suggested"]["value"].get<double>();
@@ -218,12 +231,96 @@ TEST_F(FddReplay, CalibrationTableAndSuggestionAreConsistent) {
       }
     }
   }
-  EXPECT_TRUE(saw_false_alarm) << "the sweep reaches above the fault-free minimum of M_i";
-  EXPECT_NE(CalibrationMarkdown(c).find("Suggested: motor_index_threshold ="), std::string::npos);
+  EXPECT_GT(rows_alarming, 0) << "the sweeps reach past the fault-free extremes";
+  const std::string md = CalibrationMarkdown(c);
+  EXPECT_NE(md.find("Suggested: motor_index_threshold ="), std::string::npos);
+  EXPECT_NE(md.find("the margin costs"), std::string::npos);
 }
 
-TEST(FddCalibration, RejectsNoLogsAndABadMargin) {
-  EXPECT_THROW(CalibrateCompositeFdd({}, FddCalibrationOptions{}), std::invalid_argument);
+// Campaign flights count by hand: a flight false-alarms at a value when it alarmed as flown or when
+// its rule's statistic passes the value; the margin is to the most alarming flight.
+TEST(FddCalibration, CampaignFlightsCountAsTheirStatisticsSay) {
+  const auto flight = [](double persistent_p, double debounced_m, bool alarmed) {
+    FlightExtremes f;
+    f.extremes.max_propeller_index = persistent_p + 0.2;
+    f.extremes.persistent_propeller_index = persistent_p;
+    f.extremes.min_motor_index = debounced_m - 0.1;
+    f.extremes.debounced_motor_index = debounced_m;
+    f.false_alarm = alarmed;
+    return f;
+  };
+  const CampaignFlights flights{"hand", {flight(0.5, 0.9, false), flight(0.7, 0.6, false), flight(0.1, 0.95, true)}};
+  const nlohmann::json c = CalibrateCompositeFdd({}, {flights}, FddCalibrationOptions{});
+  ASSERT_EQ(c["campaigns"].size(), 1u);
+  EXPECT_EQ(c["campaigns"][0]["flights"].get<int>(), 3);
+  EXPECT_EQ(c["campaigns"][0]["false_alarms"].get<int>(), 1);
+  EXPECT_DOUBLE_EQ(c["fault_free_extremes"]["persistent_propeller_index"].get<double>(), 0.7);
+  EXPECT_DOUBLE_EQ(c["fault_free_extremes"]["debounced_motor_index"].get<double>(), 0.6);
+  EXPECT_TRUE(c["fault_free_extremes"]["gated_takeoff_index"].is_null());  // no flight took off
+  const std::map<std::string, std::map<double, std::pair<int, double>>> expected = {
+      // value -> (false alarms, margin)
+      {"propeller_index_threshold", {{0.6, {2, 0.6 / 0.7}}, {0.7, {1, 1.0}}, {0.9, {1, 0.9 / 0.7}}}},
+      {"motor_index_threshold", {{0.5, {1, 0.6 / 0.5}}, {0.6, {2, 1.0}}, {0.9, {3, 0.6 / 0.9}}}},
+  };
+  for (const auto& sw : c["sweeps"]) {
+    const std::string name = sw["threshold"];
+    EXPECT_TRUE(sw["suggested"].is_null()) << name << ": no faulty log, no latency";
+    if (!expected.count(name)) {
+      EXPECT_FALSE(sw["exercised"].get<bool>()) << name;
+      continue;
+    }
+    int checked = 0;
+    for (const auto& r : sw["rows"]) {
+      const auto it = expected.at(name).find(r["value"].get<double>());
+      if (it == expected.at(name).end()) continue;
+      EXPECT_EQ(r["false_alarms"].get<int>(), it->second.first) << name << " " << r["value"];
+      EXPECT_NEAR(r["margin"].get<double>(), it->second.second, 1e-12) << name << " " << r["value"];
+      ++checked;
+    }
+    EXPECT_EQ(checked, 3) << name;
+  }
+  EXPECT_NE(CalibrationMarkdown(c).find("3 flights of hand (1 false alarms as flown)"), std::string::npos);
+}
+
+using CampaignInput = TempFolder;
+
+// A scenario campaign's records load as flights, each with the statistics its summary gave; a
+// campaign that does not record them is refused, naming the missing metric.
+TEST_F(CampaignInput, LoadsAScenarioCampaignsFlightsAndRefusesOneWithoutTheMetrics) {
+  std::string metrics = "fdd.false_alarm";
+  for (const auto& [name, member] : fdd::kIndexExtremesFields) metrics += ", fdd.healthy_extremes." + std::string(name);
+  const auto spec = [&](const std::string& name, const std::string& list) {
+    return Write(name + ".yaml", "name: " + name + "\nscenario: " + Config("takeoff.yaml") +
+                                     "\nseed: 3\nrepeats: 2\ngrid:\n  duration_s: [3.0]\n  stack.controller: [nmpc]\n"
+                                     "  stack.fdd: [composite]\nmetrics: [" +
+                                     list + "]\n");
+  };
+  const auto run = [&](const std::string& file) {
+    campaign::CampaignRunOptions o;
+    o.out_dir = (dir_ / fs::path(file).stem()).string();
+    o.version = "test";
+    campaign::RunCampaign(ScenarioCampaign(LoadCampaignSpec(file)), o);
+    return o.out_dir;
+  };
+  const CampaignFlights f = LoadCampaignFlights(run(spec("healthy", metrics)));
+  ASSERT_EQ(f.flights.size(), 2u);
+  for (const FlightExtremes& x : f.flights) {
+    EXPECT_FALSE(x.false_alarm);
+    EXPECT_GT(x.extremes.max_takeoff_index, 0.0);  // they took off
+    EXPECT_GE(x.extremes.debounced_motor_index, x.extremes.min_motor_index);
+    EXPECT_LE(x.extremes.persistent_propeller_index, x.extremes.max_propeller_index);
+    EXPECT_LE(x.extremes.gated_takeoff_index, x.extremes.max_takeoff_index);
+  }
+  EXPECT_NE(f.flights[0].extremes.max_takeoff_index, f.flights[1].extremes.max_takeoff_index) << "two drawn vehicles";
+  const std::string partial = run(spec("partial", "fdd.false_alarm, fdd.healthy_extremes.min_motor_index"));
+  RG_EXPECT_THROW_WITH(LoadCampaignFlights(partial), io::InputFileError,
+                       "does not record the metric 'fdd.healthy_extremes.max_propeller_index'");
+}
+
+TEST(FddCalibration, RejectsNoInputAndABadMargin) {
+  EXPECT_THROW(CalibrateCompositeFdd({}, {}, FddCalibrationOptions{}), std::invalid_argument);
+  EXPECT_THROW(CalibrateCompositeFdd({}, {CampaignFlights{"empty", {}}}, FddCalibrationOptions{}),
+               std::invalid_argument);
   FddCalibrationOptions o;
   o.margin = 1.0;
   EXPECT_THROW(o.Validate(), ValidationError);

@@ -2,13 +2,16 @@
 // is known exactly: speeds from the drive thrusts, specific force and rates from the thrusts that
 // actually act.
 
-#include <cmath>
+#include "rotorguard/fdd/composite_fdd.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <memory>
+#include <optional>
+
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
-#include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/fdd/fixed_time_fdd.h"
 #include "rotorguard/vehicle/effectiveness.h"
 #include "vehicle_fixture.h"
@@ -202,6 +205,60 @@ TEST(CompositeFdd, HealthyExtremesAreTheIndicesMostAlarmingValuesUntilTheFirstIs
   b.actual_[2] = 0.0;                            // what follows the isolation no longer counts
   b.Run(1.0);
   EXPECT_EQ(b.fdd_.healthy_extremes().max_propeller_index, at_isolation.max_propeller_index);
+}
+
+// Each rule's statistic in healthy_extremes is exactly where its threshold starts to fire: the
+// same flight, flown again with the threshold just past the statistic's extreme, isolates by that
+// rule; just short of it, it isolates nothing. The three flights: telemetry noise 30x the
+// default (the motor index), a 50 % loss of rotor 1 in hover (the propeller index held 15 ms), a
+// 70 % loss of rotor 1 at 0.3 m within the take-off window (the take-off index through its gates).
+TEST(CompositeFdd, EachRulesStatisticIsExactlyItsAlarmBoundary) {
+  struct Case {
+    const char* detector;
+    double CompositeFddOptions::*threshold;
+    double IndexExtremes::*statistic;
+    bool alarm_when_low;
+    double noise, altitude, remaining_thrust;
+  };
+  const Case cases[] = {
+      {"motor_index", &CompositeFddOptions::motor_index_threshold, &IndexExtremes::debounced_motor_index, true, 30.0,
+       1.0, 1.0},
+      {"thrust_loss_observer", &CompositeFddOptions::propeller_index_threshold,
+       &IndexExtremes::persistent_propeller_index, false, 1.0, 1.0, 0.5},
+      {"takeoff", &CompositeFddOptions::takeoff_index_threshold, &IndexExtremes::gated_takeoff_index, false, 1.0, 0.3,
+       0.3},
+  };
+  for (const Case& c : cases) {
+    // Every rule out of reach but the one under test; the flight does not depend on thresholds
+    // until an isolation.
+    const auto fly = [&](std::optional<double> threshold) {
+      CompositeFddOptions o;
+      o.motor_index_threshold = 1e-6;
+      o.propeller_index_threshold = 1.0;
+      o.takeoff_index_threshold = 1e6;
+      if (threshold) o.*c.threshold = *threshold;
+      auto b = std::make_unique<Bench>(c.noise, o);
+      b->Run(0.3, c.altitude);
+      b->actual_[1] *= c.remaining_thrust;
+      b->Run(0.7, c.altitude);
+      return b;
+    };
+    const double extreme = fly(std::nullopt)->fdd_.healthy_extremes().*c.statistic;
+    ASSERT_GT(extreme, 0.0) << c.detector;
+    ASSERT_LT(extreme, c.alarm_when_low ? 1.0 : 1e6) << c.detector;
+    // The motor rule fires at or below gamma_M, the others above their thresholds.
+    const double fires = c.alarm_when_low ? extreme : extreme * (1.0 - 1e-9);
+    const double silent = c.alarm_when_low ? extreme * (1.0 - 1e-9) : extreme * (1.0 + 1e-9);
+    const auto alarmed = fly(fires);
+    ASSERT_TRUE(alarmed->fdd_.first_isolated_rotor()) << c.detector << " at " << fires;
+    EXPECT_EQ(alarmed->fdd_.rotors()[*alarmed->fdd_.first_isolated_rotor()].detector, c.detector);
+    EXPECT_FALSE(fly(silent)->fdd_.first_isolated_rotor()) << c.detector << " at " << silent;
+    // The rule's statistic is never more alarming than the index itself.
+    const IndexExtremes e = fly(std::nullopt)->fdd_.healthy_extremes();
+    EXPECT_GE(e.debounced_motor_index, e.min_motor_index);
+    EXPECT_LE(e.persistent_propeller_index, e.max_propeller_index);
+    EXPECT_LE(e.gated_takeoff_index, e.max_takeoff_index);
+  }
 }
 
 TEST(CompositeFdd, ThresholdsAreInUnitsOfTheVehiclesHoverThrustAndOneRotorsTurn) {

@@ -2,8 +2,10 @@
 /// Threshold calibration of the composite FDD from saved runs (rotorguard fdd-calibrate): the
 /// sensor logs of fault-free and faulty flights are replayed offline through the real detector
 /// while one threshold sweeps, giving per value the detection latency, the misses and the false
-/// alarms (an ROC-style table), and the margin to the most alarming value the indices reached in
-/// fault-free flight. A suggestion picks the fastest value that keeps a stated margin.
+/// alarms (an ROC-style table), and the margin to the most alarming value each rule's statistic
+/// reached in fault-free flight: in the logs, and in campaigns of many healthy flights, whose
+/// records carry each flight's statistics (fdd.healthy_extremes). A suggestion picks the fastest
+/// value that keeps a stated margin, and says what the margin costs in latency.
 ///
 /// A replay is exact up to the first isolation of the recorded flight (the detector sees what the
 /// stack saw). After it the recorded stack had reconfigured, so a threshold that detects later
@@ -40,6 +42,25 @@ struct CalibrationLog {
 /// the line and byte for sensors.csv), an invalid vehicle.yaml included.
 CalibrationLog LoadCalibrationLog(const std::string& dir);
 
+/// One flight of a campaign: its statistics (CompositeFdd::healthy_extremes) and whether it raised a
+/// false alarm with the thresholds it flew.
+struct FlightExtremes {
+  fdd::IndexExtremes extremes;
+  bool false_alarm = false;
+};
+
+/// A finished campaign's flights (`rotorguard campaign run --out DIR`, its shards merged or not).
+struct CampaignFlights {
+  std::string dir;
+  std::vector<FlightExtremes> flights;
+};
+
+/// Reads every trial of the campaign in `dir` (campaign::ReadCampaignRecords). The campaign must
+/// record the metrics fdd.false_alarm and fdd.healthy_extremes.NAME for every statistic
+/// (fdd::kIndexExtremesFields), and every trial must have finished with them; otherwise throws
+/// io::InputFileError naming the file and what is missing.
+CampaignFlights LoadCampaignFlights(const std::string& dir);
+
 /// The settings to replay with: those the first log recorded, else the defaults. When logs
 /// recorded different settings, `note` (if given) says so.
 fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& logs, std::string* note);
@@ -65,24 +86,31 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::Composite
 
 struct FddCalibrationOptions {
   fdd::CompositeFddOptions fdd;  ///< the thresholds not being swept
-  /// Required margin to the fault-free extreme: gamma_P and the take-off threshold at least
-  /// `margin` times the largest fault-free value, gamma_M at most the smallest fault-free M_i
-  /// divided by it. > 1.
+  /// Required margin to the fault-free extreme of each rule's statistic (IndexExtremes): gamma_P
+  /// and the take-off threshold at least `margin` times the largest fault-free value, gamma_M at
+  /// most the smallest divided by it. > 1.
   double margin = 1.5;
   void Validate() const;
 };
 
 /// Runs the three sweeps (motor_index_threshold, propeller_index_threshold,
-/// takeoff_index_threshold) over the logs. The document:
+/// takeoff_index_threshold) over the logs and the campaigns' flights. The document:
 /// {"logs": [{"dir", "faulty", "fault": {...}|null, "with_configured_thresholds": {...}}],
-///  "fault_free_extremes": {"min_motor_index", "max_propeller_index", "max_takeoff_index"} (null:
-///  no fault-free flight moved the index),
+///  "campaigns": [{"dir", "flights", "false_alarms"}],
+///  "fault_free_extremes": {NAME: value|null for each of fdd::kIndexExtremesFields} (null: no
+///  fault-free flight moved the index),
 ///  "sweeps": [{"threshold", "configured", "rows": [{"value", "detected", "missed", "false_alarms",
-///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null, "note"}]}
+///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null,
+///              "fastest_without_alarm": {...}|null, "note"}]}
+/// A row's false alarms are the logs' replayed ones plus the campaign flights that alarmed or whose
+/// statistic passes the value. "fastest_without_alarm" is the fastest row with no miss and no
+/// false alarm at any margin: the suggestion's latency minus its is what the margin costs.
 /// A value that is not valid with the other thresholds (gamma_P at or below the degraded
 /// threshold) is left out.
-/// Throws std::invalid_argument when `logs` is empty.
-nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs, const FddCalibrationOptions& options);
+/// Throws std::invalid_argument when there are neither logs nor campaign flights.
+nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
+                                     const std::vector<CampaignFlights>& campaigns,
+                                     const FddCalibrationOptions& options);
 
 /// The calibration as Markdown tables with the suggestions.
 std::string CalibrationMarkdown(const nlohmann::json& calibration);

@@ -6,9 +6,12 @@
 /// After an isolation the motor index and the observer keep watching the remaining rotors for a
 /// second complete failure; partial losses and the take-off detector assume a single failure, as
 /// the paper does.
+#include <array>
+#include <deque>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "rotorguard/core/config_schema.h"
@@ -136,14 +139,34 @@ struct RotorStatus {
   std::string detector;          ///< "motor_index", "thrust_loss_observer", "takeoff"
 };
 
-/// The most alarming values a composite FDD's indices took: what a threshold must clear to raise
-/// no alarm on that flight.
+/// The most alarming values a composite FDD's indices took. The first three are the indices
+/// themselves; the last three are what each rule compares with its threshold (the index through
+/// the rule's debounce, persistence or gates), so a threshold beyond them raises no alarm on that
+/// flight: the statistics a margin is stated on (fdd-calibrate, docs/fdd.md).
 struct IndexExtremes {
   double min_motor_index = 1.0;      ///< lowest M_i (eq. 13)
   double max_propeller_index = 0.0;  ///< highest P_i (eq. 17)
   double max_takeoff_index = 0.0;    ///< highest take-off index (eq. 18's statistic, normalised)
+  /// Lowest M_i held over motor_index_samples consecutive telemetry samples: gamma_M at or above it
+  /// would have isolated a motor.
+  double debounced_motor_index = 1.0;
+  /// Highest P_i held for propeller_persistence_s: gamma_P below it would have isolated a propeller.
+  double persistent_propeller_index = 0.0;
+  /// Highest take-off index while its direction and missing-thrust conditions held: a take-off
+  /// threshold below it would have fired.
+  double gated_takeoff_index = 0.0;
   void Merge(const IndexExtremes& other);
 };
+
+/// Each statistic's name in run summaries (fdd.healthy_extremes.NAME) and its member.
+inline constexpr std::array<std::pair<std::string_view, double IndexExtremes::*>, 6> kIndexExtremesFields{{
+    {"min_motor_index", &IndexExtremes::min_motor_index},
+    {"max_propeller_index", &IndexExtremes::max_propeller_index},
+    {"max_takeoff_index", &IndexExtremes::max_takeoff_index},
+    {"debounced_motor_index", &IndexExtremes::debounced_motor_index},
+    {"persistent_propeller_index", &IndexExtremes::persistent_propeller_index},
+    {"gated_takeoff_index", &IndexExtremes::gated_takeoff_index},
+}};
 
 /// The interface every fault detector implements, so that a stack or a benchmark swaps them by name.
 class FaultDetector {
@@ -219,6 +242,8 @@ class CompositeFdd final : public FaultDetectorBase {
   RotorVector command_, expected_thrust_;
   std::vector<int> low_index_count_;
   std::vector<double> low_index_since_s_;
+  std::vector<std::deque<double>> recent_motor_index_;                         // the last motor_index_samples M_i
+  std::vector<std::deque<std::pair<double, double>>> recent_propeller_index_;  // (t, P_i) over the persistence
   std::optional<TimeNs> last_esc_ns_;
   RotorVector measured_thrust_;
   RotorVector working_;  // 1 for a rotor not isolated, else 0
