@@ -198,6 +198,9 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::Composite
   stack::OdometryImuEstimator estimator(log.vehicle.thrust_coefficient_n_s2);
   const double onset = FirstOnset(log);
   ReplayOutcome out;
+  // Records are in delivery order, so a sensor's delay can bring a sample stamped before the onset
+  // after one stamped at it: fault-free flight ends at the first record stamped at the onset.
+  bool before_onset = true;
   for (const record::SensorRecord& r : log.records) {
     if (const auto* imu = std::get_if<ImuSample>(&r)) {
       estimator.OnImu(*imu);
@@ -218,7 +221,7 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::Composite
       }
     }
     // Extremes from flight before the fault (the detector itself stops at its first isolation).
-    const bool before_onset = ToSeconds(record::RecordTime(r)) < onset;
+    before_onset = before_onset && ToSeconds(record::RecordTime(r)) < onset;
     if (before_onset) out.extremes = detector.healthy_extremes();
     if (detector.first_isolated_rotor() && !before_onset) break;  // nothing left to learn
   }
@@ -306,8 +309,6 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
     // An index no fault-free flight moved (the motor index stays 1, the others 0) gives no margin.
     const bool exercised = sw.Exercised(extremes);
     nlohmann::json rows = nlohmann::json::array();
-    std::optional<std::size_t> best, fastest_clear;
-    double best_latency = std::numeric_limits<double>::infinity(), clear_latency = best_latency;
     for (double value : sw.values) {
       fdd::CompositeFddOptions o = options.fdd;
       o.*sw.field = value;
@@ -350,17 +351,31 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
                       {"latency_s_mean", finite_or_null(mean)},
                       {"latency_s_max", finite_or_null(max)},
                       {"margin", finite_or_null(margin)}});
-      // Suggested: the fastest value with the margin, no false alarm and no miss; ties go to the
-      // value with the larger margin (earlier in the list for the motor index, later otherwise).
-      const bool clear = false_alarms == 0 && missed == 0 && !latencies.empty();
-      const bool tie_with_larger_margin = !sw.alarm_when_low && std::abs(mean - best_latency) <= 1e-9;
-      if (clear && exercised && margin >= options.margin && (mean < best_latency - 1e-9 || tie_with_larger_margin)) {
-        best_latency = mean;
-        best = rows.size() - 1;
+    }
+    // Suggested: the fastest value with the margin, no false alarm and no more misses than the
+    // fewest of any value (a fault another detector misdiagnoses is missed at every value); ties go
+    // to the value with the larger margin (earlier in the list for the motor index, later otherwise).
+    int fewest_missed = std::numeric_limits<int>::max();
+    for (const auto& r : rows) fewest_missed = std::min(fewest_missed, r["missed"].get<int>());
+    std::optional<std::size_t> best, fastest_clear;
+    double best_latency = std::numeric_limits<double>::infinity(), clear_latency = best_latency;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const nlohmann::json& r = rows[i];
+      if (r["false_alarms"].get<int>() > 0 || r["missed"].get<int>() > fewest_missed || r["latency_s_mean"].is_null()) {
+        continue;
       }
-      if (clear && mean < clear_latency - 1e-9) {
+      const double mean = r["latency_s_mean"].get<double>();
+      if (mean < clear_latency - 1e-9) {
         clear_latency = mean;
-        fastest_clear = rows.size() - 1;
+        fastest_clear = i;
+      }
+      // An unbounded margin (the rule's gates held in every fault-free flight) bounds nothing: no
+      // suggestion rests on it.
+      const bool tie_with_larger_margin = !sw.alarm_when_low && std::abs(mean - best_latency) <= 1e-9;
+      if (r["margin"].is_number() && r["margin"].get<double>() >= options.margin &&
+          (mean < best_latency - 1e-9 || tie_with_larger_margin)) {
+        best_latency = mean;
+        best = i;
       }
     }
     const auto brief = [&](std::optional<std::size_t> row) {
@@ -386,12 +401,17 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
           margin_text(c["margin"]));
     } else {
       doc["note"] = faulty_logs == 0 ? std::string("no faulty logs: latency cannot be measured (add runs with faults)")
-                    : !exercised
-                        ? std::string("no fault-free flight exercised this index (a take-off, for the take-off "
-                                      "detector): no margin can be stated")
-                        : fmt::format("no value keeps a {:g}x margin with no miss and no false alarm; add flights "
-                                      "or relax --margin",
-                                      options.margin);
+                    : !exercised     ? std::string(
+                                           "no fault-free flight exercised this index (a take-off, for the take-off "
+                                               "detector): no margin can be stated")
+                    : extremes.*sw.statistic == fdd::IndexExtremes{}.*sw.statistic
+                        ? std::string(
+                              "the rule's gates held in every fault-free flight (its statistic never moved): "
+                              "no margin bounds this threshold; keep the configured value")
+                        : fmt::format(
+                              "no value keeps a {:g}x margin with no false alarm and the fewest misses; "
+                              "add flights or relax --margin",
+                              options.margin);
     }
     sweep_docs.push_back(doc);
   }

@@ -103,8 +103,11 @@ struct FddCalibrationOptions {
 ///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null,
 ///              "fastest_without_alarm": {...}|null, "note"}]}
 /// A row's false alarms are the logs' replayed ones plus the campaign flights that alarmed or whose
-/// statistic passes the value. "fastest_without_alarm" is the fastest row with no miss and no
-/// false alarm at any margin: the suggestion's latency minus its is what the margin costs.
+/// statistic passes the value. A margin is null when the index was not exercised, or unbounded
+/// (the sweep's "exercised" is true) when the rule's gates held in every fault-free flight; no
+/// suggestion rests on an unbounded margin. The suggestion is the fastest row with no false alarm,
+/// no more misses than the fewest of any row and at least the margin; "fastest_without_alarm" is
+/// the fastest such row at any margin: the suggestion's latency minus its is what the margin costs.
 /// A value that is not valid with the other thresholds (gamma_P at or below the degraded
 /// threshold) is left out.
 /// Throws std::invalid_argument when there are neither logs nor campaign flights.
