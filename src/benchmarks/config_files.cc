@@ -11,6 +11,7 @@
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/key_table.h"
 
 namespace rotorguard::benchmarks {
 
@@ -40,6 +41,18 @@ ValidationReport ValidateConfigFile(const std::string& path) {
     return {"campaign", fmt::format("campaign '{}': {} trials of {} ({} grid key(s), {} random), spec {}", c.name,
                                     c.trials(), c.scenario, c.grid.size(), c.random.size(), c.hash)};
   }
+  // A composite FDD thresholds file (a vehicle file's `fdd`): only the detector's keys.
+  io::KeyTableWriter fdd_keys;
+  fdd::CompositeFddOptions{}.Serialize(&fdd_keys);
+  const auto is_fdd_key = [&](const std::string& k) {
+    return std::any_of(fdd_keys.rows().begin(), fdd_keys.rows().end(), [&](const io::KeyRow& r) { return r.key == k; });
+  };
+  if (!keys.empty() && std::all_of(keys.begin(), keys.end(), is_fdd_key)) {
+    const fdd::CompositeFddOptions o = harness::LoadFddThresholds(path);
+    return {"fdd thresholds",
+            fmt::format("composite FDD thresholds: gamma_M {:g}, gamma_P {:g}, take-off {:g}", o.motor_index_threshold,
+                        o.propeller_index_threshold, o.takeoff_index_threshold)};
+  }
   if (has("mission") || has("vehicle") || has("assembly")) {
     harness::Scenario s = harness::LoadScenario(path);
     harness::PlanMission(&s);  // a mission that cannot be planned is an invalid file
@@ -47,8 +60,8 @@ ValidationReport ValidateConfigFile(const std::string& path) {
                                     ToName(s.mission_kind), s.duration_s, s.faults.size(), s.vehicle_file)};
   }
   root.Fail(
-      "cannot tell the kind of this file; expected a scenario (with 'mission' and 'vehicle') or "
-      "a vehicle (with 'mass_kg' and 'rotors')");
+      "cannot tell the kind of this file; expected a scenario (with 'mission' and 'vehicle'), "
+      "a vehicle (with 'mass_kg' and 'rotors') or composite FDD thresholds (only stack.composite_fdd's keys)");
 }
 
 }  // namespace rotorguard::benchmarks

@@ -331,10 +331,11 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
           ++missed;
         }
       }
-      // A campaign flight alarms at this value when it alarmed as flown (another rule) or when the
-      // rule's statistic passes the value: the statistic is exactly what the rule compares.
+      // A campaign flight alarms at this value when the rule's statistic passes it: the statistic is
+      // exactly what the rule compares. (Each threshold answers for its own rule's alarms; a flight
+      // that alarmed as flown has statistics up to that alarm only, which "campaigns" counts.)
       for (const CampaignFlights& c : campaigns) {
-        for (const FlightExtremes& f : c.flights) false_alarms += f.false_alarm || sw.Alarms(f.extremes, value) ? 1 : 0;
+        for (const FlightExtremes& f : c.flights) false_alarms += sw.Alarms(f.extremes, value) ? 1 : 0;
       }
       const double margin = exercised ? sw.Margin(extremes, value) : std::numeric_limits<double>::quiet_NaN();
       double mean = std::numeric_limits<double>::quiet_NaN(), max = mean;
@@ -436,7 +437,7 @@ std::string CalibrationMarkdown(const nlohmann::json& c) {
   fmt::format_to(it, "FDD threshold calibration: {} logs ({} faulty, {} fault-free)", c["logs"].size(), faulty,
                  c["logs"].size() - static_cast<std::size_t>(faulty));
   for (const auto& k : c["campaigns"]) {
-    fmt::format_to(it, ", {} flights of {} ({} false alarms as flown)", k["flights"].get<int>(),
+    fmt::format_to(it, ", {} flights of {} (false alarms as flown: {})", k["flights"].get<int>(),
                    k["dir"].get<std::string>(), k["false_alarms"].get<int>());
   }
   const auto num = [](const nlohmann::json& v, const char* f) {

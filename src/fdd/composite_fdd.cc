@@ -68,8 +68,11 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   working_ = RotorVector::Ones(n_);
   low_index_count_.assign(n_, 0);
   low_index_since_s_.assign(n_, 0.0);
-  recent_motor_index_.assign(n_, {});
-  recent_propeller_index_.assign(n_, {});
+  recent_motor_index_.assign(n_, SampleRing(static_cast<std::size_t>(options_.motor_index_samples)));
+  // Twice the samples the persistence spans at the nominal IMU rate, for a faster or jittery IMU.
+  const auto persistence_samples =
+      static_cast<std::size_t>(std::ceil(2.0 * options_.propeller_persistence_s * options_.imu_rate_hz) + 4.0);
+  recent_propeller_index_.assign(n_, SampleRing(persistence_samples));
   above_since_s_.assign(n_, -1.0);
   degraded_since_s_.assign(n_, -1.0);
   degraded_sum_.assign(n_, 0.0);
@@ -94,6 +97,31 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
     ThrowValidation("CompositeFdd", "vehicle.rotors", "(a rotor at the centre of gravity)",
                     "every rotor off the centre of gravity: losing it must turn the vehicle");
   }
+}
+
+void CompositeFdd::SampleRing::Push(double t, double v) {
+  if (size_ == t_.size()) PopFront();
+  const std::size_t k = (head_ + size_) % t_.size();
+  t_[k] = t;
+  v_[k] = v;
+  ++size_;
+}
+
+void CompositeFdd::SampleRing::PopFront() {
+  head_ = (head_ + 1) % t_.size();
+  --size_;
+}
+
+double CompositeFdd::SampleRing::Min() const {
+  double m = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < size_; ++k) m = std::min(m, v_[(head_ + k) % v_.size()]);
+  return m;
+}
+
+double CompositeFdd::SampleRing::Max() const {
+  double m = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < size_; ++k) m = std::max(m, v_[(head_ + k) % v_.size()]);
+  return m;
 }
 
 void IndexExtremes::Merge(const IndexExtremes& other) {
@@ -157,7 +185,7 @@ void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
     expected_thrust_[i] += blend * (command_[i] - expected_thrust_[i]);
     if (expected_thrust_[i] < options_.min_thrust_fraction * hover_thrust_per_rotor_n_) {
       low_index_count_[i] = 0;
-      recent_motor_index_[i].clear();
+      recent_motor_index_[i].Clear();
       rotors_[i].motor_index = 1.0;
       continue;
     }
@@ -167,13 +195,11 @@ void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
     if (!first_isolated_) {
       // The rule below fires when motor_index_samples consecutive indices are all at or below
       // gamma_M, that is when their largest is.
-      std::deque<double>& recent = recent_motor_index_[i];
-      recent.push_back(index);
-      if (static_cast<int>(recent.size()) > options_.motor_index_samples) recent.pop_front();
+      SampleRing& recent = recent_motor_index_[i];
+      recent.Push(t, index);  // a ring of motor_index_samples: the oldest drops out
       extremes_.min_motor_index = std::min(extremes_.min_motor_index, index);
       if (static_cast<int>(recent.size()) == options_.motor_index_samples) {
-        extremes_.debounced_motor_index =
-            std::min(extremes_.debounced_motor_index, *std::max_element(recent.begin(), recent.end()));
+        extremes_.debounced_motor_index = std::min(extremes_.debounced_motor_index, recent.Max());
       }
     }
     low_index_count_[i] = index <= options_.motor_index_threshold ? low_index_count_[i] + 1 : 0;
@@ -212,7 +238,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
   takeoff_index_ = 0.0;
   if (!airborne_since_s_) {
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
-    for (auto& recent : recent_propeller_index_) recent.clear();
+    for (SampleRing& recent : recent_propeller_index_) recent.Clear();
     return;
   }
   // After an isolation the observer keeps watching the rotors still working, for a second complete
@@ -289,13 +315,11 @@ void CompositeFdd::RunObserver(double t, double dt) {
       extremes_.max_propeller_index = std::max(extremes_.max_propeller_index, p);
       // The rule below fires once P_i has stayed above gamma_P from a sample at least
       // propeller_persistence_s old to now, that is when the smallest P_i over that span does.
-      auto& recent = recent_propeller_index_[i];
-      recent.emplace_back(t, p);
-      while (recent.size() >= 2 && t - recent[1].first >= options_.propeller_persistence_s) recent.pop_front();
-      if (t - recent.front().first >= options_.propeller_persistence_s) {
-        double held = p;
-        for (const auto& [_, value] : recent) held = std::min(held, value);
-        extremes_.persistent_propeller_index = std::max(extremes_.persistent_propeller_index, held);
+      SampleRing& recent = recent_propeller_index_[i];
+      recent.Push(t, p);
+      while (recent.size() >= 2 && t - recent.time(1) >= options_.propeller_persistence_s) recent.PopFront();
+      if (t - recent.time(0) >= options_.propeller_persistence_s) {
+        extremes_.persistent_propeller_index = std::max(extremes_.persistent_propeller_index, recent.Min());
       }
     }
     if (working_[i] == 0.0) continue;  // isolated already

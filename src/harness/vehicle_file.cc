@@ -74,16 +74,18 @@ std::optional<std::pair<fdd::CompositeFddOptions, std::string>> LoadVehicleFdd(c
   const std::optional<ConfigNode> key = doc.root().Optional("fdd");
   if (!key) return std::nullopt;
   const std::string file = ResolveRelative(vehicle_path, key->AsString());
-  ConfigDocument thresholds = [&] {
-    try {
-      return ConfigDocument::LoadFile(file);
-    } catch (const io::InputFileError& e) {
-      throw io::InputFileError(e.path(), fmt::format("{} (named by 'fdd' at {})", e.reason(), key->Location()));
-    }
-  }();
+  try {
+    return std::pair{LoadFddThresholds(file), file};
+  } catch (const io::InputFileError& e) {
+    throw io::InputFileError(e.path(), fmt::format("{} (named by 'fdd' at {})", e.reason(), key->Location()));
+  }
+}
+
+fdd::CompositeFddOptions LoadFddThresholds(const std::string& path) {
+  const ConfigDocument thresholds = ConfigDocument::LoadFile(path);
   fdd::CompositeFddOptions o;
   io::ReadConfig(thresholds.root(), &o);
-  return std::pair{o, file};
+  return o;
 }
 
 modular::Assembly LoadAssembly(const std::string& path) {

@@ -19,6 +19,7 @@
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
+#include "rotorguard/io/json_archive.h"
 #include "test_util.h"
 
 namespace rotorguard::benchmarks {
@@ -36,6 +37,7 @@ FtcBenchOptions SmallFtc() {
   o.seed = 5;
   o.methods = {"rotorguard", "none"};
   o.vehicle = harness::LoadVehicle(kConfigs + "/vehicles/zhou2025_quad.yaml");
+  o.fdd = harness::LoadVehicleFdd(kConfigs + "/vehicles/zhou2025_quad.yaml")->first;  // as `bench ftc` does
   o.truth = sim::TruthPreset::kIdeal;  // the figures below are the exact model's
   return o;
 }
@@ -108,7 +110,7 @@ TEST_F(BenchCampaigns, FtcFliesTheVehiclesOwnFddThresholds) {
   Write("disarmed.yaml",
         "motor_index_threshold: 0.01\nmotor_index_samples: 1000\npropeller_index_threshold: 1.0\n"
         "propeller_persistence_s: 10\ntakeoff_index_threshold: 1000\n");
-  Write("quad.yaml", io::ReadFile(kConfigs + "/vehicles/zhou2025_quad.yaml") + "fdd: disarmed.yaml\n");
+  Write("quad.yaml", rotorguard::testing::ReferenceVehicleWithoutFdd() + "fdd: disarmed.yaml\n");
   const auto spec = [&](const std::string& vehicle) {
     return Write(
         "ftc_" + std::to_string(vehicle.size()) + ".yaml",
@@ -119,8 +121,9 @@ TEST_F(BenchCampaigns, FtcFliesTheVehiclesOwnFddThresholds) {
       campaign::LoadCampaign(spec(kConfigs + "/vehicles/zhou2025_quad.yaml"), CampaignKinds());
   EXPECT_NE(own.hash, shipped.hash);
   EXPECT_EQ(own.bench["options"]["fdd"]["propeller_index_threshold"], 1.0);
-  EXPECT_FALSE(shipped.bench["options"].contains("fdd"));
-  // Trial 0 is a propeller lost in hover: the defaults isolate it, the vehicle's thresholds do not.
+  EXPECT_EQ(shipped.bench["options"]["fdd"],
+            io::ToJson(harness::LoadVehicleFdd(kConfigs + "/vehicles/zhou2025_quad.yaml")->first));
+  // Trial 0 is a propeller lost in hover: the shipped thresholds isolate it, the disarmed ones do not.
   EXPECT_EQ(shipped.run(0, shipped.parameters(0)).metrics["correct"], true);
   EXPECT_EQ(own.run(0, own.parameters(0)).metrics["correct"], false);
 }

@@ -286,7 +286,8 @@ TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
   // --write: the thresholds with the suggestions applied, a file a vehicle file names with `fdd:`.
   const Result w = Cli("fdd-calibrate " + Out() + "/free " + Out() + "/faulty --write " + Out() + "/thresholds.yaml");
   ASSERT_EQ(w.exit_code, 0) << w.out;
-  const std::string vehicle = Write("calibrated.yaml", ReadText(kVehicle) + "fdd: " + Out() + "/thresholds.yaml\n");
+  const std::string vehicle = Write(
+      "calibrated.yaml", rotorguard::testing::ReferenceVehicleWithoutFdd() + "fdd: " + Out() + "/thresholds.yaml\n");
   const std::string flown =
       Write("calibrated_run.yaml", Scenario(vehicle, "stack: {controller: nmpc, fdd: composite}\n"));
   ASSERT_EQ(Cli("run " + flown + " --quiet --no-report --out " + Out() + "/calibrated").exit_code, 0);

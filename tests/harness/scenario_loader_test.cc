@@ -47,7 +47,10 @@ TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
   EXPECT_EQ(s.seed, 1u);
   EXPECT_EQ(s.mission_kind, MissionKind::kHover);
   // Every stack key at its default: compared through the keys' own JSON, so a new key counts too.
+  // The composite FDD's thresholds are the vehicle's own (its file names them).
   stack::FlightStackOptions defaults;
+  defaults.composite_fdd = LoadVehicleFdd(kVehicle)->first;
+  EXPECT_NE(defaults.composite_fdd.motor_index_threshold, fdd::CompositeFddOptions{}.motor_index_threshold);
   EXPECT_EQ(io::ToJson(s.stack), io::ToJson(defaults));
   EXPECT_EQ(io::ToJson(s.sim.imu), io::ToJson(sim::ImuOptions{}));
   EXPECT_FALSE(s.sim.lidar.enabled);
@@ -228,7 +231,8 @@ TEST_F(ScenarioLoader, VehicleOverridesApplyToTheVehicleFile) {
 
 TEST_F(ScenarioLoader, AVehiclesFddThresholdsFileIsTheDefaultAScenarioOverrides) {
   Write("thresholds.yaml", "propeller_index_threshold: 0.7\ntakeoff_index_threshold: 0.6\n");
-  const std::string vehicle = Write("quad.yaml", io::ReadInputFile(kVehicle) + "fdd: thresholds.yaml\n");
+  const std::string vehicle =
+      Write("quad.yaml", rotorguard::testing::ReferenceVehicleWithoutFdd() + "fdd: thresholds.yaml\n");
   const auto scenario = [&](const std::string& stack) {
     return Write("fdd.yaml", "vehicle: quad.yaml\nduration_s: 10\nmission: {type: hover}\n" + stack);
   };
@@ -245,7 +249,7 @@ TEST_F(ScenarioLoader, AVehiclesFddThresholdsFileIsTheDefaultAScenarioOverrides)
   RG_EXPECT_THROW_WITH(LoadScenario(scenario("")), io::ConfigError, "thresholds.yaml:2:");
   Write("thresholds.yaml", "propeller_index_threshold: 0.1\n");  // below the partial-loss threshold
   RG_EXPECT_THROW_WITH(LoadScenario(scenario("")), io::ConfigError, "propeller_index_threshold");
-  Write("quad.yaml", io::ReadInputFile(kVehicle) + "fdd: no_such.yaml\n");
+  Write("quad.yaml", rotorguard::testing::ReferenceVehicleWithoutFdd() + "fdd: no_such.yaml\n");
   RG_EXPECT_THROW_WITH(LoadScenario(scenario("")), io::InputFileError, "named by 'fdd' at");
 }
 

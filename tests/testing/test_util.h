@@ -21,6 +21,17 @@ inline std::string SourcePath(const std::string& relative) {
   return (std::filesystem::path(ROTORGUARD_SOURCE_DIR) / relative).string();
 }
 
+/// The reference vehicle file's text without its `fdd:` key, for a copy that names other
+/// thresholds (or none: the code's defaults, the paper's values).
+inline std::string ReferenceVehicleWithoutFdd() {
+  std::ifstream in(SourcePath("configs/vehicles/zhou2025_quad.yaml"));
+  std::string line, text;
+  while (std::getline(in, line)) {
+    if (line.rfind("fdd:", 0) != 0) text += line + "\n";
+  }
+  return text;
+}
+
 /// Passes when |a - b| <= tol elementwise; prints both matrices otherwise.
 template <typename A, typename B>
 ::testing::AssertionResult MatricesNear(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b,

@@ -6,10 +6,11 @@ namespace rotorguard::benchmarks {
 
 /// What `rotorguard validate` found in a file.
 struct ValidationReport {
-  std::string kind;     ///< "vehicle", "assembly", "campaign" or "scenario"
+  std::string kind;     ///< "vehicle", "assembly", "campaign", "scenario" or "fdd thresholds"
   std::string summary;  ///< one line describing the content
 };
-/// Validates a vehicle, assembly, campaign or scenario file, recognising its kind from its keys.
+/// Validates a vehicle, assembly, campaign, scenario or FDD thresholds file, recognising its kind
+/// from its keys.
 /// Throws io::ConfigError (bad content, with file, line and key path) or io::InputFileError.
 ValidationReport ValidateConfigFile(const std::string& path);
 

@@ -102,8 +102,9 @@ struct FddCalibrationOptions {
 ///  "sweeps": [{"threshold", "configured", "rows": [{"value", "detected", "missed", "false_alarms",
 ///              "latency_s_mean", "latency_s_max", "margin"}], "suggested": {...}|null,
 ///              "fastest_without_alarm": {...}|null, "note"}]}
-/// A row's false alarms are the logs' replayed ones plus the campaign flights that alarmed or whose
-/// statistic passes the value. A margin is null when the index was not exercised, or unbounded
+/// A row's false alarms are the logs' replayed ones (any rule) plus the campaign flights whose
+/// statistic for this rule passes the value ("campaigns" counts the flights that alarmed as flown:
+/// their statistics end at that alarm). A margin is null when the index was not exercised, or unbounded
 /// (the sweep's "exercised" is true) when the rule's gates held in every fault-free flight; no
 /// suggestion rests on an unbounded margin. The suggestion is the fastest row with no false alarm,
 /// no more misses than the fewest of any row and at least the margin; "fastest_without_alarm" is

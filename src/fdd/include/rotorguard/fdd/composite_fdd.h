@@ -7,7 +7,6 @@
 /// second complete failure; partial losses and the take-off detector assume a single failure, as
 /// the paper does.
 #include <array>
-#include <deque>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -231,6 +230,24 @@ class CompositeFdd final : public FaultDetectorBase {
   const IndexExtremes& healthy_extremes() const { return extremes_; }
 
  private:
+  /// The latest (time, value) samples of an index in a ring fixed at construction (nothing is
+  /// allocated in flight); when full, a new sample drops the oldest.
+  class SampleRing {
+   public:
+    explicit SampleRing(std::size_t capacity = 1) : t_(capacity), v_(capacity) {}
+    void Clear() { size_ = 0; }
+    void Push(double t, double v);
+    void PopFront();
+    std::size_t size() const { return size_; }
+    double time(std::size_t k) const { return t_[(head_ + k) % t_.size()]; }
+    double Min() const;
+    double Max() const;
+
+   private:
+    std::vector<double> t_, v_;
+    std::size_t head_ = 0, size_ = 0;  // the oldest sample, and how many
+  };
+
   void RunObserver(double t, double dt);
 
   vehicle::VehicleParams vehicle_;
@@ -242,8 +259,9 @@ class CompositeFdd final : public FaultDetectorBase {
   RotorVector command_, expected_thrust_;
   std::vector<int> low_index_count_;
   std::vector<double> low_index_since_s_;
-  std::vector<std::deque<double>> recent_motor_index_;                         // the last motor_index_samples M_i
-  std::vector<std::deque<std::pair<double, double>>> recent_propeller_index_;  // (t, P_i) over the persistence
+  // For the rules' statistics (IndexExtremes): each rotor's last motor_index_samples M_i, and its
+  // P_i over the last propeller_persistence_s.
+  std::vector<SampleRing> recent_motor_index_, recent_propeller_index_;
   std::optional<TimeNs> last_esc_ns_;
   RotorVector measured_thrust_;
   RotorVector working_;  // 1 for a rotor not isolated, else 0

@@ -116,6 +116,8 @@ vehicle::VehicleParams LoadVehicle(const std::string& path, const std::vector<Ov
 /// writes one), and that file's path; none when the vehicle file names none. Same error contract,
 /// a missing file named with the vehicle file's line.
 std::optional<std::pair<fdd::CompositeFddOptions, std::string>> LoadVehicleFdd(const std::string& vehicle_path);
+/// Loads and validates such a thresholds file (same error contract).
+fdd::CompositeFddOptions LoadFddThresholds(const std::string& path);
 /// The vehicle in the format LoadVehicle reads, every number in its shortest exact form (the
 /// thrust coefficient, converted to per rpm^2, reads back within one part in 1e15).
 std::string VehicleToYaml(const vehicle::VehicleParams& vehicle);
