@@ -305,6 +305,10 @@ TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
   const Result missing = Cli("fdd-calibrate " + Out() + "/no_such_run");
   EXPECT_EQ(missing.exit_code, 3);
   EXPECT_NE(missing.out.find("no such folder"), std::string::npos) << missing.out;
+  // --healthy takes campaign folders: a run folder has no campaign manifest.
+  const Result not_campaign = Cli("fdd-calibrate --healthy " + Out() + "/free");
+  EXPECT_EQ(not_campaign.exit_code, 3) << not_campaign.out;
+  EXPECT_NE(not_campaign.out.find("manifest"), std::string::npos) << not_campaign.out;
   // A sensor log cut in the middle of a line: exit 3, naming the file, line and byte.
   const fs::path sensors = fs::path(Out()) / "free" / "sensors.csv";
   const std::string text = ReadText(sensors);
