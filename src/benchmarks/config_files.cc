@@ -10,8 +10,8 @@
 #include "rotorguard/campaign/registry.h"
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/config_archive.h"
 #include "rotorguard/io/config_node.h"
-#include "rotorguard/io/key_table.h"
 
 namespace rotorguard::benchmarks {
 
@@ -42,10 +42,10 @@ ValidationReport ValidateConfigFile(const std::string& path) {
                                     c.trials(), c.scenario, c.grid.size(), c.random.size(), c.hash)};
   }
   // A composite FDD thresholds file (a vehicle file's `fdd`): only the detector's keys.
-  io::KeyTableWriter fdd_keys;
+  io::KeyNameCollector fdd_keys;
   fdd::CompositeFddOptions{}.Serialize(&fdd_keys);
   const auto is_fdd_key = [&](const std::string& k) {
-    return std::any_of(fdd_keys.rows().begin(), fdd_keys.rows().end(), [&](const io::KeyRow& r) { return r.key == k; });
+    return std::find(fdd_keys.names().begin(), fdd_keys.names().end(), k) != fdd_keys.names().end();
   };
   if (!keys.empty() && std::all_of(keys.begin(), keys.end(), is_fdd_key)) {
     const fdd::CompositeFddOptions o = harness::LoadFddThresholds(path);

@@ -55,6 +55,12 @@ Scored ReplayAndScore(const CalibrationLog& log, const fdd::CompositeFddOptions&
   return s;
 }
 
+/// Did fault-free flight move this statistic from where every flight starts it (IndexExtremes'
+/// defaults: the motor index at 1, the others at 0)?
+bool Moved(const fdd::IndexExtremes& e, double fdd::IndexExtremes::*member) {
+  return e.*member != fdd::IndexExtremes{}.*member;
+}
+
 struct Sweep {
   const char* name;
   double fdd::CompositeFddOptions::*field;
@@ -67,12 +73,12 @@ struct Sweep {
   bool Alarms(const fdd::IndexExtremes& e, double value) const {
     return alarm_when_low ? e.*statistic <= value : e.*statistic > value;
   }
-  bool Exercised(const fdd::IndexExtremes& e) const { return alarm_when_low ? e.*raw < 1.0 : e.*raw > 0.0; }
+  bool Exercised(const fdd::IndexExtremes& e) const { return Moved(e, raw); }
   /// How far `value` sits beyond the statistic's extreme; infinite when the rule's statistic never
-  /// left its neutral value (no sample passed the take-off gates, say).
+  /// moved (no sample passed the take-off gates, say).
   double Margin(const fdd::IndexExtremes& e, double value) const {
-    if (alarm_when_low) return e.*statistic / value;
-    return e.*statistic > 0.0 ? value / e.*statistic : std::numeric_limits<double>::infinity();
+    if (!Moved(e, statistic)) return std::numeric_limits<double>::infinity();
+    return alarm_when_low ? e.*statistic / value : value / e.*statistic;
   }
 };
 
@@ -245,12 +251,8 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
     ThrowInvalidArgument("CalibrateCompositeFdd", "logs", "(none)", "at least one run folder or campaign flight");
   }
   // The fault-free extremes of the logs: replays with the thresholds out of reach, so that no
-  // isolation stops the statistics early (a false alarm would otherwise hide how far the indices
-  // go). The debounce, the persistence and the take-off gates stay: they define the statistics.
-  fdd::CompositeFddOptions disarmed = options.fdd;
-  disarmed.motor_index_threshold = 1e-6;
-  disarmed.propeller_index_threshold = 1.0;
-  disarmed.takeoff_index_threshold = 1e6;
+  // isolation stops the statistics early (a false alarm would otherwise hide how far the indices go).
+  const fdd::CompositeFddOptions disarmed = options.fdd.Disarmed();
   fdd::IndexExtremes extremes;  // over all logs and campaign flights
   nlohmann::json log_docs = nlohmann::json::array();
   int faulty_logs = 0;
@@ -405,7 +407,7 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
                     : !exercised     ? std::string(
                                            "no fault-free flight exercised this index (a take-off, for the take-off "
                                                "detector): no margin can be stated")
-                    : extremes.*sw.statistic == fdd::IndexExtremes{}.*sw.statistic
+                    : !Moved(extremes, sw.statistic)
                         ? std::string(
                               "the rule's gates held in every fault-free flight (its statistic never moved): "
                               "no margin bounds this threshold; keep the configured value")
@@ -418,9 +420,8 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
   }
   // The statistics' extremes; null for one no fault-free flight moved from its neutral value.
   nlohmann::json extremes_doc = nlohmann::json::object();
-  const fdd::IndexExtremes neutral;
   for (const auto& [name, member] : fdd::kIndexExtremesFields) {
-    extremes_doc[std::string(name)] = extremes.*member != neutral.*member ? nlohmann::json(extremes.*member) : nullptr;
+    extremes_doc[std::string(name)] = Moved(extremes, member) ? nlohmann::json(extremes.*member) : nullptr;
   }
   return {{"logs", log_docs},
           {"campaigns", campaign_docs},

@@ -56,6 +56,14 @@ void CompositeFddOptions::Validate() const {
   if (!imu_position_m.allFinite()) ThrowValidation("CompositeFddOptions", "imu_position_m", "(non-finite)", "finite");
 }
 
+CompositeFddOptions CompositeFddOptions::Disarmed() const {
+  CompositeFddOptions o = *this;
+  o.motor_index_threshold = 1e-6;
+  o.propeller_index_threshold = 1.0;
+  o.takeoff_index_threshold = 1e6;
+  return o;
+}
+
 CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const CompositeFddOptions& options)
     : FaultDetectorBase(vehicle.num_rotors()), vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
   vehicle_.Validate();

@@ -182,10 +182,8 @@ TEST_F(FddReplay, FaultFreeExtremesEndAtTheFirstRecordOfTheOnset) {
   const record::SensorRecord moved = records[late];
   records.erase(records.begin() + static_cast<std::ptrdiff_t>(late));
   records.insert(records.begin() + static_cast<std::ptrdiff_t>(after), moved);
-  fdd::CompositeFddOptions disarmed;  // nothing fires: the replay runs through the whole log
-  disarmed.motor_index_threshold = 1e-6;
-  disarmed.propeller_index_threshold = 1.0;
-  disarmed.takeoff_index_threshold = 1e6;
+  // Nothing fires: the replay runs through the whole log.
+  const fdd::CompositeFddOptions disarmed = fdd::CompositeFddOptions{}.Disarmed();
   const fdd::IndexExtremes whole = ReplayCompositeFdd(log, disarmed).extremes;
   CalibrationLog cut = log;
   const auto first_at_onset =

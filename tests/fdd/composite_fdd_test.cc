@@ -232,10 +232,7 @@ TEST(CompositeFdd, EachRulesStatisticIsExactlyItsAlarmBoundary) {
     // Every rule out of reach but the one under test; the flight does not depend on thresholds
     // until an isolation.
     const auto fly = [&](std::optional<double> threshold) {
-      CompositeFddOptions o;
-      o.motor_index_threshold = 1e-6;
-      o.propeller_index_threshold = 1.0;
-      o.takeoff_index_threshold = 1e6;
+      CompositeFddOptions o = CompositeFddOptions{}.Disarmed();
       if (threshold) o.*c.threshold = *threshold;
       auto b = std::make_unique<Bench>(c.noise, o);
       b->Run(0.3, c.altitude);
@@ -243,7 +240,8 @@ TEST(CompositeFdd, EachRulesStatisticIsExactlyItsAlarmBoundary) {
       b->Run(0.7, c.altitude);
       return b;
     };
-    const double extreme = fly(std::nullopt)->fdd_.healthy_extremes().*c.statistic;
+    const IndexExtremes e = fly(std::nullopt)->fdd_.healthy_extremes();
+    const double extreme = e.*c.statistic;
     ASSERT_GT(extreme, 0.0) << c.detector;
     ASSERT_LT(extreme, c.alarm_when_low ? 1.0 : 1e6) << c.detector;
     // The motor rule fires at or below gamma_M, the others above their thresholds.
@@ -254,7 +252,6 @@ TEST(CompositeFdd, EachRulesStatisticIsExactlyItsAlarmBoundary) {
     EXPECT_EQ(alarmed->fdd_.rotors()[*alarmed->fdd_.first_isolated_rotor()].detector, c.detector);
     EXPECT_FALSE(fly(silent)->fdd_.first_isolated_rotor()) << c.detector << " at " << silent;
     // The rule's statistic is never more alarming than the index itself.
-    const IndexExtremes e = fly(std::nullopt)->fdd_.healthy_extremes();
     EXPECT_GE(e.debounced_motor_index, e.min_motor_index);
     EXPECT_LE(e.persistent_propeller_index, e.max_propeller_index);
     EXPECT_LE(e.gated_takeoff_index, e.max_takeoff_index);

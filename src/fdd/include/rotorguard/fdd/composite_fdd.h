@@ -76,6 +76,10 @@ struct CompositeFddOptions {
   /// accelerations are removed before the observer uses the accelerometer.
   Vector3 imu_position_m = Vector3::Zero();
   void Validate() const;
+  /// These options with every threshold out of reach (gamma_M 1e-6, gamma_P 1, take-off 1e6): no
+  /// rule fires in fault-free flight, and the debounce, persistence and gates, which define the
+  /// rules' statistics (IndexExtremes), are unchanged.
+  CompositeFddOptions Disarmed() const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
