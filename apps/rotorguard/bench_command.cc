@@ -132,6 +132,9 @@ class BenchCommand final : public Command {
           trial_seed,
           {"--methods", &ftc_methods_,
            "Comma-separated methods: rotorguard, fixedtime, ukf, indi, passive, none (default all)"},
+          {"--cells", &ftc_cells_,
+           "Comma-separated cells, phase/fault: hover/motor_stop, takeoff/propeller_loss, ... (default all;\n"
+           "a cell flies the same trials alone as among the others)"},
           jobs}},
         {&perception_,
          "perception",
@@ -306,6 +309,7 @@ class BenchCommand final : public Command {
     o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_, 1, 1'000'000));
     o.seed = Seed();
     o.methods = ParseWordList("--methods", ftc_methods_, benchmarks::FtcMethods());
+    if (!ftc_cells_.empty()) o.cells = ParseWordList("--cells", ftc_cells_, benchmarks::FtcCells());
     const std::string vehicle = ConfigPath("vehicles/zhou2025_quad.yaml");
     o.vehicle = harness::LoadVehicle(vehicle);
     if (auto fdd = harness::LoadVehicleFdd(vehicle)) o.fdd = fdd->first;
@@ -427,7 +431,7 @@ class BenchCommand final : public Command {
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3";
   std::string truth_ = "realistic";
-  std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none";
+  std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_;
   std::string perception_duration_ = "10";
   std::string planner_pairs_ = "100", planner_worlds_ = "10";
   std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;

@@ -238,6 +238,24 @@ std::vector<std::string> FtcMethods() {
   return names;
 }
 
+std::vector<std::string> FtcCells() {
+  std::vector<std::string> names;
+  for (const Cell& c : kCells) names.push_back(std::string(c.phase) + "/" + c.fault);
+  return names;
+}
+
+namespace {
+/// The indices into kCells of `names` (validated names), in kCells' order.
+std::vector<int> CellIndices(const std::vector<std::string>& names) {
+  const std::vector<std::string> all = FtcCells();
+  std::vector<int> indices;
+  for (int c = 0; c < kNumCells; ++c) {
+    if (std::find(names.begin(), names.end(), all[static_cast<std::size_t>(c)]) != names.end()) indices.push_back(c);
+  }
+  return indices;
+}
+}  // namespace
+
 void FtcBenchOptions::Validate() const {
   if (trials < 1 || trials > 1'000'000) ThrowInvalidArgument("FtcBenchOptions", "trials", trials, "a count in [1, 1e6]");
   if (jobs < 1 || jobs > 256) ThrowInvalidArgument("FtcBenchOptions", "jobs", jobs, "a count in [1, 256]");
@@ -248,16 +266,24 @@ void FtcBenchOptions::Validate() const {
       ThrowInvalidArgument("FtcBenchOptions", "methods", m, fmt::format("one of: {}", fmt::join(known, ", ")));
     }
   }
+  if (cells.empty()) ThrowInvalidArgument("FtcBenchOptions", "cells", "(none)", "at least one cell");
+  const std::vector<std::string> known_cells = FtcCells();
+  for (const std::string& c : cells) {
+    if (std::find(known_cells.begin(), known_cells.end(), c) == known_cells.end()) {
+      ThrowInvalidArgument("FtcBenchOptions", "cells", c, fmt::format("one of: {}", fmt::join(known_cells, ", ")));
+    }
+  }
   vehicle.Validate();
 }
 
 campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   o.Validate();
   const int methods = static_cast<int>(o.methods.size());
+  const std::vector<int> cells = CellIndices(o.cells);
   campaign::Campaign c;
   c.name = "bench_ftc";
   c.seed = o.seed;
-  c.trials = kNumCells * methods * o.trials;
+  c.trials = static_cast<int>(cells.size()) * methods * o.trials;
   c.group_keys = {"phase", "fault", "method"};
   c.metrics = {"success",      "correct",   "false_alarm",    "latency_s",        "altitude_change_m",
                "final_rmse_m", "eta_error", "second_correct", "second_latency_s", "crash_speed_m_s"};
@@ -267,12 +293,14 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
                             {"vehicle", o.vehicle.name},
                             {"truth", ToName(o.truth)}};
   if (o.fdd) options["fdd"] = io::ToJson(*o.fdd);  // the vehicle's own thresholds: another campaign
+  if (cells.size() < static_cast<std::size_t>(kNumCells)) options["cells"] = o.cells;  // all: as before cells existed
   c.bench = {{"name", "ftc"}, {"options", options}};
   c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::VehicleToYaml(o.vehicle));
   // Trial index = (cell, method, trial), the trial fastest. Every method flies the same draws: the
   // seed depends on the cell and trial only.
-  const auto decompose = [o, methods](int index) {
-    return std::array<int, 3>{index / (o.trials * methods), (index / o.trials) % methods, index % o.trials};
+  const auto decompose = [o, methods, cells](int index) {
+    return std::array<int, 3>{cells[static_cast<std::size_t>(index / (o.trials * methods))],
+                              (index / o.trials) % methods, index % o.trials};
   };
   c.parameters = [o, decompose](int index) {
     const auto [cell, method, trial] = decompose(index);
@@ -315,18 +343,22 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
   const std::vector<std::string> methods = options.at("methods").get<std::vector<std::string>>();
   const int trials = options.at("trials").get<int>();
   const int m_count = static_cast<int>(methods.size());
-  if (static_cast<int>(records.size()) != kNumCells * m_count * trials) {
+  const std::vector<int> flown =
+      CellIndices(options.contains("cells") ? options.at("cells").get<std::vector<std::string>>() : FtcCells());
+  const int c_count = static_cast<int>(flown.size());
+  if (static_cast<int>(records.size()) != c_count * m_count * trials) {
     throw std::invalid_argument(fmt::format("ftc: {} trial records for {} cells x {} methods x {} trials",
-                                            records.size(), kNumCells, m_count, trials));
+                                            records.size(), c_count, m_count, trials));
   }
   nlohmann::json cells = nlohmann::json::array();
   int errors = 0;
-  for (int c = 0; c < kNumCells; ++c) {
+  for (int k = 0; k < c_count; ++k) {
+    const int c = flown[static_cast<std::size_t>(k)];
     for (int m = 0; m < m_count; ++m) {
       const bool method_has_fdd = FtcMethodNamed(methods[static_cast<std::size_t>(m)]).fdd != stack::FddKind::kNone;
       std::vector<FtcTrial> cell_trials;
       for (int t = 0; t < trials; ++t) {
-        const nlohmann::json& r = records[static_cast<std::size_t>((c * m_count + m) * trials + t)];
+        const nlohmann::json& r = records[static_cast<std::size_t>((k * m_count + m) * trials + t)];
         FtcTrial trial;
         trial.seed = std::stoull(r["params"]["seed"].get<std::string>());
         trial.failure = campaign::TrialFailure(r);

@@ -80,6 +80,7 @@ campaign::Campaign LoadFtc(const io::ConfigNode& root, const std::string& path) 
   const SpecFiles files(root, path);
   FtcBenchOptions o = SeedAndTrials<FtcBenchOptions>(root, 1'000'000);
   if (root.Has("methods")) o.methods = WordList(root.Required("methods"), FtcMethods());
+  if (root.Has("cells")) o.cells = WordList(root.Required("cells"), FtcCells());
   o.vehicle = files.Load("vehicle", [](const std::string& p) { return harness::LoadVehicle(p); });
   if (auto fdd = files.Load("vehicle", [](const std::string& p) { return harness::LoadVehicleFdd(p); })) {
     o.fdd = fdd->first;

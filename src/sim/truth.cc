@@ -95,7 +95,7 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   TruthDraw d;
   d.preset = options.preset;
   d.mass_ratio = Ratio(r.mass_fraction, &rng);
-  d.inertia_ratio = Ratios(r.inertia_fraction, &rng);
+  d.mass_moment_ratio = Ratios(r.inertia_fraction, &rng);
   d.cog_offset_m = Offset(r.cog_offset_m, &rng);
   for (int i = 0; i < vehicle.num_rotors(); ++i) {
     d.thrust_coefficient_ratio.push_back(Ratio(r.thrust_coefficient_fraction, &rng));
@@ -127,13 +127,21 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   return d;
 }
 
+Matrix3 ScaleMassMoments(const Matrix3& inertia, const Vector3& ratio) {
+  // The mass's second moment Σ = ∫ r rᵀ dm = ½ tr(I) 1 − I, and back I = tr(Σ) 1 − Σ. Σ' = S Σ S
+  // with S = diag(√ratio) scales ∫x² dm, ∫y² dm, ∫z² dm by the ratios and stays positive
+  // semidefinite, so I' is a rigid body's inertia whenever I is (VehicleParams::Validate).
+  if (ratio == Vector3::Ones()) return inertia;  // the file bit for bit: the ideal world's flights
+  const Matrix3 sigma = 0.5 * inertia.trace() * Matrix3::Identity() - inertia;
+  const Vector3 s = ratio.cwiseSqrt();
+  const Matrix3 scaled = s.asDiagonal() * sigma * s.asDiagonal();
+  return scaled.trace() * Matrix3::Identity() - scaled;
+}
+
 vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const TruthDraw& d) {
   vehicle::VehicleParams v = file;
   v.mass_kg = file.mass_kg * d.mass_ratio;
-  // I' = S I S with S = diag(sqrt(ratio)): the principal moments of a diagonal I scale by the
-  // ratios, and I' stays symmetric positive definite for any I.
-  const Vector3 s = d.inertia_ratio.cwiseSqrt();
-  v.inertia_kg_m2 = s.asDiagonal() * file.inertia_kg_m2 * s.asDiagonal();
+  v.inertia_kg_m2 = ScaleMassMoments(file.inertia_kg_m2, d.mass_moment_ratio);
   v.rotor_drag_kg_s = file.rotor_drag_kg_s.cwiseProduct(d.rotor_drag_ratio);
   v.motor_time_constant_s = file.motor_time_constant_s * d.motor_time_constant_ratio;
   v.motor_stop_time_constant_s = d.motor_stop_time_constant_s;

@@ -1,8 +1,9 @@
 #include "rotorguard/stack/supervisor.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
@@ -30,6 +31,7 @@ void SupervisorOptions::Validate() const {
   if (!(std::isfinite(recovery_hold_s) && recovery_hold_s >= 0.0)) {
     ThrowValidation("SupervisorOptions", "recovery_hold_s", recovery_hold_s, "a time >= 0 s");
   }
+  positive(recovery_axis_time_constant_s, "recovery_axis_time_constant_s");
   positive(no_plan_timeout_s, "no_plan_timeout_s");
   positive(odometry_timeout_s, "odometry_timeout_s");
   positive(max_speed_m_s, "max_speed_m_s");
@@ -52,6 +54,12 @@ void Supervisor::Enter(FlightMode to, double t, std::string reason) {
 FlightMode Supervisor::Update(const SupervisorInputs& in) {
   const double t = in.t;
   const StateEstimate& e = in.estimate;
+  if (e.valid && e.q_WB.coeffs().allFinite()) {
+    const double dt = last_t_ < 0.0 ? 0.0 : std::max(0.0, t - last_t_);
+    const double blend = 1.0 - std::exp(-dt / options_.recovery_axis_time_constant_s);
+    mean_thrust_axis_ += blend * (e.q_WB * Vector3::UnitZ() - mean_thrust_axis_);
+    last_t_ = t;
+  }
   if (mode_ == FlightMode::kLanded || mode_ == FlightMode::kFlightTermination) return mode_;
   if (!in.cannot_hover.empty() && options_.terminate_when_uncontrollable) {
     Enter(FlightMode::kFlightTermination, t, in.cannot_hover);
@@ -103,7 +111,10 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
     settled_since_ = -1.0;
     Enter(FlightMode::kFailureRecovery, t, "rotor failure isolated");
   } else if (mode_ == FlightMode::kFailureRecovery) {
-    const bool settled = TiltOf(e.q_WB) < options_.recovery_tilt_rad;
+    // The mean axis within the tilt of vertical, and long: a body axis sweeping a cone wider than
+    // 60° (or tumbling) averages to less than half a unit vector.
+    const Vector3& n = mean_thrust_axis_;
+    const bool settled = n.norm() > 0.5 && n.z() > n.norm() * std::cos(options_.recovery_tilt_rad);
     if (!settled) {
       settled_since_ = -1.0;
     } else if (settled_since_ < 0.0) {
@@ -111,8 +122,8 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
     }
     if (settled && t - settled_since_ >= options_.recovery_hold_s) {
       Enter(FlightMode::kDegradedNavigation, t,
-            fmt::format("attitude settled: tilt below {:.2f} rad for {:.1f} s", options_.recovery_tilt_rad,
-                        options_.recovery_hold_s));
+            fmt::format("attitude settled: mean thrust axis within {:.2f} rad of vertical for {:.1f} s",
+                        options_.recovery_tilt_rad, options_.recovery_hold_s));
     }
   }
   return mode_;

@@ -43,13 +43,20 @@ void VehicleParams::Validate() const {
                                       "3x3 matrix",
                                       kOwner));
   }
-  const double min_eig =
-      Eigen::SelfAdjointEigenSolver<Matrix3>(inertia_kg_m2, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .minCoeff();
+  // Ascending principal moments.
+  const Eigen::Vector3d moments =
+      Eigen::SelfAdjointEigenSolver<Matrix3>(inertia_kg_m2, Eigen::EigenvaluesOnly).eigenvalues();
+  const double min_eig = moments[0];
   if (min_eig <= 0.0) {
     ThrowValidation(kOwner, "inertia_kg_m2", fmt::format("(smallest eigenvalue {:g})", min_eig),
                     "a positive definite matrix");
+  }
+  // A rigid body's second moment of mass Σ = ∫ r rᵀ dm = ½ tr(I) 1 − I is positive semidefinite:
+  // each principal moment is at most the sum of the other two (a flat plate reaches the bound).
+  if (moments[2] > (moments[0] + moments[1]) * (1.0 + 1e-9)) {
+    ThrowValidation(kOwner, "inertia_kg_m2",
+                    fmt::format("(principal moments {:g}, {:g}, {:g})", moments[0], moments[1], moments[2]),
+                    "a rigid body's inertia: each principal moment at most the sum of the other two");
   }
   for (int i = 0; i < 3; ++i) RequireNonNegative(fmt::format("rotor_drag_kg_s.{}", i), rotor_drag_kg_s[i]);
   RequireNonNegative("yaw_damping_n_m_s", yaw_damping_n_m_s);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "rotorguard/harness/scenario.h"
 #include "test_util.h"
 #include "vehicle_fixture.h"
@@ -127,6 +129,41 @@ TEST(FtcBenchmark, TheRealisticWorldFliesOtherVehiclesUnderItsOwnHash) {
   const campaign::TrialOutcome a = ideal.run(0, ideal.parameters(0));
   const campaign::TrialOutcome b = realistic.run(0, realistic.parameters(0));
   EXPECT_NE(a.metrics["altitude_change_m"], b.metrics["altitude_change_m"]);
+}
+
+TEST(FtcBenchmark, ACellFlownAloneFliesTheTrialsItFliesAmongTheOthers) {
+  // The same (cell, trial) has the same parameters, seed included, whichever cells are flown; the
+  // result aggregates exactly the cells flown, in the tables' order.
+  FtcBenchOptions o;
+  o.trials = 3;
+  o.methods = {"rotorguard", "none"};
+  o.vehicle = testing::ReferenceQuad();
+  const campaign::Campaign all = FtcCampaign(o);
+  o.cells = {"takeoff/propeller_loss", "hover/motor_stop"};
+  const campaign::Campaign two = FtcCampaign(o);
+  EXPECT_EQ(two.trials, 2 * 2 * 3);
+  EXPECT_NE(all.hash, two.hash);
+  const std::vector<std::string> names = FtcCells();
+  const auto index_of = [&](const std::string& cell) {
+    return static_cast<int>(std::find(names.begin(), names.end(), cell) - names.begin());
+  };
+  // Trial index = (cell, method, trial), the trial fastest; hover/motor_stop comes first.
+  for (int m = 0; m < 2; ++m) {
+    for (int t = 0; t < 3; ++t) {
+      EXPECT_EQ(two.parameters(m * 3 + t), all.parameters((index_of("hover/motor_stop") * 2 + m) * 3 + t));
+      EXPECT_EQ(two.parameters(6 + m * 3 + t), all.parameters((index_of("takeoff/propeller_loss") * 2 + m) * 3 + t));
+    }
+  }
+  std::vector<nlohmann::json> records(static_cast<std::size_t>(two.trials),
+                                      {{"status", "error"}, {"message", "diverged"}, {"params", {{"seed", "7"}}}});
+  const nlohmann::json r = FtcResult(two.bench["options"], records);
+  ASSERT_EQ(r["cells"].size(), 4u);
+  EXPECT_EQ(r["cells"][0]["phase"], "hover");
+  EXPECT_EQ(r["cells"][0]["fault"], "motor_stop");
+  EXPECT_EQ(r["cells"][3]["phase"], "takeoff");
+  EXPECT_EQ(r["cells"][3]["method"], "none");
+  o.cells = {"hover/nothing"};
+  RG_EXPECT_THROW_WITH(FtcCampaign(o), std::invalid_argument, "cells = hover/nothing");
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "rotorguard/core/error.h"
@@ -33,7 +34,7 @@ TEST(Truth, TheIdealWorldIsTheFileExactly) {
   ideal.preset = TruthPreset::kIdeal;
   const TruthDraw d = DrawTruth(ideal, file, 42);
   EXPECT_EQ(d.mass_ratio, 1.0);
-  EXPECT_EQ(d.inertia_ratio, Vector3::Ones());
+  EXPECT_EQ(d.mass_moment_ratio, Vector3::Ones());
   EXPECT_EQ(d.cog_offset_m, Vector3::Zero());
   EXPECT_EQ(d.thrust_coefficient_ratio, std::vector<double>(4, 1.0));
   EXPECT_EQ(d.motor_stop_time_constant_s, file.motor_stop_time_constant_s);
@@ -109,7 +110,7 @@ TEST(Truth, AnOverrideReplacesOneRangeOfThePreset) {
   const TruthDraw d = DrawTruth(o, ReferenceQuad(), 3);
   EXPECT_EQ(d.mass_ratio, 1.0);
   EXPECT_EQ(d.motor_stop_time_constant_s, 0.02);
-  EXPECT_NE(d.inertia_ratio, Vector3::Ones());  // the rest keeps the preset's spread
+  EXPECT_NE(d.mass_moment_ratio, Vector3::Ones());  // the rest keeps the preset's spread
 }
 
 TEST(Truth, AnIntervalNeedsBothEndsInOrder) {
@@ -128,12 +129,62 @@ TEST(Truth, TheDrawnVehicleMovesItsRotorsAboutTheTrueCentreOfGravity) {
   const TruthDraw d = DrawTruth(Realistic(), file, 11);
   const vehicle::VehicleParams v = TruthVehicle(file, d);
   EXPECT_DOUBLE_EQ(v.mass_kg, file.mass_kg * d.mass_ratio);
-  for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(v.inertia_kg_m2(k, k), file.inertia_kg_m2(k, k) * d.inertia_ratio[k]);
+  EXPECT_TRUE(MatricesNear(v.inertia_kg_m2, ScaleMassMoments(file.inertia_kg_m2, d.mass_moment_ratio), 0.0));
   for (int i = 0; i < 4; ++i) {
     EXPECT_TRUE(MatricesNear(v.rotors[i].p_B + d.cog_offset_m, file.rotors[i].p_B, 1e-15));
     EXPECT_DOUBLE_EQ(v.rotors[i].yaw_coefficient_m, file.rotors[i].yaw_coefficient_m * d.yaw_coefficient_ratio[i]);
   }
   EXPECT_NO_THROW(v.Validate());
+}
+
+/// The inertia about the origin of point masses m at the columns of `points`: Σ m (|r|² 1 − r rᵀ).
+Matrix3 PointMassInertia(const Eigen::Matrix<double, 3, Eigen::Dynamic>& points, double m) {
+  Matrix3 inertia = Matrix3::Zero();
+  for (Eigen::Index k = 0; k < points.cols(); ++k) {
+    const Vector3 r = points.col(k);
+    inertia += m * (r.squaredNorm() * Matrix3::Identity() - r * r.transpose());
+  }
+  return inertia;
+}
+
+TEST(Truth, ScalingTheMassMomentsIsStretchingTheBodyAlongItsAxes) {
+  // The oracle: a body of point masses stretched by √ratio along each body axis has ∫x² dm, ∫y² dm,
+  // ∫z² dm scaled by the ratios; its inertia, summed directly, is what ScaleMassMoments returns. A
+  // tilted cloud gives products of inertia too.
+  Eigen::Matrix<double, 3, Eigen::Dynamic> body(3, 7);
+  body << 0.10, -0.12, 0.03, -0.02, 0.05, 0.00, -0.07,  //
+      0.02, 0.04, -0.15, 0.11, -0.01, 0.06, -0.03,      //
+      0.01, -0.02, 0.03, 0.00, -0.04, 0.05, 0.02;
+  const Vector3 ratio(1.12, 0.9, 1.31);
+  const Eigen::Matrix<double, 3, Eigen::Dynamic> stretched = ratio.cwiseSqrt().asDiagonal() * body;
+  const Matrix3 scaled = ScaleMassMoments(PointMassInertia(body, 0.3), ratio);
+  EXPECT_TRUE(MatricesNear(scaled, PointMassInertia(stretched, 0.3), 1e-15));
+  EXPECT_GT(std::abs(scaled(0, 1)), 1e-4);  // the products of inertia were exercised
+  const Matrix3 file = ReferenceQuad().inertia_kg_m2;
+  EXPECT_EQ(ScaleMassMoments(file, Vector3::Ones()), file);  // exactly: the ideal world's vehicle
+}
+
+TEST(Truth, EveryRealisticDrawOfAFlatVehicleStaysFlat) {
+  // The reference vehicle's mass spreads farther horizontally than vertically (∫x² dm = 4.39,
+  // ∫z² dm = 2.60 g m²), so I_zz - I_xx = ∫x² dm - ∫z² dm > 0 for every draw of ±15 %: the spin
+  // after a rotor failure keeps its gyroscopic stiffness. The moments stay within ±15 % of the
+  // file's (a weighted mean of the ratios) and fill most of it.
+  const vehicle::VehicleParams file = ReferenceQuad();
+  const double a = RangesOf(TruthPreset::kRealistic).inertia_fraction;
+  double lowest_zz_over_xy = std::numeric_limits<double>::infinity(), widest = 0.0;
+  for (std::uint64_t seed = 0; seed < 4000; ++seed) {
+    const Matrix3 inertia = TruthVehicle(file, DrawTruth(Realistic(), file, seed)).inertia_kg_m2;
+    lowest_zz_over_xy = std::min(lowest_zz_over_xy, inertia(2, 2) / std::max(inertia(0, 0), inertia(1, 1)));
+    for (int k = 0; k < 3; ++k) {
+      const double ratio = inertia(k, k) / file.inertia_kg_m2(k, k);
+      EXPECT_LE(std::abs(ratio - 1.0), a);
+      widest = std::max(widest, std::abs(ratio - 1.0));
+    }
+  }
+  // The draw's worst vertex (ratios 1.15, 0.85, 1.15) gives I_zz / I_yy = 1.078; scaling the
+  // principal moments independently by ±15 % reached 0.85 · 8.650 / (1.15 · 6.992) = 0.914.
+  EXPECT_GE(lowest_zz_over_xy, 1.078);
+  EXPECT_GT(widest, 0.9 * a);
 }
 
 TEST(Truth, TheDrawnVehicleHoversOnThrustsThatBalanceItsWeightAboutItsCentreOfGravity) {

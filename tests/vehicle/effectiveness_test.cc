@@ -64,6 +64,11 @@ TEST(VehicleParams, ValidationNamesFieldAndRule) {
   p.inertia_kg_m2(2, 2) = -1e-3;
   RG_EXPECT_THROW_WITH(p.Validate(), ValidationError, "positive definite");
   p = ReferenceQuad();
+  p.inertia_kg_m2(2, 2) = 14.0e-3;  // > I_xx + I_yy = 13.854e-3: no distribution of mass has it
+  RG_EXPECT_THROW_WITH(p.Validate(), ValidationError, "each principal moment at most the sum of the other two");
+  p.inertia_kg_m2(2, 2) = 13.85e-3;  // a flat plate's bound, approached from below: a body
+  EXPECT_NO_THROW(p.Validate());
+  p = ReferenceQuad();
   for (auto& r : p.rotors) r.max_thrust_n = 2.0;  // 8 N < 11.3 N weight
   try {
     p.Validate();

@@ -21,6 +21,8 @@ namespace rotorguard::benchmarks {
 
 /// The method names RunFtcBenchmark knows.
 std::vector<std::string> FtcMethods();
+/// The cells' names, "phase/fault" (hover/motor_stop, takeoff/none, ...), in the tables' order.
+std::vector<std::string> FtcCells();
 
 struct FtcBenchOptions {
   int trials = 20;                 ///< per cell (the paper's count), >= 1
@@ -30,6 +32,9 @@ struct FtcBenchOptions {
   /// + incremental nonlinear dynamic inversion), passive (UnifP: reduced-attitude control with yaw
   /// free, no FDD), none (nominal controller, no FDD). All of them by default.
   std::vector<std::string> methods = FtcMethods();
+  /// The cells flown, by name (FtcCells; all by default). A trial's seed depends on its cell and
+  /// number only, so a cell flown alone flies the trials it flies among all the others.
+  std::vector<std::string> cells = FtcCells();
   int jobs = 1;                    ///< worker threads, >= 1
   vehicle::VehicleParams vehicle;  ///< the vehicle flown (the reference quadrotor's file by default)
   /// The composite FDD thresholds its vehicle file names (harness::LoadVehicleFdd), else the

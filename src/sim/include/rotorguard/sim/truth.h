@@ -28,7 +28,9 @@ constexpr std::span<const EnumName<TruthPreset>> NamesOf(const TruthPreset*) { r
 /// range of the motor-stop time constant. All zero: the file's vehicle exactly.
 struct TruthRanges {
   double mass_fraction = 0.0;                 ///< m = m_file (1 + U(-a, a))
-  double inertia_fraction = 0.0;              ///< each principal axis of the body frame independently
+  /// Each second moment of mass ∫x² dm, ∫y² dm, ∫z² dm (body frame) independently; the principal
+  /// moments follow from them (ScaleMassMoments).
+  double inertia_fraction = 0.0;
   double cog_offset_m = 0.0;                  ///< each axis of the centre of gravity's offset, U(-a, a)
   double thrust_coefficient_fraction = 0.0;   ///< each rotor's k_n (thrust per speed squared)
   double yaw_coefficient_fraction = 0.0;      ///< each rotor's κ_t
@@ -93,7 +95,9 @@ inline constexpr TruthOverrideKey kTruthOverrideKeys[] = {
     {"inertia_fraction",
      &TruthOptions::inertia_fraction,
      &TruthRanges::inertia_fraction,
-     {.meaning = "each principal moment drawn in I (1 ± a)", .min = 0, .max = 0.5}},
+     {.meaning = "each second moment of mass (∫x² dm, ∫y² dm, ∫z² dm) drawn in (1 ± a); the inertia follows",
+      .min = 0,
+      .max = 0.5}},
     {"cog_offset_m",
      &TruthOptions::cog_offset_m,
      &TruthRanges::cog_offset_m,
@@ -193,7 +197,7 @@ void TruthOptions::Serialize(Archive* a) {
 struct TruthDraw {
   TruthPreset preset = TruthPreset::kIdeal;
   double mass_ratio = 1.0;
-  Vector3 inertia_ratio = Vector3::Ones();  ///< of the body-frame principal moments
+  Vector3 mass_moment_ratio = Vector3::Ones();  ///< of ∫x² dm, ∫y² dm, ∫z² dm in the body frame
   Vector3 cog_offset_m = Vector3::Zero();   ///< the true centre of gravity in the file's body frame
   std::vector<double> thrust_coefficient_ratio, yaw_coefficient_ratio;  ///< per rotor
   double motor_time_constant_ratio = 1.0;
@@ -215,7 +219,8 @@ struct TruthDraw {
   void Serialize(Archive* a) {
     a->Visit("preset", &preset, {.meaning = "the scenario's truth preset"});
     a->Visit("mass_ratio", &mass_ratio, {.meaning = "true mass / the file's"});
-    a->Visit("inertia_ratio", &inertia_ratio, {.meaning = "true principal moments / the file's, body x, y, z"});
+    a->Visit("mass_moment_ratio", &mass_moment_ratio,
+             {.meaning = "true second moments of mass ∫x² dm, ∫y² dm, ∫z² dm / the file's, body frame"});
     a->Visit("cog_offset_m", &cog_offset_m, {.meaning = "the true centre of gravity in the file's body frame [m]"});
     a->Visit("thrust_coefficient_ratio", &thrust_coefficient_ratio, {.meaning = "per rotor: true k_n / the file's"});
     a->Visit("yaw_coefficient_ratio", &yaw_coefficient_ratio, {.meaning = "per rotor: true κ_t / the file's"});
@@ -244,6 +249,13 @@ struct TruthDraw {
 /// The draw of `ranges` for `vehicle` with `seed`: a pure function of its arguments. Zero ranges
 /// give the identity (ratios 1, offsets 0, the file's stop time constant) without drawing.
 TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& vehicle, std::uint64_t seed);
+
+/// The inertia of a body whose mass spreads `ratio` times as far (in second moment) along each
+/// body axis: ∫x² dm, ∫y² dm, ∫z² dm scale by the ratios. Errors of a CAD or measured inertia are
+/// errors in where the mass is; scaling the principal moments independently instead can turn a
+/// flat vehicle (I_zz the largest moment) into a tall one, and that changes the physics of the
+/// spin after a rotor failure, which balances tilting torques gyroscopically through I_zz − I_xx.
+Matrix3 ScaleMassMoments(const Matrix3& inertia, const Vector3& ratio);
 
 /// The simulated vehicle of `draw`: the file's with its mass, moments, drag, yaw coefficients and
 /// time constants scaled, and its rotors placed about the true centre of gravity. The per-rotor

@@ -44,9 +44,15 @@ enum class FlightMode {
 const char* ToString(FlightMode mode);
 
 struct SupervisorOptions {
-  /// Recovery ends once roll and pitch stay below this [rad] for `recovery_hold_s` [s].
+  /// Recovery ends once the thrust axis, averaged over the spin, stays within this of vertical
+  /// [rad] for `recovery_hold_s` [s]. Averaged, because a spinning vehicle balances a centre of
+  /// gravity off its rotors by tilting its spin axis (gyroscopic torque): the body axis cones about
+  /// the vertical at a steady 20° or more while the mean thrust holds the vehicle up.
   double recovery_tilt_rad = 0.35;
   double recovery_hold_s = 1.0;
+  /// The average's time constant [s], > 0: several times a revolution's 0.1-0.6 s (a cone of
+  /// half-angle θ leaves a ripple of sin θ / √(1 + (ω τ)²) at spin ω).
+  double recovery_axis_time_constant_s = 0.5;
   /// A goal without a successful plan for this long [s] is given up: land. > 0.
   double no_plan_timeout_s = 10.0;
   /// Odometry older than this [s] means the estimator has lost its reference: land. > 0.
@@ -70,8 +76,11 @@ struct SupervisorOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("recovery_tilt_rad", &recovery_tilt_rad,
-             {.meaning = "recovery from a failure ends once roll and pitch stay below this [rad] ..."});
+             {.meaning = "recovery from a failure ends once the thrust axis averaged over the spin stays this "
+                         "close to vertical [rad] ..."});
     a->Visit("recovery_hold_s", &recovery_hold_s, {.meaning = "... for this long [s]"});
+    a->Visit("recovery_axis_time_constant_s", &recovery_axis_time_constant_s,
+             {.meaning = "the time constant of that average [s]"});
     a->Visit("no_plan_timeout_s", &no_plan_timeout_s,
              {.meaning = "a goal without a successful plan for this long [s] lands the vehicle"});
     a->Visit("odometry_timeout_s", &odometry_timeout_s, {.meaning = "odometry older than this [s] lands the vehicle"});
@@ -129,6 +138,9 @@ class Supervisor {
   SupervisorOptions options_;
   FlightMode mode_ = FlightMode::kNominal;
   double settled_since_ = -1.0;
+  /// The body z axis in the world frame, low-passed with recovery_axis_time_constant_s.
+  Vector3 mean_thrust_axis_ = Vector3::UnitZ();
+  double last_t_ = -1.0;
   double low_thrust_since_ = -1.0;
   Vector3 landing_start_ = Vector3::Zero();
   double landing_start_s_ = 0.0;
