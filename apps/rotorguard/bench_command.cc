@@ -135,7 +135,9 @@ class BenchCommand final : public Command {
           {"--cells", &ftc_cells_,
            "Comma-separated cells, phase/fault: hover/motor_stop, takeoff/propeller_loss, ... (default all;\n"
            "a cell flies the same trials alone as among the others)"},
-          jobs}},
+          jobs,
+          {"--replay", &ftc_replay_,
+           "Fly one trial instead, CELL:METHOD:SEED (a seed from the failures listed), into --out"}}},
         {&perception_,
          "perception",
          "The simulated MID-360 on a vehicle spinning at 11 rad/s and flying 1 m/s through a 500-tree\n"
@@ -314,6 +316,7 @@ class BenchCommand final : public Command {
     o.vehicle = harness::LoadVehicle(vehicle);
     if (auto fdd = harness::LoadVehicleFdd(vehicle)) o.fdd = fdd->first;
     o.truth = Truth();
+    if (!ftc_replay_.empty()) return ReplayFtcTrial(o);
     const std::optional<nlohmann::json> r = RunBenchCampaign(benchmarks::FtcCampaign(o), "ftc");
     return r && (*r)["errors"].get<int>() > 0 ? kRunFailed : kOk;
   }
@@ -352,6 +355,33 @@ class BenchCommand final : public Command {
     return kOk;
   }
 
+  /// --replay CELL:METHOD:SEED: one trial of bench ftc, flown into a run folder.
+  int ReplayFtcTrial(const benchmarks::FtcBenchOptions& o) const {
+    const std::size_t a = ftc_replay_.find(':');
+    const std::size_t b = a == std::string::npos ? a : ftc_replay_.find(':', a + 1);
+    if (b == std::string::npos) {
+      throw UsageError(
+          fmt::format("--replay: '{}' is invalid; expected CELL:METHOD:SEED, e.g. "
+                      "takeoff/propeller_loss:rotorguard:9762846541175685646",
+                      ftc_replay_));
+    }
+    const std::string cell = ftc_replay_.substr(0, a), method = ftc_replay_.substr(a + 1, b - a - 1);
+    ParseWordList("--replay", cell, benchmarks::FtcCells());
+    ParseWordList("--replay", method, benchmarks::FtcMethods());
+    const std::uint64_t seed = ParseUnsigned("--replay", ftc_replay_.substr(b + 1), 0, UINT64_MAX);
+    return ReplayTrial(benchmarks::MakeFtcTrial(cell, method, o, seed));
+  }
+
+  /// A benchmark's trial flown into --out (default out/NAME), with its report.
+  int ReplayTrial(const harness::Scenario& trial) const {
+    harness::RunOptions replay;
+    replay.out_dir = out_.empty() ? (fs::path("out") / trial.name).string() : out_;
+    replay.report = io::HasViewer();
+    const harness::RunSummary s = harness::RunScenario(trial, replay);
+    PrintRunSummary(s, replay.out_dir, replay);
+    return s.success ? kOk : kRunFailed;
+  }
+
   /// --replay KIND:SEED[:unaware]: one trial of bench nav, flown into a run folder.
   int ReplayNavTrial(const harness::Scenario& base) const {
     const std::size_t a = nav_replay_.find(':');
@@ -364,13 +394,7 @@ class BenchCommand final : public Command {
     }
     const std::uint64_t seed =
         ParseUnsigned("--replay", nav_replay_.substr(a + 1, b == std::string::npos ? b : b - a - 1), 0, UINT64_MAX);
-    const harness::Scenario trial = benchmarks::MakeNavTrial(base, kind, seed, variant.empty());
-    harness::RunOptions replay;
-    replay.out_dir = out_.empty() ? (fs::path("out") / trial.name).string() : out_;
-    replay.report = io::HasViewer();
-    const harness::RunSummary s = harness::RunScenario(trial, replay);
-    PrintRunSummary(s, replay.out_dir, replay);
-    return s.success ? kOk : kRunFailed;
+    return ReplayTrial(benchmarks::MakeNavTrial(base, kind, seed, variant.empty()));
   }
 
   int Flatness() const {
@@ -431,7 +455,7 @@ class BenchCommand final : public Command {
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3";
   std::string truth_ = "realistic";
-  std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_;
+  std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";
   std::string planner_pairs_ = "100", planner_worlds_ = "10";
   std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;

@@ -79,7 +79,7 @@ const FtcMethod& FtcMethodNamed(const std::string& name) {
   for (const FtcMethod& m : kMethods) {
     if (name == m.name) return m;
   }
-  throw std::invalid_argument("ftc: no method named '" + name + "'");
+  ThrowInvalidArgument("ftc", "method", name, fmt::format("one of: {}", fmt::join(FtcMethods(), ", ")));
 }
 
 /// A trial's scenario: the phase's mission, the drawn fault, gust and noise seed, the method's stack.
@@ -274,6 +274,15 @@ void FtcBenchOptions::Validate() const {
     }
   }
   vehicle.Validate();
+}
+
+harness::Scenario MakeFtcTrial(const std::string& cell, const std::string& method, const FtcBenchOptions& options,
+                               std::uint64_t seed) {
+  const std::vector<int> index = CellIndices({cell});
+  if (index.empty()) {
+    ThrowInvalidArgument("MakeFtcTrial", "cell", cell, fmt::format("one of: {}", fmt::join(FtcCells(), ", ")));
+  }
+  return MakeTrial(kCells[index.front()], FtcMethodNamed(method).name, options, seed);
 }
 
 campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {

@@ -97,6 +97,22 @@ TEST_F(CliTest, ABenchmarksWorldIsNamedByTruthAndRecordedInItsJson) {
       << bad.out;
 }
 
+/// A failure listed by bench ftc, replayed alone into a run folder, fails for the same reason.
+TEST_F(CliTest, AnFtcTrialReplaysIntoARunFolderAsItFlewInTheBenchmark) {
+  const Result r = Cli("bench ftc --trials 1 --methods none --cells hover/motor_stop --seed 3 --jobs 1 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json cell = nlohmann::json::parse(r.out.substr(r.out.find('{')))["cells"].at(0);
+  ASSERT_EQ(cell["failures"].size(), 1u) << cell.dump();  // the nominal controller loses a motor
+  const nlohmann::json failure = cell["failures"][0];
+  const std::string seed = std::to_string(failure["seed"].get<std::uint64_t>());
+  const Result replay = Cli("bench ftc --replay hover/motor_stop:none:" + seed + " --out " + Out());
+  EXPECT_EQ(replay.exit_code, 1) << replay.out;
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(fs::path(Out()) / "summary.json"));
+  EXPECT_EQ(summary["failure_reason"], failure["reason"]);
+  EXPECT_EQ(Cli("bench ftc --replay hover/motor_stop:nobody:" + seed).exit_code, 2);
+  EXPECT_EQ(Cli("bench ftc --replay hover/motor_stop").exit_code, 2);
+}
+
 /// A benchmark run in two shards and merged prints the same tables as one run of it, and its
 /// campaign flags are checked (docs/campaigns.md, "Benchmarks as campaigns").
 TEST_F(CliTest, ABenchmarkInShardsMergesToTheTablesOfOneRun) {

@@ -14,6 +14,7 @@
 
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/harness/scenario.h"
 #include "rotorguard/sim/truth.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
@@ -82,6 +83,12 @@ struct FtcTrial {
 /// and the median latency; the crashes and their impact speeds. Null where a metric does not apply
 /// (no FDD; MDR of fault-free cells).
 nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty, bool with_second = false);
+
+/// One trial's scenario: the cell by name (FtcCells), the method (FtcMethods) and the trial's seed
+/// (a failure listed in the result gives it). Throws std::invalid_argument for an unknown cell or
+/// method.
+harness::Scenario MakeFtcTrial(const std::string& cell, const std::string& method, const FtcBenchOptions& options,
+                               std::uint64_t seed);
 
 /// The benchmark as a campaign (campaign.h), so that it shards, resumes and merges like any other:
 /// trial index = (cell, method, trial), the trial fastest; parameters {test, phase, fault, method,
