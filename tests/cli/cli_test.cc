@@ -468,6 +468,9 @@ TEST_F(CliTest, BadVehicleContentExitsTwoNamingTheVehicleFile) {
   v = VehicleWith("[0.0, 0.0, 8.650e-3]", "[0.0, 0.0, -8.650e-3]");
   s = Write("s.yaml", Scenario(v));
   ExpectConfigError("run " + s, v, 7, {"inertia_kg_m2", "positive definite"});
+  v = VehicleWith("[0.0, 0.0, 8.650e-3]", "[0.0, 0.0, 14.0e-3]");  // above I_xx + I_yy: no body has it
+  s = Write("s.yaml", Scenario(v));
+  ExpectConfigError("run " + s, v, 7, {"inertia_kg_m2", "each principal moment at most the sum of the other two"});
   v = Write("v.yaml", std::regex_replace(ReadText(kVehicle), std::regex("max_thrust_n: 11.5"), "max_thrust_n: 2.5"));
   s = Write("s.yaml", Scenario(v));
   const Result r = Cli("run " + s);
