@@ -355,21 +355,30 @@ class BenchCommand final : public Command {
     return kOk;
   }
 
+  /// A --replay value's colon-separated fields.
+  static std::vector<std::string> ReplayFields(const std::string& text) {
+    std::vector<std::string> fields;
+    for (std::size_t start = 0;;) {
+      const std::size_t colon = text.find(':', start);
+      fields.push_back(text.substr(start, colon == std::string::npos ? colon : colon - start));
+      if (colon == std::string::npos) return fields;
+      start = colon + 1;
+    }
+  }
+
   /// --replay CELL:METHOD:SEED: one trial of bench ftc, flown into a run folder.
   int ReplayFtcTrial(const benchmarks::FtcBenchOptions& o) const {
-    const std::size_t a = ftc_replay_.find(':');
-    const std::size_t b = a == std::string::npos ? a : ftc_replay_.find(':', a + 1);
-    if (b == std::string::npos) {
+    const std::vector<std::string> f = ReplayFields(ftc_replay_);
+    if (f.size() != 3) {
       throw UsageError(
           fmt::format("--replay: '{}' is invalid; expected CELL:METHOD:SEED, e.g. "
                       "takeoff/propeller_loss:rotorguard:9762846541175685646",
                       ftc_replay_));
     }
-    const std::string cell = ftc_replay_.substr(0, a), method = ftc_replay_.substr(a + 1, b - a - 1);
-    ParseWordList("--replay", cell, benchmarks::FtcCells());
-    ParseWordList("--replay", method, benchmarks::FtcMethods());
-    const std::uint64_t seed = ParseUnsigned("--replay", ftc_replay_.substr(b + 1), 0, UINT64_MAX);
-    return ReplayTrial(benchmarks::MakeFtcTrial(cell, method, o, seed));
+    ParseWordList("--replay", f[0], benchmarks::FtcCells());
+    ParseWordList("--replay", f[1], benchmarks::FtcMethods());
+    const std::uint64_t seed = ParseUnsigned("--replay", f[2], 0, UINT64_MAX);
+    return ReplayTrial(benchmarks::MakeFtcTrial(f[0], f[1], o, seed));
   }
 
   /// A benchmark's trial flown into --out (default out/NAME), with its report.
@@ -384,17 +393,15 @@ class BenchCommand final : public Command {
 
   /// --replay KIND:SEED[:unaware]: one trial of bench nav, flown into a run folder.
   int ReplayNavTrial(const harness::Scenario& base) const {
-    const std::size_t a = nav_replay_.find(':');
-    const std::size_t b = a == std::string::npos ? a : nav_replay_.find(':', a + 1);
-    const std::string kind = nav_replay_.substr(0, a);
-    const std::string variant = b == std::string::npos ? "" : nav_replay_.substr(b + 1);
-    if (a == std::string::npos || (kind != "forest" && kind != "room") || (!variant.empty() && variant != "unaware")) {
+    const std::vector<std::string> f = ReplayFields(nav_replay_);
+    const std::string variant = f.size() == 3 ? f[2] : "";
+    if (f.size() < 2 || f.size() > 3 || (f[0] != "forest" && f[0] != "room") ||
+        (!variant.empty() && variant != "unaware")) {
       throw UsageError(fmt::format(
           "--replay: '{}' is invalid; expected KIND:SEED or KIND:SEED:unaware, KIND forest or room", nav_replay_));
     }
-    const std::uint64_t seed =
-        ParseUnsigned("--replay", nav_replay_.substr(a + 1, b == std::string::npos ? b : b - a - 1), 0, UINT64_MAX);
-    return ReplayTrial(benchmarks::MakeNavTrial(base, kind, seed, variant.empty()));
+    const std::uint64_t seed = ParseUnsigned("--replay", f[1], 0, UINT64_MAX);
+    return ReplayTrial(benchmarks::MakeNavTrial(base, f[0], seed, variant.empty()));
   }
 
   int Flatness() const {

@@ -245,12 +245,23 @@ std::vector<std::string> FtcCells() {
 }
 
 namespace {
-/// The indices into kCells of `names` (validated names), in kCells' order.
-std::vector<int> CellIndices(const std::vector<std::string>& names) {
+/// The index into kCells of the cell `name`; throws std::invalid_argument naming `api` and
+/// `parameter` and listing the cells.
+int CellIndexNamed(const std::string& name, const char* api, const char* parameter) {
   const std::vector<std::string> all = FtcCells();
+  const auto it = std::find(all.begin(), all.end(), name);
+  if (it == all.end()) ThrowInvalidArgument(api, parameter, name, fmt::format("one of: {}", fmt::join(all, ", ")));
+  return static_cast<int>(it - all.begin());
+}
+
+/// The indices into kCells of `names`, each once, in kCells' order (the tables').
+std::vector<int> CellIndices(const std::vector<std::string>& names) {
+  std::vector<bool> flown(kNumCells, false);
+  for (const std::string& n : names)
+    flown[static_cast<std::size_t>(CellIndexNamed(n, "FtcBenchOptions", "cells"))] = true;
   std::vector<int> indices;
   for (int c = 0; c < kNumCells; ++c) {
-    if (std::find(names.begin(), names.end(), all[static_cast<std::size_t>(c)]) != names.end()) indices.push_back(c);
+    if (flown[static_cast<std::size_t>(c)]) indices.push_back(c);
   }
   return indices;
 }
@@ -267,22 +278,13 @@ void FtcBenchOptions::Validate() const {
     }
   }
   if (cells.empty()) ThrowInvalidArgument("FtcBenchOptions", "cells", "(none)", "at least one cell");
-  const std::vector<std::string> known_cells = FtcCells();
-  for (const std::string& c : cells) {
-    if (std::find(known_cells.begin(), known_cells.end(), c) == known_cells.end()) {
-      ThrowInvalidArgument("FtcBenchOptions", "cells", c, fmt::format("one of: {}", fmt::join(known_cells, ", ")));
-    }
-  }
+  CellIndices(cells);  // throws for an unknown cell
   vehicle.Validate();
 }
 
 harness::Scenario MakeFtcTrial(const std::string& cell, const std::string& method, const FtcBenchOptions& options,
                                std::uint64_t seed) {
-  const std::vector<int> index = CellIndices({cell});
-  if (index.empty()) {
-    ThrowInvalidArgument("MakeFtcTrial", "cell", cell, fmt::format("one of: {}", fmt::join(FtcCells(), ", ")));
-  }
-  return MakeTrial(kCells[index.front()], FtcMethodNamed(method).name, options, seed);
+  return MakeTrial(kCells[CellIndexNamed(cell, "MakeFtcTrial", "cell")], FtcMethodNamed(method).name, options, seed);
 }
 
 campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {

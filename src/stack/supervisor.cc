@@ -6,7 +6,6 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
-#include "rotorguard/core/math.h"
 
 namespace rotorguard::stack {
 

@@ -43,12 +43,11 @@ void VehicleParams::Validate() const {
                                       "3x3 matrix",
                                       kOwner));
   }
-  // Ascending principal moments.
+  // The principal moments, ascending.
   const Eigen::Vector3d moments =
       Eigen::SelfAdjointEigenSolver<Matrix3>(inertia_kg_m2, Eigen::EigenvaluesOnly).eigenvalues();
-  const double min_eig = moments[0];
-  if (min_eig <= 0.0) {
-    ThrowValidation(kOwner, "inertia_kg_m2", fmt::format("(smallest eigenvalue {:g})", min_eig),
+  if (moments[0] <= 0.0) {
+    ThrowValidation(kOwner, "inertia_kg_m2", fmt::format("(smallest eigenvalue {:g})", moments[0]),
                     "a positive definite matrix");
   }
   // A rigid body's second moment of mass Σ = ∫ r rᵀ dm = ½ tr(I) 1 − I is positive semidefinite:
