@@ -14,6 +14,16 @@ Matrix3 ExpSO3(const Vector3& theta) {
   return Matrix3::Identity() + a * K + b * (K * K);
 }
 
+Vector3 LogSO3(const Quaternion& q) {
+  // q = (cos(θ/2), sin(θ/2) u): θ u = 2 atan2(|v|, w) v / |v|, with w >= 0 for the shortest arc.
+  const double sign = q.w() < 0.0 ? -1.0 : 1.0;
+  const Vector3 v = sign * q.vec();
+  const double s = v.norm(), w = sign * q.w();
+  // Below 1e-6 rad atan2(s, w) / s = 1 / w to double precision.
+  const double scale = s < 1e-6 ? 2.0 / w : 2.0 * std::atan2(s, w) / s;
+  return scale * v;
+}
+
 void SinCosOfTurns(double u, double* sin_out, double* cos_out) {
   // u = j / 4 + f with j the nearest quarter and |f| <= 1/8 (both exact: 4 u - j is a difference
   // of nearby doubles), so the angle is j quarter turns plus r = 2 pi f, |r| <= pi / 4, where

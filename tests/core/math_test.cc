@@ -25,6 +25,20 @@ TEST(ExpSO3, MatchesAngleAxisOnBothSidesOfTheSeriesThreshold) {
   }
 }
 
+// The logarithm inverts Eigen's angle-axis rotation (the shortest arc, also for a quaternion
+// with w < 0), from zero to just below pi.
+TEST(LogSO3, InvertsTheAngleAxisRotation) {
+  Rng rng(5);
+  for (const double angle : {0.0, 1e-9, 1e-6, 1e-3, 0.3, 2.0, 3.14}) {
+    for (int k = 0; k < 20; ++k) {
+      const Vector3 axis = Vector3(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1)).normalized();
+      Quaternion q(Eigen::AngleAxisd(angle, axis));
+      if (k % 2) q.coeffs() = -q.coeffs();  // the same rotation
+      EXPECT_LT((LogSO3(q) - angle * axis).norm(), 1e-13) << "angle " << angle;
+    }
+  }
+}
+
 // The vector form against the matrix it stands for, on both sides of the series' threshold.
 TEST(ExpSO3Times, EqualsTheMatrixTimesTheVector) {
   Rng rng(4);

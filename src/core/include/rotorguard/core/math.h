@@ -12,6 +12,8 @@ Matrix3 Skew(const Vector3& a);
 /// The rotation matrix of a rotation vector (SO(3) exponential, Rodrigues). Below 0.05 rad it
 /// takes a series instead of trigonometric calls, exact to double precision there.
 Matrix3 ExpSO3(const Vector3& theta);
+/// The rotation vector of a unit quaternion (SO(3) logarithm), the shortest arc: |result| <= pi.
+Vector3 LogSO3(const Quaternion& q);
 namespace internal {
 /// a = sin|θ| / |θ| and b = (1 - cos|θ|) / |θ|^2 of Rodrigues' formula from t2 = |θ|^2; below
 /// 0.05 rad the series to |θ|^6, which leaves terms below 1e-16.

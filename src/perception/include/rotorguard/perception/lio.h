@@ -1,0 +1,231 @@
+#pragma once
+/// LiDAR-inertial odometry: the stack's own pose from its LiDAR frames and IMU samples, after
+/// FAST-LIO2 (Xu et al., T-RO 2022), which paper 000's vehicle flies on.
+///
+/// An iterated error-state Kalman filter on the state of the IMU's mounting point
+///   x = (p, R, v, b_g, b_a)   position, attitude (body to world), velocity, gyro and accelerometer biases,
+/// error state δx = (δp, δθ, δv, δb_g, δb_a) with R = R̂ Exp(δθ) (15 dimensions).
+/// - Propagation at every IMU sample (the mean of two consecutive samples held over their interval):
+///     ω = ω_m − b_g,  a = R (f_m − b_a) + g,  p ← p + v dt + ½ a dt²,  v ← v + a dt,  R ← R Exp(ω dt),
+///   and P ← F P Fᵀ + Q with the IMU's noise densities (FAST-LIO2 eqs. 2-8).
+/// - Every LiDAR point is moved to the IMU frame at its frame's end through the poses the
+///   propagation passed (backward propagation, FAST-LIO2 Sec. IV-C), the frame down-sampled on a
+///   voxel grid, then registered to the map: each point's five nearest map points define a plane
+///   (n, d) and the residual is n·(p + R q) + d (point to plane).
+/// - The update is iterated (FAST-LIO2 eq. 18, a Gauss-Newton on the MAP cost): at the k-th
+///   iterate x_k with e_k = x_k ⊟ x̂,
+///     (P⁻¹ + Hᵀ R⁻¹ H) δ = −P⁻¹ e_k − Hᵀ R⁻¹ r_k,   x_{k+1} = x_k ⊞ δ,
+///   the neighbours searched again at each iterate, until |δ| is small; then P ← (P⁻¹ + Hᵀ R⁻¹ H)⁻¹.
+///   Directions the frame does not constrain (a corridor, open ground) keep the prior there, so
+///   the estimate rests on the IMU along them while its covariance grows.
+/// - The registered points go into the map (PointMap), which follows the vehicle.
+///
+/// The world frame is the one the stack starts in: its z axis is up (gravity (0, 0, −g), g known),
+/// its origin and yaw the start pose's. So gravity is not a state (FAST-LIO2 estimates its
+/// direction because its world frame is the first IMU frame); the start's tilt is measured at
+/// rest (Initialise).
+///
+/// Timing: LiDAR frames arrive after their end, IMU samples as they are measured. The filter
+/// stays at the last frame's end with the later samples queued; each frame first takes the filter
+/// through the queued samples up to its end. The estimate (Estimate) is the filter propagated
+/// through the whole queue, updated at every sample.
+#include <deque>
+#include <vector>
+
+#include "rotorguard/core/config_schema.h"
+#include "rotorguard/core/messages.h"
+#include "rotorguard/perception/point_map.h"
+
+namespace rotorguard::perception {
+
+struct LioOptions {
+  /// Mounting points relative to the centre of gravity, body frame, axes aligned with it [m]:
+  /// hardware facts (the stack sets them from the vehicle's sensors).
+  Vector3 imu_position_m = Vector3::Zero();
+  Vector3 lidar_position_m = Vector3(0.0, 0.0, 0.06);
+  /// The noise the filter assumes, continuous-time densities. The accelerometer's is the
+  /// airframe's vibration (a few tenths of m/s² at the rotor frequencies) more than the sensor's.
+  double accel_noise_density = 0.1;        ///< [m/s²/√Hz], > 0
+  double gyro_noise_density = 2.0e-3;      ///< [rad/s/√Hz], > 0
+  double accel_bias_random_walk = 1.0e-3;  ///< [m/s³/√Hz], > 0
+  double gyro_bias_random_walk = 1.0e-4;   ///< [rad/s²/√Hz], > 0
+  /// Prior stds at the start: biases, and the start pose and velocity.
+  double accel_bias_initial = 0.05;        ///< [m/s²], > 0
+  double gyro_bias_initial = 5.0e-3;       ///< [rad/s], > 0
+  double initial_position_std_m = 0.01;    ///< > 0
+  double initial_attitude_std_rad = 0.01;  ///< > 0
+  double initial_velocity_std_m_s = 0.05;  ///< > 0
+  /// IMU samples averaged at the start for the tilt (from the specific force) and the gyro bias
+  /// (when the vehicle is at rest), in [1, 1000].
+  int initial_samples = 15;
+  /// A frame's points nearer than this to the sensor are dropped (the airframe, the propellers) [m], >= 0.
+  double min_range_m = 0.3;
+  /// The frame's down-sampling grid [m], in [0.05, 5]: one point per cell, the one nearest its centre.
+  double frame_voxel_m = 0.4;
+  /// Map points a plane is fitted to, in [3, 16]; the plane is kept when each lies within
+  /// plane_tolerance_m of it (> 0), and when the farthest lies within PointMapOptions::voxel_m.
+  int plane_points = 5;
+  double plane_tolerance_m = 0.1;
+  /// A point whose residual exceeds this [m] (> 0) is left out of the update (an outlier: a new
+  /// surface, a moving object).
+  double max_residual_m = 0.5;
+  /// The std of a point-to-plane residual [m], > 0: the range noise and the surfaces' roughness.
+  double point_std_m = 0.05;
+  /// Iterated update: at most max_iterations (in [1, 20]), stopping once the step is below
+  /// convergence_m in position and convergence_rad in attitude.
+  int max_iterations = 5;
+  double convergence_m = 1e-3;
+  double convergence_rad = 1e-3;
+  /// A frame with fewer matched points than this (>= 6) is not used: the IMU carries the estimate.
+  int min_points = 30;
+  /// A frame is degenerate when the position std along its weakest direction, from the frame's
+  /// points alone, exceeds this [m] (> 0): 1 / sqrt(the least eigenvalue of their information).
+  double degenerate_std_m = 0.05;
+  /// IMU samples queued without a frame are taken into the filter once older than this [s], > 0
+  /// (the LiDAR is late or has stopped: the IMU alone carries the filter on).
+  double max_queue_s = 0.3;
+  /// Map pruning runs every this many frames, >= 1.
+  int prune_every_frames = 10;
+  PointMapOptions map;
+
+  /// Throws ValidationError naming the field.
+  void Validate() const;
+  template <typename Archive>
+  void Serialize(Archive* a);
+};
+
+/// What one frame did to the filter: the LiDAR odometry's health.
+struct LioFrameSummary {
+  TimeNs t_ns = 0;          ///< the frame's end
+  bool used = false;        ///< the update ran (enough matched points, the filter initialised)
+  bool degenerate = false;  ///< the frame left a direction unconstrained (degenerate_std_m)
+  int points = 0;           ///< the frame's returns
+  int points_downsampled = 0;
+  int points_matched = 0;  ///< with a plane and a residual within max_residual_m, at the last iterate
+  int iterations = 0;
+  double residual_rms_m = 0.0;  ///< over the matched points, at the last iterate
+  /// 1 / sqrt of the least eigenvalue of the position block of the frame's information [m]
+  /// (infinity when no point matched).
+  double weakest_std_m = 0.0;
+  int map_points_added = 0;
+  long map_points = 0;
+};
+
+/// The filter's state of the IMU's mounting point.
+struct LioState {
+  TimeNs t_ns = 0;
+  Vector3 p_W = Vector3::Zero();
+  Quaternion q_WB = Quaternion::Identity();
+  Vector3 v_W = Vector3::Zero();
+  Vector3 gyro_bias = Vector3::Zero();
+  Vector3 accel_bias = Vector3::Zero();
+};
+
+using LioMatrix15 = Eigen::Matrix<double, 15, 15>;
+
+namespace internal {
+/// One propagation step (the filter's mean and its error-state transition): `x` carried over dt
+/// with the IMU measurement (f_m, w_m) held, into `next`; F = ∂δx_next/∂δx into `F` if not null.
+void LioTransition(const LioState& x, const Vector3& f_m, const Vector3& w_m, double dt, LioState* next,
+                   LioMatrix15* F);
+/// The row of ∂r/∂(δp, δθ) of the point-to-plane residual r = n·(p + R q) + d, R = R̂ Exp(δθ).
+Eigen::Matrix<double, 1, 6> PointToPlaneJacobian(const Vector3& n, const Matrix3& R, const Vector3& q);
+}  // namespace internal
+
+class Lio {
+ public:
+  using Matrix15 = LioMatrix15;
+  using Vector15 = Eigen::Matrix<double, 15, 1>;
+
+  /// `start_position_W` and `start_yaw_rad`: the body's (centre of gravity's) pose at the start,
+  /// which defines the world frame; the vehicle is at rest there.
+  Lio(const LioOptions& options, const Vector3& start_position_W, double start_yaw_rad);
+
+  /// Takes one IMU sample (non-finite or out-of-order samples are ignored).
+  void OnImu(const ImuSample& imu);
+  /// Registers one frame and adds it to the map. A frame that ends before the filter's time (it
+  /// came too late) or before the filter is initialised is counted and not used.
+  LioFrameSummary OnFrame(const LidarFrame& frame);
+
+  bool initialised() const { return initialised_; }
+  /// The estimate at the newest IMU sample, of the body: position and velocity of the centre of
+  /// gravity, bias-corrected body rates. Not valid before initialisation.
+  StateEstimate Estimate() const;
+  /// The filter's state at the newest IMU sample, and its covariance.
+  const LioState& state() const { return head_; }
+  const Matrix15& covariance() const { return head_P_; }
+  const PointMap& map() const { return map_; }
+  const LioOptions& options() const { return options_; }
+
+ private:
+  /// A propagated pose the deskewing interpolates from.
+  struct Pose {
+    TimeNs t_ns;
+    Vector3 p, v, a_W, w;  // a_W and w: held from t_ns to the next pose
+    Matrix3 R;
+  };
+  void Initialise();
+  /// Propagates (x, P) from x->t_ns to t_ns with the measurement (f, w) held; P if not null,
+  /// the pose at the start of the step into `poses` if not null.
+  void Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix15* P,
+                 std::vector<Pose>* poses) const;
+  /// Takes the filter through the queued samples up to t_ns (the last interval held to t_ns).
+  void AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses);
+  /// The head: the filter through the whole queue.
+  void RebuildHead();
+  /// Points of the frame in the IMU frame at its end, deskewed and down-sampled.
+  void DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Vector3>* out,
+                           LioFrameSummary* summary) const;
+  /// The iterated update with the deskewed points; false if too few matched.
+  void Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary);
+
+  LioOptions options_;
+  Vector3 start_position_W_;
+  double start_yaw_rad_;
+  Vector3 lidar_in_imu_;  ///< the LiDAR's position in the IMU frame (axes aligned)
+  PointMap map_;
+  bool initialised_ = false;
+  std::vector<ImuSample> initial_samples_;
+  LioState filter_;
+  Matrix15 filter_P_ = Matrix15::Zero();
+  ImuSample filter_imu_;         ///< the last sample the filter took (held beyond it)
+  std::deque<ImuSample> queue_;  ///< samples after the filter's time, oldest first
+  LioState head_;
+  Matrix15 head_P_ = Matrix15::Zero();
+  ImuSample head_imu_;
+  bool map_started_ = false;
+  int frames_ = 0;
+  // Scratch kept across frames (no allocation per frame once warm).
+  std::vector<Pose> poses_;
+  std::vector<Vector3> points_, neighbours_;
+};
+
+template <typename Archive>
+void LioOptions::Serialize(Archive* a) {
+  a->Visit("accel_noise_density", &accel_noise_density,
+           {.meaning = "accelerometer noise the filter assumes, vibration included [m/s²/√Hz]", .positive = true});
+  a->Visit("gyro_noise_density", &gyro_noise_density,
+           {.meaning = "gyro noise the filter assumes [rad/s/√Hz]", .positive = true});
+  a->Visit("accel_bias_random_walk", &accel_bias_random_walk, {.meaning = "[m/s³/√Hz]", .positive = true});
+  a->Visit("gyro_bias_random_walk", &gyro_bias_random_walk, {.meaning = "[rad/s²/√Hz]", .positive = true});
+  a->Visit("accel_bias_initial", &accel_bias_initial,
+           {.meaning = "prior std of the accelerometer bias [m/s²]", .positive = true});
+  a->Visit("gyro_bias_initial", &gyro_bias_initial,
+           {.meaning = "prior std of the gyro bias [rad/s]", .positive = true});
+  a->Visit("min_range_m", &min_range_m, {.meaning = "nearer returns are dropped (the airframe) [m]"});
+  a->Visit("frame_voxel_m", &frame_voxel_m, {.meaning = "a frame keeps one point per cell of this edge [m]"});
+  a->Visit("plane_tolerance_m", &plane_tolerance_m,
+           {.meaning = "a plane's points lie within this of it [m]", .positive = true});
+  a->Visit("max_residual_m", &max_residual_m,
+           {.meaning = "larger point-to-plane residuals are outliers [m]", .positive = true});
+  a->Visit("point_std_m", &point_std_m, {.meaning = "std of a point-to-plane residual [m]", .positive = true});
+  a->Visit("max_iterations", &max_iterations, {.meaning = "iterations of the update", .min = 1, .max = 20});
+  a->Visit("min_points", &min_points,
+           {.meaning = "a frame with fewer matched points is not used", .min = 6, .max = 100000});
+  a->Visit("degenerate_std_m", &degenerate_std_m,
+           {.meaning = "a frame is degenerate when its weakest direction's position std exceeds this [m]",
+            .positive = true});
+  a->Visit("map", &map, {.meaning = "the odometry's point map"});
+}
+
+}  // namespace rotorguard::perception

@@ -1,0 +1,382 @@
+#include "rotorguard/perception/lio.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
+
+namespace rotorguard::perception {
+
+namespace {
+// The error state's blocks.
+constexpr int kP = 0, kTheta = 3, kV = 6, kBg = 9, kBa = 12;
+const Vector3 kGravityW(0.0, 0.0, -kGravity);
+}  // namespace
+
+void LioOptions::Validate() const {
+  const auto require = [](bool ok, const char* key, double value, const char* rule) {
+    if (!ok) ThrowValidation("LioOptions", key, value, rule);
+  };
+  const auto positive = [&](double v, const char* key) { require(std::isfinite(v) && v > 0.0, key, v, "a value > 0"); };
+  if (!imu_position_m.allFinite()) ThrowValidation("LioOptions", "imu_position_m", "(non-finite)", "finite numbers");
+  if (!lidar_position_m.allFinite())
+    ThrowValidation("LioOptions", "lidar_position_m", "(non-finite)", "finite numbers");
+  positive(accel_noise_density, "accel_noise_density");
+  positive(gyro_noise_density, "gyro_noise_density");
+  positive(accel_bias_random_walk, "accel_bias_random_walk");
+  positive(gyro_bias_random_walk, "gyro_bias_random_walk");
+  positive(accel_bias_initial, "accel_bias_initial");
+  positive(gyro_bias_initial, "gyro_bias_initial");
+  positive(initial_position_std_m, "initial_position_std_m");
+  positive(initial_attitude_std_rad, "initial_attitude_std_rad");
+  positive(initial_velocity_std_m_s, "initial_velocity_std_m_s");
+  require(initial_samples >= 1 && initial_samples <= 1000, "initial_samples", initial_samples, "a count in [1, 1000]");
+  require(std::isfinite(min_range_m) && min_range_m >= 0.0, "min_range_m", min_range_m, "a range >= 0 m");
+  require(std::isfinite(frame_voxel_m) && frame_voxel_m >= 0.05 && frame_voxel_m <= 5.0, "frame_voxel_m", frame_voxel_m,
+          "an edge in [0.05, 5] m");
+  require(plane_points >= 3 && plane_points <= 16, "plane_points", plane_points, "a count in [3, 16]");
+  positive(plane_tolerance_m, "plane_tolerance_m");
+  positive(max_residual_m, "max_residual_m");
+  positive(point_std_m, "point_std_m");
+  require(max_iterations >= 1 && max_iterations <= 20, "max_iterations", max_iterations, "a count in [1, 20]");
+  positive(convergence_m, "convergence_m");
+  positive(convergence_rad, "convergence_rad");
+  require(min_points >= 6, "min_points", min_points, "a count >= 6");
+  positive(degenerate_std_m, "degenerate_std_m");
+  positive(max_queue_s, "max_queue_s");
+  require(prune_every_frames >= 1, "prune_every_frames", prune_every_frames, "a count >= 1");
+  map.Validate();
+}
+
+Lio::Lio(const LioOptions& options, const Vector3& start_position_W, double start_yaw_rad)
+    : options_(options),
+      start_position_W_(start_position_W),
+      start_yaw_rad_(start_yaw_rad),
+      lidar_in_imu_(options.lidar_position_m - options.imu_position_m),
+      map_(options.map) {
+  options_.Validate();
+  if (!start_position_W.allFinite() || !std::isfinite(start_yaw_rad)) {
+    ThrowValidation("Lio", "start pose", "(non-finite)", "finite numbers");
+  }
+}
+
+void Lio::Initialise() {
+  // At rest the accelerometer reads −g in the body frame plus its bias: its mean gives the tilt
+  // (the bias's part across gravity is indistinguishable from a tilt and is left to the filter),
+  // the gyro's mean its bias. Moving, the means are not these, and the start is taken level.
+  Vector3 f = Vector3::Zero(), w = Vector3::Zero();
+  for (const ImuSample& s : initial_samples_) {
+    f += s.specific_force_B;
+    w += s.w_B;
+  }
+  f /= static_cast<double>(initial_samples_.size());
+  w /= static_cast<double>(initial_samples_.size());
+  const bool at_rest = w.norm() < 0.05 && std::abs(f.norm() - kGravity) < 0.5;
+  // The attitude: yaw from the start pose, tilt rotating the measured up onto the world's up.
+  Quaternion q = QuaternionFromYaw(start_yaw_rad_);
+  if (at_rest) {
+    const Vector3 up_B = f.normalized();
+    // Tilt about a horizontal axis (in the yawed frame) taking body up to world up.
+    const Quaternion tilt = Quaternion::FromTwoVectors(up_B, Vector3::UnitZ());
+    // q_WB = R_z(ψ) * tilt, with the tilt's own yaw removed so that the start yaw holds.
+    const Quaternion level_tilt = QuaternionFromYaw(-YawOf(tilt)) * tilt;
+    q = (QuaternionFromYaw(start_yaw_rad_) * level_tilt).normalized();
+  }
+  filter_ = LioState{};
+  filter_.t_ns = initial_samples_.back().t_ns;
+  filter_.q_WB = q;
+  filter_.p_W = start_position_W_ + q * options_.imu_position_m;
+  filter_.gyro_bias = at_rest ? w : Vector3::Zero();
+  filter_P_.setZero();
+  filter_P_.block<3, 3>(kP, kP).diagonal().setConstant(std::pow(options_.initial_position_std_m, 2));
+  filter_P_.block<3, 3>(kTheta, kTheta).diagonal().setConstant(std::pow(options_.initial_attitude_std_rad, 2));
+  filter_P_.block<3, 3>(kV, kV).diagonal().setConstant(std::pow(options_.initial_velocity_std_m_s, 2));
+  filter_P_.block<3, 3>(kBg, kBg).diagonal().setConstant(std::pow(options_.gyro_bias_initial, 2));
+  filter_P_.block<3, 3>(kBa, kBa).diagonal().setConstant(std::pow(options_.accel_bias_initial, 2));
+  filter_imu_ = initial_samples_.back();
+  initial_samples_.clear();
+  initial_samples_.shrink_to_fit();
+  initialised_ = true;
+  RebuildHead();
+}
+
+namespace internal {
+
+void LioTransition(const LioState& x, const Vector3& f_m, const Vector3& w_m, double dt, LioState* next,
+                   LioMatrix15* F) {
+  const Vector3 w = w_m - x.gyro_bias;
+  const Vector3 f = f_m - x.accel_bias;
+  const Matrix3 R = x.q_WB.toRotationMatrix();
+  const Vector3 a = R * f + kGravityW;
+  if (F) {
+    // δp' = δp + δv dt,  δθ' = Exp(−ω dt) δθ − δb_g dt,  δv' = δv − R [f]× δθ dt − R δb_a dt
+    // (first order in dt; the biases are random walks).
+    F->setIdentity();
+    F->block<3, 3>(kP, kV) = Matrix3::Identity() * dt;
+    F->block<3, 3>(kTheta, kTheta) = ExpSO3(-w * dt);
+    F->block<3, 3>(kTheta, kBg) = -Matrix3::Identity() * dt;
+    F->block<3, 3>(kV, kTheta) = -R * Skew(f) * dt;
+    F->block<3, 3>(kV, kBa) = -R * dt;
+  }
+  *next = x;
+  next->p_W += x.v_W * dt + 0.5 * a * dt * dt;
+  next->v_W += a * dt;
+  next->q_WB = (x.q_WB * Quaternion(ExpSO3(w * dt))).normalized();
+}
+
+Eigen::Matrix<double, 1, 6> PointToPlaneJacobian(const Vector3& n, const Matrix3& R, const Vector3& q) {
+  // R Exp(δθ) q ≈ R q + R (δθ × q) = R q − R [q]× δθ.
+  Eigen::Matrix<double, 1, 6> h;
+  h.head<3>() = n.transpose();
+  h.tail<3>() = -(n.transpose() * R * Skew(q));
+  return h;
+}
+
+}  // namespace internal
+
+void Lio::Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix15* P,
+                    std::vector<Pose>* poses) const {
+  const double dt = ToSeconds(t_ns - x->t_ns);
+  if (dt <= 0.0) return;
+  if (poses) {
+    const Matrix3 R = x->q_WB.toRotationMatrix();
+    poses->push_back({x->t_ns, x->p_W, x->v_W, R * (f_m - x->accel_bias) + kGravityW, w_m - x->gyro_bias, R});
+  }
+  Matrix15 F;
+  LioState next;
+  internal::LioTransition(*x, f_m, w_m, dt, &next, P ? &F : nullptr);
+  if (P) {
+    Matrix15 Pn = F * (*P) * F.transpose();
+    // White noise densities integrate to variances σ² dt; the bias walks likewise.
+    Pn.block<3, 3>(kTheta, kTheta).diagonal().array() += std::pow(options_.gyro_noise_density, 2) * dt;
+    Pn.block<3, 3>(kV, kV).diagonal().array() += std::pow(options_.accel_noise_density, 2) * dt;
+    Pn.block<3, 3>(kBg, kBg).diagonal().array() += std::pow(options_.gyro_bias_random_walk, 2) * dt;
+    Pn.block<3, 3>(kBa, kBa).diagonal().array() += std::pow(options_.accel_bias_random_walk, 2) * dt;
+    *P = 0.5 * (Pn + Pn.transpose());
+  }
+  *x = next;
+  x->t_ns = t_ns;
+}
+
+void Lio::OnImu(const ImuSample& imu) {
+  if (!imu.w_B.allFinite() || !imu.specific_force_B.allFinite()) return;
+  if (!initialised_) {
+    if (!initial_samples_.empty() && imu.t_ns <= initial_samples_.back().t_ns) return;
+    initial_samples_.push_back(imu);
+    if (static_cast<int>(initial_samples_.size()) >= options_.initial_samples) Initialise();
+    return;
+  }
+  if (imu.t_ns <= head_imu_.t_ns) return;
+  queue_.push_back(imu);
+  // Each interval takes the mean of its two samples (second order in the rates' change).
+  Propagate(0.5 * (head_imu_.specific_force_B + imu.specific_force_B), 0.5 * (head_imu_.w_B + imu.w_B), imu.t_ns,
+            &head_, &head_P_, nullptr);
+  head_imu_ = imu;
+  // Without frames the filter follows the IMU alone, so that the queue stays short.
+  const TimeNs keep = FromSeconds(options_.max_queue_s);
+  if (imu.t_ns - queue_.front().t_ns > keep) AdvanceFilter(imu.t_ns - keep, nullptr);
+}
+
+void Lio::AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses) {
+  while (!queue_.empty() && queue_.front().t_ns <= t_ns) {
+    const ImuSample& s = queue_.front();
+    Propagate(0.5 * (filter_imu_.specific_force_B + s.specific_force_B), 0.5 * (filter_imu_.w_B + s.w_B), s.t_ns,
+              &filter_, &filter_P_, poses);
+    filter_imu_ = s;
+    queue_.pop_front();
+  }
+  // The rest of the way on the last sample (the next one is not measured yet, or lies beyond).
+  Propagate(filter_imu_.specific_force_B, filter_imu_.w_B, t_ns, &filter_, &filter_P_, poses);
+}
+
+void Lio::RebuildHead() {
+  head_ = filter_;
+  head_P_ = filter_P_;
+  ImuSample previous = filter_imu_;
+  for (const ImuSample& s : queue_) {
+    Propagate(0.5 * (previous.specific_force_B + s.specific_force_B), 0.5 * (previous.w_B + s.w_B), s.t_ns, &head_,
+              &head_P_, nullptr);
+    previous = s;
+  }
+  head_imu_ = previous;
+}
+
+StateEstimate Lio::Estimate() const {
+  StateEstimate e;
+  e.t_ns = head_.t_ns;
+  e.valid = initialised_;
+  const Matrix3 R = head_.q_WB.toRotationMatrix();
+  const Vector3 w = head_imu_.w_B - head_.gyro_bias;
+  const Vector3& l = options_.imu_position_m;
+  e.p_W = head_.p_W - R * l;
+  e.q_WB = head_.q_WB;
+  e.v_W = head_.v_W - R * w.cross(l);
+  e.w_B = w;
+  return e;
+}
+
+void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Vector3>* out,
+                              LioFrameSummary* summary) const {
+  // Each point to the IMU frame at the frame's end: q = R_eᵀ (R_j (t_IL + s) + p_j − p_e), the
+  // pose at its time from the last propagated pose before it, its rate and acceleration held.
+  const Matrix3 R_end_T = filter_.q_WB.toRotationMatrix().transpose();
+  const Vector3& p_end = filter_.p_W;
+  const double cell = options_.frame_voxel_m, min_range2 = options_.min_range_m * options_.min_range_m;
+  // One point per down-sampling cell: the one nearest the cell's centre (in the sensor frame at
+  // the frame's end, where the map sees them).
+  struct Best {
+    double d2;
+    Vector3 q;
+  };
+  std::unordered_map<std::uint64_t, Best> cells;
+  cells.reserve(frame.points_S.size() / 4 + 16);
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < frame.points_S.size(); ++i) {
+    const Vector3 s = frame.points_S[i].cast<double>();
+    if (!s.allFinite() || s.squaredNorm() < min_range2) continue;
+    const TimeNs t = frame.t_start_ns + static_cast<TimeNs>(frame.offset_ns[i]);
+    if (poses.empty()) continue;
+    // The frame's points come in time order: step the pose forward, back only if needed.
+    while (k + 1 < poses.size() && poses[k + 1].t_ns <= t) ++k;
+    while (k > 0 && poses[k].t_ns > t) --k;
+    const Pose& a = poses[k];
+    const double dt = ToSeconds(t - a.t_ns);
+    const Vector3 p = a.p + a.v * dt + 0.5 * a.a_W * dt * dt;
+    const Vector3 q = R_end_T * (a.R * ExpSO3Times(a.w * dt, lidar_in_imu_ + s) + p - p_end);
+    const Vector3 scaled = q / cell;
+    const Eigen::Vector3d fl = scaled.array().floor();
+    const Eigen::Vector3i c = fl.cast<int>();
+    const double d2 = (scaled - fl - Vector3::Constant(0.5)).squaredNorm();
+    const std::uint64_t key = (static_cast<std::uint64_t>(c.x() & 0x1FFFFF) << 42) |
+                              (static_cast<std::uint64_t>(c.y() & 0x1FFFFF) << 21) |
+                              static_cast<std::uint64_t>(c.z() & 0x1FFFFF);
+    auto [it, inserted] = cells.try_emplace(key, Best{d2, q});
+    if (!inserted && d2 < it->second.d2) it->second = Best{d2, q};
+  }
+  out->clear();
+  out->reserve(cells.size());
+  for (const auto& [key, best] : cells) out->push_back(best.q);
+  // The hash's order depends on the library; a sorted frame makes the update's sums reproducible.
+  std::sort(out->begin(), out->end(), [](const Vector3& a, const Vector3& b) {
+    return std::tie(a.x(), a.y(), a.z()) < std::tie(b.x(), b.y(), b.z());
+  });
+  summary->points_downsampled = static_cast<int>(out->size());
+}
+
+void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary) {
+  const LioState prior = filter_;
+  const Eigen::LDLT<Matrix15> prior_factor(filter_P_);
+  const Matrix15 P_inv = prior_factor.solve(Matrix15::Identity());
+  const double inv_var = 1.0 / (options_.point_std_m * options_.point_std_m);
+  LioState x = prior;
+  Eigen::Matrix<double, 6, 6> HtH;
+  Matrix15 A;
+  bool used = false;
+  for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
+    summary->iterations = iteration;
+    HtH.setZero();
+    Eigen::Matrix<double, 6, 1> Htr = Eigen::Matrix<double, 6, 1>::Zero();
+    const Matrix3 R = x.q_WB.toRotationMatrix();
+    int matched = 0;
+    double sum_r2 = 0.0;
+    for (const Vector3& q : points_I) {
+      const Vector3 w = x.p_W + R * q;
+      if (map_.Nearest(w, options_.plane_points, options_.map.voxel_m, &neighbours_) < options_.plane_points) continue;
+      // The plane through the neighbours: their centroid, and the normal along the least
+      // eigenvector of their scatter (any plane, the world origin's too).
+      Vector3 centroid = Vector3::Zero();
+      for (const Vector3& y : neighbours_) centroid += y;
+      centroid /= static_cast<double>(neighbours_.size());
+      Matrix3 scatter = Matrix3::Zero();
+      for (const Vector3& y : neighbours_) scatter.noalias() += (y - centroid) * (y - centroid).transpose();
+      Eigen::SelfAdjointEigenSolver<Matrix3> plane;
+      plane.computeDirect(scatter);
+      const Vector3 n = plane.eigenvectors().col(0);
+      const double d = -n.dot(centroid);
+      bool planar = true;
+      for (const Vector3& y : neighbours_) planar = planar && std::abs(n.dot(y) + d) <= options_.plane_tolerance_m;
+      if (!planar) continue;
+      const double r = n.dot(w) + d;
+      if (!(std::abs(r) <= options_.max_residual_m)) continue;
+      const Eigen::Matrix<double, 6, 1> h = internal::PointToPlaneJacobian(n, R, q).transpose();
+      HtH.noalias() += h * h.transpose();
+      Htr += h * r;
+      sum_r2 += r * r;
+      ++matched;
+    }
+    summary->points_matched = matched;
+    summary->residual_rms_m = matched > 0 ? std::sqrt(sum_r2 / matched) : 0.0;
+    if (matched < options_.min_points) break;
+    used = true;
+    // e = x ⊟ x̂ and the Gauss-Newton step of the MAP cost.
+    Vector15 e;
+    e.segment<3>(kP) = x.p_W - prior.p_W;
+    e.segment<3>(kTheta) = LogSO3(prior.q_WB.conjugate() * x.q_WB);
+    e.segment<3>(kV) = x.v_W - prior.v_W;
+    e.segment<3>(kBg) = x.gyro_bias - prior.gyro_bias;
+    e.segment<3>(kBa) = x.accel_bias - prior.accel_bias;
+    A = P_inv;
+    A.topLeftCorner<6, 6>() += inv_var * HtH;
+    Vector15 b = -P_inv * e;
+    b.head<6>() -= inv_var * Htr;
+    const Vector15 delta = A.ldlt().solve(b);
+    if (!delta.allFinite()) {
+      used = false;
+      break;
+    }
+    x.p_W += delta.segment<3>(kP);
+    x.q_WB = (x.q_WB * Quaternion(ExpSO3(delta.segment<3>(kTheta)))).normalized();
+    x.v_W += delta.segment<3>(kV);
+    x.gyro_bias += delta.segment<3>(kBg);
+    x.accel_bias += delta.segment<3>(kBa);
+    if (delta.segment<3>(kP).norm() < options_.convergence_m &&
+        delta.segment<3>(kTheta).norm() < options_.convergence_rad) {
+      break;
+    }
+  }
+  // Health: the position information of the frame's points alone (the Schur complement over the
+  // attitude would be stricter; the position block is what a corridor or open ground leaves weak).
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(inv_var * HtH.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
+  const double least = eig.eigenvalues()(0);
+  summary->weakest_std_m = least > 0.0 ? 1.0 / std::sqrt(least) : std::numeric_limits<double>::infinity();
+  summary->degenerate = summary->weakest_std_m > options_.degenerate_std_m;
+  summary->used = used;
+  if (!used) return;
+  filter_ = x;
+  const Matrix15 P = A.ldlt().solve(Matrix15::Identity());
+  filter_P_ = 0.5 * (P + P.transpose());
+}
+
+LioFrameSummary Lio::OnFrame(const LidarFrame& frame) {
+  LioFrameSummary summary;
+  summary.t_ns = frame.t_end_ns;
+  summary.points = static_cast<int>(frame.points_S.size());
+  summary.map_points = map_.size();
+  if (!initialised_ || frame.t_end_ns <= filter_.t_ns || frame.offset_ns.size() != frame.points_S.size()) {
+    return summary;
+  }
+  // The poses the deskewing needs run from the frame's start; the filter is at the last frame's
+  // end (or later, when the queue overflowed: those points use the first pose, extrapolated).
+  poses_.clear();
+  AdvanceFilter(frame.t_end_ns, &poses_);
+  DeskewAndDownsample(frame, poses_, &points_, &summary);
+  if (map_started_) Update(points_, &summary);
+  // The frame's points, placed with the (updated) pose, extend the map.
+  const Matrix3 R = filter_.q_WB.toRotationMatrix();
+  for (Vector3& q : points_) q = filter_.p_W + R * q;
+  if (!map_started_ || summary.used) {
+    summary.map_points_added = map_.Insert(points_);
+    map_started_ = true;
+  }
+  if (++frames_ % options_.prune_every_frames == 0) map_.Prune(filter_.p_W);
+  summary.map_points = map_.size();
+  RebuildHead();
+  return summary;
+}
+
+}  // namespace rotorguard::perception

@@ -1,0 +1,114 @@
+#include "rotorguard/perception/point_map.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+
+namespace rotorguard::perception {
+namespace {
+
+std::vector<Vector3> RandomPoints(int n, double half_extent, std::uint64_t seed) {
+  Rng rng(seed);
+  std::vector<Vector3> points;
+  for (int i = 0; i < n; ++i) {
+    points.emplace_back(rng.Uniform(-half_extent, half_extent), rng.Uniform(-half_extent, half_extent),
+                        rng.Uniform(-half_extent, half_extent));
+  }
+  return points;
+}
+
+// Within a voxel edge the neighbour search is exact: against a brute-force search over every
+// point (all stored: no spacing, room in every voxel), the same points in the same order, for
+// queries anywhere, on voxel corners included.
+TEST(PointMap, NearestNeighboursWithinAVoxelEdgeMatchABruteForceSearch) {
+  PointMapOptions o;
+  o.voxel_m = 0.5;
+  o.min_point_spacing_m = 0.0;
+  o.max_points_per_voxel = 32;
+  PointMap map(o);
+  const std::vector<Vector3> points = RandomPoints(4000, 2.0, 1);  // ~2 points per voxel: nothing refused
+  ASSERT_EQ(map.Insert(points), 4000);
+  EXPECT_EQ(map.size(), 4000);
+  Rng rng(2);
+  std::vector<Vector3> found;
+  std::vector<double> d2;
+  for (int trial = 0; trial < 500; ++trial) {
+    Vector3 q(rng.Uniform(-2, 2), rng.Uniform(-2, 2), rng.Uniform(-2, 2));
+    if (trial % 5 == 0) q = (q / 0.5).array().round().matrix() * 0.5;  // on a voxel corner
+    const double radius = rng.Uniform(0.1, 0.5);
+    const int k = 1 + trial % 8;
+    std::vector<std::pair<double, Vector3>> brute;
+    for (const Vector3& p : points) {
+      const double d = (p.cast<float>().cast<double>() - q).squaredNorm();
+      if (d <= radius * radius) brute.push_back({d, p.cast<float>().cast<double>()});
+    }
+    std::sort(brute.begin(), brute.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const int n = map.Nearest(q, k, radius, &found, &d2);
+    ASSERT_EQ(n, std::min<int>(k, static_cast<int>(brute.size()))) << "trial " << trial;
+    for (int i = 0; i < n; ++i) {
+      EXPECT_NEAR(d2[i], brute[i].first, 1e-5) << "trial " << trial << " neighbour " << i;
+      EXPECT_LT((found[i] - brute[i].second).norm(), 1e-6);
+    }
+  }
+}
+
+// The down-sampling on the map: a point within the spacing of one its voxel holds is refused, a
+// full voxel refuses everything, and inserting the same surface again adds nothing.
+TEST(PointMap, RefusesPointsTooCloseToStoredOnesAndBeyondAVoxelsCapacity) {
+  PointMapOptions o;
+  o.voxel_m = 1.0;
+  o.min_point_spacing_m = 0.1;
+  o.max_points_per_voxel = 3;
+  PointMap map(o);
+  EXPECT_EQ(map.Insert({Vector3(0.5, 0.5, 0.5), Vector3(0.55, 0.5, 0.5), Vector3(0.7, 0.5, 0.5)}), 2);
+  EXPECT_EQ(map.Insert({Vector3(0.2, 0.2, 0.2), Vector3(0.9, 0.9, 0.9)}), 1);  // the voxel is full
+  EXPECT_EQ(map.Insert({Vector3(1.5, 0.5, 0.5)}), 1);                          // the next voxel
+  EXPECT_EQ(map.size(), 4);
+  const std::vector<Vector3> surface = RandomPoints(500, 3.0, 3);
+  PointMap fresh(PointMapOptions{});
+  const int first = fresh.Insert(surface);
+  EXPECT_GT(first, 0);
+  EXPECT_EQ(fresh.Insert(surface), 0);
+  EXPECT_EQ(fresh.size(), first);
+}
+
+// Pruning deletes exactly the voxels whose centre lies beyond the window, and the search still
+// finds what remains (the swap-remove keeps the index consistent).
+TEST(PointMap, PruningKeepsTheVoxelsWithinTheWindowAndTheirNeighbours) {
+  PointMapOptions o;
+  o.voxel_m = 0.5;
+  o.min_point_spacing_m = 0.0;
+  o.window_radius_m = 3.0;
+  PointMap map(o);
+  std::vector<Vector3> line;
+  for (int i = -40; i < 40; ++i) line.emplace_back(0.25 + 0.5 * i, 0.25, 0.25);  // one point per voxel centre
+  map.Insert(line);
+  const Vector3 centre(1.0, 0.0, 0.0);
+  int kept = 0;
+  for (const Vector3& p : line) kept += (p - centre).norm() <= 3.0;
+  EXPECT_EQ(map.Prune(centre), 80 - kept);
+  EXPECT_EQ(map.size(), kept);
+  std::vector<Vector3> found;
+  for (const Vector3& p : line) {
+    EXPECT_EQ(map.Nearest(p, 1, 0.1, &found), (p - centre).norm() <= 3.0 ? 1 : 0) << p.transpose();
+  }
+}
+
+TEST(PointMap, RejectsOptionsOutsideTheirRanges) {
+  PointMapOptions o;
+  o.min_point_spacing_m = 0.5;  // not below the voxel edge
+  EXPECT_THROW(PointMap{o}, ValidationError);
+  o = {};
+  o.max_points_per_voxel = 33;
+  EXPECT_THROW(PointMap{o}, ValidationError);
+  o = {};
+  o.window_radius_m = 0.5;
+  EXPECT_THROW(PointMap{o}, ValidationError);
+}
+
+}  // namespace
+}  // namespace rotorguard::perception
