@@ -47,6 +47,16 @@ void FlightMetrics::OnStep(TimeNs t, const vehicle::StateView& s, const Vector3&
   max_tilt_rad_ = std::max(max_tilt_rad_, tilt);
 }
 
+void FlightMetrics::OnEstimate(const vehicle::StateView& state, const StateEstimate& estimate) {
+  if (!estimate.valid) return;
+  const double e = (estimate.p_W - state.p_W()).norm();
+  estimate_sum2_ += e * e;
+  ++estimates_;
+  estimate_max_m_ = std::max(estimate_max_m_, e);
+  estimate_attitude_max_rad_ =
+      std::max(estimate_attitude_max_rad_, LogSO3(state.q_WB().conjugate() * estimate.q_WB).norm());
+}
+
 void FlightMetrics::Finish(const FlightEnd& end, const std::function<Vector3(double)>& reference_at,
                            RunSummary* summary) {
   const bool after_fault = end.first_onset_s.has_value();
@@ -79,6 +89,10 @@ void FlightMetrics::Finish(const FlightEnd& end, const std::function<Vector3(dou
   if (after_fault) summary->altitude_change_m = Finite(min_altitude_after_fault_ - *onset_altitude_);
   summary->max_spin_rad_s = max_spin_rad_s_;
   summary->max_tilt_rad = max_tilt_rad_;
+  summary->estimate_position_rmse_m =
+      estimates_ > 0 ? Finite(std::sqrt(estimate_sum2_ / static_cast<double>(estimates_))) : 0.0;
+  summary->estimate_position_max_m = Finite(estimate_max_m_);
+  summary->estimate_attitude_max_rad = Finite(estimate_attitude_max_rad_);
   summary->tilt_recovery_s.reset();
   if (after_fault && !end.crashed) {
     const double onset = *end.first_onset_s;

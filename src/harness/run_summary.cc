@@ -97,6 +97,19 @@ void AddStackJson(const RunSummary& r, nlohmann::json* j) {
   }
   if (s.ukf) (*j)["ukf"] = {{"w_hat", s.ukf->w_hat}, {"settled_s", OrNull(s.ukf->settled_s)}};
   (*j)["lidar_points_dropped"] = s.lidar_points_dropped;
+  if (s.odometry) {
+    const stack::LioSummary& o = *s.odometry;
+    (*j)["odometry"] = {{"frames", o.frames},
+                        {"frames_used", o.frames_used},
+                        {"frames_degenerate", o.frames_degenerate},
+                        {"points_mean", o.points_mean},
+                        {"matched_mean", o.matched_mean},
+                        {"residual_rms_m_mean", o.residual_rms_m_mean},
+                        {"iterations_mean", o.iterations_mean},
+                        {"frame_ms_mean", o.frame_ms_mean},
+                        {"frame_ms_p99", o.frame_ms_p99},
+                        {"map_points", o.map_points}};
+  }
   nlohmann::json transitions = nlohmann::json::array();
   for (const stack::ModeTransition& m : s.transitions) {
     transitions.push_back(
@@ -130,6 +143,9 @@ nlohmann::json RunSummary::ToJson() const {
   j["altitude_change_m"] = OrNull(altitude_change_m);
   j["max_spin_rad_s"] = max_spin_rad_s;
   j["max_tilt_rad"] = max_tilt_rad;
+  j["estimate_position_rmse_m"] = estimate_position_rmse_m;
+  j["estimate_position_max_m"] = estimate_position_max_m;
+  j["estimate_attitude_max_rad"] = estimate_attitude_max_rad;
   j["tilt_recovery_s"] = OrNull(tilt_recovery_s);
   j["faults"] = nlohmann::json::array();
   for (const FaultRecord& f : faults) {

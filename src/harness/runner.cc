@@ -139,6 +139,7 @@ class ClosedLoop {
       stack_s_ += clock.seconds();
       next_control_ += stack_.control_period_ns();
       ++control_cycles_;
+      metrics_.OnEstimate(vehicle::StateView(sim_.state()), stack_.estimate());
       if (options_.on_control_cycle) options_.on_control_cycle(stack_);
       recorder_.OnControlCycle(t, stack_, command_);
     }
@@ -176,10 +177,11 @@ class ClosedLoop {
     const stack::StackCost& c = stack_.cost();
     RunCost& cost = s->cost_ms_per_sim_s;
     cost.simulator = per_sim_s(simulator_s_);
+    cost.odometry = per_sim_s(c.estimator_s);
     cost.mapper = per_sim_s(c.mapper_s);
     cost.planner = per_sim_s(c.planner_s);
     cost.controller = per_sim_s(c.controller_s);
-    cost.stack_other = per_sim_s(std::max(0.0, stack_s_ - c.mapper_s - c.planner_s - c.controller_s));
+    cost.stack_other = per_sim_s(std::max(0.0, stack_s_ - c.estimator_s - c.mapper_s - c.planner_s - c.controller_s));
     cost.runner = per_sim_s(std::max(0.0, s->wall_time_s - stack_s_ - simulator_s_));
   }
 

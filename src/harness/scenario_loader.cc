@@ -258,6 +258,9 @@ void CheckAcrossSections(const ConfigNode& root, const Scenario& s) {
       !s.sim.lidar.enabled) {
     root.Required("mission").Fail("the navigate mission plans on the LiDAR map; expected sensors.lidar");
   }
+  if (s.stack.estimator.kind == stack::EstimatorKind::kLio && !s.sim.lidar.enabled) {
+    root.FailAt("stack.estimator", "estimator lio registers the LiDAR's frames; expected sensors.lidar");
+  }
   if (s.stack.navigation.method == stack::NavigationMethod::kFlatness ||
       s.stack.controller == stack::ControllerKind::kLqr) {
     // Paper 004's planner and controller work on the vehicle's PWM model: its layout is checked now.
@@ -277,6 +280,8 @@ void FitStackToHardware(Scenario* s) {
   s->stack.ukf_fdd.imu_rate_hz = s->sim.imu.rate_hz;
   s->stack.ukf_fdd.imu_position_m = s->sim.imu.position_m;
   s->stack.estimator.imu_position_m = s->sim.imu.position_m;  // its dead-reckoning removes the lever arm
+  s->stack.estimator.lio.imu_position_m = s->sim.imu.position_m;
+  s->stack.estimator.lio.lidar_position_m = s->sim.lidar.position_m;
   // The mapper knows where its LiDAR sits and inflates obstacles by the vehicle's radius and a margin.
   s->stack.lidar.deskew.sensor_position_m = s->sim.lidar.position_m;
   s->stack.lidar.map.inflation_radius_m = s->vehicle.collision_radius_m + s->stack.lidar.inflation_margin_m;

@@ -36,10 +36,13 @@ void LioOptions::Validate() const {
   positive(initial_attitude_std_rad, "initial_attitude_std_rad");
   positive(initial_velocity_std_m_s, "initial_velocity_std_m_s");
   require(initial_samples >= 1 && initial_samples <= 1000, "initial_samples", initial_samples, "a count in [1, 1000]");
-  require(std::isfinite(min_range_m) && min_range_m >= 0.0, "min_range_m", min_range_m, "a range >= 0 m");
+  require(std::isfinite(min_range_m) && min_range_m >= 0.0 && min_range_m <= 100.0, "min_range_m", min_range_m,
+          "a range in [0, 100] m");
   require(std::isfinite(frame_voxel_m) && frame_voxel_m >= 0.05 && frame_voxel_m <= 5.0, "frame_voxel_m", frame_voxel_m,
           "an edge in [0.05, 5] m");
   require(plane_points >= 3 && plane_points <= 16, "plane_points", plane_points, "a count in [3, 16]");
+  require(std::isfinite(plane_search_radius_m) && plane_search_radius_m > 0.0 && plane_search_radius_m <= map.voxel_m,
+          "plane_search_radius_m", plane_search_radius_m, "a radius in (0, map.voxel_m] m");
   positive(plane_tolerance_m, "plane_tolerance_m");
   positive(max_residual_m, "max_residual_m");
   positive(point_std_m, "point_std_m");
@@ -65,43 +68,46 @@ Lio::Lio(const LioOptions& options, const Vector3& start_position_W, double star
   }
 }
 
-void Lio::Initialise() {
-  // At rest the accelerometer reads −g in the body frame plus its bias: its mean gives the tilt
-  // (the bias's part across gravity is indistinguishable from a tilt and is left to the filter),
-  // the gyro's mean its bias. Moving, the means are not these, and the start is taken level.
-  Vector3 f = Vector3::Zero(), w = Vector3::Zero();
-  for (const ImuSample& s : initial_samples_) {
-    f += s.specific_force_B;
-    w += s.w_B;
-  }
-  f /= static_cast<double>(initial_samples_.size());
-  w /= static_cast<double>(initial_samples_.size());
-  const bool at_rest = w.norm() < 0.05 && std::abs(f.norm() - kGravity) < 0.5;
-  // The attitude: yaw from the start pose, tilt rotating the measured up onto the world's up.
-  Quaternion q = QuaternionFromYaw(start_yaw_rad_);
-  if (at_rest) {
-    const Vector3 up_B = f.normalized();
-    // Tilt about a horizontal axis (in the yawed frame) taking body up to world up.
-    const Quaternion tilt = Quaternion::FromTwoVectors(up_B, Vector3::UnitZ());
-    // q_WB = R_z(ψ) * tilt, with the tilt's own yaw removed so that the start yaw holds.
-    const Quaternion level_tilt = QuaternionFromYaw(-YawOf(tilt)) * tilt;
-    q = (QuaternionFromYaw(start_yaw_rad_) * level_tilt).normalized();
-  }
+void Lio::Start(const ImuSample& imu) {
+  // The start pose, level, at rest, the biases unknown; the filter runs from the first sample.
   filter_ = LioState{};
-  filter_.t_ns = initial_samples_.back().t_ns;
-  filter_.q_WB = q;
-  filter_.p_W = start_position_W_ + q * options_.imu_position_m;
-  filter_.gyro_bias = at_rest ? w : Vector3::Zero();
+  filter_.t_ns = imu.t_ns;
+  filter_.q_WB = QuaternionFromYaw(start_yaw_rad_);
+  filter_.p_W = start_position_W_ + filter_.q_WB * options_.imu_position_m;
   filter_P_.setZero();
   filter_P_.block<3, 3>(kP, kP).diagonal().setConstant(std::pow(options_.initial_position_std_m, 2));
   filter_P_.block<3, 3>(kTheta, kTheta).diagonal().setConstant(std::pow(options_.initial_attitude_std_rad, 2));
   filter_P_.block<3, 3>(kV, kV).diagonal().setConstant(std::pow(options_.initial_velocity_std_m_s, 2));
   filter_P_.block<3, 3>(kBg, kBg).diagonal().setConstant(std::pow(options_.gyro_bias_initial, 2));
   filter_P_.block<3, 3>(kBa, kBa).diagonal().setConstant(std::pow(options_.accel_bias_initial, 2));
-  filter_imu_ = initial_samples_.back();
-  initial_samples_.clear();
-  initial_samples_.shrink_to_fit();
+  filter_imu_ = imu;
+  started_ = true;
+}
+
+void Lio::Initialise() {
+  // At rest the accelerometer reads −g in the body frame plus its bias: the mean of the first
+  // samples gives the tilt (the bias's part across gravity is indistinguishable from a tilt and
+  // is left to the filter), the gyro's mean its bias. A vehicle that sinks or climbs at the start
+  // still reads a vertical specific force; one that turns or shakes is taken level, biases unknown.
+  Vector3 f = filter_imu_.specific_force_B, w = filter_imu_.w_B;
+  for (const ImuSample& s : queue_) {
+    f += s.specific_force_B;
+    w += s.w_B;
+  }
+  const double n = static_cast<double>(queue_.size() + 1);
+  f /= n;
+  w /= n;
+  const bool at_rest = w.norm() < 0.05 && std::abs(f.norm() - kGravity) < 0.5 * kGravity;
+  if (at_rest) {
+    // q_WB = R_z(ψ) · tilt, the tilt taking the measured up onto the world's, its own yaw removed
+    // so that the start's yaw holds.
+    const Quaternion tilt = Quaternion::FromTwoVectors(f.normalized(), Vector3::UnitZ());
+    filter_.q_WB = (QuaternionFromYaw(start_yaw_rad_) * QuaternionFromYaw(-YawOf(tilt)) * tilt).normalized();
+    filter_.p_W = start_position_W_ + filter_.q_WB * options_.imu_position_m;
+    filter_.gyro_bias = w;
+  }
   initialised_ = true;
+  // The samples since the start again, with the tilt and the bias.
   RebuildHead();
 }
 
@@ -165,10 +171,9 @@ void Lio::Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioStat
 
 void Lio::OnImu(const ImuSample& imu) {
   if (!imu.w_B.allFinite() || !imu.specific_force_B.allFinite()) return;
-  if (!initialised_) {
-    if (!initial_samples_.empty() && imu.t_ns <= initial_samples_.back().t_ns) return;
-    initial_samples_.push_back(imu);
-    if (static_cast<int>(initial_samples_.size()) >= options_.initial_samples) Initialise();
+  if (!started_) {
+    Start(imu);
+    RebuildHead();
     return;
   }
   if (imu.t_ns <= head_imu_.t_ns) return;
@@ -177,6 +182,11 @@ void Lio::OnImu(const ImuSample& imu) {
   Propagate(0.5 * (head_imu_.specific_force_B + imu.specific_force_B), 0.5 * (head_imu_.w_B + imu.w_B), imu.t_ns,
             &head_, &head_P_, nullptr);
   head_imu_ = imu;
+  if (!initialised_) {
+    // The filter stays at the start until the rest initialisation has its samples.
+    if (static_cast<int>(queue_.size()) + 1 >= options_.initial_samples) Initialise();
+    return;
+  }
   // Without frames the filter follows the IMU alone, so that the queue stays short.
   const TimeNs keep = FromSeconds(options_.max_queue_s);
   if (imu.t_ns - queue_.front().t_ns > keep) AdvanceFilter(imu.t_ns - keep, nullptr);
@@ -206,19 +216,25 @@ void Lio::RebuildHead() {
   head_imu_ = previous;
 }
 
-StateEstimate Lio::Estimate() const {
+StateEstimate Lio::BodyEstimate(const LioState& x, const Vector3& w_m) const {
+  // The filter's state is the IMU's mount: the centre of gravity is l behind it, and moves with
+  // v − R (ω × l).
   StateEstimate e;
-  e.t_ns = head_.t_ns;
-  e.valid = initialised_;
-  const Matrix3 R = head_.q_WB.toRotationMatrix();
-  const Vector3 w = head_imu_.w_B - head_.gyro_bias;
+  e.t_ns = x.t_ns;
+  e.valid = started_;
+  const Matrix3 R = x.q_WB.toRotationMatrix();
+  const Vector3 w = w_m - x.gyro_bias;
   const Vector3& l = options_.imu_position_m;
-  e.p_W = head_.p_W - R * l;
-  e.q_WB = head_.q_WB;
-  e.v_W = head_.v_W - R * w.cross(l);
+  e.p_W = x.p_W - R * l;
+  e.q_WB = x.q_WB;
+  e.v_W = x.v_W - R * w.cross(l);
   e.w_B = w;
   return e;
 }
+
+StateEstimate Lio::Estimate() const { return BodyEstimate(head_, head_imu_.w_B); }
+
+StateEstimate Lio::FrameEstimate() const { return BodyEstimate(filter_, filter_imu_.w_B); }
 
 void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Vector3>* out,
                               LioFrameSummary* summary) const {
@@ -268,6 +284,30 @@ void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& 
   summary->points_downsampled = static_cast<int>(out->size());
 }
 
+void Lio::FindPlanes(const std::vector<Vector3>& points_I, const LioState& x) {
+  planes_.clear();
+  const Matrix3 R = x.q_WB.toRotationMatrix();
+  for (std::size_t i = 0; i < points_I.size(); ++i) {
+    const Vector3 w = x.p_W + R * points_I[i];
+    if (map_.Nearest(w, options_.plane_points, options_.plane_search_radius_m, &neighbours_) < options_.plane_points)
+      continue;
+    // The plane through the neighbours: their centroid, and the normal along the least
+    // eigenvector of their scatter (any plane, the world origin's too).
+    Vector3 centroid = Vector3::Zero();
+    for (const Vector3& y : neighbours_) centroid += y;
+    centroid /= static_cast<double>(neighbours_.size());
+    Matrix3 scatter = Matrix3::Zero();
+    for (const Vector3& y : neighbours_) scatter.noalias() += (y - centroid) * (y - centroid).transpose();
+    Eigen::SelfAdjointEigenSolver<Matrix3> eig;
+    eig.computeDirect(scatter);
+    const Vector3 n = eig.eigenvectors().col(0);
+    const double d = -n.dot(centroid);
+    bool planar = true;
+    for (const Vector3& y : neighbours_) planar = planar && std::abs(n.dot(y) + d) <= options_.plane_tolerance_m;
+    if (planar) planes_.push_back({static_cast<int>(i), n, d});
+  }
+}
+
 void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary) {
   const LioState prior = filter_;
   const Eigen::LDLT<Matrix15> prior_factor(filter_P_);
@@ -277,33 +317,29 @@ void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary)
   Eigen::Matrix<double, 6, 6> HtH;
   Matrix15 A;
   bool used = false;
+  // The planes are searched at the first iterate and again only once the pose has moved enough
+  // to change a point's neighbourhood (a tenth of the search radius, or the angle that moves a
+  // point 20 m away as much): the later iterates move millimetres, and the search is most of
+  // the update's cost.
+  LioState searched_at = x;
+  const double research_m = 0.1 * options_.plane_search_radius_m, research_rad = research_m / 20.0;
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
     summary->iterations = iteration;
+    if (iteration == 1 || (x.p_W - searched_at.p_W).norm() > research_m ||
+        LogSO3(searched_at.q_WB.conjugate() * x.q_WB).norm() > research_rad) {
+      FindPlanes(points_I, x);
+      searched_at = x;
+    }
     HtH.setZero();
     Eigen::Matrix<double, 6, 1> Htr = Eigen::Matrix<double, 6, 1>::Zero();
     const Matrix3 R = x.q_WB.toRotationMatrix();
     int matched = 0;
     double sum_r2 = 0.0;
-    for (const Vector3& q : points_I) {
-      const Vector3 w = x.p_W + R * q;
-      if (map_.Nearest(w, options_.plane_points, options_.map.voxel_m, &neighbours_) < options_.plane_points) continue;
-      // The plane through the neighbours: their centroid, and the normal along the least
-      // eigenvector of their scatter (any plane, the world origin's too).
-      Vector3 centroid = Vector3::Zero();
-      for (const Vector3& y : neighbours_) centroid += y;
-      centroid /= static_cast<double>(neighbours_.size());
-      Matrix3 scatter = Matrix3::Zero();
-      for (const Vector3& y : neighbours_) scatter.noalias() += (y - centroid) * (y - centroid).transpose();
-      Eigen::SelfAdjointEigenSolver<Matrix3> plane;
-      plane.computeDirect(scatter);
-      const Vector3 n = plane.eigenvectors().col(0);
-      const double d = -n.dot(centroid);
-      bool planar = true;
-      for (const Vector3& y : neighbours_) planar = planar && std::abs(n.dot(y) + d) <= options_.plane_tolerance_m;
-      if (!planar) continue;
-      const double r = n.dot(w) + d;
+    for (const Plane& plane : planes_) {
+      const Vector3& q = points_I[plane.point];
+      const double r = plane.n.dot(x.p_W + R * q) + plane.d;
       if (!(std::abs(r) <= options_.max_residual_m)) continue;
-      const Eigen::Matrix<double, 6, 1> h = internal::PointToPlaneJacobian(n, R, q).transpose();
+      const Eigen::Matrix<double, 6, 1> h = internal::PointToPlaneJacobian(plane.n, R, q).transpose();
       HtH.noalias() += h * h.transpose();
       Htr += h * r;
       sum_r2 += r * r;

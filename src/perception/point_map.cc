@@ -43,6 +43,51 @@ Eigen::Vector3i PointMap::CellOf(Key key) {
                          static_cast<int>(static_cast<std::int64_t>(key & kMask) - kOffset));
 }
 
+namespace {
+// The slot a key probes first: splitmix64's finaliser, which spreads neighbouring voxels' keys.
+std::size_t Home(std::uint64_t key, std::size_t mask) {
+  key ^= key >> 30;
+  key *= 0xbf58476d1ce4e5b9ULL;
+  key ^= key >> 27;
+  key *= 0x94d049bb133111ebULL;
+  key ^= key >> 31;
+  return static_cast<std::size_t>(key) & mask;
+}
+}  // namespace
+
+std::int64_t PointMap::Find(Key key) const {
+  if (slots_.empty()) return -1;
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t i = Home(key, mask);; i = (i + 1) & mask) {
+    if (slots_[i].key == key) return slots_[i].voxel;
+    if (slots_[i].key == kEmpty) return -1;
+  }
+}
+
+std::uint32_t PointMap::FindOrAdd(Key key) {
+  if (2 * (voxels_.size() + 1) > slots_.size()) Reindex(std::max<std::size_t>(1024, 2 * slots_.size()));
+  const std::size_t mask = slots_.size() - 1;
+  for (std::size_t i = Home(key, mask);; i = (i + 1) & mask) {
+    if (slots_[i].key == key) return slots_[i].voxel;
+    if (slots_[i].key == kEmpty) {
+      slots_[i] = {key, static_cast<std::uint32_t>(voxels_.size())};
+      voxels_.emplace_back();
+      voxels_.back().key = key;
+      return slots_[i].voxel;
+    }
+  }
+}
+
+void PointMap::Reindex(std::size_t capacity) {
+  slots_.assign(capacity, Slot{});
+  const std::size_t mask = capacity - 1;
+  for (std::size_t v = 0; v < voxels_.size(); ++v) {
+    std::size_t i = Home(voxels_[v].key, mask);
+    while (slots_[i].key != kEmpty) i = (i + 1) & mask;
+    slots_[i] = {voxels_[v].key, static_cast<std::uint32_t>(v)};
+  }
+}
+
 int PointMap::Insert(const std::vector<Vector3>& points_W) {
   int stored = 0;
   const float spacing2 = static_cast<float>(options_.min_point_spacing_m * options_.min_point_spacing_m);
@@ -51,12 +96,7 @@ int PointMap::Insert(const std::vector<Vector3>& points_W) {
   for (const Vector3& p : points_W) {
     if (!p.allFinite() || p.cwiseAbs().maxCoeff() > limit) continue;
     const Key key = KeyOf(Cell(p));
-    auto [it, inserted] = index_.try_emplace(key, static_cast<std::uint32_t>(voxels_.size()));
-    if (inserted) {
-      voxels_.emplace_back();
-      voxels_.back().key = key;
-    }
-    Voxel& v = voxels_[it->second];
+    Voxel& v = voxels_[FindOrAdd(key)];
     if (v.count >= options_.max_points_per_voxel) continue;
     const Eigen::Vector3f pf = p.cast<float>();
     bool near = false;
@@ -72,22 +112,22 @@ int PointMap::Insert(const std::vector<Vector3>& points_W) {
 int PointMap::Prune(const Vector3& center_W) {
   const double r2 = options_.window_radius_m * options_.window_radius_m;
   int removed = 0;
-  for (std::size_t i = 0; i < voxels_.size();) {
-    const Key key = voxels_[i].key;
-    const Vector3 centre = (CellOf(key).cast<double>().array() + 0.5).matrix() * options_.voxel_m;
-    if ((centre - center_W).squaredNorm() <= r2) {
-      ++i;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < voxels_.size(); ++i) {
+    const Vector3 centre = (CellOf(voxels_[i].key).cast<double>().array() + 0.5).matrix() * options_.voxel_m;
+    if ((centre - center_W).squaredNorm() > r2) {
+      removed += voxels_[i].count;
       continue;
     }
-    // Swap-remove: the last voxel takes this one's slot and its index entry follows it.
-    removed += voxels_[i].count;
-    index_.erase(key);
-    if (i + 1 != voxels_.size()) {
-      voxels_[i] = voxels_.back();
-      index_[voxels_[i].key] = static_cast<std::uint32_t>(i);
-    }
-    voxels_.pop_back();
+    if (kept != i) voxels_[kept] = voxels_[i];
+    ++kept;
   }
+  if (kept == voxels_.size()) return 0;
+  voxels_.resize(kept);
+  // The slots again, for the voxels that stay (a table at most half full, at least 1024).
+  std::size_t capacity = 1024;
+  while (capacity < 2 * kept) capacity *= 2;
+  Reindex(capacity);
   points_ -= removed;
   return removed;
 }
@@ -105,12 +145,23 @@ int PointMap::Nearest(const Vector3& query, int k, double radius_m, std::vector<
   int n = 0;
   const Eigen::Vector3f qf = query.cast<float>();
   const Eigen::Vector3i c = Cell(query);
+  // A neighbour voxel is visited only when it comes within r of the query: per axis the distance
+  // to the lower and the upper face of the query's voxel. With r at most half the edge, 8 of the
+  // 27 on average (2 per axis).
+  const Vector3 low = query - c.cast<double>() * options_.voxel_m;  // in [0, voxel_m)
+  const Vector3 high = Vector3::Constant(options_.voxel_m) - low;
   for (int dx = -1; dx <= 1; ++dx) {
+    const double ex = dx < 0 ? low.x() : dx > 0 ? high.x() : 0.0;
+    if (ex > r) continue;
     for (int dy = -1; dy <= 1; ++dy) {
+      const double ey = dy < 0 ? low.y() : dy > 0 ? high.y() : 0.0;
+      if (ex * ex + ey * ey > r * r) continue;
       for (int dz = -1; dz <= 1; ++dz) {
-        const auto it = index_.find(KeyOf(c + Eigen::Vector3i(dx, dy, dz)));
-        if (it == index_.end()) continue;
-        const Voxel& v = voxels_[it->second];
+        const double ez = dz < 0 ? low.z() : dz > 0 ? high.z() : 0.0;
+        if (ex * ex + ey * ey + ez * ez > r * r) continue;
+        const std::int64_t found = Find(KeyOf(c + Eigen::Vector3i(dx, dy, dz)));
+        if (found < 0) continue;
+        const Voxel& v = voxels_[static_cast<std::size_t>(found)];
         for (int i = 0; i < v.count; ++i) {
           const float d2 = (v.points[i] - qf).squaredNorm();
           if (d2 > r2 || (n == kk && d2 >= best[n - 1].first)) continue;

@@ -1,10 +1,13 @@
 #include "rotorguard/stack/estimator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
+#include "rotorguard/core/stopwatch.h"
 
 namespace rotorguard::stack {
 
@@ -16,17 +19,18 @@ void EstimatorOptions::Validate() const {
   if (!(std::isfinite(imu_history_s) && imu_history_s > 0.0)) {
     ThrowValidation("EstimatorOptions", "imu_history_s", imu_history_s, "a time > 0 s");
   }
+  if (kind == EstimatorKind::kLio) lio.Validate();
+}
+
+void Estimator::OnEscTelemetry(const EscTelemetry& esc) {
+  if (!esc.motor_speed_rad_s.allFinite()) return;  // a corrupt frame is ignored
+  motor_thrust_ = thrust_coefficient_ * esc.motor_speed_rad_s.array().square().matrix();
 }
 
 OdometryImuEstimator::OdometryImuEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options)
-    : options_(options), thrust_coefficient_(thrust_coefficient_n_s2) {
+    : Estimator(thrust_coefficient_n_s2), options_(options) {
   options_.Validate();
   imu_history_ns_ = FromSeconds(options_.imu_history_s);
-}
-
-void OdometryImuEstimator::OnEscTelemetry(const EscTelemetry& esc) {
-  if (!esc.motor_speed_rad_s.allFinite()) return;  // a corrupt frame is ignored
-  motor_thrust_ = thrust_coefficient_ * esc.motor_speed_rad_s.array().square().matrix();
 }
 
 void OdometryImuEstimator::Integrate(const ImuSample& imu, Strapdown* s) const {
@@ -86,8 +90,81 @@ StateEstimate OdometryImuEstimator::Estimate(TimeNs t) const {
   e.q_WB = s.q;
   e.v_W = s.v;
   e.w_B = w_B_;
-  e.motor_thrust_n = motor_thrust_;
+  e.motor_thrust_n = motor_thrust();
   return e;
+}
+
+LioEstimator::LioEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options,
+                           const Vector3& start_position_W, double start_yaw_rad)
+    : Estimator(thrust_coefficient_n_s2), lio_(options.lio, start_position_W, start_yaw_rad) {}
+
+void LioEstimator::OnImu(const ImuSample& imu) {
+  lio_.OnImu(imu);
+  if (!last_fix_ns_ && lio_.started()) last_fix_ns_ = imu.t_ns;  // the start pose is the first fix
+}
+
+void LioEstimator::OnLidar(const LidarFrame& frame) {
+  const Stopwatch clock;
+  const perception::LioFrameSummary s = lio_.OnFrame(frame);
+  frame_ms_.push_back(1e3 * clock.seconds());
+  frames_.push_back(s);
+  // The first frame starts the map at the start pose: it fixes nothing, nor does it lose anything.
+  if (s.used && !s.degenerate) last_fix_ns_ = frame.t_end_ns;
+  frame_estimate_ = lio_.FrameEstimate();
+  frame_estimate_.motor_thrust_n = motor_thrust();
+}
+
+StateEstimate LioEstimator::Estimate(TimeNs /*t*/) const {
+  StateEstimate e = lio_.Estimate();
+  e.motor_thrust_n = motor_thrust();
+  return e;
+}
+
+StateEstimate LioEstimator::FrameEstimate(const LidarFrame& frame) const {
+  return frame_estimate_.t_ns == frame.t_end_ns ? frame_estimate_ : Estimate(frame.t_end_ns);
+}
+
+double LioEstimator::odometry_age_s(TimeNs t) const {
+  return last_fix_ns_ ? ToSeconds(t - *last_fix_ns_) : std::numeric_limits<double>::infinity();
+}
+
+LioSummary LioEstimator::Summarize() const {
+  LioSummary s;
+  s.frames = static_cast<int>(frames_.size());
+  for (const perception::LioFrameSummary& f : frames_) {
+    if (!f.used) continue;
+    ++s.frames_used;
+    s.frames_degenerate += f.degenerate;
+    s.points_mean += f.points_downsampled;
+    s.matched_mean += f.points_matched;
+    s.residual_rms_m_mean += f.residual_rms_m;
+    s.iterations_mean += f.iterations;
+  }
+  if (s.frames_used > 0) {
+    const double n = s.frames_used;
+    s.points_mean /= n;
+    s.matched_mean /= n;
+    s.residual_rms_m_mean /= n;
+    s.iterations_mean /= n;
+  }
+  if (!frame_ms_.empty()) {
+    std::vector<double> ms = frame_ms_;
+    s.frame_ms_mean = std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(ms.size());
+    // The 99th percentile: the smallest time at or above 99 % of the frames' (nearest rank).
+    const std::size_t rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(ms.size()))) - 1;
+    std::nth_element(ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(rank), ms.end());
+    s.frame_ms_p99 = ms[rank];
+  }
+  s.map_points = lio_.map().size();
+  return s;
+}
+
+std::unique_ptr<Estimator> MakeEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options,
+                                         const Vector3& start_position_W, double start_yaw_rad) {
+  if (options.kind == EstimatorKind::kLio) {
+    return std::make_unique<LioEstimator>(thrust_coefficient_n_s2, options, start_position_W, start_yaw_rad);
+  }
+  return std::make_unique<OdometryImuEstimator>(thrust_coefficient_n_s2, options);
 }
 
 }  // namespace rotorguard::stack

@@ -101,17 +101,20 @@ void FlightStackOptions::Validate() const {
   }
 }
 
-FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
-                         std::shared_ptr<const ReferenceTrajectory> reference,
+FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<const ReferenceTrajectory> reference,
                          const FlightStackOptions& options, std::unique_ptr<control::Controller> controller)
     : model_(vehicle),
       reference_(std::move(reference)),
       options_(options),
-      estimator_(model_.params().thrust_coefficient_n_s2, options.estimator),
       supervisor_(options.supervisor),
       mapper_(options.lidar) {
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
+  {
+    // The stack starts where its mission does, at rest: the LiDAR-inertial odometry's frame.
+    const ReferencePoint start = reference_->Evaluate(0.0);
+    estimator_ = MakeEstimator(model_.params().thrust_coefficient_n_s2, options_.estimator, start.p_W, start.yaw);
+  }
   if (controller) {
     if (controller->name() != ToName(options_.controller)) {
       ThrowValidation("FlightStackOptions", "controller", ToName(options_.controller),
@@ -182,21 +185,25 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle,
 }
 
 void FlightStack::OnImu(const ImuSample& imu) {
-  estimator_.OnImu(imu);
+  estimator_->OnImu(imu);
   mapper_.OnImu(imu);
   if (fdd_) fdd_->OnImu(imu);
 }
 
 void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
-  estimator_.OnEscTelemetry(esc);
+  estimator_->OnEscTelemetry(esc);
   if (fdd_) fdd_->OnEscTelemetry(esc);
 }
 
-void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_.OnOdometry(odometry); }
+void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_->OnOdometry(odometry); }
 
 void FlightStack::OnLidar(const LidarFrame& frame) {
+  {
+    const ScopedCost cost(&cost_.estimator_s);
+    estimator_->OnLidar(frame);
+  }
   const ScopedCost cost(&cost_.mapper_s);
-  lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_.Estimate(frame.t_end_ns)).points_dropped;
+  lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_->FrameEstimate(frame)).points_dropped;
 }
 
 void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
@@ -294,7 +301,7 @@ void FlightStack::Navigate(double t, FlightMode mode) {
 const RotorCommand& FlightStack::Update(TimeNs t) {
   const double dt = last_update_ns_ ? ToSeconds(t - *last_update_ns_) : 0.0;
   last_update_ns_ = t;
-  estimate_ = estimator_.Estimate(t);
+  estimate_ = estimator_->Estimate(t);
   const double ts = ToSeconds(t);
   command_.t_ns = t;
   if (estimate_.valid) {
@@ -327,7 +334,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   SupervisorInputs in;
   in.t = ts;
   in.estimate = estimate_;
-  in.odometry_age_s = estimator_.odometry_age_s(t);
+  in.odometry_age_s = estimator_->odometry_age_s(t);
   in.isolated_rotors = isolated_rotors();
   in.navigating = navigator_ && next_waypoint_ > 0 && !navigator_->arrived();
   in.since_last_plan_s = ts - last_plan_ok_s_;
@@ -409,6 +416,7 @@ FlightStackSummary FlightStack::Summarize() const {
   s.transitions = supervisor_.transitions();
   if (const perception::VoxelMap* m = map()) s.map_voxels_occupied = m->occupied_count();
   s.lidar_points_dropped = lidar_points_dropped_;
+  if (const auto* lio = dynamic_cast<const LioEstimator*>(estimator_.get())) s.odometry = lio->Summarize();
   s.reconfigurations = reconfigurations_;
   return s;
 }

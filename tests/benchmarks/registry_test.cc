@@ -167,7 +167,7 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
                      {"planner_ms_mean", 2.0},  {"stack_ms_per_cycle_mean", 0.5},
                      {"realtime_factor", 10.0}, {"trial_realtime_factor", rmse * 100.0}};
     // The wall-clock parts of a run (ms per simulated second), the simulator's differing by trial.
-    for (const char* part : {"mapper", "planner", "controller", "stack_other", "runner"}) {
+    for (const char* part : {"odometry", "mapper", "planner", "controller", "stack_other", "runner"}) {
       m[fmt::format("cost_{}_ms_per_sim_s", part)] = 10.0;
     }
     m["cost_simulator_ms_per_sim_s"] = rmse * 1000.0;

@@ -273,7 +273,7 @@ TEST_F(CliTest, HoverRunSucceedsAndWritesLogAndSummary) {
   // Where the wall-clock time went: every part present (each is a duration, or clamped at zero),
   // and no LiDAR hence no mapping (runner_test checks the mapper and planner are timed when they
   // run).
-  for (const char* part : {"simulator", "mapper", "planner", "controller", "stack_other", "runner"}) {
+  for (const char* part : {"simulator", "odometry", "mapper", "planner", "controller", "stack_other", "runner"}) {
     ASSERT_TRUE(j["cost_ms_per_sim_s"][part].is_number()) << part;
   }
   EXPECT_EQ(j["cost_ms_per_sim_s"]["mapper"].get<double>(), 0.0);

@@ -152,6 +152,31 @@ TEST_F(ScenarioLoader, APlannerWordIsShortForItsMethod) {
             std::string::npos);
 }
 
+// The estimator: a word for its kind, or a block; the LiDAR-inertial odometry needs a LiDAR and
+// learns both mounts from the sensors.
+TEST_F(ScenarioLoader, TheEstimatorIsAWordOrABlockAndLioNeedsALidar) {
+  Scenario s =
+      LoadScenario(File("mission: {type: hover}\nsensors: {lidar: {position_m: [0, 0.01, 0.07]}}\n"
+                        "stack: {estimator: lio}\n"));
+  EXPECT_EQ(s.stack.estimator.kind, stack::EstimatorKind::kLio);
+  EXPECT_EQ(s.stack.estimator.lio.lidar_position_m, Vector3(0, 0.01, 0.07));
+  EXPECT_EQ(s.stack.estimator.lio.imu_position_m, s.sim.imu.position_m);
+  s =
+      LoadScenario(File("mission: {type: hover}\nsensors: {lidar: {}}\n"
+                        "stack: {estimator: {kind: lio, lio: {max_iterations: 3, map: {voxel_m: 0.8}}}}\n"));
+  EXPECT_EQ(s.stack.estimator.lio.max_iterations, 3);
+  EXPECT_EQ(s.stack.estimator.lio.map.voxel_m, 0.8);
+  EXPECT_EQ(LoadScenario(File("mission: {type: hover}\n")).stack.estimator.kind, stack::EstimatorKind::kOdometry);
+  std::string m = Error("mission: {type: hover}\nstack: {estimator: lio}\n");
+  EXPECT_NE(m.find("stack.estimator"), std::string::npos) << m;
+  EXPECT_NE(m.find("estimator lio registers the LiDAR's frames; expected sensors.lidar"), std::string::npos) << m;
+  m = Error(
+      "mission: {type: hover}\nsensors: {lidar: {}}\nstack: {estimator: {kind: lio, lio: {plane_search_radius_m: "
+      "2}}}\n");
+  EXPECT_NE(m.find("plane_search_radius_m"), std::string::npos) << m;
+  EXPECT_NE(m.find("(0, map.voxel_m]"), std::string::npos) << m;
+}
+
 TEST_F(ScenarioLoader, TheMissionComesBackAsAValue) {
   const io::ConfigDocument doc =
       io::ConfigDocument::LoadString("type: lemniscate\nmax_speed_m_s: 1.5\nsize_m: [4, 2, 0]\n", "m.yaml");

@@ -100,7 +100,7 @@ TEST(PointMap, PruningKeepsTheVoxelsWithinTheWindowAndTheirNeighbours) {
 
 TEST(PointMap, RejectsOptionsOutsideTheirRanges) {
   PointMapOptions o;
-  o.min_point_spacing_m = 0.5;  // not below the voxel edge
+  o.min_point_spacing_m = o.voxel_m;  // not below the voxel edge
   EXPECT_THROW(PointMap{o}, ValidationError);
   o = {};
   o.max_points_per_voxel = 33;

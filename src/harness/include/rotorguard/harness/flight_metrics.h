@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "rotorguard/core/messages.h"
 #include "rotorguard/core/types.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/vehicle/multirotor.h"
@@ -61,6 +62,10 @@ class FlightMetrics {
   /// and after_fault whether a fault has begun.
   void OnStep(TimeNs t, const vehicle::StateView& state, const Vector3& p_ref, bool after_fault);
 
+  /// The stack's estimate at a control cycle against the true state then: the estimator's
+  /// absolute trajectory error (no alignment: the stack starts at a known pose).
+  void OnEstimate(const vehicle::StateView& state, const StateEstimate& estimate);
+
   /// The last time the position error exceeded the success bound, and by how much.
   struct Violation {
     double t_s = 0.0;
@@ -71,7 +76,7 @@ class FlightMetrics {
   /// Fills `summary`'s metrics: tracking_* and max_position_error_m (a crashed vehicle held at its
   /// crash site over the rest of the window for tracking_rmse_window_m, against `reference_at`,
   /// the position the stack's reference gives at a time), min_altitude_m (the final state
-  /// counted), max_spin_rad_s, max_tilt_rad and tilt_recovery_s.
+  /// counted), max_spin_rad_s, max_tilt_rad, tilt_recovery_s and estimate_*.
   void Finish(const FlightEnd& end, const std::function<Vector3(double t_s)>& reference_at, RunSummary* summary);
 
  private:
@@ -84,6 +89,8 @@ class FlightMetrics {
   std::optional<double> onset_altitude_;  ///< at the first step after the first fault's onset
   double max_spin_rad_s_ = 0.0;
   double max_tilt_rad_ = 0.0;
+  double estimate_sum2_ = 0.0, estimate_max_m_ = 0.0, estimate_attitude_max_rad_ = 0.0;
+  long estimates_ = 0;
 };
 
 }  // namespace rotorguard::harness

@@ -28,7 +28,8 @@ struct FaultRecord {
 /// "cost_ms_per_sim_s"): the parts add up to 1000 / realtime_factor.
 struct RunCost {
   double simulator = 0.0;    ///< Simulator::Step: physics, faults and every sensor model (the LiDAR's ray casting)
-  double mapper = 0.0;       ///< the stack's LiDAR frames (FlightStack::cost)
+  double odometry = 0.0;     ///< the stack's LiDAR-inertial odometry: its frames' registration (estimator lio)
+  double mapper = 0.0;       ///< the stack's LiDAR frames in the occupancy map (FlightStack::cost)
   double planner = 0.0;      ///< the stack's navigation
   double controller = 0.0;   ///< the stack's controller
   double stack_other = 0.0;  ///< the rest of the stack: estimator, FDD, supervisor, sensor callbacks
@@ -38,7 +39,8 @@ struct RunCost {
     const char* name;
     double RunCost::*field;
   };
-  static constexpr std::array<Part, 6> kParts = {{{"simulator", &RunCost::simulator},
+  static constexpr std::array<Part, 7> kParts = {{{"simulator", &RunCost::simulator},
+                                                  {"odometry", &RunCost::odometry},
                                                   {"mapper", &RunCost::mapper},
                                                   {"planner", &RunCost::planner},
                                                   {"controller", &RunCost::controller},
@@ -99,6 +101,9 @@ struct RunSummary {
   std::optional<double> altitude_change_m;
   double max_spin_rad_s = 0.0;  ///< largest |yaw rate| of the body
   double max_tilt_rad = 0.0;    ///< largest tilt of the body z axis from the vertical
+  /// The stack's estimate against the truth at its control cycles (the estimator's absolute
+  /// trajectory error, no alignment): position RMSE and largest error, largest attitude error.
+  double estimate_position_rmse_m = 0.0, estimate_position_max_m = 0.0, estimate_attitude_max_rad = 0.0;
   /// Time from the first fault onset until the tilt stays below metrics.recovered_tilt_rad to the
   /// end (paper 000: roll and pitch recovered in about 3 s); none without a fault, after a crash,
   /// or when the tilt never settles.

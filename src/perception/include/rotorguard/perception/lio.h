@@ -23,7 +23,7 @@
 /// The world frame is the one the stack starts in: its z axis is up (gravity (0, 0, −g), g known),
 /// its origin and yaw the start pose's. So gravity is not a state (FAST-LIO2 estimates its
 /// direction because its world frame is the first IMU frame); the start's tilt is measured at
-/// rest (Initialise).
+/// rest (Initialise), over the first samples, and the filter then re-runs from the first sample.
 ///
 /// Timing: LiDAR frames arrive after their end, IMU samples as they are measured. The filter
 /// stays at the last frame's end with the later samples queued; each frame first takes the filter
@@ -61,10 +61,12 @@ struct LioOptions {
   /// A frame's points nearer than this to the sensor are dropped (the airframe, the propellers) [m], >= 0.
   double min_range_m = 0.3;
   /// The frame's down-sampling grid [m], in [0.05, 5]: one point per cell, the one nearest its centre.
-  double frame_voxel_m = 0.4;
-  /// Map points a plane is fitted to, in [3, 16]; the plane is kept when each lies within
-  /// plane_tolerance_m of it (> 0), and when the farthest lies within PointMapOptions::voxel_m.
+  double frame_voxel_m = 0.5;
+  /// Map points a plane is fitted to, in [3, 16], the nearest within plane_search_radius_m (in
+  /// (0, PointMapOptions::voxel_m]); the plane is kept when each lies within plane_tolerance_m of
+  /// it (> 0).
   int plane_points = 5;
+  double plane_search_radius_m = 0.5;
   double plane_tolerance_m = 0.1;
   /// A point whose residual exceeds this [m] (> 0) is left out of the update (an outlier: a new
   /// surface, a moving object).
@@ -147,10 +149,16 @@ class Lio {
   /// came too late) or before the filter is initialised is counted and not used.
   LioFrameSummary OnFrame(const LidarFrame& frame);
 
+  /// An IMU sample came: the estimate runs from the start pose.
+  bool started() const { return started_; }
+  /// The rest initialisation is done (initial_samples taken): frames are registered from then on.
   bool initialised() const { return initialised_; }
   /// The estimate at the newest IMU sample, of the body: position and velocity of the centre of
-  /// gravity, bias-corrected body rates. Not valid before initialisation.
+  /// gravity, bias-corrected body rates. Valid from the first IMU sample (the start pose, then
+  /// propagated).
   StateEstimate Estimate() const;
+  /// The same at the end of the last frame (what the frame was registered at).
+  StateEstimate FrameEstimate() const;
   /// The filter's state at the newest IMU sample, and its covariance.
   const LioState& state() const { return head_; }
   const Matrix15& covariance() const { return head_P_; }
@@ -164,7 +172,12 @@ class Lio {
     Vector3 p, v, a_W, w;  // a_W and w: held from t_ns to the next pose
     Matrix3 R;
   };
+  /// Starts the filter at the first IMU sample; then, with initial_samples, the rest
+  /// initialisation.
+  void Start(const ImuSample& imu);
   void Initialise();
+  /// The body's estimate from the mount's state and a gyro reading.
+  StateEstimate BodyEstimate(const LioState& x, const Vector3& w_m) const;
   /// Propagates (x, P) from x->t_ns to t_ns with the measurement (f, w) held; P if not null,
   /// the pose at the start of the step into `poses` if not null.
   void Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix15* P,
@@ -176,6 +189,14 @@ class Lio {
   /// Points of the frame in the IMU frame at its end, deskewed and down-sampled.
   void DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Vector3>* out,
                            LioFrameSummary* summary) const;
+  /// A point's plane in the map: n·y + d = 0.
+  struct Plane {
+    int point;
+    Vector3 n;
+    double d;
+  };
+  /// The plane of each point of the frame placed with `x` that has one, into planes_.
+  void FindPlanes(const std::vector<Vector3>& points_I, const LioState& x);
   /// The iterated update with the deskewed points; false if too few matched.
   void Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary);
 
@@ -184,8 +205,7 @@ class Lio {
   double start_yaw_rad_;
   Vector3 lidar_in_imu_;  ///< the LiDAR's position in the IMU frame (axes aligned)
   PointMap map_;
-  bool initialised_ = false;
-  std::vector<ImuSample> initial_samples_;
+  bool started_ = false, initialised_ = false;
   LioState filter_;
   Matrix15 filter_P_ = Matrix15::Zero();
   ImuSample filter_imu_;         ///< the last sample the filter took (held beyond it)
@@ -198,6 +218,7 @@ class Lio {
   // Scratch kept across frames (no allocation per frame once warm).
   std::vector<Pose> poses_;
   std::vector<Vector3> points_, neighbours_;
+  std::vector<Plane> planes_;
 };
 
 template <typename Archive>
@@ -212,8 +233,13 @@ void LioOptions::Serialize(Archive* a) {
            {.meaning = "prior std of the accelerometer bias [m/s²]", .positive = true});
   a->Visit("gyro_bias_initial", &gyro_bias_initial,
            {.meaning = "prior std of the gyro bias [rad/s]", .positive = true});
-  a->Visit("min_range_m", &min_range_m, {.meaning = "nearer returns are dropped (the airframe) [m]"});
-  a->Visit("frame_voxel_m", &frame_voxel_m, {.meaning = "a frame keeps one point per cell of this edge [m]"});
+  a->Visit("min_range_m", &min_range_m,
+           {.meaning = "nearer returns are dropped (the airframe) [m]", .min = 0, .max = 100});
+  a->Visit("frame_voxel_m", &frame_voxel_m,
+           {.meaning = "a frame keeps one point per cell of this edge [m]", .min = 0.05, .max = 5});
+  a->Visit(
+      "plane_search_radius_m", &plane_search_radius_m,
+      {.meaning = "a point's plane is fitted to map points within this [m], at most map.voxel_m", .positive = true});
   a->Visit("plane_tolerance_m", &plane_tolerance_m,
            {.meaning = "a plane's points lie within this of it [m]", .positive = true});
   a->Visit("max_residual_m", &max_residual_m,

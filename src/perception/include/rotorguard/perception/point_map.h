@@ -6,10 +6,10 @@
 /// down-sampling happens on the map, as in FAST-LIO2, so a surface seen again and again does not
 /// grow it). Voxels farther than window_radius_m from the vehicle are deleted (Prune), so the map
 /// follows the vehicle like the occupancy map does. Nearest neighbours within a voxel edge of the
-/// query are exact: the query's voxel and its 26 neighbours hold all of them.
+/// query are exact: the query's voxel and its 26 neighbours hold all of them, and a search
+/// radius of half the edge visits 8 of them on average (those that come within the radius).
 #include <array>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "rotorguard/core/config_schema.h"
@@ -18,7 +18,7 @@
 namespace rotorguard::perception {
 
 struct PointMapOptions {
-  double voxel_m = 0.5;  ///< hash voxel edge [m], in [0.05, 10]; the neighbour search's exact radius
+  double voxel_m = 1.0;  ///< hash voxel edge [m], in [0.05, 10]; the neighbour search's exact radius
   /// Points a voxel holds at most, in [1, kMaxPointsPerVoxel].
   int max_points_per_voxel = 20;
   static constexpr int kMaxPointsPerVoxel = 32;
@@ -31,13 +31,13 @@ struct PointMapOptions {
   void Validate() const;
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("voxel_m", &voxel_m, {.meaning = "the point map's hash voxel edge [m]"});
+    a->Visit("voxel_m", &voxel_m, {.meaning = "the point map's hash voxel edge [m]", .min = 0.05, .max = 10});
     a->Visit("max_points_per_voxel", &max_points_per_voxel,
              {.meaning = "points a voxel keeps at most", .min = 1, .max = kMaxPointsPerVoxel});
     a->Visit("min_point_spacing_m", &min_point_spacing_m,
-             {.meaning = "a point this close to one its voxel holds is not stored [m]"});
+             {.meaning = "a point this close to one its voxel holds is not stored [m], below voxel_m", .min = 0});
     a->Visit("window_radius_m", &window_radius_m,
-             {.meaning = "voxels farther than this from the vehicle are deleted [m]"});
+             {.meaning = "voxels farther than this from the vehicle are deleted [m], at least 2 voxel_m", .max = 1e4});
   }
 };
 
@@ -74,9 +74,24 @@ class PointMap {
   static Key KeyOf(const Eigen::Vector3i& c);
   static Eigen::Vector3i CellOf(Key key);
 
+  /// Key -> position in voxels_: open addressing with linear probing, at most half full. A
+  /// lookup touches one slot (16 bytes) where a node-based hash chases two pointers, and the
+  /// registration looks up 8 voxels for each of a frame's thousands of points.
+  struct Slot {
+    Key key = kEmpty;
+    std::uint32_t voxel = 0;
+  };
+  static constexpr Key kEmpty = ~Key{0};  ///< KeyOf uses 63 bits: never a key
+  /// The voxel of `key`, or -1.
+  std::int64_t Find(Key key) const;
+  /// The voxel of `key`, created empty when new.
+  std::uint32_t FindOrAdd(Key key);
+  /// Rebuilds the slots for voxels_ with `capacity` slots (a power of two).
+  void Reindex(std::size_t capacity);
+
   PointMapOptions options_;
   double inverse_voxel_ = 0.0;
-  std::unordered_map<Key, std::uint32_t> index_;  ///< key -> position in voxels_
+  std::vector<Slot> slots_;
   std::vector<Voxel> voxels_;
   long points_ = 0;
 };

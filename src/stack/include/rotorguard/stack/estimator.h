@@ -1,8 +1,13 @@
 #pragma once
 /// State estimators of the flight stack. They see sensor messages only.
 #include <deque>
+#include <memory>
+#include <optional>
+#include <span>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
+#include "rotorguard/perception/lio.h"
 
 namespace rotorguard::stack {
 
@@ -10,13 +15,41 @@ class Estimator {
  public:
   virtual ~Estimator() = default;
   virtual void OnImu(const ImuSample& imu) = 0;
+  /// External odometry (motion capture, or a LiDAR-inertial odometry outside the stack).
   virtual void OnOdometry(const OdometrySample& odometry) = 0;
-  virtual void OnEscTelemetry(const EscTelemetry& esc) = 0;
+  virtual void OnLidar(const LidarFrame& /*frame*/) {}
+  void OnEscTelemetry(const EscTelemetry& esc);
   /// The estimate at time t (valid once enough data arrived).
   virtual StateEstimate Estimate(TimeNs t) const = 0;
+  /// The estimate the LiDAR mapper places `frame` with: at the frame's end.
+  virtual StateEstimate FrameEstimate(const LidarFrame& frame) const { return Estimate(frame.t_end_ns); }
+  /// Seconds since the last pose fix at time t (an odometry sample, a LiDAR frame registered);
+  /// the supervisor lands when it grows too old.
+  virtual double odometry_age_s(TimeNs t) const = 0;
+
+ protected:
+  /// k_n with motor speed in rad/s (> 0).
+  explicit Estimator(double thrust_coefficient_n_s2) : thrust_coefficient_(thrust_coefficient_n_s2) {}
+  /// Thrust each motor drives [N], from the latest ESC telemetry through T = k_n ω² (paper 000,
+  /// Sec. III-B); empty before any.
+  const RotorVector& motor_thrust() const { return motor_thrust_; }
+
+ private:
+  double thrust_coefficient_;
+  RotorVector motor_thrust_;
 };
 
+/// Where the stack's pose comes from (docs/navigation.md).
+enum class EstimatorKind {
+  kOdometry,  ///< external odometry samples, carried to the present by the IMU (OdometryImuEstimator)
+  kLio,       ///< the stack's own LiDAR-inertial odometry (LioEstimator)
+};
+inline constexpr EnumName<EstimatorKind> kEstimatorKindNames[] = {{EstimatorKind::kOdometry, "odometry"},
+                                                                  {EstimatorKind::kLio, "lio"}};
+constexpr std::span<const EnumName<EstimatorKind>> NamesOf(const EstimatorKind*) { return kEstimatorKindNames; }
+
 struct EstimatorOptions {
+  EstimatorKind kind = EstimatorKind::kOdometry;
   /// The IMU's mounting point relative to the centre of gravity, body frame [m]: the centripetal
   /// acceleration it feels while the vehicle spins is removed before dead-reckoning.
   Vector3 imu_position_m = Vector3::Zero();
@@ -25,8 +58,16 @@ struct EstimatorOptions {
   /// IMU samples kept to carry a late odometry sample from its capture to its arrival [s], > 0:
   /// longer than the odometry's latency.
   double imu_history_s = 0.25;
+  /// The LiDAR-inertial odometry (kind lio); its mounts are set from the sensors.
+  perception::LioOptions lio;
   /// Throws ValidationError naming the field.
   void Validate() const;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("kind", &kind,
+             {.meaning = "odometry (external, e.g. motion capture) or lio (the stack's own LiDAR-inertial odometry)"});
+    a->Visit("lio", &lio, {.meaning = "the LiDAR-inertial odometry (docs/navigation.md)"});
+  }
 };
 
 /// Pose and velocity from the latest odometry (assumed to be LiDAR-inertial odometry's output),
@@ -45,10 +86,9 @@ class OdometryImuEstimator final : public Estimator {
   OdometryImuEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options = {});
   void OnImu(const ImuSample& imu) override;
   void OnOdometry(const OdometrySample& odometry) override;
-  void OnEscTelemetry(const EscTelemetry& esc) override;
   StateEstimate Estimate(TimeNs t) const override;
   /// Seconds since the last odometry at time t (infinity before the first).
-  double odometry_age_s(TimeNs t) const;
+  double odometry_age_s(TimeNs t) const override;
 
  private:
   /// A strapdown state: pose and velocity at an instant.
@@ -65,12 +105,58 @@ class OdometryImuEstimator final : public Estimator {
   bool have_imu_ = false;
   OdometrySample odometry_;
   Vector3 w_B_ = Vector3::Zero();
-  double thrust_coefficient_;
-  RotorVector motor_thrust_;
   TimeNs imu_history_ns_ = 0;          ///< options_.imu_history_s
   std::deque<ImuSample> imu_history_;  ///< the last imu_history_s of valid samples, oldest first
   Strapdown arrived_;                  ///< the latest odometry carried to its arrival
   Strapdown dead_reckoned_;            ///< restarted at every odometry sample, then integrated
 };
+
+/// How the LiDAR-inertial odometry fared over a flight (summary.json "odometry").
+struct LioSummary {
+  int frames = 0;             ///< frames received
+  int frames_used = 0;        ///< registered (the first one starts the map and is not)
+  int frames_degenerate = 0;  ///< registered with a direction left unconstrained
+  double points_mean = 0.0;   ///< down-sampled points per registered frame
+  double matched_mean = 0.0;  ///< of those, matched to a plane
+  double residual_rms_m_mean = 0.0;
+  double iterations_mean = 0.0;
+  /// Wall-clock time per frame, registration and map update [ms] (the filter's IMU propagation,
+  /// at every sample, is not in it).
+  double frame_ms_mean = 0.0, frame_ms_p99 = 0.0;
+  long map_points = 0;  ///< at the end
+};
+
+/// The stack's own LiDAR-inertial odometry (perception::Lio) from its IMU and LiDAR frames; an
+/// external odometry sample is ignored. The world frame is the start pose's (the mission's
+/// start, where the vehicle rests when the stack starts). A frame counts as a fix when the filter
+/// used it and it left no direction unconstrained; without fixes for the supervisor's timeout
+/// the IMU alone has carried the estimate too long and the vehicle lands.
+class LioEstimator final : public Estimator {
+ public:
+  LioEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options, const Vector3& start_position_W,
+               double start_yaw_rad);
+  void OnImu(const ImuSample& imu) override;
+  void OnOdometry(const OdometrySample& /*odometry*/) override {}
+  void OnLidar(const LidarFrame& frame) override;
+  StateEstimate Estimate(TimeNs t) const override;
+  StateEstimate FrameEstimate(const LidarFrame& frame) const override;
+  double odometry_age_s(TimeNs t) const override;
+  /// Every frame's health, in order.
+  const std::vector<perception::LioFrameSummary>& frames() const { return frames_; }
+  const perception::Lio& lio() const { return lio_; }
+  LioSummary Summarize() const;
+
+ private:
+  perception::Lio lio_;
+  std::vector<double> frame_ms_;       ///< wall-clock time of each frame
+  std::optional<TimeNs> last_fix_ns_;  ///< the last frame used and not degenerate (or the start)
+  std::vector<perception::LioFrameSummary> frames_;
+  StateEstimate frame_estimate_;  ///< at the last frame's end
+};
+
+/// The estimator `options.kind` names. `start_position_W` and `start_yaw_rad`: where the stack
+/// starts (the LiDAR-inertial odometry's world frame).
+std::unique_ptr<Estimator> MakeEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options,
+                                         const Vector3& start_position_W, double start_yaw_rad);
 
 }  // namespace rotorguard::stack

@@ -192,6 +192,8 @@ void FlightStackOptions::Serialize(Archive* a) {
   a->Visit("composite_fdd", &composite_fdd, {.meaning = "the composite FDD's thresholds (paper 000, eqs. 13-18)"});
   a->Visit("deskew_frames", &lidar.deskew_frames,
            {.meaning = "deskew each LiDAR frame to its end pose before mapping"});
+  a->Visit("estimator", &estimator,
+           {.meaning = "where the stack's pose comes from (docs/navigation.md)", .shorthand = "kind"});
   a->Visit("supervisor", &supervisor, {.meaning = "flight modes and emergency landing (docs/navigation.md)"});
   a->Visit("planner", &navigation,
            {.meaning = "the navigate mission's planner (docs/planning.md)", .shorthand = "method"}, [this] {
@@ -205,9 +207,10 @@ void FlightStackOptions::Serialize(Archive* a) {
 }
 
 /// Wall-clock time the stack's parts have taken so far [s]: where a flight's computation goes
-/// (the on-board budget, and the Monte Carlo one). The rest of the stack (estimator, FDD,
-/// supervisor, references) is what its callers' total leaves.
+/// (the on-board budget, and the Monte Carlo one). The rest of the stack (the estimator's IMU
+/// propagation, FDD, supervisor, references) is what its callers' total leaves.
 struct StackCost {
+  double estimator_s = 0.0;   ///< LiDAR frames in the estimator (the LiDAR-inertial odometry's registration)
   double mapper_s = 0.0;      ///< LiDAR frames: deskew, placement, map update
   double planner_s = 0.0;     ///< navigation: replanning (and the flatness navigator)
   double controller_s = 0.0;  ///< the controller's Compute (the NMPC's solve)
@@ -254,6 +257,7 @@ struct FlightStackSummary {
   FlightMode final_mode = FlightMode::kNominal;  ///< the supervisor's mode at the end ...
   std::vector<ModeTransition> transitions;       ///< ... and its transitions
   std::optional<int> map_voxels_occupied;        ///< the LiDAR map's occupied voxels; none without a LiDAR
+  std::optional<LioSummary> odometry;            ///< estimator lio
   long lidar_points_dropped = 0;                 ///< as lidar_points_dropped()
   std::vector<RotorReconfiguration> reconfigurations;  ///< in the order they happened
 };
@@ -343,7 +347,7 @@ class FlightStack {
   vehicle::MultirotorModel model_;
   std::shared_ptr<const ReferenceTrajectory> reference_;
   FlightStackOptions options_;
-  OdometryImuEstimator estimator_;
+  std::unique_ptr<Estimator> estimator_;
   Supervisor supervisor_;
   std::vector<RotorReconfiguration> reconfigurations_;  // rotors treated as failed, in order, and when
   std::string cannot_hover_;                            // why the rotors left cannot hold the vehicle ("" = they can)
