@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <numbers>
 
 #include "cli.h"
 #include "rotorguard/harness/runner.h"
@@ -125,6 +126,12 @@ void PrintRunSummary(const harness::RunSummary& s, const std::string& out_dir,
     }
   }
   if (s.tilt_recovery_s) fmt::print("tilt recovery     {:.2f} s after the first fault\n", *s.tilt_recovery_s);
+  if (const std::optional<stack::LioSummary>& o = s.stack.odometry) {
+    fmt::print("odometry          LiDAR-inertial: {} of {} frames registered ({} degenerate), {:.1f} ms per frame\n",
+               o->frames_used, o->frames, o->frames_degenerate, o->frame_ms_mean);
+  }
+  fmt::print("estimate error    {:.3f} m RMS (max {:.3f} m), attitude max {:.1f} deg\n", s.estimate_position_rmse_m,
+             s.estimate_position_max_m, s.estimate_attitude_max_rad * 180.0 / std::numbers::pi);
   fmt::print("faults            {}\n", faults.empty() ? "none" : faults);
   if (s.fdd && !s.fdd->diagnosis) fmt::print("fault detection   nothing detected\n");
   const auto diagnosis = [](const harness::FddRecord::Diagnosis& d, const std::optional<double>& latency_s) {

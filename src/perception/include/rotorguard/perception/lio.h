@@ -22,8 +22,9 @@
 ///
 /// The world frame is the one the stack starts in: its z axis is up (gravity (0, 0, −g), g known),
 /// its origin and yaw the start pose's. So gravity is not a state (FAST-LIO2 estimates its
-/// direction because its world frame is the first IMU frame); the start's tilt is measured at
-/// rest (Initialise), over the first samples, and the filter then re-runs from the first sample.
+/// direction because its world frame is the first IMU frame). The gyro bias is measured over the
+/// first samples, and on the ground the tilt too (Initialise); then the filter re-runs from the
+/// first sample.
 ///
 /// Timing: LiDAR frames arrive after their end, IMU samples as they are measured. The filter
 /// stays at the last frame's end with the later samples queued; each frame first takes the filter
@@ -55,8 +56,8 @@ struct LioOptions {
   double initial_position_std_m = 0.01;    ///< > 0
   double initial_attitude_std_rad = 0.01;  ///< > 0
   double initial_velocity_std_m_s = 0.05;  ///< > 0
-  /// IMU samples averaged at the start for the tilt (from the specific force) and the gyro bias
-  /// (when the vehicle is at rest), in [1, 1000].
+  /// IMU samples averaged at the start for the gyro bias (when the vehicle does not turn) and, on
+  /// the ground, the tilt (from the specific force), in [1, 1000].
   int initial_samples = 15;
   /// A frame's points nearer than this to the sensor are dropped (the airframe, the propellers) [m], >= 0.
   double min_range_m = 0.3;
