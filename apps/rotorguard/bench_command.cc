@@ -67,6 +67,7 @@ class BenchCommand final : public Command {
                   b == sim_ || b == qp_ || b == nmpc_ || b == campaign_ ? "Print JSON instead of a table"
                                                                         : "Print JSON instead of Markdown");
     }
+    lio_->add_flag("--json", json_, "Print JSON instead of Markdown");
     return bench;
   }
 
@@ -76,6 +77,7 @@ class BenchCommand final : public Command {
     if (*nmpc_) return Nmpc();
     if (*ftc_) return Ftc();
     if (*perception_) return Perception();
+    if (*lio_) return Lio();
     if (*planner_) return Planner();
     if (*nav_) return Nav();
     if (*flatness_) return Flatness();
@@ -144,6 +146,15 @@ class BenchCommand final : public Command {
          "forest and around a room, deskewing on and off: points_per_s_simulated, map_update_ms_mean\n"
          "per frame, map precision and recall against the world within one voxel.",
          {{"--duration", &perception_duration_, "Simulated seconds per run (default 10)"},
+          {"--seed", &seed_, "Sensor noise and forest layout (default 1)"}}},
+        {&lio_,
+         "lio",
+         "The stack's LiDAR-inertial odometry on prescribed motions with the simulated IMU (vibrating) and\n"
+         "LiDAR: a 500-tree forest and a room with a ceiling, hovering and flying 1 m/s, spinning at each\n"
+         "rate of --spins: ate_rmse_m, attitude error, drift_percent per 10 m, frame_ms_mean and\n"
+         "frame_ms_p99 on one core, the fraction of frames flagged degenerate.",
+         {{"--duration", &lio_duration_, "Simulated seconds per condition (default 20)"},
+          {"--spins", &lio_spins_, "Comma-separated yaw rates [rad/s] (default 0,5,11,20)"},
           {"--seed", &seed_, "Sensor noise and forest layout (default 1)"}}},
         {&planner_,
          "planner",
@@ -331,6 +342,23 @@ class BenchCommand final : public Command {
     return kOk;
   }
 
+  int Lio() const {
+    benchmarks::LioBenchOptions o;
+    o.duration_s = ParseFinite("--duration", lio_duration_, 1e-3, 600.0);
+    o.spins.clear();
+    std::size_t start = 0;
+    while (start <= lio_spins_.size()) {
+      const std::size_t comma = std::min(lio_spins_.find(',', start), lio_spins_.size());
+      o.spins.push_back(ParseFinite("--spins", lio_spins_.substr(start, comma - start), 0.0, 30.0));
+      start = comma + 1;
+    }
+    o.seed = Seed();
+    o.progress = CountProgress("conditions");
+    const nlohmann::json r = benchmarks::RunLioBenchmark(o);
+    fmt::print("{}", json_ ? r.dump(2) + "\n" : benchmarks::LioMarkdown(r));
+    return kOk;
+  }
+
   int Planner() const {
     benchmarks::PlannerBenchOptions o;
     o.pairs = static_cast<int>(ParseUnsigned("--pairs", planner_pairs_, 1, 100000));
@@ -454,7 +482,7 @@ class BenchCommand final : public Command {
     return same ? kOk : kRunFailed;
   }
 
-  CLI::App *sim_ = nullptr, *qp_ = nullptr, *nmpc_ = nullptr, *ftc_ = nullptr, *perception_ = nullptr,
+  CLI::App *sim_ = nullptr, *qp_ = nullptr, *nmpc_ = nullptr, *ftc_ = nullptr, *perception_ = nullptr, *lio_ = nullptr,
            *planner_ = nullptr, *nav_ = nullptr, *flatness_ = nullptr, *mars_ = nullptr, *campaign_ = nullptr;
   // Options several benchmarks share (one of them runs per invocation).
   std::string seed_ = "1", jobs_, out_, shard_ = "0/1", html_;
@@ -464,6 +492,7 @@ class BenchCommand final : public Command {
   std::string truth_ = "realistic";
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";
+  std::string lio_duration_ = "20", lio_spins_ = "0,5,11,20";
   std::string planner_pairs_ = "100", planner_worlds_ = "10";
   std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;
   std::string flatness_seeds_ = "20";

@@ -1,19 +1,24 @@
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <unordered_set>
-#include <vector>
+#include "rotorguard/benchmarks/perception_bench.h"
 
 #include <fmt/format.h>
 
-#include "rotorguard/benchmarks/perception_bench.h"
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <numeric>
+#include <unordered_set>
+#include <vector>
+
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/perception/lidar_mapper.h"
+#include "rotorguard/perception/lio.h"
 #include "rotorguard/sim/lidar.h"
 #include "rotorguard/sim/sensors.h"
 #include "rotorguard/stack/estimator.h"
@@ -23,27 +28,45 @@ namespace rotorguard::benchmarks {
 namespace {
 
 /// The prescribed motion: level, yawing at the spin rate, along a line (forest) or a circle (room).
+/// With ramp_s > 0 the speed rises from rest over that time as a smoothstep (3u² − 2u³), so that
+/// the flight starts at rest as a vehicle does; the distance covered is then
+/// s(t) = v (ramp (u³ − u⁴/2)) while ramping, v (t − ramp/2) after.
 struct Path {
   Vector3 start_W = Vector3::Zero();
   double speed_m_s = 1.0;
   double spin_rad_s = 11.0;
   double circle_radius_m = 0.0;  // 0: a straight line along +x
   Vector3 circle_center_W = Vector3::Zero();
+  double ramp_s = 0.0;
 
+  /// Distance along the path, and its first and second derivatives.
+  Eigen::Vector3d Arc(double t) const {
+    if (ramp_s <= 0.0 || t >= ramp_s) {
+      return Vector3(speed_m_s * (t - 0.5 * std::max(ramp_s, 0.0)), speed_m_s, 0.0);
+    }
+    const double u = std::max(t, 0.0) / ramp_s;
+    return speed_m_s * Vector3(ramp_s * (u * u * u - 0.5 * u * u * u * u), 3.0 * u * u - 2.0 * u * u * u,
+                               (6.0 * u - 6.0 * u * u) / ramp_s);
+  }
   Vector3 Position(double t) const {
-    if (circle_radius_m <= 0.0) return start_W + Vector3(speed_m_s * t, 0.0, 0.0);
-    const double a = speed_m_s * t / circle_radius_m;
+    const double s = Arc(t).x();
+    if (circle_radius_m <= 0.0) return start_W + Vector3(s, 0.0, 0.0);
+    const double a = s / circle_radius_m;
     return circle_center_W + circle_radius_m * Vector3(std::cos(a), std::sin(a), 0.0);
   }
   Vector3 Velocity(double t) const {
-    if (circle_radius_m <= 0.0) return Vector3(speed_m_s, 0.0, 0.0);
-    const double a = speed_m_s * t / circle_radius_m;
-    return speed_m_s * Vector3(-std::sin(a), std::cos(a), 0.0);
+    const Eigen::Vector3d arc = Arc(t);
+    if (circle_radius_m <= 0.0) return Vector3(arc.y(), 0.0, 0.0);
+    const double a = arc.x() / circle_radius_m;
+    return arc.y() * Vector3(-std::sin(a), std::cos(a), 0.0);
   }
   Vector3 Acceleration(double t) const {
-    if (circle_radius_m <= 0.0) return Vector3::Zero();
-    const double a = speed_m_s * t / circle_radius_m;
-    return -(speed_m_s * speed_m_s / circle_radius_m) * Vector3(std::cos(a), std::sin(a), 0.0);
+    const Eigen::Vector3d arc = Arc(t);
+    if (circle_radius_m <= 0.0) return Vector3(arc.z(), 0.0, 0.0);
+    const double a = arc.x() / circle_radius_m;
+    // Tangential s̈ and centripetal ṡ²/r.
+    return arc.z() * Vector3(-std::sin(a), std::cos(a), 0.0) -
+           (arc.y() * arc.y() / circle_radius_m) * Vector3(std::cos(a), std::sin(a), 0.0);
   }
   Quaternion Attitude(double t) const { return Quaternion(Eigen::AngleAxisd(spin_rad_s * t, Vector3::UnitZ())); }
 };
@@ -168,6 +191,105 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
           {"map_recall", recall}};
 }
 
+/// One condition of bench lio: the path flown for `duration_s` with the simulator's IMU (with the
+/// airframe's vibration) and LiDAR, the odometry fed as the flight stack feeds it.
+nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const LioBenchOptions& options) {
+  sim::LidarOptions lidar_options;
+  lidar_options.enabled = true;
+  sim::ImuOptions imu_options;
+  imu_options.vibration_m_s2 = 0.6;
+  imu_options.vibration_reference_speed_rad_s = 900.0;
+  sim::LidarSimulator lidar(lidar_options, scene.world, DeriveSeed(options.seed, 1));
+  sim::ImuModel imu(imu_options, DeriveSeed(options.seed, 2));
+  sim::RateTimer imu_timer(imu_options.rate_hz);
+  perception::LioOptions lio_options;
+  lio_options.imu_position_m = imu_options.position_m;
+  lio_options.lidar_position_m = lidar_options.position_m;
+  const Path& path = scene.path;
+  perception::Lio lio(lio_options, path.Position(0.0), YawOf(path.Attitude(0.0)));
+  const auto pose_at = [&](TimeNs t) {
+    return sim::BodyPose{path.Position(ToSeconds(t)), path.Attitude(ToSeconds(t))};
+  };
+  vehicle::StateVector x = vehicle::StateVector::Zero(13 + 4);
+  sim::TruthSample truth;
+  truth.x = &x;
+  truth.motor_speed_rad_s = RotorVector::Constant(4, 900.0);  // hover speed: the vibration's frequency
+  double sum2 = 0.0, max_e = 0.0, att2 = 0.0, max_att = 0.0;
+  long samples = 0, frames = 0, used = 0, degenerate = 0;
+  std::vector<double> frame_ms;
+  // The estimate's and the truth's positions at every 10 m travelled (flying), for the drift.
+  std::vector<std::pair<Vector3, Vector3>> legs;
+  bool diverged = false;
+  const TimeNs step = 1'000'000, end = FromSeconds(options.duration_s);
+  for (TimeNs t = step; t <= end; t += step) {
+    const double ts = ToSeconds(t);
+    x.segment<3>(vehicle::StateIndex::kPosition) = path.Position(ts);
+    const Quaternion q = path.Attitude(ts);
+    x.segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
+    x.segment<3>(vehicle::StateIndex::kVelocity) = path.Velocity(ts);
+    x.segment<3>(vehicle::StateIndex::kBodyRate) = Vector3(0.0, 0.0, path.spin_rad_s);
+    truth.t_ns = t;
+    truth.acc.a_W = path.Acceleration(ts);
+    if (imu_timer.Due(t)) {
+      lio.OnImu(imu.Sample(truth));
+      const StateEstimate e = lio.Estimate();
+      // Against the truth at the estimate's own time (the path gives it at any instant).
+      const sim::BodyPose p = pose_at(e.t_ns);
+      const double err = (e.p_W - p.p_W).norm();
+      const double att = LogSO3(p.q_WB.conjugate() * e.q_WB).norm();
+      if (!std::isfinite(err) || err > 1.0) diverged = true;
+      sum2 += err * err;
+      att2 += att * att;
+      max_e = std::max(max_e, std::isfinite(err) ? err : 1e9);
+      max_att = std::max(max_att, att);
+      ++samples;
+      if (motion == "flying" && path.Arc(ToSeconds(e.t_ns)).x() >= 10.0 * static_cast<double>(legs.size())) {
+        legs.emplace_back(e.p_W, p.p_W);
+      }
+    }
+    const std::optional<LidarFrame> frame = lidar.Step(t - step, pose_at(t - step), t, pose_at(t));
+    if (!frame) continue;
+    const Stopwatch clock;
+    const perception::LioFrameSummary f = lio.OnFrame(*frame);
+    frame_ms.push_back(1e3 * clock.seconds());
+    ++frames;
+    used += f.used;
+    degenerate += f.used && f.degenerate;
+  }
+  nlohmann::json drift = nullptr;
+  if (legs.size() >= 2) {
+    double sum = 0.0;
+    for (std::size_t k = 1; k < legs.size(); ++k) {
+      sum += ((legs[k].first - legs[k - 1].first) - (legs[k].second - legs[k - 1].second)).norm() / 10.0 * 100.0;
+    }
+    drift = sum / static_cast<double>(legs.size() - 1);
+  }
+  std::sort(frame_ms.begin(), frame_ms.end());
+  const auto percentile = [&](double q) {
+    if (frame_ms.empty()) return 0.0;
+    return frame_ms[static_cast<std::size_t>(std::ceil(q * static_cast<double>(frame_ms.size()))) - 1];
+  };
+  const double n = static_cast<double>(std::max<long>(1, samples));
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+  return {{"scene", scene.name},
+          {"motion", motion},
+          {"spin_rad_s", path.spin_rad_s},
+          {"ate_rmse_m", std::sqrt(sum2 / n)},
+          {"ate_max_m", max_e},
+          {"attitude_rmse_deg", kDeg * std::sqrt(att2 / n)},
+          {"attitude_max_deg", kDeg * max_att},
+          {"drift_percent", drift},
+          {"frames", frames},
+          {"frames_used", used},
+          {"degenerate_fraction", used > 0 ? static_cast<double>(degenerate) / static_cast<double>(used) : 0.0},
+          {"frame_ms_mean", frame_ms.empty() ? 0.0
+                                             : std::accumulate(frame_ms.begin(), frame_ms.end(), 0.0) /
+                                                   static_cast<double>(frame_ms.size())},
+          {"frame_ms_p99", percentile(0.99)},
+          {"map_points", lio.map().size()},
+          {"diverged", diverged}};
+}
+
 }  // namespace
 
 void PerceptionBenchOptions::Validate() const {
@@ -197,6 +319,12 @@ sim::World PerceptionRoom() {
              {Vector3(2.8, -2.0, 0.4), Vector3(1.2, 0.8, 0.8), 0.3},  // a table-sized box
              {Vector3(-3.7, 1.5, 1.0), Vector3(0.4, 1.6, 2.0), 0.0}};  // a shelf against a wall
   w.cylinders = {{Eigen::Vector2d(1.5, 1.0), 0.2, 3.0}};
+  return w;
+}
+
+sim::World LioRoom() {
+  sim::World w = PerceptionRoom();
+  w.boxes.push_back({Vector3(0.0, 0.0, 3.25), Vector3(10.0, 8.0, 0.5), 0.0});
   return w;
 }
 
@@ -263,6 +391,73 @@ std::string PerceptionMarkdown(const nlohmann::json& r) {
                     r["meets_quality_targets"].get<bool>() ? "met" : "NOT met",
                     r["meets_map_speed_target"].get<bool>() ? "met" : "NOT met",
                     r["meets_simulation_speed_target"].get<bool>() ? "met" : "NOT met");
+  return md;
+}
+
+}  // namespace rotorguard::benchmarks
+
+namespace rotorguard::benchmarks {
+
+void LioBenchOptions::Validate() const {
+  const auto require = [](bool ok, const std::string& field, double v, const char* rule) {
+    if (!ok) ThrowInvalidArgument("RunLioBenchmark", "LioBenchOptions::" + field, v, rule);
+  };
+  require(duration_s > 0.0 && duration_s <= 600.0, "duration_s", duration_s, "a duration in (0, 600] s");
+  require(speed_m_s > 0.0 && speed_m_s <= 5.0, "speed_m_s", speed_m_s, "a speed in (0, 5] m/s");
+  require(!spins.empty(), "spins", 0.0, "at least one rate");
+  for (double w : spins) require(w >= 0.0 && w <= 30.0, "spins", w, "rates in [0, 30] rad/s");
+}
+
+nlohmann::json RunLioBenchmark(const LioBenchOptions& options) {
+  options.Validate();
+  const sim::World forest = PerceptionForest(options.seed), room = LioRoom();
+  const int total = 4 * static_cast<int>(options.spins.size());
+  int done = 0;
+  nlohmann::json runs = nlohmann::json::array();
+  for (const double spin : options.spins) {
+    for (const std::string motion : {"hover", "flying"}) {
+      const double speed = motion == "flying" ? options.speed_m_s : 0.0;
+      Path line, circle;
+      // Hovering in the forest's lane, or flying along it; in the room, on a 1.5 m circle.
+      line.start_W = motion == "flying" ? Vector3(-12.0, 0.0, 1.5) : Vector3(0.0, 0.0, 1.5);
+      circle.circle_radius_m = 1.5;
+      circle.circle_center_W = Vector3(-0.5, 0.0, 1.5);
+      for (Path* p : {&line, &circle}) {
+        p->speed_m_s = speed;
+        p->spin_rad_s = spin;
+        p->ramp_s = 2.0;  // from rest, as the odometry starts
+      }
+      for (const Scene& scene : {Scene{"forest", forest, line}, Scene{"room", room, circle}}) {
+        runs.push_back(RunLioScene(scene, motion, options));
+        if (options.progress) options.progress(++done, total);
+      }
+    }
+  }
+  return {{"benchmark", "lio"},
+          {"duration_s", options.duration_s},
+          {"speed_m_s", options.speed_m_s},
+          {"seed", options.seed},
+          {"runs", runs},
+          {"host", buildinfo::HostInfo()}};
+}
+
+std::string LioMarkdown(const nlohmann::json& r) {
+  std::string md = fmt::format("LiDAR-inertial odometry, {:.0f} s per condition, flying at {:.1f} m/s.\n\n",
+                               r["duration_s"].get<double>(), r["speed_m_s"].get<double>());
+  md +=
+      "| scene | motion | spin (rad/s) | ATE RMSE / max (m) | attitude RMSE / max (deg) | drift (% per 10 m) | "
+      "frame ms mean / p99 | degenerate | diverged |\n";
+  md += "|---|---|---|---|---|---|---|---|---|\n";
+  for (const nlohmann::json& x : r["runs"]) {
+    md += fmt::format(
+        "| {} | {} | {:.0f} | {:.3f} / {:.3f} | {:.2f} / {:.2f} | {} | {:.2f} / {:.2f} | {:.1f} % | {} |\n",
+        x["scene"].get<std::string>(), x["motion"].get<std::string>(), x["spin_rad_s"].get<double>(),
+        x["ate_rmse_m"].get<double>(), x["ate_max_m"].get<double>(), x["attitude_rmse_deg"].get<double>(),
+        x["attitude_max_deg"].get<double>(),
+        x["drift_percent"].is_null() ? std::string("-") : fmt::format("{:.2f}", x["drift_percent"].get<double>()),
+        x["frame_ms_mean"].get<double>(), x["frame_ms_p99"].get<double>(),
+        100.0 * x["degenerate_fraction"].get<double>(), x["diverged"].get<bool>() ? "yes" : "no");
+  }
   return md;
 }
 

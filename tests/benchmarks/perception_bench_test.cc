@@ -39,6 +39,35 @@ TEST(PerceptionBench, TheForestLeavesTheFlightLaneClear) {
   EXPECT_NE(PerceptionForest(4).cylinders[0].center_m, w.cylinders[0].center_m) << "the seed draws the layout";
 }
 
+// Four simulated seconds at 11 rad/s: the four conditions of one spin, each followed within
+// centimetres (hovering) and a decimetre (flying), the frames all registered but the first, the
+// drift reported when flying only. The drift is the displacement's error over each 10 m: at 1 m/s
+// a 3 s flight has none to report, so this one flies 4 m/s (12 m after the 2 s from rest).
+TEST(LioBench, FollowsEveryConditionOfASpinAndReportsWhatItMeasured) {
+  LioBenchOptions o;
+  o.duration_s = 4.0;
+  o.speed_m_s = 4.0;
+  o.spins = {11.0};
+  int progress = 0;
+  o.progress = [&](int done, int total) {
+    progress = done;
+    EXPECT_EQ(total, 4);
+  };
+  const nlohmann::json r = RunLioBenchmark(o);
+  EXPECT_EQ(progress, 4);
+  ASSERT_EQ(r["runs"].size(), 4u);
+  for (const nlohmann::json& x : r["runs"]) {
+    const bool flying = x["motion"].get<std::string>() == "flying";
+    EXPECT_EQ(x["frames"].get<long>(), 40);
+    EXPECT_EQ(x["frames_used"].get<long>(), 39) << "the first frame starts the map";
+    EXPECT_FALSE(x["diverged"].get<bool>());
+    EXPECT_LT(x["ate_rmse_m"].get<double>(), flying ? 0.1 : 0.03) << x.dump();
+    EXPECT_LT(x["attitude_max_deg"].get<double>(), 2.0) << x.dump();
+    EXPECT_EQ(x["drift_percent"].is_null(), !flying) << x.dump();
+    EXPECT_GT(x["frame_ms_p99"].get<double>(), 0.0);
+  }
+}
+
 TEST(PerceptionBench, InvalidOptionsAreNamed) {
   PerceptionBenchOptions o;
   o.spin_rad_s = -1.0;
