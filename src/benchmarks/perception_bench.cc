@@ -28,9 +28,8 @@ namespace rotorguard::benchmarks {
 namespace {
 
 /// The prescribed motion: level, yawing at the spin rate, along a line (forest) or a circle (room).
-/// With ramp_s > 0 the speed rises from rest over that time as a smoothstep (3u² − 2u³), so that
-/// the flight starts at rest as a vehicle does; the distance covered is then
-/// s(t) = v (ramp (u³ − u⁴/2)) while ramping, v (t − ramp/2) after.
+/// With ramp_s > 0 the speed and the spin rise from rest over that time as a smoothstep
+/// (3u² − 2u³), so that the flight starts at rest as a vehicle does.
 struct Path {
   Vector3 start_W = Vector3::Zero();
   double speed_m_s = 1.0;
@@ -39,15 +38,16 @@ struct Path {
   Vector3 circle_center_W = Vector3::Zero();
   double ramp_s = 0.0;
 
-  /// Distance along the path, and its first and second derivatives.
-  Eigen::Vector3d Arc(double t) const {
-    if (ramp_s <= 0.0 || t >= ramp_s) {
-      return Vector3(speed_m_s * (t - 0.5 * std::max(ramp_s, 0.0)), speed_m_s, 0.0);
-    }
+  /// The integral of the unit rate that starts smoothly, the rate, and its derivative:
+  /// ramp (u³ − u⁴/2), 3u² − 2u³, (6u − 6u²) / ramp while ramping (u = t / ramp); t − ramp/2, 1, 0 after.
+  Vector3 SmoothStart(double t) const {
+    if (ramp_s <= 0.0 || t >= ramp_s) return Vector3(t - 0.5 * std::max(ramp_s, 0.0), 1.0, 0.0);
     const double u = std::max(t, 0.0) / ramp_s;
-    return speed_m_s * Vector3(ramp_s * (u * u * u - 0.5 * u * u * u * u), 3.0 * u * u - 2.0 * u * u * u,
-                               (6.0 * u - 6.0 * u * u) / ramp_s);
+    return Vector3(ramp_s * (u * u * u - 0.5 * u * u * u * u), 3.0 * u * u - 2.0 * u * u * u,
+                   (6.0 * u - 6.0 * u * u) / ramp_s);
   }
+  /// Distance along the path, and its first and second derivatives.
+  Vector3 Arc(double t) const { return speed_m_s * SmoothStart(t); }
   Vector3 Position(double t) const {
     const double s = Arc(t).x();
     if (circle_radius_m <= 0.0) return start_W + Vector3(s, 0.0, 0.0);
@@ -55,20 +55,25 @@ struct Path {
     return circle_center_W + circle_radius_m * Vector3(std::cos(a), std::sin(a), 0.0);
   }
   Vector3 Velocity(double t) const {
-    const Eigen::Vector3d arc = Arc(t);
+    const Vector3 arc = Arc(t);
     if (circle_radius_m <= 0.0) return Vector3(arc.y(), 0.0, 0.0);
     const double a = arc.x() / circle_radius_m;
     return arc.y() * Vector3(-std::sin(a), std::cos(a), 0.0);
   }
   Vector3 Acceleration(double t) const {
-    const Eigen::Vector3d arc = Arc(t);
+    const Vector3 arc = Arc(t);
     if (circle_radius_m <= 0.0) return Vector3(arc.z(), 0.0, 0.0);
     const double a = arc.x() / circle_radius_m;
     // Tangential s̈ and centripetal ṡ²/r.
     return arc.z() * Vector3(-std::sin(a), std::cos(a), 0.0) -
            (arc.y() * arc.y() / circle_radius_m) * Vector3(std::cos(a), std::sin(a), 0.0);
   }
-  Quaternion Attitude(double t) const { return Quaternion(Eigen::AngleAxisd(spin_rad_s * t, Vector3::UnitZ())); }
+  Quaternion Attitude(double t) const {
+    return Quaternion(Eigen::AngleAxisd(spin_rad_s * SmoothStart(t).x(), Vector3::UnitZ()));
+  }
+  /// Body rate and angular acceleration (about z, level flight).
+  Vector3 Rate(double t) const { return Vector3(0.0, 0.0, spin_rad_s * SmoothStart(t).y()); }
+  Vector3 AngularAcceleration(double t) const { return Vector3(0.0, 0.0, spin_rad_s * SmoothStart(t).z()); }
 };
 
 struct Scene {
@@ -124,7 +129,7 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
     const Quaternion q = scene.path.Attitude(ts);
     x.segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
     x.segment<3>(vehicle::StateIndex::kVelocity) = scene.path.Velocity(ts);
-    x.segment<3>(vehicle::StateIndex::kBodyRate) = Vector3(0.0, 0.0, scene.path.spin_rad_s);
+    x.segment<3>(vehicle::StateIndex::kBodyRate) = scene.path.Rate(ts);
     sim::TruthSample truth;
     truth.t_ns = t;
     truth.x = &x;
@@ -227,9 +232,10 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
     const Quaternion q = path.Attitude(ts);
     x.segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
     x.segment<3>(vehicle::StateIndex::kVelocity) = path.Velocity(ts);
-    x.segment<3>(vehicle::StateIndex::kBodyRate) = Vector3(0.0, 0.0, path.spin_rad_s);
+    x.segment<3>(vehicle::StateIndex::kBodyRate) = path.Rate(ts);
     truth.t_ns = t;
     truth.acc.a_W = path.Acceleration(ts);
+    truth.acc.alpha_B = path.AngularAcceleration(ts);
     if (imu_timer.Due(t)) {
       lio.OnImu(imu.Sample(truth));
       const StateEstimate e = lio.Estimate();
@@ -425,7 +431,7 @@ nlohmann::json RunLioBenchmark(const LioBenchOptions& options) {
       for (Path* p : {&line, &circle}) {
         p->speed_m_s = speed;
         p->spin_rad_s = spin;
-        p->ramp_s = 2.0;  // from rest, as the odometry starts
+        p->ramp_s = 2.0;  // from rest, as the odometry starts, up to speed and spin in 2 s
       }
       for (const Scene& scene : {Scene{"forest", forest, line}, Scene{"room", room, circle}}) {
         runs.push_back(RunLioScene(scene, motion, options));

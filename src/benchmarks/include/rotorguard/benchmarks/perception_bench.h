@@ -46,10 +46,10 @@ std::string PerceptionMarkdown(const nlohmann::json& result);
 /// `rotorguard bench lio`: the stack's LiDAR-inertial odometry (perception::Lio) on the same
 /// prescribed motions and simulated sensors, the IMU shaken by the airframe's vibration (0.6 m/s²
 /// at the rotors' frequency): in the forest and in the room (with a ceiling), hovering and flying
-/// 1 m/s (reached from rest over 2 s), spinning at each rate of `spins`. Per condition: ate_rmse_m (the estimate's
-/// position against the truth at every IMU sample, no alignment: the odometry starts at the true pose), ate_max_m,
-/// attitude_rmse_deg and attitude_max_deg, drift_percent (flying: the error of the displacement over each 10 m
-/// travelled, per cent of 10 m; null hovering), frame_ms_mean and frame_ms_p99 (Lio::OnFrame on one core),
+/// 1 m/s, spinning at each rate of `spins` (speed and spin reached from rest over 2 s). Per condition: ate_rmse_m (the
+/// estimate's position against the truth at every IMU sample, no alignment: the odometry starts at the true pose),
+/// ate_max_m, attitude_rmse_deg and attitude_max_deg, drift_percent (flying: the error of the displacement over each 10
+/// m travelled, per cent of 10 m; null hovering), frame_ms_mean and frame_ms_p99 (Lio::OnFrame on one core),
 /// degenerate_fraction, frames_used and diverged (an error above 1 m).
 struct LioBenchOptions {
   double duration_s = 20.0;                            ///< simulated seconds per condition, in (0, 600]
