@@ -175,6 +175,9 @@ class BenchCommand final : public Command {
           trial_seed,
           jobs,
           {"--kinds", &nav_kinds_, "Comma-separated world kinds: forest, room (default both)"},
+          {"--estimator", &nav_estimator_,
+           "Where the stack takes its pose from: odometry (external, the default) or lio (its own\n"
+           "LiDAR-inertial odometry)"},
           {"--replay", &nav_replay_,
            "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out"}}},
         {&flatness_,
@@ -378,6 +381,12 @@ class BenchCommand final : public Command {
     o.base = harness::LoadScenario(ConfigPath("scenarios/forest.yaml"));
     o.truth = Truth();
     o.base.truth.preset = o.truth;  // a replayed trial flies the same world
+    const std::optional<stack::EstimatorKind> estimator = FromName<stack::EstimatorKind>(nav_estimator_);
+    if (!estimator) {
+      throw UsageError(fmt::format("--estimator '{}' is invalid; expected one of: odometry, lio", nav_estimator_));
+    }
+    o.estimator = *estimator;
+    o.base.stack.estimator.kind = o.estimator;  // and on the same estimator
     if (!nav_replay_.empty()) return ReplayNavTrial(o.base);
     RunBenchCampaign(benchmarks::NavCampaign(o), "nav");
     return kOk;
@@ -494,7 +503,7 @@ class BenchCommand final : public Command {
   std::string perception_duration_ = "10";
   std::string lio_duration_ = "20", lio_spins_ = "0,5,11,20";
   std::string planner_pairs_ = "100", planner_worlds_ = "10";
-  std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;
+  std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_, nav_estimator_ = "odometry";
   std::string flatness_seeds_ = "20";
   std::string mars_trials_ = "10";
   std::string campaign_spec_, campaign_work_;

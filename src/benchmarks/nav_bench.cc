@@ -175,8 +175,9 @@ campaign::Campaign NavCampaign(const NavBenchOptions& o) {
   c.group_keys = {"kind", "variant"};
   c.metrics = {"success",        "collision",       "tracking_rmse_m",      "max_spin_rad_s",
                "mission_time_s", "realtime_factor", "trial_realtime_factor"};
-  const nlohmann::json options = {{"trials", o.trials}, {"seed", o.seed}, {"kinds", o.kinds}, {"base", o.base.name},
-                                  {"truth", ToName(o.truth)}};
+  const nlohmann::json options = {{"trials", o.trials},       {"seed", o.seed},
+                                  {"kinds", o.kinds},         {"base", o.base.name},
+                                  {"truth", ToName(o.truth)}, {"estimator", ToName(o.estimator)}};
   // "records": what a trial records. Version 2 made realtime_factor the stack's and added
   // trial_realtime_factor; the hash then refuses to resume or merge the folders of version 1.
   c.bench = {{"name", "nav"}, {"records", 2}, {"options", options}};
@@ -193,6 +194,7 @@ campaign::Campaign NavCampaign(const NavBenchOptions& o) {
   };
   harness::Scenario base = o.base;
   base.truth.preset = o.truth;
+  base.stack.estimator.kind = o.estimator;
   c.run = [base](int, const std::map<std::string, std::string>& params) {
     harness::RunOptions run;
     run.stop_when_mission_complete = true;
@@ -275,6 +277,7 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
   result["groups"] = groups;
   result["options"] = options;
   result["truth"] = options.value("truth", "ideal");  // records made before the key: the ideal world
+  result["estimator"] = options.value("estimator", "odometry");
   result["host"] = buildinfo::HostInfo();
   return result;
 }

@@ -92,6 +92,9 @@ campaign::Campaign LoadNav(const io::ConfigNode& root, const std::string& path) 
   const SpecFiles files(root, path);
   NavBenchOptions o = SeedAndTrials<NavBenchOptions>(root, 100'000);
   if (root.Has("kinds")) o.kinds = WordList(root.Required("kinds"), {"forest", "room"});
+  if (root.Has("estimator")) {
+    o.estimator = *FromName<stack::EstimatorKind>(root.Required("estimator").AsEnum(NameList<stack::EstimatorKind>()));
+  }
   o.base = files.ScenarioAt("base");
   return Checked(root, [&] { return NavCampaign(o); });
 }

@@ -230,6 +230,28 @@ TEST_F(BenchCampaigns, ASpecsTruthIsTheSameCampaignAsTheFlag) {
                        io::ConfigError, "truth: 'perfect' is not allowed; expected one of: ideal, realistic");
 }
 
+TEST_F(BenchCampaigns, ANavSpecsEstimatorIsTheSameCampaignAsTheFlagAndOverridesTheBase) {
+  // The base (the forest) flies on its LiDAR-inertial odometry; the benchmark flies the external
+  // odometry unless told otherwise, and `estimator: lio` is `bench nav --estimator lio`.
+  const std::string spec =
+      "name: n\nbench: nav\ntrials: 1\nkinds: [room]\nbase: " + kConfigs + "/scenarios/forest.yaml\n";
+  NavBenchOptions o;
+  o.trials = 1;
+  o.kinds = {"room"};
+  o.base = harness::LoadScenario(kConfigs + "/scenarios/forest.yaml");
+  ASSERT_EQ(o.base.stack.estimator.kind, stack::EstimatorKind::kLio);
+  const campaign::Campaign odometry = campaign::LoadCampaign(Write("n.yaml", spec), CampaignKinds());
+  EXPECT_EQ(odometry.bench["options"]["estimator"], "odometry");
+  EXPECT_EQ(odometry.hash, NavCampaign(o).hash);
+  o.estimator = stack::EstimatorKind::kLio;
+  const campaign::Campaign lio = campaign::LoadCampaign(Write("l.yaml", spec + "estimator: lio\n"), CampaignKinds());
+  EXPECT_EQ(lio.bench["options"]["estimator"], "lio");
+  EXPECT_EQ(lio.hash, NavCampaign(o).hash);
+  EXPECT_NE(lio.hash, odometry.hash);
+  RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("m.yaml", spec + "estimator: gps\n"), CampaignKinds()),
+                       io::ConfigError, "expected one of: odometry, lio");
+}
+
 TEST_F(BenchCampaigns, BadBenchmarkSpecsNameTheKey) {
   const std::string vehicle = "vehicle: " + kConfigs + "/vehicles/zhou2025_quad.yaml\n";
   RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("a.yaml", "name: a\nbench: hover\ntrials: 1\n"), CampaignKinds()), io::ConfigError, "bench");
