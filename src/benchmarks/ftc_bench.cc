@@ -11,9 +11,9 @@
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/failure_list.h"
-#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
@@ -217,14 +217,13 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
       {"mdr", NullIfNan(with_fdd > 0 && faulty ? missed / n : nan)},
       {"far", NullIfNan(with_fdd > 0 ? false_alarms / n : nan)},
       {"mini_alt_m", NullIfNan(min_alt)},
-      {"final_rmse_m_median", NullIfNan(final_rmse.empty() ? nan : campaign::Percentile(final_rmse, 0.5))},
+      {"final_rmse_m_median", NullIfNan(final_rmse.empty() ? nan : Percentile(final_rmse, 0.5))},
       {"eta_error_mean", NullIfNan(eta_errors.empty() ? nan : Mean(eta_errors))},
       {"eta_error_max", NullIfNan(eta_errors.empty() ? nan : *std::max_element(eta_errors.begin(), eta_errors.end()))},
       {"second_isolated", NullIfNan(with_second ? second_correct / n : nan)},
-      {"second_latency_s_median",
-       NullIfNan(second_latencies.empty() ? nan : campaign::Percentile(second_latencies, 0.5))},
+      {"second_latency_s_median", NullIfNan(second_latencies.empty() ? nan : Percentile(second_latencies, 0.5))},
       {"crashes", crash_speeds.size()},
-      {"crash_speed_m_s_median", NullIfNan(crash_speeds.empty() ? nan : campaign::Percentile(crash_speeds, 0.5))},
+      {"crash_speed_m_s_median", NullIfNan(crash_speeds.empty() ? nan : Percentile(crash_speeds, 0.5))},
       {"crash_speed_m_s_max",
        NullIfNan(crash_speeds.empty() ? nan : *std::max_element(crash_speeds.begin(), crash_speeds.end()))},
       {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution

@@ -1,17 +1,17 @@
 #include "rotorguard/benchmarks/mars_bench.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <mutex>
 #include <numbers>
 
-#include <fmt/format.h>
-
 #include "rotorguard/benchmarks/reconfiguration.h"
 #include "rotorguard/campaign/campaign.h"
-#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/harness/run_summary.h"
@@ -90,7 +90,7 @@ std::pair<double, double> TimeAllocation(const modular::Assembly& a, int samples
   }
   double mean = 0.0;
   for (const double v : us) mean += v / samples;
-  return {mean, campaign::Percentile(us, 0.99)};
+  return {mean, Percentile(us, 0.99)};
 }
 
 /// The rotors of unit No. k (index k - 1), all stopped.

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "rotorguard/buildinfo/build_info.h"
-#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/runner.h"
@@ -59,13 +59,13 @@ nlohmann::json RunNmpcBenchmark(const harness::Scenario& nominal, const harness:
           {"scenarios", {nominal.name, failed.name}},
           {"calls", all.size()},
           {"solve_ms_mean", calls > 0 ? sum / calls : 0.0},
-          {"solve_ms_median", campaign::Percentile(all, 0.5)},
-          {"solve_ms_p99", campaign::Percentile(all, 0.99)},
-          {"solve_ms_max", campaign::Percentile(all, 1.0)},
-          {"solve_ms_median_nominal", campaign::Percentile(a.solve_ms, 0.5)},
-          {"solve_ms_median_failed", campaign::Percentile(b.solve_ms, 0.5)},
+          {"solve_ms_median", Percentile(all, 0.5)},
+          {"solve_ms_p99", Percentile(all, 0.99)},
+          {"solve_ms_max", Percentile(all, 1.0)},
+          {"solve_ms_median_nominal", Percentile(a.solve_ms, 0.5)},
+          {"solve_ms_median_failed", Percentile(b.solve_ms, 0.5)},
           {"command_latency_ms_mean", latency.empty() ? 0.0 : latency_sum / static_cast<double>(latency.size())},
-          {"command_latency_ms_p99", campaign::Percentile(latency, 0.99)},
+          {"command_latency_ms_p99", Percentile(latency, 0.99)},
           {"prepare_ms_mean", calls > 0 ? (a.prepare_ms + b.prepare_ms) / calls : 0.0},
           {"feedback_ms_mean", calls > 0 ? (a.feedback_ms + b.feedback_ms) / calls : 0.0},
           {"qp_iterations_mean", calls > 0 ? (a.qp_iterations + b.qp_iterations) / calls : 0.0},

@@ -1,17 +1,17 @@
 #include "rotorguard/benchmarks/planner_bench.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <vector>
 
-#include <fmt/format.h>
-
 #include "rotorguard/buildinfo/build_info.h"
-#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/planning/planner.h"
@@ -70,8 +70,8 @@ nlohmann::json GroupJson(const Group& g) {
           {"pairs_without_path", g.no_path},
           {"success_rate", with_path > 0 ? static_cast<double>(g.succeeded) / with_path : 0.0},
           {"plan_ms_mean", mean},
-          {"plan_ms_median", campaign::Percentile(ms, 0.5)},
-          {"plan_ms_p99", campaign::Percentile(ms, 0.99)},
+          {"plan_ms_median", Percentile(ms, 0.5)},
+          {"plan_ms_p99", Percentile(ms, 0.99)},
           {"plan_ms_samples", ms},  // the distribution, for the HTML page's histogram
           {"mean_traj_duration_s", g.succeeded > 0 ? g.duration_sum / g.succeeded : 0.0},
           {"search_ms_mean", g.attempted > 0 ? g.search_ms / g.attempted : 0.0},

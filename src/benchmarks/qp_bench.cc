@@ -1,16 +1,16 @@
 #include "rotorguard/benchmarks/qp_bench.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
 #include <vector>
 
-#include <fmt/format.h>
-
 #include "rotorguard/buildinfo/build_info.h"
-#include "rotorguard/campaign/statistics.h"
 #include "rotorguard/control/ocp_qp.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
 
@@ -121,7 +121,7 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
     for (const Case& c : cases) {
       qp->x0 = c.x0;
       for (int r = 0; r < options.repetitions; ++r) reps[r] = solver.Solve(*qp).total_time_s * 1e6;
-      g.times_us.push_back(campaign::Percentile(reps, 0.5));
+      g.times_us.push_back(Percentile(reps, 0.5));
       const control::OcpQpSummary& s = solver.summary();
       if (!s.IsSolutionUsable()) ++g.failures;
       g.iterations_sum += s.iterations;
@@ -154,16 +154,16 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
           {"cases_stress", stress.size()},
           {"cases_track", track.size()},
           {"repetitions", options.repetitions},
-          {"stress_us_median", campaign::Percentile(st.times_us, 0.5)},
-          {"stress_us_p99", campaign::Percentile(st.times_us, 0.99)},
-          {"track_us_median", campaign::Percentile(tr.times_us, 0.5)},
-          {"track_us_p99", campaign::Percentile(tr.times_us, 0.99)},
+          {"stress_us_median", Percentile(st.times_us, 0.5)},
+          {"stress_us_p99", Percentile(st.times_us, 0.99)},
+          {"track_us_median", Percentile(tr.times_us, 0.5)},
+          {"track_us_p99", Percentile(tr.times_us, 0.99)},
           {"iterations_mean", cases > 0 ? (st.iterations_sum + tr.iterations_sum) / cases : 0.0},
-          {"max_u0_error", std::max(campaign::Percentile(st.u0_errors, 1.0), campaign::Percentile(tr.u0_errors, 1.0))},
-          {"u0_error_median", campaign::Percentile(all_errors, 0.5)},
-          {"u0_error_p99", campaign::Percentile(all_errors, 0.99)},
-          {"cases_u0_error_above_1e-4", std::count_if(all_errors.begin(), all_errors.end(),
-                                                      [](double e) { return e > 1e-4; })},
+          {"max_u0_error", std::max(Percentile(st.u0_errors, 1.0), Percentile(tr.u0_errors, 1.0))},
+          {"u0_error_median", Percentile(all_errors, 0.5)},
+          {"u0_error_p99", Percentile(all_errors, 0.99)},
+          {"cases_u0_error_above_1e-4",
+           std::count_if(all_errors.begin(), all_errors.end(), [](double e) { return e > 1e-4; })},
           {"cases_reference_u0_suboptimal", st.reference_suboptimal + tr.reference_suboptimal},
           {"worst_reference_relative_gap", std::max(st.worst_reference_gap, tr.worst_reference_gap)},
           {"failures", st.failures + tr.failures},

@@ -33,17 +33,4 @@ double McNemarExactP(int only_first, int only_second) {
   return std::min(1.0, 2.0 * tail);
 }
 
-double Percentile(std::vector<double> v, double p) {
-  if (!(p >= 0.0 && p <= 1.0)) {
-    throw std::invalid_argument(
-        fmt::format("Percentile: p = {} is invalid; expected a fraction in [0, 1] (0.99 for the 99th percentile)", p));
-  }
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double position = p * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(position));
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (position - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
 }  // namespace rotorguard::campaign

@@ -7,6 +7,7 @@
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/core/stopwatch.h"
 
 namespace rotorguard::stack {
@@ -148,12 +149,8 @@ LioSummary LioEstimator::Summarize() const {
     s.iterations_mean /= n;
   }
   if (!frame_ms_.empty()) {
-    std::vector<double> ms = frame_ms_;
-    s.frame_ms_mean = std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(ms.size());
-    // The 99th percentile: the smallest time at or above 99 % of the frames' (nearest rank).
-    const std::size_t rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(ms.size()))) - 1;
-    std::nth_element(ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(rank), ms.end());
-    s.frame_ms_p99 = ms[rank];
+    s.frame_ms_mean = std::accumulate(frame_ms_.begin(), frame_ms_.end(), 0.0) / static_cast<double>(frame_ms_.size());
+    s.frame_ms_p99 = Percentile(frame_ms_, 0.99);
   }
   s.map_points = lio_.map().size();
   return s;
