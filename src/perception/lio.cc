@@ -183,9 +183,7 @@ void Lio::OnImu(const ImuSample& imu) {
   }
   if (imu.t_ns <= head_imu_.t_ns) return;
   queue_.push_back(imu);
-  // Each interval takes the mean of its two samples (second order in the rates' change).
-  Propagate(0.5 * (head_imu_.specific_force_B + imu.specific_force_B), 0.5 * (head_imu_.w_B + imu.w_B), imu.t_ns,
-            &head_, &head_P_, nullptr);
+  PropagateBetween(head_imu_, imu, &head_, nullptr, nullptr);
   head_imu_ = imu;
   if (!initialised_) {
     // The filter stays at the start until the rest initialisation has its samples.
@@ -200,8 +198,7 @@ void Lio::OnImu(const ImuSample& imu) {
 void Lio::AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses) {
   while (!queue_.empty() && queue_.front().t_ns <= t_ns) {
     const ImuSample& s = queue_.front();
-    Propagate(0.5 * (filter_imu_.specific_force_B + s.specific_force_B), 0.5 * (filter_imu_.w_B + s.w_B), s.t_ns,
-              &filter_, &filter_P_, poses);
+    PropagateBetween(filter_imu_, s, &filter_, &filter_P_, poses);
     filter_imu_ = s;
     queue_.pop_front();
   }
@@ -209,16 +206,33 @@ void Lio::AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses) {
   Propagate(filter_imu_.specific_force_B, filter_imu_.w_B, t_ns, &filter_, &filter_P_, poses);
 }
 
-void Lio::RebuildHead() {
-  head_ = filter_;
-  head_P_ = filter_P_;
+void Lio::PropagateBetween(const ImuSample& previous, const ImuSample& next, LioState* x, Matrix15* P,
+                           std::vector<Pose>* poses) const {
+  // Each interval takes the mean of its two samples (second order in the rates' change).
+  Propagate(0.5 * (previous.specific_force_B + next.specific_force_B), 0.5 * (previous.w_B + next.w_B), next.t_ns, x, P,
+            poses);
+}
+
+void Lio::PropagateQueue(LioState* x, Matrix15* P) const {
+  *x = filter_;
+  if (P) *P = filter_P_;
   ImuSample previous = filter_imu_;
   for (const ImuSample& s : queue_) {
-    Propagate(0.5 * (previous.specific_force_B + s.specific_force_B), 0.5 * (previous.w_B + s.w_B), s.t_ns, &head_,
-              &head_P_, nullptr);
+    PropagateBetween(previous, s, x, P, nullptr);
     previous = s;
   }
-  head_imu_ = previous;
+}
+
+void Lio::RebuildHead() {
+  PropagateQueue(&head_, nullptr);
+  head_imu_ = queue_.empty() ? filter_imu_ : queue_.back();
+}
+
+Lio::Matrix15 Lio::covariance() const {
+  LioState x;
+  Matrix15 P;
+  PropagateQueue(&x, &P);
+  return P;
 }
 
 StateEstimate Lio::BodyEstimate(const LioState& x, const Vector3& w_m) const {
@@ -254,7 +268,7 @@ void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& 
     double d2;
     Vector3 q;
   };
-  std::unordered_map<std::uint64_t, Best> cells;
+  std::unordered_map<PointMap::Key, Best> cells;
   cells.reserve(frame.points_S.size() / 4 + 16);
   std::size_t k = 0;
   for (std::size_t i = 0; i < frame.points_S.size(); ++i) {
@@ -271,12 +285,8 @@ void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& 
     const Vector3 q = R_end_T * (a.R * ExpSO3Times(a.w * dt, lidar_in_imu_ + s) + p - p_end);
     const Vector3 scaled = q / cell;
     const Eigen::Vector3d fl = scaled.array().floor();
-    const Eigen::Vector3i c = fl.cast<int>();
     const double d2 = (scaled - fl - Vector3::Constant(0.5)).squaredNorm();
-    const std::uint64_t key = (static_cast<std::uint64_t>(c.x() & 0x1FFFFF) << 42) |
-                              (static_cast<std::uint64_t>(c.y() & 0x1FFFFF) << 21) |
-                              static_cast<std::uint64_t>(c.z() & 0x1FFFFF);
-    auto [it, inserted] = cells.try_emplace(key, Best{d2, q});
+    auto [it, inserted] = cells.try_emplace(PointMap::KeyOf(fl.cast<int>()), Best{d2, q});
     if (!inserted && d2 < it->second.d2) it->second = Best{d2, q};
   }
   out->clear();

@@ -28,7 +28,7 @@ PointMap::PointMap(const PointMapOptions& options) : options_(options) {
 Eigen::Vector3i PointMap::Cell(const Vector3& p) const { return (p * inverse_voxel_).array().floor().cast<int>(); }
 
 namespace {
-// 21 bits per axis (±2^20 voxels: ±52 km at 5 cm), offset to be non-negative.
+// 21 bits per axis (±2^20 voxels: ±52 km at 5 cm), offset to be non-negative (KeyOf).
 constexpr std::int64_t kOffset = std::int64_t{1} << 20, kMask = (std::int64_t{1} << 21) - 1;
 }  // namespace
 

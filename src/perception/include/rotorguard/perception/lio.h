@@ -160,9 +160,11 @@ class Lio {
   StateEstimate Estimate() const;
   /// The same at the end of the last frame (what the frame was registered at).
   StateEstimate FrameEstimate() const;
-  /// The filter's state at the newest IMU sample, and its covariance.
+  /// The filter's state at the newest IMU sample, and its covariance there: the filter's, carried
+  /// through the samples since the last frame (on each call: no consumer needs it at the IMU rate,
+  /// so the samples propagate the mean only).
   const LioState& state() const { return head_; }
-  const Matrix15& covariance() const { return head_P_; }
+  Matrix15 covariance() const;
   const PointMap& map() const { return map_; }
   const LioOptions& options() const { return options_; }
 
@@ -183,6 +185,11 @@ class Lio {
   /// the pose at the start of the step into `poses` if not null.
   void Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix15* P,
                  std::vector<Pose>* poses) const;
+  /// Propagate over the interval between two consecutive samples, with their mean.
+  void PropagateBetween(const ImuSample& previous, const ImuSample& next, LioState* x, Matrix15* P,
+                        std::vector<Pose>* poses) const;
+  /// The filter (and its covariance, if P is not null) carried through the queued samples.
+  void PropagateQueue(LioState* x, Matrix15* P) const;
   /// Takes the filter through the queued samples up to t_ns (the last interval held to t_ns).
   void AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses);
   /// The head: the filter through the whole queue.
@@ -211,8 +218,7 @@ class Lio {
   Matrix15 filter_P_ = Matrix15::Zero();
   ImuSample filter_imu_;         ///< the last sample the filter took (held beyond it)
   std::deque<ImuSample> queue_;  ///< samples after the filter's time, oldest first
-  LioState head_;
-  Matrix15 head_P_ = Matrix15::Zero();
+  LioState head_;                ///< the filter through the queue (mean only)
   ImuSample head_imu_;
   bool map_started_ = false;
   int frames_ = 0;

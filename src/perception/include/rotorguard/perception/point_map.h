@@ -62,16 +62,19 @@ class PointMap {
   long size() const { return points_; }
   long voxels() const { return static_cast<long>(voxels_.size()); }
 
- private:
+  /// One 64-bit key for the integer cell `c` of any grid: 21 bits per axis (±2^20 cells), offset
+  /// to be non-negative; the top bit stays clear.
   using Key = std::uint64_t;
+  static Key KeyOf(const Eigen::Vector3i& c);
+
+ private:
   struct Voxel {
     Key key = 0;
     int count = 0;
     std::array<Eigen::Vector3f, PointMapOptions::kMaxPointsPerVoxel> points;
   };
-  /// The voxel index of a coordinate on each axis, and the key packing three of them.
+  /// The voxel index of a coordinate on each axis, and the cell a key packs.
   Eigen::Vector3i Cell(const Vector3& p) const;
-  static Key KeyOf(const Eigen::Vector3i& c);
   static Eigen::Vector3i CellOf(Key key);
 
   /// Key -> position in voxels_: open addressing with linear probing, at most half full. A
