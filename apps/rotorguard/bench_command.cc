@@ -348,13 +348,7 @@ class BenchCommand final : public Command {
   int Lio() const {
     benchmarks::LioBenchOptions o;
     o.duration_s = ParseFinite("--duration", lio_duration_, 1e-3, 600.0);
-    o.spins.clear();
-    std::size_t start = 0;
-    while (start <= lio_spins_.size()) {
-      const std::size_t comma = std::min(lio_spins_.find(',', start), lio_spins_.size());
-      o.spins.push_back(ParseFinite("--spins", lio_spins_.substr(start, comma - start), 0.0, 30.0));
-      start = comma + 1;
-    }
+    o.spins = ParseFiniteList("--spins", lio_spins_, 0.0, 30.0);
     o.seed = Seed();
     o.progress = CountProgress("conditions");
     const nlohmann::json r = benchmarks::RunLioBenchmark(o);
@@ -392,20 +386,9 @@ class BenchCommand final : public Command {
     return kOk;
   }
 
-  /// A --replay value's colon-separated fields.
-  static std::vector<std::string> ReplayFields(const std::string& text) {
-    std::vector<std::string> fields;
-    for (std::size_t start = 0;;) {
-      const std::size_t colon = text.find(':', start);
-      fields.push_back(text.substr(start, colon == std::string::npos ? colon : colon - start));
-      if (colon == std::string::npos) return fields;
-      start = colon + 1;
-    }
-  }
-
   /// --replay CELL:METHOD:SEED: one trial of bench ftc, flown into a run folder.
   int ReplayFtcTrial(const benchmarks::FtcBenchOptions& o) const {
-    const std::vector<std::string> f = ReplayFields(ftc_replay_);
+    const std::vector<std::string> f = SplitFields(ftc_replay_, ':');
     if (f.size() != 3) {
       throw UsageError(
           fmt::format("--replay: '{}' is invalid; expected CELL:METHOD:SEED, e.g. "
@@ -430,7 +413,7 @@ class BenchCommand final : public Command {
 
   /// --replay KIND:SEED[:unaware]: one trial of bench nav, flown into a run folder.
   int ReplayNavTrial(const harness::Scenario& base) const {
-    const std::vector<std::string> f = ReplayFields(nav_replay_);
+    const std::vector<std::string> f = SplitFields(nav_replay_, ':');
     const std::string variant = f.size() == 3 ? f[2] : "";
     if (f.size() < 2 || f.size() > 3 || (f[0] != "forest" && f[0] != "room") ||
         (!variant.empty() && variant != "unaware")) {

@@ -98,18 +98,30 @@ campaign::Shard ParseShard(const std::string& text) {
   return s;
 }
 
+std::vector<std::string> SplitFields(const std::string& text, char separator) {
+  std::vector<std::string> fields;
+  for (std::size_t start = 0;;) {
+    const std::size_t end = text.find(separator, start);
+    fields.push_back(text.substr(start, end == std::string::npos ? end : end - start));
+    if (end == std::string::npos) return fields;
+    start = end + 1;
+  }
+}
+
+std::vector<double> ParseFiniteList(const std::string& option, const std::string& text, double lo, double hi) {
+  std::vector<double> values;
+  for (const std::string& field : SplitFields(text, ',')) values.push_back(ParseFinite(option, field, lo, hi));
+  return values;
+}
+
 std::vector<std::string> ParseWordList(const std::string& option, const std::string& text,
                                        const std::vector<std::string>& allowed) {
-  std::vector<std::string> words;
-  for (std::size_t start = 0; start <= text.size();) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string word = text.substr(start, comma - start);
+  const std::vector<std::string> words = SplitFields(text, ',');
+  for (const std::string& word : words) {
     if (std::find(allowed.begin(), allowed.end(), word) == allowed.end()) {
       throw UsageError(fmt::format("{}: '{}' is invalid; expected a comma-separated list of {}", option, word,
                                    fmt::join(allowed, ", ")));
     }
-    words.push_back(word);
-    start = comma + 1;
   }
   return words;
 }

@@ -58,6 +58,10 @@ double ParseFinite(const std::string& option, const std::string& text, double lo
 int ParseJobs(const std::string& text);
 /// --shard "i/N" with 0 <= i < N.
 campaign::Shard ParseShard(const std::string& text);
+/// The fields of `text` between `separator`s, empty ones included ("a,,b" has three).
+std::vector<std::string> SplitFields(const std::string& text, char separator);
+/// A comma-separated list of finite numbers, each in [lo, hi] (ParseFinite's rules).
+std::vector<double> ParseFiniteList(const std::string& option, const std::string& text, double lo, double hi);
 /// A comma-separated list of words, each one of `allowed`.
 std::vector<std::string> ParseWordList(const std::string& option, const std::string& text,
                                        const std::vector<std::string>& allowed);

@@ -15,6 +15,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/world_raster.h"
 #include "rotorguard/perception/lidar_mapper.h"
@@ -71,9 +72,22 @@ struct Path {
   Quaternion Attitude(double t) const {
     return Quaternion(Eigen::AngleAxisd(spin_rad_s * SmoothStart(t).x(), Vector3::UnitZ()));
   }
-  /// Body rate and angular acceleration (about z, level flight).
-  Vector3 Rate(double t) const { return Vector3(0.0, 0.0, spin_rad_s * SmoothStart(t).y()); }
-  Vector3 AngularAcceleration(double t) const { return Vector3(0.0, 0.0, spin_rad_s * SmoothStart(t).z()); }
+  sim::BodyPose Pose(TimeNs t) const { return {Position(ToSeconds(t)), Attitude(ToSeconds(t))}; }
+  /// The truth the sensor models read at time t: the state `x` (position, attitude, velocity, body
+  /// rate about z) and the accelerations, `truth` pointing at `x`.
+  void Sample(TimeNs t, vehicle::StateVector* x, sim::TruthSample* truth) const {
+    const double ts = ToSeconds(t);
+    const Vector3 smooth = SmoothStart(ts);
+    x->segment<3>(vehicle::StateIndex::kPosition) = Position(ts);
+    const Quaternion q = Attitude(ts);
+    x->segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
+    x->segment<3>(vehicle::StateIndex::kVelocity) = Velocity(ts);
+    x->segment<3>(vehicle::StateIndex::kBodyRate) = Vector3(0.0, 0.0, spin_rad_s * smooth.y());
+    truth->t_ns = t;
+    truth->x = x;
+    truth->acc.a_W = Acceleration(ts);
+    truth->acc.alpha_B = Vector3(0.0, 0.0, spin_rad_s * smooth.z());
+  }
 };
 
 struct Scene {
@@ -108,12 +122,6 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
   mapper_options.deskew.sensor_position_m = lidar_options.position_m;
   perception::LidarMapper mapper(mapper_options);
 
-  const auto pose_at = [&](TimeNs t) {
-    sim::BodyPose p;
-    p.p_W = scene.path.Position(ToSeconds(t));
-    p.q_WB = scene.path.Attitude(ToSeconds(t));
-    return p;
-  };
   const double res = mapper_options.map.resolution_m;
   std::unordered_set<std::int64_t> seen;  // voxels of the returns placed with their true poses
   vehicle::StateVector x = vehicle::StateVector::Zero(13 + 4);
@@ -124,16 +132,8 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
   // Each step as the simulator orders it: the sensors sample at the step's end, so the frame that
   // ends there arrives with the IMU and odometry samples of the same instant.
   for (TimeNs t = step; t <= end; t += step) {
-    const double ts = ToSeconds(t);
-    x.segment<3>(vehicle::StateIndex::kPosition) = scene.path.Position(ts);
-    const Quaternion q = scene.path.Attitude(ts);
-    x.segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
-    x.segment<3>(vehicle::StateIndex::kVelocity) = scene.path.Velocity(ts);
-    x.segment<3>(vehicle::StateIndex::kBodyRate) = scene.path.Rate(ts);
     sim::TruthSample truth;
-    truth.t_ns = t;
-    truth.x = &x;
-    truth.acc.a_W = scene.path.Acceleration(ts);
+    scene.path.Sample(t, &x, &truth);
     if (imu_timer.Due(t)) {
       const ImuSample s = imu.Sample(truth);
       estimator.OnImu(s);
@@ -142,11 +142,11 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
     if (odometry_timer.Due(t)) odometry.Measure(truth);
     if (OdometrySample o; odometry.Deliver(t, &o)) estimator.OnOdometry(o);
     const Stopwatch lidar_clock;
-    const std::optional<LidarFrame> frame = lidar.Step(t - step, pose_at(t - step), t, pose_at(t));
+    const std::optional<LidarFrame> frame = lidar.Step(t - step, scene.path.Pose(t - step), t, scene.path.Pose(t));
     lidar_s += lidar_clock.seconds();
     if (!frame) continue;
     for (std::size_t i = 0; i < frame->points_S.size(); ++i) {
-      const sim::BodyPose p = pose_at(frame->t_start_ns + frame->offset_ns[i]);
+      const sim::BodyPose p = scene.path.Pose(frame->t_start_ns + frame->offset_ns[i]);
       seen.insert(VoxelKey(p.p_W + p.q_WB * (lidar_options.position_m + frame->points_S[i].cast<double>()), res));
     }
     const StateEstimate estimate = estimator.Estimate(frame->t_end_ns);
@@ -212,12 +212,8 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
   lio_options.lidar_position_m = lidar_options.position_m;
   const Path& path = scene.path;
   perception::Lio lio(lio_options, path.Position(0.0), YawOf(path.Attitude(0.0)));
-  const auto pose_at = [&](TimeNs t) {
-    return sim::BodyPose{path.Position(ToSeconds(t)), path.Attitude(ToSeconds(t))};
-  };
   vehicle::StateVector x = vehicle::StateVector::Zero(13 + 4);
   sim::TruthSample truth;
-  truth.x = &x;
   truth.motor_speed_rad_s = RotorVector::Constant(4, 900.0);  // hover speed: the vibration's frequency
   double sum2 = 0.0, max_e = 0.0, att2 = 0.0, max_att = 0.0;
   long samples = 0, frames = 0, used = 0, degenerate = 0;
@@ -227,20 +223,12 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
   bool diverged = false;
   const TimeNs step = 1'000'000, end = FromSeconds(options.duration_s);
   for (TimeNs t = step; t <= end; t += step) {
-    const double ts = ToSeconds(t);
-    x.segment<3>(vehicle::StateIndex::kPosition) = path.Position(ts);
-    const Quaternion q = path.Attitude(ts);
-    x.segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
-    x.segment<3>(vehicle::StateIndex::kVelocity) = path.Velocity(ts);
-    x.segment<3>(vehicle::StateIndex::kBodyRate) = path.Rate(ts);
-    truth.t_ns = t;
-    truth.acc.a_W = path.Acceleration(ts);
-    truth.acc.alpha_B = path.AngularAcceleration(ts);
+    path.Sample(t, &x, &truth);
     if (imu_timer.Due(t)) {
       lio.OnImu(imu.Sample(truth));
       const StateEstimate e = lio.Estimate();
       // Against the truth at the estimate's own time (the path gives it at any instant).
-      const sim::BodyPose p = pose_at(e.t_ns);
+      const sim::BodyPose p = path.Pose(e.t_ns);
       const double err = (e.p_W - p.p_W).norm();
       const double att = LogSO3(p.q_WB.conjugate() * e.q_WB).norm();
       if (!std::isfinite(err) || err > 1.0) diverged = true;
@@ -253,7 +241,7 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
         legs.emplace_back(e.p_W, p.p_W);
       }
     }
-    const std::optional<LidarFrame> frame = lidar.Step(t - step, pose_at(t - step), t, pose_at(t));
+    const std::optional<LidarFrame> frame = lidar.Step(t - step, path.Pose(t - step), t, path.Pose(t));
     if (!frame) continue;
     const Stopwatch clock;
     const perception::LioFrameSummary f = lio.OnFrame(*frame);
@@ -270,11 +258,6 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
     }
     drift = sum / static_cast<double>(legs.size() - 1);
   }
-  std::sort(frame_ms.begin(), frame_ms.end());
-  const auto percentile = [&](double q) {
-    if (frame_ms.empty()) return 0.0;
-    return frame_ms[static_cast<std::size_t>(std::ceil(q * static_cast<double>(frame_ms.size()))) - 1];
-  };
   const double n = static_cast<double>(std::max<long>(1, samples));
   constexpr double kDeg = 180.0 / std::numbers::pi;
   return {{"scene", scene.name},
@@ -291,7 +274,7 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
           {"frame_ms_mean", frame_ms.empty() ? 0.0
                                              : std::accumulate(frame_ms.begin(), frame_ms.end(), 0.0) /
                                                    static_cast<double>(frame_ms.size())},
-          {"frame_ms_p99", percentile(0.99)},
+          {"frame_ms_p99", Percentile(frame_ms, 0.99)},
           {"map_points", lio.map().size()},
           {"diverged", diverged}};
 }

@@ -86,6 +86,19 @@ class CliTest : public rotorguard::testing::TempFolderTest {
   std::string Out() const { return (dir_ / "out").string(); }
 };
 
+/// Bad list and word options of the benchmarks are usage errors that name the option and the field.
+TEST_F(CliTest, ABenchmarksListOptionsNameTheFieldThatIsWrong) {
+  Result r = Cli("bench lio --spins 11,,20");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("--spins: '' is invalid; expected a finite number in [0, 30]"), std::string::npos) << r.out;
+  r = Cli("bench lio --spins 11,45");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("--spins: '45' is invalid"), std::string::npos) << r.out;
+  r = Cli("bench nav --estimator gps");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("--estimator 'gps' is invalid; expected one of: odometry, lio"), std::string::npos) << r.out;
+}
+
 /// The campaign benchmarks fly the world --truth names and say which in their JSON.
 TEST_F(CliTest, ABenchmarksWorldIsNamedByTruthAndRecordedInItsJson) {
   const Result r = Cli("bench ftc --trials 1 --methods none --seed 3 --jobs 1 --truth realistic --json");
