@@ -445,7 +445,9 @@ TEST(LioClosedLoop, TheForestFlightsFirstSecondsAndItsFailureOnTheStacksOwnOdome
   EXPECT_EQ(o.frames_used, o.frames - 1) << "the first frame starts the map";
   EXPECT_LE(o.frames_degenerate, o.frames / 100);
   EXPECT_GT(r.cost_ms_per_sim_s.odometry, 0.0) << "the registration is timed";
-  EXPECT_LT(r.estimate_position_rmse_m, 0.06);  // measured 0.03-0.04
+  EXPECT_LT(r.estimate_position_rmse_m, 0.06);  // measured 0.027 (max 0.056)
+  // Measured 0.045: mostly the estimate's age at the control cycle (the newest IMU sample's, up to
+  // 3 ms old) while the vehicle turns at up to 15 rad/s.
   EXPECT_LT(r.estimate_attitude_max_rad, 0.05);
   EXPECT_LT(r.tracking_rmse_m, 0.2);
 }
