@@ -24,6 +24,21 @@ Vector3 LogSO3(const Quaternion& q) {
   return scale * v;
 }
 
+Matrix3 InverseRightJacobianSO3(const Vector3& theta) {
+  // J_r⁻¹ = I + ½ [θ]× + (1/t² − (1 + cos t) / (2 t sin t)) [θ]×², t = |θ|; below 0.05 rad the
+  // coefficient's series 1/12 + t²/720 + t⁴/30240 (the next term is below 1e-14).
+  const double t2 = theta.squaredNorm();
+  double c;
+  if (t2 < 0.05 * 0.05) {
+    c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0;
+  } else {
+    const double t = std::sqrt(t2);
+    c = 1.0 / t2 - (1.0 + std::cos(t)) / (2.0 * t * std::sin(t));
+  }
+  const Matrix3 K = Skew(theta);
+  return Matrix3::Identity() + 0.5 * K + c * K * K;
+}
+
 void SinCosOfTurns(double u, double* sin_out, double* cos_out) {
   // u = j / 4 + f with j the nearest quarter and |f| <= 1/8 (both exact: 4 u - j is a difference
   // of nearby doubles), so the angle is j quarter turns plus r = 2 pi f, |r| <= pi / 4, where

@@ -28,23 +28,10 @@ PointMap::PointMap(const PointMapOptions& options) : options_(options) {
 Eigen::Vector3i PointMap::Cell(const Vector3& p) const { return (p * inverse_voxel_).array().floor().cast<int>(); }
 
 namespace {
-// 21 bits per axis (±2^20 voxels: ±52 km at 5 cm), offset to be non-negative (KeyOf).
+// 21 bits per axis (±2^20 voxels: ±52 km at 5 cm), offset to be non-negative (KeyOfCell).
 constexpr std::int64_t kOffset = std::int64_t{1} << 20, kMask = (std::int64_t{1} << 21) - 1;
-}  // namespace
 
-PointMap::Key PointMap::KeyOf(const Eigen::Vector3i& c) {
-  return (static_cast<Key>((c.x() + kOffset) & kMask) << 42) | (static_cast<Key>((c.y() + kOffset) & kMask) << 21) |
-         static_cast<Key>((c.z() + kOffset) & kMask);
-}
-
-Eigen::Vector3i PointMap::CellOf(Key key) {
-  return Eigen::Vector3i(static_cast<int>(static_cast<std::int64_t>(key >> 42) - kOffset),
-                         static_cast<int>(static_cast<std::int64_t>((key >> 21) & kMask) - kOffset),
-                         static_cast<int>(static_cast<std::int64_t>(key & kMask) - kOffset));
-}
-
-namespace {
-// The slot a key probes first: splitmix64's finaliser, which spreads neighbouring voxels' keys.
+// The slot a key probes first: splitmix64's finaliser, which spreads neighbouring cells' keys.
 std::size_t Home(std::uint64_t key, std::size_t mask) {
   key ^= key >> 30;
   key *= 0xbf58476d1ce4e5b9ULL;
@@ -55,37 +42,66 @@ std::size_t Home(std::uint64_t key, std::size_t mask) {
 }
 }  // namespace
 
-std::int64_t PointMap::Find(Key key) const {
-  if (slots_.empty()) return -1;
+CellKey KeyOfCell(const Eigen::Vector3i& c) {
+  return (static_cast<CellKey>((c.x() + kOffset) & kMask) << 42) |
+         (static_cast<CellKey>((c.y() + kOffset) & kMask) << 21) | static_cast<CellKey>((c.z() + kOffset) & kMask);
+}
+
+Eigen::Vector3i PointMap::CellOf(Key key) {
+  return Eigen::Vector3i(static_cast<int>(static_cast<std::int64_t>(key >> 42) - kOffset),
+                         static_cast<int>(static_cast<std::int64_t>((key >> 21) & kMask) - kOffset),
+                         static_cast<int>(static_cast<std::int64_t>(key & kMask) - kOffset));
+}
+
+void CellIndex::Clear(std::size_t expected) {
+  std::size_t capacity = 1024;
+  while (capacity < 2 * expected) capacity *= 2;
+  slots_.assign(capacity, Slot{});
+  size_ = 0;
+}
+
+std::size_t CellIndex::Probe(CellKey key) const {
   const std::size_t mask = slots_.size() - 1;
-  for (std::size_t i = Home(key, mask);; i = (i + 1) & mask) {
-    if (slots_[i].key == key) return slots_[i].voxel;
-    if (slots_[i].key == kEmpty) return -1;
+  std::size_t i = Home(key, mask);
+  while (slots_[i].key != key && slots_[i].key != kEmpty) i = (i + 1) & mask;
+  return i;
+}
+
+std::int64_t CellIndex::Find(CellKey key) const {
+  if (slots_.empty()) return -1;
+  const Slot& slot = slots_[Probe(key)];
+  return slot.key == key ? static_cast<std::int64_t>(slot.index) : -1;
+}
+
+std::uint32_t CellIndex::FindOrAdd(CellKey key, std::uint32_t next, bool* added) {
+  if (2 * (size_ + 1) > slots_.size()) Grow();
+  Slot& slot = slots_[Probe(key)];
+  *added = slot.key == kEmpty;
+  if (*added) {
+    slot = {key, next};
+    ++size_;
   }
+  return slot.index;
+}
+
+void CellIndex::Grow() {
+  std::vector<Slot> old;
+  old.swap(slots_);
+  Clear(std::max<std::size_t>(size_ + 1, old.size()));
+  for (const Slot& s : old) {
+    if (s.key != kEmpty) slots_[Probe(s.key)] = s;
+  }
+  for (const Slot& s : old) size_ += s.key != kEmpty;
 }
 
 std::uint32_t PointMap::FindOrAdd(Key key) {
-  if (2 * (voxels_.size() + 1) > slots_.size()) Reindex(std::max<std::size_t>(1024, 2 * slots_.size()));
-  const std::size_t mask = slots_.size() - 1;
-  for (std::size_t i = Home(key, mask);; i = (i + 1) & mask) {
-    if (slots_[i].key == key) return slots_[i].voxel;
-    if (slots_[i].key == kEmpty) {
-      slots_[i] = {key, static_cast<std::uint32_t>(voxels_.size())};
-      voxels_.emplace_back();
-      voxels_.back().key = key;
-      return slots_[i].voxel;
-    }
+  bool added = false;
+  const std::uint32_t v = index_.FindOrAdd(key, static_cast<std::uint32_t>(voxels_.size()), &added);
+  if (added) {
+    voxels_.emplace_back();
+    voxels_.back().key = key;
   }
-}
-
-void PointMap::Reindex(std::size_t capacity) {
-  slots_.assign(capacity, Slot{});
-  const std::size_t mask = capacity - 1;
-  for (std::size_t v = 0; v < voxels_.size(); ++v) {
-    std::size_t i = Home(voxels_[v].key, mask);
-    while (slots_[i].key != kEmpty) i = (i + 1) & mask;
-    slots_[i] = {voxels_[v].key, static_cast<std::uint32_t>(v)};
-  }
+  return v;
 }
 
 int PointMap::Insert(const std::vector<Vector3>& points_W) {
@@ -95,7 +111,7 @@ int PointMap::Insert(const std::vector<Vector3>& points_W) {
   const double limit = 0.99 * std::ldexp(options_.voxel_m, 20);
   for (const Vector3& p : points_W) {
     if (!p.allFinite() || p.cwiseAbs().maxCoeff() > limit) continue;
-    const Key key = KeyOf(Cell(p));
+    const Key key = KeyOfCell(Cell(p));
     Voxel& v = voxels_[FindOrAdd(key)];
     if (v.count >= options_.max_points_per_voxel) continue;
     const Eigen::Vector3f pf = p.cast<float>();
@@ -124,10 +140,10 @@ int PointMap::Prune(const Vector3& center_W) {
   }
   if (kept == voxels_.size()) return 0;
   voxels_.resize(kept);
-  // The slots again, for the voxels that stay (a table at most half full, at least 1024).
-  std::size_t capacity = 1024;
-  while (capacity < 2 * kept) capacity *= 2;
-  Reindex(capacity);
+  // The index again, for the voxels that stay.
+  index_.Clear(kept);
+  bool added = false;
+  for (std::size_t v = 0; v < kept; ++v) index_.FindOrAdd(voxels_[v].key, static_cast<std::uint32_t>(v), &added);
   points_ -= removed;
   return removed;
 }
@@ -159,7 +175,7 @@ int PointMap::Nearest(const Vector3& query, int k, double radius_m, std::vector<
       for (int dz = -1; dz <= 1; ++dz) {
         const double ez = dz < 0 ? low.z() : dz > 0 ? high.z() : 0.0;
         if (ex * ex + ey * ey + ez * ez > r * r) continue;
-        const std::int64_t found = Find(KeyOf(c + Eigen::Vector3i(dx, dy, dz)));
+        const std::int64_t found = index_.Find(KeyOfCell(c + Eigen::Vector3i(dx, dy, dz)));
         if (found < 0) continue;
         const Voxel& v = voxels_[static_cast<std::size_t>(found)];
         for (int i = 0; i < v.count; ++i) {

@@ -39,6 +39,25 @@ TEST(LogSO3, InvertsTheAngleAxisRotation) {
   }
 }
 
+// The inverse right Jacobian against central differences of Log(Exp(θ) Exp(δ)) in δ, on both
+// sides of the series' threshold and up to 3 rad; the differences' error is O(h²) ≈ 1e-10.
+TEST(InverseRightJacobianSO3, MatchesFiniteDifferencesOfTheLogarithm) {
+  Rng rng(6);
+  const double h = 1e-5;
+  for (const double angle : {0.0, 1e-6, 0.03, 0.0499, 0.0501, 0.5, 2.0, 3.0}) {
+    for (int k = 0; k < 10; ++k) {
+      const Vector3 theta = angle * Vector3(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1)).normalized();
+      const Quaternion q(ExpSO3(theta));
+      Matrix3 numeric;
+      for (int j = 0; j < 3; ++j) {
+        const Vector3 d = h * Vector3::Unit(j);
+        numeric.col(j) = (LogSO3(q * Quaternion(ExpSO3(d))) - LogSO3(q * Quaternion(ExpSO3(-d)))) / (2.0 * h);
+      }
+      EXPECT_LT((InverseRightJacobianSO3(theta) - numeric).cwiseAbs().maxCoeff(), 1e-8) << "angle " << angle;
+    }
+  }
+}
+
 // The vector form against the matrix it stands for, on both sides of the series' threshold.
 TEST(ExpSO3Times, EqualsTheMatrixTimesTheVector) {
   Rng rng(4);

@@ -196,5 +196,142 @@ TEST(Lio, HoldsAt20RadPerSecondWithImuBiasesAndNoise) {
   EXPECT_LT(e.attitude_max, std::numbers::pi / 180.0);
 }
 
+/// A filter at rest at the origin, level, fed `seconds` of an exact IMU at 333 Hz from `t0`.
+void FeedRest(Lio* lio, TimeNs t0, double seconds) {
+  const TimeNs period = PeriodFromRate(333.0);
+  for (TimeNs t = t0; t <= t0 + FromSeconds(seconds); t += period) {
+    ImuSample s;
+    s.t_ns = t;
+    s.specific_force_B = Vector3(0.0, 0.0, kGravity);
+    s.w_B.setZero();
+    lio->OnImu(s);
+  }
+}
+
+/// A frame over [t_start, t_start + 0.1 s] seen from the origin at rest, of the given points.
+LidarFrame StillFrame(TimeNs t_start, const std::vector<Vector3>& points) {
+  LidarFrame f;
+  f.t_start_ns = t_start;
+  f.t_end_ns = t_start + FromSeconds(0.1);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    f.points_S.push_back(points[i].cast<float>());
+    f.offset_ns.push_back(
+        static_cast<std::uint32_t>(FromSeconds(0.1) * static_cast<TimeNs>(i) / static_cast<TimeNs>(points.size())));
+  }
+  return f;
+}
+
+/// Points on the plane x = `x` (the sensor at the origin, level), a grid of `step` over y, z.
+std::vector<Vector3> Wall(double x, double y0, double y1, double step) {
+  std::vector<Vector3> points;
+  for (double y = y0; y <= y1; y += step) {
+    for (double z = -1.0; z <= 2.0; z += step) points.emplace_back(x, y, z);
+  }
+  return points;
+}
+
+// The rest test, hand-made: rates alternating ±0.2 rad/s about a mean of 0.01 are a sway, not
+// rest, and leave the gyro bias to the filter; a steady 0.01 rad/s is the bias.
+TEST(Lio, TakesTheGyroBiasAtRestOnlyWhenTheRatesAreSteady) {
+  for (const double sway : {0.0, 0.2}) {
+    LioOptions o;
+    Lio lio(o, Vector3(0.0, 0.0, 1.0), 0.0);
+    for (int i = 0; i < o.initial_samples; ++i) {
+      ImuSample s;
+      s.t_ns = FromSeconds(0.003 * i);
+      s.specific_force_B = Vector3(0.0, 0.0, kGravity);
+      s.w_B = Vector3(0.01 + (i % 2 ? sway : -sway), 0.0, 0.0);
+      lio.OnImu(s);
+    }
+    ASSERT_TRUE(lio.initialised());
+    EXPECT_NEAR(lio.state().gyro_bias.x(), sway == 0.0 ? 0.01 : 0.0, 1e-12) << "sway " << sway;
+  }
+}
+
+// Neighbours along a line (thin vertical poles seen as columns of points) fit every plane through
+// it: they give no plane, and the frame is not used; the same frame of walls is.
+TEST(Lio, NeighboursAlongALineGiveNoPlane) {
+  LioOptions o;
+  o.frame_voxel_m = 0.1;
+  o.point_stride = 1;  // every point of the hand-made scenes
+  std::vector<Vector3> poles, walls = Wall(4.0, -2.0, 2.0, 0.12);
+  for (int k = 0; k < 12; ++k) {
+    const double a = 0.5 * k;
+    for (double z = -1.0; z <= 2.0; z += 0.12) poles.emplace_back(5.0 * std::cos(a), 5.0 * std::sin(a), z);
+  }
+  for (const std::vector<Vector3>* scene : {&poles, &walls}) {
+    Lio lio(o, Vector3::Zero(), 0.0);
+    FeedRest(&lio, 0, 0.2);
+    EXPECT_GT(lio.OnFrame(StillFrame(FromSeconds(0.1), *scene)).map_points_added, 0);  // starts the map
+    FeedRest(&lio, FromSeconds(0.2) + 1, 0.1);
+    const LioFrameSummary second = lio.OnFrame(StillFrame(FromSeconds(0.2), *scene));
+    if (scene == &poles) {
+      EXPECT_EQ(second.points_matched, 0);
+      EXPECT_FALSE(second.used);
+    } else {
+      EXPECT_GT(second.points_matched, o.min_points);
+      EXPECT_TRUE(second.used);
+    }
+  }
+}
+
+// A frame that sees only unmapped surfaces has too few matches and is not used, yet it extends
+// the map (placed with the IMU's pose): the next frame of the same surfaces registers to it.
+TEST(Lio, AFrameIntoUnmappedSpaceExtendsTheMap) {
+  LioOptions o;
+  o.frame_voxel_m = 0.1;
+  o.point_stride = 1;  // every point of the hand-made scenes
+  Lio lio(o, Vector3::Zero(), 0.0);
+  FeedRest(&lio, 0, 0.2);
+  lio.OnFrame(StillFrame(FromSeconds(0.1), Wall(4.0, -2.0, 2.0, 0.12)));
+  std::vector<Vector3> unseen = Wall(-6.0, -2.0, 2.0, 0.12);
+  for (const Vector3& p : Wall(6.0, 3.0, 6.0, 0.12)) unseen.emplace_back(p.y(), p.x(), p.z());  // the wall y = 6
+  FeedRest(&lio, FromSeconds(0.2) + 1, 0.1);
+  const LioFrameSummary first = lio.OnFrame(StillFrame(FromSeconds(0.2), unseen));
+  EXPECT_FALSE(first.used);
+  EXPECT_LT(first.points_matched, o.min_points);
+  EXPECT_GT(first.map_points_added, 100);
+  FeedRest(&lio, FromSeconds(0.3) + 1, 0.1);
+  const LioFrameSummary second = lio.OnFrame(StillFrame(FromSeconds(0.3), unseen));
+  EXPECT_TRUE(second.used);
+  EXPECT_GT(second.points_matched, o.min_points);
+  EXPECT_LT((lio.Estimate().p_W).norm(), 1e-3);  // at rest, where it started
+}
+
+// Four walls without floor or ceiling leave the height unobserved: with 2 cm of range noise the
+// fitted normals tilt by a few degrees, which summed over the frame would read as a height known
+// to 2 cm; the health removes the normals' noise and flags the frame degenerate. A floor in view
+// fixes the height, and the same frame with it is not.
+TEST(Lio, FlagsWallsWithoutFloorOrCeilingAsDegenerateDespiteNoisyNormals) {
+  LioOptions o;
+  o.frame_voxel_m = 0.1;
+  o.point_stride = 1;  // every point of the hand-made scenes
+  std::vector<Vector3> walls;
+  for (const Vector3& p : Wall(4.0, -3.9, 3.9, 0.12)) {
+    walls.push_back(p);
+    walls.emplace_back(-p.x(), p.y(), p.z());
+    walls.emplace_back(p.y(), p.x(), p.z());
+    walls.emplace_back(p.y(), -p.x(), p.z());
+  }
+  std::vector<Vector3> with_floor = walls;
+  for (double x = -3.9; x <= 3.9; x += 0.12) {
+    for (double y = -3.9; y <= 3.9; y += 0.12) with_floor.emplace_back(x, y, -1.2);
+  }
+  for (const std::vector<Vector3>* scene : {&walls, &with_floor}) {
+    Rng rng(17);
+    const auto noisy = [&rng](std::vector<Vector3> points) {
+      for (Vector3& p : points) p += 0.02 * Vector3(rng.Normal(), rng.Normal(), rng.Normal());
+      return points;
+    };
+    Lio lio(o, Vector3::Zero(), 0.0);
+    FeedRest(&lio, 0, 0.2);
+    lio.OnFrame(StillFrame(FromSeconds(0.1), noisy(*scene)));
+    FeedRest(&lio, FromSeconds(0.2) + 1, 0.1);
+    const LioFrameSummary second = lio.OnFrame(StillFrame(FromSeconds(0.2), noisy(*scene)));
+    EXPECT_TRUE(second.used);
+    EXPECT_EQ(second.degenerate, scene == &walls) << "weakest std " << second.weakest_std_m << " m";
+  }
+}
+
 }  // namespace
 }  // namespace rotorguard::perception

@@ -14,6 +14,9 @@ Matrix3 Skew(const Vector3& a);
 Matrix3 ExpSO3(const Vector3& theta);
 /// The rotation vector of a unit quaternion (SO(3) logarithm), the shortest arc: |result| <= pi.
 Vector3 LogSO3(const Quaternion& q);
+/// The inverse of SO(3)'s right Jacobian at θ: Log(Exp(θ) Exp(δ)) ≈ θ + J_r⁻¹(θ) δ for a small δ
+/// (|θ| < π). A manifold filter's prior term on x ⊟ x̂ needs it when the iterate x has moved.
+Matrix3 InverseRightJacobianSO3(const Vector3& theta);
 namespace internal {
 /// a = sin|θ| / |θ| and b = (1 - cos|θ|) / |θ|^2 of Rodrigues' formula from t2 = |θ|^2; below
 /// 0.05 rad the series to |θ|^6, which leaves terms below 1e-16.

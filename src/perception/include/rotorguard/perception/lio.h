@@ -61,14 +61,20 @@ struct LioOptions {
   int initial_samples = 15;
   /// A frame's points nearer than this to the sensor are dropped (the airframe, the propellers) [m], >= 0.
   double min_range_m = 0.3;
+  /// A frame keeps every point_stride-th return (in [1, 100]; FAST-LIO2's point_filter_num, 3
+  /// in its MID-360 configuration): consecutive returns of a scan lie centimetres apart, and
+  /// the grid below keeps one point per cell of them anyway.
+  int point_stride = 3;
   /// The frame's down-sampling grid [m], in [0.05, 5]: one point per cell, the one nearest its centre.
   double frame_voxel_m = 0.5;
   /// Map points a plane is fitted to, in [3, 16], the nearest within plane_search_radius_m (in
   /// (0, PointMapOptions::voxel_m]); the plane is kept when each lies within plane_tolerance_m of
-  /// it (> 0).
+  /// it (> 0) and the points spread across it: the std along its second direction at least
+  /// min_plane_width_m (>= 0) and thrice their std off it (not a line of points).
   int plane_points = 5;
   double plane_search_radius_m = 0.5;
   double plane_tolerance_m = 0.1;
+  double min_plane_width_m = 0.05;
   /// A point whose residual exceeds this [m] (> 0) is left out of the update (an outlier: a new
   /// surface, a moving object).
   double max_residual_m = 0.5;
@@ -82,8 +88,11 @@ struct LioOptions {
   /// A frame with fewer matched points than this (>= 6) is not used: the IMU carries the estimate.
   int min_points = 30;
   /// A frame is degenerate when the position std along its weakest direction, from the frame's
-  /// points alone, exceeds this [m] (> 0): 1 / sqrt(the least eigenvalue of their information).
-  double degenerate_std_m = 0.05;
+  /// points alone, exceeds this [m] (> 0): 1 / sqrt(the least eigenvalue of their information,
+  /// less what the fitted normals' noise adds). A direction no surface constrains has none left
+  /// (an infinite std: walls without floor or ceiling, for the height); a forest's frame
+  /// constrains its weakest one to a few centimetres.
+  double degenerate_std_m = 0.2;
   /// IMU samples queued without a frame are taken into the filter once older than this [s], > 0
   /// (the LiDAR is late or has stopped: the IMU alone carries the filter on).
   double max_queue_s = 0.3;
@@ -104,11 +113,13 @@ struct LioFrameSummary {
   bool degenerate = false;  ///< the frame left a direction unconstrained (degenerate_std_m)
   int points = 0;           ///< the frame's returns
   int points_downsampled = 0;
-  int points_matched = 0;  ///< with a plane and a residual within max_residual_m, at the last iterate
+  /// With a plane and a residual within max_residual_m, at the last iterate that kept min_points
+  /// (the first iterate's when none did).
+  int points_matched = 0;
   int iterations = 0;
   double residual_rms_m = 0.0;  ///< over the matched points, at the last iterate
-  /// 1 / sqrt of the least eigenvalue of the position block of the frame's information [m]
-  /// (infinity when no point matched).
+  /// 1 / sqrt of the least eigenvalue of the position block of the frame's information, less
+  /// what the fitted normals' noise adds to it [m] (infinity when nothing is left along it).
   double weakest_std_m = 0.0;
   int map_points_added = 0;
   long map_points = 0;
@@ -192,16 +203,19 @@ class Lio {
   void PropagateQueue(LioState* x, Matrix15* P) const;
   /// Takes the filter through the queued samples up to t_ns (the last interval held to t_ns).
   void AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses);
+  /// Drops the kept poses a point at t_ns or later does not need.
+  void DropPosesBefore(TimeNs t_ns);
   /// The head: the filter through the whole queue.
   void RebuildHead();
   /// Points of the frame in the IMU frame at its end, deskewed and down-sampled.
   void DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Vector3>* out,
-                           LioFrameSummary* summary) const;
-  /// A point's plane in the map: n·y + d = 0.
+                           LioFrameSummary* summary);
+  /// A point's plane in the map: n·y + d = 0, and the covariance of its fitted normal.
   struct Plane {
     int point;
     Vector3 n;
     double d;
+    Matrix3 normal_cov;
   };
   /// The plane of each point of the frame placed with `x` that has one, into planes_.
   void FindPlanes(const std::vector<Vector3>& points_I, const LioState& x);
@@ -226,6 +240,14 @@ class Lio {
   std::vector<Pose> poses_;
   std::vector<Vector3> points_, neighbours_;
   std::vector<Plane> planes_;
+  /// The down-sampling grid's cells: each one's point nearest its centre (squared distance in
+  /// cells, and the point).
+  struct CellBest {
+    double d2;
+    Vector3 q;
+  };
+  CellIndex cell_index_;
+  std::vector<CellBest> cell_best_;
 };
 
 template <typename Archive>
@@ -240,24 +262,45 @@ void LioOptions::Serialize(Archive* a) {
            {.meaning = "prior std of the accelerometer bias [m/s²]", .positive = true});
   a->Visit("gyro_bias_initial", &gyro_bias_initial,
            {.meaning = "prior std of the gyro bias [rad/s]", .positive = true});
+  a->Visit("initial_position_std_m", &initial_position_std_m,
+           {.meaning = "prior std of the start position [m]", .positive = true});
+  a->Visit("initial_attitude_std_rad", &initial_attitude_std_rad,
+           {.meaning = "prior std of the start attitude [rad]", .positive = true});
+  a->Visit("initial_velocity_std_m_s", &initial_velocity_std_m_s,
+           {.meaning = "prior std of the start velocity [m/s]", .positive = true});
+  a->Visit("initial_samples", &initial_samples,
+           {.meaning = "IMU samples averaged at rest for the gyro bias and, on the ground, the tilt",
+            .min = 1,
+            .max = 1000});
   a->Visit("min_range_m", &min_range_m,
            {.meaning = "nearer returns are dropped (the airframe) [m]", .min = 0, .max = 100});
+  a->Visit("point_stride", &point_stride, {.meaning = "a frame keeps every this-many-th return", .min = 1, .max = 100});
   a->Visit("frame_voxel_m", &frame_voxel_m,
            {.meaning = "a frame keeps one point per cell of this edge [m]", .min = 0.05, .max = 5});
   a->Visit(
       "plane_search_radius_m", &plane_search_radius_m,
       {.meaning = "a point's plane is fitted to map points within this [m], at most map.voxel_m", .positive = true});
+  a->Visit("plane_points", &plane_points, {.meaning = "map points a plane is fitted to", .min = 3, .max = 16});
   a->Visit("plane_tolerance_m", &plane_tolerance_m,
            {.meaning = "a plane's points lie within this of it [m]", .positive = true});
+  a->Visit("min_plane_width_m", &min_plane_width_m,
+           {.meaning = "a plane's points spread at least this across it (std) [m]", .min = 0, .max = 1});
   a->Visit("max_residual_m", &max_residual_m,
            {.meaning = "larger point-to-plane residuals are outliers [m]", .positive = true});
   a->Visit("point_std_m", &point_std_m, {.meaning = "std of a point-to-plane residual [m]", .positive = true});
   a->Visit("max_iterations", &max_iterations, {.meaning = "iterations of the update", .min = 1, .max = 20});
+  a->Visit("convergence_m", &convergence_m,
+           {.meaning = "the update stops once a step moves the position less [m]", .positive = true});
+  a->Visit("convergence_rad", &convergence_rad, {.meaning = "and the attitude less than this [rad]", .positive = true});
   a->Visit("min_points", &min_points,
            {.meaning = "a frame with fewer matched points is not used", .min = 6, .max = 100000});
   a->Visit("degenerate_std_m", &degenerate_std_m,
            {.meaning = "a frame is degenerate when its weakest direction's position std exceeds this [m]",
             .positive = true});
+  a->Visit("max_queue_s", &max_queue_s,
+           {.meaning = "IMU samples older than this without a frame enter the filter [s]", .min = 0.01, .max = 10});
+  a->Visit("prune_every_frames", &prune_every_frames,
+           {.meaning = "frames between prunings of the map's window", .min = 1, .max = 100000});
   a->Visit("map", &map, {.meaning = "the odometry's point map"});
 }
 

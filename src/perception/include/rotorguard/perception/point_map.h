@@ -41,6 +41,38 @@ struct PointMapOptions {
   }
 };
 
+/// A 64-bit key for the integer cell `c` of any grid: 21 bits per axis (±2^20 cells), offset to
+/// be non-negative; the top bit stays clear.
+using CellKey = std::uint64_t;
+CellKey KeyOfCell(const Eigen::Vector3i& c);
+
+/// Cell key -> index, open addressing with linear probing, at most half full. A lookup touches
+/// one slot (16 bytes) where a node-based hash chases two pointers and allocates per key: the
+/// point map looks up 8 voxels for each of a frame's thousands of points, and the frame's
+/// down-sampling one cell for each of its tens of thousands.
+class CellIndex {
+ public:
+  /// Empty, with room for `expected` keys before it grows (its storage kept).
+  void Clear(std::size_t expected);
+  /// The index stored for `key`, or -1.
+  std::int64_t Find(CellKey key) const;
+  /// The index stored for `key`; when absent, `next` is stored for it and *added set.
+  std::uint32_t FindOrAdd(CellKey key, std::uint32_t next, bool* added);
+  std::size_t size() const { return size_; }
+
+ private:
+  struct Slot {
+    CellKey key = kEmpty;
+    std::uint32_t index = 0;
+  };
+  static constexpr CellKey kEmpty = ~CellKey{0};  ///< KeyOfCell uses 63 bits: never a key
+  /// The slot holding `key`, or the empty one where it would go.
+  std::size_t Probe(CellKey key) const;
+  void Grow();
+  std::vector<Slot> slots_;
+  std::size_t size_ = 0;
+};
+
 class PointMap {
  public:
   explicit PointMap(const PointMapOptions& options);
@@ -62,12 +94,8 @@ class PointMap {
   long size() const { return points_; }
   long voxels() const { return static_cast<long>(voxels_.size()); }
 
-  /// One 64-bit key for the integer cell `c` of any grid: 21 bits per axis (±2^20 cells), offset
-  /// to be non-negative; the top bit stays clear.
-  using Key = std::uint64_t;
-  static Key KeyOf(const Eigen::Vector3i& c);
-
  private:
+  using Key = CellKey;
   struct Voxel {
     Key key = 0;
     int count = 0;
@@ -77,24 +105,12 @@ class PointMap {
   Eigen::Vector3i Cell(const Vector3& p) const;
   static Eigen::Vector3i CellOf(Key key);
 
-  /// Key -> position in voxels_: open addressing with linear probing, at most half full. A
-  /// lookup touches one slot (16 bytes) where a node-based hash chases two pointers, and the
-  /// registration looks up 8 voxels for each of a frame's thousands of points.
-  struct Slot {
-    Key key = kEmpty;
-    std::uint32_t voxel = 0;
-  };
-  static constexpr Key kEmpty = ~Key{0};  ///< KeyOf uses 63 bits: never a key
-  /// The voxel of `key`, or -1.
-  std::int64_t Find(Key key) const;
   /// The voxel of `key`, created empty when new.
   std::uint32_t FindOrAdd(Key key);
-  /// Rebuilds the slots for voxels_ with `capacity` slots (a power of two).
-  void Reindex(std::size_t capacity);
 
   PointMapOptions options_;
   double inverse_voxel_ = 0.0;
-  std::vector<Slot> slots_;
+  CellIndex index_;  ///< key -> position in voxels_
   std::vector<Voxel> voxels_;
   long points_ = 0;
 };

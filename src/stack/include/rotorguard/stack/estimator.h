@@ -19,7 +19,9 @@ class Estimator {
   virtual void OnOdometry(const OdometrySample& odometry) = 0;
   virtual void OnLidar(const LidarFrame& /*frame*/) {}
   void OnEscTelemetry(const EscTelemetry& esc);
-  /// The estimate at time t (valid once enough data arrived).
+  /// The newest estimate, for a consumer at time t (valid once enough data arrived). It is not
+  /// extrapolated to t: the stack asks right after the IMU sample that brought it. t decides
+  /// which of the estimator's sources is stale (the external odometry's dead reckoning).
   virtual StateEstimate Estimate(TimeNs t) const = 0;
   /// The estimate the LiDAR mapper places `frame` with: at the frame's end.
   virtual StateEstimate FrameEstimate(const LidarFrame& frame) const { return Estimate(frame.t_end_ns); }
