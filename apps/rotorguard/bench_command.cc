@@ -138,6 +138,9 @@ class BenchCommand final : public Command {
            "Comma-separated cells, phase/fault: hover/motor_stop, takeoff/propeller_loss, ... (default all;\n"
            "a cell flies the same trials alone as among the others)"},
           jobs,
+          {"--estimator", &estimator_,
+           "Where the stack takes its pose from: odometry (external, in open space: the paper's\n"
+           "benchmark; the default) or lio (its own LiDAR-inertial odometry, in a hall)"},
           {"--replay", &ftc_replay_,
            "Fly one trial instead, CELL:METHOD:SEED (a seed from the failures listed), into --out"}}},
         {&perception_,
@@ -175,9 +178,9 @@ class BenchCommand final : public Command {
           trial_seed,
           jobs,
           {"--kinds", &nav_kinds_, "Comma-separated world kinds: forest, room (default both)"},
-          {"--estimator", &nav_estimator_,
-           "Where the stack takes its pose from: odometry (external, the default) or lio (its own\n"
-           "LiDAR-inertial odometry)"},
+          {"--estimator", &estimator_,
+           "Where the stack takes its pose from: lio (its own LiDAR-inertial odometry, the default)\n"
+           "or odometry (external)"},
           {"--replay", &nav_replay_,
            "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out"}}},
         {&flatness_,
@@ -320,6 +323,14 @@ class BenchCommand final : public Command {
                                  fmt::join(NameList<sim::TruthPreset>(), ", ")));
   }
 
+  /// --estimator, or `fallback` when not given.
+  stack::EstimatorKind Estimator(stack::EstimatorKind fallback) const {
+    if (estimator_.empty()) return fallback;
+    if (const std::optional<stack::EstimatorKind> e = FromName<stack::EstimatorKind>(estimator_)) return *e;
+    throw UsageError(fmt::format("--estimator '{}' is invalid; expected one of: {}", estimator_,
+                                 fmt::join(NameList<stack::EstimatorKind>(), ", ")));
+  }
+
   int Ftc() const {
     benchmarks::FtcBenchOptions o;
     o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_, 1, 1'000'000));
@@ -330,6 +341,7 @@ class BenchCommand final : public Command {
     o.vehicle = harness::LoadVehicle(vehicle);
     if (auto fdd = harness::LoadVehicleFdd(vehicle)) o.fdd = fdd->first;
     o.truth = Truth();
+    o.estimator = Estimator(stack::EstimatorKind::kOdometry);
     if (!ftc_replay_.empty()) return ReplayFtcTrial(o);
     const std::optional<nlohmann::json> r = RunBenchCampaign(benchmarks::FtcCampaign(o), "ftc");
     return r && (*r)["errors"].get<int>() > 0 ? kRunFailed : kOk;
@@ -375,11 +387,7 @@ class BenchCommand final : public Command {
     o.base = harness::LoadScenario(ConfigPath("scenarios/forest.yaml"));
     o.truth = Truth();
     o.base.truth.preset = o.truth;  // a replayed trial flies the same world
-    const std::optional<stack::EstimatorKind> estimator = FromName<stack::EstimatorKind>(nav_estimator_);
-    if (!estimator) {
-      throw UsageError(fmt::format("--estimator '{}' is invalid; expected one of: odometry, lio", nav_estimator_));
-    }
-    o.estimator = *estimator;
+    o.estimator = Estimator(stack::EstimatorKind::kLio);
     o.base.stack.estimator.kind = o.estimator;  // and on the same estimator
     if (!nav_replay_.empty()) return ReplayNavTrial(o.base);
     RunBenchCampaign(benchmarks::NavCampaign(o), "nav");
@@ -481,12 +489,12 @@ class BenchCommand final : public Command {
   bool resume_ = false, json_ = false;
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3";
-  std::string truth_ = "realistic";
+  std::string truth_ = "realistic", estimator_;
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";
   std::string lio_duration_ = "20", lio_spins_ = "0,5,11,20";
   std::string planner_pairs_ = "100", planner_worlds_ = "10";
-  std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_, nav_estimator_ = "odometry";
+  std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;
   std::string flatness_seeds_ = "20";
   std::string mars_trials_ = "10";
   std::string campaign_spec_, campaign_work_;

@@ -138,6 +138,9 @@ harness::Scenario MakeNavTrial(const harness::Scenario& base, const std::string&
     }
   } else {
     s.world = PlannerRoom(DeriveSeed(seed, 23));
+    // A room has a ceiling: without one nothing the LiDAR sees from 1.3 m up fixes the height
+    // (its lowest beam meets the floor beyond the walls).
+    s.world.boxes.push_back({Vector3(0.0, 0.0, 3.25), Vector3(11.0, 9.0, 0.5), 0.0});
     // Three corners of the room in turn, 1.3 m up.
     for (const Vector3& corner : {Vector3(-3.8, -2.8, 1.3), Vector3(3.8, 2.8, 1.3), Vector3(-3.8, 2.8, 1.3)}) {
       points.push_back(FreePoint(s.world, &rng, corner, -3.2, 3.2, -4.2, 4.2, 0.8));

@@ -76,11 +76,19 @@ Options SeedAndTrials(const io::ConfigNode& root, int max_trials) {
   return o;
 }
 
+/// The spec's `estimator` (odometry or lio) into `estimator`, when given.
+void EstimatorKey(const io::ConfigNode& root, stack::EstimatorKind* estimator) {
+  if (root.Has("estimator")) {
+    *estimator = *FromName<stack::EstimatorKind>(root.Required("estimator").AsEnum(NameList<stack::EstimatorKind>()));
+  }
+}
+
 campaign::Campaign LoadFtc(const io::ConfigNode& root, const std::string& path) {
   const SpecFiles files(root, path);
   FtcBenchOptions o = SeedAndTrials<FtcBenchOptions>(root, 1'000'000);
   if (root.Has("methods")) o.methods = WordList(root.Required("methods"), FtcMethods());
   if (root.Has("cells")) o.cells = WordList(root.Required("cells"), FtcCells());
+  EstimatorKey(root, &o.estimator);
   o.vehicle = files.Load("vehicle", [](const std::string& p) { return harness::LoadVehicle(p); });
   if (auto fdd = files.Load("vehicle", [](const std::string& p) { return harness::LoadVehicleFdd(p); })) {
     o.fdd = fdd->first;
@@ -92,9 +100,7 @@ campaign::Campaign LoadNav(const io::ConfigNode& root, const std::string& path) 
   const SpecFiles files(root, path);
   NavBenchOptions o = SeedAndTrials<NavBenchOptions>(root, 100'000);
   if (root.Has("kinds")) o.kinds = WordList(root.Required("kinds"), {"forest", "room"});
-  if (root.Has("estimator")) {
-    o.estimator = *FromName<stack::EstimatorKind>(root.Required("estimator").AsEnum(NameList<stack::EstimatorKind>()));
-  }
+  EstimatorKey(root, &o.estimator);
   o.base = files.ScenarioAt("base");
   return Checked(root, [&] { return NavCampaign(o); });
 }

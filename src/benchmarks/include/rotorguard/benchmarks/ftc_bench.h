@@ -16,6 +16,8 @@
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/sim/truth.h"
+#include "rotorguard/sim/world.h"
+#include "rotorguard/stack/estimator.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::benchmarks {
@@ -44,10 +46,19 @@ struct FtcBenchOptions {
   /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
   /// vehicle file the stack reads; every method flies the same draw of a trial.
   sim::TruthPreset truth = sim::TruthPreset::kRealistic;
+  /// Where the stack's pose comes from: the external odometry in open space (the paper's
+  /// benchmark), or its own LiDAR-inertial odometry, the trials then flown in FtcHall with the
+  /// LiDAR on (the same draws otherwise).
+  stack::EstimatorKind estimator = stack::EstimatorKind::kOdometry;
   /// Called after each finished trial with (done, total).
   std::function<void(int, int)> progress;
   void Validate() const;
 };
+
+/// The world `bench ftc --estimator lio` flies in: a hall of 14 x 10 x 4 m (walls, a ceiling, a
+/// few pillars and crates along the walls) around every phase's flight, so that the LiDAR sees
+/// surfaces in every direction and the faults, not the scene, decide the outcome.
+sim::World FtcHall();
 
 /// One trial's outcome, as the cells aggregate it.
 struct FtcTrial {

@@ -28,9 +28,9 @@ struct NavBenchOptions {
   /// The world the trials fly (sim/truth.h): how each trial's simulated vehicle departs from the
   /// vehicle file the stack reads; every method flies the same draw of a trial.
   sim::TruthPreset truth = sim::TruthPreset::kRealistic;
-  /// Where every trial's stack takes its pose from, whatever the base says: the external odometry
-  /// (the benchmark's figures in docs/benchmarks.md) or the stack's LiDAR-inertial odometry.
-  stack::EstimatorKind estimator = stack::EstimatorKind::kOdometry;
+  /// Where every trial's stack takes its pose from, whatever the base says: its own
+  /// LiDAR-inertial odometry (the default) or the external odometry.
+  stack::EstimatorKind estimator = stack::EstimatorKind::kLio;
   std::function<void(int, int)> progress;  ///< (flights done, flights in all)
   /// Throws std::invalid_argument naming the field.
   void Validate() const;
