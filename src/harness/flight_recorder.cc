@@ -19,7 +19,8 @@ namespace fs = std::filesystem;
 using vehicle::StateView;
 
 /// One row of log.csv (record/flight_log.h, LogColumns): the truth, the stack's reference,
-/// estimate and outputs, the rotors, and the FDD indices and NMPC solve time when the stack has them.
+/// estimate and outputs, the rotors, and the FDD indices, NMPC solve time and LiDAR-inertial
+/// odometry's health when the stack has them.
 void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::NumericTable* table) {
   const StateView s(sim.state());
   std::size_t c = 0;
@@ -55,6 +56,18 @@ void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::Nume
     for (int i = 0; i < n; ++i) put(static_cast<int>(rotors[i].health));
   }
   if (const control::NmpcController* nmpc = st.nmpc()) put(1e3 * nmpc->summary().solve_time_s);
+  if (const stack::LioEstimator* lio = st.lio()) {
+    // The newest frame's health, held until the next frame; before the first, a default summary
+    // (nothing used or matched, all zeros).
+    const std::vector<perception::LioFrameSummary>& frames = lio->frames();
+    const perception::LioFrameSummary f = frames.empty() ? perception::LioFrameSummary{} : frames.back();
+    put(f.used ? 1.0 : 0.0);
+    put(f.degenerate ? 1.0 : 0.0);
+    put(f.points_matched);
+    put(f.residual_rms_m);
+    // Infinite when no point matched (record::kLioWeakestStdCapM); `!(x < cap)` also caps a NaN.
+    put(f.weakest_std_m < record::kLioWeakestStdCapM ? f.weakest_std_m : record::kLioWeakestStdCapM);
+  }
   RG_INVARIANT(c == table->columns.size(), "log row and LogColumns disagree");
 }
 
@@ -82,7 +95,8 @@ FlightRecorder::FlightRecorder(const FlightRecorderOptions& options, const Scena
 }
 
 void FlightRecorder::Begin(const stack::FlightStack& st, int num_rotors) {
-  flight_.table.columns = record::LogColumns(num_rotors, st.fault_detector() != nullptr, st.nmpc() != nullptr);
+  flight_.table.columns =
+      record::LogColumns(num_rotors, st.fault_detector() != nullptr, st.nmpc() != nullptr, st.lio() != nullptr);
   flight_.table.values.resize(flight_.table.columns.size());
 }
 

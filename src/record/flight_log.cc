@@ -29,7 +29,7 @@ nlohmann::json ReadJsonFile(const std::string& path) {
 
 }  // namespace
 
-std::vector<std::string> LogColumns(int n, bool with_fdd, bool with_nmpc) {
+std::vector<std::string> LogColumns(int n, bool with_fdd, bool with_nmpc, bool with_lio) {
   std::vector<std::string> c = {"t",       "p_x",     "p_y",     "p_z",     "q_w",     "q_x",     "q_y",
                                 "q_z",     "v_x",     "v_y",     "v_z",     "w_x",     "w_y",     "w_z",
                                 "ref_p_x", "ref_p_y", "ref_p_z", "ref_v_x", "ref_v_y", "ref_v_z", "ref_yaw",
@@ -42,6 +42,9 @@ std::vector<std::string> LogColumns(int n, bool with_fdd, bool with_nmpc) {
     for (int i = 0; i < n; ++i) c.push_back(fmt::format("{}{}", prefix, i));
   }
   if (with_nmpc) c.emplace_back("nmpc_ms");
+  if (with_lio) {
+    c.insert(c.end(), {"lio_used", "lio_degenerate", "lio_matched", "lio_residual_rms_m", "lio_weakest_std_m"});
+  }
   return c;
 }
 

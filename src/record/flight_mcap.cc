@@ -78,6 +78,7 @@ void WriteFlightMcap(const FlightLog& log, const std::string& path) {
   int n = 0;
   while (table.Has(fmt::format("cmd_{}", n))) ++n;
   const bool with_fdd = table.Has("mi_0");
+  const bool with_lio = table.Has("lio_matched");
 
   const Json pose_props = {{"timestamp", kTime}, {"frame_id", kString}, {"pose", kObject}};
   const std::uint16_t tf = channels.Channel("/tf", "foxglove.FrameTransform",
@@ -93,6 +94,16 @@ void WriteFlightMcap(const FlightLog& log, const std::string& path) {
   if (with_fdd) {
     fdd = channels.Channel("/fdd", "rotorguard.FddIndices",
                            {{"timestamp", kTime}, {"motor_index", kArray}, {"propeller_index", kArray}, {"health", kArray}});
+  }
+  std::uint16_t lio = 0;
+  if (with_lio) {
+    lio = channels.Channel("/lio", "rotorguard.LioHealth",
+                           {{"timestamp", kTime},
+                            {"used", kNumber},
+                            {"degenerate", kNumber},
+                            {"points_matched", kNumber},
+                            {"residual_rms_m", kNumber},
+                            {"weakest_std_m", kNumber}});
   }
   const Json scene_props = {{"deletions", kArray}, {"entities", kArray}};
   const std::uint16_t obstacles = channels.Channel("/obstacles", "foxglove.SceneUpdate", scene_props);
@@ -210,6 +221,16 @@ void WriteFlightMcap(const FlightLog& log, const std::string& path) {
     if (with_fdd) {
       mcap.AddMessage(fdd, ns, Json{{"timestamp", stamp}, {"motor_index", per_rotor("mi_", r)},
                                     {"propeller_index", per_rotor("pi_", r)}, {"health", per_rotor("health_", r)}}.dump());
+    }
+    if (with_lio) {
+      mcap.AddMessage(lio, ns,
+                      Json{{"timestamp", stamp},
+                           {"used", col("lio_used")[r]},
+                           {"degenerate", col("lio_degenerate")[r]},
+                           {"points_matched", col("lio_matched")[r]},
+                           {"residual_rms_m", col("lio_residual_rms_m")[r]},
+                           {"weakest_std_m", col("lio_weakest_std_m")[r]}}
+                          .dump());
     }
     OrderedJson row;
     for (std::size_t c = 0; c < table.columns.size(); ++c) row[table.columns[c]] = table.values[c][r];

@@ -404,6 +404,8 @@ NavigationSummary FlightStack::SummarizeNavigation() const {
   return n;
 }
 
+const LioEstimator* FlightStack::lio() const { return dynamic_cast<const LioEstimator*>(estimator_.get()); }
+
 FlightStackSummary FlightStack::Summarize() const {
   FlightStackSummary s;
   if (navigator_ || flatness_) s.navigation = SummarizeNavigation();
@@ -416,7 +418,7 @@ FlightStackSummary FlightStack::Summarize() const {
   s.transitions = supervisor_.transitions();
   if (const perception::VoxelMap* m = map()) s.map_voxels_occupied = m->occupied_count();
   s.lidar_points_dropped = lidar_points_dropped_;
-  if (const auto* lio = dynamic_cast<const LioEstimator*>(estimator_.get())) s.odometry = lio->Summarize();
+  if (const LioEstimator* odometry = lio()) s.odometry = odometry->Summarize();
   s.reconfigurations = reconfigurations_;
   return s;
 }

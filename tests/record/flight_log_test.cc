@@ -75,6 +75,7 @@ TEST_F(FlightLogTest, CsvAndMcapHoldTheSameFlightAndTheMapsChangesRebuildTheStac
   const FlightLog mcap = ReadFlightMcap((dir_ / "flight.mcap").string());
   ASSERT_EQ(csv.table.columns, mcap.table.columns);
   EXPECT_TRUE(csv.table.Has("mi_0") && csv.table.Has("pi_3") && csv.table.Has("health_2") && csv.table.Has("nmpc_ms"));
+  EXPECT_FALSE(csv.table.Has("lio_matched")) << "the LiDAR odometry's columns only when it is the estimator";
   // One row per 1/log_rate_hz from t = 0, plus the final state.
   ASSERT_EQ(csv.table.rows(), static_cast<std::size_t>(std::llround(s.duration_s * s.log_rate_hz)) + 1);
   ASSERT_EQ(csv.table.rows(), mcap.table.rows());
@@ -99,6 +100,73 @@ TEST_F(FlightLogTest, CsvAndMcapHoldTheSameFlightAndTheMapsChangesRebuildTheStac
     EXPECT_EQ(static_cast<int>(maps[k].size()), it->second) << "snapshot at " << ts << " s";
   }
   EXPECT_EQ(maps.front(), first_map.begin()->second);
+}
+
+// The forest's first seconds on the LiDAR-inertial odometry, its propeller lost at 1 s (the spin
+// that follows is the odometry's hardest part): every row's lio_* columns hold the newest frame of
+// the estimator's own record as it stood when the row was written (read at every control cycle,
+// and once more after the last step for the final row), and nothing in the log is NaN or infinite.
+TEST_F(FlightLogTest, TheLioColumnsHoldTheOdometrysNewestFrame) {
+  const harness::Scenario s =
+      harness::LoadScenario(Config("forest.yaml"), {{"duration_s", "2"}, {"faults.0.onset.at_time_s", "1"}});
+  ASSERT_EQ(s.stack.estimator.kind, stack::EstimatorKind::kLio);
+  std::vector<perception::LioFrameSummary> newest;  // per control cycle; default before the first frame
+  const stack::FlightStack* flown = nullptr;
+  std::optional<perception::LioFrameSummary> last;
+  harness::RunOptions o;
+  o.out_dir = dir_.string();
+  o.on_control_cycle = [&](const stack::FlightStack& st) {
+    flown = &st;
+    const std::vector<perception::LioFrameSummary>& frames = st.lio()->frames();
+    newest.push_back(frames.empty() ? perception::LioFrameSummary{} : frames.back());
+  };
+  // Called with 1 once the last step is done, the stack still alive: the final row's frame.
+  o.progress = [&](double done) {
+    if (done == 1.0 && flown != nullptr && !flown->lio()->frames().empty()) last = flown->lio()->frames().back();
+  };
+  const harness::RunSummary summary = harness::RunScenario(s, o);
+  ASSERT_FALSE(summary.crashed) << summary.crash_reason.value_or("");
+  ASSERT_TRUE(last.has_value());
+
+  const FlightLog log = ReadFlightLog(dir_.string());
+  for (const char* c : {"lio_used", "lio_degenerate", "lio_matched", "lio_residual_rms_m", "lio_weakest_std_m"}) {
+    ASSERT_TRUE(log.table.Has(c)) << c;
+  }
+  for (std::size_t c = 0; c < log.table.columns.size(); ++c) {
+    for (std::size_t r = 0; r < log.table.rows(); ++r) {
+      ASSERT_TRUE(std::isfinite(log.table.values[c][r])) << log.table.columns[c] << " row " << r;
+    }
+  }
+  const std::vector<double>& t = log.table.Column("t");
+  const std::vector<double>& used = log.table.Column("lio_used");
+  const std::vector<double>& degenerate = log.table.Column("lio_degenerate");
+  const std::vector<double>& matched = log.table.Column("lio_matched");
+  const std::vector<double>& residual = log.table.Column("lio_residual_rms_m");
+  const std::vector<double>& weakest = log.table.Column("lio_weakest_std_m");
+  const auto expect_row = [&](std::size_t r, const perception::LioFrameSummary& f) {
+    EXPECT_EQ(used[r], f.used ? 1.0 : 0.0) << "row " << r;
+    EXPECT_EQ(degenerate[r], f.degenerate ? 1.0 : 0.0) << "row " << r;
+    EXPECT_EQ(matched[r], f.points_matched) << "row " << r;
+    EXPECT_NEAR(residual[r], f.residual_rms_m, 1e-8 * std::max(1.0, f.residual_rms_m)) << "row " << r;  // %.9g
+    const double capped = std::min(f.weakest_std_m, kLioWeakestStdCapM);
+    EXPECT_NEAR(weakest[r], capped, 1e-8 * std::max(1.0, capped)) << "row " << r;
+  };
+  // Every row but the final one is written in the step of a control cycle, after it.
+  int registered = 0;
+  for (std::size_t r = 0; r + 1 < log.table.rows(); ++r) {
+    const auto cycle = static_cast<std::size_t>(std::llround(t[r] * s.stack.control_rate_hz));
+    ASSERT_NEAR(static_cast<double>(cycle) / s.stack.control_rate_hz, t[r], 1e-9) << "a row off the control cycles";
+    ASSERT_LT(cycle, newest.size());
+    expect_row(r, newest[cycle]);
+    registered += newest[cycle].used;
+  }
+  // At the end: the estimator's last frame.
+  expect_row(log.table.rows() - 1, *last);
+  EXPECT_EQ(matched.back(), last->points_matched);
+  EXPECT_GT(last->points_matched, 0);
+  EXPECT_GT(registered, static_cast<int>(log.table.rows()) / 2) << "the frames were registered most of the time";
+  // The threshold the frames were judged by is in the summary, for the report's plot.
+  EXPECT_EQ(log.summary["odometry"]["degenerate_std_m"].get<double>(), s.stack.estimator.lio.degenerate_std_m);
 }
 
 TEST_F(FlightLogTest, MovingBoxesAreSampledWhereTheWorldPutsThem) {

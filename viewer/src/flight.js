@@ -1,5 +1,6 @@
 // A flight's report: the outcome and key metrics, the 3D replay with its time controls, and the
-// plots of paper 000's Figs. 7 and 10 (rotor thrusts and speeds, FDD indices, tracking).
+// plots of paper 000's Figs. 7 and 10 (rotor thrusts and speeds, FDD indices, tracking), and, when
+// the stack localised itself with its LiDAR-inertial odometry, its estimate and health.
 import { Replay } from "./replay.js";
 import { makePlot, color } from "./plots.js";
 import { eulerFromQuaternion, fmt, indexAt, rotorCount, unwrap } from "./series.js";
@@ -40,6 +41,11 @@ function header(app, data) {
   if (s.navigation) card("waypoints", `${s.navigation.waypoints_reached} / ${s.navigation.waypoints_total}`);
   if (s.map_voxels_occupied !== null && s.map_voxels_occupied !== undefined) card("map voxels", String(s.map_voxels_occupied));
   if (s.supervisor && s.supervisor.transitions.length > 0) card("flight mode at the end", s.supervisor.final_mode.replace("_", " "));
+  if (s.odometry) {
+    card("estimate RMSE", `${fmt(s.estimate_position_rmse_m)} m`);
+    card("estimate max error", `${fmt(s.estimate_position_max_m)} m · ${fmt((s.estimate_attitude_max_rad * 180) / Math.PI, 2)}°`);
+    card("LIO frames", `${s.odometry.frames_used} / ${s.odometry.frames} used · ${s.odometry.frames_degenerate} degenerate`);
+  }
   card("real-time factor", `${fmt(s.realtime_factor, 0)}×`);
   app.appendChild(cards);
 }
@@ -119,6 +125,12 @@ function replaySection(app, data, clock) {
       }
     }
     if (s.nmpc_ms) rows += `<tr><td>NMPC solve</td><td class="num">${fmt(s.nmpc_ms[i], 2)} ms</td></tr>`;
+    if (s.lio_matched) {
+      const estErr = Math.hypot(s.est_p_x[i] - s.p_x[i], s.est_p_y[i] - s.p_y[i], s.est_p_z[i] - s.p_z[i]);
+      const state = s.lio_used[i] ? (s.lio_degenerate[i] ? " · degenerate" : "") : " · not used";
+      rows += `<tr><td>estimate error</td><td class="num">${fmt(estErr)} m</td></tr>`;
+      rows += `<tr><td>LIO frame</td><td class="num">${fmt(s.lio_matched[i], 0)} matched${state}</td></tr>`;
+    }
     side.innerHTML = `<table>${rows}</table>`;
   };
   clock.onChange(update);
@@ -254,6 +266,98 @@ function plotsSection(app, data, clock) {
       series: [{ label: "solve", values: s.nmpc_ms, color: "#2ca02c" }],
     }, clock);
   }
+  if (s.lio_matched && s.est_p_x) localisationSection(app, data, clock, markers);
+}
+
+/**
+ * Angle [rad] of the rotation between two quaternions (w, x, y, z): 2 atan2(|v|, |w|) of
+ * conj(a) b. Not 2 acos |a · b|: near 1 the arc cosine turns the 4-decimal rounding of the
+ * report's data (1e-4 in the dot product) into a degree and a half of error.
+ */
+function quaternionAngle(a, b) {
+  const [aw, ax, ay, az] = a;
+  const [bw, bx, by, bz] = b;
+  const w = aw * bw + ax * bx + ay * by + az * bz;
+  const x = aw * bx - ax * bw - ay * bz + az * by;
+  const y = aw * by + ax * bz - ay * bw - az * bx;
+  const z = aw * bz - ax * by + ay * bx - az * bw;
+  return 2 * Math.atan2(Math.hypot(x, y, z), Math.abs(w));
+}
+
+/**
+ * The LiDAR-inertial odometry (the log's lio_* columns, written only when it was the stack's
+ * estimator): its estimate against the truth, and each frame's health as the filter judged it.
+ */
+function localisationSection(app, data, clock, markers) {
+  const s = data.series;
+  const t = s.t;
+  const o = data.summary.odometry || {};
+  app.appendChild(el("h2", { text: "Localisation (LiDAR-inertial odometry)" }));
+  if (data.summary.odometry) {
+    const ms = o.frame_ms_mean !== undefined ? ` · ${fmt(o.frame_ms_mean, 2)} ms per frame (p99 ${fmt(o.frame_ms_p99, 2)})` : "";
+    app.appendChild(el("div", {
+      class: "note",
+      text: `${o.frames} frames, ${o.frames_used} registered, ${o.frames_degenerate} degenerate · ` +
+        `${fmt(o.matched_mean, 0)} of ${fmt(o.points_mean, 0)} points matched per frame (mean) · ` +
+        `residual RMS ${fmt(1000 * o.residual_rms_m_mean, 1)} mm (mean)${ms} · ${o.map_points} map points at the end`,
+    }));
+  }
+  const plots = el("div", { class: "plots" });
+  app.appendChild(plots);
+  for (const axis of ["x", "y", "z"]) {
+    makePlot(plots, {
+      title: `Estimate vs truth: ${axis}`, x: t, yLabel: `${axis} [m]`, markers,
+      series: [
+        { label: "estimate", values: s[`est_p_${axis}`], color: "#1f77b4", dash: [5, 3] },
+        { label: "truth", values: s[`p_${axis}`], color: "#d62728" },
+      ],
+    }, clock);
+  }
+  makePlot(plots, {
+    title: "Estimate error: position |p_est − p|", x: t, yLabel: "m", markers,
+    series: [{
+      label: "position error",
+      values: t.map((_, i) => Math.hypot(s.est_p_x[i] - s.p_x[i], s.est_p_y[i] - s.p_y[i], s.est_p_z[i] - s.p_z[i])),
+      color: "#d62728",
+    }],
+  }, clock);
+  const deg = 180 / Math.PI;
+  makePlot(plots, {
+    title: "Estimate error: attitude angle", x: t, yLabel: "deg", markers,
+    series: [{
+      label: "attitude error",
+      values: t.map((_, i) => deg * quaternionAngle([s.q_w[i], s.q_x[i], s.q_y[i], s.q_z[i]],
+        [s.est_q_w[i], s.est_q_x[i], s.est_q_y[i], s.est_q_z[i]])),
+      color: "#9467bd",
+    }],
+  }, clock);
+  // The frames the filter did not take (the first, which starts the map, and those with too few
+  // matches) and those it took with a direction left unconstrained, as dots on their values.
+  const only = (flag, values, want) => values.map((v, i) => (flag[i] === want ? v : null));
+  makePlot(plots, {
+    title: "LiDAR odometry: matched points per frame", x: t, yLabel: "points", markers,
+    series: [
+      { label: "matched", values: s.lio_matched, color: "#2ca02c" },
+      { label: "not used", values: only(s.lio_used, s.lio_matched, 0), color: "#7f7f7f", pointsOnly: true },
+    ],
+  }, clock);
+  makePlot(plots, {
+    title: "LiDAR odometry: point-to-plane residual RMS", x: t, yLabel: "m", markers,
+    series: [{ label: "residual RMS", values: s.lio_residual_rms_m, color: "#ff7f0e" }],
+  }, clock);
+  // Log scale: a well-constrained frame's std is millimetres, an unconstrained one's is capped
+  // at 100 m in the log; 0 (no frame registered yet) is left out.
+  const weakest = s.lio_weakest_std_m.map((v) => (v > 0 ? v : null));
+  const threshold = o.degenerate_std_m;
+  makePlot(plots, {
+    title: `LiDAR odometry: position std along the weakest direction${threshold !== undefined ? ` (degenerate above ${threshold} m, dashed)` : ""}`,
+    x: t, yLabel: "m (log)", markers, yLog: true,
+    thresholds: threshold !== undefined ? [{ y: threshold, color: "#555", label: "degenerate" }] : [],
+    series: [
+      { label: "weakest std", values: weakest, color: "#1f77b4" },
+      { label: "degenerate", values: only(s.lio_degenerate, weakest, 1), color: "#d62728", pointsOnly: true },
+    ],
+  }, clock);
 }
 
 export function renderFlight(app, data) {

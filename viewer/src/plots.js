@@ -10,8 +10,11 @@ export function color(i) {
 
 /**
  * A chart in `parent`.
- * spec: { title, x (times, or another abscissa named by xLabel), series: [{label, values, color, dash, width}], yLabel,
- *         markers: [{t, color, label}], thresholds: [{y, color, label}], yRange: [lo, hi] }
+ * spec: { title, x (times, or another abscissa named by xLabel), series: [{label, values, color, dash, width, steps,
+ *         pointsOnly}], yLabel, markers: [{t, color, label}], thresholds: [{y, color, label}], yRange: [lo, hi],
+ *         yLog (a base-10 y axis; values must be positive or null) }
+ * A pointsOnly series draws a dot per sample and no line: samples picked out of another series
+ * (null elsewhere).
  * clock: { time(), onChange(fn), set(t) } — the replay's time.
  */
 export function makePlot(parent, spec, clock) {
@@ -73,8 +76,8 @@ export function makePlot(parent, spec, clock) {
       stroke: s.color || color(i),
       width: s.width || 1.5,
       dash: s.dash,
-      points: { show: false },
-      paths: s.steps ? uPlot.paths.stepped({ align: 1 }) : undefined,
+      points: s.pointsOnly ? { show: true, size: 6, fill: s.color || color(i) } : { show: false },
+      paths: s.pointsOnly ? () => null : s.steps ? uPlot.paths.stepped({ align: 1 }) : undefined,
       fill: s.steps ? `${s.color || color(i)}22` : undefined,
       value: (u, v) => (v == null ? "–" : v.toFixed(3)),
     });
@@ -85,7 +88,7 @@ export function makePlot(parent, spec, clock) {
     width: width(),
     height: spec.height || 220,
     series,
-    scales: { x: { time: false }, y: spec.yRange ? { range: spec.yRange } : {} },
+    scales: { x: { time: false }, y: { ...(spec.yRange ? { range: spec.yRange } : {}), ...(spec.yLog ? { distr: 3 } : {}) } },
     axes: [{ label: spec.xLabel || "t [s]", size: 36 }, { label: spec.yLabel || "", size: 56 }],
     legend: { live: true },
     cursor: { sync: { key: "rotorguard-time" }, drag: { x: true, y: false } },

@@ -16,7 +16,9 @@ if (!dir) {
 const bytes = readFileSync(join(dir, "flight.mcap"));
 const rows = readFileSync(join(dir, "log.csv"), "utf8").trimEnd().split("\n").length - 1;
 const scene = JSON.parse(readFileSync(join(dir, "scene.json"), "utf8"));
-const withFdd = readFileSync(join(dir, "log.csv"), "utf8").split("\n", 1)[0].split(",").includes("mi_0");
+const header = readFileSync(join(dir, "log.csv"), "utf8").split("\n", 1)[0].split(",");
+const withFdd = header.includes("mi_0");
+const withLio = header.includes("lio_matched");
 
 // Stream reading: every record in file order.
 const stream = new McapStreamReader({ validateCrcs: true });
@@ -47,6 +49,7 @@ check(badJson === 0, `every message is valid JSON (${badJson} are not)`);
 const expect = (topic, n) => check((counts.get(topic) || 0) === n, `${topic}: ${counts.get(topic) || 0} messages, expected ${n}`);
 for (const topic of ["/tf", "/pose", "/estimate", "/reference", "/rotors", "/rotorguard/log"]) expect(topic, rows);
 if (withFdd) expect("/fdd", rows);
+if (withLio) expect("/lio", rows);
 const moving = scene.world.moving_boxes.reduce((n, m) => n + m.t_s.length, 0);
 expect("/obstacles", 1 + moving);
 expect("/planner/trajectory", scene.plans.length);
@@ -60,6 +63,7 @@ for (const [topic, name] of [["/tf", "foxglove.FrameTransform"], ["/pose", "foxg
   ["/obstacles", "foxglove.SceneUpdate"], ["/map", "foxglove.PointCloud"]]) {
   check(schemaOf(topic) === name, `${topic} has schema ${name} (${schemaOf(topic)})`);
 }
+if (withLio) check(schemaOf("/lio") === "rotorguard.LioHealth", `/lio has schema rotorguard.LioHealth (${schemaOf("/lio")})`);
 check(metadata !== null && metadata.name === "rotorguard" && metadata.metadata.has("summary"),
   "the 'rotorguard' metadata record holds the summary");
 

@@ -40,7 +40,8 @@ class FlightRecorder {
   /// The sensor log's text to append to (sensors.csv's format), null when it is not written.
   std::string* sensor_log() { return sensors_ ? &sensor_buffer_ : nullptr; }
 
-  /// The stack is built: the log's columns follow what it runs (its FDD, the NMPC).
+  /// The stack is built: the log's columns follow what it runs (its FDD, the NMPC, the LiDAR-inertial
+  /// odometry).
   void Begin(const stack::FlightStack& stack, int num_rotors);
   /// After each control cycle at time t: its command and what the scene draws of the stack.
   void OnControlCycle(TimeNs t, const stack::FlightStack& stack, const RotorCommand& command);

@@ -25,8 +25,15 @@ struct FlightLog {
 /// The names of the log's columns for a vehicle of n rotors (`mode` is the supervisor's flight
 /// mode, stack::FlightMode's code), with the FDD columns (motor index
 /// mi_i, propeller index pi_i, diagnosed health code health_i) when the stack runs fault
-/// detection, and nmpc_ms (the NMPC's last solve time) when it flies the NMPC.
-std::vector<std::string> LogColumns(int num_rotors, bool with_fdd, bool with_nmpc);
+/// detection, nmpc_ms (the NMPC's last solve time) when it flies the NMPC, and the LiDAR-inertial
+/// odometry's newest frame (lio_used, lio_degenerate, lio_matched, lio_residual_rms_m,
+/// lio_weakest_std_m) when it is the stack's estimator.
+std::vector<std::string> LogColumns(int num_rotors, bool with_fdd, bool with_nmpc, bool with_lio);
+
+/// lio_weakest_std_m is written at most this [m]: a frame whose points leave a direction
+/// unconstrained has an infinite (or astronomically large) std there, which is no number a log
+/// or a plot can hold; beyond this anything is equally unconstrained in a world of tens of metres.
+inline constexpr double kLioWeakestStdCapM = 100.0;
 
 /// The log's text: the header, then one line per row, every number in %.9g.
 std::string FormatLogCsv(const io::NumericTable& table);

@@ -299,6 +299,8 @@ class FlightStack {
   const control::NmpcController* nmpc() const { return nmpc_; }
   /// The fault detector, when there is one; else null.
   const fdd::FaultDetector* fault_detector() const { return fdd_.get(); }
+  /// The LiDAR-inertial odometry, when it is the estimator (for its frames' health); else null.
+  const LioEstimator* lio() const;
   /// Waypoints reached so far (counting repeats over the rounds); the navigate mission is complete
   /// when it equals waypoints x rounds.
   int waypoints_reached() const {
