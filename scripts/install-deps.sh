@@ -15,6 +15,7 @@ packages=(
   libbenchmark-dev     # micro-benchmarks
   libceres-dev         # L-BFGS for trajectory optimisation (planning)
   coinor-libipopt-dev  # Ipopt: the NMPC's correctness oracle in tests (not linked by the product)
+  liboctomap-dev       # OctoMap: the reference map `bench perception` measures the occupancy map against
   chromium             # headless browser of the report's browser test (viewer/test)
   slurm-wlm munge      # campaigns as Slurm job arrays; a single-node cluster in tests (scripts/local-slurm.sh)
   parallel             # GNU parallel: campaign shards across machines over ssh

@@ -11,6 +11,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "rotorguard/benchmarks/octomap_reference.h"
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
@@ -121,13 +122,17 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
   mapper_options.deskew_frames = deskew;
   mapper_options.deskew.sensor_position_m = lidar_options.position_m;
   perception::LidarMapper mapper(mapper_options);
+  // The reference: OctoMap fed the very frames the mapper inserted (its world-frame points and
+  // sensor origin, in order), at the map's resolution and with its sensor model, out to the
+  // sensor's range.
+  OctomapReference reference(mapper_options.map);
 
   const double res = mapper_options.map.resolution_m;
   std::unordered_set<std::int64_t> seen;  // voxels of the returns placed with their true poses
   vehicle::StateVector x = vehicle::StateVector::Zero(13 + 4);
   double lidar_s = 0.0, map_s = 0.0, first_frame_ms = 0.0;
   long frames = 0, points = 0;
-  std::vector<double> frame_ms;
+  std::vector<double> frame_ms, octomap_ms;
   const TimeNs step = 1'000'000, end = FromSeconds(options.duration_s);
   // Each step as the simulator orders it: the sensors sample at the step's end, so the frame that
   // ends there arrives with the IMU and odometry samples of the same instant.
@@ -153,47 +158,87 @@ nlohmann::json RunScene(const Scene& scene, bool deskew, const PerceptionBenchOp
     const Stopwatch map_clock;
     mapper.OnFrame(*frame, estimate);
     const double dt = map_clock.seconds();
-    // The first frame also allocates the map (tens of MB, once per flight): reported apart.
+    const Stopwatch octomap_clock;
+    reference.Insert(mapper.last_origin_W(), mapper.last_points_W(), lidar_options.max_range_m);
+    const double octomap_dt = octomap_clock.seconds();
+    // The first frame also allocates the map (tens of MB, once per flight): reported apart, and
+    // OctoMap's first frame left out with it, so that both means cover the same frames.
     if (frames == 0) {
       first_frame_ms = 1e3 * dt;
     } else {
       map_s += dt;
       frame_ms.push_back(1e3 * dt);
+      octomap_ms.push_back(1e3 * octomap_dt);
     }
     ++frames;
     points += static_cast<long>(frame->points_S.size());
   }
   const perception::VoxelMap* map = mapper.map();
-  double recall = 0.0;
-  long truth_voxels = 0;
+  double recall = 0.0, octomap_recall = 0.0, octomap_precision = 0.0;
+  long truth_voxels = 0, octomap_occupied = 0;
   if (map) {
     // A surface voxel the sensor saw counts as found when the map has an occupied voxel within one
     // voxel of it: the 26 neighbours' centres lie within sqrt(3) voxels, the next ones at 2.
-    long found = 0;
+    // OctoMap is asked the same of the same cells: one of the 27 cells occupied (an unknown one is
+    // not), only those in the map's window, as Nearest sees no voxel outside it.
+    long found = 0, octomap_found = 0;
     for (const std::int64_t key : seen) {
       const Vector3 c = KeyCenter(key, res);
       if (!map->InWindow(c)) continue;
       ++truth_voxels;
       found += map->Nearest(c, 1.8 * res) ? 1 : 0;
+      bool hit = false;
+      for (int dx = -1; dx <= 1 && !hit; ++dx) {
+        for (int dy = -1; dy <= 1 && !hit; ++dy) {
+          for (int dz = -1; dz <= 1 && !hit; ++dz) {
+            const Vector3 n = c + res * Vector3(dx, dy, dz);
+            hit = map->InWindow(n) && reference.IsOccupied(n);
+          }
+        }
+      }
+      octomap_found += hit ? 1 : 0;
     }
-    recall = truth_voxels > 0 ? static_cast<double>(found) / static_cast<double>(truth_voxels) : 0.0;
+    const auto share = [](long part, long whole) {
+      return whole > 0 ? static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+    };
+    recall = share(found, truth_voxels);
+    octomap_recall = share(octomap_found, truth_voxels);
+    // Precision over OctoMap's occupied cells in the map's final window: the map has forgotten
+    // what left its window, OctoMap keeps the whole flight, so both are scored on the same region.
+    const std::vector<Vector3> cells = reference.OccupiedCells(map->window_min_W(), map->window_max_W());
+    octomap_occupied = static_cast<long>(cells.size());
+    octomap_precision = harness::MapPrecision(cells, res, scene.world);
   }
+  const double map_ms_p99 = Percentile(frame_ms, 0.99);
   std::sort(frame_ms.begin(), frame_ms.end());
   const auto n = static_cast<double>(std::max<long>(1, frames));
   const auto timed = static_cast<double>(std::max<std::size_t>(1, frame_ms.size()));
+  const double map_ms_mean = 1e3 * map_s / timed;
+  const double octomap_ms_mean = std::accumulate(octomap_ms.begin(), octomap_ms.end(), 0.0) / timed;
   return {{"scene", scene.name},
           {"deskew", deskew},
           {"frames", frames},
           {"points_per_frame_mean", static_cast<double>(points) / n},
           {"points_per_s_simulated", lidar_s > 0.0 ? static_cast<double>(lidar.pulses()) / lidar_s : 0.0},
-          {"map_update_ms_mean", 1e3 * map_s / timed},
+          {"map_update_ms_mean", map_ms_mean},
           {"map_first_frame_ms", first_frame_ms},
           {"map_update_ms_median", frame_ms.empty() ? 0.0 : frame_ms[frame_ms.size() / 2]},
           {"map_update_ms_max", frame_ms.empty() ? 0.0 : frame_ms.back()},
           {"map_voxels_occupied", map ? map->occupied_count() : 0},
           {"truth_voxels_in_window", truth_voxels},
           {"map_precision", map ? harness::MapPrecision(*map, scene.world) : 0.0},
-          {"map_recall", recall}};
+          {"map_recall", recall},
+          {"map_update_ms_p99", map_ms_p99},
+          {"octomap",
+           {{"insert_ms_mean", octomap_ms_mean},
+            {"insert_ms_p99", Percentile(octomap_ms, 0.99)},
+            {"precision", octomap_precision},
+            {"recall", octomap_recall},
+            {"voxels_occupied_in_window", octomap_occupied},
+            {"memory_bytes", reference.memory_bytes()}}},
+          // Against the mapper's whole frame (deskewing, placement and insertion; OctoMap is given the
+          // frame already placed), so the ratio errs in OctoMap's favour by the deskewing's share.
+          {"time_ratio_octomap_over_rotorguard", map_ms_mean > 0.0 ? octomap_ms_mean / map_ms_mean : 0.0}};
 }
 
 /// One condition of bench lio: the path flown for `duration_s` with the simulator's IMU (with the
@@ -374,6 +419,22 @@ std::string PerceptionMarkdown(const nlohmann::json& r) {
                       x["map_update_ms_mean"].get<double>(), x["map_update_ms_median"].get<double>(),
                       x["map_update_ms_max"].get<double>(), x["map_precision"].get<double>(),
                       x["map_recall"].get<double>());
+  }
+  md +=
+      "\nThe same frames inserted into OctoMap at the same resolution, with the same sensor model, scored the same way "
+      "(ms per frame without the first; the map's time is its whole frame, deskewing included):\n\n";
+  md +=
+      "| scene | deskew | map ms (mean / p99) | OctoMap ms (mean / p99) | OctoMap / map time | OctoMap precision | "
+      "OctoMap recall | OctoMap memory MB |\n";
+  md += "|---|---|---|---|---|---|---|---|\n";
+  for (const nlohmann::json& x : r["runs"]) {
+    const nlohmann::json& o = x["octomap"];
+    md += fmt::format("| {} | {} | {:.2f} / {:.2f} | {:.1f} / {:.1f} | {:.1f} | {:.3f} | {:.3f} | {:.1f} |\n",
+                      x["scene"].get<std::string>(), x["deskew"].get<bool>() ? "on" : "off",
+                      x["map_update_ms_mean"].get<double>(), x["map_update_ms_p99"].get<double>(),
+                      o["insert_ms_mean"].get<double>(), o["insert_ms_p99"].get<double>(),
+                      x["time_ratio_octomap_over_rotorguard"].get<double>(), o["precision"].get<double>(),
+                      o["recall"].get<double>(), static_cast<double>(o["memory_bytes"].get<std::size_t>()) / 1e6);
   }
   md += fmt::format("\nTargets: quality (precision and recall >= 0.95 with deskew) {}; map update <= 5 ms {}; "
                     "simulation >= 2 M points/s {}.\n",

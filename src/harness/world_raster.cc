@@ -32,8 +32,11 @@ void RasterizeWorld(const sim::World& world, perception::VoxelMap* map) {
 }
 
 double MapPrecision(const perception::VoxelMap& map, const sim::World& world) {
-  const std::vector<Vector3> occupied = map.OccupiedVoxels();
-  const double tolerance = map.resolution() * (0.5 * std::sqrt(3.0) + 1.0);
+  return MapPrecision(map.OccupiedVoxels(), map.resolution(), world);
+}
+
+double MapPrecision(const std::vector<Vector3>& occupied, double resolution_m, const sim::World& world) {
+  const double tolerance = resolution_m * (0.5 * std::sqrt(3.0) + 1.0);
   long good = 0;
   for (const Vector3& c : occupied) good += world.DistanceToSurface(c, 0.0) <= tolerance ? 1 : 0;
   return occupied.empty() ? 0.0 : static_cast<double>(good) / static_cast<double>(occupied.size());

@@ -25,6 +25,7 @@ LidarFrameSummary LidarMapper::OnFrame(const LidarFrame& frame, const StateEstim
   summary.points_dropped = frame.dropped;
   if (!e.valid || !e.p_W.allFinite() || !e.q_WB.coeffs().allFinite() || !e.v_W.allFinite()) {
     summary.points_dropped += static_cast<long>(frame.points_S.size());  // nowhere to put them yet
+    points_.clear();  // last_points_W: nothing of this frame was inserted
     return summary;
   }
   if (!map_) map_ = std::make_unique<VoxelMap>(options_.map);
@@ -36,10 +37,10 @@ LidarFrameSummary LidarMapper::OnFrame(const LidarFrame& frame, const StateEstim
     points_ = frame.points_S;
   }
   const Matrix3 R = e.q_WB.normalized().toRotationMatrix();
-  const Vector3 origin = e.p_W + R * options_.deskew.sensor_position_m;
-  for (Eigen::Vector3f& p : points_) p = (origin + R * p.cast<double>()).cast<float>();
+  origin_W_ = e.p_W + R * options_.deskew.sensor_position_m;
+  for (Eigen::Vector3f& p : points_) p = (origin_W_ + R * p.cast<double>()).cast<float>();
   map_->Recenter(e.p_W);
-  summary.map = map_->Insert(origin, points_);
+  summary.map = map_->Insert(origin_W_, points_);
   summary.points_dropped += summary.map.points_dropped;
   return summary;
 }

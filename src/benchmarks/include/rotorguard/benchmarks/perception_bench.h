@@ -6,8 +6,12 @@
 /// flight stack's own LidarMapper fed by the stack's estimator, so that the figures isolate
 /// perception from control. Reports points_per_s_simulated, map_update_ms_mean per frame (deskew,
 /// placement and insertion: LidarMapper::OnFrame; the first frame, which also allocates the map,
-/// apart as map_first_frame_ms) and the map's precision and recall against the world's truth
-/// within one voxel.
+/// apart as map_first_frame_ms; map_update_ms_p99) and the map's precision and recall against the
+/// world's truth within one voxel. The same frames (the mapper's world-frame points and sensor
+/// origins, in order) also go into OctoMap (OctomapReference: same resolution and sensor model),
+/// timed in the same loop and scored by the same rules on the same cells: the block `octomap`
+/// (insert_ms_mean, insert_ms_p99, precision, recall, voxels_occupied_in_window, memory_bytes)
+/// and time_ratio_octomap_over_rotorguard (OctoMap's mean over map_update_ms_mean).
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>

@@ -52,13 +52,19 @@ class LidarMapper {
   LidarFrameSummary OnFrame(const LidarFrame& frame, const StateEstimate& estimate);
   /// The occupancy map, once a frame was inserted; else null.
   const VoxelMap* map() const { return map_.get(); }
+  /// The last frame given to OnFrame as it was inserted: its points in the world frame (empty if
+  /// it was not inserted) and the sensor's origin. A reference map fed these sees exactly the
+  /// rays this map saw (bench perception's OctoMap).
+  const std::vector<Eigen::Vector3f>& last_points_W() const { return points_; }
+  const Vector3& last_origin_W() const { return origin_W_; }
   const LidarMapperOptions& options() const { return options_; }
 
  private:
   LidarMapperOptions options_;
   Deskewer deskewer_;
   std::unique_ptr<VoxelMap> map_;
-  std::vector<Eigen::Vector3f> points_;
+  std::vector<Eigen::Vector3f> points_;  // the last frame's, in the world frame once placed
+  Vector3 origin_W_ = Vector3::Zero();
 };
 
 }  // namespace rotorguard::perception
