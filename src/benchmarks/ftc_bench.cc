@@ -23,6 +23,20 @@
 
 namespace rotorguard::benchmarks {
 
+sim::World FtcHall() {
+  sim::World w;
+  // Interior x in [-7, 7], y in [-5, 5], z in [0, 4]: the lemniscate (6 x 3 m about the origin)
+  // keeps 2 m from every wall and pillar.
+  w.boxes = {
+      {Vector3(7.25, 0, 2), Vector3(0.5, 10.5, 4), 0.0},      {Vector3(-7.25, 0, 2), Vector3(0.5, 10.5, 4), 0.0},
+      {Vector3(0, 5.25, 2), Vector3(15, 0.5, 4), 0.0},        {Vector3(0, -5.25, 2), Vector3(15, 0.5, 4), 0.0},
+      {Vector3(0, 0, 4.25), Vector3(15, 11, 0.5), 0.0},  // the ceiling
+      {Vector3(5.5, -3.8, 0.5), Vector3(1.2, 1.2, 1.0), 0.4}, {Vector3(-5.6, 3.6, 0.75), Vector3(1.0, 1.6, 1.5), 0.0},
+      {Vector3(-2.0, -4.3, 1.0), Vector3(2.0, 0.8, 2.0), 0.0}};
+  w.cylinders = {{Eigen::Vector2d(5.5, 3.5), 0.25, 4.0}, {Eigen::Vector2d(-5.5, -3.5), 0.25, 4.0}};
+  return w;
+}
+
 namespace {
 
 struct Cell {
@@ -83,20 +97,6 @@ const FtcMethod& FtcMethodNamed(const std::string& name) {
 }
 
 /// A trial's scenario: the phase's mission, the drawn fault, gust and noise seed, the method's stack.
-sim::World FtcHall() {
-  sim::World w;
-  // Interior x in [-7, 7], y in [-5, 5], z in [0, 4]: the lemniscate (6 x 3 m about the origin)
-  // keeps 2 m from every wall and pillar.
-  w.boxes = {
-      {Vector3(7.25, 0, 2), Vector3(0.5, 10.5, 4), 0.0},      {Vector3(-7.25, 0, 2), Vector3(0.5, 10.5, 4), 0.0},
-      {Vector3(0, 5.25, 2), Vector3(15, 0.5, 4), 0.0},        {Vector3(0, -5.25, 2), Vector3(15, 0.5, 4), 0.0},
-      {Vector3(0, 0, 4.25), Vector3(15, 11, 0.5), 0.0},  // the ceiling
-      {Vector3(5.5, -3.8, 0.5), Vector3(1.2, 1.2, 1.0), 0.4}, {Vector3(-5.6, 3.6, 0.75), Vector3(1.0, 1.6, 1.5), 0.0},
-      {Vector3(-2.0, -4.3, 1.0), Vector3(2.0, 0.8, 2.0), 0.0}};
-  w.cylinders = {{Eigen::Vector2d(5.5, 3.5), 0.25, 4.0}, {Eigen::Vector2d(-5.5, -3.5), 0.25, 4.0}};
-  return w;
-}
-
 harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const FtcBenchOptions& o, std::uint64_t trial_seed) {
   Rng rng(trial_seed);
   const int rotor = std::min(o.vehicle.num_rotors() - 1, static_cast<int>(rng.Uniform() * o.vehicle.num_rotors()));

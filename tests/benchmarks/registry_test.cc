@@ -231,25 +231,65 @@ TEST_F(BenchCampaigns, ASpecsTruthIsTheSameCampaignAsTheFlag) {
 }
 
 TEST_F(BenchCampaigns, ANavSpecsEstimatorIsTheSameCampaignAsTheFlagAndOverridesTheBase) {
-  // The base (the forest) flies on its LiDAR-inertial odometry; the benchmark flies the external
-  // odometry unless told otherwise, and `estimator: lio` is `bench nav --estimator lio`.
+  // The benchmark flies the stack's LiDAR-inertial odometry unless told otherwise, whatever the
+  // base says, and `estimator: odometry` is `bench nav --estimator odometry`.
   const std::string spec =
       "name: n\nbench: nav\ntrials: 1\nkinds: [room]\nbase: " + kConfigs + "/scenarios/forest.yaml\n";
   NavBenchOptions o;
   o.trials = 1;
   o.kinds = {"room"};
   o.base = harness::LoadScenario(kConfigs + "/scenarios/forest.yaml");
-  ASSERT_EQ(o.base.stack.estimator.kind, stack::EstimatorKind::kLio);
-  const campaign::Campaign odometry = campaign::LoadCampaign(Write("n.yaml", spec), CampaignKinds());
-  EXPECT_EQ(odometry.bench["options"]["estimator"], "odometry");
-  EXPECT_EQ(odometry.hash, NavCampaign(o).hash);
-  o.estimator = stack::EstimatorKind::kLio;
-  const campaign::Campaign lio = campaign::LoadCampaign(Write("l.yaml", spec + "estimator: lio\n"), CampaignKinds());
+  ASSERT_EQ(o.estimator, stack::EstimatorKind::kLio);
+  const campaign::Campaign lio = campaign::LoadCampaign(Write("n.yaml", spec), CampaignKinds());
   EXPECT_EQ(lio.bench["options"]["estimator"], "lio");
   EXPECT_EQ(lio.hash, NavCampaign(o).hash);
+  o.estimator = stack::EstimatorKind::kOdometry;
+  o.base.stack.estimator.kind = stack::EstimatorKind::kLio;  // overridden by the benchmark's
+  const campaign::Campaign odometry =
+      campaign::LoadCampaign(Write("l.yaml", spec + "estimator: odometry\n"), CampaignKinds());
+  EXPECT_EQ(odometry.bench["options"]["estimator"], "odometry");
+  EXPECT_EQ(odometry.hash, NavCampaign(o).hash);
   EXPECT_NE(lio.hash, odometry.hash);
   RG_EXPECT_THROW_WITH(campaign::LoadCampaign(Write("m.yaml", spec + "estimator: gps\n"), CampaignKinds()),
                        io::ConfigError, "expected one of: odometry, lio");
+}
+
+// bench ftc flies the external odometry in open space unless told otherwise (its hash then is
+// the one it had before the key existed); `estimator: lio` flies each trial in the hall with the
+// LiDAR on and the stack on its own odometry, the trial's draws unchanged.
+TEST_F(BenchCampaigns, AnFtcSpecsEstimatorFliesTheSameDrawsInTheHallOnTheLio) {
+  const std::string vehicle = kConfigs + "/vehicles/zhou2025_quad.yaml";
+  const std::string spec = "name: f\nbench: ftc\ntrials: 1\nmethods: [rotorguard]\nvehicle: " + vehicle + "\n";
+  FtcBenchOptions o;
+  o.trials = 1;
+  o.methods = {"rotorguard"};
+  o.vehicle = harness::LoadVehicle(vehicle);
+  const campaign::Campaign odometry = campaign::LoadCampaign(Write("f.yaml", spec), CampaignKinds());
+  EXPECT_FALSE(odometry.bench["options"].contains("estimator"));
+  const campaign::Campaign lio = campaign::LoadCampaign(Write("g.yaml", spec + "estimator: lio\n"), CampaignKinds());
+  EXPECT_EQ(lio.bench["options"]["estimator"], "lio");
+  EXPECT_NE(lio.hash, odometry.hash);
+  o.estimator = stack::EstimatorKind::kLio;
+  const harness::Scenario on_lio = MakeFtcTrial("hover/propeller_loss", "rotorguard", o, 7);
+  o.estimator = stack::EstimatorKind::kOdometry;
+  const harness::Scenario on_odometry = MakeFtcTrial("hover/propeller_loss", "rotorguard", o, 7);
+  EXPECT_EQ(on_lio.stack.estimator.kind, stack::EstimatorKind::kLio);
+  EXPECT_TRUE(on_lio.sim.lidar.enabled);
+  EXPECT_FALSE(on_lio.world.boxes.empty());
+  EXPECT_FALSE(on_odometry.sim.lidar.enabled);
+  EXPECT_TRUE(on_odometry.world.boxes.empty());
+  ASSERT_EQ(on_lio.faults.size(), 1u);
+  EXPECT_EQ(on_lio.faults[0].rotor, on_odometry.faults[0].rotor);
+  EXPECT_EQ(on_lio.faults[0].onset.value, on_odometry.faults[0].onset.value);
+  // The LIO's mounts are the vehicle's sensors' (the stack fitted to the hardware).
+  EXPECT_EQ(on_lio.stack.estimator.lio.lidar_position_m, on_lio.sim.lidar.position_m);
+  // The hall holds every phase's flight: the start and the lemniscate's extent stay inside it.
+  for (const sim::Box& b : FtcHall().boxes) {
+    const Vector3 half = 0.5 * b.size_m;
+    for (const Vector3& p : {Vector3(0, 0, 2), Vector3(3, 1.5, 1.5), Vector3(-3, -1.5, 1.5), Vector3(0, 0, 0.1)}) {
+      EXPECT_FALSE(((p - b.center_m).cwiseAbs() - half).maxCoeff() < 1.0) << "a box within 1 m of " << p.transpose();
+    }
+  }
 }
 
 TEST_F(BenchCampaigns, BadBenchmarkSpecsNameTheKey) {
