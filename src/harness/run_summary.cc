@@ -108,8 +108,8 @@ void AddStackJson(const RunSummary& r, nlohmann::json* j) {
                         {"iterations_mean", o.iterations_mean},
                         {"frame_ms_mean", o.frame_ms_mean},
                         {"frame_ms_p99", o.frame_ms_p99},
-                        {"map_points", o.map_points}};
-    if (r.lio_degenerate_std_m) (*j)["odometry"]["degenerate_std_m"] = *r.lio_degenerate_std_m;
+                        {"map_points", o.map_points},
+                        {"degenerate_std_m", o.degenerate_std_m}};
   }
   nlohmann::json transitions = nlohmann::json::array();
   for (const stack::ModeTransition& m : s.transitions) {

@@ -107,7 +107,6 @@ class ClosedLoop {
     // The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
     s.sensors = {sc_.sim.imu.rate_hz, stack_.options().estimator.imu_position_m};
     if (sc_.stack.fdd == stack::FddKind::kComposite) s.composite_fdd = sc_.stack.composite_fdd;
-    if (const stack::LioEstimator* lio = stack_.lio()) s.lio_degenerate_std_m = lio->lio().options().degenerate_std_m;
     if (const fdd::FaultDetector* detector = stack_.fault_detector()) {
       s.fdd = ScoreFdd(detector->rotors(), sim_.fault_events());
       AddReconfigurationLatency(s.stack.reconfigurations, sim_.fault_events(), &*s.fdd);

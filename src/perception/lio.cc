@@ -355,7 +355,8 @@ void Lio::FindPlanes(const std::vector<Vector3>& points_I, const LioState& x) {
     // The fitted normal's noise: its tilt toward in-plane direction j has variance σ² / λ_j, σ²
     // the points' scatter off the plane, λ₀ / (k − 3) (the fit's own estimate: two of a plane's
     // three degrees are the normal's), times 1.3: with five points, E[1 / λ_j] exceeds 1 / E[λ_j]
-    // and the estimate falls 20-25 % short on average (simulated, 2 cm noise on 0.7 m patches).
+    // and the estimate falls short on average (21 % in a simulation of 20 000 patches of five
+    // points, 0.7 m across with 2 cm of noise: 0.0061 against a mean n_z² of 0.0077).
     // A wall's normal tilts up and down by it, which reads as information on the height that
     // the wall does not give (the health removes it).
     const double noise = 1.3 * eig.eigenvalues()(0) / std::max(k - 3.0, 1.0);

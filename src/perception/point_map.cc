@@ -85,13 +85,12 @@ std::uint32_t CellIndex::FindOrAdd(CellKey key, std::uint32_t next, bool* added)
 }
 
 void CellIndex::Grow() {
-  std::vector<Slot> old;
+  // Twice the slots, the keys re-probed into them.
+  std::vector<Slot> old(2 * std::max<std::size_t>(slots_.size(), 512));
   old.swap(slots_);
-  Clear(std::max<std::size_t>(size_ + 1, old.size()));
   for (const Slot& s : old) {
     if (s.key != kEmpty) slots_[Probe(s.key)] = s;
   }
-  for (const Slot& s : old) size_ += s.key != kEmpty;
 }
 
 std::uint32_t PointMap::FindOrAdd(Key key) {

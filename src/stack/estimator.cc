@@ -153,6 +153,7 @@ LioSummary LioEstimator::Summarize() const {
     s.frame_ms_p99 = Percentile(frame_ms_, 0.99);
   }
   s.map_points = lio_.map().size();
+  s.degenerate_std_m = lio_.options().degenerate_std_m;
   return s;
 }
 

@@ -5,7 +5,7 @@
 import { statSync } from "node:fs";
 import { resolve } from "node:path";
 import { pathToFileURL } from "node:url";
-import { chromium } from "playwright-core";
+import { launchBrowser } from "../test/browser.mjs";
 
 const [reportPath, runsText = "7"] = process.argv.slice(2);
 const runs = Number.parseInt(runsText, 10);
@@ -13,10 +13,7 @@ if (!reportPath || !(runs >= 1)) {
   console.error("usage: node bench/report_open.mjs REPORT.html [RUNS >= 1]");
   process.exit(2);
 }
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
-  args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"],
-});
+const browser = await launchBrowser();
 const times = [];
 try {
   for (let k = 0; k < runs; k += 1) {

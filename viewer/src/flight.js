@@ -126,7 +126,7 @@ function replaySection(app, data, clock) {
     }
     if (s.nmpc_ms) rows += `<tr><td>NMPC solve</td><td class="num">${fmt(s.nmpc_ms[i], 2)} ms</td></tr>`;
     if (s.lio_matched) {
-      const estErr = Math.hypot(s.est_p_x[i] - s.p_x[i], s.est_p_y[i] - s.p_y[i], s.est_p_z[i] - s.p_z[i]);
+      const estErr = estimateError(s, i);
       const state = s.lio_used[i] ? (s.lio_degenerate[i] ? " · degenerate" : "") : " · not used";
       rows += `<tr><td>estimate error</td><td class="num">${fmt(estErr)} m</td></tr>`;
       rows += `<tr><td>LIO frame</td><td class="num">${fmt(s.lio_matched[i], 0)} matched${state}</td></tr>`;
@@ -269,6 +269,11 @@ function plotsSection(app, data, clock) {
   if (s.lio_matched && s.est_p_x) localisationSection(app, data, clock, markers);
 }
 
+/** |p_est − p| at row i of the series [m]: the stack's position estimate against the truth. */
+function estimateError(s, i) {
+  return Math.hypot(s.est_p_x[i] - s.p_x[i], s.est_p_y[i] - s.p_y[i], s.est_p_z[i] - s.p_z[i]);
+}
+
 /**
  * Angle [rad] of the rotation between two quaternions (w, x, y, z): 2 atan2(|v|, |w|) of
  * conj(a) b. Not 2 acos |a · b|: near 1 the arc cosine turns the 4-decimal rounding of the
@@ -317,7 +322,7 @@ function localisationSection(app, data, clock, markers) {
     title: "Estimate error: position |p_est − p|", x: t, yLabel: "m", markers,
     series: [{
       label: "position error",
-      values: t.map((_, i) => Math.hypot(s.est_p_x[i] - s.p_x[i], s.est_p_y[i] - s.p_y[i], s.est_p_z[i] - s.p_z[i])),
+      values: t.map((_, i) => estimateError(s, i)),
       color: "#d62728",
     }],
   }, clock);

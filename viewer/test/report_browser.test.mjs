@@ -3,9 +3,7 @@
 // slider moves the vehicle to where the log says it was, and the plots are present. Saves a
 // screenshot to SCREENSHOT.png. Given a benchmark's page too, checks its tables and histograms.
 //   node test/report_browser.test.mjs REPORT.html SCREENSHOT.png [BENCH.html]
-import { existsSync } from "node:fs";
-import { resolve } from "node:path";
-import { pathToFileURL } from "node:url";
+import { launchBrowser, openReport } from "./browser.mjs";
 import { check, finish } from "./check.mjs";
 
 const [reportPath, screenshotPath, benchPath] = process.argv.slice(2);
@@ -14,35 +12,10 @@ if (!reportPath || !screenshotPath) {
   process.exit(2);
 }
 
-let chromium;
+const browser = await launchBrowser();
 try {
-  ({ chromium } = await import("playwright-core"));
-} catch (e) {
-  console.error(`FAIL playwright-core is not installed (npm ci in viewer/): ${e.message}`);
-  process.exit(1);
-}
-const executablePath = process.env.CHROMIUM || "/usr/bin/chromium";
-if (!existsSync(executablePath)) {
-  console.error(`FAIL no Chromium at ${executablePath}: install Debian's chromium (scripts/install-deps.sh) or set CHROMIUM`);
-  process.exit(1);
-}
-
-const browser = await chromium.launch({
-  executablePath,
-  headless: true,
-  // Software WebGL: CI machines have no GPU.
-  args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"],
-});
-try {
-  const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
-  const errors = [];
-  page.on("console", (m) => {
-    if (m.type() === "error") errors.push(m.text());
-  });
-  page.on("pageerror", (e) => errors.push(String(e)));
   const started = Date.now();
-  await page.goto(pathToFileURL(resolve(reportPath)).href);
-  await page.waitForFunction(() => window.rotorguardReport && window.rotorguardReport.ready === true, null, { timeout: 30000 });
+  const { page, errors } = await openReport(browser, reportPath);
   console.log(`info page ready in ${Date.now() - started} ms`);
 
   // The 3D view: a WebGL canvas whose pixels are not all one colour.
@@ -105,14 +78,7 @@ try {
   console.log(`info screenshot ${screenshotPath}`);
   check(errors.length === 0, `no console errors${errors.length ? ": " + errors.join(" | ") : ""}`);
   if (benchPath) {
-    const bench = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
-    const benchErrors = [];
-    bench.on("console", (m) => {
-      if (m.type() === "error") benchErrors.push(m.text());
-    });
-    bench.on("pageerror", (e) => benchErrors.push(String(e)));
-    await bench.goto(pathToFileURL(resolve(benchPath)).href);
-    await bench.waitForFunction(() => window.rotorguardReport && window.rotorguardReport.ready === true, null, { timeout: 30000 });
+    const { page: bench, errors: benchErrors } = await openReport(browser, benchPath);
     const tables = await bench.locator("table.data").count();
     const histograms = await bench.evaluate(() => Array.from(document.querySelectorAll(".uplot canvas")).filter((c) => c.width > 100).length);
     check(tables >= 2, `the benchmark page has its tables (${tables})`);

@@ -3,9 +3,7 @@
 // and the degeneracy threshold taken from its summary; a flight on another estimator (its log has
 // no lio_* columns) has neither the section nor its header cards.
 //   node test/report_lio.test.mjs LIO_REPORT.html OTHER_REPORT.html
-import { existsSync } from "node:fs";
-import { resolve } from "node:path";
-import { pathToFileURL } from "node:url";
+import { launchBrowser, openReport } from "./browser.mjs";
 import { check, finish } from "./check.mjs";
 
 const [lioPath, otherPath] = process.argv.slice(2);
@@ -14,31 +12,11 @@ if (!lioPath || !otherPath) {
   process.exit(2);
 }
 
-let chromium;
-try {
-  ({ chromium } = await import("playwright-core"));
-} catch (e) {
-  console.error(`FAIL playwright-core is not installed (npm ci in viewer/): ${e.message}`);
-  process.exit(1);
-}
-const executablePath = process.env.CHROMIUM || "/usr/bin/chromium";
-if (!existsSync(executablePath)) {
-  console.error(`FAIL no Chromium at ${executablePath}: install Debian's chromium (scripts/install-deps.sh) or set CHROMIUM`);
-  process.exit(1);
-}
-
 const HEADING = "Localisation (LiDAR-inertial odometry)";
 
 /** Opens a report and returns what the checks need: its headings, cards, the section's plots, the data. */
 async function open(browser, path) {
-  const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
-  const errors = [];
-  page.on("console", (m) => {
-    if (m.type() === "error") errors.push(m.text());
-  });
-  page.on("pageerror", (e) => errors.push(String(e)));
-  await page.goto(pathToFileURL(resolve(path)).href);
-  await page.waitForFunction(() => window.rotorguardReport && window.rotorguardReport.ready === true, null, { timeout: 30000 });
+  const { page, errors } = await openReport(browser, path);
   const seen = await page.evaluate((heading) => {
     const data = JSON.parse(document.getElementById("rotorguard-data").textContent);
     const cards = Array.from(document.querySelectorAll(".card .k")).map((k) => k.textContent);
@@ -67,11 +45,7 @@ async function open(browser, path) {
   return { ...seen, errors };
 }
 
-const browser = await chromium.launch({
-  executablePath,
-  headless: true,
-  args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"],
-});
+const browser = await launchBrowser();
 try {
   const lio = await open(browser, lioPath);
   check(lio.columns.length === 5, `the LIO flight's data has the lio_* columns (${lio.columns.join(", ")})`);

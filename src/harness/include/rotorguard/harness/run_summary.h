@@ -114,10 +114,6 @@ struct RunSummary {
   /// The composite FDD's thresholds when the stack ran it (summary.json "composite_fdd", its keys
   /// those of stack.composite_fdd: io::ToJson).
   std::optional<fdd::CompositeFddOptions> composite_fdd;
-  /// The LiDAR-inertial odometry's degeneracy threshold (stack.estimator.lio.degenerate_std_m)
-  /// when it is the estimator (summary.json odometry.degenerate_std_m): what its frames' weakest
-  /// direction is judged against, for whoever reads the log's lio_weakest_std_m.
-  std::optional<double> lio_degenerate_std_m;
   SensorsRecord sensors;
 
   /// The stack's own account (FlightStack::Summarize), written at summary.json's top level:

@@ -126,6 +126,9 @@ struct LioSummary {
   /// at every sample, is not in it).
   double frame_ms_mean = 0.0, frame_ms_p99 = 0.0;
   long map_points = 0;  ///< at the end
+  /// The threshold the frames were judged degenerate by (LioOptions::degenerate_std_m), for
+  /// whoever reads their weakest-direction stds (the log's lio_weakest_std_m).
+  double degenerate_std_m = 0.0;
 };
 
 /// The stack's own LiDAR-inertial odometry (perception::Lio) from its IMU and LiDAR frames; an
