@@ -23,9 +23,20 @@ void PointMapOptions::Validate() const {
 PointMap::PointMap(const PointMapOptions& options) : options_(options) {
   options_.Validate();
   inverse_voxel_ = 1.0 / options_.voxel_m;
+  capacity_ = static_cast<std::size_t>(options_.max_points_per_voxel);
 }
 
 Eigen::Vector3i PointMap::Cell(const Vector3& p) const { return (p * inverse_voxel_).array().floor().cast<int>(); }
+
+Eigen::Vector3i PointMap::BlockOf(const Eigen::Vector3i& cell) {
+  // An arithmetic shift: floor division, negative cells included.
+  return Eigen::Vector3i(cell.x() >> kBlockShift, cell.y() >> kBlockShift, cell.z() >> kBlockShift);
+}
+
+int PointMap::EntryIndex(const Eigen::Vector3i& cell) {
+  constexpr int m = kBlockEdge - 1;
+  return ((cell.x() & m) * kBlockEdge + (cell.y() & m)) * kBlockEdge + (cell.z() & m);
+}
 
 namespace {
 // 21 bits per axis (±2^20 voxels: ±52 km at 5 cm), offset to be non-negative (KeyOfCell).
@@ -42,15 +53,15 @@ std::size_t Home(std::uint64_t key, std::size_t mask) {
 }
 }  // namespace
 
-CellKey KeyOfCell(const Eigen::Vector3i& c) {
-  return (static_cast<CellKey>((c.x() + kOffset) & kMask) << 42) |
-         (static_cast<CellKey>((c.y() + kOffset) & kMask) << 21) | static_cast<CellKey>((c.z() + kOffset) & kMask);
-}
-
-Eigen::Vector3i PointMap::CellOf(Key key) {
+Eigen::Vector3i PointMap::BlockOfKey(CellKey key) {
   return Eigen::Vector3i(static_cast<int>(static_cast<std::int64_t>(key >> 42) - kOffset),
                          static_cast<int>(static_cast<std::int64_t>((key >> 21) & kMask) - kOffset),
                          static_cast<int>(static_cast<std::int64_t>(key & kMask) - kOffset));
+}
+
+CellKey KeyOfCell(const Eigen::Vector3i& c) {
+  return (static_cast<CellKey>((c.x() + kOffset) & kMask) << 42) |
+         (static_cast<CellKey>((c.y() + kOffset) & kMask) << 21) | static_cast<CellKey>((c.z() + kOffset) & kMask);
 }
 
 void CellIndex::Clear(std::size_t expected) {
@@ -93,14 +104,15 @@ void CellIndex::Grow() {
   }
 }
 
-std::uint32_t PointMap::FindOrAdd(Key key) {
+PointMap::Entry& PointMap::EntryOf(const Eigen::Vector3i& cell) {
+  const Eigen::Vector3i b = BlockOf(cell);
   bool added = false;
-  const std::uint32_t v = index_.FindOrAdd(key, static_cast<std::uint32_t>(voxels_.size()), &added);
+  const std::uint32_t i = block_index_.FindOrAdd(KeyOfCell(b), static_cast<std::uint32_t>(blocks_.size()), &added);
   if (added) {
-    voxels_.emplace_back();
-    voxels_.back().key = key;
+    blocks_.emplace_back();
+    blocks_.back().key = KeyOfCell(b);
   }
-  return v;
+  return blocks_[i].entry[static_cast<std::size_t>(EntryIndex(cell))];
 }
 
 int PointMap::Insert(const std::vector<Vector3>& points_W) {
@@ -110,14 +122,31 @@ int PointMap::Insert(const std::vector<Vector3>& points_W) {
   const double limit = 0.99 * std::ldexp(options_.voxel_m, 20);
   for (const Vector3& p : points_W) {
     if (!p.allFinite() || p.cwiseAbs().maxCoeff() > limit) continue;
-    const Key key = KeyOfCell(Cell(p));
-    Voxel& v = voxels_[FindOrAdd(key)];
-    if (v.count >= options_.max_points_per_voxel) continue;
+    Entry& e = EntryOf(Cell(p));
+    const Entry count = e & kCountMask;
+    if (count >= capacity_) continue;
     const Eigen::Vector3f pf = p.cast<float>();
-    bool near = false;
-    for (int i = 0; i < v.count && !near; ++i) near = (v.points[i] - pf).squaredNorm() < spacing2;
-    if (near) continue;
-    v.points[v.count++] = pf;
+    if (count == 0) {
+      // A new voxel: a freed one's slots, or new ones.
+      std::uint32_t v;
+      if (!free_voxels_.empty()) {
+        v = free_voxels_.back();
+        free_voxels_.pop_back();
+      } else {
+        v = static_cast<std::uint32_t>(points_W_.size() / capacity_);
+        if (v >= (Entry{1} << (32 - kCountBits))) continue;  // 2^26 voxels: the window keeps far below
+        points_W_.resize(points_W_.size() + capacity_);
+      }
+      e = v << kCountBits;
+      ++voxels_;
+    } else {
+      const Eigen::Vector3f* held = &points_W_[First(e)];
+      bool near = false;
+      for (Entry i = 0; i < count && !near; ++i) near = (held[i] - pf).squaredNorm() < spacing2;
+      if (near) continue;
+    }
+    points_W_[First(e) + count] = pf;
+    ++e;
     ++stored;
   }
   points_ += stored;
@@ -126,23 +155,31 @@ int PointMap::Insert(const std::vector<Vector3>& points_W) {
 
 int PointMap::Prune(const Vector3& center_W) {
   const double r2 = options_.window_radius_m * options_.window_radius_m;
+  const double block_m = kBlockEdge * options_.voxel_m;
   int removed = 0;
   std::size_t kept = 0;
-  for (std::size_t i = 0; i < voxels_.size(); ++i) {
-    const Vector3 centre = (CellOf(voxels_[i].key).cast<double>().array() + 0.5).matrix() * options_.voxel_m;
+  for (std::size_t i = 0; i < blocks_.size(); ++i) {
+    Block& block = blocks_[i];
+    const Eigen::Vector3i b = BlockOfKey(block.key);
+    const Vector3 centre = (b.cast<double>().array() + 0.5).matrix() * block_m;
     if ((centre - center_W).squaredNorm() > r2) {
-      removed += voxels_[i].count;
+      for (const Entry e : block.entry) {
+        if ((e & kCountMask) == 0) continue;
+        removed += static_cast<int>(e & kCountMask);
+        free_voxels_.push_back(e >> kCountBits);
+        --voxels_;
+      }
       continue;
     }
-    if (kept != i) voxels_[kept] = voxels_[i];
+    if (kept != i) blocks_[kept] = block;
     ++kept;
   }
-  if (kept == voxels_.size()) return 0;
-  voxels_.resize(kept);
-  // The index again, for the voxels that stay.
-  index_.Clear(kept);
+  if (kept == blocks_.size()) return 0;
+  blocks_.resize(kept);
+  // The index again, for the blocks that stay.
+  block_index_.Clear(kept);
   bool added = false;
-  for (std::size_t v = 0; v < kept; ++v) index_.FindOrAdd(voxels_[v].key, static_cast<std::uint32_t>(v), &added);
+  for (std::size_t i = 0; i < kept; ++i) block_index_.FindOrAdd(blocks_[i].key, static_cast<std::uint32_t>(i), &added);
   points_ -= removed;
   return removed;
 }
@@ -151,45 +188,75 @@ int PointMap::Nearest(const Vector3& query, int k, double radius_m, std::vector<
                       std::vector<double>* squared_distances) const {
   out->clear();
   if (squared_distances) squared_distances->clear();
-  if (k <= 0 || !query.allFinite()) return 0;
+  if (k <= 0 || !query.allFinite() || blocks_.empty()) return 0;
   const double r = std::min(radius_m, options_.voxel_m);
   const float r2 = static_cast<float>(r * r);
+  const Eigen::Vector3i c = Cell(query);
+  // A neighbour voxel is visited only when it comes within r of the query: per axis the distance
+  // to the lower and the upper face of the query's voxel.
+  const Vector3 low = query - c.cast<double>() * options_.voxel_m;  // in [0, voxel_m)
+  const Vector3 high = Vector3::Constant(options_.voxel_m) - low;
+  // The 3 x 3 x 3 cells span at most 2 blocks per axis; each is looked up once, when first needed.
+  const Eigen::Vector3i first_block = BlockOf(c - Eigen::Vector3i::Ones());
+  const Block* const kUnseen = &blocks_.front();  // a marker only: compared, never read
+  std::array<const Block*, 8> block_of;
+  block_of.fill(kUnseen);
   // The k best so far, sorted by distance (k is small: a plane needs five).
   std::array<std::pair<float, Eigen::Vector3f>, 16> best;
   const int kk = std::min(k, static_cast<int>(best.size()));
   int n = 0;
   const Eigen::Vector3f qf = query.cast<float>();
-  const Eigen::Vector3i c = Cell(query);
-  // A neighbour voxel is visited only when it comes within r of the query: per axis the distance
-  // to the lower and the upper face of the query's voxel. With r at most half the edge, 8 of the
-  // 27 on average (2 per axis).
-  const Vector3 low = query - c.cast<double>() * options_.voxel_m;  // in [0, voxel_m)
-  const Vector3 high = Vector3::Constant(options_.voxel_m) - low;
-  for (int dx = -1; dx <= 1; ++dx) {
-    const double ex = dx < 0 ? low.x() : dx > 0 ? high.x() : 0.0;
-    if (ex > r) continue;
-    for (int dy = -1; dy <= 1; ++dy) {
-      const double ey = dy < 0 ? low.y() : dy > 0 ? high.y() : 0.0;
-      if (ex * ex + ey * ey > r * r) continue;
-      for (int dz = -1; dz <= 1; ++dz) {
-        const double ez = dz < 0 ? low.z() : dz > 0 ? high.z() : 0.0;
-        if (ex * ex + ey * ey + ez * ez > r * r) continue;
-        const std::int64_t found = index_.Find(KeyOfCell(c + Eigen::Vector3i(dx, dy, dz)));
-        if (found < 0) continue;
-        const Voxel& v = voxels_[static_cast<std::size_t>(found)];
-        for (int i = 0; i < v.count; ++i) {
-          const float d2 = (v.points[i] - qf).squaredNorm();
-          if (d2 > r2 || (n == kk && d2 >= best[n - 1].first)) continue;
-          int j = n < kk ? n++ : n - 1;  // insertion sort into the k best
-          while (j > 0 && best[j - 1].first > d2) {
-            best[j] = best[j - 1];
-            --j;
+  // Visits the voxels whose nearest point lies in (inner, outer] of the query: first the entries,
+  // their points prefetched, then the points, so that the voxels' loads overlap rather than wait
+  // on each other.
+  const auto visit_shell = [&](double inner, double outer) {
+    std::array<Entry, 27> visit;
+    int visits = 0;
+    const double inner2 = inner < 0.0 ? -1.0 : inner * inner, outer2 = outer * outer;
+    for (int dx = -1; dx <= 1; ++dx) {
+      const double ex = dx < 0 ? low.x() : dx > 0 ? high.x() : 0.0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        const double ey = dy < 0 ? low.y() : dy > 0 ? high.y() : 0.0;
+        for (int dz = -1; dz <= 1; ++dz) {
+          const double ez = dz < 0 ? low.z() : dz > 0 ? high.z() : 0.0;
+          const double e2 = ex * ex + ey * ey + ez * ez;
+          if (e2 <= inner2 || e2 > outer2) continue;
+          const Eigen::Vector3i cell = c + Eigen::Vector3i(dx, dy, dz);
+          const Eigen::Vector3i o = BlockOf(cell) - first_block;  // 0 or 1 on each axis
+          const Block*& block = block_of[static_cast<std::size_t>((o.x() * 2 + o.y()) * 2 + o.z())];
+          if (block == kUnseen) {
+            const std::int64_t found = block_index_.Find(KeyOfCell(BlockOf(cell)));
+            block = found < 0 ? nullptr : &blocks_[static_cast<std::size_t>(found)];
           }
-          best[j] = {d2, v.points[i]};
+          if (block == nullptr) continue;
+          const Entry e = block->entry[static_cast<std::size_t>(EntryIndex(cell))];
+          if ((e & kCountMask) == 0) continue;
+          visit[static_cast<std::size_t>(visits++)] = e;
+          __builtin_prefetch(&points_W_[First(e)]);
         }
       }
     }
-  }
+    for (int m = 0; m < visits; ++m) {
+      const Entry e = visit[static_cast<std::size_t>(m)];
+      const Eigen::Vector3f* points = &points_W_[First(e)];
+      for (Entry i = 0; i < (e & kCountMask); ++i) {
+        const float d2 = (points[i] - qf).squaredNorm();
+        if (d2 > r2 || (n == kk && d2 >= best[n - 1].first)) continue;
+        int j = n < kk ? n++ : n - 1;  // insertion sort into the k best
+        while (j > 0 && best[j - 1].first > d2) {
+          best[j] = best[j - 1];
+          --j;
+        }
+        best[j] = {d2, points[i]};
+      }
+    }
+  };
+  // Within half the radius first (about a third of the cells the whole radius meets): when the
+  // k found there lie within it, every point of the cells not visited is farther (each of those
+  // cells is), and the answer is exact already. Otherwise the rest of the radius.
+  const double inner = 0.5 * r;
+  visit_shell(-1.0, inner);
+  if (n < kk || best[n - 1].first > static_cast<float>(inner * inner)) visit_shell(inner, r);
   for (int i = 0; i < n; ++i) {
     out->push_back(best[i].second.cast<double>());
     if (squared_distances) squared_distances->push_back(best[i].first);

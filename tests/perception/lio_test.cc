@@ -175,14 +175,17 @@ Errors Fly(const Flight& flight, double duration_s, const Vector3& gyro_bias, co
 }
 
 // With an exact IMU the odometry follows an 11 rad/s spin with coning through the room within a
-// centimetre: the backward propagation deskews the frames (63° of turn each) and the iterated
+// centimetre and a half: the backward propagation deskews the frames (63° of turn each) and the iterated
 // update registers them. The first frame builds the map; every later one is used.
 TEST(Lio, FollowsAFlightSpinningAt11RadPerSecondFromAnExactImu) {
   const Errors e = Fly(SpinningFlight(11.0), 6.0, Vector3::Zero(), Vector3::Zero(), 0.0, 0.0);
   EXPECT_EQ(e.frames, 60);
   EXPECT_EQ(e.used, e.frames - 1);
   EXPECT_EQ(e.degenerate, 0);
-  EXPECT_LT(e.position_rms, 0.01);
+  // 11 mm here with the map's 0.5 m voxels (8 mm with 1 m ones, whose capped points spread
+  // farther apart on a wall and fit its plane's normal better; among the forest's trunks the
+  // tighter neighbourhoods halve the error, which is why the map has them).
+  EXPECT_LT(e.position_rms, 0.015);
   EXPECT_LT(e.position_max, 0.03);
   EXPECT_LT(e.attitude_max, 0.5 * std::numbers::pi / 180.0);
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "rotorguard/core/error.h"
@@ -76,9 +77,10 @@ TEST(PointMap, RefusesPointsTooCloseToStoredOnesAndBeyondAVoxelsCapacity) {
   EXPECT_EQ(fresh.size(), first);
 }
 
-// Pruning deletes exactly the voxels whose centre lies beyond the window, and the search still
-// finds what remains (the swap-remove keeps the index consistent).
-TEST(PointMap, PruningKeepsTheVoxelsWithinTheWindowAndTheirNeighbours) {
+// Pruning deletes exactly the blocks (4 voxels a side: 2 m here) whose centre lies beyond the
+// window, and the search still finds what remains; points inserted after a pruning reuse the
+// freed voxels and are found as well.
+TEST(PointMap, PruningKeepsTheBlocksWithinTheWindowAndTheirPoints) {
   PointMapOptions o;
   o.voxel_m = 0.5;
   o.min_point_spacing_m = 0.0;
@@ -86,16 +88,32 @@ TEST(PointMap, PruningKeepsTheVoxelsWithinTheWindowAndTheirNeighbours) {
   PointMap map(o);
   std::vector<Vector3> line;
   for (int i = -40; i < 40; ++i) line.emplace_back(0.25 + 0.5 * i, 0.25, 0.25);  // one point per voxel centre
-  map.Insert(line);
+  EXPECT_EQ(map.Insert(line), 80);
+  EXPECT_EQ(map.voxels(), 80);
   const Vector3 centre(1.0, 0.0, 0.0);
+  // A point's block is [2 b, 2 b + 2) on each axis; its centre 2 b + 1 (b = 0 across y and z).
+  const auto block_centre = [](const Vector3& p) { return Vector3(2.0 * std::floor(p.x() / 2.0) + 1.0, 1.0, 1.0); };
+  const auto stays = [&](const Vector3& p) { return (block_centre(p) - centre).norm() <= 3.0; };
   int kept = 0;
-  for (const Vector3& p : line) kept += (p - centre).norm() <= 3.0;
+  for (const Vector3& p : line) kept += stays(p);
+  ASSERT_GT(kept, 0);
+  ASSERT_LT(kept, 80);
   EXPECT_EQ(map.Prune(centre), 80 - kept);
   EXPECT_EQ(map.size(), kept);
+  EXPECT_EQ(map.voxels(), kept);
+  EXPECT_EQ(map.Prune(centre), 0);  // nothing more to delete
   std::vector<Vector3> found;
-  for (const Vector3& p : line) {
-    EXPECT_EQ(map.Nearest(p, 1, 0.1, &found), (p - centre).norm() <= 3.0 ? 1 : 0) << p.transpose();
+  for (const Vector3& p : line) EXPECT_EQ(map.Nearest(p, 1, 0.1, &found), stays(p) ? 1 : 0) << p.transpose();
+  // The pruned voxels' storage serves new points, which are found where they were put.
+  std::vector<Vector3> other;
+  for (int i = 0; i < 20; ++i) other.emplace_back(0.25 + 0.5 * i, 5.25, 0.25);
+  EXPECT_EQ(map.Insert(other), 20);
+  EXPECT_EQ(map.voxels(), kept + 20);
+  for (const Vector3& p : other) {
+    ASSERT_EQ(map.Nearest(p, 1, 0.1, &found), 1);
+    EXPECT_LT((found[0] - p).norm(), 1e-6);
   }
+  for (const Vector3& p : line) EXPECT_EQ(map.Nearest(p, 1, 0.1, &found), stays(p) ? 1 : 0) << p.transpose();
 }
 
 TEST(PointMap, RejectsOptionsOutsideTheirRanges) {

@@ -4,10 +4,10 @@
 /// A point goes into the voxel that contains it; a voxel keeps at most max_points_per_voxel points,
 /// and a new point closer than min_point_spacing_m to one it already holds is not stored (the
 /// down-sampling happens on the map, as in FAST-LIO2, so a surface seen again and again does not
-/// grow it). Voxels farther than window_radius_m from the vehicle are deleted (Prune), so the map
-/// follows the vehicle like the occupancy map does. Nearest neighbours within a voxel edge of the
-/// query are exact: the query's voxel and its 26 neighbours hold all of them, and a search
-/// radius of half the edge visits 8 of them on average (those that come within the radius).
+/// grow it). Voxels are grouped in blocks of 4 x 4 x 4; blocks farther than window_radius_m from
+/// the vehicle are deleted (Prune), so the map follows the vehicle like the occupancy map does.
+/// Nearest neighbours within a voxel edge of the query are exact: the query's voxel and its 26
+/// neighbours hold all of them, and only those that come within the radius are read.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -18,14 +18,14 @@
 namespace rotorguard::perception {
 
 struct PointMapOptions {
-  double voxel_m = 1.0;  ///< hash voxel edge [m], in [0.05, 10]; the neighbour search's exact radius
+  double voxel_m = 0.5;  ///< hash voxel edge [m], in [0.05, 10]; the neighbour search's exact radius
   /// Points a voxel holds at most, in [1, kMaxPointsPerVoxel].
   int max_points_per_voxel = 20;
   static constexpr int kMaxPointsPerVoxel = 32;
   /// A point this close [m] to one its voxel holds is not stored, in [0, voxel_m).
   double min_point_spacing_m = 0.1;
-  /// Voxels whose centre is farther than this from the vehicle are deleted by Prune [m], in
-  /// [2 voxel_m, 1e4].
+  /// Blocks of 4 x 4 x 4 voxels whose centre is farther than this from the vehicle are deleted by
+  /// Prune [m], in [2 voxel_m, 1e4].
   double window_radius_m = 60.0;
   /// Throws ValidationError naming the field.
   void Validate() const;
@@ -37,7 +37,8 @@ struct PointMapOptions {
     a->Visit("min_point_spacing_m", &min_point_spacing_m,
              {.meaning = "a point this close to one its voxel holds is not stored [m], below voxel_m", .min = 0});
     a->Visit("window_radius_m", &window_radius_m,
-             {.meaning = "voxels farther than this from the vehicle are deleted [m], at least 2 voxel_m", .max = 1e4});
+             {.meaning = "blocks of 4^3 voxels farther than this from the vehicle are deleted [m], at least 2 voxel_m",
+              .max = 1e4});
   }
 };
 
@@ -81,7 +82,7 @@ class PointMap {
   /// Stores each point unless its voxel is full or holds one within min_point_spacing_m.
   /// Returns how many were stored. Non-finite points are skipped.
   int Insert(const std::vector<Vector3>& points_W);
-  /// Deletes the voxels whose centre is farther than window_radius_m from `center_W`. Returns
+  /// Deletes the blocks whose centre is farther than window_radius_m from `center_W`. Returns
   /// how many points went.
   int Prune(const Vector3& center_W);
 
@@ -92,26 +93,45 @@ class PointMap {
               std::vector<double>* squared_distances = nullptr) const;
 
   long size() const { return points_; }
-  long voxels() const { return static_cast<long>(voxels_.size()); }
+  long voxels() const { return voxels_; }
 
  private:
-  using Key = CellKey;
-  struct Voxel {
-    Key key = 0;
-    int count = 0;
-    std::array<Eigen::Vector3f, PointMapOptions::kMaxPointsPerVoxel> points;
+  /// Voxels are found through blocks of 4 x 4 x 4 cells: one hash lookup finds a block, whose
+  /// dense table gives each of its cells' voxel and point count. A query's neighbour cells share
+  /// one to a few blocks, and an empty cell (most of them around a thin trunk) costs a read of a
+  /// table already in cache, not a probe of a hash larger than the cache; a voxel's points are
+  /// read only when it holds some, and then they are all the bytes read.
+  static constexpr int kBlockShift = 2, kBlockEdge = 1 << kBlockShift;
+  /// A table entry: (voxel << kCountBits) | count; count 0: no voxel (a voxel is made for a point).
+  using Entry = std::uint32_t;
+  static constexpr int kCountBits = 6;  // counts up to kMaxPointsPerVoxel = 32
+  static constexpr Entry kCountMask = (Entry{1} << kCountBits) - 1;
+  static_assert(PointMapOptions::kMaxPointsPerVoxel <= kCountMask);
+  struct Block {
+    CellKey key = 0;
+    std::array<Entry, kBlockEdge * kBlockEdge * kBlockEdge> entry{};
   };
-  /// The voxel index of a coordinate on each axis, and the cell a key packs.
+  /// The voxel index of a coordinate on each axis.
   Eigen::Vector3i Cell(const Vector3& p) const;
-  static Eigen::Vector3i CellOf(Key key);
-
-  /// The voxel of `key`, created empty when new.
-  std::uint32_t FindOrAdd(Key key);
+  /// The block holding a cell, and the cell's entry in the block's table.
+  static Eigen::Vector3i BlockOf(const Eigen::Vector3i& cell);
+  static int EntryIndex(const Eigen::Vector3i& cell);
+  /// The cell a key packs (KeyOfCell's inverse): a block's, here.
+  static Eigen::Vector3i BlockOfKey(CellKey key);
+  /// The block of `cell`'s entry, created empty when new.
+  Entry& EntryOf(const Eigen::Vector3i& cell);
+  /// The first of a voxel's max_points_per_voxel points in points_W_.
+  std::size_t First(Entry e) const { return static_cast<std::size_t>(e >> kCountBits) * capacity_; }
 
   PointMapOptions options_;
   double inverse_voxel_ = 0.0;
-  CellIndex index_;  ///< key -> position in voxels_
-  std::vector<Voxel> voxels_;
+  std::size_t capacity_ = 0;  ///< max_points_per_voxel
+  CellIndex block_index_;     ///< block key -> position in blocks_
+  std::vector<Block> blocks_;
+  /// Each voxel's points, `capacity_` slots apiece; the slots of pruned voxels are reused.
+  std::vector<Eigen::Vector3f> points_W_;
+  std::vector<std::uint32_t> free_voxels_;
+  long voxels_ = 0;
   long points_ = 0;
 };
 
