@@ -28,6 +28,8 @@ PointMap::PointMap(const PointMapOptions& options) : options_(options) {
 
 Eigen::Vector3i PointMap::Cell(const Vector3& p) const { return (p * inverse_voxel_).array().floor().cast<int>(); }
 
+double PointMap::KeyRange() const { return 0.99 * std::ldexp(options_.voxel_m, 20); }
+
 Eigen::Vector3i PointMap::BlockOf(const Eigen::Vector3i& cell) {
   // An arithmetic shift: floor division, negative cells included.
   return Eigen::Vector3i(cell.x() >> kBlockShift, cell.y() >> kBlockShift, cell.z() >> kBlockShift);
@@ -119,7 +121,7 @@ int PointMap::Insert(const std::vector<Vector3>& points_W) {
   int stored = 0;
   const float spacing2 = static_cast<float>(options_.min_point_spacing_m * options_.min_point_spacing_m);
   // Coordinates beyond the key's range would alias; the window keeps a flight far inside it.
-  const double limit = 0.99 * std::ldexp(options_.voxel_m, 20);
+  const double limit = KeyRange();
   for (const Vector3& p : points_W) {
     if (!p.allFinite() || p.cwiseAbs().maxCoeff() > limit) continue;
     Entry& e = EntryOf(Cell(p));
@@ -188,7 +190,9 @@ int PointMap::Nearest(const Vector3& query, int k, double radius_m, std::vector<
                       std::vector<double>* squared_distances) const {
   out->clear();
   if (squared_distances) squared_distances->clear();
-  if (k <= 0 || !query.allFinite() || blocks_.empty()) return 0;
+  // A query beyond the keys' range (where Insert stores nothing) has no neighbours; its cell
+  // would not even fit an int.
+  if (k <= 0 || !query.allFinite() || blocks_.empty() || query.cwiseAbs().maxCoeff() > KeyRange()) return 0;
   const double r = std::min(radius_m, options_.voxel_m);
   const float r2 = static_cast<float>(r * r);
   const Eigen::Vector3i c = Cell(query);

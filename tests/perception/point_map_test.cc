@@ -116,6 +116,20 @@ TEST(PointMap, PruningKeepsTheBlocksWithinTheWindowAndTheirPoints) {
   for (const Vector3& p : line) EXPECT_EQ(map.Nearest(p, 1, 0.1, &found), stays(p) ? 1 : 0) << p.transpose();
 }
 
+// Points and queries beyond the keys' range (2^20 voxels: 524 km at 0.5 m) are refused and find
+// nothing, rather than aliasing onto a cell near the origin or overflowing an int.
+TEST(PointMap, IgnoresCoordinatesBeyondTheKeysRange) {
+  PointMap map(PointMapOptions{});
+  const Vector3 near(0.25, 0.25, 0.25);
+  ASSERT_EQ(map.Insert({near}), 1);
+  const double alias = std::ldexp(0.5, 21);  // one whole key period away: the same key, were it masked
+  EXPECT_EQ(map.Insert({near + Vector3(alias, 0.0, 0.0), Vector3(1e300, 0.0, 0.0)}), 0);
+  std::vector<Vector3> found;
+  EXPECT_EQ(map.Nearest(near + Vector3(alias, 0.0, 0.0), 1, 0.5, &found), 0);
+  EXPECT_EQ(map.Nearest(Vector3(-1e300, 0.0, 0.0), 1, 0.5, &found), 0);
+  EXPECT_EQ(map.Nearest(near, 1, 0.5, &found), 1);
+}
+
 TEST(PointMap, RejectsOptionsOutsideTheirRanges) {
   PointMapOptions o;
   o.min_point_spacing_m = o.voxel_m;  // not below the voxel edge

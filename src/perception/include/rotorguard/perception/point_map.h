@@ -113,12 +113,14 @@ class PointMap {
   };
   /// The voxel index of a coordinate on each axis.
   Eigen::Vector3i Cell(const Vector3& p) const;
+  /// The largest |coordinate| [m] a key holds (2^20 voxels, with a margin): beyond, none is stored.
+  double KeyRange() const;
   /// The block holding a cell, and the cell's entry in the block's table.
   static Eigen::Vector3i BlockOf(const Eigen::Vector3i& cell);
   static int EntryIndex(const Eigen::Vector3i& cell);
   /// The cell a key packs (KeyOfCell's inverse): a block's, here.
   static Eigen::Vector3i BlockOfKey(CellKey key);
-  /// The block of `cell`'s entry, created empty when new.
+  /// `cell`'s entry in its block's table (the block created, empty, when new).
   Entry& EntryOf(const Eigen::Vector3i& cell);
   /// The first of a voxel's max_points_per_voxel points in points_W_.
   std::size_t First(Entry e) const { return static_cast<std::size_t>(e >> kCountBits) * capacity_; }
