@@ -16,8 +16,11 @@ void PointMapOptions::Validate() const {
           max_points_per_voxel, "a count in [1, 32]");
   require(std::isfinite(min_point_spacing_m) && min_point_spacing_m >= 0.0 && min_point_spacing_m < voxel_m,
           "min_point_spacing_m", min_point_spacing_m, "a distance in [0, voxel_m) m");
-  require(std::isfinite(window_radius_m) && window_radius_m >= 2.0 * voxel_m && window_radius_m <= 1e4,
-          "window_radius_m", window_radius_m, "a radius in [2 voxel_m, 1e4] m");
+  // Pruning goes by blocks of 4 voxels a side, whose centre lies up to 2 sqrt(3) voxel_m from
+  // their points: from 6 voxel_m on, the vehicle's own block and every voxel within one edge of
+  // it stay (2 sqrt(3) + 1 < 6).
+  require(std::isfinite(window_radius_m) && window_radius_m >= 6.0 * voxel_m && window_radius_m <= 1e4,
+          "window_radius_m", window_radius_m, "a radius in [6 voxel_m, 1e4] m");
 }
 
 PointMap::PointMap(const PointMapOptions& options) : options_(options) {
@@ -107,12 +110,12 @@ void CellIndex::Grow() {
 }
 
 PointMap::Entry& PointMap::EntryOf(const Eigen::Vector3i& cell) {
-  const Eigen::Vector3i b = BlockOf(cell);
+  const CellKey key = KeyOfCell(BlockOf(cell));
   bool added = false;
-  const std::uint32_t i = block_index_.FindOrAdd(KeyOfCell(b), static_cast<std::uint32_t>(blocks_.size()), &added);
+  const std::uint32_t i = block_index_.FindOrAdd(key, static_cast<std::uint32_t>(blocks_.size()), &added);
   if (added) {
     blocks_.emplace_back();
-    blocks_.back().key = KeyOfCell(b);
+    blocks_.back().key = key;
   }
   return blocks_[i].entry[static_cast<std::size_t>(EntryIndex(cell))];
 }
@@ -140,7 +143,6 @@ int PointMap::Insert(const std::vector<Vector3>& points_W) {
         points_W_.resize(points_W_.size() + capacity_);
       }
       e = v << kCountBits;
-      ++voxels_;
     } else {
       const Eigen::Vector3f* held = &points_W_[First(e)];
       bool near = false;
@@ -169,7 +171,6 @@ int PointMap::Prune(const Vector3& center_W) {
         if ((e & kCountMask) == 0) continue;
         removed += static_cast<int>(e & kCountMask);
         free_voxels_.push_back(e >> kCountBits);
-        --voxels_;
       }
       continue;
     }
@@ -200,23 +201,23 @@ int PointMap::Nearest(const Vector3& query, int k, double radius_m, std::vector<
   // to the lower and the upper face of the query's voxel.
   const Vector3 low = query - c.cast<double>() * options_.voxel_m;  // in [0, voxel_m)
   const Vector3 high = Vector3::Constant(options_.voxel_m) - low;
-  // The 3 x 3 x 3 cells span at most 2 blocks per axis; each is looked up once, when first needed.
+  // The 3 x 3 x 3 cells span at most 2 blocks per axis; each is looked up once, when first needed
+  // (its position in blocks_, -1 when there is none).
   const Eigen::Vector3i first_block = BlockOf(c - Eigen::Vector3i::Ones());
-  const Block* const kUnseen = &blocks_.front();  // a marker only: compared, never read
-  std::array<const Block*, 8> block_of;
-  block_of.fill(kUnseen);
+  constexpr std::int64_t kNotLookedUp = -2;
+  std::array<std::int64_t, 8> block_at;
+  block_at.fill(kNotLookedUp);
   // The k best so far, sorted by distance (k is small: a plane needs five).
   std::array<std::pair<float, Eigen::Vector3f>, 16> best;
   const int kk = std::min(k, static_cast<int>(best.size()));
   int n = 0;
   const Eigen::Vector3f qf = query.cast<float>();
-  // Visits the voxels whose nearest point lies in (inner, outer] of the query: first the entries,
-  // their points prefetched, then the points, so that the voxels' loads overlap rather than wait
-  // on each other.
-  const auto visit_shell = [&](double inner, double outer) {
+  // Visits the voxels whose nearest point lies at a squared distance in (inner2, outer2] of the
+  // query: first the entries, their points prefetched, then the points, so that the voxels' loads
+  // overlap rather than wait on each other.
+  const auto visit_shell = [&](double inner2, double outer2) {
     std::array<Entry, 27> visit;
     int visits = 0;
-    const double inner2 = inner < 0.0 ? -1.0 : inner * inner, outer2 = outer * outer;
     for (int dx = -1; dx <= 1; ++dx) {
       const double ex = dx < 0 ? low.x() : dx > 0 ? high.x() : 0.0;
       for (int dy = -1; dy <= 1; ++dy) {
@@ -226,14 +227,11 @@ int PointMap::Nearest(const Vector3& query, int k, double radius_m, std::vector<
           const double e2 = ex * ex + ey * ey + ez * ez;
           if (e2 <= inner2 || e2 > outer2) continue;
           const Eigen::Vector3i cell = c + Eigen::Vector3i(dx, dy, dz);
-          const Eigen::Vector3i o = BlockOf(cell) - first_block;  // 0 or 1 on each axis
-          const Block*& block = block_of[static_cast<std::size_t>((o.x() * 2 + o.y()) * 2 + o.z())];
-          if (block == kUnseen) {
-            const std::int64_t found = block_index_.Find(KeyOfCell(BlockOf(cell)));
-            block = found < 0 ? nullptr : &blocks_[static_cast<std::size_t>(found)];
-          }
-          if (block == nullptr) continue;
-          const Entry e = block->entry[static_cast<std::size_t>(EntryIndex(cell))];
+          const Eigen::Vector3i b = BlockOf(cell), o = b - first_block;  // o: 0 or 1 on each axis
+          std::int64_t& at = block_at[static_cast<std::size_t>((o.x() * 2 + o.y()) * 2 + o.z())];
+          if (at == kNotLookedUp) at = block_index_.Find(KeyOfCell(b));
+          if (at < 0) continue;
+          const Entry e = blocks_[static_cast<std::size_t>(at)].entry[static_cast<std::size_t>(EntryIndex(cell))];
           if ((e & kCountMask) == 0) continue;
           visit[static_cast<std::size_t>(visits++)] = e;
           __builtin_prefetch(&points_W_[First(e)]);
@@ -258,9 +256,9 @@ int PointMap::Nearest(const Vector3& query, int k, double radius_m, std::vector<
   // Within half the radius first (about a third of the cells the whole radius meets): when the
   // k found there lie within it, every point of the cells not visited is farther (each of those
   // cells is), and the answer is exact already. Otherwise the rest of the radius.
-  const double inner = 0.5 * r;
-  visit_shell(-1.0, inner);
-  if (n < kk || best[n - 1].first > static_cast<float>(inner * inner)) visit_shell(inner, r);
+  const double inner2 = 0.25 * r * r;  // (r / 2)²
+  visit_shell(-1.0, inner2);
+  if (n < kk || best[n - 1].first > static_cast<float>(inner2)) visit_shell(inner2, r * r);
   for (int i = 0; i < n; ++i) {
     out->push_back(best[i].second.cast<double>());
     if (squared_distances) squared_distances->push_back(best[i].first);

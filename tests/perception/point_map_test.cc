@@ -116,6 +116,30 @@ TEST(PointMap, PruningKeepsTheBlocksWithinTheWindowAndTheirPoints) {
   for (const Vector3& p : line) EXPECT_EQ(map.Nearest(p, 1, 0.1, &found), stays(p) ? 1 : 0) << p.transpose();
 }
 
+// The smallest window allowed (6 voxel edges) never deletes what lies within a voxel edge of the
+// vehicle, wherever the vehicle stands in its block: the block's centre is at most 2 sqrt(3)
+// edges from any of its points. Against a brute-force count of those points before and after.
+TEST(PointMap, TheSmallestWindowKeepsTheVehiclesSurroundings) {
+  PointMapOptions o;
+  o.voxel_m = 0.5;
+  o.min_point_spacing_m = 0.0;
+  o.max_points_per_voxel = 32;
+  o.window_radius_m = 6.0 * o.voxel_m;
+  const std::vector<Vector3> points = RandomPoints(4000, 3.0, 5);
+  Rng rng(6);
+  std::vector<Vector3> found;
+  for (int trial = 0; trial < 50; ++trial) {
+    PointMap map(o);
+    ASSERT_EQ(map.Insert(points), 4000);
+    const Vector3 vehicle(rng.Uniform(-1.5, 1.5), rng.Uniform(-1.5, 1.5), rng.Uniform(-1.5, 1.5));
+    map.Prune(vehicle);
+    for (const Vector3& p : points) {
+      if ((p - vehicle).norm() > o.voxel_m) continue;
+      EXPECT_EQ(map.Nearest(p, 1, 1e-3, &found), 1) << "trial " << trial << ": " << p.transpose();
+    }
+  }
+}
+
 // Points and queries beyond the keys' range (2^20 voxels: 524 km at 0.5 m) are refused and find
 // nothing, rather than aliasing onto a cell near the origin or overflowing an int.
 TEST(PointMap, IgnoresCoordinatesBeyondTheKeysRange) {
@@ -128,6 +152,12 @@ TEST(PointMap, IgnoresCoordinatesBeyondTheKeysRange) {
   EXPECT_EQ(map.Nearest(near + Vector3(alias, 0.0, 0.0), 1, 0.5, &found), 0);
   EXPECT_EQ(map.Nearest(Vector3(-1e300, 0.0, 0.0), 1, 0.5, &found), 0);
   EXPECT_EQ(map.Nearest(near, 1, 0.5, &found), 1);
+  // At the range's edge: a point just inside is stored, and a query just outside finds nothing,
+  // though the point lies within its radius.
+  const double edge = 0.99 * std::ldexp(0.5, 20);
+  ASSERT_EQ(map.Insert({Vector3(edge - 0.1, 0.25, 0.25)}), 1);
+  EXPECT_EQ(map.Nearest(Vector3(edge - 0.05, 0.25, 0.25), 1, 0.5, &found), 1);
+  EXPECT_EQ(map.Nearest(Vector3(edge + 0.05, 0.25, 0.25), 1, 0.5, &found), 0);
 }
 
 TEST(PointMap, RejectsOptionsOutsideTheirRanges) {
@@ -139,6 +169,8 @@ TEST(PointMap, RejectsOptionsOutsideTheirRanges) {
   EXPECT_THROW(PointMap{o}, ValidationError);
   o = {};
   o.window_radius_m = 0.5;
+  EXPECT_THROW(PointMap{o}, ValidationError);
+  o.window_radius_m = 5.9 * o.voxel_m;  // below the block pruning's floor
   EXPECT_THROW(PointMap{o}, ValidationError);
 }
 

@@ -25,7 +25,7 @@ struct PointMapOptions {
   /// A point this close [m] to one its voxel holds is not stored, in [0, voxel_m).
   double min_point_spacing_m = 0.1;
   /// Blocks of 4 x 4 x 4 voxels whose centre is farther than this from the vehicle are deleted by
-  /// Prune [m], in [2 voxel_m, 1e4].
+  /// Prune [m], in [6 voxel_m, 1e4] (the vehicle's block and its surroundings always stay).
   double window_radius_m = 60.0;
   /// Throws ValidationError naming the field.
   void Validate() const;
@@ -37,7 +37,7 @@ struct PointMapOptions {
     a->Visit("min_point_spacing_m", &min_point_spacing_m,
              {.meaning = "a point this close to one its voxel holds is not stored [m], below voxel_m", .min = 0});
     a->Visit("window_radius_m", &window_radius_m,
-             {.meaning = "blocks of 4^3 voxels farther than this from the vehicle are deleted [m], at least 2 voxel_m",
+             {.meaning = "blocks of 4^3 voxels farther than this from the vehicle are deleted [m], at least 6 voxel_m",
               .max = 1e4});
   }
 };
@@ -93,7 +93,7 @@ class PointMap {
               std::vector<double>* squared_distances = nullptr) const;
 
   long size() const { return points_; }
-  long voxels() const { return voxels_; }
+  long voxels() const { return static_cast<long>(points_W_.size() / capacity_ - free_voxels_.size()); }
 
  private:
   /// Voxels are found through blocks of 4 x 4 x 4 cells: one hash lookup finds a block, whose
@@ -133,7 +133,6 @@ class PointMap {
   /// Each voxel's points, `capacity_` slots apiece; the slots of pruned voxels are reused.
   std::vector<Eigen::Vector3f> points_W_;
   std::vector<std::uint32_t> free_voxels_;
-  long voxels_ = 0;
   long points_ = 0;
 };
 
