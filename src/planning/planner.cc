@@ -35,7 +35,13 @@ void PlannerOptions::Validate() const {
   require(std::isfinite(plane_search_m) && plane_search_m >= optimizer.clearance_m, "plane_search_m", plane_search_m,
           "a distance >= optimizer.clearance_m");
   require(clearance_rounds >= 0, "clearance_rounds", clearance_rounds, ">= 0");
-  require(std::isfinite(check_step_m) && check_step_m > 0.0, "check_step_m", check_step_m, "a step > 0 m");
+  require(std::isfinite(check_step_m) && check_step_m >= 0.001 && check_step_m <= 1.0, "check_step_m", check_step_m,
+          "a step in [0.001, 1] m");
+}
+
+double CheckInterval(double step_m, double speed_m_s) {
+  const double speed = speed_m_s > 1e-3 ? speed_m_s : 1e-3;  // NaN too
+  return std::max(step_m / speed, 1e-3);
 }
 
 const char* ToString(PlanSummary::Status status) {
@@ -211,7 +217,7 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
                   summary.optimizer.message);
     }
     // Check the result against the map, every check_step_m of path at most.
-    const double dt = options_.check_step_m / std::max(limits.v_max, 1e-3);
+    const double dt = CheckInterval(options_.check_step_m, limits.v_max);
     // Positions every dt along each piece (its end included). A start inside an inflation layer
     // may leave it (as the front end allows): the positions before the first free one are not
     // held against the result.

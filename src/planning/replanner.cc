@@ -26,8 +26,10 @@ void ReplannerOptions::Validate() const {
   require(std::isfinite(post_failure_a_max) && post_failure_a_max > 0.0, "post_failure_a_max", post_failure_a_max,
           "an acceleration > 0 m/s²");
   require(std::isfinite(replan_period_s) && replan_period_s > 0.0, "replan_period_s", replan_period_s, "a period > 0 s");
-  require(std::isfinite(check_horizon_s) && check_horizon_s > 0.0, "check_horizon_s", check_horizon_s, "a horizon > 0 s");
-  require(std::isfinite(check_step_m) && check_step_m > 0.0, "check_step_m", check_step_m, "a step > 0 m");
+  require(std::isfinite(check_horizon_s) && check_horizon_s > 0.0 && check_horizon_s <= 60.0, "check_horizon_s",
+          check_horizon_s, "a horizon in (0, 60] s");
+  require(std::isfinite(check_step_m) && check_step_m >= 0.001 && check_step_m <= 1.0, "check_step_m", check_step_m,
+          "a step in [0.001, 1] m");
   require(std::isfinite(local_goal_margin_m) && local_goal_margin_m >= 0.0, "local_goal_margin_m", local_goal_margin_m,
           "a distance >= 0 m");
   if (post_failure_clearance_m) {
@@ -109,7 +111,7 @@ ReferencePoint Replanner::Reference(double t) const {
 bool Replanner::UnsafeAhead(double t, const perception::VoxelMap& map) const {
   if (trajectory_.empty()) return false;
   const double end = std::min(trajectory_.duration(), t + options_.check_horizon_s);
-  const double dt = options_.check_step_m / std::max(limits_.v_max, 1e-3);
+  const double dt = CheckInterval(options_.check_step_m, limits_.v_max);
   for (double s = t; s <= end; s += dt) {
     if (map.IsInflated(trajectory_.Evaluate(s).p_W)) return true;
   }
@@ -167,7 +169,7 @@ void Replanner::Brake(double t, const perception::VoxelMap& map) {
     return out->Build(head, tail, Eigen::Matrix3Xd(3, 0), Eigen::VectorXd::Constant(1, duration));
   };
   const auto collides = [&](const MinimumJerkTrajectory& brake, double duration) {
-    const double step = options_.check_step_m / std::max(v.norm(), 1e-3);
+    const double step = CheckInterval(options_.check_step_m, v.norm());
     for (double s = 0.0; s <= duration + 1e-9; s += std::min(step, 0.05)) {
       if (map.IsInflated(brake.Evaluate(brake.start_time() + s).p_W)) return true;
     }

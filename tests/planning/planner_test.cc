@@ -1,10 +1,12 @@
 
-#include <cmath>
+#include "rotorguard/planning/planner.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "rotorguard/planning/astar.h"
-#include "rotorguard/planning/planner.h"
 
 namespace rotorguard::planning {
 namespace {
@@ -36,6 +38,19 @@ bool EverInflated(const MinimumJerkTrajectory& traj, const perception::VoxelMap&
 
 // Through the gap: the pruned path's segments cross no inflated voxel, and it bends through the
 // gap (the straight line is blocked).
+TEST(CheckInterval, IsAStepOfPathAtTheSpeedWithAOneMillisecondFloor) {
+  // One check every step_m of path: step / speed.
+  EXPECT_DOUBLE_EQ(CheckInterval(0.05, 1.0), 0.05);
+  EXPECT_DOUBLE_EQ(CheckInterval(0.05, 25.0), 0.002);
+  // The floor: a speed limit of 1e9 m/s (which once made a 3 s flight check its trajectory
+  // every 1e-10 s, for minutes) or an infinite one checks every millisecond.
+  EXPECT_DOUBLE_EQ(CheckInterval(0.05, 1e9), 1e-3);
+  EXPECT_DOUBLE_EQ(CheckInterval(0.05, std::numeric_limits<double>::infinity()), 1e-3);
+  // A vehicle at rest, or a speed that is not a number, counts as 1 mm/s: finite, never NaN.
+  EXPECT_DOUBLE_EQ(CheckInterval(0.05, 0.0), 50.0);
+  EXPECT_DOUBLE_EQ(CheckInterval(0.05, std::nan("")), 50.0);
+}
+
 TEST(AStar, FindsThePathThroughTheGapAndItsSegmentsAreFree) {
   perception::VoxelMap map = EmptyMap();
   AddWallWithGap(&map);

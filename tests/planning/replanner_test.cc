@@ -245,6 +245,21 @@ TEST(Replanner, AFailureSwitchesToThePostFailureClearanceOnceRecovered) {
   RG_EXPECT_THROW_WITH(Replanner(o, Vector3::Zero()), std::invalid_argument, "post_failure_clearance_m");
 }
 
+// The collision check's spacing and horizon set how many map lookups a check makes: a step of
+// a micrometre or a horizon of hours would make each a long loop, and the options refuse them.
+TEST(Replanner, RefusesCheckSpacingsAndHorizonsThatWouldMakeTheCheckUnbounded) {
+  ReplannerOptions o;
+  o.check_step_m = 1e-6;
+  RG_EXPECT_THROW_WITH(o.Validate(), std::invalid_argument, "check_step_m");
+  o = ReplannerOptions{};
+  o.check_horizon_s = 3600.0;
+  RG_EXPECT_THROW_WITH(o.Validate(), std::invalid_argument, "check_horizon_s");
+  o = ReplannerOptions{};
+  o.planner.check_step_m = 0.0;
+  RG_EXPECT_THROW_WITH(o.Validate(), std::invalid_argument, "check_step_m");
+  EXPECT_NO_THROW(ReplannerOptions{}.Validate());
+}
+
 // A wall without a gap closes the way: no plan exists, so the replanner brakes to rest within
 // its limits before the wall, then holds (and keeps trying).
 TEST(Replanner, AGoalBeyondTheMapIsReachedThroughLocalGoalsAsTheWindowMoves) {

@@ -21,13 +21,19 @@
 
 namespace rotorguard::planning {
 
+/// The time between two collision checks along a trajectory flown at up to `speed_m_s`: one
+/// every `step_m` of path, but never closer than 1 ms, so that the number of checks stays bounded
+/// whatever the speed limit (at the default 5 cm step the floor acts above 50 m/s, beyond any
+/// speed a scenario accepts). A speed below 1 mm/s counts as 1 mm/s.
+double CheckInterval(double step_m, double speed_m_s);
+
 struct PlannerOptions {
   AStarOptions search;
   TrajectoryOptimizerOptions optimizer;
   double max_piece_length_m = 2.0;  ///< the path is cut into pieces at most this long [m], > 0
   double plane_search_m = 0.5;      ///< a sample gets the plane of an obstacle within this [m], >= clearance
   int clearance_rounds = 8;         ///< re-optimisations with planes added where the result collides, >= 0
-  double check_step_m = 0.05;       ///< spacing of the collision check along the result [m], > 0
+  double check_step_m = 0.05;       ///< spacing of the collision check along the result [m], in [0.001, 1]
   /// On no path at search.resolution_m, search again at the map's resolution.
   bool fine_search_fallback = true;
   /// When the back end fails from a start at rest, fly the front end's path from rest to rest.

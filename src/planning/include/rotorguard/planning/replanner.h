@@ -36,8 +36,8 @@ struct ReplannerOptions {
   /// failure after the recovery is planned with this one: the replanner knows of one failure.)
   std::optional<double> post_failure_clearance_m;
   double replan_period_s = 1.0;     ///< periodic replanning [s], > 0
-  double check_horizon_s = 3.0;     ///< how far ahead the trajectory is checked against the map [s], > 0
-  double check_step_m = 0.05;       ///< spacing of that check along the path [m], > 0
+  double check_horizon_s = 3.0;     ///< how far ahead the trajectory is checked against the map [s], in (0, 60]
+  double check_step_m = 0.05;       ///< spacing of that check along the path [m], in [0.001, 1]
   /// A goal beyond the map's window is approached through a local goal: the last free point of
   /// the straight line towards it that lies this far inside the window [m], >= 0. Replanning as
   /// the window follows the vehicle moves the local goal on (receding horizon).
