@@ -54,6 +54,7 @@ class BenchCommand final : public Command {
                     "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
                     "with `campaign merge` when all are done");
       b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
+      b->add_option("--trial-timeout", trial_timeout_, kTrialTimeoutHelp);
     }
     for (CLI::App* b : {sim_, nmpc_, ftc_, nav_, mars_, flatness_}) {
       b->add_option("--truth", truth_,
@@ -225,7 +226,7 @@ class BenchCommand final : public Command {
   /// and, with --out, written as bench.json and bench.md. A shard of several only records its
   /// trials; nullopt then.
   std::optional<nlohmann::json> RunBenchCampaign(const campaign::Campaign& c, const char* name) const {
-    campaign::CampaignRunOptions o = CampaignRunOptionsOf(out_, jobs_, shard_, resume_);
+    campaign::CampaignRunOptions o = CampaignRunOptionsOf(out_, jobs_, shard_, resume_, trial_timeout_);
     if ((o.resume || o.shard.count > 1) && o.out_dir.empty()) {
       throw UsageError(
           fmt::format("{} needs --out: the folder that keeps the trials", o.resume ? "--resume" : "--shard"));
@@ -488,6 +489,7 @@ class BenchCommand final : public Command {
   // Options several benchmarks share (one of them runs per invocation).
   std::string seed_ = "1", jobs_, out_, shard_ = "0/1", html_;
   bool resume_ = false, json_ = false;
+  std::string trial_timeout_;
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3";
   std::string truth_ = "realistic", estimator_;

@@ -35,6 +35,7 @@ class CampaignCommand final : public Command {
     run_->add_option("--jobs", jobs_text_, "Worker threads (default: the number of cores)");
     run_->add_option("--shard", shard_, "Run shard i of N (i/N, 0 <= i < N; default 0/1: all)");
     run_->add_flag("--resume", resume_, "Continue the results in --out: skip finished trials");
+    run_->add_option("--trial-timeout", trial_timeout_, kTrialTimeoutHelp);
     run_->add_flag("--quiet,-q", quiet_, "No progress line");
     slurm_ = campaign->add_subcommand(
         "slurm",
@@ -65,12 +66,12 @@ class CampaignCommand final : public Command {
  private:
   int Run() {
     const campaign::Campaign spec = campaign::LoadCampaign(spec_, benchmarks::CampaignKinds());
-    campaign::CampaignRunOptions o = CampaignRunOptionsOf(out_, jobs_text_, shard_, resume_);
+    campaign::CampaignRunOptions o = CampaignRunOptionsOf(out_, jobs_text_, shard_, resume_, trial_timeout_);
     if (!quiet_) o.progress = EtaProgress("trials");
     const campaign::CampaignRunSummary r = campaign::RunCampaign(spec, o);
     fmt::print("campaign          {} (spec {})\n", spec.name, spec.hash);
-    fmt::print("shard             {}/{}: {} trials, {} already done, {} run, {} error or diverged\n", o.shard.index,
-               o.shard.count, r.trials, r.skipped, r.ran, r.errors);
+    fmt::print("shard             {}/{}: {} trials, {} already done, {} run, {} error or diverged, {} timed out\n",
+               o.shard.index, o.shard.count, r.trials, r.skipped, r.ran, r.errors, r.timeouts);
     fmt::print("results           {}\n", r.results_file);
     return kOk;
   }
@@ -121,6 +122,7 @@ class CampaignCommand final : public Command {
   std::string spec_, out_, jobs_text_, shard_ = "0/1", merge_out_;
   std::string shards_text_, cpus_text_ = "1", partition_, time_;
   bool resume_ = false, quiet_ = false;
+  std::string trial_timeout_;
   std::vector<std::string> merge_dirs_;
 };
 

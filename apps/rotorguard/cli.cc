@@ -24,11 +24,17 @@ namespace {
 /// Library errors name the option fields they reject ("CampaignRunOptions::jobs = 0 is invalid");
 /// on the command line the user set them with these flags.
 constexpr std::pair<const char*, const char*> kFlagOfField[] = {
-    {"CampaignRunOptions::out_dir", "--out"},     {"CampaignRunOptions::resume", "--resume"},
-    {"CampaignRunOptions::jobs", "--jobs"},       {"CampaignRunOptions::shard", "--shard"},
-    {"SlurmScriptOptions::shards", "--shards"},   {"SlurmScriptOptions::cpus_per_task", "--cpus-per-task"},
-    {"SlurmScriptOptions::out_dir", "--out"},     {"SlurmScriptOptions::partition", "--partition"},
-    {"SlurmScriptOptions::time_limit", "--time"}, {"FddCalibrationOptions::margin", "--margin"},
+    {"CampaignRunOptions::out_dir", "--out"},
+    {"CampaignRunOptions::resume", "--resume"},
+    {"CampaignRunOptions::jobs", "--jobs"},
+    {"CampaignRunOptions::shard", "--shard"},
+    {"SlurmScriptOptions::shards", "--shards"},
+    {"SlurmScriptOptions::cpus_per_task", "--cpus-per-task"},
+    {"SlurmScriptOptions::out_dir", "--out"},
+    {"SlurmScriptOptions::partition", "--partition"},
+    {"SlurmScriptOptions::time_limit", "--time"},
+    {"FddCalibrationOptions::margin", "--margin"},
+    {"CampaignRunOptions::trial_timeout_factor", "--trial-timeout"},
 };
 
 }  // namespace
@@ -138,9 +144,16 @@ std::vector<harness::Override> ParseOverrides(const std::vector<std::string>& se
   return out;
 }
 
+const char* const kTrialTimeoutHelp =
+    "The watchdog: a trial that takes more than this many wall-clock seconds per simulated\n"
+    "second is stopped and recorded as `timeout` (default 100; 0: trials unwatched, in-process)";
+
 campaign::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,
-                                                  const std::string& shard, bool resume) {
+                                                  const std::string& shard, bool resume,
+                                                  const std::string& trial_timeout_text) {
   campaign::CampaignRunOptions o;
+  if (!trial_timeout_text.empty())
+    o.trial_timeout_factor = ParseFinite("--trial-timeout", trial_timeout_text, 0.0, 1e6);
   o.out_dir = out;
   o.jobs = ParseJobs(jobs_text);
   o.shard = ParseShard(shard);

@@ -70,7 +70,10 @@ std::vector<harness::Override> ParseOverrides(const std::vector<std::string>& se
 
 /// The campaign options a command line gives (campaign run and the benchmarks that run as campaigns).
 campaign::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,
-                                                  const std::string& shard, bool resume);
+                                                  const std::string& shard, bool resume,
+                                                  const std::string& trial_timeout_text);
+/// --trial-timeout's help, shared by campaign run and the benchmarks that run as campaigns.
+extern const char* const kTrialTimeoutHelp;
 
 /// A configs/ file: relative to the working directory when it has one, else the source tree's.
 std::string ConfigPath(const std::string& relative);

@@ -340,6 +340,15 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
                                               {"fault", kCells[cell].fault}, {"method", o.methods[method]},
                                               {"trial", std::to_string(trial)}, {"seed", std::to_string(seed)}};
   };
+  c.simulated_s = [o, decompose](int index, const std::map<std::string, std::string>& params) {
+    const auto [cell, method, trial] = decompose(index);
+    return MakeTrial(kCells[cell], o.methods[method], o, std::stoull(params.at("seed"))).duration_s;
+  };
+  c.reproduce = [o, decompose](int index, const std::map<std::string, std::string>& params) {
+    const auto [cell, method, trial] = decompose(index);
+    return fmt::format("rotorguard bench ftc --replay {}/{}:{}:{} --truth {} --estimator {}", kCells[cell].phase,
+                       kCells[cell].fault, o.methods[method], params.at("seed"), ToName(o.truth), ToName(o.estimator));
+  };
   c.run = [o, decompose](int index, const std::map<std::string, std::string>& params) {
     const auto [cell, method, trial] = decompose(index);
     const harness::RunSummary s =

@@ -198,6 +198,15 @@ campaign::Campaign NavCampaign(const NavBenchOptions& o) {
   harness::Scenario base = o.base;
   base.truth.preset = o.truth;
   base.stack.estimator.kind = o.estimator;
+  c.simulated_s = [base](int, const std::map<std::string, std::string>& params) {
+    return MakeNavTrial(base, params.at("kind"), std::stoull(params.at("seed")), params.at("variant") == kVariants[0])
+        .duration_s;
+  };
+  c.reproduce = [o](int, const std::map<std::string, std::string>& params) {
+    return fmt::format("rotorguard bench nav --replay {}:{}{} --truth {} --estimator {}", params.at("kind"),
+                       params.at("seed"), params.at("variant") == kVariants[0] ? "" : ":unaware", ToName(o.truth),
+                       ToName(o.estimator));
+  };
   c.run = [base](int, const std::map<std::string, std::string>& params) {
     harness::RunOptions run;
     run.stop_when_mission_complete = true;

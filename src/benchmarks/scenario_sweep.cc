@@ -220,6 +220,14 @@ campaign::Campaign ScenarioCampaign(const CampaignSpec& spec) {
   for (const auto& [key, values] : spec.grid) c.group_keys.push_back(key);
   c.metrics = spec.metrics;
   c.parameters = [spec](int index) { return TrialParameters(spec, index); };
+  c.simulated_s = [spec](int, const std::map<std::string, std::string>& params) {
+    return harness::LoadScenario(spec.scenario, OverridesOf(params)).duration_s;
+  };
+  c.reproduce = [spec](int, const std::map<std::string, std::string>& params) {
+    std::string command = "rotorguard run " + spec.scenario;
+    for (const auto& [key, value] : params) command += fmt::format(" --set '{}={}'", key, value);
+    return command;
+  };
   c.run = [spec](int, const std::map<std::string, std::string>& params) {
     const nlohmann::json r =
         harness::RunScenario(harness::LoadScenario(spec.scenario, OverridesOf(params)), harness::RunOptions{}).ToJson();

@@ -20,6 +20,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
+#include "watchdog.h"
 
 namespace rotorguard::campaign {
 
@@ -105,6 +106,69 @@ class ShardLock {
   int fd_ = -1;
 };
 
+std::string Dump(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
+
+/// Runs the trial in this thread: its status, message and metrics.
+nlohmann::json RecordTrial(const Campaign& campaign, int index, const std::map<std::string, std::string>& params) {
+  nlohmann::json record;
+  try {
+    TrialOutcome r = campaign.run(index, params);
+    bool finite = true;
+    for (auto& [name, value] : r.metrics.items()) {
+      if (value.is_number_float() && !std::isfinite(value.get<double>())) {
+        finite = false;
+        value = nullptr;  // JSON has no NaN
+      }
+    }
+    record["status"] = finite ? "ok" : "diverged";
+    record["message"] = finite ? r.message : "a metric is not finite" + (r.message.empty() ? "" : "; " + r.message);
+    record["metrics"] = std::move(r.metrics);
+  } catch (const std::exception& e) {
+    record = {{"status", "error"}, {"message", e.what()}, {"metrics", nullptr}};
+  } catch (...) {
+    record = {{"status", "error"}, {"message", "an exception of unknown type"}, {"metrics", nullptr}};
+  }
+  return record;
+}
+
+/// Runs the trial in a child process under its wall-clock budget, `factor` times its simulated
+/// time: the record it made, or a timeout or a crash recorded in its place.
+nlohmann::json WatchedTrial(const Campaign& campaign, int index, const std::map<std::string, std::string>& params,
+                            double factor) {
+  double simulated_s = 0.0;  // unknown: no budget (a trial that cannot say will fail to run too)
+  if (campaign.simulated_s) {
+    try {
+      simulated_s = campaign.simulated_s(index, params);
+    } catch (const std::exception&) {
+    }
+  }
+  const double budget_s = factor * simulated_s;
+  internal::IsolatedRun run;
+  try {
+    run = internal::RunIsolated([&] { return Dump(RecordTrial(campaign, index, params)); }, budget_s);
+  } catch (const std::exception& e) {
+    return {{"status", "error"}, {"message", e.what()}, {"metrics", nullptr}};
+  }
+  switch (run.kind) {
+    case internal::IsolatedRun::Kind::kFinished:
+      return nlohmann::json::parse(run.text);
+    case internal::IsolatedRun::Kind::kCrashed:
+      return {{"status", "error"}, {"message", run.message}, {"metrics", nullptr}};
+    case internal::IsolatedRun::Kind::kTimeout:
+      break;
+  }
+  const std::string seed = params.count("seed") ? params.at("seed") : "?";
+  const std::string reproduce = campaign.reproduce
+                                    ? campaign.reproduce(index, params)
+                                    : fmt::format("trial {} (seed {}) of campaign {}", index, seed, campaign.name);
+  return {
+      {"status", "timeout"},
+      {"message", fmt::format("stopped after {:.1f} s of wall-clock time, its budget ({:g} x its {:g} s simulated); "
+                              "seed {}; reproduce: {}",
+                              run.wall_s, factor, simulated_s, seed, reproduce)},
+      {"metrics", nullptr}};
+}
+
 }  // namespace
 
 bool IsValidCampaignName(const std::string& name) {
@@ -142,6 +206,10 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
   const std::string shard_text = fmt::format("{}/{}", options.shard.index, options.shard.count);
   if (options.jobs < 1 || options.jobs > 256) {
     ThrowValidation("CampaignRunOptions", "jobs", options.jobs, "a count in [1, 256]");
+  }
+  if (!(options.trial_timeout_factor >= 0.0 && options.trial_timeout_factor <= 1e6)) {
+    ThrowValidation("CampaignRunOptions", "trial_timeout_factor", options.trial_timeout_factor,
+                    "a factor in [0, 1e6] (0: no watchdog)");
   }
   if (options.shard.count < 1 || options.shard.index < 0 || options.shard.index >= options.shard.count) {
     ThrowValidation("CampaignRunOptions", "shard", shard_text, "i/N with 0 <= i < N (shards count from 0)");
@@ -221,7 +289,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
   summary.skipped = summary.trials - static_cast<int>(todo.size());
   AppendFile results(summary.results_file);
   std::mutex mutex;
-  int errors = 0;
+  int errors = 0, timeouts = 0;
   std::exception_ptr write_error;
   ParallelFor(
       static_cast<int>(todo.size()), options.jobs,
@@ -229,31 +297,17 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
         const int index = todo[static_cast<std::size_t>(task)];
         const std::map<std::string, std::string> params = campaign.parameters(index);
         nlohmann::json line = {{"trial", index}, {"id", TrialId(params)}, {"params", params}};
-        try {
-          TrialOutcome r = campaign.run(index, params);
-          bool finite = true;
-          for (auto& [name, value] : r.metrics.items()) {
-            if (value.is_number_float() && !std::isfinite(value.get<double>())) {
-              finite = false;
-              value = nullptr;  // JSON has no NaN
-            }
-          }
-          line["status"] = finite ? "ok" : "diverged";
-          line["message"] = finite ? r.message : "a metric is not finite" + (r.message.empty() ? "" : "; " + r.message);
-          line["metrics"] = std::move(r.metrics);
-        } catch (const std::exception& e) {
-          line["status"] = "error";
-          line["message"] = e.what();
-          line["metrics"] = nullptr;
-        } catch (...) {
-          line["status"] = "error";
-          line["message"] = "an exception of unknown type";
-          line["metrics"] = nullptr;
-        }
+        line.update(options.trial_timeout_factor > 0.0
+                        ? WatchedTrial(campaign, index, params, options.trial_timeout_factor)
+                        : RecordTrial(campaign, index, params));
         // Invalid UTF-8 in a message is replaced rather than thrown: the trial is recorded either way.
-        const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+        const std::string text = Dump(line);
         const std::lock_guard<std::mutex> guard(mutex);
-        if (line["status"] != "ok") ++errors;
+        if (line["status"] == "timeout") {
+          ++timeouts;
+        } else if (line["status"] != "ok") {
+          ++errors;
+        }
         if (write_error) return;  // the disk failed: no more lines; the run reports it below
         try {
           results.AppendLine(text);
@@ -265,6 +319,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
   if (write_error) std::rethrow_exception(write_error);  // the manifest stays unfinished: resume later
   summary.ran = static_cast<int>(todo.size());
   summary.errors = errors;
+  summary.timeouts = timeouts;
   manifest["finished"] = UtcNow();
   io::WriteFileAtomically(summary.manifest_file, manifest.dump(2) + "\n");
   return summary;

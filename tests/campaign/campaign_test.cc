@@ -4,15 +4,20 @@
 // registry that dispatches specs to their kinds. The oracle for "results do not depend on how they
 // were run" is a byte comparison of merged summaries.
 
-#include <atomic>
-#include <cmath>
-#include <filesystem>
-#include <limits>
-#include <stdexcept>
+#include "rotorguard/campaign/campaign.h"
 
 #include <gtest/gtest.h>
 
-#include "rotorguard/campaign/campaign.h"
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/registry.h"
 #include "rotorguard/campaign/statistics.h"
@@ -51,9 +56,12 @@ Campaign MadeUp(std::atomic<int>* runs, bool failing = false, bool diverging = f
 
 class CampaignEngine : public testing::TempFolderTest {
  protected:
-  CampaignRunSummary Run(const Campaign& c, const std::string& out, int jobs = 1, Shard shard = {},
-                         bool resume = false) {
+  /// In-process trials by default (trial_timeout_factor 0): the made-up trials count their runs,
+  /// which a child process would not report.
+  CampaignRunSummary Run(const Campaign& c, const std::string& out, int jobs = 1, Shard shard = {}, bool resume = false,
+                         double trial_timeout_factor = 0.0) {
     CampaignRunOptions o;
+    o.trial_timeout_factor = trial_timeout_factor;
     o.out_dir = (dir_ / out).string();
     o.jobs = jobs;
     o.shard = shard;
@@ -124,6 +132,59 @@ TEST_F(CampaignEngine, ErrorsAndNonFiniteResultsAreRecordedAndTheRestRuns) {
   EXPECT_TRUE(records[5]["metrics"]["x"].is_null()) << "JSON has no NaN";
   EXPECT_EQ(records[6]["status"], "ok");
   EXPECT_EQ(records[6]["metrics"]["x"], 36.0);
+}
+
+TEST_F(CampaignEngine, WatchedTrialsInChildProcessesRecordWhatInProcessTrialsRecord) {
+  const Campaign c = MadeUp(&runs_, /*failing=*/true, /*diverging=*/true);
+  Run(c, "in_process", 2);
+  const CampaignRunSummary watched = Run(c, "watched", 2, {}, false, /*trial_timeout_factor=*/100.0);
+  EXPECT_EQ(watched.errors, 2);  // trial 7's exception and trial 5's NaN, as in process
+  EXPECT_EQ(watched.timeouts, 0);
+  EXPECT_EQ(io::ReadFile((dir_ / "watched" / "results.jsonl").string()).size(),
+            io::ReadFile((dir_ / "in_process" / "results.jsonl").string()).size());
+  EXPECT_EQ(Merge({"watched"}, "watched"), Merge({"in_process"}, "in_process"));
+}
+
+// The watchdog's reason to be: a trial that never ends and one whose process dies are recorded,
+// and the shard's other trials run and are recorded as usual.
+TEST_F(CampaignEngine, AHungTrialTimesOutAndACrashedOneIsAnErrorWhileTheShardGoesOn) {
+  Campaign c = MadeUp(&runs_);
+  const auto made_up = c.run;
+  c.run = [made_up](int i, const std::map<std::string, std::string>& p) {
+    if (i == 3) {
+      for (;;) std::this_thread::sleep_for(std::chrono::milliseconds(10));  // hangs
+    }
+    if (i == 4) std::abort();
+    return made_up(i, p);
+  };
+  c.simulated_s = [](int, const std::map<std::string, std::string>&) { return 0.005; };  // 50 x: 0.25 s budget
+  c.reproduce = [](int i, const std::map<std::string, std::string>&) { return fmt::format("replay {}", i); };
+  const CampaignRunSummary r = Run(c, "watched", 2, {}, false, /*trial_timeout_factor=*/50.0);
+  EXPECT_EQ(r.ran, 12);
+  EXPECT_EQ(r.timeouts, 1);
+  EXPECT_EQ(r.errors, 1);
+  std::map<int, nlohmann::json> lines;
+  std::istringstream text(io::ReadFile((dir_ / "watched" / "results.jsonl").string()));
+  for (std::string line; std::getline(text, line);) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    lines[j["trial"].get<int>()] = j;
+  }
+  ASSERT_EQ(lines.size(), 12u);
+  EXPECT_EQ(lines[3]["status"], "timeout");
+  const std::string why = lines[3]["message"];
+  EXPECT_NE(why.find("50 x its 0.005 s simulated"), std::string::npos) << why;
+  EXPECT_NE(why.find("seed 1003"), std::string::npos) << why;
+  EXPECT_NE(why.find("reproduce: replay 3"), std::string::npos) << why;
+  EXPECT_EQ(lines[4]["status"], "error");
+  EXPECT_NE(lines[4]["message"].get<std::string>().find("SIGABRT"), std::string::npos) << lines[4]["message"];
+  EXPECT_EQ(lines[5]["status"], "ok");
+  EXPECT_EQ(lines[5]["metrics"]["x"], 25.0);
+  // The merge counts the timeout apart from the error.
+  Merge({"watched"}, "merged");
+  const nlohmann::json s = nlohmann::json::parse(io::ReadFile((dir_ / "merged" / "summary.json").string()));
+  EXPECT_EQ(s["overall"]["status"]["timeout"], 1);
+  EXPECT_EQ(s["overall"]["status"]["error"], 1);
+  EXPECT_EQ(s["overall"]["status"]["ok"], 10);
 }
 
 TEST_F(CampaignEngine, AMergeRefusesGapsDuplicatesAndMixedSpecs) {

@@ -53,8 +53,15 @@ struct Campaign {
   std::vector<std::string> metrics;
   /// Trial `index`'s resolved parameters (with "seed"): its identity, recorded with its results.
   std::function<std::map<std::string, std::string>(int index)> parameters;
-  /// Runs trial `index`; thread-safe. An exception is recorded as the trial's error.
+  /// Runs trial `index`; thread-safe. An exception is recorded as the trial's error. Under the
+  /// watchdog (CampaignRunOptions::trial_timeout_factor) it runs in a child process: what it
+  /// changes besides its result is lost.
   std::function<TrialOutcome(int index, const std::map<std::string, std::string>& parameters)> run;
+  /// Trial `index`'s simulated time [s], from which the watchdog sets its wall-clock budget; none
+  /// (or one that throws): the trial runs without a budget.
+  std::function<double(int index, const std::map<std::string, std::string>& parameters)> simulated_s;
+  /// The command that flies trial `index` alone, named when it times out; none: its index and seed.
+  std::function<std::string(int index, const std::map<std::string, std::string>& parameters)> reproduce;
   /// A benchmark's campaign: {"name": KIND, "options": {...}}, recorded in the manifests so that a
   /// merge also writes the kind's own result and tables (registry.h). Null for a scenario sweep.
   nlohmann::json bench;
@@ -76,6 +83,11 @@ struct CampaignRunOptions {
   int jobs = 1;         ///< worker threads, in [1, 256]
   Shard shard;          ///< 0 <= index < count <= the campaign's trials
   bool resume = false;  ///< continue the results already in out_dir (else they are an error)
+  /// The per-trial watchdog, in [0, 1e6]: each trial runs in a child process and is stopped once
+  /// it has taken this many wall-clock seconds per simulated second (Campaign::simulated_s),
+  /// recorded with status `timeout`; a trial whose process crashes is recorded as an `error`, and
+  /// the shard goes on either way. 0: the trials run in the worker threads, unwatched.
+  double trial_timeout_factor = 100.0;
   std::string version;  ///< the program's version and revision, recorded and checked
   std::function<void(int done, int total)> progress;
 };
@@ -84,7 +96,8 @@ struct CampaignRunSummary {
   int trials = 0;   ///< in the shard
   int skipped = 0;  ///< already done (resume)
   int ran = 0;
-  int errors = 0;  ///< status error or diverged
+  int errors = 0;    ///< status error or diverged
+  int timeouts = 0;  ///< status timeout: stopped by the watchdog
   std::string results_file, manifest_file;
 };
 
