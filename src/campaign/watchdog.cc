@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -49,6 +50,7 @@ IsolatedRun RunIsolated(const std::function<std::string()>& body, double budget_
     throw std::runtime_error(fmt::format("cannot start the trial's process: pipe: {}", ::strerror(errno)));
   }
   const Clock::time_point start = Clock::now();
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     const int e = errno;
@@ -57,6 +59,10 @@ IsolatedRun RunIsolated(const std::function<std::string()>& body, double budget_
     throw std::runtime_error(fmt::format("cannot start the trial's process: fork: {}", ::strerror(e)));
   }
   if (pid == 0) {
+    // A campaign killed outright takes its trials with it rather than leave them running
+    // unwatched (the signal comes when the forking thread ends; it outlives its children).
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(4);  // it ended before the line above
     ::close(fds[0]);
     // The body records its own exceptions; one that escapes is a crash like any other.
     const bool written = WriteAll(fds[1], body());
