@@ -192,6 +192,20 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   int status = 0;
   ::waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFSIGNALED(status)) << "the campaign finished before it could be killed";
+  // The trials' processes (the watchdog's children, forked without exec: the same command line)
+  // die with the run at once (within 0.2 s; the trial in flight would go on for about a second):
+  // none is left flying unwatched.
+  const auto running = [&] {
+    int n = 0;
+    for (const auto& entry : fs::directory_iterator("/proc")) {
+      std::string cmdline = ReadText(entry.path() / "cmdline");
+      std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+      if (cmdline.find(killed) != std::string::npos && cmdline.find("campaign run") != std::string::npos) ++n;
+    }
+    return n;
+  };
+  for (int i = 0; i < 20 && running() > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(running(), 0);
   const int recorded = lines();
   EXPECT_GE(recorded, 2);
   EXPECT_LT(recorded, 8);
@@ -207,6 +221,19 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   // The viewer's page of the summary (the CI build always has the viewer) names the campaign.
   const std::string page = ReadText(fs::path(whole) / "summary.html");
   EXPECT_NE(page.find("kill_test"), std::string::npos);
+  // The watchdog: a budget of 0.01 s per simulated second (0.03 s for these 3 s flights) stops
+  // every trial; each is recorded as a timeout with the command that flies it, and the run exits 0.
+  const std::string watched = (dir_ / "watched").string();
+  const Result timed_out = Cli("campaign run " + spec + " --out " + watched + " --trial-timeout 0.01 --quiet");
+  EXPECT_EQ(timed_out.exit_code, 0) << timed_out.out;
+  EXPECT_NE(timed_out.out.find("0 error or diverged, 8 timed out"), std::string::npos) << timed_out.out;
+  const std::string watched_lines = ReadText(fs::path(watched) / "results.jsonl");
+  EXPECT_EQ(std::count(watched_lines.begin(), watched_lines.end(), '\n'), 8);
+  EXPECT_NE(watched_lines.find("\"status\":\"timeout\""), std::string::npos) << watched_lines;
+  EXPECT_NE(watched_lines.find("reproduce: rotorguard run "), std::string::npos) << watched_lines;
+  const Result negative = Cli("campaign run " + spec + " --out " + (dir_ / "n").string() + " --trial-timeout -1");
+  EXPECT_EQ(negative.exit_code, 2);
+  EXPECT_NE(negative.out.find("--trial-timeout"), std::string::npos) << negative.out;
   // Without --resume the results are not touched; shard and spec errors exit 2.
   const std::string before = ReadText(results);
   EXPECT_EQ(Cli("campaign run " + spec + " --out " + killed).exit_code, 2);
