@@ -6,9 +6,11 @@
 /// from them (ScenarioKeyTables).
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/key_table.h"
 
 namespace rotorguard::harness {
 
@@ -121,12 +123,26 @@ struct StackKeys {
   }
 };
 
-/// docs/scenarios.md's key tables: a Markdown section per block (the top level, initial, sim,
-/// sensors, wind, world, metrics, each mission type, stack), every key with its default, what it
-/// accepts and its meaning, written from the declarations above and the modules' own.
+/// One of docs/scenarios.md's key tables: its heading, the prefix its keys are written with
+/// ("stack.nmpc.") and its rows.
+struct KeyTableSection {
+  std::string title;
+  std::string prefix;
+  std::vector<io::KeyRow> rows;
+};
+
+/// Every key of a scenario file, a section per block (the top level, initial, world, sim, sensors,
+/// wind, each mission type, stack and its blocks, metrics), from the declarations above and the
+/// modules' own.
+std::vector<KeyTableSection> ScenarioKeySections();
+
+/// docs/scenarios.md's key tables: ScenarioKeySections in Markdown, every key with its default,
+/// what it accepts and its meaning.
 std::string ScenarioKeyTables();
 
-/// docs/scenarios.md's table of a vehicle file's keys (vehicle::VehicleParams's declaration).
+/// The keys of a vehicle file (vehicle::VehicleParams's declaration) ...
+std::vector<io::KeyRow> VehicleKeyRows();
+/// ... and docs/scenarios.md's table of them.
 std::string VehicleKeyTable();
 
 }  // namespace rotorguard::harness
