@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/vehicle/multirotor.h"
 
 namespace rotorguard::control {
@@ -14,28 +15,13 @@ using vehicle::StateIndex;
 // A measurement later than this after the previous one restarts the velocity and rate estimates.
 constexpr double kMaxGapS = 0.1;
 
-void RequirePositive(const char* field, double v) {
-  if (!std::isfinite(v) || v <= 0.0) ThrowValidation("DisturbanceObserverOptions", field, v, "a value > 0");
-}
-
 Eigen::Vector3d Clamped(const Eigen::Vector3d& v, double max_norm) {
   const double n = v.norm();
   return n > max_norm ? Eigen::Vector3d(v * (max_norm / n)) : v;
 }
 }  // namespace
 
-void DisturbanceObserverOptions::Validate() const {
-  RequirePositive("force_bandwidth_rad_s", force_bandwidth_rad_s);
-  RequirePositive("torque_bandwidth_rad_s", torque_bandwidth_rad_s);
-  RequirePositive("max_acceleration_m_s2", max_acceleration_m_s2);
-  if (!std::isfinite(torque_bandwidth_after_failure_rad_s) || torque_bandwidth_after_failure_rad_s < 0.0) {
-    ThrowValidation("DisturbanceObserverOptions", "torque_bandwidth_after_failure_rad_s",
-                    torque_bandwidth_after_failure_rad_s, "a value >= 0");
-  }
-  RequirePositive("max_angular_acceleration_rad_s2", max_angular_acceleration_rad_s2);
-  if (!std::isfinite(min_altitude_m))
-    ThrowValidation("DisturbanceObserverOptions", "min_altitude_m", min_altitude_m, "finite");
-}
+void DisturbanceObserverOptions::Validate() const { CheckDeclaredRanges("DisturbanceObserverOptions", *this); }
 
 DisturbanceObserver::DisturbanceObserver(const NmpcModel& model, const DisturbanceObserverOptions& options)
     : model_(model), options_((options.Validate(), options)) {

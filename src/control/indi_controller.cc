@@ -1,22 +1,22 @@
 #include "rotorguard/control/indi_controller.h"
 
+#include <fmt/format.h>
+
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include <Eigen/LU>
-#include <fmt/format.h>
-
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::control {
 
 void IndiControllerOptions::Validate() const {
-  position.Validate("IndiControllerOptions.position");
-  if (!(k_h > 0.0) || !std::isfinite(k_h)) ThrowValidation("IndiControllerOptions", "k_h", k_h, "> 0");
-  if (!(d_h > 0.0) || !std::isfinite(d_h)) ThrowValidation("IndiControllerOptions", "d_h", d_h, "> 0");
-  if (!(opposite_ratio >= 0.0 && opposite_ratio < 1.0)) {
+  position.Validate("IndiControllerOptions.position");  // its open end
+  CheckDeclaredRanges("IndiControllerOptions", *this);
+  if (opposite_ratio >= 1.0) {  // the declared range's open end
     ThrowValidation("IndiControllerOptions", "opposite_ratio", opposite_ratio, "a ratio in [0, 1)");
   }
   if (!(sample_hz > 0.0) || !std::isfinite(sample_hz)) {

@@ -1,12 +1,14 @@
 
+#include "rotorguard/control/nmpc.h"
+
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include <fmt/format.h>
-
-#include "rotorguard/control/nmpc.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/vehicle/effectiveness.h"
@@ -20,11 +22,6 @@ using vehicle::StateIndex;
 // Regularises the reduced-attitude decomposition at a 180 degree tilt (where w^2 + z^2 = 0).
 constexpr double kDecompositionEpsilon = 1e-9;
 
-void RequireNonNegative(const char* field, const Eigen::VectorXd& v) {
-  if (!v.allFinite() || v.minCoeff() < 0.0) {
-    ThrowValidation("NmpcOptions", field, "(a negative or non-finite entry)", "finite values >= 0");
-  }
-}
 }  // namespace
 
 std::string_view ToString(NmpcStatus status) {
@@ -46,30 +43,9 @@ std::string NmpcSummary::BriefReport() const {
 }
 
 void NmpcOptions::Validate() const {
-  if (horizon_steps < 1 || horizon_steps > 200) {
-    ThrowValidation("NmpcOptions", "horizon_steps", horizon_steps, "an integer in [1, 200]");
-  }
-  if (!(step_s > 0.0) || step_s > 1.0) ThrowValidation("NmpcOptions", "step_s", step_s, "a step in (0, 1] s");
-  if (integrator_substeps < 1 || integrator_substeps > 20) {
-    ThrowValidation("NmpcOptions", "integrator_substeps", integrator_substeps, "an integer in [1, 20]");
-  }
-  RequireNonNegative("q_position", q_position);
-  RequireNonNegative("q_attitude", q_attitude);
-  RequireNonNegative("q_velocity", q_velocity);
-  RequireNonNegative("q_rate", q_rate);
-  if (!std::isfinite(q_thrust) || q_thrust < 0.0) ThrowValidation("NmpcOptions", "q_thrust", q_thrust, "a value >= 0");
-  if (!std::isfinite(r_input) || r_input <= 0.0) ThrowValidation("NmpcOptions", "r_input", r_input, "a value > 0");
-  if (!max_rate_rad_s.allFinite() || max_rate_rad_s.minCoeff() <= 0.0) {
-    ThrowValidation("NmpcOptions", "max_rate_rad_s", "(a non-positive entry)", "rates > 0");
-  }
-  if (max_sqp_iterations < 1 || max_sqp_iterations > 1000) {
-    ThrowValidation("NmpcOptions", "max_sqp_iterations", max_sqp_iterations, "an integer in [1, 1000]");
-  }
+  CheckDeclaredRanges("NmpcOptions", *this);
   if (!(sqp_tolerance > 0.0) || !std::isfinite(sqp_tolerance)) {
     ThrowValidation("NmpcOptions", "sqp_tolerance", sqp_tolerance, "a value > 0");
-  }
-  if (relinearise_every < 1 || relinearise_every > 20) {
-    ThrowValidation("NmpcOptions", "relinearise_every", relinearise_every, "an integer in [1, 20]");
   }
   disturbance.Validate();
   qp.Validate();

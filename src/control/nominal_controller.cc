@@ -5,26 +5,14 @@
 #include <numbers>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/math.h"
 
 namespace rotorguard::control {
 
-namespace {
-void RequirePositive(const char* field, const Vector3& v) {
-  if (!v.allFinite() || v.minCoeff() <= 0.0) {
-    ThrowValidation("NominalControllerOptions", field, "(a non-positive or non-finite entry)",
-                    "finite values > 0");
-  }
-}
-}  // namespace
-
 void NominalControllerOptions::Validate() const {
-  position.Validate("NominalControllerOptions");
-  RequirePositive("k_attitude", k_attitude);
-  RequirePositive("k_rate", k_rate);
-  if (!std::isfinite(max_rate_rad_s) || max_rate_rad_s <= 0.0) {
-    ThrowValidation("NominalControllerOptions", "max_rate_rad_s", max_rate_rad_s, "a rate > 0");
-  }
+  position.Validate("NominalControllerOptions");  // its open end
+  CheckDeclaredRanges("NominalControllerOptions", *this);
 }
 
 CascadedWrenchLaw::CascadedWrenchLaw(const vehicle::VehicleParams& vehicle, const NominalControllerOptions& options)

@@ -5,14 +5,13 @@
 #include <numbers>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::control {
 
 void PassiveControllerOptions::Validate() const {
-  position.Validate("PassiveControllerOptions");
-  if (!(k_tilt > 0.0)) ThrowValidation("PassiveControllerOptions", "k_tilt", k_tilt, "> 0");
-  if (!(k_rate > 0.0)) ThrowValidation("PassiveControllerOptions", "k_rate", k_rate, "> 0");
-  if (!(regularisation > 0.0)) ThrowValidation("PassiveControllerOptions", "regularisation", regularisation, "> 0");
+  position.Validate("PassiveControllerOptions");  // its open end
+  CheckDeclaredRanges("PassiveControllerOptions", *this);
 }
 
 PassiveController::PassiveController(const vehicle::MultirotorModel& model, const PassiveControllerOptions& options)

@@ -5,18 +5,13 @@
 #include <numbers>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::control {
 
 void PositionLoopOptions::Validate(const std::string& owner) const {
-  for (const auto& [field, v] : {std::pair{"kp_position", kp_position}, std::pair{"kd_velocity", kd_velocity},
-                                 std::pair{"ki_position", ki_position}}) {
-    if (!v.allFinite() || v.minCoeff() < 0.0) ThrowValidation(owner, field, "(a negative or non-finite entry)", "finite values >= 0");
-  }
-  if (!std::isfinite(integral_limit_m_s2) || integral_limit_m_s2 < 0.0) {
-    ThrowValidation(owner, "integral_limit_m_s2", integral_limit_m_s2, "a value >= 0");
-  }
-  if (!std::isfinite(max_tilt_rad) || max_tilt_rad <= 0.0 || max_tilt_rad >= 0.5 * std::numbers::pi) {
+  CheckDeclaredRanges(owner, *this);
+  if (max_tilt_rad >= 0.5 * std::numbers::pi) {  // the declared range's open end: tan() of it is infinite
     ThrowValidation(owner, "max_tilt_rad", max_tilt_rad, "an angle in (0, pi/2)");
   }
 }

@@ -12,71 +12,78 @@ namespace rotorguard::harness {
 
 namespace {
 
-/// "### `section`" and the table of `keys`' rows, each key prefixed by `prefix`.
+/// The rows of `keys`.
 template <typename Keys>
-std::string Section(const std::string& title, const std::string& prefix, Keys keys) {
+std::vector<io::KeyRow> RowsOf(Keys keys) {
   io::KeyTableWriter writer;
   keys.Serialize(&writer);
-  return fmt::format("### {}\n\n{}\n", title, io::KeyTableMarkdown(writer.rows(), prefix));
+  return writer.rows();
 }
 
-/// The stack's keys as a table of its own scalars and one table per block (stack.nmpc, ...).
-std::string StackSections(Scenario* d) {
-  io::KeyTableWriter writer;
-  StackKeys{d}.Serialize(&writer);
-  std::vector<io::KeyRow> scalars;
-  std::vector<std::pair<std::string, std::vector<io::KeyRow>>> blocks;  // in the order declared
-  for (io::KeyRow row : writer.rows()) {
+/// The section titled `title` of `keys`, each key prefixed by `prefix`.
+template <typename Keys>
+KeyTableSection Section(const std::string& title, const std::string& prefix, Keys keys) {
+  return {title, prefix, RowsOf(keys)};
+}
+
+/// The stack's keys as a section of its own scalars and one section per block (stack.nmpc, ...).
+void AddStackSections(Scenario* d, std::vector<KeyTableSection>* sections) {
+  KeyTableSection scalars{"`stack`", "stack.", {}};
+  std::vector<KeyTableSection> blocks;  // in the order declared
+  for (io::KeyRow row : RowsOf(StackKeys{d})) {
     const std::size_t end = row.key.find_first_of(".[");
     if (end == std::string::npos) {
-      scalars.push_back(row);
+      scalars.rows.push_back(row);
       continue;
     }
     const std::string block = row.key.substr(0, end);
-    if (blocks.empty() || blocks.back().first != block) blocks.emplace_back(block, std::vector<io::KeyRow>{});
-    blocks.back().second.push_back(row);
+    const std::string title = fmt::format("`stack.{}`", block);
+    if (blocks.empty() || blocks.back().title != title) blocks.push_back({title, "stack.", {}});
+    blocks.back().rows.push_back(row);
   }
-  std::string md = fmt::format("### `stack`\n\n{}\n", io::KeyTableMarkdown(scalars, "stack."));
-  for (const auto& [block, rows] : blocks) {
-    md += fmt::format("### `stack.{}`\n\n{}\n", block, io::KeyTableMarkdown(rows, "stack."));
-  }
-  return md;
+  sections->push_back(std::move(scalars));
+  sections->insert(sections->end(), blocks.begin(), blocks.end());
 }
 
 template <typename Options>
-std::string MissionSection(MissionKind kind, Options options) {
+KeyTableSection MissionSection(MissionKind kind, Options options) {
   const std::string type = ToName(kind);
   return Section(fmt::format("`mission` with `type: {}`", type), "mission.", options);
 }
 
 }  // namespace
 
-std::string ScenarioKeyTables() {
+std::vector<KeyTableSection> ScenarioKeySections() {
   Scenario d;  // every default, as a scenario without the key has it
+  std::vector<KeyTableSection> s;
+  s.push_back(Section("The top level", "", HeaderKeys{&d, ""}));
+  s.push_back(Section("`initial`", "initial.", InitialKeys{&d}));
+  s.push_back(Section("`world`", "world.", d.world));
+  s.push_back(Section("`sim`", "sim.", SimKeys{&d}));
+  s.push_back(Section("`sensors`", "sensors.", SensorsKeys{&d.sim}));
+  s.push_back(Section("`wind`", "wind.", d.sim.wind));
+  s.push_back(MissionSection(MissionKind::kHover, planning::HoverOptions{}));
+  s.push_back(MissionSection(MissionKind::kTakeoff, planning::TakeoffOptions{}));
+  s.push_back(MissionSection(MissionKind::kLemniscate, planning::LemniscateOptions{}));
+  s.push_back(MissionSection(MissionKind::kCircle, planning::CircleOptions{}));
+  s.push_back(MissionSection(MissionKind::kWaypoints, planning::WaypointOptions{}));
+  s.push_back(MissionSection(MissionKind::kNavigate, NavigateSpec{}));
+  s.push_back(MissionSection(MissionKind::kAssemblyPlan, AssemblyPlanSpec{}));
+  AddStackSections(&d, &s);
+  s.push_back(Section("`metrics`", "metrics.", MetricsKeys{&d}));
+  return s;
+}
+
+std::string ScenarioKeyTables() {
   std::string md;
-  md += Section("The top level", "", HeaderKeys{&d, ""});
-  md += Section("`initial`", "initial.", InitialKeys{&d});
-  md += Section("`world`", "world.", d.world);
-  md += Section("`sim`", "sim.", SimKeys{&d});
-  md += Section("`sensors`", "sensors.", SensorsKeys{&d.sim});
-  md += Section("`wind`", "wind.", d.sim.wind);
-  md += MissionSection(MissionKind::kHover, planning::HoverOptions{});
-  md += MissionSection(MissionKind::kTakeoff, planning::TakeoffOptions{});
-  md += MissionSection(MissionKind::kLemniscate, planning::LemniscateOptions{});
-  md += MissionSection(MissionKind::kCircle, planning::CircleOptions{});
-  md += MissionSection(MissionKind::kWaypoints, planning::WaypointOptions{});
-  md += MissionSection(MissionKind::kNavigate, NavigateSpec{});
-  md += MissionSection(MissionKind::kAssemblyPlan, AssemblyPlanSpec{});
-  md += StackSections(&d);
-  md += Section("`metrics`", "metrics.", MetricsKeys{&d});
+  for (const KeyTableSection& s : ScenarioKeySections()) {
+    md += fmt::format("### {}\n\n{}\n", s.title, io::KeyTableMarkdown(s.rows, s.prefix));
+  }
   return md;
 }
 
-std::string VehicleKeyTable() {
-  io::KeyTableWriter writer;
-  vehicle::VehicleParams defaults;
-  defaults.Serialize(&writer);
-  return io::KeyTableMarkdown(writer.rows(), "");
-}
+std::vector<io::KeyRow> VehicleKeyRows() { return RowsOf(vehicle::VehicleParams{}); }
+
+std::string VehicleKeyTable() { return io::KeyTableMarkdown(VehicleKeyRows(), ""); }
 
 }  // namespace rotorguard::harness

@@ -100,7 +100,7 @@ modular::Assembly LoadAssembly(const std::string& path) {
   } catch (const io::InputFileError& e) {
     throw io::InputFileError(e.path(), fmt::format("{} (named by 'unit' at {})", e.reason(), unit.Location()));
   }
-  spec.spacing_m = root.Required("spacing_m").AsPositive();
+  spec.spacing_m = root.Required("spacing_m").AsPositiveAtMost(modular::kMaxSpacingM);
   if (root.Has("shape") == root.Has("slots")) root.Fail("expected exactly one of 'shape' and 'slots'");
   if (const auto shape = root.Optional("shape")) {
     spec.slots = modular::ShapeSlots(shape->AsEnum({"3x1", "4x1", "3x2", "3x3", "3x3_plus"}));

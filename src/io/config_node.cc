@@ -169,6 +169,15 @@ double ConfigNode::AsPositive() const {
   return value;
 }
 
+double ConfigNode::AsPositiveAtMost(double hi) const {
+  const std::string expected = fmt::format("a number in (0, {}]", hi);
+  const double value = ParseFinite(expected);
+  if (!(value > 0.0 && value <= hi)) {
+    Fail(fmt::format("{} is out of range; expected {}", Quote(value_->scalar), expected));
+  }
+  return value;
+}
+
 double ConfigNode::AsNonNegative() const {
   const std::string expected = "a non-negative number (>= 0)";
   const double value = ParseFinite(expected);

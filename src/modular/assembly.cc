@@ -33,9 +33,10 @@ void AssemblySpec::Validate() const {
   // both sides of the shared edge.
   double extent = 0.0;
   for (const vehicle::Rotor& r : unit.rotors) extent = std::max({extent, std::abs(r.p_B.x()), std::abs(r.p_B.y())});
-  if (!(std::isfinite(spacing_m) && spacing_m > 2.0 * extent)) {
+  if (!(std::isfinite(spacing_m) && spacing_m > 2.0 * extent && spacing_m <= kMaxSpacingM)) {
     ThrowValidation(kOwner, "spacing_m", spacing_m,
-                    fmt::format("a docking distance > {:.4g} m (twice the unit's largest rotor offset)", 2.0 * extent));
+                    fmt::format("a docking distance > {:.4g} m (twice the unit's largest rotor offset), at most {:g} m",
+                                2.0 * extent, kMaxSpacingM));
   }
 }
 

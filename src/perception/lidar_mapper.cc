@@ -3,15 +3,14 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::perception {
 
 void LidarMapperOptions::Validate() const {
   deskew.Validate();
   map.Validate();
-  if (!(std::isfinite(inflation_margin_m) && inflation_margin_m >= 0.0)) {
-    ThrowValidation("LidarMapperOptions", "inflation_margin_m", inflation_margin_m, "a distance >= 0 m");
-  }
+  CheckDeclaredRanges("LidarMapperOptions", *this);
 }
 
 LidarMapper::LidarMapper(const LidarMapperOptions& options) : options_(options), deskewer_(options.deskew) {

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/math.h"
 
 namespace rotorguard::perception {
@@ -20,45 +21,13 @@ constexpr double kOnGroundM = 0.05;
 }  // namespace
 
 void LioOptions::Validate() const {
-  const auto require = [](bool ok, const char* key, double value, const char* rule) {
-    if (!ok) ThrowValidation("LioOptions", key, value, rule);
-  };
-  const auto positive = [&](double v, const char* key) { require(std::isfinite(v) && v > 0.0, key, v, "a value > 0"); };
+  CheckDeclaredRanges("LioOptions", *this);  // its keys; the map validates itself below
   if (!imu_position_m.allFinite()) ThrowValidation("LioOptions", "imu_position_m", "(non-finite)", "finite numbers");
   if (!lidar_position_m.allFinite())
     ThrowValidation("LioOptions", "lidar_position_m", "(non-finite)", "finite numbers");
-  positive(accel_noise_density, "accel_noise_density");
-  positive(gyro_noise_density, "gyro_noise_density");
-  positive(accel_bias_random_walk, "accel_bias_random_walk");
-  positive(gyro_bias_random_walk, "gyro_bias_random_walk");
-  positive(accel_bias_initial, "accel_bias_initial");
-  positive(gyro_bias_initial, "gyro_bias_initial");
-  positive(initial_position_std_m, "initial_position_std_m");
-  positive(initial_attitude_std_rad, "initial_attitude_std_rad");
-  positive(initial_velocity_std_m_s, "initial_velocity_std_m_s");
-  require(initial_samples >= 1 && initial_samples <= 1000, "initial_samples", initial_samples, "a count in [1, 1000]");
-  require(std::isfinite(min_range_m) && min_range_m >= 0.0 && min_range_m <= 100.0, "min_range_m", min_range_m,
-          "a range in [0, 100] m");
-  require(point_stride >= 1 && point_stride <= 100, "point_stride", point_stride, "a count in [1, 100]");
-  require(std::isfinite(frame_voxel_m) && frame_voxel_m >= 0.05 && frame_voxel_m <= 5.0, "frame_voxel_m", frame_voxel_m,
-          "an edge in [0.05, 5] m");
-  require(plane_points >= 3 && plane_points <= 16, "plane_points", plane_points, "a count in [3, 16]");
-  require(std::isfinite(plane_search_radius_m) && plane_search_radius_m > 0.0 && plane_search_radius_m <= map.voxel_m,
-          "plane_search_radius_m", plane_search_radius_m, "a radius in (0, map.voxel_m] m");
-  positive(plane_tolerance_m, "plane_tolerance_m");
-  require(std::isfinite(min_plane_width_m) && min_plane_width_m >= 0.0 && min_plane_width_m <= 1.0, "min_plane_width_m",
-          min_plane_width_m, "a width in [0, 1] m");
-  positive(max_residual_m, "max_residual_m");
-  positive(point_std_m, "point_std_m");
-  require(max_iterations >= 1 && max_iterations <= 20, "max_iterations", max_iterations, "a count in [1, 20]");
-  positive(convergence_m, "convergence_m");
-  positive(convergence_rad, "convergence_rad");
-  require(min_points >= 6, "min_points", min_points, "a count >= 6");
-  positive(degenerate_std_m, "degenerate_std_m");
-  require(std::isfinite(max_queue_s) && max_queue_s >= 0.01 && max_queue_s <= 10.0, "max_queue_s", max_queue_s,
-          "a time in [0.01, 10] s");
-  require(prune_every_frames >= 1 && prune_every_frames <= 100000, "prune_every_frames", prune_every_frames,
-          "a count in [1, 100000]");
+  if (!(plane_search_radius_m <= map.voxel_m)) {
+    ThrowValidation("LioOptions", "plane_search_radius_m", plane_search_radius_m, "a radius in (0, map.voxel_m] m");
+  }
   map.Validate();
 }
 

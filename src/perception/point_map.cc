@@ -4,23 +4,21 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::perception {
 
 void PointMapOptions::Validate() const {
+  CheckDeclaredRanges("PointMapOptions", *this);
+  // The rules between keys.
   const auto require = [](bool ok, const char* key, double value, const char* rule) {
     if (!ok) ThrowValidation("PointMapOptions", key, value, rule);
   };
-  require(std::isfinite(voxel_m) && voxel_m >= 0.05 && voxel_m <= 10.0, "voxel_m", voxel_m, "an edge in [0.05, 10] m");
-  require(max_points_per_voxel >= 1 && max_points_per_voxel <= kMaxPointsPerVoxel, "max_points_per_voxel",
-          max_points_per_voxel, "a count in [1, 32]");
-  require(std::isfinite(min_point_spacing_m) && min_point_spacing_m >= 0.0 && min_point_spacing_m < voxel_m,
-          "min_point_spacing_m", min_point_spacing_m, "a distance in [0, voxel_m) m");
+  require(min_point_spacing_m < voxel_m, "min_point_spacing_m", min_point_spacing_m, "a distance in [0, voxel_m) m");
   // Pruning goes by blocks of 4 voxels a side, whose centre lies up to 2 sqrt(3) voxel_m from
   // their points: from 6 voxel_m on, the vehicle's own block and every voxel within one edge of
   // it stay (2 sqrt(3) + 1 < 6).
-  require(std::isfinite(window_radius_m) && window_radius_m >= 6.0 * voxel_m && window_radius_m <= 1e4,
-          "window_radius_m", window_radius_m, "a radius in [6 voxel_m, 1e4] m");
+  require(window_radius_m >= 6.0 * voxel_m, "window_radius_m", window_radius_m, "a radius in [6 voxel_m, 1e4] m");
 }
 
 PointMap::PointMap(const PointMapOptions& options) : options_(options) {

@@ -11,6 +11,7 @@
 #endif
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::perception {
 
@@ -21,32 +22,24 @@ using internal::PositiveMod;
 }  // namespace
 
 void VoxelMapOptions::Validate() const {
+  CheckDeclaredRanges("VoxelMapOptions", *this);
+  // The rules between keys and the declared ranges' open ends.
   const auto require = [](bool ok, const char* field, double v, const char* rule) {
     if (!ok) ThrowValidation("VoxelMapOptions", field, v, rule);
   };
-  require(std::isfinite(resolution_m) && resolution_m > 0.0, "resolution_m", resolution_m, "a voxel edge > 0 m");
   for (int k = 0; k < 3; ++k) {
     require(std::isfinite(window_size_m[k]) && window_size_m[k] > resolution_m &&
                 window_size_m[k] / resolution_m <= 4096.0,
             "window_size_m", window_size_m[k], "extents above resolution_m, at most 4096 voxels each");
   }
-  require(log_odds_hit > 0.0 && log_odds_hit <= 30.0, "log_odds_hit", log_odds_hit, "in (0, 30]");
-  require(log_odds_miss >= -30.0 && log_odds_miss < 0.0, "log_odds_miss", log_odds_miss, "in [-30, 0)");
-  require(log_odds_min >= -30.0 && log_odds_min < 0.0, "log_odds_min", log_odds_min, "in [-30, 0)");
-  require(log_odds_max > 0.0 && log_odds_max <= 30.0, "log_odds_max", log_odds_max, "in (0, 30]");
+  require(log_odds_miss < 0.0, "log_odds_miss", log_odds_miss, "in [-30, 0)");
+  require(log_odds_min < 0.0, "log_odds_min", log_odds_min, "in [-30, 0)");
   require(occupied_threshold > 0.0 && occupied_threshold < log_odds_max, "occupied_threshold", occupied_threshold,
           "a log-odds in (0, log_odds_max)");
   require(std::isfinite(inflation_radius_m) && inflation_radius_m >= 0.0 && inflation_radius_m <= 100.0 * resolution_m,
           "inflation_radius_m", inflation_radius_m, "a radius in [0, 100 voxels]");
-  require(std::isfinite(max_clearing_range_m) && max_clearing_range_m > 0.0, "max_clearing_range_m",
-          max_clearing_range_m, "a range > 0 m");
-  if (clearing_stride < 1 || clearing_stride > kMaxClearingStride) {
-    ThrowValidation("VoxelMapOptions", "clearing_stride", clearing_stride,
-                    fmt::format("an integer in [1, {}]", kMaxClearingStride));
-  }
-  require(std::isfinite(recenter_hysteresis_m) && recenter_hysteresis_m >= 0.0 &&
-              recenter_hysteresis_m <= 0.25 * window_size_m.minCoeff(),
-          "recenter_hysteresis_m", recenter_hysteresis_m, "a distance in [0, a quarter of the smallest window extent] m");
+  require(recenter_hysteresis_m <= 0.25 * window_size_m.minCoeff(), "recenter_hysteresis_m", recenter_hysteresis_m,
+          "a distance in [0, a quarter of the smallest window extent] m");
   const double voxels = (window_size_m / resolution_m).prod();
   require(voxels <= 64e6, "window_size_m", voxels, "at most 64 million voxels");
 }

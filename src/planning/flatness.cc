@@ -24,8 +24,9 @@ void FlatnessLimits::Validate() const {
   angle("theta_max_rad", theta_max_rad);
   angle("phi_max_rad", phi_max_rad);
   if (!(rho_angle > 0.0 && rho_angle <= 1.0)) ThrowValidation("FlatnessLimits", "rho_angle", rho_angle, "in (0, 1]");
-  if (!(std::isfinite(u_max) && u_max >= 0.0)) {
-    ThrowValidation("FlatnessLimits", "u_max", u_max, "a PWM input > 0 (or 0 for the vehicle's)");
+  if (!(u_max >= 0.0 && u_max <= kMaxPwmInput)) {
+    ThrowValidation("FlatnessLimits", "u_max", u_max,
+                    fmt::format("a PWM input in (0, {:g}] (or 0 for the vehicle's)", kMaxPwmInput));
   }
   if (!(rho_u > 0.0 && rho_u <= 1.0)) ThrowValidation("FlatnessLimits", "rho_u", rho_u, "in (0, 1]");
 }

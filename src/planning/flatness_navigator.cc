@@ -9,18 +9,23 @@
 namespace rotorguard::planning {
 
 void FlatnessNavigatorOptions::Validate() const {
+  // The limits may be infinite in code (no envelope bound), which their keys, in degrees, are not:
+  // they check themselves, and the times are checked here.
   limits.Validate();
-  const auto positive = [](const char* field, double v) {
-    if (!(std::isfinite(v) && v > 0.0)) ThrowValidation("FlatnessNavigatorOptions", field, v, "a time > 0 s");
+  const std::string times = fmt::format("a time in (0, {:g}] s", kMaxTimeoutS);
+  const auto positive = [&](const char* field, double v) {
+    if (!(v > 0.0 && v <= kMaxTimeoutS)) ThrowValidation("FlatnessNavigatorOptions", field, v, times);
   };
   positive("hold_t_s", hold_t_s);
   positive("time_budget_s", time_budget_s);
   positive("min_t_s", min_t_s);
-  if (!(std::isfinite(min_hold_s) && min_hold_s >= 0.0)) {
-    ThrowValidation("FlatnessNavigatorOptions", "min_hold_s", min_hold_s, "a time >= 0 s");
+  if (!(min_hold_s >= 0.0 && min_hold_s <= kMaxTimeoutS)) {
+    ThrowValidation("FlatnessNavigatorOptions", "min_hold_s", min_hold_s,
+                    fmt::format("a time in [0, {:g}] s", kMaxTimeoutS));
   }
-  if (!(std::isfinite(max_hold_s) && max_hold_s >= min_hold_s)) {
-    ThrowValidation("FlatnessNavigatorOptions", "max_hold_s", max_hold_s, "a time >= min_hold_s");
+  if (!(max_hold_s >= min_hold_s && max_hold_s <= kMaxTimeoutS)) {
+    ThrowValidation("FlatnessNavigatorOptions", "max_hold_s", max_hold_s,
+                    fmt::format("a time in [min_hold_s, {:g}] s", kMaxTimeoutS));
   }
 }
 

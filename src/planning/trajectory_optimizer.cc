@@ -1,11 +1,13 @@
 
+#include "rotorguard/planning/trajectory_optimizer.h"
+
 #include <algorithm>
 #include <limits>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/planning/lbfgs.h"
-#include "rotorguard/planning/trajectory_optimizer.h"
 
 namespace rotorguard::planning {
 
@@ -23,12 +25,12 @@ void Unpack(const Eigen::VectorXd& x, int pieces, Eigen::Matrix3Xd* q, Eigen::Ve
 }  // namespace
 
 void DynamicLimits::Validate() const {
-  const auto require = [](double v, const char* field) {
-    if (!(std::isfinite(v) && v > 0.0)) ThrowValidation("DynamicLimits", field, v, "a finite limit > 0");
+  const auto require = [](double v, const char* field, double max) {
+    if (!(v > 0.0 && v <= max)) ThrowValidation("DynamicLimits", field, v, fmt::format("a limit in (0, {:g}]", max));
   };
-  require(v_max, "v_max");
-  require(a_max, "a_max");
-  require(j_max, "j_max");
+  require(v_max, "v_max", kMaxSpeedMS);
+  require(a_max, "a_max", kMaxAccelerationMS2);
+  require(j_max, "j_max", kMaxJerkMS3);
 }
 
 double PostFailureAccelerationLimit(double mass_kg, double rotor_max_thrust_n, double max_drag_coefficient_kg_s,
@@ -60,12 +62,11 @@ void TrajectoryOptimizerOptions::Validate() const {
   const auto require = [](bool ok, const char* field, double v, const char* rule) {
     if (!ok) ThrowValidation("TrajectoryOptimizerOptions", field, v, rule);
   };
-  for (const auto& [v, f] : {std::pair{weights.time, "weights.time"}, std::pair{weights.smoothness, "weights.smoothness"},
-                             std::pair{weights.feasibility, "weights.feasibility"},
-                             std::pair{weights.collision, "weights.collision"}}) {
-    require(std::isfinite(v) && v >= 0.0, f, v, "a finite weight >= 0");
+  CheckDeclaredRanges("TrajectoryOptimizerOptions", weights, "weights.");
+  if (!(clearance_m >= 0.0 && clearance_m <= kMaxClearanceM)) {
+    ThrowValidation("TrajectoryOptimizerOptions", "clearance_m", clearance_m,
+                    fmt::format("a distance in [0, {:g}] m", kMaxClearanceM));
   }
-  require(std::isfinite(clearance_m) && clearance_m >= 0.0, "clearance_m", clearance_m, "a distance >= 0 m");
   require(samples_per_piece >= 2 && samples_per_piece <= 1000, "samples_per_piece", samples_per_piece, "in [2, 1000]");
   require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
   require(relative_cost_tolerance > 0.0 && relative_cost_tolerance <= 0.1, "relative_cost_tolerance",

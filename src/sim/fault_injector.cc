@@ -1,10 +1,11 @@
 #include "rotorguard/sim/fault_injector.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
 
-#include <fmt/format.h>
-
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/error.h"
 
 namespace rotorguard::sim {
@@ -31,8 +32,9 @@ void FaultSpec::Validate(int index, int num_rotors, double duration_s) const {
       }
       break;
     case FaultOnset::Kind::kAtAltitude:
-      if (!std::isfinite(onset.value) || onset.value <= 0.0) {
-        ThrowValidation("FaultSpec", onset_prefix + "at_altitude_m", onset.value, "an altitude > 0 m");
+      if (!std::isfinite(onset.value) || onset.value <= 0.0 || onset.value > kMaxCoordinateM) {
+        ThrowValidation("FaultSpec", onset_prefix + "at_altitude_m", onset.value,
+                        fmt::format("an altitude in (0, {:g}] m", kMaxCoordinateM));
       }
       break;
     case FaultOnset::Kind::kDuringTakeoff:
@@ -43,11 +45,12 @@ void FaultSpec::Validate(int index, int num_rotors, double duration_s) const {
       break;
   }
   if (intermittent) {
-    if (!std::isfinite(intermittent->on_s) || intermittent->on_s <= 0.0) {
-      ThrowValidation("FaultSpec", prefix + "intermittent.on_s", intermittent->on_s, "a period > 0 s");
+    const std::string period = fmt::format("a period in (0, {:g}] s", kMaxFlightS);
+    if (!std::isfinite(intermittent->on_s) || intermittent->on_s <= 0.0 || intermittent->on_s > kMaxFlightS) {
+      ThrowValidation("FaultSpec", prefix + "intermittent.on_s", intermittent->on_s, period);
     }
-    if (!std::isfinite(intermittent->off_s) || intermittent->off_s <= 0.0) {
-      ThrowValidation("FaultSpec", prefix + "intermittent.off_s", intermittent->off_s, "a period > 0 s");
+    if (!std::isfinite(intermittent->off_s) || intermittent->off_s <= 0.0 || intermittent->off_s > kMaxFlightS) {
+      ThrowValidation("FaultSpec", prefix + "intermittent.off_s", intermittent->off_s, period);
     }
   }
 }

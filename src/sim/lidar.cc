@@ -4,31 +4,25 @@
 #include <numbers>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/math.h"
 
 namespace rotorguard::sim {
 
 void LidarOptions::Validate() const {
-  const auto require = [](bool ok, const char* key, double value, const char* rule) {
-    if (!ok) ThrowValidation("LidarOptions", key, value, rule);
-  };
-  require(std::isfinite(frame_rate_hz) && frame_rate_hz > 0.0 && frame_rate_hz <= 1000.0, "frame_rate_hz",
-          frame_rate_hz, "a rate in (0, 1000] Hz");
-  require(std::isfinite(points_per_s) && points_per_s > 0.0 && points_per_s <= 1e8, "points_per_s", points_per_s,
-          "a rate in (0, 1e8] points/s");
-  require(std::isfinite(min_range_m) && min_range_m >= 0.0, "min_range_m", min_range_m, "a range >= 0 m");
-  require(std::isfinite(max_range_m) && max_range_m > min_range_m && max_range_m <= 1e4, "max_range_m", max_range_m,
-          "a range above min_range_m, at most 1e4 m");
-  require(std::isfinite(min_elevation_rad) && min_elevation_rad >= -0.5 * std::numbers::pi, "min_elevation_rad",
-          min_elevation_rad, "an angle in [-pi/2, max_elevation_rad)");
-  require(std::isfinite(max_elevation_rad) && max_elevation_rad > min_elevation_rad &&
-              max_elevation_rad <= 0.5 * std::numbers::pi,
-          "max_elevation_rad", max_elevation_rad, "an angle in (min_elevation_rad, pi/2]");
-  require(std::isfinite(range_noise_m) && range_noise_m >= 0.0, "range_noise_m", range_noise_m, "a value >= 0 m");
-  require(dropout_probability >= 0.0 && dropout_probability < 1.0, "dropout_probability", dropout_probability,
-          "a probability in [0, 1)");
-  if (!position_m.allFinite()) ThrowValidation("LidarOptions", "position_m", "(non-finite)", "finite numbers");
-  require(std::isfinite(grid_cell_m) && grid_cell_m > 0.0, "grid_cell_m", grid_cell_m, "a cell edge > 0 m");
+  CheckDeclaredRanges("LidarOptions", *this);
+  // The rules between keys, and the open ends of the declared ranges.
+  if (!(max_range_m > min_range_m)) {
+    ThrowValidation("LidarOptions", "max_range_m", max_range_m,
+                    fmt::format("a range above min_range_m = {}", min_range_m));
+  }
+  if (!(max_elevation_rad > min_elevation_rad)) {
+    ThrowValidation("LidarOptions", "max_elevation_rad", max_elevation_rad,
+                    fmt::format("an angle above min_elevation_rad = {}", min_elevation_rad));
+  }
+  if (dropout_probability >= 1.0) {
+    ThrowValidation("LidarOptions", "dropout_probability", dropout_probability, "a probability in [0, 1)");
+  }
 }
 
 LidarPattern::LidarPattern(const LidarOptions& o)

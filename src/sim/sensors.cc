@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/math.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
@@ -28,16 +29,8 @@ Vector3 NormalVector(Rng& rng, double stddev) {
 }  // namespace
 
 void ImuOptions::Validate(double physics_rate_hz) const {
+  CheckDeclaredRanges("ImuOptions", *this);
   RequireRate("ImuOptions", rate_hz, physics_rate_hz);
-  if (!position_m.allFinite()) ThrowValidation("ImuOptions", "position_m", "(non-finite)", "finite numbers");
-  RequireNonNegative("ImuOptions", "accel_noise_density", accel_noise_density);
-  RequireNonNegative("ImuOptions", "gyro_noise_density", gyro_noise_density);
-  RequireNonNegative("ImuOptions", "accel_bias_random_walk", accel_bias_random_walk);
-  RequireNonNegative("ImuOptions", "gyro_bias_random_walk", gyro_bias_random_walk);
-  RequireNonNegative("ImuOptions", "accel_bias_initial", accel_bias_initial);
-  RequireNonNegative("ImuOptions", "gyro_bias_initial", gyro_bias_initial);
-  if (!(accel_range_m_s2 > 0.0)) ThrowValidation("ImuOptions", "accel_range_m_s2", accel_range_m_s2, "a range > 0");
-  if (!(gyro_range_rad_s > 0.0)) ThrowValidation("ImuOptions", "gyro_range_rad_s", gyro_range_rad_s, "a range > 0");
   RequireNonNegative("ImuOptions", "vibration_m_s2", vibration_m_s2);
   if (!(vibration_reference_speed_rad_s > 0.0)) {
     ThrowValidation("ImuOptions", "vibration_reference_speed_rad_s", vibration_reference_speed_rad_s, "a speed > 0");
@@ -46,10 +39,9 @@ void ImuOptions::Validate(double physics_rate_hz) const {
 }
 
 void EscOptions::Validate(double physics_rate_hz) const {
+  CheckDeclaredRanges("EscOptions", *this);
   RequireRate("EscOptions", rate_hz, physics_rate_hz);
-  RequireNonNegative("EscOptions", "noise_rpm", noise_rpm);
-  RequireNonNegative("EscOptions", "quantization_rpm", quantization_rpm);
-  if (!std::isfinite(delay_s) || delay_s < 0.0 || delay_s >= 0.5) {
+  if (delay_s >= 0.5) {  // the declared range's open end
     ThrowValidation("EscOptions", "delay_s", delay_s, "a value in [0, 0.5) s");
   }
   for (std::size_t k = 0; k < gain.size(); ++k) {
@@ -63,15 +55,8 @@ void EscOptions::Validate(double physics_rate_hz) const {
 }
 
 void OdometryOptions::Validate(double physics_rate_hz) const {
+  CheckDeclaredRanges("OdometryOptions", *this);  // the outages' times too
   RequireRate("OdometryOptions", rate_hz, physics_rate_hz);
-  RequireNonNegative("OdometryOptions", "position_noise_m", position_noise_m);
-  RequireNonNegative("OdometryOptions", "velocity_noise_m_s", velocity_noise_m_s);
-  RequireNonNegative("OdometryOptions", "attitude_noise_rad", attitude_noise_rad);
-  RequireNonNegative("OdometryOptions", "rate_noise_gain", rate_noise_gain);
-  for (std::size_t i = 0; i < outages.size(); ++i) {
-    RequireNonNegative("OdometryOptions", fmt::format("outages.{}.start_s", i), outages[i].start_s);
-    RequireNonNegative("OdometryOptions", fmt::format("outages.{}.duration_s", i), outages[i].duration_s);
-  }
   if (!std::isfinite(latency_s) || latency_s < 0.0 || latency_s >= 0.5) {
     ThrowValidation("OdometryOptions", "latency_s", latency_s, "a value in [0, 0.5) s");
   }

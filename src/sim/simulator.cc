@@ -26,8 +26,9 @@ const SimulatorOptions& Simulator::Validated(const SimulatorOptions& options,
 }
 
 void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
-  if (!std::isfinite(physics_rate_hz) || physics_rate_hz <= 0.0 || physics_rate_hz > 1e6) {
-    ThrowValidation("SimulatorOptions", "sim.physics_rate_hz", physics_rate_hz, "a rate in (0, 1e6] Hz");
+  if (!std::isfinite(physics_rate_hz) || physics_rate_hz <= 0.0 || physics_rate_hz > kMaxPhysicsRateHz) {
+    ThrowValidation("SimulatorOptions", "sim.physics_rate_hz", physics_rate_hz,
+                    fmt::format("a rate in (0, {:g}] Hz", kMaxPhysicsRateHz));
   }
   // RK4 on a first-order lag is stable for dt < 2.78 sigma and accurate for dt well below sigma:
   // require dt <= sigma / 2 for the fastest motor time constant.
@@ -57,8 +58,9 @@ void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
                       fmt::format("a rate of at most {:g} Hz (half the physics rate)", 0.5 * physics_rate_hz));
     }
   }
-  if (!std::isfinite(crash_speed_m_s) || crash_speed_m_s <= 0.0) {
-    ThrowValidation("SimulatorOptions", "sim.crash_speed_m_s", crash_speed_m_s, "a speed > 0 m/s");
+  if (!std::isfinite(crash_speed_m_s) || crash_speed_m_s <= 0.0 || crash_speed_m_s > kMaxSpeedMS) {
+    ThrowValidation("SimulatorOptions", "sim.crash_speed_m_s", crash_speed_m_s,
+                    fmt::format("a speed in (0, {:g}] m/s", kMaxSpeedMS));
   }
   if (!std::isfinite(crash_tilt_rad) || crash_tilt_rad <= 0.0 || crash_tilt_rad > std::numbers::pi) {
     ThrowValidation("SimulatorOptions", "sim.crash_tilt_rad", crash_tilt_rad, "an angle in (0, pi]");

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/rng.h"
 
 namespace rotorguard::sim {
@@ -69,6 +70,7 @@ void ValidateInterval(const std::optional<double>& min, const char* min_key, con
 }  // namespace
 
 void TruthOptions::Validate() const {
+  CheckDeclaredRanges("TruthOptions", *this);
   ValidateInterval(motor_stop_time_constant_min_s, "motor_stop_time_constant_min_s", motor_stop_time_constant_max_s,
                    "motor_stop_time_constant_max_s");
   ValidateInterval(odometry_latency_min_s, "odometry_latency_min_s", odometry_latency_max_s, "odometry_latency_max_s");

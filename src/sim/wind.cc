@@ -2,19 +2,11 @@
 
 #include <cmath>
 
-#include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::sim {
 
-void WindOptions::Validate() const {
-  if (!mean_m_s.allFinite()) ThrowValidation("WindOptions", "mean_m_s", "(non-finite)", "finite numbers");
-  if (!std::isfinite(gust_std_m_s) || gust_std_m_s < 0.0) {
-    ThrowValidation("WindOptions", "gust_std_m_s", gust_std_m_s, "a finite value >= 0");
-  }
-  if (!std::isfinite(gust_time_constant_s) || gust_time_constant_s <= 0.0) {
-    ThrowValidation("WindOptions", "gust_time_constant_s", gust_time_constant_s, "a finite value > 0");
-  }
-}
+void WindOptions::Validate() const { CheckDeclaredRanges("WindOptions", *this); }
 
 WindModel::WindModel(const WindOptions& options, std::uint64_t seed) : options_(options), rng_(seed) {
   // Start the gust process in its stationary distribution.

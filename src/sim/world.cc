@@ -1,22 +1,19 @@
 #include "rotorguard/sim/world.h"
 
-#include "rotorguard/core/error.h"
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include <fmt/format.h>
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::sim {
 
-void Box::Validate() const {
-  if (!(size_m.minCoeff() > 0.0)) throw ValidationError("size_m", "box sizes must be > 0 m");
-}
+void Box::Validate() const { CheckDeclaredRanges("Box", *this); }
 
-void MovingBox::Validate() const {
-  if (!(size_m.minCoeff() > 0.0)) throw ValidationError("size_m", "box sizes must be > 0 m");
-}
+void MovingBox::Validate() const { CheckDeclaredRanges("MovingBox", *this); }
 
 double Box::Distance(const Vector3& p) const {
   // Rotate the point into the box frame, then clamp to the half extents.

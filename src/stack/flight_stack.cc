@@ -9,6 +9,7 @@
 
 #include "rotorguard/control/allocation.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/core/stopwatch.h"
 
 namespace rotorguard::stack {
@@ -47,20 +48,17 @@ void NavigationOptions::Validate() const {
   if (!(planner_rate_hz > 0.0)) {
     ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", planner_rate_hz, "a rate in (0, control_rate_hz]");
   }
-  if (!(post_failure_safety_factor > 0.0 && post_failure_safety_factor <= 1.0)) {
-    ThrowValidation("FlightStackOptions", "navigation.post_failure_safety_factor", post_failure_safety_factor,
-                    "in (0, 1]");
-  }
-  if (!(std::isfinite(start_s) && start_s >= 0.0)) {
-    ThrowValidation("FlightStackOptions", "navigation.start_s", start_s, "a time >= 0 s");
-  }
+  // stack.planner's keys, the replanner's among them (ReplannerOptions checks its own without
+  // their upper ends).
+  CheckDeclaredRanges("NavigationOptions", *this);
   replanner.Validate();
   flatness.Validate();
 }
 
 void FlightStackOptions::Validate() const {
-  if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > 10000.0) {
-    ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz, "a rate in (0, 10000] Hz");
+  if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > kMaxRateHz) {
+    ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz,
+                    fmt::format("a rate in (0, {:g}] Hz", kMaxRateHz));
   }
   nominal.Validate();
   passive.Validate();
@@ -68,14 +66,7 @@ void FlightStackOptions::Validate() const {
   if (controller == ControllerKind::kIndi) IndiOptionsInStack(*this).Validate();  // its filters depend on the rate
   lqr.Validate();
   for (std::size_t i = 0; i < known_faults.size(); ++i) {
-    if (!std::isfinite(known_faults[i].at_time_s) || known_faults[i].at_time_s < 0.0) {
-      ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.at_time_s", i), known_faults[i].at_time_s,
-                      "a time >= 0 s");
-    }
-    if (!(known_faults[i].loss > 0.0 && known_faults[i].loss <= 1.0)) {
-      ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.loss", i), known_faults[i].loss,
-                      "a fraction in (0, 1] (1: the rotor failed)");
-    }
+    CheckDeclaredRanges("FlightStackOptions", known_faults[i], fmt::format("known_faults.{}.", i));
     if (known_faults[i].loss < 1.0 && controller != ControllerKind::kAssembly) {
       ThrowValidation("FlightStackOptions", fmt::format("known_faults.{}.loss", i), known_faults[i].loss,
                       "1 unless the controller is assembly (the one that reallocates a partial loss)");

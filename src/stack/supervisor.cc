@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::stack {
 
@@ -23,24 +24,10 @@ const char* ToString(FlightMode mode) {
 }
 
 void SupervisorOptions::Validate() const {
-  const auto positive = [](double v, const char* field) {
-    if (!(std::isfinite(v) && v > 0.0)) ThrowValidation("SupervisorOptions", field, v, "a finite value > 0");
-  };
-  positive(recovery_tilt_rad, "recovery_tilt_rad");
-  if (!(std::isfinite(recovery_hold_s) && recovery_hold_s >= 0.0)) {
-    ThrowValidation("SupervisorOptions", "recovery_hold_s", recovery_hold_s, "a time >= 0 s");
-  }
-  positive(recovery_axis_time_constant_s, "recovery_axis_time_constant_s");
-  positive(no_plan_timeout_s, "no_plan_timeout_s");
-  positive(odometry_timeout_s, "odometry_timeout_s");
-  positive(max_speed_m_s, "max_speed_m_s");
-  positive(landing_speed_m_s, "landing_speed_m_s");
-  positive(landing_depth_m, "landing_depth_m");
-  if (!(touchdown_thrust_ratio > 0.0 && touchdown_thrust_ratio < 1.0)) {
+  CheckDeclaredRanges("SupervisorOptions", *this);
+  if (touchdown_thrust_ratio >= 1.0) {  // the declared range's open end
     ThrowValidation("SupervisorOptions", "touchdown_thrust_ratio", touchdown_thrust_ratio, "in (0, 1)");
   }
-  positive(touchdown_hold_s, "touchdown_hold_s");
-  if (max_failed_rotors < 0) ThrowValidation("SupervisorOptions", "max_failed_rotors", max_failed_rotors, "a count >= 0");
 }
 
 Supervisor::Supervisor(const SupervisorOptions& options) : options_(options) { options_.Validate(); }

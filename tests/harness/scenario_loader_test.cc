@@ -239,7 +239,8 @@ TEST_F(ScenarioLoader, ErrorsNameTheFileLineAndKey) {
   m = Error("mission: {type: hover}\nstack: {flatness: {theta_max_deg: 95}}\n");
   EXPECT_NE(m.find("theta_max_deg = 95 is invalid; expected an angle in (0, 90) deg"), std::string::npos) << m;
   m = Error("mission: {type: hover}\nworld: {boxes: [{center_m: [0, 0, 1], size_m: [1, 0, 1]}]}\n");
-  EXPECT_NE(m.find("world.boxes.0.size_m: box sizes must be > 0 m"), std::string::npos) << m;
+  EXPECT_NE(m.find("world.boxes.0.size_m.1: '0' is out of range; expected a number in (0, 20000]"), std::string::npos)
+      << m;
 }
 
 TEST_F(ScenarioLoader, VehicleOverridesApplyToTheVehicleFile) {
@@ -306,6 +307,80 @@ TEST_F(ScenarioLoader, KeyTablesListEveryKeyTheLoaderTakes) {
       EXPECT_NE(tables.find("`" + block + "." + k), std::string::npos) << block << "." << k << " is not documented";
     }
   }
+}
+
+// The example: a speed limit no multirotor reaches is refused where it is written, with
+// its range, rather than flown (a collision check's step of check_step_m / v_max would vanish).
+TEST_F(ScenarioLoader, AnAbsurdSpeedLimitIsRejectedWithItsRange) {
+  const std::string f = (dir_ / "s.yaml").string();
+  EXPECT_EQ(Error("mission: {type: hover}\nstack:\n  planner: {v_max: 1e9}\n"),
+            f + ":5:20: stack.planner.v_max: '1e9' is out of range; expected a number in (0, 50]");
+  EXPECT_EQ(Error("mission: {type: hover}\nstack:\n  planner: {v_max: 50}\n"), "(no error)");
+  // The same bound for the options set in code.
+  stack::NavigationOptions n;
+  n.replanner.nominal.v_max = 1e9;
+  RG_EXPECT_THROW_WITH(n.Validate(), ValidationError,
+                       "NavigationOptions::v_max = 1000000000 is invalid; expected a number in (0, 50]");
+  n.replanner.nominal.v_max = 50.0;
+  EXPECT_NO_THROW(n.Validate());
+}
+
+/// The numeric keys of `rows` whose rule states no range bounded on both sides ("a number",
+/// "> 0", "≥ 0", "[x, y, z]"), as "key: rule".
+std::vector<std::string> UnboundedNumericKeys(const std::vector<io::KeyRow>& rows, const std::string& prefix) {
+  std::vector<std::string> unbounded;
+  for (const io::KeyRow& r : rows) {
+    if (!r.numeric) continue;
+    std::string rule = r.rule;
+    if (const std::string required = "**required**, "; rule.starts_with(required)) rule.erase(0, required.size());
+    const bool bare = rule == "a number" || rule == "> 0" || rule == "≥ 0" || rule == "an integer";
+    const bool bounded = rule.find("in [") != std::string::npos || rule.find("in (") != std::string::npos;
+    if (bare || !bounded) unbounded.push_back(prefix + r.key + ": " + r.rule);
+  }
+  return unbounded;
+}
+
+// Every number a scenario or vehicle file takes has a range bounded on both sides, stated in the
+// key tables (and so in docs/scenarios.md): a key added without one fails here.
+TEST(ScenarioDocs, EveryNumericKeyHasABoundedRange) {
+  std::vector<std::string> unbounded = UnboundedNumericKeys(VehicleKeyRows(), "vehicle: ");
+  std::size_t numeric = 0;
+  for (const KeyTableSection& section : ScenarioKeySections()) {
+    const std::vector<std::string> more = UnboundedNumericKeys(section.rows, section.prefix);
+    unbounded.insert(unbounded.end(), more.begin(), more.end());
+    for (const io::KeyRow& r : section.rows) numeric += r.numeric ? 1 : 0;
+  }
+  EXPECT_GT(numeric, 150u) << "the walk must see the numeric keys";
+  std::string list;
+  for (const std::string& k : unbounded) list += k + "\n";
+  EXPECT_TRUE(unbounded.empty()) << "keys without a bounded range:\n" << list;
+}
+
+/// Keys with and without ranges, for the walk's own test.
+struct MadeUpKeys {
+  double free = 0.0, positive = 1.0, bounded = 1.0;
+  Vector3 vector = Vector3::Zero();
+  int count = 1;
+  bool flag = false;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("free", &free, {.meaning = "x"});
+    a->Visit("positive", &positive, {.meaning = "x", .positive = true, .required = true});
+    a->Visit("bounded", &bounded, {.meaning = "x", .max = 2.0, .positive = true});
+    a->Visit("vector", &vector, {.meaning = "x"});
+    a->Visit("count", &count, {.meaning = "x", .min = 1});
+    a->Visit("flag", &flag, {.meaning = "x"});
+  }
+};
+
+// The walk above finds a key without a range, one bounded below only, and a vector without one.
+TEST(ScenarioDocs, TheRangeCheckFindsUnboundedKeys) {
+  MadeUpKeys made;
+  io::KeyTableWriter writer;
+  made.Serialize(&writer);
+  EXPECT_EQ(UnboundedNumericKeys(writer.rows(), ""),
+            (std::vector<std::string>{"free: a number", "positive: **required**, > 0", "vector: [x, y, z]",
+                                      "count: an integer ≥ 1"}));
 }
 
 /// The text between `begin` and `end` in docs/scenarios.md.

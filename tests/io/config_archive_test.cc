@@ -2,14 +2,17 @@
 // the strict reader (io/config_archive.h), the JSON archive, the YAML writer and the key table.
 #include "rotorguard/io/config_archive.h"
 
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/key_ranges.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/json_archive.h"
 #include "rotorguard/io/key_table.h"
@@ -255,6 +258,127 @@ TEST(KeyTable, RowsFollowTheDeclaration) {
   EXPECT_EQ(row("legs[].length_m").value, "") << "a required key has no default";
   EXPECT_NE(row("legs[].length_m").rule.find("**required**"), std::string::npos);
   EXPECT_EQ(row("tilt_deg").rule, "in (0, 90) deg");
+}
+
+/// Keys with upper bounds, as options structs declare them: a speed in (0, 50], a position each of
+/// whose coordinates lies in [-10, 10], a pair in [0, 5], a count, and a block without a Validate().
+struct Bounded {
+  struct Inner {
+    double gain = 1.0;
+    template <typename Archive>
+    void Serialize(Archive* a) {
+      a->Visit("gain", &gain, {.meaning = "a gain", .min = 0.0, .max = 2.0});
+    }
+  };
+  double speed_m_s = 1.0;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  double lo = 1.0, hi = 2.0;
+  int count = 3;
+  bool flag = false;
+  Inner inner;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("speed_m_s", &speed_m_s, {.meaning = "[m/s]", .max = 50.0, .positive = true});
+    a->Visit("position_m", &position_m, {.meaning = "[m]", .min = -10.0, .max = 10.0});
+    a->Visit("band_m", PairOf{&lo, &hi}, {.meaning = "[m]", .min = 0.0, .max = 5.0});
+    a->Visit("count", &count, {.meaning = "how many", .min = 1, .max = 8});
+    a->Visit("flag", &flag, {.meaning = "a switch"});
+    a->Visit("inner", &inner, {.meaning = "a block"});
+  }
+};
+
+std::string BoundedError(const std::string& yaml) {
+  try {
+    Bounded b;
+    ReadConfig(ConfigDocument::LoadString(yaml, "bounded.yaml").root(), &b);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::string RangeError(const Bounded& b) {
+  try {
+    CheckDeclaredRanges("Bounded", b);
+  } catch (const ValidationError& e) {
+    return e.field() + ": " + e.what();
+  }
+  return "(no error)";
+}
+
+// A positive number with an upper bound takes (0, max]: both ends' neighbours are told apart, and
+// the error names the file, line, column, key, value and range.
+TEST(ConfigArchive, APositiveKeyWithAMaximumTakesZeroExclusiveToTheMaximumInclusive) {
+  EXPECT_EQ(BoundedError("speed_m_s: 50\n"), "(no error)");
+  EXPECT_EQ(BoundedError("speed_m_s: 1e-9\n"), "(no error)");
+  EXPECT_EQ(BoundedError("speed_m_s: 1e9\n"),
+            "bounded.yaml:1:12: speed_m_s: '1e9' is out of range; expected a number in (0, 50]");
+  EXPECT_EQ(BoundedError("speed_m_s: 50.001\n"),
+            "bounded.yaml:1:12: speed_m_s: '50.001' is out of range; expected a number in (0, 50]");
+  EXPECT_EQ(BoundedError("speed_m_s: 0\n"),
+            "bounded.yaml:1:12: speed_m_s: '0' is out of range; expected a number in (0, 50]");
+}
+
+// A vector's, a pair's and a nested block's numbers are each checked, the error at the item.
+TEST(ConfigArchive, EachNumberOfAListLiesInTheKeysRange) {
+  EXPECT_EQ(BoundedError("position_m: [-10, 0, 10]\nband_m: [0, 5]\n"), "(no error)");
+  EXPECT_EQ(BoundedError("position_m: [0, 0, 10000]\n"),
+            "bounded.yaml:1:20: position_m.2: '10000' is out of range; expected a number in [-10, 10]");
+  EXPECT_EQ(BoundedError("band_m: [-1, 2]\n"),
+            "bounded.yaml:1:10: band_m.0: '-1' is out of range; expected a number in [0, 5]");
+  EXPECT_EQ(BoundedError("inner: {gain: 3}\n"),
+            "bounded.yaml:1:15: inner.gain: '3' is out of range; expected a number in [0, 2]");
+}
+
+// Validate()'s check of values set in code (CheckDeclaredRanges) enforces the ranges the loader
+// does, named by the key's path.
+TEST(DeclaredRanges, ValuesSetInCodeMeetTheRangesTheLoaderEnforces) {
+  EXPECT_EQ(RangeError(Bounded{}), "(no error)");
+  Bounded b;
+  b.speed_m_s = 1e9;
+  EXPECT_EQ(RangeError(b), "speed_m_s: Bounded::speed_m_s = 1000000000 is invalid; expected a number in (0, 50]");
+  b = {};
+  b.speed_m_s = 0.0;
+  EXPECT_NE(RangeError(b), "(no error)");
+  b = {};
+  b.speed_m_s = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(RangeError(b), "(no error)") << "NaN is in no range";
+  b = {};
+  b.position_m.y() = -11.0;
+  EXPECT_EQ(RangeError(b), "position_m.1: Bounded::position_m.1 = -11 is invalid; expected a number in [-10, 10]");
+  b = {};
+  b.hi = 6.0;
+  EXPECT_EQ(RangeError(b), "band_m.1: Bounded::band_m.1 = 6 is invalid; expected a number in [0, 5]");
+  b = {};
+  b.count = 9;
+  EXPECT_EQ(RangeError(b), "count: Bounded::count = 9 is invalid; expected an integer in [1, 8]");
+  b = {};
+  b.inner.gain = -0.5;
+  EXPECT_EQ(RangeError(b), "inner.gain: Bounded::inner.gain = -0.5 is invalid; expected a number in [0, 2]");
+}
+
+TEST(KeyTable, RulesStateTheRangesAndNumbersAreMarked) {
+  Bounded b;
+  KeyTableWriter table;
+  b.Serialize(&table);
+  std::vector<std::string> rules, numeric;
+  for (const KeyRow& r : table.rows()) {
+    rules.push_back(r.rule);
+    if (r.numeric) numeric.push_back(r.key);
+  }
+  EXPECT_EQ(rules,
+            (std::vector<std::string>{"in (0, 50]", "[x, y, z], each in [-10, 10]", "two numbers, each in [0, 5]",
+                                      "an integer in [1, 8]", "true or false", "in [0, 2]"}));
+  EXPECT_EQ(numeric, (std::vector<std::string>{"speed_m_s", "position_m", "band_m", "count", "inner.gain"}));
+}
+
+// An angle's bounds read as multiples of π.
+TEST(KeyTable, AnglesBoundsAreWrittenInPi) {
+  EXPECT_EQ(DeclaredRangeText({.min = -kTwoPi, .max = kTwoPi}), "in [-2π, 2π]");
+  EXPECT_EQ(DeclaredRangeText({.max = std::numbers::pi / 2.0, .positive = true}), "in (0, π/2]");
+  EXPECT_EQ(DeclaredRangeText({.min = -1.5 * std::numbers::pi, .max = std::numbers::pi}), "in [-3π/2, π]");
+  EXPECT_EQ(DeclaredRangeText({.min = 0.0, .max = 1.5}), "in [0, 1.5]");
+  EXPECT_EQ(DeclaredRangeText({}), "");
 }
 
 }  // namespace

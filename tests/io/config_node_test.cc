@@ -446,6 +446,12 @@ TEST(ConfigNodeNumber, RangeChecks) {
   EXPECT_DOUBLE_EQ(r.Required("zero").AsNonNegative(), 0.0);
   RG_EXPECT_THROW_WITH(r.Required("neg").AsNonNegative(), ConfigError,
                        "t.yaml:3:6: neg: '-0.5' is out of range; expected a non-negative number");
+  // (0, hi]: the upper end belongs to it, zero does not.
+  EXPECT_DOUBLE_EQ(r.Required("one").AsPositiveAtMost(1.0), 1.0);
+  RG_EXPECT_THROW_WITH(r.Required("zero").AsPositiveAtMost(1.0), ConfigError,
+                       "t.yaml:1:7: zero: '0' is out of range; expected a number in (0, 1]");
+  RG_EXPECT_THROW_WITH(r.Required("big").AsPositiveAtMost(2.0), ConfigError,
+                       "t.yaml:4:6: big: '2.5' is out of range; expected a number in (0, 2]");
 }
 
 TEST(ConfigNodeNumber, RangeAccessorsStillRejectNonFinite) {
@@ -454,6 +460,8 @@ TEST(ConfigNodeNumber, RangeAccessorsStillRejectNonFinite) {
                        "t.yaml:1:4: x: '.inf' is not finite; expected a positive number");
   RG_EXPECT_THROW_WITH(doc.root().Required("x").AsDoubleIn(0, 1e308), ConfigError,
                        "is not finite");
+  RG_EXPECT_THROW_WITH(doc.root().Required("x").AsPositiveAtMost(1e308), ConfigError,
+                       "t.yaml:1:4: x: '.inf' is not finite; expected a number in (0, 1e+308]");
 }
 
 TEST(ConfigNodeNumber, AsInt) {

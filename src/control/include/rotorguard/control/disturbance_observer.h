@@ -42,10 +42,11 @@ struct DisturbanceObserverOptions {
     a->Visit("torque_bandwidth_after_failure_rad_s", &torque_bandwidth_after_failure_rad_s,
              {.meaning = "... once a rotor failed and the vehicle spins [rad/s] (0: held)", .min = 0.0, .max = 1e3});
     a->Visit("max_acceleration_m_s2", &max_acceleration_m_s2,
-             {.meaning = "the largest acceleration estimated [m/s²]", .min = 1e-6});
+             {.meaning = "the largest acceleration estimated [m/s²]", .min = 1e-6, .max = kMaxAccelerationMS2});
     a->Visit("max_angular_acceleration_rad_s2", &max_angular_acceleration_rad_s2,
-             {.meaning = "the largest angular acceleration estimated [rad/s²]", .min = 1e-6});
-    a->Visit("min_altitude_m", &min_altitude_m, {.meaning = "the observer runs above this altitude [m]"});
+             {.meaning = "the largest angular acceleration estimated [rad/s²]", .min = 1e-6, .max = 1e4});
+    a->Visit("min_altitude_m", &min_altitude_m,
+             {.meaning = "the observer runs above this altitude [m]", .min = 0.0, .max = kMaxCoordinateM});
   }
 };
 

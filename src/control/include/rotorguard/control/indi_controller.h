@@ -48,13 +48,18 @@ struct IndiControllerOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     position.Serialize(a);  // used after a failure; before it, stack.nominal flies
-    a->Visit("k_h", &k_h, {.meaning = "reduced-attitude stiffness [1/s²]"});
-    a->Visit("d_h", &d_h, {.meaning = "reduced-attitude damping [1/s]"});
+    a->Visit("k_h", &k_h, {.meaning = "reduced-attitude stiffness [1/s²]", .max = 1e5, .positive = true});
+    a->Visit("d_h", &d_h, {.meaning = "reduced-attitude damping [1/s]", .max = 1000.0, .positive = true});
     a->Visit("opposite_ratio", &opposite_ratio,
-             {.meaning = "relaxed hover: the failed rotor's twin's thrust relative to its neighbours, in [0, 1)"});
-    a->Visit("filter_cutoff_hz", &filter_cutoff_hz,
-             {.meaning =
-                  "cut-off of the angular-acceleration and thrust filters [Hz], below half of stack.control_rate_hz"});
+             {.meaning = "relaxed hover: the failed rotor's twin's thrust relative to its neighbours",
+              .min = 0.0,
+              .max = 1.0,
+              .rule_text = "in [0, 1)"});
+    a->Visit(
+        "filter_cutoff_hz", &filter_cutoff_hz,
+        {.meaning = "cut-off of the angular-acceleration and thrust filters [Hz], below half of stack.control_rate_hz",
+         .max = kMaxRateHz / 2.0,
+         .positive = true});
   }
 };
 

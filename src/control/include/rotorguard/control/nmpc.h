@@ -55,15 +55,17 @@ struct NmpcOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("horizon_steps", &horizon_steps, {.meaning = "N, the shooting nodes", .min = 1, .max = 200});
-    a->Visit("step_s", &step_s, {.meaning = "time between nodes [s], in (0, 1]"});
+    a->Visit("step_s", &step_s, {.meaning = "time between nodes [s]", .max = 1.0, .positive = true});
     a->Visit("integrator_substeps", &integrator_substeps, {.meaning = "RK4 sub-steps per node", .min = 1, .max = 20});
-    a->Visit("q_position", &q_position, {.meaning = "Q_p of eq. (10)"});
-    a->Visit("q_attitude", &q_attitude, {.meaning = "Q_q of eq. (10): tilt x, tilt y, tilt², yaw"});
-    a->Visit("q_velocity", &q_velocity, {.meaning = "Q_v of eq. (10)"});
-    a->Visit("q_rate", &q_rate, {.meaning = "Q_ω of eq. (10)"});
-    a->Visit("q_thrust", &q_thrust, {.meaning = "Q_t of eq. (10) on the motor thrusts"});
-    a->Visit("r_input", &r_input, {.meaning = "R of eq. (10) on the commands, > 0"});
-    a->Visit("max_rate_rad_s", &max_rate_rad_s, {.meaning = "body-rate bounds [rad/s]"});
+    a->Visit("q_position", &q_position, {.meaning = "Q_p of eq. (10)", .min = 0.0, .max = kMaxWeight});
+    a->Visit("q_attitude", &q_attitude,
+             {.meaning = "Q_q of eq. (10): tilt x, tilt y, tilt², yaw", .min = 0.0, .max = kMaxWeight});
+    a->Visit("q_velocity", &q_velocity, {.meaning = "Q_v of eq. (10)", .min = 0.0, .max = kMaxWeight});
+    a->Visit("q_rate", &q_rate, {.meaning = "Q_ω of eq. (10)", .min = 0.0, .max = kMaxWeight});
+    a->Visit("q_thrust", &q_thrust, {.meaning = "Q_t of eq. (10) on the motor thrusts", .min = 0.0, .max = kMaxWeight});
+    a->Visit("r_input", &r_input, {.meaning = "R of eq. (10) on the commands", .max = kMaxWeight, .positive = true});
+    a->Visit("max_rate_rad_s", &max_rate_rad_s,
+             {.meaning = "body-rate bounds [rad/s]", .max = kMaxBodyRateRadS, .positive = true});
     a->Visit("max_sqp_iterations", &max_sqp_iterations,
              {.meaning = "SQP iterations a cycle (1: the real-time iteration)", .min = 1, .max = 1000});
     a->Visit("relinearise_every", &relinearise_every,

@@ -21,9 +21,12 @@ struct NominalControllerOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     position.Serialize(a);
-    a->Visit("k_attitude", &k_attitude, {.meaning = "attitude error to body rate [1/s]"});
-    a->Visit("k_rate", &k_rate, {.meaning = "rate error to angular acceleration [1/s]"});
-    a->Visit("max_rate_rad_s", &max_rate_rad_s, {.meaning = "commanded body-rate limit [rad/s]"});
+    a->Visit("k_attitude", &k_attitude,
+             {.meaning = "attitude error to body rate [1/s]", .max = 1000.0, .positive = true});
+    a->Visit("k_rate", &k_rate,
+             {.meaning = "rate error to angular acceleration [1/s]", .max = 1000.0, .positive = true});
+    a->Visit("max_rate_rad_s", &max_rate_rad_s,
+             {.meaning = "commanded body-rate limit [rad/s]", .max = kMaxBodyRateRadS, .positive = true});
   }
 };
 

@@ -24,10 +24,13 @@ struct PassiveControllerOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     position.Serialize(a);
-    a->Visit("k_tilt", &k_tilt, {.meaning = "reduced-attitude error to roll/pitch rate [1/s]"});
-    a->Visit("k_rate", &k_rate, {.meaning = "roll/pitch rate error to angular acceleration [1/s]"});
-    a->Visit("regularisation", &regularisation,
-             {.meaning = "weight towards equal rotor thrusts, relative to the thrust's"});
+    a->Visit("k_tilt", &k_tilt,
+             {.meaning = "reduced-attitude error to roll/pitch rate [1/s]", .max = 1000.0, .positive = true});
+    a->Visit("k_rate", &k_rate,
+             {.meaning = "roll/pitch rate error to angular acceleration [1/s]", .max = 1000.0, .positive = true});
+    a->Visit(
+        "regularisation", &regularisation,
+        {.meaning = "weight towards equal rotor thrusts, relative to the thrust's", .max = 1000.0, .positive = true});
   }
 };
 

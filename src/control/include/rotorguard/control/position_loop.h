@@ -2,6 +2,7 @@
 /// The outer position loop shared by the cascaded controllers: a PID on position with the
 /// reference's acceleration as feedforward, solved through eq. (1) of paper 000 for the thrust
 /// vector (gravity and the model's rotor drag compensated), with its tilt limited.
+#include <numbers>
 #include <string>
 
 #include "rotorguard/core/config_schema.h"
@@ -22,11 +23,17 @@ struct PositionLoopOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("kp_position", &kp_position, {.meaning = "position gain [1/s²]"});
-    a->Visit("kd_velocity", &kd_velocity, {.meaning = "velocity gain [1/s]"});
-    a->Visit("ki_position", &ki_position, {.meaning = "integral gain [1/s³]"});
-    a->Visit("integral_limit_m_s2", &integral_limit_m_s2, {.meaning = "clamp on the integral's acceleration [m/s²]"});
-    a->Visit("max_tilt_rad", &max_tilt_rad, {.meaning = "tilt limit of the thrust vector [rad], in (0, π/2)"});
+    // Gains a hundred times the defaults: beyond them the loop outruns any control rate.
+    a->Visit("kp_position", &kp_position, {.meaning = "position gain [1/s²]", .min = 0.0, .max = 1000.0});
+    a->Visit("kd_velocity", &kd_velocity, {.meaning = "velocity gain [1/s]", .min = 0.0, .max = 1000.0});
+    a->Visit("ki_position", &ki_position, {.meaning = "integral gain [1/s³]", .min = 0.0, .max = 1000.0});
+    a->Visit("integral_limit_m_s2", &integral_limit_m_s2,
+             {.meaning = "clamp on the integral's acceleration [m/s²]", .min = 0.0, .max = kMaxAccelerationMS2});
+    a->Visit("max_tilt_rad", &max_tilt_rad,
+             {.meaning = "tilt limit of the thrust vector [rad]",
+              .max = std::numbers::pi / 2.0,
+              .positive = true,
+              .rule_text = "in (0, π/2)"});
   }
 };
 

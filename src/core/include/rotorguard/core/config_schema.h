@@ -18,6 +18,7 @@
 #include <array>
 #include <cstddef>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <string>
@@ -30,10 +31,11 @@ namespace rotorguard {
 struct KeyInfo {
   /// The documentation's "meaning" column (units in the key's name or here).
   const char* meaning = "";
-  /// Numbers must lie in [min, max] (a list of blocks: have at least `min` items) ...
+  /// Numbers must lie in [min, max] (a list of blocks: have at least `min` items; a vector, a
+  /// pair, a triple, a matrix or a list of points: each of its numbers) ...
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
-  /// ... and, when set, be > 0 (min is then not used).
+  /// ... or, when set, in (0, max]: min is then not used.
   bool positive = false;
   /// The key must be present (the loader reports it missing); else absent keys keep the default.
   bool required = false;
@@ -45,6 +47,26 @@ struct KeyInfo {
   const char* default_text = nullptr;
   const char* rule_text = nullptr;
 };
+
+/// Ends of ranges that many keys share (docs/scenarios.md), so that a key and the Validate() of its
+/// struct state the same bound. They are what a user of a multirotor could still defend, with
+/// margin: beyond them a value is a slip of a digit or a unit, and some would make a loop over
+/// time or space run for hours (a collision check's step of check_step_m / v_max, a rate's
+/// callbacks per simulated second).
+inline constexpr double kMaxSpeedMS = 50.0;           ///< [m/s]: racing quadrotors top out near it
+inline constexpr double kMaxAccelerationMS2 = 100.0;  ///< [m/s²]: about 10 g
+inline constexpr double kMaxJerkMS3 = 1000.0;         ///< [m/s³]
+inline constexpr double kMaxBodyRateRadS = 100.0;     ///< [rad/s]: about 16 turns a second
+inline constexpr double kMaxRateHz = 10000.0;         ///< [Hz]: a loop of the stack or a sensor
+inline constexpr double kMaxCoordinateM = 10000.0;    ///< [m]: each coordinate of a place in the world
+/// [m]: each coordinate of a point on the vehicle from its centre of gravity (a rotor, a sensor),
+/// or a length on it; a line of 16 docked units (64 rotors) a few metres apart spans tens of metres.
+inline constexpr double kMaxBodyOffsetM = 50.0;
+inline constexpr double kMaxTimeoutS = 3600.0;  ///< [s]: a wait, a hold, a timeout
+inline constexpr double kMaxFlightS = 86400.0;  ///< [s]: a day; a flight's time and times within it
+inline constexpr double kMaxWeight = 1e9;       ///< a cost's weight, relative to its others
+/// A heading or a turn [rad]: any angle is one of [-2π, 2π].
+inline constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 /// A name of an enum's value, as config files write it.
 template <typename E>

@@ -84,28 +84,45 @@ struct CompositeFddOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("motor_index_threshold", &motor_index_threshold,
-             {.meaning = "γ_M: a motor index M_i (eq. 13) at or below it isolates a motor failure, in (0, 1)"});
+             {.meaning = "γ_M: a motor index M_i (eq. 13) at or below it isolates a motor failure",
+              .max = 1.0,
+              .positive = true,
+              .rule_text = "in (0, 1)"});
     a->Visit("motor_index_samples", &motor_index_samples,
              {.meaning = "consecutive telemetry samples the index must stay low", .min = 1, .max = 1000});
-    a->Visit(
-        "min_thrust_fraction", &min_thrust_fraction,
-        {.meaning = "the indices are evaluated only above this fraction of a rotor's hover thrust W/n, in (0, 1]"});
+    a->Visit("min_thrust_fraction", &min_thrust_fraction,
+             {.meaning = "the indices are evaluated only above this fraction of a rotor's hover thrust W/n",
+              .max = 1.0,
+              .positive = true});
     a->Visit("propeller_index_threshold", &propeller_index_threshold,
-             {.meaning = "γ_P: a propeller index P_i (eq. 17) above it isolates a propeller failure, in (0, 1]"});
-    a->Visit("propeller_persistence_s", &propeller_persistence_s, {.meaning = "P_i must stay above γ_P this long [s]"});
+             {.meaning = "γ_P: a propeller index P_i (eq. 17) above it isolates a propeller failure",
+              .max = 1.0,
+              .positive = true});
+    a->Visit("propeller_persistence_s", &propeller_persistence_s,
+             {.meaning = "P_i must stay above γ_P this long [s]", .min = 0.0, .max = 10.0});
     a->Visit("degraded_threshold", &degraded_threshold,
-             {.meaning = "P_i between this and γ_P for degraded_persistence_s is a partial loss"});
-    a->Visit("degraded_persistence_s", &degraded_persistence_s, {.meaning = "how long a partial loss must last [s]"});
+             {.meaning = "P_i between this and γ_P for degraded_persistence_s is a partial loss",
+              .max = 1.0,
+              .positive = true,
+              .rule_text = "in (0, propeller_index_threshold)"});
+    a->Visit("degraded_persistence_s", &degraded_persistence_s,
+             {.meaning = "how long a partial loss must last [s]", .min = 1e-3, .max = 100.0});
     a->Visit("filter_cutoff_hz", &filter_cutoff_hz,
-             {.meaning = "cut-off of the observer's low-pass filters [Hz], below the IMU's Nyquist frequency"});
+             {.meaning = "cut-off of the observer's low-pass filters [Hz], below the IMU's Nyquist frequency",
+              .max = kMaxRateHz / 2.0,
+              .positive = true});
     a->Visit("takeoff_max_altitude_m", &takeoff_max_altitude_m,
-             {.meaning = "the take-off detector (eq. 18) runs below this altitude [m] ..."});
-    a->Visit("takeoff_window_s", &takeoff_window_s, {.meaning = "... and within this long of lift-off [s]"});
-    a->Visit("takeoff_index_threshold", &takeoff_index_threshold,
-             {.meaning =
-                  "roll/pitch angular acceleration, over that of losing one rotor's hover thrust, that fires it ..."});
+             {.meaning = "the take-off detector (eq. 18) runs below this altitude [m] ...", .min = 1e-3, .max = 100.0});
+    a->Visit("takeoff_window_s", &takeoff_window_s,
+             {.meaning = "... and within this long of lift-off [s]", .min = 1e-3, .max = 1000.0});
+    // 1e6: out of reach, the detector off (Disarmed).
+    a->Visit(
+        "takeoff_index_threshold", &takeoff_index_threshold,
+        {.meaning = "roll/pitch angular acceleration, over that of losing one rotor's hover thrust, that fires it ...",
+         .min = 1e-6,
+         .max = 1e6});
     a->Visit("takeoff_direction_cosine", &takeoff_direction_cosine,
-             {.meaning = "... pointing within this cosine of the loss of one rotor ..."});
+             {.meaning = "... pointing within this cosine of the loss of one rotor ...", .max = 1.0, .positive = true});
     a->Visit("takeoff_missing_thrust_fraction", &takeoff_missing_thrust_fraction,
              {.meaning = "... while that rotor misses this fraction of its expected thrust", .min = 0.0, .max = 1.0});
     a->Visit("baseline_time_constant_s", &baseline_time_constant_s,

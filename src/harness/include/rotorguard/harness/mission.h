@@ -64,13 +64,17 @@ struct AssemblyPlanSpec {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("goal_m", &goal_m,
-             {.meaning = "where the assembly plans to, from its initial pose [m]", .required = true});
+             {.meaning = "where the assembly plans to, from its initial pose [m]",
+              .min = -kMaxCoordinateM,
+              .max = kMaxCoordinateM,
+              .required = true});
     a->Visit("method", &method, {.meaning = "ours, or baseline: Table II's SVSDF-style row"});
-    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "speed limit [m/s]", .positive = true});
-    a->Visit("max_accel_m_s2", &max_accel_m_s2, {.meaning = "acceleration limit [m/s²]", .positive = true});
-    a->Visit("max_jerk_m_s3", &max_jerk_m_s3, {.meaning = "jerk limit [m/s³]", .positive = true});
+    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "speed limit [m/s]", .max = kMaxSpeedMS, .positive = true});
+    a->Visit("max_accel_m_s2", &max_accel_m_s2,
+             {.meaning = "acceleration limit [m/s²]", .max = kMaxAccelerationMS2, .positive = true});
+    a->Visit("max_jerk_m_s3", &max_jerk_m_s3, {.meaning = "jerk limit [m/s³]", .max = kMaxJerkMS3, .positive = true});
     a->Visit("max_yaw_rate_rad_s", &max_yaw_rate_rad_s,
-             {.meaning = "both methods: the yaw's rate limit [rad/s]", .positive = true});
+             {.meaning = "both methods: the yaw's rate limit [rad/s]", .max = kMaxBodyRateRadS, .positive = true});
     a->Visit("safety_factor", &safety_factor,
              {.meaning = "ours: the share of the assembly's capacity planned for", .min = 0.01, .max = 1.0});
     a->Visit("attitude_weight", &attitude_weight,
@@ -90,9 +94,14 @@ struct NavigateSpec {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("waypoints_m", &waypoints_m, {.meaning = "the waypoints, flown to in turn [m]", .required = true});
+    a->Visit("waypoints_m", &waypoints_m,
+             {.meaning = "the waypoints, flown to in turn [m]",
+              .min = -kMaxCoordinateM,
+              .max = kMaxCoordinateM,
+              .required = true});
     a->Visit("rounds", &rounds, {.meaning = "times over the list", .min = 1, .max = 1000});
-    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+    a->Visit("yaw_rad", &yaw_rad,
+             {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
   }
 };
 

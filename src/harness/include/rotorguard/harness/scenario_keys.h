@@ -5,10 +5,13 @@
 /// The loader reads through these declarations and docs/scenarios.md's key tables are written
 /// from them (ScenarioKeyTables).
 #include <filesystem>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/key_table.h"
 
 namespace rotorguard::harness {
 
@@ -22,7 +25,7 @@ struct HeaderKeys {
     a->Visit("name", &s->name, {.meaning = "label used in outputs", .default_text = "the file's name"});
     a->Visit("description", &description, {.meaning = "free text"});
     a->Visit("duration_s", &s->duration_s,
-             {.meaning = "simulated time [s]", .min = 1e-3, .max = 1e6, .required = true});
+             {.meaning = "simulated time [s]", .min = 1e-3, .max = kMaxFlightS, .required = true});
     a->Visit("seed", &s->seed, {.meaning = "the same seed gives the same log.csv, byte for byte"});
     a->Visit("truth", &s->truth,
              {.meaning = "how the simulated vehicle departs from the vehicle file the stack reads (docs/truth.md)",
@@ -36,10 +39,12 @@ struct InitialKeys {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit(
-        "position_m", &s->initial_position_m,
-        {.meaning = "start position [m]; z = 0 starts landed (motors idle), z > 0 in hover", .rule_text = "z ≥ 0"});
-    a->Visit("yaw_rad", &s->initial_yaw_rad, {.meaning = "start heading [rad]"});
+    a->Visit("position_m", &s->initial_position_m,
+             {.meaning = "start position [m]; z = 0 starts landed (motors idle), z > 0 in hover",
+              .min = -kMaxCoordinateM,
+              .max = kMaxCoordinateM,
+              .rule_text = "[x, y, z], each in [-10000, 10000], z ≥ 0"});
+    a->Visit("yaw_rad", &s->initial_yaw_rad, {.meaning = "start heading [rad]", .min = -kTwoPi, .max = kTwoPi});
   }
 };
 
@@ -50,10 +55,17 @@ struct SimKeys {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("physics_rate_hz", &s->sim.physics_rate_hz,
-             {.meaning = "RK4 rate [Hz]; the step must be at most half the fastest motor time constant"});
-    a->Visit("log_rate_hz", &s->log_rate_hz, {.meaning = "rows per second in log.csv, at most the physics rate"});
-    a->Visit("crash_speed_m_s", &s->sim.crash_speed_m_s, {.meaning = "touching the ground faster is a crash [m/s]"});
-    a->Visit("crash_tilt_rad", &s->sim.crash_tilt_rad, {.meaning = "touching the ground more tilted is a crash [rad]"});
+             {.meaning = "RK4 rate [Hz]; the step must be at most half the fastest motor time constant",
+              .max = sim::kMaxPhysicsRateHz,
+              .positive = true});
+    // The log is held in memory until the end: beyond a sensor's rate it would only grow.
+    a->Visit("log_rate_hz", &s->log_rate_hz,
+             {.meaning = "rows per second in log.csv, at most the physics rate", .max = kMaxRateHz, .positive = true});
+    a->Visit("crash_speed_m_s", &s->sim.crash_speed_m_s,
+             {.meaning = "touching the ground faster is a crash [m/s]", .max = kMaxSpeedMS, .positive = true});
+    a->Visit(
+        "crash_tilt_rad", &s->sim.crash_tilt_rad,
+        {.meaning = "touching the ground more tilted is a crash [rad]", .max = std::numbers::pi, .positive = true});
   }
 };
 
@@ -89,7 +101,9 @@ struct MetricsKeys {
               .default_text = "the flight's end; an assembly_plan's: its plan's duration",
               .rule_text = "in [0, duration_s]"});
     a->Visit("success_error_m", &s->success.error_m,
-             {.meaning = "a run succeeds when |p - p_ref| stays at or below this [m] ...", .positive = true});
+             {.meaning = "a run succeeds when |p - p_ref| stays at or below this [m] ...",
+              .max = kMaxCoordinateM,
+              .positive = true});
     a->Visit("success_hold_s", &s->success.hold_s,
              {.meaning = "... over the flight's last success_hold_s [s] ...",
               .min = 0.0,
@@ -98,10 +112,12 @@ struct MetricsKeys {
     a->Visit("success_recovery_s", &s->success.recovery_s,
              {.meaning = "... and from success_recovery_s after the fault's correct isolation (its onset when "
                          "none) to the end [s]",
-              .min = 0.0});
+              .min = 0.0,
+              .max = kMaxFlightS});
     a->Visit("max_altitude_loss_m", &s->success.max_altitude_loss_m,
              {.meaning = "a fault costing more altitude than this fails the run [m] (take-off: 0.05)",
               .min = 0.0,
+              .max = kMaxCoordinateM,
               .default_text = "no bound"});
     a->Visit("recovered_tilt_rad", &s->recovered_tilt_rad,
              {.meaning = "roll and pitch count as recovered once the tilt stays below this [rad] (tilt_recovery_s)",
@@ -121,12 +137,26 @@ struct StackKeys {
   }
 };
 
-/// docs/scenarios.md's key tables: a Markdown section per block (the top level, initial, sim,
-/// sensors, wind, world, metrics, each mission type, stack), every key with its default, what it
-/// accepts and its meaning, written from the declarations above and the modules' own.
+/// One of docs/scenarios.md's key tables: its heading, the prefix its keys are written with
+/// ("stack.nmpc.") and its rows.
+struct KeyTableSection {
+  std::string title;
+  std::string prefix;
+  std::vector<io::KeyRow> rows;
+};
+
+/// Every key of a scenario file, a section per block (the top level, initial, world, sim, sensors,
+/// wind, each mission type, stack and its blocks, metrics), from the declarations above and the
+/// modules' own.
+std::vector<KeyTableSection> ScenarioKeySections();
+
+/// docs/scenarios.md's key tables: ScenarioKeySections in Markdown, every key with its default,
+/// what it accepts and its meaning.
 std::string ScenarioKeyTables();
 
-/// docs/scenarios.md's table of a vehicle file's keys (vehicle::VehicleParams's declaration).
+/// The keys of a vehicle file (vehicle::VehicleParams's declaration) ...
+std::vector<io::KeyRow> VehicleKeyRows();
+/// ... and docs/scenarios.md's table of them.
 std::string VehicleKeyTable();
 
 }  // namespace rotorguard::harness

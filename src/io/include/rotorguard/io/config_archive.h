@@ -123,19 +123,19 @@ class ConfigReader {
       *number.value = number.from_file(x);
     }
   }
-  /// Three numbers as one list.
+  /// Three numbers as one list, each in the key's range.
   void Visit(const char* key, TripleOf triple, const KeyInfo& info) {
     if (const std::optional<ConfigNode> n = Find(key, info)) {
-      const Eigen::Vector3d v = n->AsVector3();
-      *triple.x = v.x();
-      *triple.y = v.y();
-      *triple.z = v.z();
+      const std::vector<double> v = Numbers(*n, 3, info);
+      *triple.x = v[0];
+      *triple.y = v[1];
+      *triple.z = v[2];
     }
   }
-  /// Two numbers as one list.
+  /// Two numbers as one list, each in the key's range.
   void Visit(const char* key, PairOf pair, const KeyInfo& info) {
     if (const std::optional<ConfigNode> n = Find(key, info)) {
-      const std::vector<double> v = n->AsDoubleList(2);
+      const std::vector<double> v = Numbers(*n, 2, info);
       *pair.first = v[0];
       *pair.second = v[1];
     }
@@ -174,18 +174,23 @@ class ConfigReader {
     std::string_view key_;
   };
 
-  static void Read(const ConfigNode& n, double* v, const KeyInfo& info) {
+  /// A number in the key's range; the error names the value and the range.
+  static double Number(const ConfigNode& n, const KeyInfo& info) {
     constexpr double kInf = std::numeric_limits<double>::infinity();
-    if (info.positive) {
-      *v = n.AsPositive();
-    } else if (info.min == 0.0 && info.max == kInf) {
-      *v = n.AsNonNegative();
-    } else if (info.min > -kInf || info.max < kInf) {
-      *v = n.AsDoubleIn(info.min, info.max);
-    } else {
-      *v = n.AsDouble();
-    }
+    if (info.positive) return info.max < kInf ? n.AsPositiveAtMost(info.max) : n.AsPositive();
+    if (info.min == 0.0 && info.max == kInf) return n.AsNonNegative();
+    if (info.min > -kInf || info.max < kInf) return n.AsDoubleIn(info.min, info.max);
+    return n.AsDouble();
   }
+  /// A list of `size` numbers (any length when negative), each in the key's range: an error names
+  /// the item ("center_m.2") and its line.
+  static std::vector<double> Numbers(const ConfigNode& n, int size, const KeyInfo& info) {
+    std::vector<double> v = n.AsDoubleList(size);  // the list's shape, and finite numbers
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = Number(n.At(i), info);
+    return v;
+  }
+
+  static void Read(const ConfigNode& n, double* v, const KeyInfo& info) { *v = Number(n, info); }
   static void Read(const ConfigNode& n, std::optional<double>* v, const KeyInfo& info) {
     double x = 0.0;
     Read(n, &x, info);
@@ -199,26 +204,25 @@ class ConfigReader {
   static void Read(const ConfigNode& n, std::uint64_t* v, const KeyInfo&) { *v = n.AsUint64(); }
   static void Read(const ConfigNode& n, bool* v, const KeyInfo&) { *v = n.AsBool(); }
   static void Read(const ConfigNode& n, std::string* v, const KeyInfo&) { *v = n.AsString(); }
-  static void Read(const ConfigNode& n, Eigen::Vector3d* v, const KeyInfo&) { *v = n.AsVector3(); }
-  static void Read(const ConfigNode& n, Eigen::Vector2d* v, const KeyInfo&) {
-    const std::vector<double> x = n.AsDoubleList(2);
-    *v = Eigen::Vector2d(x[0], x[1]);
+  template <int N>
+  static void Read(const ConfigNode& n, Eigen::Matrix<double, N, 1>* v, const KeyInfo& info) {
+    const std::vector<double> x = Numbers(n, N, info);
+    for (int i = 0; i < N; ++i) (*v)[i] = x[static_cast<std::size_t>(i)];
   }
-  static void Read(const ConfigNode& n, Eigen::Matrix3d* m, const KeyInfo&) {
+  static void Read(const ConfigNode& n, Eigen::Matrix3d* m, const KeyInfo& info) {
     if (!n.IsSequence() || n.size() != 3) n.Fail("expected a 3x3 matrix written as three rows of three numbers");
     for (std::size_t r = 0; r < 3; ++r) {
-      const std::vector<double> row = n.At(r).AsDoubleList(3);
+      const std::vector<double> row = Numbers(n.At(r), 3, info);
       for (int c = 0; c < 3; ++c) (*m)(static_cast<int>(r), c) = row[static_cast<std::size_t>(c)];
     }
   }
-  static void Read(const ConfigNode& n, Eigen::Vector4d* v, const KeyInfo&) {
-    const std::vector<double> x = n.AsDoubleList(4);
-    *v = Eigen::Vector4d(x[0], x[1], x[2], x[3]);
-  }
-  static void Read(const ConfigNode& n, std::vector<Eigen::Vector3d>* v, const KeyInfo&) {
+  static void Read(const ConfigNode& n, std::vector<Eigen::Vector3d>* v, const KeyInfo& info) {
     if (!n.IsSequence() || n.size() == 0) n.Fail("expected a non-empty list of [x, y, z] points");
     v->clear();
-    for (std::size_t k = 0; k < n.size(); ++k) v->push_back(n.At(k).AsVector3());
+    for (std::size_t k = 0; k < n.size(); ++k) {
+      const std::vector<double> x = Numbers(n.At(k), 3, info);
+      v->emplace_back(x[0], x[1], x[2]);
+    }
   }
   template <NamedEnum E>
   static void Read(const ConfigNode& n, E* v, const KeyInfo&) {

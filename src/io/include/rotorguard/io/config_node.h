@@ -177,6 +177,8 @@ class ConfigNode {
   double AsDoubleIn(double lo, double hi) const;
   /// A finite number > 0.
   double AsPositive() const;
+  /// A finite number in the half-open interval (0, hi]: "expected a number in (0, hi]".
+  double AsPositiveAtMost(double hi) const;
   /// A finite number >= 0.
   double AsNonNegative() const;
   /// An integer literal: decimal or 0x hexadecimal, optional sign (no "1.5", "1e3", "abc").

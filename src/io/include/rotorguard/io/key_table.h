@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "rotorguard/core/config_schema.h"
+#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::io {
 
@@ -24,6 +25,8 @@ struct KeyRow {
   bool value_is_prose = false;  ///< ... or in words (a default that depends on other keys)
   std::string rule;             ///< what it accepts
   std::string meaning;
+  /// A number or numbers (a vector, an angle, a count): the rule is to state their range.
+  bool numeric = false;
 };
 
 /// Collects a struct's rows: `value.Serialize(&writer)`, nested blocks and lists of blocks
@@ -53,24 +56,25 @@ class KeyTableWriter {
     } else {
       // A required key has no default to show.
       Add(path, info.required ? "" : (info.default_text ? info.default_text : Text(*value)), RuleOf(*value, info),
-          info.meaning, info.default_text != nullptr);
+          info.meaning, info.default_text != nullptr, IsNumeric<T>());
     }
   }
   void Visit(const char* key, DegreesOf angle, const KeyInfo& info) {
     Add(prefix_ + key, Number(*angle.radians * 180.0 / 3.14159265358979323846),
         info.rule_text ? info.rule_text : fmt::format("in ({}, {}) deg", Number(info.min), Number(info.max)),
-        info.meaning);
+        info.meaning, false, true);
   }
   void Visit(const char* key, ConvertedOf number, const KeyInfo& info) {
-    Add(prefix_ + key, info.required ? "" : Number(number.to_file(*number.value)), RuleOf(0.0, info), info.meaning);
+    Add(prefix_ + key, info.required ? "" : Number(number.to_file(*number.value)), RuleOf(0.0, info), info.meaning,
+        false, true);
   }
   void Visit(const char* key, TripleOf t, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}, {}]", Number(*t.x), Number(*t.y), Number(*t.z)),
-        info.rule_text ? info.rule_text : "three numbers", info.meaning);
+        info.rule_text ? info.rule_text : Each("three numbers", info), info.meaning, false, true);
   }
   void Visit(const char* key, PairOf pair, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}]", Number(*pair.first), Number(*pair.second)),
-        info.rule_text ? info.rule_text : "two numbers", info.meaning);
+        info.rule_text ? info.rule_text : Each("two numbers", info), info.meaning, false, true);
   }
 
   const std::vector<KeyRow>& rows() const { return rows_; }
@@ -83,8 +87,28 @@ class KeyTableWriter {
     t->Serialize(w);
   } > {};
 
-  void Add(std::string key, std::string value, std::string rule, const char* meaning, bool prose = false) {
-    rows_.push_back({std::move(key), std::move(value), prose, std::move(rule), meaning});
+  void Add(std::string key, std::string value, std::string rule, const char* meaning, bool prose = false,
+           bool numeric = false) {
+    rows_.push_back({std::move(key), std::move(value), prose, std::move(rule), meaning, numeric});
+  }
+
+  /// Numbers: scalars (bool aside), optional numbers, the vectors and matrix keys use, lists of points.
+  template <typename T>
+  static constexpr bool IsNumeric() {
+    if constexpr (std::is_same_v<T, bool> || NamedEnum<T>) {
+      return false;
+    } else {
+      return std::is_arithmetic_v<T> || std::is_same_v<T, std::optional<double>> ||
+             std::is_same_v<T, std::vector<Eigen::Vector3d>> || std::is_same_v<T, Eigen::Vector2d> ||
+             std::is_same_v<T, Eigen::Vector3d> || std::is_same_v<T, Eigen::Vector4d> ||
+             std::is_same_v<T, Eigen::Matrix3d>;
+    }
+  }
+
+  /// A list of numbers and the range each of them must lie in: "[x, y, z], each in [-1, 1]".
+  static std::string Each(const std::string& list, const KeyInfo& info) {
+    const std::string range = DeclaredRangeText(info);
+    return range.empty() ? list : fmt::format("{}, each {}", list, range);
   }
 
   static std::string Number(double v) {
@@ -125,28 +149,22 @@ class KeyTableWriter {
     } else if constexpr (std::is_same_v<T, bool>) {
       rule = "true or false";
     } else if constexpr (std::is_same_v<T, std::vector<Eigen::Vector3d>>) {
-      rule = "a non-empty list of [x, y, z]";
+      rule = Each("a non-empty list of [x, y, z]", info);
     } else if constexpr (std::is_same_v<T, std::string>) {
       rule = "text";
     } else if constexpr (std::is_same_v<T, Eigen::Vector2d>) {
-      rule = "[x, y]";
+      rule = Each("[x, y]", info);
     } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
-      rule = "[x, y, z]";
+      rule = Each("[x, y, z]", info);
     } else if constexpr (std::is_same_v<T, Eigen::Vector4d>) {
-      rule = "four numbers";
+      rule = Each("four numbers", info);
+    } else if constexpr (std::is_same_v<T, Eigen::Matrix3d>) {
+      rule = Each("3 rows of 3", info);
+    } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+      rule = "an integer in [0, 2^64 - 1]";  // the loader's own range (a seed: any will do)
     } else {
-      constexpr double kInf = std::numeric_limits<double>::infinity();
-      const bool integer = std::is_integral_v<T>;
-      if (info.positive) {
-        rule = "> 0";
-      } else if (info.min > -kInf && info.max < kInf) {
-        rule = fmt::format("in [{}, {}]", Number(info.min), Number(info.max));
-      } else if (info.min > -kInf) {
-        rule = fmt::format("≥ {}", Number(info.min));
-      } else if (info.max < kInf) {
-        rule = fmt::format("≤ {}", Number(info.max));
-      }
-      if (integer) {
+      rule = DeclaredRangeText(info);
+      if (std::is_integral_v<T>) {
         rule = rule.empty() ? "an integer" : "an integer " + rule;
       } else if (rule.empty()) {
         rule = "a number";

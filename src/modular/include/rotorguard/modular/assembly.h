@@ -12,12 +12,15 @@
 
 namespace rotorguard::modular {
 
+/// [m]: the largest docking distance; a unit's frame is a metre or less across.
+inline constexpr double kMaxSpacingM = 10.0;
+
 /// Where the units sit: cell (i, j) of a grid whose pitch is the docking distance; unit k is at
 /// (i, j) * spacing_m along the assembly's body x and y before the centre of mass is subtracted.
 struct AssemblySpec {
   std::string name;
   vehicle::VehicleParams unit;       ///< every unit's parameters (its own frame: FLU, CoG at origin)
-  double spacing_m = 0.0;            ///< centre-to-centre distance of two docked units [m]
+  double spacing_m = 0.0;            ///< centre-to-centre distance of two docked units [m], <= kMaxSpacingM
   std::vector<Eigen::Vector2i> slots;  ///< one grid cell per unit, in unit order (paper's No. k+1)
   /// Throws ValidationError naming the field: a valid unit, at least one slot, no two units in
   /// one cell, 4 n rotors within kMaxRotors, a spacing that keeps neighbouring rotors apart.

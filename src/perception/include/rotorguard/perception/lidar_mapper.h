@@ -30,7 +30,9 @@ struct LidarMapperOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("inflation_margin_m", &inflation_margin_m,
-             {.meaning = "obstacles are inflated by the vehicle's collision_radius_m plus this [m]"});
+             {.meaning = "obstacles are inflated by the vehicle's collision_radius_m plus this [m]",
+              .min = 0.0,
+              .max = 10.0});
     map.Serialize(a);
   }
 };

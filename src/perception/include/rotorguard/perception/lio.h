@@ -31,6 +31,7 @@
 /// through the queued samples up to its end. The estimate (Estimate) is the filter propagated
 /// through the whole queue, updated at every sample.
 #include <deque>
+#include <numbers>
 #include <vector>
 
 #include "rotorguard/core/config_schema.h"
@@ -252,22 +253,26 @@ class Lio {
 
 template <typename Archive>
 void LioOptions::Serialize(Archive* a) {
+  // The filter's noise: up to ten times the vibration of a badly balanced airframe (docs/truth.md)
+  // over the sensors' own (sensors.imu); beyond, the IMU would tell it nothing.
   a->Visit("accel_noise_density", &accel_noise_density,
-           {.meaning = "accelerometer noise the filter assumes, vibration included [m/s²/√Hz]", .positive = true});
+           {.meaning = "accelerometer noise the filter assumes, vibration included [m/s²/√Hz]",
+            .max = 10.0,
+            .positive = true});
   a->Visit("gyro_noise_density", &gyro_noise_density,
-           {.meaning = "gyro noise the filter assumes [rad/s/√Hz]", .positive = true});
-  a->Visit("accel_bias_random_walk", &accel_bias_random_walk, {.meaning = "[m/s³/√Hz]", .positive = true});
-  a->Visit("gyro_bias_random_walk", &gyro_bias_random_walk, {.meaning = "[rad/s²/√Hz]", .positive = true});
+           {.meaning = "gyro noise the filter assumes [rad/s/√Hz]", .max = 1.0, .positive = true});
+  a->Visit("accel_bias_random_walk", &accel_bias_random_walk, {.meaning = "[m/s³/√Hz]", .max = 1.0, .positive = true});
+  a->Visit("gyro_bias_random_walk", &gyro_bias_random_walk, {.meaning = "[rad/s²/√Hz]", .max = 0.1, .positive = true});
   a->Visit("accel_bias_initial", &accel_bias_initial,
-           {.meaning = "prior std of the accelerometer bias [m/s²]", .positive = true});
+           {.meaning = "prior std of the accelerometer bias [m/s²]", .max = kGravity, .positive = true});
   a->Visit("gyro_bias_initial", &gyro_bias_initial,
-           {.meaning = "prior std of the gyro bias [rad/s]", .positive = true});
+           {.meaning = "prior std of the gyro bias [rad/s]", .max = 1.0, .positive = true});
   a->Visit("initial_position_std_m", &initial_position_std_m,
-           {.meaning = "prior std of the start position [m]", .positive = true});
+           {.meaning = "prior std of the start position [m]", .max = 10.0, .positive = true});
   a->Visit("initial_attitude_std_rad", &initial_attitude_std_rad,
-           {.meaning = "prior std of the start attitude [rad]", .positive = true});
+           {.meaning = "prior std of the start attitude [rad]", .max = std::numbers::pi, .positive = true});
   a->Visit("initial_velocity_std_m_s", &initial_velocity_std_m_s,
-           {.meaning = "prior std of the start velocity [m/s]", .positive = true});
+           {.meaning = "prior std of the start velocity [m/s]", .max = 10.0, .positive = true});
   a->Visit("initial_samples", &initial_samples,
            {.meaning = "IMU samples averaged at rest for the gyro bias and, on the ground, the tilt",
             .min = 1,
@@ -277,25 +282,29 @@ void LioOptions::Serialize(Archive* a) {
   a->Visit("point_stride", &point_stride, {.meaning = "a frame keeps every this-many-th return", .min = 1, .max = 100});
   a->Visit("frame_voxel_m", &frame_voxel_m,
            {.meaning = "a frame keeps one point per cell of this edge [m]", .min = 0.05, .max = 5});
-  a->Visit(
-      "plane_search_radius_m", &plane_search_radius_m,
-      {.meaning = "a point's plane is fitted to map points within this [m], at most map.voxel_m", .positive = true});
+  a->Visit("plane_search_radius_m", &plane_search_radius_m,
+           {.meaning = "a point's plane is fitted to map points within this [m], at most map.voxel_m",
+            .max = 10.0,
+            .positive = true});
   a->Visit("plane_points", &plane_points, {.meaning = "map points a plane is fitted to", .min = 3, .max = 16});
   a->Visit("plane_tolerance_m", &plane_tolerance_m,
-           {.meaning = "a plane's points lie within this of it [m]", .positive = true});
+           {.meaning = "a plane's points lie within this of it [m]", .max = 10.0, .positive = true});
   a->Visit("min_plane_width_m", &min_plane_width_m,
            {.meaning = "a plane's points spread at least this across it (std) [m]", .min = 0, .max = 1});
   a->Visit("max_residual_m", &max_residual_m,
-           {.meaning = "larger point-to-plane residuals are outliers [m]", .positive = true});
-  a->Visit("point_std_m", &point_std_m, {.meaning = "std of a point-to-plane residual [m]", .positive = true});
+           {.meaning = "larger point-to-plane residuals are outliers [m]", .max = 10.0, .positive = true});
+  a->Visit("point_std_m", &point_std_m,
+           {.meaning = "std of a point-to-plane residual [m]", .max = 10.0, .positive = true});
   a->Visit("max_iterations", &max_iterations, {.meaning = "iterations of the update", .min = 1, .max = 20});
   a->Visit("convergence_m", &convergence_m,
-           {.meaning = "the update stops once a step moves the position less [m]", .positive = true});
-  a->Visit("convergence_rad", &convergence_rad, {.meaning = "and the attitude less than this [rad]", .positive = true});
+           {.meaning = "the update stops once a step moves the position less [m]", .max = 1.0, .positive = true});
+  a->Visit("convergence_rad", &convergence_rad,
+           {.meaning = "and the attitude less than this [rad]", .max = 1.0, .positive = true});
   a->Visit("min_points", &min_points,
            {.meaning = "a frame with fewer matched points is not used", .min = 6, .max = 100000});
   a->Visit("degenerate_std_m", &degenerate_std_m,
            {.meaning = "a frame is degenerate when its weakest direction's position std exceeds this [m]",
+            .max = 100.0,
             .positive = true});
   a->Visit("max_queue_s", &max_queue_s,
            {.meaning = "IMU samples older than this without a frame enter the filter [s]", .min = 0.01, .max = 10});

@@ -34,10 +34,13 @@ struct PointMapOptions {
     a->Visit("voxel_m", &voxel_m, {.meaning = "the point map's hash voxel edge [m]", .min = 0.05, .max = 10});
     a->Visit("max_points_per_voxel", &max_points_per_voxel,
              {.meaning = "points a voxel keeps at most", .min = 1, .max = kMaxPointsPerVoxel});
-    a->Visit("min_point_spacing_m", &min_point_spacing_m,
-             {.meaning = "a point this close to one its voxel holds is not stored [m], below voxel_m", .min = 0});
+    a->Visit(
+        "min_point_spacing_m", &min_point_spacing_m,
+        {.meaning = "a point this close to one its voxel holds is not stored [m], below voxel_m", .min = 0, .max = 10});
+    // At least 6 voxel edges of the smallest voxel.
     a->Visit("window_radius_m", &window_radius_m,
              {.meaning = "blocks of 4^3 voxels farther than this from the vehicle are deleted [m], at least 6 voxel_m",
+              .min = 0.3,
               .max = 1e4});
   }
 };

@@ -65,21 +65,39 @@ struct VoxelMapOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("resolution_m", &resolution_m, {.meaning = "voxel edge [m]"});
+    // The window also holds at most 4096 voxels an axis and 64 million in all (Validate): a fine
+    // resolution needs a small window.
+    a->Visit("resolution_m", &resolution_m, {.meaning = "voxel edge [m]", .min = 0.01, .max = 5.0});
     a->Visit("window_size_m", &window_size_m,
-             {.meaning = "the map's window around the vehicle [m], rounded up to a power of two voxels per axis"});
-    a->Visit("log_odds_hit", &log_odds_hit, {.meaning = "log-odds added by a return (within ±30)"});
-    a->Visit("log_odds_miss", &log_odds_miss, {.meaning = "log-odds added by a ray passing through"});
-    a->Visit("log_odds_min", &log_odds_min, {.meaning = "lower clamp of a voxel's log-odds"});
-    a->Visit("log_odds_max", &log_odds_max, {.meaning = "upper clamp of a voxel's log-odds"});
-    a->Visit("occupied_threshold", &occupied_threshold, {.meaning = "log-odds above which a voxel is occupied"});
-    a->Visit("max_clearing_range_m", &max_clearing_range_m, {.meaning = "rays clear free space up to this range [m]"});
+             {.meaning = "the map's window around the vehicle [m], rounded up to a power of two voxels per axis; "
+                         "at most 4096 voxels an axis and 64 million in all",
+              .max = 2000.0,
+              .positive = true});
+    // The fixed-point store holds |log-odds| <= 30.
+    a->Visit("log_odds_hit", &log_odds_hit, {.meaning = "log-odds added by a return", .max = 30.0, .positive = true});
+    a->Visit(
+        "log_odds_miss", &log_odds_miss,
+        {.meaning = "log-odds added by a ray passing through", .min = -30.0, .max = 0.0, .rule_text = "in [-30, 0)"});
+    a->Visit("log_odds_min", &log_odds_min,
+             {.meaning = "lower clamp of a voxel's log-odds", .min = -30.0, .max = 0.0, .rule_text = "in [-30, 0)"});
+    a->Visit("log_odds_max", &log_odds_max,
+             {.meaning = "upper clamp of a voxel's log-odds", .max = 30.0, .positive = true});
+    a->Visit("occupied_threshold", &occupied_threshold,
+             {.meaning = "log-odds above which a voxel is occupied",
+              .max = 30.0,
+              .positive = true,
+              .rule_text = "in (0, log_odds_max)"});
+    a->Visit("max_clearing_range_m", &max_clearing_range_m,
+             {.meaning = "rays clear free space up to this range [m]", .max = 1e4, .positive = true});
     a->Visit("clearing_stride", &clearing_stride,
              {.meaning = "a frame walks one in this many of its rays (every return is still hit)",
               .min = 1,
               .max = kMaxClearingStride});
     a->Visit("recenter_hysteresis_m", &recenter_hysteresis_m,
-             {.meaning = "the window follows an axis once the vehicle is this far from its centre along it [m]"});
+             {.meaning = "the window follows an axis once the vehicle is this far from its centre along it [m]",
+              .min = 0.0,
+              .max = 500.0,
+              .rule_text = "in [0, a quarter of the smallest window_size_m]"});
   }
 };
 

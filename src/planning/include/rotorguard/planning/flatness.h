@@ -22,12 +22,16 @@ inline constexpr double kSettlingConstant = 5.83;
 
 /// The limits a plan keeps (eqs. 16, 17, 23). A limit <= 0 is invalid; an angle limit of
 /// +infinity leaves the envelope out (actuator limits only, as in the paper's Fig. 1(b)).
+/// The largest PWM input a plan may be given: beyond any PWM scale (the Qball-X4's is 0.06, one in
+/// microseconds 2000).
+inline constexpr double kMaxPwmInput = 1e4;
+
 struct FlatnessLimits {
   double theta_max_rad = 10.0 * 3.14159265358979323846 / 180.0;  ///< pitch bound, in (0, π/2)
   double phi_max_rad = 10.0 * 3.14159265358979323846 / 180.0;    ///< roll bound, in (0, π/2)
   double rho_angle = 1.0;  ///< ρ_θ = ρ_φ, the model's safety margin, in (0, 1]
   /// The largest PWM input a plan may ask of a motor (the paper's u_max), in (0, the vehicle's
-  /// u_max]; 0 takes the vehicle's.
+  /// u_max]; 0 takes the vehicle's. At most kMaxPwmInput.
   double u_max = 0.0;
   double rho_u = 1.0;  ///< ρ_u, in (0, 1]
   /// Throws ValidationError naming the field.

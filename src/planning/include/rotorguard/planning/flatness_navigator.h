@@ -20,6 +20,7 @@ namespace rotorguard::planning {
 
 struct FlatnessNavigatorOptions {
   FlatnessLimits limits;
+  // Every time in (0, kMaxTimeoutS] (min_hold_s from 0): an hour is longer than a battery lasts.
   double hold_t_s = 900.0;      ///< settling time of the slow trajectory after a detection [s], > 0
   double min_hold_s = 3.0;      ///< the shortest hold [s], >= 0
   double max_hold_s = 30.0;     ///< replan after this even if the estimate has not settled [s], >= min_hold_s
@@ -35,15 +36,29 @@ struct FlatnessNavigatorOptions {
              {.meaning = "pitch bound θ_max of eq. (16) [deg]", .min = 0.0, .max = 90.0});
     a->Visit("phi_max_deg", DegreesOf{&limits.phi_max_rad},
              {.meaning = "roll bound φ_max [deg]", .min = 0.0, .max = 90.0});
-    a->Visit("rho_angle", &limits.rho_angle, {.meaning = "ρ_θ = ρ_φ, the model's safety margin, in (0, 1]"});
-    a->Visit("u_max", &limits.u_max, {.meaning = "the largest PWM input a plan may ask of a motor (0: the vehicle's)"});
-    a->Visit("rho_u", &limits.rho_u, {.meaning = "ρ_u of eq. (23), in (0, 1]"});
-    a->Visit("hold_t_s", &hold_t_s, {.meaning = "settling time of the slow trajectory held after a detection [s]"});
-    a->Visit("min_hold_s", &min_hold_s, {.meaning = "the shortest hold [s]"});
-    a->Visit("max_hold_s", &max_hold_s, {.meaning = "re-plan after this even if the estimate has not settled [s]"});
+    a->Visit("rho_angle", &limits.rho_angle,
+             {.meaning = "ρ_θ = ρ_φ, the model's safety margin", .max = 1.0, .positive = true});
+    a->Visit("u_max", &limits.u_max,
+             {.meaning = "the largest PWM input a plan may ask of a motor (0: the vehicle's)",
+              .min = 0.0,
+              .max = kMaxPwmInput});
+    a->Visit("rho_u", &limits.rho_u, {.meaning = "ρ_u of eq. (23)", .max = 1.0, .positive = true});
+    a->Visit("hold_t_s", &hold_t_s,
+             {.meaning = "settling time of the slow trajectory held after a detection [s]",
+              .max = kMaxTimeoutS,
+              .positive = true});
+    a->Visit("min_hold_s", &min_hold_s, {.meaning = "the shortest hold [s]", .min = 0.0, .max = kMaxTimeoutS});
+    a->Visit("max_hold_s", &max_hold_s,
+             {.meaning = "re-plan after this even if the estimate has not settled [s], at least min_hold_s",
+              .min = 0.0,
+              .max = kMaxTimeoutS});
     a->Visit("time_budget_s", &time_budget_s,
-             {.meaning = "the longest re-planned leg accepted [s]; beyond it: return home, or land"});
-    a->Visit("min_t_s", &min_t_s, {.meaning = "settling time of a leg without a horizontal move [s]"});
+             {.meaning = "the longest re-planned leg accepted [s]; beyond it: return home, or land",
+              .max = kMaxTimeoutS,
+              .positive = true});
+    a->Visit(
+        "min_t_s", &min_t_s,
+        {.meaning = "settling time of a leg without a horizontal move [s]", .max = kMaxTimeoutS, .positive = true});
   }
 };
 

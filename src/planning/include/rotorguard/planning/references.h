@@ -22,8 +22,13 @@ struct HoverOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("position_m", &position_m, {.meaning = "the point to hold [m]", .default_text = "the initial position"});
-    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+    a->Visit("position_m", &position_m,
+             {.meaning = "the point to hold [m]",
+              .min = -kMaxCoordinateM,
+              .max = kMaxCoordinateM,
+              .default_text = "the initial position"});
+    a->Visit("yaw_rad", &yaw_rad,
+             {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
   }
 };
 
@@ -53,9 +58,14 @@ struct TakeoffOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("altitude_m", &altitude_m,
-             {.meaning = "the climb above the start [m] (a minimum-jerk climb)", .positive = true, .required = true});
-    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "peak climb speed [m/s]"});
-    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+             {.meaning = "the climb above the start [m] (a minimum-jerk climb)",
+              .max = kMaxCoordinateM,
+              .positive = true,
+              .required = true});
+    a->Visit("max_speed_m_s", &max_speed_m_s,
+             {.meaning = "peak climb speed [m/s]", .max = kMaxSpeedMS, .positive = true});
+    a->Visit("yaw_rad", &yaw_rad,
+             {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
   }
 };
 
@@ -141,11 +151,19 @@ struct LemniscateOptions {
   void Serialize(Archive* a) {
     a->Visit("center_m", &center_m,
              {.meaning = "centre of the figure eight x = sx/2 sin θ, y = sy/2 sin 2θ, z = sz/2 sin θ [m]",
+              .min = -kMaxCoordinateM,
+              .max = kMaxCoordinateM,
               .default_text = "the initial position"});
-    a->Visit("size_m", TripleOf{&size_x_m, &size_y_m, &size_z_m}, {.meaning = "its full extent [sx, sy, sz] [m]"});
-    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "top speed once ramped up [m/s]", .required = true});
-    a->Visit("ramp_s", &ramp_s, {.meaning = "time to full phase rate from rest [s]"});
-    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+    a->Visit("size_m", TripleOf{&size_x_m, &size_y_m, &size_z_m},
+             {.meaning = "its full extent [sx, sy, sz] [m]",
+              .min = 0.0,
+              .max = kMaxCoordinateM,
+              .rule_text = "three numbers, each in [0, 10000], sx and sy > 0"});
+    a->Visit("max_speed_m_s", &max_speed_m_s,
+             {.meaning = "top speed once ramped up [m/s]", .max = kMaxSpeedMS, .positive = true, .required = true});
+    a->Visit("ramp_s", &ramp_s, {.meaning = "time to full phase rate from rest [s]", .min = 0.0, .max = kMaxTimeoutS});
+    a->Visit("yaw_rad", &yaw_rad,
+             {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
   }
 };
 
@@ -182,14 +200,23 @@ struct CircleOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("center_m", &center_m,
-             {.meaning = "centre; the circle starts at centre + [radius, 0, 0] [m]", .required = true});
-    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .required = true});
-    a->Visit("speed_m_s", &speed_m_s, {.meaning = "tangential speed once ramped up [m/s]", .required = true});
-    a->Visit("ramp_s", &ramp_s, {.meaning = "time to full speed from rest [s]"});
+             {.meaning = "centre; the circle starts at centre + [radius, 0, 0] [m]",
+              .min = -kMaxCoordinateM,
+              .max = kMaxCoordinateM,
+              .required = true});
+    // From a centimetre: the phase rate is speed / radius, the acceleration speed² / radius.
+    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .min = 0.01, .max = kMaxCoordinateM, .required = true});
+    a->Visit(
+        "speed_m_s", &speed_m_s,
+        {.meaning = "tangential speed once ramped up [m/s]", .max = kMaxSpeedMS, .positive = true, .required = true});
+    a->Visit("ramp_s", &ramp_s, {.meaning = "time to full speed from rest [s]", .min = 0.0, .max = kMaxTimeoutS});
     a->Visit("clockwise", &clockwise, {.meaning = "seen from above"});
     a->Visit("climb_m_s", &climb_m_s,
-             {.meaning = "vertical speed: non-zero makes the circle a helix (paper 002's spiral) [m/s]"});
-    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+             {.meaning = "vertical speed: non-zero makes the circle a helix (paper 002's spiral) [m/s]",
+              .min = -kMaxSpeedMS,
+              .max = kMaxSpeedMS});
+    a->Visit("yaw_rad", &yaw_rad,
+             {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
   }
 };
 
@@ -222,12 +249,21 @@ struct WaypointOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("waypoints_m", &waypoints_m,
-             {.meaning = "the points flown to from the start, in turn, stopping at each [m]", .required = true});
+             {.meaning = "the points flown to from the start, in turn, stopping at each [m]",
+              .min = -kMaxCoordinateM,
+              .max = kMaxCoordinateM,
+              .required = true});
     a->Visit("max_speed_m_s", &max_speed_m_s,
-             {.meaning = "speed limit of the trapezoidal profile [m/s]", .required = true});
-    a->Visit("max_accel_m_s2", &max_accel_m_s2, {.meaning = "its acceleration limit [m/s²]"});
-    a->Visit("dwell_s", &dwell_s, {.meaning = "pause at each intermediate waypoint [s]"});
-    a->Visit("yaw_rad", &yaw_rad, {.meaning = "the heading held [rad]", .default_text = "the initial yaw"});
+             {.meaning = "speed limit of the trapezoidal profile [m/s]",
+              .max = kMaxSpeedMS,
+              .positive = true,
+              .required = true});
+    a->Visit("max_accel_m_s2", &max_accel_m_s2,
+             {.meaning = "its acceleration limit [m/s²]", .max = kMaxAccelerationMS2, .positive = true});
+    a->Visit("dwell_s", &dwell_s,
+             {.meaning = "pause at each intermediate waypoint [s]", .min = 0.0, .max = kMaxTimeoutS});
+    a->Visit("yaw_rad", &yaw_rad,
+             {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
   }
 };
 

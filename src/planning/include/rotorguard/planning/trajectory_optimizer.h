@@ -22,10 +22,12 @@
 namespace rotorguard::planning {
 
 /// Magnitude limits on the trajectory's derivatives.
+/// Each in (0, its kMax...] (core/config_schema.h): a limit beyond a multirotor's reach only makes
+/// the collision checks' time steps (a step in metres over v_max) vanish.
 struct DynamicLimits {
-  double v_max = 1.0;  ///< [m/s], > 0
-  double a_max = 2.0;  ///< [m/s²], > 0 (a_max,n nominal; a_max,f of eq. 33 after a failure)
-  double j_max = 6.0;  ///< [m/s³], > 0
+  double v_max = 1.0;  ///< [m/s], in (0, kMaxSpeedMS]
+  double a_max = 2.0;  ///< [m/s²], in (0, kMaxAccelerationMS2] (a_max,n nominal; a_max,f of eq. 33 after a failure)
+  double j_max = 6.0;  ///< [m/s³], in (0, kMaxJerkMS3]
   void Validate() const;
 };
 
@@ -70,7 +72,8 @@ using NearestPlane = std::function<std::optional<ObstaclePlane>(const Vector3& p
 /// places them), each sample's nearest obstacle where `nearest` finds one.
 PlaneSet BuildSamplePlanes(const MinimumJerkTrajectory& traj, int samples_per_piece, const NearestPlane& nearest);
 
-/// Eq. (22)'s weights λ = [λ_t, λ_s, λ_d, λ_c] (paper 000 Sec. VI: [10, 1, 1e4, 1e4]), each >= 0.
+/// Eq. (22)'s weights λ = [λ_t, λ_s, λ_d, λ_c] (paper 000 Sec. VI: [10, 1, 1e4, 1e4]), each in
+/// [0, kMaxWeight].
 struct CostWeights {
   double time = 10.0;
   double smoothness = 1.0;
@@ -79,16 +82,23 @@ struct CostWeights {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("time", &time, {.meaning = "λ_t, on the trajectory's duration"});
-    a->Visit("smoothness", &smoothness, {.meaning = "λ_s, on the integrated squared jerk"});
-    a->Visit("feasibility", &feasibility, {.meaning = "λ_d, on speed, acceleration and jerk beyond the limits"});
-    a->Visit("collision", &collision, {.meaning = "λ_c, on points closer than the clearance to an obstacle"});
+    a->Visit("time", &time, {.meaning = "λ_t, on the trajectory's duration", .min = 0.0, .max = kMaxWeight});
+    a->Visit("smoothness", &smoothness,
+             {.meaning = "λ_s, on the integrated squared jerk", .min = 0.0, .max = kMaxWeight});
+    a->Visit("feasibility", &feasibility,
+             {.meaning = "λ_d, on speed, acceleration and jerk beyond the limits", .min = 0.0, .max = kMaxWeight});
+    a->Visit("collision", &collision,
+             {.meaning = "λ_c, on points closer than the clearance to an obstacle", .min = 0.0, .max = kMaxWeight});
   }
 };
 
+/// [m]: the largest clearance a plan keeps from obstacles; more than any vehicle's margin, and the
+/// obstacle planes are searched for that far around every sample.
+inline constexpr double kMaxClearanceM = 10.0;
+
 struct TrajectoryOptimizerOptions {
   CostWeights weights;
-  double clearance_m = 0.3;      ///< C_o of eq. (36), the safe distance [m], >= 0
+  double clearance_m = 0.3;      ///< C_o of eq. (36), the safe distance [m], in [0, kMaxClearanceM]
   int samples_per_piece = 16;    ///< penalty samples per piece (κ / M), >= 2
   int max_iterations = 200;      ///< L-BFGS iterations, >= 1
   /// L-BFGS stops once an iteration lowers the cost by less than this fraction, in (0, 0.1]:

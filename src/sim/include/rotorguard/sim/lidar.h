@@ -11,6 +11,7 @@
 /// densely the longer it integrates, as the MID-360's rosette does; the exact Livox pattern is
 /// not public.
 #include <cstdint>
+#include <numbers>
 #include <optional>
 
 #include "rotorguard/core/config_schema.h"
@@ -39,16 +40,26 @@ struct LidarOptions {
   void Serialize(Archive* a) {
     a->Visit("enabled", &enabled,
              {.meaning = "a lidar block switches the sensor on unless this says false", .default_text = "true"});
-    a->Visit("frame_rate_hz", &frame_rate_hz, {.meaning = "frames per second"});
-    a->Visit("points_per_s", &points_per_s, {.meaning = "pulses per second"});
-    a->Visit("min_range_m", &min_range_m, {.meaning = "closer returns are dropped [m]"});
-    a->Visit("max_range_m", &max_range_m, {.meaning = "[m]"});
-    a->Visit("min_elevation_rad", &min_elevation_rad, {.meaning = "the field of view's lower edge [rad] (-7°)"});
-    a->Visit("max_elevation_rad", &max_elevation_rad, {.meaning = "its upper edge [rad] (52°)"});
-    a->Visit("range_noise_m", &range_noise_m, {.meaning = "1-σ range noise [m]"});
-    a->Visit("dropout_probability", &dropout_probability, {.meaning = "chance a return is lost, in [0, 1)"});
-    a->Visit("position_m", &position_m, {.meaning = "mounting point, body frame [m]"});
-    a->Visit("grid_cell_m", &grid_cell_m, {.meaning = "the boxes' ray-casting grid cell [m]"});
+    a->Visit("frame_rate_hz", &frame_rate_hz, {.meaning = "frames per second", .max = 1000.0, .positive = true});
+    // Every pulse is cast: ten million a simulated second is twice the densest scanning LiDAR's.
+    a->Visit("points_per_s", &points_per_s, {.meaning = "pulses per second", .max = 1e7, .positive = true});
+    a->Visit("min_range_m", &min_range_m,
+             {.meaning = "closer returns are dropped [m], below max_range_m", .min = 0.0, .max = 100.0});
+    a->Visit("max_range_m", &max_range_m, {.meaning = "[m]", .max = 1e4, .positive = true});
+    a->Visit("min_elevation_rad", &min_elevation_rad,
+             {.meaning = "the field of view's lower edge [rad] (-7°), below max_elevation_rad",
+              .min = -std::numbers::pi / 2.0,
+              .max = std::numbers::pi / 2.0});
+    a->Visit("max_elevation_rad", &max_elevation_rad,
+             {.meaning = "its upper edge [rad] (52°)", .min = -std::numbers::pi / 2.0, .max = std::numbers::pi / 2.0});
+    a->Visit("range_noise_m", &range_noise_m, {.meaning = "1-σ range noise [m]", .min = 0.0, .max = 1.0});
+    a->Visit("dropout_probability", &dropout_probability,
+             {.meaning = "chance a return is lost", .min = 0.0, .max = 1.0, .rule_text = "in [0, 1)"});
+    a->Visit("position_m", &position_m,
+             {.meaning = "mounting point, body frame [m]", .min = -kMaxBodyOffsetM, .max = kMaxBodyOffsetM});
+    // The grid has at most 2048 cells a side whatever the cell (RayCaster).
+    a->Visit("grid_cell_m", &grid_cell_m,
+             {.meaning = "the boxes' ray-casting grid cell [m]", .min = 0.01, .max = 100.0});
   }
 };
 

@@ -36,19 +36,31 @@ struct ImuOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("rate_hz", &rate_hz, {.meaning = "sample rate [Hz], at most the physics rate"});
-    a->Visit("position_m", &position_m, {.meaning = "mounting point from the centre of gravity, body frame [m]"});
-    a->Visit("accel_noise_density", &accel_noise_density, {.meaning = "accelerometer white noise [m/s²/√Hz]"});
-    a->Visit("gyro_noise_density", &gyro_noise_density, {.meaning = "gyro white noise [rad/s/√Hz]"});
-    a->Visit("accel_bias_random_walk", &accel_bias_random_walk, {.meaning = "accelerometer bias diffusion [m/s³/√Hz]"});
-    a->Visit("gyro_bias_random_walk", &gyro_bias_random_walk, {.meaning = "gyro bias diffusion [rad/s²/√Hz]"});
+    a->Visit("rate_hz", &rate_hz,
+             {.meaning = "sample rate [Hz], at most the physics rate", .max = kMaxRateHz, .positive = true});
+    a->Visit("position_m", &position_m,
+             {.meaning = "mounting point from the centre of gravity, body frame [m]",
+              .min = -kMaxBodyOffsetM,
+              .max = kMaxBodyOffsetM});
+    // The noise bounds are a hundred to a thousand times a consumer MEMS IMU's (an MPU-6000's
+    // accelerometer density is 4e-3 m/s²/√Hz, its gyro's 9e-4 rad/s/√Hz).
+    a->Visit("accel_noise_density", &accel_noise_density,
+             {.meaning = "accelerometer white noise [m/s²/√Hz]", .min = 0.0, .max = 1.0});
+    a->Visit("gyro_noise_density", &gyro_noise_density,
+             {.meaning = "gyro white noise [rad/s/√Hz]", .min = 0.0, .max = 0.1});
+    a->Visit("accel_bias_random_walk", &accel_bias_random_walk,
+             {.meaning = "accelerometer bias diffusion [m/s³/√Hz]", .min = 0.0, .max = 1.0});
+    a->Visit("gyro_bias_random_walk", &gyro_bias_random_walk,
+             {.meaning = "gyro bias diffusion [rad/s²/√Hz]", .min = 0.0, .max = 0.1});
     a->Visit("accel_bias_initial", &accel_bias_initial,
-             {.meaning = "std of the accelerometer bias at the start [m/s²]"});
-    a->Visit("gyro_bias_initial", &gyro_bias_initial, {.meaning = "std of the gyro bias at the start [rad/s]"});
+             {.meaning = "std of the accelerometer bias at the start [m/s²]", .min = 0.0, .max = kGravity});
+    a->Visit("gyro_bias_initial", &gyro_bias_initial,
+             {.meaning = "std of the gyro bias at the start [rad/s]", .min = 0.0, .max = 1.0});
+    // Up to the ±200 g of shock accelerometers and ±11 500 °/s.
     a->Visit("accel_range_m_s2", &accel_range_m_s2,
-             {.meaning = "each accelerometer axis saturates at ± this [m/s²] (16 g)", .positive = true});
+             {.meaning = "each accelerometer axis saturates at ± this [m/s²] (16 g)", .max = 2000.0, .positive = true});
     a->Visit("gyro_range_rad_s", &gyro_range_rad_s,
-             {.meaning = "each gyro axis saturates at ± this [rad/s] (2000 °/s)", .positive = true});
+             {.meaning = "each gyro axis saturates at ± this [rad/s] (2000 °/s)", .max = 200.0, .positive = true});
   }
 };
 
@@ -66,10 +78,14 @@ struct EscOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("rate_hz", &rate_hz, {.meaning = "telemetry rate [Hz], at most the physics rate"});
-    a->Visit("noise_rpm", &noise_rpm, {.meaning = "white measurement noise [rpm]"});
-    a->Visit("quantization_rpm", &quantization_rpm, {.meaning = "reported resolution [rpm] (0: none)"});
-    a->Visit("delay_s", &delay_s, {.meaning = "transport delay [s], below 0.5 s"});
+    a->Visit("rate_hz", &rate_hz,
+             {.meaning = "telemetry rate [Hz], at most the physics rate", .max = kMaxRateHz, .positive = true});
+    // A multirotor's motors turn at a few thousand to 30 000 rpm.
+    a->Visit("noise_rpm", &noise_rpm, {.meaning = "white measurement noise [rpm]", .min = 0.0, .max = 5000.0});
+    a->Visit("quantization_rpm", &quantization_rpm,
+             {.meaning = "reported resolution [rpm] (0: none)", .min = 0.0, .max = 5000.0});
+    a->Visit("delay_s", &delay_s,
+             {.meaning = "transport delay [s], below 0.5 s", .min = 0.0, .max = 0.5, .rule_text = "in [0, 0.5)"});
   }
 };
 
@@ -88,8 +104,10 @@ struct OdometryOptions {
 
     template <typename Archive>
     void Serialize(Archive* a) {
-      a->Visit("start_s", &start_s, {.meaning = "when the front end loses track [s]", .min = 0.0, .required = true});
-      a->Visit("duration_s", &duration_s, {.meaning = "for how long [s]", .min = 0.0, .required = true});
+      a->Visit("start_s", &start_s,
+               {.meaning = "when the front end loses track [s]", .min = 0.0, .max = kMaxFlightS, .required = true});
+      a->Visit("duration_s", &duration_s,
+               {.meaning = "for how long [s]", .min = 0.0, .max = kMaxFlightS, .required = true});
     }
   };
   std::vector<Outage> outages;
@@ -114,12 +132,16 @@ struct OdometryOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("rate_hz", &rate_hz, {.meaning = "rate [Hz], at most the physics rate"});
-    a->Visit("position_noise_m", &position_noise_m, {.meaning = "position std at rest [m]"});
-    a->Visit("velocity_noise_m_s", &velocity_noise_m_s, {.meaning = "velocity std at rest [m/s]"});
+    a->Visit("rate_hz", &rate_hz,
+             {.meaning = "rate [Hz], at most the physics rate", .max = kMaxRateHz, .positive = true});
+    // Up to a GNSS fix's metres and a tenth of a radian: the noise of any front end worth flying on.
+    a->Visit("position_noise_m", &position_noise_m, {.meaning = "position std at rest [m]", .min = 0.0, .max = 10.0});
+    a->Visit("velocity_noise_m_s", &velocity_noise_m_s,
+             {.meaning = "velocity std at rest [m/s]", .min = 0.0, .max = 10.0});
     a->Visit("attitude_noise_rad", &attitude_noise_rad,
-             {.meaning = "attitude std at rest, per small-angle component [rad]"});
-    a->Visit("rate_noise_gain", &rate_noise_gain, {.meaning = "the stds grow as (1 + gain·|ω|) [per rad/s]"});
+             {.meaning = "attitude std at rest, per small-angle component [rad]", .min = 0.0, .max = 0.5});
+    a->Visit("rate_noise_gain", &rate_noise_gain,
+             {.meaning = "the stds grow as (1 + gain·|ω|) [per rad/s]", .min = 0.0, .max = 100.0});
     a->Visit("outages", &outages, {.meaning = "intervals without odometry (the front end lost track)"});
   }
 };

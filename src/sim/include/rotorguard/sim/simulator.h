@@ -17,8 +17,13 @@
 
 namespace rotorguard::sim {
 
+/// [Hz]: the fastest physics rate, a 10 µs step, what a motor time constant of 20 µs would need
+/// (the step must be at most half of it); every step is one RK4 step of the whole vehicle.
+inline constexpr double kMaxPhysicsRateHz = 1e5;
+
 struct SimulatorOptions {
-  double physics_rate_hz = 1000.0;  ///< RK4 step rate; dt must be <= half the fastest motor time constant
+  /// RK4 step rate, in (0, kMaxPhysicsRateHz]; dt must be <= half the fastest motor time constant.
+  double physics_rate_hz = 1000.0;
   ImuOptions imu;
   EscOptions esc;
   OdometryOptions odometry;
@@ -27,7 +32,7 @@ struct SimulatorOptions {
   /// A constant torque on the airframe, body frame [N*m]: a payload or cable the stack is not told
   /// of. Not a scenario key: the scenario's truth draws it (truth.h).
   Vector3 external_torque_n_m = Vector3::Zero();
-  /// Touching the ground faster than this (any direction) is a crash [m/s], > 0.
+  /// Touching the ground faster than this (any direction) is a crash [m/s], in (0, kMaxSpeedMS].
   double crash_speed_m_s = 1.0;
   /// Touching the ground tilted more than this is a crash [rad], in (0, pi].
   double crash_tilt_rad = 0.6;

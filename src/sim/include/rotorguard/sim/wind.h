@@ -16,9 +16,12 @@ struct WindOptions {
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("mean_m_s", &mean_m_s, {.meaning = "mean wind, world frame [m/s]"});
-    a->Visit("gust_std_m_s", &gust_std_m_s, {.meaning = "stationary std of each Gauss-Markov gust component [m/s]"});
-    a->Visit("gust_time_constant_s", &gust_time_constant_s, {.meaning = "the gusts' correlation time [s]"});
+    a->Visit("mean_m_s", &mean_m_s,
+             {.meaning = "mean wind, world frame [m/s]", .min = -kMaxSpeedMS, .max = kMaxSpeedMS});
+    a->Visit("gust_std_m_s", &gust_std_m_s,
+             {.meaning = "stationary std of each Gauss-Markov gust component [m/s]", .min = 0.0, .max = kMaxSpeedMS});
+    a->Visit("gust_time_constant_s", &gust_time_constant_s,
+             {.meaning = "the gusts' correlation time [s]", .max = kMaxTimeoutS, .positive = true});
   }
 };
 

@@ -11,6 +11,9 @@
 
 namespace rotorguard::sim {
 
+/// [m]: a box's extent along an axis, up to the width of the coordinates' range.
+inline constexpr double kMaxWorldExtentM = 2.0 * kMaxCoordinateM;
+
 /// Box with its centre, full edge lengths and a rotation about the world z axis.
 struct Box {
   Vector3 center_m = Vector3::Zero();
@@ -19,11 +22,14 @@ struct Box {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("center_m", &center_m, {.meaning = "[m]", .required = true});
-    a->Visit("size_m", &size_m, {.meaning = "full extents along its axes [m], each > 0", .required = true});
-    a->Visit("yaw_rad", &yaw_rad, {.meaning = "rotation about z [rad]"});
+    a->Visit("center_m", &center_m,
+             {.meaning = "[m]", .min = -kMaxCoordinateM, .max = kMaxCoordinateM, .required = true});
+    a->Visit(
+        "size_m", &size_m,
+        {.meaning = "full extents along its axes [m]", .max = kMaxWorldExtentM, .positive = true, .required = true});
+    a->Visit("yaw_rad", &yaw_rad, {.meaning = "rotation about z [rad]", .min = -kTwoPi, .max = kTwoPi});
   }
-  /// Throws ValidationError when an extent is not > 0.
+  /// Throws ValidationError when a key is out of its range.
   void Validate() const;
   /// Euclidean distance from `p` to the box (0 inside).
   double Distance(const Vector3& p) const;
@@ -37,9 +43,11 @@ struct Cylinder {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("center_m", &center_m, {.meaning = "[x, y] of its axis [m]", .required = true});
-    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .positive = true, .required = true});
-    a->Visit("height_m", &height_m, {.meaning = "standing on the ground [m]", .positive = true, .required = true});
+    a->Visit("center_m", &center_m,
+             {.meaning = "[x, y] of its axis [m]", .min = -kMaxCoordinateM, .max = kMaxCoordinateM, .required = true});
+    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .max = kMaxCoordinateM, .positive = true, .required = true});
+    a->Visit("height_m", &height_m,
+             {.meaning = "standing on the ground [m]", .max = kMaxCoordinateM, .positive = true, .required = true});
   }
   double Distance(const Vector3& p) const;
 };
@@ -55,13 +63,17 @@ struct MovingBox {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("size_m", &size_m, {.meaning = "full extents [m], each > 0", .required = true});
-    a->Visit("waypoints_m", &waypoints_m, {.meaning = "the centre's polyline [m]", .required = true});
-    a->Visit("speed_m_s", &speed_m_s, {.meaning = "[m/s]", .min = 0.0, .required = true});
+    a->Visit("size_m", &size_m,
+             {.meaning = "full extents [m]", .max = kMaxWorldExtentM, .positive = true, .required = true});
+    a->Visit(
+        "waypoints_m", &waypoints_m,
+        {.meaning = "the centre's polyline [m]", .min = -kMaxCoordinateM, .max = kMaxCoordinateM, .required = true});
+    a->Visit("speed_m_s", &speed_m_s, {.meaning = "[m/s]", .min = 0.0, .max = kMaxSpeedMS, .required = true});
     a->Visit("loop", &loop, {.meaning = "back to the first waypoint after the last (else it stops there)"});
-    a->Visit("start_s", &start_s, {.meaning = "it rests at its first waypoint until then [s]", .min = 0.0});
+    a->Visit("start_s", &start_s,
+             {.meaning = "it rests at its first waypoint until then [s]", .min = 0.0, .max = kMaxFlightS});
   }
-  /// Throws ValidationError when an extent is not > 0.
+  /// Throws ValidationError when a key is out of its range.
   void Validate() const;
   /// The box's pose at time t [s].
   Box At(double t) const;

@@ -47,8 +47,11 @@ struct KnownFault {
   void Serialize(Archive* a) {
     a->Visit("rotor", &rotor,
              {.meaning = "the rotor handed over as failed", .min = 0, .max = kMaxRotors - 1, .required = true});
-    a->Visit("at_time_s", &at_time_s, {.meaning = "when [s]", .min = 0.0, .required = true});
-    a->Visit("loss", &loss, {.meaning = "1: failed; below 1 a partial loss of thrust (controller assembly only)"});
+    a->Visit("at_time_s", &at_time_s, {.meaning = "when [s]", .min = 0.0, .max = kMaxFlightS, .required = true});
+    a->Visit("loss", &loss,
+             {.meaning = "1: failed; below 1 a partial loss of thrust (controller assembly only)",
+              .max = 1.0,
+              .positive = true});
   }
 };
 
@@ -115,33 +118,43 @@ struct NavigationOptions {
   void Serialize(Archive* a) {
     planning::ReplannerOptions& r = replanner;
     a->Visit("method", &method, {.meaning = "minco, or flatness: paper 004's legs without a map (docs/flatness.md)"});
-    a->Visit("start_s", &start_s, {.meaning = "the mission starts then; the vehicle holds its start until [s]"});
-    a->Visit("rate_hz", &planner_rate_hz, {.meaning = "the planner's rate [Hz], at most the control rate"});
-    a->Visit("v_max", &r.nominal.v_max, {.meaning = "nominal speed limit [m/s]"});
-    a->Visit("a_max", &r.nominal.a_max, {.meaning = "nominal acceleration limit a_max,n [m/s²]"});
-    a->Visit("j_max", &r.nominal.j_max, {.meaning = "nominal jerk limit [m/s³]"});
     a->Visit(
-        "post_failure_safety_factor", &post_failure_safety_factor,
-        {.meaning =
-             "γ_a,f of eq. (33): with the vehicle's mass, rotor thrust and drag it gives a_max,f after a failure"});
-    a->Visit("replan_period_s", &r.replan_period_s, {.meaning = "periodic replanning [s]"});
+        "start_s", &start_s,
+        {.meaning = "the mission starts then; the vehicle holds its start until [s]", .min = 0.0, .max = kMaxFlightS});
+    a->Visit("rate_hz", &planner_rate_hz,
+             {.meaning = "the planner's rate [Hz], at most the control rate", .max = kMaxRateHz, .positive = true});
+    // The collision checks step in time by a fixed distance over v_max (DynamicLimits).
+    a->Visit("v_max", &r.nominal.v_max, {.meaning = "nominal speed limit [m/s]", .max = kMaxSpeedMS, .positive = true});
+    a->Visit("a_max", &r.nominal.a_max,
+             {.meaning = "nominal acceleration limit a_max,n [m/s²]", .max = kMaxAccelerationMS2, .positive = true});
+    a->Visit("j_max", &r.nominal.j_max, {.meaning = "nominal jerk limit [m/s³]", .max = kMaxJerkMS3, .positive = true});
+    a->Visit("post_failure_safety_factor", &post_failure_safety_factor,
+             {.meaning =
+                  "γ_a,f of eq. (33): with the vehicle's mass, rotor thrust and drag it gives a_max,f after a failure",
+              .max = 1.0,
+              .positive = true});
+    a->Visit("replan_period_s", &r.replan_period_s,
+             {.meaning = "periodic replanning [s]", .max = kMaxTimeoutS, .positive = true});
     a->Visit("clearance_m", &r.planner.optimizer.clearance_m,
-             {.meaning = "C_o of eq. (36), the distance kept from obstacles [m]"});
+             {.meaning = "C_o of eq. (36), the distance kept from obstacles [m]",
+              .min = 0.0,
+              .max = planning::kMaxClearanceM});
     a->Visit(
         "post_failure_clearance_m", &r.post_failure_clearance_m,
         {.meaning = "unset: clearance_m throughout; else C_o once the attitude recovered from a failure, and the one "
                     "tried when clearance_m finds no plan before (docs/navigation.md)",
-         .min = 0.0});
+         .min = 0.0,
+         .max = planning::kMaxClearanceM});
     a->Visit("failure_aware", &failure_aware,
              {.meaning = "false: the failure-unaware variant keeps the nominal limits after a failure"});
     a->Visit("altitude_band_m", PairOf{&r.planner.search.z_min_m, &r.planner.search.z_max_m},
-             {.meaning = "[z_min, z_max], the altitudes the search may use [m]"});
+             {.meaning = "[z_min, z_max], the altitudes the search may use [m]", .min = 0.0, .max = kMaxCoordinateM});
     a->Visit("weights", &r.planner.optimizer.weights, {.meaning = "eq. (22)'s weights"});
   }
 };
 
 struct FlightStackOptions {
-  double control_rate_hz = 200.0;    ///< controller rate (paper 000: 200 Hz), in (0, 10000]
+  double control_rate_hz = 200.0;  ///< controller rate (paper 000: 200 Hz), in (0, kMaxRateHz]
   /// The assembly controller is built by the caller and handed to the FlightStack.
   ControllerKind controller = ControllerKind::kNominal;
   control::NominalControllerOptions nominal;
@@ -181,7 +194,8 @@ control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& opti
 template <typename Archive>
 void FlightStackOptions::Serialize(Archive* a) {
   a->Visit("controller", &controller, {.meaning = "the controller (docs/control.md)"});
-  a->Visit("control_rate_hz", &control_rate_hz, {.meaning = "the controller's rate [Hz], at most sim.physics_rate_hz"});
+  a->Visit("control_rate_hz", &control_rate_hz,
+           {.meaning = "the controller's rate [Hz], at most sim.physics_rate_hz", .max = kMaxRateHz, .positive = true});
   a->Visit("nominal", &nominal, {.meaning = "the nominal cascade's gains"});
   a->Visit("passive", &passive, {.meaning = "the passive controller: stack.nominal's position gains and its own"});
   // INDI's filters are checked against the control rate it samples at.

@@ -25,6 +25,7 @@
 /// ground even when its estimate has drifted; touchdown is what a land detector sees: the
 /// controller, held up by the ground, commanding less than `touchdown_thrust_ratio` of the weight
 /// for `touchdown_hold_s`. Then the motors stop. No planner runs while landing.
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -77,20 +78,35 @@ struct SupervisorOptions {
   void Serialize(Archive* a) {
     a->Visit("recovery_tilt_rad", &recovery_tilt_rad,
              {.meaning = "recovery from a failure ends once the thrust axis averaged over the spin stays this "
-                         "close to vertical [rad] ..."});
-    a->Visit("recovery_hold_s", &recovery_hold_s, {.meaning = "... for this long [s]"});
+                         "close to vertical [rad] ...",
+              .max = std::numbers::pi / 2.0,
+              .positive = true});
+    a->Visit("recovery_hold_s", &recovery_hold_s,
+             {.meaning = "... for this long [s]", .min = 0.0, .max = kMaxTimeoutS});
     a->Visit("recovery_axis_time_constant_s", &recovery_axis_time_constant_s,
-             {.meaning = "the time constant of that average [s]"});
+             {.meaning = "the time constant of that average [s]", .max = 100.0, .positive = true});
     a->Visit("no_plan_timeout_s", &no_plan_timeout_s,
-             {.meaning = "a goal without a successful plan for this long [s] lands the vehicle"});
-    a->Visit("odometry_timeout_s", &odometry_timeout_s, {.meaning = "odometry older than this [s] lands the vehicle"});
+             {.meaning = "a goal without a successful plan for this long [s] lands the vehicle",
+              .max = kMaxTimeoutS,
+              .positive = true});
+    a->Visit("odometry_timeout_s", &odometry_timeout_s,
+             {.meaning = "odometry older than this [s] lands the vehicle", .max = kMaxTimeoutS, .positive = true});
+    // Twice the fastest speed a plan may ask for (stack.planner.v_max): above it, the estimate diverged.
     a->Visit("max_speed_m_s", &max_speed_m_s,
-             {.meaning = "a speed estimate above this [m/s] (a diverged estimator) lands the vehicle"});
-    a->Visit("landing_speed_m_s", &landing_speed_m_s, {.meaning = "peak descent rate of an emergency landing [m/s]"});
-    a->Visit("landing_depth_m", &landing_depth_m, {.meaning = "how far below the ground the descent aims [m]"});
+             {.meaning = "a speed estimate above this [m/s] (a diverged estimator) lands the vehicle",
+              .max = 2.0 * kMaxSpeedMS,
+              .positive = true});
+    a->Visit("landing_speed_m_s", &landing_speed_m_s,
+             {.meaning = "peak descent rate of an emergency landing [m/s]", .max = 10.0, .positive = true});
+    a->Visit("landing_depth_m", &landing_depth_m,
+             {.meaning = "how far below the ground the descent aims [m]", .max = 10.0, .positive = true});
     a->Visit("touchdown_thrust_ratio", &touchdown_thrust_ratio,
-             {.meaning = "collective command over weight below which ..."});
-    a->Visit("touchdown_hold_s", &touchdown_hold_s, {.meaning = "... for this long [s] is a touchdown"});
+             {.meaning = "collective command over weight below which ...",
+              .max = 1.0,
+              .positive = true,
+              .rule_text = "in (0, 1)"});
+    a->Visit("touchdown_hold_s", &touchdown_hold_s,
+             {.meaning = "... for this long [s] is a touchdown", .max = kMaxTimeoutS, .positive = true});
     a->Visit("max_failed_rotors", &max_failed_rotors,
              {.meaning = "failed rotors the vehicle flies on; one more lands it (default: no limit by count; an "
                          "assembly of n units: 4n - 4)",

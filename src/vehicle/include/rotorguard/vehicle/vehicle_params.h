@@ -28,12 +28,17 @@ struct Rotor {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("position_m", &p_B,
-             {.meaning = "hub relative to the centre of gravity, body frame [m]", .required = true});
+             {.meaning = "hub relative to the centre of gravity, body frame [m]",
+              .min = -kMaxBodyOffsetM,
+              .max = kMaxBodyOffsetM,
+              .required = true});
     a->Visit("direction", &direction,
              {.meaning = "propeller rotation seen from above; ccw gives reaction torque -κ_t T", .required = true});
-    a->Visit("yaw_coefficient_m", &yaw_coefficient_m, {.meaning = "κ_t [m]", .min = 0, .required = true});
+    // κ_t is a propeller's torque over its thrust: about a hundredth of its radius.
+    a->Visit("yaw_coefficient_m", &yaw_coefficient_m, {.meaning = "κ_t [m]", .min = 0, .max = 1, .required = true});
+    // A heavy-lift rotor gives a few hundred newtons.
     a->Visit("max_thrust_n", &max_thrust_n,
-             {.meaning = "T̄ [N]; the sum must exceed m·g", .positive = true, .required = true});
+             {.meaning = "T̄ [N]; the sum must exceed m·g", .max = 1e4, .positive = true, .required = true});
   }
 };
 
@@ -44,8 +49,9 @@ struct CollisionSphere {
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit("centre_m", &centre_B, {.meaning = "[m], body frame", .required = true});
-    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .positive = true, .required = true});
+    a->Visit("centre_m", &centre_B,
+             {.meaning = "[m], body frame", .min = -kMaxBodyOffsetM, .max = kMaxBodyOffsetM, .required = true});
+    a->Visit("radius_m", &radius_m, {.meaning = "[m]", .max = kMaxBodyOffsetM, .positive = true, .required = true});
   }
 };
 
@@ -91,31 +97,41 @@ double ThrustCoefficientToRpm(double k_n_per_rad_s2);
 
 template <typename Archive>
 void VehicleParams::Serialize(Archive* a) {
+  // The bounds hold a passenger-carrying multirotor and the largest assembly, 16 units of a few
+  // kilograms (64 rotors; configs/assemblies: inertia, drag and yaw damping grow with the units).
   a->Visit("name", &name, {.meaning = "label", .default_text = "vehicle"});
-  a->Visit("mass_kg", &mass_kg, {.meaning = "m_0 [kg]", .positive = true, .required = true});
+  a->Visit("mass_kg", &mass_kg, {.meaning = "m_0 [kg]", .max = 1000, .positive = true, .required = true});
   a->Visit("inertia_kg_m2", &inertia_kg_m2,
            {.meaning = "I_v [kg·m²]",
+            .min = -1e5,
+            .max = 1e5,
             .required = true,
-            .rule_text = "**required**, 3 rows of 3, symmetric positive definite"});
+            .rule_text = "**required**, 3 rows of 3, each in [-100000, 100000], symmetric positive definite"});
   a->Visit("rotor_drag_kg_s", &rotor_drag_kg_s,
-           {.meaning = "diagonal of D (eq. 1) [kg/s], each ≥ 0", .required = true});
-  a->Visit("yaw_damping_n_m_s", &yaw_damping_n_m_s, {.meaning = "k_dψ (eq. 3) [N·m·s]", .min = 0, .required = true});
+           {.meaning = "diagonal of D (eq. 1) [kg/s]", .min = 0, .max = 1000, .required = true});
+  a->Visit("yaw_damping_n_m_s", &yaw_damping_n_m_s,
+           {.meaning = "k_dψ (eq. 3) [N·m·s]", .min = 0, .max = 1000, .required = true});
+  // Paper 000's vehicle: 1.2e-8 N/rpm²; 1e-3 is 1000 N at 1000 rpm.
   a->Visit("thrust_coefficient_n_per_rpm2",
            ConvertedOf{&thrust_coefficient_n_s2, &ThrustCoefficientFromRpm, &ThrustCoefficientToRpm},
-           {.meaning = "k_n, T = k_n ω² with ω in rpm [N/rpm²]", .positive = true, .required = true});
+           {.meaning = "k_n, T = k_n ω² with ω in rpm [N/rpm²]", .max = 1e-3, .positive = true, .required = true});
+  // The physics step must be at most half the faster constant (sim.physics_rate_hz).
   a->Visit("motor_time_constant_s", &motor_time_constant_s,
-           {.meaning = "σ of eq. (6) [s]", .positive = true, .required = true});
+           {.meaning = "σ of eq. (6) [s]", .max = 2, .positive = true, .required = true});
   a->Visit("motor_stop_time_constant_s", &motor_stop_time_constant_s,
-           {.meaning = "how fast a stopped motor's speed decays [s]", .positive = true, .required = true});
+           {.meaning = "how fast a stopped motor's speed decays [s]", .max = 10, .positive = true, .required = true});
   a->Visit(
       "unloaded_rpm_ratio", &unloaded_speed_ratio,
       {.meaning = "speed of a motor without its propeller relative to loaded", .min = 1, .max = 3, .required = true});
-  a->Visit("collision_radius_m", &collision_radius_m,
-           {.meaning = "the sphere used for collisions [m]", .positive = true, .required = true});
+  a->Visit(
+      "collision_radius_m", &collision_radius_m,
+      {.meaning = "the sphere used for collisions [m]", .max = kMaxBodyOffsetM, .positive = true, .required = true});
   a->Visit(
       "pwm_gain_n", &pwm_gain_n,
-      {.meaning = "K of paper 004, eq. (2): thrust per unit PWM input [N], for controller lqr and planner flatness",
-       .positive = true,
+      {.meaning = "K of paper 004, eq. (2): thrust per unit PWM input [N], for controller lqr and planner flatness "
+                  "(0: none)",
+       .min = 0,
+       .max = 1e4,
        .default_text = "none"});
   a->Visit("collision_spheres", &collision_spheres,
            {.meaning = "the body's shape when it is not one sphere, each within collision_radius_m of the centre of "
