@@ -220,8 +220,12 @@ campaign::Campaign ScenarioCampaign(const CampaignSpec& spec) {
   for (const auto& [key, values] : spec.grid) c.group_keys.push_back(key);
   c.metrics = spec.metrics;
   c.parameters = [spec](int index) { return TrialParameters(spec, index); };
-  c.simulated_s = [spec](int, const std::map<std::string, std::string>& params) {
-    return harness::LoadScenario(spec.scenario, OverridesOf(params)).duration_s;
+  // The watchdog's simulated time: the scenario's duration, or the trial's where the sweep sets it
+  // (the scenario file is read once here, not once more per trial).
+  const double duration_s = harness::LoadScenario(spec.scenario).duration_s;
+  c.simulated_s = [duration_s](int, const std::map<std::string, std::string>& params) {
+    const auto swept = params.find("duration_s");
+    return swept == params.end() ? duration_s : std::stod(swept->second);
   };
   c.reproduce = [spec](int, const std::map<std::string, std::string>& params) {
     std::string command = "rotorguard run " + spec.scenario;

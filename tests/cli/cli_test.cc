@@ -231,6 +231,8 @@ TEST_F(CliTest, AKilledCampaignResumesToAByteIdenticalSummary) {
   EXPECT_EQ(std::count(watched_lines.begin(), watched_lines.end(), '\n'), 8);
   EXPECT_NE(watched_lines.find("\"status\":\"timeout\""), std::string::npos) << watched_lines;
   EXPECT_NE(watched_lines.find("reproduce: rotorguard run "), std::string::npos) << watched_lines;
+  // The budget is of the trial's own duration, which the sweep sets (3 s; the scenario's is 10 s).
+  EXPECT_NE(watched_lines.find("(0.01 x its 3 s simulated)"), std::string::npos) << watched_lines;
   const Result negative = Cli("campaign run " + spec + " --out " + (dir_ / "n").string() + " --trial-timeout -1");
   EXPECT_EQ(negative.exit_code, 2);
   EXPECT_NE(negative.out.find("--trial-timeout"), std::string::npos) << negative.out;
