@@ -28,7 +28,8 @@ test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
 # The unit tests under AddressSanitizer and UndefinedBehaviorSanitizer, in their own build folder
-# (docs/reliability.md): about three times the time of `make test`, so run before a release.
+# (docs/reliability.md): its build alone takes longer than all of `make test`, so it runs before a
+# release rather than in CI.
 SANITIZE_DIR ?= build-sanitize
 sanitize: deps
 	@mkdir -p $(SANITIZE_DIR)
