@@ -14,11 +14,7 @@
 namespace rotorguard::control {
 
 void IndiControllerOptions::Validate() const {
-  position.Validate("IndiControllerOptions.position");  // its open end
   CheckDeclaredRanges("IndiControllerOptions", *this);
-  if (opposite_ratio >= 1.0) {  // the declared range's open end
-    ThrowValidation("IndiControllerOptions", "opposite_ratio", opposite_ratio, "a ratio in [0, 1)");
-  }
   if (!(sample_hz > 0.0) || !std::isfinite(sample_hz)) {
     ThrowValidation("IndiControllerOptions", "sample_hz", sample_hz, "> 0");
   }

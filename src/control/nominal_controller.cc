@@ -10,10 +10,7 @@
 
 namespace rotorguard::control {
 
-void NominalControllerOptions::Validate() const {
-  position.Validate("NominalControllerOptions");  // its open end
-  CheckDeclaredRanges("NominalControllerOptions", *this);
-}
+void NominalControllerOptions::Validate() const { CheckDeclaredRanges("NominalControllerOptions", *this); }
 
 CascadedWrenchLaw::CascadedWrenchLaw(const vehicle::VehicleParams& vehicle, const NominalControllerOptions& options)
     : vehicle_(vehicle), options_(options), position_loop_(options.position) {

@@ -9,10 +9,7 @@
 
 namespace rotorguard::control {
 
-void PassiveControllerOptions::Validate() const {
-  position.Validate("PassiveControllerOptions");  // its open end
-  CheckDeclaredRanges("PassiveControllerOptions", *this);
-}
+void PassiveControllerOptions::Validate() const { CheckDeclaredRanges("PassiveControllerOptions", *this); }
 
 PassiveController::PassiveController(const vehicle::MultirotorModel& model, const PassiveControllerOptions& options)
     : model_(model),

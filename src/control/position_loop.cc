@@ -5,16 +5,8 @@
 #include <numbers>
 
 #include "rotorguard/core/error.h"
-#include "rotorguard/core/key_ranges.h"
 
 namespace rotorguard::control {
-
-void PositionLoopOptions::Validate(const std::string& owner) const {
-  CheckDeclaredRanges(owner, *this);
-  if (max_tilt_rad >= 0.5 * std::numbers::pi) {  // the declared range's open end: tan() of it is infinite
-    ThrowValidation(owner, "max_tilt_rad", max_tilt_rad, "an angle in (0, pi/2)");
-  }
-}
 
 Vector3 PositionLoop::DesiredThrustVector(const vehicle::VehicleParams& vp, const StateEstimate& est,
                                           const ReferencePoint& ref, double dt) {

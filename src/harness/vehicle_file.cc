@@ -3,12 +3,13 @@
 
 #include <filesystem>
 
+#include "loader_internal.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_archive.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/yaml_writer.h"
 #include "rotorguard/vehicle/multirotor.h"
-#include "loader_internal.h"
 
 // Vehicle and assembly files, and the overrides and paths every loader shares.
 namespace rotorguard::harness {
@@ -100,7 +101,7 @@ modular::Assembly LoadAssembly(const std::string& path) {
   } catch (const io::InputFileError& e) {
     throw io::InputFileError(e.path(), fmt::format("{} (named by 'unit' at {})", e.reason(), unit.Location()));
   }
-  spec.spacing_m = root.Required("spacing_m").AsPositiveAtMost(modular::kMaxSpacingM);
+  spec.spacing_m = root.Required("spacing_m").AsNumberIn({.max = modular::kMaxSpacingM, .positive = true});
   if (root.Has("shape") == root.Has("slots")) root.Fail("expected exactly one of 'shape' and 'slots'");
   if (const auto shape = root.Optional("shape")) {
     spec.slots = modular::ShapeSlots(shape->AsEnum({"3x1", "4x1", "3x2", "3x3", "3x3_plus"}));

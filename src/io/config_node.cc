@@ -1,9 +1,10 @@
-#include "config_tree.h"
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <limits>
 
-#include <fmt/format.h>
+#include "config_tree.h"
+#include "rotorguard/core/key_ranges.h"
 
 // ConfigNode: reading the tree, each accessor's error located at its node.
 namespace rotorguard::io {
@@ -169,10 +170,10 @@ double ConfigNode::AsPositive() const {
   return value;
 }
 
-double ConfigNode::AsPositiveAtMost(double hi) const {
-  const std::string expected = fmt::format("a number in (0, {}]", hi);
+double ConfigNode::AsNumberIn(const KeyInfo& info) const {
+  const std::string expected = "a number " + DeclaredRangeText(info);
   const double value = ParseFinite(expected);
-  if (!(value > 0.0 && value <= hi)) {
+  if (!InDeclaredRange(value, info)) {
     Fail(fmt::format("{} is out of range; expected {}", Quote(value_->scalar), expected));
   }
   return value;

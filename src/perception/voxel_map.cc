@@ -23,7 +23,7 @@ using internal::PositiveMod;
 
 void VoxelMapOptions::Validate() const {
   CheckDeclaredRanges("VoxelMapOptions", *this);
-  // The rules between keys and the declared ranges' open ends.
+  // The rules between keys.
   const auto require = [](bool ok, const char* field, double v, const char* rule) {
     if (!ok) ThrowValidation("VoxelMapOptions", field, v, rule);
   };
@@ -32,8 +32,6 @@ void VoxelMapOptions::Validate() const {
                 window_size_m[k] / resolution_m <= 4096.0,
             "window_size_m", window_size_m[k], "extents above resolution_m, at most 4096 voxels each");
   }
-  require(log_odds_miss < 0.0, "log_odds_miss", log_odds_miss, "in [-30, 0)");
-  require(log_odds_min < 0.0, "log_odds_min", log_odds_min, "in [-30, 0)");
   require(occupied_threshold > 0.0 && occupied_threshold < log_odds_max, "occupied_threshold", occupied_threshold,
           "a log-odds in (0, log_odds_max)");
   require(std::isfinite(inflation_radius_m) && inflation_radius_m >= 0.0 && inflation_radius_m <= 100.0 * resolution_m,

@@ -11,7 +11,7 @@ namespace rotorguard::sim {
 
 void LidarOptions::Validate() const {
   CheckDeclaredRanges("LidarOptions", *this);
-  // The rules between keys, and the open ends of the declared ranges.
+  // The rules between keys.
   if (!(max_range_m > min_range_m)) {
     ThrowValidation("LidarOptions", "max_range_m", max_range_m,
                     fmt::format("a range above min_range_m = {}", min_range_m));
@@ -19,9 +19,6 @@ void LidarOptions::Validate() const {
   if (!(max_elevation_rad > min_elevation_rad)) {
     ThrowValidation("LidarOptions", "max_elevation_rad", max_elevation_rad,
                     fmt::format("an angle above min_elevation_rad = {}", min_elevation_rad));
-  }
-  if (dropout_probability >= 1.0) {
-    ThrowValidation("LidarOptions", "dropout_probability", dropout_probability, "a probability in [0, 1)");
   }
 }
 

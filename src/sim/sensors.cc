@@ -41,9 +41,6 @@ void ImuOptions::Validate(double physics_rate_hz) const {
 void EscOptions::Validate(double physics_rate_hz) const {
   CheckDeclaredRanges("EscOptions", *this);
   RequireRate("EscOptions", rate_hz, physics_rate_hz);
-  if (delay_s >= 0.5) {  // the declared range's open end
-    ThrowValidation("EscOptions", "delay_s", delay_s, "a value in [0, 0.5) s");
-  }
   for (std::size_t k = 0; k < gain.size(); ++k) {
     if (!(gain[k] > 0.0) || !std::isfinite(gain[k])) {
       ThrowValidation("EscOptions", fmt::format("gain.{}", k), gain[k], "a positive finite ratio");

@@ -23,12 +23,7 @@ const char* ToString(FlightMode mode) {
   return "unknown";
 }
 
-void SupervisorOptions::Validate() const {
-  CheckDeclaredRanges("SupervisorOptions", *this);
-  if (touchdown_thrust_ratio >= 1.0) {  // the declared range's open end
-    ThrowValidation("SupervisorOptions", "touchdown_thrust_ratio", touchdown_thrust_ratio, "in (0, 1)");
-  }
-}
+void SupervisorOptions::Validate() const { CheckDeclaredRanges("SupervisorOptions", *this); }
 
 Supervisor::Supervisor(const SupervisorOptions& options) : options_(options) { options_.Validate(); }
 

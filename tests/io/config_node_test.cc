@@ -1,6 +1,9 @@
 #include "rotorguard/io/config_node.h"
 
+#include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdint>
@@ -11,10 +14,7 @@
 #include <string>
 #include <vector>
 
-#include <fmt/format.h>
-#include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
-
+#include "rotorguard/core/config_schema.h"
 #include "test_util.h"
 
 namespace rotorguard::io {
@@ -447,11 +447,19 @@ TEST(ConfigNodeNumber, RangeChecks) {
   RG_EXPECT_THROW_WITH(r.Required("neg").AsNonNegative(), ConfigError,
                        "t.yaml:3:6: neg: '-0.5' is out of range; expected a non-negative number");
   // (0, hi]: the upper end belongs to it, zero does not.
-  EXPECT_DOUBLE_EQ(r.Required("one").AsPositiveAtMost(1.0), 1.0);
-  RG_EXPECT_THROW_WITH(r.Required("zero").AsPositiveAtMost(1.0), ConfigError,
+  EXPECT_DOUBLE_EQ(r.Required("one").AsNumberIn({.max = 1.0, .positive = true}), 1.0);
+  RG_EXPECT_THROW_WITH(r.Required("zero").AsNumberIn({.max = 1.0, .positive = true}), ConfigError,
                        "t.yaml:1:7: zero: '0' is out of range; expected a number in (0, 1]");
-  RG_EXPECT_THROW_WITH(r.Required("big").AsPositiveAtMost(2.0), ConfigError,
+  RG_EXPECT_THROW_WITH(r.Required("big").AsNumberIn({.max = 2.0, .positive = true}), ConfigError,
                        "t.yaml:4:6: big: '2.5' is out of range; expected a number in (0, 2]");
+  // An open upper end: [0, 1) takes zero and refuses one; (0, 1) refuses both.
+  EXPECT_DOUBLE_EQ(r.Required("zero").AsNumberIn({.min = 0.0, .max = 1.0, .open_max = true}), 0.0);
+  RG_EXPECT_THROW_WITH(r.Required("one").AsNumberIn({.min = 0.0, .max = 1.0, .open_max = true}), ConfigError,
+                       "t.yaml:2:6: one: '1' is out of range; expected a number in [0, 1)");
+  RG_EXPECT_THROW_WITH(r.Required("one").AsNumberIn({.max = 1.0, .positive = true, .open_max = true}), ConfigError,
+                       "t.yaml:2:6: one: '1' is out of range; expected a number in (0, 1)");
+  RG_EXPECT_THROW_WITH(r.Required("zero").AsNumberIn({.max = 1.0, .positive = true, .open_max = true}), ConfigError,
+                       "expected a number in (0, 1)");
 }
 
 TEST(ConfigNodeNumber, RangeAccessorsStillRejectNonFinite) {
@@ -460,7 +468,7 @@ TEST(ConfigNodeNumber, RangeAccessorsStillRejectNonFinite) {
                        "t.yaml:1:4: x: '.inf' is not finite; expected a positive number");
   RG_EXPECT_THROW_WITH(doc.root().Required("x").AsDoubleIn(0, 1e308), ConfigError,
                        "is not finite");
-  RG_EXPECT_THROW_WITH(doc.root().Required("x").AsPositiveAtMost(1e308), ConfigError,
+  RG_EXPECT_THROW_WITH(doc.root().Required("x").AsNumberIn({.max = 1e308, .positive = true}), ConfigError,
                        "t.yaml:1:4: x: '.inf' is not finite; expected a number in (0, 1e+308]");
 }
 

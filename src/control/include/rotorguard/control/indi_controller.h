@@ -54,7 +54,7 @@ struct IndiControllerOptions {
              {.meaning = "relaxed hover: the failed rotor's twin's thrust relative to its neighbours",
               .min = 0.0,
               .max = 1.0,
-              .rule_text = "in [0, 1)"});
+              .open_max = true});
     a->Visit(
         "filter_cutoff_hz", &filter_cutoff_hz,
         {.meaning = "cut-off of the angular-acceleration and thrust filters [Hz], below half of stack.control_rate_hz",

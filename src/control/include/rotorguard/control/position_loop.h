@@ -18,9 +18,9 @@ struct PositionLoopOptions {
   Vector3 ki_position = Vector3(1.0, 1.0, 2.0);   ///< integral gain [1/s^3], >= 0
   double integral_limit_m_s2 = 2.0;   ///< clamp on the integral's acceleration [m/s^2], >= 0
   double max_tilt_rad = 0.7;          ///< thrust vector tilt limit [rad], in (0, pi/2)
-  /// Throws ValidationError naming `owner` and the field.
-  void Validate(const std::string& owner) const;
-  /// The keys of this struct in config files (core/config_schema.h).
+  /// The keys of this struct in config files (core/config_schema.h), within those of the
+  /// controller that flies it, whose Validate() checks their ranges (max_tilt_rad below π/2:
+  /// tan() of it is infinite).
   template <typename Archive>
   void Serialize(Archive* a) {
     // Gains a hundred times the defaults: beyond them the loop outruns any control rate.
@@ -33,7 +33,7 @@ struct PositionLoopOptions {
              {.meaning = "tilt limit of the thrust vector [rad]",
               .max = std::numbers::pi / 2.0,
               .positive = true,
-              .rule_text = "in (0, π/2)"});
+              .open_max = true});
   }
 };
 

@@ -37,6 +37,8 @@ struct KeyInfo {
   double max = std::numeric_limits<double>::infinity();
   /// ... or, when set, in (0, max]: min is then not used.
   bool positive = false;
+  /// The upper end excluded: [min, max), or (0, max) when positive.
+  bool open_max = false;
   /// The key must be present (the loader reports it missing); else absent keys keep the default.
   bool required = false;
   /// For a block: the key a plain scalar in place of the block sets (`planner: flatness` for
@@ -46,6 +48,9 @@ struct KeyInfo {
   /// depends on another key, a range that does); none: written from the value and the range.
   const char* default_text = nullptr;
   const char* rule_text = nullptr;
+  /// Words the documentation adds to the rule written from the value and the range: a rule
+  /// Validate() checks beyond the range ("z ≥ 0").
+  const char* rule_note = nullptr;
 };
 
 /// Ends of ranges that many keys share (docs/scenarios.md), so that a key and the Validate() of its

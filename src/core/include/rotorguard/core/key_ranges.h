@@ -23,10 +23,11 @@
 
 namespace rotorguard {
 
-/// Whether `v` lies in the range `info` declares: [min, max], or (0, max] when positive.
+/// Whether `v` lies in the range `info` declares: [min, max], or (0, max] when positive, the upper
+/// end excluded when open_max.
 inline bool InDeclaredRange(double v, const KeyInfo& info) {
-  if (info.positive) return v > 0.0 && v <= info.max;
-  return v >= info.min && v <= info.max;  // false for NaN
+  const bool below_max = info.open_max ? v < info.max : v <= info.max;
+  return below_max && (info.positive ? v > 0.0 : v >= info.min);  // false for NaN
 }
 
 /// An end of a range as a reader knows it: a multiple of π/2 (an angle's bound) as "π/2", "-2π";
@@ -45,15 +46,17 @@ inline std::string RangeBoundText(double v) {
   return fmt::format("{}", v);
 }
 
-/// The range `info` declares, in words: "in [0, 1]", "in (0, 50]", "≥ 0", "> 0"; "" for none.
+/// The range `info` declares, in words: "in [0, 1]", "in (0, 50]", "in [0, 1)", "≥ 0", "> 0"; ""
+/// for none.
 inline std::string DeclaredRangeText(const KeyInfo& info) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  if (info.positive) return info.max < kInf ? fmt::format("in (0, {}]", RangeBoundText(info.max)) : "> 0";
+  const char* close = info.open_max ? ")" : "]";
+  if (info.positive) return info.max < kInf ? fmt::format("in (0, {}{}", RangeBoundText(info.max), close) : "> 0";
   if (info.min > -kInf && info.max < kInf) {
-    return fmt::format("in [{}, {}]", RangeBoundText(info.min), RangeBoundText(info.max));
+    return fmt::format("in [{}, {}{}", RangeBoundText(info.min), RangeBoundText(info.max), close);
   }
   if (info.min > -kInf) return fmt::format("≥ {}", RangeBoundText(info.min));
-  if (info.max < kInf) return fmt::format("≤ {}", RangeBoundText(info.max));
+  if (info.max < kInf) return fmt::format("{} {}", info.open_max ? "<" : "≤", RangeBoundText(info.max));
   return "";
 }
 

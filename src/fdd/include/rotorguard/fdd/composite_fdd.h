@@ -87,7 +87,7 @@ struct CompositeFddOptions {
              {.meaning = "γ_M: a motor index M_i (eq. 13) at or below it isolates a motor failure",
               .max = 1.0,
               .positive = true,
-              .rule_text = "in (0, 1)"});
+              .open_max = true});
     a->Visit("motor_index_samples", &motor_index_samples,
              {.meaning = "consecutive telemetry samples the index must stay low", .min = 1, .max = 1000});
     a->Visit("min_thrust_fraction", &min_thrust_fraction,

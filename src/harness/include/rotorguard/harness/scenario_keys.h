@@ -43,7 +43,7 @@ struct InitialKeys {
              {.meaning = "start position [m]; z = 0 starts landed (motors idle), z > 0 in hover",
               .min = -kMaxCoordinateM,
               .max = kMaxCoordinateM,
-              .rule_text = "[x, y, z], each in [-10000, 10000], z ≥ 0"});
+              .rule_note = "z ≥ 0"});
     a->Visit("yaw_rad", &s->initial_yaw_rad, {.meaning = "start heading [rad]", .min = -kTwoPi, .max = kTwoPi});
   }
 };

@@ -177,10 +177,12 @@ class ConfigReader {
   /// A number in the key's range; the error names the value and the range.
   static double Number(const ConfigNode& n, const KeyInfo& info) {
     constexpr double kInf = std::numeric_limits<double>::infinity();
-    if (info.positive) return info.max < kInf ? n.AsPositiveAtMost(info.max) : n.AsPositive();
-    if (info.min == 0.0 && info.max == kInf) return n.AsNonNegative();
-    if (info.min > -kInf || info.max < kInf) return n.AsDoubleIn(info.min, info.max);
-    return n.AsDouble();
+    if (info.max == kInf) {  // the unbounded ranges' own words ("a positive number (> 0)")
+      if (info.positive) return n.AsPositive();
+      if (info.min == 0.0) return n.AsNonNegative();
+      if (info.min == -kInf) return n.AsDouble();
+    }
+    return n.AsNumberIn(info);
   }
   /// A list of `size` numbers (any length when negative), each in the key's range: an error names
   /// the item ("center_m.2") and its line.

@@ -21,6 +21,10 @@
 
 #include <Eigen/Core>
 
+namespace rotorguard {
+struct KeyInfo;
+}  // namespace rotorguard
+
 namespace rotorguard::io {
 
 /// The pseudo file name of values that came from a command-line override (ApplyOverride).
@@ -177,8 +181,8 @@ class ConfigNode {
   double AsDoubleIn(double lo, double hi) const;
   /// A finite number > 0.
   double AsPositive() const;
-  /// A finite number in the half-open interval (0, hi]: "expected a number in (0, hi]".
-  double AsPositiveAtMost(double hi) const;
+  /// A finite number in the range `info` declares (InDeclaredRange): "expected a number in (0, 50]".
+  double AsNumberIn(const KeyInfo& info) const;
   /// A finite number >= 0.
   double AsNonNegative() const;
   /// An integer literal: decimal or 0x hexadecimal, optional sign (no "1.5", "1e3", "abc").

@@ -70,11 +70,11 @@ class KeyTableWriter {
   }
   void Visit(const char* key, TripleOf t, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}, {}]", Number(*t.x), Number(*t.y), Number(*t.z)),
-        info.rule_text ? info.rule_text : Each("three numbers", info), info.meaning, false, true);
+        info.rule_text ? info.rule_text : WithNote(Each("three numbers", info), info), info.meaning, false, true);
   }
   void Visit(const char* key, PairOf pair, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}]", Number(*pair.first), Number(*pair.second)),
-        info.rule_text ? info.rule_text : Each("two numbers", info), info.meaning, false, true);
+        info.rule_text ? info.rule_text : WithNote(Each("two numbers", info), info), info.meaning, false, true);
   }
 
   const std::vector<KeyRow>& rows() const { return rows_; }
@@ -103,6 +103,11 @@ class KeyTableWriter {
              std::is_same_v<T, Eigen::Vector3d> || std::is_same_v<T, Eigen::Vector4d> ||
              std::is_same_v<T, Eigen::Matrix3d>;
     }
+  }
+
+  /// `rule`, then the key's rule_note after a comma.
+  static std::string WithNote(const std::string& rule, const KeyInfo& info) {
+    return info.rule_note == nullptr ? rule : rule + ", " + info.rule_note;
   }
 
   /// A list of numbers and the range each of them must lie in: "[x, y, z], each in [-1, 1]".
@@ -170,6 +175,7 @@ class KeyTableWriter {
         rule = "a number";
       }
     }
+    rule = WithNote(rule, info);
     return info.required ? (rule.empty() ? "**required**" : "**required**, " + rule) : rule;
   }
 

@@ -75,11 +75,10 @@ struct VoxelMapOptions {
               .positive = true});
     // The fixed-point store holds |log-odds| <= 30.
     a->Visit("log_odds_hit", &log_odds_hit, {.meaning = "log-odds added by a return", .max = 30.0, .positive = true});
-    a->Visit(
-        "log_odds_miss", &log_odds_miss,
-        {.meaning = "log-odds added by a ray passing through", .min = -30.0, .max = 0.0, .rule_text = "in [-30, 0)"});
+    a->Visit("log_odds_miss", &log_odds_miss,
+             {.meaning = "log-odds added by a ray passing through", .min = -30.0, .max = 0.0, .open_max = true});
     a->Visit("log_odds_min", &log_odds_min,
-             {.meaning = "lower clamp of a voxel's log-odds", .min = -30.0, .max = 0.0, .rule_text = "in [-30, 0)"});
+             {.meaning = "lower clamp of a voxel's log-odds", .min = -30.0, .max = 0.0, .open_max = true});
     a->Visit("log_odds_max", &log_odds_max,
              {.meaning = "upper clamp of a voxel's log-odds", .max = 30.0, .positive = true});
     a->Visit("occupied_threshold", &occupied_threshold,

@@ -158,7 +158,7 @@ struct LemniscateOptions {
              {.meaning = "its full extent [sx, sy, sz] [m]",
               .min = 0.0,
               .max = kMaxCoordinateM,
-              .rule_text = "three numbers, each in [0, 10000], sx and sy > 0"});
+              .rule_note = "sx and sy > 0"});
     a->Visit("max_speed_m_s", &max_speed_m_s,
              {.meaning = "top speed once ramped up [m/s]", .max = kMaxSpeedMS, .positive = true, .required = true});
     a->Visit("ramp_s", &ramp_s, {.meaning = "time to full phase rate from rest [s]", .min = 0.0, .max = kMaxTimeoutS});

@@ -54,7 +54,7 @@ struct LidarOptions {
              {.meaning = "its upper edge [rad] (52°)", .min = -std::numbers::pi / 2.0, .max = std::numbers::pi / 2.0});
     a->Visit("range_noise_m", &range_noise_m, {.meaning = "1-σ range noise [m]", .min = 0.0, .max = 1.0});
     a->Visit("dropout_probability", &dropout_probability,
-             {.meaning = "chance a return is lost", .min = 0.0, .max = 1.0, .rule_text = "in [0, 1)"});
+             {.meaning = "chance a return is lost", .min = 0.0, .max = 1.0, .open_max = true});
     a->Visit("position_m", &position_m,
              {.meaning = "mounting point, body frame [m]", .min = -kMaxBodyOffsetM, .max = kMaxBodyOffsetM});
     // The grid has at most 2048 cells a side whatever the cell (RayCaster).

@@ -85,7 +85,7 @@ struct EscOptions {
     a->Visit("quantization_rpm", &quantization_rpm,
              {.meaning = "reported resolution [rpm] (0: none)", .min = 0.0, .max = 5000.0});
     a->Visit("delay_s", &delay_s,
-             {.meaning = "transport delay [s], below 0.5 s", .min = 0.0, .max = 0.5, .rule_text = "in [0, 0.5)"});
+             {.meaning = "transport delay [s], below 0.5 s", .min = 0.0, .max = 0.5, .open_max = true});
   }
 };
 

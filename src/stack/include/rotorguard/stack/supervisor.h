@@ -100,11 +100,9 @@ struct SupervisorOptions {
              {.meaning = "peak descent rate of an emergency landing [m/s]", .max = 10.0, .positive = true});
     a->Visit("landing_depth_m", &landing_depth_m,
              {.meaning = "how far below the ground the descent aims [m]", .max = 10.0, .positive = true});
-    a->Visit("touchdown_thrust_ratio", &touchdown_thrust_ratio,
-             {.meaning = "collective command over weight below which ...",
-              .max = 1.0,
-              .positive = true,
-              .rule_text = "in (0, 1)"});
+    a->Visit(
+        "touchdown_thrust_ratio", &touchdown_thrust_ratio,
+        {.meaning = "collective command over weight below which ...", .max = 1.0, .positive = true, .open_max = true});
     a->Visit("touchdown_hold_s", &touchdown_hold_s,
              {.meaning = "... for this long [s] is a touchdown", .max = kMaxTimeoutS, .positive = true});
     a->Visit("max_failed_rotors", &max_failed_rotors,

@@ -106,7 +106,7 @@ void VehicleParams::Serialize(Archive* a) {
             .min = -1e5,
             .max = 1e5,
             .required = true,
-            .rule_text = "**required**, 3 rows of 3, each in [-100000, 100000], symmetric positive definite"});
+            .rule_note = "symmetric positive definite"});
   a->Visit("rotor_drag_kg_s", &rotor_drag_kg_s,
            {.meaning = "diagonal of D (eq. 1) [kg/s]", .min = 0, .max = 1000, .required = true});
   a->Visit("yaw_damping_n_m_s", &yaw_damping_n_m_s,
