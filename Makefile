@@ -5,7 +5,7 @@ ROTORGUARD_WARNINGS_AS_ERRORS ?= OFF
 DEMO_SCENARIO ?= configs/scenarios/forest.yaml
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build demo test bench sanitize clean
+.PHONY: all deps configure build demo test bench sanitize fuzz clean
 
 all: build
 
@@ -39,6 +39,21 @@ sanitize: deps
 	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
 	cd $(SANITIZE_DIR) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS)
+
+# Coverage-guided fuzzing of every input file's reader with libFuzzer under AddressSanitizer and
+# UndefinedBehaviorSanitizer (clang, in its own build folder; docs/reliability.md), FUZZ_SECONDS
+# per target; its corpora grow in $(FUZZ_DIR)/corpus. `make test` runs the targets briefly without
+# clang.
+FUZZ_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+fuzz:
+	@./scripts/install-deps.sh --fuzz
+	@mkdir -p $(FUZZ_DIR)
+	@cmake -S . -B $(FUZZ_DIR) -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROTORGUARD_FUZZ=ON \
+	  -DROTORGUARD_SANITIZERS=ON -DROTORGUARD_BUILD_BENCHMARKS=OFF -DROTORGUARD_BUILD_EXAMPLES=OFF \
+	  > $(FUZZ_DIR)/configure.log 2>&1 || (cat $(FUZZ_DIR)/configure.log; exit 1)
+	@cmake --build $(FUZZ_DIR) --target rotorguard_libfuzzer -j $(JOBS)
+	./scripts/fuzz.sh $(FUZZ_DIR) $(FUZZ_SECONDS)
 
 bench: build
 	./$(BUILD_DIR)/bin/rotorguard bench sim --json

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian package rotorguard builds, tests and runs with.
+# Installs every Debian package rotorguard builds, tests and runs with; with --fuzz also clang and
+# its libFuzzer runtime, which only `make fuzz` uses.
 # Idempotent: does nothing (and needs no network or root) when all are present.
 # Works as root or through sudo.
 set -euo pipefail
@@ -21,6 +22,12 @@ packages=(
   parallel             # GNU parallel: campaign shards across machines over ssh
   python3              # scripts/: the layering check (a test) and the behaviour snapshot
 )
+if [ "${1:-}" = "--fuzz" ]; then
+  packages+=(clang libclang-rt-14-dev)  # libFuzzer, with AddressSanitizer (docs/reliability.md)
+elif [ $# -gt 0 ]; then
+  echo "install-deps: unknown argument '$1'; expected none or --fuzz" >&2
+  exit 2
+fi
 # Node.js and npm build the report viewer (viewer/); a machine that has them already keeps its own.
 if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then
   packages+=(nodejs npm)

@@ -16,6 +16,7 @@
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/json_archive.h"
+#include "rotorguard/io/json_file.h"
 #include "rotorguard/io/yaml_writer.h"
 #include "rotorguard/record/sensor_log.h"
 #include "rotorguard/stack/estimator.h"
@@ -25,16 +26,6 @@ namespace rotorguard::benchmarks {
 namespace {
 
 namespace fs = std::filesystem;
-
-nlohmann::json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw io::InputFileError(path, fs::exists(path) ? "cannot open" : "no such file");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw io::InputFileError(path, fmt::format("not valid JSON: {}", e.what()));
-  }
-}
 
 double FirstOnset(const CalibrationLog& log) {
   double onset = std::numeric_limits<double>::infinity();
@@ -108,7 +99,7 @@ CalibrationLog LoadCalibrationLog(const std::string& dir) {
   CalibrationLog log;
   log.dir = dir;
   const std::string summary_path = (fs::path(dir) / "summary.json").string();
-  const nlohmann::json summary = ReadJson(summary_path);
+  const nlohmann::json summary = io::ReadJsonObject(summary_path);
   try {
     const nlohmann::json& sensors = summary.at("sensors");
     log.imu_rate_hz = sensors.at("imu_rate_hz").get<double>();
@@ -145,7 +136,10 @@ CampaignFlights LoadCampaignFlights(const std::string& dir) {
   std::vector<std::string> needed = {"fdd.false_alarm"};
   for (const auto& [name, member] : fdd::kIndexExtremesFields)
     needed.push_back("fdd.healthy_extremes." + std::string(name));
-  const std::vector<std::string> recorded = manifest.at("metrics").get<std::vector<std::string>>();
+  std::vector<std::string> recorded;
+  for (const nlohmann::json& m : manifest.value("metrics", nlohmann::json::array())) {
+    if (m.is_string()) recorded.push_back(m.get<std::string>());
+  }
   for (const std::string& m : needed) {
     if (std::find(recorded.begin(), recorded.end(), m) == recorded.end()) {
       throw io::InputFileError(dir, fmt::format("the campaign does not record the metric '{}'; fdd-calibrate needs "
@@ -156,15 +150,19 @@ CampaignFlights LoadCampaignFlights(const std::string& dir) {
   CampaignFlights out;
   out.dir = dir;
   for (const nlohmann::json& r : records) {
+    // ReadCampaignRecords checked each record's fields and their types; the metrics are the kind's.
     const int trial = r.at("trial").get<int>();
     if (r.at("status") != "ok") {
       throw io::InputFileError(dir, fmt::format("trial {} did not finish ({}: {}); every flight must count", trial,
                                                 r["status"].get<std::string>(), r.value("message", "")));
     }
     const nlohmann::json& metrics = r.at("metrics");
+    const auto metric = [&metrics](const std::string& key) {
+      return metrics.is_object() && metrics.contains(key) ? metrics.at(key) : nlohmann::json();
+    };
     FlightExtremes f;
     for (const auto& [name, member] : fdd::kIndexExtremesFields) {
-      const nlohmann::json& v = metrics.at("fdd.healthy_extremes." + std::string(name));
+      const nlohmann::json v = metric("fdd.healthy_extremes." + std::string(name));
       if (!v.is_number()) {
         throw io::InputFileError(dir, fmt::format("trial {} has no fdd.healthy_extremes.{} (flown without the "
                                                   "composite FDD? set stack.fdd: composite)",
@@ -172,7 +170,7 @@ CampaignFlights LoadCampaignFlights(const std::string& dir) {
       }
       f.extremes.*member = v.get<double>();
     }
-    const nlohmann::json& alarm = metrics.at("fdd.false_alarm");
+    const nlohmann::json alarm = metric("fdd.false_alarm");
     if (!alarm.is_boolean())
       throw io::InputFileError(dir, fmt::format("trial {}: fdd.false_alarm is not a boolean", trial));
     f.false_alarm = alarm.get<bool>();

@@ -20,6 +20,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
+#include "rotorguard/io/json_file.h"
 #include "watchdog.h"
 
 namespace rotorguard::campaign {
@@ -257,7 +258,7 @@ CampaignRunSummary RunCampaign(const Campaign& campaign, const CampaignRunOption
     if (!fs::exists(summary.manifest_file)) {
       throw io::CorruptFileError(summary.manifest_file, 0, "missing: the results cannot be matched to a spec");
     }
-    const nlohmann::json old = ReadJsonFile(summary.manifest_file);
+    const nlohmann::json old = io::ReadJsonObject(summary.manifest_file);
     for (const char* key : {"spec_hash", "version", "shard"}) {
       if (!old.contains(key) || old[key] != manifest[key]) {
         throw ValidationError("resume",

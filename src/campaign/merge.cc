@@ -12,6 +12,7 @@
 #include "rotorguard/campaign/statistics.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
+#include "rotorguard/io/json_file.h"
 
 namespace rotorguard::campaign {
 
@@ -104,7 +105,7 @@ std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& 
     if (found.empty()) throw io::InputFileError(dir, "no manifest.json or manifest.shard-*.json");
     std::sort(found.begin(), found.end());
     for (const fs::path& m : found) {
-      const nlohmann::json manifest = ReadJsonFile(m.string());
+      const nlohmann::json manifest = io::ReadJsonObject(m.string());
       for (const char* key :
            {"spec_hash", "version", "trials_total", "shard", "metrics", "grid_keys", "campaign", "finished"}) {
         if (!manifest.contains(key)) throw io::CorruptFileError(m.string(), 0, fmt::format("no key '{}'", key));

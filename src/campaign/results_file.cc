@@ -39,10 +39,4 @@ Recorded ReadResults(const std::string& path) {
   return r;
 }
 
-nlohmann::json ReadJsonFile(const std::string& path) {
-  nlohmann::json j = nlohmann::json::parse(io::ReadInputFile(path), nullptr, false);
-  if (j.is_discarded() || !j.is_object()) throw io::CorruptFileError(path, 0, "expected a JSON object");
-  return j;
-}
-
 }  // namespace rotorguard::campaign

@@ -17,7 +17,4 @@ struct Recorded {
 };
 Recorded ReadResults(const std::string& path);
 
-/// A JSON object file; io::CorruptFileError otherwise.
-nlohmann::json ReadJsonFile(const std::string& path);
-
 }  // namespace rotorguard::campaign

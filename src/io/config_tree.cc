@@ -280,7 +280,12 @@ CorruptFileError::CorruptFileError(std::string path, std::uint64_t byte_offset, 
 
 std::string ReadInputFile(const std::string& path) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputFileError(path, "is a directory");
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::is_directory(status)) throw InputFileError(path, "is a directory");
+  // A device or a pipe (`vehicle: /dev/zero`) could be read forever.
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    throw InputFileError(path, "is not a regular file");
+  }
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputFileError(path, ReasonFromErrno(errno));

@@ -78,6 +78,8 @@ constexpr char kLemniscate[] = "LemniscateOptions";
 constexpr char kCircle[] = "CircleOptions";
 constexpr char kWaypoint[] = "WaypointOptions";
 
+double LemniscatePhaseRate(const LemniscateOptions& o);
+
 const LemniscateOptions& Validated(const LemniscateOptions& o) {
   RequireFinite(kLemniscate, "center_m", o.center_m);
   RequirePositive(kLemniscate, "size_x_m", o.size_x_m);
@@ -86,6 +88,12 @@ const LemniscateOptions& Validated(const LemniscateOptions& o) {
   RequirePositive(kLemniscate, "max_speed_m_s", o.max_speed_m_s);
   RequireNonNegative(kLemniscate, "ramp_s", o.ramp_s);
   RequireFinite(kLemniscate, "yaw_rad", o.yaw_rad);
+  // Each positive, yet a size of 1e-300 m would make the phase rate infinite.
+  const double rate = LemniscatePhaseRate(o);
+  if (!(std::isfinite(rate) && rate > 0.0)) {
+    ThrowValidation(kLemniscate, "size_m", fmt::format("[{}, {}, {}]", o.size_x_m, o.size_y_m, o.size_z_m),
+                    fmt::format("a size at which max_speed_m_s = {} gives a finite phase rate", o.max_speed_m_s));
+  }
   return o;
 }
 

@@ -1,14 +1,15 @@
 #include "rotorguard/record/flight_log.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iterator>
 
-#include <fmt/format.h>
-
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
+#include "rotorguard/io/json_file.h"
 #include "rotorguard/record/flight_mcap.h"
 
 namespace rotorguard::record {
@@ -16,16 +17,6 @@ namespace rotorguard::record {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// Parses a JSON file; a syntax error is a CorruptFileError at its byte.
-nlohmann::json ReadJsonFile(const std::string& path) {
-  const std::string text = io::ReadInputFile(path);
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw io::CorruptFileError(path, e.byte > 0 ? e.byte - 1 : 0, "not valid JSON");
-  }
-}
 
 }  // namespace
 
@@ -74,10 +65,10 @@ FlightLog ReadFlightLog(const std::string& dir) {
   std::error_code ec;
   if (!fs::is_directory(d, ec)) throw io::InputFileError(dir, fs::exists(d, ec) ? "not a directory" : "no such directory");
   FlightLog log;
-  log.summary = ReadJsonFile((d / "summary.json").string());
+  log.summary = io::ReadJsonObject((d / "summary.json").string());
   if (fs::exists(d / "log.csv", ec) || !fs::exists(d / "flight.mcap", ec)) {
     log.table = io::ReadNumericCsv((d / "log.csv").string());
-    log.scene = ReadJsonFile((d / "scene.json").string());
+    log.scene = io::ReadJsonObject((d / "scene.json").string());
   } else {
     FlightLog from_mcap = ReadFlightMcap((d / "flight.mcap").string());
     log.table = std::move(from_mcap.table);

@@ -23,6 +23,8 @@ int DecimalsOf(const std::string& column) {
 }
 
 double Round(double v, int decimals) {
+  // Beyond 2^53 a double has no decimals to round, and v * scale could overflow to inf.
+  if (!(std::abs(v) < 0x1p53)) return v;
   const double scale = std::pow(10.0, decimals);
   const double r = std::round(v * scale) / scale;
   return r == 0.0 ? 0.0 : r;  // no "-0"

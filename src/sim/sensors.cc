@@ -14,9 +14,9 @@ namespace rotorguard::sim {
 
 namespace {
 void RequireRate(const char* owner, double rate_hz, double physics_rate_hz) {
-  if (!std::isfinite(rate_hz) || rate_hz <= 0.0 || rate_hz > physics_rate_hz) {
+  if (!std::isfinite(rate_hz) || rate_hz < kMinRateHz || rate_hz > physics_rate_hz) {
     ThrowValidation(owner, "rate_hz", rate_hz,
-                    fmt::format("a rate in (0, {}] Hz (the physics rate)", physics_rate_hz));
+                    fmt::format("a rate in [{:g}, {}] Hz (the physics rate)", kMinRateHz, physics_rate_hz));
   }
 }
 void RequireNonNegative(const char* owner, const std::string& field, double v) {

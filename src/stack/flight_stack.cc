@@ -45,8 +45,9 @@ void NavigationOptions::Validate() const {
     }
   }
   if (rounds < 1) ThrowValidation("FlightStackOptions", "navigation.rounds", rounds, ">= 1");
-  if (!(planner_rate_hz > 0.0)) {
-    ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", planner_rate_hz, "a rate in (0, control_rate_hz]");
+  if (!(planner_rate_hz >= kMinRateHz)) {
+    ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", planner_rate_hz,
+                    fmt::format("a rate in [{:g}, control_rate_hz]", kMinRateHz));
   }
   // stack.planner's keys, the replanner's among them (ReplannerOptions checks its own without
   // their upper ends).
@@ -56,9 +57,9 @@ void NavigationOptions::Validate() const {
 }
 
 void FlightStackOptions::Validate() const {
-  if (!std::isfinite(control_rate_hz) || control_rate_hz <= 0.0 || control_rate_hz > kMaxRateHz) {
+  if (!std::isfinite(control_rate_hz) || control_rate_hz < kMinRateHz || control_rate_hz > kMaxRateHz) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz,
-                    fmt::format("a rate in (0, {:g}] Hz", kMaxRateHz));
+                    fmt::format("a rate in [{:g}, {:g}] Hz", kMinRateHz, kMaxRateHz));
   }
   nominal.Validate();
   passive.Validate();

@@ -356,6 +356,15 @@ TEST_F(CampaignInput, LoadsAScenarioCampaignsFlightsAndRefusesOneWithoutTheMetri
   const std::string partial = run(spec("partial", "fdd.false_alarm, fdd.healthy_extremes.min_motor_index"));
   RG_EXPECT_THROW_WITH(LoadCampaignFlights(partial), io::InputFileError,
                        "does not record the metric 'fdd.healthy_extremes.max_propeller_index'");
+  // Found by fuzzing (tests/fuzz, results_jsonl): a record without one of the metrics its manifest
+  // lists escaped as the JSON library's out_of_range; it is the folder's error, naming the trial.
+  const std::string healthy = (dir_ / "healthy").string();
+  const fs::path results = fs::path(healthy) / "results.jsonl";
+  std::string text = io::ReadInputFile(results.string());
+  text.replace(text.find("fdd.healthy_extremes.gated_takeoff_index"), 5, "xxx.h");
+  std::ofstream(results) << text;
+  RG_EXPECT_THROW_WITH(LoadCampaignFlights(healthy), io::InputFileError,
+                       "has no fdd.healthy_extremes.gated_takeoff_index");
 }
 
 TEST(FddCalibration, RejectsNoInputAndABadMargin) {

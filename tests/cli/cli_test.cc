@@ -480,7 +480,7 @@ TEST_F(CliTest, BadScenarioContentExitsTwoNamingFileLineAndKey) {
   f = Write("margin.yaml", Scenario(v, "stack:\n  map: {inflation_margin_m: -0.1}\n"));
   ExpectConfigError("run " + f, f, 9, {"stack.map.inflation_margin_m", "-0.1", "in [0, 10]"});
   f = Write("planner.yaml", Scenario(v, "stack:\n  planner: {v_max: -1}\n"));
-  ExpectConfigError("run " + f, f, 9, {"stack.planner", "v_max", "in (0, 50]"});
+  ExpectConfigError("run " + f, f, 9, {"stack.planner", "v_max", "in [0.001, 50]"});
   std::string navigate = Scenario(v);
   const std::string hover = "mission:\n  type: hover";
   navigate.replace(navigate.find(hover), hover.size(), "mission: {type: navigate, waypoints_m: [[1, 0, 1]]}");
@@ -526,7 +526,7 @@ TEST_F(CliTest, BadVehicleContentExitsTwoNamingTheVehicleFile) {
   EXPECT_NE(rank.out.find("independent thrust"), std::string::npos) << rank.out;
   // The sensor default clashes with a slow physics rate: reported at the sensors key path.
   const std::string slow = Write("slow.yaml", Scenario(kVehicle, "sim: {physics_rate_hz: 500}\n"));
-  ExpectConfigError("run " + slow, slow, 1, {"sensors.esc.rate_hz", "(0, 500]"});
+  ExpectConfigError("run " + slow, slow, 1, {"sensors.esc.rate_hz", "[0.01, 500]"});
 }
 
 TEST_F(CliTest, SetOnAPathThatDoesNotExistExitsTwo) {

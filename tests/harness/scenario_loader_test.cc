@@ -314,13 +314,13 @@ TEST_F(ScenarioLoader, KeyTablesListEveryKeyTheLoaderTakes) {
 TEST_F(ScenarioLoader, AnAbsurdSpeedLimitIsRejectedWithItsRange) {
   const std::string f = (dir_ / "s.yaml").string();
   EXPECT_EQ(Error("mission: {type: hover}\nstack:\n  planner: {v_max: 1e9}\n"),
-            f + ":5:20: stack.planner.v_max: '1e9' is out of range; expected a number in (0, 50]");
+            f + ":5:20: stack.planner.v_max: '1e9' is out of range; expected a number in [0.001, 50]");
   EXPECT_EQ(Error("mission: {type: hover}\nstack:\n  planner: {v_max: 50}\n"), "(no error)");
   // The same bound for the options set in code.
   stack::NavigationOptions n;
   n.replanner.nominal.v_max = 1e9;
   RG_EXPECT_THROW_WITH(n.Validate(), ValidationError,
-                       "NavigationOptions::v_max = 1000000000 is invalid; expected a number in (0, 50]");
+                       "NavigationOptions::v_max = 1000000000 is invalid; expected a number in [0.001, 50]");
   n.replanner.nominal.v_max = 50.0;
   EXPECT_NO_THROW(n.Validate());
 }

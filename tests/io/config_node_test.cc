@@ -104,6 +104,11 @@ TEST_F(TempDir, LoadFileDirectoryThrowsInputFileError) {
   RG_EXPECT_THROW_WITH(ConfigDocument::LoadFile(dir_.string()), InputFileError, "is a directory");
 }
 
+TEST_F(TempDir, LoadFileRefusesADeviceThatCouldBeReadForever) {
+  RG_EXPECT_THROW_WITH(ConfigDocument::LoadFile("/dev/zero"), InputFileError,
+                       "/dev/zero: cannot read input file: is not a regular file");
+}
+
 TEST_F(TempDir, LoadFileUnreadableThrowsInputFileError) {
   if (::geteuid() == 0) GTEST_SKIP() << "root can read any file";
   const std::string path = Write("secret.yaml", "a: 1\n");

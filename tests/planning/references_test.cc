@@ -355,6 +355,12 @@ TEST(LemniscateReferenceTest, RejectsInvalidOptions) {
                        "LemniscateOptions::yaw_rad");
   // A flat figure eight is fine.
   EXPECT_NO_THROW((void)LemniscateReference({.size_z_m = 0.0}));
+  // Found by fuzzing (tests/fuzz, config): positive values whose phase rate max |c'| / speed leaves
+  // the doubles aborted on the base class's invariant instead of being refused.
+  RG_EXPECT_THROW_WITH((void)LemniscateReference({.size_x_m = 1e-300, .size_y_m = 1e-300, .size_z_m = 0.0}),
+                       std::invalid_argument, "LemniscateOptions::size_m");
+  RG_EXPECT_THROW_WITH((void)LemniscateReference({.max_speed_m_s = 4.9e-324}), std::invalid_argument,
+                       "finite phase rate");
 }
 
 // ----- circle

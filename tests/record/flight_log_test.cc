@@ -264,6 +264,20 @@ TEST_F(FlightLogTest, ReportDataIsThinnedAndKeepsTheFinalState) {
   EXPECT_THROW(FlightReportData(log, o), std::invalid_argument);
 }
 
+// Found by fuzzing (tests/fuzz, log_csv): rounding 1e308 to 4 decimals multiplied it past the
+// largest double, and the report's data held inf.
+TEST_F(FlightLogTest, ReportDataOfHugeFiniteValuesStaysFinite) {
+  FlightLog log;
+  log.summary = {{"scenario", "synthetic"}};
+  log.scene = {{"world", nlohmann::json::object()}};
+  log.table.columns = {"t", "p_x", "rpm_0"};
+  log.table.values = {{0.0, 0.01}, {1e308, -1.7e308}, {1e300, 123456789012345678.0}};
+  const nlohmann::json d = FlightReportData(log);
+  EXPECT_DOUBLE_EQ(d["series"]["p_x"][0].get<double>(), 1e308);
+  EXPECT_DOUBLE_EQ(d["series"]["p_x"][1].get<double>(), -1.7e308);
+  EXPECT_DOUBLE_EQ(d["series"]["rpm_0"][1].get<double>(), 123456789012345678.0);  // nothing left to round
+}
+
 TEST_F(FlightLogTest, DamagedOrMissingFilesAreNamedWithTheirOffset) {
   const harness::Scenario s = harness::LoadScenario(Config("hover.yaml"), {{"duration_s", "0.5"}});
   harness::RunOptions o;
@@ -285,6 +299,13 @@ TEST_F(FlightLogTest, DamagedOrMissingFilesAreNamedWithTheirOffset) {
   const std::string scene = io::ReadInputFile((dir_ / "scene.json").string());
   Write("scene.json", scene.substr(0, scene.size() / 2));
   EXPECT_THROW(ReadFlightLog(dir_.string()), io::CorruptFileError);
+  // Found by fuzzing (tests/fuzz, scene_json): a number beyond a double escaped as the JSON
+  // library's own out_of_range.
+  Write("scene.json", "{\"world\": {\"x\": 1e999}}");
+  RG_EXPECT_THROW_WITH(ReadFlightLog(dir_.string()), io::CorruptFileError, "scene.json");
+  Write("scene.json", "[1, 2]");
+  RG_EXPECT_THROW_WITH(ReadFlightLog(dir_.string()), io::CorruptFileError, "expected a JSON object");
+  Write("scene.json", scene);
   // Without log.csv and scene.json the MCAP file is read instead, and checked.
   fs::remove(dir_ / "log.csv");
   fs::remove(dir_ / "scene.json");

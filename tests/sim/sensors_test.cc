@@ -1,10 +1,13 @@
 #include "rotorguard/sim/sensors.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
+#include "rotorguard/core/error.h"
 #include "rotorguard/vehicle/vehicle_params.h"
+#include "test_util.h"
 
 namespace rotorguard::sim {
 namespace {
@@ -332,6 +335,25 @@ TEST(RateTimer, FiresOnItsGridFromPhysicsSteps) {
   int fired = 0;
   for (TimeNs t = 0; t < 1'000'000'000; t += 1'000'000) fired += timer.Due(t) ? 1 : 0;
   EXPECT_EQ(fired, 333);
+}
+
+// Found by generating flights (tests/fuzz): a rate of 4.9e-324 Hz made the period +inf seconds,
+// whose conversion to integer nanoseconds was undefined and came out negative, and Due() looped
+// forever. Periods now saturate, and rates below kMinRateHz are refused.
+TEST(RateTimer, ARateTooSlowToTickAgainFiresOnceAndNeverLoops) {
+  EXPECT_EQ(FromSeconds(std::numeric_limits<double>::infinity()), std::numeric_limits<TimeNs>::max());
+  EXPECT_EQ(FromSeconds(-1e300), std::numeric_limits<TimeNs>::min());
+  EXPECT_EQ(FromSeconds(std::numeric_limits<double>::quiet_NaN()), std::numeric_limits<TimeNs>::max());
+  EXPECT_EQ(FromSeconds(9.2e9), 9'200'000'000'000'000'000);  // just inside: 292 years
+  RateTimer timer(4.9e-324);
+  EXPECT_TRUE(timer.Due(0));
+  EXPECT_FALSE(timer.Due(1'000'000'000));
+  EXPECT_FALSE(timer.Due(std::numeric_limits<TimeNs>::max() - 1));
+  EscOptions esc;
+  esc.rate_hz = 4.9e-324;
+  RG_EXPECT_THROW_WITH(esc.Validate(1000.0), rotorguard::ValidationError, "rate_hz");
+  esc.rate_hz = kMinRateHz;
+  EXPECT_NO_THROW(esc.Validate(1000.0));
 }
 
 }  // namespace

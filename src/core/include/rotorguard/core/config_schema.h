@@ -59,10 +59,19 @@ struct KeyInfo {
 /// time or space run for hours (a collision check's step of check_step_m / v_max, a rate's
 /// callbacks per simulated second).
 inline constexpr double kMaxSpeedMS = 50.0;           ///< [m/s]: racing quadrotors top out near it
+/// [m/s], [m/s²], [m/s³]: the slowest a limit of motion may be. Below, it is a slip of a unit, and a
+/// curve's phase rate or a profile's duration computed from it leaves the doubles (4.9e-324 m/s
+/// made a lemniscate's phase rate 0).
+inline constexpr double kMinSpeedMS = 1e-3;
+inline constexpr double kMinAccelerationMS2 = 1e-3;
+inline constexpr double kMinJerkMS3 = 1e-3;
 inline constexpr double kMaxAccelerationMS2 = 100.0;  ///< [m/s²]: about 10 g
 inline constexpr double kMaxJerkMS3 = 1000.0;         ///< [m/s³]
 inline constexpr double kMaxBodyRateRadS = 100.0;     ///< [rad/s]: about 16 turns a second
 inline constexpr double kMaxRateHz = 10000.0;         ///< [Hz]: a loop of the stack or a sensor
+/// [Hz]: its slowest, a tick each 100 s; below, a "rate" is a slip of a unit, and its period (1 /
+/// rate) leaves the range of the simulation's integer nanoseconds.
+inline constexpr double kMinRateHz = 0.01;
 inline constexpr double kMaxCoordinateM = 10000.0;    ///< [m]: each coordinate of a place in the world
 /// [m]: each coordinate of a point on the vehicle from its centre of gravity (a rotor, a sensor),
 /// or a length on it; a line of 16 docked units (64 rotors) a few metres apart spans tens of metres.

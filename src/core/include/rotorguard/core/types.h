@@ -1,10 +1,10 @@
 #pragma once
 /// Basic types shared by every module: fixed-capacity rotor vectors (no heap allocation on the
 /// control path) and integer simulation time.
-#include <cstdint>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <limits>
 
 namespace rotorguard {
 
@@ -27,9 +27,13 @@ using AllocationMatrix = Eigen::Matrix<double, Eigen::Dynamic, 4, 0, kMaxRotors,
 using TimeNs = std::int64_t;
 inline constexpr TimeNs kNanosPerSecond = 1'000'000'000;
 inline constexpr double ToSeconds(TimeNs t) { return static_cast<double>(t) * 1e-9; }
-/// Rounds to the nearest nanosecond.
+/// Rounds to the nearest nanosecond; beyond the range of TimeNs (about ±292 years) it saturates
+/// (and NaN counts as "never"): converting such a double to an integer would be undefined.
 inline TimeNs FromSeconds(double s) {
-  return static_cast<TimeNs>(s * 1e9 + (s >= 0 ? 0.5 : -0.5));
+  const double ns = s * 1e9 + (s >= 0 ? 0.5 : -0.5);
+  if (!(ns < 0x1p63)) return std::numeric_limits<TimeNs>::max();
+  if (!(ns >= -0x1p63)) return std::numeric_limits<TimeNs>::min();
+  return static_cast<TimeNs>(ns);
 }
 /// Period in nanoseconds of a rate in Hz, rounded to the nearest nanosecond.
 inline TimeNs PeriodFromRate(double rate_hz) { return FromSeconds(1.0 / rate_hz); }

@@ -69,10 +69,10 @@ struct AssemblyPlanSpec {
               .max = kMaxCoordinateM,
               .required = true});
     a->Visit("method", &method, {.meaning = "ours, or baseline: Table II's SVSDF-style row"});
-    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "speed limit [m/s]", .max = kMaxSpeedMS, .positive = true});
+    a->Visit("max_speed_m_s", &max_speed_m_s, {.meaning = "speed limit [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
     a->Visit("max_accel_m_s2", &max_accel_m_s2,
-             {.meaning = "acceleration limit [m/s²]", .max = kMaxAccelerationMS2, .positive = true});
-    a->Visit("max_jerk_m_s3", &max_jerk_m_s3, {.meaning = "jerk limit [m/s³]", .max = kMaxJerkMS3, .positive = true});
+             {.meaning = "acceleration limit [m/s²]", .min = kMinAccelerationMS2, .max = kMaxAccelerationMS2});
+    a->Visit("max_jerk_m_s3", &max_jerk_m_s3, {.meaning = "jerk limit [m/s³]", .min = kMinJerkMS3, .max = kMaxJerkMS3});
     a->Visit("max_yaw_rate_rad_s", &max_yaw_rate_rad_s,
              {.meaning = "both methods: the yaw's rate limit [rad/s]", .max = kMaxBodyRateRadS, .positive = true});
     a->Visit("safety_factor", &safety_factor,

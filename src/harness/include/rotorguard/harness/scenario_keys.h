@@ -60,9 +60,9 @@ struct SimKeys {
               .positive = true});
     // The log is held in memory until the end: beyond a sensor's rate it would only grow.
     a->Visit("log_rate_hz", &s->log_rate_hz,
-             {.meaning = "rows per second in log.csv, at most the physics rate", .max = kMaxRateHz, .positive = true});
+             {.meaning = "rows per second in log.csv, at most the physics rate", .min = kMinRateHz, .max = kMaxRateHz});
     a->Visit("crash_speed_m_s", &s->sim.crash_speed_m_s,
-             {.meaning = "touching the ground faster is a crash [m/s]", .max = kMaxSpeedMS, .positive = true});
+             {.meaning = "touching the ground faster is a crash [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
     a->Visit(
         "crash_tilt_rad", &s->sim.crash_tilt_rad,
         {.meaning = "touching the ground more tilted is a crash [rad]", .max = std::numbers::pi, .positive = true});

@@ -27,6 +27,15 @@ struct KeyRow {
   std::string meaning;
   /// A number or numbers (a vector, an angle, a count): the rule is to state their range.
   bool numeric = false;
+  /// What a program that writes values needs (the valid-scenario generator, docs/reliability.md):
+  /// a number's declared range (min, max, positive, open_max of its KeyInfo) ...
+  KeyInfo range;
+  /// ... how many numbers it holds (1; 2 a pair; 3 a triple or [x, y, z]; 4; 9 a matrix; -1 a list
+  /// of points; 0 not a number) and whether they are integers ...
+  int count = 0;
+  bool integer = false;
+  /// ... or the names an enum (or a bool: true, false) takes.
+  std::vector<std::string> choices;
 };
 
 /// Collects a struct's rows: `value.Serialize(&writer)`, nested blocks and lists of blocks
@@ -57,24 +66,44 @@ class KeyTableWriter {
       // A required key has no default to show.
       Add(path, info.required ? "" : (info.default_text ? info.default_text : Text(*value)), RuleOf(*value, info),
           info.meaning, info.default_text != nullptr, IsNumeric<T>());
+      KeyRow& row = rows_.back();
+      row.range = info;
+      row.count = CountOf<T>();
+      row.integer = std::is_integral_v<T> && !std::is_same_v<T, bool>;
+      if constexpr (NamedEnum<T>) {
+        row.choices = NameList<T>();
+      } else if constexpr (std::is_same_v<T, bool>) {
+        row.choices = {"true", "false"};
+      }
     }
   }
   void Visit(const char* key, DegreesOf angle, const KeyInfo& info) {
     Add(prefix_ + key, Number(*angle.radians * 180.0 / 3.14159265358979323846),
         info.rule_text ? info.rule_text : fmt::format("in ({}, {}) deg", Number(info.min), Number(info.max)),
         info.meaning, false, true);
+    // An open interval at both ends (the loader's rule): its closest closed one in doubles.
+    rows_.back().range = info;
+    rows_.back().range.min = std::nextafter(info.min, info.max);
+    rows_.back().range.max = std::nextafter(info.max, info.min);
+    rows_.back().count = 1;
   }
   void Visit(const char* key, ConvertedOf number, const KeyInfo& info) {
     Add(prefix_ + key, info.required ? "" : Number(number.to_file(*number.value)), RuleOf(0.0, info), info.meaning,
         false, true);
+    rows_.back().range = info;
+    rows_.back().count = 1;
   }
   void Visit(const char* key, TripleOf t, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}, {}]", Number(*t.x), Number(*t.y), Number(*t.z)),
         info.rule_text ? info.rule_text : WithNote(Each("three numbers", info), info), info.meaning, false, true);
+    rows_.back().range = info;
+    rows_.back().count = 3;
   }
   void Visit(const char* key, PairOf pair, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}]", Number(*pair.first), Number(*pair.second)),
         info.rule_text ? info.rule_text : WithNote(Each("two numbers", info), info), info.meaning, false, true);
+    rows_.back().range = info;
+    rows_.back().count = 2;
   }
 
   const std::vector<KeyRow>& rows() const { return rows_; }
@@ -89,7 +118,14 @@ class KeyTableWriter {
 
   void Add(std::string key, std::string value, std::string rule, const char* meaning, bool prose = false,
            bool numeric = false) {
-    rows_.push_back({std::move(key), std::move(value), prose, std::move(rule), meaning, numeric});
+    KeyRow row;
+    row.key = std::move(key);
+    row.value = std::move(value);
+    row.value_is_prose = prose;
+    row.rule = std::move(rule);
+    row.meaning = meaning;
+    row.numeric = numeric;
+    rows_.push_back(std::move(row));
   }
 
   /// Numbers: scalars (bool aside), optional numbers, the vectors and matrix keys use, lists of points.
@@ -102,6 +138,26 @@ class KeyTableWriter {
              std::is_same_v<T, std::vector<Eigen::Vector3d>> || std::is_same_v<T, Eigen::Vector2d> ||
              std::is_same_v<T, Eigen::Vector3d> || std::is_same_v<T, Eigen::Vector4d> ||
              std::is_same_v<T, Eigen::Matrix3d>;
+    }
+  }
+
+  /// How many numbers a value of T holds (KeyRow::count).
+  template <typename T>
+  static constexpr int CountOf() {
+    if constexpr (!IsNumeric<T>()) {
+      return 0;
+    } else if constexpr (std::is_same_v<T, std::vector<Eigen::Vector3d>>) {
+      return -1;
+    } else if constexpr (std::is_same_v<T, Eigen::Vector2d>) {
+      return 2;
+    } else if constexpr (std::is_same_v<T, Eigen::Vector3d>) {
+      return 3;
+    } else if constexpr (std::is_same_v<T, Eigen::Vector4d>) {
+      return 4;
+    } else if constexpr (std::is_same_v<T, Eigen::Matrix3d>) {
+      return 9;
+    } else {
+      return 1;
     }
   }
 

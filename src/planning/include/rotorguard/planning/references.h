@@ -63,7 +63,7 @@ struct TakeoffOptions {
               .positive = true,
               .required = true});
     a->Visit("max_speed_m_s", &max_speed_m_s,
-             {.meaning = "peak climb speed [m/s]", .max = kMaxSpeedMS, .positive = true});
+             {.meaning = "peak climb speed [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
     a->Visit("yaw_rad", &yaw_rad,
              {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
   }
@@ -160,7 +160,7 @@ struct LemniscateOptions {
               .max = kMaxCoordinateM,
               .rule_note = "sx and sy > 0"});
     a->Visit("max_speed_m_s", &max_speed_m_s,
-             {.meaning = "top speed once ramped up [m/s]", .max = kMaxSpeedMS, .positive = true, .required = true});
+             {.meaning = "top speed once ramped up [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS, .required = true});
     a->Visit("ramp_s", &ramp_s, {.meaning = "time to full phase rate from rest [s]", .min = 0.0, .max = kMaxTimeoutS});
     a->Visit("yaw_rad", &yaw_rad,
              {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
@@ -208,7 +208,7 @@ struct CircleOptions {
     a->Visit("radius_m", &radius_m, {.meaning = "[m]", .min = 0.01, .max = kMaxCoordinateM, .required = true});
     a->Visit(
         "speed_m_s", &speed_m_s,
-        {.meaning = "tangential speed once ramped up [m/s]", .max = kMaxSpeedMS, .positive = true, .required = true});
+        {.meaning = "tangential speed once ramped up [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS, .required = true});
     a->Visit("ramp_s", &ramp_s, {.meaning = "time to full speed from rest [s]", .min = 0.0, .max = kMaxTimeoutS});
     a->Visit("clockwise", &clockwise, {.meaning = "seen from above"});
     a->Visit("climb_m_s", &climb_m_s,
@@ -255,11 +255,11 @@ struct WaypointOptions {
               .required = true});
     a->Visit("max_speed_m_s", &max_speed_m_s,
              {.meaning = "speed limit of the trapezoidal profile [m/s]",
+              .min = kMinSpeedMS,
               .max = kMaxSpeedMS,
-              .positive = true,
               .required = true});
     a->Visit("max_accel_m_s2", &max_accel_m_s2,
-             {.meaning = "its acceleration limit [m/s²]", .max = kMaxAccelerationMS2, .positive = true});
+             {.meaning = "its acceleration limit [m/s²]", .min = kMinAccelerationMS2, .max = kMaxAccelerationMS2});
     a->Visit("dwell_s", &dwell_s,
              {.meaning = "pause at each intermediate waypoint [s]", .min = 0.0, .max = kMaxTimeoutS});
     a->Visit("yaw_rad", &yaw_rad,

@@ -23,7 +23,7 @@ namespace rotorguard::sim {
 
 struct LidarOptions {
   bool enabled = false;             ///< off by default: ray casting costs time
-  double frame_rate_hz = 10.0;      ///< frames per second, > 0
+  double frame_rate_hz = 10.0;      ///< frames per second, in [kMinRateHz, 1000]
   double points_per_s = 200000.0;   ///< pulses per second, > 0
   double min_range_m = 0.1;         ///< closer returns are dropped, >= 0
   double max_range_m = 40.0;        ///< > min_range_m
@@ -40,7 +40,7 @@ struct LidarOptions {
   void Serialize(Archive* a) {
     a->Visit("enabled", &enabled,
              {.meaning = "a lidar block switches the sensor on unless this says false", .default_text = "true"});
-    a->Visit("frame_rate_hz", &frame_rate_hz, {.meaning = "frames per second", .max = 1000.0, .positive = true});
+    a->Visit("frame_rate_hz", &frame_rate_hz, {.meaning = "frames per second", .min = kMinRateHz, .max = 1000.0});
     // Every pulse is cast: ten million a simulated second is twice the densest scanning LiDAR's.
     a->Visit("points_per_s", &points_per_s, {.meaning = "pulses per second", .max = 1e7, .positive = true});
     a->Visit("min_range_m", &min_range_m,

@@ -37,7 +37,7 @@ struct ImuOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("rate_hz", &rate_hz,
-             {.meaning = "sample rate [Hz], at most the physics rate", .max = kMaxRateHz, .positive = true});
+             {.meaning = "sample rate [Hz], at most the physics rate", .min = kMinRateHz, .max = kMaxRateHz});
     a->Visit("position_m", &position_m,
              {.meaning = "mounting point from the centre of gravity, body frame [m]",
               .min = -kMaxBodyOffsetM,
@@ -79,7 +79,7 @@ struct EscOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("rate_hz", &rate_hz,
-             {.meaning = "telemetry rate [Hz], at most the physics rate", .max = kMaxRateHz, .positive = true});
+             {.meaning = "telemetry rate [Hz], at most the physics rate", .min = kMinRateHz, .max = kMaxRateHz});
     // A multirotor's motors turn at a few thousand to 30 000 rpm.
     a->Visit("noise_rpm", &noise_rpm, {.meaning = "white measurement noise [rpm]", .min = 0.0, .max = 5000.0});
     a->Visit("quantization_rpm", &quantization_rpm,
@@ -133,7 +133,7 @@ struct OdometryOptions {
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit("rate_hz", &rate_hz,
-             {.meaning = "rate [Hz], at most the physics rate", .max = kMaxRateHz, .positive = true});
+             {.meaning = "rate [Hz], at most the physics rate", .min = kMinRateHz, .max = kMaxRateHz});
     // Up to a GNSS fix's metres and a tenth of a radian: the noise of any front end worth flying on.
     a->Visit("position_noise_m", &position_noise_m, {.meaning = "position std at rest [m]", .min = 0.0, .max = 10.0});
     a->Visit("velocity_noise_m_s", &velocity_noise_m_s,

@@ -122,12 +122,16 @@ struct NavigationOptions {
         "start_s", &start_s,
         {.meaning = "the mission starts then; the vehicle holds its start until [s]", .min = 0.0, .max = kMaxFlightS});
     a->Visit("rate_hz", &planner_rate_hz,
-             {.meaning = "the planner's rate [Hz], at most the control rate", .max = kMaxRateHz, .positive = true});
+             {.meaning = "the planner's rate [Hz], at most the control rate", .min = kMinRateHz, .max = kMaxRateHz});
     // The collision checks step in time by a fixed distance over v_max (DynamicLimits).
-    a->Visit("v_max", &r.nominal.v_max, {.meaning = "nominal speed limit [m/s]", .max = kMaxSpeedMS, .positive = true});
+    a->Visit("v_max", &r.nominal.v_max,
+             {.meaning = "nominal speed limit [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
     a->Visit("a_max", &r.nominal.a_max,
-             {.meaning = "nominal acceleration limit a_max,n [m/s²]", .max = kMaxAccelerationMS2, .positive = true});
-    a->Visit("j_max", &r.nominal.j_max, {.meaning = "nominal jerk limit [m/s³]", .max = kMaxJerkMS3, .positive = true});
+             {.meaning = "nominal acceleration limit a_max,n [m/s²]",
+              .min = kMinAccelerationMS2,
+              .max = kMaxAccelerationMS2});
+    a->Visit("j_max", &r.nominal.j_max,
+             {.meaning = "nominal jerk limit [m/s³]", .min = kMinJerkMS3, .max = kMaxJerkMS3});
     a->Visit("post_failure_safety_factor", &post_failure_safety_factor,
              {.meaning =
                   "γ_a,f of eq. (33): with the vehicle's mass, rotor thrust and drag it gives a_max,f after a failure",
@@ -154,7 +158,7 @@ struct NavigationOptions {
 };
 
 struct FlightStackOptions {
-  double control_rate_hz = 200.0;  ///< controller rate (paper 000: 200 Hz), in (0, kMaxRateHz]
+  double control_rate_hz = 200.0;  ///< controller rate (paper 000: 200 Hz), in [kMinRateHz, kMaxRateHz]
   /// The assembly controller is built by the caller and handed to the FlightStack.
   ControllerKind controller = ControllerKind::kNominal;
   control::NominalControllerOptions nominal;
@@ -194,8 +198,9 @@ control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& opti
 template <typename Archive>
 void FlightStackOptions::Serialize(Archive* a) {
   a->Visit("controller", &controller, {.meaning = "the controller (docs/control.md)"});
-  a->Visit("control_rate_hz", &control_rate_hz,
-           {.meaning = "the controller's rate [Hz], at most sim.physics_rate_hz", .max = kMaxRateHz, .positive = true});
+  a->Visit(
+      "control_rate_hz", &control_rate_hz,
+      {.meaning = "the controller's rate [Hz], at most sim.physics_rate_hz", .min = kMinRateHz, .max = kMaxRateHz});
   a->Visit("nominal", &nominal, {.meaning = "the nominal cascade's gains"});
   a->Visit("passive", &passive, {.meaning = "the passive controller: stack.nominal's position gains and its own"});
   // INDI's filters are checked against the control rate it samples at.
