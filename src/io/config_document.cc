@@ -1,9 +1,3 @@
-#include "config_tree.h"
-
-#include <algorithm>
-#include <sstream>
-#include <utility>
-
 #include <fmt/format.h>
 #include <yaml-cpp/anchor.h>
 #include <yaml-cpp/depthguard.h>
@@ -13,6 +7,12 @@
 #include <yaml-cpp/mark.h>
 #include <yaml-cpp/parser.h>
 
+#include <algorithm>
+#include <sstream>
+#include <string_view>
+#include <utility>
+
+#include "config_tree.h"
 #include "rotorguard/core/error.h"
 
 // ConfigDocument: parsing a file into our own tree, and overrides.
@@ -284,11 +284,57 @@ class ParseContext {
   std::string base_path_;
 };
 
+/// The offset of the first byte of `text` that is not part of well-formed UTF-8 (RFC 3629: no
+/// overlong forms, no surrogates, nothing above U+10FFFF), or npos.
+std::size_t FirstInvalidUtf8(std::string_view text) {
+  const auto byte = [&text](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const unsigned char c = byte(i);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    int length = 0;
+    unsigned char lo = 0x80, hi = 0xBF;  // the range of the second byte
+    if (c >= 0xC2 && c <= 0xDF) {
+      length = 2;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      length = 3;
+      if (c == 0xE0) lo = 0xA0;  // overlong
+      if (c == 0xED) hi = 0x9F;  // surrogates
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      length = 4;
+      if (c == 0xF0) lo = 0x90;  // overlong
+      if (c == 0xF4) hi = 0x8F;  // above U+10FFFF
+    } else {
+      return i;
+    }
+    if (i + length > text.size() || byte(i + 1) < lo || byte(i + 1) > hi) return i;
+    for (int k = 2; k < length; ++k) {
+      if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return i;
+    }
+    i += length;
+  }
+  return std::string_view::npos;
+}
+
 /// Parses exactly one YAML document; nullptr when the text holds none (empty or only comments).
 /// Every yaml-cpp exception becomes a ConfigError with yaml-cpp's (1-based) location.
 ValuePtr ParseSingleDocument(const std::string& text, const std::string& file, bool from_override,
                              const std::string& base_path) {
   const ParseContext context(file, from_override, base_path);
+  // YAML is UTF-8 here; a stray byte would pass the parser and break every JSON output that names
+  // the value (found by fuzzing: a scenario name with byte 0x84 stopped `run` at summary.json).
+  if (const std::size_t bad = FirstInvalidUtf8(text); bad != std::string_view::npos) {
+    const std::size_t newline = text.rfind('\n', bad);  // the byte itself is not one
+    const int line =
+        1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(bad), '\n'));
+    const int column = 1 + static_cast<int>(newline == std::string::npos ? bad : bad - newline - 1);
+    throw ConfigError(
+        file, from_override ? 0 : line, from_override ? 0 : column, base_path,
+        fmt::format("byte 0x{:02X} is not valid UTF-8; expected UTF-8 text", static_cast<unsigned char>(text[bad])));
+  }
   std::istringstream in(text);
   try {
     YAML::Parser parser(in);

@@ -59,7 +59,9 @@ nlohmann::json FlightReportData(const FlightLog& log, const FlightReportOptions&
   nlohmann::json data;
   data["kind"] = "flight";
   data["format"] = 1;
-  data["title"] = log.summary.value("scenario", std::string("flight"));
+  // A summary read back may hold anything under a key (found by fuzzing: an object as "scenario").
+  const auto scenario = log.summary.find("scenario");
+  data["title"] = scenario != log.summary.end() && scenario->is_string() ? scenario->get<std::string>() : "flight";
   data["summary"] = log.summary;
   data["scene"] = log.scene;
   data["series"] = std::move(series);

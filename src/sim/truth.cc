@@ -140,6 +140,15 @@ Matrix3 ScaleMassMoments(const Matrix3& inertia, const Vector3& ratio) {
   return scaled.trace() * Matrix3::Identity() - scaled;
 }
 
+namespace {
+// A point of the file's body moved by the drawn CoG offset, kept within the range of a body point:
+// a file at the range's edge must describe a simulated vehicle the simulator accepts. (Found by
+// generating flights: an IMU at 50 m flew as 50.01 m and the run stopped with an unlocated error.)
+Vector3 MovedBodyPoint(const Vector3& p) {
+  return p.cwiseMax(Vector3::Constant(-kMaxBodyOffsetM)).cwiseMin(Vector3::Constant(kMaxBodyOffsetM));
+}
+}  // namespace
+
 vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const TruthDraw& d) {
   vehicle::VehicleParams v = file;
   v.mass_kg = file.mass_kg * d.mass_ratio;
@@ -149,13 +158,15 @@ vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const Tr
   v.motor_stop_time_constant_s = d.motor_stop_time_constant_s;
   // Rotor positions are relative to the centre of gravity: a CoG at c moves every hub by -c.
   for (std::size_t i = 0; i < v.rotors.size(); ++i) {
-    v.rotors[i].p_B = file.rotors[i].p_B - d.cog_offset_m;
+    v.rotors[i].p_B = MovedBodyPoint(file.rotors[i].p_B - d.cog_offset_m);
     if (i < d.yaw_coefficient_ratio.size()) v.rotors[i].yaw_coefficient_m *= d.yaw_coefficient_ratio[i];
   }
-  for (vehicle::CollisionSphere& c : v.collision_spheres) c.centre_B -= d.cog_offset_m;
+  for (vehicle::CollisionSphere& c : v.collision_spheres) c.centre_B = MovedBodyPoint(c.centre_B - d.cog_offset_m);
   // The spheres, moved, stay within the bound about the true CoG only if it grows by the offset. A
   // body of one sphere keeps it centred on the CoG (off by the offset, at most 12 mm).
-  if (!v.collision_spheres.empty()) v.collision_radius_m = file.collision_radius_m + d.cog_offset_m.norm();
+  if (!v.collision_spheres.empty()) {
+    v.collision_radius_m = std::min(file.collision_radius_m + d.cog_offset_m.norm(), kMaxBodyOffsetM);
+  }
   return v;
 }
 
@@ -167,7 +178,7 @@ RotorVector ThrustRatios(const TruthDraw& draw) {
 SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const vehicle::VehicleParams& file,
                                        const TruthDraw& draw) {
   SimulatorOptions o = scenario;
-  o.imu.position_m = scenario.imu.position_m - draw.cog_offset_m + draw.imu_offset_m;
+  o.imu.position_m = MovedBodyPoint(scenario.imu.position_m - draw.cog_offset_m + draw.imu_offset_m);
   o.imu.vibration_m_s2 = draw.imu_vibration_m_s2;
   // The vibration's amplitude is given at the file's hover speed: T = m g / n = k_n ω².
   o.imu.vibration_reference_speed_rad_s = std::sqrt(file.weight_n() / file.num_rotors() / file.thrust_coefficient_n_s2);

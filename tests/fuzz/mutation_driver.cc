@@ -30,6 +30,7 @@ using rotorguard::fuzz::Target;
 
 constexpr std::string_view kUsage =
     "usage: rotorguard_fuzz TARGET [--runs N] [--seed S] [--timeout SECONDS]\n"
+    "       rotorguard_fuzz TARGET --input FILE   (runs FILE alone: a finding's crash-TARGET)\n"
     "       rotorguard_fuzz --list\n";
 
 // Tokens that parsers of YAML, JSON and CSV must refuse or handle.
@@ -228,6 +229,11 @@ int main(int argc, char** argv) {
   if (target == nullptr) {
     std::fprintf(stderr, "rotorguard_fuzz: no target '%s'; --list shows them\n", args[0].c_str());
     return 2;
+  }
+  if (args.size() == 3 && args[1] == "--input") {
+    const Outcome outcome = rotorguard::fuzz::RunOne(*target, ReadAll(args[2]));
+    std::printf("%s: %s\n", args[2].c_str(), outcome == Outcome::kAccepted ? "accepted" : "refused");
+    return 0;
   }
   std::uint64_t runs = 10000, seed = 1, timeout_s = 10;
   for (std::size_t i = 1; i < args.size(); i += 2) {

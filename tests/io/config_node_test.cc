@@ -116,6 +116,22 @@ TEST_F(TempDir, LoadFileUnreadableThrowsInputFileError) {
   RG_EXPECT_THROW_WITH(ConfigDocument::LoadFile(path), InputFileError, "permission denied");
 }
 
+// Found by fuzzing (tests/fuzz, config): a byte that is not UTF-8 passed the loader, and `run` then
+// stopped writing summary.json, whose JSON must be UTF-8.
+TEST(ConfigDocumentUtf8, ABrokenByteIsRefusedWithItsLineAndColumn) {
+  RG_EXPECT_THROW_WITH(ConfigDocument::LoadString("a: 1\nname: \"h\x84v\"\n", "s.yaml"), ConfigError,
+                       "s.yaml:2:9: byte 0x84 is not valid UTF-8; expected UTF-8 text");
+  RG_EXPECT_THROW_WITH(ConfigDocument::LoadString("\xC0\x80: 1\n", "s.yaml"), ConfigError, "s.yaml:1:1: byte 0xC0");
+  RG_EXPECT_THROW_WITH(ConfigDocument::LoadString("a: \"\xED\xA0\x80\"\n", "s.yaml"), ConfigError,
+                       "0xED");  // surrogate
+  RG_EXPECT_THROW_WITH(ConfigDocument::LoadString("a: \"\xF4\x90\x80\x80\"\n", "s.yaml"), ConfigError, "0xF4");
+  RG_EXPECT_THROW_WITH(ConfigDocument::LoadString("a: \"\xE2\x82\"\n", "s.yaml"), ConfigError, "0xE2");  // cut
+  // Well-formed multi-byte text is fine: ω (2 bytes), ≥ (3), 𝜔 (4).
+  EXPECT_NO_THROW(ConfigDocument::LoadString("a: \"\xCF\x89 \xE2\x89\xA5 \xF0\x9D\x9C\x94\"\n", "s.yaml"));
+  ConfigDocument d = ConfigDocument::LoadString("a: 1\n", "s.yaml");
+  RG_EXPECT_THROW_WITH(d.ApplyOverride("a", "\xFF"), ConfigError, "--set: a: byte 0xFF is not valid UTF-8");
+}
+
 TEST_F(TempDir, LoadFileReadsAndReportsThatFilesName) {
   const std::string path = Write("vehicle.yaml", "mass_kg: 1.5\nmasss_kg: 2\n");
   const ConfigDocument doc = ConfigDocument::LoadFile(path);

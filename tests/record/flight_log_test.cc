@@ -276,6 +276,10 @@ TEST_F(FlightLogTest, ReportDataOfHugeFiniteValuesStaysFinite) {
   EXPECT_DOUBLE_EQ(d["series"]["p_x"][0].get<double>(), 1e308);
   EXPECT_DOUBLE_EQ(d["series"]["p_x"][1].get<double>(), -1.7e308);
   EXPECT_DOUBLE_EQ(d["series"]["rpm_0"][1].get<double>(), 123456789012345678.0);  // nothing left to round
+  // Found by fuzzing (tests/fuzz, summary_json): a "scenario" that is not text threw the JSON
+  // library's type_error while making the title.
+  log.summary = {{"scenario", {{"x", 1}}}};
+  EXPECT_EQ(FlightReportData(log)["title"], "flight");
 }
 
 TEST_F(FlightLogTest, DamagedOrMissingFilesAreNamedWithTheirOffset) {

@@ -137,6 +137,24 @@ TEST(Truth, TheDrawnVehicleMovesItsRotorsAboutTheTrueCentreOfGravity) {
   EXPECT_NO_THROW(v.Validate());
 }
 
+// Found by generating flights (tests/fuzz): an IMU at the edge of its range (50 m) was drawn 1 cm
+// beyond it, and the simulator refused the realistic world's options of a valid scenario.
+TEST(Truth, ABodyPointAtTheEdgeOfItsRangeStaysInsideWhenTheCentreOfGravityMoves) {
+  const vehicle::VehicleParams file = ReferenceQuad();
+  SimulatorOptions scenario;
+  scenario.imu.position_m = Vector3(kMaxBodyOffsetM, -kMaxBodyOffsetM, 0.0);
+  int moved_out = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const TruthDraw d = DrawTruth(Realistic(), file, seed);
+    const Vector3 unclamped = scenario.imu.position_m - d.cog_offset_m + d.imu_offset_m;
+    moved_out += unclamped.cwiseAbs().maxCoeff() > kMaxBodyOffsetM;
+    const SimulatorOptions o = TruthSimulatorOptions(scenario, file, d);
+    EXPECT_LE(o.imu.position_m.cwiseAbs().maxCoeff(), kMaxBodyOffsetM);
+    EXPECT_NO_THROW(o.Validate(TruthVehicle(file, d)));
+  }
+  EXPECT_GT(moved_out, 0) << "no draw left the range: the test would pass without the clamp";
+}
+
 /// The inertia about the origin of point masses m at the columns of `points`: Σ m (|r|² 1 − r rᵀ).
 Matrix3 PointMassInertia(const Eigen::Matrix<double, 3, Eigen::Dynamic>& points, double m) {
   Matrix3 inertia = Matrix3::Zero();
