@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -85,6 +87,35 @@ std::string StatsCell(const nlohmann::json& s) {
                      0.5 * (s["ci95"][1].get<double>() - s["ci95"][0].get<double>()));
 }
 
+// A manifest's keys and their types, as RunCampaign writes them (found by fuzzing: a null
+// trials_total escaped as the JSON library's type_error).
+void CheckManifest(const nlohmann::json& manifest, const std::string& path) {
+  const auto fail = [&path](const char* key, const char* expected) {
+    throw io::CorruptFileError(path, 0, fmt::format("'{}' is missing or not {}", key, expected));
+  };
+  for (const char* key : {"spec_hash", "version", "campaign"}) {
+    if (!manifest.contains(key) || !manifest[key].is_string()) fail(key, "text");
+  }
+  const auto it = manifest.find("trials_total");
+  if (it == manifest.end() || !it->is_number_integer() || it->get<std::int64_t>() < 0 ||
+      it->get<std::int64_t>() > std::numeric_limits<int>::max()) {
+    fail("trials_total", "a count");
+  }
+  const auto shard = manifest.find("shard");
+  if (shard == manifest.end() || !shard->is_string() || shard->get<std::string>().find('/') == std::string::npos) {
+    fail("shard", "text 'i/N'");
+  }
+  for (const char* key : {"metrics", "grid_keys"}) {
+    if (!manifest.contains(key) || !manifest[key].is_array()) fail(key, "a list of names");
+    for (const nlohmann::json& name : manifest[key]) {
+      if (!name.is_string()) fail(key, "a list of names");
+    }
+  }
+  if (!manifest.contains("finished") || !(manifest["finished"].is_string() || manifest["finished"].is_null())) {
+    fail("finished", "a time or null");
+  }
+}
+
 }  // namespace
 
 std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& dirs, nlohmann::json* manifest_out) {
@@ -106,10 +137,7 @@ std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& 
     std::sort(found.begin(), found.end());
     for (const fs::path& m : found) {
       const nlohmann::json manifest = io::ReadJsonObject(m.string());
-      for (const char* key :
-           {"spec_hash", "version", "trials_total", "shard", "metrics", "grid_keys", "campaign", "finished"}) {
-        if (!manifest.contains(key)) throw io::CorruptFileError(m.string(), 0, fmt::format("no key '{}'", key));
-      }
+      CheckManifest(manifest, m.string());
       if (!manifests.empty()) {
         for (const char* key : {"spec_hash", "version"}) {
           if (manifest[key] != manifests.front()[key]) {
@@ -150,16 +178,19 @@ std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& 
     }
   }
   const int total = manifests.front()["trials_total"].get<int>();
-  std::vector<int> missing;
+  // Counted, not listed: a damaged manifest's trials_total must not cost its size in memory.
+  std::vector<int> first;
+  int missing = 0;
   for (int i = 0; i < total; ++i) {
-    if (!trials.count(i)) missing.push_back(i);
+    if (trials.count(i)) continue;
+    ++missing;
+    if (first.size() < 10) first.push_back(i);
   }
-  if (!missing.empty()) {
-    std::vector<int> first(missing.begin(), missing.begin() + std::min<std::size_t>(missing.size(), 10));
+  if (missing > 0) {
     throw std::invalid_argument(
         fmt::format("campaign merge: {} of {} trials are missing (first: {}); run or resume "
                     "the shards that hold them",
-                    missing.size(), total, fmt::join(first, ", ")));
+                    missing, total, fmt::join(first, ", ")));
   }
   if (static_cast<int>(trials.size()) != total) {
     throw std::invalid_argument(fmt::format("campaign merge: trials beyond the campaign's {}", total));

@@ -239,6 +239,13 @@ void ReadStack(const ConfigNode& root, Scenario* s) {
                               s->vehicle.num_rotors() - 1));
     }
   }
+  // Found by generating flights: validate accepted INDI on a 24-rotor assembly, which the stack
+  // then refused at take-off without a location.
+  if (s->stack.controller == stack::ControllerKind::kIndi && s->vehicle.num_rotors() != 4) {
+    root.FailAt("stack.controller", fmt::format("controller indi is for a quadrotor, and the vehicle has {} rotors; "
+                                                "expected nominal, passive, nmpc or assembly",
+                                                s->vehicle.num_rotors()));
+  }
   if (s->stack.controller == stack::ControllerKind::kAssembly && !s->assembly) {
     root.FailAt("stack.controller",
                 "controller assembly flies an assembly; expected the key 'assembly' in place of 'vehicle'");

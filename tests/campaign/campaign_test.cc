@@ -198,6 +198,20 @@ TEST_F(CampaignEngine, AMergeRefusesGapsDuplicatesAndMixedSpecs) {
   other.hash = "hash-2";
   Run(other, "s1_other", 1, Shard{1, 2});
   RG_EXPECT_THROW_WITH(Merge({"s0", "s1_other"}, "mixed"), std::invalid_argument, "spec_hash");
+  // Found by fuzzing (tests/fuzz, manifest_json): a manifest whose keys hold the wrong types escaped
+  // as the JSON library's type_error; it is a damaged file, named with the key.
+  const fs::path m = dir_ / "s1" / "manifest.shard-1.json";
+  const std::string manifest = io::ReadFile(m.string());
+  nlohmann::json damaged = nlohmann::json::parse(manifest);
+  damaged["trials_total"] = nullptr;
+  io::WriteFileAtomically(m.string(), damaged.dump());
+  RG_EXPECT_THROW_WITH(Merge({"s0", "s1"}, "damaged"), io::CorruptFileError,
+                       "'trials_total' is missing or not a count");
+  damaged = nlohmann::json::parse(manifest);
+  damaged["metrics"] = {"x", 3};
+  io::WriteFileAtomically(m.string(), damaged.dump());
+  RG_EXPECT_THROW_WITH(Merge({"s0", "s1"}, "damaged"), io::CorruptFileError, "'metrics' is missing or not a list");
+  io::WriteFileAtomically(m.string(), manifest);
   // A resume against another spec is refused, the folder untouched.
   const std::string before = io::ReadFile((dir_ / "s0" / "results.shard-0.jsonl").string());
   RG_EXPECT_THROW_WITH(Run(other, "s0", 1, Shard{0, 2}, true), ValidationError, "spec_hash");

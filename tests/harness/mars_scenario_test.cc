@@ -64,6 +64,11 @@ TEST(MarsScenario, AssemblyKeysAreCheckedNamingTheKey) {
   };
   std::string m = message("scenarios/hover.yaml", {{"stack.controller", "assembly"}});
   EXPECT_NE(m.find("controller assembly flies an assembly"), std::string::npos) << m;
+  // Found by generating flights (tests/fuzz): INDI on an assembly passed validate, then failed the run.
+  m = message("scenarios/mars_plan_3x2.yaml", {{"stack.controller", "indi"}});
+  EXPECT_NE(m.find("stack.controller: controller indi is for a quadrotor, and the vehicle has 24 rotors"),
+            std::string::npos)
+      << m;
   m = message("scenarios/mars_spiral_3x2.yaml", {{"stack.assembly.reallocation", "hybrid"}});
   EXPECT_NE(m.find("stack.assembly.reallocation"), std::string::npos) << m;
   m = message("scenarios/mars_spiral_3x2.yaml", {{"stack.known_faults.0.loss", "1.5"}});

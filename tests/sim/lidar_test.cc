@@ -1,15 +1,17 @@
 
+#include "rotorguard/sim/lidar.h"
+
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <numbers>
 #include <set>
 
-#include <gtest/gtest.h>
-
-#include "rotorguard/core/error.h"
-#include "rotorguard/sim/lidar.h"
 #include "room_fixture.h"
+#include "rotorguard/core/error.h"
+#include "test_util.h"
 
 namespace rotorguard::sim {
 namespace {
@@ -137,6 +139,19 @@ TEST(LidarSimulator, CountsPulsesWithoutReturnAndDropouts) {
   const std::vector<LidarFrame> lossy_frames = Fly(&lossy, 0.25, hover);
   EXPECT_NEAR(lossy_frames[0].points_S.size() / 20000.0, below * 0.7, 0.01);
   EXPECT_EQ(static_cast<int>(lossy_frames[0].points_S.size()) + lossy_frames[0].dropped, 20000);
+}
+
+// Found by generating flights (tests/fuzz): 4.9e-324 points per second put the second pulse at
+// +inf s, whose integer time came out negative, and the simulator never left its first step. Such
+// rates are refused now (and a pulse time beyond the range of TimeNs saturates).
+TEST(LidarOptions, APulseRateTooSlowToTimeIsRefused) {
+  LidarOptions o;
+  o.enabled = true;
+  o.points_per_s = 4.9e-324;
+  RG_EXPECT_THROW_WITH(o.Validate(), rotorguard::ValidationError, "points_per_s");
+  EXPECT_THROW(LidarSimulator(o, World{}, 1), rotorguard::ValidationError);
+  o.points_per_s = 1.0;
+  EXPECT_NO_THROW(o.Validate());
 }
 
 TEST(LidarSimulator, RangeNoiseHasTheConfiguredSpread) {

@@ -24,7 +24,7 @@ namespace rotorguard::sim {
 struct LidarOptions {
   bool enabled = false;             ///< off by default: ray casting costs time
   double frame_rate_hz = 10.0;      ///< frames per second, in [kMinRateHz, 1000]
-  double points_per_s = 200000.0;   ///< pulses per second, > 0
+  double points_per_s = 200000.0;   ///< pulses per second, in [1, 1e7]
   double min_range_m = 0.1;         ///< closer returns are dropped, >= 0
   double max_range_m = 40.0;        ///< > min_range_m
   double min_elevation_rad = -0.12217304763960307;  ///< -7 degrees, in [-pi/2, max)
@@ -42,7 +42,7 @@ struct LidarOptions {
              {.meaning = "a lidar block switches the sensor on unless this says false", .default_text = "true"});
     a->Visit("frame_rate_hz", &frame_rate_hz, {.meaning = "frames per second", .min = kMinRateHz, .max = 1000.0});
     // Every pulse is cast: ten million a simulated second is twice the densest scanning LiDAR's.
-    a->Visit("points_per_s", &points_per_s, {.meaning = "pulses per second", .max = 1e7, .positive = true});
+    a->Visit("points_per_s", &points_per_s, {.meaning = "pulses per second", .min = 1.0, .max = 1e7});
     a->Visit("min_range_m", &min_range_m,
              {.meaning = "closer returns are dropped [m], below max_range_m", .min = 0.0, .max = 100.0});
     a->Visit("max_range_m", &max_range_m, {.meaning = "[m]", .max = 1e4, .positive = true});
