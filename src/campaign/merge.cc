@@ -178,15 +178,15 @@ std::vector<nlohmann::json> ReadCampaignRecords(const std::vector<std::string>& 
     }
   }
   const int total = manifests.front()["trials_total"].get<int>();
-  // Counted, not listed: a damaged manifest's trials_total must not cost its size in memory.
-  std::vector<int> first;
-  int missing = 0;
-  for (int i = 0; i < total; ++i) {
-    if (trials.count(i)) continue;
-    ++missing;
-    if (first.size() < 10) first.push_back(i);
-  }
+  // Counted from the recorded trials, not by walking [0, total): a damaged manifest's trials_total
+  // must cost neither its size in memory nor its count in lookups.
+  const auto recorded = std::distance(trials.lower_bound(0), trials.lower_bound(total));
+  const std::int64_t missing = total - recorded;
   if (missing > 0) {
+    std::vector<int> first;  // at most trials.size() + 10 lookups
+    for (int i = 0; i < total && first.size() < 10; ++i) {
+      if (!trials.count(i)) first.push_back(i);
+    }
     throw std::invalid_argument(
         fmt::format("campaign merge: {} of {} trials are missing (first: {}); run or resume "
                     "the shards that hold them",

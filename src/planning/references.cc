@@ -78,7 +78,15 @@ constexpr char kLemniscate[] = "LemniscateOptions";
 constexpr char kCircle[] = "CircleOptions";
 constexpr char kWaypoint[] = "WaypointOptions";
 
-double LemniscatePhaseRate(const LemniscateOptions& o);
+/// Omega such that the fastest point of the curve moves at max_speed. With
+///   c'(theta) = [sx/2 cos(theta), sy cos(2 theta), sz/2 cos(theta)],
+///   |c'|^2 = (sx^2/4 + sz^2/4) cos^2(theta) + sy^2 cos^2(2 theta),
+/// both terms are at most their coefficient and reach it together at theta = 0 (the centre
+/// crossing), so max |c'| = sqrt(sx^2/4 + sz^2/4 + sy^2) and speed = |c'| Omega.
+double LemniscatePhaseRate(const LemniscateOptions& o) {
+  const double max_dc = std::sqrt(0.25 * (o.size_x_m * o.size_x_m + o.size_z_m * o.size_z_m) + o.size_y_m * o.size_y_m);
+  return o.max_speed_m_s / max_dc;
+}
 
 const LemniscateOptions& Validated(const LemniscateOptions& o) {
   RequireFinite(kLemniscate, "center_m", o.center_m);
@@ -95,17 +103,6 @@ const LemniscateOptions& Validated(const LemniscateOptions& o) {
                     fmt::format("a size at which max_speed_m_s = {} gives a finite phase rate", o.max_speed_m_s));
   }
   return o;
-}
-
-/// Omega such that the fastest point of the curve moves at max_speed. With
-///   c'(theta) = [sx/2 cos(theta), sy cos(2 theta), sz/2 cos(theta)],
-///   |c'|^2 = (sx^2/4 + sz^2/4) cos^2(theta) + sy^2 cos^2(2 theta),
-/// both terms are at most their coefficient and reach it together at theta = 0 (the centre
-/// crossing), so max |c'| = sqrt(sx^2/4 + sz^2/4 + sy^2) and speed = |c'| Omega.
-double LemniscatePhaseRate(const LemniscateOptions& o) {
-  const double max_dc = std::sqrt(0.25 * (o.size_x_m * o.size_x_m + o.size_z_m * o.size_z_m) +
-                                  o.size_y_m * o.size_y_m);
-  return o.max_speed_m_s / max_dc;
 }
 
 const CircleOptions& Validated(const CircleOptions& o) {

@@ -1,7 +1,6 @@
 #include "rotorguard/sim/lidar.h"
 
 #include <cmath>
-#include <limits>
 #include <numbers>
 
 #include "rotorguard/core/error.h"
@@ -53,8 +52,7 @@ LidarSimulator::LidarSimulator(const LidarOptions& options, const World& world, 
 TimeNs LidarSimulator::PulseTime(std::uint64_t k) const {
   // Saturated: a pulse beyond the range of TimeNs never comes (found by generating flights: 4.9e-324
   // points per second made the second pulse's time +inf, its integer negative, and Step() loop).
-  const double ns = static_cast<double>(k) * 1e9 / options_.points_per_s;
-  return ns < 0x1p63 ? static_cast<TimeNs>(std::llround(ns)) : std::numeric_limits<TimeNs>::max();
+  return SaturatedNs(std::round(static_cast<double>(k) * 1e9 / options_.points_per_s));
 }
 
 std::optional<LidarFrame> LidarSimulator::Step(TimeNs t0, const BodyPose& pose0, TimeNs t1, const BodyPose& pose1) {

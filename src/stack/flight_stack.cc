@@ -45,10 +45,6 @@ void NavigationOptions::Validate() const {
     }
   }
   if (rounds < 1) ThrowValidation("FlightStackOptions", "navigation.rounds", rounds, ">= 1");
-  if (!(planner_rate_hz >= kMinRateHz)) {
-    ThrowValidation("FlightStackOptions", "navigation.planner_rate_hz", planner_rate_hz,
-                    fmt::format("a rate in [{:g}, control_rate_hz]", kMinRateHz));
-  }
   // stack.planner's keys, the replanner's among them (ReplannerOptions checks its own without
   // their upper ends).
   CheckDeclaredRanges("NavigationOptions", *this);

@@ -11,7 +11,7 @@
 //   - an output is half-written (a temporary file left, report.html cut short) or unreadable
 //     (summary.json, log.csv, sensors.csv read back as `report` and `fdd-calibrate` read them);
 //   - a number in summary.json or in the report's data is not finite.
-// The findings' scenarios are kept as flight-finding-N.yaml; the exit code is 1 when there is one.
+// The findings' scenarios are kept as flight-finding-SEED-N.yaml; the exit code is 1 when there is one.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -25,7 +25,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 #include <thread>
@@ -44,7 +43,10 @@ namespace {
 namespace fs = std::filesystem;
 using rotorguard::io::KeyRow;
 
-constexpr double kBudgetPerSimulatedSecond = 100.0;  // the wall-clock bound of docs/reliability.md
+constexpr double kBudgetPerSimulatedSecond = 100.0;
+constexpr const char* kUsage =
+    "usage: rotorguard_flight_fuzz [--flights N] [--seed S] [--jobs J in [1, 64]]\n";  // the wall-clock bound of
+                                                                                       // docs/reliability.md
 
 // A key that can be set: its full dotted path ("stack.nmpc.horizon_steps", "world.boxes[].size_m")
 // and its declaration.
@@ -118,8 +120,9 @@ class Generator {
   std::mt19937_64 rng_;
 };
 
-// The node at `path` below `root` ("a.b[].c"), made where MayCreate allows; a list's item is one
-// of its items, drawn. Null when the path does not exist and may not be made.
+// The map holding the key at `path` below `root` ("a.b[].c") and the key's name: blocks on the way
+// are made where MayCreate allows, and a list's item is one of its items, drawn. False when the
+// path does not exist and may not be made.
 bool Resolve(YAML::Node root, const std::string& path, Generator* g, YAML::Node* parent, std::string* leaf) {
   YAML::Node node = root;
   std::string walked;
@@ -221,9 +224,52 @@ struct Flight {
   pid_t pid = -1;
 };
 
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+// Scenario `index`: drawn from a base of configs/scenarios, written into the scratch folder.
+Flight DrawFlight(int index, const std::vector<std::string>& bases, const std::vector<Key>& keys,
+                  const fs::path& scratch, Generator* g) {
+  Flight f;
+  f.index = index;
+  f.base = bases[g->Below(bases.size())];
+  YAML::Node root = YAML::LoadFile((scratch / "scenarios" / f.base).string());
+  f.duration_s = g->Uniform(1.0, 3.0);
+  root["duration_s"] = f.duration_s;
+  root["seed"] = static_cast<std::uint64_t>(g->rng()() >> 1);
+  const std::string mission = root["mission"]["type"] ? root["mission"]["type"].as<std::string>() : "";
+  const int changes = 1 + static_cast<int>(g->Below(8));
+  for (int c = 0; c < changes; ++c) {
+    const Key& k = keys[g->Below(keys.size())];
+    if (!k.mission_type.empty() && k.mission_type != mission) continue;
+    YAML::Node parent;
+    std::string leaf;
+    if (!Resolve(root, k.path, g, &parent, &leaf)) continue;
+    YAML::Node value = Value(k, parent[leaf], f.duration_s, g);
+    if (value.IsDefined() && !value.IsNull()) parent[leaf] = value;
+  }
+  MutateFaults(root, f.duration_s, g);
+  // Windows inside the flight (the metrics' keys are bounded by duration_s).
+  for (const char* key : {"tracking_start_s", "tracking_end_s", "success_hold_s"}) {
+    if (root["metrics"][key] && root["metrics"][key].as<double>() > f.duration_s) root["metrics"][key] = f.duration_s;
+  }
+  f.scenario = (scratch / "scenarios" / ("generated-" + std::to_string(f.index) + ".yaml")).string();
+  YAML::Emitter emitter;
+  emitter.SetDoublePrecision(17);
+  emitter << root;
+  std::ofstream(f.scenario) << emitter.c_str() << "\n";
+  return f;
+}
+
+// Starts `rotorguard run` on the flight's scenario, its output silenced.
+void Launch(Flight* f) {
+  f->start = std::chrono::steady_clock::now();
+  f->pid = fork();
+  if (f->pid == 0) {
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, STDOUT_FILENO);
+    dup2(null, STDERR_FILENO);
+    execl(ROTORGUARD_CLI, ROTORGUARD_CLI, "run", f->scenario.c_str(), "--out", f->out_dir.c_str(), "-q",
+          static_cast<char*>(nullptr));
+    _exit(127);  // exec failed
+  }
 }
 
 // What is wrong with a finished flight's outputs, or empty.
@@ -237,17 +283,13 @@ std::string CheckOutputs(const Flight& f, int code) {
   const fs::path dir(f.out_dir);
   if (code == 4 && !fs::exists(dir / "summary.json")) return "";
   try {
-    const nlohmann::json summary = nlohmann::json::parse(ReadText((dir / "summary.json").string()));
-    rotorguard::fuzz::RequireFinite(summary, f.scenario, "summary.json");
+    // The report's data holds summary.json and scene.json whole, and log.csv's columns.
     const rotorguard::record::FlightLog log = rotorguard::record::ReadFlightLog(f.out_dir);
     rotorguard::fuzz::RequireFinite(rotorguard::record::FlightReportData(log), f.scenario, "report data");
-    if (fs::exists(dir / "vehicle.yaml")) {
-      const rotorguard::benchmarks::CalibrationLog c = rotorguard::benchmarks::LoadCalibrationLog(f.out_dir);
-      (void)c;
-    }
-    if (fs::exists(dir / "report.html")) {
-      const std::string page = ReadText((dir / "report.html").string());
-      if (page.find("</html>") == std::string::npos) return "report.html is cut short";
+    if (fs::exists(dir / "vehicle.yaml")) (void)rotorguard::benchmarks::LoadCalibrationLog(f.out_dir);  // sensors.csv
+    if (fs::exists(dir / "report.html") &&
+        rotorguard::io::ReadInputFile((dir / "report.html").string()).find("</html>") == std::string::npos) {
+      return "report.html is cut short";
     }
   } catch (const std::exception& e) {
     return std::string("an output cannot be read back: ") + e.what();
@@ -265,12 +307,12 @@ int main(int argc, char** argv) {
     char* end = nullptr;
     if (v == nullptr || (*v = std::strtoull(argv[i + 1], &end, 10), *end != '\0') ||
         (v == &jobs && (jobs < 1 || jobs > 64))) {
-      std::fprintf(stderr, "usage: rotorguard_flight_fuzz [--flights N] [--seed S] [--jobs J in [1, 64]]\n");
+      std::fputs(kUsage, stderr);
       return 2;
     }
   }
   if (argc % 2 == 0) {
-    std::fprintf(stderr, "usage: rotorguard_flight_fuzz [--flights N] [--seed S] [--jobs J in [1, 64]]\n");
+    std::fputs(kUsage, stderr);
     return 2;
   }
   const fs::path scratch(rotorguard::fuzz::ScratchFolder());
@@ -290,7 +332,7 @@ int main(int argc, char** argv) {
 
   const auto finding = [&](const Flight& f, const std::string& what) {
     ++findings;
-    const std::string keep = "flight-finding-" + std::to_string(f.index) + ".yaml";
+    const std::string keep = "flight-finding-" + std::to_string(seed) + "-" + std::to_string(f.index) + ".yaml";
     fs::copy_file(f.scenario, keep, fs::copy_options::overwrite_existing);
     std::fprintf(stderr, "FINDING (flight %d from %s, kept as %s): %s\n", f.index, f.base.c_str(), keep.c_str(),
                  what.c_str());
@@ -304,37 +346,7 @@ int main(int argc, char** argv) {
                      generated - flown, generated);
         return 1;
       }
-      Flight f;
-      f.index = generated++;
-      f.base = bases[g.Below(bases.size())];
-      YAML::Node root = YAML::LoadFile((scratch / "scenarios" / f.base).string());
-      f.duration_s = g.Uniform(1.0, 3.0);
-      root["duration_s"] = f.duration_s;
-      root["seed"] = static_cast<std::uint64_t>(g.rng()() >> 1);
-      const std::string mission = root["mission"]["type"] ? root["mission"]["type"].as<std::string>() : "";
-      const int changes = 1 + static_cast<int>(g.Below(8));
-      for (int c = 0; c < changes; ++c) {
-        const Key& k = keys[g.Below(keys.size())];
-        if (!k.mission_type.empty() && k.mission_type != mission) continue;
-        YAML::Node parent;
-        std::string leaf;
-        if (!Resolve(root, k.path, &g, &parent, &leaf)) continue;
-        YAML::Node value = Value(k, parent[leaf], f.duration_s, &g);
-        if (value.IsDefined() && !value.IsNull()) parent[leaf] = value;
-      }
-      MutateFaults(root, f.duration_s, &g);
-      // Windows inside the flight (the metrics' keys are bounded by duration_s).
-      for (const char* key : {"tracking_start_s", "tracking_end_s", "success_hold_s"}) {
-        if (root["metrics"][key] && root["metrics"][key].as<double>() > f.duration_s)
-          root["metrics"][key] = f.duration_s;
-      }
-      f.scenario = (scratch / "scenarios" / ("generated-" + std::to_string(f.index) + ".yaml")).string();
-      {
-        YAML::Emitter emitter;
-        emitter.SetDoublePrecision(17);
-        emitter << root;
-        std::ofstream(f.scenario) << emitter.c_str() << "\n";
-      }
+      Flight f = DrawFlight(generated++, bases, keys, scratch, &g);
       try {
         rotorguard::benchmarks::ValidateConfigFile(f.scenario);
       } catch (const rotorguard::io::ConfigError& e) {
@@ -347,16 +359,7 @@ int main(int argc, char** argv) {
       }
       ++flown;
       f.out_dir = (scratch / ("out-" + std::to_string(f.index))).string();
-      f.start = std::chrono::steady_clock::now();
-      f.pid = fork();
-      if (f.pid == 0) {
-        const int null = open("/dev/null", O_WRONLY);
-        dup2(null, STDOUT_FILENO);
-        dup2(null, STDERR_FILENO);
-        execl(ROTORGUARD_CLI, ROTORGUARD_CLI, "run", f.scenario.c_str(), "--out", f.out_dir.c_str(), "-q",
-              static_cast<char*>(nullptr));
-        _exit(127);
-      }
+      Launch(&f);
       running.push_back(f);
     }
     // Reap and check the finished ones; stop those past their budget.

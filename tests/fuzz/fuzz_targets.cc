@@ -28,34 +28,36 @@ namespace fs = std::filesystem;
   std::abort();
 }
 
-// The scratch folder: configs/ and the corpus fixtures copied, removed when the process exits.
-const fs::path& Scratch() {
-  static const fs::path root = [] {
-    const char* tmp = std::getenv("TMPDIR");
-    std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/rotorguard-fuzz-XXXXXX";
-    if (mkdtemp(pattern.data()) == nullptr) {
-      std::perror("rotorguard fuzz: cannot make a scratch folder");
-      std::exit(2);
-    }
-    const fs::path dir(pattern);
-    const fs::path source(ROTORGUARD_SOURCE_DIR);
-    for (const char* sub : {"scenarios", "vehicles", "assemblies", "campaigns"}) {
-      fs::copy(source / "configs" / sub, dir / sub, fs::copy_options::recursive);
-    }
-    for (const char* sub : {"run", "mcap", "campaign"}) {
-      fs::copy(source / "tests/fuzz/corpus" / sub, dir / sub, fs::copy_options::recursive);
-    }
-    fs::create_directories(dir / "input");
-    std::atexit([] {
-      std::error_code ec;
-      fs::remove_all(Scratch(), ec);
-    });
-    return dir;
-  }();
-  return root;
+// Every number of an IndexExtremes is finite, or a finding.
+void RequireFiniteExtremes(const fdd::IndexExtremes& extremes, const std::string& input) {
+  for (const auto& [name, field] : fdd::kIndexExtremesFields) {
+    if (!std::isfinite(extremes.*field)) Finding(input, "a non-finite extreme " + std::string(name));
+  }
 }
 
+// An input read by two commands is accepted when both accept it.
+Outcome Both(Outcome a, Outcome b) {
+  return a == Outcome::kAccepted && b == Outcome::kAccepted ? Outcome::kAccepted : Outcome::kRefused;
+}
+
+const fs::path kCorpus = fs::path(ROTORGUARD_SOURCE_DIR) / "tests/fuzz/corpus";
+
 }  // namespace
+
+const std::string& ScratchFolder() {
+  static const io::TemporaryFolder folder("rotorguard-fuzz");  // removed when the process exits normally
+  static const bool filled = [] {
+    const fs::path dir(folder.path());
+    for (const char* sub : {"scenarios", "vehicles", "assemblies", "campaigns"}) {
+      fs::copy(fs::path(ROTORGUARD_SOURCE_DIR) / "configs" / sub, dir / sub, fs::copy_options::recursive);
+    }
+    for (const char* sub : {"run", "mcap", "campaign"}) fs::copy(kCorpus / sub, dir / sub, fs::copy_options::recursive);
+    fs::create_directories(dir / "input");
+    return true;
+  }();
+  (void)filled;
+  return folder.path();
+}
 
 void RequireFinite(const nlohmann::json& j, const std::string& input, const std::string& where) {
   if (j.is_number_float() && !std::isfinite(j.get<double>())) {
@@ -66,11 +68,6 @@ void RequireFinite(const nlohmann::json& j, const std::string& input, const std:
   } else if (j.is_array()) {
     for (std::size_t i = 0; i < j.size(); ++i) RequireFinite(j[i], input, where + "/" + std::to_string(i));
   }
-}
-
-const std::string& ScratchFolder() {
-  static const std::string text = Scratch().string();
-  return text;
 }
 
 namespace {
@@ -106,7 +103,7 @@ Outcome Guarded(const std::string& input, const std::string& names, F&& read,
 // `rotorguard validate`: any config file, its kind recognised from its keys. A refusal may name the
 // file it references (a scenario's vehicle), so it must name the scratch folder.
 Outcome ValidateConfig(const std::string& path) {
-  return Guarded(path, Scratch().string(), [&] {
+  return Guarded(path, ScratchFolder(), [&] {
     const benchmarks::ValidationReport r = benchmarks::ValidateConfigFile(path);
     if (r.kind.empty() || r.summary.empty()) Finding(path, "an accepted file without a kind or summary");
   });
@@ -129,18 +126,12 @@ Outcome ReplayRun(const std::string& path) {
     const benchmarks::CalibrationLog log = benchmarks::LoadCalibrationLog(dir);
     const benchmarks::ReplayOutcome outcome =
         benchmarks::ReplayCompositeFdd(log, benchmarks::RecordedFddOptions({log}, nullptr));
-    for (const auto& [name, field] : fdd::kIndexExtremesFields) {
-      if (!std::isfinite(outcome.extremes.*field)) Finding(path, "a non-finite extreme " + std::string(name));
-    }
+    RequireFiniteExtremes(outcome.extremes, path);
   });
 }
 
 // A run's summary.json is read by both.
-Outcome ReadAndReplayRun(const std::string& path) {
-  const Outcome read = ReadRun(path);
-  const Outcome replayed = ReplayRun(path);
-  return read == Outcome::kAccepted && replayed == Outcome::kAccepted ? Outcome::kAccepted : Outcome::kRefused;
-}
+Outcome ReadAndReplayRun(const std::string& path) { return Both(ReadRun(path), ReplayRun(path)); }
 
 // `campaign merge DIR` and `fdd-calibrate --healthy DIR`: a campaign's results. Shards that do not
 // form one whole campaign (a trial missing or twice, two specs) are the command line's fault, which
@@ -155,7 +146,8 @@ Outcome ReadCampaign(const std::string& path) {
   const Outcome merged = Guarded(
       path, dir,
       [&] {
-        RequireFinite(campaign::MergeCampaign({dir}, (Scratch() / "merged").string(), benchmarks::CampaignKinds()),
+        RequireFinite(campaign::MergeCampaign({dir}, (fs::path(ScratchFolder()) / "merged").string(),
+                                              benchmarks::CampaignKinds()),
                       path, "merged summary");
       },
       IsMergeUsageError);
@@ -163,13 +155,11 @@ Outcome ReadCampaign(const std::string& path) {
       path, dir,
       [&] {
         for (const benchmarks::FlightExtremes& f : benchmarks::LoadCampaignFlights(dir).flights) {
-          for (const auto& [name, field] : fdd::kIndexExtremesFields) {
-            if (!std::isfinite(f.extremes.*field)) Finding(path, "a non-finite extreme " + std::string(name));
-          }
+          RequireFiniteExtremes(f.extremes, path);
         }
       },
       IsMergeUsageError);
-  return merged == Outcome::kAccepted && flights == Outcome::kAccepted ? Outcome::kAccepted : Outcome::kRefused;
+  return Both(merged, flights);
 }
 
 }  // namespace
@@ -181,35 +171,27 @@ const std::vector<Target>& Targets() {
        {"configs", "tests/fuzz/corpus/run/vehicle.yaml"},
        "rotorguard validate: scenario, vehicle, assembly, campaign spec, FDD thresholds",
        ValidateConfig},
-      {"log_csv", "run/log.csv", {"tests/fuzz/corpus/run/log.csv"}, "rotorguard report: a run's log.csv", ReadRun},
-      {"scene_json",
-       "run/scene.json",
-       {"tests/fuzz/corpus/run/scene.json"},
-       "rotorguard report: a run's scene.json",
-       ReadRun},
+      {"log_csv", "run/log.csv", {}, "rotorguard report: a run's log.csv", ReadRun},
+      {"scene_json", "run/scene.json", {}, "rotorguard report: a run's scene.json", ReadRun},
       {"summary_json",
        "run/summary.json",
-       {"tests/fuzz/corpus/run/summary.json"},
+       {},
        "rotorguard report and fdd-calibrate: a run's summary.json",
        ReadAndReplayRun},
       {"sensors_csv",
        "run/sensors.csv",
-       {"tests/fuzz/corpus/run/sensors.csv"},
+       {},
        "rotorguard fdd-calibrate: a run's sensors.csv, replayed through the composite FDD",
        ReplayRun},
-      {"flight_mcap",
-       "mcap/flight.mcap",
-       {"tests/fuzz/corpus/mcap/flight.mcap"},
-       "rotorguard report: a run's flight.mcap",
-       ReadRun},
+      {"flight_mcap", "mcap/flight.mcap", {}, "rotorguard report: a run's flight.mcap", ReadRun},
       {"results_jsonl",
        "campaign/results.jsonl",
-       {"tests/fuzz/corpus/campaign/results.jsonl"},
+       {},
        "rotorguard campaign merge and fdd-calibrate --healthy: a campaign's results.jsonl",
        ReadCampaign},
       {"manifest_json",
        "campaign/manifest.json",
-       {"tests/fuzz/corpus/campaign/manifest.json"},
+       {},
        "rotorguard campaign merge and fdd-calibrate --healthy: a campaign's manifest.json",
        ReadCampaign},
   };
@@ -224,7 +206,7 @@ const Target* FindTarget(std::string_view name) {
 }
 
 Outcome RunOne(const Target& target, std::string_view bytes) {
-  const std::string path = (Scratch() / target.file).string();
+  const std::string path = (fs::path(ScratchFolder()) / target.file).string();
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -240,6 +222,7 @@ std::vector<std::string> SeedFiles(const Target& target) {
   const fs::path source(ROTORGUARD_SOURCE_DIR);
   const std::string extension = fs::path(target.file).extension().string();
   std::vector<std::string> files;
+  if (fs::is_regular_file(kCorpus / target.file)) files.push_back((kCorpus / target.file).string());
   for (std::string_view seed : target.seeds) {
     const fs::path p = source / seed;
     if (fs::is_directory(p)) {

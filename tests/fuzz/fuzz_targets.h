@@ -26,8 +26,8 @@ struct Target {
   /// The file the input replaces, relative to the scratch folder; its name is what a refusal must
   /// name.
   std::string_view file;
-  /// The seeds, relative to the source tree: files, or folders searched for files with the
-  /// target's extension.
+  /// Seeds beyond the fixture's own file (tests/fuzz/corpus/`file`, when there is one), relative
+  /// to the source tree: files, or folders searched for files with the target's extension.
   std::vector<std::string_view> seeds;
   std::string_view what;  ///< the reader it exercises, for --help
   Outcome (*run)(const std::string& path);
@@ -43,14 +43,15 @@ const Target* FindTarget(std::string_view name);
 /// and runs the target on it. A finding aborts.
 Outcome RunOne(const Target& target, std::string_view bytes);
 
-/// The scratch folder (made on first use with configs/ and the fixtures copied in, removed at exit).
+/// The scratch folder (an io::TemporaryFolder made on first use with configs/ and the fixtures
+/// copied in).
 const std::string& ScratchFolder();
 
 /// The finite-number check of the targets: a finding naming `where` (a JSON pointer below it) and
 /// `input` when a number of `j` is not finite.
 void RequireFinite(const nlohmann::json& j, const std::string& input, const std::string& where);
 
-/// The seed files of a target: its `seeds` resolved in the source tree, sorted.
+/// The seed files of a target: its fixture file, then its `seeds` resolved in the source tree, sorted.
 std::vector<std::string> SeedFiles(const Target& target);
 
 }  // namespace rotorguard::fuzz

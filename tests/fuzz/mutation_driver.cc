@@ -14,7 +14,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <random>
 #include <string>
@@ -22,6 +21,7 @@
 #include <vector>
 
 #include "fuzz_targets.h"
+#include "rotorguard/io/config_node.h"
 
 namespace {
 
@@ -194,13 +194,14 @@ class Mutator {
   const std::vector<std::string>* seeds_;
 };
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::fprintf(stderr, "rotorguard_fuzz: cannot read the seed %s\n", path.c_str());
+// A seed or an --input file; the program stops (exit 2) when it cannot be read.
+std::string ReadInput(const std::string& path) {
+  try {
+    return rotorguard::io::ReadInputFile(path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rotorguard_fuzz: %s\n", e.what());
     std::exit(2);
   }
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 bool ParseCount(const char* text, std::uint64_t* out) {
@@ -231,7 +232,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (args.size() == 3 && args[1] == "--input") {
-    const Outcome outcome = rotorguard::fuzz::RunOne(*target, ReadAll(args[2]));
+    const Outcome outcome = rotorguard::fuzz::RunOne(*target, ReadInput(args[2]));
     std::printf("%s: %s\n", args[2].c_str(), outcome == Outcome::kAccepted ? "accepted" : "refused");
     return 0;
   }
@@ -256,8 +257,9 @@ int main(int argc, char** argv) {
   for (int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL}) signal(sig, OnCrash);
   signal(SIGALRM, OnTimeout);
 
+  const std::vector<std::string> seed_files = rotorguard::fuzz::SeedFiles(*target);
   std::vector<std::string> seeds;
-  for (const std::string& path : rotorguard::fuzz::SeedFiles(*target)) seeds.push_back(ReadAll(path));
+  for (const std::string& path : seed_files) seeds.push_back(ReadInput(path));
   if (seeds.empty()) {
     std::fprintf(stderr, "rotorguard_fuzz: the target %s has no seed\n", args[0].c_str());
     return 2;
@@ -272,7 +274,7 @@ int main(int argc, char** argv) {
   for (std::size_t i = 0; i < seeds.size(); ++i) {
     if (run(seeds[i]) != Outcome::kAccepted) {
       std::fprintf(stderr, "rotorguard_fuzz: the seed %s of %s is refused: its mutants would test nothing\n",
-                   rotorguard::fuzz::SeedFiles(*target)[i].c_str(), args[0].c_str());
+                   seed_files[i].c_str(), args[0].c_str());
       return 1;
     }
   }

@@ -330,7 +330,7 @@ TEST_F(ScenarioLoader, AnAbsurdSpeedLimitIsRejectedWithItsRange) {
 std::vector<std::string> UnboundedNumericKeys(const std::vector<io::KeyRow>& rows, const std::string& prefix) {
   std::vector<std::string> unbounded;
   for (const io::KeyRow& r : rows) {
-    if (!r.numeric) continue;
+    if (!r.numeric()) continue;
     std::string rule = r.rule;
     if (const std::string required = "**required**, "; rule.starts_with(required)) rule.erase(0, required.size());
     const bool bare = rule == "a number" || rule == "> 0" || rule == "≥ 0" || rule == "an integer";
@@ -348,7 +348,7 @@ TEST(ScenarioDocs, EveryNumericKeyHasABoundedRange) {
   for (const KeyTableSection& section : ScenarioKeySections()) {
     const std::vector<std::string> more = UnboundedNumericKeys(section.rows, section.prefix);
     unbounded.insert(unbounded.end(), more.begin(), more.end());
-    for (const io::KeyRow& r : section.rows) numeric += r.numeric ? 1 : 0;
+    for (const io::KeyRow& r : section.rows) numeric += r.numeric() ? 1 : 0;
   }
   EXPECT_GT(numeric, 150u) << "the walk must see the numeric keys";
   std::string list;

@@ -364,7 +364,7 @@ TEST(KeyTable, RulesStateTheRangesAndNumbersAreMarked) {
   std::vector<std::string> rules, numeric;
   for (const KeyRow& r : table.rows()) {
     rules.push_back(r.rule);
-    if (r.numeric) numeric.push_back(r.key);
+    if (r.numeric()) numeric.push_back(r.key);
   }
   EXPECT_EQ(rules,
             (std::vector<std::string>{"in (0, 50]", "[x, y, z], each in [-10, 10]", "two numbers, each in [0, 5]",

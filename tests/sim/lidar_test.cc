@@ -143,7 +143,7 @@ TEST(LidarSimulator, CountsPulsesWithoutReturnAndDropouts) {
 
 // Found by generating flights (tests/fuzz): 4.9e-324 points per second put the second pulse at
 // +inf s, whose integer time came out negative, and the simulator never left its first step. Such
-// rates are refused now (and a pulse time beyond the range of TimeNs saturates).
+// rates are refused now; pulse times saturate as FromSeconds does (SaturatedNs, tested with RateTimer).
 TEST(LidarOptions, APulseRateTooSlowToTimeIsRefused) {
   LidarOptions o;
   o.enabled = true;

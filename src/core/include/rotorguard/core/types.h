@@ -3,6 +3,7 @@
 /// control path) and integer simulation time.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -27,14 +28,15 @@ using AllocationMatrix = Eigen::Matrix<double, Eigen::Dynamic, 4, 0, kMaxRotors,
 using TimeNs = std::int64_t;
 inline constexpr TimeNs kNanosPerSecond = 1'000'000'000;
 inline constexpr double ToSeconds(TimeNs t) { return static_cast<double>(t) * 1e-9; }
-/// Rounds to the nearest nanosecond; beyond the range of TimeNs (about ±292 years) it saturates
-/// (and NaN counts as "never"): converting such a double to an integer would be undefined.
-inline TimeNs FromSeconds(double s) {
-  const double ns = s * 1e9 + (s >= 0 ? 0.5 : -0.5);
+/// A time in nanoseconds, already rounded, as TimeNs: beyond its range (about ±292 years) it
+/// saturates, and NaN counts as "never", as converting such a double to an integer is undefined.
+inline TimeNs SaturatedNs(double ns) {
   if (!(ns < 0x1p63)) return std::numeric_limits<TimeNs>::max();
   if (!(ns >= -0x1p63)) return std::numeric_limits<TimeNs>::min();
   return static_cast<TimeNs>(ns);
 }
+/// Rounds to the nearest nanosecond (SaturatedNs beyond the range).
+inline TimeNs FromSeconds(double s) { return SaturatedNs(std::trunc(s * 1e9 + (s >= 0 ? 0.5 : -0.5))); }
 /// Period in nanoseconds of a rate in Hz, rounded to the nearest nanosecond.
 inline TimeNs PeriodFromRate(double rate_hz) { return FromSeconds(1.0 / rate_hz); }
 

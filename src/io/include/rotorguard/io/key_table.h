@@ -25,8 +25,6 @@ struct KeyRow {
   bool value_is_prose = false;  ///< ... or in words (a default that depends on other keys)
   std::string rule;             ///< what it accepts
   std::string meaning;
-  /// A number or numbers (a vector, an angle, a count): the rule is to state their range.
-  bool numeric = false;
   /// What a program that writes values needs (the valid-scenario generator, docs/reliability.md):
   /// a number's declared range (min, max, positive, open_max of its KeyInfo) ...
   KeyInfo range;
@@ -36,6 +34,9 @@ struct KeyRow {
   bool integer = false;
   /// ... or the names an enum (or a bool: true, false) takes.
   std::vector<std::string> choices;
+
+  /// A number or numbers (a vector, an angle, a count): the rule is to state their range.
+  bool numeric() const { return count != 0; }
 };
 
 /// Collects a struct's rows: `value.Serialize(&writer)`, nested blocks and lists of blocks
@@ -49,7 +50,7 @@ class KeyTableWriter {
     const std::string path = prefix_ + key;
     if constexpr (requires { value->Serialize(this); }) {
       if (info.shorthand != nullptr) {
-        Add(path, "", fmt::format("a map, or the value of `{}` alone", info.shorthand), info.meaning);
+        Add(path, "", fmt::format("a map, or the value of `{}` alone", info.shorthand), info);
       }
       KeyTableWriter nested(path + ".");
       value->Serialize(&nested);
@@ -57,18 +58,16 @@ class KeyTableWriter {
     } else if constexpr (IsBlockList<T>::value) {
       std::string rule = info.min >= 1.0 ? "a non-empty list of maps" : "a list of maps";
       if (info.required) rule = "**required**, " + rule;
-      Add(path, info.required ? "" : "none", info.rule_text ? info.rule_text : rule, info.meaning);
+      Add(path, info.required ? "" : "none", info.rule_text ? info.rule_text : rule, info);
       typename T::value_type item{};
       KeyTableWriter nested(path + "[].");
       item.Serialize(&nested);
       rows_.insert(rows_.end(), nested.rows_.begin(), nested.rows_.end());
     } else {
       // A required key has no default to show.
-      Add(path, info.required ? "" : (info.default_text ? info.default_text : Text(*value)), RuleOf(*value, info),
-          info.meaning, info.default_text != nullptr, IsNumeric<T>());
+      Add(path, info.required ? "" : (info.default_text ? info.default_text : Text(*value)), RuleOf(*value, info), info,
+          CountOf<T>(), info.default_text != nullptr);
       KeyRow& row = rows_.back();
-      row.range = info;
-      row.count = CountOf<T>();
       row.integer = std::is_integral_v<T> && !std::is_same_v<T, bool>;
       if constexpr (NamedEnum<T>) {
         row.choices = NameList<T>();
@@ -79,31 +78,21 @@ class KeyTableWriter {
   }
   void Visit(const char* key, DegreesOf angle, const KeyInfo& info) {
     Add(prefix_ + key, Number(*angle.radians * 180.0 / 3.14159265358979323846),
-        info.rule_text ? info.rule_text : fmt::format("in ({}, {}) deg", Number(info.min), Number(info.max)),
-        info.meaning, false, true);
+        info.rule_text ? info.rule_text : fmt::format("in ({}, {}) deg", Number(info.min), Number(info.max)), info, 1);
     // An open interval at both ends (the loader's rule): its closest closed one in doubles.
-    rows_.back().range = info;
     rows_.back().range.min = std::nextafter(info.min, info.max);
     rows_.back().range.max = std::nextafter(info.max, info.min);
-    rows_.back().count = 1;
   }
   void Visit(const char* key, ConvertedOf number, const KeyInfo& info) {
-    Add(prefix_ + key, info.required ? "" : Number(number.to_file(*number.value)), RuleOf(0.0, info), info.meaning,
-        false, true);
-    rows_.back().range = info;
-    rows_.back().count = 1;
+    Add(prefix_ + key, info.required ? "" : Number(number.to_file(*number.value)), RuleOf(0.0, info), info, 1);
   }
   void Visit(const char* key, TripleOf t, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}, {}]", Number(*t.x), Number(*t.y), Number(*t.z)),
-        info.rule_text ? info.rule_text : WithNote(Each("three numbers", info), info), info.meaning, false, true);
-    rows_.back().range = info;
-    rows_.back().count = 3;
+        info.rule_text ? info.rule_text : WithNote(Each("three numbers", info), info), info, 3);
   }
   void Visit(const char* key, PairOf pair, const KeyInfo& info) {
     Add(prefix_ + key, fmt::format("[{}, {}]", Number(*pair.first), Number(*pair.second)),
-        info.rule_text ? info.rule_text : WithNote(Each("two numbers", info), info), info.meaning, false, true);
-    rows_.back().range = info;
-    rows_.back().count = 2;
+        info.rule_text ? info.rule_text : WithNote(Each("two numbers", info), info), info, 2);
   }
 
   const std::vector<KeyRow>& rows() const { return rows_; }
@@ -116,15 +105,17 @@ class KeyTableWriter {
     t->Serialize(w);
   } > {};
 
-  void Add(std::string key, std::string value, std::string rule, const char* meaning, bool prose = false,
-           bool numeric = false) {
+  /// A row for a key declared with `info`, holding `count` numbers (KeyRow::count).
+  void Add(std::string key, std::string value, std::string rule, const KeyInfo& info, int count = 0,
+           bool prose = false) {
     KeyRow row;
     row.key = std::move(key);
     row.value = std::move(value);
     row.value_is_prose = prose;
     row.rule = std::move(rule);
-    row.meaning = meaning;
-    row.numeric = numeric;
+    row.meaning = info.meaning;
+    row.range = info;
+    row.count = count;
     rows_.push_back(std::move(row));
   }
 
