@@ -1,15 +1,22 @@
 
+#include "rotorguard/harness/assembly_mission.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <stdexcept>
 
 #include "rotorguard/core/stopwatch.h"
-#include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/world_raster.h"
-#include "rotorguard/perception/voxel_map.h"
 
 namespace rotorguard::harness {
+
+perception::VoxelMapOptions KnownMapOptions(const AssemblyPlanSpec& spec, const modular::Assembly& assembly) {
+  perception::VoxelMapOptions o;
+  o.resolution_m = spec.map_resolution_m;
+  o.inflation_radius_m = assembly.unit_radius_m + 0.05;
+  return o;
+}
 
 AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
   AssemblyPlanResult r;
@@ -27,11 +34,8 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
     if (f.at_time_s <= 0.0) eta[f.rotor] = std::min(eta[f.rotor], 1.0 - f.loss);
   }
 
-  // The world's geometry as a known map, inflated by a unit's radius and a margin for the A*.
-  perception::VoxelMapOptions mo;
-  mo.resolution_m = spec.map_resolution_m;
-  mo.inflation_radius_m = a.unit_radius_m + 0.05;
-  perception::VoxelMap map(mo);
+  // The world's geometry as a known map.
+  perception::VoxelMap map(KnownMapOptions(spec, a));
   map.Recenter(0.5 * (s.initial_position_m + spec.goal_m));
   RasterizeWorld(s.world, &map);
 

@@ -597,7 +597,7 @@ std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius
     const Vector3 n = d > 1e-12 ? Vector3((p - q) / d) : Vector3::UnitZ();
     best = NearestObstacle{q, d, n};
   };
-  if (radius_m + half_diagonal <= kSortedOffsetRadius * res_) {
+  if (radius_m <= FastNearestRadiusM(res_)) {
     for (const SortedOffset& o : sorted_offsets_) {
       const double lower = o.distance * res_ - half_diagonal;
       if (lower > radius_m || (best && lower > best->distance_m)) break;

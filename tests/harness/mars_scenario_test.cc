@@ -1,11 +1,12 @@
 // Paper 002's assemblies in the closed loop (configs/scenarios/mars_spiral_3x2.yaml): the assembly
 // flies as one multirotor of 24 rotors in the simulator, the stack's assembly controller
 // reallocates over the rotors it knows to be degraded.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/runner.h"
@@ -174,6 +175,21 @@ TEST(MarsScenario, AnUnplannableAssemblyMissionIsAConfigErrorNamingTheMission) {
   } catch (const io::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("plans for an assembly"), std::string::npos) << e.what();
   }
+}
+
+TEST(MarsScenario, TheFinestKnownMapAKeyAcceptsCanBeBuilt) {
+  // Found by generating flights (tests/fuzz): mission.map_resolution_m 0.02, in the key's range
+  // then, made a 432-million-voxel window that the map refused after `validate` had passed.
+  Scenario s = LoadScenario(Config("scenarios/mars_plan_3x2.yaml"));
+  AssemblyPlanSpec spec = *s.assembly_plan;
+  spec.map_resolution_m = AssemblyPlanSpec::kMinMapResolutionM;
+  EXPECT_NO_THROW(KnownMapOptions(spec, *s.assembly).Validate());
+  // The voxel map's own limit lies at 0.038 m (24 * 24 * 6 m^3 over 64 million voxels); the key
+  // stops at 0.05 m, where the window's power-of-two store takes 134 MB instead of 1 GB at 0.04 m.
+  spec.map_resolution_m = 0.035;
+  EXPECT_THROW(KnownMapOptions(spec, *s.assembly).Validate(), std::invalid_argument);
+  RG_EXPECT_THROW_WITH(LoadScenario(Config("scenarios/mars_plan_3x2.yaml"), {{"mission.map_resolution_m", "0.02"}}),
+                       io::ConfigError, "mission.map_resolution_m");
 }
 
 class AssemblyFile : public testing::TempFolderTest {};

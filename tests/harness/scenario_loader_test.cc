@@ -3,6 +3,7 @@
 // name the file, line and key, the mission comes back as a value, and docs/scenarios.md's key
 // tables are the ones the loader reads.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/io/json_archive.h"
+#include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/planning/references.h"
 #include "test_util.h"
 
@@ -323,6 +325,26 @@ TEST_F(ScenarioLoader, AnAbsurdSpeedLimitIsRejectedWithItsRange) {
                        "NavigationOptions::v_max = 1000000000 is invalid; expected a number in [0.001, 50]");
   n.replanner.nominal.v_max = 50.0;
   EXPECT_NO_THROW(n.Validate());
+}
+
+TEST_F(ScenarioLoader, ClearancesBeyondTheMapsFastObstacleSearchAreRefusedNamingTheKey) {
+  // Found by generating flights (tests/fuzz): stack.planner.clearance_m 10, in its range, made every
+  // obstacle query of the planner scan a 20-m cube, and a 2.6-s forest flight plan for minutes.
+  const std::string nav = "mission: {type: navigate, waypoints_m: [[5, 0, 1]]}\nsensors: {lidar: {}}\nstack:\n";
+  const double fast = perception::VoxelMap::FastNearestRadiusM(0.1);  // the map's default voxel
+  EXPECT_NEAR(fast, 1.11, 0.005);
+  EXPECT_EQ(Error(nav + fmt::format("  planner: {{clearance_m: {}}}\n", fast)), "(no error)");
+  std::string m = Error(nav + "  planner: {clearance_m: 1.2}\n");
+  EXPECT_NE(m.find("stack.planner.clearance_m: FlightStackOptions::planner.clearance_m = 1.2 is invalid; expected a "
+                   "distance of at most 1.11 m"),
+            std::string::npos)
+      << m;
+  m = Error(nav + "  planner: {post_failure_clearance_m: 10}\n");
+  EXPECT_NE(m.find("stack.planner.post_failure_clearance_m"), std::string::npos) << m;
+  // A map too fine for the planner's own 0.5-m search is named by its resolution.
+  m = Error(nav + "  planner: {clearance_m: 0.1}\n  map: {resolution_m: 0.02, window_size_m: [8, 8, 4]}\n");
+  EXPECT_NE(m.find("stack.map.resolution_m"), std::string::npos) << m;
+  EXPECT_NE(m.find("a voxel edge of at least 0.0449 m"), std::string::npos) << m;
 }
 
 /// The numeric keys of `rows` whose rule states no range bounded on both sides ("a number",

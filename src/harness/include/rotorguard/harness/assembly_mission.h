@@ -7,6 +7,7 @@
 
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/modular/assembly_trajectory.h"
+#include "rotorguard/perception/voxel_map.h"
 
 namespace rotorguard::harness {
 
@@ -21,6 +22,10 @@ struct AssemblyPlanResult {
   double astar_attitude_deviation_rad = 0.0;
   std::shared_ptr<const modular::AssemblyTrajectory> trajectory;  ///< when ok
 };
+
+/// The known map an assembly plans on: the voxel map's default window (24 x 24 x 6 m) at the
+/// spec's resolution, inflated by a unit's radius and a 5 cm margin for the A*.
+perception::VoxelMapOptions KnownMapOptions(const AssemblyPlanSpec& spec, const modular::Assembly& assembly);
 
 /// Plans `scenario`'s assembly_plan mission (which must have an assembly and the spec) for the
 /// faults known at the start (stack.known_faults at 0 s). Never throws for an unplannable mission:

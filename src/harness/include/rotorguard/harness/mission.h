@@ -60,6 +60,10 @@ struct AssemblyPlanSpec {
   /// λ_t of eq. (11) for both methods: the larger, the more agile (closer to the limits) the plan.
   double time_weight = 10.0;
   double map_resolution_m = 0.1;
+  /// The finest known map: its window (KnownMapOptions) then holds 33.5 million voxels, 134 MB,
+  /// under the voxel map's 64 million. Finer, the map would not be built (found by the flight
+  /// fuzzer at 0.02 m, which `validate` then accepted).
+  static constexpr double kMinMapResolutionM = 0.05;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -82,7 +86,9 @@ struct AssemblyPlanSpec {
     a->Visit("time_weight", &time_weight,
              {.meaning = "λ_t of eq. (11): the larger, the more agile the plan", .min = 0.0, .max = 1e6});
     a->Visit("map_resolution_m", &map_resolution_m,
-             {.meaning = "voxel edge of the known map [m]", .min = 0.02, .max = 1.0});
+             {.meaning = "voxel edge of the known map, a 24 x 24 x 6 m window between start and goal [m]",
+              .min = kMinMapResolutionM,
+              .max = 1.0});
   }
 };
 
