@@ -44,7 +44,7 @@ class BenchCommand final : public Command {
     }
     // The benchmarks that run on the campaign engine (benchmarks/registry.h): their trials can be
     // kept, resumed, sharded and merged like a campaign's.
-    for (CLI::App* b : {ftc_, nav_, mars_}) {
+    for (CLI::App* b : {ftc_, nav_, mars_, flatness_}) {
       b->add_option("--out", out_,
                     b == nav_ ? "The trials' records and the result (bench.json, bench.md); with --replay: the\n"
                                 "run folder (default out/nav_KIND_SEED)"
@@ -436,14 +436,11 @@ class BenchCommand final : public Command {
 
   int Flatness() const {
     benchmarks::FlatnessBenchOptions o;
-    o.seeds = static_cast<int>(ParseUnsigned("--seeds", flatness_seeds_, 1, 10000));
+    o.trials = static_cast<int>(ParseUnsigned("--seeds", flatness_seeds_, 1, 10000));
     o.seed = Seed();
-    o.jobs = ParseJobs(jobs_);
     o.fig2 = harness::LoadScenario(ConfigPath("scenarios/flatness_fig2.yaml"));
     o.truth = Truth();
-    o.progress = CountProgress("flights");
-    const nlohmann::json r = benchmarks::RunFlatnessBenchmark(o);
-    PrintMarkdownResult("flatness", r, benchmarks::FlatnessMarkdown(r));
+    RunBenchCampaign(benchmarks::FlatnessCampaign(o), "flatness");
     return kOk;
   }
 

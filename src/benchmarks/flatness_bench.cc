@@ -1,15 +1,17 @@
 #include "rotorguard/benchmarks/flatness_bench.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
-
-#include <fmt/format.h>
 
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/campaign/failure_list.h"
-#include "rotorguard/campaign/parallel.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/runner.h"
@@ -22,13 +24,6 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-struct Fig2Flight {
-  bool success = false, replanned = false;
-  double w_estimate = 0.0, settle_s = -1.0, detect_s = -1.0, replan_ts_s = 0.0, replan_nominal_ts_s = 0.0;
-  double replan_actuator_s = 0.0, replan_nominal_actuator_s = 0.0, max_tilt_deg = 0.0, fault_free_tilt_deg = 0.0;
-  std::string decision, binding, failure;
-};
-
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -36,131 +31,202 @@ double Median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+nlohmann::json OrNull(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
+
+/// Trial 0, part fig1: the closed forms of Fig. 1 and the facts of the Fig. 2 scenario the tables quote.
+nlohmann::json FigureOne(const harness::Scenario& fig2) {
+  const vehicle::PwmQuadModel model = vehicle::PwmQuadModel::FromVehicle(fig2.vehicle);
+  const planning::FlatnessLimits& limits = fig2.stack.navigation.flatness.limits;
+  const Eigen::Vector2d move = (fig2.stack.navigation.waypoints.front() - fig2.initial_position_m).head<2>();
+  // The envelope-bound plan (eq. 16) and the actuator-bound plan (eq. 23) of the move.
+  planning::FlatnessLimits actuator_only = limits;
+  actuator_only.theta_max_rad = actuator_only.phi_max_rad = std::numeric_limits<double>::infinity();
+  const planning::SettlingTime plan = planning::PlanSettlingTime(model, limits, move);
+  const planning::SettlingTime actuator = planning::PlanSettlingTime(model, actuator_only, move);
+  const sim::FaultSpec& fault = fig2.faults.front();
+  return {{"ts_envelope_s", plan.envelope_s},
+          {"ts_actuator_s", actuator.actuator_s},
+          {"ts_plan_s", plan.t_s},
+          {"ts_plan_binding", planning::ToString(plan.binding)},
+          {"theta_max_deg", limits.theta_max_rad / kDeg},
+          {"fault_rotor", fault.rotor},
+          {"fault_w", fault.eta},
+          {"fault_onset_s", fault.onset.value}};
+}
+
+/// A trial of part fig2: the faulty flight, then the same flight without its fault.
+campaign::TrialOutcome FlyFigureTwo(harness::Scenario s) {
+  const vehicle::PwmQuadModel model = vehicle::PwmQuadModel::FromVehicle(s.vehicle);
+  const planning::FlatnessLimits& limits = s.stack.navigation.flatness.limits;
+  const int faulty = s.faults.front().rotor;
+  const double onset = s.faults.front().onset.value;
+  campaign::TrialOutcome out;
+  const harness::RunSummary r = harness::RunScenario(s, harness::RunOptions{});
+  nlohmann::json& m = out.metrics;
+  m["success"] = r.success;
+  m["max_tilt_deg"] = r.max_tilt_rad / kDeg;
+  m["w_estimate"] = nullptr;
+  m["settle_s"] = nullptr;
+  if (const std::optional<stack::UkfSummary>& ukf = r.stack.ukf) {
+    if (faulty < static_cast<int>(ukf->w_hat.size())) m["w_estimate"] = ukf->w_hat[static_cast<std::size_t>(faulty)];
+    if (ukf->settled_s) m["settle_s"] = *ukf->settled_s - onset;
+  }
+  m["detect_s"] =
+      OrNull(r.fdd && r.fdd->diagnosis ? std::optional(r.fdd->diagnosis->detection_s - onset) : std::nullopt);
+  m["replanned"] = false;
+  for (const planning::FlatnessDecision& d : r.stack.flatness_decisions) {
+    if (d.kind != "continue" && d.kind != "return" && d.kind != "land") continue;
+    const planning::SettlingTime nominal = planning::PlanSettlingTime(model, limits, d.delta_m.head<2>());
+    m["replanned"] = true;
+    m["replan_decision"] = d.kind;
+    m["replan_binding"] = d.binding;
+    m["replan_ts_s"] = d.t_s;
+    m["replan_actuator_s"] = d.actuator_s;
+    m["replan_nominal_ts_s"] = std::max(nominal.t_s, s.stack.navigation.flatness.min_t_s);
+    m["replan_nominal_actuator_s"] = nominal.actuator_s;
+  }
+  out.message = r.failure_reason.value_or("");
+  s.faults.clear();  // the pitch the plan asks for
+  m["fault_free_tilt_deg"] = harness::RunScenario(s, harness::RunOptions{}).max_tilt_rad / kDeg;
+  return out;
+}
+
 }  // namespace
 
 void FlatnessBenchOptions::Validate() const {
-  if (seeds < 1 || seeds > 10000) ThrowInvalidArgument("FlatnessBenchOptions", "seeds", seeds, "a count in [1, 10000]");
+  if (trials < 1 || trials > 10000)
+    ThrowInvalidArgument("FlatnessBenchOptions", "trials", trials, "a count in [1, 10000]");
   if (jobs < 1 || jobs > 256) ThrowInvalidArgument("FlatnessBenchOptions", "jobs", jobs, "a count in [1, 256]");
   if (fig2.stack.navigation.method != stack::NavigationMethod::kFlatness || fig2.faults.empty() || fig2.stack.navigation.waypoints.empty()) {
     ThrowInvalidArgument("FlatnessBenchOptions", "fig2", fig2.name, "a flatness navigate scenario with a fault");
   }
 }
 
-nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
+campaign::Campaign FlatnessCampaign(const FlatnessBenchOptions& o) {
   o.Validate();
-  const vehicle::PwmQuadModel model = vehicle::PwmQuadModel::FromVehicle(o.fig2.vehicle);
-  const planning::FlatnessLimits& limits = o.fig2.stack.navigation.flatness.limits;
-  const Vector3 move = o.fig2.stack.navigation.waypoints.front() - o.fig2.initial_position_m;
-  // Fig. 1: the envelope-bound plan (eq. 16) and the actuator-bound plan (eq. 23) of the move.
-  planning::FlatnessLimits actuator_only = limits;
-  actuator_only.theta_max_rad = actuator_only.phi_max_rad = std::numeric_limits<double>::infinity();
-  const planning::SettlingTime fig1 = planning::PlanSettlingTime(model, limits, move.head<2>());
-  const planning::SettlingTime fig1b = planning::PlanSettlingTime(model, actuator_only, move.head<2>());
-  const int faulty = o.fig2.faults.front().rotor;
-  const double onset = o.fig2.faults.front().onset.value;
+  campaign::Campaign c;
+  c.name = "bench_flatness";
+  c.seed = o.seed;
+  c.trials = 1 + o.trials;
+  c.group_keys = {"part"};
+  c.metrics = {"success", "w_estimate", "settle_s", "detect_s", "replanned", "replan_ts_s", "fault_free_tilt_deg"};
+  const nlohmann::json options = {
+      {"trials", o.trials}, {"seed", o.seed}, {"scenario", o.fig2.name}, {"truth", ToName(o.truth)}};
+  c.bench = {{"name", "flatness"}, {"records", 1}, {"options", options}};
+  c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::ScenarioFingerprint(o.fig2));
+  c.parameters = [o](int index) -> std::map<std::string, std::string> {
+    if (index == 0) return {{"part", "fig1"}, {"seed", std::to_string(o.seed)}};
+    return {{"part", "fig2"},
+            {"trial", std::to_string(index - 1)},
+            {"seed", std::to_string(o.seed + static_cast<std::uint64_t>(index - 1))}};
+  };
+  harness::Scenario fig2 = o.fig2;
+  fig2.truth.preset = o.truth;
+  // Two flights a trial; the closed forms of trial 0 run without a budget.
+  c.simulated_s = [fig2](int index, const std::map<std::string, std::string>&) {
+    return index == 0 ? 0.0 : 2.0 * fig2.duration_s;
+  };
+  c.reproduce = [fig2](int, const std::map<std::string, std::string>& params) {
+    return fmt::format("rotorguard run {} --seed {} --set truth={}", fig2.file.empty() ? fig2.name : fig2.file,
+                       params.at("seed"), ToName(fig2.truth.preset));
+  };
+  c.run = [fig2](int index, const std::map<std::string, std::string>& params) {
+    if (index == 0) return campaign::TrialOutcome{FigureOne(fig2), ""};
+    harness::Scenario s = fig2;
+    s.seed = std::stoull(params.at("seed"));
+    return FlyFigureTwo(std::move(s));
+  };
+  return c;
+}
 
-  std::vector<Fig2Flight> flights(static_cast<std::size_t>(o.seeds));
-  campaign::ParallelFor(2 * o.seeds, o.jobs, [&](int task) {
-    Fig2Flight& f = flights[static_cast<std::size_t>(task / 2)];
-    harness::Scenario s = o.fig2;
-    s.seed = o.seed + static_cast<std::uint64_t>(task / 2);
-    s.truth.preset = o.truth;
-    try {
-      if (task % 2 == 1) {  // the same flight without the fault: the pitch the plan asks for
-        s.faults.clear();
-        f.fault_free_tilt_deg = harness::RunScenario(s, harness::RunOptions{}).max_tilt_rad / kDeg;
-        return;
-      }
-      const harness::RunSummary r = harness::RunScenario(s, harness::RunOptions{});
-      f.success = r.success;
-      f.failure = r.failure_reason.value_or("");
-      f.max_tilt_deg = r.max_tilt_rad / kDeg;
-      if (const std::optional<stack::UkfSummary>& ukf = r.stack.ukf) {
-        if (faulty < static_cast<int>(ukf->w_hat.size())) f.w_estimate = ukf->w_hat[static_cast<std::size_t>(faulty)];
-        if (ukf->settled_s) f.settle_s = *ukf->settled_s - onset;
-      }
-      if (r.fdd) f.detect_s = r.fdd->diagnosis ? r.fdd->diagnosis->detection_s - onset : -1.0;
-      for (const planning::FlatnessDecision& d : r.stack.flatness_decisions) {
-        if (d.kind != "continue" && d.kind != "return" && d.kind != "land") continue;
-        f.replanned = true;
-        f.decision = d.kind;
-        f.replan_ts_s = d.t_s;
-        f.binding = d.binding;
-        f.replan_actuator_s = d.actuator_s;
-        const Eigen::Vector2d delta(d.delta_m.x(), d.delta_m.y());
-        const planning::SettlingTime nominal = planning::PlanSettlingTime(model, limits, delta);
-        f.replan_nominal_ts_s = std::max(nominal.t_s, o.fig2.stack.navigation.flatness.min_t_s);
-        f.replan_nominal_actuator_s = nominal.actuator_s;
-      }
-    } catch (const std::exception& e) {
-      f.failure = std::string("error: ") + e.what();
-    }
-  }, o.progress);
-
+nlohmann::json FlatnessResult(const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
+  const int trials = options.at("trials").get<int>();
+  if (records.size() != static_cast<std::size_t>(trials) + 1) {
+    throw std::invalid_argument(fmt::format("flatness: {} trial records for 1 + {} trials", records.size(), trials));
+  }
+  if (records[0]["status"] != "ok") {
+    throw std::invalid_argument("flatness: Fig. 1's closed forms were not recorded: " +
+                                campaign::TrialFailure(records[0]));
+  }
+  const nlohmann::json& fig1 = records[0]["metrics"];
   std::vector<double> w, settle, detect, ts, ts_nominal, act, act_nominal, tilt, tilt_free;
-  int success = 0, replanned = 0;
+  int success = 0, replanned = 0, identified = 0;
   std::map<std::string, int> decisions, bindings;
   campaign::FailureList failures(10);
-  for (std::size_t i = 0; i < flights.size(); ++i) {
-    const Fig2Flight& f = flights[i];
-    success += f.success;
-    tilt.push_back(f.max_tilt_deg);
-    tilt_free.push_back(f.fault_free_tilt_deg);
-    w.push_back(f.w_estimate);
-    if (f.settle_s >= 0.0) settle.push_back(f.settle_s);
-    if (f.detect_s >= 0.0) detect.push_back(f.detect_s);
-    if (!f.success) failures.Add({{"seed", o.seed + i}, {"reason", f.failure}});
-    if (!f.replanned) continue;
+  const double truth = fig1.at("fault_w").get<double>();
+  const auto add = [](const nlohmann::json& m, const char* key, std::vector<double>* to) {
+    if (m.contains(key) && m[key].is_number()) to->push_back(m[key].get<double>());
+  };
+  for (std::size_t i = 1; i < records.size(); ++i) {
+    const nlohmann::json& r = records[i];
+    const std::string failure = campaign::TrialFailure(r);
+    const nlohmann::json& m = r["metrics"];
+    const bool flew = r["status"] == "ok";
+    if (flew && m.at("success").get<bool>()) {
+      ++success;
+    } else {
+      failures.Add({{"seed", std::stoull(r["params"]["seed"].get<std::string>())}, {"reason", failure}});
+    }
+    if (!flew) continue;
+    add(m, "max_tilt_deg", &tilt);
+    add(m, "fault_free_tilt_deg", &tilt_free);
+    add(m, "w_estimate", &w);
+    add(m, "settle_s", &settle);
+    add(m, "detect_s", &detect);
+    identified += m["w_estimate"].is_number() && std::abs(m["w_estimate"].get<double>() - truth) <= 0.05;
+    if (!m.at("replanned").get<bool>()) continue;
     ++replanned;
-    ++decisions[f.decision];
-    ++bindings[f.binding];
-    ts.push_back(f.replan_ts_s);
-    ts_nominal.push_back(f.replan_nominal_ts_s);
-    act.push_back(f.replan_actuator_s);
-    act_nominal.push_back(f.replan_nominal_actuator_s);
+    ++decisions[m.at("replan_decision").get<std::string>()];
+    ++bindings[m.at("replan_binding").get<std::string>()];
+    add(m, "replan_ts_s", &ts);
+    add(m, "replan_nominal_ts_s", &ts_nominal);
+    add(m, "replan_actuator_s", &act);
+    add(m, "replan_nominal_actuator_s", &act_nominal);
   }
+  const auto median = [](const std::vector<double>& v) {
+    return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(v));
+  };
   const auto range = [](const std::vector<double>& v) {
     if (v.empty()) return nlohmann::json(nullptr);
     return nlohmann::json({{"median", Median(v)}, {"min", *std::min_element(v.begin(), v.end())},
                            {"max", *std::max_element(v.begin(), v.end())}});
   };
-  const double truth = o.fig2.faults.front().eta;
-  int identified = 0;
-  for (const double e : w) identified += std::abs(e - truth) <= 0.05;
-  return {
-      {"benchmark", "flatness"},
-      {"ts_envelope_s", fig1.envelope_s},
-      {"ts_actuator_s", fig1b.actuator_s},
-      {"ts_plan_s", fig1.t_s},
-      {"ts_plan_binding", planning::ToString(fig1.binding)},
-      {"flights", o.seeds},
-      {"success_rate", static_cast<double>(success) / o.seeds},
-      {"fault", {{"rotor", faulty}, {"w", truth}, {"onset_s", onset}}},
-      {"ukf_w_estimate", Median(w)},
-      {"ukf_w_estimate_range", range(w)},
-      {"ukf_identified_rate", static_cast<double>(identified) / o.seeds},
-      {"ukf_detect_s", detect.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(detect))},
-      {"ukf_settle_s", settle.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(settle))},
-      {"ukf_settle_s_range", range(settle)},
-      {"replanned_rate", static_cast<double>(replanned) / o.seeds},
-      {"replan_decisions", decisions},
-      {"replan_bindings", bindings},
-      {"replan_ts_s", ts.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(ts))},
-      {"replan_ts_s_range", range(ts)},
-      {"replan_ts_nominal_s", ts_nominal.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(ts_nominal))},
-      {"replan_actuator_s", act.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(act))},
-      {"replan_actuator_nominal_s",
-       act_nominal.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(act_nominal))},
-      {"theta_max_deg", limits.theta_max_rad / kDeg},
-      {"max_pitch_deg", Median(tilt_free)},
-      {"max_pitch_deg_range", range(tilt_free)},
-      {"max_tilt_deg_with_fault", Median(tilt)},
-      {"failures", failures.listed()},
-      {"failures_not_listed", failures.not_listed()},
-      {"options",
-       {{"seeds", o.seeds}, {"seed", o.seed}, {"jobs", o.jobs}, {"scenario", o.fig2.name}, {"truth", ToName(o.truth)}}},
-      {"truth", ToName(o.truth)},
-      {"host", buildinfo::HostInfo()}};
+  return {{"benchmark", "flatness"},
+          {"ts_envelope_s", fig1.at("ts_envelope_s")},
+          {"ts_actuator_s", fig1.at("ts_actuator_s")},
+          {"ts_plan_s", fig1.at("ts_plan_s")},
+          {"ts_plan_binding", fig1.at("ts_plan_binding")},
+          {"flights", trials},
+          {"success_rate", static_cast<double>(success) / trials},
+          {"fault", {{"rotor", fig1.at("fault_rotor")}, {"w", truth}, {"onset_s", fig1.at("fault_onset_s")}}},
+          {"ukf_w_estimate", median(w)},
+          {"ukf_w_estimate_range", range(w)},
+          {"ukf_identified_rate", static_cast<double>(identified) / trials},
+          {"ukf_detect_s", median(detect)},
+          {"ukf_settle_s", median(settle)},
+          {"ukf_settle_s_range", range(settle)},
+          {"replanned_rate", static_cast<double>(replanned) / trials},
+          {"replan_decisions", decisions},
+          {"replan_bindings", bindings},
+          {"replan_ts_s", median(ts)},
+          {"replan_ts_s_range", range(ts)},
+          {"replan_ts_nominal_s", median(ts_nominal)},
+          {"replan_actuator_s", median(act)},
+          {"replan_actuator_nominal_s", median(act_nominal)},
+          {"theta_max_deg", fig1.at("theta_max_deg")},
+          {"max_pitch_deg", median(tilt_free)},
+          {"max_pitch_deg_range", range(tilt_free)},
+          {"max_tilt_deg_with_fault", median(tilt)},
+          {"failures", failures.listed()},
+          {"failures_not_listed", failures.not_listed()},
+          {"options", options},
+          {"truth", options.at("truth")},
+          {"host", buildinfo::HostInfo()}};
+}
+
+nlohmann::json RunFlatnessBenchmark(const FlatnessBenchOptions& o) {
+  const campaign::Campaign c = FlatnessCampaign(o);
+  return FlatnessResult(c.bench["options"], campaign::RunWholeCampaign(c, o.jobs, o.progress));
 }
 
 std::string FlatnessMarkdown(const nlohmann::json& r) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "rotorguard/benchmarks/flatness_bench.h"
 #include "rotorguard/benchmarks/ftc_bench.h"
 #include "rotorguard/benchmarks/mars_bench.h"
 #include "rotorguard/benchmarks/nav_bench.h"
@@ -123,6 +124,13 @@ campaign::Campaign LoadMars(const io::ConfigNode& root, const std::string& path)
   return Checked(root, [&] { return MarsCampaign(o); });
 }
 
+campaign::Campaign LoadFlatness(const io::ConfigNode& root, const std::string& path) {
+  const SpecFiles files(root, path);
+  FlatnessBenchOptions o = SeedAndTrials<FlatnessBenchOptions>(root, 10'000);
+  o.fig2 = files.ScenarioAt("fig2");
+  return Checked(root, [&] { return FlatnessCampaign(o); });
+}
+
 campaign::CampaignRegistry MakeKinds() {
   campaign::CampaignRegistry kinds;
   kinds.Add({"",
@@ -141,6 +149,10 @@ campaign::CampaignRegistry MakeKinds() {
   kinds.Add({"mars", LoadMars, [](const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
                const nlohmann::json r = MarsResult(options, records);
                return campaign::BenchReport{r, MarsMarkdown(r)};
+             }});
+  kinds.Add({"flatness", LoadFlatness, [](const nlohmann::json& options, const std::vector<nlohmann::json>& records) {
+               const nlohmann::json r = FlatnessResult(options, records);
+               return campaign::BenchReport{r, FlatnessMarkdown(r)};
              }});
   return kinds;
 }

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 
+#include "rotorguard/benchmarks/flatness_bench.h"
 #include "rotorguard/benchmarks/ftc_bench.h"
 #include "rotorguard/benchmarks/nav_bench.h"
 #include "rotorguard/campaign/campaign.h"
@@ -215,6 +216,65 @@ TEST_F(BenchCampaigns, NavResultCountsTheFailuresItDoesNotList) {
   const std::string md = NavMarkdown(r);
   EXPECT_NE(md.find("rotorguard failed: 3 more, not listed"), std::string::npos) << md;
   EXPECT_NE(md.find("failure_unaware failed: 3 more, not listed"), std::string::npos) << md;
+}
+
+TEST_F(BenchCampaigns, FlatnessInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSameCampaign) {
+  FlatnessBenchOptions o;
+  o.trials = 2;
+  o.seed = 3;
+  o.fig2 = harness::LoadScenario(kConfigs + "/scenarios/flatness_fig2.yaml");
+  o.truth = sim::TruthPreset::kIdeal;
+  const campaign::Campaign c = FlatnessCampaign(o);
+  ASSERT_EQ(c.trials, 3);  // Fig. 1's closed forms, then one trial per flight
+  campaign::CampaignRunOptions whole;
+  whole.jobs = 2;
+  const nlohmann::json direct = FlatnessResult(c.bench["options"], *campaign::RunCampaignRecords(c, whole));
+  // Paper 004's figures (docs/flatness.md): Fig. 1's 5.46 s, and in the exact world the UKF
+  // identifies the 40 % loss and every flight arrives.
+  EXPECT_NEAR(direct["ts_envelope_s"].get<double>(), 5.46, 0.005);
+  EXPECT_EQ(direct["success_rate"], 1.0) << direct["failures"].dump();
+  EXPECT_EQ(direct["ukf_identified_rate"], 1.0) << direct["ukf_w_estimate_range"].dump();
+  EXPECT_EQ(direct["replanned_rate"], 1.0);
+  for (int i = 0; i < 2; ++i) {
+    campaign::CampaignRunOptions shard;
+    shard.out_dir = (dir_ / "s").string();
+    shard.shard = campaign::Shard{i, 2};
+    shard.version = "test";
+    EXPECT_FALSE(campaign::RunCampaignRecords(c, shard).has_value());
+  }
+  const nlohmann::json merged =
+      campaign::MergeCampaign({(dir_ / "s").string()}, (dir_ / "m").string(), CampaignKinds());
+  nlohmann::json a = merged["bench"], b = direct;
+  a.erase("host");
+  b.erase("host");
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(io::ReadFile((dir_ / "m" / "bench.md").string()), FlatnessMarkdown(direct));
+  const campaign::Campaign from_file = campaign::LoadCampaign(
+      Write("f.yaml", "name: f\nbench: flatness\ntrials: 2\nseed: 3\ntruth: ideal\nfig2: " + kConfigs +
+                          "/scenarios/flatness_fig2.yaml\n"),
+      CampaignKinds());
+  EXPECT_EQ(from_file.hash, c.hash);
+  for (int i = 0; i < c.trials; ++i) EXPECT_EQ(from_file.parameters(i), c.parameters(i));
+}
+
+TEST_F(BenchCampaigns, AFlatnessFlightPastItsBudgetIsAFailureNamingTheCommandThatFliesIt) {
+  FlatnessBenchOptions o;
+  o.trials = 1;
+  o.fig2 = harness::LoadScenario(kConfigs + "/scenarios/flatness_fig2.yaml");
+  const campaign::Campaign c = FlatnessCampaign(o);
+  campaign::CampaignRunOptions run;
+  run.trial_timeout_factor = 1e-6;  // 0.12 ms for the two 60-s flights: none can finish
+  const std::vector<nlohmann::json> records = *campaign::RunCampaignRecords(c, run);
+  EXPECT_EQ(records[0]["status"], "ok");  // the closed forms run without a budget
+  EXPECT_EQ(records[1]["status"], "timeout");
+  const nlohmann::json r = FlatnessResult(c.bench["options"], records);
+  EXPECT_EQ(r["success_rate"], 0.0);
+  ASSERT_EQ(r["failures"].size(), 1u);
+  EXPECT_NE(r["failures"][0]["reason"].get<std::string>().find("rotorguard run " + o.fig2.file +
+                                                               " --seed 1 --set truth=realistic"),
+            std::string::npos)
+      << r["failures"][0].dump();
+  EXPECT_TRUE(r["ukf_w_estimate"].is_null());  // no flight, no median
 }
 
 TEST_F(BenchCampaigns, ASpecsTruthIsTheSameCampaignAsTheFlag) {

@@ -32,7 +32,8 @@ std::string Fingerprint(const std::string& text);
 std::string TrialFailure(const nlohmann::json& record);
 
 /// What one trial recorded besides its parameters: its metrics (numbers, booleans or null, keyed by
-/// name) and a message (why a flight failed; "" for none).
+/// name; or a word, such as the decision a flight took, which summaries give no statistics for) and
+/// a message (why a flight failed; "" for none).
 struct TrialOutcome {
   nlohmann::json metrics = nlohmann::json::object();
   std::string message;
