@@ -144,28 +144,28 @@ nlohmann::json FlatnessResult(const nlohmann::json& options, const std::vector<n
   if (records.size() != static_cast<std::size_t>(trials) + 1) {
     throw std::invalid_argument(fmt::format("flatness: {} trial records for 1 + {} trials", records.size(), trials));
   }
-  if (records[0]["status"] != "ok") {
+  if (records[0].value("status", "") != "ok") {
     throw std::invalid_argument("flatness: Fig. 1's closed forms were not recorded: " +
                                 campaign::TrialFailure(records[0]));
   }
-  const nlohmann::json& fig1 = records[0]["metrics"];
+  const nlohmann::json& fig1 = records[0].at("metrics");
   std::vector<double> w, settle, detect, ts, ts_nominal, act, act_nominal, tilt, tilt_free;
   int success = 0, replanned = 0, identified = 0;
   std::map<std::string, int> decisions, bindings;
   campaign::FailureList failures(10);
   const double truth = fig1.at("fault_w").get<double>();
   const auto add = [](const nlohmann::json& m, const char* key, std::vector<double>* to) {
-    if (m.contains(key) && m[key].is_number()) to->push_back(m[key].get<double>());
+    if (m.contains(key) && m.at(key).is_number()) to->push_back(m.at(key).get<double>());
   };
   for (std::size_t i = 1; i < records.size(); ++i) {
     const nlohmann::json& r = records[i];
     const std::string failure = campaign::TrialFailure(r);
-    const nlohmann::json& m = r["metrics"];
-    const bool flew = r["status"] == "ok";
+    const bool flew = r.value("status", "") == "ok";
+    const nlohmann::json& m = r.at("metrics");
     if (flew && m.at("success").get<bool>()) {
       ++success;
     } else {
-      failures.Add({{"seed", std::stoull(r["params"]["seed"].get<std::string>())}, {"reason", failure}});
+      failures.Add({{"seed", std::stoull(r.at("params").at("seed").get<std::string>())}, {"reason", failure}});
     }
     if (!flew) continue;
     add(m, "max_tilt_deg", &tilt);
@@ -173,7 +173,8 @@ nlohmann::json FlatnessResult(const nlohmann::json& options, const std::vector<n
     add(m, "w_estimate", &w);
     add(m, "settle_s", &settle);
     add(m, "detect_s", &detect);
-    identified += m["w_estimate"].is_number() && std::abs(m["w_estimate"].get<double>() - truth) <= 0.05;
+    identified += m.contains("w_estimate") && m.at("w_estimate").is_number() &&
+                  std::abs(m.at("w_estimate").get<double>() - truth) <= 0.05;
     if (!m.at("replanned").get<bool>()) continue;
     ++replanned;
     ++decisions[m.at("replan_decision").get<std::string>()];
