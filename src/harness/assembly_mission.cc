@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "rotorguard/core/error.h"
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/world_raster.h"
 
@@ -95,7 +96,12 @@ AssemblyPlanResult PlanAssemblyMission(const Scenario& s) {
 
 void PlanMission(Scenario* s) {
   if (!s->assembly_plan || s->reference) return;
-  const AssemblyPlanResult plan = PlanAssemblyMission(*s);
+  AssemblyPlanResult plan;
+  try {
+    plan = PlanAssemblyMission(*s);
+  } catch (const ValidationError& e) {  // options made from the spec that a part refuses (the map's size)
+    plan.message = e.what();
+  }
   if (!plan.ok) {
     const std::string message = "cannot plan the assembly's path: " + plan.message;
     if (s->source.mission) s->source.mission->Fail(message);

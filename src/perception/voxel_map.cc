@@ -587,7 +587,7 @@ std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius
   // The query lies within half a diagonal of its voxel's centre, so a voxel whose centre is d from
   // that centre is at least d - half_diagonal from the query: the offsets, visited by increasing
   // d, can stop once that bound exceeds the radius or the best distance found.
-  const double half_diagonal = 0.5 * std::sqrt(3.0) * res_;
+  const double half_diagonal = 0.5 * std::numbers::sqrt3 * res_;
   std::optional<NearestObstacle> best;
   const auto consider = [&](const Index& i) {
     if (!InWindow(i) || !OccupiedBit(Address(i))) return;

@@ -88,23 +88,22 @@ void FlightStackOptions::Validate() const {
     const planning::ReplannerOptions& r = navigation.replanner;
     const double resolution_m = lidar.map.resolution_m;
     const double fast_m = perception::VoxelMap::FastNearestRadiusM(resolution_m);
-    const std::pair<const char*, double> searches[] = {
-        {"planner.clearance_m", r.planner.optimizer.clearance_m},
-        {"planner.post_failure_clearance_m", r.post_failure_clearance_m.value_or(0.0)},
-        {"map.resolution_m", r.planner.plane_search_m}};
-    for (std::size_t i = 0; i < std::size(searches); ++i) {
-      const auto& [field, search_m] = searches[i];
-      if (search_m <= fast_m) continue;
-      if (i == 2) {  // the planner's own search radius, not a key: the map is too fine for it
-        ThrowValidation("FlightStackOptions", field, resolution_m,
-                        fmt::format("a voxel edge of at least {:.3g} m: the planner searches {:g} m around each "
-                                    "sample, within 12 voxels less half a diagonal",
-                                    resolution_m * search_m / fast_m, search_m));
+    for (const auto& [field, clearance] :
+         {std::pair{"planner.clearance_m", r.planner.optimizer.clearance_m},
+          std::pair{"planner.post_failure_clearance_m", r.post_failure_clearance_m.value_or(0.0)}}) {
+      if (clearance > fast_m) {
+        ThrowValidation("FlightStackOptions", field, clearance,
+                        fmt::format("a distance of at most {:.3g} m: the planner's obstacle search reaches 12 "
+                                    "voxels less half a diagonal (map.resolution_m = {:g} m)",
+                                    fast_m, resolution_m));
       }
-      ThrowValidation("FlightStackOptions", field, search_m,
-                      fmt::format("a distance of at most {:.3g} m: the planner's obstacle search reaches 12 voxels "
-                                  "less half a diagonal (map.resolution_m = {:g} m)",
-                                  fast_m, resolution_m));
+    }
+    // plane_search_m is no key: beyond the clearances, it is the map that is too fine for it.
+    if (const double search_m = r.planner.plane_search_m; search_m > fast_m) {
+      ThrowValidation("FlightStackOptions", "map.resolution_m", resolution_m,
+                      fmt::format("a voxel edge of at least {:.3g} m: the planner searches {:g} m around each "
+                                  "sample, within 12 voxels less half a diagonal",
+                                  resolution_m * search_m / fast_m, search_m));
     }
   }
   if (!known_faults.empty() && controller != ControllerKind::kNmpc && controller != ControllerKind::kIndi &&

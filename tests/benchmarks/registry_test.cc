@@ -224,11 +224,10 @@ TEST_F(BenchCampaigns, FlatnessInShardsMergesToTheResultOfOneRunAndItsSpecFileIs
   o.seed = 3;
   o.fig2 = harness::LoadScenario(kConfigs + "/scenarios/flatness_fig2.yaml");
   o.truth = sim::TruthPreset::kIdeal;
+  o.jobs = 2;
   const campaign::Campaign c = FlatnessCampaign(o);
   ASSERT_EQ(c.trials, 3);  // Fig. 1's closed forms, then one trial per flight
-  campaign::CampaignRunOptions whole;
-  whole.jobs = 2;
-  const nlohmann::json direct = FlatnessResult(c.bench["options"], *campaign::RunCampaignRecords(c, whole));
+  const nlohmann::json direct = RunFlatnessBenchmark(o);  // whole, on two threads, in a temporary folder
   // Paper 004's figures (docs/flatness.md): Fig. 1's 5.46 s, and in the exact world the UKF
   // identifies the 40 % loss and every flight arrives.
   EXPECT_NEAR(direct["ts_envelope_s"].get<double>(), 5.46, 0.005);

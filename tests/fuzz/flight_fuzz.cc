@@ -43,10 +43,9 @@ namespace {
 namespace fs = std::filesystem;
 using rotorguard::io::KeyRow;
 
+// The wall-clock bound of docs/reliability.md.
 constexpr double kBudgetPerSimulatedSecond = 100.0;
-constexpr const char* kUsage =
-    "usage: rotorguard_flight_fuzz [--flights N] [--seed S] [--jobs J in [1, 64]]\n";  // the wall-clock bound of
-                                                                                       // docs/reliability.md
+constexpr const char* kUsage = "usage: rotorguard_flight_fuzz [--flights N] [--seed S] [--jobs J in [1, 64]]\n";
 
 // A key that can be set: its full dotted path ("stack.nmpc.horizon_steps", "world.boxes[].size_m")
 // and its declaration.

@@ -185,11 +185,16 @@ TEST(MarsScenario, TheFinestKnownMapAKeyAcceptsCanBeBuilt) {
   spec.map_resolution_m = AssemblyPlanSpec::kMinMapResolutionM;
   EXPECT_NO_THROW(KnownMapOptions(spec, *s.assembly).Validate());
   // The voxel map's own limit lies at 0.038 m (24 * 24 * 6 m^3 over 64 million voxels); the key
-  // stops at 0.05 m, where the window's power-of-two store takes 134 MB instead of 1 GB at 0.04 m.
+  // stops at 0.05 m, where the window's power-of-two store (4 bytes a voxel) takes 128 MiB instead
+  // of 1 GiB at 0.04 m.
   spec.map_resolution_m = 0.035;
   EXPECT_THROW(KnownMapOptions(spec, *s.assembly).Validate(), std::invalid_argument);
   RG_EXPECT_THROW_WITH(LoadScenario(Config("scenarios/mars_plan_3x2.yaml"), {{"mission.map_resolution_m", "0.02"}}),
                        io::ConfigError, "mission.map_resolution_m");
+  // Set past the loader, the map the plan needs is the mission's error, not the map's.
+  s.assembly_plan->map_resolution_m = 0.035;
+  RG_EXPECT_THROW_WITH(PlanMission(&s), io::ConfigError,
+                       "cannot plan the assembly's path: VoxelMapOptions::window_size_m");
 }
 
 class AssemblyFile : public testing::TempFolderTest {};

@@ -3,7 +3,6 @@
 /// control path) and integer simulation time.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -28,15 +27,15 @@ using AllocationMatrix = Eigen::Matrix<double, Eigen::Dynamic, 4, 0, kMaxRotors,
 using TimeNs = std::int64_t;
 inline constexpr TimeNs kNanosPerSecond = 1'000'000'000;
 inline constexpr double ToSeconds(TimeNs t) { return static_cast<double>(t) * 1e-9; }
-/// A time in nanoseconds, already rounded, as TimeNs: beyond its range (about ±292 years) it
-/// saturates, and NaN counts as "never", as converting such a double to an integer is undefined.
+/// A time in nanoseconds as TimeNs, truncated toward zero as a cast does: beyond its range (about
+/// ±292 years) it saturates, and NaN counts as "never", as converting such a double is undefined.
 inline TimeNs SaturatedNs(double ns) {
   if (!(ns < 0x1p63)) return std::numeric_limits<TimeNs>::max();
   if (!(ns >= -0x1p63)) return std::numeric_limits<TimeNs>::min();
   return static_cast<TimeNs>(ns);
 }
 /// Rounds to the nearest nanosecond (SaturatedNs beyond the range).
-inline TimeNs FromSeconds(double s) { return SaturatedNs(std::trunc(s * 1e9 + (s >= 0 ? 0.5 : -0.5))); }
+inline TimeNs FromSeconds(double s) { return SaturatedNs(s * 1e9 + (s >= 0 ? 0.5 : -0.5)); }
 /// Period in nanoseconds of a rate in Hz, rounded to the nearest nanosecond.
 inline TimeNs PeriodFromRate(double rate_hz) { return FromSeconds(1.0 / rate_hz); }
 

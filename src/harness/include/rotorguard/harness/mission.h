@@ -60,9 +60,9 @@ struct AssemblyPlanSpec {
   /// λ_t of eq. (11) for both methods: the larger, the more agile (closer to the limits) the plan.
   double time_weight = 10.0;
   double map_resolution_m = 0.1;
-  /// The finest known map: its window (KnownMapOptions) then holds 33.5 million voxels, 134 MB,
-  /// under the voxel map's 64 million. Finer, the map would not be built (found by the flight
-  /// fuzzer at 0.02 m, which `validate` then accepted).
+  /// The finest known map: its window (KnownMapOptions) then holds 27.6 million voxels, under the
+  /// voxel map's 64 million (`validate` of mars_plan_3x2.yaml at 0.05 m peaks at 172 MB). Finer,
+  /// the map would not be built (found by the flight fuzzer at 0.02 m, which `validate` accepted).
   static constexpr double kMinMapResolutionM = 0.05;
 
   template <typename Archive>

@@ -12,6 +12,7 @@
 /// map's update.
 #include <algorithm>
 #include <cstdint>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -149,13 +150,13 @@ class VoxelMap {
   /// call from two threads at once on one map, nor with SegmentCollides: both fill a memo.
   bool IsInflated(const Vector3& p_W) const;
   /// The nearest occupied voxel within `radius_m` of p, if any. Up to FastNearestRadiusM it visits
-  /// at most 7,240 voxels by increasing distance and stops at the first obstacle; beyond, it scans
+  /// at most 7,153 voxels by increasing distance and stops at the first obstacle; beyond, it scans
   /// a cube, whose cost grows with the radius cubed.
   std::optional<NearestObstacle> Nearest(const Vector3& p_W, double radius_m) const;
   /// The largest radius of Nearest's fast search at `resolution_m`: 12 voxels, less half a
   /// voxel's diagonal (the query's offset from its voxel's centre).
   static double FastNearestRadiusM(double resolution_m) {
-    return (kSortedOffsetRadius - 0.5 * 1.7320508075688772) * resolution_m;
+    return (kSortedOffsetRadius - 0.5 * std::numbers::sqrt3) * resolution_m;
   }
   /// Whether the segment a-b passes through an inflated voxel (unknown and outside-window space
   /// count as free: the planner is optimistic about what it has not seen). Fills the same memo
