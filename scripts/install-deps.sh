@@ -21,6 +21,10 @@ packages=(
   slurm-wlm munge      # campaigns as Slurm job arrays; a single-node cluster in tests (scripts/local-slurm.sh)
   parallel             # GNU parallel: campaign shards across machines over ssh
   python3              # scripts/: the layering check (a test) and the behaviour snapshot
+  python3-dev pybind11-dev  # the Python package (python/, docs/python.md)
+  python3-numpy        # its arrays
+  python3-matplotlib   # the Python examples' plots (examples/python/)
+  python3-pytest       # its tests
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-14-dev)  # libFuzzer, with AddressSanitizer (docs/reliability.md)

@@ -80,7 +80,7 @@ FlightRecorder::FlightRecorder(const FlightRecorderOptions& options, const Scena
       scenario_(&scenario),
       log_period_ns_(PeriodFromRate(scenario.log_rate_hz)),
       scene_(scenario.vehicle, scenario.world, {}, scenario.assembly.get()) {
-  if (!enabled()) return;
+  if (!writes()) return;
   std::error_code ec;
   fs::create_directories(options_.out_dir, ec);
   if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", options_.out_dir, ec.message()));
@@ -101,15 +101,15 @@ void FlightRecorder::Begin(const stack::FlightStack& st, int num_rotors) {
 }
 
 void FlightRecorder::OnControlCycle(TimeNs t, const stack::FlightStack& st, const RotorCommand& command) {
-  if (!enabled()) return;
+  if (!writes()) return;
   if (sensors_) record::AppendCommand(command, &sensor_buffer_);
   scene_.OnControlCycle(ToSeconds(t), st);
 }
 
 void FlightRecorder::OnStep(TimeNs t, const sim::Simulator& sim, const stack::FlightStack& st) {
-  if (!enabled() || t < next_log_ns_) return;
+  if (!logs() || t < next_log_ns_) return;
   AppendRow(sim, st, &flight_.table);
-  scene_.OnTime(ToSeconds(t));
+  if (writes()) scene_.OnTime(ToSeconds(t));
   next_log_ns_ += log_period_ns_;
 }
 
@@ -121,8 +121,9 @@ void FlightRecorder::AfterStep() {
 }
 
 void FlightRecorder::WriteFlight(const sim::Simulator& sim, const stack::FlightStack& st) {
-  if (!enabled()) return;
+  if (!logs()) return;
   AppendRow(sim, st, &flight_.table);
+  if (!writes()) return;
   flight_.scene = scene_.ToJson();
   if (options_.log_format != LogFormat::kMcap) {
     record::WriteFlightLogFiles(flight_, options_.out_dir);
@@ -137,7 +138,7 @@ void FlightRecorder::WriteFlight(const sim::Simulator& sim, const stack::FlightS
 }
 
 void FlightRecorder::WriteSummary(const RunSummary& summary) {
-  if (!enabled()) return;
+  if (!writes()) return;
   flight_.summary = summary.ToJson();
   if (options_.log_format != LogFormat::kCsv)
     record::WriteFlightMcap(flight_, InFolder(options_.out_dir, "flight.mcap"));

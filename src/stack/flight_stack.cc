@@ -386,6 +386,14 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   return command_;
 }
 
+const RotorCommand& FlightStack::OverrideCommand(const RotorVector& thrust_n) {
+  RG_INVARIANT(thrust_n.size() == model_.num_rotors() && thrust_n.allFinite(),
+               "OverrideCommand: one finite thrust per rotor");
+  command_.thrust_n = thrust_n;
+  if (fdd_) fdd_->SetCommand(command_.thrust_n);
+  return command_;
+}
+
 NavigationSummary FlightStack::SummarizeNavigation() const {
   const std::vector<Vector3>& w = options_.navigation.waypoints;
   NavigationSummary n;

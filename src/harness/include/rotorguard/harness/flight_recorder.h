@@ -28,6 +28,9 @@ struct FlightRecorderOptions {
   LogFormat log_format = LogFormat::kCsv;
   /// Also write report.html (record/report.h); needs a program built with the viewer (io::HasViewer).
   bool report = false;
+  /// Keep log.csv's rows in memory (FlightRecorder::log) even when nothing is written: the Python
+  /// module's `.log`.
+  bool keep_log = false;
 };
 
 class FlightRecorder {
@@ -36,7 +39,9 @@ class FlightRecorder {
   /// mix); opens sensors.csv. Throws std::runtime_error when the folder cannot be made.
   FlightRecorder(const FlightRecorderOptions& options, const Scenario& scenario);
 
-  bool enabled() const { return !options_.out_dir.empty(); }
+  /// Whether files are written (an output folder is given), and whether the log's rows are kept.
+  bool writes() const { return !options_.out_dir.empty(); }
+  bool logs() const { return writes() || options_.keep_log; }
   /// The sensor log's text to append to (sensors.csv's format), null when it is not written.
   std::string* sensor_log() { return sensors_ ? &sensor_buffer_ : nullptr; }
 
@@ -55,6 +60,11 @@ class FlightRecorder {
   /// Then flight.mcap, summary.json and report.html, as asked. Throws std::runtime_error when a
   /// file cannot be written.
   void WriteSummary(const RunSummary& summary);
+
+  /// log.csv's rows so far when they are kept (logs()), else null.
+  const io::NumericTable* log() const { return logs() ? &flight_.table : nullptr; }
+  /// Moves the rows out (empty when they are not kept).
+  io::NumericTable TakeLog() { return logs() ? std::move(flight_.table) : io::NumericTable{}; }
 
  private:
   FlightRecorderOptions options_;

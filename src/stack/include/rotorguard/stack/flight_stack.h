@@ -299,6 +299,11 @@ class FlightStack {
   void OnLidar(const LidarFrame& frame);
   /// One control cycle at time t: estimate, reference, controller. Call every control_period_ns().
   const RotorCommand& Update(TimeNs t);
+  /// Replaces the command of the control cycle just run (Update) with one computed outside the
+  /// stack (a controller written in Python, harness::Flight): the fault detection and the next
+  /// cycle's supervisor see it as the command sent. Every mode is overridden, the landed and
+  /// terminated ones too. `thrust_n` must hold one finite thrust per rotor (the caller checks).
+  const RotorCommand& OverrideCommand(const RotorVector& thrust_n);
 
   TimeNs control_period_ns() const { return control_period_ns_; }
   const StateEstimate& estimate() const { return estimate_; }

@@ -1,0 +1,410 @@
+// rotorguard._core: the C++ side of the Python package (python/rotorguard/, docs/python.md).
+// It exposes three things: loading a scenario, flying it to the end (run), and a flight stepped
+// from Python (Flight), whose simulator (the truth) and stack are separate views. Errors are
+// raised as the classes of rotorguard/errors.py, which carry file, line and key.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/buildinfo/build_info.h"
+#include "rotorguard/campaign/campaign.h"
+#include "rotorguard/campaign/merge.h"
+#include "rotorguard/campaign/statistics.h"
+#include "rotorguard/control/nmpc.h"
+#include "rotorguard/control/nominal_controller.h"
+#include "rotorguard/core/config_schema.h"
+#include "rotorguard/fdd/composite_fdd.h"
+#include "rotorguard/harness/flight.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/io/config_node.h"
+#include "rotorguard/sim/simulator.h"
+#include "rotorguard/stack/flight_stack.h"
+#include "rotorguard/vehicle/multirotor.h"
+
+namespace py = pybind11;
+
+namespace rotorguard::python {
+namespace {
+
+/// A numpy array that owns `values` (moved, not copied).
+py::array_t<double> ArrayOf(std::vector<double>&& values) {
+  auto* owned = new std::vector<double>(std::move(values));
+  py::capsule free_when_done(owned, [](void* p) { delete static_cast<std::vector<double>*>(p); });
+  return py::array_t<double>({static_cast<py::ssize_t>(owned->size())}, {sizeof(double)}, owned->data(),
+                             free_when_done);
+}
+
+/// A copy of a fixed or dynamic Eigen vector as a 1-D numpy array.
+template <typename Derived>
+py::array_t<double> ArrayOf(const Eigen::MatrixBase<Derived>& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  auto out = a.mutable_unchecked<1>();
+  for (Eigen::Index i = 0; i < v.size(); ++i) out(i) = v(i);
+  return a;
+}
+
+py::array_t<double> ArrayOf(const Quaternion& q) { return ArrayOf(Eigen::Vector4d(q.w(), q.x(), q.y(), q.z())); }
+
+py::array_t<double> MatrixOf(const Eigen::MatrixXd& m) {
+  py::array_t<double> a({static_cast<py::ssize_t>(m.rows()), static_cast<py::ssize_t>(m.cols())});
+  auto out = a.mutable_unchecked<2>();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    for (Eigen::Index c = 0; c < m.cols(); ++c) out(r, c) = m(r, c);
+  }
+  return a;
+}
+
+/// The log's columns as {name: numpy array}, moved out of the table.
+py::dict ColumnsOf(io::NumericTable&& table) {
+  py::dict columns;
+  for (std::size_t c = 0; c < table.columns.size(); ++c) {
+    columns[py::str(table.columns[c])] = ArrayOf(std::move(table.values[c]));
+  }
+  return columns;
+}
+
+/// summary.json's object as a Python dict (through the json module: one conversion for every
+/// nested field the summary holds).
+py::object DictOf(const harness::RunSummary& summary) {
+  return py::module_::import("json").attr("loads")(summary.ToJson().dump());
+}
+
+/// The rotor command a Python sequence gives, one thrust per rotor [N].
+RotorVector CommandOf(const py::array_t<double, py::array::c_style | py::array::forcecast>& thrust) {
+  if (thrust.ndim() != 1) throw std::invalid_argument("command: expected a 1-D array of thrusts [N]");
+  RotorVector u(static_cast<int>(thrust.shape(0)));
+  auto in = thrust.unchecked<1>();
+  for (py::ssize_t i = 0; i < thrust.shape(0); ++i) u[static_cast<int>(i)] = in(i);
+  return u;
+}
+
+harness::Scenario Load(const std::string& path, const std::vector<std::pair<std::string, std::string>>& overrides) {
+  return harness::LoadScenario(path, overrides);
+}
+
+harness::RunOptions OptionsOf(const std::optional<std::string>& out, const std::string& log_format, bool report,
+                              bool keep_log, bool stop_when_mission_complete) {
+  harness::RunOptions o;
+  o.out_dir = out.value_or("");
+  if (log_format == "csv") {
+    o.log_format = harness::LogFormat::kCsv;
+  } else if (log_format == "mcap") {
+    o.log_format = harness::LogFormat::kMcap;
+  } else if (log_format == "both") {
+    o.log_format = harness::LogFormat::kBoth;
+  } else {
+    throw std::invalid_argument("log_format: '" + log_format + "' is invalid; expected csv, mcap or both");
+  }
+  o.report = report;
+  o.keep_log = keep_log;
+  o.stop_when_mission_complete = stop_when_mission_complete;
+  return o;
+}
+
+/// The truth's view of a flight: what the simulator flies. Only the Flight hands it out.
+struct SimulatorView {
+  const harness::Flight* flight;
+  const sim::Simulator& sim() const { return flight->simulator(); }
+};
+
+/// The flight stack's view: what it received, estimated, diagnosed and commanded.
+struct StackView {
+  const harness::Flight* flight;
+  const stack::FlightStack& stack() const { return flight->stack(); }
+};
+
+py::dict EstimateOf(const StateEstimate& e) {
+  py::dict d;
+  d["t_s"] = ToSeconds(e.t_ns);
+  d["valid"] = e.valid;
+  d["position"] = ArrayOf(e.p_W);
+  d["attitude"] = ArrayOf(e.q_WB);
+  d["velocity"] = ArrayOf(e.v_W);
+  d["angular_velocity"] = ArrayOf(e.w_B);
+  return d;
+}
+
+/// The sensor messages of the latest step, by kind (those the step produced).
+py::dict MessagesOf(const sim::SensorOutputs& o) {
+  py::dict d;
+  if (o.imu) {
+    d["imu"] =
+        py::dict(py::arg("t_s") = ToSeconds(o.imu->t_ns), py::arg("specific_force") = ArrayOf(o.imu->specific_force_B),
+                 py::arg("angular_velocity") = ArrayOf(o.imu->w_B));
+  }
+  if (o.esc) {
+    d["esc"] = py::dict(py::arg("t_s") = ToSeconds(o.esc->t_ns),
+                        py::arg("motor_speed_rad_s") = ArrayOf(o.esc->motor_speed_rad_s));
+  }
+  if (o.odometry) {
+    d["odometry"] =
+        py::dict(py::arg("t_s") = ToSeconds(o.odometry->t_ns), py::arg("position") = ArrayOf(o.odometry->p_W),
+                 py::arg("attitude") = ArrayOf(o.odometry->q_WB), py::arg("velocity") = ArrayOf(o.odometry->v_W));
+  }
+  if (o.lidar) {
+    d["lidar"] = py::dict(py::arg("t_start_s") = ToSeconds(o.lidar->t_start_ns),
+                          py::arg("t_end_s") = ToSeconds(o.lidar->t_end_ns),
+                          py::arg("points") = static_cast<py::ssize_t>(o.lidar->points_S.size()));
+  }
+  return d;
+}
+
+void TranslateErrors(std::exception_ptr p) {
+  // The classes of rotorguard/errors.py, made with the C++ error's fields.
+  const auto raise = [](const char* name, py::tuple args) {
+    py::object cls = py::module_::import("rotorguard.errors").attr(name);
+    py::object error = cls(*args);
+    PyErr_SetObject(cls.ptr(), error.ptr());
+  };
+  try {
+    if (p) std::rethrow_exception(p);
+  } catch (const io::ConfigError& e) {
+    raise("ConfigError", py::make_tuple(e.what(), e.file(), e.line(), e.column(), e.key_path(), e.message()));
+  } catch (const io::InputFileError& e) {
+    raise("InputFileError", py::make_tuple(e.what(), e.path(), e.reason()));
+  } catch (const io::CorruptFileError& e) {
+    raise("CorruptFileError", py::make_tuple(e.what(), e.path(), e.byte_offset(), e.message()));
+  }
+}
+
+}  // namespace
+}  // namespace rotorguard::python
+
+PYBIND11_MODULE(_core, m) {
+  using namespace rotorguard;
+  using namespace rotorguard::python;
+  m.doc() = "rotorguard's C++ core: scenarios, flights and their views (use the rotorguard package)";
+  py::register_exception_translator(&TranslateErrors);
+
+  py::class_<harness::Scenario>(m, "Scenario", "A loaded, validated scenario (rotorguard.load_scenario)")
+      .def_readonly("name", &harness::Scenario::name)
+      .def_readonly("file", &harness::Scenario::file)
+      .def_readwrite("seed", &harness::Scenario::seed)
+      .def_readonly("duration_s", &harness::Scenario::duration_s)
+      .def_property_readonly("num_rotors", [](const harness::Scenario& s) { return s.vehicle.num_rotors(); })
+      .def_property_readonly("control_rate_hz", [](const harness::Scenario& s) { return s.stack.control_rate_hz; })
+      .def_property_readonly("controller",
+                             [](const harness::Scenario& s) { return std::string(ToName(s.stack.controller)); })
+      .def_property_readonly("nominal_gains",
+                             [](const harness::Scenario& s) {
+                               // stack.nominal: the nominal cascade's gains (docs/control.md).
+                               const control::NominalControllerOptions& n = s.stack.nominal;
+                               return py::dict(py::arg("kp_position") = ArrayOf(n.position.kp_position),
+                                               py::arg("kd_velocity") = ArrayOf(n.position.kd_velocity),
+                                               py::arg("ki_position") = ArrayOf(n.position.ki_position),
+                                               py::arg("integral_limit_m_s2") = n.position.integral_limit_m_s2,
+                                               py::arg("max_tilt_rad") = n.position.max_tilt_rad,
+                                               py::arg("k_attitude") = ArrayOf(n.k_attitude),
+                                               py::arg("k_rate") = ArrayOf(n.k_rate),
+                                               py::arg("max_rate_rad_s") = n.max_rate_rad_s);
+                             })
+      .def("__repr__", [](const harness::Scenario& s) {
+        return "<rotorguard.Scenario '" + s.name + "' from '" + s.file + "', seed " + std::to_string(s.seed) + ">";
+      });
+
+  m.def("wilson_interval", &campaign::WilsonInterval, py::arg("successes"), py::arg("trials"),
+        "The 95 % Wilson score interval (lo, hi) of `successes` in `trials` ((0, 1) for no trial)");
+  m.def("mcnemar_exact_p", &campaign::McNemarExactP, py::arg("only_first"), py::arg("only_second"),
+        "The exact McNemar test's two-sided p-value of a paired comparison's discordant pairs");
+
+  m.def("load_scenario", &Load, py::arg("path"), py::arg("overrides"),
+        "Loads and validates a scenario file with key.path=value overrides");
+
+  m.def(
+      "run",
+      [](const harness::Scenario& scenario, const std::optional<std::string>& out, const std::string& log_format,
+         bool report, bool keep_log, bool stop_when_mission_complete) {
+        harness::RunOptions options = OptionsOf(out, log_format, report, keep_log, stop_when_mission_complete);
+        std::optional<harness::RunSummary> summary;
+        io::NumericTable log;
+        {
+          // The flight holds no Python object: other threads run meanwhile (flights in parallel).
+          py::gil_scoped_release release;
+          harness::Flight flight(scenario, options);
+          flight.Fly();
+          summary = flight.Finish();
+          log = flight.TakeLog();
+        }
+        return py::make_tuple(DictOf(*summary), ColumnsOf(std::move(log)), summary->success,
+                              summary->infeasible_request);
+      },
+      py::arg("scenario"), py::arg("out"), py::arg("log_format"), py::arg("report"), py::arg("keep_log"),
+      py::arg("stop_when_mission_complete"));
+
+  // Campaigns (docs/campaigns.md): their records cross as JSON text, which the package parses.
+  m.def(
+      "run_campaign",
+      [](const std::string& spec, const std::optional<std::string>& out, int jobs, int shard_index, int shard_count,
+         bool resume, double trial_timeout_factor) -> py::object {
+        std::optional<std::vector<nlohmann::json>> records;
+        {
+          py::gil_scoped_release release;
+          const campaign::Campaign campaign = campaign::LoadCampaign(spec, benchmarks::CampaignKinds());
+          campaign::CampaignRunOptions o;
+          o.out_dir = out.value_or("");
+          o.jobs = jobs;
+          o.shard = {shard_index, shard_count};
+          o.resume = resume;
+          o.trial_timeout_factor = trial_timeout_factor;
+          o.version = buildinfo::ProgramVersion();
+          records = campaign::RunCampaignRecords(campaign, o);
+        }
+        if (!records) return py::none();
+        return py::str(nlohmann::json(*records).dump());
+      },
+      py::arg("spec"), py::arg("out"), py::arg("jobs"), py::arg("shard_index"), py::arg("shard_count"),
+      py::arg("resume"), py::arg("trial_timeout_factor"));
+  m.def(
+      "read_campaign",
+      [](const std::vector<std::string>& dirs) {
+        nlohmann::json manifest;
+        const std::vector<nlohmann::json> records = campaign::ReadCampaignRecords(dirs, &manifest);
+        return py::make_tuple(nlohmann::json(records).dump(), manifest.dump());
+      },
+      py::arg("dirs"));
+  m.def(
+      "merge_campaign",
+      [](const std::vector<std::string>& dirs, const std::string& out) {
+        return campaign::MergeCampaign(dirs, out, benchmarks::CampaignKinds()).dump();
+      },
+      py::arg("dirs"), py::arg("out"));
+
+  py::class_<SimulatorView>(m, "SimulatorView", "The truth: the simulated vehicle, its rotors and faults")
+      .def_property_readonly("time_s", [](const SimulatorView& v) { return v.sim().time_s(); })
+      .def_property_readonly("state", [](const SimulatorView& v) { return ArrayOf(v.sim().state()); })
+      .def_property_readonly("position",
+                             [](const SimulatorView& v) { return ArrayOf(vehicle::StateView(v.sim().state()).p_W()); })
+      .def_property_readonly("attitude",
+                             [](const SimulatorView& v) { return ArrayOf(vehicle::StateView(v.sim().state()).q_WB()); })
+      .def_property_readonly("velocity",
+                             [](const SimulatorView& v) { return ArrayOf(vehicle::StateView(v.sim().state()).v_W()); })
+      .def_property_readonly("angular_velocity",
+                             [](const SimulatorView& v) { return ArrayOf(vehicle::StateView(v.sim().state()).w_B()); })
+      .def_property_readonly("rotor_thrusts", [](const SimulatorView& v) { return ArrayOf(v.sim().rotor_thrusts()); })
+      .def_property_readonly("motor_speeds", [](const SimulatorView& v) { return ArrayOf(v.sim().motor_speeds()); })
+      .def_property_readonly("applied_command",
+                             [](const SimulatorView& v) { return ArrayOf(v.sim().applied_command()); })
+      .def_property_readonly("wind", [](const SimulatorView& v) { return ArrayOf(v.sim().wind()); })
+      .def_property_readonly("landed", [](const SimulatorView& v) { return v.sim().landed(); })
+      .def_property_readonly("crashed", [](const SimulatorView& v) { return v.sim().crashed(); })
+      .def_property_readonly("crash_reason", [](const SimulatorView& v) { return v.sim().crash_reason(); })
+      .def_property_readonly("faults",
+                             [](const SimulatorView& v) {
+                               std::vector<std::string> kinds;
+                               for (const vehicle::RotorFaultState& f : v.sim().faults()) {
+                                 kinds.emplace_back(vehicle::ToString(f.kind));
+                               }
+                               return kinds;
+                             })
+      .def_property_readonly("fault_events", [](const SimulatorView& v) {
+        py::list events;
+        for (const sim::FaultEvent& e : v.sim().fault_events()) {
+          events.append(py::dict(py::arg("rotor") = e.rotor, py::arg("kind") = std::string(vehicle::ToString(e.kind)),
+                                 py::arg("onset_s") = e.onset_s));
+        }
+        return events;
+      });
+
+  py::class_<StackView>(m, "StackView", "The flight stack: its estimate, reference, modes, fault detection, command")
+      .def_property_readonly("estimate", [](const StackView& v) { return EstimateOf(v.stack().estimate()); })
+      .def_property_readonly("reference",
+                             [](const StackView& v) {
+                               const ReferencePoint& r = v.stack().reference_point();
+                               return py::dict(
+                                   py::arg("position") = ArrayOf(r.p_W), py::arg("velocity") = ArrayOf(r.v_W),
+                                   py::arg("acceleration") = ArrayOf(r.a_W), py::arg("jerk") = ArrayOf(r.j_W),
+                                   py::arg("yaw") = r.yaw, py::arg("yaw_rate") = r.yaw_rate);
+                             })
+      .def_property_readonly("command", [](const StackView& v) { return ArrayOf(v.stack().command().thrust_n); })
+      .def_property_readonly("mode",
+                             [](const StackView& v) { return std::string(ToString(v.stack().supervisor().mode())); })
+      .def_property_readonly("control_period_s",
+                             [](const StackView& v) { return ToSeconds(v.stack().control_period_ns()); })
+      .def_property_readonly("isolated_rotors", [](const StackView& v) { return v.stack().isolated_rotors(); })
+      .def_property_readonly("waypoints_reached", [](const StackView& v) { return v.stack().waypoints_reached(); })
+      .def_property_readonly(
+          "fdd",
+          [](const StackView& v) -> py::object {
+            const fdd::FaultDetector* detector = v.stack().fault_detector();
+            if (detector == nullptr) return py::none();
+            py::list rotors;
+            for (const fdd::RotorStatus& r : detector->rotors()) {
+              rotors.append(py::dict(py::arg("health") = std::string(fdd::ToString(r.health)),
+                                     py::arg("motor_index") = r.motor_index,
+                                     py::arg("propeller_index") = r.propeller_index, py::arg("eta") = r.eta,
+                                     py::arg("detected_s") = r.detected_s, py::arg("detector") = r.detector));
+            }
+            return rotors;
+          })
+      .def_property_readonly(
+          "nmpc",
+          [](const StackView& v) -> py::object {
+            const control::NmpcController* nmpc = v.stack().nmpc();
+            if (nmpc == nullptr) return py::none();
+            const control::NmpcSummary& s = nmpc->summary();
+            return py::dict(py::arg("status") = std::string(control::ToString(s.status)),
+                            py::arg("sqp_iterations") = s.sqp_iterations, py::arg("qp_iterations") = s.qp_iterations,
+                            py::arg("kkt_residual") = s.kkt_residual, py::arg("objective") = s.objective,
+                            py::arg("solve_time_s") = s.solve_time_s, py::arg("fallbacks") = s.fallbacks);
+          })
+      .def_property_readonly("model", [](const StackView& v) {
+        // The vehicle as the stack knows it (its file), which the truth departs from.
+        const vehicle::MultirotorModel& model = v.stack().model();
+        const vehicle::VehicleParams& p = model.params();
+        return py::dict(py::arg("mass_kg") = p.mass_kg, py::arg("inertia_kg_m2") = MatrixOf(p.inertia_kg_m2),
+                        py::arg("effectiveness") = MatrixOf(model.effectiveness()),
+                        py::arg("max_thrust_n") = ArrayOf(model.max_thrust()),
+                        py::arg("hover_thrusts_n") = ArrayOf(model.HoverThrusts()),
+                        py::arg("rotor_drag_kg_s") = ArrayOf(p.rotor_drag_kg_s),
+                        py::arg("yaw_damping_n_m_s") = p.yaw_damping_n_m_s,
+                        py::arg("motor_time_constant_s") = p.motor_time_constant_s, py::arg("gravity_m_s2") = kGravity);
+      });
+
+  py::class_<harness::Flight>(m, "Flight")
+      .def(py::init([](const harness::Scenario& scenario, const std::optional<std::string>& out,
+                       const std::string& log_format, bool report, bool keep_log, bool stop_when_mission_complete) {
+             return std::make_unique<harness::Flight>(
+                 scenario, OptionsOf(out, log_format, report, keep_log, stop_when_mission_complete));
+           }),
+           py::arg("scenario"), py::arg("out"), py::arg("log_format"), py::arg("report"), py::arg("keep_log"),
+           py::arg("stop_when_mission_complete"))
+      .def_property_readonly("done", &harness::Flight::done)
+      .def_property_readonly("time_s", [](const harness::Flight& f) { return f.simulator().time_s(); })
+      .def_property_readonly("steps_total", &harness::Flight::steps_total)
+      .def_property_readonly("steps_taken", &harness::Flight::steps_taken)
+      .def("step", &harness::Flight::Step, "One physics step (the stack's control cycle first when due)")
+      .def(
+          "step_control",
+          [](harness::Flight& f,
+             const std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>>& command) {
+            if (!command) return f.StepControlPeriod(nullptr);
+            const RotorVector u = CommandOf(*command);
+            return f.StepControlPeriod(&u);
+          },
+          py::arg("command") = py::none())
+      .def("fly", &harness::Flight::Fly, py::call_guard<py::gil_scoped_release>())
+      .def("finish",
+           [](harness::Flight& f) {
+             std::optional<harness::RunSummary> summary;
+             {
+               py::gil_scoped_release release;
+               summary = f.Finish();
+             }
+             return py::make_tuple(DictOf(*summary), summary->success, summary->infeasible_request);
+           })
+      .def("take_log", [](harness::Flight& f) { return ColumnsOf(f.TakeLog()); })
+      .def_property_readonly("messages", [](const harness::Flight& f) { return MessagesOf(f.simulator().outputs()); })
+      .def_property_readonly(
+          "simulator", [](const harness::Flight& f) { return SimulatorView{&f}; }, py::keep_alive<0, 1>())
+      .def_property_readonly(
+          "stack", [](const harness::Flight& f) { return StackView{&f}; }, py::keep_alive<0, 1>());
+}
