@@ -106,26 +106,38 @@ def main():
     parser.add_argument("--forest-duration", type=float, help="seconds of the forest flight (default: its 120)")
     parser.add_argument("--hover-duration", type=float, default=20.0)
     parser.add_argument("--cli", default=os.path.join(ROOT, "build", "bin", "rotorguard"))
+    parser.add_argument("--parts", default="run_overhead,python_controller,threads",
+                        help="which measurements, comma-separated (default: all three)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     if args.repeats < 1:
         parser.error(f"--repeats {args.repeats} is invalid; expected an integer >= 1")
-    results = {
-        "run_overhead": run_overhead(args.cli, args.repeats, args.forest_duration),
-        "python_controller": python_controller(args.repeats, args.hover_duration),
-        "threads": threads(args.repeats, args.hover_duration),
+    parts = {
+        "run_overhead": lambda: run_overhead(args.cli, args.repeats, args.forest_duration),
+        "python_controller": lambda: python_controller(args.repeats, args.hover_duration),
+        "threads": lambda: threads(args.repeats, args.hover_duration),
     }
+    chosen = args.parts.split(",")
+    for part in chosen:
+        if part not in parts:
+            parser.error(f"--parts: '{part}' is invalid; expected some of {', '.join(parts)}")
+    results = {part: parts[part]() for part in chosen}
     if args.json:
         print(json.dumps(results, indent=2))
         return 0
-    o, c, t = results["run_overhead"], results["python_controller"], results["threads"]
-    print(f"run overhead (forest, {o['sim_s']:g} s): rotorguard.run {o['python_s_median']:.2f} s, "
-          f"CLI {o['cli_s_median']:.2f} s: ratio {o['ratio']:.3f} (target <= 1.05)")
-    print(f"hover stepped from Python at {c['control_rate_hz']:g} Hz ({c['sim_s']:g} s): "
-          f"{c['controller_realtime_factor']:.0f}x real time with the numpy controller (target >= 50), "
-          f"{c['stepping_realtime_factor']:.0f}x stepping alone, {c['run_realtime_factor']:.0f}x run")
-    print(f"two flights ({t['sim_s']:g} s each): {t['serial_s_median']:.2f} s one after the other, "
-          f"{t['two_threads_s_median']:.2f} s in two threads: {t['speedup']:.2f}x on {t['cores']} cores")
+    if "run_overhead" in results:
+        o = results["run_overhead"]
+        print(f"run overhead (forest, {o['sim_s']:g} s): rotorguard.run {o['python_s_median']:.2f} s, "
+              f"CLI {o['cli_s_median']:.2f} s: ratio {o['ratio']:.3f} (target <= 1.05)")
+    if "python_controller" in results:
+        c = results["python_controller"]
+        print(f"hover stepped from Python at {c['control_rate_hz']:g} Hz ({c['sim_s']:g} s): "
+              f"{c['controller_realtime_factor']:.0f}x real time with the numpy controller (target >= 50), "
+              f"{c['stepping_realtime_factor']:.0f}x stepping alone, {c['run_realtime_factor']:.0f}x run")
+    if "threads" in results:
+        t = results["threads"]
+        print(f"two flights ({t['sim_s']:g} s each): {t['serial_s_median']:.2f} s one after the other, "
+              f"{t['two_threads_s_median']:.2f} s in two threads: {t['speedup']:.2f}x on {t['cores']} cores")
     return 0
 
 

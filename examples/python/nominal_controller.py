@@ -25,7 +25,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 
 def rotation(q):
     """The rotation matrix of a unit quaternion (w, x, y, z)."""
-    w, x, y, z = q / np.linalg.norm(q)
+    w, x, y, z = q / norm(q)
     return np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
@@ -53,10 +53,19 @@ def quaternion(R):
     return q
 
 
+def cross(a, b):
+    """a x b of two 3-vectors (numpy's cross is general and slow for one pair)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+def norm(v):
+    return math.sqrt(v @ v)
+
+
 def quaternion_product(a, b):
     aw, av = a[0], a[1:]
     bw, bv = b[0], b[1:]
-    return np.concatenate(([aw * bw - av @ bv], aw * bv + bw * av + np.cross(av, bv)))
+    return np.concatenate(([aw * bw - av @ bv], aw * bv + bw * av + cross(av, bv)))
 
 
 class NominalController:
@@ -98,7 +107,7 @@ class NominalController:
         f = self.m * (a_cmd + np.array([0.0, 0.0, self.g])) + R @ (self.drag * (R.T @ est["velocity"]))
         f[2] = max(f[2], 0.1 * self.m * self.g)
         max_horizontal = f[2] * math.tan(k["max_tilt_rad"])
-        horizontal = np.linalg.norm(f[:2])
+        horizontal = norm(f[:2])
         if horizontal > max_horizontal:
             f[:2] *= max_horizontal / horizontal
         return f
@@ -108,29 +117,29 @@ class NominalController:
         k = self.k
         R = rotation(est["attitude"])
         f_des = self.thrust_vector(est, ref, dt)
-        z_des = f_des / np.linalg.norm(f_des)
+        z_des = f_des / norm(f_des)
         x_c = np.array([math.cos(ref["yaw"]), math.sin(ref["yaw"]), 0.0])
-        y_des = np.cross(z_des, x_c)
-        if np.linalg.norm(y_des) < 1e-6:
+        y_des = cross(z_des, x_c)
+        if norm(y_des) < 1e-6:
             y_des = R[:, 1]
-        y_des = y_des / np.linalg.norm(y_des)
-        x_des = np.cross(y_des, z_des)
+        y_des = y_des / norm(y_des)
+        x_des = cross(y_des, z_des)
         R_des = np.column_stack((x_des, y_des, z_des))
         thrust = max(0.0, f_des @ R[:, 2])
-        c = max(np.linalg.norm(f_des) / self.m, 0.1 * self.g)
+        c = max(norm(f_des) / self.m, 0.1 * self.g)
         h = (ref["jerk"] - (z_des @ ref["jerk"]) * z_des) / c
         w_ff_des = np.array([-(h @ y_des), h @ x_des, ref["yaw_rate"] * z_des[2]])
-        q = est["attitude"] / np.linalg.norm(est["attitude"])
+        q = est["attitude"] / norm(est["attitude"])
         q_e = quaternion_product(q * np.array([1.0, -1.0, -1.0, -1.0]), quaternion(R_des))
         if q_e[0] < 0.0:
             q_e = -q_e
         w_des = 2.0 * k["k_attitude"] * q_e[1:] + R.T @ R_des @ w_ff_des
-        rate_norm = np.linalg.norm(w_des)
+        rate_norm = norm(w_des)
         if rate_norm > k["max_rate_rad_s"]:
             w_des *= k["max_rate_rad_s"] / rate_norm
         w = est["angular_velocity"]
         alpha_des = k["k_rate"] * (w_des - w)
-        tau = self.I @ alpha_des + np.cross(w, self.I @ w) + np.array([0.0, 0.0, self.yaw_damping * w[2]])
+        tau = self.I @ alpha_des + cross(w, self.I @ w) + np.array([0.0, 0.0, self.yaw_damping * w[2]])
         return np.concatenate(([thrust], tau))
 
 
