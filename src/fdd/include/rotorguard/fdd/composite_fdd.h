@@ -290,7 +290,6 @@ class CompositeFdd final : public FaultDetectorBase {
   std::optional<double> relearn_since_s_;
   bool have_esc_ = false;
   // Observer.
-  double imu_rate_hz_ = 0.0;
   std::optional<TimeNs> last_imu_ns_;
   LowPass2<3> force_filter_, rate_filter_;
   FilteredDerivative<3> alpha_filter_;
