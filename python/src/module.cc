@@ -1,7 +1,8 @@
-// rotorguard._core: the C++ side of the Python package (python/rotorguard/, docs/python.md).
-// It exposes three things: loading a scenario, flying it to the end (run), and a flight stepped
-// from Python (Flight), whose simulator (the truth) and stack are separate views. Errors are
-// raised as the classes of rotorguard/errors.py, which carry file, line and key.
+// rotorguard._core: the C++ side of the Python package (python/rotorguard/, docs/python.md):
+// loading a scenario, flying it to the end (run), a flight stepped from Python (Flight), whose
+// simulator (the truth) and stack are separate views, and campaigns (run, read, merge) with their
+// statistics. Errors are raised as the classes of rotorguard/errors.py, which carry file, line
+// and key.
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
