@@ -15,6 +15,9 @@ if [ ${#targets[@]} -eq 0 ]; then
   mapfile -t targets < <(ROTORGUARD_FUZZ_TARGET=list "$fuzzer" 2>&1 | sed -n 's/^target: //p')
 fi
 status=0
+# Seconds an input may take: a scenario's validation plans its mission, and an assembly's plan
+# takes tens of seconds under the sanitizers and the coverage instrumentation.
+timeout=${FUZZ_INPUT_TIMEOUT:-120}
 export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 for t in "${targets[@]}"; do
   corpus="$dir/corpus/$t"
@@ -22,16 +25,17 @@ for t in "${targets[@]}"; do
   while read -r seed; do cp -n "$seed" "$corpus/seed-$(basename "$(dirname "$seed")")-$(basename "$seed")" 2>/dev/null || true; done \
     < <(ROTORGUARD_FUZZ_TARGET=$t ROTORGUARD_FUZZ_SEEDS=1 "$fuzzer" 2>/dev/null)
   log="$dir/fuzz-$t.log"
-  if ROTORGUARD_FUZZ_TARGET=$t "$fuzzer" "$corpus" -max_total_time="$seconds" -timeout=30 -rss_limit_mb=4096 \
+  if ROTORGUARD_FUZZ_TARGET=$t "$fuzzer" "$corpus" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=4096 \
        -artifact_prefix="$dir/" -print_final_stats=1 > "$log" 2>&1; then
     verdict="no finding"
   else
     verdict="FINDING (see $log)"
     status=1
   fi
+  # A run stopped early (a finding in the seeds) may have printed no coverage yet.
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
-  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1)
-  ft=$(grep -o 'ft: [0-9]*' "$log" | tail -1)
+  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 || true)
+  ft=$(grep -o 'ft: [0-9]*' "$log" | tail -1 || true)
   printf '%-14s %10s inputs in %s s, %s, %s, corpus %s files: %s\n' "$t" "${runs:-?}" "$seconds" "${cov:-cov: ?}" \
     "${ft:-ft: ?}" "$(ls "$corpus" | wc -l)" "$verdict"
 done
