@@ -82,7 +82,9 @@ struct Flight {
   sim::BodyPose Pose(TimeNs t) const { return {position(ToSeconds(t)), attitude(ToSeconds(t))}; }
   ImuSample Imu(TimeNs t_ns, const Vector3& imu_position_B) const {
     const double t = ToSeconds(t_ns), h = 1e-3;
-    const auto mount = [&](double s) { return position(s) + attitude(s) * imu_position_B; };
+    // Returns a Vector3, not the sum expression: that would refer to temporaries gone once the
+    // lambda returns (AddressSanitizer: stack-use-after-scope).
+    const auto mount = [&](double s) -> Vector3 { return position(s) + attitude(s) * imu_position_B; };
     const Vector3 a = (mount(t + h) - 2.0 * mount(t) + mount(t - h)) / (h * h);
     const Quaternion q = attitude(t);
     ImuSample s;
