@@ -66,9 +66,7 @@ class RunCommand final : public Command {
 
  private:
   harness::LogFormat ParseLogFormat() const {
-    if (log_format_ == "csv") return harness::LogFormat::kCsv;
-    if (log_format_ == "mcap") return harness::LogFormat::kMcap;
-    if (log_format_ == "both") return harness::LogFormat::kBoth;
+    if (const std::optional<harness::LogFormat> f = FromName<harness::LogFormat>(log_format_)) return *f;
     throw UsageError(fmt::format("--log-format: '{}' is invalid; expected csv, mcap or both", log_format_));
   }
 

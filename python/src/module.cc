@@ -88,23 +88,13 @@ RotorVector CommandOf(const py::array_t<double, py::array::c_style | py::array::
   return u;
 }
 
-harness::Scenario Load(const std::string& path, const std::vector<std::pair<std::string, std::string>>& overrides) {
-  return harness::LoadScenario(path, overrides);
-}
-
 harness::RunOptions OptionsOf(const std::optional<std::string>& out, const std::string& log_format, bool report,
                               bool keep_log, bool stop_when_mission_complete) {
   harness::RunOptions o;
   o.out_dir = out.value_or("");
-  if (log_format == "csv") {
-    o.log_format = harness::LogFormat::kCsv;
-  } else if (log_format == "mcap") {
-    o.log_format = harness::LogFormat::kMcap;
-  } else if (log_format == "both") {
-    o.log_format = harness::LogFormat::kBoth;
-  } else {
-    throw std::invalid_argument("log_format: '" + log_format + "' is invalid; expected csv, mcap or both");
-  }
+  const std::optional<harness::LogFormat> format = FromName<harness::LogFormat>(log_format);
+  if (!format) throw std::invalid_argument("log_format: '" + log_format + "' is invalid; expected csv, mcap or both");
+  o.log_format = *format;
   o.report = report;
   o.keep_log = keep_log;
   o.stop_when_mission_complete = stop_when_mission_complete;
@@ -217,7 +207,7 @@ PYBIND11_MODULE(_core, m) {
   m.def("mcnemar_exact_p", &campaign::McNemarExactP, py::arg("only_first"), py::arg("only_second"),
         "The exact McNemar test's two-sided p-value of a paired comparison's discordant pairs");
 
-  m.def("load_scenario", &Load, py::arg("path"), py::arg("overrides"),
+  m.def("load_scenario", &harness::LoadScenario, py::arg("path"), py::arg("overrides"),
         "Loads and validates a scenario file with key.path=value overrides");
 
   m.def(

@@ -3,9 +3,11 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/failure_diagnosis.h"
 #include "rotorguard/harness/flight_metrics.h"
@@ -22,7 +24,7 @@ namespace {
 /// own rule checked.
 Scenario Flown(const Scenario& sc) {
   Scenario flown = sc;
-  if (!flown.reference && flown.assembly_plan) PlanMission(&flown);  // an assembly's plan is made before it flies
+  PlanMission(&flown);  // an assembly's plan is made before it flies (nothing to do for the others)
   if (flown.stack.control_rate_hz > flown.sim.physics_rate_hz) {
     ThrowInvalidArgument("RunScenario", "stack.control_rate_hz", flown.stack.control_rate_hz,
                          "at most sim.physics_rate_hz (the runner polls the stack at physics steps)");
@@ -197,7 +199,6 @@ class Flight::Loop {
   const stack::FlightStack& stack() const { return stack_; }
   const Scenario& scenario() const { return sc_; }
   FlightRecorder& recorder() { return recorder_; }
-  const FlightRecorder& recorder() const { return recorder_; }
   std::int64_t steps_total() const { return steps_; }
   std::int64_t steps_taken() const { return static_cast<std::int64_t>(physics_steps_); }
 
@@ -305,8 +306,6 @@ const sim::Simulator& Flight::simulator() const { return loop_->simulator(); }
 const stack::FlightStack& Flight::stack() const { return loop_->stack(); }
 
 const Scenario& Flight::scenario() const { return loop_->scenario(); }
-
-const io::NumericTable* Flight::log() const { return loop_->recorder().log(); }
 
 io::NumericTable Flight::TakeLog() { return loop_->recorder().TakeLog(); }
 

@@ -5,9 +5,7 @@
 /// in place of the stack's controller's. The simulator (the truth) and the flight stack stay two
 /// objects that exchange only sensor messages and rotor commands (docs/architecture.md).
 #include <memory>
-#include <optional>
 
-#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/core/types.h"
 #include "rotorguard/harness/runner.h"
 
@@ -63,10 +61,9 @@ class Flight {
   const stack::FlightStack& stack() const;
   /// The scenario flown (an assembly's with its planned reference).
   const Scenario& scenario() const;
-  /// The log's rows so far (record::LogColumns) when RunOptions::keep_log or an output folder asks
-  /// for them, else null. Finish adds the last row.
-  const io::NumericTable* log() const;
-  /// Moves the log out (after Finish; the Python module hands its columns to numpy without a copy).
+  /// Moves the log's rows (record::LogColumns) out, after Finish, which adds the last: empty
+  /// unless RunOptions::keep_log or an output folder asked for them. The Python module hands the
+  /// columns to numpy without a copy.
   io::NumericTable TakeLog();
   /// The physics steps to the scenario's duration, and those taken.
   std::int64_t steps_total() const;

@@ -6,8 +6,10 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
@@ -22,6 +24,9 @@ namespace rotorguard::harness {
 /// What a run folder holds besides summary.json: kCsv log.csv, scene.json and sensors.csv; kMcap
 /// flight.mcap (record/flight_mcap.h); kBoth all of them.
 enum class LogFormat { kCsv, kMcap, kBoth };
+inline constexpr EnumName<LogFormat> kLogFormatNames[] = {
+    {LogFormat::kCsv, "csv"}, {LogFormat::kMcap, "mcap"}, {LogFormat::kBoth, "both"}};
+constexpr std::span<const EnumName<LogFormat>> NamesOf(const LogFormat*) { return kLogFormatNames; }
 
 struct FlightRecorderOptions {
   std::string out_dir;  ///< "" records nothing
@@ -61,9 +66,7 @@ class FlightRecorder {
   /// file cannot be written.
   void WriteSummary(const RunSummary& summary);
 
-  /// log.csv's rows so far when they are kept (logs()), else null.
-  const io::NumericTable* log() const { return logs() ? &flight_.table : nullptr; }
-  /// Moves the rows out (empty when they are not kept).
+  /// Moves log.csv's rows out (empty when they are not kept: logs()).
   io::NumericTable TakeLog() { return logs() ? std::move(flight_.table) : io::NumericTable{}; }
 
  private:
