@@ -124,6 +124,25 @@ py::dict EstimateOf(const StateEstimate& e) {
   return d;
 }
 
+/// A LiDAR frame's returns as an (n, 3) float32 array in the sensor frame [m]. A copy: the
+/// simulator replaces the frame at its next one.
+py::array_t<float> PointsOf(const LidarFrame& frame) {
+  const auto n = static_cast<py::ssize_t>(frame.points_S.size());
+  py::array_t<float> a({n, py::ssize_t{3}});
+  auto out = a.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < n; ++i) {
+    for (py::ssize_t k = 0; k < 3; ++k) out(i, k) = frame.points_S[static_cast<std::size_t>(i)](k);
+  }
+  return a;
+}
+
+/// Per return: its time after the frame's start [s].
+py::array_t<double> OffsetsOf(const LidarFrame& frame) {
+  std::vector<double> offsets(frame.offset_ns.size());
+  for (std::size_t i = 0; i < offsets.size(); ++i) offsets[i] = ToSeconds(frame.offset_ns[i]);
+  return ArrayOf(std::move(offsets));
+}
+
 /// The sensor messages of the latest step, by kind (those the step produced).
 py::dict MessagesOf(const sim::SensorOutputs& o) {
   py::dict d;
@@ -143,8 +162,8 @@ py::dict MessagesOf(const sim::SensorOutputs& o) {
   }
   if (o.lidar) {
     d["lidar"] = py::dict(py::arg("t_start_s") = ToSeconds(o.lidar->t_start_ns),
-                          py::arg("t_end_s") = ToSeconds(o.lidar->t_end_ns),
-                          py::arg("points") = static_cast<py::ssize_t>(o.lidar->points_S.size()));
+                          py::arg("t_end_s") = ToSeconds(o.lidar->t_end_ns), py::arg("points") = PointsOf(*o.lidar),
+                          py::arg("offsets_s") = OffsetsOf(*o.lidar), py::arg("dropped") = o.lidar->dropped);
   }
   return d;
 }

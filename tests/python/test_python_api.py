@@ -279,3 +279,45 @@ def test_the_messages_are_what_the_sensors_read_in_a_hover():
     mean = np.mean([f for _, f in forces], axis=0)
     assert mean[2] == pytest.approx(flight.stack.model["gravity_m_s2"], rel=0.03)
     assert np.linalg.norm(mean[:2]) < 0.3
+
+
+def rotation(q):
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def test_the_lidar_points_lie_on_the_walls_of_a_hand_made_room(tmp_path):
+    # A floor (top at z = 0) and a wall (face at x = 3 m) around a hover at 1 m: every return of a
+    # frame, placed in the world with the true pose at the frame's end and the sensor's mount,
+    # lies on one of the two surfaces, within the range noise (2 cm) and the rotation of the
+    # frame's 0.1 s.
+    with open(HOVER) as f:
+        text = f.read().replace("../vehicles/", os.path.join(ROOT, "configs", "vehicles") + "/")
+    room = tmp_path / "room.yaml"
+    room.write_text(text + "world:\n  boxes:\n"
+                    "    - {center_m: [0, 0, -0.5], size_m: [100, 100, 1]}\n"
+                    "    - {center_m: [3.5, 0, 2], size_m: [1, 100, 4]}\n"
+                    "sensors:\n  lidar: {}\n")
+    flight = rotorguard.Flight(room, set={"truth": "ideal", "duration_s": 5.0}, log=False)
+    while flight.time_s < 3.0:
+        flight.step_control()
+    while "lidar" not in flight.messages:
+        flight.step()
+    frame = flight.messages["lidar"]
+    points = frame["points"].astype(float)
+    assert points.ndim == 2 and points.shape[1] == 3 and frame["offsets_s"].shape == (len(points),)
+    assert len(points) + frame["dropped"] == 20000  # the default 200,000 pulses/s at 10 Hz
+    span = frame["t_end_s"] - frame["t_start_s"]
+    assert np.all((frame["offsets_s"] >= 0.0) & (frame["offsets_s"] < span)) and np.all(np.diff(frame["offsets_s"]) >= 0)
+    ranges = np.linalg.norm(points, axis=1)
+    elevation = np.arcsin(points[:, 2] / ranges)
+    assert np.all((elevation > math.radians(-7.0) - 1e-4) & (elevation < math.radians(52.0) + 1e-4))
+    truth = flight.simulator
+    world = (rotation(truth.attitude) @ (points + [0.0, 0.0, 0.06]).T).T + truth.position
+    off_surface = np.minimum(np.abs(world[:, 2]), np.abs(world[:, 0] - 3.0))
+    near = ranges < 10.0
+    assert near.sum() > 1000
+    assert np.median(off_surface[near]) < 0.03 and off_surface[near].max() < 0.15
+    assert np.percentile(off_surface, 99) < 0.3
