@@ -1,6 +1,7 @@
 // rotorguard bench NAME: the papers' benchmarks and the project's own, as tables or JSON.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -9,6 +10,7 @@
 #include "cli.h"
 #include "rotorguard/benchmarks/campaign_bench.h"
 #include "rotorguard/benchmarks/flatness_bench.h"
+#include "rotorguard/benchmarks/free_space_bench.h"
 #include "rotorguard/benchmarks/ftc_bench.h"
 #include "rotorguard/benchmarks/mars_bench.h"
 #include "rotorguard/benchmarks/nav_bench.h"
@@ -69,6 +71,9 @@ class BenchCommand final : public Command {
                                                                         : "Print JSON instead of Markdown");
     }
     lio_->add_flag("--json", json_, "Print JSON instead of Markdown");
+    planner_->add_flag("--free-space", planner_free_space_,
+                       "The trajectory optimiser alone on random free-space problems (docs/planning.md):\n"
+                       "free_space records of solve_us_median, eval_us_median, cost_mean, duration_s_mean");
     return bench;
   }
 
@@ -168,7 +173,9 @@ class BenchCommand final : public Command {
          "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.",
          {{"--pairs", &planner_pairs_, "Start/goal pairs per world kind (default 100)"},
           {"--worlds", &planner_worlds_, "Distinct worlds per kind (default 10, at most --pairs)"},
-          {"--seed", &seed_, "Worlds and pairs (default 1)"}}},
+          {"--seed", &seed_, "Worlds and pairs, or the free-space problems (default 1)"},
+          {"--problems", &planner_problems_, "With --free-space: problems per size (default 200)"},
+          {"--pieces", &planner_pieces_, "With --free-space: comma-separated sizes in pieces (default 5,10)"}}},
         {&nav_,
          "nav",
          "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
@@ -371,6 +378,7 @@ class BenchCommand final : public Command {
   }
 
   int Planner() const {
+    if (planner_free_space_) return PlannerFreeSpace();
     benchmarks::PlannerBenchOptions o;
     o.pairs = static_cast<int>(ParseUnsigned("--pairs", planner_pairs_, 1, 100000));
     o.worlds = static_cast<int>(ParseUnsigned("--worlds", planner_worlds_, 1, static_cast<std::uint64_t>(o.pairs)));
@@ -378,6 +386,23 @@ class BenchCommand final : public Command {
     o.progress = CountProgress("plans");
     const nlohmann::json r = benchmarks::RunPlannerBenchmark(o);
     PrintMarkdownResult("planner", r, benchmarks::PlannerMarkdown(r));
+    return kOk;
+  }
+
+  int PlannerFreeSpace() const {
+    benchmarks::FreeSpaceBenchOptions o;
+    o.problems = static_cast<int>(ParseUnsigned("--problems", planner_problems_, 1, 100000));
+    o.pieces.clear();
+    for (const double m : ParseFiniteList("--pieces", planner_pieces_, 1.0, 100.0)) {
+      if (m != std::floor(m)) {
+        throw UsageError(fmt::format("--pieces: '{}' is invalid; expected whole numbers in [1, 100]", planner_pieces_));
+      }
+      o.pieces.push_back(static_cast<int>(m));
+    }
+    o.seed = Seed();
+    o.progress = CountProgress("problems");
+    const nlohmann::json r = benchmarks::RunFreeSpaceBenchmark(o);
+    PrintMarkdownResult("planner", r, benchmarks::FreeSpaceMarkdown(r));
     return kOk;
   }
 
@@ -493,7 +518,8 @@ class BenchCommand final : public Command {
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";
   std::string lio_duration_ = "20", lio_spins_ = "0,5,11,20";
-  std::string planner_pairs_ = "100", planner_worlds_ = "10";
+  std::string planner_pairs_ = "100", planner_worlds_ = "10", planner_problems_ = "200", planner_pieces_ = "5,10";
+  bool planner_free_space_ = false;
   std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;
   std::string flatness_seeds_ = "20";
   std::string mars_trials_ = "10";

@@ -30,7 +30,7 @@ void DynamicLimits::Validate() const {
   };
   require(v_max, "v_max", kMaxSpeedMS);
   require(a_max, "a_max", kMaxAccelerationMS2);
-  require(j_max, "j_max", kMaxJerkMS3);
+  if (limits_jerk()) require(j_max, "j_max", kMaxJerkMS3);
 }
 
 double PostFailureAccelerationLimit(double mass_kg, double rotor_max_thrust_n, double max_drag_coefficient_kg_s,
@@ -123,6 +123,7 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   // quantity times s.
   const double limit2[3] = {limits.v_max * limits.v_max, limits.a_max * limits.a_max, limits.j_max * limits.j_max};
   const int k_samples = o.samples_per_piece;
+  const int max_order = limits.limits_jerk() ? 3 : 2;  // the derivatives with a limit
   for (int i = 0; i < pieces; ++i) {
     const auto c = traj.coefficients().middleRows<kC>(kC * i);
     std::size_t cursor = 0;  // the piece's planes, sorted by sample: the first of sample j
@@ -134,7 +135,7 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
       const double s = static_cast<double>(j) / k_samples, ts = s * t(i);
       const Eigen::Matrix<double, 5, kC> basis = MinimumJerkTrajectory::BasisRows(ts);
       const Eigen::Matrix<double, 5, 3> der = basis * c;  // p, v, a, j, snap
-      for (int d = 1; d <= 3; ++d) {  // J_d: velocity, acceleration, jerk (eqs. 26-29)
+      for (int d = 1; d <= max_order; ++d) {              // J_d: velocity, acceleration, jerk (eqs. 26-29)
         double slope;
         const double pen = CubicPenalty(der.row(d).squaredNorm() - limit2[d - 1], &slope);
         if (slope == 0.0) continue;
@@ -228,10 +229,13 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   // no choice of waypoints or durations could undercut.
   const double limit[3] = {std::max(limits.v_max, head.col(1).norm()), std::max(limits.a_max, head.col(2).norm()),
                            limits.j_max};
+  const Stopwatch check_clock;
   for (;;) {
     if (!traj.Build(head, tail, q, t)) return fail(Status::kSolverFailure, "the optimised trajectory cannot be built");
-    double ratio[3];  // max |derivative| / limit
-    for (int d = 1; d <= 3; ++d) ratio[d - 1] = traj.MaxNorm(d, options_.check_samples_per_piece) / limit[d - 1];
+    double ratio[3] = {0.0, 0.0, 0.0};  // max |derivative| / limit, of the limited ones
+    for (int d = 1; d <= (limits.limits_jerk() ? 3 : 2); ++d) {
+      ratio[d - 1] = traj.MaxNorm(d, options_.check_samples_per_piece) / limit[d - 1];
+    }
     summary.limit_margin = 1.0 - std::max({ratio[0], ratio[1], ratio[2]});
     if (summary.limit_margin >= 0.0) break;
     if (summary.slowdowns == options_.max_slowdowns) {
@@ -242,6 +246,7 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
     const double k = std::max({ratio[0], std::sqrt(ratio[1]), std::cbrt(ratio[2]), 1.0}) * options_.slowdown_factor;
     t *= std::min(k, 2.0);
   }
+  summary.check_ms = check_clock.milliseconds();
   *out = std::move(traj);
   summary.status = Status::kSuccess;
   summary.message = lbfgs.message;

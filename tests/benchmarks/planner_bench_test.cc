@@ -1,10 +1,12 @@
 #include "rotorguard/benchmarks/planner_bench.h"
-#include "rotorguard/harness/world_raster.h"
+
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include <gtest/gtest.h>
+#include "rotorguard/benchmarks/free_space_bench.h"
+#include "rotorguard/harness/world_raster.h"
 
 namespace rotorguard::benchmarks {
 namespace {
@@ -80,6 +82,46 @@ TEST(PlannerBench, BadOptionsAreNamed) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("worlds"), std::string::npos) << e.what();
   }
+}
+
+// The free-space problems as defined: every point in the 20 x 20 x 2 m box, each step 1.5-4 m,
+// each initial duration the step's length at v_max = 1 m/s; the same problem for the same
+// arguments and another for another index; and a small run reports one record per size.
+TEST(FreeSpaceBench, ProblemsFollowTheirDefinition) {
+  for (const int pieces : {1, 5, 10}) {
+    for (int index = 0; index < 50; ++index) {
+      const FreeSpaceProblem p = DrawFreeSpaceProblem(pieces, 7, index);
+      ASSERT_EQ(p.points.cols(), pieces + 1);
+      ASSERT_EQ(p.durations.size(), pieces);
+      for (int i = 0; i <= pieces; ++i) {
+        const Vector3 q = p.points.col(i);
+        EXPECT_TRUE(q.x() >= -10 && q.x() <= 10 && q.y() >= -10 && q.y() <= 10 && q.z() >= 0 && q.z() <= 2)
+            << q.transpose();
+      }
+      for (int i = 0; i < pieces; ++i) {
+        const double step = (p.points.col(i + 1) - p.points.col(i)).norm();
+        EXPECT_GE(step, 1.5 - 1e-12);
+        EXPECT_LE(step, 4.0 + 1e-12);
+        EXPECT_NEAR(p.durations(i), step / FreeSpaceLimits().v_max, 1e-12);
+      }
+    }
+    EXPECT_EQ(DrawFreeSpaceProblem(pieces, 7, 3).points, DrawFreeSpaceProblem(pieces, 7, 3).points);
+    EXPECT_NE(DrawFreeSpaceProblem(pieces, 7, 3).points, DrawFreeSpaceProblem(pieces, 7, 4).points);
+  }
+  FreeSpaceBenchOptions o;
+  o.pieces = {2, 3};
+  o.problems = 3;
+  o.evaluations = 2;
+  const nlohmann::json r = RunFreeSpaceBenchmark(o);
+  ASSERT_EQ(r["free_space"].size(), 2u);
+  for (const nlohmann::json& size : r["free_space"]) {
+    EXPECT_EQ(size["failed"].get<int>(), 0);
+    // The time weight is 10: the cost holds 10 T, T the optimised duration, which the dense check
+    // stretches by a few percent at most.
+    EXPECT_GT(size["cost_mean"].get<double>(), 0.9 * 10.0 * size["duration_s_mean"].get<double>());
+  }
+  o.pieces = {0};
+  EXPECT_THROW(RunFreeSpaceBenchmark(o), std::invalid_argument);
 }
 
 }  // namespace

@@ -183,5 +183,52 @@ TEST(TrajectoryOptimizer, InvalidInputsAndOptionsAreNamed) {
   EXPECT_NE(s.message.find("v_max"), std::string::npos) << s.message;
 }
 
+// Without a jerk limit the objective is the one whose jerk limit is never reached (its penalty
+// term is zero everywhere), value and gradient, and its gradient still matches central
+// differences; the optimum keeps v and a within their limits on a dense check. Only j_max may be
+// unlimited, and a NaN limit is no limit but an error.
+TEST(TrajectoryOptimizer, NoJerkLimitDropsTheJerkTermAndItsCheck) {
+  TrajectoryOptimizerOptions o;
+  o.weights.collision = 0.0;
+  const TrajectoryOptimizer optimizer(o);
+  const PvaState head = Rest(Vector3(0, 0, 1)), tail = Rest(Vector3(6, 3, 1.5));
+  Eigen::Matrix3Xd q;
+  Eigen::VectorXd t;
+  StraightGuess(head.col(0), tail.col(0), 4, 1.5, &q, &t);  // fast: v and a penalties active
+  Eigen::VectorXd x(4 * 4 - 3);
+  x.head(9) = Eigen::Map<const Eigen::VectorXd>(q.data(), 9) + Eigen::VectorXd::LinSpaced(9, -0.2, 0.2);
+  for (int i = 0; i < 4; ++i) x(9 + i) = TrajectoryOptimizer::TauOf(t(i));
+  const DynamicLimits none{1.0, 0.8, DynamicLimits::kNoLimit}, unreachable{1.0, 0.8, 1e9};
+  Eigen::VectorXd g_none, g_unreachable;
+  const double f_none = optimizer.Objective(head, tail, none, {}, x, &g_none);
+  EXPECT_NEAR(f_none, optimizer.Objective(head, tail, unreachable, {}, x, &g_unreachable), 1e-12 * f_none);
+  EXPECT_LT((g_none - g_unreachable).norm(), 1e-12 * g_none.norm());
+  EXPECT_GT(f_none, 10.0 * t.sum() + 1.0) << "the limits' penalties are active";
+  for (int k = 0; k < x.size(); ++k) {
+    const double h = 1e-6;
+    Eigen::VectorXd plus = x, minus = x;
+    plus(k) += h;
+    minus(k) -= h;
+    const double fd = (optimizer.Objective(head, tail, none, {}, plus, nullptr) -
+                       optimizer.Objective(head, tail, none, {}, minus, nullptr)) /
+                      (2 * h);
+    EXPECT_NEAR(g_none(k), fd, 1e-5 * std::max(1.0, std::abs(fd))) << "variable " << k;
+  }
+  MinimumJerkTrajectory traj;
+  const TrajectoryOptimizerSummary s = optimizer.Optimize(head, tail, q, t, none, {}, &traj);
+  ASSERT_TRUE(s.ok()) << s.message;
+  EXPECT_LE(traj.MaxNorm(1, 2000), none.v_max * 1.001);
+  EXPECT_LE(traj.MaxNorm(2, 2000), none.a_max * 1.001);
+  EXPECT_GE(s.check_ms, 0.0);
+  EXPECT_LE(s.check_ms, s.solve_ms);
+
+  EXPECT_NO_THROW(none.Validate());
+  for (const DynamicLimits& bad :
+       {DynamicLimits{DynamicLimits::kNoLimit, 1.0, 1.0}, DynamicLimits{1.0, DynamicLimits::kNoLimit, 1.0},
+        DynamicLimits{1.0, 1.0, std::nan("")}}) {
+    EXPECT_THROW(bad.Validate(), ValidationError);
+  }
+}
+
 }  // namespace
 }  // namespace rotorguard::planning

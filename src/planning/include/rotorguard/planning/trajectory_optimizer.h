@@ -11,9 +11,10 @@
 /// a limit is exceeded, time is stretched until it holds (see `Summary`).
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <optional>
-#include <vector>
 #include <string>
+#include <vector>
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
@@ -25,9 +26,13 @@ namespace rotorguard::planning {
 /// Each in (0, its kMax...] (core/config_schema.h): a limit beyond a multirotor's reach only makes
 /// the collision checks' time steps (a step in metres over v_max) vanish.
 struct DynamicLimits {
+  /// j_max's value for no jerk limit: the objective then has no jerk term and the dense check
+  /// samples no jerk.
+  static constexpr double kNoLimit = std::numeric_limits<double>::infinity();
   double v_max = 1.0;  ///< [m/s], in (0, kMaxSpeedMS]
   double a_max = 2.0;  ///< [m/s²], in (0, kMaxAccelerationMS2] (a_max,n nominal; a_max,f of eq. 33 after a failure)
-  double j_max = 6.0;  ///< [m/s³], in (0, kMaxJerkMS3]
+  double j_max = 6.0;  ///< [m/s³], in (0, kMaxJerkMS3], or kNoLimit
+  bool limits_jerk() const { return j_max != kNoLimit; }
   void Validate() const;
 };
 
@@ -124,6 +129,7 @@ struct TrajectoryOptimizerSummary {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   double solve_ms = 0.0;
+  double check_ms = 0.0;  ///< of solve_ms, the dense limit check and its time stretching
   /// min over v, a, j of (limit - max value) / limit on the dense check: >= 0 when all hold.
   /// (A head velocity or acceleration beyond its limit raises that limit to the head's value.)
   double limit_margin = 0.0;
