@@ -175,7 +175,9 @@ class BenchCommand final : public Command {
           {"--worlds", &planner_worlds_, "Distinct worlds per kind (default 10, at most --pairs)"},
           {"--seed", &seed_, "Worlds and pairs, or the free-space problems (default 1)"},
           {"--problems", &planner_problems_, "With --free-space: problems per size (default 200)"},
-          {"--pieces", &planner_pieces_, "With --free-space: comma-separated sizes in pieces (default 5,10)"}}},
+          {"--pieces", &planner_pieces_, "With --free-space: comma-separated sizes in pieces (default 5,10)"},
+          {"--lbfgs", &planner_lbfgs_,
+           "With --free-space: the optimiser's L-BFGS, ceres (the default) or lewis_overton (docs/planning.md)"}}},
         {&nav_,
          "nav",
          "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
@@ -399,6 +401,11 @@ class BenchCommand final : public Command {
       }
       o.pieces.push_back(static_cast<int>(m));
     }
+    const std::vector<std::string> lbfgs = ParseWordList("--lbfgs", planner_lbfgs_, {"ceres", "lewis_overton"});
+    if (lbfgs.size() != 1) {
+      throw UsageError(fmt::format("--lbfgs: '{}' is invalid; expected one of ceres, lewis_overton", planner_lbfgs_));
+    }
+    o.lbfgs = lbfgs[0] == "ceres" ? planning::LbfgsMethod::kCeres : planning::LbfgsMethod::kLewisOverton;
     o.seed = Seed();
     o.progress = CountProgress("problems");
     const nlohmann::json r = benchmarks::RunFreeSpaceBenchmark(o);
@@ -518,7 +525,8 @@ class BenchCommand final : public Command {
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";
   std::string lio_duration_ = "20", lio_spins_ = "0,5,11,20";
-  std::string planner_pairs_ = "100", planner_worlds_ = "10", planner_problems_ = "200", planner_pieces_ = "5,10";
+  std::string planner_pairs_ = "100", planner_worlds_ = "10", planner_problems_ = "200", planner_pieces_ = "5,10",
+              planner_lbfgs_ = "ceres";
   bool planner_free_space_ = false;
   std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;
   std::string flatness_seeds_ = "20";

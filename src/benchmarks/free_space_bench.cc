@@ -46,8 +46,9 @@ planning::DynamicLimits FreeSpaceLimits() {
   return limits;
 }
 
-planning::TrajectoryOptimizerOptions FreeSpaceOptimizerOptions() {
+planning::TrajectoryOptimizerOptions FreeSpaceOptimizerOptions(planning::LbfgsMethod lbfgs) {
   planning::TrajectoryOptimizerOptions o;
+  o.lbfgs_method = lbfgs;
   o.weights = {.time = 10.0, .smoothness = 1.0, .feasibility = 1e4, .collision = 0.0};
   o.samples_per_piece = 16;  // 17 samples, both ends included
   o.max_iterations = 200;
@@ -78,7 +79,7 @@ FreeSpaceProblem DrawFreeSpaceProblem(int pieces, std::uint64_t seed, int index)
 nlohmann::json RunFreeSpaceBenchmark(const FreeSpaceBenchOptions& options) {
   options.Validate();
   const planning::DynamicLimits limits = FreeSpaceLimits();
-  const planning::TrajectoryOptimizer optimizer(FreeSpaceOptimizerOptions());
+  const planning::TrajectoryOptimizer optimizer(FreeSpaceOptimizerOptions(options.lbfgs));
   const int total = static_cast<int>(options.pieces.size()) * options.problems;
   int done = 0;
   nlohmann::json sizes = nlohmann::json::array();
@@ -130,7 +131,7 @@ nlohmann::json RunFreeSpaceBenchmark(const FreeSpaceBenchOptions& options) {
                      {"evaluations_mean", Mean(evaluations)},
                      {"stretched_by_check", stretched}});
   }
-  const planning::TrajectoryOptimizerOptions o = FreeSpaceOptimizerOptions();
+  const planning::TrajectoryOptimizerOptions o = FreeSpaceOptimizerOptions(options.lbfgs);
   return {{"benchmark", "planner_free_space"},
           {"seed", options.seed},
           {"problem",
@@ -142,7 +143,8 @@ nlohmann::json RunFreeSpaceBenchmark(const FreeSpaceBenchOptions& options) {
             {"weights", {o.weights.time, o.weights.smoothness, o.weights.feasibility}},
             {"samples_per_piece", o.samples_per_piece + 1},
             {"max_iterations", o.max_iterations},
-            {"relative_cost_tolerance", o.relative_cost_tolerance}}},
+            {"relative_cost_tolerance", o.relative_cost_tolerance},
+            {"lbfgs", options.lbfgs == planning::LbfgsMethod::kCeres ? "ceres" : "lewis_overton"}}},
           {"free_space", sizes},
           {"host", buildinfo::HostInfo()}};
 }
@@ -150,8 +152,9 @@ nlohmann::json RunFreeSpaceBenchmark(const FreeSpaceBenchOptions& options) {
 std::string FreeSpaceMarkdown(const nlohmann::json& r) {
   std::string md = fmt::format(
       "The trajectory optimiser on {} random free-space problems per size, seed {} (rest to rest, v_max 1 m/s, "
-      "a_max 2 m/s², no jerk limit).\n\n",
-      r["free_space"][0]["problems"].get<int>(), r["seed"].get<std::uint64_t>());
+      "a_max 2 m/s², no jerk limit), L-BFGS: {}.\n\n",
+      r["free_space"][0]["problems"].get<int>(), r["seed"].get<std::uint64_t>(),
+      r["problem"]["lbfgs"].get<std::string>());
   md +=
       "| pieces | solve µs (median / p90) | one evaluation µs | check µs | cost (mean) | duration s (mean) | "
       "iterations | evaluations | stretched | failed |\n";

@@ -1,13 +1,18 @@
 #include "rotorguard/planning/lbfgs.h"
 
-#include <algorithm>
-#include <cmath>
-#include <mutex>
-
 #include <ceres/first_order_function.h>
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
 #include <glog/logging.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <vector>
+
+#include "rotorguard/core/error.h"
 
 namespace rotorguard::planning {
 
@@ -37,9 +42,111 @@ class CeresObjective final : public ceres::FirstOrderFunction {
   int* evaluations_;
 };
 
+/// LbfgsMethod::kLewisOverton.
+LbfgsSummary MinimizeLewisOverton(const GradientObjective& f, const LbfgsOptions& options, Eigen::VectorXd* x) {
+  // Armijo's sufficient decrease and the weak Wolfe curvature condition (Nocedal & Wright, eq. 3.6).
+  constexpr double kArmijo = 1e-4, kCurvature = 0.9;
+  constexpr int kMaxLineSearch = 60;
+  LbfgsSummary summary;
+  const auto n = x->size();
+  Eigen::VectorXd g(n), x_trial(n), g_trial(n), d(n);
+  double fx = f(*x, &g);
+  ++summary.evaluations;
+  if (!std::isfinite(fx) || g.size() != n || !g.allFinite()) {
+    summary.failed = true;
+    summary.message = "the starting point has no finite cost and gradient";
+    return summary;
+  }
+  const int m = options.memory;
+  Eigen::MatrixXd s_pairs(n, m), y_pairs(n, m);
+  Eigen::VectorXd rho(m), alpha(m);
+  int stored = 0, newest = -1;  // a ring of the last `stored` pairs, newest at `newest`
+  std::vector<double> history(static_cast<std::size_t>(options.past), fx);  // f of the last `past` iterates
+  d = -g;
+  double step = 1.0 / std::max(d.norm(), 1e-300);  // the first step moves x by one unit
+  for (int k = 1; k <= options.max_iterations; ++k) {
+    const double slope = g.dot(d);
+    if (!(slope < 0.0)) {  // not a descent direction (rounding at a flat point): steepest descent
+      d = -g;
+      stored = 0;
+      if (!(g.dot(d) < 0.0)) {
+        summary.message = "the gradient vanished";
+        break;
+      }
+    }
+    const double g_dot_d = g.dot(d);
+    double low = 0.0, high = std::numeric_limits<double>::infinity(), t = step, f_trial = fx;
+    bool accepted = false;
+    for (int ls = 0; ls < kMaxLineSearch && !accepted; ++ls) {
+      x_trial = *x + t * d;
+      f_trial = f(x_trial, &g_trial);
+      ++summary.evaluations;
+      const bool finite = std::isfinite(f_trial) && g_trial.size() == n && g_trial.allFinite();
+      if (!finite || f_trial > fx + kArmijo * t * g_dot_d) {
+        high = t;
+      } else if (g_trial.dot(d) < kCurvature * g_dot_d) {
+        low = t;
+      } else {
+        accepted = true;
+        break;
+      }
+      t = std::isinf(high) ? 2.0 * t : 0.5 * (low + high);
+    }
+    summary.iterations = k;
+    if (!accepted) {
+      summary.message = "the line search found no step that satisfies the Wolfe conditions";
+      break;
+    }
+    // The new pair, kept when its curvature is positive (always, under the Wolfe conditions, but for
+    // rounding).
+    const Eigen::VectorXd s_new = x_trial - *x, y_new = g_trial - g;
+    const double sy = s_new.dot(y_new);
+    *x = x_trial;
+    g = g_trial;
+    const double f_before = history.front();
+    std::rotate(history.begin(), history.begin() + 1, history.end());
+    history.back() = f_trial;
+    fx = f_trial;
+    if (sy > 1e-12 * s_new.norm() * y_new.norm()) {
+      newest = (newest + 1) % m;
+      s_pairs.col(newest) = s_new;
+      y_pairs.col(newest) = y_new;
+      rho(newest) = 1.0 / sy;
+      stored = std::min(stored + 1, m);
+    }
+    // The decrease test over the last `past` iterations.
+    if (k >= options.past && f_before - fx < options.relative_cost_tolerance * std::max(std::abs(fx), 1e-300)) {
+      summary.message = "the cost fell by less than the tolerance over the last iterations";
+      break;
+    }
+    // d = -H g by the two-loop recursion, H0 = (s'y / y'y) I of the newest pair.
+    d = -g;
+    for (int j = 0, i = newest; j < stored; ++j, i = (i - 1 + m) % m) {
+      alpha(i) = rho(i) * s_pairs.col(i).dot(d);
+      d.noalias() -= alpha(i) * y_pairs.col(i);
+    }
+    if (stored > 0) d *= 1.0 / (rho(newest) * y_pairs.col(newest).squaredNorm());
+    for (int j = 0, i = (newest - stored + 1 + m) % m; j < stored; ++j, i = (i + 1) % m) {
+      const double beta = rho(i) * y_pairs.col(i).dot(d);
+      d.noalias() += (alpha(i) - beta) * s_pairs.col(i);
+    }
+    step = 1.0;
+    if (k == options.max_iterations) summary.message = "the iteration limit";
+  }
+  return summary;
+}
+
 }  // namespace
 
 LbfgsSummary MinimizeLbfgs(const GradientObjective& f, const LbfgsOptions& options, Eigen::VectorXd* x) {
+  const auto require = [](bool ok, const char* field, double value, const char* rule) {
+    if (!ok) ThrowInvalidArgument("MinimizeLbfgs", std::string("LbfgsOptions::") + field, value, rule);
+  };
+  require(options.max_iterations >= 1, "max_iterations", options.max_iterations, ">= 1");
+  require(options.relative_cost_tolerance > 0.0, "relative_cost_tolerance", options.relative_cost_tolerance, "> 0");
+  require(options.memory >= 1, "memory", options.memory, ">= 1");
+  require(options.past >= 1, "past", options.past, ">= 1");
+  if (options.method == LbfgsMethod::kLewisOverton) return MinimizeLewisOverton(f, options, x);
   static std::once_flag quiet;
   std::call_once(quiet, [] { FLAGS_minloglevel = std::max(FLAGS_minloglevel, static_cast<int>(google::GLOG_ERROR)); });
   LbfgsSummary summary;

@@ -74,6 +74,8 @@ void TrajectoryOptimizerOptions::Validate() const {
   require(check_samples_per_piece >= samples_per_piece, "check_samples_per_piece", check_samples_per_piece,
           "at least samples_per_piece");
   require(max_slowdowns >= 0, "max_slowdowns", max_slowdowns, ">= 0");
+  require(lbfgs_memory >= 1, "lbfgs_memory", lbfgs_memory, ">= 1");
+  require(lbfgs_past >= 1, "lbfgs_past", lbfgs_past, ">= 1");
   require(slowdown_factor > 1.0 && slowdown_factor <= 2.0, "slowdown_factor", slowdown_factor, "in (1, 2]");
 }
 
@@ -209,7 +211,12 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
 
   const LbfgsSummary lbfgs = MinimizeLbfgs(
       [&](const Eigen::VectorXd& v, Eigen::VectorXd* g) { return Objective(head, tail, limits, sorted, v, g); },
-      {options_.max_iterations, options_.relative_cost_tolerance}, &x);
+      {.max_iterations = options_.max_iterations,
+       .relative_cost_tolerance = options_.relative_cost_tolerance,
+       .method = options_.lbfgs_method,
+       .memory = options_.lbfgs_memory,
+       .past = options_.lbfgs_past},
+      &x);
   summary.iterations = lbfgs.iterations;
   summary.evaluations = lbfgs.evaluations;
   summary.final_cost = Objective(head, tail, limits, sorted, x, nullptr);

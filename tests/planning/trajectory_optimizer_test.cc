@@ -95,32 +95,37 @@ TEST(TrajectoryOptimizer, PostFailureAccelerationLimitIsEquation33) {
 
 // Free space, rest to rest over 8 m: the result respects v, a and j limits on a sampling 30 times
 // denser than the optimiser's own check and takes no less than the bang-bang time, for nominal
-// limits and for a lower post-failure acceleration limit, which makes the flight longer.
+// limits and for a lower post-failure acceleration limit, which makes the flight longer; with
+// either L-BFGS.
 TEST(TrajectoryOptimizer, OutputRespectsItsLimitsAndALowerAccelerationLimitSlowsIt) {
-  const TrajectoryOptimizer optimizer{TrajectoryOptimizerOptions{}};
-  const PvaState head = Rest(Vector3(0, 0, 1)), tail = Rest(Vector3(8, 2, 1));
-  Eigen::Matrix3Xd q;
-  Eigen::VectorXd t;
-  StraightGuess(head.col(0), tail.col(0), 5, 2.0, &q, &t);
-  double durations[2];
-  int run = 0;
-  for (const double a_max : {2.0, 0.3}) {
-    const DynamicLimits limits{1.0, a_max, 2.0};
-    MinimumJerkTrajectory traj;
-    const TrajectoryOptimizerSummary s = optimizer.Optimize(head, tail, q, t, limits, {}, &traj);
-    ASSERT_TRUE(s.ok()) << s.message;
-    EXPECT_GE(s.limit_margin, 0.0);
-    EXPECT_LE(traj.MaxNorm(1, 2000), limits.v_max * 1.001);
-    EXPECT_LE(traj.MaxNorm(2, 2000), limits.a_max * 1.001);
-    EXPECT_LE(traj.MaxNorm(3, 2000), limits.j_max * 1.001);
-    EXPECT_LT((traj.Evaluate(traj.total_duration()).p_W - tail.col(0)).norm(), 1e-9);
-    // No flight from rest to rest over d within v_max and a_max is faster than the bang-bang
-    // profile: d / v + v / a when it reaches v_max, else 2 sqrt(d / a).
-    const double d = (tail.col(0) - head.col(0)).norm(), v = limits.v_max, a = limits.a_max;
-    EXPECT_GE(traj.total_duration(), d >= v * v / a ? d / v + v / a : 2.0 * std::sqrt(d / a));
-    durations[run++] = traj.total_duration();
+  for (const LbfgsMethod method : {LbfgsMethod::kCeres, LbfgsMethod::kLewisOverton}) {
+    TrajectoryOptimizerOptions options;
+    options.lbfgs_method = method;
+    const TrajectoryOptimizer optimizer(options);
+    const PvaState head = Rest(Vector3(0, 0, 1)), tail = Rest(Vector3(8, 2, 1));
+    Eigen::Matrix3Xd q;
+    Eigen::VectorXd t;
+    StraightGuess(head.col(0), tail.col(0), 5, 2.0, &q, &t);
+    double durations[2];
+    int run = 0;
+    for (const double a_max : {2.0, 0.3}) {
+      const DynamicLimits limits{1.0, a_max, 2.0};
+      MinimumJerkTrajectory traj;
+      const TrajectoryOptimizerSummary s = optimizer.Optimize(head, tail, q, t, limits, {}, &traj);
+      ASSERT_TRUE(s.ok()) << s.message;
+      EXPECT_GE(s.limit_margin, 0.0);
+      EXPECT_LE(traj.MaxNorm(1, 2000), limits.v_max * 1.001);
+      EXPECT_LE(traj.MaxNorm(2, 2000), limits.a_max * 1.001);
+      EXPECT_LE(traj.MaxNorm(3, 2000), limits.j_max * 1.001);
+      EXPECT_LT((traj.Evaluate(traj.total_duration()).p_W - tail.col(0)).norm(), 1e-9);
+      // No flight from rest to rest over d within v_max and a_max is faster than the bang-bang
+      // profile: d / v + v / a when it reaches v_max, else 2 sqrt(d / a).
+      const double d = (tail.col(0) - head.col(0)).norm(), v = limits.v_max, a = limits.a_max;
+      EXPECT_GE(traj.total_duration(), d >= v * v / a ? d / v + v / a : 2.0 * std::sqrt(d / a));
+      durations[run++] = traj.total_duration();
+    }
+    EXPECT_GT(durations[1], durations[0]) << "a_max,f = 0.3 m/s² takes longer than 2 m/s²";
   }
-  EXPECT_GT(durations[1], durations[0]) << "a_max,f = 0.3 m/s² takes longer than 2 m/s²";
 }
 
 // A pillar on the straight line: planes from the initial guess's samples, then, as the planner

@@ -24,13 +24,29 @@ inline double CubicPenalty(double x, double* slope) {
 /// f(x) and, when `gradient` is not null, its gradient; NaN when x has no value.
 using GradientObjective = std::function<double(const Eigen::VectorXd& x, Eigen::VectorXd* gradient)>;
 
+/// Which L-BFGS minimises.
+enum class LbfgsMethod {
+  /// Ceres' GradientProblemSolver: Wolfe line search (bracketing and zoom), the initial inverse
+  /// Hessian scaled by its approximate-eigenvalue estimate; stops once one iteration lowers f by
+  /// less than relative_cost_tolerance.
+  kCeres,
+  /// This library's own: the two-loop recursion over `memory` pairs, a weak-Wolfe line search by
+  /// bisection and doubling (Lewis & Overton, "Nonsmooth optimization via quasi-Newton methods",
+  /// Math. Prog. 2013), and a stop once f fell by less than relative_cost_tolerance over the last
+  /// `past` iterations (liblbfgs' delta test), which one short step does not trigger.
+  kLewisOverton,
+};
+
 struct LbfgsOptions {
   int max_iterations = 200;               ///< >= 1
-  double relative_cost_tolerance = 1e-4;  ///< stop once an iteration lowers f by less than this fraction
+  double relative_cost_tolerance = 1e-4;  ///< stop once f falls by less than this fraction (see LbfgsMethod)
+  LbfgsMethod method = LbfgsMethod::kCeres;
+  int memory = 64;  ///< kLewisOverton: correction pairs kept, >= 1
+  int past = 3;     ///< kLewisOverton: iterations the decrease test spans, >= 1
 };
 
 struct LbfgsSummary {
-  bool failed = false;  ///< Ceres reported a failure (x may still be the best point it reached)
+  bool failed = false;  ///< the solver failed (x may still be the best point it reached)
   int iterations = 0;
   int evaluations = 0;
   std::string message;

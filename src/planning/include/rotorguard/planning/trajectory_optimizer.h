@@ -18,6 +18,7 @@
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
+#include "rotorguard/planning/lbfgs.h"
 #include "rotorguard/planning/minco.h"
 
 namespace rotorguard::planning {
@@ -110,6 +111,11 @@ struct TrajectoryOptimizerOptions {
   /// 1e-4 plans the 400 bench queries in 3.7-5.1 ms on average, 1e-5 in 6-6.6 ms for trajectories 4 %
   /// shorter in time (docs/planning.md).
   double relative_cost_tolerance = 1e-4;
+  /// The L-BFGS (lbfgs.h): Ceres' (the default) or this library's with the Lewis-Overton line
+  /// search, its memory and its decrease test's span (each >= 1).
+  LbfgsMethod lbfgs_method = LbfgsMethod::kCeres;
+  int lbfgs_memory = 64;
+  int lbfgs_past = 3;
   /// The dense feasibility check: samples per piece, and the at most `max_slowdowns` rounds that
   /// stretch all durations by the factor that the worst excess calls for (v / k, a / k², j / k³),
   /// times `slowdown_factor` for a margin.
