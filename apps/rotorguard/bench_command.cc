@@ -1,5 +1,6 @@
 // rotorguard bench NAME: the papers' benchmarks and the project's own, as tables or JSON.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <filesystem>
@@ -177,7 +178,7 @@ class BenchCommand final : public Command {
           {"--problems", &planner_problems_, "With --free-space: problems per size (default 200)"},
           {"--pieces", &planner_pieces_, "With --free-space: comma-separated sizes in pieces (default 5,10)"},
           {"--lbfgs", &planner_lbfgs_,
-           "With --free-space: the optimiser's L-BFGS, ceres (the default) or lewis_overton (docs/planning.md)"}}},
+           "The optimiser's L-BFGS: ceres (the default) or lewis_overton (docs/planning.md)"}}},
         {&nav_,
          "nav",
          "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
@@ -384,11 +385,22 @@ class BenchCommand final : public Command {
     benchmarks::PlannerBenchOptions o;
     o.pairs = static_cast<int>(ParseUnsigned("--pairs", planner_pairs_, 1, 100000));
     o.worlds = static_cast<int>(ParseUnsigned("--worlds", planner_worlds_, 1, static_cast<std::uint64_t>(o.pairs)));
+    o.lbfgs = Lbfgs();
     o.seed = Seed();
     o.progress = CountProgress("plans");
     const nlohmann::json r = benchmarks::RunPlannerBenchmark(o);
     PrintMarkdownResult("planner", r, benchmarks::PlannerMarkdown(r));
     return kOk;
+  }
+
+  /// --lbfgs of bench planner.
+  planning::LbfgsMethod Lbfgs() const {
+    const std::optional<planning::LbfgsMethod> method = FromName<planning::LbfgsMethod>(planner_lbfgs_);
+    if (!method) {
+      throw UsageError(fmt::format("--lbfgs: '{}' is invalid; expected one of {}", planner_lbfgs_,
+                                   fmt::join(NameList<planning::LbfgsMethod>(), ", ")));
+    }
+    return *method;
   }
 
   int PlannerFreeSpace() const {
@@ -401,11 +413,7 @@ class BenchCommand final : public Command {
       }
       o.pieces.push_back(static_cast<int>(m));
     }
-    const std::vector<std::string> lbfgs = ParseWordList("--lbfgs", planner_lbfgs_, {"ceres", "lewis_overton"});
-    if (lbfgs.size() != 1) {
-      throw UsageError(fmt::format("--lbfgs: '{}' is invalid; expected one of ceres, lewis_overton", planner_lbfgs_));
-    }
-    o.lbfgs = lbfgs[0] == "ceres" ? planning::LbfgsMethod::kCeres : planning::LbfgsMethod::kLewisOverton;
+    o.lbfgs = Lbfgs();
     o.seed = Seed();
     o.progress = CountProgress("problems");
     const nlohmann::json r = benchmarks::RunFreeSpaceBenchmark(o);

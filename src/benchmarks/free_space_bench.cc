@@ -144,7 +144,7 @@ nlohmann::json RunFreeSpaceBenchmark(const FreeSpaceBenchOptions& options) {
             {"samples_per_piece", o.samples_per_piece + 1},
             {"max_iterations", o.max_iterations},
             {"relative_cost_tolerance", o.relative_cost_tolerance},
-            {"lbfgs", options.lbfgs == planning::LbfgsMethod::kCeres ? "ceres" : "lewis_overton"}}},
+            {"lbfgs", ToName(options.lbfgs)}}},
           {"free_space", sizes},
           {"host", buildinfo::HostInfo()}};
 }

@@ -128,6 +128,7 @@ nlohmann::json RunPlannerBenchmark(const PlannerBenchOptions& options) {
   planning::DynamicLimits nominal{1.0, 2.0, 6.0}, failed = nominal;
   failed.a_max = planning::PostFailureAccelerationLimit(1.15, 11.5, 0.65, nominal.v_max, 0.05);
   planning::PlannerOptions planner_options;
+  planner_options.optimizer.lbfgs_method = options.lbfgs;
   const planning::Planner planner(planner_options);
   std::map<std::string, Group> groups;
   Group all;
@@ -205,6 +206,7 @@ nlohmann::json RunPlannerBenchmark(const PlannerBenchOptions& options) {
   result["seed"] = options.seed;
   result["pairs_per_kind"] = options.pairs;
   result["worlds_per_kind"] = options.worlds;
+  result["lbfgs"] = ToName(options.lbfgs);
   result["limits_nominal"] = {{"v_max", nominal.v_max}, {"a_max", nominal.a_max}, {"j_max", nominal.j_max}};
   result["limits_post_failure"] = {{"v_max", failed.v_max}, {"a_max", failed.a_max}, {"j_max", failed.j_max}};
   result["groups"] = group_json;

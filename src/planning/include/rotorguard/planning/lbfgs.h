@@ -3,10 +3,12 @@
 /// 000, eq. 22; paper 002, eq. 11): Ceres' L-BFGS (GradientProblemSolver) behind a wrapper that
 /// treats any non-finite cost or gradient as a failed evaluation, which the line search backs away
 /// from (Ceres alone can accept a NaN cost and declare convergence).
+#include <Eigen/Core>
 #include <functional>
+#include <span>
 #include <string>
 
-#include <Eigen/Core>
+#include "rotorguard/core/config_schema.h"
 
 namespace rotorguard::planning {
 
@@ -36,6 +38,11 @@ enum class LbfgsMethod {
   /// `past` iterations (liblbfgs' delta test), which one short step does not trigger.
   kLewisOverton,
 };
+
+/// As config files write them (stack.planner.lbfgs) and bench planner's --lbfgs.
+inline constexpr EnumName<LbfgsMethod> kLbfgsMethodNames[] = {{LbfgsMethod::kCeres, "ceres"},
+                                                              {LbfgsMethod::kLewisOverton, "lewis_overton"}};
+constexpr std::span<const EnumName<LbfgsMethod>> NamesOf(const LbfgsMethod*) { return kLbfgsMethodNames; }
 
 struct LbfgsOptions {
   int max_iterations = 200;               ///< >= 1
