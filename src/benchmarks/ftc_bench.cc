@@ -400,9 +400,9 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
       for (int t = 0; t < trials; ++t) {
         const nlohmann::json& r = records[static_cast<std::size_t>((k * m_count + m) * trials + t)];
         FtcTrial trial;
-        trial.seed = std::stoull(r["params"]["seed"].get<std::string>());
+        trial.seed = std::stoull(r.at("params").at("seed").get<std::string>());
         trial.failure = campaign::TrialFailure(r);
-        if (r["status"] != "ok") {  // an error or a non-finite metric: the trial failed
+        if (r.at("status") != "ok") {  // an error or a non-finite metric: the trial failed
           ++errors;
           trial.errored = true;
           // It isolated nothing: for a method that detects faults, a missed detection.
@@ -410,22 +410,23 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
           cell_trials.push_back(trial);
           continue;
         }
-        const nlohmann::json& x = r["metrics"];
-        trial.success = x["success"].get<bool>();
+        const nlohmann::json& x = r.at("metrics");
+        trial.success = x.at("success").get<bool>();
         const auto number = [&x](const char* key) {
-          return !x.contains(key) || x[key].is_null() ? std::numeric_limits<double>::quiet_NaN() : x[key].get<double>();
+          return !x.contains(key) || x.at(key).is_null() ? std::numeric_limits<double>::quiet_NaN()
+                                                         : x.at(key).get<double>();
         };
         trial.altitude_change_m = number("altitude_change_m");
         trial.final_rmse_m = number("final_rmse_m");
         trial.eta_error = number("eta_error");
         trial.crash_speed_m_s = number("crash_speed_m_s");
         trial.second_latency_s = number("second_latency_s");
-        if (x.contains("second_correct")) trial.second_correct = x["second_correct"].get<bool>();
+        if (x.contains("second_correct")) trial.second_correct = x.at("second_correct").get<bool>();
         if (x.contains("correct")) {
           trial.has_fdd = true;
-          trial.correct = x["correct"].get<bool>();
-          trial.false_alarm = x["false_alarm"].get<bool>();
-          trial.latency_s = x["latency_s"].is_null() ? -1.0 : x["latency_s"].get<double>();
+          trial.correct = x.at("correct").get<bool>();
+          trial.false_alarm = x.at("false_alarm").get<bool>();
+          trial.latency_s = x.at("latency_s").is_null() ? -1.0 : x.at("latency_s").get<double>();
         }
         cell_trials.push_back(trial);
       }

@@ -390,9 +390,9 @@ nlohmann::json TableOne(const std::vector<const nlohmann::json*>& records, int t
     // Every trial of the row records the allocator's verdict; one that threw records nothing.
     bool can_hover = false;
     for (std::size_t k = 0; k < static_cast<std::size_t>(methods * trials); ++k) {
-      const nlohmann::json& m = (*records[row * static_cast<std::size_t>(methods * trials) + k])["metrics"];
+      const nlohmann::json& m = records[row * static_cast<std::size_t>(methods * trials) + k]->at("metrics");
       if (m.is_object() && m.contains("hover_attainable")) {
-        can_hover = m["hover_attainable"].get<bool>();
+        can_hover = m.at("hover_attainable").get<bool>();
         break;
       }
     }
@@ -456,14 +456,14 @@ nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, i
                                             records.size(), kTableTwoRows, trials));
   }
   const auto planned = [](const nlohmann::json& x) {
-    return x["status"] == "ok" && x["metrics"].value("planned", false);
+    return x.at("status") == "ok" && x.at("metrics").value("planned", false);
   };
   for (std::size_t row = 0; row < static_cast<std::size_t>(kTableTwoRows); ++row) {
     const auto at = [&](int m, int t) -> const nlohmann::json& {
       return *records[(2 * row + static_cast<std::size_t>(m)) * static_cast<std::size_t>(trials) +
                       static_cast<std::size_t>(t)];
     };
-    nlohmann::json r = {{"shape", at(0, 0)["params"]["shape"]}, {"fault", at(0, 0)["params"]["fault"]}};
+    nlohmann::json r = {{"shape", at(0, 0).at("params").at("shape")}, {"fault", at(0, 0).at("params").at("fault")}};
     std::vector<const nlohmann::json*> paired[2];  // the flights of the trials both methods planned
     for (int t = 0; t < trials; ++t) {
       if (!planned(at(0, t)) || !planned(at(1, t))) continue;
@@ -479,8 +479,8 @@ nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, i
       r[name + "_plan_rate"] = static_cast<double>(flown.size()) / trials;
       for (int t = 0; t < trials; ++t) {
         if (planned(at(m, t))) continue;
-        r[name + "_plan_failure"] =
-            at(m, t)["status"] == "ok" ? at(m, t)["message"].get<std::string>() : campaign::TrialFailure(at(m, t));
+        r[name + "_plan_failure"] = at(m, t).at("status") == "ok" ? at(m, t).at("message").get<std::string>()
+                                                                  : campaign::TrialFailure(at(m, t));
         break;
       }
       if (flown.empty()) continue;
@@ -491,17 +491,17 @@ nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, i
       // The plans' figures: their means, and the most any of them asks of the assembly.
       double duration = 0.0, deviation = 0.0, plan_ms = 0.0, accel = 0.0, thrust_accel = 0.0, yaw_accel = 0.0;
       for (const nlohmann::json* f : flown) {
-        const nlohmann::json& x = (*f)["metrics"];
-        duration += x["duration_s"].get<double>() / static_cast<double>(flown.size());
-        deviation += x["attitude_deviation_deg"].get<double>() / static_cast<double>(flown.size());
-        plan_ms += x["plan_ms"].get<double>() / static_cast<double>(flown.size());
-        accel = std::max(accel, x["max_accel_m_s2"].get<double>());
-        thrust_accel = std::max(thrust_accel, x["max_thrust_accel_m_s2"].get<double>());
-        yaw_accel = std::max(yaw_accel, x["max_yaw_accel_rad_s2"].get<double>());
+        const nlohmann::json& x = f->at("metrics");
+        duration += x.at("duration_s").get<double>() / static_cast<double>(flown.size());
+        deviation += x.at("attitude_deviation_deg").get<double>() / static_cast<double>(flown.size());
+        plan_ms += x.at("plan_ms").get<double>() / static_cast<double>(flown.size());
+        accel = std::max(accel, x.at("max_accel_m_s2").get<double>());
+        thrust_accel = std::max(thrust_accel, x.at("max_thrust_accel_m_s2").get<double>());
+        yaw_accel = std::max(yaw_accel, x.at("max_yaw_accel_rad_s2").get<double>());
         // The assembly's capacity depends on the row alone.
-        r["capacity_accel_m_s2"] = x["capacity_accel_m_s2"];
-        r["capacity_thrust_accel_m_s2"] = x["capacity_thrust_accel_m_s2"];
-        r["capacity_yaw_accel_rad_s2"] = x["capacity_yaw_accel_rad_s2"];
+        r["capacity_accel_m_s2"] = x.at("capacity_accel_m_s2");
+        r["capacity_thrust_accel_m_s2"] = x.at("capacity_thrust_accel_m_s2");
+        r["capacity_yaw_accel_rad_s2"] = x.at("capacity_yaw_accel_rad_s2");
       }
       r[name + "_duration_s"] = duration;
       r[name + "_attitude_deviation_deg"] = deviation;
@@ -549,34 +549,37 @@ nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohm
   nlohmann::json failures = nlohmann::json::array();
   for (const nlohmann::json* f : t1) {
     if (failures.size() >= 10) break;
-    if (Succeeded(*f) || (*f)["params"]["method"] == "none") continue;
-    failures.push_back({{"case", (*f)["params"]["case"]},
-                        {"method", (*f)["params"]["method"]},
-                        {"seed", std::stoull((*f)["params"]["seed"].get<std::string>())},
+    if (Succeeded(*f) || f->at("params").at("method") == "none") continue;
+    failures.push_back({{"case", f->at("params").at("case")},
+                        {"method", f->at("params").at("method")},
+                        {"seed", std::stoull(f->at("params").at("seed").get<std::string>())},
                         {"reason", campaign::TrialFailure(*f)}});
   }
   const auto worst = [&](const char* variant) {
-    return reconfig.is_null() ? nlohmann::json(nullptr)
-                              : nlohmann::json(std::max(reconfig[variant]["separation_max_attitude_deg"].get<double>(),
-                                                        reconfig[variant]["docking_max_attitude_deg"].get<double>()));
+    return reconfig.is_null()
+               ? nlohmann::json(nullptr)
+               : nlohmann::json(std::max(reconfig.at(variant).at("separation_max_attitude_deg").get<double>(),
+                                         reconfig.at(variant).at("docking_max_attitude_deg").get<double>()));
   };
-  nlohmann::json result = {{"benchmark", "mars"},
-                           {"assembly", options.at("assembly")},
-                           {"trials", trials},
-                           {"table1", table1},
-                           {"table1_full_within_1_5x_fault_free", within},
-                           {"alloc_units", options.at("alloc_units")},
-                           // Null when the timing trial failed (never a figure that passes the target).
-                           {"alloc_us_mean", (*alloc[0])["status"] == "ok" ? (*alloc[0])["metrics"]["alloc_us_mean"] : nlohmann::json()},
-                           {"alloc_us_p99", (*alloc[0])["status"] == "ok" ? (*alloc[0])["metrics"]["alloc_us_p99"] : nlohmann::json()},
-                           {"reconfig", reconfig},
-                           {"reconfig_max_attitude_deg", worst("prepared")},
-                           {"reconfig_max_attitude_deg_naive", worst("naive")},
-                           {"failures", failures},
-                           {"options", options}};
+  nlohmann::json result = {
+      {"benchmark", "mars"},
+      {"assembly", options.at("assembly")},
+      {"trials", trials},
+      {"table1", table1},
+      {"table1_full_within_1_5x_fault_free", within},
+      {"alloc_units", options.at("alloc_units")},
+      // Null when the timing trial failed (never a figure that passes the target).
+      {"alloc_us_mean",
+       alloc[0]->at("status") == "ok" ? alloc[0]->at("metrics").at("alloc_us_mean") : nlohmann::json()},
+      {"alloc_us_p99", alloc[0]->at("status") == "ok" ? alloc[0]->at("metrics").at("alloc_us_p99") : nlohmann::json()},
+      {"reconfig", reconfig},
+      {"reconfig_max_attitude_deg", worst("prepared")},
+      {"reconfig_max_attitude_deg_naive", worst("naive")},
+      {"failures", failures},
+      {"options", options}};
   for (const char* key : {"table2", "table2_rows_compared", "table2_improvement_average", "table2_improvement_row_mean",
                           "table2_improvement_average_to_crash", "table2_ours_better_in_every_row"}) {
-    result[key] = table2.is_null() ? nlohmann::json(nullptr) : table2[key];
+    result[key] = table2.is_null() ? nlohmann::json(nullptr) : table2.at(key);
   }
   result["truth"] = options.value("truth", "ideal");  // records made before the key: the ideal world
   return result;

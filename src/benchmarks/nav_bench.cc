@@ -241,18 +241,18 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
   for (const nlohmann::json& r : records) {
     NavTrial t;
     t.failure = campaign::TrialFailure(r);
-    if (r["status"] == "ok") {
-      const nlohmann::json& x = r["metrics"];
-      t.success = x["success"].get<bool>();
-      t.crashed = x["crashed"].get<bool>();
-      t.collision = x["collision"].get<bool>();
-      t.tracking_rmse_m = x["tracking_rmse_m"].get<double>();
-      t.max_spin_rad_s = x["max_spin_rad_s"].get<double>();
-      t.mission_time_s = x["mission_time_s"].is_null() ? -1.0 : x["mission_time_s"].get<double>();
-      t.planner_ms_mean = x["planner_ms_mean"].get<double>();
-      t.stack_ms_per_cycle_mean = x["stack_ms_per_cycle_mean"].get<double>();
-      t.realtime_factor = x["realtime_factor"].get<double>();
-      t.trial_realtime_factor = x["trial_realtime_factor"].get<double>();
+    if (r.at("status") == "ok") {
+      const nlohmann::json& x = r.at("metrics");
+      t.success = x.at("success").get<bool>();
+      t.crashed = x.at("crashed").get<bool>();
+      t.collision = x.at("collision").get<bool>();
+      t.tracking_rmse_m = x.at("tracking_rmse_m").get<double>();
+      t.max_spin_rad_s = x.at("max_spin_rad_s").get<double>();
+      t.mission_time_s = x.at("mission_time_s").is_null() ? -1.0 : x.at("mission_time_s").get<double>();
+      t.planner_ms_mean = x.at("planner_ms_mean").get<double>();
+      t.stack_ms_per_cycle_mean = x.at("stack_ms_per_cycle_mean").get<double>();
+      t.realtime_factor = x.at("realtime_factor").get<double>();
+      t.trial_realtime_factor = x.at("trial_realtime_factor").get<double>();
       for (const harness::RunCost::Part& p : harness::RunCost::kParts) t.cost_ms_per_sim_s[p.name] = x.at(CostMetric(p.name)).get<double>();
     }
     results.push_back(t);
@@ -270,7 +270,7 @@ nlohmann::json NavResult(const nlohmann::json& options, const std::vector<nlohma
       for (int t = 0; t < trials; ++t) {
         const std::size_t index = (k * static_cast<std::size_t>(trials) + static_cast<std::size_t>(t)) * 2 + v;
         group.push_back(&results[index]);
-        group_seeds.push_back(std::stoull(records[index]["params"]["seed"].get<std::string>()));
+        group_seeds.push_back(std::stoull(records[index].at("params").at("seed").get<std::string>()));
       }
       const std::vector<std::string> group_kinds(group.size(), kinds[k]);
       groups[kinds[k]][kVariants[v]] = Aggregate(group, group_seeds, group_kinds);

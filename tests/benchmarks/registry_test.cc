@@ -202,6 +202,24 @@ TEST_F(BenchCampaigns, NavResultAggregatesHandMadeRecords) {
   EXPECT_NEAR(r["rotorguard"]["success_wilson95"][0].get<double>(), campaign::WilsonInterval(2, 2).first, 1e-15);
 }
 
+// A record edited by hand so that an "ok" trial lacks a metric (or its params their seed) is an
+// error that names the key, not a read past the record.
+TEST_F(BenchCampaigns, NavResultRefusesARecordWithoutItsMetricsNamingTheKey) {
+  const campaign::Campaign c = RoomNavCampaign(1);
+  ASSERT_EQ(c.trials, 2);
+  std::vector<nlohmann::json> records = {Record(0, c.parameters(0), {{"crashed", false}}),
+                                         Record(1, c.parameters(1), nullptr, "error", "boom")};
+  try {
+    NavResult(c.bench["options"], records);
+    ADD_FAILURE() << "a record without its success read";
+  } catch (const nlohmann::json::out_of_range& e) {
+    EXPECT_NE(std::string(e.what()).find("'success'"), std::string::npos) << e.what();
+  }
+  records[0] = Record(0, c.parameters(0), nullptr, "error", "boom");
+  records[0]["params"].erase("seed");
+  EXPECT_THROW(NavResult(c.bench["options"], records), nlohmann::json::out_of_range);
+}
+
 // Thirteen failed flights of one variant: ten are listed with their seeds, the other three are
 // counted, in the JSON and in the Markdown, rather than dropped.
 TEST_F(BenchCampaigns, NavResultCountsTheFailuresItDoesNotList) {
