@@ -1,8 +1,6 @@
 // rotorguard bench NAME: the papers' benchmarks and the project's own, as tables or JSON.
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
-#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -329,18 +327,11 @@ class BenchCommand final : public Command {
   }
 
   /// --truth: the world the benchmarks fly.
-  sim::TruthPreset Truth() const {
-    if (const std::optional<sim::TruthPreset> p = FromName<sim::TruthPreset>(truth_)) return *p;
-    throw UsageError(fmt::format("--truth '{}' is invalid; expected one of: {}", truth_,
-                                 fmt::join(NameList<sim::TruthPreset>(), ", ")));
-  }
+  sim::TruthPreset Truth() const { return ParseName<sim::TruthPreset>("--truth", truth_); }
 
   /// --estimator, or `fallback` when not given.
   stack::EstimatorKind Estimator(stack::EstimatorKind fallback) const {
-    if (estimator_.empty()) return fallback;
-    if (const std::optional<stack::EstimatorKind> e = FromName<stack::EstimatorKind>(estimator_)) return *e;
-    throw UsageError(fmt::format("--estimator '{}' is invalid; expected one of: {}", estimator_,
-                                 fmt::join(NameList<stack::EstimatorKind>(), ", ")));
+    return estimator_.empty() ? fallback : ParseName<stack::EstimatorKind>("--estimator", estimator_);
   }
 
   int Ftc() const {
@@ -385,7 +376,7 @@ class BenchCommand final : public Command {
     benchmarks::PlannerBenchOptions o;
     o.pairs = static_cast<int>(ParseUnsigned("--pairs", planner_pairs_, 1, 100000));
     o.worlds = static_cast<int>(ParseUnsigned("--worlds", planner_worlds_, 1, static_cast<std::uint64_t>(o.pairs)));
-    o.lbfgs = Lbfgs();
+    o.lbfgs = ParseName<planning::LbfgsMethod>("--lbfgs", planner_lbfgs_);
     o.seed = Seed();
     o.progress = CountProgress("plans");
     const nlohmann::json r = benchmarks::RunPlannerBenchmark(o);
@@ -393,27 +384,14 @@ class BenchCommand final : public Command {
     return kOk;
   }
 
-  /// --lbfgs of bench planner.
-  planning::LbfgsMethod Lbfgs() const {
-    const std::optional<planning::LbfgsMethod> method = FromName<planning::LbfgsMethod>(planner_lbfgs_);
-    if (!method) {
-      throw UsageError(fmt::format("--lbfgs: '{}' is invalid; expected one of {}", planner_lbfgs_,
-                                   fmt::join(NameList<planning::LbfgsMethod>(), ", ")));
-    }
-    return *method;
-  }
-
   int PlannerFreeSpace() const {
     benchmarks::FreeSpaceBenchOptions o;
     o.problems = static_cast<int>(ParseUnsigned("--problems", planner_problems_, 1, 100000));
     o.pieces.clear();
-    for (const double m : ParseFiniteList("--pieces", planner_pieces_, 1.0, 100.0)) {
-      if (m != std::floor(m)) {
-        throw UsageError(fmt::format("--pieces: '{}' is invalid; expected whole numbers in [1, 100]", planner_pieces_));
-      }
-      o.pieces.push_back(static_cast<int>(m));
+    for (const std::string& m : SplitFields(planner_pieces_, ',')) {
+      o.pieces.push_back(static_cast<int>(ParseUnsigned("--pieces", m, 1, 100)));
     }
-    o.lbfgs = Lbfgs();
+    o.lbfgs = ParseName<planning::LbfgsMethod>("--lbfgs", planner_lbfgs_);
     o.seed = Seed();
     o.progress = CountProgress("problems");
     const nlohmann::json r = benchmarks::RunFreeSpaceBenchmark(o);

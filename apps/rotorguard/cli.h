@@ -2,15 +2,20 @@
 // The command line's shared parts: exit codes, strict argument parsing, progress lines, and the
 // Command interface each subcommand file implements (run, report, validate, fdd-calibrate, bench,
 // campaign). Commands parse, call the libraries and print; no algorithm lives here.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "rotorguard/campaign/campaign.h"
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/harness/flight_recorder.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
@@ -65,6 +70,13 @@ std::vector<double> ParseFiniteList(const std::string& option, const std::string
 /// A comma-separated list of words, each one of `allowed`.
 std::vector<std::string> ParseWordList(const std::string& option, const std::string& text,
                                        const std::vector<std::string>& allowed);
+/// The value of a named enum (core/config_schema.h's NamesOf) that `text` names.
+template <NamedEnum E>
+E ParseName(const std::string& option, const std::string& text) {
+  if (const std::optional<E> value = FromName<E>(text)) return *value;
+  throw UsageError(
+      fmt::format("{} '{}' is invalid; expected one of: {}", option, text, fmt::join(NameList<E>(), ", ")));
+}
 /// --set key.path=value, repeatable.
 std::vector<harness::Override> ParseOverrides(const std::vector<std::string>& sets);
 

@@ -20,12 +20,6 @@ constexpr double kStepMin = 1.5, kStepMax = 4.0;
 
 bool InBox(const Vector3& p) { return (p.array() >= kBoxLow.array()).all() && (p.array() <= kBoxHigh.array()).all(); }
 
-double Mean(const std::vector<double>& v) {
-  double s = 0.0;
-  for (double x : v) s += x;
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-}
-
 }  // namespace
 
 void FreeSpaceBenchOptions::Validate() const {
@@ -48,11 +42,11 @@ planning::DynamicLimits FreeSpaceLimits() {
 
 planning::TrajectoryOptimizerOptions FreeSpaceOptimizerOptions(planning::LbfgsMethod lbfgs) {
   planning::TrajectoryOptimizerOptions o;
-  o.lbfgs_method = lbfgs;
+  o.lbfgs.method = lbfgs;
   o.weights = {.time = 10.0, .smoothness = 1.0, .feasibility = 1e4, .collision = 0.0};
   o.samples_per_piece = 16;  // 17 samples, both ends included
-  o.max_iterations = 200;
-  o.relative_cost_tolerance = 1e-4;
+  o.lbfgs.max_iterations = 200;
+  o.lbfgs.relative_cost_tolerance = 1e-4;
   return o;
 }
 
@@ -93,20 +87,19 @@ nlohmann::json RunFreeSpaceBenchmark(const FreeSpaceBenchOptions& options) {
       tail.col(0) = p.points.col(m);
       const Eigen::Matrix3Xd waypoints = p.points.middleCols(1, m - 1);
       // One evaluation of the cost and its gradient at the initial guess, averaged over many.
-      Eigen::VectorXd x(4 * m - 3), gradient;
-      x.head(3 * (m - 1)) = Eigen::Map<const Eigen::VectorXd>(waypoints.data(), 3 * (m - 1));
-      for (int i = 0; i < m; ++i) x(3 * (m - 1) + i) = planning::TrajectoryOptimizer::TauOf(p.durations(i));
+      const Eigen::VectorXd x = planning::TrajectoryOptimizer::Variables(waypoints, p.durations);
+      Eigen::VectorXd gradient;
       double sink = 0.0;
       const Stopwatch eval_clock;
       for (int e = 0; e < options.evaluations; ++e) sink += optimizer.Objective(head, tail, limits, {}, x, &gradient);
       eval_us.push_back(1e6 * eval_clock.seconds() / options.evaluations);
-      if (!std::isfinite(sink)) ++failed;  // (also keeps the evaluations from being optimised away)
 
       planning::MinimumJerkTrajectory traj;
       const planning::TrajectoryOptimizerSummary s =
           optimizer.Optimize(head, tail, waypoints, p.durations, limits, {}, &traj);
       solve_us.push_back(1e3 * s.solve_ms);
-      if (!s.ok()) {
+      // (The sum's check also keeps the timed evaluations from being optimised away.)
+      if (!std::isfinite(sink) || !s.ok()) {
         ++failed;
       } else {
         check_us.push_back(1e3 * s.check_ms);
@@ -131,19 +124,20 @@ nlohmann::json RunFreeSpaceBenchmark(const FreeSpaceBenchOptions& options) {
                      {"evaluations_mean", Mean(evaluations)},
                      {"stretched_by_check", stretched}});
   }
-  const planning::TrajectoryOptimizerOptions o = FreeSpaceOptimizerOptions(options.lbfgs);
+  const planning::TrajectoryOptimizerOptions& o = optimizer.options();
+  const Vector3 box = kBoxHigh - kBoxLow;
   return {{"benchmark", "planner_free_space"},
           {"seed", options.seed},
           {"problem",
-           {{"box_m", {20.0, 20.0, 2.0}},
+           {{"box_m", {box.x(), box.y(), box.z()}},
             {"step_m", {kStepMin, kStepMax}},
             {"v_max", limits.v_max},
             {"a_max", limits.a_max},
             {"j_max", nullptr},
             {"weights", {o.weights.time, o.weights.smoothness, o.weights.feasibility}},
             {"samples_per_piece", o.samples_per_piece + 1},
-            {"max_iterations", o.max_iterations},
-            {"relative_cost_tolerance", o.relative_cost_tolerance},
+            {"max_iterations", o.lbfgs.max_iterations},
+            {"relative_cost_tolerance", o.lbfgs.relative_cost_tolerance},
             {"lbfgs", ToName(options.lbfgs)}}},
           {"free_space", sizes},
           {"host", buildinfo::HostInfo()}};

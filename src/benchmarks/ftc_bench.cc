@@ -191,12 +191,6 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
   return s;
 }
 
-double Mean(const std::vector<double>& v) {
-  double s = 0.0;
-  for (double x : v) s += x;
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-}
-
 nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 }  // namespace

@@ -128,7 +128,7 @@ nlohmann::json RunPlannerBenchmark(const PlannerBenchOptions& options) {
   planning::DynamicLimits nominal{1.0, 2.0, 6.0}, failed = nominal;
   failed.a_max = planning::PostFailureAccelerationLimit(1.15, 11.5, 0.65, nominal.v_max, 0.05);
   planning::PlannerOptions planner_options;
-  planner_options.optimizer.lbfgs_method = options.lbfgs;
+  planner_options.optimizer.lbfgs.method = options.lbfgs;
   const planning::Planner planner(planner_options);
   std::map<std::string, Group> groups;
   Group all;

@@ -21,4 +21,10 @@ double Percentile(std::vector<double> v, double p) {
   return v[lo] + (position - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
+double Mean(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (const double v : values) sum += v;
+  return values.empty() ? 0.0 : sum / static_cast<double>(values.size());
+}
+
 }  // namespace rotorguard

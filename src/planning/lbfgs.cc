@@ -49,7 +49,7 @@ LbfgsSummary MinimizeLewisOverton(const GradientObjective& f, const LbfgsOptions
   constexpr int kMaxLineSearch = 60;
   LbfgsSummary summary;
   const auto n = x->size();
-  Eigen::VectorXd g(n), x_trial(n), g_trial(n), d(n);
+  Eigen::VectorXd g(n), x_trial(n), g_trial(n), d(n), s_new(n), y_new(n);
   double fx = f(*x, &g);
   ++summary.evaluations;
   if (!std::isfinite(fx) || g.size() != n || !g.allFinite()) {
@@ -65,19 +65,19 @@ LbfgsSummary MinimizeLewisOverton(const GradientObjective& f, const LbfgsOptions
   d = -g;
   double step = 1.0 / std::max(d.norm(), 1e-300);  // the first step moves x by one unit
   for (int k = 1; k <= options.max_iterations; ++k) {
-    const double slope = g.dot(d);
-    if (!(slope < 0.0)) {  // not a descent direction (rounding at a flat point): steepest descent
+    double g_dot_d = g.dot(d);
+    if (!(g_dot_d < 0.0)) {  // not a descent direction (rounding at a flat point): steepest descent
       d = -g;
       stored = 0;
-      if (!(g.dot(d) < 0.0)) {
+      g_dot_d = -g.squaredNorm();
+      if (!(g_dot_d < 0.0)) {
         summary.message = "the gradient vanished";
         break;
       }
     }
-    const double g_dot_d = g.dot(d);
     double low = 0.0, high = std::numeric_limits<double>::infinity(), t = step, f_trial = fx;
     bool accepted = false;
-    for (int ls = 0; ls < kMaxLineSearch && !accepted; ++ls) {
+    for (int ls = 0; ls < kMaxLineSearch; ++ls) {
       x_trial = *x + t * d;
       f_trial = f(x_trial, &g_trial);
       ++summary.evaluations;
@@ -99,7 +99,8 @@ LbfgsSummary MinimizeLewisOverton(const GradientObjective& f, const LbfgsOptions
     }
     // The new pair, kept when its curvature is positive (always, under the Wolfe conditions, but for
     // rounding).
-    const Eigen::VectorXd s_new = x_trial - *x, y_new = g_trial - g;
+    s_new = x_trial - *x;
+    y_new = g_trial - g;
     const double sy = s_new.dot(y_new);
     *x = x_trial;
     g = g_trial;
@@ -131,8 +132,8 @@ LbfgsSummary MinimizeLewisOverton(const GradientObjective& f, const LbfgsOptions
       d.noalias() += (alpha(i) - beta) * s_pairs.col(i);
     }
     step = 1.0;
-    if (k == options.max_iterations) summary.message = "the iteration limit";
   }
+  if (summary.message.empty()) summary.message = "the iteration limit";
   return summary;
 }
 

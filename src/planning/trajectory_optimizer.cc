@@ -68,14 +68,14 @@ void TrajectoryOptimizerOptions::Validate() const {
                     fmt::format("a distance in [0, {:g}] m", kMaxClearanceM));
   }
   require(samples_per_piece >= 2 && samples_per_piece <= 1000, "samples_per_piece", samples_per_piece, "in [2, 1000]");
-  require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
-  require(relative_cost_tolerance > 0.0 && relative_cost_tolerance <= 0.1, "relative_cost_tolerance",
-          relative_cost_tolerance, "in (0, 0.1]");
+  require(lbfgs.max_iterations >= 1, "lbfgs.max_iterations", lbfgs.max_iterations, ">= 1");
+  require(lbfgs.relative_cost_tolerance > 0.0 && lbfgs.relative_cost_tolerance <= 0.1, "lbfgs.relative_cost_tolerance",
+          lbfgs.relative_cost_tolerance, "in (0, 0.1]");
+  require(lbfgs.memory >= 1, "lbfgs.memory", lbfgs.memory, ">= 1");
+  require(lbfgs.past >= 1, "lbfgs.past", lbfgs.past, ">= 1");
   require(check_samples_per_piece >= samples_per_piece, "check_samples_per_piece", check_samples_per_piece,
           "at least samples_per_piece");
   require(max_slowdowns >= 0, "max_slowdowns", max_slowdowns, ">= 0");
-  require(lbfgs_memory >= 1, "lbfgs_memory", lbfgs_memory, ">= 1");
-  require(lbfgs_past >= 1, "lbfgs_past", lbfgs_past, ">= 1");
   require(slowdown_factor > 1.0 && slowdown_factor <= 2.0, "slowdown_factor", slowdown_factor, "in (1, 2]");
 }
 
@@ -125,7 +125,6 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   // quantity times s.
   const double limit2[3] = {limits.v_max * limits.v_max, limits.a_max * limits.a_max, limits.j_max * limits.j_max};
   const int k_samples = o.samples_per_piece;
-  const int max_order = limits.limits_jerk() ? 3 : 2;  // the derivatives with a limit
   for (int i = 0; i < pieces; ++i) {
     const auto c = traj.coefficients().middleRows<kC>(kC * i);
     std::size_t cursor = 0;  // the piece's planes, sorted by sample: the first of sample j
@@ -137,7 +136,7 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
       const double s = static_cast<double>(j) / k_samples, ts = s * t(i);
       const Eigen::Matrix<double, 5, kC> basis = MinimumJerkTrajectory::BasisRows(ts);
       const Eigen::Matrix<double, 5, 3> der = basis * c;  // p, v, a, j, snap
-      for (int d = 1; d <= max_order; ++d) {              // J_d: velocity, acceleration, jerk (eqs. 26-29)
+      for (int d = 1; d <= limits.highest_limited_order(); ++d) {  // J_d: velocity, acceleration, jerk (eqs. 26-29)
         double slope;
         const double pen = CubicPenalty(der.row(d).squaredNorm() - limit2[d - 1], &slope);
         if (slope == 0.0) continue;
@@ -176,6 +175,14 @@ double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail
   return cost;
 }
 
+Eigen::VectorXd TrajectoryOptimizer::Variables(const Eigen::Matrix3Xd& waypoints, const Eigen::VectorXd& durations) {
+  const auto pieces = durations.size();
+  Eigen::VectorXd x(4 * pieces - 3);
+  x.head(3 * (pieces - 1)) = Eigen::Map<const Eigen::VectorXd>(waypoints.data(), 3 * (pieces - 1));
+  for (Eigen::Index i = 0; i < pieces; ++i) x(3 * (pieces - 1) + i) = TauOf(durations(i));
+  return x;
+}
+
 TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, const PvaState& tail,
                                                          const Eigen::Matrix3Xd& waypoints,
                                                          const Eigen::VectorXd& durations, const DynamicLimits& limits,
@@ -202,21 +209,13 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   for (std::vector<SamplePlane>& list : sorted) {
     std::stable_sort(list.begin(), list.end(), [](const SamplePlane& a, const SamplePlane& b) { return a.sample < b.sample; });
   }
-  const int n = 4 * pieces - 3;
-  Eigen::VectorXd x(n);
-  x.head(3 * (pieces - 1)) = Eigen::Map<const Eigen::VectorXd>(waypoints.data(), 3 * (pieces - 1));
-  for (int i = 0; i < pieces; ++i) x(3 * (pieces - 1) + i) = TauOf(durations(i));
+  Eigen::VectorXd x = Variables(waypoints, durations);
   summary.initial_cost = Objective(head, tail, limits, sorted, x, nullptr);
   if (!std::isfinite(summary.initial_cost)) return fail(Status::kInvalidInput, "the initial guess has no trajectory");
 
   const LbfgsSummary lbfgs = MinimizeLbfgs(
       [&](const Eigen::VectorXd& v, Eigen::VectorXd* g) { return Objective(head, tail, limits, sorted, v, g); },
-      {.max_iterations = options_.max_iterations,
-       .relative_cost_tolerance = options_.relative_cost_tolerance,
-       .method = options_.lbfgs_method,
-       .memory = options_.lbfgs_memory,
-       .past = options_.lbfgs_past},
-      &x);
+      options_.lbfgs, &x);
   summary.iterations = lbfgs.iterations;
   summary.evaluations = lbfgs.evaluations;
   summary.final_cost = Objective(head, tail, limits, sorted, x, nullptr);
@@ -240,7 +239,7 @@ TrajectoryOptimizerSummary TrajectoryOptimizer::Optimize(const PvaState& head, c
   for (;;) {
     if (!traj.Build(head, tail, q, t)) return fail(Status::kSolverFailure, "the optimised trajectory cannot be built");
     double ratio[3] = {0.0, 0.0, 0.0};  // max |derivative| / limit, of the limited ones
-    for (int d = 1; d <= (limits.limits_jerk() ? 3 : 2); ++d) {
+    for (int d = 1; d <= limits.highest_limited_order(); ++d) {
       ratio[d - 1] = traj.MaxNorm(d, options_.check_samples_per_piece) / limit[d - 1];
     }
     summary.limit_margin = 1.0 - std::max({ratio[0], ratio[1], ratio[2]});

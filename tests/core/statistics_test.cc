@@ -33,5 +33,12 @@ TEST(Percentile, TakesAFractionNotAPercentage) {
   EXPECT_THROW(Percentile({1.0}, std::nan("")), std::invalid_argument);
 }
 
+// The mean of a hand-made sample, and 0 for none (as Percentile's empty sample).
+TEST(Mean, IsTheSumOverTheCount) {
+  EXPECT_EQ(Mean({1.0, 2.0, 6.0}), 3.0);
+  EXPECT_EQ(Mean({-0.5}), -0.5);
+  EXPECT_EQ(Mean({}), 0.0);
+}
+
 }  // namespace
 }  // namespace rotorguard

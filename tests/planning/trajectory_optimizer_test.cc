@@ -100,7 +100,7 @@ TEST(TrajectoryOptimizer, PostFailureAccelerationLimitIsEquation33) {
 TEST(TrajectoryOptimizer, OutputRespectsItsLimitsAndALowerAccelerationLimitSlowsIt) {
   for (const LbfgsMethod method : {LbfgsMethod::kCeres, LbfgsMethod::kLewisOverton}) {
     TrajectoryOptimizerOptions options;
-    options.lbfgs_method = method;
+    options.lbfgs.method = method;
     const TrajectoryOptimizer optimizer(options);
     const PvaState head = Rest(Vector3(0, 0, 1)), tail = Rest(Vector3(8, 2, 1));
     Eigen::Matrix3Xd q;
@@ -200,9 +200,8 @@ TEST(TrajectoryOptimizer, NoJerkLimitDropsTheJerkTermAndItsCheck) {
   Eigen::Matrix3Xd q;
   Eigen::VectorXd t;
   StraightGuess(head.col(0), tail.col(0), 4, 1.5, &q, &t);  // fast: v and a penalties active
-  Eigen::VectorXd x(4 * 4 - 3);
-  x.head(9) = Eigen::Map<const Eigen::VectorXd>(q.data(), 9) + Eigen::VectorXd::LinSpaced(9, -0.2, 0.2);
-  for (int i = 0; i < 4; ++i) x(9 + i) = TrajectoryOptimizer::TauOf(t(i));
+  Eigen::VectorXd x = TrajectoryOptimizer::Variables(q, t);
+  x.head(9) += Eigen::VectorXd::LinSpaced(9, -0.2, 0.2);
   const DynamicLimits none{1.0, 0.8, DynamicLimits::kNoLimit}, unreachable{1.0, 0.8, 1e9};
   Eigen::VectorXd g_none, g_unreachable;
   const double f_none = optimizer.Objective(head, tail, none, {}, x, &g_none);
@@ -224,7 +223,7 @@ TEST(TrajectoryOptimizer, NoJerkLimitDropsTheJerkTermAndItsCheck) {
   ASSERT_TRUE(s.ok()) << s.message;
   EXPECT_LE(traj.MaxNorm(1, 2000), none.v_max * 1.001);
   EXPECT_LE(traj.MaxNorm(2, 2000), none.a_max * 1.001);
-  EXPECT_GE(s.check_ms, 0.0);
+  EXPECT_GT(s.check_ms, 0.0);  // measured: the check sampled something
   EXPECT_LE(s.check_ms, s.solve_ms);
 
   EXPECT_NO_THROW(none.Validate());

@@ -281,13 +281,6 @@ def test_the_messages_are_what_the_sensors_read_in_a_hover():
     assert np.linalg.norm(mean[:2]) < 0.3
 
 
-def rotation(q):
-    w, x, y, z = q
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def test_the_lidar_points_lie_on_the_walls_of_a_hand_made_room(tmp_path):
     # A floor (top at z = 0) and a wall (face at x = 3 m) around a hover at 1 m: every return of a
     # frame, placed in the world with the true pose at the frame's end and the sensor's mount,
@@ -315,6 +308,7 @@ def test_the_lidar_points_lie_on_the_walls_of_a_hand_made_room(tmp_path):
     elevation = np.arcsin(points[:, 2] / ranges)
     assert np.all((elevation > math.radians(-7.0) - 1e-4) & (elevation < math.radians(52.0) + 1e-4))
     truth = flight.simulator
+    rotation = load_example("nominal_controller").rotation  # the attitude's matrix
     world = (rotation(truth.attitude) @ (points + [0.0, 0.0, 0.06]).T).T + truth.position
     off_surface = np.minimum(np.abs(world[:, 2]), np.abs(world[:, 0] - 3.0))
     near = ranges < 10.0

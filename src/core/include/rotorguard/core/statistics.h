@@ -1,5 +1,5 @@
 #pragma once
-/// Quantiles of a sample: every median and percentile the project reports (benchmarks, campaigns,
+/// Quantiles and the mean of a sample: every median and percentile the project reports (benchmarks, campaigns,
 /// the flight stack's own accounts) comes from here, so that a p99 means one thing everywhere.
 #include <vector>
 
@@ -10,5 +10,8 @@ namespace rotorguard {
 /// Fan's type 7, numpy's default: the median of an even sample is the mean of its middle two); 0
 /// for an empty sample. Throws std::invalid_argument for p outside [0, 1].
 double Percentile(std::vector<double> values, double p);
+
+/// The arithmetic mean of a sample; 0 for an empty sample.
+double Mean(const std::vector<double>& values);
 
 }  // namespace rotorguard

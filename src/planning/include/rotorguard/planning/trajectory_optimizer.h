@@ -34,6 +34,8 @@ struct DynamicLimits {
   double a_max = 2.0;  ///< [m/s²], in (0, kMaxAccelerationMS2] (a_max,n nominal; a_max,f of eq. 33 after a failure)
   double j_max = 6.0;  ///< [m/s³], in (0, kMaxJerkMS3], or kNoLimit
   bool limits_jerk() const { return j_max != kNoLimit; }
+  /// The highest derivative with a limit: 3 (jerk), or 2 without a jerk limit.
+  int highest_limited_order() const { return limits_jerk() ? 3 : 2; }
   void Validate() const;
 };
 
@@ -106,16 +108,10 @@ struct TrajectoryOptimizerOptions {
   CostWeights weights;
   double clearance_m = 0.3;      ///< C_o of eq. (36), the safe distance [m], in [0, kMaxClearanceM]
   int samples_per_piece = 16;    ///< penalty samples per piece (κ / M), >= 2
-  int max_iterations = 200;      ///< L-BFGS iterations, >= 1
-  /// L-BFGS stops once an iteration lowers the cost by less than this fraction, in (0, 0.1]:
-  /// 1e-4 plans the 400 bench queries in 3.7-5.1 ms on average, 1e-5 in 6-6.6 ms for trajectories 4 %
-  /// shorter in time (docs/planning.md).
-  double relative_cost_tolerance = 1e-4;
-  /// The L-BFGS (lbfgs.h): Ceres' (the default) or this library's with the Lewis-Overton line
-  /// search, its memory and its decrease test's span (each >= 1).
-  LbfgsMethod lbfgs_method = LbfgsMethod::kCeres;
-  int lbfgs_memory = 64;
-  int lbfgs_past = 3;
+  /// The L-BFGS (lbfgs.h): Ceres' (the default) or this library's, at most 200 iterations, and a
+  /// relative cost tolerance in (0, 0.1]: 1e-4 plans the 400 bench queries in 3.7-5.1 ms on
+  /// average, 1e-5 in 6-6.6 ms for trajectories 4 % shorter in time (docs/planning.md).
+  LbfgsOptions lbfgs;
   /// The dense feasibility check: samples per piece, and the at most `max_slowdowns` rounds that
   /// stretch all durations by the factor that the worst excess calls for (v / k, a / k², j / k³),
   /// times `slowdown_factor` for a margin.
@@ -161,6 +157,9 @@ class TrajectoryOptimizer {
   double Objective(const PvaState& head, const PvaState& tail, const DynamicLimits& limits, const PlaneSet& planes,
                    const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const;
 
+  /// x = [q (column by column), τ] of waypoints (3 x (M - 1)) and durations (M > 0): Objective's
+  /// variables, from which Optimize starts.
+  static Eigen::VectorXd Variables(const Eigen::Matrix3Xd& waypoints, const Eigen::VectorXd& durations);
   /// T(τ) = τ + sqrt(τ² + 1) and its inverse.
   static double DurationOf(double tau) { return tau + std::sqrt(tau * tau + 1.0); }
   static double TauOf(double duration) { return (duration * duration - 1.0) / (2.0 * duration); }

@@ -155,7 +155,7 @@ struct NavigationOptions {
     a->Visit("altitude_band_m", PairOf{&r.planner.search.z_min_m, &r.planner.search.z_max_m},
              {.meaning = "[z_min, z_max], the altitudes the search may use [m]", .min = 0.0, .max = kMaxCoordinateM});
     a->Visit("weights", &r.planner.optimizer.weights, {.meaning = "eq. (22)'s weights"});
-    a->Visit("lbfgs", &r.planner.optimizer.lbfgs_method,
+    a->Visit("lbfgs", &r.planner.optimizer.lbfgs.method,
              {.meaning = "the trajectory optimiser's L-BFGS: ceres, or lewis_overton, the library's own "
                          "(docs/planning.md)"});
   }
