@@ -109,8 +109,9 @@ void LioEstimator::OnLidar(const LidarFrame& frame) {
   const perception::LioFrameSummary s = lio_.OnFrame(frame);
   frame_ms_.push_back(1e3 * clock.seconds());
   frames_.push_back(s);
-  // The first frame starts the map at the start pose: it fixes nothing, nor does it lose anything.
-  if (s.used && !s.degenerate) last_fix_ns_ = frame.t_end_ns;
+  // The first frames start the map at the IMU's pose from the start pose: the reference, as the
+  // start pose is (they fix nothing the IMU does not, nor do they lose anything).
+  if (s.seed || (s.used && !s.degenerate)) last_fix_ns_ = frame.t_end_ns;
   frame_estimate_ = lio_.FrameEstimate();
   frame_estimate_.motor_thrust_n = motor_thrust();
 }
