@@ -139,14 +139,19 @@ LbfgsSummary MinimizeLewisOverton(const GradientObjective& f, const LbfgsOptions
 
 }  // namespace
 
-LbfgsSummary MinimizeLbfgs(const GradientObjective& f, const LbfgsOptions& options, Eigen::VectorXd* x) {
+void LbfgsOptions::Validate() const {
   const auto require = [](bool ok, const char* field, double value, const char* rule) {
-    if (!ok) ThrowInvalidArgument("MinimizeLbfgs", std::string("LbfgsOptions::") + field, value, rule);
+    if (!ok) ThrowValidation("LbfgsOptions", field, value, rule);
   };
-  require(options.max_iterations >= 1, "max_iterations", options.max_iterations, ">= 1");
-  require(options.relative_cost_tolerance > 0.0, "relative_cost_tolerance", options.relative_cost_tolerance, "> 0");
-  require(options.memory >= 1, "memory", options.memory, ">= 1");
-  require(options.past >= 1, "past", options.past, ">= 1");
+  require(max_iterations >= 1, "max_iterations", max_iterations, ">= 1");
+  require(relative_cost_tolerance > 0.0 && relative_cost_tolerance <= 0.1, "relative_cost_tolerance",
+          relative_cost_tolerance, "in (0, 0.1]");
+  require(memory >= 1, "memory", memory, ">= 1");
+  require(past >= 1, "past", past, ">= 1");
+}
+
+LbfgsSummary MinimizeLbfgs(const GradientObjective& f, const LbfgsOptions& options, Eigen::VectorXd* x) {
+  options.Validate();
   if (options.method == LbfgsMethod::kLewisOverton) return MinimizeLewisOverton(f, options, x);
   static std::once_flag quiet;
   std::call_once(quiet, [] { FLAGS_minloglevel = std::max(FLAGS_minloglevel, static_cast<int>(google::GLOG_ERROR)); });

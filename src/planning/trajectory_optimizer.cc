@@ -68,11 +68,7 @@ void TrajectoryOptimizerOptions::Validate() const {
                     fmt::format("a distance in [0, {:g}] m", kMaxClearanceM));
   }
   require(samples_per_piece >= 2 && samples_per_piece <= 1000, "samples_per_piece", samples_per_piece, "in [2, 1000]");
-  require(lbfgs.max_iterations >= 1, "lbfgs.max_iterations", lbfgs.max_iterations, ">= 1");
-  require(lbfgs.relative_cost_tolerance > 0.0 && lbfgs.relative_cost_tolerance <= 0.1, "lbfgs.relative_cost_tolerance",
-          lbfgs.relative_cost_tolerance, "in (0, 0.1]");
-  require(lbfgs.memory >= 1, "lbfgs.memory", lbfgs.memory, ">= 1");
-  require(lbfgs.past >= 1, "lbfgs.past", lbfgs.past, ">= 1");
+  lbfgs.Validate();
   require(check_samples_per_piece >= samples_per_piece, "check_samples_per_piece", check_samples_per_piece,
           "at least samples_per_piece");
   require(max_slowdowns >= 0, "max_slowdowns", max_slowdowns, ">= 0");

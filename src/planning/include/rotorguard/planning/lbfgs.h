@@ -50,6 +50,8 @@ struct LbfgsOptions {
   LbfgsMethod method = LbfgsMethod::kCeres;
   int memory = 64;  ///< kLewisOverton: correction pairs kept, >= 1
   int past = 3;     ///< kLewisOverton: iterations the decrease test spans, >= 1
+  /// Throws ValidationError naming the field (the tolerance in (0, 0.1]).
+  void Validate() const;
 };
 
 struct LbfgsSummary {
