@@ -1,8 +1,11 @@
 // Micro-benchmarks of the NMPC's parts (Google Benchmark): the RK4 step with and without exact
-// sensitivities, the condensing of an N = 20, nx = 17, nu = 4 OCP QP, the dense dual active-set
-// solve and its factorisation, and one real-time iteration in hover and while spinning after a failure.
+// sensitivities, an N = 20, nx = 17, nu = 4 OCP QP solved by each of the two solvers (condensing
+// with the dense dual active-set solve and its factorisation; Riccati), and one real-time
+// iteration in hover and while spinning after a failure with each.
 // Run: build/bin/nmpc_benchmark
 #include <benchmark/benchmark.h>
+
+#include <memory>
 
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/control/nmpc_model.h"
@@ -77,19 +80,23 @@ control::OcpQp NmpcSizedQp() {
   return qp;
 }
 
-void BM_CondensingQpSolve(benchmark::State& state) {
+// One solve of that QP, warm-started as in flight (the same QP again: its active set is the start).
+// Arg: 0 condensing, 1 Riccati (docs/control.md, "Two QP solvers"). prepare_us is condensing and
+// factorisation, or the Riccati factorisation with the start's responses; feedback_us the rest.
+void BM_OcpQpSolve(benchmark::State& state) {
   const control::OcpQp qp = NmpcSizedQp();
-  control::CondensingQpSolver solver(qp.dims);
-  double condense = 0.0, dense = 0.0;
+  const auto method = state.range(0) == 0 ? control::OcpQpMethod::kCondensing : control::OcpQpMethod::kRiccati;
+  const std::unique_ptr<control::OcpQpSolver> solver = control::MakeOcpQpSolver(method, qp.dims);
+  double prepare = 0.0, feedback = 0.0;
   for (auto _ : state) {
-    const control::OcpQpSummary& s = solver.Solve(qp);
-    condense += s.condense_time_s;
-    dense += s.dense_solve_time_s;
+    const control::OcpQpSummary& s = solver->Solve(qp);
+    prepare += s.condense_time_s;
+    feedback += s.dense_solve_time_s;
   }
-  state.counters["condense_us"] = 1e6 * condense / static_cast<double>(state.iterations());
-  state.counters["dense_us"] = 1e6 * dense / static_cast<double>(state.iterations());
+  state.counters["prepare_us"] = 1e6 * prepare / static_cast<double>(state.iterations());
+  state.counters["feedback_us"] = 1e6 * feedback / static_cast<double>(state.iterations());
 }
-BENCHMARK(BM_CondensingQpSolve);
+BENCHMARK(BM_OcpQpSolve)->Arg(0)->Arg(1)->ArgName("riccati");
 
 // The dense solver's factorisation (Cholesky and J0 = L^-T) of the condensed Hessian: 80 inputs
 // in hover, 60 once a failed rotor's 20 are eliminated (the leading block of the same Hessian).
@@ -135,11 +142,13 @@ BENCHMARK(BM_RiccatiFactorisation);
 
 // A call of the controller at 200 Hz: the feedback and the preparation for the next call. Arg 1:
 // relinearise_every, the mixed-level iteration's period (1: the paper's RTI, 3: the navigation
-// scenarios', 5: what a longer period would add); the time is the mean over the calls, linearising and reusing.
+// scenarios', 5: what a longer period would add); the time is the mean over the calls, linearising
+// and reusing. Arg 2: the QP solver, 0 condensing (the default), 1 Riccati.
 void BM_NmpcRealTimeIteration(benchmark::State& state) {
   const bool failed = state.range(0) != 0;
   control::NmpcOptions options;
   options.relinearise_every = static_cast<int>(state.range(1));
+  options.qp_solver = state.range(2) == 0 ? control::OcpQpMethod::kCondensing : control::OcpQpMethod::kRiccati;
   control::NmpcController nmpc(ReferenceVehicle(), options);
   if (failed) nmpc.SetRotorFailed(0);
   planning::HoverOptions ho;
@@ -159,6 +168,8 @@ void BM_NmpcRealTimeIteration(benchmark::State& state) {
     benchmark::DoNotOptimize(cmd.data());
   }
 }
-BENCHMARK(BM_NmpcRealTimeIteration)->ArgsProduct({{0, 1}, {1, 3, 5}})->ArgNames({"failed", "relinearise_every"});
+BENCHMARK(BM_NmpcRealTimeIteration)
+    ->ArgsProduct({{0, 1}, {1, 3, 5}, {0, 1}})
+    ->ArgNames({"failed", "relinearise_every", "riccati"});
 
 }  // namespace

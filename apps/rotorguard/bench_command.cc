@@ -124,12 +124,13 @@ class BenchCommand final : public Command {
          "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
          "iterations_mean and max_u0_error against the instance's optimal u_0.",
          {{"--instance", &qp_instance_, "Instance file (JSON), e.g. a copy of qp_hover_n20.json", true},
-          {"--repetitions", &qp_repetitions_, "Solves per case; the median time counts (default 3)"}}},
+          {"--repetitions", &qp_repetitions_, "Solves per case; the median time counts (default 3)"},
+          {"--solver", &qp_solver_, "riccati (default) or condensing"}}},
         {&nmpc_,
          "nmpc",
          "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
          "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.",
-         {}},
+         {{"--qp-solver", &nmpc_qp_solver_, "The NMPC's QP solver: condensing (default, the stack's) or riccati"}}},
         {&ftc_,
          "ftc",
          "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
@@ -278,6 +279,7 @@ class BenchCommand final : public Command {
   int Qp() const {
     benchmarks::QpBenchOptions o;
     o.repetitions = static_cast<int>(ParseUnsigned("--repetitions", qp_repetitions_, 1, 1000));
+    o.solver = ParseName<control::OcpQpMethod>("--solver", qp_solver_);
     const nlohmann::json r = benchmarks::RunQpBenchmark(qp_instance_, o);
     WriteHtml("qp", r);
     if (json_) {
@@ -299,9 +301,11 @@ class BenchCommand final : public Command {
   }
 
   int Nmpc() const {
+    const auto solver = ParseName<control::OcpQpMethod>("--qp-solver", nmpc_qp_solver_);
     harness::Scenario nominal =
         harness::LoadScenario(ConfigPath("scenarios/lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}});
     harness::Scenario failed = harness::LoadScenario(ConfigPath("scenarios/nmpc_lemniscate_1ms_rotor0_failed.yaml"));
+    nominal.stack.nmpc.qp_solver = failed.stack.nmpc.qp_solver = solver;
     nominal.truth = WorldOf(nominal.truth);
     failed.truth = WorldOf(failed.truth);
     const nlohmann::json r = benchmarks::RunNmpcBenchmark(nominal, failed);
@@ -506,7 +510,8 @@ class BenchCommand final : public Command {
   bool resume_ = false, json_ = false;
   std::string trial_timeout_;
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
-  std::string qp_instance_, qp_repetitions_ = "3";
+  std::string qp_instance_, qp_repetitions_ = "3", qp_solver_ = "riccati";
+  std::string nmpc_qp_solver_ = "condensing";
   std::string truth_ = "realistic", estimator_;
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -18,6 +19,7 @@ namespace rotorguard::benchmarks {
 
 namespace {
 using nlohmann::json;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 Eigen::VectorXd Vector(const json& j, const std::string& what, int size) {
   if (!j.is_array() || static_cast<int>(j.size()) != size) {
@@ -44,6 +46,7 @@ struct Case {
 
 struct GroupResult {
   std::vector<double> times_us;
+  std::vector<double> prepare_us, feedback_us;  ///< the two phases of the median solve's case
   std::vector<double> u0_errors;
   double iterations_sum = 0.0;
   int failures = 0;
@@ -112,7 +115,7 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
   // are: a start from the previous solve's active set would make the repetitions free.
   control::DenseQpOptions cold;
   cold.warm_start = false;
-  control::CondensingQpSolver solver(dims, cold);
+  const std::unique_ptr<control::OcpQpSolver> solver = control::MakeOcpQpSolver(options.solver, dims, cold);
   // Each case where u_0 differs from the reference by more than this is cross-examined.
   constexpr double kExamineError = 1e-4;
   const auto run = [&](const std::vector<Case>& cases) {
@@ -120,12 +123,20 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
     std::vector<double> reps(static_cast<std::size_t>(options.repetitions));
     for (const Case& c : cases) {
       qp->x0 = c.x0;
-      for (int r = 0; r < options.repetitions; ++r) reps[r] = solver.Solve(*qp).total_time_s * 1e6;
+      double prepare_min = kInf, feedback_min = kInf;
+      for (int r = 0; r < options.repetitions; ++r) {
+        const control::OcpQpSummary& s = solver->Solve(*qp);
+        reps[r] = s.total_time_s * 1e6;
+        prepare_min = std::min(prepare_min, s.condense_time_s * 1e6);
+        feedback_min = std::min(feedback_min, s.dense_solve_time_s * 1e6);
+      }
       g.times_us.push_back(Percentile(reps, 0.5));
-      const control::OcpQpSummary& s = solver.summary();
+      g.prepare_us.push_back(prepare_min);
+      g.feedback_us.push_back(feedback_min);
+      const control::OcpQpSummary& s = solver->summary();
       if (!s.IsSolutionUsable()) ++g.failures;
       g.iterations_sum += s.iterations;
-      const double error = (solver.u()[0] - c.u0).cwiseAbs().maxCoeff();
+      const double error = (solver->u()[0] - c.u0).cwiseAbs().maxCoeff();
       g.u0_errors.push_back(error);
       if (error > kExamineError && s.IsSolutionUsable()) {
         // The best objective with u_0 pinned to the reference's value, against ours.
@@ -133,7 +144,7 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
         const Eigen::VectorXd lower = qp->u_lower[0], upper = qp->u_upper[0];
         qp->u_lower[0] = c.u0;
         qp->u_upper[0] = c.u0;
-        const control::OcpQpSummary& pinned = solver.Solve(*qp);
+        const control::OcpQpSummary& pinned = solver->Solve(*qp);
         if (pinned.IsSolutionUsable() && pinned.objective > ours * (1.0 + 1e-12)) {
           ++g.reference_suboptimal;
           g.worst_reference_gap = std::max(g.worst_reference_gap, (pinned.objective - ours) / std::abs(ours));
@@ -150,7 +161,9 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
   all_errors.insert(all_errors.end(), tr.u0_errors.begin(), tr.u0_errors.end());
   return {{"benchmark", "qp"},
           {"instance", path},
-          {"solver", "condensing + Goldfarb-Idnani dual active set"},
+          {"solver", options.solver == control::OcpQpMethod::kRiccati
+                         ? "riccati: Riccati factorisation + range-space Goldfarb-Idnani dual active set"
+                         : "condensing: condensing + Goldfarb-Idnani dual active set"},
           {"cases_stress", stress.size()},
           {"cases_track", track.size()},
           {"repetitions", options.repetitions},
@@ -158,6 +171,10 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
           {"stress_us_p99", Percentile(st.times_us, 0.99)},
           {"track_us_median", Percentile(tr.times_us, 0.5)},
           {"track_us_p99", Percentile(tr.times_us, 0.99)},
+          {"stress_prepare_us_median", Percentile(st.prepare_us, 0.5)},
+          {"stress_feedback_us_median", Percentile(st.feedback_us, 0.5)},
+          {"track_prepare_us_median", Percentile(tr.prepare_us, 0.5)},
+          {"track_feedback_us_median", Percentile(tr.feedback_us, 0.5)},
           {"iterations_mean", cases > 0 ? (st.iterations_sum + tr.iterations_sum) / cases : 0.0},
           {"max_u0_error", std::max(Percentile(st.u0_errors, 1.0), Percentile(tr.u0_errors, 1.0))},
           {"u0_error_median", Percentile(all_errors, 0.5)},

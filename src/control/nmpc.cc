@@ -63,7 +63,7 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
                     model_.nx(),
                     model_.nu(),
                     {StateIndex::kBodyRate, StateIndex::kBodyRate + 1, StateIndex::kBodyRate + 2}}),
-      qp_solver_(qp_.dims, options.qp),
+      qp_solver_(MakeOcpQpSolver(options.qp_solver, qp_.dims, options.qp)),
       observer_(model_, options.disturbance),
       failed_(static_cast<std::size_t>(model_.nu()), false) {
   weights_.resize(nx_);
@@ -354,7 +354,7 @@ bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, doub
   }
   qp_.x0.setZero();  // condensed around the plan's own first node; the measurement comes later
   gap_ = gap;
-  const OcpQpSummary& qs = reuse ? qp_solver_.PrepareVectors(qp_) : qp_solver_.Prepare(qp_);
+  const OcpQpSummary& qs = reuse ? qp_solver_->PrepareVectors(qp_) : qp_solver_->Prepare(qp_);
   ++(reuse ? summary_.linearisations_reused : summary_.linearisations);
   reused_since_linearisation_ = reuse ? reused_since_linearisation_ + 1 : 0;
   summary_.prepare_time_s += clock.seconds();
@@ -364,7 +364,7 @@ bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, doub
 bool NmpcController::FeedbackIteration(const Eigen::VectorXd& x0) {
   Stopwatch clock;
   x0_delta_ = x0 - x_[0];
-  const OcpQpSummary* qs = &qp_solver_.Feedback(x0_delta_);
+  const OcpQpSummary* qs = &qp_solver_->Feedback(x0_delta_);
   if (qs->status == QpStatus::kInfeasible) {
     // The body-rate bounds are hard constraints, and the motors can change the rate only so fast:
     // a measured rate far beyond its bound (a gust, a collision, a late isolation) leaves no
@@ -376,9 +376,9 @@ bool NmpcController::FeedbackIteration(const Eigen::VectorXd& x0) {
     }
     ++summary_.rate_bounds_relaxed;
     summary_.feedback_time_s += clock.Restart();
-    qp_solver_.Prepare(qp_);
+    qp_solver_->Prepare(qp_);
     summary_.prepare_time_s += clock.Restart();
-    qs = &qp_solver_.Feedback(x0_delta_);
+    qs = &qp_solver_->Feedback(x0_delta_);
   }
   const OcpQpSummary& q = *qs;
   summary_.qp_iterations += q.iterations;
@@ -388,13 +388,13 @@ bool NmpcController::FeedbackIteration(const Eigen::VectorXd& x0) {
   bool ok = q.IsSolutionUsable();
   double step = 0.0;
   for (int k = 0; ok && k <= N_; ++k) {
-    ok = qp_solver_.x()[k].allFinite() && (k == N_ || qp_solver_.u()[k].allFinite());
+    ok = qp_solver_->x()[k].allFinite() && (k == N_ || qp_solver_->u()[k].allFinite());
     if (!ok) break;
-    step = std::max(step, qp_solver_.x()[k].cwiseAbs().maxCoeff());
-    x_[k] += qp_solver_.x()[k];
+    step = std::max(step, qp_solver_->x()[k].cwiseAbs().maxCoeff());
+    x_[k] += qp_solver_->x()[k];
     if (k < N_) {
-      step = std::max(step, qp_solver_.u()[k].cwiseAbs().maxCoeff());
-      u_[k] += qp_solver_.u()[k];
+      step = std::max(step, qp_solver_->u()[k].cwiseAbs().maxCoeff());
+      u_[k] += qp_solver_->u()[k];
     }
   }
   summary_.step_norm = step;

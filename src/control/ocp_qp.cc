@@ -1,28 +1,22 @@
 
+#include "rotorguard/control/ocp_qp.h"
+
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
-#include "rotorguard/control/ocp_qp.h"
+#include "rotorguard/control/riccati_qp.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/stopwatch.h"
+#include "stage_maps.h"
 
 namespace rotorguard::control {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-/// A stage's A_k, B_k and Q_k as fixed-size maps (NX, NU when known at compile time, else Dynamic).
-template <int NX, int NU>
-struct StageMaps {
-  const OcpQp& qp;
-  int nx, nu;
-  Eigen::Map<const Eigen::Matrix<double, NX, NX>> A(int k) const { return {qp.A[k].data(), nx, nx}; }
-  Eigen::Map<const Eigen::Matrix<double, NX, NU>> B(int k) const { return {qp.B[k].data(), nx, nu}; }
-  Eigen::Map<const Eigen::Matrix<double, NX, NX>> Q(int k) const { return {qp.Q[k].data(), nx, nx}; }
-};
+using internal::StageMaps;
 }  // namespace
 
 void OcpQpDims::Validate() const {
@@ -91,7 +85,6 @@ template <int NX, int NU>
 void CondensingQpSolver::CondenseMatrices(const OcpQp& qp) {
   using MatXX = Eigen::Matrix<double, NX, NX>;
   using MatXU = Eigen::Matrix<double, NX, NU>;
-  using MatUU = Eigen::Matrix<double, NU, NU>;
   const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
   const std::vector<int>& idx = dims_.state_bound_index;
   const int nbx = static_cast<int>(idx.size());
@@ -125,7 +118,7 @@ void CondensingQpSolver::CondenseMatrices(const OcpQp& qp) {
     auto column = dense_.H.block(0, j * nu, (j + 1) * nu, nu);
     column.noalias() = Srow(j + 1).transpose() * Y(j);
     dense_.H.block(j * nu, 0, nu, j * nu) = column.topRows(j * nu).transpose();
-    dense_.H.block(j * nu, j * nu, nu, nu) += Eigen::Map<const MatUU>(qp.R[j].data(), nu, nu);
+    dense_.H.block(j * nu, j * nu, nu, nu) += stage.R(j);
   }
   // State bounds become rows of C: x_k[idx] = x_bar_k[idx] + sum_{j<k} S_kj[idx, :] u_j.
   if (nbx > 0) {
@@ -171,10 +164,22 @@ void CondensingQpSolver::CondenseVectors(const OcpQp& qp) {
   }
 }
 
-const OcpQpSummary& CondensingQpSolver::Solve(const OcpQp& qp) {
+const OcpQpSummary& OcpQpSolver::Solve(const OcpQp& qp) {
   Prepare(qp);
   if (summary_.status == QpStatus::kNumericalFailure) return summary_;
   return Feedback(qp.x0);
+}
+
+void OcpQpSolver::RequireSameDims(const OcpQp& qp, const OcpQpDims& dims, const char* solver) {
+  if (qp.dims.horizon != dims.horizon || qp.dims.nx != dims.nx || qp.dims.nu != dims.nu ||
+      qp.dims.state_bound_index != dims.state_bound_index) {
+    throw std::invalid_argument(fmt::format("{}: the problem's dimensions differ from the solver's", solver));
+  }
+}
+
+std::unique_ptr<OcpQpSolver> MakeOcpQpSolver(OcpQpMethod method, const OcpQpDims& dims, const DenseQpOptions& options) {
+  if (method == OcpQpMethod::kRiccati) return std::make_unique<RiccatiQpSolver>(dims, options);
+  return std::make_unique<CondensingQpSolver>(dims, options);
 }
 
 const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp) { return Prepare(qp, /*whole=*/true); }
@@ -186,10 +191,9 @@ const OcpQpSummary& CondensingQpSolver::PrepareVectors(const OcpQp& qp) {
 const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp, bool whole) {
   const Stopwatch clock;
   summary_ = OcpQpSummary{};
-  RequireSameDims(qp);
-  // Sizes known at compile time make Eigen's small products several times faster: the NMPC's
-  // quadrotor (nx = 17, nu = 4) gets its own instantiation (measured: docs/control.md).
-  const bool nmpc_sizes = dims_.nx == 17 && dims_.nu == 4;
+  RequireSameDims(qp, dims_, "CondensingQpSolver");
+  // The NMPC's sizes get their own instantiation (measured: docs/control.md).
+  const bool nmpc_sizes = internal::IsNmpcSize(dims_);
   if (nmpc_sizes) {
     CondenseVectors<17, 4>(qp);
   } else {
@@ -213,13 +217,6 @@ const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp, bool whole) {
   }
   summary_.condense_time_s = clock.seconds();
   return summary_;
-}
-
-void CondensingQpSolver::RequireSameDims(const OcpQp& qp) const {
-  if (qp.dims.horizon != dims_.horizon || qp.dims.nx != dims_.nx || qp.dims.nu != dims_.nu ||
-      qp.dims.state_bound_index != dims_.state_bound_index) {
-    throw std::invalid_argument("CondensingQpSolver: the problem's dimensions differ from the solver's");
-  }
 }
 
 void CondensingQpSolver::KeepPreparedVectors(const OcpQp& qp) {

@@ -223,6 +223,46 @@ TEST(Nmpc, ReusesTheLinearisationForTheConfiguredNumberOfPreparations) {
   EXPECT_LT(largest_difference, 0.05) << "of thrusts of 4 to 9 N";
 }
 
+TEST(Nmpc, BothQpSolversGiveTheSameCommands) {
+  // The two solvers of the same QPs (condensing; Riccati, docs/control.md "Two QP solvers") through
+  // what the NMPC asks of them: whole and vector-only preparations (relinearise_every 3), warm
+  // starts, a rotor failure (inputs bounded to zero) and an infeasible QP re-solved without rate
+  // bounds. The commands agree to rounding.
+  NmpcOptions condensing_options, riccati_options;
+  condensing_options.relinearise_every = riccati_options.relinearise_every = 3;
+  condensing_options.qp_solver = OcpQpMethod::kCondensing;
+  riccati_options.qp_solver = OcpQpMethod::kRiccati;
+  NmpcController condensing(ReferenceQuad(), condensing_options), riccati(ReferenceQuad(), riccati_options);
+  const auto ref = HoverAt(1.5);
+  StateEstimate est = HoverEstimate(1.0);
+  est.v_W = Vector3(0.5, -0.3, 0.0);
+  est.q_WB = Quaternion(Eigen::AngleAxisd(0.15, Vector3::UnitX()));
+  double largest_difference = 0.0;
+  int relaxed = 0, relaxed_condensing = 0, iterations = 0;
+  for (int i = 0; i < 30; ++i) {
+    if (i == 12) {
+      condensing.SetRotorFailed(0);
+      riccati.SetRotorFailed(0);
+    }
+    StateEstimate now = est;
+    if (i == 20) now.w_B = Vector3(16.0, 0.0, 0.0);  // beyond what the rate bounds allow
+    RotorVector a, b;
+    condensing.Compute(now, ref, 0.005 * i, 0.005, &a);
+    riccati.Compute(now, ref, 0.005 * i, 0.005, &b);
+    ASSERT_TRUE(riccati.summary().IsSolutionUsable()) << "call " << i << ": " << riccati.summary().BriefReport();
+    ASSERT_EQ(condensing.summary().status, riccati.summary().status) << "call " << i;
+    largest_difference = std::max(largest_difference, (a - b).cwiseAbs().maxCoeff());
+    relaxed += riccati.summary().rate_bounds_relaxed;
+    relaxed_condensing += condensing.summary().rate_bounds_relaxed;
+    iterations += riccati.summary().qp_iterations;
+    est.p_W += 0.005 * est.v_W;
+  }
+  EXPECT_LT(largest_difference, 1e-7) << "of thrusts of 0 to 9 N";
+  EXPECT_EQ(relaxed, relaxed_condensing);
+  EXPECT_GE(relaxed, 1);
+  EXPECT_GT(iterations, 0) << "bounds must have entered the active set";
+}
+
 TEST(Nmpc, OptionsValidationNamesTheField) {
   NmpcOptions o;
   o.horizon_steps = 0;

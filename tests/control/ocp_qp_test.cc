@@ -6,10 +6,12 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "rotorguard/control/riccati_qp.h"
 #include "rotorguard/core/rng.h"
 #include "test_util.h"
 
@@ -392,6 +394,192 @@ TEST(CondensingQp, RejectsMismatchedDimensionsAndBadDims) {
   EXPECT_THROW(solver.Solve(qp), std::invalid_argument);
   EXPECT_THROW(OcpQp(OcpQpDims{0, 3, 1, {}}), std::invalid_argument);
   EXPECT_THROW(OcpQp(OcpQpDims{4, 3, 1, {3}}), std::invalid_argument);
+}
+
+// ---- RiccatiQpSolver: the stage form, against oracles independent of its recursions.
+
+/// Checks the KKT conditions of `qp`, condensed the naive way, at the solver's inputs and
+/// multipliers: feasibility, stationarity H u + g = y_u + C' y_x, and multipliers that are zero off
+/// their bounds and of the right sign on them. For a strictly convex QP they define the optimum.
+/// Returns the number of bounds active at the point.
+int ExpectKktOfTheNaiveCondensing(const OcpQp& qp, const RiccatiQpSolver& solver) {
+  const int N = qp.dims.horizon, nu = qp.dims.nu, nbx = static_cast<int>(qp.dims.state_bound_index.size());
+  Eigen::MatrixXd H, C;
+  Eigen::VectorXd g, lc, uc;
+  NaiveCondense(qp, &H, &g, &C, &lc, &uc);
+  Eigen::VectorXd u(N * nu), yu(N * nu), yx(N * nbx);
+  for (int k = 0; k < N; ++k) {
+    u.segment(k * nu, nu) = solver.u()[k];
+    yu.segment(k * nu, nu) = solver.input_multipliers()[k];
+    yx.segment(k * nbx, nbx) = solver.state_multipliers()[k + 1];
+  }
+  const Eigen::VectorXd residual = H * u + g - yu - C.transpose() * yx;
+  EXPECT_LE(residual.cwiseAbs().maxCoeff(), 1e-8 * (1.0 + g.cwiseAbs().maxCoeff())) << "stationarity";
+  const Eigen::VectorXd cu = C * u;
+  int active = 0;
+  // A side is "at" its bound within kAt; a multiplier above kZero must sit on its side's bound.
+  constexpr double kAt = 1e-8, kZero = 1e-9;
+  const auto check = [&](double value, double lower, double upper, double y, const std::string& what) {
+    EXPECT_GE(value, lower - kAt) << what;
+    EXPECT_LE(value, upper + kAt) << what;
+    if (y > kZero) {
+      EXPECT_NEAR(value, lower, kAt) << what << ": a positive multiplier off the lower bound";
+    }
+    if (y < -kZero) {
+      EXPECT_NEAR(value, upper, kAt) << what << ": a negative multiplier off the upper bound";
+    }
+    active += std::abs(value - lower) < kAt || std::abs(value - upper) < kAt;
+  };
+  for (int k = 0; k < N; ++k) {
+    for (int i = 0; i < nu; ++i) {
+      check(u[k * nu + i], qp.u_lower[k][i], qp.u_upper[k][i], yu[k * nu + i], fmt::format("u_{}[{}]", k, i));
+    }
+  }
+  for (int r = 0; r < N * nbx; ++r) check(cu[r], lc[r], uc[r], yx[r], fmt::format("state bound row {}", r));
+  // The returned states are the inputs' trajectory, exactly.
+  for (int k = 0; k < N; ++k) {
+    EXPECT_TRUE(MatricesNear(solver.x()[k + 1], qp.A[k] * solver.x()[k] + qp.B[k] * solver.u()[k] + qp.c[k], 1e-12));
+  }
+  return active;
+}
+
+TEST(RiccatiQp, SolutionsSatisfyTheKktConditionsOfTheNaivelyCondensedQp) {
+  Rng rng(41);
+  int binding = 0, problems = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    // Input bounds bind in the first kind (random dynamics with state bounds are mostly
+    // infeasible), input and state bounds in the second; the third is the NMPC's size (the
+    // compile-time-sized code path).
+    const OcpQp qp = trial % 3 == 0   ? RandomOcp(8, 5, 2, {}, rng)
+                     : trial % 3 == 1 ? OcpPulledAgainstItsStateBounds(10, 6, 3, {0, 3}, rng)
+                                      : OcpPulledAgainstItsStateBounds(12, 17, 4, {0, 3, 10}, rng);
+    RiccatiQpSolver solver(qp.dims);
+    const OcpQpSummary& s = solver.Solve(qp);
+    ASSERT_TRUE(s.IsSolutionUsable()) << "trial " << trial << ": " << s.BriefReport();
+    SCOPED_TRACE(fmt::format("trial {}", trial));
+    const int active = ExpectKktOfTheNaiveCondensing(qp, solver);
+    EXPECT_EQ(active, s.active_constraints);
+    EXPECT_LE(s.max_violation, 1e-8);
+    binding += active;
+    ++problems;
+  }
+  EXPECT_EQ(problems, 30);
+  EXPECT_GT(binding, 100) << "the problems must exercise the bounds";
+}
+
+TEST(RiccatiQp, UnconstrainedSolutionEqualsTheCondensingSolvers) {
+  // No bound binds: the minimum of the dynamics-constrained quadratic, which both solvers compute
+  // by different factorisations (Riccati; condensing and Cholesky).
+  Rng rng(43);
+  for (int trial = 0; trial < 5; ++trial) {
+    OcpQp qp = RandomOcp(15, 17, 4, {2, 7}, rng);
+    for (int k = 0; k < 15; ++k) {
+      qp.u_lower[k].setConstant(-1e9);
+      qp.u_upper[k].setConstant(1e9);
+      qp.x_lower[k + 1].setConstant(-1e12);
+      qp.x_upper[k + 1].setConstant(1e12);
+    }
+    RiccatiQpSolver riccati(qp.dims);
+    CondensingQpSolver condensing(qp.dims);
+    ASSERT_TRUE(riccati.Solve(qp).IsSolutionUsable());
+    ASSERT_TRUE(condensing.Solve(qp).IsSolutionUsable());
+    EXPECT_EQ(riccati.summary().active_constraints, 0);
+    for (int k = 0; k < 15; ++k) {
+      EXPECT_TRUE(MatricesNear(riccati.u()[k], condensing.u()[k], 1e-8 * (1.0 + condensing.u()[k].norm())));
+    }
+  }
+}
+
+TEST(RiccatiQp, AWarmStartReachesTheColdSolutionInFewerIterations) {
+  // A sequence of QPs with the initial state moving a little, as the NMPC's calls: started from
+  // the previous active set, the solution is the cold one.
+  Rng rng(47);
+  const OcpQp base = OcpPulledAgainstItsStateBounds(10, 6, 3, {0, 3}, rng);
+  DenseQpOptions cold_options;
+  cold_options.warm_start = false;
+  RiccatiQpSolver warm(base.dims), cold(base.dims, cold_options);
+  int warm_iterations = 0, cold_iterations = 0;
+  for (int step = 0; step < 10; ++step) {
+    OcpQp qp = base;
+    qp.x0 = base.x0 + 0.02 * step * Eigen::VectorXd::Ones(6);
+    const OcpQpSummary& w = warm.Solve(qp);
+    const OcpQpSummary& c = cold.Solve(qp);
+    ASSERT_TRUE(w.IsSolutionUsable() && c.IsSolutionUsable());
+    EXPECT_EQ(w.start, step == 0 ? QpStart::kCold : QpStart::kWarm);
+    EXPECT_EQ(c.start, QpStart::kCold);
+    for (int k = 0; k < 10; ++k) EXPECT_TRUE(MatricesNear(warm.u()[k], cold.u()[k], 1e-9)) << "step " << step;
+    if (step > 0) {
+      warm_iterations += w.iterations;
+      cold_iterations += c.iterations;
+    }
+  }
+  EXPECT_LT(warm_iterations, cold_iterations / 2);
+}
+
+TEST(RiccatiQp, BoundsWhoseNormalsAreDependentAreHandled) {
+  // x_{k+1}[0] = u_k[0] exactly, and both are bounded by the same +-0.6: the two bounds of a pair
+  // are the same constraint, so at most one can enter the active set. A cost pulling x[0] to 4
+  // makes them bind. Oracle: the KKT conditions and the condensing solver.
+  Rng rng(53);
+  OcpQp qp = OcpPulledAgainstItsStateBounds(6, 4, 2, {0}, rng);
+  for (int k = 0; k < 6; ++k) {
+    qp.A[k].row(0).setZero();
+    qp.B[k].row(0) << 1.0, 0.0;
+    qp.c[k][0] = 0.0;
+    qp.x_lower[k + 1][0] = -0.6;
+    qp.x_upper[k + 1][0] = 0.6;
+  }
+  RiccatiQpSolver solver(qp.dims);
+  const OcpQpSummary& s = solver.Solve(qp);
+  ASSERT_TRUE(s.IsSolutionUsable()) << s.BriefReport();
+  ExpectKktOfTheNaiveCondensing(qp, solver);
+  CondensingQpSolver condensing(qp.dims);
+  ASSERT_TRUE(condensing.Solve(qp).IsSolutionUsable());
+  int at_bound = 0;
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_TRUE(MatricesNear(solver.u()[k], condensing.u()[k], 1e-8)) << "u_" << k;
+    at_bound += std::abs(solver.u()[k][0] - 0.6) < 1e-9;
+  }
+  EXPECT_GT(at_bound, 0) << "the pair must bind";
+}
+
+TEST(RiccatiQp, ReportsInfeasibleBoundsAndRejectsBadData) {
+  Rng rng(59);
+  const OcpQp base = OcpPulledAgainstItsStateBounds(5, 4, 2, {0}, rng);
+  RiccatiQpSolver solver(base.dims);
+  {  // crossed bounds
+    OcpQp qp = base;
+    qp.u_lower[2][1] = 1.0;
+    qp.u_upper[2][1] = 0.5;
+    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kInfeasible);
+  }
+  {  // a state bound no admissible input reaches: x_1 depends on u_0 alone, |u_0| <= 0.6
+    OcpQp qp = base;
+    const double reachable = (qp.A[0] * qp.x0 + qp.c[0])[0] + qp.B[0].row(0).cwiseAbs().sum() * 0.6;
+    qp.x_lower[1][0] = reachable + 1.0;
+    qp.x_upper[1][0] = reachable + 2.0;
+    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kInfeasible);
+  }
+  for (int bad = 0; bad < 3; ++bad) {
+    OcpQp qp = base;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (bad == 0) qp.A[3](1, 2) = nan;
+    if (bad == 1) qp.u_lower[0][0] = nan;
+    if (bad == 2) qp.x0[1] = nan;
+    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure) << "bad " << bad;
+    for (const auto& u : solver.u()) EXPECT_TRUE(u.allFinite());
+    for (const auto& x : solver.x()) EXPECT_TRUE(x.allFinite());
+  }
+  {  // R not positive definite
+    OcpQp qp = base;
+    qp.R[4] = -Eigen::MatrixXd::Identity(2, 2);
+    qp.Q[5].setZero();
+    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure);
+  }
+  // Solvable again after the failures.
+  EXPECT_TRUE(solver.Solve(base).IsSolutionUsable());
+  RiccatiQpSolver other(OcpQpDims{6, 4, 2, {0}});
+  EXPECT_THROW(other.Solve(base), std::invalid_argument);
 }
 
 }  // namespace

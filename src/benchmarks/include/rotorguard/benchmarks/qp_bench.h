@@ -2,14 +2,16 @@
 /// `rotorguard bench qp`: the NMPC's QP solver on a reference OCP QP instance (JSON: N, nx, nu,
 /// A, B, Q_diag, R_diag, input and state bounds, and cases of x0 with the optimal u_0 found by an
 /// interior-point solver). Every case is solved cold; times and the error in u_0 are reported.
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include <nlohmann/json.hpp>
+#include "rotorguard/control/ocp_qp.h"
 
 namespace rotorguard::benchmarks {
 
 struct QpBenchOptions {
   int repetitions = 3;  ///< each case is solved this many times; its median time counts, >= 1
+  control::OcpQpMethod solver = control::OcpQpMethod::kRiccati;
 };
 
 /// Runs the benchmark on the instance at `path`. Throws io::InputFileError when the file cannot be

@@ -10,6 +10,7 @@
 /// with it and with each rotor's known effectiveness (docs/control.md).
 #include <Eigen/Core>
 #include <algorithm>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -50,6 +51,10 @@ struct NmpcOptions {
   /// What the model misses, estimated in flight and predicted with (offset-free NMPC).
   DisturbanceObserverOptions disturbance;
   DenseQpOptions qp;
+  /// The QP solver of each iteration: condensing (the states eliminated, a dense active-set solve)
+  /// or riccati (the stage form factorised by a Riccati recursion); the same QP, the same solution
+  /// (docs/control.md, "Two QP solvers").
+  OcpQpMethod qp_solver = OcpQpMethod::kCondensing;
   void Validate() const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
@@ -70,6 +75,7 @@ struct NmpcOptions {
              {.meaning = "SQP iterations a cycle (1: the real-time iteration)", .min = 1, .max = 1000});
     a->Visit("relinearise_every", &relinearise_every,
              {.meaning = "a full linearisation every this many preparations (docs/control.md)", .min = 1, .max = 20});
+    a->Visit("qp_solver", &qp_solver, {.meaning = "condensing or riccati (docs/control.md, \"Two QP solvers\")"});
     a->Visit("disturbance", &disturbance,
              {.meaning = "the disturbance observer that makes the NMPC offset-free (docs/control.md)"});
   }
@@ -173,7 +179,7 @@ class NmpcController final : public Controller {
   Rk4Sensitivity integrator_;
   int nx_, nu_, N_;
   OcpQp qp_;
-  CondensingQpSolver qp_solver_;
+  std::unique_ptr<OcpQpSolver> qp_solver_;
   Eigen::VectorXd weights_;          // diagonal of W for y (nx entries)
   Eigen::VectorXd u_max_;
   DisturbanceObserver observer_;   // the rotors' effectiveness (0 once failed) is model_'s

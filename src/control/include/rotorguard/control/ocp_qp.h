@@ -10,15 +10,26 @@
 /// and its solver by condensing: the states are eliminated (x_k = x_bar_k + sum_j S_kj u_j) with
 /// O(N^2) recursions, and the dense QP in the N*nu inputs is solved by the Goldfarb-Idnani dual
 /// active-set method (DenseQpSolver). docs/control.md explains the choice and its measurements.
+#include <Eigen/Core>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "rotorguard/control/dense_qp.h"
+#include "rotorguard/core/config_schema.h"
 
 namespace rotorguard::control {
+
+/// The two solvers of an OcpQp.
+enum class OcpQpMethod {
+  kCondensing,  ///< CondensingQpSolver: the states eliminated, a dense active-set solve
+  kRiccati,     ///< RiccatiQpSolver (riccati_qp.h): the stage form, factorised by a Riccati recursion
+};
+/// As bench qp's --solver writes them.
+inline constexpr EnumName<OcpQpMethod> kOcpQpMethodNames[] = {{OcpQpMethod::kCondensing, "condensing"},
+                                                              {OcpQpMethod::kRiccati, "riccati"}};
+constexpr std::span<const EnumName<OcpQpMethod>> NamesOf(const OcpQpMethod*) { return kOcpQpMethodNames; }
 
 struct OcpQpDims {
   int horizon = 20;  ///< N, >= 1
@@ -57,31 +68,57 @@ struct OcpQpSummary {
   std::string BriefReport() const;
 };
 
-class CondensingQpSolver {
+/// A solver of OcpQp in the real-time iteration's two phases: the preparation, before the state is
+/// measured, and the feedback once it is. CondensingQpSolver and RiccatiQpSolver (riccati_qp.h).
+class OcpQpSolver {
  public:
-  explicit CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options = {});
+  virtual ~OcpQpSolver() = default;
   /// Solves `qp` (whose dims must equal the solver's): Prepare(qp) then Feedback(qp.x0).
   const OcpQpSummary& Solve(const OcpQp& qp);
+  /// Preparation phase: everything that does not depend on qp.x0. `qp` must outlive the following
+  /// Feedback calls and stay unchanged.
+  virtual const OcpQpSummary& Prepare(const OcpQp& qp) = 0;
+  /// Preparation for a `qp` whose matrices (A, B, Q, R) are those of the last Prepare, its vectors
+  /// (x0, c, q, r and the bounds) new: what depends on the matrices alone is kept. The caller
+  /// vouches for the matrices; without a usable preparation before, it is Prepare.
+  virtual const OcpQpSummary& PrepareVectors(const OcpQp& qp) = 0;
+  /// Feedback phase: the prepared QP for the initial state x0, and its trajectory.
+  virtual const OcpQpSummary& Feedback(const Eigen::VectorXd& x0) = 0;
+  const std::vector<Eigen::VectorXd>& u() const { return u_; }  ///< N inputs
+  const std::vector<Eigen::VectorXd>& x() const { return x_; }  ///< N + 1 states
+  const OcpQpSummary& summary() const { return summary_; }
+
+ protected:
+  /// Throws std::invalid_argument naming `solver` when qp's dims differ from `dims`.
+  static void RequireSameDims(const OcpQp& qp, const OcpQpDims& dims, const char* solver);
+  std::vector<Eigen::VectorXd> x_, u_;
+  OcpQpSummary summary_;
+};
+
+/// The solver `method` names, for `dims`.
+std::unique_ptr<OcpQpSolver> MakeOcpQpSolver(OcpQpMethod method, const OcpQpDims& dims,
+                                             const DenseQpOptions& options = {});
+
+class CondensingQpSolver final : public OcpQpSolver {
+ public:
+  explicit CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options = {});
   /// Preparation phase of a real-time iteration: condenses `qp` around its x0 and factorises the
   /// Hessian. Inputs whose bounds coincide (a failed rotor's, u_bar_i = 0) are fixed: they are
   /// eliminated, and the dense QP is solved over the free inputs only (fewer variables, and no
   /// active-set changes for bounds that hold by construction). `qp` must outlive the following
   /// Feedback calls and stay unchanged.
-  const OcpQpSummary& Prepare(const OcpQp& qp);
+  const OcpQpSummary& Prepare(const OcpQp& qp) override;
   /// Preparation for a `qp` whose matrices (A, B, Q, R) are those of the last Prepare, its vectors
   /// (x0, c, q, r and the bounds) new: the condensed Hessian, the state-bound rows and the
   /// factorisation are kept, and only the condensed gradient and bounds are recomputed, O(N nx^2)
   /// instead of O(N^2 nx^2 nu) plus a factorisation. The mixed-level real-time iteration's cheap
   /// step (NmpcOptions::relinearise_every). The caller vouches for the matrices; a change in which
   /// inputs are fixed by equal bounds, or no usable preparation before, falls back to Prepare.
-  const OcpQpSummary& PrepareVectors(const OcpQp& qp);
+  const OcpQpSummary& PrepareVectors(const OcpQp& qp) override;
   /// Feedback phase: the QP for the measured initial state x0 (only the gradient and bounds move,
   /// linearly in x0 - prepared x0, by one forward pass through the A_k), solved on the prepared
   /// factorisation, and the trajectory.
-  const OcpQpSummary& Feedback(const Eigen::VectorXd& x0);
-  const std::vector<Eigen::VectorXd>& u() const { return u_; }  ///< N inputs
-  const std::vector<Eigen::VectorXd>& x() const { return x_; }  ///< N + 1 states
-  const OcpQpSummary& summary() const { return summary_; }
+  const OcpQpSummary& Feedback(const Eigen::VectorXd& x0) override;
   /// The condensed problem of the last Solve (for inspection and tests).
   const DenseQp& condensed() const { return dense_; }
 
@@ -95,7 +132,6 @@ class CondensingQpSolver {
   void CondenseMatrices(const OcpQp& qp);
   template <int NX, int NU>
   void CondenseVectors(const OcpQp& qp);
-  void RequireSameDims(const OcpQp& qp) const;
   /// The prepared gradient and bounds, from which Feedback shifts by the measured x0.
   void KeepPreparedVectors(const OcpQp& qp);
   /// pattern_fixed_: the inputs whose bounds in dense_ coincide.
@@ -112,7 +148,7 @@ class CondensingQpSolver {
   // s_rows_[k] = [S_k0 ... S_k,k-1] side by side (nx x k nu), S_kj = dx_k/du_j: one product per
   // stage builds a row of them, and one per input the Hessian's column of blocks.
   std::vector<Eigen::MatrixXd> s_rows_, w_matrix_, y_;
-  std::vector<Eigen::VectorXd> x_bar_, w_vector_, x_, u_;
+  std::vector<Eigen::VectorXd> x_bar_, w_vector_;
   Eigen::MatrixXd tmp_;
   // The prepared gradient and state-bound rows, and the scratch of their shift by x0 in Feedback.
   Eigen::VectorXd g0_, lc0_, uc0_, prepared_x0_, dx_, dx_next_, cdx_, qx_, ru_;
@@ -131,7 +167,6 @@ class CondensingQpSolver {
   Eigen::VectorXd z_fixed_, g_fixed_, c_fixed_, z_;
   std::unique_ptr<DenseQp> reduced_;
   std::unique_ptr<DenseQpSolver> reduced_solver_;
-  OcpQpSummary summary_;
 };
 
 }  // namespace rotorguard::control

@@ -1,0 +1,533 @@
+#include "rotorguard/control/riccati_qp.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "rotorguard/core/stopwatch.h"
+#include "stage_maps.h"
+
+namespace rotorguard::control {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+using internal::StageMaps;
+// A side whose normal keeps less than this share of its H^-1 norm outside the span of the active
+// normals (d² = e'H^-1 e - b'M^-1 b against e'H^-1 e) is taken as dependent on them: no primal step
+// (Goldfarb and Idnani's dual step only) and never added.
+constexpr double kDependence = 1e-12;
+}  // namespace
+
+RiccatiQpSolver::RiccatiQpSolver(const OcpQpDims& dims, const DenseQpOptions& options)
+    : dims_(dims), options_(options) {
+  dims_.Validate();
+  options_.Validate();
+  const int N = dims.horizon, nx = dims.nx, nu = dims.nu;
+  nbx_ = static_cast<int>(dims.state_bound_index.size());
+  nc_ = N * nu + N * nbx_;
+  nmpc_sizes_ = internal::IsNmpcSize(dims_);
+  P_.assign(N + 1, Eigen::MatrixXd::Zero(nx, nx));
+  PB_.assign(N, Eigen::MatrixXd::Zero(nx, nu));
+  Lu_.assign(N, Eigen::MatrixXd::Zero(nu, nu));
+  K_.assign(N, Eigen::MatrixXd::Zero(nu, nx));
+  kff_.assign(N, Eigen::VectorXd::Zero(nu));
+  kr_.assign(N, Eigen::VectorXd::Zero(nu));
+  x_.assign(N + 1, Eigen::VectorXd::Zero(nx));
+  u_.assign(N, Eigen::VectorXd::Zero(nu));
+  y_u_.assign(N, Eigen::VectorXd::Zero(nu));
+  y_x_.assign(N + 1, Eigen::VectorXd::Zero(nbx_));
+  tmp_xx_.resize(nx, nx);
+  lower_.resize(nc_);
+  upper_.resize(nc_);
+  w0_.resize(nc_);
+  w_.resize(nc_);
+  step_.resize(nc_);
+  responses_.resize(nc_, nc_);
+  have_response_.assign(static_cast<std::size_t>(nc_), 0);
+  // At most N nu sides are independent (the inputs' count), and dependent ones are never added.
+  const int max_active = std::min(nc_, N * nu);
+  L_ = Eigen::MatrixXd::Zero(max_active + 1, max_active + 1);
+  multipliers_.resize(max_active + 1);
+  b_.resize(max_active + 1);
+  r_.resize(max_active + 1);
+  update_.resize(max_active + 1);
+  active_.reserve(static_cast<std::size_t>(max_active + 1));
+  previous_.reserve(static_cast<std::size_t>(max_active + 1));
+  is_active_.assign(2 * static_cast<std::size_t>(nc_), 0);
+}
+
+template <int NX, int NU>
+bool RiccatiQpSolver::Factorize(const OcpQp& qp) {
+  using MatXX = Eigen::Matrix<double, NX, NX>;
+  using MatXU = Eigen::Matrix<double, NX, NU>;
+  using MatUX = Eigen::Matrix<double, NU, NX>;
+  using MatUU = Eigen::Matrix<double, NU, NU>;
+  const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
+  const StageMaps<NX, NU> stage{qp, nx, nu};
+  const auto P = [&](int k) { return Eigen::Map<MatXX>(P_[k].data(), nx, nx); };
+  Eigen::Map<MatXX> tmp(tmp_xx_.data(), nx, nx);
+  // P_N = Q_N; for k = N-1 .. 0: u_k = K_k x_k minimises the stage cost plus the cost-to-go
+  // 1/2 x' P_{k+1} x with K_k = -(R_k + B'P_{k+1}B)^-1 B'P_{k+1}A, and P_k = Q_k + A'P_{k+1}A +
+  // (B'P_{k+1}A)' K_k. P_0 is not needed: x_0 is fixed.
+  P(N) = stage.Q(N);
+  for (int k = N - 1; k >= 0; --k) {
+    Eigen::Map<MatXU> PB(PB_[k].data(), nx, nu);
+    PB.noalias() = P(k + 1) * stage.B(k);
+    MatUU Ru(nu, nu);
+    Ru.noalias() = stage.B(k).transpose() * PB;
+    Ru += stage.R(k);
+    if (!Ru.allFinite()) return false;
+    Eigen::LLT<MatUU> llt(Ru);
+    if (llt.info() != Eigen::Success) return false;
+    Eigen::Map<MatUU>(Lu_[k].data(), nu, nu) = llt.matrixL();
+    MatUX F(nu, nx);
+    F.noalias() = PB.transpose() * stage.A(k);
+    Eigen::Map<MatUX> K(K_[k].data(), nu, nx);
+    K = -llt.solve(F);
+    if (k == 0) return K.allFinite();
+    tmp.noalias() = P(k + 1) * stage.A(k);
+    P(k) = stage.Q(k);
+    P(k).noalias() += stage.A(k).transpose() * tmp;
+    P(k).noalias() += F.transpose() * K;
+    // Symmetric in exact arithmetic; rounding would make the products drift apart over the horizon.
+    tmp = P(k).transpose();
+    P(k) = 0.5 * (P(k) + tmp);
+  }
+  return true;
+}
+
+template <int NX, int NU>
+void RiccatiQpSolver::SolveStageHessian(int k, Eigen::Matrix<double, NU, 1>* h) const {
+  const int nu = dims_.nu;
+  const auto L =
+      Eigen::Map<const Eigen::Matrix<double, NU, NU>>(Lu_[k].data(), nu, nu).template triangularView<Eigen::Lower>();
+  L.solveInPlace(*h);
+  L.transpose().solveInPlace(*h);
+}
+
+template <int NX, int NU>
+void RiccatiQpSolver::BackwardVectors(const OcpQp& qp) {
+  using MatXX = Eigen::Matrix<double, NX, NX>;
+  using MatXU = Eigen::Matrix<double, NX, NU>;
+  using VecX = Eigen::Matrix<double, NX, 1>;
+  using VecU = Eigen::Matrix<double, NU, 1>;
+  const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
+  const StageMaps<NX, NU> stage{qp, nx, nu};
+  const auto vx = [&](const Eigen::VectorXd& v) { return Eigen::Map<const VecX>(v.data(), nx); };
+  // The cost-to-go's linear term p_k (1/2 x'P_k x + p_k'x): with s = P_{k+1} c_k + p_{k+1}, the
+  // feedforward is k_k = -(R_k + B'P_{k+1}B)^-1 (r_k + B's) and p_k = q_k + A'(s + P_{k+1} B k_k).
+  VecX p = vx(qp.q[N]);
+  for (int k = N - 1; k >= 0; --k) {
+    VecX s = vx(qp.c[k]);
+    s = Eigen::Map<const MatXX>(P_[k + 1].data(), nx, nx) * s + p;
+    VecU h = Eigen::Map<const VecU>(qp.r[k].data(), nu);
+    h.noalias() += stage.B(k).transpose() * s;
+    SolveStageHessian<NX, NU>(k, &h);
+    Eigen::Map<VecU>(kff_[k].data(), nu) = -h;
+    if (k > 0) {
+      s.noalias() -= Eigen::Map<const MatXU>(PB_[k].data(), nx, nu) * h;
+      p = vx(qp.q[k]);
+      p.noalias() += stage.A(k).transpose() * s;
+    }
+  }
+}
+
+template <int NX, int NU>
+void RiccatiQpSolver::Forward(const Eigen::VectorXd& x0) {
+  using MatUX = Eigen::Matrix<double, NU, NX>;
+  using VecX = Eigen::Matrix<double, NX, 1>;
+  using VecU = Eigen::Matrix<double, NU, 1>;
+  const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
+  const StageMaps<NX, NU> stage{*qp_, nx, nu};
+  // u_k = K_k x_k + k_k from x0.
+  const std::vector<int>& idx = dims_.state_bound_index;
+  VecX x = Eigen::Map<const VecX>(x0.data(), nx);
+  for (int k = 0; k < N; ++k) {
+    VecU u = Eigen::Map<const VecU>(kff_[k].data(), nu);
+    u.noalias() += Eigen::Map<const MatUX>(K_[k].data(), nu, nx) * x;
+    w0_.segment(k * nu, nu) = u;
+    VecX next = Eigen::Map<const VecX>(qp_->c[k].data(), nx);
+    next.noalias() += stage.A(k) * x;
+    next.noalias() += stage.B(k) * u;
+    x = next;
+    for (int b = 0; b < nbx_; ++b) w0_[N * nu + k * nbx_ + b] = x[idx[b]];
+  }
+}
+
+template <int NX, int NU>
+void RiccatiQpSolver::ComputeResponse(int index) {
+  using MatXU = Eigen::Matrix<double, NX, NU>;
+  using MatUX = Eigen::Matrix<double, NU, NX>;
+  using VecX = Eigen::Matrix<double, NX, 1>;
+  using VecU = Eigen::Matrix<double, NU, 1>;
+  const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
+  const StageMaps<NX, NU> stage{*qp_, nx, nu};
+  // v = H^-1 e minimises 1/2 z'Hz - e'z over the trajectories from x_0 = 0 with c = 0: the linear
+  // term -e sits at one stage, so the backward pass starts there, and the feedforwards k_k are
+  // non-zero only up to it.
+  VecX p(nx);
+  int last = 0;  // the last stage whose feedforward is non-zero
+  int from = 0;  // the first stage of the backward pass below
+  if (index < N * nu) {
+    // r_j = -e_i: k_j = (R_j + B'P_{j+1}B)^-1 e_i and p_j = A_j' P_{j+1} B_j k_j.
+    const int j = index / nu;
+    VecU h = VecU::Zero(nu);
+    h[index % nu] = 1.0;
+    SolveStageHessian<NX, NU>(j, &h);
+    Eigen::Map<VecU>(kr_[j].data(), nu) = h;
+    if (j > 0) p.noalias() = stage.A(j).transpose() * (Eigen::Map<const MatXU>(PB_[j].data(), nx, nu) * h);
+    last = j;
+    from = j - 1;
+  } else {
+    // q_k = -e_i for the bounded state i of stage k (1..N): p_k = -e_i.
+    const int s = index - N * nu, k = 1 + s / nbx_;
+    p.setZero();
+    p[dims_.state_bound_index[static_cast<std::size_t>(s % nbx_)]] = -1.0;
+    last = from = k - 1;
+  }
+  // With no linear term of its own, stage m has k_m = -(R_m + B'P_{m+1}B)^-1 B'p_{m+1} and
+  // p_m = A'(p_{m+1} + P_{m+1} B k_m).
+  for (int m = from; m >= 0; --m) {
+    VecU h(nu);
+    h.noalias() = stage.B(m).transpose() * p;
+    SolveStageHessian<NX, NU>(m, &h);
+    h = -h;
+    Eigen::Map<VecU>(kr_[m].data(), nu) = h;
+    if (m > 0) {
+      p.noalias() += Eigen::Map<const MatXU>(PB_[m].data(), nx, nu) * h;
+      p = stage.A(m).transpose() * p;
+    }
+  }
+  // Forward from x_0 = 0, writing the bounded components.
+  const std::vector<int>& idx = dims_.state_bound_index;
+  auto out = responses_.col(index);
+  VecX x = VecX::Zero(nx);
+  for (int k = 0; k < N; ++k) {
+    VecU u(nu);
+    u.noalias() = Eigen::Map<const MatUX>(K_[k].data(), nu, nx) * x;
+    if (k <= last) u += Eigen::Map<const VecU>(kr_[k].data(), nu);
+    out.segment(k * nu, nu) = u;
+    VecX next(nx);
+    next.noalias() = stage.A(k) * x;
+    next.noalias() += stage.B(k) * u;
+    x = next;
+    for (int b = 0; b < nbx_; ++b) out[N * nu + k * nbx_ + b] = x[idx[b]];
+  }
+}
+
+Eigen::Ref<const Eigen::VectorXd> RiccatiQpSolver::Response(int index) {
+  if (!have_response_[static_cast<std::size_t>(index)]) {
+    if (nmpc_sizes_) {
+      ComputeResponse<17, 4>(index);
+    } else {
+      ComputeResponse<Eigen::Dynamic, Eigen::Dynamic>(index);
+    }
+    have_response_[static_cast<std::size_t>(index)] = 1;
+  }
+  return responses_.col(index);
+}
+
+bool RiccatiQpSolver::AddToActiveSet(const Side& c) {
+  const Eigen::Ref<const Eigen::VectorXd> v = Response(c.index);
+  // M's new row: [N_A' H^-1 n_c; n_c' H^-1 n_c], appended to its Cholesky factor.
+  for (int j = 0; j < q_; ++j) b_[j] = active_[j].sign * c.sign * v[active_[j].index];
+  auto l = b_.head(q_);
+  L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().solveInPlace(l);
+  const double d2 = v[c.index] - l.squaredNorm();
+  if (!(d2 > kDependence * v[c.index])) return false;
+  L_.row(q_).head(q_) = l.transpose();
+  L_(q_, q_) = std::sqrt(d2);
+  active_.push_back(c);
+  is_active_[2 * c.index + (c.sign < 0)] = 1;
+  ++q_;
+  return true;
+}
+
+void RiccatiQpSolver::DropFromActiveSet(int position) {
+  const Side c = active_[position];
+  is_active_[2 * c.index + (c.sign < 0)] = 0;
+  active_.erase(active_.begin() + position);
+  for (int j = position; j < q_ - 1; ++j) multipliers_[j] = multipliers_[j + 1];
+  // Without row and column `position`, M's factor keeps its rows above; below, the trailing block
+  // T (rows and columns after `position`) must factorise T T' + x x' with x the dropped column's
+  // part below the diagonal: a rank-one update by rotations, then everything moves up and left.
+  const int m = q_ - 1 - position, first = position + 1;
+  auto x = update_.head(m);
+  x = L_.col(position).segment(first, m);
+  for (int k = 0; k < m; ++k) {
+    const double lkk = L_(first + k, first + k), xk = x[k];
+    const double r = std::sqrt(lkk * lkk + xk * xk), cs = r / lkk, sn = xk / lkk;
+    L_(first + k, first + k) = r;
+    for (int i = k + 1; i < m; ++i) {
+      double& lik = L_(first + i, first + k);
+      lik = (lik + sn * x[i]) / cs;
+      x[i] = cs * x[i] - sn * lik;
+    }
+  }
+  for (int i = first; i < q_; ++i) {
+    L_.row(i - 1).head(position) = L_.row(i).head(position);
+    L_.row(i - 1).segment(position, i - position) = L_.row(i).segment(first, i - position);
+  }
+  L_.row(q_ - 1).head(q_).setZero();
+  --q_;
+}
+
+void RiccatiQpSolver::MinimiseOnActiveSet() {
+  // On the active sides as equalities the minimum is w = w0 + V λ with V = H^-1 N and λ the
+  // multipliers, M λ = b_A - N_A' w0 (Goldfarb and Idnani's start from an S-pair): drop the most
+  // negative multiplier until none is left.
+  while (true) {
+    auto lambda = multipliers_.head(q_);
+    for (int j = 0; j < q_; ++j) lambda[j] = SignedBound(active_[j]) - active_[j].sign * w0_[active_[j].index];
+    const auto L = L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>();
+    L.solveInPlace(lambda);
+    L.transpose().solveInPlace(lambda);
+    w_ = w0_;
+    for (int j = 0; j < q_; ++j) w_ += (lambda[j] * active_[j].sign) * Response(active_[j].index);
+    int most_negative = -1;
+    for (int j = 0; j < q_; ++j) {
+      if (lambda[j] < 0.0 && (most_negative < 0 || lambda[j] < lambda[most_negative])) most_negative = j;
+    }
+    if (most_negative < 0) return;
+    DropFromActiveSet(most_negative);
+  }
+}
+
+QpStatus RiccatiQpSolver::Iterate() {
+  const double tol = options_.feasibility_tolerance;
+  while (true) {
+    // The most violated side that is not active.
+    Side p{-1, 0.0};
+    double worst = -tol;
+    for (int i = 0; i < nc_; ++i) {
+      if (w_[i] - lower_[i] < worst && !is_active_[2 * i]) {
+        worst = w_[i] - lower_[i];
+        p = {i, 1.0};
+      }
+      if (upper_[i] - w_[i] < worst && !is_active_[2 * i + 1]) {
+        worst = upper_[i] - w_[i];
+        p = {i, -1.0};
+      }
+    }
+    if (p.index < 0) return QpStatus::kSolved;
+
+    double slack = worst;
+    double u_p = 0.0;
+    while (true) {
+      if (iterations_ >= options_.max_iterations) return QpStatus::kMaxIterations;
+      const Eigen::Ref<const Eigen::VectorXd> v = Response(p.index);
+      // The dual direction r = M^-1 N_A' H^-1 n_p and the primal one H^-1 n_p - V r.
+      for (int j = 0; j < q_; ++j) b_[j] = active_[j].sign * p.sign * v[active_[j].index];
+      auto l = b_.head(q_);
+      L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().solveInPlace(l);
+      const double d2 = v[p.index] - l.squaredNorm();
+      r_.head(q_) = l;
+      L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().transpose().solveInPlace(r_.head(q_));
+      step_ = p.sign * v;
+      for (int j = 0; j < q_; ++j) step_ -= (r_[j] * active_[j].sign) * Response(active_[j].index);
+      double t1 = kInf;
+      int drop = -1;
+      for (int j = 0; j < q_; ++j) {
+        if (r_[j] > 0.0 && multipliers_[j] / r_[j] < t1) {
+          t1 = multipliers_[j] / r_[j];
+          drop = j;
+        }
+      }
+      const double ns = p.sign * step_[p.index];
+      const bool primal_step = d2 > kDependence * v[p.index] && ns > 0.0;
+      const double t2 = primal_step ? -slack / ns : kInf;
+      const double t = std::min(t1, t2);
+      if (!std::isfinite(t)) return QpStatus::kInfeasible;
+      ++iterations_;
+      multipliers_.head(q_) -= t * r_.head(q_);
+      u_p += t;
+      if (!primal_step) {
+        DropFromActiveSet(drop);  // dual step only: make room for p
+        continue;
+      }
+      w_ += t * step_;
+      if (t2 <= t1) {
+        if (!AddToActiveSet(p)) return QpStatus::kNumericalFailure;  // the same test passed above
+        multipliers_[q_ - 1] = u_p;
+        break;
+      }
+      DropFromActiveSet(drop);
+      slack = p.sign * w_[p.index] - SignedBound(p);
+    }
+    if (!w_.allFinite()) return QpStatus::kNumericalFailure;
+  }
+}
+
+template <int NX, int NU>
+void RiccatiQpSolver::ExpandTrajectory(const Eigen::VectorXd& x0) {
+  using VecX = Eigen::Matrix<double, NX, 1>;
+  using VecU = Eigen::Matrix<double, NU, 1>;
+  const OcpQp& qp = *qp_;
+  const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
+  const StageMaps<NX, NU> stage{qp, nx, nu};
+  const auto X = [&](int k) { return Eigen::Map<VecX>(x_[k].data(), nx); };
+  const auto U = [&](int k) { return Eigen::Map<VecU>(u_[k].data(), nu); };
+  const std::vector<int>& idx = dims_.state_bound_index;
+  for (int k = 0; k < N; ++k) y_u_[k].setZero();
+  for (int k = 0; k <= N; ++k) y_x_[k].setZero();
+  for (int j = 0; j < q_; ++j) {
+    const Side& c = active_[j];
+    const double y = c.sign * multipliers_[j];
+    if (c.index < N * nu) {
+      y_u_[c.index / nu][c.index % nu] += y;
+    } else {
+      const int s = c.index - N * nu;
+      y_x_[1 + s / nbx_][s % nbx_] += y;
+    }
+  }
+  // The inputs are components of w; the states follow from them by the dynamics, exactly.
+  x_[0] = x0;
+  double objective = 0.0, violation = 0.0;
+  for (int k = 0; k < N; ++k) {
+    U(k) = w_.segment(k * nu, nu);
+    X(k + 1) = Eigen::Map<const VecX>(qp.c[k].data(), nx);
+    X(k + 1).noalias() += stage.A(k) * X(k);
+    X(k + 1).noalias() += stage.B(k) * U(k);
+    violation = std::max({violation, (qp.u_lower[k] - u_[k]).maxCoeff(), (u_[k] - qp.u_upper[k]).maxCoeff()});
+    for (int b = 0; b < nbx_; ++b) {
+      const double xb = x_[k + 1][idx[b]];
+      violation = std::max({violation, qp.x_lower[k + 1][b] - xb, xb - qp.x_upper[k + 1][b]});
+    }
+  }
+  for (int k = 0; k <= N; ++k) {
+    objective += X(k).dot(0.5 * (stage.Q(k) * X(k)) + Eigen::Map<const VecX>(qp.q[k].data(), nx));
+    if (k < N) objective += U(k).dot(0.5 * (stage.R(k) * U(k)) + Eigen::Map<const VecU>(qp.r[k].data(), nu));
+  }
+  summary_.objective = objective;
+  summary_.max_violation = violation;
+}
+
+void RiccatiQpSolver::ClearActiveSet() {
+  q_ = 0;
+  active_.clear();
+  std::fill(is_active_.begin(), is_active_.end(), 0);
+}
+
+const OcpQpSummary& RiccatiQpSolver::Fail(QpStatus status) {
+  for (auto& u : u_) u.setZero();
+  for (auto& x : x_) x.setZero();
+  for (auto& y : y_u_) y.setZero();
+  for (auto& y : y_x_) y.setZero();
+  ClearActiveSet();
+  previous_.clear();
+  summary_.status = status;
+  return summary_;
+}
+
+const OcpQpSummary& RiccatiQpSolver::Prepare(const OcpQp& qp) { return Prepare(qp, /*whole=*/true); }
+
+const OcpQpSummary& RiccatiQpSolver::PrepareVectors(const OcpQp& qp) { return Prepare(qp, /*whole=*/!prepared_); }
+
+const OcpQpSummary& RiccatiQpSolver::Prepare(const OcpQp& qp, bool whole) {
+  const Stopwatch clock;
+  summary_ = OcpQpSummary{};
+  RequireSameDims(qp, dims_, "RiccatiQpSolver");
+  const int N = dims_.horizon, nu = dims_.nu;
+  qp_ = &qp;
+  prepared_ = false;
+  const auto fail = [&](QpStatus status) -> const OcpQpSummary& {
+    summary_.condense_time_s = clock.seconds();
+    return Fail(status);
+  };
+  // The bounded components' bounds; infinite sides never bind, NaN is rejected, crossed ones
+  // make the QP infeasible (reported by the feedback, as an infeasible set of constraints is).
+  for (int k = 0; k < N; ++k) {
+    lower_.segment(k * nu, nu) = qp.u_lower[k];
+    upper_.segment(k * nu, nu) = qp.u_upper[k];
+    lower_.segment(N * nu + k * nbx_, nbx_) = qp.x_lower[k + 1];
+    upper_.segment(N * nu + k * nbx_, nbx_) = qp.x_upper[k + 1];
+  }
+  if (lower_.array().isNaN().any() || upper_.array().isNaN().any()) return fail(QpStatus::kNumericalFailure);
+  crossed_ = (lower_.array() > upper_.array()).any();
+  if (whole) {
+    const bool factorized = nmpc_sizes_ ? Factorize<17, 4>(qp) : Factorize<Eigen::Dynamic, Eigen::Dynamic>(qp);
+    if (!factorized) return fail(QpStatus::kNumericalFailure);
+    std::fill(have_response_.begin(), have_response_.end(), 0);
+  }
+  if (nmpc_sizes_) {
+    BackwardVectors<17, 4>(qp);
+  } else {
+    BackwardVectors<Eigen::Dynamic, Eigen::Dynamic>(qp);
+  }
+  for (const auto& k : kff_) {
+    if (!k.allFinite()) return fail(QpStatus::kNumericalFailure);
+  }
+  // The start of the next feedback. On a new factorisation, the previous solve's active set (its
+  // sides with finite bounds and independent normals) is added afresh; with the factorisation
+  // kept, the active set and its Schur complement are kept too.
+  if (whole) {
+    ClearActiveSet();
+    start_ = previous_.empty() ? QpStart::kCold : QpStart::kWarm;
+    for (const Side& c : previous_) {
+      if (std::isfinite(SignedBound(c))) AddToActiveSet(c);
+    }
+  } else {
+    start_ = q_ > 0 ? QpStart::kHot : QpStart::kCold;
+  }
+  prepared_ = true;
+  summary_.condense_time_s = clock.seconds();
+  return summary_;
+}
+
+const OcpQpSummary& RiccatiQpSolver::Feedback(const Eigen::VectorXd& x0) {
+  if (qp_ == nullptr) throw std::logic_error("RiccatiQpSolver::Feedback called before Prepare");
+  const Stopwatch clock;
+  const double prepare_s = summary_.condense_time_s;
+  summary_ = OcpQpSummary{};
+  summary_.condense_time_s = prepare_s;
+  const auto finish = [&](QpStatus status) -> const OcpQpSummary& {
+    if (status != QpStatus::kSolved && status != QpStatus::kMaxIterations) Fail(status);
+    summary_.status = status;
+    summary_.dense_solve_time_s = clock.seconds();
+    summary_.total_time_s = summary_.condense_time_s + summary_.dense_solve_time_s;
+    return summary_;
+  };
+  if (!prepared_ || x0.size() != dims_.nx || !x0.allFinite()) return finish(QpStatus::kNumericalFailure);
+  if (crossed_) return finish(QpStatus::kInfeasible);
+  if (nmpc_sizes_) {
+    Forward<17, 4>(x0);
+  } else {
+    Forward<Eigen::Dynamic, Eigen::Dynamic>(x0);
+  }
+  if (!w0_.allFinite()) return finish(QpStatus::kNumericalFailure);
+  summary_.start = start_;
+  iterations_ = 0;
+  // A side whose bound is now infinite binds no more.
+  for (int j = q_ - 1; j >= 0; --j) {
+    if (!std::isfinite(SignedBound(active_[j]))) DropFromActiveSet(j);
+  }
+  MinimiseOnActiveSet();
+  QpStatus status = Iterate();
+  if (status == QpStatus::kSolved) {
+    // The iterate accumulated its steps' rounding: the minimum on the final active set, computed
+    // afresh, and the iterations again should that have moved a side past its bound.
+    MinimiseOnActiveSet();
+    status = Iterate();
+  }
+  if (status == QpStatus::kNumericalFailure || !w_.allFinite()) return finish(QpStatus::kNumericalFailure);
+  if (nmpc_sizes_) {
+    ExpandTrajectory<17, 4>(x0);
+  } else {
+    ExpandTrajectory<Eigen::Dynamic, Eigen::Dynamic>(x0);
+  }
+  summary_.iterations = iterations_;
+  summary_.active_constraints = q_;
+  if (status == QpStatus::kSolved && options_.warm_start) {
+    previous_.assign(active_.begin(), active_.end());
+    start_ = QpStart::kHot;  // a feedback again on this preparation starts from this set
+  } else {
+    previous_.clear();
+    ClearActiveSet();
+    start_ = QpStart::kCold;
+  }
+  return finish(status);
+}
+
+}  // namespace rotorguard::control
