@@ -32,6 +32,10 @@ RiccatiQpSolver::RiccatiQpSolver(const OcpQpDims& dims, const DenseQpOptions& op
   PB_.assign(N, Eigen::MatrixXd::Zero(nx, nu));
   Lu_.assign(N, Eigen::MatrixXd::Zero(nu, nu));
   K_.assign(N, Eigen::MatrixXd::Zero(nu, nx));
+  Bt_.assign(N, Eigen::MatrixXd::Zero(nx, nu));
+  fixed_.assign(static_cast<std::size_t>(N * nu), 0);
+  pattern_.assign(static_cast<std::size_t>(N * nu), 0);
+  costate_.resize(nx);
   kff_.assign(N, Eigen::VectorXd::Zero(nu));
   kr_.assign(N, Eigen::VectorXd::Zero(nu));
   x_.assign(N + 1, Eigen::VectorXd::Zero(nx));
@@ -71,13 +75,26 @@ bool RiccatiQpSolver::Factorize(const OcpQp& qp) {
   // P_N = Q_N; for k = N-1 .. 0: u_k = K_k x_k minimises the stage cost plus the cost-to-go
   // 1/2 x' P_{k+1} x with K_k = -(R_k + B'P_{k+1}B)^-1 B'P_{k+1}A, and P_k = Q_k + A'P_{k+1}A +
   // (B'P_{k+1}A)' K_k. P_0 is not needed: x_0 is fixed.
+  // An input fixed by equal bounds (a failed rotor's) is taken out of the stage: its column of B
+  // is zeroed (its share moves into c_k in BackwardVectors) and its row and column of R become a
+  // unit, so that it decouples and the recursion gives it exactly its value, k_k[i] = u_i with
+  // K_k's row i zero. It never enters the active set.
   P(N) = stage.Q(N);
   for (int k = N - 1; k >= 0; --k) {
-    Eigen::Map<MatXU> PB(PB_[k].data(), nx, nu);
-    PB.noalias() = P(k + 1) * stage.B(k);
+    Eigen::Map<MatXU> Bt(Bt_[k].data(), nx, nu);
+    Bt = stage.B(k);
     MatUU Ru(nu, nu);
-    Ru.noalias() = stage.B(k).transpose() * PB;
-    Ru += stage.R(k);
+    Ru = stage.R(k);
+    for (int i = 0; i < nu; ++i) {
+      if (!fixed_[static_cast<std::size_t>(k * nu + i)]) continue;
+      Bt.col(i).setZero();
+      Ru.row(i).setZero();
+      Ru.col(i).setZero();
+      Ru(i, i) = 1.0;
+    }
+    Eigen::Map<MatXU> PB(PB_[k].data(), nx, nu);
+    PB.noalias() = P(k + 1) * Bt;
+    Ru.noalias() += Bt.transpose() * PB;
     if (!Ru.allFinite()) return false;
     Eigen::LLT<MatUU> llt(Ru);
     if (llt.info() != Eigen::Success) return false;
@@ -118,12 +135,23 @@ void RiccatiQpSolver::BackwardVectors(const OcpQp& qp) {
   const auto vx = [&](const Eigen::VectorXd& v) { return Eigen::Map<const VecX>(v.data(), nx); };
   // The cost-to-go's linear term p_k (1/2 x'P_k x + p_k'x): with s = P_{k+1} c_k + p_{k+1}, the
   // feedforward is k_k = -(R_k + B'P_{k+1}B)^-1 (r_k + B's) and p_k = q_k + A'(s + P_{k+1} B k_k).
+  // A fixed input u_i = f adds B_i f to c_k and R_k[:, i] f to r_k, and its decoupled unit row
+  // gets the linear term -f (Factorize).
   VecX p = vx(qp.q[N]);
   for (int k = N - 1; k >= 0; --k) {
     VecX s = vx(qp.c[k]);
-    s = Eigen::Map<const MatXX>(P_[k + 1].data(), nx, nx) * s + p;
     VecU h = Eigen::Map<const VecU>(qp.r[k].data(), nu);
-    h.noalias() += stage.B(k).transpose() * s;
+    for (int i = 0; i < nu; ++i) {
+      if (!fixed_[static_cast<std::size_t>(k * nu + i)]) continue;
+      const double f = lower_[k * nu + i];
+      s += f * stage.B(k).col(i);
+      h += f * stage.R(k).col(i);
+    }
+    for (int i = 0; i < nu; ++i) {
+      if (fixed_[static_cast<std::size_t>(k * nu + i)]) h[i] = -lower_[k * nu + i];
+    }
+    s = Eigen::Map<const MatXX>(P_[k + 1].data(), nx, nx) * s + p;
+    h.noalias() += Eigen::Map<const MatXU>(Bt_[k].data(), nx, nu).transpose() * s;
     SolveStageHessian<NX, NU>(k, &h);
     Eigen::Map<VecU>(kff_[k].data(), nu) = -h;
     if (k > 0) {
@@ -191,7 +219,7 @@ void RiccatiQpSolver::ComputeResponse(int index) {
   // p_m = A'(p_{m+1} + P_{m+1} B k_m).
   for (int m = from; m >= 0; --m) {
     VecU h(nu);
-    h.noalias() = stage.B(m).transpose() * p;
+    h.noalias() = Eigen::Map<const MatXU>(Bt_[m].data(), nx, nu).transpose() * p;
     SolveStageHessian<NX, NU>(m, &h);
     h = -h;
     Eigen::Map<VecU>(kr_[m].data(), nu) = h;
@@ -402,6 +430,23 @@ void RiccatiQpSolver::ExpandTrajectory(const Eigen::VectorXd& x0) {
   }
   summary_.objective = objective;
   summary_.max_violation = violation;
+  if (std::find(fixed_.begin(), fixed_.end(), 1) == fixed_.end()) return;
+  // A fixed input's multiplier from stationarity in u_k, R u_k + r_k + B_k' λ_{k+1} = y_k, with the
+  // costate of the dynamics λ_N = Q_N x_N + q_N - E y_N, λ_k = Q_k x_k + q_k + A_k' λ_{k+1} - E y_k
+  // (E y_k: the bounded states' multipliers placed at their indices).
+  Eigen::Map<VecX> lambda(costate_.data(), nx);
+  lambda = stage.Q(N) * X(N) + Eigen::Map<const VecX>(qp.q[N].data(), nx);
+  for (int k = N - 1; k >= 0; --k) {
+    for (int b = 0; b < nbx_; ++b) lambda[idx[b]] -= y_x_[k + 1][b];
+    for (int i = 0; i < nu; ++i) {
+      if (!fixed_[static_cast<std::size_t>(k * nu + i)]) continue;
+      y_u_[k][i] = stage.R(k).col(i).dot(U(k)) + qp.r[k][i] + stage.B(k).col(i).dot(lambda);
+    }
+    if (k > 0) {
+      VecX next = stage.A(k).transpose() * lambda;
+      lambda = next + stage.Q(k) * X(k) + Eigen::Map<const VecX>(qp.q[k].data(), nx);
+    }
+  }
 }
 
 void RiccatiQpSolver::ClearActiveSet() {
@@ -446,6 +491,13 @@ const OcpQpSummary& RiccatiQpSolver::Prepare(const OcpQp& qp, bool whole) {
   }
   if (lower_.array().isNaN().any() || upper_.array().isNaN().any()) return fail(QpStatus::kNumericalFailure);
   crossed_ = (lower_.array() > upper_.array()).any();
+  // Inputs fixed by equal bounds are taken out of the recursion's stages (Factorize): a change of
+  // which ones takes a whole preparation, a change of their values only the vectors.
+  for (int i = 0; i < N * nu; ++i) pattern_[static_cast<std::size_t>(i)] = lower_[i] == upper_[i];
+  if (pattern_ != fixed_) {
+    fixed_ = pattern_;
+    whole = true;
+  }
   if (whole) {
     const bool factorized = nmpc_sizes_ ? Factorize<17, 4>(qp) : Factorize<Eigen::Dynamic, Eigen::Dynamic>(qp);
     if (!factorized) return fail(QpStatus::kNumericalFailure);
@@ -466,7 +518,7 @@ const OcpQpSummary& RiccatiQpSolver::Prepare(const OcpQp& qp, bool whole) {
     ClearActiveSet();
     start_ = previous_.empty() ? QpStart::kCold : QpStart::kWarm;
     for (const Side& c : previous_) {
-      if (std::isfinite(SignedBound(c))) AddToActiveSet(c);
+      if (std::isfinite(SignedBound(c)) && !IsFixed(c.index)) AddToActiveSet(c);
     }
   } else {
     start_ = q_ > 0 ? QpStart::kHot : QpStart::kCold;
@@ -499,9 +551,10 @@ const OcpQpSummary& RiccatiQpSolver::Feedback(const Eigen::VectorXd& x0) {
   if (!w0_.allFinite()) return finish(QpStatus::kNumericalFailure);
   summary_.start = start_;
   iterations_ = 0;
-  // A side whose bound is now infinite binds no more.
+  // A side whose bound is now infinite binds no more; one whose input is now fixed holds by
+  // construction.
   for (int j = q_ - 1; j >= 0; --j) {
-    if (!std::isfinite(SignedBound(active_[j]))) DropFromActiveSet(j);
+    if (!std::isfinite(SignedBound(active_[j])) || IsFixed(active_[j].index)) DropFromActiveSet(j);
   }
   MinimiseOnActiveSet();
   QpStatus status = Iterate();
@@ -518,7 +571,7 @@ const OcpQpSummary& RiccatiQpSolver::Feedback(const Eigen::VectorXd& x0) {
     ExpandTrajectory<Eigen::Dynamic, Eigen::Dynamic>(x0);
   }
   summary_.iterations = iterations_;
-  summary_.active_constraints = q_;
+  summary_.active_constraints = q_ + static_cast<int>(std::count(fixed_.begin(), fixed_.end(), 1));
   if (status == QpStatus::kSolved && options_.warm_start) {
     previous_.assign(active_.begin(), active_.end());
     start_ = QpStart::kHot;  // a feedback again on this preparation starts from this set

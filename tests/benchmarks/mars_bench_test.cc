@@ -41,11 +41,11 @@ TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError
   }
   // The baseline plans the same trajectory whatever the fault: with the end unit No. 4 dead it asks
   // for more yaw acceleration than the row can give (ours, above, does not). Whether the row then
-  // falls is a draw this one flight cannot settle: rounding at the 1e-16 level (a heap address
-  // changes how Eigen's reductions peel) moves the baseline's plan for seed 1 between asking 0.88
-  // and 0.71 rad/s² of yaw where 0.42 can be given, and it falls with the first and survives the
-  // second; of its planned flights over seeds 1-5, two or three of three fall. The error over a
-  // crashed flight's plan window is tested on hand-made records below (MarsTableTwo).
+  // falls is a draw this one flight cannot settle: rounding at the 1e-16 level (most likely where
+  // a vector's data starts, which decides how Eigen's reductions peel) moves the baseline's plan for seed 1 between
+  // asking 0.88 and 0.71 rad/s² of yaw where 0.42 can be given, and it falls with the first and survives the second; of
+  // its planned flights over seeds 1-5, two or three of three fall. The error over a crashed flight's plan window is
+  // tested on hand-made records below (MarsTableTwo).
   const nlohmann::json& dead_end = r["table2"][2];
   ASSERT_EQ(dead_end["fault"].get<std::string>(), "No. 4");
   ASSERT_TRUE(dead_end["baseline_planned"].get<bool>());

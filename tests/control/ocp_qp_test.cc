@@ -543,6 +543,45 @@ TEST(RiccatiQp, BoundsWhoseNormalsAreDependentAreHandled) {
   EXPECT_GT(at_bound, 0) << "the pair must bind";
 }
 
+TEST(RiccatiQp, InputsFixedByEqualBoundsAreHeldExactlyAndTheKktConditionsHold) {
+  // A failed rotor's inputs: bounds equal at every stage (pattern 0) or some (pattern 1), with state
+  // bounds binding. The fixed inputs leave the recursion and must come out exactly at their value,
+  // with the multipliers that make the whole QP's KKT conditions hold. Then a preparation of the
+  // vectors alone with the fixed values moved, and one whose fixed inputs changed (a whole one),
+  // against fresh solves.
+  Rng rng(61);
+  const OcpQp base = OcpPulledAgainstItsStateBounds(8, 6, 3, {0, 3}, rng);
+  RiccatiQpSolver solver(base.dims);
+  int compared = 0;
+  for (int pattern : {0, 1, 1, 2, 0}) {
+    OcpQp qp = base;
+    for (int k = 0; k < 8; ++k) {
+      if (pattern == 0) qp.u_lower[k][1] = qp.u_upper[k][1] = 0.25;                                  // every stage
+      if (pattern == 1 && k % 3 == 0) qp.u_lower[k][2] = qp.u_upper[k][2] = -0.1 + 0.01 * compared;  // some
+    }
+    const OcpQpSummary& s = solver.PrepareVectors(qp);  // whole when the fixed inputs changed
+    ASSERT_NE(s.status, QpStatus::kNumericalFailure);
+    ASSERT_TRUE(solver.Feedback(qp.x0).IsSolutionUsable()) << solver.summary().BriefReport();
+    SCOPED_TRACE(fmt::format("pattern {} ({})", pattern, compared));
+    ExpectKktOfTheNaiveCondensing(qp, solver);
+    RiccatiQpSolver fresh(qp.dims);
+    ASSERT_TRUE(fresh.Solve(qp).IsSolutionUsable());
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_TRUE(MatricesNear(solver.u()[k], fresh.u()[k], 1e-9)) << "u_" << k;
+      if (pattern == 0) {
+        EXPECT_EQ(solver.u()[k][1], 0.25);  // exactly, not to a tolerance
+      }
+      if (pattern == 1 && k % 3 == 0) {
+        EXPECT_EQ(solver.u()[k][2], qp.u_lower[k][2]);
+      }
+    }
+    EXPECT_GE(solver.summary().active_constraints, pattern == 0 ? 8 : (pattern == 1 ? 3 : 0));
+    EXPECT_GT(StateBoundsAtTheirLimit(solver.x(), {0, 3}), 0);
+    ++compared;
+  }
+  EXPECT_EQ(compared, 5);
+}
+
 TEST(RiccatiQp, ReportsInfeasibleBoundsAndRejectsBadData) {
   Rng rng(59);
   const OcpQp base = OcpPulledAgainstItsStateBounds(5, 4, 2, {0}, rng);

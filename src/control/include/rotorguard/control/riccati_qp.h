@@ -104,6 +104,12 @@ class RiccatiQpSolver final : public OcpQpSolver {
   // The factorisation: P_k (k = 1..N), P_{k+1} B_k, the lower Cholesky factor of
   // R_k + B_k' P_{k+1} B_k, and K_k with u_k = K_k x_k + k_k.
   std::vector<Eigen::MatrixXd> P_, PB_, Lu_, K_;
+  // B_k with the columns of fixed inputs zeroed; per input k * nu + i, whether equal bounds fix it
+  // (and the scratch in which a preparation finds them).
+  std::vector<Eigen::MatrixXd> Bt_;
+  std::vector<char> fixed_, pattern_;
+  bool IsFixed(int index) const { return index < dims_.horizon * dims_.nu && fixed_[static_cast<std::size_t>(index)]; }
+  Eigen::VectorXd costate_;
   // The unconstrained solution's feedforwards k_k, and a response's.
   std::vector<Eigen::VectorXd> kff_, kr_, y_u_, y_x_;
   Eigen::MatrixXd tmp_xx_;
