@@ -258,6 +258,9 @@ Eigen::Ref<const Eigen::VectorXd> RiccatiQpSolver::Response(int index) {
 }
 
 bool RiccatiQpSolver::AddToActiveSet(const Side& c) {
+  // At most N nu normals are independent; rounding may pass one more through the test below, never
+  // more than the factor's rows.
+  if (q_ >= static_cast<int>(L_.rows())) return false;
   const Eigen::Ref<const Eigen::VectorXd> v = Response(c.index);
   // M's new row: [N_A' H^-1 n_c; n_c' H^-1 n_c], appended to its Cholesky factor.
   for (int j = 0; j < q_; ++j) b_[j] = active_[j].sign * c.sign * v[active_[j].index];

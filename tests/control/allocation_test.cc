@@ -56,30 +56,35 @@ TEST(Allocation, TheCounterSeesAllocations) {
 }
 
 TEST(Allocation, NmpcRealTimeIterationsAllocateNothing) {
-  // Every call linearising (the paper's RTI) and every third (the navigation scenarios').
-  for (int failed : {-1, 0}) for (int every : {1, 3}) {
-    NmpcOptions options;
-    options.relinearise_every = every;
-    NmpcController nmpc(rotorguard::testing::ReferenceQuad(), options);
-    planning::LemniscateOptions lo;
-    lo.center_m = Vector3(0, 0, 1.5);
-    const planning::LemniscateReference ref(lo);
-    StateEstimate est;
-    est.valid = true;
-    est.p_W = Vector3(0.1, -0.05, 1.45);
-    est.w_B = Vector3(0.1, 0.2, failed >= 0 ? 10.0 : 0.3);
-    est.motor_thrust_n = RotorVector::Constant(4, 2.82);
-    RotorVector cmd;
-    double t = 0.0;
-    nmpc.Compute(est, ref, t, 0.0, &cmd);
-    if (failed >= 0) nmpc.SetRotorFailed(failed);
-    for (int k = 0; k < 5; ++k) nmpc.Compute(est, ref, t += 0.005, 0.005, &cmd);  // warm up
-    const long n = CountAllocations([&] {
-      for (int k = 0; k < 50; ++k) nmpc.Compute(est, ref, t += 0.005, 0.005, &cmd);
-    });
-    EXPECT_EQ(n, 0) << (failed >= 0 ? "after a failure" : "nominal") << ", relinearise_every " << every;
-    EXPECT_TRUE(nmpc.summary().IsSolutionUsable());
-  }
+  // Every call linearising (the paper's RTI) and every third (the navigation scenarios'), with
+  // either QP solver.
+  for (const OcpQpMethod solver : {OcpQpMethod::kCondensing, OcpQpMethod::kRiccati})
+    for (int failed : {-1, 0})
+      for (int every : {1, 3}) {
+        NmpcOptions options;
+        options.relinearise_every = every;
+        options.qp_solver = solver;
+        NmpcController nmpc(rotorguard::testing::ReferenceQuad(), options);
+        planning::LemniscateOptions lo;
+        lo.center_m = Vector3(0, 0, 1.5);
+        const planning::LemniscateReference ref(lo);
+        StateEstimate est;
+        est.valid = true;
+        est.p_W = Vector3(0.1, -0.05, 1.45);
+        est.w_B = Vector3(0.1, 0.2, failed >= 0 ? 10.0 : 0.3);
+        est.motor_thrust_n = RotorVector::Constant(4, 2.82);
+        RotorVector cmd;
+        double t = 0.0;
+        nmpc.Compute(est, ref, t, 0.0, &cmd);
+        if (failed >= 0) nmpc.SetRotorFailed(failed);
+        for (int k = 0; k < 5; ++k) nmpc.Compute(est, ref, t += 0.005, 0.005, &cmd);  // warm up
+        const long n = CountAllocations([&] {
+          for (int k = 0; k < 50; ++k) nmpc.Compute(est, ref, t += 0.005, 0.005, &cmd);
+        });
+        EXPECT_EQ(n, 0) << ToName(solver) << ", " << (failed >= 0 ? "after a failure" : "nominal")
+                        << ", relinearise_every " << every;
+        EXPECT_TRUE(nmpc.summary().IsSolutionUsable());
+      }
 }
 
 TEST(Allocation, FaultDetectionAllocatesNothing) {
