@@ -46,10 +46,11 @@ OcpQp::OcpQp(const OcpQpDims& d) : dims(d) {
 }
 
 std::string OcpQpSummary::BriefReport() const {
-  return fmt::format("OCP QP {}: {} start, {} iterations, {} active, objective {:.6g}, condense {:.1f} us, solve "
-                     "{:.1f} us",
-                     ToString(status), ToString(start), iterations, active_constraints, objective,
-                     condense_time_s * 1e6, dense_solve_time_s * 1e6);
+  return fmt::format(
+      "OCP QP {}: {} start, {} iterations, {} active, objective {:.6g}, prepare {:.1f} us, feedback "
+      "{:.1f} us",
+      ToString(status), ToString(start), iterations, active_constraints, objective, prepare_time_s * 1e6,
+      feedback_time_s * 1e6);
 }
 
 CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options)
@@ -215,7 +216,7 @@ const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp, bool whole) {
   } else if (!PrepareReduced()) {
     summary_.status = QpStatus::kNumericalFailure;
   }
-  summary_.condense_time_s = clock.seconds();
+  summary_.prepare_time_s = clock.seconds();
   return summary_;
 }
 
@@ -346,8 +347,8 @@ const OcpQpSummary& CondensingQpSolver::Feedback(const Eigen::VectorXd& x0) {
     }
   }
   summary_.objective = objective;
-  summary_.dense_solve_time_s = clock.seconds();
-  summary_.total_time_s = summary_.condense_time_s + summary_.dense_solve_time_s;
+  summary_.feedback_time_s = clock.seconds();
+  summary_.total_time_s = summary_.prepare_time_s + summary_.feedback_time_s;
   return summary_;
 }
 

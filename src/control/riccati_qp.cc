@@ -163,31 +163,33 @@ void RiccatiQpSolver::BackwardVectors(const OcpQp& qp) {
 }
 
 template <int NX, int NU>
-void RiccatiQpSolver::Forward(const Eigen::VectorXd& x0) {
+void RiccatiQpSolver::ForwardPass(const Eigen::VectorXd* x0, const std::vector<Eigen::VectorXd>& feedforward, int last,
+                                  Eigen::Ref<Eigen::VectorXd> out) const {
   using MatUX = Eigen::Matrix<double, NU, NX>;
   using VecX = Eigen::Matrix<double, NX, 1>;
   using VecU = Eigen::Matrix<double, NU, 1>;
   const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
   const StageMaps<NX, NU> stage{*qp_, nx, nu};
-  // u_k = K_k x_k + k_k from x0.
   const std::vector<int>& idx = dims_.state_bound_index;
-  VecX x = Eigen::Map<const VecX>(x0.data(), nx);
+  // u_k = K_k x_k + k_k (k_k zero after stage `last`), x_{k+1} = A_k x_k + B_k u_k (+ c_k).
+  VecX x = x0 != nullptr ? VecX(Eigen::Map<const VecX>(x0->data(), nx)) : VecX(VecX::Zero(nx));
   for (int k = 0; k < N; ++k) {
-    VecU u = Eigen::Map<const VecU>(kff_[k].data(), nu);
-    u.noalias() += Eigen::Map<const MatUX>(K_[k].data(), nu, nx) * x;
-    w0_.segment(k * nu, nu) = u;
-    VecX next = Eigen::Map<const VecX>(qp_->c[k].data(), nx);
-    next.noalias() += stage.A(k) * x;
+    VecU u(nu);
+    u.noalias() = Eigen::Map<const MatUX>(K_[k].data(), nu, nx) * x;
+    if (k <= last) u += Eigen::Map<const VecU>(feedforward[k].data(), nu);
+    out.segment(k * nu, nu) = u;
+    VecX next(nx);
+    next.noalias() = stage.A(k) * x;
     next.noalias() += stage.B(k) * u;
+    if (x0 != nullptr) next += Eigen::Map<const VecX>(qp_->c[k].data(), nx);
     x = next;
-    for (int b = 0; b < nbx_; ++b) w0_[N * nu + k * nbx_ + b] = x[idx[b]];
+    for (int b = 0; b < nbx_; ++b) out[N * nu + k * nbx_ + b] = x[idx[b]];
   }
 }
 
 template <int NX, int NU>
 void RiccatiQpSolver::ComputeResponse(int index) {
   using MatXU = Eigen::Matrix<double, NX, NU>;
-  using MatUX = Eigen::Matrix<double, NU, NX>;
   using VecX = Eigen::Matrix<double, NX, 1>;
   using VecU = Eigen::Matrix<double, NU, 1>;
   const int N = dims_.horizon, nx = dims_.nx, nu = dims_.nu;
@@ -228,21 +230,8 @@ void RiccatiQpSolver::ComputeResponse(int index) {
       p = stage.A(m).transpose() * p;
     }
   }
-  // Forward from x_0 = 0, writing the bounded components.
-  const std::vector<int>& idx = dims_.state_bound_index;
-  auto out = responses_.col(index);
-  VecX x = VecX::Zero(nx);
-  for (int k = 0; k < N; ++k) {
-    VecU u(nu);
-    u.noalias() = Eigen::Map<const MatUX>(K_[k].data(), nu, nx) * x;
-    if (k <= last) u += Eigen::Map<const VecU>(kr_[k].data(), nu);
-    out.segment(k * nu, nu) = u;
-    VecX next(nx);
-    next.noalias() = stage.A(k) * x;
-    next.noalias() += stage.B(k) * u;
-    x = next;
-    for (int b = 0; b < nbx_; ++b) out[N * nu + k * nbx_ + b] = x[idx[b]];
-  }
+  // Forward from x_0 = 0 with no gaps, writing the bounded components.
+  ForwardPass<NX, NU>(nullptr, kr_, last, responses_.col(index));
 }
 
 Eigen::Ref<const Eigen::VectorXd> RiccatiQpSolver::Response(int index) {
@@ -257,18 +246,25 @@ Eigen::Ref<const Eigen::VectorXd> RiccatiQpSolver::Response(int index) {
   return responses_.col(index);
 }
 
-bool RiccatiQpSolver::AddToActiveSet(const Side& c) {
-  // At most N nu normals are independent; rounding may pass one more through the test below, never
-  // more than the factor's rows.
-  if (q_ >= static_cast<int>(L_.rows())) return false;
+double RiccatiQpSolver::SchurComplementRow(const Side& c) {
+  // M's new row would be [N_A' H^-1 n_c; n_c' H^-1 n_c]: l = L^-1 N_A' H^-1 n_c (into b_) and the
+  // new diagonal's square d² = n_c' H^-1 n_c - |l|², the part of n_c outside the active normals' span.
   const Eigen::Ref<const Eigen::VectorXd> v = Response(c.index);
-  // M's new row: [N_A' H^-1 n_c; n_c' H^-1 n_c], appended to its Cholesky factor.
   for (int j = 0; j < q_; ++j) b_[j] = active_[j].sign * c.sign * v[active_[j].index];
   auto l = b_.head(q_);
   L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().solveInPlace(l);
-  const double d2 = v[c.index] - l.squaredNorm();
-  if (!(d2 > kDependence * v[c.index])) return false;
-  L_.row(q_).head(q_) = l.transpose();
+  return v[c.index] - l.squaredNorm();
+}
+
+bool RiccatiQpSolver::IsIndependent(const Side& c, double d2) const {
+  return d2 > kDependence * responses_(c.index, c.index);
+}
+
+bool RiccatiQpSolver::AppendToActiveSet(const Side& c, double d2) {
+  // At most N nu normals are independent; rounding may pass one more through the test, never more
+  // than the factor's rows.
+  if (q_ >= static_cast<int>(L_.rows()) || !IsIndependent(c, d2)) return false;
+  L_.row(q_).head(q_) = b_.head(q_).transpose();
   L_(q_, q_) = std::sqrt(d2);
   active_.push_back(c);
   is_active_[2 * c.index + (c.sign < 0)] = 1;
@@ -348,15 +344,12 @@ QpStatus RiccatiQpSolver::Iterate() {
     double u_p = 0.0;
     while (true) {
       if (iterations_ >= options_.max_iterations) return QpStatus::kMaxIterations;
-      const Eigen::Ref<const Eigen::VectorXd> v = Response(p.index);
-      // The dual direction r = M^-1 N_A' H^-1 n_p and the primal one H^-1 n_p - V r.
-      for (int j = 0; j < q_; ++j) b_[j] = active_[j].sign * p.sign * v[active_[j].index];
-      auto l = b_.head(q_);
-      L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().solveInPlace(l);
-      const double d2 = v[p.index] - l.squaredNorm();
-      r_.head(q_) = l;
+      // The dual direction r = M^-1 N_A' H^-1 n_p = L^-T l and the primal one H^-1 n_p - V r; b_
+      // keeps l for p's row of the factor should p be added below.
+      const double d2 = SchurComplementRow(p);
+      r_.head(q_) = b_.head(q_);
       L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().transpose().solveInPlace(r_.head(q_));
-      step_ = p.sign * v;
+      step_ = p.sign * responses_.col(p.index);
       for (int j = 0; j < q_; ++j) step_ -= (r_[j] * active_[j].sign) * Response(active_[j].index);
       double t1 = kInf;
       int drop = -1;
@@ -367,7 +360,7 @@ QpStatus RiccatiQpSolver::Iterate() {
         }
       }
       const double ns = p.sign * step_[p.index];
-      const bool primal_step = d2 > kDependence * v[p.index] && ns > 0.0;
+      const bool primal_step = IsIndependent(p, d2) && ns > 0.0;
       const double t2 = primal_step ? -slack / ns : kInf;
       const double t = std::min(t1, t2);
       if (!std::isfinite(t)) return QpStatus::kInfeasible;
@@ -380,7 +373,8 @@ QpStatus RiccatiQpSolver::Iterate() {
       }
       w_ += t * step_;
       if (t2 <= t1) {
-        if (!AddToActiveSet(p)) return QpStatus::kNumericalFailure;  // the same test passed above
+        // Independent by the test above: only a full factor refuses it.
+        if (!AppendToActiveSet(p, d2)) return QpStatus::kNumericalFailure;
         multipliers_[q_ - 1] = u_p;
         break;
       }
@@ -481,7 +475,7 @@ const OcpQpSummary& RiccatiQpSolver::Prepare(const OcpQp& qp, bool whole) {
   qp_ = &qp;
   prepared_ = false;
   const auto fail = [&](QpStatus status) -> const OcpQpSummary& {
-    summary_.condense_time_s = clock.seconds();
+    summary_.prepare_time_s = clock.seconds();
     return Fail(status);
   };
   // The bounded components' bounds; infinite sides never bind, NaN is rejected, crossed ones
@@ -521,35 +515,36 @@ const OcpQpSummary& RiccatiQpSolver::Prepare(const OcpQp& qp, bool whole) {
     ClearActiveSet();
     start_ = previous_.empty() ? QpStart::kCold : QpStart::kWarm;
     for (const Side& c : previous_) {
-      if (std::isfinite(SignedBound(c)) && !IsFixed(c.index)) AddToActiveSet(c);
+      if (std::isfinite(SignedBound(c)) && !IsFixed(c.index)) AppendToActiveSet(c, SchurComplementRow(c));
     }
   } else {
     start_ = q_ > 0 ? QpStart::kHot : QpStart::kCold;
   }
   prepared_ = true;
-  summary_.condense_time_s = clock.seconds();
+  summary_.prepare_time_s = clock.seconds();
   return summary_;
 }
 
 const OcpQpSummary& RiccatiQpSolver::Feedback(const Eigen::VectorXd& x0) {
   if (qp_ == nullptr) throw std::logic_error("RiccatiQpSolver::Feedback called before Prepare");
   const Stopwatch clock;
-  const double prepare_s = summary_.condense_time_s;
+  const double prepare_s = summary_.prepare_time_s;
   summary_ = OcpQpSummary{};
-  summary_.condense_time_s = prepare_s;
+  summary_.prepare_time_s = prepare_s;
   const auto finish = [&](QpStatus status) -> const OcpQpSummary& {
     if (status != QpStatus::kSolved && status != QpStatus::kMaxIterations) Fail(status);
     summary_.status = status;
-    summary_.dense_solve_time_s = clock.seconds();
-    summary_.total_time_s = summary_.condense_time_s + summary_.dense_solve_time_s;
+    summary_.feedback_time_s = clock.seconds();
+    summary_.total_time_s = summary_.prepare_time_s + summary_.feedback_time_s;
     return summary_;
   };
   if (!prepared_ || x0.size() != dims_.nx || !x0.allFinite()) return finish(QpStatus::kNumericalFailure);
   if (crossed_) return finish(QpStatus::kInfeasible);
+  // The unconstrained minimum from the measured state.
   if (nmpc_sizes_) {
-    Forward<17, 4>(x0);
+    ForwardPass<17, 4>(&x0, kff_, dims_.horizon - 1, w0_);
   } else {
-    Forward<Eigen::Dynamic, Eigen::Dynamic>(x0);
+    ForwardPass<Eigen::Dynamic, Eigen::Dynamic>(&x0, kff_, dims_.horizon - 1, w0_);
   }
   if (!w0_.allFinite()) return finish(QpStatus::kNumericalFailure);
   summary_.start = start_;

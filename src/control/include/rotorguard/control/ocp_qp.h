@@ -7,9 +7,11 @@
 ///              u_lower_k <= u_k <= u_upper_k                            (k = 0 .. N-1)
 ///              x_lower_k <= x_k[state_bound_index] <= x_upper_k         (k = 1 .. N)
 ///
-/// and its solver by condensing: the states are eliminated (x_k = x_bar_k + sum_j S_kj u_j) with
-/// O(N^2) recursions, and the dense QP in the N*nu inputs is solved by the Goldfarb-Idnani dual
-/// active-set method (DenseQpSolver). docs/control.md explains the choice and its measurements.
+/// and its two solvers, which take the same Goldfarb-Idnani dual active-set path to the same point
+/// and differ in what they factorise: CondensingQpSolver (here) eliminates the states
+/// (x_k = x_bar_k + sum_j S_kj u_j) with O(N^2) recursions and solves the dense QP in the N*nu
+/// inputs (DenseQpSolver); RiccatiQpSolver (riccati_qp.h) keeps the stage form and factorises it by
+/// a Riccati recursion. docs/control.md, "Two QP solvers", compares them.
 #include <Eigen/Core>
 #include <memory>
 #include <span>
@@ -61,8 +63,11 @@ struct OcpQpSummary {
   int active_constraints = 0;
   double objective = 0.0;
   double max_violation = 0.0;   ///< largest bound violation of the returned trajectory
-  double condense_time_s = 0.0;      ///< preparation: condensing and factorisation
-  double dense_solve_time_s = 0.0;   ///< feedback: gradient and bound updates, active-set solve
+  /// Prepare / PrepareVectors: condensing and the dense factorisation, or the Riccati
+  /// factorisation and the warm start's Schur complement.
+  double prepare_time_s = 0.0;
+  /// Feedback: the shift by the measured x0, the active-set iterations and the trajectory.
+  double feedback_time_s = 0.0;
   double total_time_s = 0.0;
   bool IsSolutionUsable() const { return status == QpStatus::kSolved; }
   std::string BriefReport() const;

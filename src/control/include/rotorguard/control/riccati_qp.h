@@ -17,7 +17,6 @@
 /// inversion of the N nu-square Hessian before its first iteration: the Riccati form wins where
 /// few bounds are active (docs/control.md, "Two QP solvers", gives the measurements).
 #include <Eigen/Core>
-#include <string>
 #include <vector>
 
 #include "rotorguard/control/dense_qp.h"
@@ -64,9 +63,12 @@ class RiccatiQpSolver final : public OcpQpSolver {
   /// The backward pass for the linear terms: the feedforwards kff_.
   template <int NX, int NU>
   void BackwardVectors(const OcpQp& qp);
-  /// The unconstrained minimum from x0 by the forward pass; its bounded components go to w0_.
+  /// The factorised recursion forward, writing the trajectory's bounded components to `out`: from
+  /// *x0 with the gaps c_k (the unconstrained minimum), or from zero without them (x0 null: a
+  /// response), with the feedforwards of stages 0..last.
   template <int NX, int NU>
-  void Forward(const Eigen::VectorXd& x0);
+  void ForwardPass(const Eigen::VectorXd* x0, const std::vector<Eigen::VectorXd>& feedforward, int last,
+                   Eigen::Ref<Eigen::VectorXd> out) const;
   /// Prepare and PrepareVectors: the factorisation when `whole`.
   const OcpQpSummary& Prepare(const OcpQp& qp, bool whole);
   /// No active side.
@@ -77,10 +79,17 @@ class RiccatiQpSolver final : public OcpQpSolver {
   /// The response of `index`, computed on first use after a factorisation.
   Eigen::Ref<const Eigen::VectorXd> Response(int index);
 
+  /// Whether `index` is an input fixed by equal bounds (out of the recursion, never active).
+  bool IsFixed(int index) const { return index < dims_.horizon * dims_.nu && fixed_[static_cast<std::size_t>(index)]; }
   double SignedBound(const Side& c) const { return c.sign * (c.sign > 0 ? lower_[c.index] : upper_[c.index]); }
-  /// Appends c to the active set: its row of the Schur complement's Cholesky factor from the
-  /// responses. False (nothing added) when c's normal is dependent on the active ones.
-  bool AddToActiveSet(const Side& c);
+  /// c's row of the Schur complement's Cholesky factor, l = L^-1 N_A' H^-1 n_c, left in b_; returns
+  /// the square of the new diagonal, d² = n_c' H^-1 n_c - |l|².
+  double SchurComplementRow(const Side& c);
+  /// Whether c's normal, with that d², is independent of the active ones (kDependence).
+  bool IsIndependent(const Side& c, double d2) const;
+  /// Appends c with the row SchurComplementRow(c) left in b_. False (nothing added) when c is
+  /// dependent on the active sides or the factor is full.
+  bool AppendToActiveSet(const Side& c, double d2);
   void DropFromActiveSet(int position);
   /// w_ and multipliers_ the minimum with the active sides held as equalities; sides with a
   /// negative multiplier are dropped until none is left.
@@ -108,7 +117,6 @@ class RiccatiQpSolver final : public OcpQpSolver {
   // (and the scratch in which a preparation finds them).
   std::vector<Eigen::MatrixXd> Bt_;
   std::vector<char> fixed_, pattern_;
-  bool IsFixed(int index) const { return index < dims_.horizon * dims_.nu && fixed_[static_cast<std::size_t>(index)]; }
   Eigen::VectorXd costate_;
   // The unconstrained solution's feedforwards k_k, and a response's.
   std::vector<Eigen::VectorXd> kff_, kr_, y_u_, y_x_;
