@@ -177,7 +177,7 @@ class BenchCommand final : public Command {
           {"--problems", &planner_problems_, "With --free-space: problems per size (default 200)"},
           {"--pieces", &planner_pieces_, "With --free-space: comma-separated sizes in pieces (default 5,10)"},
           {"--lbfgs", &planner_lbfgs_,
-           "The optimiser's L-BFGS: ceres (the default) or lewis_overton (docs/planning.md)"}}},
+           "The optimiser's L-BFGS: lewis_overton (the library's own, the default) or ceres (docs/planning.md)"}}},
         {&nav_,
          "nav",
          "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
@@ -517,7 +517,7 @@ class BenchCommand final : public Command {
   std::string perception_duration_ = "10";
   std::string lio_duration_ = "20", lio_spins_ = "0,5,11,20";
   std::string planner_pairs_ = "100", planner_worlds_ = "10", planner_problems_ = "200", planner_pieces_ = "5,10",
-              planner_lbfgs_ = "ceres";
+              planner_lbfgs_ = "lewis_overton";
   bool planner_free_space_ = false;
   std::string nav_trials_ = "100", nav_kinds_ = "forest,room", nav_replay_;
   std::string flatness_seeds_ = "20";

@@ -320,8 +320,8 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
   if (gradient) {
     Eigen::Matrix3Xd dqp, dqy;
     Eigen::VectorXd dtp_total, dty_total;
-    pos.PropagateGradient(dcp, dt, &dqp, &dtp_total);
-    yaw.PropagateGradient(dcy, Eigen::VectorXd::Zero(m), &dqy, &dty_total);
+    pos.PropagateGradient(&dcp, dt, &dqp, &dtp_total);
+    yaw.PropagateGradient(&dcy, Eigen::VectorXd::Zero(m), &dqy, &dty_total);
     gradient->resize(x.size());
     gradient->head(3 * (m - 1)) = Eigen::Map<const Eigen::VectorXd>(dqp.data(), 3 * (m - 1));
     gradient->segment(3 * (m - 1), m - 1) = dqy.row(0).transpose();

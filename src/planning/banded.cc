@@ -9,6 +9,14 @@ BandedMatrix::BandedMatrix(int n, int lower, int upper)
     : n_(n), lower_(lower), upper_(upper), width_(lower + upper + 1),
       data_(static_cast<std::size_t>(n) * static_cast<std::size_t>(lower + upper + 1), 0.0) {}
 
+void BandedMatrix::Reset(int n, int lower, int upper) {
+  n_ = n;
+  lower_ = lower;
+  upper_ = upper;
+  width_ = lower + upper + 1;
+  data_.assign(static_cast<std::size_t>(n) * static_cast<std::size_t>(width_), 0.0);
+}
+
 bool BandedMatrix::Factorize() {
   // Doolittle elimination restricted to the band: without row exchanges L keeps the lower and U
   // the upper bandwidth, and L's multipliers overwrite the eliminated entries.

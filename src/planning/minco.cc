@@ -14,9 +14,7 @@ constexpr int kC = MinimumJerkTrajectory::kCoefficients;
 
 namespace {
 
-// k! / (k - order)!: the factor of t^(k - order) in the order-th derivative of t^k.
-constexpr double kFactor[6][kC] = {{1, 1, 1, 1, 1, 1},    {0, 1, 2, 3, 4, 5},     {0, 0, 2, 6, 12, 20},
-                                   {0, 0, 0, 6, 24, 60},  {0, 0, 0, 0, 24, 120},  {0, 0, 0, 0, 0, 120}};
+constexpr auto& kFactor = MinimumJerkTrajectory::kDerivativeFactor;
 
 }  // namespace
 
@@ -41,13 +39,17 @@ Eigen::Matrix<double, 5, kC> MinimumJerkTrajectory::BasisRows(double t) {
   return b;
 }
 
-bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
-                                  const Eigen::VectorXd& durations) {
+void MinimumJerkTrajectory::Clear() {
   durations_.resize(0);
   coefficients_.resize(0, 3);
+}
+
+bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
+                                  const Eigen::VectorXd& durations) {
   const int m = static_cast<int>(durations.size());
   if (m < 1 || waypoints.cols() != m - 1 || !head.allFinite() || !tail.allFinite() || !waypoints.allFinite() ||
       !durations.allFinite() || (durations.array() <= 0.0).any()) {
+    Clear();
     return false;
   }
   // Rows, ordered so that the matrix has 4 sub- and 3 super-diagonals and factors without
@@ -56,9 +58,13 @@ bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, co
   // and second derivatives (piece i at T_i minus piece i + 1 at 0), piece i + 1's position at 0
   // equals q_i, continuity of the third and fourth; the tail (p, v, a of the last piece at its
   // end). Columns: coefficient k of piece i at 6i + k.
+  // The system and its right-hand side (solved in place into the coefficients) reuse the last
+  // build's storage: an optimiser rebuilds the same size hundreds of times a solve.
   const int n = kC * m;
-  BandedMatrix a(n, 4, 3);
-  Eigen::MatrixX3d b = Eigen::MatrixX3d::Zero(n, 3);
+  BandedMatrix& a = system_;
+  a.Reset(n, 4, 3);
+  Eigen::MatrixX3d& b = coefficients_;
+  b.setZero(n, 3);
   const double factorial[] = {1.0, 1.0, 2.0, 6.0, 24.0};
   for (int d = 0; d < 3; ++d) {
     a(d, d) = factorial[d];
@@ -85,11 +91,15 @@ bool MinimumJerkTrajectory::Build(const PvaState& head, const PvaState& tail, co
     for (int k = d; k < kC; ++k) a(n - 3 + d, last + k) = row(k);
     b.row(n - 3 + d) = tail.col(d).transpose();
   }
-  if (!a.Factorize()) return false;
+  if (!a.Factorize()) {
+    Clear();
+    return false;
+  }
   a.Solve(b);
-  if (!b.allFinite()) return false;
-  system_ = std::move(a);
-  coefficients_ = std::move(b);
+  if (!b.allFinite()) {
+    Clear();
+    return false;
+  }
   durations_ = durations;
   total_duration_ = durations.sum();
   return true;
@@ -145,9 +155,9 @@ void MinimumJerkTrajectory::EnergyPartials(Eigen::MatrixX3d* d_coefficients, Eig
   }
 }
 
-void MinimumJerkTrajectory::PropagateGradient(const Eigen::MatrixX3d& d_coefficients,
-                                              const Eigen::VectorXd& d_durations_partial,
-                                              Eigen::Matrix3Xd* d_waypoints, Eigen::VectorXd* d_durations) const {
+void MinimumJerkTrajectory::PropagateGradient(Eigen::MatrixX3d* d_coefficients,
+                                              const Eigen::VectorXd& d_durations_partial, Eigen::Matrix3Xd* d_waypoints,
+                                              Eigen::VectorXd* d_durations) const {
   // A c = b(q): dJ/db = A^-T dJ/dc (the adjoint, G), and b holds q_i in rows 6i + 3 and 6i + 6. A depends on
   // T_i through piece i's rows at its end: dc/dT_i = -A^-1 (dA/dT_i) c, so dJ/dT_i loses
   // G . (dA/dT_i c), where (dA/dT_i c) in a row that evaluates derivative d of piece i at T_i is
@@ -156,7 +166,7 @@ void MinimumJerkTrajectory::PropagateGradient(const Eigen::MatrixX3d& d_coeffici
   if (system_.size() != kC * m) {
     throw std::logic_error("MinimumJerkTrajectory::PropagateGradient: the trajectory does not come from Build");
   }
-  Eigen::MatrixXd g = d_coefficients;
+  Eigen::MatrixX3d& g = *d_coefficients;
   system_.SolveTransposed(g);
   d_waypoints->resize(3, m - 1);
   *d_durations = d_durations_partial;

@@ -22,6 +22,20 @@ void Unpack(const Eigen::VectorXd& x, int pieces, Eigen::Matrix3Xd* q, Eigen::Ve
   for (int i = 0; i < pieces; ++i) (*t)(i) = TrajectoryOptimizer::DurationOf(x(3 * (pieces - 1) + i));
 }
 
+/// The objective's buffers, kept between evaluations (a solve makes hundreds of the same size, and
+/// none then allocates): one set per thread, so that optimisers on several threads share none.
+struct ObjectiveWorkspace {
+  Eigen::Matrix3Xd q, dq;
+  Eigen::VectorXd t, dt, d_durations;
+  Eigen::MatrixX3d dc;
+  MinimumJerkTrajectory traj;
+};
+
+ObjectiveWorkspace& Workspace() {
+  thread_local ObjectiveWorkspace workspace;
+  return workspace;
+}
+
 }  // namespace
 
 void DynamicLimits::Validate() const {
@@ -103,69 +117,85 @@ TrajectoryOptimizer::TrajectoryOptimizer(const TrajectoryOptimizerOptions& optio
 double TrajectoryOptimizer::Objective(const PvaState& head, const PvaState& tail, const DynamicLimits& limits,
                                       const PlaneSet& planes, const Eigen::VectorXd& x,
                                       Eigen::VectorXd* gradient) const {
+  ObjectiveWorkspace& w = Workspace();
   const int pieces = static_cast<int>((x.size() + 3) / 4);
-  Eigen::Matrix3Xd q;
-  Eigen::VectorXd t;
-  Unpack(x, pieces, &q, &t);
-  MinimumJerkTrajectory traj;
-  if (!traj.Build(head, tail, q, t)) return std::numeric_limits<double>::quiet_NaN();
+  Unpack(x, pieces, &w.q, &w.t);
+  MinimumJerkTrajectory& traj = w.traj;
+  if (!traj.Build(head, tail, w.q, w.t)) return std::numeric_limits<double>::quiet_NaN();
   const TrajectoryOptimizerOptions& o = options_;
-  Eigen::MatrixX3d dc;
-  Eigen::VectorXd dt;
+  const Eigen::VectorXd& t = w.t;
+  Eigen::MatrixX3d& dc = w.dc;
+  Eigen::VectorXd& dt = w.dt;
   traj.EnergyPartials(&dc, &dt);
   double cost = o.weights.time * t.sum() + o.weights.smoothness * traj.Energy();
   dc *= o.weights.smoothness;
   dt = dt * o.weights.smoothness + Eigen::VectorXd::Constant(pieces, o.weights.time);
   // Sampled penalties, cubed throughout (the paper cubes the clearance term only). A sample at
   // t = s T_i moves with T_i: its explicit derivative is the next derivative of the sampled
-  // quantity times s.
+  // quantity times s. Only the derivatives a term uses are evaluated: v, a (and j with a jerk
+  // limit) and the next one for the time derivative; the position only with obstacle planes.
   const double limit2[3] = {limits.v_max * limits.v_max, limits.a_max * limits.a_max, limits.j_max * limits.j_max};
+  const int max_order = limits.highest_limited_order();
+  const bool clearance = !planes.empty() && o.weights.collision > 0.0;
+  const int first_order = clearance ? 0 : 1;
+  constexpr auto& kFactor = MinimumJerkTrajectory::kDerivativeFactor;
   const int k_samples = o.samples_per_piece;
   for (int i = 0; i < pieces; ++i) {
-    const auto c = traj.coefficients().middleRows<kC>(kC * i);
+    const Eigen::Matrix<double, kC, 3> c = traj.coefficients().middleRows<kC>(kC * i);
+    Eigen::Matrix<double, kC, 3> dci = Eigen::Matrix<double, kC, 3>::Zero();
+    double dti = 0.0;
+    // The derivatives' polynomials: row k of poly[d] multiplies t^k in derivative d.
+    Eigen::Matrix<double, kC, 3> poly[5];
+    for (int d = first_order; d <= max_order + 1; ++d) {
+      for (int k = 0; k + d < kC; ++k) poly[d].row(k) = kFactor[d][k + d] * c.row(k + d);
+    }
     std::size_t cursor = 0;  // the piece's planes, sorted by sample: the first of sample j
     for (int j = 0; j <= k_samples; ++j) {
-      if (!planes.empty()) {
-        const std::vector<SamplePlane>& list = planes[static_cast<std::size_t>(i)];
-        while (cursor < list.size() && list[cursor].sample < j) ++cursor;
-      }
       const double s = static_cast<double>(j) / k_samples, ts = s * t(i);
-      const Eigen::Matrix<double, 5, kC> basis = MinimumJerkTrajectory::BasisRows(ts);
-      const Eigen::Matrix<double, 5, 3> der = basis * c;  // p, v, a, j, snap
-      for (int d = 1; d <= limits.highest_limited_order(); ++d) {  // J_d: velocity, acceleration, jerk (eqs. 26-29)
+      double power[kC];  // ts^k
+      power[0] = 1.0;
+      for (int k = 1; k < kC; ++k) power[k] = power[k - 1] * ts;
+      Vector3 der[5];  // p, v, a, j, snap at ts, by Horner's rule
+      for (int d = first_order; d <= max_order + 1; ++d) {
+        Eigen::RowVector3d v = poly[d].row(kC - 1 - d);
+        for (int k = kC - 2 - d; k >= 0; --k) v = v * ts + poly[d].row(k);
+        der[d] = v.transpose();
+      }
+      // d cost / d (derivative d at this sample) into the piece's coefficients and duration.
+      const auto accumulate = [&](int d, const Vector3& dp) {
+        for (int k = d; k < kC; ++k) dci.row(k) += (kFactor[d][k] * power[k - d]) * dp.transpose();
+        dti += dp.dot(der[d + 1]) * s;
+      };
+      for (int d = 1; d <= max_order; ++d) {  // J_d: velocity, acceleration, jerk (eqs. 26-29)
         double slope;
-        const double pen = CubicPenalty(der.row(d).squaredNorm() - limit2[d - 1], &slope);
+        const double pen = CubicPenalty(der[d].squaredNorm() - limit2[d - 1], &slope);
         if (slope == 0.0) continue;
         cost += o.weights.feasibility * pen;
-        const Eigen::RowVector3d dp = o.weights.feasibility * slope * 2.0 * der.row(d);  // d cost / d derivative
-        dc.middleRows<kC>(kC * i) += basis.row(d).transpose() * dp;
-        dt(i) += dp.dot(der.row(d + 1)) * s;
+        accumulate(d, (o.weights.feasibility * slope * 2.0) * der[d]);
       }
-      if (!planes.empty() && o.weights.collision > 0.0) {  // J_c (eqs. 34-36)
-        const Vector3 p = der.row(0).transpose();
+      if (clearance) {  // J_c (eqs. 34-36)
         const std::vector<SamplePlane>& list = planes[static_cast<std::size_t>(i)];
+        while (cursor < list.size() && list[cursor].sample < j) ++cursor;
         for (std::size_t k = cursor; k < list.size() && list[k].sample == j; ++k) {
           const ObstaclePlane& plane = list[k].plane;
           double slope;
-          const double pen = CubicPenalty(o.clearance_m - (p - plane.point).dot(plane.normal), &slope);
+          const double pen = CubicPenalty(o.clearance_m - (der[0] - plane.point).dot(plane.normal), &slope);
           if (slope == 0.0) continue;  // (a NaN plane makes the cost NaN: a failed evaluation, not a skip)
           cost += o.weights.collision * pen;
-          const Eigen::RowVector3d dp = -o.weights.collision * slope * plane.normal.transpose();
-          dc.middleRows<kC>(kC * i) += basis.row(0).transpose() * dp;
-          dt(i) += dp.dot(der.row(1)) * s;
+          accumulate(0, (-o.weights.collision * slope) * plane.normal);
         }
       }
     }
+    dc.middleRows<kC>(kC * i) += dci;
+    dt(i) += dti;
   }
   if (gradient) {
-    Eigen::Matrix3Xd dq;
-    Eigen::VectorXd d_durations;
-    traj.PropagateGradient(dc, dt, &dq, &d_durations);
+    traj.PropagateGradient(&dc, dt, &w.dq, &w.d_durations);
     gradient->resize(x.size());
-    gradient->head(3 * (pieces - 1)) = Eigen::Map<const Eigen::VectorXd>(dq.data(), 3 * (pieces - 1));
+    gradient->head(3 * (pieces - 1)) = Eigen::Map<const Eigen::VectorXd>(w.dq.data(), 3 * (pieces - 1));
     for (int i = 0; i < pieces; ++i) {
       const double tau = x(3 * (pieces - 1) + i);
-      (*gradient)(3 * (pieces - 1) + i) = d_durations(i) * t(i) / std::sqrt(tau * tau + 1.0);  // dT/dτ
+      (*gradient)(3 * (pieces - 1) + i) = w.d_durations(i) * t(i) / std::sqrt(tau * tau + 1.0);  // dT/dτ
     }
   }
   return cost;

@@ -1,14 +1,16 @@
 // The control-rate path allocates nothing once warmed up (STYLE.md, "Model / Data"): malloc is
 // interposed in this test executable (glibc's own allocator does the work) and counted while the
-// NMPC, its QP solvers and the fault detector run.
+// NMPC, its QP solvers and the fault detector run; and in the planner's inner loop, the trajectory
+// optimiser's cost and gradient (hundreds of evaluations a solve).
+#include <gtest/gtest.h>
+
 #include <atomic>
 #include <cstddef>
-
-#include <gtest/gtest.h>
 
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/planning/references.h"
+#include "rotorguard/planning/trajectory_optimizer.h"
 #include "vehicle_fixture.h"
 
 extern "C" {
@@ -109,6 +111,31 @@ TEST(Allocation, FaultDetectionAllocatesNothing) {
               for (int k = 10; k < 200; ++k) step(k * 3'000'000);
             }),
             0);
+}
+
+TEST(Allocation, TrajectoryObjectiveAllocatesNothingOnceWarm) {
+  // A 5-piece problem, in free space and with obstacle planes; the second evaluation of a size
+  // on a thread reuses the first's buffers.
+  planning::TrajectoryOptimizerOptions o;
+  const planning::TrajectoryOptimizer optimizer(o);
+  planning::PvaState head = planning::PvaState::Zero(), tail = planning::PvaState::Zero();
+  tail.col(0) = Vector3(8.0, 2.0, 1.0);
+  Eigen::Matrix3Xd waypoints(3, 4);
+  waypoints << 1.5, 3.5, 5.0, 6.5, 0.5, 1.0, 2.5, 2.0, 0.5, 1.0, 0.8, 1.2;
+  const Eigen::VectorXd x = planning::TrajectoryOptimizer::Variables(waypoints, Eigen::VectorXd::Constant(5, 2.0));
+  planning::PlaneSet planes(5);
+  planes[1].push_back({3, {Vector3(3.0, 0.2, 1.0), Vector3(0.0, 1.0, 0.0)}});
+  planes[1].push_back({4, {Vector3(3.2, 0.3, 1.0), Vector3(0.0, 1.0, 0.0)}});
+  const planning::DynamicLimits limits{1.0, 2.0, 6.0};
+  for (const planning::PlaneSet& p : {planning::PlaneSet{}, planes}) {
+    Eigen::VectorXd gradient(x.size());
+    double cost = optimizer.Objective(head, tail, limits, p, x, &gradient);
+    EXPECT_EQ(CountAllocations([&] {
+                for (int k = 0; k < 20; ++k) cost += optimizer.Objective(head, tail, limits, p, x, &gradient);
+              }),
+              0);
+    EXPECT_TRUE(std::isfinite(cost));
+  }
 }
 
 }  // namespace

@@ -133,8 +133,8 @@ TEST(MinimumJerkTrajectory, ARestToRestChainIsOneRestToRestPiecePerSegment) {
   EXPECT_LT((chain.Evaluate(1e9).p_W - points.col(3)).norm(), 1e-12);
   Eigen::Matrix3Xd dq;
   Eigen::VectorXd dt;
-  EXPECT_THROW(chain.PropagateGradient(Eigen::MatrixX3d::Zero(18, 3), Eigen::VectorXd::Zero(3), &dq, &dt),
-               std::logic_error);
+  Eigen::MatrixX3d partials = Eigen::MatrixX3d::Zero(18, 3);
+  EXPECT_THROW(chain.PropagateGradient(&partials, Eigen::VectorXd::Zero(3), &dq, &dt), std::logic_error);
   EXPECT_FALSE(chain.BuildRestToRest(points, Eigen::Vector3d(1.0, 0.0, 1.0))) << "a zero duration";
   EXPECT_TRUE(chain.empty());
   EXPECT_FALSE(chain.BuildRestToRest(points, Eigen::Vector2d(1.0, 1.0))) << "sizes";
@@ -156,7 +156,7 @@ TEST(MinimumJerkTrajectory, EnergyGradientMatchesFiniteDifferences) {
     Eigen::VectorXd dt_partial, dt;
     Eigen::Matrix3Xd dq;
     traj.EnergyPartials(&dc, &dt_partial);
-    traj.PropagateGradient(dc, dt_partial, &dq, &dt);
+    traj.PropagateGradient(&dc, dt_partial, &dq, &dt);
     const auto energy = [&](const Eigen::Matrix3Xd& q, const Eigen::VectorXd& t) {
       MinimumJerkTrajectory other;
       EXPECT_TRUE(other.Build(p.head, p.tail, q, t));

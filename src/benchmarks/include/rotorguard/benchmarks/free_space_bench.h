@@ -24,7 +24,7 @@ struct FreeSpaceBenchOptions {
   int problems = 200;                 ///< problems per size, in [1, 100000]
   std::uint64_t seed = 1;
   int evaluations = 200;  ///< timed evaluations per problem for eval_us, in [1, 100000]
-  planning::LbfgsMethod lbfgs = planning::LbfgsMethod::kCeres;  ///< the optimiser's L-BFGS
+  planning::LbfgsMethod lbfgs = planning::LbfgsMethod::kLewisOverton;  ///< the optimiser's L-BFGS
   /// Called after each problem with (done, total).
   std::function<void(int, int)> progress;
   /// Throws std::invalid_argument naming the field.

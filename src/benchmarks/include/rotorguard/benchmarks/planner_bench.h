@@ -21,7 +21,7 @@ struct PlannerBenchOptions {
   int pairs = 100;           ///< start/goal pairs per world kind, in [1, 100000]
   std::uint64_t seed = 1;    ///< worlds and pairs
   int worlds = 10;           ///< distinct worlds per kind (pairs spread over them), in [1, pairs]
-  planning::LbfgsMethod lbfgs = planning::LbfgsMethod::kCeres;  ///< the optimiser's L-BFGS
+  planning::LbfgsMethod lbfgs = planning::LbfgsMethod::kLewisOverton;  ///< the optimiser's L-BFGS
   /// Called after each plan with (done, total).
   std::function<void(int, int)> progress;
   /// Throws std::invalid_argument naming the field.

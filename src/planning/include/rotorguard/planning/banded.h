@@ -14,6 +14,8 @@ class BandedMatrix {
  public:
   /// An n x n zero matrix with `lower` sub- and `upper` super-diagonals.
   BandedMatrix(int n, int lower, int upper);
+  /// The same, in this matrix's storage (no allocation when it held as many entries before).
+  void Reset(int n, int lower, int upper);
 
   int size() const { return n_; }
   /// Element (i, j); |i - j| must lie within the band.

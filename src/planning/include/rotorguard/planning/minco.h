@@ -22,12 +22,17 @@ using PvaState = Eigen::Matrix3d;
 class MinimumJerkTrajectory final : public ReferenceTrajectory {
  public:
   static constexpr int kCoefficients = 6;  // degree 5 = 2s - 1
+  /// k! / (k - order)!: the factor of t^(k - order) in the order-th derivative of t^k.
+  static constexpr double kDerivativeFactor[6][kCoefficients] = {{1, 1, 1, 1, 1, 1},    {0, 1, 2, 3, 4, 5},
+                                                                 {0, 0, 2, 6, 12, 20},  {0, 0, 0, 6, 24, 60},
+                                                                 {0, 0, 0, 0, 24, 120}, {0, 0, 0, 0, 0, 120}};
 
   MinimumJerkTrajectory() = default;
 
   /// Builds the minimum-jerk coefficients for `waypoints` (3 x (M - 1), the junctions) and
-  /// `durations` (M, each > 0). Returns false (leaving the trajectory empty) when a duration is not
-  /// positive and finite, an input is not finite or the sizes do not match.
+  /// `durations` (M, each > 0), in this trajectory's storage (no allocation when it held M pieces
+  /// before). Returns false (leaving the trajectory empty) when a duration is not positive and
+  /// finite, an input is not finite or the sizes do not match.
   bool Build(const PvaState& head, const PvaState& tail, const Eigen::Matrix3Xd& waypoints,
              const Eigen::VectorXd& durations);
 
@@ -53,8 +58,9 @@ class MinimumJerkTrajectory final : public ReferenceTrajectory {
   void EnergyPartials(Eigen::MatrixX3d* d_coefficients, Eigen::VectorXd* d_durations) const;
 
   /// Maps the partial derivatives of a cost J(c, T) to its total derivatives with respect to the
-  /// waypoints (3 x (M - 1)) and durations (M) through the adjoint of the banded system.
-  void PropagateGradient(const Eigen::MatrixX3d& d_coefficients, const Eigen::VectorXd& d_durations_partial,
+  /// waypoints (3 x (M - 1)) and durations (M) through the adjoint of the banded system, solved in
+  /// place: `d_coefficients` holds the adjoint afterwards (no allocation for the optimisers).
+  void PropagateGradient(Eigen::MatrixX3d* d_coefficients, const Eigen::VectorXd& d_durations_partial,
                          Eigen::Matrix3Xd* d_waypoints, Eigen::VectorXd* d_durations) const;
 
   /// The row d^order/dt^order [1, t, ..., t^5]: a piece's derivative is Basis(t, order) times its
@@ -81,6 +87,8 @@ class MinimumJerkTrajectory final : public ReferenceTrajectory {
   void set_yaw(double yaw) { yaw_ = yaw; }
 
  private:
+  void Clear();  // empty: no pieces
+
   Eigen::VectorXd durations_;
   Eigen::MatrixX3d coefficients_;
   BandedMatrix system_{0, 4, 3};  // factored

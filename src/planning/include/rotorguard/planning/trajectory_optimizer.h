@@ -108,10 +108,10 @@ struct TrajectoryOptimizerOptions {
   CostWeights weights;
   double clearance_m = 0.3;      ///< C_o of eq. (36), the safe distance [m], in [0, kMaxClearanceM]
   int samples_per_piece = 16;    ///< penalty samples per piece (κ / M), >= 2
-  /// The L-BFGS (lbfgs.h): Ceres' (the default) or this library's, at most 200 iterations, and a
-  /// relative cost tolerance in (0, 0.1]: 1e-4 plans the 400 bench queries in 3.7-5.1 ms on
-  /// average, 1e-5 in 6-6.6 ms for trajectories 4 % shorter in time (docs/planning.md).
-  LbfgsOptions lbfgs;
+  /// The L-BFGS (lbfgs.h): this library's (the default: lower costs than Ceres' and than GCOPTER's
+  /// L-BFGS on the same problems) or Ceres', at most 200 iterations, and a relative cost tolerance
+  /// in (0, 0.1] (docs/planning.md, "The L-BFGS").
+  LbfgsOptions lbfgs{.method = LbfgsMethod::kLewisOverton};
   /// The dense feasibility check: samples per piece, and the at most `max_slowdowns` rounds that
   /// stretch all durations by the factor that the worst excess calls for (v / k, a / k², j / k³),
   /// times `slowdown_factor` for a margin.

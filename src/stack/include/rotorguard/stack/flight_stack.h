@@ -156,7 +156,7 @@ struct NavigationOptions {
              {.meaning = "[z_min, z_max], the altitudes the search may use [m]", .min = 0.0, .max = kMaxCoordinateM});
     a->Visit("weights", &r.planner.optimizer.weights, {.meaning = "eq. (22)'s weights"});
     a->Visit("lbfgs", &r.planner.optimizer.lbfgs.method,
-             {.meaning = "the trajectory optimiser's L-BFGS: ceres, or lewis_overton, the library's own "
+             {.meaning = "the trajectory optimiser's L-BFGS: lewis_overton, the library's own, or ceres "
                          "(docs/planning.md)"});
   }
 };
