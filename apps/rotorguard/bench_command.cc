@@ -130,7 +130,7 @@ class BenchCommand final : public Command {
          "nmpc",
          "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
          "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.",
-         {{"--qp-solver", &nmpc_qp_solver_, "The NMPC's QP solver: condensing (default, the stack's) or riccati"}}},
+         {{"--qp-solver", &nmpc_qp_solver_, "The NMPC's QP solver: riccati (default, the stack's) or condensing"}}},
         {&ftc_,
          "ftc",
          "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
@@ -511,7 +511,7 @@ class BenchCommand final : public Command {
   std::string trial_timeout_;
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3", qp_solver_ = "riccati";
-  std::string nmpc_qp_solver_ = "condensing";
+  std::string nmpc_qp_solver_ = "riccati";
   std::string truth_ = "realistic", estimator_;
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";

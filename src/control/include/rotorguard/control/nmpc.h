@@ -51,10 +51,10 @@ struct NmpcOptions {
   /// What the model misses, estimated in flight and predicted with (offset-free NMPC).
   DisturbanceObserverOptions disturbance;
   DenseQpOptions qp;
-  /// The QP solver of each iteration: condensing (the states eliminated, a dense active-set solve)
-  /// or riccati (the stage form factorised by a Riccati recursion); the same QP, the same solution
-  /// (docs/control.md, "Two QP solvers").
-  OcpQpMethod qp_solver = OcpQpMethod::kCondensing;
+  /// The QP solver of each iteration: riccati (the stage form factorised by a Riccati recursion,
+  /// the default: faster on average) or condensing (the states eliminated, a dense active-set
+  /// solve); the same QP, the same solution (docs/control.md, "Two QP solvers").
+  OcpQpMethod qp_solver = OcpQpMethod::kRiccati;
   void Validate() const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
