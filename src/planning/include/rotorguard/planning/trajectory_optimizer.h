@@ -3,9 +3,10 @@
 ///   min over {q, T} of  λ_t J_t + λ_s J_s + λ_d J_d + λ_c J_c
 /// with J_t the total time (eq. 23), J_s the jerk energy (eq. 24), J_d the velocity, acceleration
 /// and jerk limits sampled along each piece (eqs. 25-29) and J_c the clearance from obstacle planes
-/// (eqs. 34-36), a set of planes per piece. Durations are optimised through a smooth positive map, T = τ + sqrt(τ² + 1), so
-/// that the problem is unconstrained, and solved by Ceres' L-BFGS (GradientProblemSolver) behind a
-/// wrapper that treats any non-finite cost or gradient as a failed evaluation.
+/// (eqs. 34-36), a set of planes per piece. Durations are optimised through a smooth positive
+/// map, T = τ + sqrt(τ² + 1), so that the problem is unconstrained, and solved by an L-BFGS
+/// (lbfgs.h: this library's by default, or Ceres'), to which any non-finite cost or gradient is a
+/// failed evaluation.
 ///
 /// Penalties alone do not guarantee limits, so the result is checked densely afterwards and, while
 /// a limit is exceeded, time is stretched until it holds (see `Summary`).
