@@ -73,10 +73,12 @@ struct Sweep {
   }
 };
 
-/// The detector's options with the IMU the log's run read.
+/// The detector's options with the IMU the log's run read and the command delay it expected.
 fdd::CompositeFddOptions WithLogImu(fdd::CompositeFddOptions options, const CalibrationLog& log) {
   options.imu_rate_hz = log.imu_rate_hz;
   options.imu_position_m = log.imu_position_m;
+  options.command_delay_s = log.command_delay_s;
+  options.imu_notch = log.imu_notch;
   return options;
 }
 
@@ -106,6 +108,10 @@ CalibrationLog LoadCalibrationLog(const std::string& dir) {
     const std::vector<double> p = sensors.at("imu_position_m").get<std::vector<double>>();
     if (p.size() != 3) throw std::runtime_error("sensors.imu_position_m: expected 3 numbers");
     log.imu_position_m = Vector3(p[0], p[1], p[2]);
+    if (sensors.contains("command_delay_s")) log.command_delay_s = sensors.at("command_delay_s").get<double>();
+    if (sensors.contains("imu_notch")) io::FromJson(sensors.at("imu_notch"), &log.imu_notch);
+    log.imu_notch.sample_rate_hz = log.imu_rate_hz;
+    log.imu_notch.Validate();
     for (const nlohmann::json& f : summary.at("faults")) {
       log.faults.push_back({f.at("rotor").get<int>(), f.at("kind").get<std::string>(), f.at("onset_s").get<double>()});
     }
@@ -198,6 +204,7 @@ fdd::CompositeFddOptions RecordedFddOptions(const std::vector<CalibrationLog>& l
 
 ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::CompositeFddOptions& options) {
   fdd::CompositeFdd detector(log.vehicle, WithLogImu(options, log));
+  RpmNotchBank<6> imu_filter(log.vehicle.num_rotors(), log.imu_notch);  // as the stack filtered
   // The stack's estimator, fed as the stack fed it: the estimate the detector saw.
   stack::OdometryImuEstimator estimator(log.vehicle.thrust_coefficient_n_s2);
   const double onset = FirstOnset(log);
@@ -206,10 +213,18 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::Composite
   // after one stamped at it: fault-free flight ends at the first record stamped at the onset.
   bool before_onset = true;
   for (const record::SensorRecord& r : log.records) {
-    if (const auto* imu = std::get_if<ImuSample>(&r)) {
-      estimator.OnImu(*imu);
-      detector.OnImu(*imu);
+    if (const auto* raw = std::get_if<ImuSample>(&r)) {
+      // As the stack does: the estimator integrates the raw samples, the detector reads them notched.
+      estimator.OnImu(*raw);
+      Eigen::Matrix<double, 6, 1> x;
+      x << raw->specific_force_B, raw->w_B;
+      const Eigen::Matrix<double, 6, 1> y = imu_filter.Filter(x);
+      ImuSample imu = *raw;
+      imu.specific_force_B = y.head<3>();
+      imu.w_B = y.tail<3>();
+      detector.OnImu(imu);
     } else if (const auto* esc = std::get_if<EscTelemetry>(&r)) {
+      imu_filter.OnRotorSpeeds(esc->t_ns, esc->motor_speed_rad_s);
       estimator.OnEscTelemetry(*esc);
       detector.OnEscTelemetry(*esc);
     } else if (const auto* odometry = std::get_if<OdometrySample>(&r)) {
@@ -221,7 +236,7 @@ ReplayOutcome ReplayCompositeFdd(const CalibrationLog& log, const fdd::Composite
       const StateEstimate e = estimator.Estimate(command.t_ns);
       if (e.valid) {
         detector.SetEstimate(e);
-        detector.SetCommand(command.thrust_n);
+        detector.SetCommand(command);
       }
     }
     // Extremes from flight before the fault (the detector itself stops at its first isolation).

@@ -47,6 +47,9 @@ void NmpcOptions::Validate() const {
   if (!(sqp_tolerance > 0.0) || !std::isfinite(sqp_tolerance)) {
     ThrowValidation("NmpcOptions", "sqp_tolerance", sqp_tolerance, "a value > 0");
   }
+  if (!(expected_delay_s >= 0.0 && expected_delay_s <= 0.1)) {
+    ThrowValidation("NmpcOptions", "expected_delay_s", expected_delay_s, "a delay in [0, 0.1] s");
+  }
   disturbance.Validate();
   qp.Validate();
 }
@@ -80,6 +83,10 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
   dy_.resize(nx_, nx_);
   x0_.resize(nx_);
   x0_delta_.resize(nx_);
+  for (Eigen::VectorXd& k : k_) k.resize(nx_);
+  x_stage_.resize(nx_);
+  u_acting_.resize(nu_);
+  sent_.assign(kSentCommands, SentCommand{-std::numeric_limits<double>::infinity(), Eigen::VectorXd::Zero(nu_)});
   weighted_y_.resize(nx_);
   for (int k = 0; k < N_; ++k) qp_.R[k] = options_.r_input * Eigen::MatrixXd::Identity(nu_, nu_);
   torque_offset_ = Eigen::VectorXd::Zero(nu_);
@@ -88,6 +95,7 @@ NmpcController::NmpcController(const vehicle::VehicleParams& vehicle, const Nmpc
 
 void NmpcController::Reset() {
   initialised_ = false;
+  for (SentCommand& c : sent_) c.t = -std::numeric_limits<double>::infinity();
   prepared_for_t_.reset();
   reused_since_linearisation_ = -1;
   summary_ = NmpcSummary{};
@@ -277,6 +285,47 @@ void NmpcController::HoverCommand(RotorVector* thrust_command) const {
   *thrust_command = t.cwiseMax(0.0).cwiseMin(u_max_);
 }
 
+void NmpcController::RememberSent(double t, const RotorVector& command) {
+  SentCommand& c = sent_[static_cast<std::size_t>(sent_next_)];
+  c.t = t;
+  c.u = command;
+  sent_next_ = (sent_next_ + 1) % kSentCommands;
+}
+
+void NmpcController::PredictOverDelay(double t) {
+  const double d = options_.expected_delay_s;
+  const double end = t + d;
+  double s = t;
+  while (s < end) {
+    // The command acting at s: the latest sent whose instant plus the delay has come; before any,
+    // the motors hold their state. The piece ends where the next one starts acting.
+    double acting_since = -std::numeric_limits<double>::infinity(), next = end;
+    u_acting_ = x0_.tail(nu_);
+    for (const SentCommand& c : sent_) {
+      const double acts = c.t + d;
+      if (acts <= s && acts > acting_since) {
+        acting_since = acts;
+        u_acting_ = c.u;
+      } else if (acts > s && acts < next) {
+        next = acts;
+      }
+    }
+    // One RK4 step per piece: the delay is a few milliseconds, far below the model's time scales
+    // but for the motors' (30 ms), which RK4 integrates to O(h^5).
+    const double h = next - s;
+    model_.Dynamics(x0_, u_acting_, &k_[0]);
+    x_stage_ = x0_ + 0.5 * h * k_[0];
+    model_.Dynamics(x_stage_, u_acting_, &k_[1]);
+    x_stage_ = x0_ + 0.5 * h * k_[1];
+    model_.Dynamics(x_stage_, u_acting_, &k_[2]);
+    x_stage_ = x0_ + h * k_[2];
+    model_.Dynamics(x_stage_, u_acting_, &k_[3]);
+    x0_ += (h / 6.0) * (k_[0] + 2.0 * k_[1] + 2.0 * k_[2] + k_[3]);
+    x0_.segment<4>(StateIndex::kQuaternion).normalize();
+    s = next;
+  }
+}
+
 void NmpcController::Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t) {
   for (int k = 0; k <= N_; ++k) x_[k] = x0;
   for (int k = 0; k < N_; ++k) {
@@ -425,6 +474,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     } else {
       HoverCommand(thrust_command);
     }
+    if (std::isfinite(t)) RememberSent(t, *thrust_command);
     summary_.solve_time_s = clock.seconds();
     return;
   }
@@ -447,6 +497,13 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
   // What the model misses, from this measurement, into the prediction (nothing when disabled).
   observer_.Update(x0_, t);
   ApplyCorrection();
+  // The command of this call acts only after the delay: the plan starts from the state then, and
+  // runs on the clock of that instant (the references, the preparation for the next call).
+  const double t_call = t;
+  if (options_.expected_delay_s > 0.0) {
+    PredictOverDelay(t);
+    t += options_.expected_delay_s;
+  }
 
   int iterations = options_.max_sqp_iterations;
   // Real-time iteration: when the previous call prepared the QP for this very time, only the
@@ -485,6 +542,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     ++summary_.fallbacks;
     reused_since_linearisation_ = -1;  // a fallback: the next preparation linearises
   }
+  RememberSent(t_call, *thrust_command);
   summary_.command_latency_s = clock.seconds();
   // Preparation for the next call, after the command is out: shift the plan by this call's period
   // (the stack's control period) and linearise and condense around it.

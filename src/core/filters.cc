@@ -1,5 +1,6 @@
 #include "rotorguard/core/filters.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -58,6 +59,49 @@ const typename FilteredDerivative<N>::Vec& FilteredDerivative<N>::Step(const Vec
   return filter_.Step(derivative);
 }
 
+template <int N>
+void Notch2<N>::SetCentre(double centre_hz, double bandwidth_hz, double sample_hz) {
+  if (!(sample_hz > 0.0) || !std::isfinite(sample_hz)) {
+    ThrowInvalidArgument("Notch2", "sample_hz", sample_hz, "a rate > 0 [Hz]");
+  }
+  if (!(centre_hz > 0.0) || !(centre_hz < 0.5 * sample_hz)) {
+    ThrowInvalidArgument("Notch2", "centre_hz", centre_hz, fmt::format("a centre in (0, {}) Hz (below Nyquist)", sample_hz / 2));
+  }
+  if (!(bandwidth_hz > 0.0) || !std::isfinite(bandwidth_hz)) {
+    ThrowInvalidArgument("Notch2", "bandwidth_hz", bandwidth_hz, "a width > 0 [Hz]");
+  }
+  // Orfanidis' second-order notch (Introduction to Signal Processing, sec. 11.3): zeros on the unit
+  // circle at w0 = 2 pi f0 / fs, poles on their rays at radius sqrt(2 beta - 1), beta =
+  // 1 / (1 + tan(dw / 2)) with dw = 2 pi B / fs: the -3 dB points lie exactly dw apart in the
+  // digital domain (the RBJ cookbook's Q gives the analogue width, which the bilinear transform
+  // narrows near Nyquist).
+  const double w0 = 2.0 * std::numbers::pi * centre_hz / sample_hz;
+  const double dw = std::min(2.0 * std::numbers::pi * bandwidth_hz / sample_hz, 0.99 * std::numbers::pi);
+  const double beta = 1.0 / (1.0 + std::tan(0.5 * dw)), c = std::cos(w0);
+  b0_ = beta;
+  b1_ = -2.0 * beta * c;
+  b2_ = beta;
+  a1_ = -2.0 * beta * c;
+  a2_ = 2.0 * beta - 1.0;
+  bypassed_ = false;
+}
+
+template <int N>
+const typename Notch2<N>::Vec& Notch2<N>::Step(const Vec& x) {
+  if (!initialised_) {  // as if x had always been the input: no start-up transient
+    x1_ = x2_ = y1_ = y2_ = x;
+    initialised_ = true;
+  }
+  y_ = bypassed_ ? x : Vec(b0_ * x + b1_ * x1_ + b2_ * x2_ - a1_ * y1_ - a2_ * y2_);
+  x2_ = x1_;
+  x1_ = x;
+  y2_ = y1_;
+  y1_ = y_;
+  return y_;
+}
+
+template class Notch2<4>;
+template class Notch2<6>;
 template class LowPass2<1>;
 template class LowPass2<3>;
 template class LowPass2<4>;

@@ -16,6 +16,16 @@ std::uint64_t DeriveSeed(std::uint64_t seed, std::uint64_t index) {
   return SplitMix64(SplitMix64(seed) ^ SplitMix64(index + 0x632BE59BD9B4E019ull));
 }
 
+std::uint64_t DeriveSeed(std::uint64_t seed, std::string_view name) {
+  // FNV-1a, 64 bits: a fixed, specified hash (std::hash differs between standard libraries).
+  std::uint64_t h = 14695981039346656037ull;
+  for (const char c : name) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 1099511628211ull;
+  }
+  return DeriveSeed(seed, h);
+}
+
 Rng::Rng(std::uint64_t seed) {
   std::uint64_t x = seed;
   for (auto& s : s_) {

@@ -46,6 +46,7 @@ void CompositeFddOptions::Validate() const {
   RequireIn("filter_cutoff_hz", filter_cutoff_hz, 1e-3, 0.5 * imu_rate_hz - 1e-6, "a cut-off below half imu_rate_hz");
   RequireIn("takeoff_direction_cosine", takeoff_direction_cosine, 1e-6, 1.0, "a value in (0, 1]");
   if (!imu_position_m.allFinite()) ThrowValidation("CompositeFddOptions", "imu_position_m", "(non-finite)", "finite");
+  RequireIn("command_delay_s", command_delay_s, 0.0, 0.5, "a delay in [0, 0.5] s");
 }
 
 CompositeFddOptions CompositeFddOptions::Disarmed() const {
@@ -57,12 +58,15 @@ CompositeFddOptions CompositeFddOptions::Disarmed() const {
 }
 
 CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const CompositeFddOptions& options)
-    : FaultDetectorBase(vehicle.num_rotors()), vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
-  vehicle_.Validate();
-  options_.Validate();
+    : FaultDetectorBase(vehicle.num_rotors()),
+      vehicle_((vehicle.Validate(), vehicle)),
+      options_((options.Validate(), options)),
+      n_(vehicle.num_rotors()),
+      motors_(vehicle.num_rotors(), vehicle.motor_time_constant_s,
+              options.command_delay_s + options.motor_index_delay_margin_s),
+      wrench_notch_(vehicle.num_rotors(), options.imu_notch) {
   effectiveness_ = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors);
   pinv_ = vehicle::PseudoInverse(effectiveness_);
-  command_ = RotorVector::Zero(n_);
   expected_thrust_ = RotorVector::Zero(n_);
   measured_thrust_ = RotorVector::Zero(n_);
   working_ = RotorVector::Ones(n_);
@@ -165,24 +169,19 @@ void FaultDetectorBase::SetEstimate(const StateEstimate& estimate) {
   have_estimate_ = true;
 }
 
-void CompositeFdd::SetCommand(const RotorVector& thrust_command) {
-  if (thrust_command.size() == n_ && thrust_command.allFinite()) command_ = thrust_command;
-}
+void CompositeFdd::SetCommand(const RotorCommand& command) { motors_.OnCommand(command.t_ns, command.thrust_n); }
 
 void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
   if (esc.motor_speed_rad_s.size() != n_ || !esc.motor_speed_rad_s.allFinite()) return;
+  wrench_notch_.OnRotorSpeeds(esc.t_ns, esc.motor_speed_rad_s);
   const double t = ToSeconds(esc.t_ns);
-  // Expected motor state: the commanded thrust through the motor lag of eq. (6).
-  const bool first = !last_esc_ns_;
-  const double dt = first ? 0.0 : ToSeconds(esc.t_ns - *last_esc_ns_);
-  last_esc_ns_ = esc.t_ns;
-  const double blend = dt > 0.0 ? 1.0 - std::exp(-dt / vehicle_.motor_time_constant_s) : 0.0;
   const double kn = vehicle_.thrust_coefficient_n_s2;
+  for (int i = 0; i < n_; ++i) measured_thrust_[i] = kn * esc.motor_speed_rad_s[i] * esc.motor_speed_rad_s[i];
+  // Expected motor state: the commands, each from its instant plus the expected delay, through the
+  // motor lag of eq. (6); the model starts where the motors are.
+  if (!motors_.started()) motors_.Start(esc.t_ns, measured_thrust_);
+  expected_thrust_ = motors_.AdvanceTo(esc.t_ns);
   for (int i = 0; i < n_; ++i) {
-    measured_thrust_[i] = kn * esc.motor_speed_rad_s[i] * esc.motor_speed_rad_s[i];
-    // The motor model starts where the motors are, then follows the commands.
-    if (first) expected_thrust_[i] = measured_thrust_[i];
-    expected_thrust_[i] += blend * (command_[i] - expected_thrust_[i]);
     if (expected_thrust_[i] < options_.min_thrust_fraction * hover_thrust_per_rotor_n_) {
       low_index_count_[i] = 0;
       recent_motor_index_[i].Clear();
@@ -221,7 +220,7 @@ void CompositeFdd::OnImu(const ImuSample& imu) {
   alpha_filter_.Step(imu.w_B, dt);
   for (int i = 0; i < n_; ++i) working_[i] = IsIsolated(rotors_[i].health) ? 0.0 : 1.0;
   // An isolated rotor gives no thrust, whatever its motor's speed (a lost propeller spins freely).
-  Eigen::Vector4d wrench = effectiveness_ * measured_thrust_.cwiseProduct(working_);
+  const Eigen::Vector4d wrench = wrench_notch_.Filter(effectiveness_ * measured_thrust_.cwiseProduct(working_));
   wrench_filter_.Step(wrench);
   RunObserver(ToSeconds(imu.t_ns), dt);
 }
@@ -329,7 +328,13 @@ void CompositeFdd::RunObserver(double t, double dt) {
     // whatever the inertia.
     const bool costs_thrust =
         isolated == 0 || lost[0] >= options_.second_failure_missing_thrust_fraction * measured_thrust_[i];
-    if (p > options_.propeller_index_threshold && costs_thrust) {
+    // The rotor the observer blames must be the one losing the most thrust in newtons: P_i divides
+    // by the rotor's own thrust, and the rotors beside a lost one, which the controller turns down
+    // to hold the attitude, have the smallest; a torque residual's error (the vibration's, the
+    // filters' lag) then reads as a large index on one of them (docs/fdd.md).
+    bool largest_loss = true;
+    for (int j = 0; j < n_; ++j) largest_loss = largest_loss && (j == i || working_[j] == 0.0 || thrust_loss_[j] <= thrust_loss_[i]);
+    if (p > options_.propeller_index_threshold && costs_thrust && largest_loss) {
       if (above_since_s_[i] < 0.0) above_since_s_[i] = t;
       if (t - above_since_s_[i] >= options_.propeller_persistence_s) {
         Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer", above_since_s_[i]);

@@ -25,6 +25,9 @@ void FixedTimeFddOptions::Validate() const {
   RequirePositive("k2", k2);
   RequirePositive("k2_fast", k2_fast);
   RequirePositive("imu_rate_hz", imu_rate_hz);
+  if (!(command_delay_s >= 0.0 && command_delay_s <= 0.5)) {
+    ThrowValidation("FixedTimeFddOptions", "command_delay_s", command_delay_s, "a delay in [0, 0.5] s");
+  }
   if (!(estimate_cutoff_hz > 0.0) || estimate_cutoff_hz >= 0.5 * imu_rate_hz) {
     ThrowValidation("FixedTimeFddOptions", "estimate_cutoff_hz", estimate_cutoff_hz, "a cut-off below half imu_rate_hz");
   }
@@ -37,12 +40,14 @@ void FixedTimeFddOptions::Validate() const {
 }
 
 FixedTimeFdd::FixedTimeFdd(const vehicle::VehicleParams& vehicle, const FixedTimeFddOptions& options)
-    : FaultDetectorBase(vehicle.num_rotors()), vehicle_(vehicle), options_(options), n_(vehicle.num_rotors()) {
-  vehicle_.Validate();
-  options_.Validate();
+    : FaultDetectorBase(vehicle.num_rotors()),
+      vehicle_((vehicle.Validate(), vehicle)),
+      options_((options.Validate(), options)),
+      n_(vehicle.num_rotors()),
+      motors_(vehicle.num_rotors(), vehicle.motor_time_constant_s, options.command_delay_s) {
   effectiveness_ = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors);
   pinv_ = vehicle::PseudoInverse(effectiveness_);
-  command_ = modelled_thrust_ = RotorVector::Zero(n_);
+  modelled_thrust_ = RotorVector::Zero(n_);
   above_since_s_.assign(n_, -1.0);
   loss_ = Eigen::VectorXd::Zero(n_);
   torque_filter_ = LowPass2<3>(options_.estimate_cutoff_hz, options_.imu_rate_hz);
@@ -52,9 +57,7 @@ FixedTimeFdd::FixedTimeFdd(const vehicle::VehicleParams& vehicle, const FixedTim
   thrust_filter_ = LowPass2<1>(options_.estimate_cutoff_hz, options_.imu_rate_hz);
 }
 
-void FixedTimeFdd::SetCommand(const RotorVector& thrust_command) {
-  if (thrust_command.size() == n_ && thrust_command.allFinite()) command_ = thrust_command;
-}
+void FixedTimeFdd::SetCommand(const RotorCommand& command) { motors_.OnCommand(command.t_ns, command.thrust_n); }
 
 void FixedTimeFdd::OnImu(const ImuSample& imu) {
   if (!imu.specific_force_B.allFinite() || !imu.w_B.allFinite()) return;
@@ -64,8 +67,7 @@ void FixedTimeFdd::OnImu(const ImuSample& imu) {
   const vehicle::VehicleParams& vp = vehicle_;
   const Matrix3& I = vp.inertia_kg_m2;
   // The modelled rotors: the commands through the motor lag (no telemetry in this method).
-  const double blend = 1.0 - std::exp(-dt / vp.motor_time_constant_s);
-  modelled_thrust_ += blend * (command_ - modelled_thrust_);
+  modelled_thrust_ = motors_.AdvanceTo(imu.t_ns);
   const Eigen::Vector4d wrench = effectiveness_ * modelled_thrust_;
   // Fixed-time sliding-mode observer of w_dot = f(w, u) + d.
   const Vector3& w = imu.w_B;

@@ -14,6 +14,9 @@ void UkfFddOptions::Validate() const {
   };
   positive("imu_rate_hz", imu_rate_hz);
   if (!imu_position_m.allFinite()) ThrowValidation("UkfFddOptions", "imu_position_m", "(non-finite)", "finite numbers");
+  if (!(command_delay_s >= 0.0 && command_delay_s <= 0.5)) {
+    ThrowValidation("UkfFddOptions", "command_delay_s", command_delay_s, "a delay in [0, 0.5] s");
+  }
   positive("rate_process_density", rate_process_density);
   positive("loss_random_walk", loss_random_walk);
   positive("accel_std", accel_std);
@@ -35,13 +38,12 @@ void UkfFddOptions::Validate() const {
 UkfFdd::UkfFdd(const vehicle::VehicleParams& vehicle, const UkfFddOptions& options)
     : FaultDetectorBase(vehicle.num_rotors()),
       vehicle_(vehicle),
-      options_(options),
+      options_((options.Validate(), options)),
       n_(vehicle.num_rotors()),
       effectiveness_(vehicle::ComputeEffectivenessMatrix(vehicle.rotors)),
-      command_(RotorVector::Zero(vehicle.num_rotors())),
+      motors_(vehicle.num_rotors(), vehicle.motor_time_constant_s, options.command_delay_s),
       modelled_thrust_(RotorVector::Zero(vehicle.num_rotors())),
       above_since_s_(static_cast<std::size_t>(vehicle.num_rotors()), -1.0) {
-  options_.Validate();
   Eigen::VectorXd x0 = Eigen::VectorXd::Zero(3 + n_);
   Eigen::VectorXd p0(3 + n_);
   p0.head<3>().setConstant(0.1 * 0.1);
@@ -49,8 +51,11 @@ UkfFdd::UkfFdd(const vehicle::VehicleParams& vehicle, const UkfFddOptions& optio
   ukf_.emplace(x0, p0.asDiagonal().toDenseMatrix());
 }
 
-void UkfFdd::SetCommand(const RotorVector& thrust_command) {
-  if (thrust_command.size() == n_ && thrust_command.allFinite()) command_ = thrust_command;
+void UkfFdd::SetCommand(const RotorCommand& command) {
+  if (command.thrust_n.size() != n_ || !command.thrust_n.allFinite()) return;
+  RotorVector clamped = command.thrust_n;
+  for (int i = 0; i < n_; ++i) clamped[i] = std::clamp(clamped[i], 0.0, vehicle_.rotors[static_cast<std::size_t>(i)].max_thrust_n);
+  motors_.OnCommand(command.t_ns, clamped);
 }
 
 Eigen::VectorXd UkfFdd::loss() const { return ukf_->x().tail(n_).cwiseMax(0.0).cwiseMin(1.0); }
@@ -66,8 +71,7 @@ void UkfFdd::OnImu(const ImuSample& imu) {
   const Matrix3& I = vp.inertia_kg_m2;
   const Matrix3 I_inv = I.inverse();
   // The rotors as commanded, through the motor lag (eq. 6 of paper 000; the PWM gain of paper 004).
-  for (int i = 0; i < n_; ++i) command_[i] = std::clamp(command_[i], 0.0, vp.rotors[static_cast<std::size_t>(i)].max_thrust_n);
-  modelled_thrust_ += (1.0 - std::exp(-dt / vp.motor_time_constant_s)) * (command_ - modelled_thrust_);
+  modelled_thrust_ = motors_.AdvanceTo(imu.t_ns);
   const bool flying = have_estimate_ && (estimate_.p_W.z() > 0.05 || modelled_thrust_.sum() > 0.9 * vp.weight_n());
   if (!flying) {
     ukf_->set_x((Eigen::VectorXd(3 + n_) << imu.w_B, Eigen::VectorXd::Zero(n_)).finished());

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/failure_diagnosis.h"
@@ -51,6 +52,13 @@ FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int
   return o;
 }
 
+/// MetricsOptionsOf, measured at the file's body frame of the truth's vehicle `draw`.
+FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int64_t steps, const sim::TruthDraw& draw) {
+  FlightMetricsOptions o = MetricsOptionsOf(sc, dt_ns, steps);
+  o.body_origin_m = -draw.cog_offset_m;
+  return o;
+}
+
 /// The simulator of `truth` (which it keeps a reference to) with the sensors and disturbances of
 /// `draw`, starting hovering when the start is in the air, idle on the ground.
 sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel& truth, const sim::TruthDraw& draw) {
@@ -82,7 +90,7 @@ class Flight::Loop {
         sim_(MakeSimulator(sc_, truth_, draw_)),
         stack_(sc_.vehicle, sc_.reference, sc_.stack, ExternalController(sc_)),
         steps_(std::llround(sc_.duration_s / ToSeconds(sim_.step_ns()))),
-        metrics_(MetricsOptionsOf(sc_, sim_.step_ns(), steps_)),
+        metrics_(MetricsOptionsOf(sc_, sim_.step_ns(), steps_, draw_)),
         command_(stack_.command()) {
     recorder_.Begin(stack_, sim_.model().num_rotors());
     DeliverToStack(sim_.outputs(), &stack_, recorder_.sensor_log());
@@ -91,13 +99,16 @@ class Flight::Loop {
 
   bool done() const { return done_; }
 
-  /// The control cycle at the current instant: the stack's Update, its command flown from here.
+  /// The control cycle at the current instant: the stack's Update, its command sent to the ESCs
+  /// once the cycle's computation delay has passed (at the next physics step, CommandSentAt).
   void RunControlCycle() {
     NoteHealthyExtremes();
     const TimeNs t = sim_.time_ns();
     const Stopwatch clock;
     command_ = stack_.Update(t);
-    stack_s_ += clock.seconds();
+    const double cycle_s = clock.seconds();
+    stack_s_ += cycle_s;
+    command_sent_ns_ = t + ComputationDelayNs(cycle_s);
     next_control_ += stack_.control_period_ns();
     ++control_cycles_;
     metrics_.OnEstimate(vehicle::StateView(sim_.state()), stack_.estimate());
@@ -116,6 +127,7 @@ class Flight::Loop {
     if (cycle_to_record_) {
       recorder_.OnControlCycle(*cycle_to_record_, stack_, command_);
       cycle_to_record_.reset();
+      sim_.Send(command_, command_sent_ns_);  // final now: a caller's Override came before
     } else {
       NoteHealthyExtremes();  // before each step; a control cycle's instant noted them before it
     }
@@ -123,7 +135,7 @@ class Flight::Loop {
     metrics_.OnStep(t, vehicle::StateView(sim_.state()), p_ref, !sim_.fault_events().empty());
     recorder_.OnStep(t, sim_, stack_);
     Stopwatch clock;
-    const sim::SensorOutputs& outputs = sim_.Step(command_);
+    const sim::SensorOutputs& outputs = sim_.Step();
     simulator_s_ += clock.Restart();
     DeliverToStack(outputs, &stack_, recorder_.sensor_log());
     stack_s_ += clock.seconds();
@@ -173,7 +185,8 @@ class Flight::Loop {
     s.stack = stack_.Summarize();
     s.mission_time_s = mission_time_s_;
     // The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
-    s.sensors = {sc_.sim.imu.rate_hz, stack_.options().estimator.imu_position_m};
+    s.sensors = {sc_.sim.imu.rate_hz, stack_.options().estimator.imu_position_m, stack_.options().command_delay_s,
+                 stack_.options().imu_notch};
     if (sc_.stack.fdd == stack::FddKind::kComposite) s.composite_fdd = sc_.stack.composite_fdd;
     if (const fdd::FaultDetector* detector = stack_.fault_detector()) {
       s.fdd = ScoreFdd(detector->rotors(), sim_.fault_events());
@@ -185,7 +198,7 @@ class Flight::Loop {
     for (const sim::FaultEvent& e : sim_.fault_events()) {
       s.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
     }
-    FlightEnd end{sim_.time_ns(), sim_.crashed(), vehicle::StateView(sim_.state()).p_W(), std::nullopt};
+    FlightEnd end{sim_.time_ns(), sim_.crashed(), metrics_.BodyOrigin(vehicle::StateView(sim_.state())), std::nullopt};
     if (!sim_.fault_events().empty()) end.first_onset_s = sim_.fault_events().front().onset_s;
     metrics_.Finish(
         end, [this](double t) { return stack_.reference().Evaluate(t).p_W; }, &s);
@@ -203,6 +216,16 @@ class Flight::Loop {
   std::int64_t steps_taken() const { return static_cast<std::int64_t>(physics_steps_); }
 
  private:
+  /// A cycle's computation delay [ns]: the flight's drawn delay within its jitter, or the stack's
+  /// wall-clock time for the cycle (`cycle_s`, sim.computation_delay: measured). The ideal world
+  /// draws none: its commands act at their cycle's instant, as every flight before the delays did.
+  TimeNs ComputationDelayNs(double cycle_s) {
+    if (sc_.computation_delay == ComputationDelay::kMeasured) return FromSeconds(cycle_s);
+    const double jitter = draw_.computation_delay_jitter_fraction;
+    const double scale = jitter > 0.0 ? 1.0 + delay_rng_.Uniform(-jitter, jitter) : 1.0;
+    return FromSeconds(draw_.computation_delay_s * scale);
+  }
+
   /// The detector has seen only flight before any fault: its extremes are a healthy flight's.
   void NoteHealthyExtremes() {
     if (composite_ && sim_.fault_events().empty()) healthy_extremes_ = composite_->healthy_extremes();
@@ -249,6 +272,8 @@ class Flight::Loop {
   std::int64_t steps_;
   FlightMetrics metrics_;
   RotorCommand command_;
+  TimeNs command_sent_ns_ = 0;  // when the last cycle's command leaves the computer
+  Rng delay_rng_{DeriveSeed(sc_.seed, "computation_delay")};
   TimeNs next_control_ = 0;
   double stack_s_ = 0.0, simulator_s_ = 0.0;  // wall-clock time in each [s]
   std::uint64_t physics_steps_ = 0, control_cycles_ = 0;

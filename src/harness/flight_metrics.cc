@@ -28,14 +28,19 @@ double Finite(double v) { return std::isfinite(v) ? v : 0.0; }
 
 FlightMetrics::FlightMetrics(const FlightMetricsOptions& options) : options_(options) {}
 
+Vector3 FlightMetrics::BodyOrigin(const vehicle::StateView& s) const {
+  return s.p_W() + s.q_WB() * options_.body_origin_m;
+}
+
 void FlightMetrics::OnStep(TimeNs t, const vehicle::StateView& s, const Vector3& p_ref, bool after_fault) {
   const double t_s = ToSeconds(t);
+  const Vector3 p = BodyOrigin(s);
   if (t >= options_.tracking_start_ns && t < options_.tracking_end_ns) {
-    tracking_.Add(ToSeconds(options_.step_ns), s.p_W(), p_ref);
+    tracking_.Add(ToSeconds(options_.step_ns), p, p_ref);
   }
-  const double error = (s.p_W() - p_ref).norm();
+  const double error = (p - p_ref).norm();
   if (!(error <= options_.success_error_m)) last_violation_ = Violation{t_s, error};
-  const double altitude = s.p_W().z();
+  const double altitude = p.z();
   min_altitude_all_ = std::min(min_altitude_all_, altitude);
   if (after_fault) {
     if (!onset_altitude_) onset_altitude_ = altitude;
@@ -49,7 +54,7 @@ void FlightMetrics::OnStep(TimeNs t, const vehicle::StateView& s, const Vector3&
 
 void FlightMetrics::OnEstimate(const vehicle::StateView& state, const StateEstimate& estimate) {
   if (!estimate.valid) return;
-  const double e = (estimate.p_W - state.p_W()).norm();
+  const double e = (estimate.p_W - BodyOrigin(state)).norm();
   estimate_sum2_ += e * e;
   ++estimates_;
   estimate_max_m_ = std::max(estimate_max_m_, e);

@@ -109,7 +109,9 @@ void AddStackJson(const RunSummary& r, nlohmann::json* j) {
                         {"frame_ms_mean", o.frame_ms_mean},
                         {"frame_ms_p99", o.frame_ms_p99},
                         {"map_points", o.map_points},
-                        {"degenerate_std_m", o.degenerate_std_m}};
+                        {"degenerate_std_m", o.degenerate_std_m},
+                        {"lidar_rotation_rad", Vec(o.lidar_rotation_rad)},
+                        {"lidar_time_offset_s", o.lidar_time_offset_s}};
   }
   nlohmann::json transitions = nlohmann::json::array();
   for (const stack::ModeTransition& m : s.transitions) {
@@ -154,7 +156,10 @@ nlohmann::json RunSummary::ToJson() const {
   }
   j["fdd"] = fdd ? FddJson(*fdd) : nlohmann::json(nullptr);  // null: the stack ran no fault detection
   j["composite_fdd"] = composite_fdd ? io::ToJson(*composite_fdd) : nlohmann::json(nullptr);
-  j["sensors"] = {{"imu_rate_hz", sensors.imu_rate_hz}, {"imu_position_m", Vec(sensors.imu_position_m)}};
+  j["sensors"] = {{"imu_rate_hz", sensors.imu_rate_hz},
+                  {"imu_position_m", Vec(sensors.imu_position_m)},
+                  {"command_delay_s", sensors.command_delay_s},
+                  {"imu_notch", io::ToJson(sensors.imu_notch)}};
   AddStackJson(*this, &j);
   j["stack_ms_per_cycle_mean"] = stack_ms_per_cycle_mean;
   j["cost_ms_per_sim_s"] = cost_ms_per_sim_s.ToJson();

@@ -286,6 +286,7 @@ void FitStackToHardware(Scenario* s) {
   s->stack.fixed_time_fdd.imu_position_m = s->sim.imu.position_m;
   s->stack.ukf_fdd.imu_rate_hz = s->sim.imu.rate_hz;
   s->stack.ukf_fdd.imu_position_m = s->sim.imu.position_m;
+  s->stack.imu_notch.sample_rate_hz = s->sim.imu.rate_hz;
   s->stack.estimator.imu_position_m = s->sim.imu.position_m;  // its dead-reckoning removes the lever arm
   s->stack.estimator.lio.imu_position_m = s->sim.imu.position_m;
   s->stack.estimator.lio.lidar_position_m = s->sim.lidar.position_m;

@@ -416,13 +416,17 @@ void ConfigDocument::ApplyOverride(const std::string& key_path, const std::strin
     const std::string where =
         walked.empty() ? std::string("at the top level") : fmt::format("under '{}'", walked);
     if (current.kind == Kind::kMap) {
-      const auto it = current.index.find(segment);
+      auto it = current.index.find(segment);
       if (it == current.index.end()) {
-        std::vector<std::string> keys;
-        for (const MapEntry& entry : current.entries) keys.push_back(entry.key);
-        throw ConfigError(source, 0, 0, key_path,
-                          fmt::format("no key '{}' {}; existing keys: {}", segment, where,
-                                      keys.empty() ? std::string("(none)") : JoinList(keys)));
+        // A key the file does not write: added (and the rest of the path as maps), so that any
+        // declared key can be set; the schema rejects one that is not declared, naming --set and
+        // the keys it expects. Nothing can fail after this point: the override applies whole.
+        auto added = std::make_shared<Value>();
+        added->kind = Kind::kMap;
+        added->from_override = true;
+        current.index.emplace(segment, current.entries.size());
+        current.entries.push_back(MapEntry{segment, 0, 0, std::move(added), /*from_override=*/true});
+        it = current.index.find(segment);
       }
       slot = &current.entries[it->second].value;
     } else if (current.kind == Kind::kSequence) {

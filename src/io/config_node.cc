@@ -106,8 +106,10 @@ void ConfigNode::RejectUnknownKeys() const {
             ? fmt::format("unknown key '{}'; no keys are expected here", entry.key)
             : fmt::format("unknown key '{}'; expected one of: {}", entry.key,
                           JoinList(value_->asked_keys));
-    // The key itself was written in this map, so it shares the map's source.
-    throw ConfigError(SourceFile(*value_, doc_->file), entry.key_line, entry.key_column,
+    // The key itself was written in this map, so it shares the map's source, unless an override
+    // added it.
+    const std::string source = entry.from_override ? std::string(kOverrideSource) : SourceFile(*value_, doc_->file);
+    throw ConfigError(source, entry.key_line, entry.key_column,
                       JoinPath(key_path_, entry.key), message);
   }
 }

@@ -25,6 +25,7 @@ struct MapEntry {
   int key_line = 0;
   int key_column = 0;
   std::shared_ptr<Value> value;
+  bool from_override = false;  ///< the key was added by an override (--set), not written in the file
 };
 
 /// Our own tree, built from yaml-cpp's parser events rather than from YAML::Node: YAML::Node

@@ -19,7 +19,21 @@ LidarMapper::LidarMapper(const LidarMapperOptions& options) : options_(options),
 
 void LidarMapper::OnImu(const ImuSample& imu) { deskewer_.OnImu(imu); }
 
-LidarFrameSummary LidarMapper::OnFrame(const LidarFrame& frame, const StateEstimate& e) {
+LidarFrameSummary LidarMapper::OnFrame(const LidarFrame& input, const StateEstimate& e,
+                                       const LidarCalibration& calibration) {
+  // The frame in the body's axes and on the IMU's clock: its points turned, captured at their
+  // stamps minus the offset, and deskewed to the estimate's time, the frame's stamped end.
+  const bool calibrated = calibration.q_BS.coeffs() != Quaternion::Identity().coeffs() || calibration.clock_offset_s != 0.0;
+  if (calibrated) {
+    const Eigen::Matrix3f R_BS = calibration.q_BS.normalized().toRotationMatrix().cast<float>();
+    calibrated_.points_S.resize(input.points_S.size());
+    for (std::size_t i = 0; i < input.points_S.size(); ++i) calibrated_.points_S[i] = R_BS * input.points_S[i];
+    calibrated_.offset_ns = input.offset_ns;
+    calibrated_.t_start_ns = input.t_start_ns - FromSeconds(calibration.clock_offset_s);
+    calibrated_.t_end_ns = input.t_end_ns;
+    calibrated_.dropped = input.dropped;
+  }
+  const LidarFrame& frame = calibrated ? calibrated_ : input;
   LidarFrameSummary summary;
   summary.points_dropped = frame.dropped;
   if (!e.valid || !e.p_W.allFinite() || !e.q_WB.coeffs().allFinite() || !e.v_W.allFinite()) {

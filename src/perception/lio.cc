@@ -14,7 +14,9 @@ namespace rotorguard::perception {
 
 namespace {
 // The error state's blocks.
-constexpr int kP = 0, kTheta = 3, kV = 6, kBg = 9, kBa = 12;
+constexpr int kP = 0, kTheta = 3, kV = 6, kBg = 9, kBa = 12, kPhi = 15, kDt = 18;
+// A calibration held fixed keeps a prior this tight (the filter's information must stay finite).
+constexpr double kFixedRotationStdRad = 1e-7, kFixedTimeOffsetStdS = 1e-8;
 const Vector3 kGravityW(0.0, 0.0, -kGravity);
 // The world's ground is z = 0: a start this close to it rests on the landing gear.
 constexpr double kOnGroundM = 0.05;
@@ -55,6 +57,10 @@ void Lio::Start(const ImuSample& imu) {
   filter_P_.block<3, 3>(kV, kV).diagonal().setConstant(std::pow(options_.initial_velocity_std_m_s, 2));
   filter_P_.block<3, 3>(kBg, kBg).diagonal().setConstant(std::pow(options_.gyro_bias_initial, 2));
   filter_P_.block<3, 3>(kBa, kBa).diagonal().setConstant(std::pow(options_.accel_bias_initial, 2));
+  const bool calibrate = options_.estimate_lidar_calibration;
+  filter_P_.block<3, 3>(kPhi, kPhi).diagonal().setConstant(
+      std::pow(calibrate ? options_.lidar_rotation_std_rad : kFixedRotationStdRad, 2));
+  filter_P_(kDt, kDt) = std::pow(calibrate ? options_.lidar_time_offset_std_s : kFixedTimeOffsetStdS, 2);
   filter_imu_ = imu;
   started_ = true;
 }
@@ -103,14 +109,14 @@ void Lio::Initialise() {
 namespace internal {
 
 void LioTransition(const LioState& x, const Vector3& f_m, const Vector3& w_m, double dt, LioState* next,
-                   LioMatrix15* F) {
+                   LioMatrix* F) {
   const Vector3 w = w_m - x.gyro_bias;
   const Vector3 f = f_m - x.accel_bias;
   const Matrix3 R = x.q_WB.toRotationMatrix();
   const Vector3 a = R * f + kGravityW;
   if (F) {
     // δp' = δp + δv dt,  δθ' = Exp(−ω dt) δθ − δb_g dt,  δv' = δv − R [f]× δθ dt − R δb_a dt
-    // (first order in dt; the biases are random walks).
+    // (first order in dt; the biases and the LiDAR's calibration are random walks).
     F->setIdentity();
     F->block<3, 3>(kP, kV) = Matrix3::Identity() * dt;
     F->block<3, 3>(kTheta, kTheta) = ExpSO3(-w * dt);
@@ -132,9 +138,20 @@ Eigen::Matrix<double, 1, 6> PointToPlaneJacobian(const Vector3& n, const Matrix3
   return h;
 }
 
+Eigen::Matrix<double, 1, 4> PointToPlaneCalibrationJacobian(const Vector3& n, const Matrix3& R, const Matrix3& M,
+                                                            const Matrix3& R_IL, const Vector3& s, const Vector3& u) {
+  // q(δφ, δt_d) = q − M R_IL [s]× δφ − u δt_d (R_IL Exp(δφ) s ≈ R_IL s − R_IL [s]× δφ; a later
+  // capture, t_d smaller, moves the point along its velocity).
+  const Eigen::Matrix<double, 1, 3> nR = n.transpose() * R;
+  Eigen::Matrix<double, 1, 4> h;
+  h.head<3>() = -(nR * M * R_IL * Skew(s));
+  h(3) = -nR.dot(u);
+  return h;
+}
+
 }  // namespace internal
 
-void Lio::Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix15* P,
+void Lio::Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix* P,
                     std::vector<Pose>* poses) const {
   const double dt = ToSeconds(t_ns - x->t_ns);
   if (dt <= 0.0) return;
@@ -142,16 +159,20 @@ void Lio::Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioStat
     const Matrix3 R = x->q_WB.toRotationMatrix();
     poses->push_back({x->t_ns, x->p_W, x->v_W, R * (f_m - x->accel_bias) + kGravityW, w_m - x->gyro_bias, R});
   }
-  Matrix15 F;
+  Matrix F;
   LioState next;
   internal::LioTransition(*x, f_m, w_m, dt, &next, P ? &F : nullptr);
   if (P) {
-    Matrix15 Pn = F * (*P) * F.transpose();
+    Matrix Pn = F * (*P) * F.transpose();
     // White noise densities integrate to variances σ² dt; the bias walks likewise.
     Pn.block<3, 3>(kTheta, kTheta).diagonal().array() += std::pow(options_.gyro_noise_density, 2) * dt;
     Pn.block<3, 3>(kV, kV).diagonal().array() += std::pow(options_.accel_noise_density, 2) * dt;
     Pn.block<3, 3>(kBg, kBg).diagonal().array() += std::pow(options_.gyro_bias_random_walk, 2) * dt;
     Pn.block<3, 3>(kBa, kBa).diagonal().array() += std::pow(options_.accel_bias_random_walk, 2) * dt;
+    if (options_.estimate_lidar_calibration) {
+      Pn.block<3, 3>(kPhi, kPhi).diagonal().array() += std::pow(options_.lidar_rotation_random_walk, 2) * dt;
+      Pn(kDt, kDt) += std::pow(options_.lidar_time_offset_random_walk, 2) * dt;
+    }
     *P = 0.5 * (Pn + Pn.transpose());
   }
   *x = next;
@@ -207,14 +228,14 @@ void Lio::AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses) {
   Propagate(filter_imu_.specific_force_B, filter_imu_.w_B, t_ns, &filter_, &filter_P_, poses);
 }
 
-void Lio::PropagateBetween(const ImuSample& previous, const ImuSample& next, LioState* x, Matrix15* P,
+void Lio::PropagateBetween(const ImuSample& previous, const ImuSample& next, LioState* x, Matrix* P,
                            std::vector<Pose>* poses) const {
   // Each interval takes the mean of its two samples (second order in the rates' change).
   Propagate(0.5 * (previous.specific_force_B + next.specific_force_B), 0.5 * (previous.w_B + next.w_B), next.t_ns, x, P,
             poses);
 }
 
-void Lio::PropagateQueue(LioState* x, Matrix15* P) const {
+void Lio::PropagateQueue(LioState* x, Matrix* P) const {
   *x = filter_;
   if (P) *P = filter_P_;
   ImuSample previous = filter_imu_;
@@ -229,9 +250,9 @@ void Lio::RebuildHead() {
   head_imu_ = queue_.empty() ? filter_imu_ : queue_.back();
 }
 
-Lio::Matrix15 Lio::covariance() const {
+Lio::Matrix Lio::covariance() const {
   LioState x;
-  Matrix15 P;
+  Matrix P;
   PropagateQueue(&x, &P);
   return P;
 }
@@ -256,12 +277,15 @@ StateEstimate Lio::Estimate() const { return BodyEstimate(head_, head_imu_.w_B);
 
 StateEstimate Lio::FrameEstimate() const { return BodyEstimate(filter_, filter_imu_.w_B); }
 
-void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Vector3>* out,
+void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Deskewed>* out,
                               LioFrameSummary* summary) {
-  // Each point to the IMU frame at the frame's end: q = R_eᵀ (R_j (t_IL + s) + p_j − p_e), the
-  // pose at its time from the last propagated pose before it, its rate and acceleration held.
+  // Each point to the IMU frame at the frame's end: q = R_eᵀ (R_j (t_IL + R_IL s) + p_j − p_e),
+  // the pose at its capture (its stamp minus the clock's offset) from the last propagated pose
+  // before it, its rate and acceleration held.
   const Matrix3 R_end_T = filter_.q_WB.toRotationMatrix().transpose();
   const Vector3& p_end = filter_.p_W;
+  const Matrix3 R_IL = filter_.q_IL.toRotationMatrix();
+  const TimeNs offset_ns = FromSeconds(filter_.lidar_time_offset_s);
   const double cell = options_.frame_voxel_m, min_range2 = options_.min_range_m * options_.min_range_m;
   // One point per down-sampling cell: the one nearest the cell's centre (in the sensor frame at
   // the frame's end, where the map sees them).
@@ -272,7 +296,7 @@ void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& 
   for (std::size_t i = 0; i < frame.points_S.size(); i += stride) {
     const Vector3 s = frame.points_S[i].cast<double>();
     if (!s.allFinite() || s.squaredNorm() < min_range2) continue;
-    const TimeNs t = frame.t_start_ns + static_cast<TimeNs>(frame.offset_ns[i]);
+    const TimeNs t = frame.t_start_ns + static_cast<TimeNs>(frame.offset_ns[i]) - offset_ns;
     if (poses.empty()) continue;
     // The frame's points come in time order: step the pose forward, back only if needed.
     while (k + 1 < poses.size() && poses[k + 1].t_ns <= t) ++k;
@@ -280,22 +304,29 @@ void Lio::DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& 
     const Pose& a = poses[k];
     const double dt = ToSeconds(t - a.t_ns);
     const Vector3 p = a.p + a.v * dt + 0.5 * a.a_W * dt * dt;
-    const Vector3 q = R_end_T * (a.R * ExpSO3Times(a.w * dt, lidar_in_imu_ + s) + p - p_end);
+    const Matrix3 R_j = a.R * ExpSO3(a.w * dt);
+    const Vector3 arm = lidar_in_imu_ + R_IL * s;  // the point from the IMU, in the IMU's frame
+    const Vector3 q = R_end_T * (R_j * arm + p - p_end);
     const Vector3 scaled = q / cell;
     const Eigen::Vector3d fl = scaled.array().floor();
     const double d2 = (scaled - fl - Vector3::Constant(0.5)).squaredNorm();
     bool added = false;
     const std::uint32_t c =
         cell_index_.FindOrAdd(KeyOfCell(fl.cast<int>()), static_cast<std::uint32_t>(cell_best_.size()), &added);
+    if (!added && d2 >= cell_best_[c].d2) continue;
+    // What the calibration's Jacobian needs: the point's rotation to the frame's end, and its
+    // velocity there from the body's motion at its capture (v + R (ω x arm)).
+    const Matrix3 M = R_end_T * R_j;
+    const Vector3 u = R_end_T * (a.v + a.a_W * dt) + M * a.w.cross(arm);
     if (added) {
-      cell_best_.push_back({d2, q});
-    } else if (d2 < cell_best_[c].d2) {
-      cell_best_[c] = {d2, q};
+      cell_best_.push_back({d2, {q, s, u, M}});
+    } else {
+      cell_best_[c] = {d2, {q, s, u, M}};
     }
   }
   // In the order the cells were first seen: the points' (time) order, reproducible.
   out->clear();
-  for (const CellBest& best : cell_best_) out->push_back(best.q);
+  for (const CellBest& best : cell_best_) out->push_back(best.point);
   summary->points_downsampled = static_cast<int>(out->size());
 }
 
@@ -344,16 +375,33 @@ void Lio::FindPlanes(const std::vector<Vector3>& points_I, const LioState& x) {
   }
 }
 
-void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary) {
+void Lio::Update(const std::vector<Deskewed>& points, LioFrameSummary* summary) {
   const LioState prior = filter_;
-  const Eigen::LDLT<Matrix15> prior_factor(filter_P_);
-  const Matrix15 P_inv = prior_factor.solve(Matrix15::Identity());
+  const Eigen::LDLT<Matrix> prior_factor(filter_P_);
+  const Matrix P_inv = prior_factor.solve(Matrix::Identity());
   const double inv_var = 1.0 / (options_.point_std_m * options_.point_std_m);
+  // The measurement's states: (δp, δθ) and the calibration's (δφ, δt_d).
+  constexpr int kH = 10;
+  using MatrixH = Eigen::Matrix<double, kH, kH>;
+  using VectorH = Eigen::Matrix<double, kH, 1>;
+  const auto to_state = [](int k) { return k < 6 ? k : kPhi + (k - 6); };
   LioState x = prior;
-  Eigen::Matrix<double, 6, 6> HtH = Eigen::Matrix<double, 6, 6>::Zero();
+  MatrixH HtH = MatrixH::Zero();
   Matrix3 normal_noise = Matrix3::Zero();  // Σ of the matched planes' normal covariances
-  Matrix15 A;
+  Matrix A;
   bool used = false;
+  // The points as the iterate's calibration places them, linear in its change since the deskewing
+  // (the prior's calibration): q + ∂q/∂(δφ, δt_d) (φ, τ).
+  const Matrix3 R_IL0 = prior.q_IL.toRotationMatrix();
+  const auto place = [&](const LioState& at) {
+    const Vector3 phi = LogSO3(prior.q_IL.conjugate() * at.q_IL);
+    const double tau = at.lidar_time_offset_s - prior.lidar_time_offset_s;
+    points_.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Deskewed& d = points[i];
+      points_[i] = d.q - d.M * (R_IL0 * d.s.cross(phi)) - d.u * tau;  // R_IL0 Exp(φ) s ≈ R_IL0 (s − s × φ)
+    }
+  };
   // The planes are searched at the first iterate and again only once the pose has moved enough
   // to change a point's neighbourhood (a tenth of the search radius, or the angle that moves a
   // point 20 m away as much): the later iterates move millimetres, and the search is most of
@@ -361,22 +409,27 @@ void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary)
   LioState searched_at = x;
   const double research_m = 0.1 * options_.plane_search_radius_m, research_rad = research_m / 20.0;
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
+    place(x);
     if (iteration == 1 || (x.p_W - searched_at.p_W).norm() > research_m ||
         LogSO3(searched_at.q_WB.conjugate() * x.q_WB).norm() > research_rad) {
-      FindPlanes(points_I, x);
+      FindPlanes(points_, x);
       searched_at = x;
     }
-    Eigen::Matrix<double, 6, 6> HtH_k = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> Htr = Eigen::Matrix<double, 6, 1>::Zero();
+    MatrixH HtH_k = MatrixH::Zero();
+    VectorH Htr = VectorH::Zero();
     Matrix3 normal_noise_k = Matrix3::Zero();
     const Matrix3 R = x.q_WB.toRotationMatrix();
+    const Matrix3 R_IL = x.q_IL.toRotationMatrix();
     int matched = 0;
     double sum_r2 = 0.0;
     for (const Plane& plane : planes_) {
-      const Vector3& q = points_I[plane.point];
+      const Vector3& q = points_[plane.point];
       const double r = plane.n.dot(x.p_W + R * q) + plane.d;
       if (!(std::abs(r) <= options_.max_residual_m)) continue;
-      const Eigen::Matrix<double, 6, 1> h = internal::PointToPlaneJacobian(plane.n, R, q).transpose();
+      const Deskewed& d = points[static_cast<std::size_t>(plane.point)];
+      VectorH h;
+      h.head<6>() = internal::PointToPlaneJacobian(plane.n, R, q).transpose();
+      h.tail<4>() = internal::PointToPlaneCalibrationJacobian(plane.n, R, d.M, R_IL, d.s, d.u).transpose();
       HtH_k.noalias() += h * h.transpose();
       normal_noise_k += plane.normal_cov;
       Htr += h * r;
@@ -393,22 +446,27 @@ void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary)
     normal_noise = normal_noise_k;
     if (matched < options_.min_points) break;
     // The MAP cost in the error e = x ⊟ x̂ and its Gauss-Newton step in δ, x ← x ⊞ δ: the prior
-    // term's Jacobian is J = ∂e/∂δ, the identity but for the attitude's J_r⁻¹(e_θ) (the IEKF's
+    // term's Jacobian is J = ∂e/∂δ, the identity but for the rotations' J_r⁻¹(e) (the IEKF's
     // prior on the manifold; it is the identity at the first iterate, where x = x̂).
-    Vector15 e;
+    Vector e;
     e.segment<3>(kP) = x.p_W - prior.p_W;
     e.segment<3>(kTheta) = LogSO3(prior.q_WB.conjugate() * x.q_WB);
     e.segment<3>(kV) = x.v_W - prior.v_W;
     e.segment<3>(kBg) = x.gyro_bias - prior.gyro_bias;
     e.segment<3>(kBa) = x.accel_bias - prior.accel_bias;
-    Matrix15 J = Matrix15::Identity();
+    e.segment<3>(kPhi) = LogSO3(prior.q_IL.conjugate() * x.q_IL);
+    e(kDt) = x.lidar_time_offset_s - prior.lidar_time_offset_s;
+    Matrix J = Matrix::Identity();
     J.block<3, 3>(kTheta, kTheta) = InverseRightJacobianSO3(e.segment<3>(kTheta));
-    const Matrix15 JtP_inv = J.transpose() * P_inv;
+    J.block<3, 3>(kPhi, kPhi) = InverseRightJacobianSO3(e.segment<3>(kPhi));
+    const Matrix JtP_inv = J.transpose() * P_inv;
     A.noalias() = JtP_inv * J;
-    A.topLeftCorner<6, 6>() += inv_var * HtH;
-    Vector15 b = -JtP_inv * e;
-    b.head<6>() -= inv_var * Htr;
-    const Vector15 delta = A.ldlt().solve(b);
+    Vector b = -JtP_inv * e;
+    for (int r = 0; r < kH; ++r) {
+      b(to_state(r)) -= inv_var * Htr(r);
+      for (int c = 0; c < kH; ++c) A(to_state(r), to_state(c)) += inv_var * HtH(r, c);
+    }
+    const Vector delta = A.ldlt().solve(b);
     if (!delta.allFinite()) {
       used = false;
       break;
@@ -419,6 +477,8 @@ void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary)
     x.v_W += delta.segment<3>(kV);
     x.gyro_bias += delta.segment<3>(kBg);
     x.accel_bias += delta.segment<3>(kBa);
+    x.q_IL = (x.q_IL * Quaternion(ExpSO3(delta.segment<3>(kPhi)))).normalized();
+    x.lidar_time_offset_s += delta(kDt);
     if (delta.segment<3>(kP).norm() < options_.convergence_m &&
         delta.segment<3>(kTheta).norm() < options_.convergence_rad) {
       break;
@@ -434,10 +494,14 @@ void Lio::Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary)
   summary->weakest_std_m = least > 0.0 ? 1.0 / std::sqrt(least) : std::numeric_limits<double>::infinity();
   summary->degenerate = summary->weakest_std_m > options_.degenerate_std_m;
   summary->used = used;
-  if (!used) return;
+  if (!used) {
+    place(prior);  // the map takes the points as the prior placed them
+    return;
+  }
   filter_ = x;
+  place(filter_);  // and as the update's calibration places them
   // The posterior's covariance in the tangent space at x (the cost's Hessian's inverse there).
-  const Matrix15 P = A.ldlt().solve(Matrix15::Identity());
+  const Matrix P = A.ldlt().solve(Matrix::Identity());
   filter_P_ = 0.5 * (P + P.transpose());
 }
 
@@ -453,11 +517,16 @@ LioFrameSummary Lio::OnFrame(const LidarFrame& frame) {
   // end (or later, when the queue overflowed: those points use the first pose, extrapolated).
   DropPosesBefore(frame.t_start_ns);
   AdvanceFilter(frame.t_end_ns, &poses_);
-  DeskewAndDownsample(frame, poses_, &points_, &summary);
+  DeskewAndDownsample(frame, poses_, &deskewed_, &summary);
   // The poses are the prior's; the next frame's run from the (updated) filter.
   poses_.clear();
   summary.seed = frames_ < options_.seed_frames;
-  if (!summary.seed) Update(points_, &summary);
+  if (summary.seed) {
+    points_.clear();
+    for (const Deskewed& d : deskewed_) points_.push_back(d.q);
+  } else {
+    Update(deskewed_, &summary);  // leaves the points, as placed, in points_
+  }
   // The frame's points, placed with the filter's pose at the frame's end (updated, or the IMU's
   // alone when the frame had too few matches), extend the map, as in FAST-LIO2: a frame into
   // unmapped space is how the map reaches it. Only a broken update (a non-finite step) keeps
@@ -469,6 +538,8 @@ LioFrameSummary Lio::OnFrame(const LidarFrame& frame) {
   }
   if (++frames_ % options_.prune_every_frames == 0) map_.Prune(filter_.p_W);
   summary.map_points = map_.size();
+  summary.lidar_rotation_rad = LogSO3(filter_.q_IL);
+  summary.lidar_time_offset_s = filter_.lidar_time_offset_s;
   RebuildHead();
   return summary;
 }

@@ -20,6 +20,14 @@ void LidarOptions::Validate() const {
     ThrowValidation("LidarOptions", "max_elevation_rad", max_elevation_rad,
                     fmt::format("an angle above min_elevation_rad = {}", min_elevation_rad));
   }
+  // The truth side's: a rotation (any scale) and a clock offset well within a frame.
+  if (!rotation.coeffs().allFinite() || rotation.norm() < 1e-6) {
+    ThrowValidation("LidarOptions", "rotation", "(zero or non-finite)", "a finite non-zero quaternion");
+  }
+  if (!std::isfinite(clock_offset_s) || std::abs(clock_offset_s) >= 0.5 / frame_rate_hz) {
+    ThrowValidation("LidarOptions", "clock_offset_s", clock_offset_s,
+                    fmt::format("an offset of less than half a frame, {:g} s", 0.5 / frame_rate_hz));
+  }
 }
 
 LidarPattern::LidarPattern(const LidarOptions& o)
@@ -45,6 +53,8 @@ LidarSimulator::LidarSimulator(const LidarOptions& options, const World& world, 
     : options_(options), pattern_(options), caster_(world, RayCasterOptions{options.grid_cell_m}), rng_(seed) {
   options_.Validate();
   frame_ns_ = PeriodFromRate(options_.frame_rate_hz);
+  R_BS_ = options_.rotation.normalized().toRotationMatrix();
+  clock_offset_ns_ = FromSeconds(options_.clock_offset_s);
   frame_.t_start_ns = 0;
   frame_.t_end_ns = frame_ns_;
 }
@@ -80,7 +90,7 @@ std::optional<LidarFrame> LidarSimulator::Step(TimeNs t0, const BodyPose& pose0,
     const Matrix3 R = (q0 * Quaternion(Eigen::AngleAxisd(s * arc.angle(), arc.axis()))).toRotationMatrix();
     const Vector3 dir_S = pattern_.Direction(next_pulse_);
     const Vector3 origin = p + R * options_.position_m;
-    const auto hit = caster_.Cast(origin, R * dir_S, options_.max_range_m, ToSeconds(t));
+    const auto hit = caster_.Cast(origin, R * (R_BS_ * dir_S), options_.max_range_m, ToSeconds(t));
     ++next_pulse_;
     if (!hit || hit->distance_m < options_.min_range_m || rng_.Uniform() < options_.dropout_probability) {
       ++frame_.dropped;
@@ -90,7 +100,15 @@ std::optional<LidarFrame> LidarSimulator::Step(TimeNs t0, const BodyPose& pose0,
     frame_.points_S.push_back((range * dir_S).cast<float>());
     frame_.offset_ns.push_back(static_cast<std::uint32_t>(t - frame_.t_start_ns));
   }
-  return done;
+  if (done && clock_offset_ns_ != 0) {
+    // Stamped by the sensor's clock; delivered once its stamped end has come, never earlier.
+    done->t_start_ns += clock_offset_ns_;
+    done->t_end_ns += clock_offset_ns_;
+  }
+  if (done) held_ = std::move(done);
+  std::optional<LidarFrame> out;
+  if (held_ && held_->t_end_ns <= t1) out.swap(held_);
+  return out;
 }
 
 }  // namespace rotorguard::sim

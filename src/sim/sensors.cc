@@ -36,6 +36,19 @@ void ImuOptions::Validate(double physics_rate_hz) const {
     ThrowValidation("ImuOptions", "vibration_reference_speed_rad_s", vibration_reference_speed_rad_s, "a speed > 0");
   }
   RequireNonNegative("ImuOptions", "vibration_fault_factor", vibration_fault_factor);
+  RequireNonNegative("ImuOptions", "axial_vibration_m_s2", axial_vibration_m_s2);
+  RequireNonNegative("ImuOptions", "gyro_vibration_gain", gyro_vibration_gain);
+  if (!(airframe_mass_kg > 0.0) || !std::isfinite(airframe_mass_kg)) {
+    ThrowValidation("ImuOptions", "airframe_mass_kg", airframe_mass_kg, "a mass > 0 [kg]");
+  }
+  if (!airframe_inverse_inertia.allFinite()) {
+    ThrowValidation("ImuOptions", "airframe_inverse_inertia", "(non-finite)", "a finite matrix");
+  }
+  for (std::size_t i = 0; i < rotor_positions_m.size(); ++i) {
+    if (!rotor_positions_m[i].allFinite()) {
+      ThrowValidation("ImuOptions", fmt::format("rotor_positions_m.{}", i), "(non-finite)", "a finite position [m]");
+    }
+  }
 }
 
 void EscOptions::Validate(double physics_rate_hz) const {
@@ -48,6 +61,9 @@ void EscOptions::Validate(double physics_rate_hz) const {
   }
   if (!(dropout_probability >= 0.0 && dropout_probability < 1.0)) {
     ThrowValidation("EscOptions", "dropout_probability", dropout_probability, "a probability in [0, 1)");
+  }
+  if (!(command_latency_s >= 0.0 && command_latency_s < 0.5)) {
+    ThrowValidation("EscOptions", "command_latency_s", command_latency_s, "a latency in [0, 0.5) s");
   }
 }
 
@@ -82,6 +98,7 @@ ImuModel::ImuModel(const ImuOptions& options, std::uint64_t seed)
     : options_(options), rng_(seed), dt_(1.0 / options.rate_hz) {
   accel_bias_ = NormalVector(rng_, options_.accel_bias_initial);
   gyro_bias_ = NormalVector(rng_, options_.gyro_bias_initial);
+  vibrates_ = options_.vibration_m_s2 > 0.0 || options_.axial_vibration_m_s2 > 0.0;
 }
 
 ImuSample ImuModel::Sample(const TruthSample& truth) {
@@ -100,7 +117,7 @@ ImuSample ImuModel::Sample(const TruthSample& truth) {
   out.specific_force_B =
       f_B + accel_bias_ + NormalVector(rng_, options_.accel_noise_density / std::sqrt(dt_));
   out.w_B = w + gyro_bias_ + NormalVector(rng_, options_.gyro_noise_density / std::sqrt(dt_));
-  if (options_.vibration_m_s2 > 0.0) out.specific_force_B += Vibration(truth);
+  if (vibrates_) AddVibration(truth, &out);
   // A MEMS sensor saturates: each axis reads at most its range.
   const double a = options_.accel_range_m_s2, g = options_.gyro_range_rad_s;
   out.specific_force_B = out.specific_force_B.cwiseMax(Vector3::Constant(-a)).cwiseMin(Vector3::Constant(a));
@@ -108,26 +125,38 @@ ImuSample ImuModel::Sample(const TruthSample& truth) {
   return out;
 }
 
-Vector3 ImuModel::Vibration(const TruthSample& truth) {
+void ImuModel::AddVibration(const TruthSample& truth, ImuSample* sample) {
   const RotorVector& speed = truth.motor_speed_rad_s;
   rotor_phase_.resize(static_cast<std::size_t>(speed.size()), 0.0);
-  Vector3 v = Vector3::Zero();
   for (int i = 0; i < speed.size(); ++i) {
     double& phase = rotor_phase_[static_cast<std::size_t>(i)];
-    // The phase advances by ω dt between samples: at the IMU's rate the rotor's frequency aliases,
-    // as it does on a sensor without an anti-aliasing filter.
+    // The phase advances by ω dt between samples: at the IMU's rate the rotor's frequency and its
+    // harmonic alias, as they do on a sensor without an anti-aliasing filter.
     phase = std::fmod(phase + speed[i] * dt_, 2.0 * std::numbers::pi);
     const double ratio = speed[i] / options_.vibration_reference_speed_rad_s;
-    double amplitude = options_.vibration_m_s2 * ratio * ratio;
+    double scale = ratio * ratio;  // a centrifugal force: the imbalance's grows with ω²
     if (truth.faults != nullptr && i < static_cast<int>(truth.faults->size())) {
       const vehicle::FaultKind kind = (*truth.faults)[static_cast<std::size_t>(i)].kind;
       if (kind == vehicle::FaultKind::kPropellerLoss || kind == vehicle::FaultKind::kLossOfEffectiveness) {
-        amplitude *= options_.vibration_fault_factor;
+        scale *= options_.vibration_fault_factor;
       }
     }
-    v += amplitude * Vector3(std::cos(phase), std::sin(phase), 0.0);
+    const double c1 = std::cos(phase), s1 = std::sin(phase), c2 = std::cos(2.0 * phase), s2 = std::sin(2.0 * phase);
+    const double a = scale * options_.vibration_m_s2, b = scale * options_.axial_vibration_m_s2;
+    sample->specific_force_B += Vector3(a * c1, a * s1, b * c2);
+    // The same forces' moment about the centre of gravity rocks the airframe: angular
+    // acceleration I⁻¹ (r x m f), whose rate oscillates as its integral over the force's period
+    // (cos -> sin / Ω), read by the gyro; the accelerometer off the centre feels α x p.
+    const double omega = speed[i];
+    if (options_.gyro_vibration_gain > 0.0 && omega > 0.0 && i < static_cast<int>(options_.rotor_positions_m.size())) {
+      const Vector3& r = options_.rotor_positions_m[static_cast<std::size_t>(i)];
+      const Matrix3& I_inv = options_.airframe_inverse_inertia;
+      const double k = options_.gyro_vibration_gain * options_.airframe_mass_kg;
+      const Vector3 force(a * c1, a * s1, b * c2), force_integral(a * s1 / omega, -a * c1 / omega, b * s2 / (2.0 * omega));
+      sample->w_B += k * (I_inv * r.cross(force_integral));
+      sample->specific_force_B += (k * (I_inv * r.cross(force))).cross(options_.position_m);
+    }
   }
-  return v;
 }
 
 EscModel::EscModel(const EscOptions& options, int num_rotors, std::uint64_t seed)
@@ -219,8 +248,12 @@ void OdometryModel::Measure(const TruthSample& truth) {
   const double scale = (1.0 + options_.rate_noise_gain * s.w_B().norm()) * FewFeaturesFactor(s.p_W(), t);
   OdometrySample out;
   out.t_ns = truth.t_ns;
-  out.p_W = s.p_W() + NormalVector(rng_, options_.position_noise_m * scale);
-  out.v_W = s.v_W() + NormalVector(rng_, options_.velocity_noise_m_s * scale);
+  // The pose of the file's body frame, o = body_origin_m from the centre of gravity: p + R o, and
+  // its velocity v + R (w x o).
+  const Matrix3 R = s.q_WB().toRotationMatrix();
+  const Vector3& o = options_.body_origin_m;
+  out.p_W = s.p_W() + R * o + NormalVector(rng_, options_.position_noise_m * scale);
+  out.v_W = s.v_W() + R * s.w_B().cross(o) + NormalVector(rng_, options_.velocity_noise_m_s * scale);
   const Vector3 dtheta = NormalVector(rng_, options_.attitude_noise_rad * scale);
   const double angle = dtheta.norm();
   const Quaternion dq = angle > 0.0 ? Quaternion(Eigen::AngleAxisd(angle, dtheta / angle))

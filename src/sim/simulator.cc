@@ -93,7 +93,10 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
   x_.segment<4>(StateIndex::kQuaternion).normalize();
   landed_ = x_[StateIndex::kPosition + 2] <= 0.0;
   if (landed_) x_[StateIndex::kPosition + 2] = 0.0;
-  command_ = RotorVector::Zero(model.num_rotors());
+  // Before the first command acts, the ESCs hold what the motors do (a flight that starts in the
+  // air has been commanded its hover before).
+  command_ = x_.tail(model.num_rotors()).cwiseMax(0.0).cwiseMin(model.max_thrust());
+  command_latency_ns_ = FromSeconds(options_.esc.command_latency_s);
   UpdateOutputs();
   vehicle::Disturbance still_air;
   still_air.wind_W = wind_.velocity();
@@ -168,22 +171,69 @@ void Simulator::ResolveGroundContact(const vehicle::StateVector& before) {
   x_.segment<3>(StateIndex::kBodyRate).setZero();
 }
 
+void Simulator::Send(const RotorCommand& command, TimeNs sent_ns) {
+  if (sent_ns < t_ns_) {
+    ThrowInvalidArgument("Simulator::Send", "sent_ns", static_cast<double>(sent_ns),
+                         fmt::format("a time at or after the simulator's, {} ns", t_ns_));
+  }
+  TimeNs acts = sent_ns + command_latency_ns_;
+  if (queue_size_ > 0) {
+    // In the order sent: never before the command queued last.
+    acts = std::max(acts, queue_[static_cast<std::size_t>((queue_head_ + queue_size_ - 1) % kCommandQueue)].acts_ns);
+  }
+  if (queue_size_ == kCommandQueue) {  // full: the oldest acts now
+    command_ = queue_[static_cast<std::size_t>(queue_head_)].thrust_n;
+    queue_head_ = (queue_head_ + 1) % kCommandQueue;
+    --queue_size_;
+    ++commands_overrun_;
+  }
+  SentCommand& slot = queue_[static_cast<std::size_t>((queue_head_ + queue_size_) % kCommandQueue)];
+  slot.acts_ns = acts;
+  // A non-finite command reaches the motors as zero thrust (a real ESC would reject the frame).
+  slot.thrust_n.resize(model_.num_rotors());
+  for (int i = 0; i < model_.num_rotors(); ++i) {
+    const double u = i < command.thrust_n.size() ? command.thrust_n[i] : 0.0;
+    slot.thrust_n[i] = std::isfinite(u) ? std::clamp(u, 0.0, model_.max_thrust()[i]) : 0.0;
+  }
+  ++queue_size_;
+}
+
+void Simulator::ActivateCommands(TimeNs t) {
+  while (queue_size_ > 0 && queue_[static_cast<std::size_t>(queue_head_)].acts_ns <= t) {
+    command_ = queue_[static_cast<std::size_t>(queue_head_)].thrust_n;
+    queue_head_ = (queue_head_ + 1) % kCommandQueue;
+    --queue_size_;
+  }
+}
+
 const SensorOutputs& Simulator::Step(const RotorCommand& command) {
+  if (!crashed()) Send(command, t_ns_);
+  return Step();
+}
+
+const SensorOutputs& Simulator::Step() {
   outputs_ = SensorOutputs{};
   if (crashed()) return outputs_;
   const double dt = ToSeconds(dt_ns_);
-  // A non-finite command reaches the motors as zero thrust (a real ESC would reject the frame).
-  for (int i = 0; i < model_.num_rotors(); ++i) {
-    const double u = i < command.thrust_n.size() ? command.thrust_n[i] : 0.0;
-    command_[i] = std::isfinite(u) ? std::clamp(u, 0.0, model_.max_thrust()[i]) : 0.0;
-  }
   injector_.Update(t_ns_, x_[StateIndex::kPosition + 2], !landed_, &faults_);
   vehicle::Disturbance disturbance;
   disturbance.wind_W = wind_.Step(dt);
   disturbance.torque_B = options_.external_torque_n_m;
   x_before_ = x_;
-  integrator_.Step(command_, faults_, disturbance, dt, &x_);
-  t_ns_ += dt_ns_;
+  // The step in pieces where a command starts acting within it (a delayed command acts from its
+  // own instant, not from the next step's).
+  const TimeNs end = t_ns_ + dt_ns_;
+  TimeNs t = t_ns_;
+  ActivateCommands(t);
+  while (queue_size_ > 0 && queue_[static_cast<std::size_t>(queue_head_)].acts_ns < end) {
+    const TimeNs next = queue_[static_cast<std::size_t>(queue_head_)].acts_ns;
+    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_);
+    t = next;
+    ActivateCommands(t);
+  }
+  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_);
+  t_ns_ = end;
+  ActivateCommands(t_ns_);  // applied_command(): the one acting at the new time
   UpdateOutputs();
   if (!x_.allFinite()) {
     crash_reason_ = "state diverged (non-finite)";

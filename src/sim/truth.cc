@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "rotorguard/core/error.h"
@@ -34,6 +35,16 @@ TruthRanges RangesOf(TruthPreset preset) {
   r.odometry_yaw_drift_rad_per_sqrt_s = 0.001;
   r.odometry_few_features_gain = 1.0;
   r.odometry_outage_rate_hz = 1.0 / 60.0;
+  r.computation_delay_min_s = 0.001;
+  r.computation_delay_max_s = 0.004;
+  r.computation_delay_jitter_fraction = 0.25;
+  r.esc_command_latency_min_s = 0.0005;
+  r.esc_command_latency_max_s = 0.002;
+  r.imu_noise_fraction = 0.5;
+  r.lidar_rotation_rad = 0.0087266462599716;  // 0.5°
+  r.lidar_clock_offset_s = 0.002;
+  r.imu_axial_vibration_m_s2 = 0.8;
+  r.gyro_vibration_gain = 3.0;
   return r;
 }
 
@@ -49,6 +60,14 @@ TruthRanges TruthOptions::Ranges() const {
   if (odometry_latency_min_s) {
     r.odometry_latency_min_s = *odometry_latency_min_s;
     r.odometry_latency_max_s = *odometry_latency_max_s;
+  }
+  if (computation_delay_min_s) {
+    r.computation_delay_min_s = *computation_delay_min_s;
+    r.computation_delay_max_s = *computation_delay_max_s;
+  }
+  if (esc_command_latency_min_s) {
+    r.esc_command_latency_min_s = *esc_command_latency_min_s;
+    r.esc_command_latency_max_s = *esc_command_latency_max_s;
   }
   return r;
 }
@@ -74,6 +93,10 @@ void TruthOptions::Validate() const {
   ValidateInterval(motor_stop_time_constant_min_s, "motor_stop_time_constant_min_s", motor_stop_time_constant_max_s,
                    "motor_stop_time_constant_max_s");
   ValidateInterval(odometry_latency_min_s, "odometry_latency_min_s", odometry_latency_max_s, "odometry_latency_max_s");
+  ValidateInterval(computation_delay_min_s, "computation_delay_min_s", computation_delay_max_s,
+                   "computation_delay_max_s");
+  ValidateInterval(esc_command_latency_min_s, "esc_command_latency_min_s", esc_command_latency_max_s,
+                   "esc_command_latency_max_s");
 }
 
 namespace {
@@ -87,6 +110,9 @@ Vector3 Ratios(double a, Rng* rng) {
 }
 
 Vector3 Offset(double a, Rng* rng) { return Ratios(a, rng) - Vector3::Ones(); }
+
+/// Uniform in [lo, hi], or lo without drawing when the interval is a point.
+double Between(double lo, double hi, Rng* rng) { return hi > lo ? rng->Uniform(lo, hi) : lo; }
 
 }  // namespace
 
@@ -126,6 +152,16 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   }
   d.odometry_few_features_gain = r.odometry_few_features_gain;
   d.odometry_outage_rate_hz = r.odometry_outage_rate_hz;
+  // Drawn after everything above (whose values stay those of the releases before the delays).
+  d.computation_delay_s = Between(r.computation_delay_min_s, r.computation_delay_max_s, &rng);
+  d.computation_delay_jitter_fraction = r.computation_delay_jitter_fraction;
+  d.esc_command_latency_s = Between(r.esc_command_latency_min_s, r.esc_command_latency_max_s, &rng);
+  d.imu_accel_noise_ratio = Ratio(r.imu_noise_fraction, &rng);
+  d.imu_gyro_noise_ratio = Ratio(r.imu_noise_fraction, &rng);
+  d.lidar_rotation_rad = Offset(r.lidar_rotation_rad, &rng);
+  if (r.lidar_clock_offset_s > 0.0) d.lidar_clock_offset_s = rng.Uniform(-r.lidar_clock_offset_s, r.lidar_clock_offset_s);
+  if (r.imu_axial_vibration_m_s2 > 0.0) d.imu_axial_vibration_m_s2 = rng.Uniform(0.5, 1.0) * r.imu_axial_vibration_m_s2;
+  if (r.gyro_vibration_gain > 0.0) d.gyro_vibration_gain = rng.Uniform(std::min(1.0, r.gyro_vibration_gain), r.gyro_vibration_gain);
   return d;
 }
 
@@ -190,6 +226,24 @@ SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const v
   o.odometry.yaw_drift_rad_per_sqrt_s = draw.odometry_yaw_drift_rad_per_sqrt_s;
   o.odometry.few_features_gain = draw.odometry_few_features_gain;
   o.odometry.outage_rate_hz = draw.odometry_outage_rate_hz;
+  o.esc.command_latency_s = draw.esc_command_latency_s;
+  // The front end reports the file's body frame, whose origin lies at -c from the true CoG; the
+  // LiDAR is mounted on that body, so it moves by -c too, and is turned and its clock off.
+  o.odometry.body_origin_m = -draw.cog_offset_m;
+  o.lidar.position_m = MovedBodyPoint(scenario.lidar.position_m - draw.cog_offset_m);
+  const double angle = draw.lidar_rotation_rad.norm();
+  if (angle > 0.0) o.lidar.rotation = Quaternion(Eigen::AngleAxisd(angle, draw.lidar_rotation_rad / angle));
+  o.lidar.clock_offset_s = draw.lidar_clock_offset_s;
+  o.imu.accel_noise_density = scenario.imu.accel_noise_density * draw.imu_accel_noise_ratio;
+  o.imu.gyro_noise_density = scenario.imu.gyro_noise_density * draw.imu_gyro_noise_ratio;
+  o.imu.axial_vibration_m_s2 = draw.imu_axial_vibration_m_s2;
+  o.imu.gyro_vibration_gain = draw.gyro_vibration_gain;
+  if (draw.gyro_vibration_gain > 0.0) {
+    const vehicle::VehicleParams v = TruthVehicle(file, draw);
+    for (const vehicle::Rotor& r : v.rotors) o.imu.rotor_positions_m.push_back(r.p_B);
+    o.imu.airframe_mass_kg = v.mass_kg;
+    o.imu.airframe_inverse_inertia = v.inertia_kg_m2.inverse();
+  }
   return o;
 }
 

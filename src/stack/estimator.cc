@@ -155,6 +155,10 @@ LioSummary LioEstimator::Summarize() const {
   }
   s.map_points = lio_.map().size();
   s.degenerate_std_m = lio_.options().degenerate_std_m;
+  if (!frames_.empty()) {
+    s.lidar_rotation_rad = frames_.back().lidar_rotation_rad;
+    s.lidar_time_offset_s = frames_.back().lidar_time_offset_s;
+  }
   return s;
 }
 

@@ -119,7 +119,8 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
       reference_(std::move(reference)),
       options_(options),
       supervisor_(options.supervisor),
-      mapper_(options.lidar) {
+      mapper_(options.lidar),
+      imu_filter_(vehicle.num_rotors(), options.imu_notch) {
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
   {
@@ -137,7 +138,9 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
     ThrowValidation("FlightStackOptions", "controller", ToName(options_.controller),
                     "a controller built by the caller (the assembly controller lives in the modular module)");
   } else if (options_.controller == ControllerKind::kNmpc) {
-    auto nmpc = std::make_unique<control::NmpcController>(model_.params(), options_.nmpc);
+    control::NmpcOptions nmpc_options = options_.nmpc;
+    nmpc_options.expected_delay_s = options_.command_delay_s;
+    auto nmpc = std::make_unique<control::NmpcController>(model_.params(), nmpc_options);
     nmpc_ = nmpc.get();
     controller_ = std::move(nmpc);
   } else if (options_.controller == ControllerKind::kIndi) {
@@ -162,15 +165,24 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
   degraded_told_.assign(static_cast<std::size_t>(model_.num_rotors()), false);
   effectiveness_.assign(static_cast<std::size_t>(model_.num_rotors()), 1.0);
   for (const vehicle::Rotor& r : model_.params().rotors) rotor_max_thrust_n_.push_back(r.max_thrust_n);
+  // Every detector models the motors as acting on a command after the delay the stack expects.
+  const auto delayed = [this](auto detector_options) {
+    detector_options.command_delay_s = options_.command_delay_s;
+    return detector_options;
+  };
   switch (options_.fdd) {
-    case FddKind::kComposite:
-      fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), options_.composite_fdd);
+    case FddKind::kComposite: {
+      // It compares the notched IMU with its telemetry's wrench, which it notches alike.
+      fdd::CompositeFddOptions o = delayed(options_.composite_fdd);
+      o.imu_notch = options_.imu_notch;
+      fdd_ = std::make_unique<fdd::CompositeFdd>(model_.params(), o);
       break;
+    }
     case FddKind::kFixedTime:
-      fdd_ = std::make_unique<fdd::FixedTimeFdd>(model_.params(), options_.fixed_time_fdd);
+      fdd_ = std::make_unique<fdd::FixedTimeFdd>(model_.params(), delayed(options_.fixed_time_fdd));
       break;
     case FddKind::kUkf:
-      fdd_ = std::make_unique<fdd::UkfFdd>(model_.params(), options_.ukf_fdd);
+      fdd_ = std::make_unique<fdd::UkfFdd>(model_.params(), delayed(options_.ukf_fdd));
       break;
     case FddKind::kNone:
       break;
@@ -196,13 +208,25 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
   }
 }
 
-void FlightStack::OnImu(const ImuSample& imu) {
-  estimator_->OnImu(imu);
-  mapper_.OnImu(imu);
-  if (fdd_) fdd_->OnImu(imu);
+void FlightStack::OnImu(const ImuSample& raw) {
+  // The odometry and the mapper's deskewing integrate the raw samples, as FAST-LIO2 does: the
+  // vibration averages out in the integral, and the notches' delay (a few milliseconds, varying with
+  // the rotors' speeds) would put the IMU behind the LiDAR. What reads rates and accelerations
+  // sample by sample, the fault detection and the controller's body rates, reads them notched.
+  Eigen::Matrix<double, 6, 1> x;
+  x << raw.specific_force_B, raw.w_B;
+  const Eigen::Matrix<double, 6, 1> y = imu_filter_.Filter(x);
+  ImuSample filtered = raw;
+  filtered.specific_force_B = y.head<3>();
+  filtered.w_B = y.tail<3>();
+  estimator_->OnImu(raw);
+  mapper_.OnImu(raw);
+  if (fdd_) fdd_->OnImu(filtered);
+  if (raw.w_B.allFinite() && filtered.w_B.allFinite()) rate_notch_correction_ = filtered.w_B - raw.w_B;
 }
 
 void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
+  imu_filter_.OnRotorSpeeds(esc.t_ns, esc.motor_speed_rad_s);
   estimator_->OnEscTelemetry(esc);
   if (fdd_) fdd_->OnEscTelemetry(esc);
 }
@@ -215,7 +239,13 @@ void FlightStack::OnLidar(const LidarFrame& frame) {
     estimator_->OnLidar(frame);
   }
   const ScopedCost cost(&cost_.mapper_s);
-  lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_->FrameEstimate(frame)).points_dropped;
+  // The map places the points as the odometry learnt the LiDAR's mount, when it learns it.
+  perception::LidarCalibration calibration;
+  if (const LioEstimator* odometry = lio()) {
+    calibration.q_BS = odometry->lio().state().q_IL;
+    calibration.clock_offset_s = odometry->lio().state().lidar_time_offset_s;
+  }
+  lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_->FrameEstimate(frame), calibration).points_dropped;
 }
 
 void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
@@ -314,6 +344,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   const double dt = last_update_ns_ ? ToSeconds(t - *last_update_ns_) : 0.0;
   last_update_ns_ = t;
   estimate_ = estimator_->Estimate(t);
+  estimate_.w_B += rate_notch_correction_;  // the controller's rates: the estimator's, notched
   const double ts = ToSeconds(t);
   command_.t_ns = t;
   if (estimate_.valid) {
@@ -382,7 +413,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
     const ScopedCost cost(&cost_.controller_s);
     controller_->Compute(estimate_, followed, ts, dt, &command_.thrust_n);
   }
-  if (fdd_) fdd_->SetCommand(command_.thrust_n);
+  if (fdd_) fdd_->SetCommand(command_);
   return command_;
 }
 
@@ -390,7 +421,7 @@ const RotorCommand& FlightStack::OverrideCommand(const RotorVector& thrust_n) {
   RG_INVARIANT(thrust_n.size() == model_.num_rotors() && thrust_n.allFinite(),
                "OverrideCommand: one finite thrust per rotor");
   command_.thrust_n = thrust_n;
-  if (fdd_) fdd_->SetCommand(command_.thrust_n);
+  if (fdd_) fdd_->SetCommand(command_);
   return command_;
 }
 

@@ -104,7 +104,7 @@ TEST(Allocation, FaultDetectionAllocatesNothing) {
     detector.OnEscTelemetry(esc);
     detector.OnImu(imu);
     detector.SetEstimate(est);
-    detector.SetCommand(RotorVector::Constant(4, 2.82));
+    detector.SetCommand(RotorCommand{t, RotorVector::Constant(4, 2.82)});
   };
   for (int k = 0; k < 10; ++k) step(k * 3'000'000);
   EXPECT_EQ(CountAllocations([&] {

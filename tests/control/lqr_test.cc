@@ -134,13 +134,7 @@ Flight FlyMove(const vehicle::VehicleParams& vp, const vehicle::RotorFaults& fau
     const double t = k * dt_sim;
     if (k % 5 == 0) {  // 200 Hz
       const vehicle::StateView s(x);
-      StateEstimate e;
-      e.valid = true;
-      e.p_W = s.p_W();
-      e.q_WB = s.q_WB();
-      e.v_W = s.v_W();
-      e.w_B = s.w_B();
-      lqr.Compute(e, ref, t, 0.005, &u);
+      lqr.Compute(rotorguard::testing::ExactEstimate(x), ref, t, 0.005, &u);
       f.finite = f.finite && u.allFinite();
       f.max_error_m = std::max(f.max_error_m, (s.p_W() - ref.Evaluate(t).p_W).norm());
       const Matrix3 R = s.q_WB().toRotationMatrix();

@@ -68,7 +68,7 @@ class BenchOf {
         e.valid = true;
         e.p_W = Vector3(0, 0, altitude);
         fdd_.SetEstimate(e);
-        fdd_.SetCommand(drive_);
+        fdd_.SetCommand(RotorCommand{t_, drive_});
       }
       for (int i = 0; i < 4; ++i) {
         if (fdd_.rotors()[i].detected_s && !first_) first_ = *fdd_.rotors()[i].detected_s;

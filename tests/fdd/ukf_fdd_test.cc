@@ -63,16 +63,10 @@ Outcome Fly(int faulty, double w, double onset_s, double seconds, std::uint64_t 
       fdd.OnImu(imu);
     }
     if (k % 5 == 0) {  // estimate and control at 200 Hz
-      StateEstimate e;
-      e.t_ns = FromSeconds(t);
-      e.valid = true;
-      e.p_W = s.p_W();
-      e.q_WB = s.q_WB();
-      e.v_W = s.v_W();
-      e.w_B = s.w_B();
+      const StateEstimate e = rotorguard::testing::ExactEstimate(x, FromSeconds(t));
       fdd.SetEstimate(e);
       lqr.Compute(e, ref, t, 0.005, &u);
-      fdd.SetCommand(u);
+      fdd.SetCommand(RotorCommand{FromSeconds(t), u});
     }
     rk4.Step(u, faults, vehicle::Disturbance{}, 1e-3, &x);
     if (t > 1.0) {

@@ -431,10 +431,13 @@ TEST(NavigationClosedLoop, FliesTheRoomsWaypointsOnItsLidarMap) {
 
 // The stack localises itself: the forest's first 25 s in the realistic world, propeller 0 lost at
 // 16 s, flown on the stack's LiDAR-inertial odometry instead of the simulated odometry. Every
-// frame after the first eight is registered (they start the map; measured: 242 of 250), almost
-// none degenerate (the trunks and the ground constrain every direction; measured: none), the
-// estimate stays within centimetres of the truth through the failure and the 11 rad/s spin that
-// follows, and the vehicle flies where it should.
+// frame after the first eight is registered (they start the map; measured: 241 of 249), none
+// degenerate (the trunks and the ground constrain every direction), the estimate stays within
+// centimetres of the truth through the failure and the 15 rad/s spin that follows, and the
+// vehicle flies where it should. The realistic world's LiDAR is turned from the body (up to 0.5°
+// per axis) and its clock off (up to 2 ms); the odometry learns both, but the first frames start
+// the map with the mount as the file gives it, and the map keeps that turn: most of the 6 cm
+// measured here (2.4 cm with the mount exact; docs/navigation.md).
 TEST(LioClosedLoop, TheForestFlightsFirstSecondsAndItsFailureOnTheStacksOwnOdometry) {
   Scenario s = LoadScenario(Config("forest.yaml"), {{"truth", "realistic"}, {"duration_s", "25"}});
   s.stack.estimator.kind = stack::EstimatorKind::kLio;
@@ -442,16 +445,19 @@ TEST(LioClosedLoop, TheForestFlightsFirstSecondsAndItsFailureOnTheStacksOwnOdome
   ASSERT_FALSE(r.crashed) << r.crash_reason.value_or("");
   EXPECT_GT(r.max_spin_rad_s, 9.0) << "the failure happened";
   const stack::LioSummary& o = r.stack.odometry.value();
-  EXPECT_EQ(o.frames, 250);
+  // A frame arrives once its stamped end has come: a clock ahead holds the last one past 25 s.
+  EXPECT_EQ(o.frames, r.truth.lidar_clock_offset_s > 0.0 ? 249 : 250);
   EXPECT_GE(o.frames_used, o.frames - s.stack.estimator.lio.seed_frames - 1)
       << "the first frames start the map, the next may extend it";
   EXPECT_LE(o.frames_degenerate, o.frames / 100);
   EXPECT_GT(r.cost_ms_per_sim_s.odometry, 0.0) << "the registration is timed";
-  EXPECT_LT(r.estimate_position_rmse_m, 0.06);  // measured 0.031 (max 0.076)
-  // Measured 0.044: mostly the estimate's age at the control cycle (the newest IMU sample's, up to
+  EXPECT_LT(r.estimate_position_rmse_m, 0.08);  // measured 0.060 (max 0.109)
+  // The clock's offset it learnt: measured 1.458 ms against the drawn 1.452 ms.
+  EXPECT_NEAR(o.lidar_time_offset_s, r.truth.lidar_clock_offset_s, 3e-4);
+  // Measured 0.047: mostly the estimate's age at the control cycle (the newest IMU sample's, up to
   // 3 ms old) while the vehicle turns at up to 15 rad/s.
-  EXPECT_LT(r.estimate_attitude_max_rad, 0.05);
-  EXPECT_LT(r.tracking_rmse_m, 0.2);
+  EXPECT_LT(r.estimate_attitude_max_rad, 0.06);
+  EXPECT_LT(r.tracking_rmse_m, 0.2);  // measured 0.180
 }
 
 }  // namespace

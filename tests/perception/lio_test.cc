@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 #include "room_fixture.h"
 #include "rotorguard/core/math.h"
@@ -14,19 +15,21 @@ namespace rotorguard::perception {
 namespace {
 
 /// x ⊞ δ and y ⊟ x on the filter's state (R = R̂ Exp(δθ)).
-LioState BoxPlus(const LioState& x, const Lio::Vector15& d) {
+LioState BoxPlus(const LioState& x, const Lio::Vector& d) {
   LioState y = x;
   y.p_W += d.segment<3>(0);
   y.q_WB = (x.q_WB * Quaternion(ExpSO3(d.segment<3>(3)))).normalized();
   y.v_W += d.segment<3>(6);
   y.gyro_bias += d.segment<3>(9);
   y.accel_bias += d.segment<3>(12);
+  y.q_IL = (x.q_IL * Quaternion(ExpSO3(d.segment<3>(15)))).normalized();
+  y.lidar_time_offset_s += d(18);
   return y;
 }
-Lio::Vector15 BoxMinus(const LioState& y, const LioState& x) {
-  Lio::Vector15 d;
+Lio::Vector BoxMinus(const LioState& y, const LioState& x) {
+  Lio::Vector d;
   d << y.p_W - x.p_W, LogSO3(x.q_WB.conjugate() * y.q_WB), y.v_W - x.v_W, y.gyro_bias - x.gyro_bias,
-      y.accel_bias - x.accel_bias;
+      y.accel_bias - x.accel_bias, LogSO3(x.q_IL.conjugate() * y.q_IL), y.lidar_time_offset_s - x.lidar_time_offset_s;
   return d;
 }
 
@@ -40,17 +43,19 @@ TEST(Lio, TheTransitionMatrixMatchesFiniteDifferencesOfThePropagation) {
   x.v_W = Vector3(0.5, -0.3, 0.2);
   x.gyro_bias = Vector3(0.01, -0.02, 0.005);
   x.accel_bias = Vector3(0.1, 0.05, -0.08);
+  x.q_IL = Quaternion(Eigen::AngleAxisd(0.01, Vector3(1.0, -1.0, 0.2).normalized()));
+  x.lidar_time_offset_s = 0.0015;
   const Vector3 f_m(0.8, -0.5, 9.9), w_m(0.4, -0.6, 11.0);
   const double dt = 0.003, h = 1e-6;
   LioState next;
-  LioMatrix15 F;
+  LioMatrix F;
   internal::LioTransition(x, f_m, w_m, dt, &next, &F);
-  for (int j = 0; j < 15; ++j) {
-    const Lio::Vector15 e = Lio::Vector15::Unit(j) * h;
+  for (int j = 0; j < kLioStates; ++j) {
+    const Lio::Vector e = Lio::Vector::Unit(j) * h;
     LioState plus, minus;
     internal::LioTransition(BoxPlus(x, e), f_m, w_m, dt, &plus, nullptr);
     internal::LioTransition(BoxPlus(x, -e), f_m, w_m, dt, &minus, nullptr);
-    const Lio::Vector15 column = (BoxMinus(plus, next) - BoxMinus(minus, next)) / (2.0 * h);
+    const Lio::Vector column = (BoxMinus(plus, next) - BoxMinus(minus, next)) / (2.0 * h);
     EXPECT_LT((column - F.col(j)).cwiseAbs().maxCoeff(), 1e-4) << "column " << j << "\n"
                                                                << column.transpose() << "\n"
                                                                << F.col(j).transpose();
@@ -69,6 +74,34 @@ TEST(Lio, ThePointToPlaneJacobianMatchesFiniteDifferences) {
   for (int j = 0; j < 6; ++j) {
     const Eigen::Matrix<double, 6, 1> e = Eigen::Matrix<double, 6, 1>::Unit(j) * h;
     EXPECT_NEAR((residual(e) - residual(-e)) / (2.0 * h), J(j), 1e-8) << "column " << j;
+  }
+}
+
+// The calibration's row against central differences of the residual of a point deskewed with a
+// perturbed calibration, r(δφ, δt_d) = n·(p + R R_eᵀ (R(τ) (l + R_IL Exp(δφ) s) + p(τ) − p_e)) + d
+// with τ = t − δt_d, on a body turning at 11 rad/s and moving at 2 m/s: the linearisation the
+// update makes of a point's placement, first order in the rotation and in time (to 1e-6).
+TEST(Lio, TheCalibrationJacobianMatchesFiniteDifferencesOfTheDeskewing) {
+  const Vector3 n = Vector3(0.3, -0.8, 0.5).normalized(), p(1.0, 2.0, -0.5), l(0.01, -0.02, 0.03), s(3.0, -1.0, 0.7);
+  const Matrix3 R = Eigen::AngleAxisd(2.1, Vector3(0.1, 0.9, -0.4).normalized()).toRotationMatrix();
+  const Matrix3 R_IL = Eigen::AngleAxisd(0.008, Vector3(0.5, 1.0, -0.3).normalized()).toRotationMatrix();
+  const Vector3 w(0.5, -0.3, 11.0), v(2.0, -0.5, 0.3);
+  const Matrix3 R_j = Eigen::AngleAxisd(0.4, Vector3::UnitZ()).toRotationMatrix(), R_e = Matrix3::Identity();
+  const Vector3 p_j(0.1, 0.2, 0.0), p_e = Vector3::Zero();
+  // The body's pose about the capture: turning at w (body frame) and moving at v.
+  const auto placed = [&](const Eigen::Matrix<double, 4, 1>& d) {
+    const double dt = -d(3);
+    const Matrix3 R_t = R_j * ExpSO3(w * dt);
+    const Vector3 q = R_e.transpose() * (R_t * (l + R_IL * ExpSO3(d.head<3>()) * s) + p_j + v * dt - p_e);
+    return n.dot(p + R * q) + 0.4;
+  };
+  const Matrix3 M = R_e.transpose() * R_j;
+  const Vector3 u = R_e.transpose() * v + M * w.cross(l + R_IL * s);
+  const Eigen::Matrix<double, 1, 4> J = internal::PointToPlaneCalibrationJacobian(n, R, M, R_IL, s, u);
+  const double h = 1e-7;
+  for (int j = 0; j < 4; ++j) {
+    const Eigen::Matrix<double, 4, 1> e = Eigen::Matrix<double, 4, 1>::Unit(j) * h;
+    EXPECT_NEAR((placed(e) - placed(-e)) / (2.0 * h), J(j), 1e-6) << "column " << j;
   }
 }
 
@@ -123,16 +156,27 @@ Flight SpinningFlight(double spin) {
 
 struct Errors {
   double position_rms = 0.0, position_max = 0.0, attitude_max = 0.0;
+  double attitude_max_last_2s = 0.0;  ///< over the flight's last two seconds
   int frames = 0, used = 0, degenerate = 0;
+  LioState final_state;  ///< the filter's at the end (its calibration estimate among it)
+};
+
+/// How the LiDAR is really mounted: its axes' rotation and its clock's offset (the stack assumes
+/// neither).
+struct LidarMount {
+  Quaternion rotation = Quaternion::Identity();
+  double clock_offset_s = 0.0;
 };
 
 /// Flies `flight` for `duration_s`: IMU at 333 Hz (with `gyro_bias`, `accel_bias` and white noise
 /// of the given stds per sample), the simulator's LiDAR in the room at 10 Hz. Errors against the
 /// flight at every IMU sample after the first second.
 Errors Fly(const Flight& flight, double duration_s, const Vector3& gyro_bias, const Vector3& accel_bias,
-           double gyro_noise, double accel_noise, LioOptions o = {}) {
+           double gyro_noise, double accel_noise, LioOptions o = {}, const LidarMount& mount = {}) {
   sim::LidarOptions lo;
   lo.enabled = true;  // 2 cm range noise, 1 % dropouts
+  lo.rotation = mount.rotation;
+  lo.clock_offset_s = mount.clock_offset_s;
   // The room with a ceiling: from 1.2 m the LiDAR's lowest beam (-7°) meets the ground 10 m away,
   // beyond the walls, so without one nothing the scans see would fix the height.
   sim::World room = rotorguard::testing::Room();
@@ -162,7 +206,9 @@ Errors Fly(const Flight& flight, double duration_s, const Vector3& gyro_bias, co
         sum2 += dp * dp;
         ++n;
         e.position_max = std::max(e.position_max, dp);
-        e.attitude_max = std::max(e.attitude_max, LogSO3(truth.q_WB.conjugate() * est.q_WB).norm());
+        const double attitude = LogSO3(truth.q_WB.conjugate() * est.q_WB).norm();
+        e.attitude_max = std::max(e.attitude_max, attitude);
+        if (ToSeconds(s.t_ns) > duration_s - 2.0) e.attitude_max_last_2s = std::max(e.attitude_max_last_2s, attitude);
       }
     }
     if (auto frame = lidar.Step(t, flight.Pose(t), t + step, flight.Pose(t + step))) {
@@ -173,6 +219,7 @@ Errors Fly(const Flight& flight, double duration_s, const Vector3& gyro_bias, co
     }
   }
   e.position_rms = std::sqrt(sum2 / std::max(n, 1));
+  e.final_state = lio.state();
   return e;
 }
 
@@ -199,6 +246,30 @@ TEST(Lio, HoldsAt20RadPerSecondWithImuBiasesAndNoise) {
   EXPECT_EQ(e.used, e.frames - LioOptions{}.seed_frames);
   EXPECT_LT(e.position_rms, 0.05);
   EXPECT_LT(e.attitude_max, std::numbers::pi / 180.0);
+}
+
+// A LiDAR mounted 0.8° off the IMU's axes with its clock 2 ms ahead (a mount drawn at the edge of
+// the realistic world's ranges), unknown to the filter: it learns both in flight, within a tenth
+// of a degree and a fifth of a millisecond, and its position holds the centimetre it holds with an
+// exact mount. Its attitude keeps an error of up to the mount's angle: the first frames, which
+// start the map before anything is learnt, were placed with the assumed mount, and the map keeps
+// them. Held at the assumed mount, the same flight's attitude error is twice that. (Measured:
+// 0.02° and 1.85 ms learnt; attitude over the last 2 s 0.80° learnt, 1.74° held.)
+TEST(Lio, LearnsTheLidarsRotationAndClockOffsetInFlight) {
+  LidarMount mount;
+  const Vector3 axis = Vector3(1.0, -1.0, 0.4).normalized();
+  const double angle = 0.8 * std::numbers::pi / 180.0;
+  mount.rotation = Quaternion(Eigen::AngleAxisd(angle, axis));
+  mount.clock_offset_s = 0.002;
+  const Errors learnt = Fly(SpinningFlight(11.0), 8.0, Vector3::Zero(), Vector3::Zero(), 0.0, 0.0, {}, mount);
+  EXPECT_LT(LogSO3(mount.rotation.conjugate() * learnt.final_state.q_IL).norm(), 0.1 * std::numbers::pi / 180.0);
+  EXPECT_NEAR(learnt.final_state.lidar_time_offset_s, mount.clock_offset_s, 2e-4);
+  EXPECT_LT(learnt.position_rms, 0.015);
+  EXPECT_LT(learnt.attitude_max_last_2s, angle + 0.1 * std::numbers::pi / 180.0);
+  LioOptions fixed;
+  fixed.estimate_lidar_calibration = false;
+  const Errors held = Fly(SpinningFlight(11.0), 8.0, Vector3::Zero(), Vector3::Zero(), 0.0, 0.0, fixed, mount);
+  EXPECT_GT(held.attitude_max_last_2s, 1.8 * learnt.attitude_max_last_2s);
 }
 
 /// A filter at rest at the origin, level, fed `seconds` of an exact IMU at 333 Hz from `t0`.

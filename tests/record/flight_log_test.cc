@@ -210,7 +210,10 @@ TEST_F(FlightLogTest, AnAssemblysSceneCarriesItsUnitsAndEachRotorsUnit) {
 }
 
 TEST_F(FlightLogTest, PlansAreTheTrajectoriesTheReferenceFollowed) {
-  const harness::Scenario s = harness::LoadScenario(Config("room_navigate.yaml"), {{"duration_s", "4"}});
+  // Logged at every physics step: a plan starts at a control instant and samples every 0.1 s, so
+  // each of its samples falls on a row.
+  const harness::Scenario s =
+      harness::LoadScenario(Config("room_navigate.yaml"), {{"duration_s", "4"}, {"sim.log_rate_hz", "1000"}});
   harness::RunOptions o;
   o.out_dir = dir_.string();
   harness::RunScenario(s, o);

@@ -77,20 +77,28 @@ std::vector<LidarFrame> Fly(LidarSimulator* lidar, double duration_s, const std:
 // Every point, put back in the world with the sensor's exact pose at its own time, lies on a
 // surface of the room; with the frame-end pose instead, a vehicle spinning at 11 rad/s smears
 // them (the distortion deskewing removes).
-TEST(LidarSimulator, PointsLieOnSurfacesFromTheirOwnPoseAndSmearFromTheFrameEnd) {
+/// A noiseless sensor without dropouts: every point exactly where its pulse hit.
+LidarOptions ExactLidar() {
   LidarOptions o;
   o.enabled = true;
   o.range_noise_m = 0.0;
   o.dropout_probability = 0.0;
+  return o;
+}
+
+/// Drifting at 0.2 m/s, 1 m up, spinning at 11 rad/s.
+BodyPose SpinningPose(double t) {
+  BodyPose p;
+  p.p_W = Vector3(0.2 * t, 0.0, 1.0);
+  p.q_WB = Quaternion(Eigen::AngleAxisd(11.0 * t, Vector3::UnitZ()));
+  return p;
+}
+
+TEST(LidarSimulator, PointsLieOnSurfacesFromTheirOwnPoseAndSmearFromTheFrameEnd) {
+  const LidarOptions o = ExactLidar();
   const World room = rotorguard::testing::Room();
   LidarSimulator lidar(o, room, 3);
-  constexpr double kSpin = 11.0;
-  const auto pose_at = [](double t) {
-    BodyPose p;
-    p.p_W = Vector3(0.2 * t, 0.0, 1.0);
-    p.q_WB = Quaternion(Eigen::AngleAxisd(kSpin * t, Vector3::UnitZ()));
-    return p;
-  };
+  const auto pose_at = SpinningPose;
   const std::vector<LidarFrame> frames = Fly(&lidar, 0.35, pose_at);
   ASSERT_EQ(frames.size(), 3u);
   for (const LidarFrame& f : frames) {
@@ -108,6 +116,38 @@ TEST(LidarSimulator, PointsLieOnSurfacesFromTheirOwnPoseAndSmearFromTheFrameEnd)
     end_mean /= static_cast<double>(f.points_S.size());
     EXPECT_LT(own_max, 2e-4) << "float precision";
     EXPECT_GT(end_mean, 0.1) << "the spin distorts the frame";
+  }
+}
+
+// A sensor mounted turned and with its clock off (the truth's draw, never told to the stack): each
+// point lies on a surface when placed with the true mount rotation at its true capture time, and
+// the frame's stamps are the capture times plus the offset. Placed as the stack would place it (no
+// rotation, the stamps taken as capture times) it misses the surfaces.
+TEST(LidarSimulator, ATurnedMountAndAnOffClockLeavePointsWhereOnlyTheTrueMountPlacesThem) {
+  LidarOptions o = ExactLidar();
+  o.rotation = Quaternion(Eigen::AngleAxisd(0.0087, Vector3(1, -1, 0.5).normalized()));
+  o.clock_offset_s = 0.0017;
+  const World room = rotorguard::testing::Room();
+  LidarSimulator lidar(o, room, 3);
+  const auto pose_at = SpinningPose;
+  const std::vector<LidarFrame> frames = Fly(&lidar, 0.35, pose_at);
+  ASSERT_EQ(frames.size(), 3u);
+  const TimeNs offset = FromSeconds(o.clock_offset_s);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const LidarFrame& f = frames[k];
+    EXPECT_EQ(f.t_start_ns, static_cast<TimeNs>(k) * 100'000'000 + offset);
+    double true_max = 0.0, assumed_mean = 0.0;
+    for (std::size_t i = 0; i < f.points_S.size(); ++i) {
+      const TimeNs stamp = f.t_start_ns + f.offset_ns[i];
+      const BodyPose at = pose_at(ToSeconds(stamp - offset)), assumed = pose_at(ToSeconds(stamp));
+      const Vector3 p_S = f.points_S[i].cast<double>();
+      true_max = std::max(true_max, room.DistanceToSurface(at.p_W + at.q_WB * (o.position_m + o.rotation * p_S), 0.0));
+      assumed_mean += room.DistanceToSurface(assumed.p_W + assumed.q_WB * (o.position_m + p_S), 0.0);
+    }
+    assumed_mean /= static_cast<double>(f.points_S.size());
+    EXPECT_LT(true_max, 2e-4) << "float precision";
+    // 0.5° of mount and 1.7 ms at 11 rad/s (1.1°) put the room's points (2-4 m away) 1 cm off.
+    EXPECT_GT(assumed_mean, 0.005);
   }
 }
 

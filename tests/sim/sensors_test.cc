@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <limits>
+#include <numbers>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/vehicle/vehicle_params.h"
@@ -104,6 +106,63 @@ TEST(Imu, ARotorsImbalanceShakesItWithAmplitudeGrowingAsSpeedSquared) {
   EXPECT_NEAR(VibrationRms(&two, speeds, nullptr, 200000), std::sqrt(0.8 * 0.8 + 1.6 * 1.6), 0.01);
 }
 
+/// The amplitude of the sinusoid of frequency f [Hz] in x sampled at fs [Hz]: 2 |Σ x_k e^(-i 2π f k / fs)| / n.
+double AmplitudeAt(const std::vector<double>& x, double f, double fs) {
+  std::complex<double> sum = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    sum += x[k] * std::exp(std::complex<double>(0.0, -2.0 * std::numbers::pi * f * static_cast<double>(k) / fs));
+  }
+  return 2.0 * std::abs(sum) / static_cast<double>(x.size());
+}
+
+/// Where a frequency f lands when sampled at fs: in [0, fs / 2].
+double AliasOf(double f, double fs) {
+  const double folded = std::fmod(f, fs);
+  return folded > 0.5 * fs ? fs - folded : folded;
+}
+
+// The vibration reaches every channel (docs/truth.md): the accelerometer in the rotor plane at the
+// rotor's frequency and along its axis at the blade pass (twice it); the gyro through the rocking
+// these forces make on a rigid body: the axial force m b at the hub r = (0.1, 0, 0) is a pitch
+// torque of 0.1 m b, I_yy⁻¹ of it an angular acceleration, whose rate oscillates at the blade pass
+// with amplitude α / 2Ω; the in-plane force m a a yaw torque 0.1 m a at the rotor's frequency, rate
+// amplitude α / Ω. Each lands where sampling at 333 Hz aliases it: 143.2 Hz stays, the blade pass
+// at 286.5 Hz folds to 46.5 Hz.
+TEST(Imu, VibrationReachesEveryChannelWhereSamplingAliasesItsFrequencies) {
+  ImuOptions o = VibratingImu(0.8, 900.0);
+  o.axial_vibration_m_s2 = 0.5;
+  o.gyro_vibration_gain = 1.0;
+  o.rotor_positions_m = {Vector3(0.1, 0.0, 0.0)};
+  o.airframe_mass_kg = 1.2;
+  o.airframe_inverse_inertia = Vector3(1.0 / 0.007, 1.0 / 0.007, 1.0 / 0.009).asDiagonal();
+  ImuModel imu(o, 1);
+  const vehicle::StateVector x = SpinningState(0.0);
+  TruthSample truth;
+  truth.x = &x;
+  const double omega = 900.0;
+  truth.motor_speed_rad_s = RotorVector::Constant(1, omega);
+  std::vector<double> ax, az, gx, gy, gz;
+  for (int k = 0; k < 33300; ++k) {
+    const ImuSample s = imu.Sample(truth);
+    ax.push_back(s.specific_force_B.x());
+    az.push_back(s.specific_force_B.z() - kGravity);
+    gx.push_back(s.w_B.x());
+    gy.push_back(s.w_B.y());
+    gz.push_back(s.w_B.z());
+  }
+  const double fs = 333.0, rotor = omega / (2.0 * std::numbers::pi);
+  const double f1 = AliasOf(rotor, fs), f2 = AliasOf(2.0 * rotor, fs);
+  ASSERT_NEAR(f2, 46.5, 0.1);
+  // Leakage between the two tones over 100 s of samples is below 1e-3 of their amplitudes.
+  EXPECT_NEAR(AmplitudeAt(ax, f1, fs), 0.8, 0.01);
+  EXPECT_NEAR(AmplitudeAt(az, f2, fs), 0.5, 0.01);
+  EXPECT_NEAR(AmplitudeAt(az, f1, fs), 0.0, 0.01) << "the axial force is at the blade pass only";
+  const double pitch_rate = 0.1 * 1.2 * 0.5 / 0.007 / (2.0 * omega), yaw_rate = 0.1 * 1.2 * 0.8 / 0.009 / omega;
+  EXPECT_NEAR(AmplitudeAt(gy, f2, fs), pitch_rate, 0.01 * pitch_rate);
+  EXPECT_NEAR(AmplitudeAt(gz, f1, fs), yaw_rate, 0.01 * yaw_rate);
+  EXPECT_LT(AmplitudeAt(gx, f2, fs) + AmplitudeAt(gx, f1, fs), 1e-3 * pitch_rate) << "an arm along x rocks about y and z";
+}
+
 TEST(Imu, EachAxisSaturatesAtItsRange) {
   ImuOptions o = VibratingImu(0.0, 1.0);
   o.accel_range_m_s2 = 5.0;
@@ -200,6 +259,33 @@ TEST(Odometry, NoiseGrowsWithBodyRate) {
   }
   // Same random stream, std scaled by (1 + 0.2 * 10) = 3.
   EXPECT_NEAR(std::sqrt(e1 / e0), 3.0, 1e-9);
+}
+
+// The front end reports the pose of the vehicle file's body frame, not of the true centre of
+// gravity: a point o away from it in the body, p + R o, moving with v + R (ω x o).
+TEST(Odometry, ReportsTheFilesBodyFrameWhereverTheCentreOfGravityIs) {
+  OdometryOptions o;
+  o.position_noise_m = o.velocity_noise_m_s = o.attitude_noise_rad = 0.0;
+  o.body_origin_m = Vector3(-0.006, 0.004, -0.003);
+  const World empty;
+  OdometryModel odometry(o, empty, 5);
+  vehicle::StateVector x = SpinningState(11.0);
+  const Quaternion q = Quaternion(Eigen::AngleAxisd(0.7, Vector3(1, 2, 3).normalized()));
+  x.segment<4>(vehicle::StateIndex::kQuaternion) << q.w(), q.x(), q.y(), q.z();
+  x.segment<3>(vehicle::StateIndex::kPosition) = Vector3(1, 2, 3);
+  x.segment<3>(vehicle::StateIndex::kVelocity) = Vector3(0.5, -0.2, 0.1);
+  TruthSample truth;
+  truth.x = &x;
+  odometry.Measure(truth);
+  OdometrySample out;
+  ASSERT_TRUE(odometry.Deliver(0, &out));
+  const Matrix3 R = q.toRotationMatrix();
+  const Vector3 w(0, 0, 11.0);
+  EXPECT_TRUE(out.p_W.isApprox(Vector3(1, 2, 3) + R * o.body_origin_m, 1e-14));
+  EXPECT_TRUE(out.v_W.isApprox(Vector3(0.5, -0.2, 0.1) + R * w.cross(o.body_origin_m), 1e-14));
+  EXPECT_NEAR((out.v_W - Vector3(0.5, -0.2, 0.1)).norm(), 11.0 * o.body_origin_m.head<2>().norm(), 1e-12)
+      << "at 11 rad/s a 7 mm offset moves at 8 cm/s";
+  EXPECT_TRUE(out.q_WB.isApprox(q, 1e-14));
 }
 
 TEST(Odometry, ArrivesLateStampedAtCapture) {

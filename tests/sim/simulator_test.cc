@@ -1,6 +1,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "rotorguard/core/error.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/vehicle/vehicle_params.h"
@@ -149,6 +151,54 @@ TEST(Simulator, NonFiniteCommandsReachTheMotorsAsZero) {
   rig.sim.Step(bad);
   EXPECT_EQ(rig.sim.applied_command()[2], 0.0);
   EXPECT_TRUE(rig.sim.state().allFinite());
+}
+
+// A command acts from its own instant, the sending time plus the ESCs' latency, inside a physics
+// step: a motor's thrust then follows eq. (6)'s lag from that instant, T(t) = u + (T0 - u)
+// exp(-(t - t_a) / σ). Rounding the instant to the 1 ms step would move the curve by up to 1 ms,
+// a thrust error of (u - T0) dt / σ: 0.1 N here, far above the tolerance.
+TEST(Simulator, ACommandActsFromItsOwnInstantWithinAStep) {
+  const vehicle::MultirotorModel model(ReferenceQuad());
+  SimulatorOptions o;
+  o.esc.command_latency_s = 0.00137;
+  const RotorVector hover = model.HoverThrusts();
+  Simulator sim(model, {}, {}, o, 1, model.MakeState(Vector3(0, 0, 2), 0.0, hover));
+  RotorCommand up;
+  up.thrust_n = hover + RotorVector::Constant(4, 1.0);
+  const TimeNs sent = 400'000;  // 0.4 ms into the first step
+  sim.Send(up, sent);
+  const double t_acts = ToSeconds(sent) + o.esc.command_latency_s;  // inside the second step
+  const double sigma = model.params().motor_time_constant_s;
+  for (int k = 0; k < 20; ++k) {
+    sim.Step();
+    const double t = sim.time_s();
+    const double expected = t <= t_acts ? hover[0] : up.thrust_n[0] + (hover[0] - up.thrust_n[0]) * std::exp(-(t - t_acts) / sigma);
+    // RK4 on the motors' linear lag with (dt / σ)^5 / 120 ~ 3e-10 of relative error per step.
+    EXPECT_NEAR(sim.rotor_thrusts()[0], expected, 1e-8) << "t = " << t;
+  }
+  EXPECT_EQ(sim.applied_command()[0], up.thrust_n[0]);
+}
+
+// Commands act in the order sent: one sent before the instant of one still waiting acts after it,
+// and a full queue lets its oldest act at once (counted), so that nothing waits unboundedly.
+TEST(Simulator, CommandsActInTheOrderSentAndAFullQueueIsCounted) {
+  const vehicle::MultirotorModel model(ReferenceQuad());
+  SimulatorOptions o;
+  o.esc.command_latency_s = 0.002;
+  Simulator sim(model, {}, {}, o, 1, model.MakeState(Vector3(0, 0, 2), 0.0, model.HoverThrusts()));
+  RotorCommand a, b;
+  a.thrust_n = RotorVector::Constant(4, 1.0);
+  b.thrust_n = RotorVector::Constant(4, 2.0);
+  sim.Send(a, 1'000'000);  // acts at 3 ms
+  sim.Send(b, 500'000);    // would act at 2.5 ms; waits for a
+  sim.Step();
+  sim.Step();
+  EXPECT_NE(sim.applied_command()[0], 1.0);  // at 2 ms neither acts yet
+  sim.Step();
+  EXPECT_EQ(sim.applied_command()[0], 2.0) << "a acted at 3 ms, then b at once";
+  EXPECT_THROW(sim.Send(a, 0), std::invalid_argument) << "a command cannot be sent in the past";
+  for (int k = 0; k < Simulator::kCommandQueue + 3; ++k) sim.Send(k % 2 ? a : b, sim.time_ns());
+  EXPECT_EQ(sim.commands_overrun(), 3u);
 }
 
 TEST(Simulator, RejectsAStepTooLongForTheMotors) {

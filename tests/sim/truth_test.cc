@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "rotorguard/core/error.h"
@@ -50,6 +51,41 @@ TEST(Truth, TheIdealWorldIsTheFileExactly) {
     EXPECT_EQ(v.rotors[i].yaw_coefficient_m, file.rotors[i].yaw_coefficient_m);
   }
   EXPECT_EQ(ThrustRatios(d), RotorVector::Ones(4));
+  EXPECT_EQ(d.computation_delay_s, 0.0);
+  EXPECT_EQ(d.esc_command_latency_s, 0.0);
+  // The sensors where the file puts them: nothing moved, turned, delayed, shaken or noisier.
+  const SimulatorOptions scenario;
+  const SimulatorOptions o = TruthSimulatorOptions(scenario, file, d);
+  EXPECT_EQ(o.odometry.body_origin_m, Vector3::Zero());
+  EXPECT_EQ(o.lidar.position_m, scenario.lidar.position_m);
+  EXPECT_EQ(o.lidar.rotation.coeffs(), Quaternion::Identity().coeffs());
+  EXPECT_EQ(o.lidar.clock_offset_s, 0.0);
+  EXPECT_EQ(o.imu.accel_noise_density, scenario.imu.accel_noise_density);
+  EXPECT_EQ(o.imu.gyro_noise_density, scenario.imu.gyro_noise_density);
+  EXPECT_EQ(o.imu.vibration_m_s2 + o.imu.axial_vibration_m_s2 + o.imu.gyro_vibration_gain, 0.0);
+  EXPECT_EQ(o.esc.command_latency_s, 0.0);
+}
+
+// Every sensor that reports a pose reports the file's body frame, wherever the drawn centre of
+// gravity sits: the odometry's origin and the LiDAR's mount move by minus the offset from the true
+// centre of gravity (which the simulator's state follows), as the IMU's does.
+TEST(Truth, SensorsSitOnTheFilesBodyFrameNotOnTheTrueCentreOfGravity) {
+  const vehicle::VehicleParams file = ReferenceQuad();
+  const TruthDraw d = DrawTruth(Realistic(), file, 11);
+  ASSERT_GT(d.cog_offset_m.norm(), 1e-3);
+  SimulatorOptions scenario;
+  scenario.lidar.position_m = Vector3(0.01, -0.02, 0.06);
+  const SimulatorOptions o = TruthSimulatorOptions(scenario, file, d);
+  EXPECT_TRUE(o.odometry.body_origin_m.isApprox(-d.cog_offset_m, 1e-15));
+  EXPECT_TRUE(o.lidar.position_m.isApprox(scenario.lidar.position_m - d.cog_offset_m, 1e-15));
+  EXPECT_TRUE(o.imu.position_m.isApprox(scenario.imu.position_m - d.cog_offset_m + d.imu_offset_m, 1e-15));
+  // The LiDAR's axes turned by the drawn rotation vector; its clock off by the drawn offset.
+  EXPECT_NEAR(Eigen::AngleAxisd(o.lidar.rotation).angle(), d.lidar_rotation_rad.norm(), 1e-12);
+  EXPECT_EQ(o.lidar.clock_offset_s, d.lidar_clock_offset_s);
+  EXPECT_EQ(o.imu.gyro_noise_density, scenario.imu.gyro_noise_density * d.imu_gyro_noise_ratio);
+  ASSERT_EQ(o.imu.rotor_positions_m.size(), 4u);
+  EXPECT_TRUE(o.imu.rotor_positions_m[0].isApprox(file.rotors[0].p_B - d.cog_offset_m, 1e-12));
+  EXPECT_EQ(o.imu.airframe_mass_kg, file.mass_kg * d.mass_ratio);
 }
 
 TEST(Truth, ADrawIsAPureFunctionOfItsSeed) {
@@ -66,9 +102,18 @@ TEST(Truth, ADrawIsAPureFunctionOfItsSeed) {
 TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   const vehicle::VehicleParams file = ReferenceQuad();
   const TruthRanges r = RangesOf(TruthPreset::kRealistic);
-  std::vector<double> mass, kn, stop, torque, cog, latency;
+  std::vector<double> mass, kn, stop, torque, cog, latency, computation, esc_latency, noise, lidar_turn, lidar_clock;
   for (std::uint64_t seed = 0; seed < 4000; ++seed) {
     const TruthDraw d = DrawTruth(Realistic(), file, seed);
+    computation.push_back(d.computation_delay_s);
+    esc_latency.push_back(d.esc_command_latency_s);
+    noise.push_back(d.imu_gyro_noise_ratio);
+    lidar_turn.push_back(d.lidar_rotation_rad.y());
+    lidar_clock.push_back(d.lidar_clock_offset_s);
+    EXPECT_GE(d.imu_axial_vibration_m_s2, 0.5 * r.imu_axial_vibration_m_s2);
+    EXPECT_LE(d.imu_axial_vibration_m_s2, r.imu_axial_vibration_m_s2);
+    EXPECT_GE(d.gyro_vibration_gain, 1.0);
+    EXPECT_LE(d.gyro_vibration_gain, r.gyro_vibration_gain);
     mass.push_back(d.mass_ratio - 1.0);
     kn.insert(kn.end(), d.thrust_coefficient_ratio.begin(), d.thrust_coefficient_ratio.end());
     stop.push_back(d.motor_stop_time_constant_s);
@@ -91,8 +136,23 @@ TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   fills(kn, 1.0, r.thrust_coefficient_fraction);
   fills(torque, 0.0, r.external_torque_n_m);
   fills(cog, 0.0, r.cog_offset_m);
-  const double half_width = 0.5 * (r.odometry_latency_max_s - r.odometry_latency_min_s);
-  fills(latency, r.odometry_latency_min_s + half_width, half_width);
+  const auto fills_interval = [&fills](const std::vector<double>& x, double lo, double hi) {
+    fills(x, 0.5 * (lo + hi), 0.5 * (hi - lo));
+  };
+  fills_interval(latency, r.odometry_latency_min_s, r.odometry_latency_max_s);
+  // The loop's delays: computation over at least 1-4 ms, the ESCs' latency over 0.5-2 ms.
+  EXPECT_LE(r.computation_delay_min_s, 0.001);
+  EXPECT_GE(r.computation_delay_max_s, 0.004);
+  EXPECT_LE(r.esc_command_latency_min_s, 0.0005);
+  EXPECT_GE(r.esc_command_latency_max_s, 0.002);
+  fills_interval(computation, r.computation_delay_min_s, r.computation_delay_max_s);
+  fills_interval(esc_latency, r.esc_command_latency_min_s, r.esc_command_latency_max_s);
+  fills(noise, 1.0, r.imu_noise_fraction);
+  // The LiDAR: turned by ±0.5° about each axis at least, its clock off by ±2 ms at least.
+  EXPECT_GE(r.lidar_rotation_rad, 0.5 * std::numbers::pi / 180.0 - 1e-15);
+  EXPECT_GE(r.lidar_clock_offset_s, 0.002);
+  fills(lidar_turn, 0.0, r.lidar_rotation_rad);
+  fills(lidar_clock, 0.0, r.lidar_clock_offset_s);
   // Log-uniform on [5, 50] ms: inside, and its median the geometric mean sqrt(5 * 50) = 15.8 ms
   // (the standard error of a median of 4000 draws is about 2 % of it).
   const auto [lo, hi] = std::minmax_element(stop.begin(), stop.end());
@@ -122,6 +182,13 @@ TEST(Truth, AnIntervalNeedsBothEndsInOrder) {
   o = TruthOptions();
   o.odometry_latency_max_s = 0.02;
   RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "odometry_latency_min_s is missing");
+  o = TruthOptions();
+  o.computation_delay_min_s = 0.003;
+  o.computation_delay_max_s = 0.001;
+  RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "at least computation_delay_min_s = 0.003");
+  o = TruthOptions();
+  o.esc_command_latency_min_s = 0.001;
+  RG_EXPECT_THROW_WITH(o.Validate(), ValidationError, "esc_command_latency_max_s is missing");
 }
 
 TEST(Truth, TheDrawnVehicleMovesItsRotorsAboutTheTrueCentreOfGravity) {

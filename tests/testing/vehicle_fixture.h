@@ -1,9 +1,25 @@
 #pragma once
 /// The reference vehicle of paper 000 (Table II and configs/vehicles/zhou2025_quad.yaml), built in code for unit tests that
 /// must not depend on config files.
+#include "rotorguard/core/messages.h"
+#include "rotorguard/vehicle/multirotor.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::testing {
+
+/// A perfect estimate of the state `x` at time t: its pose, velocity, rates and motor thrusts.
+inline StateEstimate ExactEstimate(const vehicle::StateVector& x, TimeNs t = 0) {
+  const vehicle::StateView s(x);
+  StateEstimate e;
+  e.t_ns = t;
+  e.valid = true;
+  e.p_W = s.p_W();
+  e.q_WB = s.q_WB();
+  e.v_W = s.v_W();
+  e.w_B = s.w_B();
+  e.motor_thrust_n = x.tail(x.size() - vehicle::StateIndex::kMotor);
+  return e;
+}
 
 inline vehicle::VehicleParams ReferenceQuad() {
   using vehicle::Rotor;

@@ -31,6 +31,13 @@ struct CalibrationLog {
   vehicle::VehicleParams vehicle;
   double imu_rate_hz = 0.0;
   Vector3 imu_position_m = Vector3::Zero();
+  double command_delay_s = 0.0;  ///< stack.command_delay_s as flown (0 in logs from before it existed)
+  /// The IMU notches as flown (disabled in logs from before they existed).
+  RpmNotchOptions imu_notch = [] {
+    RpmNotchOptions o;
+    o.enabled = false;
+    return o;
+  }();
   std::vector<harness::FaultRecord> faults;  ///< the injected faults (ground truth for scoring)
   /// The composite FDD's settings in the recorded flight (summary.json "composite_fdd"), when the
   /// stack ran it.

@@ -10,6 +10,7 @@
 /// with it and with each rotor's known effectiveness (docs/control.md).
 #include <Eigen/Core>
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -55,6 +56,12 @@ struct NmpcOptions {
   /// the default: faster on average) or condensing (the states eliminated, a dense active-set
   /// solve); the same QP, the same solution (docs/control.md, "Two QP solvers").
   OcpQpMethod qp_solver = OcpQpMethod::kRiccati;
+  /// The delay the NMPC expects from the instant of a call (the state it is given) to its command
+  /// acting on the motors: the cycle's computation and the ESCs' latency [s], in [0, 0.1]. Its
+  /// prediction starts from the state propagated over this delay with the commands it has already
+  /// sent (the last one acts until the new one does), as delay-compensated MPC does on vehicles.
+  /// 0: the state as given. In a FlightStack: stack.command_delay_s, not a key of its own.
+  double expected_delay_s = 0.0;
   void Validate() const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
@@ -156,6 +163,9 @@ class NmpcController final : public Controller {
                   Eigen::VectorXd* grad_x, Eigen::VectorXd* grad_u) const;
   /// Upper input bounds u_bar (zero for failed rotors); the lower bounds are zero.
   const Eigen::VectorXd& input_upper_bounds() const { return u_max_; }
+  /// The state the last call's plan started from: the given state propagated over
+  /// expected_delay_s (NmpcOptions), at the call's time plus that delay.
+  const Eigen::VectorXd& predicted_state() const { return x0_; }
 
  private:
   void Initialise(const Eigen::VectorXd& x0, const ReferenceTrajectory& reference, double t);
@@ -172,6 +182,11 @@ class NmpcController final : public Controller {
   Eigen::Vector3d ReferenceThrustVector(const ReferencePoint& ref) const;
   double ReferenceTotalThrust(const ReferencePoint& ref) const;
   void HoverCommand(RotorVector* thrust_command) const;
+  /// x0_ (the state at time t) carried to t + expected_delay_s through the model, each command
+  /// sent acting from its instant plus the delay (the motors' state holds before the first).
+  void PredictOverDelay(double t);
+  /// Remembers a command sent at time t (a ring of kSentCommands).
+  void RememberSent(double t, const RotorVector& command);
 
   vehicle::VehicleParams vehicle_;
   NmpcOptions options_;
@@ -209,8 +224,16 @@ class NmpcController final : public Controller {
   double gap_ = 0.0;
   Eigen::VectorXd x0_delta_;
   NmpcSummary summary_;
+  /// The commands sent, newest last in a ring: what acts during the next call's delay.
+  static constexpr int kSentCommands = 8;
+  struct SentCommand {
+    double t = -std::numeric_limits<double>::infinity();
+    Eigen::VectorXd u;
+  };
+  std::vector<SentCommand> sent_;
+  int sent_next_ = 0;
   // scratch
-  Eigen::VectorXd x_next_, y_, x0_, weighted_y_;
+  Eigen::VectorXd x_next_, y_, x0_, weighted_y_, k_[4], x_stage_, u_acting_;
   Eigen::MatrixXd dy_;
 };
 

@@ -28,6 +28,27 @@ class LowPass2 {
   bool initialised_ = false;
 };
 
+/// y = H(z) x per channel with H a second-order notch (Orfanidis' design): zero gain at the
+/// centre, -3 dB exactly `bandwidth` apart, unit gain far from it. The centre can move every sample
+/// (an RPM-tracking notch, whose rotor speeds change); Bypass passes x unchanged, the filter's
+/// memory following, so that a notch switched on later starts without a transient.
+template <int N>
+class Notch2 {
+ public:
+  using Vec = Eigen::Matrix<double, N, 1>;
+  /// Centre and -3 dB width [Hz] at `sample_hz`: the centre in (0, sample_hz / 2), the width > 0.
+  /// Throws std::invalid_argument (a real-time caller checks beforehand: Bypass where it would).
+  void SetCentre(double centre_hz, double bandwidth_hz, double sample_hz);
+  void Bypass() { bypassed_ = true; }
+  bool bypassed() const { return bypassed_; }
+  const Vec& Step(const Vec& x);
+
+ private:
+  double b0_ = 1.0, b1_ = 0.0, b2_ = 1.0, a1_ = 0.0, a2_ = 0.0;
+  Vec x1_ = Vec::Zero(), x2_ = Vec::Zero(), y1_ = Vec::Zero(), y2_ = Vec::Zero(), y_ = Vec::Zero();
+  bool bypassed_ = true, initialised_ = false;
+};
+
 /// The derivative of a signal, low-pass filtered: y = LowPass2(dx/dt) with dx/dt by backward
 /// differences over the actual time between samples.
 template <int N>

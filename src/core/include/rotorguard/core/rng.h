@@ -2,6 +2,7 @@
 /// Seeded random numbers with algorithms specified here (not std::*_distribution, whose algorithms
 /// differ between standard libraries), so that a seed gives the same numbers everywhere.
 #include <cstdint>
+#include <string_view>
 
 namespace rotorguard {
 
@@ -11,6 +12,11 @@ std::uint64_t SplitMix64(std::uint64_t x);
 /// Seed of stream `index` under `seed` (e.g. trial i of a campaign, or one sensor of a run).
 /// Independent of thread count or sharding: a pure function of its arguments.
 std::uint64_t DeriveSeed(std::uint64_t seed, std::uint64_t index);
+
+/// Seed of the stream named `name` under `seed`: DeriveSeed(seed, FNV-1a 64 of the name). Every
+/// workload that draws trials names its own stream, so that two workloads on one seed never fly
+/// the same draws (a calibration and the evaluation of what it calibrated, say).
+std::uint64_t DeriveSeed(std::uint64_t seed, std::string_view name);
 
 /// xoshiro256** generator (Blackman & Vigna) with uniform and normal transforms of its own.
 class Rng {

@@ -16,7 +16,9 @@
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/filters.h"
 #include "rotorguard/core/messages.h"
+#include "rotorguard/core/rpm_notch.h"
 #include "rotorguard/core/types.h"
+#include "rotorguard/fdd/commanded_motors.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::fdd {
@@ -27,6 +29,11 @@ struct CompositeFddOptions {
   double motor_index_threshold = 0.2;
   /// Consecutive telemetry samples the index must stay low (debounce), >= 1.
   int motor_index_samples = 2;
+  /// The index's reference, the motors as commanded, waits this much beyond the command delay
+  /// the stack expects [s], in [0, 0.1]: the true delay varies from vehicle to vehicle and cycle to
+  /// cycle, and a reference that leads the motors reads a healthy motor spinning up as stopped.
+  /// Judged against the latest plausible response, a stopped motor is found this much later.
+  double motor_index_delay_margin_s = 0.005;
   /// The indices are evaluated only while the rotor's thrust (expected, for M_i; measured, for
   /// P_i) exceeds this fraction of its share of the hover thrust, W / n (w_expected -> 0 makes
   /// the ratios meaningless), in (0, 1].
@@ -75,6 +82,18 @@ struct CompositeFddOptions {
   /// IMU mounting point relative to the centre of gravity, body frame [m]: its lever-arm
   /// accelerations are removed before the observer uses the accelerometer.
   Vector3 imu_position_m = Vector3::Zero();
+  /// The delay from a command's instant to the motors acting on it that the stack expects [s],
+  /// >= 0: the motors are modelled as acting on it then (CommandedMotors). Set by the stack from
+  /// stack.command_delay_s, not a key of its own.
+  double command_delay_s = 0.0;
+  /// The notches the stack runs its IMU through before this detector (stack.imu_notch): the
+  /// detector passes its telemetry's wrench through a bank alike, so that the two it compares are
+  /// delayed alike. Set by the stack, not a key of its own; disabled by default.
+  RpmNotchOptions imu_notch = [] {
+    RpmNotchOptions o;
+    o.enabled = false;
+    return o;
+  }();
   void Validate() const;
   /// These options with every threshold out of reach (gamma_M 1e-6, gamma_P 1, take-off 1e6): no
   /// rule fires in fault-free flight, and the debounce, persistence and gates, which define the
@@ -90,6 +109,11 @@ struct CompositeFddOptions {
               .open_max = true});
     a->Visit("motor_index_samples", &motor_index_samples,
              {.meaning = "consecutive telemetry samples the index must stay low", .min = 1, .max = 1000});
+    a->Visit("motor_index_delay_margin_s", &motor_index_delay_margin_s,
+             {.meaning = "the index's reference waits this much beyond stack.command_delay_s [s]: the delay's "
+                         "uncertainty",
+              .min = 0.0,
+              .max = 0.1});
     a->Visit("min_thrust_fraction", &min_thrust_fraction,
              {.meaning = "the indices are evaluated only above this fraction of a rotor's hover thrust W/n",
               .max = 1.0,
@@ -195,8 +219,8 @@ class FaultDetector {
   virtual std::string_view name() const = 0;
   virtual void OnImu(const ImuSample& imu) = 0;
   virtual void OnEscTelemetry(const EscTelemetry& esc) = 0;
-  /// The commanded thrusts sent to the motors and the stack's current estimate.
-  virtual void SetCommand(const RotorVector& thrust_command) = 0;
+  /// The command sent to the motors (its instant and thrusts) and the stack's current estimate.
+  virtual void SetCommand(const RotorCommand& command) = 0;
   virtual void SetEstimate(const StateEstimate& estimate) = 0;
   virtual const std::vector<RotorStatus>& rotors() const = 0;
   /// Rotors isolated as failed since the last call; cleared by the call.
@@ -233,8 +257,8 @@ class CompositeFdd final : public FaultDetectorBase {
   std::string_view name() const override { return "composite"; }
   void OnImu(const ImuSample& imu) override;
   void OnEscTelemetry(const EscTelemetry& esc) override;
-  /// The commanded thrusts sent to the motors: the motor index's reference.
-  void SetCommand(const RotorVector& thrust_command) override;
+  /// The command sent to the motors: the motor index's reference.
+  void SetCommand(const RotorCommand& command) override;
   /// The observer's latest per-rotor thrust-loss estimate [N] (eq. 16, from the baseline), for
   /// inspection.
   const Eigen::VectorXd& thrust_loss() const { return thrust_loss_; }
@@ -276,14 +300,15 @@ class CompositeFdd final : public FaultDetectorBase {
   int n_;
   EffectivenessMatrix effectiveness_;
   AllocationMatrix pinv_;
-  // Motor index.
-  RotorVector command_, expected_thrust_;
+  // Motor index: the motors as commanded (the expected thrusts), against their telemetry.
+  CommandedMotors motors_;
+  RotorVector expected_thrust_;
+  RpmNotchBank<4> wrench_notch_;  // the telemetry's wrench, notched as the stack notches the IMU
   std::vector<int> low_index_count_;
   std::vector<double> low_index_since_s_;
   // For the rules' statistics (IndexExtremes): each rotor's last motor_index_samples M_i, and its
   // P_i over the last propeller_persistence_s.
   std::vector<SampleRing> recent_motor_index_, recent_propeller_index_;
-  std::optional<TimeNs> last_esc_ns_;
   RotorVector measured_thrust_;
   RotorVector working_;  // 1 for a rotor not isolated, else 0
   int isolated_seen_ = 0;

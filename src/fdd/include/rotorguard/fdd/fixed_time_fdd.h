@@ -28,6 +28,9 @@ struct FixedTimeFddOptions {
   double persistence_s = 0.02;  ///< ... when it persists this long [s], >= 0
   double imu_rate_hz = 333.0;   ///< filter design rate [Hz]
   Vector3 imu_position_m = Vector3::Zero();  ///< lever arm removed from the accelerometer
+  /// The delay from a command's instant to the motors acting on it that the stack expects [s],
+  /// >= 0 (CommandedMotors). Set by the stack from stack.command_delay_s.
+  double command_delay_s = 0.0;
   void Validate() const;
 };
 
@@ -37,7 +40,7 @@ class FixedTimeFdd final : public FaultDetectorBase {
   std::string_view name() const override { return "fixedtime"; }
   void OnImu(const ImuSample& imu) override;
   void OnEscTelemetry(const EscTelemetry&) override {}  // the method does not use telemetry
-  void SetCommand(const RotorVector& thrust_command) override;
+  void SetCommand(const RotorCommand& command) override;
   /// Latest estimated loss of effectiveness per rotor.
   const Eigen::VectorXd& loss() const { return loss_; }
 
@@ -47,7 +50,8 @@ class FixedTimeFdd final : public FaultDetectorBase {
   int n_;
   EffectivenessMatrix effectiveness_;
   AllocationMatrix pinv_;
-  RotorVector command_, modelled_thrust_;
+  CommandedMotors motors_;  // the rotors as commanded (no telemetry in this method)
+  RotorVector modelled_thrust_;
   std::optional<TimeNs> last_imu_ns_;
   Vector3 w_hat_ = Vector3::Zero(), d_hat_ = Vector3::Zero();
   bool observer_started_ = false;

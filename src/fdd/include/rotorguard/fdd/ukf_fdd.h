@@ -21,6 +21,10 @@ namespace rotorguard::fdd {
 struct UkfFddOptions {
   double imu_rate_hz = 333.0;                ///< nominal IMU rate [Hz], > 0 (noise densities to variances)
   Vector3 imu_position_m = Vector3::Zero();  ///< the accelerometer's lever arm (centripetal term modelled)
+  /// The delay from a command's instant to the motors acting on it that the stack expects [s],
+  /// >= 0 (CommandedMotors). Set by the stack from stack.command_delay_s.
+  double command_delay_s = 0.0;
+
   /// Process noise: body-rate model error [rad/s²/√Hz] and the losses' random walk [1/√s], > 0.
   double rate_process_density = 0.5;
   double loss_random_walk = 0.3;
@@ -45,7 +49,7 @@ class UkfFdd final : public FaultDetectorBase {
   std::string_view name() const override { return "ukf"; }
   void OnImu(const ImuSample& imu) override;
   void OnEscTelemetry(const EscTelemetry&) override {}  // paper 004's testbed has no telemetry
-  void SetCommand(const RotorVector& thrust_command) override;
+  void SetCommand(const RotorCommand& command) override;
 
   /// ŵ_i, clamped to [0, 1].
   Eigen::VectorXd loss() const;
@@ -64,7 +68,8 @@ class UkfFdd final : public FaultDetectorBase {
   UkfFddOptions options_;
   int n_;
   EffectivenessMatrix effectiveness_;
-  RotorVector command_, modelled_thrust_;
+  CommandedMotors motors_;  // the rotors as commanded
+  RotorVector modelled_thrust_;
   std::optional<TimeNs> last_imu_ns_;
   std::optional<UnscentedKalmanFilter> ukf_;
   std::vector<double> above_since_s_;

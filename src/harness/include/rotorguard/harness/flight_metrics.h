@@ -40,6 +40,10 @@ struct FlightMetricsOptions {
   double tracking_start_s = 0.0;
   double success_error_m = 0.5;       ///< the success rule's bound on |p - p_ref| [m]
   double recovered_tilt_rad = 0.0873;  ///< roll and pitch count as recovered below this tilt [rad]
+  /// Where the vehicle file's body frame has its origin, from the true centre of gravity (body
+  /// frame) [m]: positions are measured there, the point the stack estimates and the reference
+  /// means (minus the drawn offset of the centre of gravity; zero in the ideal world).
+  Vector3 body_origin_m = Vector3::Zero();
 };
 
 /// How a flight ended.
@@ -65,6 +69,8 @@ class FlightMetrics {
   /// The stack's estimate at a control cycle against the true state then: the estimator's
   /// absolute trajectory error (no alignment: the stack starts at a known pose).
   void OnEstimate(const vehicle::StateView& state, const StateEstimate& estimate);
+  /// The vehicle file's body-frame origin of the true state (FlightMetricsOptions::body_origin_m).
+  Vector3 BodyOrigin(const vehicle::StateView& state) const;
 
   /// The last time the position error exceeded the success bound, and by how much.
   struct Violation {

@@ -53,6 +53,8 @@ struct RunCost {
 struct SensorsRecord {
   double imu_rate_hz = 0.0;
   Vector3 imu_position_m = Vector3::Zero();
+  double command_delay_s = 0.0;  ///< stack.command_delay_s: when the stack expects its commands to act
+  RpmNotchOptions imu_notch;  ///< the IMU's vibration notches the stack ran (stack.imu_notch)
 };
 
 /// The outcome of one run: summary.json's fields, nested as it nests them (docs/scenarios.md,

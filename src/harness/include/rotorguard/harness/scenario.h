@@ -5,10 +5,12 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/harness/mission.h"
 #include "rotorguard/io/config_node.h"
@@ -23,6 +25,16 @@
 #include "rotorguard/vehicle/vehicle_params.h"
 
 namespace rotorguard::harness {
+
+/// Where a control cycle's computation delay comes from (key sim.computation_delay): the truth's
+/// draw (reproducible), or the wall-clock time the stack took for the cycle on this computer (a
+/// study of a given computer; not reproducible bit for bit).
+enum class ComputationDelay { kDrawn, kMeasured };
+inline constexpr EnumName<ComputationDelay> kComputationDelayNames[] = {{ComputationDelay::kDrawn, "drawn"},
+                                                                        {ComputationDelay::kMeasured, "measured"}};
+constexpr std::span<const EnumName<ComputationDelay>> NamesOf(const ComputationDelay*) {
+  return kComputationDelayNames;
+}
 
 /// The success rule a scenario states (its `metrics` keys success_error_m, success_hold_s,
 /// success_recovery_s, max_altitude_loss_m; docs/metrics.md, "SucR").
@@ -62,6 +74,8 @@ struct Scenario {
   std::optional<AssemblyPlanSpec> assembly_plan;  ///< mission assembly_plan
   std::vector<sim::FaultSpec> faults;
   sim::SimulatorOptions sim;
+  /// A cycle's command reaches the ESCs this long after the cycle's instant (sim.computation_delay).
+  ComputationDelay computation_delay = ComputationDelay::kDrawn;
   stack::FlightStackOptions stack;
   double log_rate_hz = 100.0;       ///< rows per second in log.csv
   /// Tracking metrics cover [tracking_start_s, TrackingEndS(scenario)].

@@ -66,6 +66,9 @@ struct SimKeys {
     a->Visit(
         "crash_tilt_rad", &s->sim.crash_tilt_rad,
         {.meaning = "touching the ground more tilted is a crash [rad]", .max = std::numbers::pi, .positive = true});
+    a->Visit("computation_delay", &s->computation_delay,
+             {.meaning = "a control cycle's computation delay: drawn (the truth's range, docs/truth.md) or measured "
+                         "(the stack's wall-clock time for the cycle on this computer; not reproducible)"});
   }
 };
 

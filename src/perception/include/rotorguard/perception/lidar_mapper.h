@@ -37,6 +37,14 @@ struct LidarMapperOptions {
   }
 };
 
+/// How the LiDAR sits beyond its mounting point: its axes' rotation from the body's and its
+/// clock's offset (its stamps minus the capture times), as the LiDAR-inertial odometry learnt them
+/// (Lio); the identity and no offset when nothing learnt them.
+struct LidarCalibration {
+  Quaternion q_BS = Quaternion::Identity();
+  double clock_offset_s = 0.0;
+};
+
 struct LidarFrameSummary {
   /// Pulses of the frame without a usable point: no return (counted by the sensor), non-finite,
   /// outside the map's window, or all of them when the estimate is not valid yet.
@@ -51,7 +59,9 @@ class LidarMapper {
   void OnImu(const ImuSample& imu);
   /// Deskews, places and inserts one frame with `estimate` taken at the frame's end. The map is
   /// created with the first frame that has a valid estimate.
-  LidarFrameSummary OnFrame(const LidarFrame& frame, const StateEstimate& estimate);
+  /// Its points are turned and their times moved by `calibration` first.
+  LidarFrameSummary OnFrame(const LidarFrame& frame, const StateEstimate& estimate,
+                            const LidarCalibration& calibration = {});
   /// The occupancy map, once a frame was inserted; else null.
   const VoxelMap* map() const { return map_.get(); }
   /// The last frame given to OnFrame as it was inserted: its points in the world frame (empty if
@@ -66,6 +76,7 @@ class LidarMapper {
   Deskewer deskewer_;
   std::unique_ptr<VoxelMap> map_;
   std::vector<Eigen::Vector3f> points_;  // the last frame's, in the world frame once placed
+  LidarFrame calibrated_;                // scratch: a frame turned and re-timed by its calibration
   Vector3 origin_W_ = Vector3::Zero();
 };
 

@@ -2,16 +2,23 @@
 /// LiDAR-inertial odometry: the stack's own pose from its LiDAR frames and IMU samples, after
 /// FAST-LIO2 (Xu et al., T-RO 2022), which paper 000's vehicle flies on.
 ///
-/// An iterated error-state Kalman filter on the state of the IMU's mounting point
-///   x = (p, R, v, b_g, b_a)   position, attitude (body to world), velocity, gyro and accelerometer biases,
-/// error state δx = (δp, δθ, δv, δb_g, δb_a) with R = R̂ Exp(δθ) (15 dimensions).
+/// An iterated error-state Kalman filter on the state of the IMU's mounting point and the LiDAR's
+/// calibration
+///   x = (p, R, v, b_g, b_a, R_IL, t_d)   position, attitude (body to world), velocity, gyro and
+///   accelerometer biases, the LiDAR's axes in the IMU's and the LiDAR clock's offset (its stamps
+///   minus the capture times),
+/// error state δx = (δp, δθ, δv, δb_g, δb_a, δφ, δt_d) with R = R̂ Exp(δθ), R_IL = R̂_IL Exp(δφ)
+/// (19 dimensions). A LiDAR is never mounted exactly as drawn nor its clock exactly the IMU's:
+/// FAST-LIO2 estimates the extrinsic rotation online the same way, and LI-Init the time offset; at
+/// 11 rad/s a 2 ms offset turns a frame by 1.3°.
 /// - Propagation at every IMU sample (the mean of two consecutive samples held over their interval):
 ///     ω = ω_m − b_g,  a = R (f_m − b_a) + g,  p ← p + v dt + ½ a dt²,  v ← v + a dt,  R ← R Exp(ω dt),
 ///   and P ← F P Fᵀ + Q with the IMU's noise densities (FAST-LIO2 eqs. 2-8).
-/// - Every LiDAR point is moved to the IMU frame at its frame's end through the poses the
-///   propagation passed (backward propagation, FAST-LIO2 Sec. IV-C), the frame down-sampled on a
-///   voxel grid, then registered to the map: each point's five nearest map points define a plane
-///   (n, d) and the residual is n·(p + R q) + d (point to plane).
+/// - Every LiDAR point s, captured at its stamp minus t_d, is moved to the IMU frame at its frame's
+///   end, q = R_eᵀ (R_j (l + R_IL s) + p_j − p_e), through the poses the propagation passed
+///   (backward propagation, FAST-LIO2 Sec. IV-C), the frame down-sampled on a voxel grid, then
+///   registered to the map: each point's five nearest map points define a plane (n, d) and the
+///   residual is n·(p + R q) + d (point to plane), q linear in δφ and δt_d about the deskewing's.
 /// - The update is iterated (FAST-LIO2 eq. 18, a Gauss-Newton on the MAP cost): at the k-th
 ///   iterate x_k with e_k = x_k ⊟ x̂,
 ///     (P⁻¹ + Hᵀ R⁻¹ H) δ = −P⁻¹ e_k − Hᵀ R⁻¹ r_k,   x_{k+1} = x_k ⊞ δ,
@@ -46,6 +53,14 @@ struct LioOptions {
   /// hardware facts (the stack sets them from the vehicle's sensors).
   Vector3 imu_position_m = Vector3::Zero();
   Vector3 lidar_position_m = Vector3(0.0, 0.0, 0.06);
+  /// The LiDAR's calibration the filter estimates: prior stds of its axes' rotation from the
+  /// IMU's [rad] (> 0) and of its clock's offset [s] (> 0), and their random walks [rad/√s],
+  /// [s/√s] (>= 0). estimate_lidar_calibration false: both held at the mount as given.
+  bool estimate_lidar_calibration = true;
+  double lidar_rotation_std_rad = 0.02;
+  double lidar_time_offset_std_s = 0.005;
+  double lidar_rotation_random_walk = 1.0e-4;
+  double lidar_time_offset_random_walk = 1.0e-5;
   /// The noise the filter assumes, continuous-time densities. The accelerometer's is the
   /// airframe's vibration (a few tenths of m/s² at the rotor frequencies) more than the sensor's.
   double accel_noise_density = 0.1;        ///< [m/s²/√Hz], > 0
@@ -138,9 +153,13 @@ struct LioFrameSummary {
   double weakest_std_m = 0.0;
   int map_points_added = 0;
   long map_points = 0;
+  /// The LiDAR's calibration after the frame: its axes' rotation from the IMU's (rotation vector)
+  /// [rad] and its clock's offset [s].
+  Vector3 lidar_rotation_rad = Vector3::Zero();
+  double lidar_time_offset_s = 0.0;
 };
 
-/// The filter's state of the IMU's mounting point.
+/// The filter's state of the IMU's mounting point, and of the LiDAR's calibration.
 struct LioState {
   TimeNs t_ns = 0;
   Vector3 p_W = Vector3::Zero();
@@ -148,23 +167,33 @@ struct LioState {
   Vector3 v_W = Vector3::Zero();
   Vector3 gyro_bias = Vector3::Zero();
   Vector3 accel_bias = Vector3::Zero();
+  Quaternion q_IL = Quaternion::Identity();  ///< the LiDAR's axes in the IMU's
+  double lidar_time_offset_s = 0.0;          ///< the LiDAR's stamps minus its capture times [s]
 };
 
-using LioMatrix15 = Eigen::Matrix<double, 15, 15>;
+/// The error state's dimension and blocks.
+inline constexpr int kLioStates = 19;
+using LioMatrix = Eigen::Matrix<double, kLioStates, kLioStates>;
+using LioVector = Eigen::Matrix<double, kLioStates, 1>;
 
 namespace internal {
 /// One propagation step (the filter's mean and its error-state transition): `x` carried over dt
 /// with the IMU measurement (f_m, w_m) held, into `next`; F = ∂δx_next/∂δx into `F` if not null.
 void LioTransition(const LioState& x, const Vector3& f_m, const Vector3& w_m, double dt, LioState* next,
-                   LioMatrix15* F);
+                   LioMatrix* F);
 /// The row of ∂r/∂(δp, δθ) of the point-to-plane residual r = n·(p + R q) + d, R = R̂ Exp(δθ).
 Eigen::Matrix<double, 1, 6> PointToPlaneJacobian(const Vector3& n, const Matrix3& R, const Vector3& q);
+/// ∂r/∂(δφ, δt_d) of the same residual through q(δφ, δt_d) = q − M R_IL [s]× δφ − u δt_d: M the
+/// point's rotation from its capture to the frame's end (R_eᵀ R_j), s the point in the LiDAR's
+/// frame, u its velocity in the frame-end IMU frame from the body's motion at its capture.
+Eigen::Matrix<double, 1, 4> PointToPlaneCalibrationJacobian(const Vector3& n, const Matrix3& R, const Matrix3& M,
+                                                            const Matrix3& R_IL, const Vector3& s, const Vector3& u);
 }  // namespace internal
 
 class Lio {
  public:
-  using Matrix15 = LioMatrix15;
-  using Vector15 = Eigen::Matrix<double, 15, 1>;
+  using Matrix = LioMatrix;
+  using Vector = LioVector;
 
   /// `start_position_W` and `start_yaw_rad`: the body's (centre of gravity's) pose at the start,
   /// which defines the world frame; the vehicle is at rest there.
@@ -190,7 +219,7 @@ class Lio {
   /// through the samples since the last frame (on each call: no consumer needs it at the IMU rate,
   /// so the samples propagate the mean only).
   const LioState& state() const { return head_; }
-  Matrix15 covariance() const;
+  Matrix covariance() const;
   const PointMap& map() const { return map_; }
   const LioOptions& options() const { return options_; }
 
@@ -209,21 +238,27 @@ class Lio {
   StateEstimate BodyEstimate(const LioState& x, const Vector3& w_m) const;
   /// Propagates (x, P) from x->t_ns to t_ns with the measurement (f, w) held; P if not null,
   /// the pose at the start of the step into `poses` if not null.
-  void Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix15* P,
+  void Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix* P,
                  std::vector<Pose>* poses) const;
   /// Propagate over the interval between two consecutive samples, with their mean.
-  void PropagateBetween(const ImuSample& previous, const ImuSample& next, LioState* x, Matrix15* P,
+  void PropagateBetween(const ImuSample& previous, const ImuSample& next, LioState* x, Matrix* P,
                         std::vector<Pose>* poses) const;
   /// The filter (and its covariance, if P is not null) carried through the queued samples.
-  void PropagateQueue(LioState* x, Matrix15* P) const;
+  void PropagateQueue(LioState* x, Matrix* P) const;
   /// Takes the filter through the queued samples up to t_ns (the last interval held to t_ns).
   void AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses);
   /// Drops the kept poses a point at t_ns or later does not need.
   void DropPosesBefore(TimeNs t_ns);
   /// The head: the filter through the whole queue.
   void RebuildHead();
+  /// A deskewed point: q in the IMU frame at the frame's end, and what its calibration Jacobian
+  /// needs (internal::PointToPlaneCalibrationJacobian).
+  struct Deskewed {
+    Vector3 q, s, u;
+    Matrix3 M;
+  };
   /// Points of the frame in the IMU frame at its end, deskewed and down-sampled.
-  void DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Vector3>* out,
+  void DeskewAndDownsample(const LidarFrame& frame, const std::vector<Pose>& poses, std::vector<Deskewed>* out,
                            LioFrameSummary* summary);
   /// A point's plane in the map: n·y + d = 0, and the covariance of its fitted normal.
   struct Plane {
@@ -235,7 +270,7 @@ class Lio {
   /// The plane of each point of the frame placed with `x` that has one, into planes_.
   void FindPlanes(const std::vector<Vector3>& points_I, const LioState& x);
   /// The iterated update with the deskewed points; false if too few matched.
-  void Update(const std::vector<Vector3>& points_I, LioFrameSummary* summary);
+  void Update(const std::vector<Deskewed>& points, LioFrameSummary* summary);
 
   LioOptions options_;
   Vector3 start_position_W_;
@@ -244,7 +279,7 @@ class Lio {
   PointMap map_;
   bool started_ = false, initialised_ = false;
   LioState filter_;
-  Matrix15 filter_P_ = Matrix15::Zero();
+  Matrix filter_P_ = Matrix::Zero();
   ImuSample filter_imu_;         ///< the last sample the filter took (held beyond it)
   std::deque<ImuSample> queue_;  ///< samples after the filter's time, oldest first
   LioState head_;                ///< the filter through the queue (mean only)
@@ -252,13 +287,14 @@ class Lio {
   int frames_ = 0;
   // Scratch kept across frames (no allocation per frame once warm).
   std::vector<Pose> poses_;
+  std::vector<Deskewed> deskewed_;
   std::vector<Vector3> points_, neighbours_;
   std::vector<Plane> planes_;
   /// The down-sampling grid's cells: each one's point nearest its centre (squared distance in
   /// cells, and the point).
   struct CellBest {
     double d2;
-    Vector3 q;
+    Deskewed point;
   };
   CellIndex cell_index_;
   std::vector<CellBest> cell_best_;
@@ -268,6 +304,16 @@ template <typename Archive>
 void LioOptions::Serialize(Archive* a) {
   // The filter's noise: up to ten times the vibration of a badly balanced airframe (docs/truth.md)
   // over the sensors' own (sensors.imu); beyond, the IMU would tell it nothing.
+  a->Visit("estimate_lidar_calibration", &estimate_lidar_calibration,
+           {.meaning = "estimate the LiDAR's rotation from the IMU and its clock's offset in flight"});
+  a->Visit("lidar_rotation_std_rad", &lidar_rotation_std_rad,
+           {.meaning = "prior std of the LiDAR's axes' rotation from the IMU's [rad]", .max = 0.5, .positive = true});
+  a->Visit("lidar_time_offset_std_s", &lidar_time_offset_std_s,
+           {.meaning = "prior std of the LiDAR clock's offset [s]", .max = 0.05, .positive = true});
+  a->Visit("lidar_rotation_random_walk", &lidar_rotation_random_walk,
+           {.meaning = "random walk of the LiDAR's rotation [rad/√s]", .min = 0.0, .max = 0.1});
+  a->Visit("lidar_time_offset_random_walk", &lidar_time_offset_random_walk,
+           {.meaning = "random walk of the LiDAR clock's offset [s/√s]", .min = 0.0, .max = 0.01});
   a->Visit("accel_noise_density", &accel_noise_density,
            {.meaning = "accelerometer noise the filter assumes, vibration included [m/s²/√Hz]",
             .max = 10.0,

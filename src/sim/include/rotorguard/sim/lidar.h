@@ -33,6 +33,12 @@ struct LidarOptions {
   double dropout_probability = 0.01;  ///< chance a return is lost, in [0, 1)
   Vector3 position_m = Vector3(0.0, 0.0, 0.06);  ///< mounting point, body frame (axes aligned)
   double grid_cell_m = 1.0;                      ///< the boxes' ray-casting grid cell [m], > 0
+  /// Truth side (the scenario's truth, not sensor keys): the sensor's true mounting point from the
+  /// true centre of gravity (position_m is from the file's body frame: the simulator moves it by
+  /// the drawn offset), its axes' rotation from the body's, and the offset of its clock: a frame
+  /// captured over [t0, t1) is stamped [t0, t1) + clock_offset_s.
+  Quaternion rotation = Quaternion::Identity();
+  double clock_offset_s = 0.0;
   /// Throws ValidationError naming the field (SimulatorOptions prefixes "sensors.lidar.").
   void Validate() const;
   /// The keys of this struct in config files (core/config_schema.h).
@@ -84,7 +90,7 @@ class LidarSimulator {
   LidarSimulator(const LidarOptions& options, const World& world, std::uint64_t seed);
   /// Casts the pulses due in (t0, t1] from poses interpolated between `pose0` (at t0) and `pose1`
   /// (at t1): position linearly, attitude along the shortest arc. Returns a frame when t1 reaches
-  /// the end of one (at most one per call: steps are far shorter than frames).
+  /// the end of one as its stamps say (at most one per call: steps are far shorter than frames).
   std::optional<LidarFrame> Step(TimeNs t0, const BodyPose& pose0, TimeNs t1, const BodyPose& pose1);
   /// Pulses cast so far.
   std::uint64_t pulses() const { return next_pulse_; }
@@ -99,6 +105,9 @@ class LidarSimulator {
   TimeNs frame_ns_;
   std::uint64_t next_pulse_ = 0;
   LidarFrame frame_;
+  Matrix3 R_BS_ = Matrix3::Identity();    // the sensor's axes in the body's
+  TimeNs clock_offset_ns_ = 0;
+  std::optional<LidarFrame> held_;  // finished, waiting for its stamped end
 };
 
 }  // namespace rotorguard::sim

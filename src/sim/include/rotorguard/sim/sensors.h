@@ -32,6 +32,20 @@ struct ImuOptions {
   double vibration_m_s2 = 0.0;
   double vibration_reference_speed_rad_s = 1.0;
   double vibration_fault_factor = 10.0;
+  /// Beyond the in-plane shaking, as the amplitudes above scale: each rotor's force along its
+  /// axis at the blade-pass frequency (twice the rotor's, a two-bladed propeller) at the
+  /// accelerometer [m/s²].
+  double axial_vibration_m_s2 = 0.0;
+  /// The airframe's rocking that these forces make, from rigid-body mechanics: each rotor's
+  /// imbalance force m a at its hub r_i (rotor_positions_m, from the centre of gravity) turns the
+  /// airframe by I⁻¹ (r_i × m a); the gyro reads its integral at the force's frequency, the
+  /// accelerometer at `position_m` the tangential acceleration. Times gyro_vibration_gain (>= 0; 0
+  /// without rocking), for what a flexing frame adds. Needs airframe_mass_kg and the inverse
+  /// inertia (the truth's vehicle); empty rotor positions: no rocking.
+  double gyro_vibration_gain = 0.0;
+  std::vector<Vector3> rotor_positions_m;
+  double airframe_mass_kg = 1.0;
+  Matrix3 airframe_inverse_inertia = Matrix3::Identity();
   void Validate(double physics_rate_hz) const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
@@ -74,6 +88,9 @@ struct EscOptions {
   /// frame is lost (a CRC error on the wire), in [0, 1).
   std::vector<double> gain;
   double dropout_probability = 0.0;
+  /// Truth side: from a command's arrival at the ESCs to the motors acting on it [s], in [0, 0.5)
+  /// (the command protocol's frame, the ESC's own loop; Simulator::Send).
+  double command_latency_s = 0.0;
   void Validate(double physics_rate_hz) const;
   /// The keys of this struct in config files (core/config_schema.h).
   template <typename Archive>
@@ -126,6 +143,9 @@ struct OdometryOptions {
   double feature_range_m = 20.0;
   double outage_rate_hz = 0.0;
   double outage_min_s = 0.05, outage_max_s = 0.3;
+  /// Truth side: where the vehicle file's body frame (the frame whose pose a front end reports)
+  /// has its origin, from the true centre of gravity, body frame [m]: minus the drawn offset.
+  Vector3 body_origin_m = Vector3::Zero();
   /// Whether time t [s] lies in an outage.
   bool InOutage(double t) const;
   void Validate(double physics_rate_hz) const;
@@ -163,13 +183,15 @@ class ImuModel {
   const Vector3& gyro_bias() const { return gyro_bias_; }
 
  private:
-  /// The vibration at the accelerometer now, each rotor's phase advanced by one sample.
-  Vector3 Vibration(const TruthSample& truth);
+  /// The airframe's vibration now, added to the accelerometer and the gyro, each rotor's phase
+  /// advanced by one sample.
+  void AddVibration(const TruthSample& truth, ImuSample* sample);
 
   ImuOptions options_;
   Rng rng_;
   double dt_;
   Vector3 accel_bias_, gyro_bias_;
+  bool vibrates_ = false;
   std::vector<double> rotor_phase_;  ///< each rotor's angle [rad], for the vibration
 };
 

@@ -2,6 +2,7 @@
 /// The simulator: truth dynamics at the physics rate (RK4), motors and injected faults, wind,
 /// ground contact, collisions, and the sensors at their own rates. Bit-for-bit deterministic for
 /// a seed; never reads the wall clock.
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -55,8 +56,19 @@ class Simulator {
   Simulator(const vehicle::MultirotorModel& model, World world, std::vector<FaultSpec> faults,
             const SimulatorOptions& options, std::uint64_t seed, const vehicle::StateVector& initial);
 
-  /// Advances one physics step holding `command` (thrust per rotor [N]); returns the sensor
+  /// Commands that can wait for their instant at once (a ring: nothing allocated in flight).
+  static constexpr int kCommandQueue = 32;
+
+  /// Hands `command` (thrust per rotor [N]) to the ESCs at time `sent_ns`, at or after the current
+  /// time: the motors act on it `sensors.esc` command latency later, switching at that instant
+  /// within a physics step (not rounded to the step). Commands act in the order they are sent: one
+  /// sent before a queued one's instant waits for it. At most kCommandQueue wait; sending more
+  /// makes the oldest act at once (counted by commands_overrun()).
+  void Send(const RotorCommand& command, TimeNs sent_ns);
+  /// Advances one physics step, each command sent acting from its instant on; returns the sensor
   /// messages due at the new time. Does nothing once crashed.
+  const SensorOutputs& Step();
+  /// Send(command, time_ns()) and Step(): without an ESC latency, `command` holds over the step.
   const SensorOutputs& Step(const RotorCommand& command);
 
   /// Sensor messages of the latest step (at construction: those sampled at t = 0).
@@ -71,8 +83,10 @@ class Simulator {
   /// Thrust each rotor applies now [N], and each motor's speed [rad/s].
   const RotorVector& rotor_thrusts() const { return thrust_; }
   const RotorVector& motor_speeds() const { return speed_; }
-  /// Commands after saturation to [0, T_bar], as the motors see them.
+  /// Commands after saturation to [0, T_bar], as the motors see them (the one acting now).
   const RotorVector& applied_command() const { return command_; }
+  /// Commands that had to act early because kCommandQueue were waiting.
+  std::uint64_t commands_overrun() const { return commands_overrun_; }
   const Vector3& wind() const { return wind_.velocity(); }
   const World& world() const { return world_; }
   bool landed() const { return landed_; }
@@ -89,6 +103,17 @@ class Simulator {
   /// Validates before any member is built from the options (throws ValidationError).
   static const SimulatorOptions& Validated(const SimulatorOptions& options,
                                            const vehicle::VehicleParams& vehicle);
+  /// The waiting commands whose instant has come (at or before t) act, in order.
+  void ActivateCommands(TimeNs t);
+
+  struct SentCommand {
+    TimeNs acts_ns = 0;
+    RotorVector thrust_n;
+  };
+  std::array<SentCommand, kCommandQueue> queue_;
+  int queue_head_ = 0, queue_size_ = 0;
+  TimeNs command_latency_ns_ = 0;
+  std::uint64_t commands_overrun_ = 0;
 
   const vehicle::MultirotorModel& model_;
   World world_;

@@ -53,6 +53,25 @@ struct TruthRanges {
   double odometry_yaw_drift_rad_per_sqrt_s = 0.0;
   double odometry_few_features_gain = 0.0;
   double odometry_outage_rate_hz = 0.0;
+  /// The loop's delays: a control cycle's computation (from the sensor data it starts from to its
+  /// command leaving the computer) drawn uniformly in [min, max] per flight, and each cycle's
+  /// within (1 ± jitter) of it; the ESCs' command latency (from a command's arrival to the motors
+  /// acting on it) drawn uniformly in [min, max] per flight [s].
+  double computation_delay_min_s = 0.0, computation_delay_max_s = 0.0;
+  double computation_delay_jitter_fraction = 0.0;
+  double esc_command_latency_min_s = 0.0, esc_command_latency_max_s = 0.0;
+  /// The sensors' own departures: each IMU noise density (accelerometer, gyro) drawn in
+  /// (1 ± a) times the scenario's; the LiDAR's axes turned by up to ± a about each body axis
+  /// [rad]; its clock offset by ± a [s].
+  double imu_noise_fraction = 0.0;
+  double lidar_rotation_rad = 0.0;
+  double lidar_clock_offset_s = 0.0;
+  /// Vibration beyond imu_vibration_m_s2's in-plane one, per healthy rotor at hover speed, drawn
+  /// in [a/2, a]: along the rotor axis at the blade-pass frequency (twice the rotor's) at the
+  /// accelerometer [m/s²]; and the airframe's rocking these forces make (rigid-body mechanics,
+  /// ImuOptions) times a frame's flex, drawn in [1, a] (0: no rocking).
+  double imu_axial_vibration_m_s2 = 0.0;
+  double gyro_vibration_gain = 0.0;
 };
 
 /// The ranges of a preset.
@@ -65,7 +84,10 @@ struct TruthOptions {
       yaw_coefficient_fraction, motor_time_constant_fraction, rotor_drag_fraction, imu_offset_m, external_torque_n_m,
       motor_stop_time_constant_min_s, motor_stop_time_constant_max_s, imu_vibration_m_s2, esc_gain_fraction,
       esc_dropout_probability, odometry_latency_min_s, odometry_latency_max_s, odometry_drift_m_per_sqrt_s,
-      odometry_yaw_drift_rad_per_sqrt_s, odometry_few_features_gain, odometry_outage_rate_hz;
+      odometry_yaw_drift_rad_per_sqrt_s, odometry_few_features_gain, odometry_outage_rate_hz,
+      computation_delay_min_s, computation_delay_max_s, computation_delay_jitter_fraction, esc_command_latency_min_s,
+      esc_command_latency_max_s, imu_noise_fraction, lidar_rotation_rad, lidar_clock_offset_s,
+      imu_axial_vibration_m_s2, gyro_vibration_gain;
 
   /// The preset's ranges with the overrides applied.
   TruthRanges Ranges() const;
@@ -77,9 +99,9 @@ struct TruthOptions {
 };
 
 /// One override of the truth block: its key (the field's name), what it accepts and means, and
-/// the range it replaces; none for the two ends of the stop time constant's and of the odometry
-/// latency's interval, which replace their interval together (TruthOptions::Ranges). The keys, the
-/// loader and Ranges() all follow this list.
+/// the range it replaces; none for the two ends of an interval (the stop time constant's, the
+/// odometry latency's, the loop's delays'), which replace their interval together
+/// (TruthOptions::Ranges). The keys, the loader and Ranges() all follow this list.
 struct TruthOverrideKey {
   const char* key;
   std::optional<double> TruthOptions::*override;
@@ -183,6 +205,60 @@ inline constexpr TruthOverrideKey kTruthOverrideKeys[] = {
      &TruthOptions::odometry_outage_rate_hz,
      &TruthRanges::odometry_outage_rate_hz,
      {.meaning = "the odometry loses track for 0.05-0.3 s this often on average [1/s]", .min = 0, .max = 1}},
+    {"computation_delay_min_s",
+     &TruthOptions::computation_delay_min_s,
+     nullptr,
+     {.meaning = "a control cycle's command leaves the computer this long after its instant, drawn uniformly in "
+                 "[min, max] per flight [s] (sim.computation_delay: measured uses the stack's own time instead)",
+      .min = 0,
+      .max = 0.1}},
+    {"computation_delay_max_s",
+     &TruthOptions::computation_delay_max_s,
+     nullptr,
+     {.meaning = "(set both or neither)", .min = 0, .max = 0.1}},
+    {"computation_delay_jitter_fraction",
+     &TruthOptions::computation_delay_jitter_fraction,
+     &TruthRanges::computation_delay_jitter_fraction,
+     {.meaning = "each cycle's computation delay drawn in (1 ± a) times the flight's", .min = 0, .max = 1}},
+    {"esc_command_latency_min_s",
+     &TruthOptions::esc_command_latency_min_s,
+     nullptr,
+     {.meaning = "the motors act on a command this long after it reaches the ESCs, drawn uniformly in [min, max] "
+                 "per flight [s]",
+      .min = 0,
+      .max = 0.1}},
+    {"esc_command_latency_max_s",
+     &TruthOptions::esc_command_latency_max_s,
+     nullptr,
+     {.meaning = "(set both or neither)", .min = 0, .max = 0.1}},
+    {"imu_noise_fraction",
+     &TruthOptions::imu_noise_fraction,
+     &TruthRanges::imu_noise_fraction,
+     {.meaning = "each IMU noise density (accelerometer, gyro) drawn in (1 ± a) times the sensors.imu one",
+      .min = 0,
+      .max = 0.9}},
+    {"lidar_rotation_rad",
+     &TruthOptions::lidar_rotation_rad,
+     &TruthRanges::lidar_rotation_rad,
+     {.meaning = "the LiDAR's axes turned from the body's by ± a about each axis [rad]", .min = 0, .max = 0.2}},
+    {"lidar_clock_offset_s",
+     &TruthOptions::lidar_clock_offset_s,
+     &TruthRanges::lidar_clock_offset_s,
+     {.meaning = "the LiDAR's stamps off its capture times by ± a [s]", .min = 0, .max = 0.02}},
+    {"imu_axial_vibration_m_s2",
+     &TruthOptions::imu_axial_vibration_m_s2,
+     &TruthRanges::imu_axial_vibration_m_s2,
+     {.meaning = "each healthy rotor's vibration along its axis at the blade-pass frequency, at the accelerometer "
+                 "at hover speed, drawn in [a/2, a] [m/s²]; ten times more after a propeller loss or damage",
+      .min = 0,
+      .max = 20}},
+    {"gyro_vibration_gain",
+     &TruthOptions::gyro_vibration_gain,
+     &TruthRanges::gyro_vibration_gain,
+     {.meaning = "the airframe's rocking at the gyro, the vibration forces' rigid-body moment times a frame flex "
+                 "drawn in [1, a] (0: none)",
+      .min = 0,
+      .max = 100}},
 };
 
 template <typename Archive>
@@ -215,6 +291,15 @@ struct TruthDraw {
   double odometry_yaw_drift_rad_per_sqrt_s = 0.0;  ///< OdometryOptions::yaw_drift_rad_per_sqrt_s
   double odometry_few_features_gain = 0.0;         ///< OdometryOptions::few_features_gain
   double odometry_outage_rate_hz = 0.0;            ///< OdometryOptions::outage_rate_hz
+  double computation_delay_s = 0.0;                ///< a control cycle's computation, the flight's [s]
+  double computation_delay_jitter_fraction = 0.0;  ///< each cycle's: (1 ± this) times the flight's
+  double esc_command_latency_s = 0.0;              ///< EscOptions::command_latency_s
+  double imu_accel_noise_ratio = 1.0;              ///< true / the scenario's accelerometer noise density
+  double imu_gyro_noise_ratio = 1.0;               ///< true / the scenario's gyro noise density
+  Vector3 lidar_rotation_rad = Vector3::Zero();    ///< the LiDAR's axes: rotation vector from the body's
+  double lidar_clock_offset_s = 0.0;               ///< LidarOptions::clock_offset_s
+  double imu_axial_vibration_m_s2 = 0.0;           ///< ImuOptions::axial_vibration_m_s2
+  double gyro_vibration_gain = 0.0;                ///< ImuOptions::gyro_vibration_gain
 
   /// summary.json's "truth" object.
   template <typename Archive>
@@ -245,6 +330,23 @@ struct TruthDraw {
              {.meaning = "growth of odometry noise and drift with no obstacle in view"});
     a->Visit("odometry_outage_rate_hz", &odometry_outage_rate_hz,
              {.meaning = "how often the odometry loses track [1/s]"});
+    a->Visit("computation_delay_s", &computation_delay_s,
+             {.meaning = "a control cycle's computation delay, the flight's mean [s]"});
+    a->Visit("computation_delay_jitter_fraction", &computation_delay_jitter_fraction,
+             {.meaning = "each cycle's computation delay lies within (1 ± this) of the mean"});
+    a->Visit("esc_command_latency_s", &esc_command_latency_s,
+             {.meaning = "from a command's arrival at the ESCs to the motors acting on it [s]"});
+    a->Visit("imu_accel_noise_ratio", &imu_accel_noise_ratio,
+             {.meaning = "true accelerometer noise density / the scenario's"});
+    a->Visit("imu_gyro_noise_ratio", &imu_gyro_noise_ratio, {.meaning = "true gyro noise density / the scenario's"});
+    a->Visit("lidar_rotation_rad", &lidar_rotation_rad,
+             {.meaning = "the LiDAR's axes: rotation vector from the body's [rad]"});
+    a->Visit("lidar_clock_offset_s", &lidar_clock_offset_s,
+             {.meaning = "the LiDAR's stamps minus its capture times [s]"});
+    a->Visit("imu_axial_vibration_m_s2", &imu_axial_vibration_m_s2,
+             {.meaning = "a healthy rotor's axial vibration at hover speed, blade-pass frequency [m/s²]"});
+    a->Visit("gyro_vibration_gain", &gyro_vibration_gain,
+             {.meaning = "the airframe's rocking over the vibration forces' rigid-body moment"});
   }
 };
 
@@ -268,9 +370,11 @@ vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const Tr
 /// same speed (MultirotorModel's thrust_ratio).
 RotorVector ThrustRatios(const TruthDraw& draw);
 
-/// The scenario's simulator options with the sensors and disturbances of `draw`: the IMU where it
-/// really is about the true centre of gravity and its vibration (given at `file`'s hover speed),
-/// the external torque, the ESC's gains and lost frames, the odometry's latency, drift and outages.
+/// The scenario's simulator options with the sensors and disturbances of `draw`: the IMU and the
+/// LiDAR where they really are about the true centre of gravity (the LiDAR turned and its clock
+/// off), the IMU's noise and vibration (given at `file`'s hover speed), the external torque, the
+/// ESC's gains, lost frames and command latency, the odometry's latency, drift and outages and the
+/// frame whose pose it reports (the file's body frame).
 SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const vehicle::VehicleParams& file,
                                        const TruthDraw& draw);
 

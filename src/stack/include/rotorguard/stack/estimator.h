@@ -126,6 +126,10 @@ struct LioSummary {
   /// at every sample, is not in it).
   double frame_ms_mean = 0.0, frame_ms_p99 = 0.0;
   long map_points = 0;  ///< at the end
+  /// The LiDAR's calibration the odometry learnt, at the end: its axes' rotation from the IMU's
+  /// (rotation vector) [rad] and its clock's offset [s].
+  Vector3 lidar_rotation_rad = Vector3::Zero();
+  double lidar_time_offset_s = 0.0;
   /// The threshold the frames were judged degenerate by (LioOptions::degenerate_std_m), for
   /// whoever reads their weakest-direction stds (the log's lio_weakest_std_m).
   double degenerate_std_m = 0.0;

@@ -28,6 +28,7 @@
 #include "rotorguard/planning/references.h"
 #include "rotorguard/planning/replanner.h"
 #include "rotorguard/stack/estimator.h"
+#include "rotorguard/core/rpm_notch.h"
 #include "rotorguard/stack/supervisor.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -163,6 +164,11 @@ struct NavigationOptions {
 
 struct FlightStackOptions {
   double control_rate_hz = 200.0;  ///< controller rate (paper 000: 200 Hz), in [kMinRateHz, kMaxRateHz]
+  /// The delay the stack expects from a control cycle's instant to its command acting on the motors
+  /// (the cycle's computation and the ESCs' latency) [s]: the NMPC predicts its start over it and
+  /// the fault detectors model the motors as acting on a command then. 3 ms: paper 000's NMPC takes
+  /// 1.88 ms on its Jetson, an ESC about 1 ms.
+  double command_delay_s = 0.003;
   /// The assembly controller is built by the caller and handed to the FlightStack.
   ControllerKind controller = ControllerKind::kNominal;
   control::NominalControllerOptions nominal;
@@ -186,6 +192,8 @@ struct FlightStackOptions {
   NavigationOptions navigation;
   EstimatorOptions estimator;
   SupervisorOptions supervisor;
+  /// The IMU's vibration notches on the rotors' telemetry (sample_rate_hz set from the sensors).
+  RpmNotchOptions imu_notch;
   /// Throws ValidationError naming the field.
   void Validate() const;
 
@@ -205,6 +213,11 @@ void FlightStackOptions::Serialize(Archive* a) {
   a->Visit(
       "control_rate_hz", &control_rate_hz,
       {.meaning = "the controller's rate [Hz], at most sim.physics_rate_hz", .min = kMinRateHz, .max = kMaxRateHz});
+  a->Visit("command_delay_s", &command_delay_s,
+           {.meaning = "the delay expected from a cycle's instant to its command acting on the motors [s]: the NMPC "
+                       "predicts over it, the fault detectors' motor models wait it (docs/control.md, \"Delay\")",
+            .min = 0.0,
+            .max = 0.1});
   a->Visit("nominal", &nominal, {.meaning = "the nominal cascade's gains"});
   a->Visit("passive", &passive, {.meaning = "the passive controller: stack.nominal's position gains and its own"});
   // INDI's filters are checked against the control rate it samples at.
@@ -218,6 +231,8 @@ void FlightStackOptions::Serialize(Archive* a) {
   a->Visit("estimator", &estimator,
            {.meaning = "where the stack's pose comes from (docs/navigation.md)", .shorthand = "kind"});
   a->Visit("supervisor", &supervisor, {.meaning = "flight modes and emergency landing (docs/navigation.md)"});
+  a->Visit("imu_notch", &imu_notch,
+           {.meaning = "notches on the IMU at the rotors' frequencies from their telemetry (docs/navigation.md)"});
   a->Visit("planner", &navigation,
            {.meaning = "the navigate mission's planner (docs/planning.md)", .shorthand = "method"}, [this] {
              navigation.replanner.WidenPlaneSearch();
@@ -406,6 +421,8 @@ class FlightStack {
   StateEstimate estimate_;
   ReferencePoint reference_point_;
   RotorCommand command_;
+  RpmNotchBank<6> imu_filter_;  // the IMU's vibration notches, for the FDD and the controller's rates
+  Vector3 rate_notch_correction_ = Vector3::Zero();  // the latest gyro sample's notched minus raw
 };
 
 }  // namespace rotorguard::stack
