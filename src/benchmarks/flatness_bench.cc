@@ -112,13 +112,13 @@ campaign::Campaign FlatnessCampaign(const FlatnessBenchOptions& o) {
   c.metrics = {"success", "w_estimate", "settle_s", "detect_s", "replanned", "replan_ts_s", "fault_free_tilt_deg"};
   const nlohmann::json options = {
       {"trials", o.trials}, {"seed", o.seed}, {"scenario", o.fig2.name}, {"truth", ToName(o.truth)}};
-  c.bench = {{"name", "flatness"}, {"records", 1}, {"options", options}};
+  c.bench = {{"name", "flatness"}, {"records", 1}, {"options", options}, {"seed_stream", "bench flatness"}};
   c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::ScenarioFingerprint(o.fig2));
   c.parameters = [o](int index) -> std::map<std::string, std::string> {
     if (index == 0) return {{"part", "fig1"}, {"seed", std::to_string(o.seed)}};
     return {{"part", "fig2"},
             {"trial", std::to_string(index - 1)},
-            {"seed", std::to_string(o.seed + static_cast<std::uint64_t>(index - 1))}};
+            {"seed", std::to_string(TrialSeed(o.seed, "bench flatness", static_cast<std::uint64_t>(index - 1)))}};
   };
   harness::Scenario fig2 = o.fig2;
   fig2.truth.preset = o.truth;

@@ -46,8 +46,9 @@ struct Cell {
   const char* kind = "none";  // the injected vehicle::FaultKind
   double eta = 0.0;           // loss_of_effectiveness only
   bool intermittent = false;  // on 0.5 s, off 0.5 s from the onset
-  // A second failure, a propeller loss 2.5-3.5 s after the first: on the first rotor's diagonal
-  // twin ("twin") or on a rotor beside it ("adjacent"); nullptr: none.
+  // A second failure, a propeller loss 0.1-6 s after the first (reported by when it came after the
+  // first one's isolation: kSecondOnsetBinEdges): on the first rotor's diagonal twin ("twin") or on
+  // a rotor beside it ("adjacent"); nullptr: none.
   const char* second = nullptr;
 };
 
@@ -174,8 +175,11 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     sim::FaultSpec f;
     f.rotor = pick;
     f.kind = vehicle::FaultKind::kPropellerLoss;
-    f.onset = {sim::FaultOnset::Kind::kAtTime, onset.value + 2.5 + rng.Uniform()};
+    f.onset = {sim::FaultOnset::Kind::kAtTime, onset.value + rng.Uniform(0.1, 6.0)};
     s.faults.push_back(f);
+    // Flown for 3 s after it, settling window included.
+    s.duration_s = std::max(s.duration_s, f.onset.value + 3.0);
+    s.tracking_start_s = s.duration_s - 3.0;
   }
   if (o.fdd) s.stack.composite_fdd = *o.fdd;
   if (o.estimator == stack::EstimatorKind::kLio) {
@@ -197,7 +201,10 @@ nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v)
 
 nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty, bool with_second) {
   std::vector<double> latencies, final_rmse, eta_errors, second_latencies, crash_speeds;
-  int second_correct = 0;
+  int second_correct = 0, healthy_isolated = 0;
+  // Per bin of the second onset after the first isolation: trials, and second failures isolated.
+  constexpr int kBins = static_cast<int>(std::size(kSecondOnsetBinEdges)) - 1;
+  std::array<int, kBins> bin_trials{}, bin_isolated{};
   int success = 0, missed = 0, false_alarms = 0, with_fdd = 0;
   double min_alt = std::numeric_limits<double>::infinity();
   campaign::FailureList failures(5);  // the first few, to reproduce them
@@ -213,6 +220,16 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
       ++second_correct;
       second_latencies.push_back(r.second_latency_s);
     }
+    if (r.correct && r.healthy_rotors_isolated > 0) ++healthy_isolated;
+    if (std::isfinite(r.second_after_isolation_s)) {
+      for (int b = 0; b < kBins; ++b) {
+        if (r.second_after_isolation_s < kSecondOnsetBinEdges[b + 1] || b + 1 == kBins) {
+          ++bin_trials[static_cast<std::size_t>(b)];
+          bin_isolated[static_cast<std::size_t>(b)] += r.second_correct ? 1 : 0;
+          break;
+        }
+      }
+    }
     if (!r.has_fdd) continue;
     ++with_fdd;
     false_alarms += r.false_alarm ? 1 : 0;
@@ -222,6 +239,14 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
   }
   const double n = static_cast<double>(trials.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  nlohmann::json bins = nlohmann::json::array();
+  for (int b = 0; with_second && b < kBins; ++b) {
+    const int k = bin_trials[static_cast<std::size_t>(b)];
+    bins.push_back({{"from_s", kSecondOnsetBinEdges[b]},
+                    {"to_s", kSecondOnsetBinEdges[b + 1]},
+                    {"trials", k},
+                    {"isolated", NullIfNan(k > 0 ? bin_isolated[static_cast<std::size_t>(b)] / static_cast<double>(k) : nan)}});
+  }
   return {
       {"trials", trials.size()},
       {"fdd_latency_s_mean", NullIfNan(latencies.empty() ? nan : Mean(latencies))},
@@ -235,6 +260,9 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
       {"eta_error_max", NullIfNan(eta_errors.empty() ? nan : *std::max_element(eta_errors.begin(), eta_errors.end()))},
       {"second_isolated", NullIfNan(with_second ? second_correct / n : nan)},
       {"second_latency_s_median", NullIfNan(second_latencies.empty() ? nan : Percentile(second_latencies, 0.5))},
+      {"second_by_onset_after_isolation", bins},
+      // A rotor isolated without a fault of its own after a correct first isolation.
+      {"false_second_isolations", with_fdd > 0 && faulty ? nlohmann::json(healthy_isolated) : nlohmann::json(nullptr)},
       {"crashes", crash_speeds.size()},
       {"crash_speed_m_s_median", NullIfNan(crash_speeds.empty() ? nan : Percentile(crash_speeds, 0.5))},
       {"crash_speed_m_s_max",
@@ -308,8 +336,9 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   c.seed = o.seed;
   c.trials = static_cast<int>(cells.size()) * methods * o.trials;
   c.group_keys = {"phase", "fault", "method"};
-  c.metrics = {"success",      "correct",   "false_alarm",    "latency_s",        "altitude_change_m",
-               "final_rmse_m", "eta_error", "second_correct", "second_latency_s", "crash_speed_m_s"};
+  c.metrics = {"success",          "correct",          "false_alarm",        "latency_s",
+               "altitude_change_m", "final_rmse_m",     "eta_error",          "second_correct",
+               "second_latency_s",  "crash_speed_m_s",  "second_after_isolation_s", "healthy_rotors_isolated"};
   nlohmann::json options = {{"trials", o.trials},
                             {"seed", o.seed},
                             {"methods", o.methods},
@@ -319,7 +348,8 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   if (o.estimator != stack::EstimatorKind::kOdometry) options["estimator"] = ToName(o.estimator);
   if (o.fdd) options["fdd"] = io::ToJson(*o.fdd);  // the vehicle's own thresholds: another campaign
   if (cells.size() < static_cast<std::size_t>(kNumCells)) options["cells"] = o.cells;  // all: as before cells existed
-  c.bench = {{"name", "ftc"}, {"options", options}};
+  // The trials' seed stream in the fingerprint: folders flown on other seeds neither resume nor merge.
+  c.bench = {{"name", "ftc"}, {"options", options}, {"seed_stream", "bench ftc"}};
   c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::VehicleToYaml(o.vehicle));
   // Trial index = (cell, method, trial), the trial fastest. Every method flies the same draws: the
   // seed depends on the cell and trial only.
@@ -329,7 +359,7 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   };
   c.parameters = [o, decompose](int index) {
     const auto [cell, method, trial] = decompose(index);
-    const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
+    const std::uint64_t seed = TrialSeed(o.seed, "bench ftc", static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
     return std::map<std::string, std::string>{{"test", kCells[cell].test},   {"phase", kCells[cell].phase},
                                               {"fault", kCells[cell].fault}, {"method", o.methods[method]},
                                               {"trial", std::to_string(trial)}, {"seed", std::to_string(seed)}};
@@ -361,10 +391,17 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
       out.metrics["correct"] = s.fdd->correct;
       out.metrics["false_alarm"] = s.fdd->false_alarm;
       out.metrics["latency_s"] = s.fdd->latency_s ? nlohmann::json(*s.fdd->latency_s) : nlohmann::json(nullptr);
+      out.metrics["healthy_rotors_isolated"] = s.fdd->healthy_rotors_isolated;
       if (s.fdd->second) {
         out.metrics["second_correct"] = s.fdd->second->correct;
         out.metrics["second_latency_s"] =
             s.fdd->second->latency_s ? nlohmann::json(*s.fdd->second->latency_s) : nlohmann::json(nullptr);
+        // When the second onset came after the first failure's isolation (the detector's blind
+        // time, if it has one, starts there).
+        const bool first_isolated = s.fdd->correct && s.fdd->diagnosis;
+        out.metrics["second_after_isolation_s"] =
+            first_isolated && s.faults.size() >= 2 ? nlohmann::json(s.faults[1].onset_s - s.fdd->diagnosis->detection_s)
+                                                   : nlohmann::json(nullptr);
       }
     }
     out.message = s.failure_reason.value_or("");
@@ -415,6 +452,8 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         trial.eta_error = number("eta_error");
         trial.crash_speed_m_s = number("crash_speed_m_s");
         trial.second_latency_s = number("second_latency_s");
+        trial.second_after_isolation_s = number("second_after_isolation_s");
+        if (x.contains("healthy_rotors_isolated")) trial.healthy_rotors_isolated = x.at("healthy_rotors_isolated").get<int>();
         if (x.contains("second_correct")) trial.second_correct = x.at("second_correct").get<bool>();
         if (x.contains("correct")) {
           trial.has_fdd = true;
@@ -511,6 +550,7 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                         {"|η̂ − η| max", "eta_error_max", "{:.3f}", 1.0, "none", true},
                         {"second failure isolated (%)", "second_isolated", "{:.1f}", 100.0, "none", true},
                         {"second failure latency median (s)", "second_latency_s_median", "{:.3f}", 1.0, "none", true},
+                        {"false second isolations (trials)", "false_second_isolations", "{:.0f}", 1.0, "none", true},
                         {"impact speed median (m/s)", "crash_speed_m_s_median", "{:.2f}", 1.0, "none", true},
                         {"impact speed max (m/s)", "crash_speed_m_s_max", "{:.2f}", 1.0, "none", true}};
     for (const Row& row : rows) {
@@ -530,6 +570,17 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                                 : test == "+"   ? ""
                                                 : Paper(phase, fault, row.paper);
       out += line + " " + paper + " |\n";
+    }
+    // A second failure's isolation by when it came after the first one's isolation.
+    for (std::size_t b = 0; b < c0["second_by_onset_after_isolation"].size(); ++b) {
+      const nlohmann::json& bin0 = c0["second_by_onset_after_isolation"][b];
+      std::string line = fmt::format("| {} | {} | {} | second isolated, onset {:g}-{:g} s after the first isolation (%) |",
+                                     test, phase, fault, bin0["from_s"].get<double>(), bin0["to_s"].get<double>());
+      for (const auto& m : methods) {
+        const nlohmann::json bin = cell(phase, fault, m)["second_by_onset_after_isolation"][b];  // a copy: cell() is a temporary
+        line += fmt::format(" {} (of {}) |", Fmt(bin["isolated"], "{:.1f}", 100.0), bin["trials"].get<int>());
+      }
+      out += line + "  |\n";
     }
   }
   return out;

@@ -267,7 +267,7 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
   // under the same yaw-rate limit (v3: one plan per row and planner, a crashed flight's wreck held
   // over the plan's window; v1: to the crash; v2: scored over the window of the plan the scene was
   // loaded with).
-  c.bench = {{"name", "mars"}, {"records", 4}, {"options", options}};
+  c.bench = {{"name", "mars"}, {"records", 4}, {"options", options}, {"seed_stream", "bench mars"}};
   std::string inputs = c.bench.dump() + "\n" + harness::ScenarioFingerprint(o.spiral) + harness::VehicleToYaml(o.nine_units.vehicle);
   if (reconfig) inputs += harness::ScenarioFingerprint(o.reconfigure);
   if (table2) inputs += harness::ScenarioFingerprint(o.plan_4x1) + harness::ScenarioFingerprint(o.plan_3x2);
@@ -277,7 +277,7 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
     if (index == 0) return {{"part", "alloc"}, {"seed", std::to_string(o.seed)}};
     int k = index - 1;
     // Every row and method flies the same seeds: the rows differ by their faults only.
-    const auto seed = [&](int trial) { return std::to_string(o.seed + static_cast<std::uint64_t>(trial)); };
+    const auto seed = [&](int trial) { return std::to_string(TrialSeed(o.seed, "bench mars", static_cast<std::uint64_t>(trial))); };
     if (k < n1) {
       const int trial = k % trials, method = (k / trials) % static_cast<int>(kMethods.size());
       const int row = k / (trials * static_cast<int>(kMethods.size()));

@@ -183,13 +183,13 @@ campaign::Campaign NavCampaign(const NavBenchOptions& o) {
                                   {"truth", ToName(o.truth)}, {"estimator", ToName(o.estimator)}};
   // "records": what a trial records. Version 2 made realtime_factor the stack's and added
   // trial_realtime_factor; the hash then refuses to resume or merge the folders of version 1.
-  c.bench = {{"name", "nav"}, {"records", 2}, {"options", options}};
+  c.bench = {{"name", "nav"}, {"records", 2}, {"options", options}, {"seed_stream", "bench nav"}};
   c.hash = campaign::Fingerprint(c.bench.dump() + "\n" + harness::ScenarioFingerprint(o.base));
   // Trial index = (kind, trial, variant), the variant fastest: both variants fly the same world,
   // fault and noise (the seed depends on the kind and trial only).
   c.parameters = [o](int index) {
     const int kind = index / (2 * o.trials), trial = (index / 2) % o.trials;
-    const std::uint64_t seed = DeriveSeed(o.seed, static_cast<std::uint64_t>(kind) * 1'000'003ull + trial);
+    const std::uint64_t seed = TrialSeed(o.seed, "bench nav", static_cast<std::uint64_t>(kind) * 1'000'003ull + trial);
     return std::map<std::string, std::string>{{"kind", o.kinds[static_cast<std::size_t>(kind)]},
                                               {"variant", kVariants[index % 2]},
                                               {"trial", std::to_string(trial)},

@@ -99,7 +99,9 @@ CampaignSpec LoadCampaignSpec(const io::ConfigNode& root, const std::string& pat
   spec.scenario = fs::weakly_canonical(fs::absolute(fs::path(path).parent_path() / scenario.AsString())).string();
   if (const auto s = root.Optional("seed")) spec.seed = s->AsUint64();
   if (const auto r = root.Optional("repeats")) spec.repeats = static_cast<int>(r->AsIntIn(1, 10'000'000));
-  nlohmann::json canonical = {{"name", spec.name}, {"seed", spec.seed}, {"repeats", spec.repeats}};
+  // The trials' seeds come from the stream named after the campaign (TrialParameters).
+  nlohmann::json canonical = {
+      {"name", spec.name}, {"seed", spec.seed}, {"repeats", spec.repeats}, {"seed_stream", "campaign " + spec.name}};
   if (const auto grid = root.Optional("grid")) {
     for (const std::string& key : grid->Keys()) {
       const io::ConfigNode values = grid->Required(key);
@@ -196,7 +198,7 @@ std::map<std::string, std::string> TrialParameters(const CampaignSpec& spec, int
     p[it->first] = it->second[static_cast<std::size_t>(point % n)];
     point /= n;
   }
-  const std::uint64_t seed = DeriveSeed(spec.seed, static_cast<std::uint64_t>(index));
+  const std::uint64_t seed = TrialSeed(spec.seed, "campaign " + spec.name, static_cast<std::uint64_t>(index));
   Rng draws(DeriveSeed(seed, 1));  // its own stream: the trial's seed drives the simulation
   for (const auto& [key, r] : spec.random) {
     if (r.kind == RandomSweep::Kind::kUniform) {

@@ -26,6 +26,10 @@ std::uint64_t DeriveSeed(std::uint64_t seed, std::string_view name) {
   return DeriveSeed(seed, h);
 }
 
+std::uint64_t TrialSeed(std::uint64_t seed, std::string_view workload, std::uint64_t trial) {
+  return DeriveSeed(DeriveSeed(seed, workload), trial);
+}
+
 Rng::Rng(std::uint64_t seed) {
   std::uint64_t x = seed;
   for (auto& s : s_) {

@@ -230,8 +230,15 @@ void CompositeFdd::RunObserver(double t, double dt) {
   // or when the rotors (by their measured speeds) lift at least kLiftFraction of the weight. The
   // latter starts the take-off window at lift-off rather than at some altitude.
   constexpr double kLiftFraction = 0.9;
-  const bool flying = have_estimate_ && (estimate_.p_W.z() > 0.05 ||
-                                          wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
+  // The ground in contact carries what the rotors do not: the accelerometer then reads more
+  // support than the rotors give (by kContactFraction of the weight), whatever the estimate's
+  // height says (a drifted estimate, a landing on a step). The detector stays armed, and judges
+  // the air only.
+  constexpr double kContactFraction = 0.25;
+  const double support = vehicle_.mass_kg * force_filter_.value().z() - wrench_filter_.value()[0];
+  const bool contact = support > kContactFraction * vehicle_.weight_n();
+  const bool flying = have_estimate_ && !contact &&
+                      (estimate_.p_W.z() > 0.05 || wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
   if (flying && !airborne_since_s_) airborne_since_s_ = t;
   if (!flying) airborne_since_s_.reset();
   takeoff_index_ = 0.0;

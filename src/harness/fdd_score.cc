@@ -46,6 +46,10 @@ FddRecord ScoreFdd(const std::vector<fdd::RotorStatus>& rotors, const std::vecto
   FddRecord r;
   r.second = ScoreSecond(rotors, events);
   for (int i = 0; i < static_cast<int>(rotors.size()); ++i) {
+    const bool faulty = std::any_of(events.begin(), events.end(), [i](const sim::FaultEvent& e) { return e.rotor == i; });
+    if (!faulty && fdd::IsIsolated(rotors[static_cast<std::size_t>(i)].health)) ++r.healthy_rotors_isolated;
+  }
+  for (int i = 0; i < static_cast<int>(rotors.size()); ++i) {
     const fdd::RotorStatus& status = rotors[static_cast<std::size_t>(i)];
     if (!status.detected_s) continue;
     if (!r.diagnosis || *status.detected_s < r.diagnosis->detection_s) {

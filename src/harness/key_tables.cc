@@ -64,6 +64,7 @@ std::vector<KeyTableSection> ScenarioKeySections() {
   s.push_back(Section("`wind`", "wind.", d.sim.wind));
   s.push_back(MissionSection(MissionKind::kHover, planning::HoverOptions{}));
   s.push_back(MissionSection(MissionKind::kTakeoff, planning::TakeoffOptions{}));
+  s.push_back(MissionSection(MissionKind::kLand, planning::LandingOptions{}));
   s.push_back(MissionSection(MissionKind::kLemniscate, planning::LemniscateOptions{}));
   s.push_back(MissionSection(MissionKind::kCircle, planning::CircleOptions{}));
   s.push_back(MissionSection(MissionKind::kWaypoints, planning::WaypointOptions{}));

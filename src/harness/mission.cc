@@ -42,6 +42,10 @@ Mission ParseMission(const io::ConfigNode& node, const Vector3& start_m, double 
       m.reference = Build<planning::TakeoffReference>(
           node, planning::TakeoffOptions{.start_m = start_m, .yaw_rad = start_yaw_rad});
       break;
+    case MissionKind::kLand:
+      m.reference = Build<planning::LandingReference>(
+          node, planning::LandingOptions{.start_m = start_m, .yaw_rad = start_yaw_rad});
+      break;
     case MissionKind::kLemniscate:
       m.reference = Build<planning::LemniscateReference>(
           node, planning::LemniscateOptions{.center_m = start_m, .yaw_rad = start_yaw_rad});

@@ -55,6 +55,7 @@ nlohmann::json FddJson(const FddRecord& f) {
   j["reconfiguration_latency_s"] = OrNull(f.reconfiguration_latency_s);
   j["healthy_extremes"] = f.healthy_extremes ? ExtremesJson(*f.healthy_extremes) : nlohmann::json(nullptr);
   j["second"] = f.second ? SecondJson(*f.second) : nlohmann::json(nullptr);
+  j["healthy_rotors_isolated"] = f.healthy_rotors_isolated;
   return j;
 }
 

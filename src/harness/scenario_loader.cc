@@ -113,9 +113,10 @@ void CheckTrackingWindow(const ConfigNode& metrics, const Scenario& s) {
 }
 
 /// The mission must keep the reference above the ground (z >= 0) over the flight: a reference
-/// below ground cannot be flown and is a configuration mistake.
+/// below ground cannot be flown and is a configuration mistake; but a landing's.
 void CheckReferenceAboveGround(const ConfigNode& mission, const Scenario& s) {
   if (!s.reference) return;  // an assembly_plan not planned yet
+  if (s.mission_kind == MissionKind::kLand) return;  // it aims below the ground, for the ground to stop it
   // References are smooth on this scale; long runs are sampled more coarsely (at most 1e5 points).
   const double end = std::min(s.duration_s, s.reference->duration());
   const double step = std::max(0.01, end / 1e5);

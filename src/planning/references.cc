@@ -167,6 +167,24 @@ ReferencePoint TakeoffReference::Evaluate(double t) const {
   return r;
 }
 
+TakeoffOptions LandingReference::DescentOf(const LandingOptions& o) {
+  constexpr const char* kLanding = "LandingOptions";
+  RequireFinite(kLanding, "start_m", o.start_m);
+  if (!(o.start_m.z() > 0.0)) ThrowValidation(kLanding, "start_m.z", o.start_m.z(), "a start above the ground (z > 0)");
+  if (!std::isfinite(o.start_s) || o.start_s < 0.0) ThrowValidation(kLanding, "start_s", o.start_s, "a time >= 0 s");
+  if (!std::isfinite(o.depth_m) || o.depth_m <= 0.0) ThrowValidation(kLanding, "depth_m", o.depth_m, "a depth > 0 m");
+  TakeoffOptions d;
+  d.start_m = o.start_m;
+  d.altitude_m = -(o.start_m.z() + o.depth_m);
+  d.max_speed_m_s = o.max_speed_m_s;
+  d.yaw_rad = o.yaw_rad;
+  return d;
+}
+
+LandingReference::LandingReference(const LandingOptions& options) : options_(options), descent_(DescentOf(options)) {}
+
+ReferencePoint LandingReference::Evaluate(double t) const { return descent_.Evaluate(t - options_.start_s); }
+
 // ---------------------------------------------------------------------------------------------
 // Ramped-phase curves
 

@@ -383,6 +383,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   in.since_last_plan_s = ts - last_plan_ok_s_;
   in.thrust_ratio = command_.thrust_n.sum() / model_.params().weight_n();
   in.cannot_hover = cannot_hover_;
+  in.landing = !landing_ && reference().Evaluate(ts).p_W.z() <= 0.0;  // a mission that lands
   if (flatness_ && flatness_->land_request()) in.land_request = "re-planning decided to land: " + *flatness_->land_request();
   const FlightMode mode = supervisor_.Update(in);
 
@@ -405,8 +406,10 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   reference_point_ = followed.Evaluate(ts);
   if (!estimate_.valid || mode == FlightMode::kLanded || mode == FlightMode::kFlightTermination) {
     // Nothing to act on yet, on the ground after a landing, or a vehicle that cannot hover: motors
-    // off.
+    // off, and the fault detection told so (it stays armed: a motor that keeps turning after the
+    // landing is still a fault, and one spinning down as commanded is none).
     command_.thrust_n.setZero();
+    if (fdd_) fdd_->SetCommand(command_);
     return command_;
   }
   {

@@ -46,7 +46,7 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
     Enter(FlightMode::kFlightTermination, t, in.cannot_hover);
     return mode_;
   }
-  if (mode_ == FlightMode::kEmergencyLanding) {
+  if (mode_ == FlightMode::kEmergencyLanding || in.landing) {
     // A land detector: the ground holds the vehicle up, so the controller chasing a reference
     // below it commands ever less thrust.
     if (in.thrust_ratio >= options_.touchdown_thrust_ratio) {
@@ -59,7 +59,7 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
             fmt::format("touchdown: thrust below {:.0f} % of the weight for {:.1f} s (estimated altitude {:.2f} m)",
                         100.0 * options_.touchdown_thrust_ratio, options_.touchdown_hold_s, e.p_W.z()));
     }
-    return mode_;
+    if (mode_ == FlightMode::kEmergencyLanding || mode_ == FlightMode::kLanded) return mode_;
   }
   if (!e.valid) return mode_;  // not flying yet: nothing to judge
   // Reasons to give the mission up, most fundamental first.

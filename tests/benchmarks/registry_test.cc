@@ -287,8 +287,9 @@ TEST_F(BenchCampaigns, AFlatnessFlightPastItsBudgetIsAFailureNamingTheCommandTha
   const nlohmann::json r = FlatnessResult(c.bench["options"], records);
   EXPECT_EQ(r["success_rate"], 0.0);
   ASSERT_EQ(r["failures"].size(), 1u);
-  EXPECT_NE(r["failures"][0]["reason"].get<std::string>().find("rotorguard run " + o.fig2.file +
-                                                               " --seed 1 --set truth=realistic"),
+  const std::string seed = std::to_string(TrialSeed(o.seed, "bench flatness", 0));
+  EXPECT_NE(r["failures"][0]["reason"].get<std::string>().find("rotorguard run " + o.fig2.file + " --seed " + seed +
+                                                               " --set truth=realistic"),
             std::string::npos)
       << r["failures"][0].dump();
   EXPECT_TRUE(r["ukf_w_estimate"].is_null());  // no flight, no median

@@ -231,7 +231,7 @@ TEST_F(ScenarioLoader, ErrorsNameTheFileLineAndKey) {
             std::string::npos)
       << m;
   m = Error("mission: {type: cruise}\n");
-  EXPECT_NE(m.find("hover, takeoff, lemniscate, circle, waypoints, navigate, assembly_plan"), std::string::npos) << m;
+  EXPECT_NE(m.find("hover, takeoff, land, lemniscate, circle, waypoints, navigate, assembly_plan"), std::string::npos) << m;
   m = Error("mission: {type: lemniscate}\n");
   EXPECT_NE(m.find("missing required key 'max_speed_m_s'"), std::string::npos) << m;
   m = Error("mission: {type: hover}\nstack: {known_faults: [{rotor: 1}]}\n");

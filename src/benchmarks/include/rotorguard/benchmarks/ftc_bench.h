@@ -85,7 +85,16 @@ struct FtcTrial {
   /// A second failed rotor isolated with its kind, and how long after its onset [s] (NaN if not).
   bool second_correct = false;
   double second_latency_s = std::numeric_limits<double>::quiet_NaN();
+  /// The second failure's onset after the first failure's isolation [s] (NaN without both).
+  double second_after_isolation_s = std::numeric_limits<double>::quiet_NaN();
+  /// Rotors isolated without a fault of their own (after a correct first isolation: a false second
+  /// isolation).
+  int healthy_rotors_isolated = 0;
 };
+
+/// The bins of a second failure's onset after the first isolation that bench ftc reports [s]:
+/// [edge_k, edge_k+1).
+inline constexpr double kSecondOnsetBinEdges[] = {0.0, 0.3, 1.0, 2.0, 4.0, 6.5};
 
 /// A cell's metrics (docs/metrics.md): fdd_latency_s_mean/max over correct isolations, sucr, mdr (faulty
 /// cells: no correct isolation within 1 s, errored trials included), far, mini_alt_m (least altitude

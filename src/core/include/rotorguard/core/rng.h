@@ -18,6 +18,11 @@ std::uint64_t DeriveSeed(std::uint64_t seed, std::uint64_t index);
 /// the same draws (a calibration and the evaluation of what it calibrated, say).
 std::uint64_t DeriveSeed(std::uint64_t seed, std::string_view name);
 
+/// Trial `trial` of the workload named `workload` ("bench ftc", "campaign fdd_far_takeoff") under
+/// `seed`: DeriveSeed(DeriveSeed(seed, workload), trial). No two workloads share a trial's seed,
+/// nor a trial's seed a scenario's own small seeds (1, 2, 3...).
+std::uint64_t TrialSeed(std::uint64_t seed, std::string_view workload, std::uint64_t trial);
+
 /// xoshiro256** generator (Blackman & Vigna) with uniform and normal transforms of its own.
 class Rng {
  public:

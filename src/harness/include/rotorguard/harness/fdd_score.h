@@ -37,6 +37,9 @@ struct FddRecord {
     std::optional<double> latency_s;  ///< detection - onset, when correct
   };
   std::optional<Second> second;  ///< none: a single faulty rotor, or none at all
+  /// Rotors isolated (motor, propeller or unclassified failure) on which no fault was injected:
+  /// after a correct first isolation, a false second one.
+  int healthy_rotors_isolated = 0;
   /// The composite detector's index extremes before the first fault's onset (over the whole flight
   /// without one, up to a first isolation): how far a healthy flight pushed its indices.
   std::optional<fdd::IndexExtremes> healthy_extremes;

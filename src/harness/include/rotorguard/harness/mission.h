@@ -18,6 +18,7 @@ namespace rotorguard::harness {
 enum class MissionKind {
   kHover,         ///< hold a point
   kTakeoff,       ///< a minimum-jerk climb from the start
+  kLand,          ///< the start held, then a minimum-jerk descent to the ground
   kLemniscate,    ///< the figure eight of paper 000's tracking tests
   kCircle,        ///< a horizontal circle, or a helix (paper 002's spiral)
   kWaypoints,     ///< straight legs through waypoints, stopping at each
@@ -26,6 +27,7 @@ enum class MissionKind {
 };
 inline constexpr EnumName<MissionKind> kMissionKindNames[] = {{MissionKind::kHover, "hover"},
                                                               {MissionKind::kTakeoff, "takeoff"},
+                                                              {MissionKind::kLand, "land"},
                                                               {MissionKind::kLemniscate, "lemniscate"},
                                                               {MissionKind::kCircle, "circle"},
                                                               {MissionKind::kWaypoints, "waypoints"},

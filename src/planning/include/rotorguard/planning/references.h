@@ -90,6 +90,44 @@ class TakeoffReference final : public ReferenceTrajectory {
   double climb_time_s_;
 };
 
+struct LandingOptions {
+  Vector3 start_m = Vector3::Zero();  ///< position at t = 0, world frame [m]; finite, above the ground
+  double start_s = 2.0;               ///< the start is held until then [s]; finite, >= 0
+  double max_speed_m_s = 0.5;         ///< peak descent speed [m/s]; finite, > 0
+  double depth_m = 0.3;               ///< the descent aims this far below the ground [m]; finite, > 0
+  double yaw_rad = 0.0;               ///< heading held throughout [rad]; finite
+  /// The keys of this struct in config files (core/config_schema.h).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("start_s", &start_s, {.meaning = "the start is held until then [s]", .min = 0.0, .max = kMaxFlightS});
+    a->Visit("max_speed_m_s", &max_speed_m_s,
+             {.meaning = "peak descent speed [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
+    a->Visit("depth_m", &depth_m,
+             {.meaning = "the descent aims this far below the ground, so that the ground stops it [m]",
+              .max = 10.0,
+              .positive = true});
+    a->Visit("yaw_rad", &yaw_rad,
+             {.meaning = "the heading held [rad]", .min = -kTwoPi, .max = kTwoPi, .default_text = "the initial yaw"});
+  }
+};
+
+/// A landing: the start held until start_s, then TakeoffReference's minimum-jerk descent from rest to
+/// depth_m below the ground (z = -depth_m). The ground stops the vehicle before the reference does,
+/// and the stack's land detector (stack/supervisor.h) stops its motors, as an emergency landing's.
+class LandingReference final : public ReferenceTrajectory {
+ public:
+  /// Throws ValidationError (std::invalid_argument) naming the first invalid field of `options`.
+  explicit LandingReference(const LandingOptions& options);
+  [[nodiscard]] ReferencePoint Evaluate(double t) const override;
+  /// The hold and the descent [s].
+  [[nodiscard]] double duration() const override { return options_.start_s + descent_.duration(); }
+
+ private:
+  static TakeoffOptions DescentOf(const LandingOptions& options);
+  LandingOptions options_;
+  TakeoffReference descent_;
+};
+
 // ---------------------------------------------------------------------------------------------
 // Parametric curves with a ramped phase (shared by the lemniscate and the circle)
 

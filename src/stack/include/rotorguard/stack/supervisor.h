@@ -125,6 +125,9 @@ struct SupervisorInputs {
   double since_last_plan_s = 0.0;    ///< time since the planner last succeeded (0 when it just did)
   double thrust_ratio = 1.0;         ///< the last collective thrust command / the vehicle's weight
   std::string land_request;          ///< a planner's decision to land, with its reason ("" = none)
+  /// The mission's reference is at or below the ground (a planned landing): the land detector
+  /// watches for the touchdown, as it does in an emergency landing.
+  bool landing = false;
   /// Why the vehicle cannot hover on the rotors it has left ("" = it can).
   std::string cannot_hover;
 };
