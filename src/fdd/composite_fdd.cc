@@ -75,7 +75,8 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   recent_motor_index_.assign(n_, SampleRing(static_cast<std::size_t>(options_.motor_index_samples)));
   // Twice the samples the persistence spans at the nominal IMU rate, for a faster or jittery IMU.
   const auto persistence_samples =
-      static_cast<std::size_t>(std::ceil(2.0 * options_.propeller_persistence_s * options_.imu_rate_hz) + 4.0);
+      static_cast<std::size_t>(std::ceil(2.0 * std::max(options_.propeller_persistence_s, options_.second_failure_persistence_s) *
+                                         options_.imu_rate_hz) + 4.0);
   recent_propeller_index_.assign(n_, SampleRing(persistence_samples));
   above_since_s_.assign(n_, -1.0);
   degraded_since_s_.assign(n_, -1.0);
@@ -135,6 +136,7 @@ void IndexExtremes::Merge(const IndexExtremes& other) {
   debounced_motor_index = std::min(debounced_motor_index, other.debounced_motor_index);
   persistent_propeller_index = std::max(persistent_propeller_index, other.persistent_propeller_index);
   gated_takeoff_index = std::max(gated_takeoff_index, other.gated_takeoff_index);
+  second_failure_index = std::max(second_failure_index, other.second_failure_index);
 }
 
 FaultDetectorBase::FaultDetectorBase(int num_rotors) : rotors_(static_cast<std::size_t>(num_rotors)) {}
@@ -230,13 +232,16 @@ void CompositeFdd::RunObserver(double t, double dt) {
   // or when the rotors (by their measured speeds) lift at least kLiftFraction of the weight. The
   // latter starts the take-off window at lift-off rather than at some altitude.
   constexpr double kLiftFraction = 0.9;
-  // The ground in contact carries what the rotors do not: the accelerometer then reads more
-  // support than the rotors give (by kContactFraction of the weight), whatever the estimate's
-  // height says (a drifted estimate, a landing on a step). The detector stays armed, and judges
-  // the air only.
+  // The ground in contact carries what the rotors do not: the rotors then lift less than the
+  // weight (by kContactFraction of it) while the accelerometer reads that much more support than
+  // they give, whatever the estimate's height says (a drifted estimate, a landing on a step). The
+  // detector stays armed, and judges the air only. Both conditions: in the air a spinning vehicle's
+  // force balance alone swings by a quarter of the weight (its thrust model errors at strongly
+  // unequal rotor speeds), but its rotors then carry the weight.
   constexpr double kContactFraction = 0.25;
   const double support = vehicle_.mass_kg * force_filter_.value().z() - wrench_filter_.value()[0];
-  const bool contact = support > kContactFraction * vehicle_.weight_n();
+  const bool contact = support > kContactFraction * vehicle_.weight_n() &&
+                       wrench_filter_.value()[0] < (1.0 - kContactFraction) * vehicle_.weight_n();
   const bool flying = have_estimate_ && !contact &&
                       (estimate_.p_W.z() > 0.05 || wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
   if (flying && !airborne_since_s_) airborne_since_s_ = t;
@@ -259,6 +264,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
     pinv_ = working_effectiveness.completeOrthogonalDecomposition().pseudoInverse();
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
     std::fill(degraded_since_s_.begin(), degraded_since_s_.end(), -1.0);
+    for (SampleRing& recent : recent_propeller_index_) recent.Clear();
   }
   const vehicle::VehicleParams& vp = vehicle_;
   const Vector3& w = rate_filter_.value();
@@ -332,18 +338,32 @@ void CompositeFdd::RunObserver(double t, double dt) {
     if (learning && isolated > 0) continue;
     // After an isolation the spinning vehicle's torque residual (inertia errors times the spin)
     // can point at a rotor; a lost propeller also costs thrust, which the force balance sees
-    // whatever the inertia.
+    // whatever the inertia: at least a fraction of the rotor's thrust, and of the loss the
+    // observer puts on it (a rotor the controller has turned nearly off has a large index for a
+    // torque residual the force balance does not show).
     const bool costs_thrust =
-        isolated == 0 || lost[0] >= options_.second_failure_missing_thrust_fraction * measured_thrust_[i];
+        isolated == 0 ||
+        (lost[0] >= options_.second_failure_missing_thrust_fraction * std::max(measured_thrust_[i], thrust_loss_[i]) &&
+         measured_thrust_[i] >= options_.second_failure_min_thrust_fraction * hover_thrust_per_rotor_n_);
     // The rotor the observer blames must be the one losing the most thrust in newtons: P_i divides
     // by the rotor's own thrust, and the rotors beside a lost one, which the controller turns down
     // to hold the attitude, have the smallest; a torque residual's error (the vibration's, the
     // filters' lag) then reads as a large index on one of them (docs/fdd.md).
     bool largest_loss = true;
     for (int j = 0; j < n_; ++j) largest_loss = largest_loss && (j == i || working_[j] == 0.0 || thrust_loss_[j] <= thrust_loss_[i]);
+    if (isolated > 0) {
+      // The second-failure rule's statistic: P_i through its gates, held for the persistence.
+      SampleRing& recent = recent_propeller_index_[i];
+      recent.Push(t, costs_thrust && largest_loss ? p : 0.0);
+      while (recent.size() >= 2 && t - recent.time(1) >= options_.second_failure_persistence_s) recent.PopFront();
+      if (t - recent.time(0) >= options_.second_failure_persistence_s) {
+        extremes_.second_failure_index = std::max(extremes_.second_failure_index, recent.Min());
+      }
+    }
     if (p > options_.propeller_index_threshold && costs_thrust && largest_loss) {
       if (above_since_s_[i] < 0.0) above_since_s_[i] = t;
-      if (t - above_since_s_[i] >= options_.propeller_persistence_s) {
+      const double persistence = isolated == 0 ? options_.propeller_persistence_s : options_.second_failure_persistence_s;
+      if (t - above_since_s_[i] >= persistence) {
         Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer", above_since_s_[i]);
       }
     } else {

@@ -193,6 +193,10 @@ class Flight::Loop {
       AddReconfigurationLatency(s.stack.reconfigurations, sim_.fault_events(), &*s.fdd);
       if (composite_) {
         s.fdd->healthy_extremes = sim_.fault_events().empty() ? composite_->healthy_extremes() : healthy_extremes_;
+        // The second-failure rule's statistic is a healthy one while at most one rotor has failed.
+        s.fdd->healthy_extremes->second_failure_index = sim_.fault_events().size() <= 1
+                                                            ? composite_->healthy_extremes().second_failure_index
+                                                            : second_failure_index_;
       }
     }
     for (const sim::FaultEvent& e : sim_.fault_events()) {
@@ -229,6 +233,9 @@ class Flight::Loop {
   /// The detector has seen only flight before any fault: its extremes are a healthy flight's.
   void NoteHealthyExtremes() {
     if (composite_ && sim_.fault_events().empty()) healthy_extremes_ = composite_->healthy_extremes();
+    if (composite_ && sim_.fault_events().size() <= 1) {
+      second_failure_index_ = composite_->healthy_extremes().second_failure_index;
+    }
   }
 
   /// Notes when a navigate mission reached its last waypoint; true once it has also had 3 s to
@@ -279,6 +286,7 @@ class Flight::Loop {
   std::uint64_t physics_steps_ = 0, control_cycles_ = 0;
   const fdd::CompositeFdd* composite_ = dynamic_cast<const fdd::CompositeFdd*>(stack_.fault_detector());
   fdd::IndexExtremes healthy_extremes_;  // the composite detector's, before the first fault
+  double second_failure_index_ = 0.0;    // its second-failure statistic, before the second fault
   std::optional<double> mission_time_s_;
   std::optional<TimeNs> cycle_to_record_;  // a control cycle run, its command not yet recorded
   bool done_ = steps_ <= 0;

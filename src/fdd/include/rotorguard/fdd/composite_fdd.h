@@ -56,12 +56,21 @@ struct CompositeFddOptions {
   /// losses from it (docs/fdd.md). 0: losses from the file's model alone. In [0, 100].
   double baseline_time_constant_s = 0.5;
   /// After an isolation the observer learns the reconfigured vehicle's residual for this long [s]
-  /// and judges nothing meanwhile; then it watches the remaining rotors for a second complete
-  /// loss (docs/fdd.md). In [0, 100].
-  double post_isolation_relearn_s = 2.0;
+  /// and judges nothing meanwhile (the reconfiguration's step through the motor lag and the
+  /// filters); then it watches the remaining rotors for a second complete loss (docs/fdd.md).
+  /// In [0, 100].
+  double post_isolation_relearn_s = 0.1;
   /// ... and isolates a second propeller failure only while the force balance misses at least
   /// this fraction of that rotor's thrust, in [0, 1].
   double second_failure_missing_thrust_fraction = 0.5;
+  /// ... on a rotor giving at least this fraction of the hover thrust per rotor, in [0, 1]: below
+  /// it the loss is within what the spinning vehicle's force balance swings by (docs/fdd.md), and
+  /// the rotor matters little (the one the controller turns nearly off beside a failure).
+  double second_failure_min_thrust_fraction = 0.5;
+  /// ... above gamma_P for this long [s] (the first failure's rule holds propeller_persistence_s):
+  /// a vehicle spinning on three rotors drives them through steps the telemetry lags, and the
+  /// mismatch reads as a short loss. In [0, 10].
+  double second_failure_persistence_s = 0.05;
   /// Take-off detector (eq. 18): active while the vehicle is airborne below this altitude [m] and
   /// within takeoff_window_s of lift-off, > 0.
   double takeoff_max_altitude_m = 0.6;
@@ -162,6 +171,10 @@ struct CompositeFddOptions {
         {.meaning = "... and a second propeller failure must miss this fraction of its thrust in the force balance",
          .min = 0.0,
          .max = 1.0});
+    a->Visit("second_failure_min_thrust_fraction", &second_failure_min_thrust_fraction,
+             {.meaning = "... on a rotor giving at least this fraction of the hover thrust per rotor", .min = 0.0, .max = 1.0});
+    a->Visit("second_failure_persistence_s", &second_failure_persistence_s,
+             {.meaning = "... for this long [s]", .min = 0.0, .max = 10.0});
   }
 };
 
@@ -199,17 +212,22 @@ struct IndexExtremes {
   /// Highest take-off index while its direction and missing-thrust conditions held: a take-off
   /// threshold below it would have fired.
   double gated_takeoff_index = 0.0;
+  /// After an isolation: highest P_i of a remaining rotor held for second_failure_persistence_s while the
+  /// second-failure gates held (force balance, thrust, largest loss): gamma_P below it would have
+  /// isolated a second rotor. 0 in a flight with no isolation.
+  double second_failure_index = 0.0;
   void Merge(const IndexExtremes& other);
 };
 
 /// Each statistic's name in run summaries (fdd.healthy_extremes.NAME) and its member.
-inline constexpr std::array<std::pair<std::string_view, double IndexExtremes::*>, 6> kIndexExtremesFields{{
+inline constexpr std::array<std::pair<std::string_view, double IndexExtremes::*>, 7> kIndexExtremesFields{{
     {"min_motor_index", &IndexExtremes::min_motor_index},
     {"max_propeller_index", &IndexExtremes::max_propeller_index},
     {"max_takeoff_index", &IndexExtremes::max_takeoff_index},
     {"debounced_motor_index", &IndexExtremes::debounced_motor_index},
     {"persistent_propeller_index", &IndexExtremes::persistent_propeller_index},
     {"gated_takeoff_index", &IndexExtremes::gated_takeoff_index},
+    {"second_failure_index", &IndexExtremes::second_failure_index},
 }};
 
 /// The interface every fault detector implements, so that a stack or a benchmark swaps them by name.
