@@ -5,7 +5,7 @@ ROTORGUARD_WARNINGS_AS_ERRORS ?= OFF
 DEMO_SCENARIO ?= configs/scenarios/forest.yaml
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build demo test bench sanitize fuzz clean
+.PHONY: all deps configure build demo test bench results sanitize fuzz clean
 
 all: build
 
@@ -57,6 +57,11 @@ fuzz:
 
 bench: build
 	./$(BUILD_DIR)/bin/rotorguard bench sim --json
+
+# The published benchmarks -> docs/results.md and README's results block (scripts/results.py;
+# finished jobs in out/results are kept, an interrupted one resumes).
+results: build
+	python3 scripts/results.py --build $(BUILD_DIR)
 
 clean:
 	rm -rf $(BUILD_DIR)

@@ -155,6 +155,17 @@ CampaignFlights LoadCampaignFlights(const std::string& dir) {
   }
   CampaignFlights out;
   out.dir = dir;
+  // The manifest's name and seed, for the record of the seeds used (a bad one is a corrupt input).
+  if (manifest.contains("campaign")) {
+    if (!manifest["campaign"].is_string())
+      throw io::InputFileError(dir, "manifest.json: 'campaign' is not a string; expected the campaign's name");
+    out.campaign = manifest["campaign"].get<std::string>();
+  }
+  if (manifest.contains("seed")) {
+    if (!manifest["seed"].is_number_unsigned())
+      throw io::InputFileError(dir, "manifest.json: 'seed' is not an unsigned integer; expected the campaign's seed");
+    out.seed = manifest["seed"].get<std::uint64_t>();
+  }
   for (const nlohmann::json& r : records) {
     // ReadCampaignRecords checked each record's fields and their types; the metrics are the kind's.
     const int trial = r.at("trial").get<int>();
@@ -181,6 +192,15 @@ CampaignFlights LoadCampaignFlights(const std::string& dir) {
       throw io::InputFileError(dir, fmt::format("trial {}: fdd.false_alarm is not a boolean", trial));
     f.false_alarm = alarm.get<bool>();
     out.flights.push_back(f);
+    const nlohmann::json& params = r.at("params");
+    if (params.contains("seed") && params.at("seed").is_string()) {
+      try {
+        out.trial_seeds.push_back(std::stoull(params.at("seed").get<std::string>()));
+      } catch (const std::exception&) {
+        throw io::InputFileError(dir, fmt::format("trial {}: its seed '{}' is not an unsigned integer", trial,
+                                                  params.at("seed").get<std::string>()));
+      }
+    }
   }
   return out;
 }
@@ -296,7 +316,14 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
       extremes.Merge(f.extremes);
       alarms += f.false_alarm ? 1 : 0;
     }
-    campaign_docs.push_back({{"dir", c.dir}, {"flights", c.flights.size()}, {"false_alarms", alarms}});
+    // The seeds it used, so that an evaluation set can be shown to share no vehicle with it.
+    campaign_docs.push_back({{"dir", c.dir},
+                             {"campaign", c.campaign},
+                             {"seed", c.seed},
+                             {"seed_stream", "campaign " + c.campaign},
+                             {"trial_seeds", c.trial_seeds},
+                             {"flights", c.flights.size()},
+                             {"false_alarms", alarms}});
   }
   const std::vector<Sweep> sweeps = {
       {"motor_index_threshold",

@@ -13,6 +13,7 @@
 #include <map>
 
 #include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/core/rng.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/flight_metrics.h"
@@ -293,7 +294,9 @@ TEST(FddCalibration, CampaignFlightsCountAsTheirStatisticsSay) {
     f.false_alarm = alarmed;
     return f;
   };
-  const CampaignFlights flights{"hand", {flight(0.5, 0.9, false), flight(0.7, 0.6, false), flight(0.1, 0.95, true)}};
+  CampaignFlights flights;
+  flights.dir = "hand";
+  flights.flights = {flight(0.5, 0.9, false), flight(0.7, 0.6, false), flight(0.1, 0.95, true)};
   const nlohmann::json c = CalibrateCompositeFdd({}, {flights}, FddCalibrationOptions{});
   ASSERT_EQ(c["campaigns"].size(), 1u);
   EXPECT_EQ(c["campaigns"][0]["flights"].get<int>(), 3);
@@ -348,6 +351,14 @@ TEST_F(CampaignInput, LoadsAScenarioCampaignsFlightsAndRefusesOneWithoutTheMetri
   };
   const CampaignFlights f = LoadCampaignFlights(run(spec("healthy", metrics)));
   ASSERT_EQ(f.flights.size(), 2u);
+  // The seeds it used, from the campaign's own stream: an evaluation set can be shown disjoint.
+  EXPECT_EQ(f.campaign, "healthy");
+  EXPECT_EQ(f.seed, 3u);
+  EXPECT_EQ(f.trial_seeds, (std::vector<std::uint64_t>{TrialSeed(3, "campaign healthy", 0),
+                                                       TrialSeed(3, "campaign healthy", 1)}));
+  const nlohmann::json c = CalibrateCompositeFdd({}, {f}, FddCalibrationOptions{});
+  EXPECT_EQ(c["campaigns"][0]["seed_stream"], "campaign healthy");
+  EXPECT_EQ(c["campaigns"][0]["trial_seeds"].size(), 2u);
   for (const FlightExtremes& x : f.flights) {
     EXPECT_FALSE(x.false_alarm);
     EXPECT_GT(x.extremes.max_takeoff_index, 0.0);  // they took off
@@ -372,7 +383,9 @@ TEST_F(CampaignInput, LoadsAScenarioCampaignsFlightsAndRefusesOneWithoutTheMetri
 
 TEST(FddCalibration, RejectsNoInputAndABadMargin) {
   EXPECT_THROW(CalibrateCompositeFdd({}, {}, FddCalibrationOptions{}), std::invalid_argument);
-  EXPECT_THROW(CalibrateCompositeFdd({}, {CampaignFlights{"empty", {}}}, FddCalibrationOptions{}),
+  CampaignFlights empty;
+  empty.dir = "empty";
+  EXPECT_THROW(CalibrateCompositeFdd({}, {empty}, FddCalibrationOptions{}),
                std::invalid_argument);
   FddCalibrationOptions o;
   o.margin = 1.0;

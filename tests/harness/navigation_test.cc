@@ -142,11 +142,18 @@ TEST(Navigation, TheFailureUnawareVariantKeepsItsNominalAccelerationLimit) {
   }
 }
 
+// In the realistic world, with the composite FDD armed through the descent and the touchdown: the
+// motors stopped on the ground are not a failure (the detector is told the command it stopped them
+// with, and judges the air only).
 TEST(Navigation, LosingOdometryLandsAndTheLandingCompletesWhenItReturns) {
-  Scenario s =
-      LoadScenario(Config("hover.yaml"), {{"truth", "ideal"}, {"duration_s", "14"}, {"stack.controller", "nmpc"}});
+  Scenario s = LoadScenario(Config("hover.yaml"),
+                            {{"duration_s", "14"}, {"stack.controller", "nmpc"}, {"stack.fdd", "composite"}});
+  ASSERT_EQ(s.truth.preset, sim::TruthPreset::kRealistic);
   s.sim.odometry.outages.push_back({2.0, 1.0});  // 0.5 s without odometry is a lost estimator
   const RunSummary r = RunScenario(s);
+  ASSERT_TRUE(r.fdd.has_value());
+  EXPECT_FALSE(r.fdd->diagnosis.has_value()) << r.fdd->diagnosis->kind << " on rotor " << r.fdd->diagnosis->rotor
+                                             << " at " << r.fdd->diagnosis->detection_s;
   EXPECT_FALSE(r.crashed) << r.crash_reason.value_or("");
   EXPECT_FALSE(r.success);
   ASSERT_EQ(r.stack.transitions.size(), 2u);

@@ -1,6 +1,8 @@
-// Closed-loop flights of the shipped scenarios: the nominal stack through sensors only. They hold
-// the stack to figures of the world where its model is exact (`truth: ideal`); the realistic
-// world's outcomes are shipped_scenarios_test.cc's and the benchmarks' (docs/benchmarks.md).
+// Closed-loop flights of the shipped scenarios: the nominal stack through sensors only. Behaviour
+// (a take-off settles, a fault is isolated and survived, no false alarm, a crash without FTC) is
+// held in the realistic world, the scenarios' default; tests that hold the stack to a figure of
+// the model itself (a tracking error of centimetres, an exact latency) pin `truth: ideal` and say
+// so. shipped_scenarios_test.cc flies every shipped scenario in both worlds at three seeds.
 
 #include "rotorguard/harness/runner.h"
 
@@ -90,16 +92,18 @@ TEST_F(RunnerFiles, TheSameSeedFliesTheSameDrawAndAnotherSeedAnother) {
 }
 
 TEST(Runner, TakesOffFromTheGroundAndSettlesAtAltitude) {
-  const Scenario s = LoadScenario(Config("takeoff.yaml"), {{"truth", "ideal"}});
+  const Scenario s = LoadScenario(Config("takeoff.yaml"));
+  ASSERT_EQ(s.truth.preset, sim::TruthPreset::kRealistic);
   ASSERT_EQ(s.initial_position_m.z(), 0.0);
   const RunSummary r = RunScenario(s);
   EXPECT_TRUE(r.success) << r.crash_reason.value_or("");
   EXPECT_FALSE(r.altitude_change_m.has_value()) << "no fault";
-  EXPECT_LT(r.tracking_rmse_m, 0.05);
+  EXPECT_LT(r.tracking_rmse_m, 0.10);
 }
 
 TEST(Runner, NominalControllerCrashesAfterAMotorStop) {
-  const RunSummary r = RunScenario(LoadScenario(Config("hover_motor_stop_nominal.yaml"), {{"truth", "ideal"}}));
+  const RunSummary r = RunScenario(LoadScenario(Config("hover_motor_stop_nominal.yaml")));
+  EXPECT_EQ(r.truth.preset, sim::TruthPreset::kRealistic);
   EXPECT_TRUE(r.crashed);
   EXPECT_FALSE(r.success);
   ASSERT_EQ(r.faults.size(), 1u);
@@ -264,19 +268,24 @@ TEST(NmpcClosedLoop, Tracks1msLemniscateWithAFailedRotorWithin15Centimetres) {
 TEST(FddClosedLoop, IsolatesAndSurvivesEachFaultKindInHover) {
   for (const char* kind : {"propeller_loss", "motor_stop"}) {
     const RunSummary r =
-        RunScenario(LoadScenario(Config(std::string("fdd_hover_") + kind + ".yaml"), {{"truth", "ideal"}}));
+        RunScenario(LoadScenario(Config(std::string("fdd_hover_") + kind + ".yaml")));  // realistic
+    EXPECT_EQ(r.truth.preset, sim::TruthPreset::kRealistic);
     EXPECT_TRUE(r.success) << kind << ": " << r.failure_reason.value_or("");
     ASSERT_TRUE(r.fdd.has_value());
     ASSERT_TRUE(r.fdd->detected()) << kind;
     EXPECT_TRUE(r.fdd->correct) << kind << ": " << r.fdd->diagnosis->kind << " on rotor " << r.fdd->diagnosis->rotor;
     EXPECT_FALSE(r.fdd->false_alarm);
-    EXPECT_LT(r.fdd->latency_s.value_or(1e9), std::string(kind) == "motor_stop" ? 0.028 : 0.10) << kind;
-    EXPECT_GT(r.min_altitude_m, 1.8) << kind;
+    // The realistic world's motor coasts down with a drawn stop time constant, and every command
+    // acts after the drawn delay (bench ftc's latencies: docs/results.md).
+    EXPECT_LT(r.fdd->latency_s.value_or(1e9), std::string(kind) == "motor_stop" ? 0.08 : 0.15) << kind;
+    EXPECT_GT(r.min_altitude_m, 1.5) << kind;  // from 2 m
     // The indices' healthy extremes are those before the onset: the stopped motor's M_i near 0
-    // and the lost propeller's P_i near 1 are not among them.
+    // and the lost propeller's P_i near 1 are not among them (the raw P_i moves with the drawn
+    // vehicle's vibration; the rule's statistic, held for its persistence, stays well below 0.8).
     ASSERT_TRUE(r.fdd->healthy_extremes) << kind;
     EXPECT_GT(r.fdd->healthy_extremes->min_motor_index, 0.8) << kind;
-    EXPECT_LT(r.fdd->healthy_extremes->max_propeller_index, 0.3) << kind;
+    EXPECT_LT(r.fdd->healthy_extremes->max_propeller_index, 0.6) << kind;
+    EXPECT_LT(r.fdd->healthy_extremes->persistent_propeller_index, 0.4) << kind;
   }
 }
 
@@ -318,8 +327,7 @@ TEST(FddClosedLoop, ASecondFailureFliesOnOnTheTwinAndStopsTheMotorsBesideIt) {
 
 TEST(FddClosedLoop, NoFalseAlarmOnTheAggressiveNominalLemniscate) {
   for (std::uint64_t seed : {21u, 22u}) {
-    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"),
-                              {{"truth", "ideal"}, {"stack.controller", "nmpc"}, {"stack.fdd", "composite"}});
+    Scenario s = LoadScenario(Config("lemniscate_2ms.yaml"), {{"stack.controller", "nmpc"}, {"stack.fdd", "composite"}});
     s.seed = seed;
     const RunSummary r = RunScenario(s);
     ASSERT_TRUE(r.fdd.has_value());

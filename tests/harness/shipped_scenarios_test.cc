@@ -31,6 +31,7 @@ const std::map<std::string, std::string>& IntendedFailures() {
   static const std::map<std::string, std::string> failures = {
       {"hover_motor_stop_nominal", "crash"},            // the nominal controller without FDD
       {"fdd_hover_second_failure", "flight termination"},  // two adjacent rotors out: no way to hover
+      {"emergency_landing", "emergency landing"},          // the odometry lost: the supervisor lands
   };
   return failures;
 }

@@ -59,6 +59,9 @@ struct FlightExtremes {
 /// A finished campaign's flights (`rotorguard campaign run --out DIR`, its shards merged or not).
 struct CampaignFlights {
   std::string dir;
+  std::string campaign;     ///< its name: its trials' seed stream is "campaign NAME" (core/rng.h)
+  std::uint64_t seed = 0;   ///< the campaign's seed
+  std::vector<std::uint64_t> trial_seeds;  ///< each flight's seed, in trial order
   std::vector<FlightExtremes> flights;
 };
 

@@ -1,0 +1,514 @@
+#!/usr/bin/env python3
+"""make results: runs the published benchmarks and writes docs/results.md from their records.
+
+    scripts/results.py [--build build] [--out out/results] [--only NAME ...] [--render-only]
+
+Each job is one `rotorguard bench ...` or `rotorguard campaign run ...` command whose trial records
+(results.jsonl) land in OUT/NAME. A job whose folder already holds its finished result is not run
+again (delete the folder to rerun it; an unfinished one is resumed), so the page can be rendered
+from jobs run at different times on one build. Every figure of docs/results.md is computed here
+from the trial records: rates with their 95 % Wilson intervals, means with their 95 % normal
+intervals. The page names each table's command, world and the machine (CPU model) it ran on; the
+README's block between `<!-- BEGIN results -->` and `<!-- END results -->` is written from the same
+figures, and a test (tests/docs) fails when README quotes a number the page does not hold.
+"""
+import argparse
+import datetime
+import json
+import math
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+Z95 = 1.959963984540054
+
+# The FTC benchmark's cells flown at 1000 trials: the single complete failures (Tables III and IV),
+# the second failures and the fault-free cells (the false-alarm rate).
+FTC_CELLS = ('hover/propeller_loss,hover/motor_stop,tracking/propeller_loss,tracking/motor_stop,'
+             'takeoff/propeller_loss,takeoff/motor_stop,hover/motor_stop_then_twin,'
+             'hover/motor_stop_then_adjacent,hover/none,tracking/none,takeoff/none')
+
+# name, kind, arguments after `rotorguard`, what it measures
+JOBS = [
+    ('ftc_rotorguard', 'bench',
+     ['bench', 'ftc', '--trials', '1000', '--seed', '1', '--methods', 'rotorguard', '--truth', 'realistic',
+      '--cells', FTC_CELLS],
+     'rotorguard on paper 000\'s FTC benchmark'),
+    ('ftc_baselines', 'bench',
+     ['bench', 'ftc', '--trials', '100', '--seed', '1', '--methods', 'fixedtime,indi', '--truth', 'realistic',
+      '--cells', FTC_CELLS],
+     'the baselines on the same cells'),
+] + [
+    ('far_' + s, 'campaign', ['campaign', 'run', 'configs/campaigns/fdd_far_%s.yaml' % s], d)
+    for s, d in (('takeoff', '1000 take-offs to 1.5 m and a hover, 10 s'),
+                 ('landing', '1000 hovers at 1.5 m and landings, 10 s'),
+                 ('emergency_landing', '1000 hovers whose odometry is lost for 1 s, landed by the supervisor, 12 s'),
+                 ('lemniscate', '1000 flights of 60 s of the 2 m/s lemniscate, gusts 0-0.5 m/s'),
+                 ('lemniscate_3ms', '1000 flights of 60 s of the lemniscate at 3 m/s, gusts 0-0.5 m/s'),
+                 ('gusts', '1000 flights of 60 s of the 2 m/s lemniscate in gusts of 0-1.5 m/s std'))
+]
+
+
+# Post-failure tracking: paper 000's 1 m/s lemniscate with propeller 0 lost, as shipped (drawn
+# delays, the stack expecting 3 ms), and the same with the true delay fixed at 3.5 ms (2.5 ms of
+# computation and 1 ms of ESC latency) while the NMPC assumes none, half, all or twice of it.
+TRACKING_SCENARIO = 'configs/scenarios/nmpc_lemniscate_1ms_rotor0_failed.yaml'
+TRACKING_SEEDS = list(range(1, 21))
+FIXED_DELAY = ['truth.computation_delay_min_s=0.0025', 'truth.computation_delay_max_s=0.0025',
+               'truth.esc_command_latency_min_s=0.001', 'truth.esc_command_latency_max_s=0.001']
+ASSUMED_DELAYS = [0.0, 0.00175, 0.0035, 0.007]
+RUN_JOBS = {
+    'nmpc_tracking': [('seed%d' % k, k, []) for k in TRACKING_SEEDS],
+    'nmpc_delay': [('seed%d_assumed%g' % (k, d * 1000), k, FIXED_DELAY + ['stack.command_delay_s=%g' % d])
+                   for d in ASSUMED_DELAYS for k in TRACKING_SEEDS],
+}
+JOBS += [('nmpc_tracking', 'runs', ['run', TRACKING_SCENARIO, '--seed', 'K'],
+          '20 seeds of the 1 m/s lemniscate with propeller 0 lost'),
+         ('nmpc_delay', 'runs', ['run', TRACKING_SCENARIO, '--seed', 'K', '--set', 'truth.computation_delay_min_s=0.0025',
+                                 '--set', 'truth.computation_delay_max_s=0.0025', '--set',
+                                 'truth.esc_command_latency_min_s=0.001', '--set', 'truth.esc_command_latency_max_s=0.001',
+                                 '--set', 'stack.command_delay_s=D'],
+          'the same 20 seeds with a true delay of 3.5 ms, the NMPC assuming D = 0, 1.75, 3.5 or 7 ms')]
+
+
+def run_flights(binary, name, folder):
+    """Flies RUN_JOBS[name], keeps each flight's figures in folder/done.json."""
+    os.makedirs(folder, exist_ok=True)
+    rows = []
+    for label, seed, sets in RUN_JOBS[name]:
+        out = os.path.join(folder, label)
+        if not os.path.exists(os.path.join(out, 'summary.json')):
+            cmd = [binary, 'run', TRACKING_SCENARIO, '--seed', str(seed), '--no-report', '--out', out]
+            for kv in sets:
+                cmd += ['--set', kv]
+            subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        with open(os.path.join(out, 'summary.json')) as f:
+            summary = json.load(f)
+        rows.append(dict(label=label, seed=seed, sets=sets, success=summary['success'],
+                         truth_vs_ref=summary['tracking_rmse_m'], est_vs_truth=summary['estimate_position_rmse_m'],
+                         est_vs_ref=estimate_vs_reference(out, summary)))
+    with open(os.path.join(folder, 'done.json'), 'w') as f:
+        json.dump(rows, f, indent=1)
+
+
+def estimate_vs_reference(folder, summary):
+    """RMS of the stack's position estimate against the reference over the tracking window (log.csv)."""
+    import csv
+    start = summary.get('tracking_window_s', [5.0])[0] if isinstance(summary.get('tracking_window_s'), list) else 5.0
+    sq, n = 0.0, 0
+    with open(os.path.join(folder, 'log.csv')) as f:
+        for r in csv.DictReader(f):
+            if float(r['t']) < start:
+                continue
+            sq += sum((float(r['est_p_' + a]) - float(r['ref_p_' + a])) ** 2 for a in 'xyz')
+            n += 1
+    return math.sqrt(sq / n) if n else float('nan')
+
+
+def wilson(k, n):
+    if n <= 0:
+        return (0.0, 1.0)
+    p = k / n
+    z2 = Z95 * Z95
+    denom = 1.0 + z2 / n
+    centre = (p + z2 / (2 * n)) / denom
+    half = Z95 * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denom
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def pct(k, n):
+    """'99.9 % [99.4, 100.0]' for k of n."""
+    if n == 0:
+        return '/'
+    lo, hi = wilson(k, n)
+    return '%.1f %% [%.1f, %.1f]' % (100.0 * k / n, 100.0 * lo, 100.0 * hi)
+
+
+def mean_ci(values, digits=3):
+    if not values:
+        return '/'
+    n = len(values)
+    m = sum(values) / n
+    sd = math.sqrt(sum((v - m) ** 2 for v in values) / (n - 1)) if n > 1 else 0.0
+    half = Z95 * sd / math.sqrt(n)
+    return '%.*f [%.*f, %.*f]' % (digits, m, digits, m - half, digits, m + half)
+
+
+def median(values):
+    v = sorted(values)
+    if not v:
+        return float('nan')
+    mid = len(v) // 2
+    return v[mid] if len(v) % 2 else 0.5 * (v[mid - 1] + v[mid])
+
+
+def cpu_model():
+    try:
+        with open('/proc/cpuinfo') as f:
+            for line in f:
+                if line.startswith('model name'):
+                    return line.split(':', 1)[1].strip()
+    except OSError:
+        pass
+    return 'unknown CPU'
+
+
+def records(folder):
+    path = os.path.join(folder, 'results.jsonl')
+    out = []
+    with open(path) as f:
+        for line in f:
+            line = line.strip()
+            if line:
+                out.append(json.loads(line))
+    return out
+
+
+def finished(kind, folder):
+    if kind == 'runs':
+        return os.path.exists(os.path.join(folder, 'done.json'))
+    if kind == 'bench':
+        return os.path.exists(os.path.join(folder, 'bench.json'))
+    return os.path.exists(os.path.join(folder, 'summary.json'))
+
+
+def run_job(binary, name, kind, args, folder):
+    cmd = [binary] + args + ['--out', folder]
+    if os.path.isdir(folder) and os.path.exists(os.path.join(folder, 'results.jsonl')):
+        cmd.append('--resume')
+    print('results: %s: %s' % (name, ' '.join(cmd)), flush=True)
+    subprocess.run(cmd, cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    if kind == 'campaign':
+        subprocess.run([binary, 'campaign', 'merge', folder], cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+
+
+def load_thresholds():
+    """The shipped composite-FDD thresholds (a flat YAML map of numbers)."""
+    out = {}
+    with open(os.path.join(ROOT, 'configs/vehicles/zhou2025_quad_fdd.yaml')) as f:
+        for line in f:
+            line = line.split('#', 1)[0].strip()
+            if ':' in line:
+                k, v = line.split(':', 1)
+                try:
+                    out[k.strip()] = float(v)
+                except ValueError:
+                    pass
+    return out
+
+
+def manifest(folder):
+    with open(os.path.join(folder, 'manifest.json')) as f:
+        return json.load(f)
+
+
+def command_text(args):
+    return 'rotorguard ' + ' '.join(args)
+
+
+# --- the tables ---------------------------------------------------------------------------------
+
+PAPER_LATENCY = {('hover', 'propeller_loss'): '0.105', ('hover', 'motor_stop'): '0.032',
+                 ('tracking', 'propeller_loss'): '0.184', ('tracking', 'motor_stop'): '0.028',
+                 ('takeoff', 'propeller_loss'): '0.020', ('takeoff', 'motor_stop'): '0.020'}
+PAPER_SUCR = {('hover', 'propeller_loss'): '100', ('hover', 'motor_stop'): '100',
+              ('tracking', 'propeller_loss'): '90', ('tracking', 'motor_stop'): '100',
+              ('takeoff', 'propeller_loss'): 'ok', ('takeoff', 'motor_stop'): 'ok'}
+BINS = [(0.0, 0.3), (0.3, 1.0), (1.0, 2.0), (2.0, 4.0), (4.0, 6.5)]
+
+
+def ftc_cells(recs):
+    cells = {}
+    for r in recs:
+        p = r['params']
+        cells.setdefault((p['phase'], p['fault'], p['method']), []).append(r)
+    return cells
+
+
+def ftc_table(recs, methods):
+    cells = ftc_cells(recs)
+    lines = ['| phase | fault | method | trials | SucR | MDR | FAR | FDD latency mean (s) | latency max (s) | paper: SucR (%), latency (s) |',
+             '|---|---|---|---|---|---|---|---|---|---|']
+    summary = {}
+    for (phase, fault, method), rs in cells.items():
+        if method not in methods or fault == 'none' or fault.startswith('motor_stop_then'):
+            continue
+        n = len(rs)
+        ok = [r for r in rs if r['status'] == 'ok']
+        success = sum(1 for r in ok if r['metrics'].get('success'))
+        correct = sum(1 for r in ok if r['metrics'].get('correct'))
+        false_alarm = sum(1 for r in ok if r['metrics'].get('false_alarm'))
+        has_fdd = any('correct' in r['metrics'] for r in ok)
+        lat = [r['metrics']['latency_s'] for r in ok if r['metrics'].get('correct') and r['metrics'].get('latency_s') is not None]
+        missed = n - correct
+        lines.append('| %s | %s | %s | %d | %s | %s | %s | %s | %s | %s, %s |' % (
+            phase, fault, method, n, pct(success, n), pct(missed, n) if has_fdd else '/',
+            pct(false_alarm, n) if has_fdd else '/', mean_ci(lat), '%.3f' % max(lat) if lat else '/',
+            PAPER_SUCR.get((phase, fault), ''), PAPER_LATENCY.get((phase, fault), '')))
+        summary[(phase, fault, method)] = dict(n=n, success=success, missed=missed, lat=lat)
+    return '\n'.join(lines), summary
+
+
+def ftc_fault_free(recs, methods):
+    cells = ftc_cells(recs)
+    lines = ['| phase | method | trials | false alarms | FAR |', '|---|---|---|---|---|']
+    out = {}
+    for (phase, fault, method), rs in cells.items():
+        if method not in methods or fault != 'none':
+            continue
+        n = len(rs)
+        alarms = sum(1 for r in rs if r['status'] != 'ok' or r['metrics'].get('false_alarm'))
+        lines.append('| %s | %s | %d | %d | %s |' % (phase, method, n, alarms, pct(alarms, n)))
+        out[(phase, method)] = (alarms, n)
+    return '\n'.join(lines), out
+
+
+def ftc_second(recs, methods):
+    cells = ftc_cells(recs)
+    lines = ['| second failure | method | trials | SucR | second isolated | false second isolations | '
+             + ' | '.join('onset %g-%g s after the first isolation' % b for b in BINS) + ' |',
+             '|---|---|---|---|---|---|' + '---|' * len(BINS)]
+    out = {}
+    for (phase, fault, method), rs in cells.items():
+        if method not in methods or not fault.startswith('motor_stop_then'):
+            continue
+        n = len(rs)
+        ok = [r for r in rs if r['status'] == 'ok']
+        success = sum(1 for r in ok if r['metrics'].get('success'))
+        second = sum(1 for r in ok if r['metrics'].get('second_correct'))
+        false2 = sum(1 for r in ok if r['metrics'].get('correct') and (r['metrics'].get('healthy_rotors_isolated') or 0) > 0)
+        bins = []
+        for lo, hi in BINS:
+            inb = [r for r in ok if r['metrics'].get('second_after_isolation_s') is not None
+                   and lo <= r['metrics']['second_after_isolation_s'] < hi]
+            k = sum(1 for r in inb if r['metrics'].get('second_correct'))
+            bins.append((k, len(inb)))
+        lines.append('| %s | %s | %d | %s | %s | %d | %s |' % (
+            fault.replace('motor_stop_then_', ''), method, n, pct(success, n), pct(second, n), false2,
+            ' | '.join('%s of %d' % (pct(k, m), m) if m else '/' for k, m in bins)))
+        out[(fault, method)] = dict(n=n, second=second, false2=false2, bins=bins)
+    return '\n'.join(lines), out
+
+
+def false_second_in_single(recs):
+    """Healthy rotors isolated after a correct first isolation, over the single-failure cells."""
+    n = k = 0
+    for r in recs:
+        p = r['params']
+        if p['fault'] == 'none' or p['fault'].startswith('motor_stop_then') or r['status'] != 'ok':
+            continue
+        if p['method'] != 'rotorguard':
+            continue
+        n += 1
+        if r['metrics'].get('correct') and (r['metrics'].get('healthy_rotors_isolated') or 0) > 0:
+            k += 1
+    return k, n
+
+
+MARGINS = [  # (statistic, threshold key, lower is alarming, name)
+    ('fdd.healthy_extremes.debounced_motor_index', 'motor_index_threshold', True, 'motor index'),
+    ('fdd.healthy_extremes.persistent_propeller_index', 'propeller_index_threshold', False, 'propeller index'),
+    ('fdd.healthy_extremes.gated_takeoff_index', 'takeoff_index_threshold', False, 'take-off index'),
+]
+
+
+def far_row(name, desc, recs, thresholds):
+    n = len(recs)
+    ok = [r for r in recs if r['status'] == 'ok']
+    alarms = sum(1 for r in ok if r['metrics'].get('fdd.detected'))
+    errors = n - len(ok)
+    cells = []
+    for stat, key, lower, _ in MARGINS:
+        vals = [r['metrics'][stat] for r in ok if r['metrics'].get(stat) is not None]
+        g = thresholds[key]
+        if not vals:
+            cells.append('/')
+        elif lower:
+            worst = min(vals)
+            cells.append('%.3f (%.2fx)' % (worst, worst / g))
+        else:
+            worst = max(vals)
+            cells.append('%.3f (%s)' % (worst, '%.2fx' % (g / worst) if worst > 0 else 'not moved'))
+    return ('| %s | %s | %d | %d | %s | %d | %s |' % (name, desc, n, alarms, pct(alarms, n), errors, ' | '.join(cells)),
+            (alarms, n))
+
+
+def render(out_dir, present):
+    thresholds = load_thresholds()
+    version = subprocess.run(['git', 'describe', '--always', '--dirty'], cwd=ROOT, capture_output=True,
+                             text=True).stdout.strip() or 'unknown'
+    head = ['# Results', '',
+            '<!-- Generated by `make results` (scripts/results.py); do not edit by hand. -->', '',
+            'Every figure below is computed from the trial records of the commands named with it (a benchmark\'s',
+            'table names the build that ran it), rendered at %s on %s (%d cores as the jobs saw them; the jobs ran'
+            % (version, cpu_model(), os.cpu_count() or 0),
+            'there, two worker threads). World: `realistic`, each trial its own vehicle',
+            'drawn about the file, with the computation and ESC delays, sensors on the file\'s body frame and',
+            'vibration of docs/truth.md. Rates carry their 95 % Wilson interval, means their 95 % normal',
+            'interval, both in brackets. Metric definitions: docs/metrics.md.', '']
+    body = []
+    readme = []
+    if 'ftc_rotorguard' in present:
+        args = dict((j[0], j[2]) for j in JOBS)['ftc_rotorguard']
+        recs = records(os.path.join(out_dir, 'ftc_rotorguard'))
+        m = manifest(os.path.join(out_dir, 'ftc_rotorguard'))
+        base = []
+        if 'ftc_baselines' in present:
+            base = records(os.path.join(out_dir, 'ftc_baselines'))
+        table, single = ftc_table(recs + base, ('rotorguard', 'fixedtime', 'indi'))
+        body += ['## FTC benchmark: paper 000, Tables III and IV', '',
+                 '`%s` (rotorguard, %s; host %s, finished %s)' % (command_text(args), m.get('version', ''),
+                                                                m.get('host', ''), m.get('finished', '')), '']
+        if base:
+            bargs = dict((j[0], j[2]) for j in JOBS)['ftc_baselines']
+            body += ['`%s` (FixedA = `fixedtime`, our re-implementation of the fixed-time observer with the same NMPC; '
+                     'INDI driven by the same FDD)' % command_text(bargs), '']
+        body += ['Single complete failures. SucR: the vehicle hovers or tracks on after the failure; MDR: the faulty',
+                 'rotor not isolated correctly; FAR: a diagnosis before the onset or of another rotor; latency: onset',
+                 'to isolation, over the correct isolations. The paper reports 20 trials per cell.', '', table, '']
+        ff, ffd = ftc_fault_free(recs + base, ('rotorguard', 'fixedtime', 'indi'))
+        body += ['Fault-free cells (every diagnosis is a false alarm; an error counts as one):', '', ff, '']
+        st, sec = ftc_second(recs + base, ('rotorguard',))
+        k2, n2 = false_second_in_single(recs)
+        body += ['Second failures, a propeller lost 0.1-6 s after the first failure (a motor stop in hover), on the',
+                 'rotor beside it (adjacent: the vehicle cannot hover on the two left and is terminated) or on its',
+                 'diagonal twin (which the controller turns nearly off, so that its loss is neither needed nor',
+                 'visible above the spinning vehicle\'s force-balance noise; the vehicle flies on):', '', st, '']
+        adj = sec.get(('motor_stop_then_adjacent', 'rotorguard'))
+        late_k = late_n = 0
+        if adj:
+            late = [(k, n) for (lo, hi), (k, n) in zip(BINS, adj['bins']) if lo >= 0.3]
+            late_k, late_n = sum(k for k, _ in late), sum(n for _, n in late)
+            body += ['Adjacent, the second failure 0.3 s or more after the first isolation: isolated in %d of %d trials (%s).'
+                     % (late_k, late_n, pct(late_k, late_n)), '']
+        body += ['False second isolations over the single-failure cells above: %d of %d flights (%s).' % (k2, n2, pct(k2, n2)), '']
+        # README: the headline figures, realistic.
+        def rng(keys, f):
+            vals = [f(single[k]) for k in keys if k in single]
+            if not vals:
+                return '/'
+            lo, hi = min(vals), max(vals)
+            return '%.1f' % lo if abs(lo - hi) < 0.05 else '%.1f-%.1f' % (lo, hi)
+        rows = []
+        for phase in ('hover', 'tracking', 'takeoff'):
+            keys = [(phase, f, 'rotorguard') for f in ('propeller_loss', 'motor_stop')]
+            rows.append('%s %s %%' % (phase, rng(keys, lambda s: 100.0 * s['success'] / s['n'])))
+        mdr = max((100.0 * s['missed'] / s['n'] for k, s in single.items() if k[2] == 'rotorguard'), default=float('nan'))
+        lat = {}
+        for fault in ('motor_stop', 'propeller_loss'):
+            lat[fault] = ' / '.join('%.3f' % (sum(single[(p, fault, 'rotorguard')]['lat']) / len(single[(p, fault, 'rotorguard')]['lat']))
+                                   for p in ('hover', 'tracking', 'takeoff') if (p, fault, 'rotorguard') in single and single[(p, fault, 'rotorguard')]['lat'])
+        far_cells = ', '.join('%s %d of %d' % (ph, a, n) for (ph, meth), (a, n) in sorted(ffd.items()) if meth == 'rotorguard')
+        readme += ['- FTC benchmark (paper 000, Tables III and IV), 1000 trials per cell, realistic world: SucR %s; '
+                   'MDR at most %.1f %%; false alarms in the fault-free cells: %s; mean isolation latency, hover / '
+                   'tracking / take-off, %s s (motor stops) and %s s (propeller losses).'
+                   % ('; '.join(rows), mdr, far_cells, lat['motor_stop'], lat['propeller_loss'])]
+        if adj:
+            readme += ['- A second failure beside the first, 0.3 s or more after the first isolation: isolated in %s of '
+                       '%d trials; false second isolations: %d in %d single-failure flights.'
+                       % (pct(late_k, late_n), late_n, k2, n2)]
+    far = [j for j in JOBS if j[1] == 'campaign' and j[0] in present]
+    if far:
+        body += ['## False alarms on evaluation sets', '',
+                 'Healthy flights, composite FDD armed throughout (landings included: the detector is not switched',
+                 'off on the ground, it understands it). Each set derives its vehicles from its own seed stream; no',
+                 'threshold was calibrated on any of them (the calibration sets are `fdd_calibration_*`). A',
+                 'margin is the most alarming healthy value of a rule\'s statistic against its threshold (docs/metrics.md):',
+                 'the lowest debounced motor index over gamma_M = %g, gamma_P = %g over the highest persistent propeller'
+                 % (thresholds['motor_index_threshold'], thresholds['propeller_index_threshold']),
+                 'index, the take-off threshold %g over the highest gated take-off index.' % thresholds['takeoff_index_threshold'], '',
+                 '| set | flights | n | false alarms | FAR | errors | lowest debounced M_i (margin) | highest persistent P_i (margin) | highest gated take-off index (margin) |',
+                 '|---|---|---|---|---|---|---|---|---|']
+        total = [0, 0]
+        for name, _, args, desc in far:
+            recs = records(os.path.join(out_dir, name))
+            row, (a, n) = far_row('`%s`' % args[2].split('/')[-1].replace('.yaml', ''), desc, recs, thresholds)
+            body.append(row)
+            total[0] += a
+            total[1] += n
+        body += ['', 'Each set: `rotorguard campaign run configs/campaigns/<set>.yaml --out DIR`, then `campaign merge DIR`.',
+                 'All sets together: %d false alarms in %d flights (%s).' % (total[0], total[1], pct(total[0], total[1])), '']
+        readme += ['- False alarms on %d healthy evaluation flights (%s): %d (%s).'
+                   % (total[1], ', '.join(j[0].replace('far_', '').replace('_', ' ') for j in far), total[0], pct(total[0], total[1]))]
+    if 'nmpc_tracking' in present:
+        with open(os.path.join(out_dir, 'nmpc_tracking', 'done.json')) as f:
+            rows = json.load(f)
+        med = lambda key: median([r[key] for r in rows])
+        body += ['## Post-failure tracking: the 1 m/s lemniscate with propeller 0 lost', '',
+                 '`rotorguard run %s --seed K` for K = 1..%d, as shipped: drawn delays (the stack expects 3 ms),'
+                 % (TRACKING_SCENARIO, len(rows)),
+                 'wind gusts of 0.3 m/s, the tracking window from 5 s. The estimate\'s error against the reference is',
+                 'what the controller achieves; the truth\'s against the reference adds the odometry\'s drift (the',
+                 'estimate\'s error against the truth). Paper 000\'s real flights: 0.14-0.15 m.', '',
+                 '| flights | successes | estimate vs reference, median (m) | truth vs reference, median (m) | estimate vs truth, median (m) |',
+                 '|---|---|---|---|---|',
+                 '| %d | %d | %.3f | %.3f | %.3f |' % (len(rows), sum(1 for r in rows if r['success']), med('est_vs_ref'),
+                                                    med('truth_vs_ref'), med('est_vs_truth')), '']
+        readme += ['- Post-failure tracking (1 m/s lemniscate, propeller 0 lost, %d seeds): median error of the estimate '
+                   'against the reference %.3f m; of the truth %.3f m, of which the odometry drift (estimate against '
+                   'truth) %.3f m.' % (len(rows), med('est_vs_ref'), med('truth_vs_ref'), med('est_vs_truth'))]
+    if 'nmpc_delay' in present:
+        with open(os.path.join(out_dir, 'nmpc_delay', 'done.json')) as f:
+            rows = json.load(f)
+        body += ['## The NMPC\'s assumed delay against the true one', '',
+                 'The same flights with the true delay fixed at 3.5 ms (2.5 ms of computation, 1 ms of ESC latency,',
+                 'the computation within 25 % jitter) while the NMPC predicts over `stack.command_delay_s` = D:', '',
+                 '| D (ms) | of the true delay | flights | successes | estimate vs reference, median (m) | truth vs reference, median (m) |',
+                 '|---|---|---|---|---|---|']
+        for d in ASSUMED_DELAYS:
+            rs = [r for r in rows if r['sets'][-1] == 'stack.command_delay_s=%g' % d]
+            body.append('| %g | %s | %d | %d | %.3f | %.3f |' % (
+                d * 1000, {0.0: 'none', 0.00175: 'half', 0.0035: 'equal', 0.007: 'double'}[d], len(rs),
+                sum(1 for r in rs if r['success']), median([r['est_vs_ref'] for r in rs]),
+                median([r['truth_vs_ref'] for r in rs])))
+        body += ['', 'Each flight: `rotorguard run %s --seed K --set truth.computation_delay_min_s=0.0025 --set '
+                 'truth.computation_delay_max_s=0.0025 --set truth.esc_command_latency_min_s=0.001 --set '
+                 'truth.esc_command_latency_max_s=0.001 --set stack.command_delay_s=D`.' % TRACKING_SCENARIO, '']
+    missing = [j[0] for j in JOBS if j[0] not in present]
+    if missing:
+        body += ['## Not in this page', '', 'Jobs of `make results` not run for this page: %s.' % ', '.join(missing), '']
+    with open(os.path.join(ROOT, 'docs/results.md'), 'w') as f:
+        f.write('\n'.join(head + body).rstrip() + '\n')
+    write_readme_block(readme)
+
+
+def write_readme_block(lines):
+    path = os.path.join(ROOT, 'README.md')
+    with open(path) as f:
+        text = f.read()
+    begin, end = '<!-- BEGIN results -->\n', '<!-- END results -->'
+    i, j = text.find(begin), text.find(end)
+    if i < 0 or j < 0:
+        sys.exit('results: README.md has no <!-- BEGIN results --> ... <!-- END results --> block')
+    text = text[:i + len(begin)] + '\n'.join(lines) + '\n' + text[j:]
+    with open(path, 'w') as f:
+        f.write(text)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('--build', default=os.path.join(ROOT, 'build'))
+    ap.add_argument('--out', default=os.path.join(ROOT, 'out', 'results'))
+    ap.add_argument('--only', nargs='*', default=None, help='run only these jobs (the page shows every finished one)')
+    ap.add_argument('--render-only', action='store_true', help='run nothing; render the finished jobs')
+    a = ap.parse_args()
+    binary = os.path.join(a.build, 'bin', 'rotorguard')
+    os.makedirs(a.out, exist_ok=True)
+    for name, kind, args, _ in JOBS:
+        folder = os.path.join(a.out, name)
+        if a.render_only or (a.only is not None and name not in a.only) or finished(kind, folder):
+            continue
+        if kind == 'runs':
+            print('results: %s: %d flights of rotorguard run %s' % (name, len(RUN_JOBS[name]), TRACKING_SCENARIO), flush=True)
+            run_flights(binary, name, folder)
+        else:
+            run_job(binary, name, kind, args, folder)
+    present = {name for name, kind, _, _ in JOBS if finished(kind, os.path.join(a.out, name))}
+    render(a.out, present)
+    print('results: docs/results.md and README.md written from %s' % ', '.join(sorted(present)) if present
+          else 'results: nothing finished yet')
+
+
+if __name__ == '__main__':
+    main()
