@@ -122,7 +122,8 @@ def pct(k, n):
     if n == 0:
         return '/'
     lo, hi = wilson(k, n)
-    return '%.1f %% [%.1f, %.1f]' % (100.0 * k / n, 100.0 * lo, 100.0 * hi)
+    d = 2 if 0 < k < 0.01 * n else 1  # a rate below 1 % keeps its second decimal: 2 of 5000 is not 0.0 %
+    return '%.*f %% [%.*f, %.*f]' % (d, 100.0 * k / n, d, 100.0 * lo, d, 100.0 * hi)
 
 
 def mean_ci(values, digits=3):
@@ -421,16 +422,20 @@ def render(out_dir, present):
                  '| set | flights | n | false alarms | FAR | errors | lowest debounced M_i (margin) | highest persistent P_i (margin) | highest gated take-off index (margin) |',
                  '|---|---|---|---|---|---|---|---|---|']
         total = [0, 0]
+        where = []
         for name, _, args, desc in far:
             recs = records(os.path.join(out_dir, name))
             row, (a, n) = far_row('`%s`' % args[2].split('/')[-1].replace('.yaml', ''), desc, recs, thresholds)
             body.append(row)
             total[0] += a
             total[1] += n
+            if a:
+                where.append('%d in %s' % (a, name.replace('far_', '').replace('_', ' ')))
         body += ['', 'Each set: `rotorguard campaign run configs/campaigns/<set>.yaml --out DIR`, then `campaign merge DIR`.',
                  'All sets together: %d false alarms in %d flights (%s).' % (total[0], total[1], pct(total[0], total[1])), '']
-        readme += ['- False alarms on %d healthy evaluation flights (%s): %d (%s).'
-                   % (total[1], ', '.join(j[0].replace('far_', '').replace('_', ' ') for j in far), total[0], pct(total[0], total[1]))]
+        readme += ['- False alarms on %d healthy evaluation flights (%s, 1000 each): %d (%s)%s.'
+                   % (total[1], ', '.join(j[0].replace('far_', '').replace('_', ' ') for j in far), total[0],
+                      pct(total[0], total[1]), ': ' + ', '.join(where) if where else '')]
     if 'nmpc_tracking' in present:
         with open(os.path.join(out_dir, 'nmpc_tracking', 'done.json')) as f:
             rows = json.load(f)
