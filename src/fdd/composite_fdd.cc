@@ -129,6 +129,13 @@ double CompositeFdd::SampleRing::Max() const {
   return m;
 }
 
+std::optional<double> CompositeFdd::SampleRing::HeldOver(double t, double v, double span) {
+  Push(t, v);
+  while (size_ >= 2 && t - time(1) >= span) PopFront();
+  if (t - time(0) < span) return std::nullopt;
+  return Min();
+}
+
 void IndexExtremes::Merge(const IndexExtremes& other) {
   min_motor_index = std::min(min_motor_index, other.min_motor_index);
   max_propeller_index = std::max(max_propeller_index, other.max_propeller_index);
@@ -327,11 +334,8 @@ void CompositeFdd::RunObserver(double t, double dt) {
       extremes_.max_propeller_index = std::max(extremes_.max_propeller_index, p);
       // The rule below fires once P_i has stayed above gamma_P from a sample at least
       // propeller_persistence_s old to now, that is when the smallest P_i over that span does.
-      SampleRing& recent = recent_propeller_index_[i];
-      recent.Push(t, p);
-      while (recent.size() >= 2 && t - recent.time(1) >= options_.propeller_persistence_s) recent.PopFront();
-      if (t - recent.time(0) >= options_.propeller_persistence_s) {
-        extremes_.persistent_propeller_index = std::max(extremes_.persistent_propeller_index, recent.Min());
+      if (const auto held = recent_propeller_index_[i].HeldOver(t, p, options_.propeller_persistence_s)) {
+        extremes_.persistent_propeller_index = std::max(extremes_.persistent_propeller_index, *held);
       }
     }
     if (working_[i] == 0.0) continue;  // isolated already
@@ -353,11 +357,9 @@ void CompositeFdd::RunObserver(double t, double dt) {
     for (int j = 0; j < n_; ++j) largest_loss = largest_loss && (j == i || working_[j] == 0.0 || thrust_loss_[j] <= thrust_loss_[i]);
     if (isolated > 0) {
       // The second-failure rule's statistic: P_i through its gates, held for the persistence.
-      SampleRing& recent = recent_propeller_index_[i];
-      recent.Push(t, costs_thrust && largest_loss ? p : 0.0);
-      while (recent.size() >= 2 && t - recent.time(1) >= options_.second_failure_persistence_s) recent.PopFront();
-      if (t - recent.time(0) >= options_.second_failure_persistence_s) {
-        extremes_.second_failure_index = std::max(extremes_.second_failure_index, recent.Min());
+      if (const auto held = recent_propeller_index_[i].HeldOver(t, costs_thrust && largest_loss ? p : 0.0,
+                                                                 options_.second_failure_persistence_s)) {
+        extremes_.second_failure_index = std::max(extremes_.second_failure_index, *held);
       }
     }
     if (p > options_.propeller_index_threshold && costs_thrust && largest_loss) {

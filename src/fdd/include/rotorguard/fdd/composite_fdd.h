@@ -305,6 +305,10 @@ class CompositeFdd final : public FaultDetectorBase {
     double time(std::size_t k) const { return t_[(head_ + k) % t_.size()]; }
     double Min() const;
     double Max() const;
+    /// Pushes (t, v), keeps the samples spanning the last `span` seconds, and returns the smallest
+    /// value held over the whole span (the value a persistence rule compares), or nullopt while
+    /// the samples span less.
+    std::optional<double> HeldOver(double t, double v, double span);
 
    private:
     std::vector<double> t_, v_;
