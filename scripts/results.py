@@ -4,7 +4,8 @@
     scripts/results.py [--build build] [--out out/results] [--only NAME ...] [--render-only]
 
 Each job is one `rotorguard bench ...` or `rotorguard campaign run ...` command whose trial records
-(results.jsonl) land in OUT/NAME. A job whose folder already holds its finished result is not run
+(results.jsonl) land in OUT/NAME, a set of `rotorguard run` flights (their summaries), or the
+threshold calibration (two campaigns, sixteen runs and `rotorguard fdd-calibrate`). A job whose folder already holds its finished result is not run
 again (delete the folder to rerun it; an unfinished one is resumed), so the page can be rendered
 from jobs run at different times on one build. Every figure of docs/results.md is computed here
 from the trial records: rates with their 95 % Wilson intervals, means with their 95 % normal
@@ -17,6 +18,7 @@ import datetime
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 
@@ -58,9 +60,12 @@ TRACKING_SEEDS = list(range(1, 21))
 FIXED_DELAY = ['truth.computation_delay_min_s=0.0025', 'truth.computation_delay_max_s=0.0025',
                'truth.esc_command_latency_min_s=0.001', 'truth.esc_command_latency_max_s=0.001']
 ASSUMED_DELAYS = [0.0, 0.00175, 0.0035, 0.007]
+# A `runs` job: flights of `rotorguard run SCENARIO --seed K [--set ...]`, two at a time, each
+# kept as its summary.json (the logs are deleted once read). Entries: (label, scenario, seed, sets).
 RUN_JOBS = {
-    'nmpc_tracking': [('seed%d' % k, k, []) for k in TRACKING_SEEDS],
-    'nmpc_delay': [('seed%d_assumed%g' % (k, d * 1000), k, FIXED_DELAY + ['stack.command_delay_s=%g' % d])
+    'nmpc_tracking': [('seed%d' % k, TRACKING_SCENARIO, k, []) for k in TRACKING_SEEDS],
+    'nmpc_delay': [('seed%d_assumed%g' % (k, d * 1000), TRACKING_SCENARIO, k,
+                    FIXED_DELAY + ['stack.command_delay_s=%g' % d])
                    for d in ASSUMED_DELAYS for k in TRACKING_SEEDS],
 }
 JOBS += [('nmpc_tracking', 'runs', ['run', TRACKING_SCENARIO, '--seed', 'K'],
@@ -71,23 +76,119 @@ JOBS += [('nmpc_tracking', 'runs', ['run', TRACKING_SCENARIO, '--seed', 'K'],
                                  '--set', 'stack.command_delay_s=D'],
           'the same 20 seeds with a true delay of 3.5 ms, the NMPC assuming D = 0, 1.75, 3.5 or 7 ms')]
 
+# Every shipped scenario at 50 seeds no test or document flies (ctest flies 1-3), in the realistic
+# world and, beside it, the ideal one (what the realistic world costs). The scenarios written to show a
+# failure succeed when they show it: the same words tests/harness/shipped_scenarios_test.cc
+# (IntendedFailures) checks for.
+SHIPPED_SEEDS = list(range(1001, 1051))
+INTENDED_FAILURES = {'hover_motor_stop_nominal': 'crash', 'fdd_hover_second_failure': 'flight termination',
+                     'emergency_landing': 'emergency landing'}
 
-def run_flights(binary, name, folder):
-    """Flies RUN_JOBS[name], keeps each flight's figures in folder/done.json."""
-    os.makedirs(folder, exist_ok=True)
-    rows = []
-    for label, seed, sets in RUN_JOBS[name]:
-        out = os.path.join(folder, label)
+
+def shipped_scenarios():
+    """(name, path relative to ROOT, stated world) of configs/scenarios/*.yaml."""
+    out = []
+    folder = os.path.join(ROOT, 'configs', 'scenarios')
+    for f in sorted(os.listdir(folder)):
+        if not f.endswith('.yaml'):
+            continue
+        world = 'realistic'
+        with open(os.path.join(folder, f)) as fh:
+            for line in fh:
+                if line.startswith('truth:'):
+                    world = 'ideal' if 'ideal' in line.split('#', 1)[0] else 'realistic'
+        out.append((f[:-5], 'configs/scenarios/' + f, world))
+    return out
+
+
+RUN_JOBS['shipped'] = [('%s_%s_seed%d' % (name, w, k), path, k, ['truth=%s' % w])
+                       for name, path, stated in shipped_scenarios()
+                       for w in ('realistic', 'ideal')
+                       for k in SHIPPED_SEEDS]
+JOBS += [('shipped', 'runs', ['run', 'configs/scenarios/NAME.yaml', '--seed', 'K', '--set', 'truth=WORLD'],
+          'every shipped scenario at seeds 1001-1050')]
+
+
+# The calibration of the composite FDD's thresholds, on flights apart from every evaluation above:
+# the two calibration campaigns (their own seed streams) and 16 faulty runs (a motor stop and a
+# propeller loss, in hover and at take-off, on each rotor, each its own vehicle: run seeds
+# 111-144), through `rotorguard fdd-calibrate`. The page sets its suggestions beside the shipped
+# thresholds and checks that no evaluation set shares a vehicle with it.
+CALIBRATION_CAMPAIGNS = ['fdd_calibration_lemniscate', 'fdd_calibration_takeoff']
+CALIBRATION_RUNS = [run for r in range(4) for run in (
+    ('hover_motor_%d' % r, 'configs/scenarios/fdd_hover_motor_stop.yaml', 111 + r, ['faults.0.rotor=%d' % r]),
+    ('hover_propeller_%d' % r, 'configs/scenarios/fdd_hover_propeller_loss.yaml', 121 + r, ['faults.0.rotor=%d' % r]),
+    ('takeoff_propeller_%d' % r, 'configs/scenarios/fdd_takeoff_propeller_loss.yaml', 131 + r,
+     ['faults.0.rotor=%d' % r, 'truth=realistic']),
+    ('takeoff_motor_%d' % r, 'configs/scenarios/fdd_takeoff_propeller_loss.yaml', 141 + r,
+     ['faults.0.rotor=%d' % r, 'faults.0.kind=motor_stop', 'truth=realistic']))]
+JOBS += [('calibration', 'calibration', ['fdd-calibrate', 'runs/*', '--healthy'] + CALIBRATION_CAMPAIGNS,
+          'the thresholds calibrated on the calibration sets')]
+
+
+def run_calibration(binary, folder):
+    """The calibration campaigns and faulty runs (their logs kept: fdd-calibrate replays them)."""
+    for c in CALIBRATION_CAMPAIGNS:
+        out = os.path.join(folder, c)
         if not os.path.exists(os.path.join(out, 'summary.json')):
-            cmd = [binary, 'run', TRACKING_SCENARIO, '--seed', str(seed), '--no-report', '--out', out]
+            run_job(binary, c, 'campaign', ['campaign', 'run', 'configs/campaigns/%s.yaml' % c], out)
+    runs = []
+    for label, scenario, seed, sets in CALIBRATION_RUNS:
+        out = os.path.join(folder, 'runs', label)
+        if not os.path.exists(os.path.join(out, 'summary.json')):
+            cmd = [binary, 'run', scenario, '--seed', str(seed), '-q', '--no-report', '--out', out]
             for kv in sets:
                 cmd += ['--set', kv]
             subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        with open(os.path.join(out, 'summary.json')) as f:
-            summary = json.load(f)
-        rows.append(dict(label=label, seed=seed, sets=sets, success=summary['success'],
-                         truth_vs_ref=summary['tracking_rmse_m'], est_vs_truth=summary['estimate_position_rmse_m'],
-                         est_vs_ref=estimate_vs_reference(out, summary)))
+        runs.append(out)
+    cmd = [binary, 'fdd-calibrate'] + runs
+    for c in CALIBRATION_CAMPAIGNS:
+        cmd += ['--healthy', os.path.join(folder, c)]
+    subprocess.run(cmd + ['--out', os.path.join(folder, 'calibration')], cwd=ROOT, check=True,
+                   stdout=subprocess.DEVNULL)
+
+
+def fly(binary, out, scenario, seed, sets):
+    """One flight into `out`; returns its summary (None when it wrote none) and deletes its logs."""
+    if not os.path.exists(os.path.join(out, 'summary.json')):
+        cmd = [binary, 'run', scenario, '--seed', str(seed), '-q', '--no-report', '--out', out]
+        for kv in sets:
+            cmd += ['--set', kv]
+        subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    path = os.path.join(out, 'summary.json')
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        return json.load(f)
+
+
+def run_flights(binary, name, folder, workers=2):
+    """Flies RUN_JOBS[name], two flights at a time, keeps each flight's figures in folder/done.json."""
+    from concurrent.futures import ThreadPoolExecutor
+    os.makedirs(folder, exist_ok=True)
+    jobs = RUN_JOBS[name]
+
+    def one(job):
+        label, scenario, seed, sets = job
+        out = os.path.join(folder, label)
+        summary = fly(binary, out, scenario, seed, sets)
+        row = dict(label=label, scenario=scenario, seed=seed, sets=sets, success=bool(summary and summary['success']),
+                   failure_reason=(summary or {}).get('failure_reason') or ('no summary' if summary is None else ''))
+        if summary is not None and name != 'shipped':
+            row.update(truth_vs_ref=summary['tracking_rmse_m'], est_vs_truth=summary['estimate_position_rmse_m'],
+                       est_vs_ref=estimate_vs_reference(out, summary))
+        if summary is not None:
+            for f in os.listdir(out):  # the figures are read: keep the summary, not the logs
+                if f != 'summary.json' and os.path.isfile(os.path.join(out, f)):
+                    os.remove(os.path.join(out, f))
+        return row
+
+    rows = []
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        for i, row in enumerate(pool.map(one, jobs)):
+            rows.append(row)
+            if (i + 1) % 50 == 0 or i + 1 == len(jobs):
+                print('results: %s: %d of %d flights' % (name, i + 1, len(jobs)), flush=True)
     with open(os.path.join(folder, 'done.json'), 'w') as f:
         json.dump(rows, f, indent=1)
 
@@ -171,6 +272,8 @@ def finished(kind, folder):
         return os.path.exists(os.path.join(folder, 'done.json'))
     if kind == 'bench':
         return os.path.exists(os.path.join(folder, 'bench.json'))
+    if kind == 'calibration':
+        return os.path.exists(os.path.join(folder, 'calibration', 'calibration.json'))
     return os.path.exists(os.path.join(folder, 'summary.json'))
 
 
@@ -409,6 +512,45 @@ def render(out_dir, present):
             readme += ['- A second failure beside the first, 0.3 s or more after the first isolation: isolated in %s of '
                        '%d trials; false second isolations: %d in %d single-failure flights.'
                        % (pct(late_k, late_n), late_n, k2, n2)]
+    if 'calibration' in present:
+        with open(os.path.join(out_dir, 'calibration', 'calibration', 'calibration.json')) as f:
+            cal = json.load(f)
+        flights = sum(c['flights'] for c in cal['campaigns'])
+        body += ['## Threshold calibration', '',
+                 '`rotorguard fdd-calibrate RUNS... --healthy %s` over the calibration sets\' %d healthy flights'
+                 % (' --healthy '.join(CALIBRATION_CAMPAIGNS), flights),
+                 '(%s) and %d faulty runs (`rotorguard run` of `fdd_hover_motor_stop`, `fdd_hover_propeller_loss` and'
+                 % ('; '.join('%d of `%s`, false alarms as flown: %d' % (c['flights'], c['campaign'], c['false_alarms'])
+                              for c in cal['campaigns']), len(cal['logs'])),
+                 '`fdd_takeoff_propeller_loss`, both kinds, each rotor, seeds 111-144, realistic). The suggestion is the',
+                 'fastest value with no false alarm, the fewest misses and a margin of %gx to the most alarming healthy value;'
+                 % cal['margin_required'],
+                 'docs/fdd.md says why a shipped value differs from it.', '',
+                 '| threshold | shipped | its margin | detected / missed of %d | mean latency (s) | suggested | its margin | mean latency (s) |'
+                 % len(cal['logs']),
+                 '|---|---|---|---|---|---|---|---|']
+        for sw in cal['sweeps']:
+            shipped = thresholds.get(sw['threshold'])
+            row = min(sw['rows'], key=lambda r: abs(r['value'] - shipped)) if shipped is not None and sw['rows'] else None
+            sug = sw.get('suggested')
+            fmt = lambda v, d=3: '/' if v is None else '%.*f' % (d, v)
+            body.append('| %s | %g | %s | %s | %s | %s | %s | %s |' % (
+                sw['threshold'], shipped,
+                fmt(row['margin'], 2) + 'x' if row and abs(row['value'] - shipped) < 1e-9 else '/',
+                '%d / %d' % (row['detected'], row['missed']) if row else '/',
+                fmt(row['latency_s_mean']) if row else '/',
+                '%g' % sug['value'] if sug else 'none', fmt(sug['margin'], 2) + 'x' if sug else '/',
+                fmt(sug['latency_s_mean']) if sug else '/'))
+        cal_seeds = set(int(x) for c in cal['campaigns'] for x in c['trial_seeds'])
+        shared = []
+        for name, kind, _, _ in JOBS:
+            if kind == 'campaign' and name in present:
+                seeds = set(int(r['params']['seed']) for r in records(os.path.join(out_dir, name)))
+                shared.append('%s %d' % (name.replace('far_', ''), len(seeds & cal_seeds)))
+        if shared:
+            body += ['', 'Vehicles the evaluation sets below share with the calibration\'s %d: %s.'
+                     % (len(cal_seeds), ', '.join(shared))]
+        body.append('')
     far = [j for j in JOBS if j[1] == 'campaign' and j[0] in present]
     if far:
         body += ['## False alarms on evaluation sets', '',
@@ -470,6 +612,47 @@ def render(out_dir, present):
         body += ['', 'Each flight: `rotorguard run %s --seed K --set truth.computation_delay_min_s=0.0025 --set '
                  'truth.computation_delay_max_s=0.0025 --set truth.esc_command_latency_min_s=0.001 --set '
                  'truth.esc_command_latency_max_s=0.001 --set stack.command_delay_s=D`.' % TRACKING_SCENARIO, '']
+    if 'shipped' in present:
+        with open(os.path.join(out_dir, 'shipped', 'done.json')) as f:
+            rows = json.load(f)
+        body += ['## Every shipped scenario at 50 seeds', '',
+                 '`rotorguard run configs/scenarios/NAME.yaml --seed K --set truth=WORLD` for K = %d..%d (vehicles no test'
+                 % (SHIPPED_SEEDS[0], SHIPPED_SEEDS[-1]),
+                 'or document flies: ctest flies seeds 1-3), in the realistic world and, beside it, the ideal one. A file',
+                 'that states `truth: ideal` is not yet realistic (the file says why). A scenario written to show a',
+                 'failure succeeds when it shows that failure (the words in brackets).', '',
+                 '| scenario | states | world | flights | successes | rate | failures (most frequent reasons) |',
+                 '|---|---|---|---|---|---|---|']
+        stated = dict((n, w) for n, _, w in shipped_scenarios())
+        realistic_k = realistic_n = 0
+        weakest = []
+        for name, _, _ in shipped_scenarios():
+            for world in ('realistic', 'ideal'):
+                rs = [r for r in rows if r['label'].startswith('%s_%s_seed' % (name, world))]
+                if not rs:
+                    continue
+                intended = INTENDED_FAILURES.get(name)
+                ok = [(intended in (r['failure_reason'] or '')) if intended else r['success'] for r in rs]
+                k, n = sum(ok), len(rs)
+                reasons = {}
+                for r, good in zip(rs, ok):
+                    if not good:  # the reason's kind: its words up to the first figure
+                        why = re.split(r'[0-9]', r['failure_reason'] or 'succeeded')[0].rstrip(' :=(,')
+                        reasons[why] = reasons.get(why, 0) + 1
+                top = '; '.join('%s (%d)' % (w, c) for w, c in sorted(reasons.items(), key=lambda x: -x[1])[:2])
+                body.append('| `%s`%s | %s | %s | %d | %d | %s | %s |' % (
+                    name, ' (%s)' % intended if intended else '', stated[name], world, n, k, pct(k, n), top or '/'))
+                if world == 'realistic' and stated[name] == 'realistic':
+                    realistic_k += k
+                    realistic_n += n
+                    weakest.append((k / n if n else 0.0, name, k, n))
+        body += ['', 'Over the scenarios that state `realistic`: %d of %d flights as intended (%s).'
+                 % (realistic_k, realistic_n, pct(realistic_k, realistic_n)), '']
+        weakest.sort()
+        readme += ['- Every shipped scenario that states the realistic world, at 50 fresh seeds each: %d of %d flights '
+                   'as intended (%s); the weakest, `%s`, %d of %d.'
+                   % (realistic_k, realistic_n, pct(realistic_k, realistic_n), weakest[0][1], weakest[0][2],
+                      weakest[0][3])]
     missing = [j[0] for j in JOBS if j[0] not in present]
     if missing:
         body += ['## Not in this page', '', 'Jobs of `make results` not run for this page: %s.' % ', '.join(missing), '']
@@ -504,8 +687,12 @@ def main():
         folder = os.path.join(a.out, name)
         if a.render_only or (a.only is not None and name not in a.only) or finished(kind, folder):
             continue
-        if kind == 'runs':
-            print('results: %s: %d flights of rotorguard run %s' % (name, len(RUN_JOBS[name]), TRACKING_SCENARIO), flush=True)
+        if kind == 'calibration':
+            print('results: calibration: %s, %d faulty runs, fdd-calibrate' % (', '.join(CALIBRATION_CAMPAIGNS),
+                                                                            len(CALIBRATION_RUNS)), flush=True)
+            run_calibration(binary, folder)
+        elif kind == 'runs':
+            print('results: %s: %d flights of rotorguard run' % (name, len(RUN_JOBS[name])), flush=True)
             run_flights(binary, name, folder)
         else:
             run_job(binary, name, kind, args, folder)

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -91,6 +92,34 @@ TEST_F(Campaigns, TrialsCoverTheGridWithCounterStyleSeedsAndDraws) {
   }
   EXPECT_EQ(ids.size(), 6u);
   EXPECT_EQ(rotors.size(), 3u);
+}
+
+TEST(ShippedCampaigns, NoEvaluationSetFliesAVehicleOfTheCalibrationSets) {
+  // The shipped thresholds are calibrated on fdd_calibration_* and judged on fdd_far_* (docs/fdd.md,
+  // "Calibration and evaluation"): a judged flight must be a vehicle the calibration never saw. A
+  // spec copied under the name of another, or a stream shared again, fails here.
+  std::set<std::string> calibration;
+  std::map<std::string, std::set<std::string>> evaluation;
+  for (const auto& e : fs::directory_iterator(testing::SourcePath("configs/campaigns"))) {
+    const std::string stem = e.path().stem().string();
+    const bool cal = stem.rfind("fdd_calibration_", 0) == 0, far = stem.rfind("fdd_far_", 0) == 0;
+    if (!cal && !far) continue;
+    const CampaignSpec spec = LoadCampaignSpec(e.path().string());
+    std::set<std::string> seeds;
+    for (int i = 0; i < spec.trials(); ++i) seeds.insert(TrialParameters(spec, i).at("seed"));
+    EXPECT_EQ(seeds.size(), static_cast<std::size_t>(spec.trials())) << stem << ": every trial its own vehicle";
+    if (cal) {
+      calibration.insert(seeds.begin(), seeds.end());
+    } else {
+      EXPECT_GE(spec.trials(), 1000) << stem;
+      evaluation[stem] = std::move(seeds);
+    }
+  }
+  EXPECT_GE(calibration.size(), 1000u);
+  EXPECT_GE(evaluation.size(), 6u);
+  for (const auto& [name, seeds] : evaluation) {
+    for (const std::string& s : seeds) EXPECT_EQ(calibration.count(s), 0u) << name << " flies seed " << s;
+  }
 }
 
 TEST_F(Campaigns, JobsAndShardsGiveByteIdenticalSummaries) {
