@@ -1,0 +1,84 @@
+// LatencyHistogram against the exact order statistics of the recorded values, and the real-time
+// request's validation and report.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "rotorguard/core/error.h"
+#include "rotorguard/core/rng.h"
+#include "rotorguard/runtime/latency.h"
+#include "rotorguard/runtime/realtime.h"
+
+namespace rotorguard::runtime {
+namespace {
+
+/// The q-quantile of sorted values as the histogram defines it: the value of rank ceil(q n).
+double ExactQuantile(std::vector<TimeNs> v, double q) {
+  std::sort(v.begin(), v.end());
+  const auto k = static_cast<std::size_t>(std::max(1.0, std::ceil(q * static_cast<double>(v.size()))));
+  return ToSeconds(v[k - 1]);
+}
+
+TEST(LatencyHistogram, QuantilesAreTheExactOnesToTheBinWidth) {
+  Rng rng(3);
+  std::vector<TimeNs> values;
+  LatencyHistogram h, a, b;
+  for (int i = 0; i < 20000; ++i) {
+    // Log-uniform from 20 us to 20 ms, a few far outliers.
+    TimeNs ns = static_cast<TimeNs>(std::pow(10.0, rng.Uniform(4.3, 7.3)));
+    if (i % 5000 == 0) ns = 2'000'000'000;
+    values.push_back(ns);
+    h.Record(ns);
+    (i % 2 ? a : b).Record(ns);
+  }
+  const double ratio = std::pow(10.0, 1.0 / LatencyHistogram::kBinsPerDecade);  // one bin
+  for (double q : {0.01, 0.25, 0.5, 0.9, 0.99, 0.999}) {
+    const double exact = ExactQuantile(values, q);
+    EXPECT_LE(h.Quantile(q), exact * ratio) << q;
+    EXPECT_GE(h.Quantile(q), exact / ratio) << q;
+  }
+  EXPECT_DOUBLE_EQ(h.min_s(), ToSeconds(*std::min_element(values.begin(), values.end())));
+  EXPECT_DOUBLE_EQ(h.max_s(), 2.0);
+  EXPECT_DOUBLE_EQ(h.Quantile(1.0), 2.0);
+  double sum = 0.0;
+  for (TimeNs v : values) sum += ToSeconds(v);
+  EXPECT_NEAR(h.mean_s(), sum / static_cast<double>(values.size()), 1e-12);
+  a.Merge(b);
+  EXPECT_EQ(a.count(), h.count());
+  for (double q : {0.1, 0.5, 0.99}) EXPECT_DOUBLE_EQ(a.Quantile(q), h.Quantile(q)) << q;
+  EXPECT_DOUBLE_EQ(a.max_s(), h.max_s());
+}
+
+TEST(LatencyHistogram, EmptyAndOutOfRangeValues) {
+  LatencyHistogram h;
+  EXPECT_EQ(h.Quantile(0.5), 0.0);
+  EXPECT_EQ(h.mean_s(), 0.0);
+  h.Record(-5);  // a clock stepping back is a zero latency, not a negative one
+  h.Record(50);  // below the first bin
+  h.Record(FromSeconds(100.0));  // beyond the last bin: still its exact maximum
+  EXPECT_EQ(h.count(), 3u);
+  EXPECT_EQ(h.min_s(), 0.0);
+  EXPECT_DOUBLE_EQ(h.max_s(), 100.0);
+  EXPECT_DOUBLE_EQ(h.Quantile(1.0), 100.0);
+  EXPECT_GE(h.Quantile(0.99), 0.0);
+  EXPECT_LE(h.Quantile(0.99), 100.0);
+}
+
+TEST(Realtime, ValidatesThePriorityAndReportsWhatItGranted) {
+  RealtimeOptions o;
+  o.fifo_priority = 100;
+  EXPECT_THROW(RequestRealtime(o), ValidationError);
+  o.fifo_priority = -1;
+  EXPECT_THROW(RequestRealtime(o), ValidationError);
+  o.fifo_priority = 0;
+  o.lock_memory = false;
+  const RealtimeGrant g = RequestRealtime(o);
+  EXPECT_FALSE(g.memory_locked);
+  EXPECT_FALSE(g.fifo);
+  EXPECT_EQ(g.note, "memory not locked (not asked), normal scheduler (not asked)");
+}
+
+}  // namespace
+}  // namespace rotorguard::runtime
