@@ -151,6 +151,44 @@ Eigen::Matrix<double, 1, 4> PointToPlaneCalibrationJacobian(const Vector3& n, co
 
 }  // namespace internal
 
+void LioHead::Propagate(const ImuSample& imu) {
+  // Lio::PropagateBetween's mean: the interval's two samples averaged and held over it. A sample
+  // the state's time has passed (it came after a frame that ended later) only starts the next
+  // interval, as it does for the filter.
+  const double dt = ToSeconds(imu.t_ns - state_.t_ns);
+  if (imu.t_ns <= imu_.t_ns) return;
+  if (dt > 0.0) {
+    LioState next;
+    const internal::IntervalMeasurement m(imu_, imu);
+    internal::LioTransition(state_, m.f_m, m.w_m, dt, &next, nullptr);
+    state_ = next;
+    state_.t_ns = imu.t_ns;
+  }
+  imu_ = imu;
+}
+
+void LioHeadFollower::OnImu(const ImuSample& imu) {
+  if (!imu.w_B.allFinite() || !imu.specific_force_B.allFinite()) return;
+  if (count_ > 0 && imu.t_ns <= ring_[static_cast<std::size_t>((next_ + kSamples - 1) % kSamples)].t_ns) return;
+  ring_[static_cast<std::size_t>(next_)] = imu;
+  next_ = (next_ + 1) % kSamples;
+  count_ = std::min(count_ + 1, kSamples);
+  if (valid()) head_.Propagate(imu);
+}
+
+void LioHeadFollower::OnPosterior(const LioPosterior& posterior) {
+  if (posterior.serial <= serial_) return;
+  serial_ = posterior.serial;
+  head_.Reset(posterior.state, posterior.imu);
+  // The samples since the posterior's held one, oldest first.
+  const int oldest = (next_ + kSamples - count_) % kSamples;
+  if (count_ == kSamples && ring_[static_cast<std::size_t>(oldest)].t_ns > posterior.imu.t_ns) ++gaps_;
+  for (int k = 0; k < count_; ++k) {
+    const ImuSample& s = ring_[static_cast<std::size_t>((oldest + k) % kSamples)];
+    if (s.t_ns > posterior.imu.t_ns) head_.Propagate(s);
+  }
+}
+
 void Lio::Propagate(const Vector3& f_m, const Vector3& w_m, TimeNs t_ns, LioState* x, Matrix* P,
                     std::vector<Pose>* poses) const {
   const double dt = ToSeconds(t_ns - x->t_ns);
@@ -186,16 +224,16 @@ void Lio::OnImu(const ImuSample& imu) {
     RebuildHead();
     return;
   }
-  if (imu.t_ns <= head_imu_.t_ns) return;
+  if (imu.t_ns <= head_.imu().t_ns) return;
   if (initialised_ && imu.t_ns <= filter_.t_ns) {
     // A sample the last frame's end has passed (it came after that frame): the filter crossed
     // its interval on the sample before; it starts the filter's next interval.
-    filter_imu_ = head_imu_ = imu;
+    filter_imu_ = imu;
+    head_.Reset(head_.state(), imu);
     return;
   }
   queue_.push_back(imu);
-  PropagateBetween(head_imu_, imu, &head_, nullptr, nullptr);
-  head_imu_ = imu;
+  head_.Propagate(imu);
   if (!initialised_) {
     // The filter stays at the start until the rest initialisation has its samples.
     if (static_cast<int>(queue_.size()) + 1 >= options_.initial_samples) Initialise();
@@ -230,9 +268,8 @@ void Lio::AdvanceFilter(TimeNs t_ns, std::vector<Pose>* poses) {
 
 void Lio::PropagateBetween(const ImuSample& previous, const ImuSample& next, LioState* x, Matrix* P,
                            std::vector<Pose>* poses) const {
-  // Each interval takes the mean of its two samples (second order in the rates' change).
-  Propagate(0.5 * (previous.specific_force_B + next.specific_force_B), 0.5 * (previous.w_B + next.w_B), next.t_ns, x, P,
-            poses);
+  const internal::IntervalMeasurement m(previous, next);
+  Propagate(m.f_m, m.w_m, next.t_ns, x, P, poses);
 }
 
 void Lio::PropagateQueue(LioState* x, Matrix* P) const {
@@ -246,8 +283,11 @@ void Lio::PropagateQueue(LioState* x, Matrix* P) const {
 }
 
 void Lio::RebuildHead() {
-  PropagateQueue(&head_, nullptr);
-  head_imu_ = queue_.empty() ? filter_imu_ : queue_.back();
+  head_.Reset(filter_, filter_imu_);
+  for (const ImuSample& s : queue_) head_.Propagate(s);
+  posterior_.state = filter_;
+  posterior_.imu = filter_imu_;
+  ++posterior_.serial;
 }
 
 Lio::Matrix Lio::covariance() const {
@@ -257,15 +297,15 @@ Lio::Matrix Lio::covariance() const {
   return P;
 }
 
-StateEstimate Lio::BodyEstimate(const LioState& x, const Vector3& w_m) const {
+StateEstimate LioBodyEstimate(const LioState& x, const Vector3& w_m, const Vector3& imu_position_m, bool valid) {
   // The filter's state is the IMU's mount: the centre of gravity is l behind it, and moves with
   // v − R (ω × l).
   StateEstimate e;
   e.t_ns = x.t_ns;
-  e.valid = started_;
+  e.valid = valid;
   const Matrix3 R = x.q_WB.toRotationMatrix();
   const Vector3 w = w_m - x.gyro_bias;
-  const Vector3& l = options_.imu_position_m;
+  const Vector3& l = imu_position_m;
   e.p_W = x.p_W - R * l;
   e.q_WB = x.q_WB;
   e.v_W = x.v_W - R * w.cross(l);
@@ -273,7 +313,11 @@ StateEstimate Lio::BodyEstimate(const LioState& x, const Vector3& w_m) const {
   return e;
 }
 
-StateEstimate Lio::Estimate() const { return BodyEstimate(head_, head_imu_.w_B); }
+StateEstimate Lio::BodyEstimate(const LioState& x, const Vector3& w_m) const {
+  return LioBodyEstimate(x, w_m, options_.imu_position_m, started_);
+}
+
+StateEstimate Lio::Estimate() const { return BodyEstimate(head_.state(), head_.imu().w_B); }
 
 StateEstimate Lio::FrameEstimate() const { return BodyEstimate(filter_, filter_imu_.w_B); }
 

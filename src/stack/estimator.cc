@@ -130,6 +130,24 @@ double LioEstimator::odometry_age_s(TimeNs t) const {
   return last_fix_ns_ ? ToSeconds(t - *last_fix_ns_) : std::numeric_limits<double>::infinity();
 }
 
+void LioHeadEstimator::OnLioUpdate(const LioUpdate& update) {
+  if (update.posterior.serial <= serial_) return;
+  serial_ = update.posterior.serial;
+  follower_.OnPosterior(update.posterior);
+  last_fix_ns_ = update.last_fix_ns;
+}
+
+StateEstimate LioHeadEstimator::Estimate(TimeNs /*t*/) const {
+  const perception::LioHead& head = follower_.head();
+  StateEstimate e = perception::LioBodyEstimate(head.state(), head.imu().w_B, imu_position_m_, follower_.valid());
+  e.motor_thrust_n = motor_thrust();
+  return e;
+}
+
+double LioHeadEstimator::odometry_age_s(TimeNs t) const {
+  return last_fix_ns_ ? ToSeconds(t - *last_fix_ns_) : std::numeric_limits<double>::infinity();
+}
+
 LioSummary LioEstimator::Summarize() const {
   LioSummary s;
   s.frames = static_cast<int>(frames_.size());
@@ -162,10 +180,9 @@ LioSummary LioEstimator::Summarize() const {
   return s;
 }
 
-std::unique_ptr<Estimator> MakeEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options,
-                                         const Vector3& start_position_W, double start_yaw_rad) {
+std::unique_ptr<Estimator> MakeControlEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options) {
   if (options.kind == EstimatorKind::kLio) {
-    return std::make_unique<LioEstimator>(thrust_coefficient_n_s2, options, start_position_W, start_yaw_rad);
+    return std::make_unique<LioHeadEstimator>(thrust_coefficient_n_s2, options.lio.imu_position_m);
   }
   return std::make_unique<OdometryImuEstimator>(thrust_coefficient_n_s2, options);
 }

@@ -38,20 +38,6 @@ control::IndiControllerOptions IndiOptionsInStack(const FlightStackOptions& o) {
   return indi;
 }
 
-void NavigationOptions::Validate() const {
-  for (std::size_t i = 0; i < waypoints.size(); ++i) {
-    if (!waypoints[i].allFinite()) {
-      ThrowValidation("FlightStackOptions", fmt::format("navigation.waypoints.{}", i), "(non-finite)", "finite numbers");
-    }
-  }
-  if (rounds < 1) ThrowValidation("FlightStackOptions", "navigation.rounds", rounds, ">= 1");
-  // stack.planner's keys, the replanner's among them (ReplannerOptions checks its own without
-  // their upper ends).
-  CheckDeclaredRanges("NavigationOptions", *this);
-  replanner.Validate();
-  flatness.Validate();
-}
-
 void FlightStackOptions::Validate() const {
   if (!std::isfinite(control_rate_hz) || control_rate_hz < kMinRateHz || control_rate_hz > kMaxRateHz) {
     ThrowValidation("FlightStackOptions", "control_rate_hz", control_rate_hz,
@@ -119,14 +105,16 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
       reference_(std::move(reference)),
       options_(options),
       supervisor_(options.supervisor),
-      mapper_(options.lidar),
       imu_filter_(vehicle.num_rotors(), options.imu_notch) {
   options_.Validate();
   if (!reference_) throw std::invalid_argument("FlightStack: reference is null; expected a trajectory");
   {
     // The stack starts where its mission does, at rest: the LiDAR-inertial odometry's frame.
     const ReferencePoint start = reference_->Evaluate(0.0);
-    estimator_ = MakeEstimator(model_.params().thrust_coefficient_n_s2, options_.estimator, start.p_W, start.yaw);
+    const double k_n = model_.params().thrust_coefficient_n_s2;
+    estimator_ = MakeControlEstimator(k_n, options_.estimator);
+    lio_head_ = dynamic_cast<LioHeadEstimator*>(estimator_.get());
+    perception_ = std::make_unique<PerceptionTask>(k_n, options_.estimator, options_.lidar, start.p_W, start.yaw);
   }
   if (controller) {
     if (controller->name() != ToName(options_.controller)) {
@@ -189,38 +177,22 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
   }
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
-  if (!options_.navigation.waypoints.empty() && options_.navigation.method == NavigationMethod::kFlatness) {
-    const ReferencePoint start = reference_->Evaluate(0.0);
-    flatness_ = std::make_unique<planning::FlatnessNavigator>(vehicle::PwmQuadModel::FromVehicle(model_.params()),
-                                                              options_.navigation.flatness, start.p_W, start.yaw);
-  } else if (!options_.navigation.waypoints.empty()) {
-    // Eq. (33) for this vehicle: the weakest rotor's thrust, the largest drag coefficient. A
-    // vehicle whose two remaining rotors cannot hold its weight gets a token limit (it cannot fly
-    // on after a failure anyway).
-    const vehicle::VehicleParams& p = model_.params();
-    const double rotor_thrust = *std::min_element(rotor_max_thrust_n_.begin(), rotor_max_thrust_n_.end());
-    planning::ReplannerOptions r = options_.navigation.replanner;
-    r.post_failure_a_max = std::max(0.05, planning::PostFailureAccelerationLimit(
-                                              p.mass_kg, rotor_thrust, p.rotor_drag_kg_s.maxCoeff(), r.nominal.v_max,
-                                              options_.navigation.post_failure_safety_factor));
-    const ReferencePoint start = reference_->Evaluate(0.0);
-    navigator_ = std::make_unique<planning::Replanner>(r, start.p_W, start.yaw);
-  }
+  planning_ = PlanningTask::Make(model_.params(), options_.navigation, reference_->Evaluate(0.0));
 }
 
 void FlightStack::OnImu(const ImuSample& raw) {
-  // The odometry and the mapper's deskewing integrate the raw samples, as FAST-LIO2 does: the
-  // vibration averages out in the integral, and the notches' delay (a few milliseconds, varying with
-  // the rotors' speeds) would put the IMU behind the LiDAR. What reads rates and accelerations
-  // sample by sample, the fault detection and the controller's body rates, reads them notched.
+  // The odometry (both its frames' side and the controller's head) and the mapper integrate the
+  // raw samples (PerceptionTask::OnImu says why). What reads rates and accelerations sample by
+  // sample, the fault detection and the controller's body rates, reads them notched.
   Eigen::Matrix<double, 6, 1> x;
   x << raw.specific_force_B, raw.w_B;
   const Eigen::Matrix<double, 6, 1> y = imu_filter_.Filter(x);
   ImuSample filtered = raw;
   filtered.specific_force_B = y.head<3>();
   filtered.w_B = y.tail<3>();
+  perception_->OnImu(raw);
   estimator_->OnImu(raw);
-  mapper_.OnImu(raw);
+  TakeOdometryUpdate();
   if (fdd_) fdd_->OnImu(filtered);
   if (raw.w_B.allFinite() && filtered.w_B.allFinite()) rate_notch_correction_ = filtered.w_B - raw.w_B;
 }
@@ -228,24 +200,24 @@ void FlightStack::OnImu(const ImuSample& raw) {
 void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
   imu_filter_.OnRotorSpeeds(esc.t_ns, esc.motor_speed_rad_s);
   estimator_->OnEscTelemetry(esc);
+  perception_->OnEscTelemetry(esc);
   if (fdd_) fdd_->OnEscTelemetry(esc);
 }
 
 void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_->OnOdometry(odometry); }
 
 void FlightStack::OnLidar(const LidarFrame& frame) {
-  {
-    const ScopedCost cost(&cost_.estimator_s);
-    estimator_->OnLidar(frame);
+  perception_->OnFrame(frame, estimator_->FrameEstimate(frame));
+  TakeOdometryUpdate();
+}
+
+void FlightStack::TakeOdometryUpdate() {
+  // In one thread the controller's estimate takes each update as it is made: it is then the
+  // odometry's own (an onboard executor hands it over when the perception task publishes it).
+  if (!lio_head_) return;
+  if (const std::optional<LioUpdate> u = perception_->update(); u && u->posterior.serial > lio_head_->serial()) {
+    lio_head_->OnLioUpdate(*u);
   }
-  const ScopedCost cost(&cost_.mapper_s);
-  // The map places the points as the odometry learnt the LiDAR's mount, when it learns it.
-  perception::LidarCalibration calibration;
-  if (const LioEstimator* odometry = lio()) {
-    calibration.q_BS = odometry->lio().state().q_IL;
-    calibration.clock_offset_s = odometry->lio().state().lidar_time_offset_s;
-  }
-  lidar_points_dropped_ += mapper_.OnFrame(frame, estimator_->FrameEstimate(frame), calibration).points_dropped;
 }
 
 void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
@@ -269,7 +241,7 @@ void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
   }
   if (nmpc_) nmpc_->RewindDisturbance(onset);
   controller_->SetRotorFailed(rotor);
-  if (navigator_ && options_.navigation.failure_aware) navigator_->OnFailure();
+  if (planning_) planning_->OnFailure();
 }
 
 void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset) {
@@ -285,59 +257,25 @@ void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset)
   effectiveness_[i] = eta;
   controller_->SetRotorEffectiveness(rotor, eta);
   // The planner keeps to what the weakened vehicle can still accelerate (failure-aware only).
-  if (navigator_ && options_.navigation.failure_aware) {
-    navigator_->LimitAcceleration(std::max(
+  if (planning_) {
+    planning_->LimitAcceleration(std::max(
         0.05, planning::DegradedAccelerationLimit(options_.navigation.replanner.nominal.a_max,
                                                   model_.params().weight_n(), rotor_max_thrust_n_, effectiveness_)));
   }
 }
 
-void FlightStack::NavigateFlatness(double t) {
-  if (t < next_plan_s_ || t < options_.navigation.start_s) return;
-  next_plan_s_ = t + 1.0 / options_.navigation.planner_rate_hz;
-  // Any detection starts the hold; the UKF's losses and settling drive the re-plan (other
-  // detectors give their eta and are taken as settled).
-  Eigen::Vector4d w_hat = Eigen::Vector4d::Zero();
-  bool detected = false, settled = true;
-  if (fdd_) {
-    for (int i = 0; i < std::min(4, model_.num_rotors()); ++i) {
-      const fdd::RotorStatus& r = fdd_->rotors()[static_cast<std::size_t>(i)];
-      w_hat[i] = std::clamp(r.eta, 0.0, 0.99);
-      detected = detected || r.detected_s.has_value();
-    }
-    if (const auto* ukf = dynamic_cast<const fdd::UkfFdd*>(fdd_.get())) settled = ukf->settled();
+FaultEstimates FlightStack::Faults() const {
+  // Any detection starts the flatness navigator's hold; the UKF's losses and settling drive its
+  // re-plan (other detectors give their eta and are taken as settled).
+  FaultEstimates f;
+  if (!fdd_) return f;
+  for (int i = 0; i < std::min(4, model_.num_rotors()); ++i) {
+    const fdd::RotorStatus& r = fdd_->rotors()[static_cast<std::size_t>(i)];
+    f.w_hat[i] = std::clamp(r.eta, 0.0, 0.99);
+    f.detected = f.detected || r.detected_s.has_value();
   }
-  if (detected && !flatness_told_) {
-    flatness_told_ = true;
-    flatness_->OnFaultDetected(t);
-  }
-  flatness_->Update(t, settled, w_hat);
-  const std::vector<Vector3>& w = options_.navigation.waypoints;
-  const int total = static_cast<int>(w.size()) * options_.navigation.rounds;
-  if (next_waypoint_ > 0 && flatness_->arrived(t) && !flatness_->returning()) flatness_reached_ = next_waypoint_;
-  if (next_waypoint_ < total && !flatness_->returning() && (next_waypoint_ == 0 || flatness_->arrived(t))) {
-    flatness_->SetGoal(w[static_cast<std::size_t>(next_waypoint_++) % w.size()], t);
-  }
-}
-
-void FlightStack::Navigate(double t, FlightMode mode) {
-  if (flatness_) return NavigateFlatness(t);
-  if (!navigator_ || !map() || t < next_plan_s_ || t < options_.navigation.start_s) return;
-  // The waypoints in turn, each once the last was reached; the planner at its own rate. While the
-  // attitude recovers from a failure the mission waits: no new waypoint.
-  next_plan_s_ = t + 1.0 / options_.navigation.planner_rate_hz;
-  if (mode == FlightMode::kDegradedNavigation) navigator_->OnRecovered();  // the failure's transient is over
-  const std::vector<Vector3>& w = options_.navigation.waypoints;
-  const int total = static_cast<int>(w.size()) * options_.navigation.rounds;
-  if (mode != FlightMode::kFailureRecovery && next_waypoint_ < total && (next_waypoint_ == 0 || navigator_->arrived())) {
-    if (next_waypoint_ == 0) last_plan_ok_s_ = t;  // the no-plan clock starts with the mission
-    navigator_->SetGoal(w[static_cast<std::size_t>(next_waypoint_++) % w.size()]);
-  }
-  navigator_->Update(t, *map());
-  for (; plan_events_seen_ < navigator_->events().size(); ++plan_events_seen_) {
-    if (navigator_->events()[plan_events_seen_].status == planning::PlanSummary::Status::kSuccess) last_plan_ok_s_ = t;
-  }
-  if (navigator_->arrived()) last_plan_ok_s_ = t;  // holding at a waypoint is not a planning failure
+  if (const auto* ukf = dynamic_cast<const fdd::UkfFdd*>(fdd_.get())) f.settled = ukf->settled();
+  return f;
 }
 
 const RotorCommand& FlightStack::Update(TimeNs t) {
@@ -379,12 +317,12 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   in.estimate = estimate_;
   in.odometry_age_s = estimator_->odometry_age_s(t);
   in.isolated_rotors = isolated_rotors();
-  in.navigating = navigator_ && next_waypoint_ > 0 && !navigator_->arrived();
-  in.since_last_plan_s = ts - last_plan_ok_s_;
+  in.navigating = planning_ && planning_->navigating();
+  in.since_last_plan_s = ts - (planning_ ? planning_->last_plan_ok_s() : 0.0);
   in.thrust_ratio = command_.thrust_n.sum() / model_.params().weight_n();
   in.cannot_hover = cannot_hover_;
   in.landing = !landing_ && reference().Evaluate(ts).p_W.z() <= 0.0;  // a mission that lands
-  if (flatness_ && flatness_->land_request()) in.land_request = "re-planning decided to land: " + *flatness_->land_request();
+  if (planning_ && planning_->land_request()) in.land_request = "re-planning decided to land: " + *planning_->land_request();
   const FlightMode mode = supervisor_.Update(in);
 
   if (mode == FlightMode::kEmergencyLanding && !landing_) {
@@ -398,9 +336,9 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
     landing_.emplace(o);
     descent_.emplace(*landing_, supervisor_.landing_start_s());
   }
-  if (!landing_) {
+  if (!landing_ && planning_) {
     const ScopedCost cost(&cost_.planner_s);
-    Navigate(ts, mode);
+    planning_->Update(ts, mode, map(), Faults());
   }
   const ReferenceTrajectory& followed = reference();
   reference_point_ = followed.Evaluate(ts);
@@ -428,42 +366,19 @@ const RotorCommand& FlightStack::OverrideCommand(const RotorVector& thrust_n) {
   return command_;
 }
 
-NavigationSummary FlightStack::SummarizeNavigation() const {
-  const std::vector<Vector3>& w = options_.navigation.waypoints;
-  NavigationSummary n;
-  n.waypoints_reached = waypoints_reached();
-  n.waypoints_total = static_cast<int>(w.size()) * options_.navigation.rounds;
-  if (!navigator_) return n;
-  const std::vector<planning::Replanner::Event>& events = navigator_->events();
-  n.plans = static_cast<int>(events.size());
-  for (const planning::Replanner::Event& e : events) {
-    ++n.plans_by_reason[e.reason];
-    n.planner_ms_mean += e.plan_ms / static_cast<double>(events.size());
-    if (e.status == planning::PlanSummary::Status::kSuccess) {
-      n.plans_fine_search += e.fine_search;
-      n.plans_rest_to_rest += e.rest_to_rest;
-      continue;
-    }
-    ++n.plans_failed;
-    n.failed_plans.push_back(fmt::format("{:.2f} s {}: {}", e.t, e.reason, planning::ToString(e.status)));
-  }
-  using Status = planning::PlanSummary::Status;
-  const Status last = navigator_->last_plan().status;
-  if (n.waypoints_reached < n.waypoints_total && !events.empty() &&
-      (last == Status::kGoalBlocked || last == Status::kGoalOutOfBounds || last == Status::kNoPath)) {
-    const Vector3& goal = w[static_cast<std::size_t>(n.waypoints_reached) % w.size()];
-    n.unreachable = fmt::format("waypoint {} at [{:g}, {:g}, {:g}] is unreachable: {} ({})", n.waypoints_reached + 1,
-                                goal.x(), goal.y(), goal.z(), planning::ToString(last), navigator_->last_plan().message);
-  }
-  return n;
-}
+const LioEstimator* FlightStack::lio() const { return perception_->lio(); }
 
-const LioEstimator* FlightStack::lio() const { return dynamic_cast<const LioEstimator*>(estimator_.get()); }
+StackCost FlightStack::cost() const {
+  StackCost c = cost_;
+  c.estimator_s = perception_->odometry_s();
+  c.mapper_s = perception_->mapper_s();
+  return c;
+}
 
 FlightStackSummary FlightStack::Summarize() const {
   FlightStackSummary s;
-  if (navigator_ || flatness_) s.navigation = SummarizeNavigation();
-  if (flatness_) s.flatness_decisions = flatness_->decisions();
+  if (planning_) s.navigation = planning_->Summarize();
+  if (const planning::FlatnessNavigator* f = flatness()) s.flatness_decisions = f->decisions();
   if (const auto* ukf = dynamic_cast<const fdd::UkfFdd*>(fdd_.get())) {
     const Eigen::VectorXd w = ukf->loss();
     s.ukf = UkfSummary{std::vector<double>(w.data(), w.data() + w.size()), ukf->settled_after_detection_s()};
@@ -471,7 +386,7 @@ FlightStackSummary FlightStack::Summarize() const {
   s.final_mode = supervisor_.mode();
   s.transitions = supervisor_.transitions();
   if (const perception::VoxelMap* m = map()) s.map_voxels_occupied = m->occupied_count();
-  s.lidar_points_dropped = lidar_points_dropped_;
+  s.lidar_points_dropped = lidar_points_dropped();
   if (const LioEstimator* odometry = lio()) s.odometry = odometry->Summarize();
   s.reconfigurations = reconfigurations_;
   return s;

@@ -159,7 +159,24 @@ struct Errors {
   double attitude_max_last_2s = 0.0;  ///< over the flight's last two seconds
   int frames = 0, used = 0, degenerate = 0;
   LioState final_state;  ///< the filter's at the end (its calibration estimate among it)
+  /// With a follower: the samples at which it held the Lio's newest posterior, and at how many of
+  /// them its head differed from the Lio's in any bit.
+  int follower_compared = 0, follower_differed = 0;
 };
+
+/// A LioHeadFollower fed the same IMU samples and the Lio's posteriors `delay_samples` samples
+/// after each was published (a frame that finished late, on another thread).
+struct LateFollower {
+  LioHeadFollower follower;
+  int delay_samples = 5;
+  LioPosterior pending;
+  int since_published = 0;
+};
+
+bool SameBits(const LioState& a, const LioState& b) {
+  return a.t_ns == b.t_ns && a.p_W == b.p_W && a.v_W == b.v_W && a.q_WB.coeffs() == b.q_WB.coeffs() &&
+         a.gyro_bias == b.gyro_bias && a.accel_bias == b.accel_bias;
+}
 
 /// How the LiDAR is really mounted: its axes' rotation and its clock's offset (the stack assumes
 /// neither).
@@ -172,7 +189,8 @@ struct LidarMount {
 /// of the given stds per sample), the simulator's LiDAR in the room at 10 Hz. Errors against the
 /// flight at every IMU sample after the first second.
 Errors Fly(const Flight& flight, double duration_s, const Vector3& gyro_bias, const Vector3& accel_bias,
-           double gyro_noise, double accel_noise, LioOptions o = {}, const LidarMount& mount = {}) {
+           double gyro_noise, double accel_noise, LioOptions o = {}, const LidarMount& mount = {},
+           LateFollower* late = nullptr) {
   sim::LidarOptions lo;
   lo.enabled = true;  // 2 cm range noise, 1 % dropouts
   lo.rotation = mount.rotation;
@@ -199,6 +217,19 @@ Errors Fly(const Flight& flight, double duration_s, const Vector3& gyro_bias, co
       s.specific_force_B += accel_bias + accel_noise * Vector3(rng.Normal(), rng.Normal(), rng.Normal());
       lio.OnImu(s);
       next_imu += imu_period;
+      if (late) {
+        late->follower.OnImu(s);
+        if (lio.posterior().serial > late->pending.serial) {
+          late->pending = lio.posterior();
+          late->since_published = 0;
+        }
+        if (++late->since_published == late->delay_samples) late->follower.OnPosterior(late->pending);
+        if (late->follower.valid() && late->since_published >= late->delay_samples) {
+          ++e.follower_compared;
+          e.follower_differed += !SameBits(late->follower.head().state(), lio.state()) ||
+                                 late->follower.head().imu().t_ns != s.t_ns;
+        }
+      }
       if (lio.initialised() && ToSeconds(s.t_ns) > 1.0) {
         const StateEstimate est = lio.Estimate();
         const sim::BodyPose truth = flight.Pose(est.t_ns);
@@ -237,6 +268,20 @@ TEST(Lio, FollowsAFlightSpinningAt11RadPerSecondFromAnExactImu) {
   EXPECT_LT(e.position_rms, 0.015);
   EXPECT_LT(e.position_max, 0.03);
   EXPECT_LT(e.attitude_max, 0.5 * std::numbers::pi / 180.0);
+}
+
+// The control thread of the onboard runtime follows the odometry's head from the IMU and the
+// posteriors the odometry's thread publishes, each arriving 5 samples (15 ms) after the frame's
+// update: carried through the samples since, its head is the Lio's own to the bit at every sample
+// once the posterior arrived (and so is every state estimate the controller reads).
+TEST(Lio, AFollowerGivenEachPosteriorLateHasTheLiosHeadToTheBit) {
+  LateFollower late;
+  const Errors e = Fly(SpinningFlight(11.0), 3.0, Vector3(0.003, -0.002, 0.003), Vector3(0.05, -0.03, 0.04), 0.01, 0.1,
+                       LioOptions{}, LidarMount{}, &late);
+  EXPECT_GE(e.frames, 29);
+  EXPECT_GT(e.follower_compared, 800);  // nearly every sample of 3 s at 333 Hz
+  EXPECT_EQ(e.follower_differed, 0);
+  EXPECT_EQ(late.follower.gaps(), 0);
 }
 
 // With biases (gyro 3 mrad/s, accelerometer 0.05 m/s²) and white noise 3x the IMU's datasheet,

@@ -38,6 +38,7 @@
 /// stays at the last frame's end with the later samples queued; each frame first takes the filter
 /// through the queued samples up to its end. The estimate (Estimate) is the filter propagated
 /// through the whole queue, updated at every sample.
+#include <array>
 #include <deque>
 #include <numbers>
 #include <vector>
@@ -177,6 +178,13 @@ using LioMatrix = Eigen::Matrix<double, kLioStates, kLioStates>;
 using LioVector = Eigen::Matrix<double, kLioStates, 1>;
 
 namespace internal {
+/// The measurement held over the interval between two consecutive IMU samples: their mean
+/// (second order in the rates' change). The filter and every head propagate with it.
+struct IntervalMeasurement {
+  Vector3 f_m, w_m;
+  IntervalMeasurement(const ImuSample& previous, const ImuSample& next)
+      : f_m(0.5 * (previous.specific_force_B + next.specific_force_B)), w_m(0.5 * (previous.w_B + next.w_B)) {}
+};
 /// One propagation step (the filter's mean and its error-state transition): `x` carried over dt
 /// with the IMU measurement (f_m, w_m) held, into `next`; F = ∂δx_next/∂δx into `F` if not null.
 void LioTransition(const LioState& x, const Vector3& f_m, const Vector3& w_m, double dt, LioState* next,
@@ -189,6 +197,71 @@ Eigen::Matrix<double, 1, 6> PointToPlaneJacobian(const Vector3& n, const Matrix3
 Eigen::Matrix<double, 1, 4> PointToPlaneCalibrationJacobian(const Vector3& n, const Matrix3& R, const Matrix3& M,
                                                             const Matrix3& R_IL, const Vector3& s, const Vector3& u);
 }  // namespace internal
+
+/// The filter's mean carried from a posterior through the IMU samples after it: the odometry's
+/// estimate at the newest sample ("the head"). Each interval between two samples takes their mean
+/// (Lio's propagation, without the covariance). Lio keeps one over its own queue.
+class LioHead {
+ public:
+  /// Starts at `posterior`, `posterior_imu` being the sample it holds beyond its time.
+  void Reset(const LioState& posterior, const ImuSample& posterior_imu) {
+    state_ = posterior;
+    imu_ = posterior_imu;
+  }
+  /// Carries the head to a newer sample (one not newer than the last is ignored; one the state's
+  /// time has passed is only held).
+  void Propagate(const ImuSample& imu);
+  const LioState& state() const { return state_; }
+  /// The newest sample taken (its rates are the estimate's).
+  const ImuSample& imu() const { return imu_; }
+
+ private:
+  LioState state_;
+  ImuSample imu_;
+};
+
+/// What a consumer on another thread needs to follow a Lio (LioHeadFollower): the filter's
+/// posterior (after a frame's update, the rest initialisation or the start), the sample it holds
+/// beyond its time, and its serial number.
+struct LioPosterior {
+  LioState state;
+  ImuSample imu;
+  std::uint64_t serial = 0;  ///< 0: none yet
+};
+
+/// The body's estimate from a state of the IMU's mount and a gyro reading: position and velocity
+/// of the centre of gravity (`imu_position_m` behind the mount), bias-corrected body rates;
+/// `valid` as given.
+StateEstimate LioBodyEstimate(const LioState& x, const Vector3& w_m, const Vector3& imu_position_m, bool valid);
+
+/// A Lio's head kept by another thread, from the IMU samples it sees and the posteriors the Lio
+/// publishes: the onboard runtime's control thread, while the odometry registers frames on its
+/// own. A posterior that arrives late (the frame took long) is carried through the samples since
+/// its time, so the head is the Lio's own, to the bit, once the follower has seen the same
+/// samples and posteriors (tests/perception/lio_test.cc). Allocation-free: the samples are kept
+/// in a ring of kSamples (0.77 s at 333 Hz), and a posterior older than the ring is carried from
+/// its oldest sample (counted in gaps()).
+class LioHeadFollower {
+ public:
+  static constexpr int kSamples = 256;
+  /// One IMU sample, in the order the Lio took them (non-finite ones are ignored, as the Lio
+  /// ignores them).
+  void OnImu(const ImuSample& imu);
+  /// A posterior the Lio published (an older serial than the last is ignored).
+  void OnPosterior(const LioPosterior& posterior);
+  /// No posterior yet: the head is not valid.
+  bool valid() const { return serial_ > 0; }
+  const LioHead& head() const { return head_; }
+  /// Posteriors older than the oldest sample kept.
+  int gaps() const { return gaps_; }
+
+ private:
+  std::array<ImuSample, kSamples> ring_{};
+  int count_ = 0, next_ = 0;  // samples kept, and where the next one goes
+  LioHead head_;
+  std::uint64_t serial_ = 0;
+  int gaps_ = 0;
+};
 
 class Lio {
  public:
@@ -218,7 +291,9 @@ class Lio {
   /// The filter's state at the newest IMU sample, and its covariance there: the filter's, carried
   /// through the samples since the last frame (on each call: no consumer needs it at the IMU rate,
   /// so the samples propagate the mean only).
-  const LioState& state() const { return head_; }
+  const LioState& state() const { return head_.state(); }
+  /// The filter's latest posterior (LioHeadFollower).
+  const LioPosterior& posterior() const { return posterior_; }
   Matrix covariance() const;
   const PointMap& map() const { return map_; }
   const LioOptions& options() const { return options_; }
@@ -282,8 +357,8 @@ class Lio {
   Matrix filter_P_ = Matrix::Zero();
   ImuSample filter_imu_;         ///< the last sample the filter took (held beyond it)
   std::deque<ImuSample> queue_;  ///< samples after the filter's time, oldest first
-  LioState head_;                ///< the filter through the queue (mean only)
-  ImuSample head_imu_;
+  LioHead head_;                 ///< the filter through the queue (mean only)
+  LioPosterior posterior_;       ///< the filter when the head was last rebuilt from it
   int frames_ = 0;
   // Scratch kept across frames (no allocation per frame once warm).
   std::vector<Pose> poses_;

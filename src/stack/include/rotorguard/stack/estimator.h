@@ -135,6 +135,13 @@ struct LioSummary {
   double degenerate_std_m = 0.0;
 };
 
+/// What the LiDAR-inertial odometry's frames tell the estimate the controller reads: the filter's
+/// newest posterior (perception::LioPosterior) and its last fix.
+struct LioUpdate {
+  perception::LioPosterior posterior;
+  std::optional<TimeNs> last_fix_ns;  ///< a frame used without an unconstrained direction, or the start
+};
+
 /// The stack's own LiDAR-inertial odometry (perception::Lio) from its IMU and LiDAR frames; an
 /// external odometry sample is ignored. The world frame is the start pose's (the mission's
 /// start, where the vehicle rests when the stack starts). A frame counts as a fix when the filter
@@ -153,6 +160,8 @@ class LioEstimator final : public Estimator {
   /// Every frame's health, in order.
   const std::vector<perception::LioFrameSummary>& frames() const { return frames_; }
   const perception::Lio& lio() const { return lio_; }
+  /// Its newest posterior and fix, for a LioHeadEstimator (a new serial after each frame used).
+  LioUpdate update() const { return {lio_.posterior(), last_fix_ns_}; }
   LioSummary Summarize() const;
 
  private:
@@ -163,9 +172,35 @@ class LioEstimator final : public Estimator {
   StateEstimate frame_estimate_;  ///< at the last frame's end
 };
 
-/// The estimator `options.kind` names. `start_position_W` and `start_yaw_rad`: where the stack
-/// starts (the LiDAR-inertial odometry's world frame).
-std::unique_ptr<Estimator> MakeEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options,
-                                         const Vector3& start_position_W, double start_yaw_rad);
+/// The estimate the controller reads when the stack localises on its own LiDAR-inertial odometry:
+/// the odometry's head kept on the controller's side (perception::LioHeadFollower) from the IMU
+/// samples and the odometry's updates, so that the frames may be registered elsewhere (the
+/// perception task, on its own thread onboard: docs/runtime.md). Given each update as soon as it
+/// is made, its estimate is the odometry's own, to the bit (FlightStack does so in lockstep).
+class LioHeadEstimator final : public Estimator {
+ public:
+  /// `imu_position_m`: the IMU's mount from the centre of gravity, as the odometry's options say.
+  LioHeadEstimator(double thrust_coefficient_n_s2, const Vector3& imu_position_m)
+      : Estimator(thrust_coefficient_n_s2), imu_position_m_(imu_position_m) {}
+  void OnImu(const ImuSample& imu) override { follower_.OnImu(imu); }
+  void OnOdometry(const OdometrySample& /*odometry*/) override {}
+  /// An update of the odometry (an older serial than the last one taken is ignored).
+  void OnLioUpdate(const LioUpdate& update);
+  /// The serial of the last update taken (0: none).
+  std::uint64_t serial() const { return serial_; }
+  StateEstimate Estimate(TimeNs t) const override;
+  double odometry_age_s(TimeNs t) const override;
+
+ private:
+  perception::LioHeadFollower follower_;
+  Vector3 imu_position_m_;
+  std::uint64_t serial_ = 0;
+  std::optional<TimeNs> last_fix_ns_;
+};
+
+/// The estimator the controller reads for `options.kind`: the external odometry carried by the
+/// IMU, or the LiDAR-inertial odometry's head (LioHeadEstimator, whose frames the PerceptionTask
+/// registers).
+std::unique_ptr<Estimator> MakeControlEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options);
 
 }  // namespace rotorguard::stack

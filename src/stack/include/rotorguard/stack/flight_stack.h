@@ -28,6 +28,8 @@
 #include "rotorguard/planning/references.h"
 #include "rotorguard/planning/replanner.h"
 #include "rotorguard/stack/estimator.h"
+#include "rotorguard/stack/perception_task.h"
+#include "rotorguard/stack/planning_task.h"
 #include "rotorguard/core/rpm_notch.h"
 #include "rotorguard/stack/supervisor.h"
 #include "rotorguard/vehicle/multirotor.h"
@@ -56,15 +58,6 @@ struct KnownFault {
   }
 };
 
-/// How the navigate mission plans (key stack.planner.method).
-enum class NavigationMethod {
-  kMinco,     ///< paper 000's failure-aware MINCO planner on the LiDAR map (the Replanner)
-  kFlatness,  ///< paper 004's closed-form critically damped legs, hold-then-replan after a detected fault
-};
-inline constexpr EnumName<NavigationMethod> kNavigationMethodNames[] = {{NavigationMethod::kMinco, "minco"},
-                                                                        {NavigationMethod::kFlatness, "flatness"}};
-constexpr std::span<const EnumName<NavigationMethod>> NamesOf(const NavigationMethod*) { return kNavigationMethodNames; }
-
 /// The stack's controller (key stack.controller).
 enum class ControllerKind {
   kNominal,   ///< the geometric cascade, not fault tolerant
@@ -91,76 +84,6 @@ inline constexpr EnumName<FddKind> kFddKindNames[] = {{FddKind::kNone, "none"},
                                                       {FddKind::kFixedTime, "fixedtime"},
                                                       {FddKind::kUkf, "ukf"}};
 constexpr std::span<const EnumName<FddKind>> NamesOf(const FddKind*) { return kFddKindNames; }
-
-/// Navigation among obstacles (mission type navigate; docs/planning.md): the waypoints flown in
-/// order, `rounds` times, each planned on the LiDAR map by the replanner at `planner_rate_hz`.
-/// After an isolated failure the acceleration limit drops to eq. (33)'s a_max,f for the stack's
-/// vehicle model with the safety factor `post_failure_safety_factor`.
-struct NavigationOptions {
-  std::vector<Vector3> waypoints;  ///< empty: the mission reference is flown instead
-  int rounds = 1;                  ///< >= 1
-  double planner_rate_hz = 10.0;   ///< in (0, control_rate_hz]
-  double post_failure_safety_factor = 0.05;  ///< γ_a,f of eq. (33), in (0, 1]
-  /// false: the failure-unaware variant, whose planner keeps its nominal acceleration limit after
-  /// a failure (the NMPC still reconfigures): the comparison row of `rotorguard bench nav`.
-  bool failure_aware = true;
-  /// The flatness method needs no map and sees no obstacles, and needs a vehicle with a PWM model.
-  NavigationMethod method = NavigationMethod::kMinco;
-  planning::ReplannerOptions replanner;      ///< its post_failure_a_max is set from eq. (33)
-  planning::FlatnessNavigatorOptions flatness;
-  /// The mission starts at this time [s] (the vehicle holds its start until then), >= 0.
-  double start_s = 0.0;
-  /// Throws ValidationError naming the field ("navigation.rounds"); the rate is checked against
-  /// the control rate by FlightStackOptions.
-  void Validate() const;
-
-  /// The keys of stack.planner (the waypoints and rounds are the mission's).
-  template <typename Archive>
-  void Serialize(Archive* a) {
-    planning::ReplannerOptions& r = replanner;
-    a->Visit("method", &method, {.meaning = "minco, or flatness: paper 004's legs without a map (docs/flatness.md)"});
-    a->Visit(
-        "start_s", &start_s,
-        {.meaning = "the mission starts then; the vehicle holds its start until [s]", .min = 0.0, .max = kMaxFlightS});
-    a->Visit("rate_hz", &planner_rate_hz,
-             {.meaning = "the planner's rate [Hz], at most the control rate", .min = kMinRateHz, .max = kMaxRateHz});
-    // The collision checks step in time by a fixed distance over v_max (DynamicLimits).
-    a->Visit("v_max", &r.nominal.v_max,
-             {.meaning = "nominal speed limit [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
-    a->Visit("a_max", &r.nominal.a_max,
-             {.meaning = "nominal acceleration limit a_max,n [m/s²]",
-              .min = kMinAccelerationMS2,
-              .max = kMaxAccelerationMS2});
-    a->Visit("j_max", &r.nominal.j_max,
-             {.meaning = "nominal jerk limit [m/s³]", .min = kMinJerkMS3, .max = kMaxJerkMS3});
-    a->Visit("post_failure_safety_factor", &post_failure_safety_factor,
-             {.meaning =
-                  "γ_a,f of eq. (33): with the vehicle's mass, rotor thrust and drag it gives a_max,f after a failure",
-              .max = 1.0,
-              .positive = true});
-    a->Visit("replan_period_s", &r.replan_period_s,
-             {.meaning = "periodic replanning [s]", .max = kMaxTimeoutS, .positive = true});
-    a->Visit("clearance_m", &r.planner.optimizer.clearance_m,
-             {.meaning = "C_o of eq. (36), the distance kept from obstacles [m], within the planner's obstacle "
-                         "search: 11.13 voxels of stack.map (1.11 m at 0.1 m)",
-              .min = 0.0,
-              .max = planning::kMaxClearanceM});
-    a->Visit(
-        "post_failure_clearance_m", &r.post_failure_clearance_m,
-        {.meaning = "unset: clearance_m throughout; else C_o once the attitude recovered from a failure, and the one "
-                    "tried when clearance_m finds no plan before (docs/navigation.md); bounded as clearance_m",
-         .min = 0.0,
-         .max = planning::kMaxClearanceM});
-    a->Visit("failure_aware", &failure_aware,
-             {.meaning = "false: the failure-unaware variant keeps the nominal limits after a failure"});
-    a->Visit("altitude_band_m", PairOf{&r.planner.search.z_min_m, &r.planner.search.z_max_m},
-             {.meaning = "[z_min, z_max], the altitudes the search may use [m]", .min = 0.0, .max = kMaxCoordinateM});
-    a->Visit("weights", &r.planner.optimizer.weights, {.meaning = "eq. (22)'s weights"});
-    a->Visit("lbfgs", &r.planner.optimizer.lbfgs.method,
-             {.meaning = "the trajectory optimiser's L-BFGS: lewis_overton, the library's own, or ceres "
-                         "(docs/planning.md)"});
-  }
-};
 
 struct FlightStackOptions {
   double control_rate_hz = 200.0;  ///< controller rate (paper 000: 200 Hz), in [kMinRateHz, kMaxRateHz]
@@ -254,25 +177,6 @@ struct StackCost {
   double controller_s = 0.0;  ///< the controller's Compute (the NMPC's solve)
 };
 
-/// The navigate mission as the stack flew it (FlightStack::Summarize).
-struct NavigationSummary {
-  int waypoints_reached = 0;  ///< counting repeats over the rounds
-  int waypoints_total = 0;    ///< waypoints x rounds
-  /// The replanner's planning queries (method minco; all zero for flatness): how many, how many
-  /// failed, how many of the successful ones needed the planner's fallbacks (the search at the
-  /// map's resolution, the path flown from rest to rest), and by what started them ("goal",
-  /// "failure", "obstacle ahead", "periodic").
-  int plans = 0, plans_failed = 0, plans_fine_search = 0, plans_rest_to_rest = 0;
-  std::map<std::string, int> plans_by_reason;
-  double planner_ms_mean = 0.0;  ///< wall-clock time of a query, mean (0 without queries)
-  /// Each failed query: time, reason and status ("12.30 s periodic: no_path").
-  std::vector<std::string> failed_plans;
-  /// When the mission is incomplete and its last plan found the pending waypoint unreachable
-  /// (inside an obstacle's inflation, outside the map or the altitude band, enclosed): which
-  /// waypoint and why, "waypoint 3 at [1, 2, 1] is unreachable: no_path (...)". Empty otherwise.
-  std::string unreachable;
-};
-
 /// What the UKF fault estimator concluded (fdd ukf).
 struct UkfSummary {
   std::vector<double> w_hat;        ///< its final loss-of-effectiveness estimates, per rotor
@@ -330,8 +234,7 @@ class FlightStack {
   /// else the navigator when navigating, else the mission's.
   const ReferenceTrajectory& reference() const {
     if (descent_) return *descent_;
-    if (flatness_) return *flatness_;
-    return navigator_ ? static_cast<const ReferenceTrajectory&>(*navigator_) : *reference_;
+    return planning_ ? planning_->reference() : *reference_;
   }
   const RotorCommand& command() const { return command_; }
   const vehicle::MultirotorModel& model() const { return model_; }
@@ -346,21 +249,18 @@ class FlightStack {
   const LioEstimator* lio() const;
   /// Waypoints reached so far (counting repeats over the rounds); the navigate mission is complete
   /// when it equals waypoints x rounds.
-  int waypoints_reached() const {
-    if (flatness_) return flatness_reached_;
-    return navigator_ ? std::max(0, next_waypoint_ - (navigator_->arrived() ? 0 : 1)) : 0;
-  }
+  int waypoints_reached() const { return planning_ ? planning_->waypoints_reached() : 0; }
   /// The navigation's replanner (mission type navigate, method minco); else null.
-  const planning::Replanner* navigator() const { return navigator_.get(); }
+  const planning::Replanner* navigator() const { return planning_ ? planning_->replanner() : nullptr; }
   /// The flatness navigator (mission type navigate, method flatness); else null.
-  const planning::FlatnessNavigator* flatness() const { return flatness_.get(); }
+  const planning::FlatnessNavigator* flatness() const { return planning_ ? planning_->flatness() : nullptr; }
   /// The occupancy map, once a LiDAR frame arrived; else null.
-  const perception::VoxelMap* map() const { return mapper_.map(); }
+  const perception::VoxelMap* map() const { return perception_->map(); }
   /// LiDAR pulses without a usable point: no return (counted by the sensor), non-finite, outside
   /// the map's window, or arriving before the estimate is valid.
-  long lidar_points_dropped() const { return lidar_points_dropped_; }
+  long lidar_points_dropped() const { return perception_->points_dropped(); }
   /// Wall-clock time taken by the mapper, the planner and the controller so far.
-  const StackCost& cost() const { return cost_; }
+  StackCost cost() const;
   /// The supervisor: the flight mode and its logged transitions.
   const Supervisor& supervisor() const { return supervisor_; }
   /// Rotors the stack treats as failed (isolated by its FDD or handed over as known faults).
@@ -380,14 +280,10 @@ class FlightStack {
   /// time, with the disturbance estimate returned to the onset's) and the planner's acceleration
   /// limit (DegradedAccelerationLimit), unless the failure-unaware variant flies.
   void OnRotorDegraded(int rotor, double effectiveness, double onset);
-  /// The navigator's part of a control cycle: the next waypoint when due (not while recovering
-  /// from a failure), the planner at its rate, the time of its last success.
-  void Navigate(double t, FlightMode mode);
-  /// The flatness navigator's part: waypoints in turn once each leg settled, hold on a detection,
-  /// re-plan once the estimate settled.
-  void NavigateFlatness(double t);
-  /// Summarize's account of the navigate mission.
-  NavigationSummary SummarizeNavigation() const;
+  /// What the planning task reads of the fault detection this cycle.
+  FaultEstimates Faults() const;
+  /// Hands the odometry's newest update, if any, to the controller's estimate.
+  void TakeOdometryUpdate();
 
   vehicle::MultirotorModel model_;
   std::shared_ptr<const ReferenceTrajectory> reference_;
@@ -398,19 +294,12 @@ class FlightStack {
   std::string cannot_hover_;                            // why the rotors left cannot hold the vehicle ("" = they can)
   std::optional<planning::TakeoffReference> landing_;  // the emergency landing's descent ...
   std::optional<TimeShiftedReference> descent_;         // ... from the time it started
-  std::size_t plan_events_seen_ = 0;
-  double last_plan_ok_s_ = 0.0;          // the planner's last success (or the first goal's time)
   std::unique_ptr<control::Controller> controller_;
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
   std::unique_ptr<fdd::FaultDetector> fdd_;
-  perception::LidarMapper mapper_;
-  std::unique_ptr<planning::Replanner> navigator_;
-  std::unique_ptr<planning::FlatnessNavigator> flatness_;
-  int flatness_reached_ = 0;
-  bool flatness_told_ = false;  // the navigator heard of the detection
-  int next_waypoint_ = 0;       // of the waypoints repeated `rounds` times
-  double next_plan_s_ = 0.0;    // the navigator's next update
-  long lidar_points_dropped_ = 0;
+  std::unique_ptr<PerceptionTask> perception_;  // the LiDAR's: the odometry's frames and the map
+  LioHeadEstimator* lio_head_ = nullptr;         // estimator_, when it follows the odometry's head
+  std::unique_ptr<PlanningTask> planning_;  // a navigate mission's; else null
   StackCost cost_;
   std::vector<bool> known_fault_applied_;
   std::vector<bool> degraded_told_;    // per rotor: the controller heard of its partial loss
