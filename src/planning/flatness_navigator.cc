@@ -1,5 +1,7 @@
 #include "rotorguard/planning/flatness_navigator.h"
 
+#include "rotorguard/planning/followed_reference.h"
+
 #include <cmath>
 
 #include <fmt/format.h>
@@ -43,6 +45,13 @@ ReferencePoint FlatnessNavigator::Evaluate(double t) const {
   return r;
 }
 
+std::shared_ptr<const ReferenceTrajectory> FlatnessNavigator::Followed() const {
+  ReferencePoint hold;
+  hold.p_W = home_;
+  hold.yaw = yaw_;
+  return std::make_shared<FollowedReference<CriticallyDampedReference>>(leg_, hold);
+}
+
 bool FlatnessNavigator::arrived(double t) const {
   return leg_ && !hold_since_ && !land_request_ && t >= leg_->t0() + leg_->t_s();
 }
@@ -62,6 +71,7 @@ std::optional<SettlingTime> FlatnessNavigator::Plan(const Vector3& goal, double 
 void FlatnessNavigator::Start(const Vector3& goal, double t, double t_s) {
   const ReferencePoint r = Evaluate(t);
   leg_.emplace(t, r.p_W, r.v_W, goal, t_s, yaw_);
+  ++path_serial_;
   goal_ = goal;
 }
 
@@ -87,6 +97,7 @@ void FlatnessNavigator::OnFaultDetected(double t) {
   // the paper drops it ("the system velocity will drop to zero"): the reference stops and the
   // controller brakes.
   leg_.emplace(t, Evaluate(t).p_W, Vector3::Zero(), goal_, options_.hold_t_s, yaw_);
+  ++path_serial_;
   decisions_.push_back({t, "hold", options_.hold_t_s, "", Eigen::Vector4d::Zero(), "fault detected"});
 }
 

@@ -1,5 +1,7 @@
 #include "rotorguard/planning/replanner.h"
 
+#include "rotorguard/planning/followed_reference.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -108,6 +110,14 @@ ReferencePoint Replanner::Reference(double t) const {
   return r;
 }
 
+std::shared_ptr<const ReferenceTrajectory> Replanner::Followed() const {
+  ReferencePoint hold;
+  hold.p_W = hold_;
+  hold.yaw = yaw_;
+  return std::make_shared<FollowedReference<MinimumJerkTrajectory>>(
+      trajectory_.empty() ? std::nullopt : std::optional<MinimumJerkTrajectory>(trajectory_), hold);
+}
+
 bool Replanner::UnsafeAhead(double t, const perception::VoxelMap& map) const {
   if (trajectory_.empty()) return false;
   const double end = std::min(trajectory_.duration(), t + options_.check_horizon_s);
@@ -142,6 +152,7 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
     traj.set_start_time(t);
     traj.set_yaw(yaw_);
     trajectory_ = std::move(traj);
+    ++path_serial_;
     mode_ = Mode::kFollowing;
   }
   return ok;
@@ -198,6 +209,7 @@ void Replanner::Brake(double t, const perception::VoxelMap& map) {
   brake.set_start_time(t);
   brake.set_yaw(yaw_);
   trajectory_ = std::move(brake);
+  ++path_serial_;
   mode_ = Mode::kBraking;
 }
 

@@ -30,6 +30,7 @@ std::unique_ptr<PlanningTask> PlanningTask::Make(const vehicle::VehicleParams& p
   if (options.method == NavigationMethod::kFlatness) {
     task->flatness_ = std::make_unique<planning::FlatnessNavigator>(vehicle::PwmQuadModel::FromVehicle(p),
                                                                     options.flatness, start.p_W, start.yaw);
+    task->followed_ = task->flatness_->Followed();
     return task;
   }
   // Eq. (33) for this vehicle: the weakest rotor's thrust, the largest drag coefficient. A
@@ -42,6 +43,7 @@ std::unique_ptr<PlanningTask> PlanningTask::Make(const vehicle::VehicleParams& p
       std::max(0.05, planning::PostFailureAccelerationLimit(p.mass_kg, rotor_thrust, p.rotor_drag_kg_s.maxCoeff(),
                                                             r.nominal.v_max, options.post_failure_safety_factor));
   task->navigator_ = std::make_unique<planning::Replanner>(r, start.p_W, start.yaw);
+  task->followed_ = task->navigator_->Followed();
   return task;
 }
 
@@ -54,8 +56,19 @@ void PlanningTask::LimitAcceleration(double a_max) {
 }
 
 void PlanningTask::Update(double t, FlightMode mode, const perception::VoxelMap* map, const FaultEstimates& faults) {
-  if (flatness_) return UpdateFlatness(t, faults);
-  UpdateMinco(t, mode, map);
+  if (flatness_) {
+    UpdateFlatness(t, faults);
+  } else {
+    UpdateMinco(t, mode, map);
+  }
+  Publish();
+}
+
+void PlanningTask::Publish() {
+  const std::uint64_t serial = flatness_ ? flatness_->path_serial() : navigator_->path_serial();
+  if (serial == followed_serial_) return;
+  followed_serial_ = serial;
+  followed_ = flatness_ ? flatness_->Followed() : navigator_->Followed();
 }
 
 void PlanningTask::UpdateFlatness(double t, const FaultEstimates& faults) {
@@ -92,11 +105,6 @@ void PlanningTask::UpdateMinco(double t, FlightMode mode, const perception::Voxe
     if (navigator_->events()[plan_events_seen_].status == planning::PlanSummary::Status::kSuccess) last_plan_ok_s_ = t;
   }
   if (navigator_->arrived()) last_plan_ok_s_ = t;  // holding at a waypoint is not a planning failure
-}
-
-const ReferenceTrajectory& PlanningTask::reference() const {
-  if (flatness_) return *flatness_;
-  return *navigator_;
 }
 
 bool PlanningTask::navigating() const { return navigator_ && next_waypoint_ > 0 && !navigator_->arrived(); }

@@ -111,6 +111,40 @@ TEST(Replanner, PlansOnAGoalReplansPeriodicallyAndArrives) {
   EXPECT_LT(r.Reference(15.0).v_W.norm(), 1e-9);
 }
 
+// What the replanner follows, as a value (FollowedReference): a copy made at a path serial
+// evaluates as the replanner does, to the bit, until the serial changes; then it keeps the path
+// it copied (a controller reading it is never disturbed by the planner's next plan).
+TEST(Replanner, TheFollowedReferenceIsTheReplannersReferenceAsAValue) {
+  const perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5), 0.7);
+  const std::shared_ptr<const ReferenceTrajectory> hold = r.Followed();
+  EXPECT_EQ(hold->Evaluate(3.0).p_W, Vector3(0, 0, 1.5));
+  EXPECT_EQ(hold->Evaluate(3.0).yaw, 0.7);
+  r.SetGoal(Vector3(5, 1, 1.5));
+  std::shared_ptr<const ReferenceTrajectory> copy;
+  std::uint64_t serial = r.path_serial(), changes = 0;
+  for (double t = 0.0; t <= 12.0; t += 0.05) {
+    r.Update(t, map);
+    if (r.path_serial() != serial || !copy) {
+      // A new path: the copy made before it no longer agrees somewhere ahead.
+      if (copy && r.path_serial() != serial) {
+        ++changes;
+        bool differs = false;
+        for (double s = t; s <= t + 2.0; s += 0.1) differs = differs || copy->Evaluate(s).p_W != r.Evaluate(s).p_W;
+        EXPECT_TRUE(differs) << "t = " << t;
+      }
+      serial = r.path_serial();
+      copy = r.Followed();
+    }
+    for (double s = t; s <= t + 1.0; s += 0.1) {
+      const ReferencePoint a = copy->Evaluate(s), b = r.Evaluate(s);
+      ASSERT_TRUE(a.p_W == b.p_W && a.v_W == b.v_W && a.a_W == b.a_W && a.yaw == b.yaw) << "t = " << t << ", s = " << s;
+    }
+  }
+  EXPECT_GE(changes, 2u) << "the goal's plan and the periodic replans";
+  EXPECT_EQ(hold->Evaluate(3.0).p_W, Vector3(0, 0, 1.5)) << "the first copy still holds";
+}
+
 // The heading given at construction is held before and through every plan.
 TEST(Replanner, KeepsTheHeadingItWasGiven) {
   const perception::VoxelMap map = EmptyMap();

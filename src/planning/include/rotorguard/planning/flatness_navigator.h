@@ -7,7 +7,9 @@
 /// least `min_hold_s`, at most `max_hold_s` later) the remaining distance is re-planned with the
 /// degraded actuator limit (1 − ŵ_i) ρ_u u_max, and the vehicle continues, returns home or lands
 /// depending on that settling time against `time_budget_s`. Every decision is logged.
+#include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -99,6 +101,10 @@ class FlatnessNavigator final : public ReferenceTrajectory {
   const std::vector<FlatnessDecision>& decisions() const { return decisions_; }
   /// The leg being flown, if any.
   const std::optional<CriticallyDampedReference>& leg() const { return leg_; }
+  /// Counts the changes of what is followed (a new leg); see Replanner::path_serial.
+  std::uint64_t path_serial() const { return path_serial_; }
+  /// An immutable copy of what is followed (FollowedReference): Evaluate's reference, as a value.
+  std::shared_ptr<const ReferenceTrajectory> Followed() const;
 
  private:
   /// A leg from the reference state at t to `goal` with the losses `w_hat`; nullopt when
@@ -111,6 +117,7 @@ class FlatnessNavigator final : public ReferenceTrajectory {
   Vector3 home_, goal_;
   double yaw_;
   std::optional<CriticallyDampedReference> leg_;
+  std::uint64_t path_serial_ = 0;
   std::optional<double> hold_since_;
   std::optional<std::string> land_request_;
   bool returning_ = false;

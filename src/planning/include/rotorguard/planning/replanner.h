@@ -10,7 +10,9 @@
 /// trying.
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -105,6 +107,11 @@ class Replanner final : public ReferenceTrajectory {
   const DynamicLimits& limits() const { return limits_; }
   /// The trajectory being followed (empty while holding before any plan).
   const MinimumJerkTrajectory& trajectory() const { return trajectory_; }
+  /// Counts the changes of what is followed (a new trajectory): a FollowedReference made at one
+  /// count evaluates as the replanner does until the next.
+  std::uint64_t path_serial() const { return path_serial_; }
+  /// An immutable copy of what is followed (FollowedReference): Evaluate's reference, as a value.
+  std::shared_ptr<const ReferenceTrajectory> Followed() const;
   /// The last planning query's summary.
   const PlanSummary& last_plan() const { return last_plan_; }
   /// The goal the last query planned to: the goal, or a local goal towards it (LocalGoal).
@@ -129,6 +136,7 @@ class Replanner final : public ReferenceTrajectory {
   DynamicLimits limits_;
   Mode mode_ = Mode::kIdle;
   MinimumJerkTrajectory trajectory_;
+  std::uint64_t path_serial_ = 0;
   Vector3 hold_;
   double yaw_ = 0.0;
   Vector3 goal_ = Vector3::Zero(), planned_goal_ = Vector3::Zero();

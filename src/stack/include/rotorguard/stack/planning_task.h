@@ -144,8 +144,12 @@ class PlanningTask {
   /// A partial loss: the acceleration limit the weakened vehicle keeps (failure-aware only).
   void LimitAcceleration(double a_max);
 
-  /// The reference to follow: the trajectory being flown, or the hold.
-  const ReferenceTrajectory& reference() const;
+  /// The reference to follow: the trajectory being flown, or the hold, as a value the navigator
+  /// made when it last changed what it follows (planning::FollowedReference): the controller
+  /// reads it without touching the navigator, and onboard it is what the planner's thread
+  /// publishes.
+  const ReferenceTrajectory& reference() const { return *followed_; }
+  std::shared_ptr<const ReferenceTrajectory> followed() const { return followed_; }
   /// A waypoint is being flown to (not all reached, not holding at one).
   bool navigating() const;
   /// When the planner last succeeded (or the mission started, or a waypoint was held) [s].
@@ -160,13 +164,17 @@ class PlanningTask {
   const planning::FlatnessNavigator* flatness() const { return flatness_.get(); }
 
  private:
-  PlanningTask(const NavigationOptions& options) : options_(options) {}
+  explicit PlanningTask(const NavigationOptions& options) : options_(options) {}
   void UpdateMinco(double t, FlightMode mode, const perception::VoxelMap* map);
   void UpdateFlatness(double t, const FaultEstimates& faults);
+  /// A new followed_ when the navigator changed what it follows.
+  void Publish();
 
   NavigationOptions options_;
   std::unique_ptr<planning::Replanner> navigator_;
   std::unique_ptr<planning::FlatnessNavigator> flatness_;
+  std::shared_ptr<const ReferenceTrajectory> followed_;
+  std::uint64_t followed_serial_ = 0;  // the navigator's path_serial when followed_ was made
   std::size_t plan_events_seen_ = 0;
   double last_plan_ok_s_ = 0.0;  // the planner's last success (or the first goal's time)
   int flatness_reached_ = 0;
