@@ -190,7 +190,27 @@ def run_flights(binary, name, folder, workers=2):
             if (i + 1) % 50 == 0 or i + 1 == len(jobs):
                 print('results: %s: %d of %d flights' % (name, i + 1, len(jobs)), flush=True)
     with open(os.path.join(folder, 'done.json'), 'w') as f:
-        json.dump(rows, f, indent=1)
+        json.dump({'version': program_version(binary), 'flights': rows}, f, indent=1)
+
+
+def program_version(binary):
+    """What `rotorguard --version` says: the release and the revision it was built from."""
+    return subprocess.run([binary, '--version'], capture_output=True, text=True).stdout.strip() or 'unknown'
+
+
+def load_flights(folder):
+    """(version, rows) of a runs job's done.json (older ones hold the rows alone: version None)."""
+    with open(os.path.join(folder, 'done.json')) as f:
+        done = json.load(f)
+    if isinstance(done, list):
+        return None, done
+    return done['version'], done['flights']
+
+
+def built(version):
+    """' (rotorguard VERSION)' when the build is known."""
+    return ' (rotorguard %s)' % version if version else ''
+
 
 
 def estimate_vs_reference(folder, summary):
@@ -579,15 +599,14 @@ def render(out_dir, present):
                    % (total[1], ', '.join(j[0].replace('far_', '').replace('_', ' ') for j in far), total[0],
                       pct(total[0], total[1]), ': ' + ', '.join(where) if where else '')]
     if 'nmpc_tracking' in present:
-        with open(os.path.join(out_dir, 'nmpc_tracking', 'done.json')) as f:
-            rows = json.load(f)
+        version, rows = load_flights(os.path.join(out_dir, 'nmpc_tracking'))
         med = lambda key: median([r[key] for r in rows])
         body += ['## Post-failure tracking: the 1 m/s lemniscate with propeller 0 lost', '',
                  '`rotorguard run %s --seed K` for K = 1..%d, as shipped: drawn delays (the stack expects 3 ms),'
                  % (TRACKING_SCENARIO, len(rows)),
                  'wind gusts of 0.3 m/s, the tracking window from 5 s. The estimate\'s error against the reference is',
                  'what the controller achieves; the truth\'s against the reference adds the odometry\'s drift (the',
-                 'estimate\'s error against the truth). Paper 000\'s real flights: 0.14-0.15 m.', '',
+                 'estimate\'s error against the truth). Paper 000\'s real flights: 0.14-0.15 m.' + built(version), '',
                  '| flights | successes | estimate vs reference, median (m) | truth vs reference, median (m) | estimate vs truth, median (m) |',
                  '|---|---|---|---|---|',
                  '| %d | %d | %.3f | %.3f | %.3f |' % (len(rows), sum(1 for r in rows if r['success']), med('est_vs_ref'),
@@ -596,8 +615,7 @@ def render(out_dir, present):
                    'against the reference %.3f m; of the truth %.3f m, of which the odometry drift (estimate against '
                    'truth) %.3f m.' % (len(rows), med('est_vs_ref'), med('truth_vs_ref'), med('est_vs_truth'))]
     if 'nmpc_delay' in present:
-        with open(os.path.join(out_dir, 'nmpc_delay', 'done.json')) as f:
-            rows = json.load(f)
+        version, rows = load_flights(os.path.join(out_dir, 'nmpc_delay'))
         body += ['## The NMPC\'s assumed delay against the true one', '',
                  'The same flights with the true delay fixed at 3.5 ms (2.5 ms of computation, 1 ms of ESC latency,',
                  'the computation within 25 % jitter) while the NMPC predicts over `stack.command_delay_s` = D:', '',
@@ -611,16 +629,15 @@ def render(out_dir, present):
                 median([r['truth_vs_ref'] for r in rs])))
         body += ['', 'Each flight: `rotorguard run %s --seed K --set truth.computation_delay_min_s=0.0025 --set '
                  'truth.computation_delay_max_s=0.0025 --set truth.esc_command_latency_min_s=0.001 --set '
-                 'truth.esc_command_latency_max_s=0.001 --set stack.command_delay_s=D`.' % TRACKING_SCENARIO, '']
+                 'truth.esc_command_latency_max_s=0.001 --set stack.command_delay_s=D`%s.' % (TRACKING_SCENARIO, built(version)), '']
     if 'shipped' in present:
-        with open(os.path.join(out_dir, 'shipped', 'done.json')) as f:
-            rows = json.load(f)
+        version, rows = load_flights(os.path.join(out_dir, 'shipped'))
         body += ['## Every shipped scenario at 50 seeds', '',
                  '`rotorguard run configs/scenarios/NAME.yaml --seed K --set truth=WORLD` for K = %d..%d (vehicles no test'
                  % (SHIPPED_SEEDS[0], SHIPPED_SEEDS[-1]),
                  'or document flies: ctest flies seeds 1-3), in the realistic world and, beside it, the ideal one. A file',
                  'that states `truth: ideal` is not yet realistic (the file says why). A scenario written to show a',
-                 'failure succeeds when it shows that failure (the words in brackets).', '',
+                 'failure succeeds when it shows that failure (the words in brackets)%s.' % built(version), '',
                  '| scenario | states | world | flights | successes | rate | failures (most frequent reasons) |',
                  '|---|---|---|---|---|---|---|']
         stated = dict((n, w) for n, _, w in shipped_scenarios())

@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
       "Exit codes: 0 success; 1 the run failed (crash); 2 usage or invalid config;\n"
       "3 an input file is unreadable; 4 an infeasible request.",
       "rotorguard"};
-  app.set_version_flag("--version", rotorguard::buildinfo::Version());
+  app.set_version_flag("--version", rotorguard::buildinfo::ProgramVersion());  // the release and its revision
   app.require_subcommand(1);
 
   std::vector<std::unique_ptr<cli::Command>> commands;

@@ -86,6 +86,15 @@ class CliTest : public rotorguard::testing::TempFolderTest {
   std::string Out() const { return (dir_ / "out").string(); }
 };
 
+/// --version names the release and the source revision, as every result's manifest does, so that a
+/// figure made with a copied binary can be traced to its build.
+TEST_F(CliTest, TheVersionNamesTheReleaseAndTheRevision) {
+  const Result r = Cli("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_TRUE(std::regex_match(r.out, std::regex(R"([0-9]+\.[0-9]+\.[0-9]+ \((unknown|[0-9a-f]{7,}(-dirty)?)\)\n)")))
+      << r.out;
+}
+
 /// Bad list and word options of the benchmarks are usage errors that name the option and the field.
 TEST_F(CliTest, ABenchmarksListOptionsNameTheFieldThatIsWrong) {
   Result r = Cli("bench lio --spins 11,,20");
