@@ -150,6 +150,7 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
     }
   }
   known_fault_applied_.assign(options_.known_faults.size(), false);
+  planning_events_.reserve(2 * kMaxRotors);  // the cycle raises them without allocating
   degraded_told_.assign(static_cast<std::size_t>(model_.num_rotors()), false);
   effectiveness_.assign(static_cast<std::size_t>(model_.num_rotors()), 1.0);
   for (const vehicle::Rotor& r : model_.params().rotors) rotor_max_thrust_n_.push_back(r.max_thrust_n);
@@ -241,7 +242,7 @@ void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
   }
   if (nmpc_) nmpc_->RewindDisturbance(onset);
   controller_->SetRotorFailed(rotor);
-  if (planning_) planning_->OnFailure();
+  planning_events_.push_back({PlanningEvent::Kind::kFailure, 0.0});
 }
 
 void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset) {
@@ -257,11 +258,11 @@ void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset)
   effectiveness_[i] = eta;
   controller_->SetRotorEffectiveness(rotor, eta);
   // The planner keeps to what the weakened vehicle can still accelerate (failure-aware only).
-  if (planning_) {
-    planning_->LimitAcceleration(std::max(
-        0.05, planning::DegradedAccelerationLimit(options_.navigation.replanner.nominal.a_max,
-                                                  model_.params().weight_n(), rotor_max_thrust_n_, effectiveness_)));
-  }
+  planning_events_.push_back(
+      {PlanningEvent::Kind::kAccelerationLimit,
+       std::max(0.05, planning::DegradedAccelerationLimit(options_.navigation.replanner.nominal.a_max,
+                                                          model_.params().weight_n(), rotor_max_thrust_n_,
+                                                          effectiveness_))});
 }
 
 FaultEstimates FlightStack::Faults() const {
@@ -279,7 +280,21 @@ FaultEstimates FlightStack::Faults() const {
 }
 
 const RotorCommand& FlightStack::Update(TimeNs t) {
-  const double dt = last_update_ns_ ? ToSeconds(t - *last_update_ns_) : 0.0;
+  // Lockstep: the planning task runs between the cycle's halves, on what they hand it at once.
+  const FlightMode mode = BeginCycle(t, planning_ ? planning_->status() : PlanStatus{});
+  if (planning_) {
+    for (const PlanningEvent& e : planning_events_) planning_->OnEvent(e);
+  }
+  planning_events_.clear();
+  if (!landing_ && planning_) {
+    const ScopedCost cost(&cost_.planner_s);
+    planning_->Update(ToSeconds(t), mode, map(), Faults());
+  }
+  return EndCycle(t, mode, planning_ ? planning_->followed().get() : nullptr);
+}
+
+FlightMode FlightStack::BeginCycle(TimeNs t, const PlanStatus& plan) {
+  cycle_dt_s_ = last_update_ns_ ? ToSeconds(t - *last_update_ns_) : 0.0;
   last_update_ns_ = t;
   estimate_ = estimator_->Estimate(t);
   estimate_.w_B += rate_notch_correction_;  // the controller's rates: the estimator's, notched
@@ -317,12 +332,12 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   in.estimate = estimate_;
   in.odometry_age_s = estimator_->odometry_age_s(t);
   in.isolated_rotors = isolated_rotors();
-  in.navigating = planning_ && planning_->navigating();
-  in.since_last_plan_s = ts - (planning_ ? planning_->last_plan_ok_s() : 0.0);
+  in.navigating = plan.navigating;
+  in.since_last_plan_s = ts - plan.last_plan_ok_s;
   in.thrust_ratio = command_.thrust_n.sum() / model_.params().weight_n();
   in.cannot_hover = cannot_hover_;
   in.landing = !landing_ && reference().Evaluate(ts).p_W.z() <= 0.0;  // a mission that lands
-  if (planning_ && planning_->land_request()) in.land_request = "re-planning decided to land: " + *planning_->land_request();
+  if (plan.land_request) in.land_request = "re-planning decided to land: " + *plan.land_request;
   const FlightMode mode = supervisor_.Update(in);
 
   if (mode == FlightMode::kEmergencyLanding && !landing_) {
@@ -336,11 +351,13 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
     landing_.emplace(o);
     descent_.emplace(*landing_, supervisor_.landing_start_s());
   }
-  if (!landing_ && planning_) {
-    const ScopedCost cost(&cost_.planner_s);
-    planning_->Update(ts, mode, map(), Faults());
-  }
-  const ReferenceTrajectory& followed = reference();
+  return mode;
+}
+
+const RotorCommand& FlightStack::EndCycle(TimeNs t, FlightMode mode, const ReferenceTrajectory* plan) {
+  const double ts = ToSeconds(t);
+  const double dt = cycle_dt_s_;
+  const ReferenceTrajectory& followed = descent_ ? *descent_ : plan ? *plan : *reference_;
   reference_point_ = followed.Evaluate(ts);
   if (!estimate_.valid || mode == FlightMode::kLanded || mode == FlightMode::kFlightTermination) {
     // Nothing to act on yet, on the ground after a landing, or a vehicle that cannot hover: motors

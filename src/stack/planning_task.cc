@@ -47,12 +47,13 @@ std::unique_ptr<PlanningTask> PlanningTask::Make(const vehicle::VehicleParams& p
   return task;
 }
 
-void PlanningTask::OnFailure() {
-  if (navigator_ && options_.failure_aware) navigator_->OnFailure();
-}
-
-void PlanningTask::LimitAcceleration(double a_max) {
-  if (navigator_ && options_.failure_aware) navigator_->LimitAcceleration(a_max);
+void PlanningTask::OnEvent(const PlanningEvent& event) {
+  if (!navigator_ || !options_.failure_aware) return;
+  if (event.kind == PlanningEvent::Kind::kFailure) {
+    navigator_->OnFailure();
+  } else {
+    navigator_->LimitAcceleration(event.a_max);
+  }
 }
 
 void PlanningTask::Update(double t, FlightMode mode, const perception::VoxelMap* map, const FaultEstimates& faults) {

@@ -220,7 +220,17 @@ class FlightStack {
   /// A LiDAR frame: deskewed and inserted into the map (the map is created with the first frame).
   void OnLidar(const LidarFrame& frame);
   /// One control cycle at time t: estimate, reference, controller. Call every control_period_ns().
+  /// It runs BeginCycle, then the planning task (with the events the first half raised), then
+  /// EndCycle with the planning's reference: the lockstep order. An onboard executor runs the
+  /// planning on its own thread and the two halves with its newest outputs (docs/runtime.md).
   const RotorCommand& Update(TimeNs t);
+  /// The cycle's first half: the estimate, known faults and the FDD's isolations (the controller
+  /// reconfigured, the planning's events raised), the supervisor's mode judged with `plan`, an
+  /// emergency landing started. Returns the mode.
+  FlightMode BeginCycle(TimeNs t, const PlanStatus& plan);
+  /// The second half: the reference (an emergency landing's descent, else `plan` when not null,
+  /// else the mission's) and the controller's command for the mode.
+  const RotorCommand& EndCycle(TimeNs t, FlightMode mode, const ReferenceTrajectory* plan);
   /// Replaces the command of the control cycle just run (Update) with one computed outside the
   /// stack (a controller written in Python, harness::Flight): the fault detection and the next
   /// cycle's supervisor see it as the command sent. Every mode is overridden, the landed and
@@ -300,6 +310,8 @@ class FlightStack {
   std::unique_ptr<PerceptionTask> perception_;  // the LiDAR's: the odometry's frames and the map
   LioHeadEstimator* lio_head_ = nullptr;         // estimator_, when it follows the odometry's head
   std::unique_ptr<PlanningTask> planning_;  // a navigate mission's; else null
+  std::vector<PlanningEvent> planning_events_;  // raised by the cycle's first half, for the planning
+  double cycle_dt_s_ = 0.0;                     // since the previous cycle
   StackCost cost_;
   std::vector<bool> known_fault_applied_;
   std::vector<bool> degraded_told_;    // per rotor: the controller heard of its partial loss

@@ -128,6 +128,21 @@ struct FaultEstimates {
   bool settled = true;
 };
 
+/// What the control cycle reads of the planning (its supervisor judges it).
+struct PlanStatus {
+  bool navigating = false;      ///< a waypoint is being flown to
+  double last_plan_ok_s = 0.0;  ///< the planner's last success (or the mission's start, or a held waypoint) [s]
+  std::optional<std::string> land_request;  ///< the flatness navigator decided to land, and why
+};
+
+/// What the control side tells the planning between its calls: a rotor isolated (the post-failure
+/// limits), or a partial loss's acceleration limit.
+struct PlanningEvent {
+  enum class Kind { kFailure, kAccelerationLimit };
+  Kind kind = Kind::kFailure;
+  double a_max = 0.0;  ///< kAccelerationLimit's [m/s²]
+};
+
 class PlanningTask {
  public:
   /// The task of a navigate mission (`options.waypoints` not empty), starting at rest at `start`;
@@ -139,10 +154,11 @@ class PlanningTask {
   /// when due (not while recovering from a failure), the planner on `map` (null before the first
   /// LiDAR frame: the MINCO planner waits for it), the time of its last success.
   void Update(double t, FlightMode mode, const perception::VoxelMap* map, const FaultEstimates& faults);
-  /// A rotor isolated: the post-failure limits, unless the failure-unaware variant flies.
-  void OnFailure();
-  /// A partial loss: the acceleration limit the weakened vehicle keeps (failure-aware only).
-  void LimitAcceleration(double a_max);
+  /// A rotor isolated: the post-failure limits; a partial loss: the acceleration limit the
+  /// weakened vehicle keeps (failure-aware only, both).
+  void OnEvent(const PlanningEvent& event);
+  /// The status the control cycle's supervisor judges.
+  PlanStatus status() const { return {navigating(), last_plan_ok_s_, land_request()}; }
 
   /// The reference to follow: the trajectory being flown, or the hold, as a value the navigator
   /// made when it last changed what it follows (planning::FollowedReference): the controller
