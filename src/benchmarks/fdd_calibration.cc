@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "rotorguard/benchmarks/scenario_sweep.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/flight_metrics.h"
@@ -320,7 +321,7 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
     campaign_docs.push_back({{"dir", c.dir},
                              {"campaign", c.campaign},
                              {"seed", c.seed},
-                             {"seed_stream", "campaign " + c.campaign},
+                             {"seed_stream", CampaignSeedStream(c.campaign)},
                              {"trial_seeds", c.trial_seeds},
                              {"flights", c.flights.size()},
                              {"false_alarms", alarms}});

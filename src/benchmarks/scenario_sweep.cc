@@ -80,6 +80,8 @@ int CampaignSpec::trials() const {
   return static_cast<int>(n);
 }
 
+std::string CampaignSeedStream(const std::string& name) { return "campaign " + name; }
+
 CampaignSpec LoadCampaignSpec(const std::string& path) {
   const io::ConfigDocument doc = io::ConfigDocument::LoadFile(path);
   return LoadCampaignSpec(doc.root(), path);
@@ -102,7 +104,7 @@ CampaignSpec LoadCampaignSpec(const io::ConfigNode& root, const std::string& pat
   if (const auto r = root.Optional("repeats")) spec.repeats = static_cast<int>(r->AsIntIn(1, 10'000'000));
   // The trials' seeds come from the stream named after the campaign (TrialParameters).
   nlohmann::json canonical = {
-      {"name", spec.name}, {"seed", spec.seed}, {"repeats", spec.repeats}, {"seed_stream", "campaign " + spec.name}};
+      {"name", spec.name}, {"seed", spec.seed}, {"repeats", spec.repeats}, {"seed_stream", CampaignSeedStream(spec.name)}};
   if (const auto grid = root.Optional("grid")) {
     for (const std::string& key : grid->Keys()) {
       const io::ConfigNode values = grid->Required(key);
@@ -199,7 +201,7 @@ std::map<std::string, std::string> TrialParameters(const CampaignSpec& spec, int
     p[it->first] = it->second[static_cast<std::size_t>(point % n)];
     point /= n;
   }
-  const std::uint64_t seed = TrialSeed(spec.seed, "campaign " + spec.name, static_cast<std::uint64_t>(index));
+  const std::uint64_t seed = TrialSeed(spec.seed, CampaignSeedStream(spec.name), static_cast<std::uint64_t>(index));
   Rng draws(DeriveSeed(seed, 1));  // its own stream: the trial's seed drives the simulation
   for (const auto& [key, r] : spec.random) {
     if (r.kind == RandomSweep::Kind::kUniform) {

@@ -229,7 +229,7 @@ void Lio::OnImu(const ImuSample& imu) {
     // A sample the last frame's end has passed (it came after that frame): the filter crossed
     // its interval on the sample before; it starts the filter's next interval.
     filter_imu_ = imu;
-    head_.Reset(head_.state(), imu);
+    head_.Propagate(imu);  // the head, at the frame's end too, only holds it
     return;
   }
   queue_.push_back(imu);

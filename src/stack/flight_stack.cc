@@ -288,7 +288,7 @@ const RotorCommand& FlightStack::Update(TimeNs t) {
   planning_events_.clear();
   if (!landing_ && planning_) {
     const ScopedCost cost(&cost_.planner_s);
-    planning_->Update(ToSeconds(t), mode, map(), Faults());
+    planning_->Update(ToSeconds(t), mode, map(), flatness() ? Faults() : FaultEstimates{});  // only it reads them
   }
   return EndCycle(t, mode, planning_ ? planning_->followed().get() : nullptr);
 }

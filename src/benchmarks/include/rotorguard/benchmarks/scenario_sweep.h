@@ -40,6 +40,10 @@ struct CampaignSpec {
   int trials() const;
 };
 
+/// The seed stream a campaign named `name` draws its trials' vehicles from (TrialSeed's
+/// workload): its own, so that no other campaign or benchmark flies them.
+std::string CampaignSeedStream(const std::string& name);
+
 /// Loads and validates a spec. Throws io::ConfigError naming file, line and key (an unknown key,
 /// an empty sweep, a sweep over a key the scenario does not have, an unknown metric) or
 /// io::InputFileError.
