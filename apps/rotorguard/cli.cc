@@ -144,6 +144,32 @@ std::vector<harness::Override> ParseOverrides(const std::vector<std::string>& se
   return out;
 }
 
+void ScenarioArguments::Register(CLI::App* command) {
+  app = command;
+  command->add_option("scenario", path, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
+  command->add_option("--set", sets,
+                      "Override a value: key.path=value (e.g. duration_s=5, faults.0.rotor=2, vehicle.mass_kg=1.2); "
+                      "the key must exist in the file. Repeatable.");
+  command->add_option("--seed", seed_text, "Random seed, an integer in [0, 2^64-1] (overrides the file's seed)");
+}
+
+harness::Scenario ScenarioArguments::Load() const {
+  const std::vector<harness::Override> overrides = ParseOverrides(sets);
+  std::optional<std::uint64_t> seed;
+  if (app->count("--seed") > 0) seed = ParseUnsigned("--seed", seed_text, 0, UINT64_MAX);
+  harness::Scenario scenario = harness::LoadScenario(path, overrides);
+  if (seed) scenario.seed = *seed;
+  return scenario;
+}
+
+void CreateOutputFolder(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir)) {
+    throw UsageError(fmt::format("--out: cannot create folder '{}'{}", dir, ec ? ": " + ec.message() : ""));
+  }
+}
+
 const char* const kTrialTimeoutHelp =
     "The watchdog: a trial that takes more than this many wall-clock seconds per simulated\n"
     "second is stopped and recorded as `timeout` (default 100; 0: trials unwatched, in-process)";

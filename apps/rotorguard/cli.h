@@ -47,6 +47,7 @@ std::unique_ptr<Command> MakeFddCalibrateCommand();
 std::unique_ptr<Command> MakeBenchCommand();
 std::unique_ptr<Command> MakeCampaignCommand();
 std::unique_ptr<Command> MakeKeysCommand();
+std::unique_ptr<Command> MakeSitlCommand();
 
 /// The exit code of an error, by its type (UsageError, io::ConfigError: 2; io::InputFileError,
 /// io::CorruptFileError: 3; std::invalid_argument: 2; anything else: 1), and its message with the
@@ -79,6 +80,20 @@ E ParseName(const std::string& option, const std::string& text) {
 }
 /// --set key.path=value, repeatable.
 std::vector<harness::Override> ParseOverrides(const std::vector<std::string>& sets);
+
+/// The scenario a flying command takes (run, sitl, node): the file, --set overrides and --seed.
+struct ScenarioArguments {
+  std::string path, seed_text;
+  std::vector<std::string> sets;
+  CLI::App* app = nullptr;
+  /// Adds the positional scenario and --set and --seed to `command`.
+  void Register(CLI::App* command);
+  /// The scenario as given (LoadScenario's errors, UsageError for a bad --set or --seed).
+  harness::Scenario Load() const;
+};
+
+/// Creates the folder `dir` (and its parents); UsageError naming --out when it cannot.
+void CreateOutputFolder(const std::string& dir);
 
 /// The campaign options a command line gives (campaign run and the benchmarks that run as campaigns).
 campaign::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,

@@ -50,9 +50,7 @@ class FddCalibrateCommand final : public Command {
     const nlohmann::json r = benchmarks::CalibrateCompositeFdd(logs, campaigns, o);
     const std::string md = benchmarks::CalibrationMarkdown(r);
     if (!out_.empty()) {
-      std::error_code ec;
-      fs::create_directories(out_, ec);
-      if (ec || !fs::is_directory(out_)) throw UsageError(fmt::format("--out: cannot create folder '{}'", out_));
+      CreateOutputFolder(out_);
       io::WriteFileAtomically((fs::path(out_) / "calibration.json").string(), r.dump(2) + "\n");
       io::WriteFileAtomically((fs::path(out_) / "calibration.md").string(), md);
     }

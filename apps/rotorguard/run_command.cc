@@ -23,27 +23,18 @@ class RunCommand final : public Command {
                                         "and DIR/vehicle.yaml.\n"
                                         "Exit 0 when the mission succeeds, 1 when it fails (crash), 4 when a\n"
                                         "waypoint is unreachable.");
-    run->add_option("scenario", scenario_path_, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
+    scenario_.Register(run);
     run->add_option("--out", out_dir_, "Output folder (default: out/<scenario name>)");
-    run->add_option("--set", sets_,
-                    "Override a value: key.path=value (e.g. duration_s=5, faults.0.rotor=2, vehicle.mass_kg=1.2); "
-                    "the key must exist in the file. Repeatable.");
-    run->add_option("--seed", seed_text_, "Random seed, an integer in [0, 2^64-1] (overrides the file's seed)");
     run->add_flag("--quiet,-q", quiet_, "No progress bar and no summary table");
     run->add_option("--log-format", log_format_,
                     "csv (log.csv, scene.json, sensors.csv; the default), mcap (flight.mcap, for Foxglove and "
                     "PlotJuggler) or both");
     run->add_flag("--no-report", no_report_, "Do not write report.html");
-    app_ = run;
     return run;
   }
 
   int Execute() override {
-    const std::vector<harness::Override> overrides = ParseOverrides(sets_);
-    std::optional<std::uint64_t> seed;
-    if (app_->count("--seed") > 0) seed = ParseUnsigned("--seed", seed_text_, 0, UINT64_MAX);
-    harness::Scenario scenario = harness::LoadScenario(scenario_path_, overrides);
-    if (seed) scenario.seed = *seed;
+    const harness::Scenario scenario = scenario_.Load();
     harness::RunOptions options;
     options.log_format = ParseLogFormat();
     options.report = !no_report_ && io::HasViewer();
@@ -51,12 +42,7 @@ class RunCommand final : public Command {
       fmt::print(stderr, "note: no report.html: this rotorguard was built without the report viewer (npm)\n");
     }
     options.out_dir = out_dir_.empty() ? (fs::path("out") / scenario.name).string() : out_dir_;
-    std::error_code ec;
-    fs::create_directories(options.out_dir, ec);
-    if (ec || !fs::is_directory(options.out_dir)) {
-      throw UsageError(
-          fmt::format("--out: cannot create folder '{}'{}", options.out_dir, ec ? ": " + ec.message() : ""));
-    }
+    CreateOutputFolder(options.out_dir);
     options.progress = FlightProgress(!quiet_, scenario.duration_s);
     const harness::RunSummary summary = harness::RunScenario(scenario, options);
     if (!quiet_) PrintRunSummary(summary, options.out_dir, options);
@@ -70,9 +56,8 @@ class RunCommand final : public Command {
     throw UsageError(fmt::format("--log-format: '{}' is invalid; expected csv, mcap or both", log_format_));
   }
 
-  CLI::App* app_ = nullptr;
-  std::string scenario_path_, out_dir_, seed_text_, log_format_ = "csv";
-  std::vector<std::string> sets_;
+  ScenarioArguments scenario_;
+  std::string out_dir_, log_format_ = "csv";
   bool quiet_ = false, no_report_ = false;
 };
 

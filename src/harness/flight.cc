@@ -1,5 +1,7 @@
 #include "rotorguard/harness/flight.h"
 
+#include "flight_internal.h"
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -19,10 +21,8 @@
 
 namespace rotorguard::harness {
 
-namespace {
+namespace internal {
 
-/// The scenario as it flies: an assembly's mission planned (its reference made), and the loop's
-/// own rule checked.
 Scenario Flown(const Scenario& sc) {
   Scenario flown = sc;
   PlanMission(&flown);  // an assembly's plan is made before it flies (nothing to do for the others)
@@ -52,15 +52,12 @@ FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int
   return o;
 }
 
-/// MetricsOptionsOf, measured at the file's body frame of the truth's vehicle `draw`.
 FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int64_t steps, const sim::TruthDraw& draw) {
   FlightMetricsOptions o = MetricsOptionsOf(sc, dt_ns, steps);
   o.body_origin_m = -draw.cog_offset_m;
   return o;
 }
 
-/// The simulator of `truth` (which it keeps a reference to) with the sensors and disturbances of
-/// `draw`, starting hovering when the start is in the air, idle on the ground.
 sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel& truth, const sim::TruthDraw& draw) {
   const RotorVector motors =
       sc.initial_position_m.z() > 0.0 ? truth.HoverThrusts() : RotorVector::Zero(truth.num_rotors());
@@ -68,14 +65,50 @@ sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel&
                         truth.MakeState(sc.initial_position_m, sc.initial_yaw_rad, motors));
 }
 
-/// The controller the stack cannot build itself (it lives in a module above it), when asked for.
 std::unique_ptr<control::Controller> ExternalController(const Scenario& sc) {
   if (sc.stack.controller != stack::ControllerKind::kAssembly) return nullptr;
   if (!sc.assembly) throw std::invalid_argument("RunScenario: controller assembly needs the scenario's assembly");
   return std::make_unique<modular::AssemblyController>(*sc.assembly, AssemblyControllerOptionsOf(sc));
 }
 
-}  // namespace
+ComputationDelayModel::ComputationDelayModel(const Scenario& sc, const sim::TruthDraw& draw)
+    : kind_(sc.computation_delay),
+      delay_s_(draw.computation_delay_s),
+      jitter_(draw.computation_delay_jitter_fraction),
+      rng_(DeriveSeed(sc.seed, "computation_delay")) {}
+
+TimeNs ComputationDelayModel::Next(double cycle_s) {
+  if (kind_ == ComputationDelay::kMeasured) return FromSeconds(cycle_s);
+  const double scale = jitter_ > 0.0 ? 1.0 + rng_.Uniform(-jitter_, jitter_) : 1.0;
+  return FromSeconds(delay_s_ * scale);
+}
+
+void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::Simulator& sim,
+                     const stack::FlightStack& st, RunSummary* s) {
+  s->scenario = sc.name;
+  s->seed = sc.seed;
+  s->truth = draw;
+  s->sim_time_s = sim.time_s();
+  s->crashed = sim.crashed();
+  s->crash_reason = sim.crash_reason();
+  s->crash_speed_m_s = sim.crash_speed_m_s();
+  s->stack = st.Summarize();
+  // The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
+  s->sensors = {sc.sim.imu.rate_hz, st.options().estimator.imu_position_m, st.options().command_delay_s,
+                st.options().imu_notch};
+  if (sc.stack.fdd == stack::FddKind::kComposite) s->composite_fdd = sc.stack.composite_fdd;
+  if (const fdd::FaultDetector* detector = st.fault_detector()) {
+    s->fdd = ScoreFdd(detector->rotors(), sim.fault_events());
+    AddReconfigurationLatency(s->stack.reconfigurations, sim.fault_events(), &*s->fdd);
+  }
+  for (const sim::FaultEvent& e : sim.fault_events()) {
+    s->faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
+  }
+}
+
+}  // namespace internal
+
+using namespace internal;
 
 /// One run's closed loop: the simulator (the truth), the flight stack built from the vehicle file
 /// alone, and what watches them (the metrics, the recorder, the clocks).
@@ -108,7 +141,7 @@ class Flight::Loop {
     command_ = stack_.Update(t);
     const double cycle_s = clock.seconds();
     stack_s_ += cycle_s;
-    command_sent_ns_ = t + ComputationDelayNs(cycle_s);
+    command_sent_ns_ = t + delay_.Next(cycle_s);
     next_control_ += stack_.control_period_ns();
     ++control_cycles_;
     metrics_.OnEstimate(vehicle::StateView(sim_.state()), stack_.estimate());
@@ -173,24 +206,11 @@ class Flight::Loop {
     recorder_.WriteFlight(sim_, stack_);
     if (options_.progress) options_.progress(1.0);
     RunSummary s;
-    s.scenario = sc_.name;
-    s.seed = sc_.seed;
-    s.truth = draw_;
-    s.sim_time_s = sim_.time_s();
+    SummarizeFlight(sc_, draw_, sim_, stack_, &s);
     s.physics_steps = physics_steps_;
     s.control_cycles = control_cycles_;
-    s.crashed = sim_.crashed();
-    s.crash_reason = sim_.crash_reason();
-    s.crash_speed_m_s = sim_.crash_speed_m_s();
-    s.stack = stack_.Summarize();
     s.mission_time_s = mission_time_s_;
-    // The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
-    s.sensors = {sc_.sim.imu.rate_hz, stack_.options().estimator.imu_position_m, stack_.options().command_delay_s,
-                 stack_.options().imu_notch};
-    if (sc_.stack.fdd == stack::FddKind::kComposite) s.composite_fdd = sc_.stack.composite_fdd;
-    if (const fdd::FaultDetector* detector = stack_.fault_detector()) {
-      s.fdd = ScoreFdd(detector->rotors(), sim_.fault_events());
-      AddReconfigurationLatency(s.stack.reconfigurations, sim_.fault_events(), &*s.fdd);
+    if (s.fdd) {
       if (composite_) {
         s.fdd->healthy_extremes = sim_.fault_events().empty() ? composite_->healthy_extremes() : healthy_extremes_;
         // The second-failure rule's statistic is a healthy one while at most one rotor has failed.
@@ -198,9 +218,6 @@ class Flight::Loop {
                                                             ? composite_->healthy_extremes().second_failure_index
                                                             : second_failure_index_;
       }
-    }
-    for (const sim::FaultEvent& e : sim_.fault_events()) {
-      s.faults.push_back({e.rotor, std::string(vehicle::ToString(e.kind)), e.onset_s});
     }
     FlightEnd end{sim_.time_ns(), sim_.crashed(), metrics_.BodyOrigin(vehicle::StateView(sim_.state())), std::nullopt};
     if (!sim_.fault_events().empty()) end.first_onset_s = sim_.fault_events().front().onset_s;
@@ -220,16 +237,6 @@ class Flight::Loop {
   std::int64_t steps_taken() const { return static_cast<std::int64_t>(physics_steps_); }
 
  private:
-  /// A cycle's computation delay [ns]: the flight's drawn delay within its jitter, or the stack's
-  /// wall-clock time for the cycle (`cycle_s`, sim.computation_delay: measured). The ideal world
-  /// draws none: its commands act at their cycle's instant, as every flight before the delays did.
-  TimeNs ComputationDelayNs(double cycle_s) {
-    if (sc_.computation_delay == ComputationDelay::kMeasured) return FromSeconds(cycle_s);
-    const double jitter = draw_.computation_delay_jitter_fraction;
-    const double scale = jitter > 0.0 ? 1.0 + delay_rng_.Uniform(-jitter, jitter) : 1.0;
-    return FromSeconds(draw_.computation_delay_s * scale);
-  }
-
   /// The detector has seen only flight before any fault: its extremes are a healthy flight's.
   void NoteHealthyExtremes() {
     if (composite_ && sim_.fault_events().empty()) healthy_extremes_ = composite_->healthy_extremes();
@@ -280,7 +287,7 @@ class Flight::Loop {
   FlightMetrics metrics_;
   RotorCommand command_;
   TimeNs command_sent_ns_ = 0;  // when the last cycle's command leaves the computer
-  Rng delay_rng_{DeriveSeed(sc_.seed, "computation_delay")};
+  ComputationDelayModel delay_{sc_, draw_};
   TimeNs next_control_ = 0;
   double stack_s_ = 0.0, simulator_s_ = 0.0;  // wall-clock time in each [s]
   std::uint64_t physics_steps_ = 0, control_cycles_ = 0;

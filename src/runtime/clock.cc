@@ -1,6 +1,9 @@
 #include "rotorguard/runtime/clock.h"
 
+#include "rotorguard/core/error.h"
+
 #include <cerrno>
+#include <cmath>
 #include <ctime>
 
 namespace rotorguard::runtime {
@@ -17,10 +20,18 @@ TimeNs SteadyClock::Monotonic() {
 
 SteadyClock::SteadyClock() : origin_(Monotonic()) {}
 
-TimeNs SteadyClock::Now() const { return Monotonic() - origin_; }
+SteadyClock::SteadyClock(TimeNs origin, double rate) : origin_(origin), rate_(rate) {
+  if (!(rate > 0.0 && rate <= 1000.0)) ThrowValidation("SteadyClock", "rate", rate, "in (0, 1000]");
+}
+
+TimeNs SteadyClock::Now() const {
+  const TimeNs wall = Monotonic() - origin_;
+  return rate_ == 1.0 ? wall : static_cast<TimeNs>(std::llround(static_cast<double>(wall) * rate_));
+}
 
 bool SteadyClock::SleepUntil(TimeNs t) {
-  const TimeNs until = origin_ + t;
+  const TimeNs until =
+      origin_ + (rate_ == 1.0 ? t : static_cast<TimeNs>(std::ceil(static_cast<double>(t) / rate_)));
   const timespec ts{static_cast<time_t>(until / kNanosPerSecond), static_cast<long>(until % kNanosPerSecond)};
   // An absolute sleep: a signal's interruption resumes towards the same instant, no drift.
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {

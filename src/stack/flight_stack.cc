@@ -179,6 +179,12 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
   control_period_ns_ = PeriodFromRate(options_.control_rate_hz);
   command_.thrust_n = RotorVector::Zero(model_.num_rotors());
   planning_ = PlanningTask::Make(model_.params(), options_.navigation, reference_->Evaluate(0.0));
+  if (planning_) plan_ = planning_->followed();
+}
+
+FlightStack::Tasks FlightStack::DetachTasks() {
+  tasks_detached_ = true;
+  return {perception_.get(), planning_.get()};
 }
 
 void FlightStack::OnImu(const ImuSample& raw) {
@@ -191,9 +197,9 @@ void FlightStack::OnImu(const ImuSample& raw) {
   ImuSample filtered = raw;
   filtered.specific_force_B = y.head<3>();
   filtered.w_B = y.tail<3>();
-  perception_->OnImu(raw);
+  if (!tasks_detached_) perception_->OnImu(raw);
   estimator_->OnImu(raw);
-  TakeOdometryUpdate();
+  if (!tasks_detached_) TakeOdometryUpdate();
   if (fdd_) fdd_->OnImu(filtered);
   if (raw.w_B.allFinite() && filtered.w_B.allFinite()) rate_notch_correction_ = filtered.w_B - raw.w_B;
 }
@@ -201,13 +207,14 @@ void FlightStack::OnImu(const ImuSample& raw) {
 void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
   imu_filter_.OnRotorSpeeds(esc.t_ns, esc.motor_speed_rad_s);
   estimator_->OnEscTelemetry(esc);
-  perception_->OnEscTelemetry(esc);
+  if (!tasks_detached_) perception_->OnEscTelemetry(esc);
   if (fdd_) fdd_->OnEscTelemetry(esc);
 }
 
 void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_->OnOdometry(odometry); }
 
 void FlightStack::OnLidar(const LidarFrame& frame) {
+  RG_INVARIANT(!tasks_detached_, "FlightStack::OnLidar: the perception task runs elsewhere (DetachTasks)");
   perception_->OnFrame(frame, estimator_->FrameEstimate(frame));
   TakeOdometryUpdate();
 }
@@ -216,9 +223,11 @@ void FlightStack::TakeOdometryUpdate() {
   // In one thread the controller's estimate takes each update as it is made: it is then the
   // odometry's own (an onboard executor hands it over when the perception task publishes it).
   if (!lio_head_) return;
-  if (const std::optional<LioUpdate> u = perception_->update(); u && u->posterior.serial > lio_head_->serial()) {
-    lio_head_->OnLioUpdate(*u);
-  }
+  if (const std::optional<LioUpdate> u = perception_->update()) OnLioUpdate(*u);
+}
+
+void FlightStack::OnLioUpdate(const LioUpdate& update) {
+  if (lio_head_ && update.posterior.serial > lio_head_->serial()) lio_head_->OnLioUpdate(update);
 }
 
 void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
@@ -265,11 +274,11 @@ void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset)
                                                           effectiveness_))});
 }
 
-FaultEstimates FlightStack::Faults() const {
-  // Any detection starts the flatness navigator's hold; the UKF's losses and settling drive its
+FaultEstimates FlightStack::PlanningFaults() const {
+  // Only the flatness navigator reads them. Any detection starts the flatness navigator's hold; the UKF's losses and settling drive its
   // re-plan (other detectors give their eta and are taken as settled).
   FaultEstimates f;
-  if (!fdd_) return f;
+  if (!fdd_ || !planning_ || !planning_->flatness()) return f;
   for (int i = 0; i < std::min(4, model_.num_rotors()); ++i) {
     const fdd::RotorStatus& r = fdd_->rotors()[static_cast<std::size_t>(i)];
     f.w_hat[i] = std::clamp(r.eta, 0.0, 0.99);
@@ -280,20 +289,21 @@ FaultEstimates FlightStack::Faults() const {
 }
 
 const RotorCommand& FlightStack::Update(TimeNs t) {
+  RG_INVARIANT(!tasks_detached_, "FlightStack::Update: the tasks run elsewhere (DetachTasks); use BeginCycle, EndCycle");
   // Lockstep: the planning task runs between the cycle's halves, on what they hand it at once.
   const FlightMode mode = BeginCycle(t, planning_ ? planning_->status() : PlanStatus{});
   if (planning_) {
     for (const PlanningEvent& e : planning_events_) planning_->OnEvent(e);
   }
-  planning_events_.clear();
   if (!landing_ && planning_) {
     const ScopedCost cost(&cost_.planner_s);
-    planning_->Update(ToSeconds(t), mode, map(), flatness() ? Faults() : FaultEstimates{});  // only it reads them
+    planning_->Update(ToSeconds(t), mode, map(), PlanningFaults());
   }
-  return EndCycle(t, mode, planning_ ? planning_->followed().get() : nullptr);
+  return EndCycle(t, mode, planning_ ? planning_->followed() : nullptr);
 }
 
 FlightMode FlightStack::BeginCycle(TimeNs t, const PlanStatus& plan) {
+  planning_events_.clear();
   cycle_dt_s_ = last_update_ns_ ? ToSeconds(t - *last_update_ns_) : 0.0;
   last_update_ns_ = t;
   estimate_ = estimator_->Estimate(t);
@@ -354,10 +364,11 @@ FlightMode FlightStack::BeginCycle(TimeNs t, const PlanStatus& plan) {
   return mode;
 }
 
-const RotorCommand& FlightStack::EndCycle(TimeNs t, FlightMode mode, const ReferenceTrajectory* plan) {
+const RotorCommand& FlightStack::EndCycle(TimeNs t, FlightMode mode, std::shared_ptr<const ReferenceTrajectory> plan) {
   const double ts = ToSeconds(t);
   const double dt = cycle_dt_s_;
-  const ReferenceTrajectory& followed = descent_ ? *descent_ : plan ? *plan : *reference_;
+  if (plan) plan_ = std::move(plan);
+  const ReferenceTrajectory& followed = descent_ ? *descent_ : plan_ ? *plan_ : *reference_;
   reference_point_ = followed.Evaluate(ts);
   if (!estimate_.valid || mode == FlightMode::kLanded || mode == FlightMode::kFlightTermination) {
     // Nothing to act on yet, on the ground after a landing, or a vehicle that cannot hover: motors

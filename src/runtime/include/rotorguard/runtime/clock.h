@@ -21,18 +21,24 @@ class Clock {
   virtual bool SleepUntil(TimeNs t) = 0;
 };
 
-/// CLOCK_MONOTONIC, counted from its construction (or from `origin`, a CLOCK_MONOTONIC time in ns).
+/// CLOCK_MONOTONIC, counted from its construction (or from `origin`, a CLOCK_MONOTONIC time in ns),
+/// running at `rate` times real time: rate 1 on a vehicle; in software in the loop the simulator
+/// and the stack follow one such clock (the same origin and rate, in two processes as in one), and
+/// a flight runs at real time (1), faster or slower.
 class SteadyClock final : public Clock {
  public:
   SteadyClock();
-  explicit SteadyClock(TimeNs origin) : origin_(origin) {}
+  explicit SteadyClock(TimeNs origin, double rate = 1.0);
   TimeNs Now() const override;
   bool SleepUntil(TimeNs t) override;
+  TimeNs origin() const { return origin_; }
+  double rate() const { return rate_; }
   /// CLOCK_MONOTONIC now [ns]: an origin for clocks that must agree.
   static TimeNs Monotonic();
 
  private:
   TimeNs origin_;
+  double rate_ = 1.0;
 };
 
 /// The simulated time one simulator publishes and the stack's loops follow; it may live in memory

@@ -19,7 +19,9 @@ inline constexpr std::size_t kCacheLine = 64;
 template <typename T, std::size_t Capacity>
 class SpscQueue {
   static_assert(Capacity >= 2 && (Capacity & (Capacity - 1)) == 0, "SpscQueue: Capacity is a power of two, >= 2");
-  static_assert(std::is_nothrow_copy_assignable_v<T>, "SpscQueue: an element is copied without throwing");
+  // An element is copy-assigned into and out of its slot: fixed-size data (Eigen's fixed-size and
+  // bounded types, a shared_ptr), which copies without allocating or throwing.
+  static_assert(std::is_copy_assignable_v<T>, "SpscQueue: an element is copy-assigned");
 
  public:
   SpscQueue() = default;

@@ -229,8 +229,30 @@ class FlightStack {
   /// emergency landing started. Returns the mode.
   FlightMode BeginCycle(TimeNs t, const PlanStatus& plan);
   /// The second half: the reference (an emergency landing's descent, else `plan` when not null,
-  /// else the mission's) and the controller's command for the mode.
-  const RotorCommand& EndCycle(TimeNs t, FlightMode mode, const ReferenceTrajectory* plan);
+  /// else the mission's) and the controller's command for the mode. The stack keeps `plan` as the
+  /// reference it follows until the next EndCycle.
+  const RotorCommand& EndCycle(TimeNs t, FlightMode mode, std::shared_ptr<const ReferenceTrajectory> plan);
+
+  /// The tasks an onboard executor runs on threads of their own (docs/runtime.md).
+  struct Tasks {
+    PerceptionTask* perception = nullptr;  ///< always
+    PlanningTask* planning = nullptr;      ///< a navigate mission's; else null
+  };
+  /// Hands the perception and planning tasks to the caller, for good: from now on the stack's
+  /// OnImu and OnEscTelemetry no longer feed the perception task, OnLidar and Update may not be
+  /// called, and the caller runs the cycle as BeginCycle, EndCycle, giving the control side the
+  /// odometry's updates (OnLioUpdate) and the planning its events (planning_events) and faults
+  /// (PlanningFaults). Summarize, map and cost read the tasks: call them once the caller's
+  /// threads have stopped.
+  Tasks DetachTasks();
+  /// The LiDAR-inertial odometry's update for the control side's estimate (estimator lio; an
+  /// update older than the last one taken is ignored).
+  void OnLioUpdate(const LioUpdate& update);
+  /// The events the last BeginCycle raised for the planning task (valid until the next one).
+  std::span<const PlanningEvent> planning_events() const { return planning_events_; }
+  /// What the planning task reads of the fault detection (the flatness navigator's; empty for the
+  /// others).
+  FaultEstimates PlanningFaults() const;
   /// Replaces the command of the control cycle just run (Update) with one computed outside the
   /// stack (a controller written in Python, harness::Flight): the fault detection and the next
   /// cycle's supervisor see it as the command sent. Every mode is overridden, the landed and
@@ -244,7 +266,7 @@ class FlightStack {
   /// else the navigator when navigating, else the mission's.
   const ReferenceTrajectory& reference() const {
     if (descent_) return *descent_;
-    return planning_ ? planning_->reference() : *reference_;
+    return plan_ ? *plan_ : *reference_;
   }
   const RotorCommand& command() const { return command_; }
   const vehicle::MultirotorModel& model() const { return model_; }
@@ -290,8 +312,6 @@ class FlightStack {
   /// time, with the disturbance estimate returned to the onset's) and the planner's acceleration
   /// limit (DegradedAccelerationLimit), unless the failure-unaware variant flies.
   void OnRotorDegraded(int rotor, double effectiveness, double onset);
-  /// What the planning task reads of the fault detection this cycle.
-  FaultEstimates Faults() const;
   /// Hands the odometry's newest update, if any, to the controller's estimate.
   void TakeOdometryUpdate();
 
@@ -311,6 +331,8 @@ class FlightStack {
   LioHeadEstimator* lio_head_ = nullptr;         // estimator_, when it follows the odometry's head
   std::unique_ptr<PlanningTask> planning_;  // a navigate mission's; else null
   std::vector<PlanningEvent> planning_events_;  // raised by the cycle's first half, for the planning
+  std::shared_ptr<const ReferenceTrajectory> plan_;  // the planning's reference last followed; null: the mission's
+  bool tasks_detached_ = false;                      // an onboard executor runs perception_ and planning_
   double cycle_dt_s_ = 0.0;                     // since the previous cycle
   StackCost cost_;
   std::vector<bool> known_fault_applied_;

@@ -1,0 +1,59 @@
+#pragma once
+/// Software in the loop (docs/runtime.md): the simulator steps in real time (or at a factor of
+/// it) on the calling thread while the flight stack runs on the onboard executor's threads. Sensor
+/// messages go to the stack as they are made; each command acts when it arrives, on the step's
+/// time grid at the instant it was sent (sub-step resolution), plus the ESCs' drawn latency. The
+/// stack's computation and hand-off delays are in the loop: measured, not drawn.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/harness/run_summary.h"
+#include "rotorguard/harness/runner.h"
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/runtime/onboard_executor.h"
+
+namespace rotorguard::harness {
+
+struct SitlOptions {
+  /// Simulated seconds per wall-clock second, in (0, 10]: 1 is real time.
+  double realtime_factor = 1.0;
+  /// The simulator's time is the clock: the simulator waits at each control instant for the
+  /// cycle's command, which acts after the scenario's computation delay, as in `run`; the
+  /// executor's cycles run on the clock's instants and wait for the perception. The threaded
+  /// stack then flies the lockstep runner's flight to the bit (tests/harness/sitl_test.cc);
+  /// realtime_factor is not used.
+  bool lockstep_clock = false;
+  /// The executor's options (lockstep_clock sets its trigger and wait_for_perception).
+  runtime::OnboardExecutorOptions executor;
+  /// Throws ValidationError naming the field.
+  void Validate() const;
+};
+
+/// How the simulator's side of the loop fared.
+struct SitlLinkReport {
+  std::uint64_t commands = 0;        ///< commands received and applied
+  std::uint64_t commands_after_end = 0;  ///< sent before the flight ended, received after it
+  std::uint64_t commands_late = 0;   ///< received after the step they were sent in had been simulated
+  double late_max_s = 0.0;           ///< the latest such arrival after its sending instant [s]
+  std::uint64_t steps_behind = 0;    ///< physics steps begun more than half a step after their end had passed on the clock
+  double behind_max_s = 0.0;         ///< the furthest the simulator fell behind the clock [s]
+  runtime::LatencyHistogram command_delay;  ///< a command's IMU sample -> it acts on the ESCs (before their latency)
+};
+
+struct SitlResult {
+  RunSummary summary;
+  runtime::OnboardReport runtime;
+  SitlLinkReport link;
+  /// The runtime's and the link's figures (runtime.json).
+  nlohmann::json RuntimeJson() const;
+};
+
+/// Flies `scenario` in software in the loop with the stack in this process. Writes summary.json
+/// and runtime.json to options.out_dir when it is set (the log and the report are the lockstep
+/// runner's). Throws as RunScenario does.
+SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const SitlOptions& sitl);
+
+}  // namespace rotorguard::harness

@@ -1,0 +1,213 @@
+#pragma once
+/// OnboardExecutor: a FlightStack on wall-clock (or simulated) time, its tasks on threads of their
+/// own, as on a vehicle (docs/runtime.md). The lockstep executor (FlightStack::Update) runs the
+/// same objects one after the other; this one runs them concurrently:
+///
+///   intake (the caller's thread: a driver or a transport) --queues--> control thread
+///   control: sensor intake, estimation, FDD, supervisor, controller; a cycle on the first IMU
+///            sample at or past each control instant; the command to the CommandSink
+///   perception: the LiDAR-inertial odometry and the map, on each frame (the IMU and ESC
+///            telemetry copied to it by the control thread)
+///   planning: PlanningTask::Update after each control cycle, on the newest cycle's inputs
+///
+/// Hand-offs are the runtime's bounded, allocation-free queues and triple buffers; the map is the
+/// only object two threads share (the perception writes it, the planning reads it) and the control
+/// thread never touches it. Every cycle's command is stamped with its IMU sample's time (the state
+/// it was computed from) and the time it was sent on the executor's clock, so its latency is
+/// measured.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <shared_mutex>
+#include <string>
+#include <thread>
+
+#include "rotorguard/core/messages.h"
+#include "rotorguard/runtime/clock.h"
+#include "rotorguard/runtime/doorbell.h"
+#include "rotorguard/runtime/latency.h"
+#include "rotorguard/runtime/latest.h"
+#include "rotorguard/runtime/realtime.h"
+#include "rotorguard/runtime/spsc_queue.h"
+#include "rotorguard/stack/flight_stack.h"
+
+namespace rotorguard::runtime {
+
+/// A control cycle's command as it leaves the stack.
+struct StampedCommand {
+  std::uint64_t cycle = 0;  ///< 1, 2, ...
+  TimeNs state_t_ns = 0;    ///< the instant of the IMU sample that started the cycle (the state it used)
+  TimeNs sent_t_ns = 0;     ///< when it was sent, on the executor's clock
+  double compute_s = 0.0;   ///< the cycle's own work, on the steady clock [s]
+  RotorVector thrust_n;
+};
+
+/// What the control thread reports of each cycle (what a recorder logs): the command, the mode,
+/// the estimate and the reference point it was computed with.
+struct CycleTelemetry {
+  StampedCommand command;
+  stack::FlightMode mode = stack::FlightMode::kNominal;
+  StateEstimate estimate;
+  ReferencePoint reference;
+  int isolated_rotors = 0;
+};
+
+/// Where commands and telemetry go: called on the control thread, so it must neither block nor
+/// allocate (a queue push; a transport's send).
+class CommandSink {
+ public:
+  virtual ~CommandSink() = default;
+  virtual void Send(const CycleTelemetry& cycle) = 0;
+};
+
+/// What starts a control cycle.
+enum class CycleTrigger {
+  /// The first IMU sample at or past each control instant (on a vehicle: the cycle runs on the
+  /// freshest data; its instant is the sample's).
+  kImu,
+  /// Each control instant on the clock, with the messages in by then (the lockstep runner's
+  /// order, when the clock is the simulator's time).
+  kClock,
+};
+
+struct OnboardExecutorOptions {
+  CycleTrigger trigger = CycleTrigger::kImu;
+  /// Before each cycle the control thread waits until the perception has finished every frame
+  /// handed in before it: with trigger kClock on the simulator's time, the flight is the lockstep
+  /// runner's to the bit (for tests and comparisons; a vehicle never waits).
+  bool wait_for_perception = false;
+  /// Memory locking for the process and SCHED_FIFO for the control thread (priority
+  /// realtime.fifo_priority; the perception and planning threads one and two below it), when
+  /// permitted; the grant is reported.
+  RealtimeOptions realtime{.lock_memory = false, .fifo_priority = 0};
+  /// A cycle's command sent later than this after its IMU sample is a deadline miss [s]; 0: one
+  /// control period.
+  double deadline_s = 0.0;
+  /// Throws ValidationError naming the field.
+  void Validate() const;
+};
+
+/// A loop's timing over a run.
+struct LoopReport {
+  std::uint64_t runs = 0;        ///< cycles, frames or planning calls
+  std::uint64_t misses = 0;      ///< control: deadline misses
+  std::uint64_t skipped = 0;     ///< control: instants passed without a cycle (the thread was late)
+  LatencyHistogram latency;      ///< control: IMU capture -> command sent; perception: frame end -> update published
+  LatencyHistogram compute;      ///< the work itself, on the steady clock
+  double cpu_s = 0.0;            ///< the thread's CPU time
+  std::uint64_t dropped = 0;     ///< inputs refused by a full queue
+};
+
+struct OnboardReport {
+  LoopReport control, perception, planning;
+  RealtimeGrant realtime;
+};
+
+class OnboardExecutor {
+ public:
+  /// Takes `stack`'s tasks (FlightStack::DetachTasks); `stack`, `clock` and `sink` outlive the
+  /// executor. Nothing runs before Start.
+  OnboardExecutor(stack::FlightStack* stack, Clock* clock, CommandSink* sink, const OnboardExecutorOptions& options = {});
+  /// Stops the threads.
+  ~OnboardExecutor();
+  OnboardExecutor(const OnboardExecutor&) = delete;
+  OnboardExecutor& operator=(const OnboardExecutor&) = delete;
+
+  /// The sensor intake, called from one thread (a driver's or a transport's), in the order the
+  /// messages arrive. Never blocks: a full queue drops the message and counts it.
+  void OnImu(const ImuSample& imu);
+  void OnEscTelemetry(const EscTelemetry& esc);
+  void OnOdometry(const OdometrySample& odometry);
+  void OnLidar(std::shared_ptr<const LidarFrame> frame);
+
+  void Start();
+  /// Lets the threads finish what they hold, then joins them (idempotent).
+  void Stop();
+  /// The loops' figures; complete once stopped.
+  OnboardReport Report() const;
+  /// Sensor messages the control thread has taken in so far (any thread may ask).
+  std::uint64_t messages_taken() const { return messages_taken_.load(std::memory_order_acquire); }
+
+ private:
+  /// One sensor message in the intake's order (a tagged record: copying it never allocates).
+  struct SensorMessage {
+    enum class Kind { kImu, kEsc, kOdometry };
+    Kind kind = Kind::kImu;
+    ImuSample imu;
+    EscTelemetry esc;
+    OdometrySample odometry;
+    std::uint64_t seq = 0;  // the intake's count before it
+  };
+  /// Pushes `m` to the control thread (dropped and counted when its queue is full).
+  void Intake(SensorMessage m);
+  /// What the planning reads of the cycle just run.
+  struct PlanningInput {
+    TimeNs t_ns = 0;
+    stack::FlightMode mode = stack::FlightMode::kNominal;
+    stack::FaultEstimates faults;
+    bool landing = false;  // an emergency landing flies its own descent: the planning rests
+  };
+  /// What the control cycle reads of the planning.
+  struct PlanningOutput {
+    std::shared_ptr<const ReferenceTrajectory> followed;
+    stack::PlanStatus status;
+  };
+
+  void ControlLoop();
+  /// The control thread takes in every sensor message waiting; true when there was one.
+  bool TakeMessages();
+  /// Blocks until the perception finished every frame handed in so far (wait_for_perception).
+  void WaitForPerception();
+  void PerceptionLoop();
+  void PlanningLoop();
+  /// A control cycle at the IMU sample of time t.
+  void RunCycle(TimeNs t);
+
+  stack::FlightStack* stack_;
+  stack::FlightStack::Tasks tasks_;
+  Clock* clock_;
+  CommandSink* sink_;
+  OnboardExecutorOptions options_;
+  TimeNs deadline_ns_ = 0;
+
+  // intake -> control
+  SpscQueue<SensorMessage, 1024> intake_;
+  Doorbell intake_bell_;
+  // control -> perception
+  SpscQueue<SensorMessage, 4096> perception_messages_;  // the IMU samples and ESC telemetry
+  Latest<StateEstimate> control_estimate_;  // the frames' placement without the odometry
+  // intake -> perception
+  /// A frame, and how many sensor messages the intake had taken before it: the perception
+  /// registers it once the control thread has passed it every IMU sample up to there.
+  struct FrameMessage {
+    std::shared_ptr<const LidarFrame> frame;
+    std::uint64_t after_messages = 0;
+  };
+  SpscQueue<FrameMessage, 8> frames_;
+  std::uint64_t messages_in_ = 0;                   // the intake's count (its thread only)
+  std::atomic<std::uint64_t> messages_taken_{0};    // the control thread's count, forwarded
+  Doorbell perception_bell_;
+  std::atomic<std::uint64_t> frames_in_{0}, frames_done_{0};  // wait_for_perception's count
+  // perception -> control
+  Latest<stack::LioUpdate> lio_updates_;
+  // control -> planning
+  SpscQueue<stack::PlanningEvent, 64> planning_events_;
+  Latest<PlanningInput> planning_input_;
+  Doorbell planning_bell_;
+  // planning -> control
+  Latest<PlanningOutput> planning_output_;
+  std::shared_mutex map_mutex_;  // the perception writes the map, the planning reads it
+
+  std::optional<TimeNs> next_cycle_ns_;
+  TimeNs newest_imu_ns_ = 0;
+  bool have_imu_ = false;
+  std::uint64_t cycles_ = 0;
+  OnboardReport report_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> control_done_{false};  // the control thread has ended: nothing more is passed on
+  bool started_ = false;
+  std::thread control_, perception_, planning_;
+};
+
+}  // namespace rotorguard::runtime
