@@ -48,6 +48,7 @@ std::unique_ptr<Command> MakeBenchCommand();
 std::unique_ptr<Command> MakeCampaignCommand();
 std::unique_ptr<Command> MakeKeysCommand();
 std::unique_ptr<Command> MakeSitlCommand();
+std::unique_ptr<Command> MakeNodeCommand();
 
 /// The exit code of an error, by its type (UsageError, io::ConfigError: 2; io::InputFileError,
 /// io::CorruptFileError: 3; std::invalid_argument: 2; anything else: 1), and its message with the

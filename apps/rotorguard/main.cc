@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   std::vector<std::unique_ptr<cli::Command>> commands;
   commands.push_back(cli::MakeRunCommand());
   commands.push_back(cli::MakeSitlCommand());
+  commands.push_back(cli::MakeNodeCommand());
   commands.push_back(cli::MakeReportCommand());
   commands.push_back(cli::MakeValidateCommand());
   commands.push_back(cli::MakeKeysCommand());

@@ -13,6 +13,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// This program's own path (the node is this program with another command).
+std::string SelfPath() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("sitl: cannot find this program's path (/proc/self/exe): " + ec.message());
+  return self.string();
+}
+
 class SitlCommand final : public Command {
  public:
   CLI::App* Register(CLI::App* app) override {
@@ -29,6 +37,8 @@ class SitlCommand final : public Command {
     sitl->add_flag("--lockstep-clock", sitl_.lockstep_clock,
                    "The simulator's time is the clock and it waits for each cycle's command, which acts after the\n"
                    "scenario's computation delay: the threaded stack flies `run`'s flight (a check, not a timing)");
+    sitl->add_flag("--in-process", in_process_,
+                   "Run the stack in this process (default: in its own, `rotorguard node`, through shared memory)");
     sitl->add_flag("--quiet,-q", quiet_, "No progress bar and no summary table");
     app_ = sitl;
     return sitl;
@@ -38,6 +48,11 @@ class SitlCommand final : public Command {
     harness::SitlOptions sitl = sitl_;
     if (app_->count("--realtime-factor") > 0) sitl.realtime_factor = ParsePositive("--realtime-factor", factor_text_, 10.0);
     const harness::Scenario scenario = scenario_.Load();
+    if (!in_process_) {
+      // The node flies the same scenario: the same file, overrides and seed.
+      sitl.node_command = {SelfPath(), "node", scenario_.path, "--seed", std::to_string(scenario.seed)};
+      for (const std::string& set : scenario_.sets) sitl.node_command.insert(sitl.node_command.end(), {"--set", set});
+    }
     harness::RunOptions options;
     options.out_dir = out_dir_.empty() ? (fs::path("out") / (scenario.name + "-sitl")).string() : out_dir_;
     CreateOutputFolder(options.out_dir);
@@ -55,25 +70,30 @@ class SitlCommand final : public Command {
 
  private:
   static void PrintRuntime(const harness::SitlResult& r) {
-    const runtime::LoopReport& c = r.runtime.control;
-    fmt::print("control loop      {} cycles, {} deadline misses; IMU sample to command sent p50 {:.3f} ms, p99 {:.3f} ms, "
-               "max {:.3f} ms\n",
-               c.runs, c.misses, 1e3 * c.latency.Quantile(0.5), 1e3 * c.latency.Quantile(0.99), 1e3 * c.latency.max_s());
-    const runtime::LoopReport& p = r.runtime.perception;
-    if (p.runs > 0) {
-      fmt::print("perception loop   {} frames; frame end to update p50 {:.1f} ms, p99 {:.1f} ms\n", p.runs,
-                 1e3 * p.latency.Quantile(0.5), 1e3 * p.latency.Quantile(0.99));
+    const nlohmann::json& c = r.loops.at("control");
+    const auto ms = [](const nlohmann::json& loop, const char* histogram, const char* q) {
+      return loop.at(histogram).at(q).get<double>();
+    };
+    fmt::print("control loop      {} cycles ({} skipped), {} deadline misses; IMU sample to command sent p50 {:.3f} ms, "
+               "p99 {:.3f} ms, max {:.3f} ms\n",
+               c.at("runs").get<std::uint64_t>(), c.at("skipped").get<std::uint64_t>(),
+               c.at("deadline_misses").get<std::uint64_t>(), ms(c, "latency", "p50_ms"), ms(c, "latency", "p99_ms"),
+               ms(c, "latency", "max_ms"));
+    const nlohmann::json& p = r.loops.at("perception");
+    if (p.at("runs").get<std::uint64_t>() > 0) {
+      fmt::print("perception loop   {} frames; frame end to update p50 {:.1f} ms, p99 {:.1f} ms\n",
+                 p.at("runs").get<std::uint64_t>(), ms(p, "latency", "p50_ms"), ms(p, "latency", "p99_ms"));
     }
-    const runtime::LoopReport& n = r.runtime.planning;
-    if (n.runs > 0) {
-      fmt::print("planning loop     {} calls; compute p99 {:.2f} ms, max {:.2f} ms\n", n.runs,
-                 1e3 * n.compute.Quantile(0.99), 1e3 * n.compute.max_s());
+    const nlohmann::json& n = r.loops.at("planning");
+    if (n.at("runs").get<std::uint64_t>() > 0) {
+      fmt::print("planning loop     {} calls; compute p99 {:.2f} ms, max {:.2f} ms\n", n.at("runs").get<std::uint64_t>(),
+                 ms(n, "compute", "p99_ms"), ms(n, "compute", "max_ms"));
     }
-    fmt::print("cpu               control {:.2f} s, perception {:.2f} s, planning {:.2f} s\n", c.cpu_s, p.cpu_s,
-               n.cpu_s);
-    fmt::print("scheduling        {}\n", r.runtime.realtime.note);
-    fmt::print("simulator         {} steps behind the clock (at most {:.2f} ms), {} of {} commands late\n",
-               r.link.steps_behind, 1e3 * r.link.behind_max_s, r.link.commands_late, r.link.commands);
+    fmt::print("cpu               control {:.2f} s, perception {:.2f} s, planning {:.2f} s\n", c.at("cpu_s").get<double>(),
+               p.at("cpu_s").get<double>(), n.at("cpu_s").get<double>());
+    fmt::print("scheduling        {}\n", r.loops.at("realtime").at("note").get<std::string>());
+    fmt::print("simulator         {} process(es); {} steps behind the clock (at most {:.2f} ms), {} of {} commands late\n",
+               r.link.processes, r.link.steps_behind, 1e3 * r.link.behind_max_s, r.link.commands_late, r.link.commands);
   }
 
   static double ParsePositive(const std::string& option, const std::string& text, double hi) {
@@ -85,12 +105,36 @@ class SitlCommand final : public Command {
   CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
   std::string out_dir_, factor_text_;
-  bool quiet_ = false;
+  bool quiet_ = false, in_process_ = false;
   harness::SitlOptions sitl_;
+};
+
+/// rotorguard node SCENARIO --channel NAME: the stack's process of `sitl`.
+class NodeCommand final : public Command {
+ public:
+  CLI::App* Register(CLI::App* app) override {
+    CLI::App* node = app->add_subcommand(
+        "node",
+        "The flight stack's process of `sitl` (which starts it): flies SCENARIO's stack on the onboard executor,\n"
+        "exchanging sensor messages and commands with the simulator through the shared-memory channel NAME.");
+    scenario_.Register(node);
+    node->add_option("--channel", channel_, "The shared-memory channel `sitl` created (/rotorguard-sitl-...)")
+        ->required();
+    return node;
+  }
+  int Execute() override {
+    harness::RunNode(scenario_.Load(), channel_);
+    return kOk;
+  }
+
+ private:
+  ScenarioArguments scenario_;
+  std::string channel_;
 };
 
 }  // namespace
 
 std::unique_ptr<Command> MakeSitlCommand() { return std::make_unique<SitlCommand>(); }
+std::unique_ptr<Command> MakeNodeCommand() { return std::make_unique<NodeCommand>(); }
 
 }  // namespace rotorguard::cli

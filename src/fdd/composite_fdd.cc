@@ -18,17 +18,6 @@ void RequireIn(const char* field, double v, double lo, double hi, const char* ru
 }
 }  // namespace
 
-std::string_view ToString(RotorHealth h) {
-  switch (h) {
-    case RotorHealth::kOk: return "ok";
-    case RotorHealth::kMotorFailed: return "motor_failed";
-    case RotorHealth::kPropellerFailed: return "propeller_failed";
-    case RotorHealth::kDegraded: return "degraded";
-    case RotorHealth::kFailed: return "failed";
-  }
-  return "unknown";
-}
-
 bool IsIsolated(RotorHealth health) {
   return health == RotorHealth::kMotorFailed || health == RotorHealth::kPropellerFailed ||
          health == RotorHealth::kFailed;

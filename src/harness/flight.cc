@@ -83,8 +83,21 @@ TimeNs ComputationDelayModel::Next(double cycle_s) {
   return FromSeconds(delay_s_ * scale);
 }
 
+StackAccount AccountOf(const stack::FlightStack& st) {
+  StackAccount a;
+  a.summary = st.Summarize();
+  if (const fdd::FaultDetector* detector = st.fault_detector()) a.fdd_rotors = detector->rotors();
+  if (const auto* composite = dynamic_cast<const fdd::CompositeFdd*>(st.fault_detector())) {
+    a.composite_extremes = composite->healthy_extremes();
+  }
+  a.imu_position_m = st.options().estimator.imu_position_m;
+  a.command_delay_s = st.options().command_delay_s;
+  a.imu_notch = st.options().imu_notch;
+  return a;
+}
+
 void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::Simulator& sim,
-                     const stack::FlightStack& st, RunSummary* s) {
+                     const StackAccount& st, RunSummary* s) {
   s->scenario = sc.name;
   s->seed = sc.seed;
   s->truth = draw;
@@ -92,13 +105,11 @@ void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::
   s->crashed = sim.crashed();
   s->crash_reason = sim.crash_reason();
   s->crash_speed_m_s = sim.crash_speed_m_s();
-  s->stack = st.Summarize();
-  // The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
-  s->sensors = {sc.sim.imu.rate_hz, st.options().estimator.imu_position_m, st.options().command_delay_s,
-                st.options().imu_notch};
+  s->stack = st.summary;
+  s->sensors = {sc.sim.imu.rate_hz, st.imu_position_m, st.command_delay_s, st.imu_notch};
   if (sc.stack.fdd == stack::FddKind::kComposite) s->composite_fdd = sc.stack.composite_fdd;
-  if (const fdd::FaultDetector* detector = st.fault_detector()) {
-    s->fdd = ScoreFdd(detector->rotors(), sim.fault_events());
+  if (st.fdd_rotors) {
+    s->fdd = ScoreFdd(*st.fdd_rotors, sim.fault_events());
     AddReconfigurationLatency(s->stack.reconfigurations, sim.fault_events(), &*s->fdd);
   }
   for (const sim::FaultEvent& e : sim.fault_events()) {
@@ -206,7 +217,7 @@ class Flight::Loop {
     recorder_.WriteFlight(sim_, stack_);
     if (options_.progress) options_.progress(1.0);
     RunSummary s;
-    SummarizeFlight(sc_, draw_, sim_, stack_, &s);
+    SummarizeFlight(sc_, draw_, sim_, AccountOf(stack_), &s);
     s.physics_steps = physics_steps_;
     s.control_cycles = control_cycles_;
     s.mission_time_s = mission_time_s_;

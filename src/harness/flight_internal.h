@@ -41,10 +41,32 @@ class ComputationDelayModel {
   Rng rng_;
 };
 
+/// What a flight's summary reads of the stack at its end: from the stack in this process, or sent
+/// by a software-in-the-loop node from its own.
+struct StackAccount {
+  stack::FlightStackSummary summary;
+  std::optional<std::vector<fdd::RotorStatus>> fdd_rotors;  ///< none without fault detection
+  std::optional<fdd::IndexExtremes> composite_extremes;     ///< the composite detector's, over the flight
+  /// The IMU as the stack knows it (its estimator's lever arm), not as the simulator mounts it.
+  Vector3 imu_position_m = Vector3::Zero();
+  double command_delay_s = 0.0;
+  RpmNotchOptions imu_notch;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("summary", &summary);
+    a->Visit("fdd_rotors", &fdd_rotors);
+    a->Visit("composite_extremes", &composite_extremes);
+    a->Visit("imu_position_m", &imu_position_m);
+    a->Visit("command_delay_s", &command_delay_s);
+    a->Visit("imu_notch", &imu_notch);
+  }
+};
+StackAccount AccountOf(const stack::FlightStack& st);
+
 /// The summary's account of the flight's end from the simulator and the stack: the scenario, the
 /// drawn truth, the crash, the stack's summary, its sensors as it knows them, the FDD scored
 /// against the faults that happened, and the faults.
 void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::Simulator& sim,
-                     const stack::FlightStack& st, RunSummary* s);
+                     const StackAccount& st, RunSummary* s);
 
 }  // namespace rotorguard::harness::internal

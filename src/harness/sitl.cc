@@ -1,8 +1,14 @@
 #include "rotorguard/harness/sitl.h"
 
 #include <fmt/format.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cstring>
 #include <array>
 #include <filesystem>
 #include <stdexcept>
@@ -14,6 +20,9 @@
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/failure_diagnosis.h"
 #include "rotorguard/io/files.h"
+#include "rotorguard/io/json_archive.h"
+#include "rotorguard/runtime/shared_memory.h"
+#include "rotorguard/runtime/sitl_channel.h"
 #include "rotorguard/runtime/spsc_queue.h"
 
 namespace rotorguard::harness {
@@ -100,9 +109,226 @@ nlohmann::json LoopJson(const runtime::LoopReport& r) {
           {"miss_rate", r.runs ? static_cast<double>(r.misses) / static_cast<double>(r.runs) : 0.0},
           {"latency", HistogramJson(r.latency)},
           {"compute", HistogramJson(r.compute)},
+          {"skipped", r.skipped},
           {"cpu_s", r.cpu_s},
           {"dropped", r.dropped}};
 }
+
+/// The executor's loops and its scheduling, as runtime.json holds them.
+nlohmann::json LoopsJson(const runtime::OnboardReport& r) {
+  return {{"control", LoopJson(r.control)},
+          {"perception", LoopJson(r.perception)},
+          {"planning", LoopJson(r.planning)},
+          {"realtime", {{"memory_locked", r.realtime.memory_locked}, {"fifo", r.realtime.fifo}, {"note", r.realtime.note}}}};
+}
+
+/// The stack's side of the loop as the simulator sees it: where sensor messages go and commands
+/// come from, the clock the stack follows, and the stack's account at the end.
+class StackLink {
+ public:
+  virtual ~StackLink() = default;
+  /// The stack is ready for t = 0 once this returns (its threads started).
+  virtual void Start() = 0;
+  virtual runtime::Clock& clock() = 0;
+  /// With lockstep_clock: the simulator's time moves to t, once the messages delivered so far are
+  /// in the stack's hands.
+  virtual void AdvanceTime(TimeNs t) = 0;
+  virtual void Deliver(const sim::SensorOutputs& outputs) = 0;
+  virtual bool TryReceive(runtime::CycleTelemetry* cycle) = 0;
+  /// Stops the stack; its account and its loops' report (JSON).
+  virtual StackAccount Finish(nlohmann::json* loops) = 0;
+};
+
+/// The stack in this process, on the executor's threads; the commands come back through a queue.
+class InProcessLink final : public StackLink {
+ public:
+  InProcessLink(const Scenario& sc, const SitlOptions& sitl, const runtime::OnboardExecutorOptions& executor)
+      : stack_(sc.vehicle, sc.reference, sc.stack, ExternalController(sc)),
+        steady_(runtime::SteadyClock::Monotonic() + kLeadNs, sitl.realtime_factor),
+        simulated_clock_(&time_),
+        clock_(sitl.lockstep_clock ? static_cast<runtime::Clock&>(simulated_clock_) : steady_),
+        executor_(&stack_, &clock_, &sink_, executor) {}
+  void Start() override { executor_.Start(); }
+  runtime::Clock& clock() override { return clock_; }
+  void AdvanceTime(TimeNs t) override { time_.Advance(t); }
+  void Deliver(const sim::SensorOutputs& o) override {
+    if (o.imu) executor_.OnImu(*o.imu);
+    if (o.esc) executor_.OnEscTelemetry(*o.esc);
+    if (o.odometry) executor_.OnOdometry(*o.odometry);
+    if (o.lidar) executor_.OnLidar(std::make_shared<const LidarFrame>(*o.lidar));
+  }
+  bool TryReceive(runtime::CycleTelemetry* cycle) override { return sink_.TryReceive(cycle); }
+  StackAccount Finish(nlohmann::json* loops) override {
+    time_.Stop();
+    executor_.Stop();
+    *loops = LoopsJson(executor_.Report());
+    return AccountOf(stack_);
+  }
+
+ private:
+  static constexpr TimeNs kLeadNs = 20'000'000;  // time 0 a little ahead, so that the threads are up
+  stack::FlightStack stack_;
+  QueueSink sink_;
+  runtime::SteadyClock steady_;
+  runtime::SimulatedTime time_{-1};  // time 0 comes once its messages are in
+  runtime::SimulatedClock simulated_clock_;
+  runtime::Clock& clock_;
+  runtime::OnboardExecutor executor_;
+};
+
+/// The stack in another process (`rotorguard node`), through a shared-memory channel.
+class SharedMemoryLink final : public StackLink {
+ public:
+  SharedMemoryLink(const SitlOptions& sitl, const runtime::OnboardExecutorOptions& executor)
+      : channel_(runtime::Shared<runtime::SitlChannel>::Create(ChannelName(), runtime::kSitlChannelMagic)),
+        lockstep_(sitl.lockstep_clock) {
+    runtime::SitlChannel& ch = *channel_;
+    ch.trigger = executor.trigger;
+    ch.lockstep_order = executor.lockstep_order;
+    ch.lockstep_clock = sitl.lockstep_clock;
+    ch.clock_rate = sitl.realtime_factor;
+    for (int i = 0; i < runtime::SitlChannel::kFrameSlots; ++i) ch.free_slots.TryPush(i);
+    std::vector<std::string> argv = sitl.node_command;
+    argv.insert(argv.end(), {"--channel", channel_.name()});
+    node_ = Spawn(argv);
+  }
+  ~SharedMemoryLink() override {
+    if (node_ > 0) {  // not waited for: a failure on the way
+      kill(node_, SIGKILL);
+      waitpid(node_, nullptr, 0);
+    }
+  }
+  void Start() override {
+    WaitFor(runtime::NodeState::kBuilt, 60.0, "build its stack");
+    if (!lockstep_) {
+      steady_ = runtime::SteadyClock(runtime::SteadyClock::Monotonic() + kLeadNs, channel_->clock_rate);
+      channel_->clock_origin_ns.store(steady_.origin(), std::memory_order_release);
+      channel_->node_bell.Ring();
+    }
+    WaitFor(runtime::NodeState::kFlying, 10.0, "start its threads");
+  }
+  runtime::Clock& clock() override {
+    return lockstep_ ? static_cast<runtime::Clock&>(simulated_clock_) : steady_;
+  }
+  void AdvanceTime(TimeNs t) override {
+    time_.Advance(t);
+    runtime::SitlMessage m;
+    m.kind = runtime::SitlMessage::Kind::kTime;
+    m.time_ns = t;
+    Push(m);
+    channel_->to_node_bell.Ring();
+  }
+  void Deliver(const sim::SensorOutputs& o) override {
+    runtime::SitlMessage m;
+    const auto sensor = [&](runtime::SensorMessage::Kind kind) {
+      m.kind = runtime::SitlMessage::Kind::kSensor;
+      m.sensor.kind = kind;
+      Push(m);
+    };
+    if (o.imu) m.sensor.imu = *o.imu, sensor(runtime::SensorMessage::Kind::kImu);
+    if (o.esc) m.sensor.esc = *o.esc, sensor(runtime::SensorMessage::Kind::kEsc);
+    if (o.odometry) m.sensor.odometry = *o.odometry, sensor(runtime::SensorMessage::Kind::kOdometry);
+    if (o.lidar) PushFrame(*o.lidar);
+    channel_->to_node_bell.Ring();
+  }
+  bool TryReceive(runtime::CycleTelemetry* cycle) override { return channel_->cycles.TryPop(cycle); }
+  StackAccount Finish(nlohmann::json* loops) override {
+    time_.Stop();
+    runtime::SitlMessage end;
+    end.kind = runtime::SitlMessage::Kind::kEnd;
+    Push(end);
+    channel_->to_node_bell.Ring();
+    WaitFor(runtime::NodeState::kDone, 60.0, "finish");
+    const nlohmann::json j = nlohmann::json::parse(
+        std::string(channel_->account.data(), channel_->account_size.load(std::memory_order_acquire)));
+    int status = 0;
+    waitpid(node_, &status, 0);
+    node_ = 0;
+    *loops = j.at("loops");
+    StackAccount account;
+    io::FromJson(j.at("account"), &account);
+    return account;
+  }
+
+ private:
+  static constexpr TimeNs kLeadNs = 100'000'000;
+
+  static std::string ChannelName() {
+    static std::atomic<int> counter{0};
+    return fmt::format("/rotorguard-sitl-{}-{}", getpid(), counter.fetch_add(1));
+  }
+  static pid_t Spawn(const std::vector<std::string>& argv) {
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    pid_t pid = 0;
+    if (const int e = posix_spawnp(&pid, args[0], nullptr, nullptr, args.data(), environ); e != 0) {
+      throw std::runtime_error(fmt::format("sitl: cannot start the node '{}': {}", argv[0], std::strerror(e)));
+    }
+    return pid;
+  }
+  /// Waits until the node reaches `state`; throws naming what it was doing when it failed, exited
+  /// or took longer than `timeout_s`.
+  void WaitFor(runtime::NodeState state, double timeout_s, const char* doing) {
+    const TimeNs until = runtime::SteadyClock::Monotonic() + FromSeconds(timeout_s);
+    for (;;) {
+      const std::uint32_t seen = channel_->node_bell.Count();
+      const int now = channel_->node_state.load(std::memory_order_acquire);
+      if (now == static_cast<int>(runtime::NodeState::kFailed)) {
+        throw std::runtime_error(fmt::format(
+            "sitl: the node failed to {}: {}", doing,
+            std::string(channel_->account.data(), channel_->account_size.load(std::memory_order_acquire))));
+      }
+      if (now >= static_cast<int>(state)) return;
+      int status = 0;
+      if (waitpid(node_, &status, WNOHANG) == node_) {
+        node_ = 0;
+        throw std::runtime_error(fmt::format("sitl: the node exited ({}) before it could {}",
+                                             WIFEXITED(status) ? fmt::format("status {}", WEXITSTATUS(status))
+                                                               : fmt::format("signal {}", WTERMSIG(status)),
+                                             doing));
+      }
+      if (runtime::SteadyClock::Monotonic() > until) {
+        throw std::runtime_error(fmt::format("sitl: the node did not {} within {:g} s", doing, timeout_s));
+      }
+      channel_->node_bell.Wait(seen, 50'000'000);
+    }
+  }
+  void Push(const runtime::SitlMessage& m) {
+    // The node takes messages as they come; a full queue means it stopped taking them.
+    for (int i = 0; !channel_->to_node.TryPush(m); ++i) {
+      if (i > 100000) throw std::runtime_error("sitl: the node stopped taking sensor messages");
+      std::this_thread::yield();
+    }
+  }
+  void PushFrame(const LidarFrame& frame) {
+    int slot = 0;
+    if (!channel_->free_slots.TryPop(&slot)) {
+      ++frames_dropped_;  // every slot still held: the node is behind
+      return;
+    }
+    runtime::FrameSlot& f = channel_->frames[static_cast<std::size_t>(slot)];
+    const std::size_t n = std::min<std::size_t>(frame.points_S.size(), runtime::FrameSlot::kMaxPoints);
+    f.t_start_ns = frame.t_start_ns;
+    f.t_end_ns = frame.t_end_ns;
+    f.dropped = frame.dropped + static_cast<int>(frame.points_S.size() - n);
+    f.points = static_cast<int>(n);
+    std::copy_n(frame.points_S.begin(), n, f.points_S.begin());
+    std::copy_n(frame.offset_ns.begin(), n, f.offset_ns.begin());
+    runtime::SitlMessage m;
+    m.kind = runtime::SitlMessage::Kind::kFrame;
+    m.frame_slot = slot;
+    Push(m);
+  }
+
+  runtime::Shared<runtime::SitlChannel> channel_;
+  runtime::SteadyClock steady_;
+  runtime::SimulatedTime time_{-1};  // the simulator's, with lockstep_clock (the node keeps its own copy)
+  runtime::SimulatedClock simulated_clock_{&time_};
+  bool lockstep_;
+  pid_t node_ = 0;
+  std::uint64_t frames_dropped_ = 0;
+};
 
 }  // namespace
 
@@ -114,21 +340,16 @@ void SitlOptions::Validate() const {
 }
 
 nlohmann::json SitlResult::RuntimeJson() const {
-  return {{"control", LoopJson(runtime.control)},
-          {"perception", LoopJson(runtime.perception)},
-          {"planning", LoopJson(runtime.planning)},
-          {"realtime",
-           {{"memory_locked", runtime.realtime.memory_locked},
-            {"fifo", runtime.realtime.fifo},
-            {"note", runtime.realtime.note}}},
-          {"link",
-           {{"commands", link.commands},
-            {"commands_after_end", link.commands_after_end},
-            {"commands_late", link.commands_late},
-            {"late_max_ms", 1e3 * link.late_max_s},
-            {"steps_behind", link.steps_behind},
-            {"behind_max_ms", 1e3 * link.behind_max_s},
-            {"command_delay", HistogramJson(link.command_delay)}}}};
+  nlohmann::json j = loops;
+  j["link"] = {{"commands", link.commands},
+               {"commands_after_end", link.commands_after_end},
+               {"commands_late", link.commands_late},
+               {"late_max_ms", 1e3 * link.late_max_s},
+               {"steps_behind", link.steps_behind},
+               {"behind_max_ms", 1e3 * link.behind_max_s},
+               {"command_delay", HistogramJson(link.command_delay)},
+               {"processes", link.processes}};
+  return j;
 }
 
 SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const SitlOptions& sitl) {
@@ -139,40 +360,34 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     std::error_code ec;
     std::filesystem::create_directories(options.out_dir, ec);
     if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", options.out_dir, ec.message()));
-    for (const char* name : {"summary.json", "runtime.json"}) std::filesystem::remove(std::filesystem::path(options.out_dir) / name, ec);
+    for (const char* name : {"summary.json", "runtime.json"}) {
+      std::filesystem::remove(std::filesystem::path(options.out_dir) / name, ec);
+    }
   }
   const sim::TruthDraw draw = sim::DrawTruth(sc.truth, sc.vehicle, sc.seed);
   const vehicle::MultirotorModel truth(sim::TruthVehicle(sc.vehicle, draw), sim::ThrustRatios(draw));
   sim::Simulator sim = MakeSimulator(sc, truth, draw);
-  stack::FlightStack stack(sc.vehicle, sc.reference, sc.stack, ExternalController(sc));
   const TimeNs dt = sim.step_ns();
   const std::int64_t steps = std::llround(sc.duration_s / ToSeconds(dt));
   FlightMetrics metrics(MetricsOptionsOf(sc, dt, steps, draw));
   ReferenceTrace reference(sc.reference.get());
   TruthHistory history;
+  ComputationDelayModel delay(sc, draw);
 
-  QueueSink sink;
-  // Real time: both sides follow one steady clock, the flight's time 0 a little ahead so that the
-  // threads are up. Lockstep clock: the simulator's time.
-  runtime::SteadyClock steady(runtime::SteadyClock::Monotonic() + 20'000'000, sitl.realtime_factor);
-  runtime::SimulatedTime simulated;
-  runtime::SimulatedClock simulated_clock(&simulated);
-  runtime::Clock& clock = sitl.lockstep_clock ? static_cast<runtime::Clock&>(simulated_clock) : steady;
   runtime::OnboardExecutorOptions executor_options = sitl.executor;
   if (sitl.lockstep_clock) {
     executor_options.trigger = runtime::CycleTrigger::kClock;
-    executor_options.wait_for_perception = true;
+    executor_options.lockstep_order = true;
   }
-  runtime::OnboardExecutor executor(&stack, &clock, &sink, executor_options);
-  ComputationDelayModel delay(sc, draw);
+  std::unique_ptr<StackLink> stack;
+  if (sitl.node_command.empty()) {
+    stack = std::make_unique<InProcessLink>(sc, sitl, executor_options);
+  } else {
+    stack = std::make_unique<SharedMemoryLink>(sitl, executor_options);
+  }
   SitlResult result;
   SitlLinkReport& link = result.link;
-  const auto deliver = [&executor](const sim::SensorOutputs& o) {
-    if (o.imu) executor.OnImu(*o.imu);
-    if (o.esc) executor.OnEscTelemetry(*o.esc);
-    if (o.odometry) executor.OnOdometry(*o.odometry);
-    if (o.lidar) executor.OnLidar(std::make_shared<const LidarFrame>(*o.lidar));
-  };
+  link.processes = sitl.node_command.empty() ? 1 : 2;
   // A cycle's command to the ESCs, at `acts`; its estimate judged against the truth at its instant.
   const auto apply = [&](const runtime::CycleTelemetry& c, TimeNs acts) {
     ++link.commands;
@@ -181,13 +396,14 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     reference.Add(c.command.state_t_ns, c.reference);
     metrics.OnEstimate(vehicle::StateView(history.At(c.command.state_t_ns)), c.estimate);
   };
-  deliver(sim.outputs());
+  stack->Deliver(sim.outputs());
   history.Add(sim.time_ns(), sim.state());
-  executor.Start();
+  stack->Start();
+  runtime::Clock& clock = stack->clock();
   if (!sitl.lockstep_clock) clock.SleepUntil(0);
 
   const std::int64_t progress_stride = std::max<std::int64_t>(1, steps / 100);
-  const TimeNs period = stack.control_period_ns();
+  const TimeNs period = PeriodFromRate(sc.stack.control_rate_hz);
   TimeNs next_control = 0;
   std::int64_t k = 0;
   bool done = steps <= 0;
@@ -196,9 +412,9 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     runtime::CycleTelemetry c;
     if (sitl.lockstep_clock) {
       // The clock moves to t once t's messages are in; a control instant waits for its command.
-      simulated.Advance(t);
+      stack->AdvanceTime(t);
       if (t >= next_control) {
-        while (!sink.TryReceive(&c)) std::this_thread::yield();
+        while (!stack->TryReceive(&c)) std::this_thread::yield();
         RG_INVARIANT(c.command.state_t_ns == t, "SITL lockstep: the cycle of the instant waited for");
         apply(c, t + delay.Next(c.command.compute_s));
         next_control += period;
@@ -212,7 +428,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
         link.behind_max_s = std::max(link.behind_max_s, ToSeconds(behind));
       }
       clock.SleepUntil(t + dt);
-      while (sink.TryReceive(&c)) {
+      while (stack->TryReceive(&c)) {
         if (c.command.sent_t_ns < t) {
           ++link.commands_late;
           link.late_max_s = std::max(link.late_max_s, ToSeconds(t - c.command.sent_t_ns));
@@ -225,26 +441,21 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     history.Add(sim.time_ns(), sim.state());
     ++k;
     done = sim.crashed() || k >= steps;
-    if (!done) deliver(outputs);  // the flight's end has no cycle (as in `run`)
+    if (!done) stack->Deliver(outputs);  // the flight's end has no cycle (as in `run`)
     if (options.progress && !done && k % progress_stride == 0) {
       options.progress(static_cast<double>(k) / static_cast<double>(steps));
     }
   }
-  simulated.Stop();
-  executor.Stop();
-  result.runtime = executor.Report();
-  for (runtime::CycleTelemetry c; sink.TryReceive(&c);) ++link.commands_after_end;
+  const StackAccount account = stack->Finish(&result.loops);
+  for (runtime::CycleTelemetry c; stack->TryReceive(&c);) ++link.commands_after_end;
   if (options.progress) options.progress(1.0);
 
   RunSummary& s = result.summary;
-  SummarizeFlight(sc, draw, sim, stack, &s);
+  SummarizeFlight(sc, draw, sim, account, &s);
   s.physics_steps = static_cast<std::uint64_t>(k);
-  s.control_cycles = result.runtime.control.runs;
-  if (s.fdd) {
-    if (const auto* composite = dynamic_cast<const fdd::CompositeFdd*>(stack.fault_detector());
-        composite && sim.fault_events().empty()) {
-      s.fdd->healthy_extremes = composite->healthy_extremes();
-    }
+  s.control_cycles = result.loops.at("control").at("runs").get<std::uint64_t>();
+  if (s.fdd && account.composite_extremes && sim.fault_events().empty()) {
+    s.fdd->healthy_extremes = account.composite_extremes;
   }
   FlightEnd end{sim.time_ns(), sim.crashed(), metrics.BodyOrigin(vehicle::StateView(sim.state())), std::nullopt};
   if (!sim.fault_events().empty()) end.first_onset_s = sim.fault_events().front().onset_s;
@@ -258,6 +469,107 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     io::WriteFileAtomically((dir / "runtime.json").string(), result.RuntimeJson().dump(2) + "\n");
   }
   return result;
+}
+
+namespace {
+
+/// The node's side: what it does once its channel is open, until its account is written.
+void FlyNode(const Scenario& sc, runtime::SitlChannel& ch) {
+  stack::FlightStack st(sc.vehicle, sc.reference, sc.stack, ExternalController(sc));
+  const auto set_state = [&ch](runtime::NodeState state) {
+    ch.node_state.store(static_cast<int>(state), std::memory_order_release);
+    ch.node_bell.Ring();
+  };
+  set_state(runtime::NodeState::kBuilt);
+  // The clock: the simulator's time as its messages tell it, or the steady clock from the origin
+  // the simulator sets.
+  runtime::SimulatedTime time(-1);  // time 0 comes once its messages are in
+  runtime::SimulatedClock simulated(&time);
+  std::optional<runtime::SteadyClock> steady;
+  if (!ch.lockstep_clock) {
+    for (;;) {
+      const std::uint32_t seen = ch.node_bell.Count();
+      if (const TimeNs origin = ch.clock_origin_ns.load(std::memory_order_acquire); origin != 0) {
+        steady.emplace(origin, ch.clock_rate);
+        break;
+      }
+      ch.node_bell.Wait(seen, 50'000'000);
+    }
+  }
+  runtime::Clock& clock = steady ? static_cast<runtime::Clock&>(*steady) : simulated;
+  class ChannelSink final : public runtime::CommandSink {
+   public:
+    explicit ChannelSink(runtime::SitlChannel* ch) : ch_(ch) {}
+    void Send(const runtime::CycleTelemetry& cycle) override { ch_->cycles.TryPush(cycle); }
+
+   private:
+    runtime::SitlChannel* ch_;
+  } sink(&ch);
+  runtime::OnboardExecutorOptions options;
+  options.trigger = ch.trigger;
+  options.lockstep_order = ch.lockstep_order;
+  runtime::OnboardExecutor executor(&st, &clock, &sink, options);
+  executor.Start();
+  set_state(runtime::NodeState::kFlying);
+  // The intake: the simulator's messages in their order, frames copied out of their slots.
+  for (bool end = false; !end;) {
+    const std::uint32_t seen = ch.to_node_bell.Count();
+    runtime::SitlMessage m;
+    bool any = false;
+    while (!end && ch.to_node.TryPop(&m)) {
+      any = true;
+      switch (m.kind) {
+        case runtime::SitlMessage::Kind::kSensor:
+          executor.OnSensor(m.sensor);
+          break;
+        case runtime::SitlMessage::Kind::kFrame: {
+          const runtime::FrameSlot& f = ch.frames[static_cast<std::size_t>(m.frame_slot)];
+          auto frame = std::make_shared<LidarFrame>();
+          frame->t_start_ns = f.t_start_ns;
+          frame->t_end_ns = f.t_end_ns;
+          frame->dropped = f.dropped;
+          frame->points_S.assign(f.points_S.begin(), f.points_S.begin() + f.points);
+          frame->offset_ns.assign(f.offset_ns.begin(), f.offset_ns.begin() + f.points);
+          ch.free_slots.TryPush(m.frame_slot);
+          executor.OnLidar(std::move(frame));
+          break;
+        }
+        case runtime::SitlMessage::Kind::kTime:
+          time.Advance(m.time_ns);
+          break;
+        case runtime::SitlMessage::Kind::kEnd:
+          time.Stop();
+          end = true;
+          break;
+      }
+    }
+    if (!any && !end) ch.to_node_bell.Wait(seen, 50'000'000);
+  }
+  executor.Stop();
+  const std::string text =
+      nlohmann::json{{"account", io::ToJson(AccountOf(st))}, {"loops", LoopsJson(executor.Report())}}.dump();
+  if (text.size() > ch.account.size()) throw std::runtime_error("node: the stack's account is larger than the channel's");
+  std::copy(text.begin(), text.end(), ch.account.begin());
+  ch.account_size.store(text.size(), std::memory_order_release);
+  set_state(runtime::NodeState::kDone);
+}
+
+}  // namespace
+
+void RunNode(const Scenario& scenario, const std::string& channel) {
+  runtime::Shared<runtime::SitlChannel> ch = runtime::Shared<runtime::SitlChannel>::Open(channel, runtime::kSitlChannelMagic);
+  try {
+    FlyNode(Flown(scenario), *ch);
+  } catch (const std::exception& e) {
+    // The simulator's side reports it: it waits on the state.
+    const std::string what = e.what();
+    const std::size_t n = std::min(what.size(), ch->account.size());
+    std::copy_n(what.begin(), n, ch->account.begin());
+    ch->account_size.store(n, std::memory_order_release);
+    ch->node_state.store(static_cast<int>(runtime::NodeState::kFailed), std::memory_order_release);
+    ch->node_bell.Ring();
+    throw;
+  }
 }
 
 }  // namespace rotorguard::harness

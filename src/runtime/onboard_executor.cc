@@ -85,10 +85,21 @@ void OnboardExecutor::OnOdometry(const OdometrySample& odometry) {
   Intake(m);
 }
 
+void OnboardExecutor::OnSensor(const SensorMessage& message) {
+  if (message.kind != SensorMessage::Kind::kFrame) Intake(message);
+}
+
 void OnboardExecutor::OnLidar(std::shared_ptr<const LidarFrame> frame) {
   if (!frame) return;
-  if (!frames_.TryPush({std::move(frame), messages_in_})) return;
+  const TimeNs end = frame->t_end_ns;
+  const std::uint64_t number = ++frames_numbered_;
+  if (!frames_.TryPush({std::move(frame), number})) return;
   frames_in_.fetch_add(1, std::memory_order_acq_rel);
+  SensorMessage m;
+  m.kind = SensorMessage::Kind::kFrame;
+  m.frame = number;
+  m.frame_end_ns = end;
+  Intake(m);
   perception_bell_.Ring();
 }
 
@@ -120,7 +131,7 @@ void OnboardExecutor::Stop() {
     if (t->joinable()) t->join();
   }
   report_.control.dropped = intake_.dropped();
-  report_.perception.dropped = perception_messages_.dropped() + frames_.dropped();
+  report_.perception.dropped += perception_messages_.dropped() + frames_.dropped() + frame_tickets_.dropped();
   report_.planning.dropped = planning_events_.dropped();
 }
 
@@ -134,27 +145,35 @@ bool OnboardExecutor::TakeMessages() {
     switch (m.kind) {
       case SensorMessage::Kind::kImu:
         stack_->OnImu(m.imu);
-        perception_messages_.TryPush(m);
+        forwarded_ += perception_messages_.TryPush(m) ? 1 : 0;
         newest_imu_ns_ = m.imu.t_ns;
         have_imu_ = true;
         break;
       case SensorMessage::Kind::kEsc:
         stack_->OnEscTelemetry(m.esc);
-        perception_messages_.TryPush(m);
+        forwarded_ += perception_messages_.TryPush(m) ? 1 : 0;
         break;
       case SensorMessage::Kind::kOdometry:
         stack_->OnOdometry(m.odometry);
         break;
+      case SensorMessage::Kind::kFrame: {
+        LidarFrame header;  // the estimate for a frame reads its times only
+        header.t_end_ns = m.frame_end_ns;
+        frame_tickets_.TryPush({m.frame, m.seq, stack_->FrameEstimate(header)});
+        break;
+      }
     }
     messages_taken_.fetch_add(1, std::memory_order_release);
   }
-  if (any) perception_bell_.Ring();
+  if (any) perception_bell_.Ring();  // the messages passed on, and any frame's ticket
   return any;
 }
 
 void OnboardExecutor::WaitForPerception() {
   const std::uint64_t in = frames_in_.load(std::memory_order_acquire);
-  while (frames_done_.load(std::memory_order_acquire) < in && !stop_.load(std::memory_order_acquire)) {
+  while ((frames_done_.load(std::memory_order_acquire) < in ||
+          perception_processed_.load(std::memory_order_acquire) < forwarded_) &&
+         !stop_.load(std::memory_order_acquire)) {
     std::this_thread::yield();
   }
 }
@@ -166,7 +185,7 @@ void OnboardExecutor::ControlLoop() {
     // Each control instant on the clock, with the messages in by then.
     for (TimeNs t = 0; clock_->SleepUntil(t) && !stop_.load(std::memory_order_acquire); t += period) {
       TakeMessages();
-      if (options_.wait_for_perception) WaitForPerception();
+      if (options_.lockstep_order) WaitForPerception();
       stack::LioUpdate u;
       if (lio_updates_.Read(&u)) stack_->OnLioUpdate(u);
       RunCycle(t);
@@ -188,7 +207,7 @@ void OnboardExecutor::ControlLoop() {
     const bool any = TakeMessages();
     if (any && have_imu_) {
       // The odometry's newest update, then a cycle when an IMU sample reached the next instant.
-      if (options_.wait_for_perception) WaitForPerception();
+      if (options_.lockstep_order) WaitForPerception();
       stack::LioUpdate u;
       if (lio_updates_.Read(&u)) stack_->OnLioUpdate(u);
       if (!next_cycle_ns_) next_cycle_ns_ = newest_imu_ns_;
@@ -218,8 +237,14 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   // The planning hears of the cycle's events and inputs, then plans while the cycle goes on.
   if (tasks_.planning) {
     for (const stack::PlanningEvent& e : stack_->planning_events()) planning_events_.TryPush(e);
-    planning_input_.Publish({t, mode, stack_->PlanningFaults(), mode == stack::FlightMode::kEmergencyLanding});
+    planning_input_.Publish({t, mode, stack_->PlanningFaults(), stack_->landing(), cycles_ + 1});
     planning_bell_.Ring();
+    if (options_.lockstep_order) {
+      while (planning_calls_.load(std::memory_order_acquire) < cycles_ + 1 && !stop_.load(std::memory_order_acquire)) {
+        std::this_thread::yield();
+      }
+      plan = planning_output_.Newest();
+    }
   }
   const RotorCommand& command = stack_->EndCycle(t, mode, plan ? plan->followed : nullptr);
   CycleTelemetry cycle;
@@ -233,7 +258,6 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   cycle.command.compute_s = ToSeconds(SteadyClock::Monotonic() - start);
   cycle.command.sent_t_ns = clock_->Now();
   sink_->Send(cycle);
-  control_estimate_.Publish(cycle.estimate);
   const TimeNs latency = cycle.command.sent_t_ns - t;
   LoopReport& r = report_.control;
   ++r.runs;
@@ -242,40 +266,60 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   r.compute.Record(SteadyClock::Monotonic() - start);
 }
 
+void OnboardExecutor::PublishLioUpdate(std::uint64_t* published_serial) {
+  const std::optional<stack::LioUpdate> u = tasks_.perception->update();
+  if (!u || u->posterior.serial <= *published_serial) return;
+  *published_serial = u->posterior.serial;
+  lio_updates_.Publish(*u);
+}
+
 void OnboardExecutor::PerceptionLoop() {
   const double cpu0 = ThreadCpuSeconds();
-  StateEstimate external;
+  std::uint64_t processed = 0, published_serial = 0;
   while (true) {
     const std::uint32_t seen = perception_bell_.Count();
-    // A frame is registered after the IMU samples and telemetry that arrived before it, once the
-    // control thread has passed them all on (the lockstep order); later ones wait for it. The
-    // frame queue is looked at before each message: a message that arrived after a frame makes
-    // that frame visible here.
-    const FrameMessage* frame = nullptr;
+    // A frame is registered after the IMU samples and telemetry that arrived before it: once its
+    // ticket has come (the control thread had passed all of them on), the messages before it are
+    // drained, and later ones wait for it. A frame without a ticket (its marker was dropped) is
+    // dropped; so is a ticket without its frame.
+    const FrameMessage* frame = frames_.Front();
+    const FrameTicket* ticket = frame_tickets_.Front();
+    while (frame && ticket && ticket->number < frame->number) {
+      frame_tickets_.Pop();
+      ticket = frame_tickets_.Front();
+    }
+    if (frame && ticket && ticket->number > frame->number) {
+      frames_.Pop();
+      ++report_.perception.dropped;
+      continue;
+    }
+    const bool ready = frame && ticket;
+    const std::uint64_t until = ready ? ticket->after_messages : std::numeric_limits<std::uint64_t>::max();
     bool any = false;
-    for (;;) {
-      if (!frame) frame = frames_.Front();
-      const SensorMessage* m = perception_messages_.Front();
-      if (!m || (frame && m->seq >= frame->after_messages)) break;
+    for (const SensorMessage* m = perception_messages_.Front(); m && m->seq < until; m = perception_messages_.Front()) {
       if (m->kind == SensorMessage::Kind::kImu) {
         tasks_.perception->OnImu(m->imu);
       } else {
         tasks_.perception->OnEscTelemetry(m->esc);
       }
       perception_messages_.Pop();
+      ++processed;
       any = true;
     }
-    if (frame && messages_taken_.load(std::memory_order_acquire) < frame->after_messages) frame = nullptr;
+    if (any) PublishLioUpdate(&published_serial);  // the odometry may start (or restart) on a sample
+    perception_processed_.store(processed, std::memory_order_release);
+    if (!ready) frame = nullptr;
     if (frame) {
       const TimeNs start = SteadyClock::Monotonic();
       const std::shared_ptr<const LidarFrame> f = frame->frame;  // the queue's slot is reused once popped
+      const StateEstimate external = ticket->external;
       frames_.Pop();
-      if (const StateEstimate* e = control_estimate_.Newest()) external = *e;
+      frame_tickets_.Pop();
       {
         const std::unique_lock lock(map_mutex_);
         tasks_.perception->OnFrame(*f, external);
       }
-      if (const std::optional<stack::LioUpdate> u = tasks_.perception->update()) lio_updates_.Publish(*u);
+      PublishLioUpdate(&published_serial);
       frames_done_.fetch_add(1, std::memory_order_acq_rel);
       LoopReport& r = report_.perception;
       ++r.runs;
@@ -319,6 +363,7 @@ void OnboardExecutor::PlanningLoop() {
         r.latency.Record(clock_->Now() - in.t_ns);
         r.compute.Record(SteadyClock::Monotonic() - start);
       }
+      planning_calls_.store(in.cycle, std::memory_order_release);
       continue;
     }
     if (stop_.load(std::memory_order_acquire)) break;

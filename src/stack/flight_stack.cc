@@ -215,7 +215,7 @@ void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_->OnOdo
 
 void FlightStack::OnLidar(const LidarFrame& frame) {
   RG_INVARIANT(!tasks_detached_, "FlightStack::OnLidar: the perception task runs elsewhere (DetachTasks)");
-  perception_->OnFrame(frame, estimator_->FrameEstimate(frame));
+  perception_->OnFrame(frame, FrameEstimate(frame));
   TakeOdometryUpdate();
 }
 

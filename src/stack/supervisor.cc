@@ -10,19 +10,6 @@
 
 namespace rotorguard::stack {
 
-const char* ToString(FlightMode mode) {
-  switch (mode) {
-    case FlightMode::kNominal: return "nominal";
-    case FlightMode::kFailureRecovery: return "failure_recovery";
-    case FlightMode::kDegradedNavigation: return "degraded_navigation";
-    case FlightMode::kEmergencyLanding: return "emergency_landing";
-    case FlightMode::kLanded: return "landed";
-    case FlightMode::kFlightTermination:
-      return "flight_termination";
-  }
-  return "unknown";
-}
-
 void SupervisorOptions::Validate() const { CheckDeclaredRanges("SupervisorOptions", *this); }
 
 Supervisor::Supervisor(const SupervisorOptions& options) : options_(options) { options_.Validate(); }

@@ -95,6 +95,57 @@ TEST_F(CliTest, TheVersionNamesTheReleaseAndTheRevision) {
       << r.out;
 }
 
+/// Software in the loop through two processes (docs/runtime.md): `sitl` starts `rotorguard node`
+/// and flies a propeller loss in real time against it; the stack's process isolates the rotor and
+/// both processes' figures reach the summary and runtime.json.
+TEST_F(CliTest, SitlFliesAPropellerLossInRealTimeWithTheStackInItsOwnProcess) {
+  const std::string scenario = rotorguard::testing::SourcePath("configs/scenarios/fdd_hover_propeller_loss.yaml");
+  const Result r = Cli("sitl " + scenario + " --set duration_s=6 --seed 2 -q --out " + (dir_ / "sitl").string());
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  const nlohmann::json s = nlohmann::json::parse(ReadText(dir_ / "sitl" / "summary.json"));
+  EXPECT_TRUE(s["success"].get<bool>()) << s["failure_reason"];
+  EXPECT_TRUE(s["fdd"]["correct"].get<bool>());
+  EXPECT_EQ(s["fdd"]["rotor"], 0);
+  EXPECT_EQ(s["supervisor"]["transitions"][0]["to"], "failure_recovery");
+  const nlohmann::json rt = nlohmann::json::parse(ReadText(dir_ / "sitl" / "runtime.json"));
+  EXPECT_EQ(rt["link"]["processes"], 2);
+  const auto runs = rt["control"]["runs"].get<std::uint64_t>();
+  // 6 s at 200 Hz: a cycle per control instant, unless the control thread was late (skipped).
+  EXPECT_EQ(runs + rt["control"]["skipped"].get<std::uint64_t>(), 1200u);
+  EXPECT_EQ(rt["link"]["commands"].get<std::uint64_t>() + rt["link"]["commands_after_end"].get<std::uint64_t>(), runs);
+  EXPECT_EQ(s["control_cycles"].get<std::uint64_t>(), runs);
+}
+
+/// On the simulator's clock (the simulator waits for each command), the stack in its own process
+/// flies `run`'s flight to the bit: the transport loses, reorders and alters nothing, the LiDAR
+/// frames through their shared-memory slots to the LiDAR-inertial odometry included (the forest,
+/// its failure brought forward).
+TEST_F(CliTest, SitlOnTheSimulatorsClockInTwoProcessesFliesRunsFlightToTheBit) {
+  const std::string scenario = rotorguard::testing::SourcePath("configs/scenarios/forest.yaml");
+  const std::string args = scenario + " --set duration_s=5 --set faults.0.onset.at_time_s=3.5 --seed 4 -q --out ";
+  // Five seconds of a 120-s mission do not reach its goal: both exit 1 (the mission failed).
+  const Result run = Cli("run " + args + (dir_ / "run").string() + " --no-report");
+  ASSERT_TRUE(fs::exists(dir_ / "run" / "summary.json")) << run.out;
+  const Result r = Cli("sitl " + args + (dir_ / "sitl").string() + " --lockstep-clock");
+  EXPECT_EQ(r.exit_code, run.exit_code) << r.out;
+  const nlohmann::json a = nlohmann::json::parse(ReadText(dir_ / "run" / "summary.json"));
+  const nlohmann::json b = nlohmann::json::parse(ReadText(dir_ / "sitl" / "summary.json"));
+  for (const char* key : {"control_cycles", "physics_steps", "min_altitude_m", "max_spin_rad_s", "max_tilt_rad",
+                          "estimate_position_rmse_m", "estimate_attitude_max_rad", "success"}) {
+    EXPECT_EQ(a[key], b[key]) << key;
+  }
+  EXPECT_EQ(a["fdd"]["detection_s"], b["fdd"]["detection_s"]);
+  EXPECT_EQ(nlohmann::json::parse(ReadText(dir_ / "sitl" / "runtime.json"))["link"]["processes"], 2);
+}
+
+/// A node given a channel no simulator made says which, and fails.
+TEST_F(CliTest, ANodeWithoutItsChannelNamesIt) {
+  const std::string scenario = rotorguard::testing::SourcePath("configs/scenarios/hover.yaml");
+  const Result r = Cli("node " + scenario + " --channel /rotorguard-sitl-none");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("/rotorguard-sitl-none"), std::string::npos) << r.out;
+}
+
 /// Bad list and word options of the benchmarks are usage errors that name the option and the field.
 TEST_F(CliTest, ABenchmarksListOptionsNameTheFieldThatIsWrong) {
   Result r = Cli("bench lio --spins 11,,20");

@@ -180,7 +180,13 @@ struct CompositeFddOptions {
 
 /// kFailed: a rotor isolated as failed by a method that cannot tell the motor from the propeller.
 enum class RotorHealth { kOk, kMotorFailed, kPropellerFailed, kDegraded, kFailed };
-std::string_view ToString(RotorHealth health);
+inline constexpr EnumName<RotorHealth> kRotorHealthNames[] = {{RotorHealth::kOk, "ok"},
+                                                              {RotorHealth::kMotorFailed, "motor_failed"},
+                                                              {RotorHealth::kPropellerFailed, "propeller_failed"},
+                                                              {RotorHealth::kDegraded, "degraded"},
+                                                              {RotorHealth::kFailed, "failed"}};
+constexpr std::span<const EnumName<RotorHealth>> NamesOf(const RotorHealth*) { return kRotorHealthNames; }
+inline std::string_view ToString(RotorHealth health) { return ToName(health); }
 /// Motor, propeller or unclassified failure: the rotor is out of the vehicle.
 bool IsIsolated(RotorHealth health);
 
@@ -194,6 +200,16 @@ struct RotorStatus {
   /// threshold (the detection time for detectors that cannot tell).
   std::optional<double> onset_s;
   std::string detector;          ///< "motor_index", "thrust_loss_observer", "takeoff"
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("health", &health);
+    a->Visit("eta", &eta);
+    a->Visit("motor_index", &motor_index);
+    a->Visit("propeller_index", &propeller_index);
+    a->Visit("detected_s", &detected_s);
+    a->Visit("onset_s", &onset_s);
+    a->Visit("detector", &detector);
+  }
 };
 
 /// The most alarming values a composite FDD's indices took. The first three are the indices
@@ -217,6 +233,8 @@ struct IndexExtremes {
   /// isolated a second rotor. 0 in a flight with no isolation.
   double second_failure_index = 0.0;
   void Merge(const IndexExtremes& other);
+  template <typename Archive>
+  void Serialize(Archive* a);
 };
 
 /// Each statistic's name in run summaries (fdd.healthy_extremes.NAME) and its member.
@@ -229,6 +247,11 @@ inline constexpr std::array<std::pair<std::string_view, double IndexExtremes::*>
     {"gated_takeoff_index", &IndexExtremes::gated_takeoff_index},
     {"second_failure_index", &IndexExtremes::second_failure_index},
 }};
+
+template <typename Archive>
+void IndexExtremes::Serialize(Archive* a) {
+  for (const auto& [name, member] : kIndexExtremesFields) a->Visit(name.data(), &(this->*member));  // literals: terminated
+}
 
 /// The interface every fault detector implements, so that a stack or a benchmark swaps them by name.
 class FaultDetector {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -26,8 +27,12 @@ struct SitlOptions {
   /// stack then flies the lockstep runner's flight to the bit (tests/harness/sitl_test.cc);
   /// realtime_factor is not used.
   bool lockstep_clock = false;
-  /// The executor's options (lockstep_clock sets its trigger and wait_for_perception).
+  /// The executor's options (lockstep_clock sets its trigger and lockstep_order).
   runtime::OnboardExecutorOptions executor;
+  /// Empty: the stack runs in this process. Else the command line that starts it in another
+  /// (`rotorguard node SCENARIO ...`), given `--channel NAME` at its end: the two processes share
+  /// a memory segment (runtime/sitl_channel.h). The node must fly the same scenario.
+  std::vector<std::string> node_command;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -41,11 +46,15 @@ struct SitlLinkReport {
   std::uint64_t steps_behind = 0;    ///< physics steps begun more than half a step after their end had passed on the clock
   double behind_max_s = 0.0;         ///< the furthest the simulator fell behind the clock [s]
   runtime::LatencyHistogram command_delay;  ///< a command's IMU sample -> it acts on the ESCs (before their latency)
+  int processes = 1;                 ///< the simulator's and the stack's: 1 or 2
 };
 
 struct SitlResult {
   RunSummary summary;
-  runtime::OnboardReport runtime;
+  /// The executor's loops ("control", "perception", "planning": runs, deadline_misses, skipped,
+  /// latency and compute percentiles, cpu_s, dropped) and its scheduling ("realtime"), as the
+  /// process that ran it reported them.
+  nlohmann::json loops;
   SitlLinkReport link;
   /// The runtime's and the link's figures (runtime.json).
   nlohmann::json RuntimeJson() const;
@@ -55,5 +64,11 @@ struct SitlResult {
 /// and runtime.json to options.out_dir when it is set (the log and the report are the lockstep
 /// runner's). Throws as RunScenario does.
 SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const SitlOptions& sitl);
+
+/// The stack's process of a two-process flight: opens the shared-memory `channel` a RunSitl
+/// created, builds the stack of `scenario` (the one the simulator flies), runs it on the onboard
+/// executor until the flight ends and writes its account back. Throws std::runtime_error when the
+/// channel cannot be opened or holds another layout (and tells the simulator of any failure).
+void RunNode(const Scenario& scenario, const std::string& channel);
 
 }  // namespace rotorguard::harness

@@ -45,7 +45,14 @@ class JsonWriter {
                          }) {  // an Eigen vector
       return std::vector<double>(value.data(), value.data() + value.size());
     } else if constexpr (requires { value.has_value(); }) {
-      return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+      return value ? ToValue(*value) : nlohmann::json(nullptr);
+    } else if constexpr (requires {
+                           typename T::key_type;
+                           typename T::mapped_type;
+                         }) {  // a map with string keys: an object
+      nlohmann::json object = nlohmann::json::object();
+      for (auto& [key, item] : value) object[key] = ToValue(item);
+      return object;
     } else if constexpr (requires {
                            value.begin();
                            typename T::value_type;
@@ -112,8 +119,14 @@ class JsonReader {
       if (j.is_null()) {
         value->reset();
       } else {
-        *value = j.get<typename T::value_type>();
+        FromValue(j, &value->emplace());
       }
+    } else if constexpr (requires {
+                           typename T::key_type;
+                           typename T::mapped_type;
+                         }) {
+      value->clear();
+      for (const auto& [key, item] : j.items()) FromValue(item, &(*value)[key]);
     } else if constexpr (requires {
                            value->begin();
                            typename T::value_type;

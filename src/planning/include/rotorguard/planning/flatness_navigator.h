@@ -73,6 +73,18 @@ struct FlatnessDecision {
   std::string reason;
   Vector3 delta_m = Vector3::Zero();  ///< the distance the leg covers (Δ of eq. 8)
   double envelope_s = 0.0, actuator_s = 0.0;  ///< the candidates (eqs. 16-17 and 23)
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("t", &t);
+    a->Visit("kind", &kind);
+    a->Visit("t_s", &t_s);
+    a->Visit("binding", &binding);
+    a->Visit("w_hat", &w_hat);
+    a->Visit("reason", &reason);
+    a->Visit("delta_m", &delta_m);
+    a->Visit("envelope_s", &envelope_s);
+    a->Visit("actuator_s", &actuator_s);
+  }
 };
 
 class FlatnessNavigator final : public ReferenceTrajectory {

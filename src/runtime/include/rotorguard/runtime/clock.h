@@ -44,6 +44,9 @@ class SteadyClock final : public Clock {
 /// The simulated time one simulator publishes and the stack's loops follow; it may live in memory
 /// shared between processes (it holds only lock-free atomics).
 struct SimulatedTime {
+  SimulatedTime() = default;
+  /// Starts at `start`: -1 keeps a loop waiting for time 0 until the simulator has reached it.
+  explicit SimulatedTime(TimeNs start) : now(start) {}
   std::atomic<TimeNs> now{0};
   std::atomic<bool> stopped{false};
   Doorbell advanced;  // rung on every advance and at the stop

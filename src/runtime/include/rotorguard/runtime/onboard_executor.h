@@ -53,6 +53,21 @@ struct CycleTelemetry {
   int isolated_rotors = 0;
 };
 
+/// One sensor message, tagged (copying it never allocates): what the executor's intake queues
+/// and a transport carry.
+struct SensorMessage {
+  /// kFrame: where a LiDAR frame arrived among the others (the executor's own marker; the frame
+  /// itself goes to the perception by OnLidar).
+  enum class Kind { kImu, kEsc, kOdometry, kFrame };
+  Kind kind = Kind::kImu;
+  ImuSample imu;
+  EscTelemetry esc;
+  OdometrySample odometry;
+  std::uint64_t seq = 0;      ///< the executor's intake count before it (set by the executor)
+  std::uint64_t frame = 0;    ///< kFrame: the frame's number
+  TimeNs frame_end_ns = 0;    ///< kFrame: its end
+};
+
 /// Where commands and telemetry go: called on the control thread, so it must neither block nor
 /// allocate (a queue push; a transport's send).
 class CommandSink {
@@ -73,10 +88,12 @@ enum class CycleTrigger {
 
 struct OnboardExecutorOptions {
   CycleTrigger trigger = CycleTrigger::kImu;
-  /// Before each cycle the control thread waits until the perception has finished every frame
-  /// handed in before it: with trigger kClock on the simulator's time, the flight is the lockstep
-  /// runner's to the bit (for tests and comparisons; a vehicle never waits).
-  bool wait_for_perception = false;
+  /// The lockstep runner's order: before each cycle the control thread waits until the perception
+  /// has finished every frame handed in before it, and within the cycle until the planning has
+  /// made its call between the cycle's halves. With trigger kClock on the simulator's time, the
+  /// flight is the lockstep runner's to the bit (for tests and comparisons; a vehicle never
+  /// waits).
+  bool lockstep_order = false;
   /// Memory locking for the process and SCHED_FIFO for the control thread (priority
   /// realtime.fifo_priority; the perception and planning threads one and two below it), when
   /// permitted; the grant is reported.
@@ -120,6 +137,8 @@ class OnboardExecutor {
   void OnEscTelemetry(const EscTelemetry& esc);
   void OnOdometry(const OdometrySample& odometry);
   void OnLidar(std::shared_ptr<const LidarFrame> frame);
+  /// An IMU sample, ESC telemetry or odometry.
+  void OnSensor(const SensorMessage& message);
 
   void Start();
   /// Lets the threads finish what they hold, then joins them (idempotent).
@@ -130,15 +149,6 @@ class OnboardExecutor {
   std::uint64_t messages_taken() const { return messages_taken_.load(std::memory_order_acquire); }
 
  private:
-  /// One sensor message in the intake's order (a tagged record: copying it never allocates).
-  struct SensorMessage {
-    enum class Kind { kImu, kEsc, kOdometry };
-    Kind kind = Kind::kImu;
-    ImuSample imu;
-    EscTelemetry esc;
-    OdometrySample odometry;
-    std::uint64_t seq = 0;  // the intake's count before it
-  };
   /// Pushes `m` to the control thread (dropped and counted when its queue is full).
   void Intake(SensorMessage m);
   /// What the planning reads of the cycle just run.
@@ -147,6 +157,7 @@ class OnboardExecutor {
     stack::FlightMode mode = stack::FlightMode::kNominal;
     stack::FaultEstimates faults;
     bool landing = false;  // an emergency landing flies its own descent: the planning rests
+    std::uint64_t cycle = 0;
   };
   /// What the control cycle reads of the planning.
   struct PlanningOutput {
@@ -157,8 +168,11 @@ class OnboardExecutor {
   void ControlLoop();
   /// The control thread takes in every sensor message waiting; true when there was one.
   bool TakeMessages();
-  /// Blocks until the perception finished every frame handed in so far (wait_for_perception).
+  /// Blocks until the perception finished every frame handed in so far and every message passed
+  /// on (lockstep_order).
   void WaitForPerception();
+  /// Publishes the odometry's update when it has a new one.
+  void PublishLioUpdate(std::uint64_t* published_serial);
   void PerceptionLoop();
   void PlanningLoop();
   /// A control cycle at the IMU sample of time t.
@@ -176,19 +190,31 @@ class OnboardExecutor {
   Doorbell intake_bell_;
   // control -> perception
   SpscQueue<SensorMessage, 4096> perception_messages_;  // the IMU samples and ESC telemetry
-  Latest<StateEstimate> control_estimate_;  // the frames' placement without the odometry
   // intake -> perception
-  /// A frame, and how many sensor messages the intake had taken before it: the perception
-  /// registers it once the control thread has passed it every IMU sample up to there.
+  /// A frame and its number; the perception registers it once its ticket has come.
   struct FrameMessage {
     std::shared_ptr<const LidarFrame> frame;
-    std::uint64_t after_messages = 0;
+    std::uint64_t number = 0;
+  };
+  /// What the control thread adds to a frame when it reaches the frame's place among the other
+  /// messages: every message before it has been passed on, and the frame's placement when the
+  /// pose comes from external odometry (the control side's estimate at the frame's end, as the
+  /// lockstep runner gives it).
+  struct FrameTicket {
+    std::uint64_t number = 0;
+    std::uint64_t after_messages = 0;  // the messages before the frame: seq below this
+    StateEstimate external;
   };
   SpscQueue<FrameMessage, 8> frames_;
+  SpscQueue<FrameTicket, 16> frame_tickets_;
   std::uint64_t messages_in_ = 0;                   // the intake's count (its thread only)
-  std::atomic<std::uint64_t> messages_taken_{0};    // the control thread's count, forwarded
+  std::uint64_t frames_numbered_ = 0;               // the intake's frames (its thread only)
+  std::atomic<std::uint64_t> messages_taken_{0};    // the control thread's count
   Doorbell perception_bell_;
-  std::atomic<std::uint64_t> frames_in_{0}, frames_done_{0};  // wait_for_perception's count
+  std::atomic<std::uint64_t> frames_in_{0}, frames_done_{0};  // lockstep_order's counts
+  std::atomic<std::uint64_t> planning_calls_{0};               // cycles the planning has taken
+  std::uint64_t forwarded_ = 0;                                 // messages the control thread passed on
+  std::atomic<std::uint64_t> perception_processed_{0};         // ... and the perception took
   // perception -> control
   Latest<stack::LioUpdate> lio_updates_;
   // control -> planning

@@ -133,6 +133,22 @@ struct LioSummary {
   /// The threshold the frames were judged degenerate by (LioOptions::degenerate_std_m), for
   /// whoever reads their weakest-direction stds (the log's lio_weakest_std_m).
   double degenerate_std_m = 0.0;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("frames", &frames);
+    a->Visit("frames_used", &frames_used);
+    a->Visit("frames_degenerate", &frames_degenerate);
+    a->Visit("points_mean", &points_mean);
+    a->Visit("matched_mean", &matched_mean);
+    a->Visit("residual_rms_m_mean", &residual_rms_m_mean);
+    a->Visit("iterations_mean", &iterations_mean);
+    a->Visit("frame_ms_mean", &frame_ms_mean);
+    a->Visit("frame_ms_p99", &frame_ms_p99);
+    a->Visit("map_points", &map_points);
+    a->Visit("lidar_rotation_rad", &lidar_rotation_rad);
+    a->Visit("lidar_time_offset_s", &lidar_time_offset_s);
+    a->Visit("degenerate_std_m", &degenerate_std_m);
+  }
 };
 
 /// What the LiDAR-inertial odometry's frames tell the estimate the controller reads: the filter's

@@ -181,6 +181,11 @@ struct StackCost {
 struct UkfSummary {
   std::vector<double> w_hat;        ///< its final loss-of-effectiveness estimates, per rotor
   std::optional<double> settled_s;  ///< when it first settled after a detection [s]; none: never
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("w_hat", &w_hat);
+    a->Visit("settled_s", &settled_s);
+  }
 };
 
 /// What the stack did over a flight, taken from its parts: the run summary's account of the stack.
@@ -189,6 +194,11 @@ struct UkfSummary {
 struct RotorReconfiguration {
   int rotor = 0;
   double t_s = 0.0;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("rotor", &rotor);
+    a->Visit("t_s", &t_s);
+  }
 };
 
 struct FlightStackSummary {
@@ -202,6 +212,19 @@ struct FlightStackSummary {
   std::optional<LioSummary> odometry;            ///< estimator lio
   long lidar_points_dropped = 0;                 ///< as lidar_points_dropped()
   std::vector<RotorReconfiguration> reconfigurations;  ///< in the order they happened
+  /// Every field (the software-in-the-loop node sends it to the simulator's side: docs/runtime.md).
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("navigation", &navigation);
+    a->Visit("flatness_decisions", &flatness_decisions);
+    a->Visit("ukf", &ukf);
+    a->Visit("final_mode", &final_mode);
+    a->Visit("transitions", &transitions);
+    a->Visit("map_voxels_occupied", &map_voxels_occupied);
+    a->Visit("odometry", &odometry);
+    a->Visit("lidar_points_dropped", &lidar_points_dropped);
+    a->Visit("reconfigurations", &reconfigurations);
+  }
 };
 
 class FlightStack {
@@ -253,6 +276,11 @@ class FlightStack {
   /// What the planning task reads of the fault detection (the flatness navigator's; empty for the
   /// others).
   FaultEstimates PlanningFaults() const;
+  /// The control side's estimate for placing `frame` in the map when the pose comes from external
+  /// odometry (the LiDAR-inertial odometry places its frames itself).
+  StateEstimate FrameEstimate(const LidarFrame& frame) const { return estimator_->FrameEstimate(frame); }
+  /// An emergency landing has started: the stack flies its own descent and the planning rests.
+  bool landing() const { return landing_.has_value(); }
   /// Replaces the command of the control cycle just run (Update) with one computed outside the
   /// stack (a controller written in Python, harness::Flight): the fault detection and the next
   /// cycle's supervisor see it as the command sent. Every mode is overridden, the landed and

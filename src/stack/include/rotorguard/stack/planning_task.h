@@ -118,6 +118,19 @@ struct NavigationSummary {
   /// (inside an obstacle's inflation, outside the map or the altitude band, enclosed): which
   /// waypoint and why, "waypoint 3 at [1, 2, 1] is unreachable: no_path (...)". Empty otherwise.
   std::string unreachable;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("waypoints_reached", &waypoints_reached);
+    a->Visit("waypoints_total", &waypoints_total);
+    a->Visit("plans", &plans);
+    a->Visit("plans_failed", &plans_failed);
+    a->Visit("plans_fine_search", &plans_fine_search);
+    a->Visit("plans_rest_to_rest", &plans_rest_to_rest);
+    a->Visit("plans_by_reason", &plans_by_reason);
+    a->Visit("planner_ms_mean", &planner_ms_mean);
+    a->Visit("failed_plans", &failed_plans);
+    a->Visit("unreachable", &unreachable);
+  }
 };
 
 /// What the flatness navigator reads of the fault detection each call (paper 004: any detection

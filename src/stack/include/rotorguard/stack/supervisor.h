@@ -42,7 +42,15 @@ enum class FlightMode {
   kLanded,
   kFlightTermination,  ///< motors stopped in the air: the vehicle cannot hover on its remaining rotors
 };
-const char* ToString(FlightMode mode);
+inline constexpr EnumName<FlightMode> kFlightModeNames[] = {
+    {FlightMode::kNominal, "nominal"},
+    {FlightMode::kFailureRecovery, "failure_recovery"},
+    {FlightMode::kDegradedNavigation, "degraded_navigation"},
+    {FlightMode::kEmergencyLanding, "emergency_landing"},
+    {FlightMode::kLanded, "landed"},
+    {FlightMode::kFlightTermination, "flight_termination"}};
+constexpr std::span<const EnumName<FlightMode>> NamesOf(const FlightMode*) { return kFlightModeNames; }
+inline const char* ToString(FlightMode mode) { return ToName(mode); }
 
 struct SupervisorOptions {
   /// Recovery ends once the thrust axis, averaged over the spin, stays within this of vertical
@@ -136,6 +144,13 @@ struct ModeTransition {
   double t = 0.0;
   FlightMode from = FlightMode::kNominal, to = FlightMode::kNominal;
   std::string reason;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("t", &t);
+    a->Visit("from", &from);
+    a->Visit("to", &to);
+    a->Visit("reason", &reason);
+  }
 };
 
 class Supervisor {
