@@ -37,6 +37,10 @@ class SitlCommand final : public Command {
     sitl->add_flag("--lockstep-clock", sitl_.lockstep_clock,
                    "The simulator's time is the clock and it waits for each cycle's command, which acts after the\n"
                    "scenario's computation delay: the threaded stack flies `run`'s flight (a check, not a timing)");
+    sitl->add_option("--fifo-priority", fifo_text_,
+                     "Run the stack's control thread under SCHED_FIFO at this priority, in [3, 99] (perception and\n"
+                     "planning one and two below), with its memory locked; needs CAP_SYS_NICE and CAP_IPC_LOCK (or\n"
+                     "rtprio and memlock limits), else the normal scheduler, as runtime.json reports (default: 0, none)");
     sitl->add_flag("--in-process", in_process_,
                    "Run the stack in this process (default: in its own, `rotorguard node`, through shared memory)");
     sitl->add_flag("--quiet,-q", quiet_, "No progress bar and no summary table");
@@ -47,6 +51,10 @@ class SitlCommand final : public Command {
   int Execute() override {
     harness::SitlOptions sitl = sitl_;
     if (app_->count("--realtime-factor") > 0) sitl.realtime_factor = ParsePositive("--realtime-factor", factor_text_, 10.0);
+    if (app_->count("--fifo-priority") > 0) {
+      sitl.executor.realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
+      sitl.executor.realtime.lock_memory = true;
+    }
     const harness::Scenario scenario = scenario_.Load();
     if (!in_process_) {
       // The node flies the same scenario: the same file, overrides and seed.
@@ -104,7 +112,7 @@ class SitlCommand final : public Command {
 
   CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
-  std::string out_dir_, factor_text_;
+  std::string out_dir_, factor_text_, fifo_text_;
   bool quiet_ = false, in_process_ = false;
   harness::SitlOptions sitl_;
 };

@@ -185,6 +185,7 @@ class SharedMemoryLink final : public StackLink {
     runtime::SitlChannel& ch = *channel_;
     ch.trigger = executor.trigger;
     ch.lockstep_order = executor.lockstep_order;
+    ch.realtime = executor.realtime;
     ch.lockstep_clock = sitl.lockstep_clock;
     ch.clock_rate = sitl.realtime_factor;
     for (int i = 0; i < runtime::SitlChannel::kFrameSlots; ++i) ch.free_slots.TryPush(i);
@@ -348,7 +349,8 @@ nlohmann::json SitlResult::RuntimeJson() const {
                {"steps_behind", link.steps_behind},
                {"behind_max_ms", 1e3 * link.behind_max_s},
                {"command_delay", HistogramJson(link.command_delay)},
-               {"processes", link.processes}};
+               {"processes", link.processes},
+               {"simulator_scheduling", link.simulator_realtime}};
   return j;
 }
 
@@ -396,6 +398,9 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     reference.Add(c.command.state_t_ns, c.reference);
     metrics.OnEstimate(vehicle::StateView(history.At(c.command.state_t_ns)), c.estimate);
   };
+  // The simulator's thread paces the world: it runs at the control thread's priority when that
+  // one runs under SCHED_FIFO (it produces what the control thread consumes).
+  if (sitl.executor.realtime.fifo_priority > 0) link.simulator_realtime = runtime::RequestRealtime(sitl.executor.realtime).note;
   stack->Deliver(sim.outputs());
   history.Add(sim.time_ns(), sim.state());
   stack->Start();
@@ -508,6 +513,7 @@ void FlyNode(const Scenario& sc, runtime::SitlChannel& ch) {
   runtime::OnboardExecutorOptions options;
   options.trigger = ch.trigger;
   options.lockstep_order = ch.lockstep_order;
+  options.realtime = ch.realtime;
   runtime::OnboardExecutor executor(&st, &clock, &sink, options);
   executor.Start();
   set_state(runtime::NodeState::kFlying);

@@ -47,6 +47,7 @@ struct SitlLinkReport {
   double behind_max_s = 0.0;         ///< the furthest the simulator fell behind the clock [s]
   runtime::LatencyHistogram command_delay;  ///< a command's IMU sample -> it acts on the ESCs (before their latency)
   int processes = 1;                 ///< the simulator's and the stack's: 1 or 2
+  std::string simulator_realtime = "normal scheduler (not asked)";  ///< the simulator thread's scheduling
 };
 
 struct SitlResult {

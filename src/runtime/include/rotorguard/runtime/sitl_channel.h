@@ -57,6 +57,7 @@ struct SitlChannel {
   CycleTrigger trigger = CycleTrigger::kImu;
   bool lockstep_order = false;
   bool lockstep_clock = false;
+  RealtimeOptions realtime{.lock_memory = false, .fifo_priority = 0};
   std::atomic<TimeNs> clock_origin_ns{0};
   double clock_rate = 1.0;
 
