@@ -75,19 +75,21 @@ std::string InFolder(const std::string& dir, const char* name) { return (fs::pat
 
 }  // namespace
 
+void PrepareRunFolder(const std::string& dir, std::initializer_list<const char*> outputs) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", dir, ec.message()));
+  for (const char* name : outputs) fs::remove(InFolder(dir, name), ec);
+}
+
 FlightRecorder::FlightRecorder(const FlightRecorderOptions& options, const Scenario& scenario)
     : options_(options),
       scenario_(&scenario),
       log_period_ns_(PeriodFromRate(scenario.log_rate_hz)),
       scene_(scenario.vehicle, scenario.world, {}, scenario.assembly.get()) {
   if (!writes()) return;
-  std::error_code ec;
-  fs::create_directories(options_.out_dir, ec);
-  if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", options_.out_dir, ec.message()));
-  // A summary left by an earlier run must not pass for this run's, nor its files mix with these.
-  for (const char* name : {"summary.json", "report.html", "flight.mcap", "log.csv", "scene.json", "sensors.csv"}) {
-    fs::remove(InFolder(options_.out_dir, name), ec);
-  }
+  PrepareRunFolder(options_.out_dir,
+                   {"summary.json", "report.html", "flight.mcap", "log.csv", "scene.json", "sensors.csv"});
   if (options_.log_format != LogFormat::kMcap) {
     sensors_.emplace(InFolder(options_.out_dir, "sensors.csv"));
     sensor_buffer_ = record::kSensorLogHeader;

@@ -19,6 +19,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/failure_diagnosis.h"
+#include "rotorguard/harness/flight_recorder.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/io/json_archive.h"
 #include "rotorguard/runtime/shared_memory.h"
@@ -122,6 +123,16 @@ nlohmann::json LoopsJson(const runtime::OnboardReport& r) {
           {"realtime", {{"memory_locked", r.realtime.memory_locked}, {"fifo", r.realtime.fifo}, {"note", r.realtime.note}}}};
 }
 
+/// A simulator step's IMU sample, ESC telemetry and odometry, each as a message to `f`, in the
+/// order the lockstep runner hands them to the stack (DeliverToStack); the LiDAR frame is the
+/// caller's.
+template <typename F>
+void EachSensorMessage(const sim::SensorOutputs& o, F&& f) {
+  if (o.imu) f(runtime::SensorMessage::Of(*o.imu));
+  if (o.esc) f(runtime::SensorMessage::Of(*o.esc));
+  if (o.odometry) f(runtime::SensorMessage::Of(*o.odometry));
+}
+
 /// The stack's side of the loop as the simulator sees it: where sensor messages go and commands
 /// come from, the clock the stack follows, and the stack's account at the end.
 class StackLink {
@@ -152,9 +163,7 @@ class InProcessLink final : public StackLink {
   runtime::Clock& clock() override { return clock_; }
   void AdvanceTime(TimeNs t) override { time_.Advance(t); }
   void Deliver(const sim::SensorOutputs& o) override {
-    if (o.imu) executor_.OnImu(*o.imu);
-    if (o.esc) executor_.OnEscTelemetry(*o.esc);
-    if (o.odometry) executor_.OnOdometry(*o.odometry);
+    EachSensorMessage(o, [this](const runtime::SensorMessage& m) { executor_.OnSensor(m); });
     if (o.lidar) executor_.OnLidar(std::make_shared<const LidarFrame>(*o.lidar));
   }
   bool TryReceive(runtime::CycleTelemetry* cycle) override { return sink_.TryReceive(cycle); }
@@ -220,15 +229,11 @@ class SharedMemoryLink final : public StackLink {
     channel_->to_node_bell.Ring();
   }
   void Deliver(const sim::SensorOutputs& o) override {
-    runtime::SitlMessage m;
-    const auto sensor = [&](runtime::SensorMessage::Kind kind) {
-      m.kind = runtime::SitlMessage::Kind::kSensor;
-      m.sensor.kind = kind;
-      Push(m);
-    };
-    if (o.imu) m.sensor.imu = *o.imu, sensor(runtime::SensorMessage::Kind::kImu);
-    if (o.esc) m.sensor.esc = *o.esc, sensor(runtime::SensorMessage::Kind::kEsc);
-    if (o.odometry) m.sensor.odometry = *o.odometry, sensor(runtime::SensorMessage::Kind::kOdometry);
+    EachSensorMessage(o, [this](const runtime::SensorMessage& m) {
+      runtime::SitlMessage message;  // kind kSensor
+      message.sensor = m;
+      Push(message);
+    });
     if (o.lidar) PushFrame(*o.lidar);
     channel_->to_node_bell.Ring();
   }
@@ -344,6 +349,7 @@ nlohmann::json SitlResult::RuntimeJson() const {
   nlohmann::json j = loops;
   j["link"] = {{"commands", link.commands},
                {"commands_after_end", link.commands_after_end},
+               {"commands_before_their_sample", link.commands_before_their_sample},
                {"commands_late", link.commands_late},
                {"late_max_ms", 1e3 * link.late_max_s},
                {"steps_behind", link.steps_behind},
@@ -358,14 +364,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   sitl.Validate();
   const Stopwatch wall;
   const Scenario sc = Flown(scenario);
-  if (!options.out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(options.out_dir, ec);
-    if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", options.out_dir, ec.message()));
-    for (const char* name : {"summary.json", "runtime.json"}) {
-      std::filesystem::remove(std::filesystem::path(options.out_dir) / name, ec);
-    }
-  }
+  if (!options.out_dir.empty()) PrepareRunFolder(options.out_dir, {"summary.json", "runtime.json"});
   const sim::TruthDraw draw = sim::DrawTruth(sc.truth, sc.vehicle, sc.seed);
   const vehicle::MultirotorModel truth(sim::TruthVehicle(sc.vehicle, draw), sim::ThrustRatios(draw));
   sim::Simulator sim = MakeSimulator(sc, truth, draw);
@@ -393,6 +392,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   // A cycle's command to the ESCs, at `acts`; its estimate judged against the truth at its instant.
   const auto apply = [&](const runtime::CycleTelemetry& c, TimeNs acts) {
     ++link.commands;
+    if (c.command.sent_t_ns < c.command.state_t_ns) ++link.commands_before_their_sample;
     link.command_delay.Record(acts - c.command.state_t_ns);
     sim.Send(RotorCommand{c.command.state_t_ns, c.command.thrust_n}, acts);
     reference.Add(c.command.state_t_ns, c.reference);
@@ -401,11 +401,13 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   // The simulator's thread paces the world: it runs at the control thread's priority when that
   // one runs under SCHED_FIFO (it produces what the control thread consumes).
   if (sitl.executor.realtime.fifo_priority > 0) link.simulator_realtime = runtime::RequestRealtime(sitl.executor.realtime).note;
-  stack->Deliver(sim.outputs());
-  history.Add(sim.time_ns(), sim.state());
+  // Time 0's messages go once the clock has reached 0 (on the simulator's clock, the stack waits
+  // for the simulator's time anyway): a message is never in the stack's hands before its stamp.
   stack->Start();
   runtime::Clock& clock = stack->clock();
   if (!sitl.lockstep_clock) clock.SleepUntil(0);
+  stack->Deliver(sim.outputs());
+  history.Add(sim.time_ns(), sim.state());
 
   const std::int64_t progress_stride = std::max<std::int64_t>(1, steps / 100);
   const TimeNs period = PeriodFromRate(sc.stack.control_rate_hz);

@@ -64,27 +64,6 @@ void OnboardExecutor::Intake(SensorMessage m) {
   intake_bell_.Ring();
 }
 
-void OnboardExecutor::OnImu(const ImuSample& imu) {
-  SensorMessage m;
-  m.kind = SensorMessage::Kind::kImu;
-  m.imu = imu;
-  Intake(m);
-}
-
-void OnboardExecutor::OnEscTelemetry(const EscTelemetry& esc) {
-  SensorMessage m;
-  m.kind = SensorMessage::Kind::kEsc;
-  m.esc = esc;
-  Intake(m);
-}
-
-void OnboardExecutor::OnOdometry(const OdometrySample& odometry) {
-  SensorMessage m;
-  m.kind = SensorMessage::Kind::kOdometry;
-  m.odometry = odometry;
-  Intake(m);
-}
-
 void OnboardExecutor::OnSensor(const SensorMessage& message) {
   if (message.kind != SensorMessage::Kind::kFrame) Intake(message);
 }
@@ -254,7 +233,6 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   cycle.mode = mode;
   cycle.estimate = stack_->estimate();
   cycle.reference = stack_->reference_point();
-  cycle.isolated_rotors = stack_->isolated_rotors();
   cycle.command.compute_s = ToSeconds(SteadyClock::Monotonic() - start);
   cycle.command.sent_t_ns = clock_->Now();
   sink_->Send(cycle);

@@ -109,6 +109,8 @@ TEST_F(CliTest, SitlFliesAPropellerLossInRealTimeWithTheStackInItsOwnProcess) {
   EXPECT_EQ(s["supervisor"]["transitions"][0]["to"], "failure_recovery");
   const nlohmann::json rt = nlohmann::json::parse(ReadText(dir_ / "sitl" / "runtime.json"));
   EXPECT_EQ(rt["link"]["processes"], 2);
+  // The two processes' clocks agree: no command is stamped before the sample it was computed from.
+  EXPECT_EQ(rt["link"]["commands_before_their_sample"], 0);
   const auto runs = rt["control"]["runs"].get<std::uint64_t>();
   // 6 s at 200 Hz: a cycle per control instant, unless the control thread was late (skipped).
   EXPECT_EQ(runs + rt["control"]["skipped"].get<std::uint64_t>(), 1200u);

@@ -4,6 +4,7 @@
 /// and every command it sent), vehicle.yaml (the vehicle the stack flew), summary.json and, when
 /// asked, report.html. summary.json comes last, so that a folder with one holds a whole run.
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <span>
@@ -37,6 +38,11 @@ struct FlightRecorderOptions {
   /// module's `.log`.
   bool keep_log = false;
 };
+
+/// Creates a run's output folder `dir` and removes the files of `outputs` an earlier run left there:
+/// a summary left behind must not pass for this run's, nor its files mix with these. Throws
+/// std::runtime_error when the folder cannot be created.
+void PrepareRunFolder(const std::string& dir, std::initializer_list<const char*> outputs);
 
 class FlightRecorder {
  public:

@@ -41,6 +41,9 @@ struct SitlOptions {
 struct SitlLinkReport {
   std::uint64_t commands = 0;        ///< commands received and applied
   std::uint64_t commands_after_end = 0;  ///< sent before the flight ended, received after it
+  /// Stamped as sent before the IMU sample they were computed from: the two sides' clocks or the
+  /// stamps disagree (0 when they agree).
+  std::uint64_t commands_before_their_sample = 0;
   std::uint64_t commands_late = 0;   ///< received after the step they were sent in had been simulated
   double late_max_s = 0.0;           ///< the latest such arrival after its sending instant [s]
   std::uint64_t steps_behind = 0;    ///< physics steps begun more than half a step after their end had passed on the clock

@@ -50,7 +50,6 @@ struct CycleTelemetry {
   stack::FlightMode mode = stack::FlightMode::kNominal;
   StateEstimate estimate;
   ReferencePoint reference;
-  int isolated_rotors = 0;
 };
 
 /// One sensor message, tagged (copying it never allocates): what the executor's intake queues
@@ -66,6 +65,24 @@ struct SensorMessage {
   std::uint64_t seq = 0;      ///< the executor's intake count before it (set by the executor)
   std::uint64_t frame = 0;    ///< kFrame: the frame's number
   TimeNs frame_end_ns = 0;    ///< kFrame: its end
+
+  static SensorMessage Of(const ImuSample& imu) {
+    SensorMessage m;
+    m.imu = imu;
+    return m;
+  }
+  static SensorMessage Of(const EscTelemetry& esc) {
+    SensorMessage m;
+    m.kind = Kind::kEsc;
+    m.esc = esc;
+    return m;
+  }
+  static SensorMessage Of(const OdometrySample& odometry) {
+    SensorMessage m;
+    m.kind = Kind::kOdometry;
+    m.odometry = odometry;
+    return m;
+  }
 };
 
 /// Where commands and telemetry go: called on the control thread, so it must neither block nor
@@ -133,9 +150,9 @@ class OnboardExecutor {
 
   /// The sensor intake, called from one thread (a driver's or a transport's), in the order the
   /// messages arrive. Never blocks: a full queue drops the message and counts it.
-  void OnImu(const ImuSample& imu);
-  void OnEscTelemetry(const EscTelemetry& esc);
-  void OnOdometry(const OdometrySample& odometry);
+  void OnImu(const ImuSample& imu) { Intake(SensorMessage::Of(imu)); }
+  void OnEscTelemetry(const EscTelemetry& esc) { Intake(SensorMessage::Of(esc)); }
+  void OnOdometry(const OdometrySample& odometry) { Intake(SensorMessage::Of(odometry)); }
   void OnLidar(std::shared_ptr<const LidarFrame> frame);
   /// An IMU sample, ESC telemetry or odometry.
   void OnSensor(const SensorMessage& message);
