@@ -14,6 +14,7 @@
 #include "rotorguard/benchmarks/mars_bench.h"
 #include "rotorguard/benchmarks/nav_bench.h"
 #include "rotorguard/benchmarks/nmpc_bench.h"
+#include "rotorguard/benchmarks/sitl_bench.h"
 #include "rotorguard/benchmarks/perception_bench.h"
 #include "rotorguard/benchmarks/planner_bench.h"
 #include "rotorguard/benchmarks/qp_bench.h"
@@ -63,7 +64,7 @@ class BenchCommand final : public Command {
                     "docs/truth.md) or ideal (the vehicle file exactly) (default realistic)");
     }
     // Every benchmark can also write its page: tables and distributions (record/report.h).
-    for (CLI::App* b : {sim_, qp_, nmpc_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
+    for (CLI::App* b : {sim_, qp_, nmpc_, sitl_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
       b->add_option("--html", html_, "Also write the result as an HTML page to this file");
       b->add_flag("--json", json_,
                   b == sim_ || b == qp_ || b == nmpc_ || b == campaign_ ? "Print JSON instead of a table"
@@ -80,6 +81,7 @@ class BenchCommand final : public Command {
     if (*sim_) return Sim();
     if (*qp_) return Qp();
     if (*nmpc_) return Nmpc();
+    if (*sitl_) return Sitl();
     if (*ftc_) return Ftc();
     if (*perception_) return Perception();
     if (*lio_) return Lio();
@@ -131,6 +133,18 @@ class BenchCommand final : public Command {
          "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
          "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.",
          {{"--qp-solver", &nmpc_qp_solver_, "The NMPC's QP solver: riccati (default, the stack's) or condensing"}}},
+        {&sitl_,
+         "sitl",
+         "The onboard runtime in software in the loop (docs/runtime.md): the forest flown --repeats times idle\n"
+         "and with one core busy, the stack in its own process (deadline misses, IMU-to-command latency), and\n"
+         "paper 000's hover and tracking failure cells, --ftc-trials flights each, against lockstep with the\n"
+         "measured delay (equal outcomes, FDD latency). At real time: about 25 min with the defaults.",
+         {{"--scenario", &sitl_scenario_, "The timing flights' scenario (default configs/scenarios/forest.yaml)"},
+          {"--repeats", &sitl_repeats_, "Timing flights per load (default 3; 0: none)"},
+          {"--loads", &sitl_loads_, "Comma-separated: idle, one_core_busy (default both)"},
+          {"--fifo-priority", &sitl_fifo_, "SCHED_FIFO priority of the stack's control thread, in [3, 99] (default 0: none)"},
+          {"--ftc-trials", &sitl_ftc_trials_, "Flights per FTC cell (default 20; 0: none)"},
+          {"--ftc-seed", &sitl_ftc_seed_, "The FTC flights' first seed (default 5001)"}}},
         {&ftc_,
          "ftc",
          "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
@@ -338,15 +352,20 @@ class BenchCommand final : public Command {
     return estimator_.empty() ? fallback : ParseName<stack::EstimatorKind>("--estimator", estimator_);
   }
 
+  /// The FTC trials' vehicle: the reference quadrotor with its file's FDD thresholds.
+  static void UseReferenceVehicle(benchmarks::FtcBenchOptions* o) {
+    const std::string vehicle = ConfigPath("vehicles/zhou2025_quad.yaml");
+    o->vehicle = harness::LoadVehicle(vehicle);
+    if (auto fdd = harness::LoadVehicleFdd(vehicle)) o->fdd = fdd->first;
+  }
+
   int Ftc() const {
     benchmarks::FtcBenchOptions o;
     o.trials = static_cast<int>(ParseUnsigned("--trials", ftc_trials_, 1, 1'000'000));
     o.seed = Seed();
     o.methods = ParseWordList("--methods", ftc_methods_, benchmarks::FtcMethods());
     if (!ftc_cells_.empty()) o.cells = ParseWordList("--cells", ftc_cells_, benchmarks::FtcCells());
-    const std::string vehicle = ConfigPath("vehicles/zhou2025_quad.yaml");
-    o.vehicle = harness::LoadVehicle(vehicle);
-    if (auto fdd = harness::LoadVehicleFdd(vehicle)) o.fdd = fdd->first;
+    UseReferenceVehicle(&o);
     o.truth = Truth();
     o.estimator = Estimator(stack::EstimatorKind::kOdometry);
     if (!ftc_replay_.empty()) return ReplayFtcTrial(o);
@@ -503,7 +522,32 @@ class BenchCommand final : public Command {
     return same ? kOk : kRunFailed;
   }
 
-  CLI::App *sim_ = nullptr, *qp_ = nullptr, *nmpc_ = nullptr, *ftc_ = nullptr, *perception_ = nullptr, *lio_ = nullptr,
+  int Sitl() const {
+    benchmarks::SitlBenchOptions o;
+    o.scenario = sitl_scenario_.empty() ? ConfigPath("scenarios/forest.yaml") : sitl_scenario_;
+    o.repeats = static_cast<int>(ParseUnsigned("--repeats", sitl_repeats_, 0, 100));
+    o.loads = SplitFields(sitl_loads_, ',');
+    for (const std::string& l : o.loads) {
+      if (l != "idle" && l != "one_core_busy") {
+        throw UsageError(fmt::format("--loads: '{}' is invalid; expected idle or one_core_busy", l));
+      }
+    }
+    o.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", sitl_fifo_, 0, 99));
+    if (o.fifo_priority > 0 && o.fifo_priority < 3) {
+      throw UsageError(fmt::format("--fifo-priority '{}' is invalid; expected 0 or a number in [3, 99]", sitl_fifo_));
+    }
+    o.ftc_trials = static_cast<int>(ParseUnsigned("--ftc-trials", sitl_ftc_trials_, 0, 1000));
+    o.ftc_seed = ParseUnsigned("--ftc-seed", sitl_ftc_seed_, 0, UINT64_MAX - 1000);
+    o.self = SelfPath();
+    UseReferenceVehicle(&o.ftc);
+    o.ftc.truth = sim::TruthPreset::kRealistic;
+    const nlohmann::json r =
+        benchmarks::RunSitlBenchmark(o, [](const std::string& line) { fmt::print(stderr, "sitl: {}\n", line); });
+    PrintMarkdownResult("sitl", r, benchmarks::SitlMarkdown(r));
+    return kOk;
+  }
+
+  CLI::App *sim_ = nullptr, *qp_ = nullptr, *nmpc_ = nullptr, *sitl_ = nullptr, *ftc_ = nullptr, *perception_ = nullptr, *lio_ = nullptr,
            *planner_ = nullptr, *nav_ = nullptr, *flatness_ = nullptr, *mars_ = nullptr, *campaign_ = nullptr;
   // Options several benchmarks share (one of them runs per invocation).
   std::string seed_ = "1", jobs_, out_, shard_ = "0/1", html_;
@@ -512,6 +556,8 @@ class BenchCommand final : public Command {
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3", qp_solver_ = "riccati";
   std::string nmpc_qp_solver_ = "riccati";
+  std::string sitl_scenario_, sitl_repeats_ = "3", sitl_loads_ = "idle,one_core_busy", sitl_fifo_ = "0",
+              sitl_ftc_trials_ = "20", sitl_ftc_seed_ = "5001";
   std::string truth_ = "realistic", estimator_;
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";

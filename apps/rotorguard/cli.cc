@@ -162,6 +162,13 @@ harness::Scenario ScenarioArguments::Load() const {
   return scenario;
 }
 
+std::string SelfPath() {
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("cannot find this program's path (/proc/self/exe): " + ec.message());
+  return self.string();
+}
+
 void CreateOutputFolder(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -95,6 +95,9 @@ struct ScenarioArguments {
 
 /// Creates the folder `dir` (and its parents); UsageError naming --out when it cannot.
 void CreateOutputFolder(const std::string& dir);
+/// This program's own path (software in the loop starts its node as this program with another
+/// command). Throws std::runtime_error when /proc/self/exe cannot be read.
+std::string SelfPath();
 
 /// The campaign options a command line gives (campaign run and the benchmarks that run as campaigns).
 campaign::CampaignRunOptions CampaignRunOptionsOf(const std::string& out, const std::string& jobs_text,

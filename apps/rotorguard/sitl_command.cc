@@ -6,20 +6,13 @@
 
 #include "cli.h"
 #include "rotorguard/harness/sitl.h"
+#include "rotorguard/io/report_html.h"
 
 namespace rotorguard::cli {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-/// This program's own path (the node is this program with another command).
-std::string SelfPath() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) throw std::runtime_error("sitl: cannot find this program's path (/proc/self/exe): " + ec.message());
-  return self.string();
-}
 
 class SitlCommand final : public Command {
  public:
@@ -28,7 +21,8 @@ class SitlCommand final : public Command {
         "sitl",
         "Fly a scenario in software in the loop: the simulator in real time (or --realtime-factor times it),\n"
         "the stack on its own threads (control, perception, planning) with the real computation and hand-off\n"
-        "delays in the loop. Writes DIR/summary.json and DIR/runtime.json (deadline misses, latencies, CPU).\n"
+        "delays in the loop. Writes what `run` writes (summary.json, log.csv, report.html, ...) and\n"
+        "DIR/runtime.json (deadline misses, latencies, CPU, the deadline policy's steps).\n"
         "Exit 0 when the mission succeeds, 1 when it fails, 4 when a waypoint is unreachable.");
     scenario_.Register(sitl);
     sitl->add_option("--out", out_dir_, "Output folder (default: out/<scenario name>-sitl)");
@@ -41,6 +35,10 @@ class SitlCommand final : public Command {
                      "Run the stack's control thread under SCHED_FIFO at this priority, in [3, 99] (perception and\n"
                      "planning one and two below), with its memory locked; needs CAP_SYS_NICE and CAP_IPC_LOCK (or\n"
                      "rtprio and memlock limits), else the normal scheduler, as runtime.json reports (default: 0, none)");
+    sitl->add_option("--stall", stall_texts_,
+                     "Fault injection: the control cycle at AT seconds stalls for DURATION seconds (AT:DURATION,\n"
+                     "repeatable), as a computer that falls behind; the deadline policy holds the last plan, then hands\n"
+                     "over to the fallback controller, which lands (docs/runtime.md)");
     sitl->add_flag("--in-process", in_process_,
                    "Run the stack in this process (default: in its own, `rotorguard node`, through shared memory)");
     sitl->add_flag("--quiet,-q", quiet_, "No progress bar and no summary table");
@@ -55,6 +53,7 @@ class SitlCommand final : public Command {
       sitl.executor.realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
       sitl.executor.realtime.lock_memory = true;
     }
+    for (const std::string& text : stall_texts_) sitl.executor.stalls.push_back(ParseStall(text));
     const harness::Scenario scenario = scenario_.Load();
     if (!in_process_) {
       // The node flies the same scenario: the same file, overrides and seed.
@@ -65,6 +64,7 @@ class SitlCommand final : public Command {
     options.out_dir = out_dir_.empty() ? (fs::path("out") / (scenario.name + "-sitl")).string() : out_dir_;
     CreateOutputFolder(options.out_dir);
     options.progress = FlightProgress(!quiet_, scenario.duration_s);
+    options.report = io::HasViewer();
     const harness::SitlResult result = harness::RunSitl(scenario, options, sitl);
     if (!quiet_) {
       PrintRunSummary(result.summary, "", options);
@@ -97,11 +97,27 @@ class SitlCommand final : public Command {
       fmt::print("planning loop     {} calls; compute p99 {:.2f} ms, max {:.2f} ms\n", n.at("runs").get<std::uint64_t>(),
                  ms(n, "compute", "p99_ms"), ms(n, "compute", "max_ms"));
     }
+    const nlohmann::json& d = r.loops.at("deadline_policy");
+    if (d.at("holds").get<std::uint64_t>() + d.at("fallbacks").get<std::uint64_t>() > 0) {
+      fmt::print("deadline policy   {} commands held from the last plan, {} hand-overs to the fallback controller\n",
+                 d.at("holds").get<std::uint64_t>(), d.at("fallbacks").get<std::uint64_t>());
+    }
     fmt::print("cpu               control {:.2f} s, perception {:.2f} s, planning {:.2f} s\n", c.at("cpu_s").get<double>(),
                p.at("cpu_s").get<double>(), n.at("cpu_s").get<double>());
     fmt::print("scheduling        {}\n", r.loops.at("realtime").at("note").get<std::string>());
     fmt::print("simulator         {} process(es); {} steps behind the clock (at most {:.2f} ms), {} of {} commands late\n",
                r.link.processes, r.link.steps_behind, 1e3 * r.link.behind_max_s, r.link.commands_late, r.link.commands);
+  }
+
+  static runtime::OnboardExecutorOptions::Stall ParseStall(const std::string& text) {
+    const std::size_t colon = text.find(':');
+    if (colon == std::string::npos) {
+      throw UsageError(fmt::format("--stall '{}' is invalid; expected AT:DURATION in seconds, e.g. 3.0:0.02", text));
+    }
+    runtime::OnboardExecutorOptions::Stall s;
+    s.at_s = ParseFinite("--stall AT", text.substr(0, colon), 0.0, 1e6);
+    s.duration_s = ParsePositive("--stall DURATION", text.substr(colon + 1), 10.0);
+    return s;
   }
 
   static double ParsePositive(const std::string& option, const std::string& text, double hi) {
@@ -113,6 +129,7 @@ class SitlCommand final : public Command {
   CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
   std::string out_dir_, factor_text_, fifo_text_;
+  std::vector<std::string> stall_texts_;
   bool quiet_ = false, in_process_ = false;
   harness::SitlOptions sitl_;
 };

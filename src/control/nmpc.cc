@@ -359,6 +359,20 @@ void NmpcController::ShiftBy(double elapsed) {
   for (int k = 0; k <= N_; ++k) x_[k].segment<4>(StateIndex::kQuaternion).normalize();
 }
 
+bool NmpcController::PlannedCommand(double t, RotorVector* thrust_command) const {
+  if (!initialised_ || !std::isfinite(t)) return false;
+  // The input acting at t + delay, between the nodes around it (ShiftBy's interpolation).
+  const double pos = std::clamp((t + options_.expected_delay_s - plan_t0_) / options_.step_s, 0.0,
+                                static_cast<double>(N_ - 1));
+  const int i = std::min(static_cast<int>(pos), std::max(N_ - 2, 0));
+  const double frac = N_ > 1 ? pos - i : 0.0;
+  RotorVector u = u_[static_cast<std::size_t>(i)];  // fixed capacity: the control thread never allocates
+  if (N_ > 1) u = (1.0 - frac) * u + frac * u_[static_cast<std::size_t>(i) + 1];
+  if (!u.allFinite()) return false;
+  *thrust_command = u.cwiseMax(0.0).cwiseMin(u_max_);
+  return true;
+}
+
 bool NmpcController::PrepareIteration(const ReferenceTrajectory& reference, double t, bool reuse) {
   const Stopwatch clock;
   // Linearise the dynamics (exact RK4 sensitivities) and the cost (Gauss-Newton) along the plan;
@@ -517,6 +531,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     ShiftBy(t - last_t_);
   }
   last_t_ = t;
+  plan_t0_ = t;
   x_shift_ = x_;
   u_shift_ = u_;
   bool ok = true;
@@ -553,6 +568,7 @@ void NmpcController::Compute(const StateEstimate& est, const ReferenceTrajectory
     // not a need: the relaxed QP kept the same matrices).
     const bool reuse = summary_.rate_bounds_relaxed == 0 && reused_since_linearisation_ >= 0 &&
                        reused_since_linearisation_ + 1 < options_.relinearise_every;
+    plan_t0_ = t + dt;
     if (PrepareIteration(reference, t + dt, reuse)) prepared_for_t_ = t + dt;
   }
   // Unprepared, the next call iterates from scratch: its own preparation linearises.

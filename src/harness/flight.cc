@@ -177,7 +177,7 @@ class Flight::Loop {
     }
     const Vector3 p_ref = stack_.reference().Evaluate(ToSeconds(t)).p_W;  // the planner's when navigating
     metrics_.OnStep(t, vehicle::StateView(sim_.state()), p_ref, !sim_.fault_events().empty());
-    recorder_.OnStep(t, sim_, stack_);
+    recorder_.OnStep(t, sim_, StackRow::Of(stack_));
     Stopwatch clock;
     const sim::SensorOutputs& outputs = sim_.Step();
     simulator_s_ += clock.Restart();
@@ -214,7 +214,7 @@ class Flight::Loop {
     if (finished_) throw std::logic_error("Flight::Finish: the flight has been finished already");
     finished_ = true;
     done_ = true;
-    recorder_.WriteFlight(sim_, stack_);
+    recorder_.WriteFlight(sim_, StackRow::Of(stack_), stack_.model().params());
     if (options_.progress) options_.progress(1.0);
     RunSummary s;
     SummarizeFlight(sc_, draw_, sim_, AccountOf(stack_), &s);

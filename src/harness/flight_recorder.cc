@@ -21,7 +21,7 @@ using vehicle::StateView;
 /// One row of log.csv (record/flight_log.h, LogColumns): the truth, the stack's reference,
 /// estimate and outputs, the rotors, and the FDD indices, NMPC solve time and LiDAR-inertial
 /// odometry's health when the stack has them.
-void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::NumericTable* table) {
+void AppendRow(const sim::Simulator& sim, const StackRow& row, io::NumericTable* table) {
   const StateView s(sim.state());
   std::size_t c = 0;
   const auto put = [&](double v) { table->values[c++].push_back(v); };
@@ -32,23 +32,28 @@ void AppendRow(const sim::Simulator& sim, const stack::FlightStack& st, io::Nume
   q4(s.q_WB());
   v3(s.v_W());
   v3(s.w_B());
-  const ReferencePoint& r = st.reference_point();
+  const ReferencePoint& r = row.reference;
   v3(r.p_W);
   v3(r.v_W);
   put(r.yaw);
-  const StateEstimate& e = st.estimate();
+  const StateEstimate& e = row.estimate;
   v3(e.p_W);
   q4(e.q_WB);
   v3(e.v_W);
   v3(e.w_B);
   v3(sim.wind());
   put(sim.landed() ? 1.0 : 0.0);
-  put(static_cast<int>(st.supervisor().mode()));
+  put(static_cast<int>(row.mode));
   const int n = sim.model().num_rotors();
   for (int i = 0; i < n; ++i) put(sim.applied_command()[i]);
   for (int i = 0; i < n; ++i) put(sim.rotor_thrusts()[i]);
   for (int i = 0; i < n; ++i) put(vehicle::RadPerSecondToRpm(sim.motor_speeds()[i]));
   for (int i = 0; i < n; ++i) put(static_cast<int>(sim.faults()[i].kind));  // docs/scenarios.md, "Outputs"
+  if (!row.stack) {
+    RG_INVARIANT(c == table->columns.size(), "log row and LogColumns disagree");
+    return;
+  }
+  const stack::FlightStack& st = *row.stack;
   if (const fdd::FaultDetector* detector = st.fault_detector()) {
     const std::vector<fdd::RotorStatus>& rotors = detector->rotors();
     for (int i = 0; i < n; ++i) put(rotors[i].motor_index);
@@ -102,13 +107,22 @@ void FlightRecorder::Begin(const stack::FlightStack& st, int num_rotors) {
   flight_.table.values.resize(flight_.table.columns.size());
 }
 
+void FlightRecorder::BeginWithoutStack(int num_rotors) {
+  flight_.table.columns = record::LogColumns(num_rotors, false, false, false);
+  flight_.table.values.resize(flight_.table.columns.size());
+}
+
+void FlightRecorder::OnCommand(const RotorCommand& command) {
+  if (sensors_) record::AppendCommand(command, &sensor_buffer_);
+}
+
 void FlightRecorder::OnControlCycle(TimeNs t, const stack::FlightStack& st, const RotorCommand& command) {
   if (!writes()) return;
   if (sensors_) record::AppendCommand(command, &sensor_buffer_);
   scene_.OnControlCycle(ToSeconds(t), st);
 }
 
-void FlightRecorder::OnStep(TimeNs t, const sim::Simulator& sim, const stack::FlightStack& st) {
+void FlightRecorder::OnStep(TimeNs t, const sim::Simulator& sim, const StackRow& st) {
   if (!logs() || t < next_log_ns_) return;
   AppendRow(sim, st, &flight_.table);
   if (writes()) scene_.OnTime(ToSeconds(t));
@@ -122,7 +136,7 @@ void FlightRecorder::AfterStep() {
   }
 }
 
-void FlightRecorder::WriteFlight(const sim::Simulator& sim, const stack::FlightStack& st) {
+void FlightRecorder::WriteFlight(const sim::Simulator& sim, const StackRow& st, const vehicle::VehicleParams& stack_vehicle) {
   if (!logs()) return;
   AppendRow(sim, st, &flight_.table);
   if (!writes()) return;
@@ -133,7 +147,7 @@ void FlightRecorder::WriteFlight(const sim::Simulator& sim, const stack::FlightS
     sensors_->Commit();
   }
   // The vehicle the stack flew, so that the run's folder is enough to replay its sensor log.
-  io::WriteFileAtomically(InFolder(options_.out_dir, "vehicle.yaml"), VehicleToYaml(st.model().params()));
+  io::WriteFileAtomically(InFolder(options_.out_dir, "vehicle.yaml"), VehicleToYaml(stack_vehicle));
   // The vehicle the simulator flew (summary.json's "truth" has the per-rotor thrust ratios, the
   // IMU's offset and the external torque, which a vehicle file does not hold).
   io::WriteFileAtomically(InFolder(options_.out_dir, "truth_vehicle.yaml"), VehicleToYaml(sim.model().params()));

@@ -119,7 +119,12 @@ void AddStackJson(const RunSummary& r, nlohmann::json* j) {
     transitions.push_back(
         {{"t", m.t}, {"from", stack::ToString(m.from)}, {"to", stack::ToString(m.to)}, {"reason", m.reason}});
   }
-  (*j)["supervisor"] = {{"final_mode", stack::ToString(s.final_mode)}, {"transitions", transitions}};
+  nlohmann::json deadline = nlohmann::json::array();
+  for (const stack::DeadlineEvent& e : s.deadline_events) {
+    deadline.push_back({{"t", e.t}, {"step", ToName(e.step)}, {"missed", e.missed}});
+  }
+  (*j)["supervisor"] = {
+      {"final_mode", stack::ToString(s.final_mode)}, {"transitions", transitions}, {"deadline_events", deadline}};
 }
 
 }  // namespace

@@ -120,6 +120,7 @@ nlohmann::json LoopsJson(const runtime::OnboardReport& r) {
   return {{"control", LoopJson(r.control)},
           {"perception", LoopJson(r.perception)},
           {"planning", LoopJson(r.planning)},
+          {"deadline_policy", {{"holds", r.holds}, {"fallbacks", r.fallbacks}}},
           {"realtime", {{"memory_locked", r.realtime.memory_locked}, {"fifo", r.realtime.fifo}, {"note", r.realtime.note}}}};
 }
 
@@ -195,6 +196,10 @@ class SharedMemoryLink final : public StackLink {
     ch.trigger = executor.trigger;
     ch.lockstep_order = executor.lockstep_order;
     ch.realtime = executor.realtime;
+    ch.hold_periods = executor.hold_periods;
+    ch.plan_ahead_s = executor.plan_ahead_s;
+    ch.stall_count = std::min(executor.stalls.size(), ch.stalls.size());  // SitlOptions::Validate checks
+    std::copy_n(executor.stalls.begin(), ch.stall_count, ch.stalls.begin());
     ch.lockstep_clock = sitl.lockstep_clock;
     ch.clock_rate = sitl.realtime_factor;
     for (int i = 0; i < runtime::SitlChannel::kFrameSlots; ++i) ch.free_slots.TryPush(i);
@@ -343,6 +348,10 @@ void SitlOptions::Validate() const {
     ThrowValidation("SitlOptions", "realtime_factor", realtime_factor, "in (0, 10] (1: real time)");
   }
   executor.Validate();
+  if (executor.stalls.size() > runtime::SitlChannel::kMaxStalls) {
+    ThrowValidation("SitlOptions", "executor.stalls", executor.stalls.size(),
+                    fmt::format("at most {} stalls (what the node's channel carries)", runtime::SitlChannel::kMaxStalls));
+  }
 }
 
 nlohmann::json SitlResult::RuntimeJson() const {
@@ -364,7 +373,9 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   sitl.Validate();
   const Stopwatch wall;
   const Scenario sc = Flown(scenario);
-  if (!options.out_dir.empty()) PrepareRunFolder(options.out_dir, {"summary.json", "runtime.json"});
+  // The run's folder as `run` writes it (summary, log, scene, sensors, report), and runtime.json.
+  FlightRecorder recorder(options, sc);
+  if (!options.out_dir.empty()) PrepareRunFolder(options.out_dir, {"runtime.json"});
   const sim::TruthDraw draw = sim::DrawTruth(sc.truth, sc.vehicle, sc.seed);
   const vehicle::MultirotorModel truth(sim::TruthVehicle(sc.vehicle, draw), sim::ThrustRatios(draw));
   sim::Simulator sim = MakeSimulator(sc, truth, draw);
@@ -374,6 +385,8 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   ReferenceTrace reference(sc.reference.get());
   TruthHistory history;
   ComputationDelayModel delay(sc, draw);
+  recorder.BeginWithoutStack(sim.model().num_rotors());
+  StackRow row;  // the stack's newest cycle as the log shows it
 
   runtime::OnboardExecutorOptions executor_options = sitl.executor;
   if (sitl.lockstep_clock) {
@@ -395,6 +408,10 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     if (c.command.sent_t_ns < c.command.state_t_ns) ++link.commands_before_their_sample;
     link.command_delay.Record(acts - c.command.state_t_ns);
     sim.Send(RotorCommand{c.command.state_t_ns, c.command.thrust_n}, acts);
+    recorder.OnCommand(RotorCommand{c.command.state_t_ns, c.command.thrust_n});
+    row.reference = c.reference;
+    row.estimate = c.estimate;
+    row.mode = c.mode;
     reference.Add(c.command.state_t_ns, c.reference);
     metrics.OnEstimate(vehicle::StateView(history.At(c.command.state_t_ns)), c.estimate);
   };
@@ -407,6 +424,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   runtime::Clock& clock = stack->clock();
   if (!sitl.lockstep_clock) clock.SleepUntil(0);
   stack->Deliver(sim.outputs());
+  AppendSensorLog(sim.outputs(), recorder.sensor_log());
   history.Add(sim.time_ns(), sim.state());
 
   const std::int64_t progress_stride = std::max<std::int64_t>(1, steps / 100);
@@ -444,11 +462,16 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
       }
     }
     metrics.OnStep(t, vehicle::StateView(sim.state()), reference.At(ToSeconds(t)), !sim.fault_events().empty());
+    recorder.OnStep(t, sim, row);
     const sim::SensorOutputs& outputs = sim.Step();
+    recorder.AfterStep();
     history.Add(sim.time_ns(), sim.state());
     ++k;
     done = sim.crashed() || k >= steps;
-    if (!done) stack->Deliver(outputs);  // the flight's end has no cycle (as in `run`)
+    if (!done) {
+      stack->Deliver(outputs);  // the flight's end has no cycle (as in `run`)
+      AppendSensorLog(outputs, recorder.sensor_log());
+    }
     if (options.progress && !done && k % progress_stride == 0) {
       options.progress(static_cast<double>(k) / static_cast<double>(steps));
     }
@@ -470,10 +493,11 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   DiagnoseFailure(metrics.last_violation(), sc.success, &s);
   s.wall_time_s = wall.seconds();
   s.realtime_factor = s.wall_time_s > 0.0 ? s.sim_time_s / s.wall_time_s : 0.0;
+  recorder.WriteFlight(sim, row, sc.vehicle);
+  recorder.WriteSummary(s);
   if (!options.out_dir.empty()) {
-    const std::filesystem::path dir(options.out_dir);
-    io::WriteFileAtomically((dir / "summary.json").string(), s.ToJson().dump(2) + "\n");
-    io::WriteFileAtomically((dir / "runtime.json").string(), result.RuntimeJson().dump(2) + "\n");
+    io::WriteFileAtomically((std::filesystem::path(options.out_dir) / "runtime.json").string(),
+                            result.RuntimeJson().dump(2) + "\n");
   }
   return result;
 }
@@ -516,6 +540,9 @@ void FlyNode(const Scenario& sc, runtime::SitlChannel& ch) {
   options.trigger = ch.trigger;
   options.lockstep_order = ch.lockstep_order;
   options.realtime = ch.realtime;
+  options.hold_periods = ch.hold_periods;
+  options.plan_ahead_s = ch.plan_ahead_s;
+  options.stalls.assign(ch.stalls.begin(), ch.stalls.begin() + static_cast<std::ptrdiff_t>(std::min(ch.stall_count, ch.stalls.size())));
   runtime::OnboardExecutor executor(&st, &clock, &sink, options);
   executor.Start();
   set_state(runtime::NodeState::kFlying);

@@ -103,6 +103,7 @@ void Replanner::LimitAcceleration(double a_max) {
 void Replanner::OnRecovered() { recovered_ = failed_; }
 
 ReferencePoint Replanner::Reference(double t) const {
+  if (!earlier_.empty() && t < trajectory_.start_time()) return PathInEffect(earlier_, t).Evaluate(t);
   if (!trajectory_.empty()) return trajectory_.Evaluate(t);
   ReferencePoint r;
   r.p_W = hold_;
@@ -114,6 +115,12 @@ std::shared_ptr<const ReferenceTrajectory> Replanner::Followed() const {
   ReferencePoint hold;
   hold.p_W = hold_;
   hold.yaw = yaw_;
+  if (!earlier_.empty()) {
+    std::vector<MinimumJerkTrajectory> paths = earlier_;
+    paths.push_back(trajectory_);
+    return std::make_shared<FollowedReference<PathsInTurn<MinimumJerkTrajectory>>>(
+        PathsInTurn<MinimumJerkTrajectory>(std::move(paths)), hold);
+  }
   return std::make_shared<FollowedReference<MinimumJerkTrajectory>>(
       trajectory_.empty() ? std::nullopt : std::optional<MinimumJerkTrajectory>(trajectory_), hold);
 }
@@ -123,14 +130,17 @@ bool Replanner::UnsafeAhead(double t, const perception::VoxelMap& map) const {
   const double end = std::min(trajectory_.duration(), t + options_.check_horizon_s);
   const double dt = CheckInterval(options_.check_step_m, limits_.v_max);
   for (double s = t; s <= end; s += dt) {
-    if (map.IsInflated(trajectory_.Evaluate(s).p_W)) return true;
+    if (map.IsInflated(Reference(s).p_W)) return true;
   }
   return false;
 }
 
 bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   MinimumJerkTrajectory traj;
-  const PvaState start = StateOf(Reference(t));
+  // Onboard, the plan starts when its computation is expected to be done, from the reference
+  // then: the followed path until that instant stays as it was.
+  const double start_s = t + plan_ahead_s_;
+  const PvaState start = StateOf(Reference(start_s));
   // A goal beyond the window is approached through a local goal at its edge (receding horizon);
   // when the whole way there is blocked, the planner is asked for the goal itself and says why.
   planned_goal_ = LocalGoal(map, start.col(0), goal_, options_.local_goal_margin_m).value_or(goal_);
@@ -149,8 +159,16 @@ bool Replanner::Replan(double t, const perception::VoxelMap& map) {
   const bool ok = last_plan_.ok();
   last_plan_t_ = t;
   if (ok) {
-    traj.set_start_time(t);
+    traj.set_start_time(start_s);
     traj.set_yaw(yaw_);
+    if (plan_ahead_s_ > 0.0 && !trajectory_.empty()) {
+      // What is followed until the new plan starts: the paths in effect from t to start_s.
+      earlier_.push_back(trajectory_);
+      while (earlier_.size() > 1 && earlier_[1].start_time() <= t) earlier_.erase(earlier_.begin());
+      while (earlier_.size() > 1 && earlier_.back().start_time() >= start_s) earlier_.pop_back();
+    } else {
+      earlier_.clear();
+    }
     trajectory_ = std::move(traj);
     ++path_serial_;
     mode_ = Mode::kFollowing;
@@ -208,6 +226,7 @@ void Replanner::Brake(double t, const perception::VoxelMap& map) {
   }
   brake.set_start_time(t);
   brake.set_yaw(yaw_);
+  earlier_.clear();  // a brake starts at once
   trajectory_ = std::move(brake);
   ++path_serial_;
   mode_ = Mode::kBraking;

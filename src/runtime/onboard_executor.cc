@@ -5,7 +5,9 @@
 #include <sched.h>
 #include <time.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <mutex>
 
 #include "rotorguard/core/error.h"
@@ -40,6 +42,21 @@ void OnboardExecutorOptions::Validate() const {
   if (!(deadline_s >= 0.0 && deadline_s <= 1.0)) {
     ThrowValidation("OnboardExecutorOptions", "deadline_s", deadline_s, "in [0, 1] s (0: one control period)");
   }
+  if (!(plan_ahead_s >= 0.0 && plan_ahead_s <= 1.0)) {
+    ThrowValidation("OnboardExecutorOptions", "plan_ahead_s", plan_ahead_s, "in [0, 1] s");
+  }
+  if (hold_periods < 0 || hold_periods > 2) {
+    ThrowValidation("OnboardExecutorOptions", "hold_periods", hold_periods, "in [0, 2] control periods");
+  }
+  for (std::size_t i = 0; i < stalls.size(); ++i) {
+    if (!(stalls[i].at_s >= 0.0 && std::isfinite(stalls[i].at_s))) {
+      ThrowValidation("OnboardExecutorOptions", fmt::format("stalls.{}.at_s", i), stalls[i].at_s, "a finite time >= 0 [s]");
+    }
+    if (!(stalls[i].duration_s > 0.0 && stalls[i].duration_s <= 10.0)) {
+      ThrowValidation("OnboardExecutorOptions", fmt::format("stalls.{}.duration_s", i), stalls[i].duration_s,
+                      "in (0, 10] s");
+    }
+  }
   if (realtime.fifo_priority > 0 && realtime.fifo_priority < 3) {
     ThrowValidation("OnboardExecutorOptions", "realtime.fifo_priority", realtime.fifo_priority,
                     "0 or at least 3 (the perception and planning threads run one and two below it)");
@@ -51,6 +68,11 @@ OnboardExecutor::OnboardExecutor(stack::FlightStack* stack, Clock* clock, Comman
     : stack_(stack), tasks_(stack->DetachTasks()), clock_(clock), sink_(sink), options_(options) {
   options_.Validate();
   deadline_ns_ = options_.deadline_s > 0.0 ? FromSeconds(options_.deadline_s) : stack_->control_period_ns();
+  std::sort(options_.stalls.begin(), options_.stalls.end(),
+            [](const OnboardExecutorOptions::Stall& a, const OnboardExecutorOptions::Stall& b) { return a.at_s < b.at_s; });
+  if (tasks_.planning && !options_.lockstep_order) tasks_.planning->set_plan_ahead_s(options_.plan_ahead_s);
+  policy_ = options_.deadline_policy && !options_.lockstep_order;
+  if (policy_) stack_->PrepareFallback();
   // The control cycle reads the planning's status and reference before its first output.
   if (tasks_.planning) planning_output_.Publish({tasks_.planning->followed(), tasks_.planning->status()});
 }
@@ -60,6 +82,7 @@ OnboardExecutor::~OnboardExecutor() { Stop(); }
 void OnboardExecutor::Intake(SensorMessage m) {
   m.seq = messages_in_;
   if (!intake_.TryPush(m)) return;
+  if (m.kind == SensorMessage::Kind::kImu) newest_intake_imu_ns_.store(m.imu.t_ns, std::memory_order_release);
   ++messages_in_;
   intake_bell_.Ring();
 }
@@ -89,16 +112,26 @@ void OnboardExecutor::Start() {
   const int priority = report_.realtime.fifo ? options_.realtime.fifo_priority : 0;
   control_ = std::thread([this, priority] {
     FollowFifo(priority);
+    if (options_.on_thread_start) options_.on_thread_start("control");
     ControlLoop();
   });
   perception_ = std::thread([this, priority] {
     FollowFifo(priority > 0 ? priority - 1 : 0);
+    if (options_.on_thread_start) options_.on_thread_start("perception");
     PerceptionLoop();
   });
   planning_ = std::thread([this, priority] {
     FollowFifo(priority > 0 ? priority - 2 : 0);
+    if (options_.on_thread_start) options_.on_thread_start("planning");
     PlanningLoop();
   });
+  if (policy_) {
+    guard_ = std::thread([this, priority] {
+      FollowFifo(priority > 0 ? std::min(priority + 1, sched_get_priority_max(SCHED_FIFO)) : 0);
+      if (options_.on_thread_start) options_.on_thread_start("guard");
+      GuardLoop();
+    });
+  }
 }
 
 void OnboardExecutor::Stop() {
@@ -106,7 +139,8 @@ void OnboardExecutor::Stop() {
   intake_bell_.Ring();
   perception_bell_.Ring();
   planning_bell_.Ring();
-  for (std::thread* t : {&control_, &perception_, &planning_}) {
+  guard_bell_.Ring();
+  for (std::thread* t : {&control_, &perception_, &planning_, &guard_}) {
     if (t->joinable()) t->join();
   }
   report_.control.dropped = intake_.dropped();
@@ -209,7 +243,15 @@ void OnboardExecutor::ControlLoop() {
 }
 
 void OnboardExecutor::RunCycle(TimeNs t) {
+  // Fault injection: a computer that falls behind.
+  for (; next_stall_ < options_.stalls.size() && t >= FromSeconds(options_.stalls[next_stall_].at_s); ++next_stall_) {
+    clock_->SleepUntil(t + FromSeconds(options_.stalls[next_stall_].duration_s));
+  }
   const TimeNs start = SteadyClock::Monotonic();
+  // What the deadline guard did since the last cycle, reported by the supervisor (a hand-over
+  // lands from this cycle on).
+  stack::DeadlineEvent event;
+  while (deadline_events_.TryPop(&event)) stack_->OnDeadline(event);
   const PlanningOutput* plan = planning_output_.Newest();
   const stack::PlanStatus none;
   const stack::FlightMode mode = stack_->BeginCycle(t, plan ? plan->status : none);
@@ -233,15 +275,94 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   cycle.mode = mode;
   cycle.estimate = stack_->estimate();
   cycle.reference = stack_->reference_point();
+  // The plan's commands for the instants after this one: what the guard holds if they are late.
+  std::array<RotorVector, 2> held;
+  for (int j = 0; policy_ && j < options_.hold_periods; ++j) {
+    held[static_cast<std::size_t>(j)] = stack_->HeldCommand(t + (j + 1) * stack_->control_period_ns());
+  }
   cycle.command.compute_s = ToSeconds(SteadyClock::Monotonic() - start);
+  LockSend();
   cycle.command.sent_t_ns = clock_->Now();
   sink_->Send(cycle);
+  const bool first = !have_fresh_;
+  fresh_ = cycle;
+  held_ = held;
+  // A command in time ends a run of misses; a late one does not (a computer that is always late
+  // is handed over, not held forever).
+  if (cycle.command.sent_t_ns - t <= deadline_ns_) missed_ = 0;
+  have_fresh_ = true;
+  UnlockSend();
+  if (first) guard_bell_.Ring();
   const TimeNs latency = cycle.command.sent_t_ns - t;
   LoopReport& r = report_.control;
   ++r.runs;
   r.latency.Record(latency);
   if (latency > deadline_ns_) ++r.misses;
   r.compute.Record(SteadyClock::Monotonic() - start);
+}
+
+void OnboardExecutor::LockSend() {
+  for (int spins = 0; send_lock_.test_and_set(std::memory_order_acquire); ++spins) {
+    if (spins > 64) std::this_thread::yield();  // a holder that was preempted (no SCHED_FIFO)
+  }
+}
+
+void OnboardExecutor::UnlockSend() { send_lock_.clear(std::memory_order_release); }
+
+void OnboardExecutor::GuardLoop() {
+  const TimeNs period = stack_->control_period_ns();
+  // An IMU-triggered cycle's instant is its sample's, at or up to an IMU interval past the grid's
+  // instant: a command counts as the instant's when its state is within half a period of it, and
+  // the guard judges a quarter period after the deadline (an IMU interval of up to 1.25 ms at 200 Hz).
+  const TimeNs slack = period / 2;
+  const TimeNs grace = period / 4;
+  std::optional<TimeNs> watched;  // the next instant judged at its deadline (only ever later)
+  while (!stop_.load(std::memory_order_acquire)) {
+    const std::uint32_t seen = guard_bell_.Count();
+    LockSend();
+    const bool have = have_fresh_;
+    const TimeNs fresh = fresh_.command.state_t_ns;
+    UnlockSend();
+    if (!have) {
+      guard_bell_.Wait(seen, kPollNs);
+      continue;
+    }
+    if (!watched || fresh + period > *watched) watched = fresh + period;
+    const TimeNs instant = *watched;
+    if (!clock_->SleepUntil(instant + deadline_ns_ + grace) || stop_.load(std::memory_order_acquire)) break;
+    if (newest_intake_imu_ns_.load(std::memory_order_acquire) < instant - slack) {
+      // No IMU sample for the instant: a sensor that stopped (or the end of a flight) is the
+      // estimator's matter, not a late computer's.
+      if (!clock_->SleepUntil(clock_->Now() + period)) break;
+      continue;
+    }
+    LockSend();
+    if (fresh_.command.state_t_ns >= instant - slack) {
+      UnlockSend();  // the instant's own command came
+      continue;
+    }
+    // A miss: the last plan's command for the instant, or, once too many came in a row, the
+    // fallback controller (its hand-over is the control thread's next cycle).
+    const int j = static_cast<int>((instant - fresh_.command.state_t_ns + slack) / period);
+    stack::DeadlineEvent e;
+    e.t = ToSeconds(instant);
+    e.missed = ++missed_;
+    e.step = missed_ <= options_.hold_periods ? stack::DeadlineStep::kHold : stack::DeadlineStep::kFallback;
+    if (e.step == stack::DeadlineStep::kHold) {
+      CycleTelemetry c = fresh_;
+      c.command.held = j;
+      c.command.thrust_n = held_[static_cast<std::size_t>(std::clamp(j, 1, options_.hold_periods) - 1)];
+      c.command.sent_t_ns = clock_->Now();
+      sink_->Send(c);
+    }
+    UnlockSend();
+    *watched += period;
+    if (e.missed <= options_.hold_periods + 1) {  // the steps of one run of misses, not every one after
+      deadline_events_.TryPush(e);
+      ++(e.step == stack::DeadlineStep::kHold ? report_.holds : report_.fallbacks);
+      deadline_steps_.fetch_add(1, std::memory_order_acq_rel);
+    }
+  }
 }
 
 void OnboardExecutor::PublishLioUpdate(std::uint64_t* published_serial) {

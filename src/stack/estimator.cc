@@ -32,6 +32,10 @@ OdometryImuEstimator::OdometryImuEstimator(double thrust_coefficient_n_s2, const
     : Estimator(thrust_coefficient_n_s2), options_(options) {
   options_.Validate();
   imu_history_ns_ = FromSeconds(options_.imu_history_s);
+  // Room for the history at an IMU of up to 4 kHz (a faster one, or a longer history than 16 s,
+  // grows it once).
+  imu_history_ = RingBuffer<ImuSample>(
+      static_cast<std::size_t>(std::ceil(std::min(options_.imu_history_s, 16.0) * 4000.0)) + 1);
 }
 
 void OdometryImuEstimator::Integrate(const ImuSample& imu, Strapdown* s) const {

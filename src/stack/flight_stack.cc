@@ -250,7 +250,9 @@ void FlightStack::OnRotorFailed(int rotor, double t, double onset) {
         fmt::join(failed_rotors, ", "));
   }
   if (nmpc_) nmpc_->RewindDisturbance(onset);
+  if (fallback_nmpc_) fallback_nmpc_->RewindDisturbance(onset);
   controller_->SetRotorFailed(rotor);
+  if (fallback_) fallback_->SetRotorFailed(rotor);
   planning_events_.push_back({PlanningEvent::Kind::kFailure, 0.0});
 }
 
@@ -263,9 +265,11 @@ void FlightStack::OnRotorDegraded(int rotor, double effectiveness, double onset)
   // A detector's estimate may come back to 1 (the UKF's): "told" is its own flag.
   if (degraded_told_[i] && std::abs(eta - effectiveness_[i]) < kChange) return;
   if (!degraded_told_[i] && nmpc_) nmpc_->RewindDisturbance(onset);
+  if (!degraded_told_[i] && fallback_nmpc_) fallback_nmpc_->RewindDisturbance(onset);
   degraded_told_[i] = true;
   effectiveness_[i] = eta;
   controller_->SetRotorEffectiveness(rotor, eta);
+  if (fallback_) fallback_->SetRotorEffectiveness(rotor, eta);
   // The planner keeps to what the weakened vehicle can still accelerate (failure-aware only).
   planning_events_.push_back(
       {PlanningEvent::Kind::kAccelerationLimit,
@@ -380,10 +384,45 @@ const RotorCommand& FlightStack::EndCycle(TimeNs t, FlightMode mode, std::shared
   }
   {
     const ScopedCost cost(&cost_.controller_s);
-    controller_->Compute(estimate_, followed, ts, dt, &command_.thrust_n);
+    // The fallback runs every cycle, so that its filters are warm when it takes over; once it
+    // has, the controller that was too slow no longer runs.
+    if (fallback_) fallback_->Compute(estimate_, followed, ts, dt, &fallback_command_);
+    if (fallback_flying_ && fallback_) {
+      command_.thrust_n = fallback_command_;
+    } else {
+      controller_->Compute(estimate_, followed, ts, dt, &command_.thrust_n);
+    }
   }
   if (fdd_) fdd_->SetCommand(command_);
   return command_;
+}
+
+RotorVector FlightStack::HeldCommand(TimeNs t) const {
+  RotorVector u = command_.thrust_n;
+  if (command_.thrust_n.isZero()) return u;  // motors stopped (landed, terminated, not flying yet)
+  flying_controller().PlannedCommand(ToSeconds(t), &u);
+  return u;
+}
+
+void FlightStack::PrepareFallback() {
+  RG_INVARIANT(!last_update_ns_, "FlightStack::PrepareFallback: before the first cycle");
+  if (fallback_ || !nmpc_) return;
+  // The same NMPC, fault-aware as the flown one, at a fraction of its cost: half the horizon and
+  // a mixed-level iteration (Jacobians and the condensed factorisation reused between
+  // re-linearisations). The INDI controller would cost less still, but taking over from the NMPC
+  // in the spin of a failed rotor it tumbles (tilt about 1 rad throughout, docs/runtime.md).
+  control::NmpcOptions reduced = nmpc_->options();
+  reduced.horizon_steps = std::max(1, reduced.horizon_steps / 2);
+  reduced.relinearise_every = std::max(reduced.relinearise_every, 4);
+  auto nmpc = std::make_unique<control::NmpcController>(model_.params(), reduced);
+  fallback_nmpc_ = nmpc.get();
+  fallback_ = std::move(nmpc);
+  fallback_command_ = RotorVector::Zero(model_.num_rotors());
+}
+
+void FlightStack::OnDeadline(const DeadlineEvent& e) {
+  if (e.step == DeadlineStep::kFallback) fallback_flying_ = true;
+  supervisor_.OnDeadline(e, flying_controller().name());
 }
 
 const RotorCommand& FlightStack::OverrideCommand(const RotorVector& thrust_n) {
@@ -417,6 +456,7 @@ FlightStackSummary FlightStack::Summarize() const {
   s.lidar_points_dropped = lidar_points_dropped();
   if (const LioEstimator* odometry = lio()) s.odometry = odometry->Summarize();
   s.reconfigurations = reconfigurations_;
+  s.deadline_events = supervisor_.deadline_events();
   return s;
 }
 

@@ -12,7 +12,13 @@ namespace rotorguard::stack {
 
 void SupervisorOptions::Validate() const { CheckDeclaredRanges("SupervisorOptions", *this); }
 
-Supervisor::Supervisor(const SupervisorOptions& options) : options_(options) { options_.Validate(); }
+Supervisor::Supervisor(const SupervisorOptions& options) : options_(options) {
+  options_.Validate();
+  // Room for a flight's events: a hold of the deadline policy, on the control thread, allocates
+  // nothing (a transition's reason still does: it is an event).
+  transitions_.reserve(16);
+  deadline_events_.reserve(64);
+}
 
 void Supervisor::Enter(FlightMode to, double t, std::string reason) {
   transitions_.push_back({t, mode_, to, std::move(reason)});
@@ -68,6 +74,8 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
     land = fmt::format("no feasible trajectory for {:.1f} s", in.since_last_plan_s);
   } else if (!in.land_request.empty()) {
     land = in.land_request;
+  } else if (!deadline_land_.empty()) {
+    land = deadline_land_;
   }
   if (!land.empty()) {
     landing_start_ = e.p_W.allFinite() ? e.p_W : Vector3::Zero();
@@ -95,6 +103,14 @@ FlightMode Supervisor::Update(const SupervisorInputs& in) {
     }
   }
   return mode_;
+}
+
+void Supervisor::OnDeadline(const DeadlineEvent& e, std::string_view controller) {
+  deadline_events_.push_back(e);
+  if (e.step == DeadlineStep::kFallback && deadline_land_.empty()) {
+    deadline_land_ = fmt::format("control deadline missed at {} instants in a row (t = {:.3f} s): the {} controller lands",
+                                 e.missed, e.t, controller);
+  }
 }
 
 }  // namespace rotorguard::stack

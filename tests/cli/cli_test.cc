@@ -116,6 +116,9 @@ TEST_F(CliTest, SitlFliesAPropellerLossInRealTimeWithTheStackInItsOwnProcess) {
   EXPECT_EQ(runs + rt["control"]["skipped"].get<std::uint64_t>(), 1200u);
   EXPECT_EQ(rt["link"]["commands"].get<std::uint64_t>() + rt["link"]["commands_after_end"].get<std::uint64_t>(), runs);
   EXPECT_EQ(s["control_cycles"].get<std::uint64_t>(), runs);
+  for (const char* file : {"log.csv", "scene.json", "sensors.csv", "vehicle.yaml", "truth_vehicle.yaml"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "sitl" / file)) << file;
+  }
 }
 
 /// On the simulator's clock (the simulator waits for each command), the stack in its own process
@@ -138,6 +141,32 @@ TEST_F(CliTest, SitlOnTheSimulatorsClockInTwoProcessesFliesRunsFlightToTheBit) {
   }
   EXPECT_EQ(a["fdd"]["detection_s"], b["fdd"]["detection_s"]);
   EXPECT_EQ(nlohmann::json::parse(ReadText(dir_ / "sitl" / "runtime.json"))["link"]["processes"], 2);
+  // log.csv: `run`'s columns but the stack's internals (FDD indices, NMPC time, odometry health,
+  // which stay in the node), row for row the same text.
+  const auto table = [](const std::string& text) {
+    std::vector<std::vector<std::string>> rows;
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) {
+      std::vector<std::string> fields;
+      std::istringstream cells(line);
+      for (std::string f; std::getline(cells, f, ',');) fields.push_back(f);
+      rows.push_back(fields);
+    }
+    return rows;
+  };
+  const auto ra = table(ReadText(dir_ / "run" / "log.csv")), rb = table(ReadText(dir_ / "sitl" / "log.csv"));
+  ASSERT_EQ(ra.size(), rb.size());
+  ASSERT_GT(rb.size(), 10u);
+  std::size_t compared = 0;
+  for (std::size_t j = 0; j < rb[0].size(); ++j) {
+    const auto col = std::find(ra[0].begin(), ra[0].end(), rb[0][j]);
+    ASSERT_NE(col, ra[0].end()) << rb[0][j];
+    const auto i = static_cast<std::size_t>(col - ra[0].begin());
+    for (std::size_t k = 1; k < rb.size(); ++k) ASSERT_EQ(ra[k][i], rb[k][j]) << rb[0][j] << ", row " << k;
+    ++compared;
+  }
+  EXPECT_GE(compared, 50u) << "truth, reference, estimate, mode, rotors";
+  EXPECT_LT(rb[0].size(), ra[0].size()) << "the stack's internal columns are the node's";
 }
 
 /// A node given a channel no simulator made says which, and fails.
@@ -146,6 +175,16 @@ TEST_F(CliTest, ANodeWithoutItsChannelNamesIt) {
   const Result r = Cli("node " + scenario + " --channel /rotorguard-sitl-none");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.out.find("/rotorguard-sitl-none"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, AStallWithoutItsDurationIsAUsageErrorShowingTheForm) {
+  const std::string scenario = rotorguard::testing::SourcePath("configs/scenarios/hover.yaml");
+  Result r = Cli("sitl " + scenario + " --stall 3.0");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("--stall '3.0' is invalid; expected AT:DURATION"), std::string::npos) << r.out;
+  r = Cli("sitl " + scenario + " --stall 3.0:0");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.out.find("--stall DURATION '0' is invalid"), std::string::npos) << r.out;
 }
 
 /// Bad list and word options of the benchmarks are usage errors that name the option and the field.

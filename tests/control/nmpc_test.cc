@@ -136,6 +136,35 @@ TEST(Nmpc, AFailedRotorGetsZeroThrustAndTheTwinIdlesInTheReference) {
   RG_EXPECT_THROW_WITH(nmpc.SetRotorFailed(4), std::invalid_argument, "rotor = 4");
 }
 
+TEST(Nmpc, ThePlannedCommandIsThePlansInputOnItsClockAfterTheExpectedDelay) {
+  // A rolling vehicle, so that the plan's inputs change from node to node.
+  NmpcOptions o;
+  o.expected_delay_s = 0.01;
+  NmpcController nmpc(ReferenceQuad(), o);
+  const auto ref = HoverAt(1.0);
+  StateEstimate est = HoverEstimate(1.0);
+  est.w_B = Vector3(3.0, -1.0, 0.5);
+  RotorVector cmd, planned;
+  EXPECT_FALSE(nmpc.PlannedCommand(0.0, &planned)) << "no plan before the first call";
+  // dt = 0: no preparation; the plan's node 0 is at the call's time plus the delay.
+  nmpc.Compute(est, ref, 1.0, 0.0, &cmd);
+  const std::vector<Eigen::VectorXd>& u = nmpc.planned_inputs();
+  ASSERT_GT((u[1] - u[0]).norm(), 1e-3) << "a plan whose inputs do not change checks nothing";
+  ASSERT_TRUE(nmpc.PlannedCommand(1.0, &planned));
+  EXPECT_TRUE(MatricesNear(planned, cmd, 1e-12)) << "at the call's own time: the command it sent";
+  // 10 ms later: a fifth of the way from node 0 to node 1 (50 ms apart), held to the bounds.
+  const Eigen::VectorXd expected = (0.8 * u[0] + 0.2 * u[1]).cwiseMax(0.0).cwiseMin(nmpc.input_upper_bounds());
+  ASSERT_TRUE(nmpc.PlannedCommand(1.01, &planned));
+  EXPECT_TRUE(MatricesNear(planned, expected, 1e-12));
+  // With the preparation for the next call (dt = 5 ms), the plan is shifted: its node 0 is the
+  // input for the next call, the same instant as before.
+  nmpc.Compute(est, ref, 1.005, 0.005, &cmd);
+  ASSERT_TRUE(nmpc.PlannedCommand(1.01, &planned));
+  const Eigen::VectorXd shifted =
+      nmpc.planned_inputs()[0].cwiseMax(0.0).cwiseMin(nmpc.input_upper_bounds());
+  EXPECT_TRUE(MatricesNear(planned, shifted, 1e-12));
+}
+
 TEST(Nmpc, LosingADiagonalPairLeavesTheOtherPairSharingTheWeight) {
   NmpcController nmpc(ReferenceQuad(), {});
   nmpc.SetRotorFailed(0);

@@ -145,6 +145,41 @@ TEST(Replanner, TheFollowedReferenceIsTheReplannersReferenceAsAValue) {
   EXPECT_EQ(hold->Evaluate(3.0).p_W, Vector3(0, 0, 1.5)) << "the first copy still holds";
 }
 
+// Onboard, a plan made at t starts at t + the planning's expected computation time, from the
+// reference then: until then the path followed is the one before, to the bit, whenever within
+// that budget the new one is published; at the switch the reference is continuous in p, v and a.
+// The followed copy evaluates as the replanner does, earlier paths included.
+TEST(Replanner, APlanStartedAheadKeepsThePathFollowedUntilItsStart) {
+  const perception::VoxelMap map = EmptyMap();
+  Replanner r(ReplannerOptions{}, Vector3(0, 0, 1.5));
+  r.set_plan_ahead_s(0.05);
+  r.SetGoal(Vector3(5, 1, 1.5));
+  int replans = 0;
+  for (double t = 0.0; t <= 8.0; t += 0.05) {
+    const std::uint64_t serial = r.path_serial();
+    const std::shared_ptr<const ReferenceTrajectory> before = r.Followed();
+    r.Update(t, map);
+    if (r.path_serial() == serial) continue;
+    ++replans;
+    const std::shared_ptr<const ReferenceTrajectory> after = r.Followed();
+    for (double s = t; s < t + 0.05 - 1e-9; s += 0.005) {
+      const ReferencePoint a = before->Evaluate(s), b = after->Evaluate(s);
+      ASSERT_TRUE(a.p_W == b.p_W && a.v_W == b.v_W && a.a_W == b.a_W) << "t = " << t << ", s = " << s;
+    }
+    const ReferencePoint a = before->Evaluate(t + 0.05), b = after->Evaluate(t + 0.05);
+    ASSERT_LT((a.p_W - b.p_W).norm(), 1e-9) << "t = " << t;
+    ASSERT_LT((a.v_W - b.v_W).norm(), 1e-9) << "t = " << t;
+    ASSERT_LT((a.a_W - b.a_W).norm(), 1e-9) << "t = " << t;
+    for (double s = t; s <= t + 1.0; s += 0.01) {
+      const ReferencePoint x = after->Evaluate(s), y = r.Evaluate(s);
+      ASSERT_TRUE(x.p_W == y.p_W && x.v_W == y.v_W) << "t = " << t << ", s = " << s;
+    }
+  }
+  EXPECT_GE(replans, 3) << "the goal's plan and the periodic replans";
+  EXPECT_TRUE(r.arrived());
+  EXPECT_LT((r.Reference(8.0).p_W - Vector3(5, 1, 1.5)).norm(), 1e-6);
+}
+
 // The heading given at construction is held before and through every plan.
 TEST(Replanner, KeepsTheHeadingItWasGiven) {
   const perception::VoxelMap map = EmptyMap();

@@ -18,6 +18,11 @@ class Controller {
   /// Never writes non-finite values: a non-finite input yields a safe fallback command.
   virtual void Compute(const StateEstimate& estimate, const ReferenceTrajectory& reference, double t, double dt,
                        RotorVector* thrust_command) = 0;
+  /// The command this controller's last plan gives for a later call at time t [s] (t after the
+  /// last call): what an onboard executor holds on the motors while a cycle is late (the NMPC's
+  /// shifted plan). False for a controller without a plan ahead: the executor then holds its
+  /// last command.
+  virtual bool PlannedCommand(double /*t*/, RotorVector* /*thrust_command*/) const { return false; }
   /// Clears internal state (integrators, filters).
   virtual void Reset() = 0;
   /// A rotor has been isolated as failed. Controllers that can reconfigure do; the default ignores

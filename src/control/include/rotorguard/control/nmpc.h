@@ -147,6 +147,9 @@ class NmpcController final : public Controller {
   const ModelCorrection& model_correction() const { return model_.correction(); }
   const NmpcSummary& summary() const { return summary_; }
   const NmpcOptions& options() const { return options_; }
+  /// The plan's input at the plan's time t + expected_delay_s, interpolated between its nodes as
+  /// the warm start's shift does: the shifted plan an executor holds while a cycle is late.
+  bool PlannedCommand(double t, RotorVector* thrust_command) const override;
   /// The current plan: N + 1 states and N inputs (after the last call).
   const std::vector<Eigen::VectorXd>& planned_states() const { return x_; }
   const std::vector<Eigen::VectorXd>& planned_inputs() const { return u_; }
@@ -217,6 +220,7 @@ class NmpcController final : public Controller {
   std::vector<Eigen::VectorXd> x_shift_, u_shift_;
   bool initialised_ = false;
   double last_t_ = 0.0;
+  double plan_t0_ = 0.0;  // the plan's time (a call's time plus the expected delay) at node 0
   std::optional<double> prepared_for_t_;  // time the prepared QP is for, in RTI mode
   // RTI preparations since the last linearisation; -1 forces the next one to linearise (the
   // weights or bounds' pattern changed, or there is no linearisation to reuse).

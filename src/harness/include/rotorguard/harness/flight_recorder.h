@@ -44,6 +44,19 @@ struct FlightRecorderOptions {
 /// std::runtime_error when the folder cannot be created.
 void PrepareRunFolder(const std::string& dir, std::initializer_list<const char*> outputs);
 
+/// The stack's side of a log row: the stack in this process (with its FDD indices, NMPC solve
+/// time and odometry health), or what a software-in-the-loop node reports of its newest cycle
+/// (stack null: the log has no such columns).
+struct StackRow {
+  ReferencePoint reference;
+  StateEstimate estimate;
+  stack::FlightMode mode = stack::FlightMode::kNominal;
+  const stack::FlightStack* stack = nullptr;
+  static StackRow Of(const stack::FlightStack& st) {
+    return {st.reference_point(), st.estimate(), st.supervisor().mode(), &st};
+  }
+};
+
 class FlightRecorder {
  public:
   /// Creates the folder and removes the files an earlier run left in it (nothing of two runs may
@@ -59,15 +72,19 @@ class FlightRecorder {
   /// The stack is built: the log's columns follow what it runs (its FDD, the NMPC, the LiDAR-inertial
   /// odometry).
   void Begin(const stack::FlightStack& stack, int num_rotors);
+  /// Or, the stack in another process: the log's common columns only.
+  void BeginWithoutStack(int num_rotors);
   /// After each control cycle at time t: its command and what the scene draws of the stack.
   void OnControlCycle(TimeNs t, const stack::FlightStack& stack, const RotorCommand& command);
+  /// Or, the stack in another process: its command, to the sensor log.
+  void OnCommand(const RotorCommand& command);
   /// Before each physics step: a log row when one is due.
-  void OnStep(TimeNs t, const sim::Simulator& sim, const stack::FlightStack& stack);
+  void OnStep(TimeNs t, const sim::Simulator& sim, const StackRow& stack);
   /// After each physics step: the sensor log goes to its file in chunks of about 1 MB.
   void AfterStep();
   /// At the flight's end: its last row, then log.csv, scene.json, sensors.csv, vehicle.yaml (the
   /// stack's) and truth_vehicle.yaml (the simulator's).
-  void WriteFlight(const sim::Simulator& sim, const stack::FlightStack& stack);
+  void WriteFlight(const sim::Simulator& sim, const StackRow& stack, const vehicle::VehicleParams& stack_vehicle);
   /// Then flight.mcap, summary.json and report.html, as asked. Throws std::runtime_error when a
   /// file cannot be written.
   void WriteSummary(const RunSummary& summary);

@@ -31,5 +31,8 @@ RunSummary RunScenario(const Scenario& scenario, const RunOptions& options = {})
 /// Hands a simulator step's sensor messages to the stack (the only way the truth reaches it), and
 /// appends them to `sensor_log` (sensors.csv's format) when given.
 void DeliverToStack(const sim::SensorOutputs& outputs, stack::FlightStack* stack, std::string* sensor_log = nullptr);
+/// Appends a step's IMU sample, ESC telemetry and odometry to `sensor_log` (sensors.csv's format;
+/// null: nothing).
+void AppendSensorLog(const sim::SensorOutputs& outputs, std::string* sensor_log);
 
 }  // namespace rotorguard::harness

@@ -6,6 +6,7 @@
 /// the planner's thread publishes it and the control thread reads it (docs/runtime.md).
 #include <limits>
 #include <optional>
+#include <vector>
 
 #include "rotorguard/core/trajectory.h"
 
@@ -23,6 +24,29 @@ class FollowedReference final : public ReferenceTrajectory {
  private:
   std::optional<Path> path_;
   ReferencePoint hold_;
+};
+
+/// Of paths followed in turn, each from its start_time() until the next one's (the first also
+/// before its own), the one in effect at t.
+template <typename Path>
+const Path& PathInEffect(const std::vector<Path>& paths, double t) {
+  std::size_t i = 0;
+  while (i + 1 < paths.size() && t >= paths[i + 1].start_time()) ++i;
+  return paths[i];
+}
+
+/// Paths followed in turn (PathInEffect): a plan made at t to start at t + its expected
+/// computation time, from the state the path followed until then predicts for that start, so
+/// that the switch is continuous however late within that budget the plan is published
+/// (docs/runtime.md, "Late results").
+template <typename Path>
+class PathsInTurn {
+ public:
+  explicit PathsInTurn(std::vector<Path> paths) : paths_(std::move(paths)) {}
+  ReferencePoint Evaluate(double t) const { return PathInEffect(paths_, t).Evaluate(t); }
+
+ private:
+  std::vector<Path> paths_;
 };
 
 }  // namespace rotorguard::planning

@@ -112,6 +112,11 @@ class Replanner final : public ReferenceTrajectory {
   std::uint64_t path_serial() const { return path_serial_; }
   /// An immutable copy of what is followed (FollowedReference): Evaluate's reference, as a value.
   std::shared_ptr<const ReferenceTrajectory> Followed() const;
+  /// A plan made at t starts at t + `s` from the reference then (the followed path until then):
+  /// what an onboard executor sets to its planning's expected computation time, so that a plan
+  /// published late is still continuous. 0 (lockstep, where planning takes no time): at t. A
+  /// brake starts at once, always.
+  void set_plan_ahead_s(double s) { plan_ahead_s_ = std::max(0.0, s); }
   /// The last planning query's summary.
   const PlanSummary& last_plan() const { return last_plan_; }
   /// The goal the last query planned to: the goal, or a local goal towards it (LocalGoal).
@@ -136,6 +141,10 @@ class Replanner final : public ReferenceTrajectory {
   DynamicLimits limits_;
   Mode mode_ = Mode::kIdle;
   MinimumJerkTrajectory trajectory_;
+  // Plans started ahead (plan_ahead_s_ > 0): the trajectories followed in turn before
+  // trajectory_ starts (PathInEffect); empty in lockstep.
+  std::vector<MinimumJerkTrajectory> earlier_;
+  double plan_ahead_s_ = 0.0;
   std::uint64_t path_serial_ = 0;
   Vector3 hold_;
   double yaw_ = 0.0;

@@ -9,19 +9,26 @@
 ///   perception: the LiDAR-inertial odometry and the map, on each frame (the IMU and ESC
 ///            telemetry copied to it by the control thread)
 ///   planning: PlanningTask::Update after each control cycle, on the newest cycle's inputs
+///   deadline guard: when an instant's deadline passes without a fresh command, sends the last
+///            plan's command for it (at most `hold_periods` instants in a row); one more hands
+///            the control to the fallback controller, which lands (docs/runtime.md)
 ///
 /// Hand-offs are the runtime's bounded, allocation-free queues and triple buffers; the map is the
 /// only object two threads share (the perception writes it, the planning reads it) and the control
 /// thread never touches it. Every cycle's command is stamped with its IMU sample's time (the state
 /// it was computed from) and the time it was sent on the executor's clock, so its latency is
 /// measured.
+#include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <shared_mutex>
 #include <string>
+#include <string_view>
 #include <thread>
+#include <vector>
 
 #include "rotorguard/core/messages.h"
 #include "rotorguard/runtime/clock.h"
@@ -40,6 +47,9 @@ struct StampedCommand {
   TimeNs state_t_ns = 0;    ///< the instant of the IMU sample that started the cycle (the state it used)
   TimeNs sent_t_ns = 0;     ///< when it was sent, on the executor's clock
   double compute_s = 0.0;   ///< the cycle's own work, on the steady clock [s]
+  /// 0: the cycle's own command; j > 0: the deadline guard's, the cycle's plan held at the j-th
+  /// instant after its own (the later cycles were late).
+  int held = 0;
   RotorVector thrust_n;
 };
 
@@ -85,8 +95,9 @@ struct SensorMessage {
   }
 };
 
-/// Where commands and telemetry go: called on the control thread, so it must neither block nor
-/// allocate (a queue push; a transport's send).
+/// Where commands and telemetry go: called on the control thread, and on the deadline guard's when
+/// a cycle is late (never both at once), so it must neither block nor allocate (a queue push; a
+/// transport's send).
 class CommandSink {
  public:
   virtual ~CommandSink() = default;
@@ -118,6 +129,29 @@ struct OnboardExecutorOptions {
   /// A cycle's command sent later than this after its IMU sample is a deadline miss [s]; 0: one
   /// control period.
   double deadline_s = 0.0;
+  /// The deadline policy: an instant whose deadline passed without a fresh command (while its
+  /// IMU sample had come) gets the last plan's command for it, for at most this many instants in
+  /// a row, in [0, 2]; one more hands the control to the stack's fallback controller, which lands.
+  /// Off with lockstep_order (time then waits for the stack).
+  int hold_periods = 2;
+  /// The deadline policy on (off: a late cycle's instant passes without a command; with
+  /// lockstep_order it is always off).
+  bool deadline_policy = true;
+  /// A replan made at a cycle's instant t starts at t + this [s], from the reference the control
+  /// follows until then, in [0, 1]: the planning thread's expected computation time, so that a
+  /// plan published within it switches without a jump (docs/runtime.md, "Late results"). Off
+  /// (0) with lockstep_order.
+  double plan_ahead_s = 0.05;
+  /// Fault injection (tests, demonstrations): the control cycle at the first instant t at or past
+  /// `at_s` stalls until t + `duration_s` on the executor's clock, as a computer that falls behind.
+  struct Stall {
+    double at_s = 0.0;
+    double duration_s = 0.0;
+  };
+  std::vector<Stall> stalls;
+  /// Called first on each of the executor's threads with its name ("control", "perception",
+  /// "planning", "guard"): CPU affinity, a profiler's registration, a test's instrumentation.
+  std::function<void(std::string_view thread)> on_thread_start;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -135,6 +169,8 @@ struct LoopReport {
 
 struct OnboardReport {
   LoopReport control, perception, planning;
+  std::uint64_t holds = 0;      ///< the deadline guard's commands (the last plan held)
+  std::uint64_t fallbacks = 0;  ///< its hand-overs to the fallback controller
   RealtimeGrant realtime;
 };
 
@@ -164,6 +200,8 @@ class OnboardExecutor {
   OnboardReport Report() const;
   /// Sensor messages the control thread has taken in so far (any thread may ask).
   std::uint64_t messages_taken() const { return messages_taken_.load(std::memory_order_acquire); }
+  /// The deadline guard's steps so far (holds and hand-overs; any thread may ask).
+  std::uint64_t deadline_steps() const { return deadline_steps_.load(std::memory_order_acquire); }
 
  private:
   /// Pushes `m` to the control thread (dropped and counted when its queue is full).
@@ -194,6 +232,12 @@ class OnboardExecutor {
   void PlanningLoop();
   /// A control cycle at the IMU sample of time t.
   void RunCycle(TimeNs t);
+  /// The deadline guard's thread (docs/runtime.md, "Deadline policy").
+  void GuardLoop();
+  /// The send lock: the control thread's and the guard's commands never interleave (either
+  /// holds it for a copy and a send only).
+  void LockSend();
+  void UnlockSend();
 
   stack::FlightStack* stack_;
   stack::FlightStack::Tasks tasks_;
@@ -201,6 +245,7 @@ class OnboardExecutor {
   CommandSink* sink_;
   OnboardExecutorOptions options_;
   TimeNs deadline_ns_ = 0;
+  bool policy_ = false;  // the deadline policy runs (a guard thread, a fallback controller)
 
   // intake -> control
   SpscQueue<SensorMessage, 1024> intake_;
@@ -242,6 +287,17 @@ class OnboardExecutor {
   Latest<PlanningOutput> planning_output_;
   std::shared_mutex map_mutex_;  // the perception writes the map, the planning reads it
 
+  // control <-> deadline guard, under send_lock_ (a spin lock: the holders copy and send only)
+  std::atomic_flag send_lock_;
+  bool have_fresh_ = false;                         // a cycle's command was sent
+  CycleTelemetry fresh_;                            // the last cycle's own command
+  std::array<RotorVector, 2> held_;                 // its plan's commands at the next instants
+  int missed_ = 0;  // instants in a row whose deadline passed without their command (the guard counts, a timely command resets)
+  std::atomic<TimeNs> newest_intake_imu_ns_{-1};   // the intake's newest IMU sample
+  SpscQueue<stack::DeadlineEvent, 64> deadline_events_;  // guard -> control: reported at the next cycle
+  Doorbell guard_bell_;
+  std::atomic<std::uint64_t> deadline_steps_{0};
+  std::size_t next_stall_ = 0;
   std::optional<TimeNs> next_cycle_ns_;
   TimeNs newest_imu_ns_ = 0;
   bool have_imu_ = false;
@@ -250,7 +306,7 @@ class OnboardExecutor {
   std::atomic<bool> stop_{false};
   std::atomic<bool> control_done_{false};  // the control thread has ended: nothing more is passed on
   bool started_ = false;
-  std::thread control_, perception_, planning_;
+  std::thread control_, perception_, planning_, guard_;
 };
 
 }  // namespace rotorguard::runtime

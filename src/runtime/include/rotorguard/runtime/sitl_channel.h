@@ -16,7 +16,7 @@
 namespace rotorguard::runtime {
 
 /// The layout's version: a change of anything below changes it.
-inline constexpr std::uint64_t kSitlChannelMagic = 0x72672d7369746c01ull;  // "rg-sitl", 1
+inline constexpr std::uint64_t kSitlChannelMagic = 0x72672d7369746c02ull;  // "rg-sitl", 2
 
 /// A LiDAR frame in shared memory (LidarFrame without its vectors).
 struct FrameSlot {
@@ -50,6 +50,7 @@ enum class NodeState : int {
 struct SitlChannel {
   static constexpr int kFrameSlots = 4;
   static constexpr std::size_t kAccountBytes = 1 << 22;
+  static constexpr std::size_t kMaxStalls = 8;
 
   // Set by the simulator: the executor's options, and the clock (lockstep: the simulator's time,
   // in kTime messages; else a steady clock from clock_origin_ns at clock_rate, set once the node
@@ -58,6 +59,10 @@ struct SitlChannel {
   bool lockstep_order = false;
   bool lockstep_clock = false;
   RealtimeOptions realtime{.lock_memory = false, .fifo_priority = 0};
+  int hold_periods = 2;
+  double plan_ahead_s = 0.05;
+  std::array<OnboardExecutorOptions::Stall, kMaxStalls> stalls{};
+  std::size_t stall_count = 0;
   std::atomic<TimeNs> clock_origin_ns{0};
   double clock_rate = 1.0;
 

@@ -1,12 +1,12 @@
 #pragma once
 /// State estimators of the flight stack. They see sensor messages only.
-#include <deque>
 #include <memory>
 #include <optional>
 #include <span>
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/messages.h"
+#include "rotorguard/core/ring_buffer.h"
 #include "rotorguard/perception/lio.h"
 
 namespace rotorguard::stack {
@@ -108,7 +108,7 @@ class OdometryImuEstimator final : public Estimator {
   OdometrySample odometry_;
   Vector3 w_B_ = Vector3::Zero();
   TimeNs imu_history_ns_ = 0;          ///< options_.imu_history_s
-  std::deque<ImuSample> imu_history_;  ///< the last imu_history_s of valid samples, oldest first
+  RingBuffer<ImuSample> imu_history_;  ///< the last imu_history_s of valid samples, oldest first
   Strapdown arrived_;                  ///< the latest odometry carried to its arrival
   Strapdown dead_reckoned_;            ///< restarted at every odometry sample, then integrated
 };

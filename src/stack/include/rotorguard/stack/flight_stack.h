@@ -212,6 +212,7 @@ struct FlightStackSummary {
   std::optional<LioSummary> odometry;            ///< estimator lio
   long lidar_points_dropped = 0;                 ///< as lidar_points_dropped()
   std::vector<RotorReconfiguration> reconfigurations;  ///< in the order they happened
+  std::vector<DeadlineEvent> deadline_events;          ///< an onboard executor's deadline policy's steps
   /// Every field (the software-in-the-loop node sends it to the simulator's side: docs/runtime.md).
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -224,6 +225,7 @@ struct FlightStackSummary {
     a->Visit("odometry", &odometry);
     a->Visit("lidar_points_dropped", &lidar_points_dropped);
     a->Visit("reconfigurations", &reconfigurations);
+    a->Visit("deadline_events", &deadline_events);
   }
 };
 
@@ -281,6 +283,22 @@ class FlightStack {
   StateEstimate FrameEstimate(const LidarFrame& frame) const { return estimator_->FrameEstimate(frame); }
   /// An emergency landing has started: the stack flies its own descent and the planning rests.
   bool landing() const { return landing_.has_value(); }
+  /// The deadline policy of an onboard executor (docs/runtime.md, "Deadline policy"): the command
+  /// the last cycle's plan gives for the later control instant t (the NMPC's shifted plan; a
+  /// controller without a plan ahead: its last command; zero with the motors stopped).
+  RotorVector HeldCommand(TimeNs t) const;
+  /// Keeps a fallback controller of the current fault state ready for a hand-over, computed every
+  /// cycle without being flown: when the NMPC flies, the same NMPC reduced (half its horizon, a
+  /// mixed-level iteration), reconfigured with it at every isolation. Other controllers are their
+  /// own fallback. Call before the first cycle.
+  void PrepareFallback();
+  /// A step of the deadline policy, reported by the supervisor. kFallback hands the control to the
+  /// fallback controller for good and lands the vehicle.
+  void OnDeadline(const DeadlineEvent& e);
+  /// The controller flying: the fallback once it took over, else the configured one.
+  const control::Controller& flying_controller() const {
+    return fallback_flying_ && fallback_ ? *fallback_ : *controller_;
+  }
   /// Replaces the command of the control cycle just run (Update) with one computed outside the
   /// stack (a controller written in Python, harness::Flight): the fault detection and the next
   /// cycle's supervisor see it as the command sent. Every mode is overridden, the landed and
@@ -354,6 +372,10 @@ class FlightStack {
   std::optional<TimeShiftedReference> descent_;         // ... from the time it started
   std::unique_ptr<control::Controller> controller_;
   control::NmpcController* nmpc_ = nullptr;  // the controller, when it is the NMPC
+  std::unique_ptr<control::Controller> fallback_;  // PrepareFallback's controller of the fault state
+  control::NmpcController* fallback_nmpc_ = nullptr;
+  RotorVector fallback_command_;                   // its command of the last cycle
+  bool fallback_flying_ = false;                   // the deadline policy handed over to it
   std::unique_ptr<fdd::FaultDetector> fdd_;
   std::unique_ptr<PerceptionTask> perception_;  // the LiDAR's: the odometry's frames and the map
   LioHeadEstimator* lio_head_ = nullptr;         // estimator_, when it follows the odometry's head

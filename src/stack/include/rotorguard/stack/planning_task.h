@@ -191,6 +191,11 @@ class PlanningTask {
   NavigationSummary Summarize() const;
   const planning::Replanner* replanner() const { return navigator_.get(); }
   const planning::FlatnessNavigator* flatness() const { return flatness_.get(); }
+  /// The replanner's plans start this far ahead of the instant they are made at
+  /// (Replanner::set_plan_ahead_s; the flatness navigator's legs start when made).
+  void set_plan_ahead_s(double s) {
+    if (navigator_) navigator_->set_plan_ahead_s(s);
+  }
 
  private:
   explicit PlanningTask(const NavigationOptions& options) : options_(options) {}

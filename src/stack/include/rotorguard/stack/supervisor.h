@@ -153,6 +153,27 @@ struct ModeTransition {
   }
 };
 
+/// A step of an onboard executor's deadline policy (docs/runtime.md, "Deadline policy").
+enum class DeadlineStep {
+  kHold,      ///< no fresh command by an instant's deadline: the last plan's command for it was sent
+  kFallback,  ///< a third instant in a row: the controller of the current fault state lands the vehicle
+};
+inline constexpr EnumName<DeadlineStep> kDeadlineStepNames[] = {{DeadlineStep::kHold, "hold"},
+                                                                 {DeadlineStep::kFallback, "fallback"}};
+constexpr std::span<const EnumName<DeadlineStep>> NamesOf(const DeadlineStep*) { return kDeadlineStepNames; }
+
+struct DeadlineEvent {
+  double t = 0.0;  ///< the control instant whose deadline passed [s]
+  DeadlineStep step = DeadlineStep::kHold;
+  int missed = 0;  ///< instants in a row without a fresh command, this one included
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit("t", &t);
+    a->Visit("step", &step);
+    a->Visit("missed", &missed);
+  }
+};
+
 class Supervisor {
  public:
   explicit Supervisor(const SupervisorOptions& options = {});
@@ -160,6 +181,10 @@ class Supervisor {
   FlightMode Update(const SupervisorInputs& in);
   FlightMode mode() const { return mode_; }
   const std::vector<ModeTransition>& transitions() const { return transitions_; }
+  /// Logs a step of the deadline policy (the executor's, reported at the next cycle); a fallback
+  /// lands the vehicle from the next Update on, with `controller` named in the reason.
+  void OnDeadline(const DeadlineEvent& e, std::string_view controller);
+  const std::vector<DeadlineEvent>& deadline_events() const { return deadline_events_; }
   /// Where the emergency landing started (valid in kEmergencyLanding and kLanded).
   const Vector3& landing_start() const { return landing_start_; }
   double landing_start_s() const { return landing_start_s_; }
@@ -177,6 +202,8 @@ class Supervisor {
   Vector3 landing_start_ = Vector3::Zero();
   double landing_start_s_ = 0.0;
   std::vector<ModeTransition> transitions_;
+  std::vector<DeadlineEvent> deadline_events_;
+  std::string deadline_land_;  // the fallback's reason to land ("" = none)
 };
 
 }  // namespace rotorguard::stack
