@@ -63,6 +63,7 @@ nlohmann::json TimingFlight(const SitlBenchOptions& o, const std::string& load, 
   return {{"load", load},
           {"seed", sc.seed},
           {"success", r.summary.success},
+          {"failure_reason", r.summary.failure_reason.value_or("")},
           {"cycles", c.at("runs")},
           {"misses", c.at("deadline_misses")},
           {"skipped", c.at("skipped")},
@@ -78,7 +79,7 @@ nlohmann::json TimingFlight(const SitlBenchOptions& o, const std::string& load, 
 
 nlohmann::json TimingSummary(const std::vector<nlohmann::json>& flights, const std::string& load) {
   std::vector<double> p50, p99;
-  std::uint64_t cycles = 0, misses = 0, holds = 0, fallbacks = 0;
+  std::uint64_t cycles = 0, misses = 0, skipped = 0, holds = 0, fallbacks = 0;
   int flown = 0, successes = 0;
   for (const nlohmann::json& f : flights) {
     if (f.at("load") != load) continue;
@@ -86,20 +87,25 @@ nlohmann::json TimingSummary(const std::vector<nlohmann::json>& flights, const s
     successes += f.at("success").get<bool>() ? 1 : 0;
     cycles += f.at("cycles").get<std::uint64_t>();
     misses += f.at("misses").get<std::uint64_t>();
+    skipped += f.at("skipped").get<std::uint64_t>();
     holds += f.at("holds").get<std::uint64_t>();
     fallbacks += f.at("fallbacks").get<std::uint64_t>();
     p50.push_back(f.at("latency_p50_ms").get<double>());
     p99.push_back(f.at("latency_p99_ms").get<double>());
   }
-  // The miss rate's interval: a Wilson interval over the cycles (a rate of rare events; the
-  // flights' cycles are not independent, so it is a guide, not a bound).
-  const auto [lo, hi] = campaign::WilsonInterval(static_cast<int>(misses), static_cast<int>(cycles));
+  // An instant misses its deadline when its command came late or never (the control thread came
+  // past it late: skipped). The rate's interval is a Wilson interval over the instants (a guide,
+  // not a bound: a flight's instants are not independent).
+  const std::uint64_t instants = cycles + skipped, missed = misses + skipped;
+  const auto [lo, hi] = campaign::WilsonInterval(static_cast<int>(missed), static_cast<int>(instants));
   return {{"load", load},
           {"flights", flown},
           {"successes", successes},
+          {"instants", instants},
           {"cycles", cycles},
           {"misses", misses},
-          {"miss_rate", cycles ? static_cast<double>(misses) / static_cast<double>(cycles) : 0.0},
+          {"skipped", skipped},
+          {"miss_rate", instants ? static_cast<double>(missed) / static_cast<double>(instants) : 0.0},
           {"miss_rate_ci", {lo, hi}},
           {"latency_p50_ms_median", p50.empty() ? 0.0 : Percentile(p50, 0.5)},
           {"latency_p99_ms_median", p99.empty() ? 0.0 : Percentile(p99, 0.5)},
@@ -129,6 +135,8 @@ nlohmann::json FtcPair(const FtcBenchOptions& ftc, const std::string& cell, std:
           {"seed", seed},
           {"sitl_success", s.success},
           {"lockstep_success", l.success},
+          {"sitl_failure_reason", s.failure_reason.value_or("")},
+          {"lockstep_failure_reason", l.failure_reason.value_or("")},
           {"sitl_fdd_latency_s", latency(s)},
           {"lockstep_fdd_latency_s", latency(l)},
           {"delay_p10_ms", 1e3 * lo},
@@ -243,12 +251,13 @@ std::string SitlMarkdown(const nlohmann::json& r) {
   if (!r.at("timing").empty()) {
     md += fmt::format("Timing: {} ({} flights per load; the stack {})\n\n", r.at("options").at("scenario").get<std::string>(),
                       r.at("options").at("repeats").get<int>(), r.at("options").at("stack_process").get<std::string>());
-    md += "| load | flights | successes | cycles | misses | miss rate [95 %] | latency p50 (ms), median | p99 (ms), median | p99 (ms), max | holds | hand-overs |\n";
-    md += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "| load | flights | successes | instants | late | skipped | miss rate [95 %] | latency p50 (ms), median | p99 (ms), median | p99 (ms), max | holds | hand-overs |\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const nlohmann::json& t : r.at("timing")) {
-      md += fmt::format("| {} | {} | {} | {} | {} | {:.1e} [{:.1e}, {:.1e}] | {:.3f} | {:.3f} | {:.3f} | {} | {} |\n",
+      md += fmt::format("| {} | {} | {} | {} | {} | {} | {:.1e} [{:.1e}, {:.1e}] | {:.3f} | {:.3f} | {:.3f} | {} | {} |\n",
                         t.at("load").get<std::string>(), t.at("flights").get<int>(), t.at("successes").get<int>(),
-                        t.at("cycles").get<std::uint64_t>(), t.at("misses").get<std::uint64_t>(),
+                        t.at("instants").get<std::uint64_t>(), t.at("misses").get<std::uint64_t>(),
+                        t.at("skipped").get<std::uint64_t>(),
                         t.at("miss_rate").get<double>(), t.at("miss_rate_ci")[0].get<double>(),
                         t.at("miss_rate_ci")[1].get<double>(), t.at("latency_p50_ms_median").get<double>(),
                         t.at("latency_p99_ms_median").get<double>(), t.at("latency_p99_ms_max").get<double>(),

@@ -82,7 +82,13 @@ OnboardExecutor::~OnboardExecutor() { Stop(); }
 void OnboardExecutor::Intake(SensorMessage m) {
   m.seq = messages_in_;
   if (!intake_.TryPush(m)) return;
-  if (m.kind == SensorMessage::Kind::kImu) newest_intake_imu_ns_.store(m.imu.t_ns, std::memory_order_release);
+  if (m.kind == SensorMessage::Kind::kImu && policy_) {
+    const std::uint64_t n = imu_written_.load(std::memory_order_relaxed);
+    ImuArrival& a = imu_arrivals_[n % kImuArrivals];
+    a.arrival.store(clock_->Now(), std::memory_order_relaxed);
+    a.stamp.store(m.imu.t_ns, std::memory_order_relaxed);
+    imu_written_.store(n + 1, std::memory_order_release);
+  }
   ++messages_in_;
   intake_bell_.Ring();
 }
@@ -309,6 +315,19 @@ void OnboardExecutor::LockSend() {
 
 void OnboardExecutor::UnlockSend() { send_lock_.clear(std::memory_order_release); }
 
+std::optional<TimeNs> OnboardExecutor::ArrivalOfSampleAtOrAfter(TimeNs t) const {
+  // Newest first, back to the first sample at or after t; the intake overwrites the oldest entry
+  // only after kImuArrivals newer samples, far more than an instant's deadline spans.
+  const std::uint64_t n = imu_written_.load(std::memory_order_acquire);
+  std::optional<TimeNs> arrival;
+  for (std::uint64_t k = n; k > 0 && n - k < kImuArrivals; --k) {
+    const ImuArrival& a = imu_arrivals_[(k - 1) % kImuArrivals];
+    if (a.stamp.load(std::memory_order_relaxed) < t) break;
+    arrival = a.arrival.load(std::memory_order_relaxed);
+  }
+  return arrival;
+}
+
 void OnboardExecutor::GuardLoop() {
   const TimeNs period = stack_->control_period_ns();
   // An IMU-triggered cycle's instant is its sample's, at or up to an IMU interval past the grid's
@@ -330,11 +349,17 @@ void OnboardExecutor::GuardLoop() {
     if (!watched || fresh + period > *watched) watched = fresh + period;
     const TimeNs instant = *watched;
     if (!clock_->SleepUntil(instant + deadline_ns_ + grace) || stop_.load(std::memory_order_acquire)) break;
-    if (newest_intake_imu_ns_.load(std::memory_order_acquire) < instant - slack) {
+    const std::optional<TimeNs> arrival = ArrivalOfSampleAtOrAfter(instant - slack);
+    if (!arrival) {
       // No IMU sample for the instant: a sensor that stopped (or the end of a flight) is the
       // estimator's matter, not a late computer's.
       if (!clock_->SleepUntil(clock_->Now() + period)) break;
       continue;
+    }
+    // A sample that arrived late (a burst after a sensor's or a transport's delay) gives the
+    // cycle its full deadline from its arrival.
+    if (*arrival > instant) {
+      if (!clock_->SleepUntil(*arrival + deadline_ns_ + grace) || stop_.load(std::memory_order_acquire)) break;
     }
     LockSend();
     if (fresh_.command.state_t_ns >= instant - slack) {

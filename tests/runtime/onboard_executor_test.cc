@@ -276,6 +276,31 @@ TEST_F(DeadlinePolicyTest, ACycleLateByLessThanItsDeadlineIsNeitherHeldNorHanded
   EXPECT_EQ(&stack_.flying_controller(), &stack_.controller());
 }
 
+TEST_F(DeadlinePolicyTest, SamplesThatArriveLateTogetherGiveTheCycleItsDeadlineFromTheirArrival) {
+  // The IMU's samples of 5-20 ms come in one burst at 20 ms (a sensor's or a transport's delay):
+  // one cycle runs on the newest, in time from the burst; the instants it passed over are no
+  // late computer's and nothing is held.
+  Build(StallingAt(100.0, 0.001));  // the policy on, no stall within the test
+  AdvanceWithImu(0);
+  ASSERT_EQ(Cycles(1).size(), 1u);
+  time_.Advance(20 * kMs);
+  for (TimeNs t = 5 * kMs; t <= 20 * kMs; t += 5 * kMs) {
+    ImuSample imu;
+    imu.t_ns = t;
+    imu.specific_force_B = {0.0, 0.0, kGravity};
+    executor_->OnImu(imu);
+  }
+  ASSERT_EQ(Cycles(2).size(), 2u);
+  time_.Advance(40 * kMs);  // past every deadline counted from the burst
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  time_.Stop();
+  executor_->Stop();
+  const std::vector<CycleTelemetry> cycles = sink_.cycles();
+  ASSERT_EQ(cycles.size(), 2u);
+  EXPECT_EQ(cycles[1].command.state_t_ns, 20 * kMs);
+  EXPECT_EQ(executor_->Report().holds + executor_->Report().fallbacks, 0u);
+}
+
 TEST(OnboardExecutorOptions, AFifoPriorityTooLowForTheSlowerThreadsIsRefusedNamingTheField) {
   OnboardExecutorOptions o;
   o.realtime.fifo_priority = 2;

@@ -293,7 +293,18 @@ class OnboardExecutor {
   CycleTelemetry fresh_;                            // the last cycle's own command
   std::array<RotorVector, 2> held_;                 // its plan's commands at the next instants
   int missed_ = 0;  // instants in a row whose deadline passed without their command (the guard counts, a timely command resets)
-  std::atomic<TimeNs> newest_intake_imu_ns_{-1};   // the intake's newest IMU sample
+  // The intake's IMU samples, stamp and arrival on the clock, the newest kImuArrivals of them: an
+  // instant's deadline runs from its sample's arrival when that came late (a sensor burst is not
+  // a late computer). Written by the intake thread only; imu_written_ counts the entries.
+  static constexpr std::size_t kImuArrivals = 128;
+  struct ImuArrival {
+    std::atomic<TimeNs> stamp{0}, arrival{0};
+  };
+  std::array<ImuArrival, kImuArrivals> imu_arrivals_;
+  std::atomic<std::uint64_t> imu_written_{0};
+  /// The arrival of the first IMU sample stamped at or after `t` (none: no such sample yet, or it
+  /// is no longer among the newest kImuArrivals).
+  std::optional<TimeNs> ArrivalOfSampleAtOrAfter(TimeNs t) const;
   SpscQueue<stack::DeadlineEvent, 64> deadline_events_;  // guard -> control: reported at the next cycle
   Doorbell guard_bell_;
   std::atomic<std::uint64_t> deadline_steps_{0};
