@@ -177,7 +177,7 @@ class Flight::Loop {
     }
     const Vector3 p_ref = stack_.reference().Evaluate(ToSeconds(t)).p_W;  // the planner's when navigating
     metrics_.OnStep(t, vehicle::StateView(sim_.state()), p_ref, !sim_.fault_events().empty());
-    recorder_.OnStep(t, sim_, StackRow::Of(stack_));
+    if (recorder_.RowDue(t)) recorder_.OnStep(t, sim_, StackRow::Of(stack_));  // copies the estimate: only when due
     Stopwatch clock;
     const sim::SensorOutputs& outputs = sim_.Step();
     simulator_s_ += clock.Restart();

@@ -123,7 +123,7 @@ void FlightRecorder::OnControlCycle(TimeNs t, const stack::FlightStack& st, cons
 }
 
 void FlightRecorder::OnStep(TimeNs t, const sim::Simulator& sim, const StackRow& st) {
-  if (!logs() || t < next_log_ns_) return;
+  if (!RowDue(t)) return;
   AppendRow(sim, st, &flight_.table);
   if (writes()) scene_.OnTime(ToSeconds(t));
   next_log_ns_ += log_period_ns_;

@@ -78,6 +78,8 @@ class FlightRecorder {
   void OnControlCycle(TimeNs t, const stack::FlightStack& stack, const RotorCommand& command);
   /// Or, the stack in another process: its command, to the sensor log.
   void OnCommand(const RotorCommand& command);
+  /// Whether a log row is due at t (the caller builds the row only then: OnStep runs every step).
+  bool RowDue(TimeNs t) const { return logs() && t >= next_log_ns_; }
   /// Before each physics step: a log row when one is due.
   void OnStep(TimeNs t, const sim::Simulator& sim, const StackRow& stack);
   /// After each physics step: the sensor log goes to its file in chunks of about 1 MB.
