@@ -143,6 +143,8 @@ class BenchCommand final : public Command {
           {"--repeats", &sitl_repeats_, "Timing flights per load (default 3; 0: none)"},
           {"--loads", &sitl_loads_, "Comma-separated: idle, one_core_busy (default both)"},
           {"--fifo-priority", &sitl_fifo_, "SCHED_FIFO priority of the stack's control thread, in [3, 99] (default 0: none)"},
+          {"--control-cpu", &sitl_cpu_, "Pin the time-critical threads to this CPU, perception and planning to the others (default: none)"},
+          {"--platform-seconds", &sitl_platform_, "Seconds per load of the machine's own wake-up timing, without the stack (default 60; 0: none)"},
           {"--ftc-trials", &sitl_ftc_trials_, "Flights per FTC cell (default 20; 0: none)"},
           {"--ftc-seed", &sitl_ftc_seed_, "The FTC flights' first seed (default 5001)"}}},
         {&ftc_,
@@ -536,6 +538,8 @@ class BenchCommand final : public Command {
     if (o.fifo_priority > 0 && o.fifo_priority < 3) {
       throw UsageError(fmt::format("--fifo-priority '{}' is invalid; expected 0 or a number in [3, 99]", sitl_fifo_));
     }
+    if (!sitl_cpu_.empty()) o.control_cpu = static_cast<int>(ParseUnsigned("--control-cpu", sitl_cpu_, 0, CPU_SETSIZE - 1));
+    if (!sitl_platform_.empty()) o.platform_s = ParseFinite("--platform-seconds", sitl_platform_, 0.0, 3600.0);
     o.ftc_trials = static_cast<int>(ParseUnsigned("--ftc-trials", sitl_ftc_trials_, 0, 1000));
     o.ftc_seed = ParseUnsigned("--ftc-seed", sitl_ftc_seed_, 0, UINT64_MAX - 1000);
     o.self = SelfPath();
@@ -556,7 +560,7 @@ class BenchCommand final : public Command {
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3", qp_solver_ = "riccati";
   std::string nmpc_qp_solver_ = "riccati";
-  std::string sitl_scenario_, sitl_repeats_ = "3", sitl_loads_ = "idle,one_core_busy", sitl_fifo_ = "0",
+  std::string sitl_scenario_, sitl_repeats_ = "3", sitl_loads_ = "idle,one_core_busy", sitl_fifo_ = "0", sitl_cpu_, sitl_platform_,
               sitl_ftc_trials_ = "20", sitl_ftc_seed_ = "5001";
   std::string truth_ = "realistic", estimator_;
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;

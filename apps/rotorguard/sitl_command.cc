@@ -35,6 +35,9 @@ class SitlCommand final : public Command {
                      "Run the stack's control thread under SCHED_FIFO at this priority, in [3, 99] (perception and\n"
                      "planning one and two below), with its memory locked; needs CAP_SYS_NICE and CAP_IPC_LOCK (or\n"
                      "rtprio and memlock limits), else the normal scheduler, as runtime.json reports (default: 0, none)");
+    sitl->add_option("--control-cpu", cpu_text_,
+                     "Pin the time-critical threads (control, its deadline guard, the sensor intake, the simulator)\n"
+                     "to this CPU and the perception and planning threads to the others (default: no pinning)");
     sitl->add_option("--stall", stall_texts_,
                      "Fault injection: the control cycle at AT seconds stalls for DURATION seconds (AT:DURATION,\n"
                      "repeatable), as a computer that falls behind; the deadline policy holds the last plan, then hands\n"
@@ -52,6 +55,9 @@ class SitlCommand final : public Command {
     if (app_->count("--fifo-priority") > 0) {
       sitl.executor.realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
       sitl.executor.realtime.lock_memory = true;
+    }
+    if (app_->count("--control-cpu") > 0) {
+      sitl.executor.realtime.control_cpu = static_cast<int>(ParseUnsigned("--control-cpu", cpu_text_, 0, CPU_SETSIZE - 1));
     }
     for (const std::string& text : stall_texts_) sitl.executor.stalls.push_back(ParseStall(text));
     const harness::Scenario scenario = scenario_.Load();
@@ -128,7 +134,7 @@ class SitlCommand final : public Command {
 
   CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
-  std::string out_dir_, factor_text_, fifo_text_;
+  std::string out_dir_, factor_text_, fifo_text_, cpu_text_;
   std::vector<std::string> stall_texts_;
   bool quiet_ = false, in_process_ = false;
   harness::SitlOptions sitl_;

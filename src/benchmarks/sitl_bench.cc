@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <thread>
 
 #include "rotorguard/benchmarks/ftc_bench.h"
@@ -15,6 +16,9 @@
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/harness/sitl.h"
+#include "rotorguard/runtime/clock.h"
+#include "rotorguard/runtime/latency.h"
+#include "rotorguard/runtime/realtime.h"
 
 namespace rotorguard::benchmarks {
 
@@ -24,11 +28,13 @@ namespace {
 constexpr const char* kFtcCells[] = {"hover/propeller_loss", "hover/motor_stop", "tracking/propeller_loss",
                                      "tracking/motor_stop"};
 
-/// One core kept busy for its lifetime: a thread of this process spinning at the normal priority.
+/// One core kept busy for its lifetime: a thread of this process spinning at the normal priority,
+/// on whichever CPU the scheduler gives it (never its creator's real-time scheduling or CPU).
 class BusyCore {
  public:
   BusyCore()
       : thread_([this] {
+          runtime::UseNormalScheduling();
           std::uint64_t n = 0;
           while (!stop_.load(std::memory_order_relaxed)) n = n + 1;
           sink_.store(n, std::memory_order_relaxed);
@@ -46,14 +52,49 @@ class BusyCore {
   std::thread thread_;
 };
 
+/// The realtime options the benchmark's flights ask for.
+runtime::RealtimeOptions Realtime(const SitlBenchOptions& o) {
+  return {.lock_memory = o.fifo_priority > 0, .fifo_priority = o.fifo_priority, .control_cpu = o.control_cpu};
+}
+
+/// The machine's own timing, without the stack: a thread with the control thread's scheduling that
+/// only sleeps to absolute instants one control period apart (as the control loop does between
+/// its cycles) for `seconds`, under a load. How late it wakes is the floor under any loop's miss
+/// rate on this machine: a virtual machine whose host takes its CPUs away shows it here.
+nlohmann::json PlatformProbe(const SitlBenchOptions& o, const std::string& load, TimeNs period) {
+  std::optional<BusyCore> busy[2];
+  if (load != "idle") busy[0].emplace();
+  if (load == "two_cores_busy") busy[1].emplace();
+  runtime::LatencyHistogram lateness;
+  std::uint64_t late = 0;
+  std::string scheduling;
+  std::thread([&] {
+    scheduling = runtime::RequestRealtime(Realtime(o)).note;
+    runtime::SteadyClock clock(runtime::SteadyClock::Monotonic(), 1.0);
+    for (TimeNs t = period; t <= FromSeconds(o.platform_s); t += period) {
+      clock.SleepUntil(t);
+      const TimeNs l = clock.Now() - t;
+      lateness.Record(l);
+      late += l > period ? 1 : 0;
+    }
+  }).join();
+  const std::uint64_t n = lateness.count();
+  return {{"load", load},
+          {"wakeups", n},
+          {"later_than_a_period", late},
+          {"rate", n ? static_cast<double>(late) / static_cast<double>(n) : 0.0},
+          {"p99_ms", 1e3 * lateness.Quantile(0.99)},
+          {"max_ms", 1e3 * lateness.max_s()},
+          {"scheduling", scheduling}};
+}
+
 double Ms(const nlohmann::json& loop, const char* histogram, const char* q) { return loop.at(histogram).at(q).get<double>(); }
 
 nlohmann::json TimingFlight(const SitlBenchOptions& o, const std::string& load, int repeat) {
   harness::Scenario sc = harness::LoadScenario(o.scenario);
   sc.seed += static_cast<std::uint64_t>(repeat);
   harness::SitlOptions sitl;
-  sitl.executor.realtime.fifo_priority = o.fifo_priority;
-  sitl.executor.realtime.lock_memory = o.fifo_priority > 0;
+  sitl.executor.realtime = Realtime(o);
   if (!o.self.empty()) sitl.node_command = {o.self, "node", o.scenario, "--seed", std::to_string(sc.seed)};
   std::optional<BusyCore> busy;
   if (load == "one_core_busy") busy.emplace();
@@ -114,9 +155,11 @@ nlohmann::json TimingSummary(const std::vector<nlohmann::json>& flights, const s
           {"fallbacks", fallbacks}};
 }
 
-nlohmann::json FtcPair(const FtcBenchOptions& ftc, const std::string& cell, std::uint64_t seed) {
-  const harness::Scenario sc = MakeFtcTrial(cell, "rotorguard", ftc, seed);
-  const harness::SitlResult sitl = harness::RunSitl(sc, {}, {});
+nlohmann::json FtcPair(const SitlBenchOptions& o, const std::string& cell, std::uint64_t seed) {
+  const harness::Scenario sc = MakeFtcTrial(cell, "rotorguard", o.ftc, seed);
+  harness::SitlOptions options;
+  options.executor.realtime = Realtime(o);
+  const harness::SitlResult sitl = harness::RunSitl(sc, {}, options);
   // Lockstep with the delay the software-in-the-loop flight measured: from the IMU sample to the
   // command reaching the ESCs, drawn per flight in its 10th-90th percentile range.
   const double lo = sitl.link.command_delay.Quantile(0.1), hi = sitl.link.command_delay.Quantile(0.9);
@@ -191,6 +234,13 @@ void SitlBenchOptions::Validate() const {
   if (fifo_priority != 0 && (fifo_priority < 3 || fifo_priority > 99)) {
     ThrowValidation("SitlBenchOptions", "fifo_priority", fifo_priority, "0 (none) or in [3, 99]");
   }
+  if (control_cpu < -1 || control_cpu >= CPU_SETSIZE) {
+    ThrowValidation("SitlBenchOptions", "control_cpu", control_cpu, "-1 (no pinning) or a CPU number");
+  }
+  if (!(platform_s >= 0.0 && platform_s <= 3600.0)) {
+    ThrowValidation("SitlBenchOptions", "platform_s", platform_s, "in [0, 3600] s (0: no probe)");
+  }
+  if (platform_s > 0.0 && scenario.empty()) ThrowValidation("SitlBenchOptions", "scenario", "(none)", "a scenario file (its control rate)");
   if (ftc_trials < 0 || ftc_trials > 1000) ThrowValidation("SitlBenchOptions", "ftc_trials", ftc_trials, "in [0, 1000]");
   if (ftc_trials > 0) ftc.vehicle.Validate();
 }
@@ -201,6 +251,17 @@ nlohmann::json RunSitlBenchmark(const SitlBenchOptions& o, const std::function<v
     if (progress) progress(line);
   };
   std::vector<nlohmann::json> flights, pairs;
+  nlohmann::json platform = nlohmann::json::array();
+  if (o.platform_s > 0.0) {
+    const TimeNs period = PeriodFromRate(harness::LoadScenario(o.scenario).stack.control_rate_hz);
+    for (const char* load : {"idle", "one_core_busy", "two_cores_busy"}) {
+      platform.push_back(PlatformProbe(o, load, period));
+      const nlohmann::json& p = platform.back();
+      say(fmt::format("platform {}: {} of {} wakeups later than a period, p99 {:.3f} ms, max {:.3f} ms", load,
+                      p.at("later_than_a_period").get<std::uint64_t>(), p.at("wakeups").get<std::uint64_t>(),
+                      p.at("p99_ms").get<double>(), p.at("max_ms").get<double>()));
+    }
+  }
   for (const std::string& load : o.loads) {
     for (int r = 0; r < o.repeats; ++r) {
       flights.push_back(TimingFlight(o, load, r));
@@ -212,7 +273,7 @@ nlohmann::json RunSitlBenchmark(const SitlBenchOptions& o, const std::function<v
   }
   for (const char* cell : kFtcCells) {
     for (int k = 0; k < o.ftc_trials; ++k) {
-      pairs.push_back(FtcPair(o.ftc, cell, o.ftc_seed + static_cast<std::uint64_t>(k)));
+      pairs.push_back(FtcPair(o, cell, o.ftc_seed + static_cast<std::uint64_t>(k)));
       const nlohmann::json& p = pairs.back();
       say(fmt::format("ftc {} {}/{}: sitl {}, lockstep {}", cell, k + 1, o.ftc_trials,
                       p.at("sitl_success").get<bool>() ? "success" : "failure",
@@ -231,11 +292,14 @@ nlohmann::json RunSitlBenchmark(const SitlBenchOptions& o, const std::function<v
             {"repeats", o.repeats},
             {"loads", o.loads},
             {"fifo_priority", o.fifo_priority},
+            {"control_cpu", o.control_cpu},
+            {"platform_s", o.platform_s},
             {"ftc_trials", o.ftc_trials},
             {"ftc_seed", o.ftc_seed},
             {"ftc_world", o.ftc.truth == sim::TruthPreset::kRealistic ? "realistic" : "ideal"},
             {"stack_process", o.self.empty() ? "in process" : "its own (rotorguard node)"}}},
           {"host", buildinfo::HostInfo()},
+          {"platform", platform},
           {"timing", timing},
           {"ftc", ftc},
           {"flights", flights},
@@ -248,6 +312,18 @@ std::string SitlMarkdown(const nlohmann::json& r) {
   md += fmt::format("CPU: {} ({} hardware threads), rotorguard {} ({})\n\n", host.at("cpu").get<std::string>(),
                     host.at("hardware_threads").get<int>(), host.at("version").get<std::string>(),
                     host.at("git_revision").get<std::string>());
+  if (!r.at("platform").empty()) {
+    md += fmt::format("The machine without the stack: a thread with the control thread's scheduling sleeping to "
+                      "instants one control period apart, {} s per load\n\n",
+                      r.at("options").at("platform_s").get<double>());
+    md += "| load | wakeups | later than a period | rate | p99 (ms) | max (ms) |\n|---|---|---|---|---|---|\n";
+    for (const nlohmann::json& p : r.at("platform")) {
+      md += fmt::format("| {} | {} | {} | {:.1e} | {:.3f} | {:.3f} |\n", p.at("load").get<std::string>(),
+                        p.at("wakeups").get<std::uint64_t>(), p.at("later_than_a_period").get<std::uint64_t>(),
+                        p.at("rate").get<double>(), p.at("p99_ms").get<double>(), p.at("max_ms").get<double>());
+    }
+    md += "\n";
+  }
   if (!r.at("timing").empty()) {
     md += fmt::format("Timing: {} ({} flights per load; the stack {})\n\n", r.at("options").at("scenario").get<std::string>(),
                       r.at("options").at("repeats").get<int>(), r.at("options").at("stack_process").get<std::string>());

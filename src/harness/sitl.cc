@@ -22,6 +22,7 @@
 #include "rotorguard/harness/flight_recorder.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/io/json_archive.h"
+#include "rotorguard/runtime/realtime.h"
 #include "rotorguard/runtime/shared_memory.h"
 #include "rotorguard/runtime/sitl_channel.h"
 #include "rotorguard/runtime/spsc_queue.h"
@@ -104,12 +105,23 @@ nlohmann::json HistogramJson(const runtime::LatencyHistogram& h) {
           {"mean_ms", 1e3 * h.mean_s()}};
 }
 
+/// The slowest records, slowest first: the instant [s], its latency and compute [ms].
+nlohmann::json SlowestJson(const runtime::SlowestRecords& s) {
+  nlohmann::json j = nlohmann::json::array();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    j.push_back({{"t_s", ToSeconds(s[i].t_ns)}, {"latency_ms", 1e-6 * static_cast<double>(s[i].latency_ns)},
+                 {"compute_ms", 1e-6 * static_cast<double>(s[i].compute_ns)}});
+  }
+  return j;
+}
+
 nlohmann::json LoopJson(const runtime::LoopReport& r) {
   return {{"runs", r.runs},
           {"deadline_misses", r.misses},
           {"miss_rate", r.runs ? static_cast<double>(r.misses) / static_cast<double>(r.runs) : 0.0},
           {"latency", HistogramJson(r.latency)},
           {"compute", HistogramJson(r.compute)},
+          {"slowest", SlowestJson(r.slowest)},
           {"skipped", r.skipped},
           {"cpu_s", r.cpu_s},
           {"dropped", r.dropped}};
@@ -363,6 +375,9 @@ nlohmann::json SitlResult::RuntimeJson() const {
                {"late_max_ms", 1e3 * link.late_max_s},
                {"steps_behind", link.steps_behind},
                {"behind_max_ms", 1e3 * link.behind_max_s},
+               {"behind_slowest", SlowestJson(link.behind)},
+               {"step_work", HistogramJson(link.step_work)},
+               {"step_work_slowest", SlowestJson(link.step_work_slowest)},
                {"command_delay", HistogramJson(link.command_delay)},
                {"processes", link.processes},
                {"simulator_scheduling", link.simulator_realtime}};
@@ -371,6 +386,8 @@ nlohmann::json SitlResult::RuntimeJson() const {
 
 SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const SitlOptions& sitl) {
   sitl.Validate();
+  // The calling thread becomes the simulator's (real-time and pinned when asked) for the flight only.
+  const runtime::ThreadSchedulingScope caller_scheduling;
   const Stopwatch wall;
   const Scenario sc = Flown(scenario);
   // The run's folder as `run` writes it (summary, log, scene, sensors, report), and runtime.json.
@@ -415,9 +432,9 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     reference.Add(c.command.state_t_ns, c.reference);
     metrics.OnEstimate(vehicle::StateView(history.At(c.command.state_t_ns)), c.estimate);
   };
-  // The simulator's thread paces the world: it runs at the control thread's priority when that
-  // one runs under SCHED_FIFO (it produces what the control thread consumes).
-  if (sitl.executor.realtime.fifo_priority > 0) link.simulator_realtime = runtime::RequestRealtime(sitl.executor.realtime).note;
+  // The simulator's thread paces the world: it runs at the control thread's priority, and on its
+  // CPU, when that one runs under SCHED_FIFO or pinned (it stands for the sensors' drivers).
+  if (sitl.executor.realtime.fifo_priority > 0 || sitl.executor.realtime.control_cpu >= 0) link.simulator_realtime = runtime::RequestRealtime(sitl.executor.realtime).note;
   // Time 0's messages go once the clock has reached 0 (on the simulator's clock, the stack waits
   // for the simulator's time anyway): a message is never in the stack's hands before its stamp.
   stack->Start();
@@ -434,6 +451,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   bool done = steps <= 0;
   while (!done) {
     const TimeNs t = sim.time_ns();
+    TimeNs work_start = 0;
     runtime::CycleTelemetry c;
     if (sitl.lockstep_clock) {
       // The clock moves to t once t's messages are in; a control instant waits for its command.
@@ -451,8 +469,10 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
       if (behind > dt / 2) {
         ++link.steps_behind;
         link.behind_max_s = std::max(link.behind_max_s, ToSeconds(behind));
+        link.behind.Add(t, behind);
       }
       clock.SleepUntil(t + dt);
+      work_start = runtime::SteadyClock::Monotonic();
       while (stack->TryReceive(&c)) {
         if (c.command.sent_t_ns < t) {
           ++link.commands_late;
@@ -471,6 +491,11 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     if (!done) {
       stack->Deliver(outputs);  // the flight's end has no cycle (as in `run`)
       AppendSensorLog(outputs, recorder.sensor_log());
+    }
+    if (work_start != 0) {
+      const TimeNs work = runtime::SteadyClock::Monotonic() - work_start;
+      link.step_work.Record(work);
+      link.step_work_slowest.Add(t, work);
     }
     if (options.progress && !done && k % progress_stride == 0) {
       options.progress(static_cast<double>(k) / static_cast<double>(steps));

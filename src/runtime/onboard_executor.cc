@@ -118,22 +118,26 @@ void OnboardExecutor::Start() {
   const int priority = report_.realtime.fifo ? options_.realtime.fifo_priority : 0;
   control_ = std::thread([this, priority] {
     FollowFifo(priority);
+    PinThread(options_.realtime.control_cpu, ThreadRole::kTimeCritical);
     if (options_.on_thread_start) options_.on_thread_start("control");
     ControlLoop();
   });
   perception_ = std::thread([this, priority] {
     FollowFifo(priority > 0 ? priority - 1 : 0);
+    PinThread(options_.realtime.control_cpu, ThreadRole::kCompute);
     if (options_.on_thread_start) options_.on_thread_start("perception");
     PerceptionLoop();
   });
   planning_ = std::thread([this, priority] {
     FollowFifo(priority > 0 ? priority - 2 : 0);
+    PinThread(options_.realtime.control_cpu, ThreadRole::kCompute);
     if (options_.on_thread_start) options_.on_thread_start("planning");
     PlanningLoop();
   });
   if (policy_) {
     guard_ = std::thread([this, priority] {
       FollowFifo(priority > 0 ? std::min(priority + 1, sched_get_priority_max(SCHED_FIFO)) : 0);
+      PinThread(options_.realtime.control_cpu, ThreadRole::kTimeCritical);
       if (options_.on_thread_start) options_.on_thread_start("guard");
       GuardLoop();
     });
@@ -304,7 +308,9 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   ++r.runs;
   r.latency.Record(latency);
   if (latency > deadline_ns_) ++r.misses;
-  r.compute.Record(SteadyClock::Monotonic() - start);
+  const TimeNs compute = SteadyClock::Monotonic() - start;
+  r.compute.Record(compute);
+  r.slowest.Add(t, latency, compute);
 }
 
 void OnboardExecutor::LockSend() {
@@ -447,8 +453,10 @@ void OnboardExecutor::PerceptionLoop() {
       frames_done_.fetch_add(1, std::memory_order_acq_rel);
       LoopReport& r = report_.perception;
       ++r.runs;
-      r.latency.Record(clock_->Now() - f->t_end_ns);
-      r.compute.Record(SteadyClock::Monotonic() - start);
+      const TimeNs latency = clock_->Now() - f->t_end_ns, compute = SteadyClock::Monotonic() - start;
+      r.latency.Record(latency);
+      r.compute.Record(compute);
+      r.slowest.Add(f->t_end_ns, latency, compute);
       continue;
     }
     // Once the control thread has ended, what it passed on is all there will be.
@@ -484,8 +492,10 @@ void OnboardExecutor::PlanningLoop() {
         planning_output_.Publish({std::move(followed), tasks_.planning->status()});
         LoopReport& r = report_.planning;
         ++r.runs;
-        r.latency.Record(clock_->Now() - in.t_ns);
-        r.compute.Record(SteadyClock::Monotonic() - start);
+        const TimeNs latency = clock_->Now() - in.t_ns, compute = SteadyClock::Monotonic() - start;
+        r.latency.Record(latency);
+        r.compute.Record(compute);
+        r.slowest.Add(in.t_ns, latency, compute);
       }
       planning_calls_.store(in.cycle, std::memory_order_release);
       continue;

@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -16,6 +17,39 @@ void RealtimeOptions::Validate() const {
   if (fifo_priority < 0 || fifo_priority > 99) {
     ThrowValidation("RealtimeOptions", "fifo_priority", fifo_priority, "0 (no change) or a priority in [1, 99]");
   }
+  if (control_cpu < -1 || control_cpu >= CPU_SETSIZE) {
+    ThrowValidation("RealtimeOptions", "control_cpu", control_cpu, fmt::format("-1 (no pinning) or a CPU in [0, {})", CPU_SETSIZE));
+  }
+}
+
+ThreadSchedulingScope::ThreadSchedulingScope() {
+  have_policy_ = pthread_getschedparam(pthread_self(), &policy_, &param_) == 0;
+  have_cpus_ = pthread_getaffinity_np(pthread_self(), sizeof(cpus_), &cpus_) == 0;
+}
+
+ThreadSchedulingScope::~ThreadSchedulingScope() {
+  if (have_cpus_) pthread_setaffinity_np(pthread_self(), sizeof(cpus_), &cpus_);
+  if (have_policy_) pthread_setschedparam(pthread_self(), policy_, &param_);
+}
+
+void UseNormalScheduling() {
+  sched_param p{};
+  pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (long cpu = 0; cpu < sysconf(_SC_NPROCESSORS_ONLN) && cpu < CPU_SETSIZE; ++cpu) CPU_SET(cpu, &set);
+  pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+}
+
+bool PinThread(int control_cpu, ThreadRole role) {
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  if (control_cpu < 0 || control_cpu >= online || (role == ThreadRole::kCompute && online < 2)) return false;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (int cpu = 0; cpu < online; ++cpu) {
+    if ((cpu == control_cpu) == (role == ThreadRole::kTimeCritical)) CPU_SET(cpu, &set);
+  }
+  return pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
 }
 
 RealtimeGrant RequestRealtime(const RealtimeOptions& options) {
@@ -42,7 +76,14 @@ RealtimeGrant RequestRealtime(const RealtimeOptions& options) {
                              options.fifo_priority, std::strerror(err));
     }
   }
-  g.note = memory + ", " + priority;
+  std::string cpu;
+  if (options.control_cpu >= 0) {
+    g.pinned = PinThread(options.control_cpu, ThreadRole::kTimeCritical);
+    cpu = g.pinned ? fmt::format(", pinned to CPU {}", options.control_cpu)
+                   : fmt::format(", not pinned (CPU {} is not among this machine's {} online CPUs)", options.control_cpu,
+                                 sysconf(_SC_NPROCESSORS_ONLN));
+  }
+  g.note = memory + ", " + priority + cpu;
   return g;
 }
 

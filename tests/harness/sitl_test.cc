@@ -7,6 +7,7 @@
 //  - In real time, a propeller loss is isolated and flown out, every command stamped and counted.
 #include "rotorguard/harness/sitl.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <ostream>
@@ -18,9 +19,12 @@
 #include "rotorguard/harness/scenario.h"
 #include "same_flight.h"
 #include "test_util.h"
+#include "thread_cpus.h"
 
 namespace rotorguard::harness {
 namespace {
+
+using testing::AllowedCpus;
 
 Scenario Load(const std::string& name, std::vector<Override> overrides) {
   return LoadScenario(testing::SourcePath("configs/scenarios/" + name + ".yaml"), overrides);
@@ -67,7 +71,14 @@ TEST(SitlInRealTime, APropellerLossIsIsolatedAndFlownOutWithEveryCommandStampedA
   const Scenario sc = Load("fdd_hover_propeller_loss", {{"seed", "5"}, {"duration_s", "4"}});
   SitlOptions o;
   o.realtime_factor = 0.5;
+  // The time-critical threads pinned to the first CPU this process may use, the simulator's (this
+  // thread) among them for the flight only: it gets its CPUs back after.
+  const std::vector<int> cpus = AllowedCpus();
+  o.executor.realtime.control_cpu = cpus.front();
   const SitlResult r = RunSitl(sc, {}, o);
+  EXPECT_EQ(AllowedCpus(), cpus);
+  EXPECT_TRUE(r.loops.at("realtime").at("note").get<std::string>().ends_with(fmt::format("pinned to CPU {}", cpus.front())))
+      << r.loops.at("realtime").at("note");
   const RunSummary& s = r.summary;
   EXPECT_TRUE(s.success) << s.failure_reason.value_or("");
   ASSERT_TRUE(s.fdd && s.fdd->diagnosis);

@@ -1,18 +1,26 @@
-// LatencyHistogram against the exact order statistics of the recorded values, and the real-time
-// request's validation and report.
+// LatencyHistogram against the exact order statistics of the recorded values, SlowestRecords
+// against a sort, and the real-time request: validation, CPU pinning, and its report.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/runtime/latency.h"
 #include "rotorguard/runtime/realtime.h"
+#include "thread_cpus.h"
 
 namespace rotorguard::runtime {
 namespace {
+
+using testing::AllowedCpus;
 
 /// The q-quantile of sorted values as the histogram defines it: the value of rank ceil(q n).
 double ExactQuantile(std::vector<TimeNs> v, double q) {
@@ -64,6 +72,80 @@ TEST(LatencyHistogram, EmptyAndOutOfRangeValues) {
   EXPECT_DOUBLE_EQ(h.Quantile(1.0), 100.0);
   EXPECT_GE(h.Quantile(0.99), 0.0);
   EXPECT_LE(h.Quantile(0.99), 100.0);
+}
+
+TEST(SlowestRecords, KeepsTheSlowestWithTheirInstantsSlowestFirst) {
+  Rng rng(5);
+  std::vector<std::pair<TimeNs, TimeNs>> all;  // (latency, instant)
+  SlowestRecords s;
+  EXPECT_EQ(s.size(), 0u);
+  for (TimeNs t = 0; t < 1000; ++t) {
+    const auto latency = static_cast<TimeNs>(rng.Uniform(0.0, 1e7));
+    all.emplace_back(latency, t);
+    s.Add(t, latency, latency / 2);
+    EXPECT_EQ(s.size(), std::min<std::size_t>(all.size(), SlowestRecords::kKept));
+  }
+  // The oracle: all records sorted by latency, the first kKept.
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (std::size_t i = 0; i < SlowestRecords::kKept; ++i) {
+    EXPECT_EQ(s[i].latency_ns, all[i].first) << i;
+    EXPECT_EQ(s[i].t_ns, all[i].second) << i;
+    EXPECT_EQ(s[i].compute_ns, all[i].first / 2) << i;
+  }
+}
+
+TEST(Realtime, PinsTimeCriticalThreadsToTheControlCpuAndComputeThreadsToTheOthers) {
+  const int online = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
+  const std::vector<int> allowed = AllowedCpus();  // the process's CPUs (a container may restrict them)
+  const int control = allowed.front();
+  // Each case on its own thread: the test runner's thread keeps its affinity.
+  std::thread([&] {
+    EXPECT_FALSE(PinThread(-1, ThreadRole::kTimeCritical));
+    EXPECT_FALSE(PinThread(online, ThreadRole::kTimeCritical));  // no such CPU
+    EXPECT_EQ(AllowedCpus(), allowed);
+    EXPECT_TRUE(PinThread(control, ThreadRole::kTimeCritical));
+    EXPECT_EQ(AllowedCpus(), std::vector<int>{control});
+  }).join();
+  if (allowed.size() >= 2) {
+    std::thread([&] {
+      EXPECT_TRUE(PinThread(control, ThreadRole::kCompute));
+      EXPECT_EQ(AllowedCpus(), std::vector<int>(allowed.begin() + 1, allowed.end()));
+    }).join();
+  }
+  if (online == 1) {
+    std::thread([&] { EXPECT_FALSE(PinThread(0, ThreadRole::kCompute)); }).join();  // a compute thread keeps it
+  }
+  RealtimeOptions o;
+  o.control_cpu = -2;
+  EXPECT_THROW(o.Validate(), ValidationError);
+  std::thread([&] {
+    const RealtimeGrant g = RequestRealtime({.lock_memory = false, .fifo_priority = 0, .control_cpu = control});
+    EXPECT_TRUE(g.pinned);
+    EXPECT_EQ(g.note, fmt::format("memory not locked (not asked), normal scheduler (not asked), pinned to CPU {}", control));
+  }).join();
+}
+
+TEST(Realtime, AThreadLentToAFlightGetsItsSchedulingBackAndALoadNeverInheritsIt) {
+  const std::vector<int> allowed = AllowedCpus();
+  std::thread([&] {
+    {
+      const ThreadSchedulingScope scope;
+      ASSERT_TRUE(PinThread(allowed.front(), ThreadRole::kTimeCritical));
+      EXPECT_EQ(AllowedCpus(), std::vector<int>{allowed.front()});
+    }
+    EXPECT_EQ(AllowedCpus(), allowed);
+    // Pinned again, a thread it starts inherits the pinning unless it asks for the normal
+    // scheduling, as a benchmark's background load does.
+    ASSERT_TRUE(PinThread(allowed.front(), ThreadRole::kTimeCritical));
+    std::vector<int> inherited, normal;
+    std::thread([&] {
+      inherited = AllowedCpus();
+      UseNormalScheduling();
+      normal = AllowedCpus();
+    }).join();
+    EXPECT_EQ(inherited, std::vector<int>{allowed.front()});
+    EXPECT_EQ(normal, allowed);
+  }).join();
 }
 
 TEST(Realtime, ValidatesThePriorityAndReportsWhatItGranted) {

@@ -1,5 +1,7 @@
 #pragma once
 /// `rotorguard bench sitl`: the onboard runtime in software in the loop (docs/runtime.md).
+///  - Platform: the machine's own wake-up lateness under each load, without the stack (the floor
+///    under any loop's miss rate).
 ///  - Timing: a scenario (the forest: the LiDAR-inertial odometry on every frame, the replanner,
 ///    the NMPC) flown `repeats` times in each load condition, the stack in its own process
 ///    (`rotorguard node`): the miss rate (control instants whose command was sent more than a
@@ -26,6 +28,11 @@ struct SitlBenchOptions {
   int repeats = 3;        ///< flights per load condition, in [0, 100]
   std::vector<std::string> loads = {"idle", "one_core_busy"};  ///< each idle or one_core_busy
   int fifo_priority = 0;  ///< 0: the normal scheduler; else SCHED_FIFO at it (sitl --fifo-priority)
+  int control_cpu = -1;   ///< -1: no pinning; else the time-critical threads' CPU (sitl --control-cpu)
+  /// Seconds per load (idle, one core busy, two cores busy) of the machine's own timing, without
+  /// the stack: a thread scheduled as the control thread sleeping to instants one control period
+  /// apart; how late it wakes (0: none).
+  double platform_s = 60.0;
   /// The command that starts the stack's process: this program's path (`node` is appended).
   std::string self;
   int ftc_trials = 20;  ///< flights per FTC cell, in [0, 1000]

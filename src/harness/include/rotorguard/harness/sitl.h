@@ -48,6 +48,11 @@ struct SitlLinkReport {
   double late_max_s = 0.0;           ///< the latest such arrival after its sending instant [s]
   std::uint64_t steps_behind = 0;    ///< physics steps begun more than half a step after their end had passed on the clock
   double behind_max_s = 0.0;         ///< the furthest the simulator fell behind the clock [s]
+  runtime::SlowestRecords behind;    ///< the steps furthest behind (latency: how far behind)
+  /// The simulator's work per physics step on the wall clock (commands in, the step, sensors out,
+  /// the log): what makes it fall behind when it does.
+  runtime::LatencyHistogram step_work;
+  runtime::SlowestRecords step_work_slowest;
   runtime::LatencyHistogram command_delay;  ///< a command's IMU sample -> it acts on the ESCs (before their latency)
   int processes = 1;                 ///< the simulator's and the stack's: 1 or 2
   std::string simulator_realtime = "normal scheduler (not asked)";  ///< the simulator thread's scheduling

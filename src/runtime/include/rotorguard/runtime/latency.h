@@ -3,6 +3,7 @@
 /// latencies with logarithmic bins, recorded without allocating (the control thread records into
 /// it).
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -38,6 +39,26 @@ class LatencyHistogram {
   std::uint64_t count_ = 0;
   TimeNs min_ns_ = 0, max_ns_ = 0;
   double sum_s_ = 0.0;
+};
+
+/// The slowest few records with the instants they belong to: where in a flight a loop was late,
+/// to lay beside what else ran then. Fixed storage, so the control thread records into it too.
+class SlowestRecords {
+ public:
+  static constexpr std::size_t kKept = 8;
+  struct Record {
+    TimeNs t_ns = 0;        ///< the instant (a cycle's sample, a frame's end, a step's start)
+    TimeNs latency_ns = 0;  ///< what was slow about it
+    TimeNs compute_ns = 0;  ///< the work itself in it, where the loop measures it (else 0)
+  };
+  void Add(TimeNs t_ns, TimeNs latency_ns, TimeNs compute_ns = 0) noexcept;
+  /// The kept records, slowest first.
+  std::size_t size() const { return size_; }
+  const Record& operator[](std::size_t i) const { return records_[i]; }
+
+ private:
+  std::array<Record, kKept> records_{};
+  std::size_t size_ = 0;
 };
 
 }  // namespace rotorguard::runtime

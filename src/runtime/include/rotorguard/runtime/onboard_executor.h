@@ -163,6 +163,7 @@ struct LoopReport {
   std::uint64_t skipped = 0;     ///< control: instants passed without a cycle (the thread was late)
   LatencyHistogram latency;      ///< control: IMU capture -> command sent; perception: frame end -> update published
   LatencyHistogram compute;      ///< the work itself, on the steady clock
+  SlowestRecords slowest;        ///< the slowest latencies with their instants and compute
   double cpu_s = 0.0;            ///< the thread's CPU time
   std::uint64_t dropped = 0;     ///< inputs refused by a full queue
 };
