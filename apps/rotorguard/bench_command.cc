@@ -135,10 +135,11 @@ class BenchCommand final : public Command {
          {{"--qp-solver", &nmpc_qp_solver_, "The NMPC's QP solver: riccati (default, the stack's) or condensing"}}},
         {&sitl_,
          "sitl",
-         "The onboard runtime in software in the loop (docs/runtime.md): the forest flown --repeats times idle\n"
-         "and with one core busy, the stack in its own process (deadline misses, IMU-to-command latency), and\n"
-         "paper 000's hover and tracking failure cells, --ftc-trials flights each, against lockstep with the\n"
-         "measured delay (equal outcomes, FDD latency). At real time: about 25 min with the defaults.",
+         "The onboard runtime in software in the loop (docs/runtime.md): the machine's own wake-up timing\n"
+         "without the stack, the forest flown --repeats times idle and with one core busy, the stack in its own\n"
+         "process (deadline misses, IMU-to-command latency), and paper 000's hover and tracking failure cells,\n"
+         "--ftc-trials flights each, against lockstep with the measured delay (equal outcomes, FDD latency).\n"
+         "At real time: about 30 min with the defaults (3 + 12 + 15).",
          {{"--scenario", &sitl_scenario_, "The timing flights' scenario (default configs/scenarios/forest.yaml)"},
           {"--repeats", &sitl_repeats_, "Timing flights per load (default 3; 0: none)"},
           {"--loads", &sitl_loads_, "Comma-separated: idle, one_core_busy (default both)"},
