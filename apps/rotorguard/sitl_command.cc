@@ -112,7 +112,7 @@ class SitlCommand final : public Command {
                p.at("cpu_s").get<double>(), n.at("cpu_s").get<double>());
     fmt::print("scheduling        {}\n", r.loops.at("realtime").at("note").get<std::string>());
     fmt::print("simulator         {} process(es); {} steps behind the clock (at most {:.2f} ms), {} of {} commands late\n",
-               r.link.processes, r.link.steps_behind, 1e3 * r.link.behind_max_s, r.link.commands_late, r.link.commands);
+               r.link.processes, r.link.steps_behind, 1e-6 * static_cast<double>(r.link.behind.max_ns()), r.link.commands_late, r.link.commands);
   }
 
   static runtime::OnboardExecutorOptions::Stall ParseStall(const std::string& text) {

@@ -234,9 +234,7 @@ void SitlBenchOptions::Validate() const {
   if (fifo_priority != 0 && (fifo_priority < 3 || fifo_priority > 99)) {
     ThrowValidation("SitlBenchOptions", "fifo_priority", fifo_priority, "0 (none) or in [3, 99]");
   }
-  if (control_cpu < -1 || control_cpu >= CPU_SETSIZE) {
-    ThrowValidation("SitlBenchOptions", "control_cpu", control_cpu, "-1 (no pinning) or a CPU number");
-  }
+  Realtime(*this).Validate();  // control_cpu
   if (!(platform_s >= 0.0 && platform_s <= 3600.0)) {
     ThrowValidation("SitlBenchOptions", "platform_s", platform_s, "in [0, 3600] s (0: no probe)");
   }

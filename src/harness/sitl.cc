@@ -374,7 +374,7 @@ nlohmann::json SitlResult::RuntimeJson() const {
                {"commands_late", link.commands_late},
                {"late_max_ms", 1e3 * link.late_max_s},
                {"steps_behind", link.steps_behind},
-               {"behind_max_ms", 1e3 * link.behind_max_s},
+               {"behind_max_ms", 1e-6 * static_cast<double>(link.behind.max_ns())},
                {"behind_slowest", SlowestJson(link.behind)},
                {"step_work", HistogramJson(link.step_work)},
                {"step_work_slowest", SlowestJson(link.step_work_slowest)},
@@ -468,7 +468,6 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
       const TimeNs behind = clock.Now() - (t + dt);
       if (behind > dt / 2) {
         ++link.steps_behind;
-        link.behind_max_s = std::max(link.behind_max_s, ToSeconds(behind));
         link.behind.Add(t, behind);
       }
       clock.SleepUntil(t + dt);

@@ -116,32 +116,20 @@ void OnboardExecutor::Start() {
   started_ = true;
   report_.realtime = RequestRealtime(options_.realtime);
   const int priority = report_.realtime.fifo ? options_.realtime.fifo_priority : 0;
-  control_ = std::thread([this, priority] {
-    FollowFifo(priority);
-    PinThread(options_.realtime.control_cpu, ThreadRole::kTimeCritical);
-    if (options_.on_thread_start) options_.on_thread_start("control");
-    ControlLoop();
-  });
-  perception_ = std::thread([this, priority] {
-    FollowFifo(priority > 0 ? priority - 1 : 0);
-    PinThread(options_.realtime.control_cpu, ThreadRole::kCompute);
-    if (options_.on_thread_start) options_.on_thread_start("perception");
-    PerceptionLoop();
-  });
-  planning_ = std::thread([this, priority] {
-    FollowFifo(priority > 0 ? priority - 2 : 0);
-    PinThread(options_.realtime.control_cpu, ThreadRole::kCompute);
-    if (options_.on_thread_start) options_.on_thread_start("planning");
-    PlanningLoop();
-  });
-  if (policy_) {
-    guard_ = std::thread([this, priority] {
-      FollowFifo(priority > 0 ? std::min(priority + 1, sched_get_priority_max(SCHED_FIFO)) : 0);
-      PinThread(options_.realtime.control_cpu, ThreadRole::kTimeCritical);
-      if (options_.on_thread_start) options_.on_thread_start("guard");
-      GuardLoop();
+  // Each thread runs `below` the control thread's SCHED_FIFO priority (when granted; the guard
+  // above it) on the CPUs of its role, then its loop.
+  const auto start = [this, priority](const char* name, int below, ThreadRole role, void (OnboardExecutor::*loop)()) {
+    return std::thread([this, priority, name, below, role, loop] {
+      FollowFifo(priority > 0 ? std::clamp(priority - below, 1, sched_get_priority_max(SCHED_FIFO)) : 0);
+      PinThread(options_.realtime.control_cpu, role);
+      if (options_.on_thread_start) options_.on_thread_start(name);
+      (this->*loop)();
     });
-  }
+  };
+  control_ = start("control", 0, ThreadRole::kTimeCritical, &OnboardExecutor::ControlLoop);
+  perception_ = start("perception", 1, ThreadRole::kCompute, &OnboardExecutor::PerceptionLoop);
+  planning_ = start("planning", 2, ThreadRole::kCompute, &OnboardExecutor::PlanningLoop);
+  if (policy_) guard_ = start("guard", -1, ThreadRole::kTimeCritical, &OnboardExecutor::GuardLoop);
 }
 
 void OnboardExecutor::Stop() {
@@ -304,13 +292,8 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   UnlockSend();
   if (first) guard_bell_.Ring();
   const TimeNs latency = cycle.command.sent_t_ns - t;
-  LoopReport& r = report_.control;
-  ++r.runs;
-  r.latency.Record(latency);
-  if (latency > deadline_ns_) ++r.misses;
-  const TimeNs compute = SteadyClock::Monotonic() - start;
-  r.compute.Record(compute);
-  r.slowest.Add(t, latency, compute);
+  report_.control.Record(t, latency, SteadyClock::Monotonic() - start);
+  if (latency > deadline_ns_) ++report_.control.misses;
 }
 
 void OnboardExecutor::LockSend() {
@@ -451,12 +434,7 @@ void OnboardExecutor::PerceptionLoop() {
       }
       PublishLioUpdate(&published_serial);
       frames_done_.fetch_add(1, std::memory_order_acq_rel);
-      LoopReport& r = report_.perception;
-      ++r.runs;
-      const TimeNs latency = clock_->Now() - f->t_end_ns, compute = SteadyClock::Monotonic() - start;
-      r.latency.Record(latency);
-      r.compute.Record(compute);
-      r.slowest.Add(f->t_end_ns, latency, compute);
+      report_.perception.Record(f->t_end_ns, clock_->Now() - f->t_end_ns, SteadyClock::Monotonic() - start);
       continue;
     }
     // Once the control thread has ended, what it passed on is all there will be.
@@ -490,12 +468,7 @@ void OnboardExecutor::PlanningLoop() {
           next_kept = (next_kept + 1) % kept.size();
         }
         planning_output_.Publish({std::move(followed), tasks_.planning->status()});
-        LoopReport& r = report_.planning;
-        ++r.runs;
-        const TimeNs latency = clock_->Now() - in.t_ns, compute = SteadyClock::Monotonic() - start;
-        r.latency.Record(latency);
-        r.compute.Record(compute);
-        r.slowest.Add(in.t_ns, latency, compute);
+        report_.planning.Record(in.t_ns, clock_->Now() - in.t_ns, SteadyClock::Monotonic() - start);
       }
       planning_calls_.store(in.cycle, std::memory_order_release);
       continue;

@@ -6,6 +6,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -32,24 +33,33 @@ ThreadSchedulingScope::~ThreadSchedulingScope() {
   if (have_policy_) pthread_setschedparam(pthread_self(), policy_, &param_);
 }
 
+namespace {
+
+int OnlineCpus() { return static_cast<int>(std::min<long>(sysconf(_SC_NPROCESSORS_ONLN), CPU_SETSIZE)); }
+
+/// Runs the calling thread on the online CPUs that `keep` accepts.
+template <typename Keep>
+bool RunOn(Keep keep) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (int cpu = 0; cpu < OnlineCpus(); ++cpu) {
+    if (keep(cpu)) CPU_SET(cpu, &set);
+  }
+  return pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+}
+
+}  // namespace
+
 void UseNormalScheduling() {
   sched_param p{};
   pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  for (long cpu = 0; cpu < sysconf(_SC_NPROCESSORS_ONLN) && cpu < CPU_SETSIZE; ++cpu) CPU_SET(cpu, &set);
-  pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+  RunOn([](int) { return true; });
 }
 
 bool PinThread(int control_cpu, ThreadRole role) {
-  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  const int online = OnlineCpus();
   if (control_cpu < 0 || control_cpu >= online || (role == ThreadRole::kCompute && online < 2)) return false;
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  for (int cpu = 0; cpu < online; ++cpu) {
-    if ((cpu == control_cpu) == (role == ThreadRole::kTimeCritical)) CPU_SET(cpu, &set);
-  }
-  return pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+  return RunOn([&](int cpu) { return (cpu == control_cpu) == (role == ThreadRole::kTimeCritical); });
 }
 
 RealtimeGrant RequestRealtime(const RealtimeOptions& options) {
@@ -81,7 +91,7 @@ RealtimeGrant RequestRealtime(const RealtimeOptions& options) {
     g.pinned = PinThread(options.control_cpu, ThreadRole::kTimeCritical);
     cpu = g.pinned ? fmt::format(", pinned to CPU {}", options.control_cpu)
                    : fmt::format(", not pinned (CPU {} is not among this machine's {} online CPUs)", options.control_cpu,
-                                 sysconf(_SC_NPROCESSORS_ONLN));
+                                 OnlineCpus());
   }
   g.note = memory + ", " + priority + cpu;
   return g;

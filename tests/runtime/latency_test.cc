@@ -79,6 +79,7 @@ TEST(SlowestRecords, KeepsTheSlowestWithTheirInstantsSlowestFirst) {
   std::vector<std::pair<TimeNs, TimeNs>> all;  // (latency, instant)
   SlowestRecords s;
   EXPECT_EQ(s.size(), 0u);
+  EXPECT_EQ(s.max_ns(), 0);
   for (TimeNs t = 0; t < 1000; ++t) {
     const auto latency = static_cast<TimeNs>(rng.Uniform(0.0, 1e7));
     all.emplace_back(latency, t);
@@ -92,6 +93,7 @@ TEST(SlowestRecords, KeepsTheSlowestWithTheirInstantsSlowestFirst) {
     EXPECT_EQ(s[i].t_ns, all[i].second) << i;
     EXPECT_EQ(s[i].compute_ns, all[i].first / 2) << i;
   }
+  EXPECT_EQ(s.max_ns(), all.front().first);
 }
 
 TEST(Realtime, PinsTimeCriticalThreadsToTheControlCpuAndComputeThreadsToTheOthers) {

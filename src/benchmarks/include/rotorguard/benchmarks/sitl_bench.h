@@ -6,7 +6,8 @@
 ///    the NMPC) flown `repeats` times in each load condition, the stack in its own process
 ///    (`rotorguard node`): the miss rate (control instants whose command was sent more than a
 ///    control period after its IMU sample, or never: the thread came past the instant late), the
-///    latency from IMU sample to command sent, holds and hand-overs of the deadline policy. "one_core_busy": a thread of this process spins for the whole flight.
+///    latency from IMU sample to command sent, holds and hand-overs of the deadline policy.
+///    "one_core_busy": a thread of this process spins for the whole flight.
 ///  - FTC cells: paper 000's hover and tracking cells with a propeller loss and a motor stop,
 ///    `ftc_trials` flights each in software in the loop (stack in this process, on the executor's
 ///    threads) and the same flights in lockstep with the computation delay set to the range the

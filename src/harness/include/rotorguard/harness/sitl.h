@@ -47,8 +47,7 @@ struct SitlLinkReport {
   std::uint64_t commands_late = 0;   ///< received after the step they were sent in had been simulated
   double late_max_s = 0.0;           ///< the latest such arrival after its sending instant [s]
   std::uint64_t steps_behind = 0;    ///< physics steps begun more than half a step after their end had passed on the clock
-  double behind_max_s = 0.0;         ///< the furthest the simulator fell behind the clock [s]
-  runtime::SlowestRecords behind;    ///< the steps furthest behind (latency: how far behind)
+  runtime::SlowestRecords behind;    ///< of those, the furthest behind the clock (latency: how far)
   /// The simulator's work per physics step on the wall clock (commands in, the step, sensors out,
   /// the log): what makes it fall behind when it does.
   runtime::LatencyHistogram step_work;

@@ -55,6 +55,8 @@ class SlowestRecords {
   /// The kept records, slowest first.
   std::size_t size() const { return size_; }
   const Record& operator[](std::size_t i) const { return records_[i]; }
+  /// The slowest latency recorded, 0 when none [ns].
+  TimeNs max_ns() const { return size_ ? records_[0].latency_ns : 0; }
 
  private:
   std::array<Record, kKept> records_{};

@@ -166,6 +166,13 @@ struct LoopReport {
   SlowestRecords slowest;        ///< the slowest latencies with their instants and compute
   double cpu_s = 0.0;            ///< the thread's CPU time
   std::uint64_t dropped = 0;     ///< inputs refused by a full queue
+  /// One run at instant t: its latency and its compute, into the histograms and the slowest few.
+  void Record(TimeNs t, TimeNs latency_ns, TimeNs compute_ns) noexcept {
+    ++runs;
+    latency.Record(latency_ns);
+    compute.Record(compute_ns);
+    slowest.Add(t, latency_ns, compute_ns);
+  }
 };
 
 struct OnboardReport {
