@@ -20,7 +20,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-INCLUDE = re.compile(r'^#include "rotorguard/([a-z_]+)/([a-z_]+\.h)"', re.M)
+INCLUDE = re.compile(r'^#include "rotorguard/([a-z0-9_]+)/([a-z0-9_]+\.h)"', re.M)
 
 
 class Violation(Exception):

@@ -25,6 +25,9 @@ packages=(
   python3-numpy        # its arrays
   python3-matplotlib   # the Python examples' plots (examples/python/)
   python3-pytest       # its tests
+  # ROS 1 (docs/ros.md): roscpp, the message generators, roscore, rostopic and rosbag's tools
+  # (ros-core-dev), rosbag's C++ library, and tf2's messages; the build turns ROS on when they are here.
+  ros-core-dev librosbag-dev libtf2-msgs-dev
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-14-dev)  # libFuzzer, with AddressSanitizer (docs/reliability.md)

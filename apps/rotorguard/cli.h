@@ -19,6 +19,9 @@
 #include "rotorguard/harness/flight_recorder.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/harness/sitl.h"
+#include "rotorguard/harness/stack_observer.h"
+#include "rotorguard/runtime/realtime.h"
 
 namespace rotorguard::cli {
 
@@ -49,6 +52,20 @@ std::unique_ptr<Command> MakeCampaignCommand();
 std::unique_ptr<Command> MakeKeysCommand();
 std::unique_ptr<Command> MakeSitlCommand();
 std::unique_ptr<Command> MakeNodeCommand();
+std::unique_ptr<Command> MakeReplayCommand();
+
+// ---- ROS (ros_support.cc; each throws UsageError naming the option in a build without ROS).
+/// Whether this rotorguard was built with ROS 1 (ROTORGUARD_ROS).
+bool BuiltWithRos();
+/// --bag PATH: a recorder of the flight's sensor messages and cycles.
+std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string& path);
+/// sitl --ros: the stack's link over ROS through the master `master_uri` ("" : ROS_MASTER_URI),
+/// the node started from sitl->node_command (with --ros added).
+void UseRosLink(harness::SitlOptions* sitl, const std::string& master_uri);
+/// node --ros: flies the node over ROS until told to stop; `args` are the ROS remappings
+/// (from:=to) given after the options.
+void RunNodeOverRos(const harness::Scenario& scenario, const std::string& master_uri, const std::vector<std::string>& args,
+                    bool start_now, const runtime::RealtimeOptions& realtime);
 
 /// The exit code of an error, by its type (UsageError, io::ConfigError: 2; io::InputFileError,
 /// io::CorruptFileError: 3; std::invalid_argument: 2; anything else: 1), and its message with the

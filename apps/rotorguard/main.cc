@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   commands.push_back(cli::MakeRunCommand());
   commands.push_back(cli::MakeSitlCommand());
   commands.push_back(cli::MakeNodeCommand());
+  commands.push_back(cli::MakeReplayCommand());
   commands.push_back(cli::MakeReportCommand());
   commands.push_back(cli::MakeValidateCommand());
   commands.push_back(cli::MakeKeysCommand());

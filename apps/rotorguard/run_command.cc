@@ -30,6 +30,9 @@ class RunCommand final : public Command {
                     "csv (log.csv, scene.json, sensors.csv; the default), mcap (flight.mcap, for Foxglove and "
                     "PlotJuggler) or both");
     run->add_flag("--no-report", no_report_, "Do not write report.html");
+    run->add_option("--bag", bag_,
+                    "Also record the sensor messages the stack was given and its cycles (command, estimate, FDD\n"
+                    "health) to this rosbag, for `rotorguard replay` and ROS's tools (docs/ros.md; needs ROS)");
     return run;
   }
 
@@ -44,7 +47,10 @@ class RunCommand final : public Command {
     options.out_dir = out_dir_.empty() ? (fs::path("out") / scenario.name).string() : out_dir_;
     CreateOutputFolder(options.out_dir);
     options.progress = FlightProgress(!quiet_, scenario.duration_s);
+    std::unique_ptr<harness::StackObserver> bag;
+    if (!bag_.empty()) options.observer = (bag = MakeBagRecorder(bag_)).get();
     const harness::RunSummary summary = harness::RunScenario(scenario, options);
+    if (!quiet_ && bag) fmt::print("bag               {}\n", bag_);
     if (!quiet_) PrintRunSummary(summary, options.out_dir, options);
     if (summary.infeasible_request) return kInfeasible;
     return summary.success ? kOk : kRunFailed;
@@ -57,7 +63,7 @@ class RunCommand final : public Command {
   }
 
   ScenarioArguments scenario_;
-  std::string out_dir_, log_format_ = "csv";
+  std::string out_dir_, log_format_ = "csv", bag_;
   bool quiet_ = false, no_report_ = false;
 };
 

@@ -44,6 +44,13 @@ class SitlCommand final : public Command {
                      "over to the fallback controller, which lands (docs/runtime.md)");
     sitl->add_flag("--in-process", in_process_,
                    "Run the stack in this process (default: in its own, `rotorguard node`, through shared memory)");
+    sitl->add_option("--bag", bag_,
+                     "Also record the sensor messages the simulator sent and the cycles it received to this rosbag\n"
+                     "(docs/ros.md; needs ROS)");
+    sitl->add_flag("--ros", ros_,
+                   "The stack's node talks to the simulator over ROS 1 topics (the master of ROS_MASTER_URI or\n"
+                   "--ros-master), the simulator publishing /clock with /use_sim_time set (docs/ros.md)");
+    sitl->add_option("--ros-master", ros_master_, "The ROS master's URI for --ros (default: ROS_MASTER_URI)");
     sitl->add_flag("--quiet,-q", quiet_, "No progress bar and no summary table");
     app_ = sitl;
     return sitl;
@@ -61,14 +68,19 @@ class SitlCommand final : public Command {
     }
     for (const std::string& text : stall_texts_) sitl.executor.stalls.push_back(ParseStall(text));
     const harness::Scenario scenario = scenario_.Load();
+    if (ros_ && in_process_) throw UsageError("--ros and --in-process: a ROS node is a process of its own");
+    if (!ros_ && !ros_master_.empty()) throw UsageError("--ros-master: only with --ros");
     if (!in_process_) {
       // The node flies the same scenario: the same file, overrides and seed.
       sitl.node_command = {SelfPath(), "node", scenario_.path, "--seed", std::to_string(scenario.seed)};
       for (const std::string& set : scenario_.sets) sitl.node_command.insert(sitl.node_command.end(), {"--set", set});
     }
+    if (ros_) UseRosLink(&sitl, ros_master_);
     harness::RunOptions options;
     options.out_dir = out_dir_.empty() ? (fs::path("out") / (scenario.name + "-sitl")).string() : out_dir_;
     CreateOutputFolder(options.out_dir);
+    std::unique_ptr<harness::StackObserver> bag;
+    if (!bag_.empty()) options.observer = (bag = MakeBagRecorder(bag_)).get();
     options.progress = FlightProgress(!quiet_, scenario.duration_s);
     options.report = io::HasViewer();
     const harness::SitlResult result = harness::RunSitl(scenario, options, sitl);
@@ -77,6 +89,7 @@ class SitlCommand final : public Command {
       PrintRuntime(result);
       fmt::print("summary           {}\n", (fs::path(options.out_dir) / "summary.json").string());
       fmt::print("runtime           {}\n", (fs::path(options.out_dir) / "runtime.json").string());
+      if (bag) fmt::print("bag               {}\n", bag_);
     }
     if (result.summary.infeasible_request) return kInfeasible;
     return result.summary.success ? kOk : kRunFailed;
@@ -134,9 +147,9 @@ class SitlCommand final : public Command {
 
   CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
-  std::string out_dir_, factor_text_, fifo_text_, cpu_text_;
+  std::string out_dir_, factor_text_, fifo_text_, cpu_text_, bag_, ros_master_;
   std::vector<std::string> stall_texts_;
-  bool quiet_ = false, in_process_ = false;
+  bool quiet_ = false, in_process_ = false, ros_ = false;
   harness::SitlOptions sitl_;
 };
 
@@ -146,21 +159,38 @@ class NodeCommand final : public Command {
   CLI::App* Register(CLI::App* app) override {
     CLI::App* node = app->add_subcommand(
         "node",
-        "The flight stack's process of `sitl` (which starts it): flies SCENARIO's stack on the onboard executor,\n"
-        "exchanging sensor messages and commands with the simulator through the shared-memory channel NAME.");
+        "The flight stack as a process of its own, on the onboard executor: SCENARIO's stack (its vehicle file and\n"
+        "stack keys). With --channel NAME, the node of `sitl` (which starts it), through its shared-memory\n"
+        "channel; with --ros, a ROS 1 node: sensor topics in, commands, estimate and FDD health out, until a\n"
+        "shutdown message or SIGINT (docs/ros.md). ROS remappings (imu:=/livox/imu) follow the options.");
     scenario_.Register(node);
-    node->add_option("--channel", channel_, "The shared-memory channel `sitl` created (/rotorguard-sitl-...)")
-        ->required();
+    node->add_option("--channel", channel_, "The shared-memory channel `sitl` created (/rotorguard-sitl-...)");
+    node->add_flag("--ros", ros_, "Talk over ROS 1 (the master of ROS_MASTER_URI or --ros-master)");
+    node->add_option("--ros-master", ros_master_, "The ROS master's URI for --ros (default: ROS_MASTER_URI)");
+    node->add_flag("--start-now", start_now_,
+                   "With --ros: the mission starts (t = 0) once the stack is built, not at a mission_start message");
+    node->allow_extras();
+    app_ = node;
     return node;
   }
   int Execute() override {
-    harness::RunNode(scenario_.Load(), channel_);
+    const std::vector<std::string> extras = app_->remaining();
+    if (ros_ == !channel_.empty()) throw UsageError("node: give either --channel NAME (sitl's shared memory) or --ros");
+    if (!ros_ && !extras.empty()) throw UsageError(fmt::format("node: unexpected argument '{}'", extras.front()));
+    if (!ros_ && (start_now_ || !ros_master_.empty())) throw UsageError("node: --start-now and --ros-master need --ros");
+    if (ros_) {
+      RunNodeOverRos(scenario_.Load(), ros_master_, extras, start_now_, {.lock_memory = false, .fifo_priority = 0});
+    } else {
+      harness::RunNode(scenario_.Load(), channel_);
+    }
     return kOk;
   }
 
  private:
+  CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
-  std::string channel_;
+  std::string channel_, ros_master_;
+  bool ros_ = false, start_now_ = false;
 };
 
 }  // namespace

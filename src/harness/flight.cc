@@ -138,6 +138,7 @@ class Flight::Loop {
         command_(stack_.command()) {
     recorder_.Begin(stack_, sim_.model().num_rotors());
     DeliverToStack(sim_.outputs(), &stack_, recorder_.sensor_log());
+    if (options_.observer) options_.observer->OnSensors(sim_.time_ns(), sim_.outputs());
     if (!done_) RunControlCycle();
   }
 
@@ -157,6 +158,13 @@ class Flight::Loop {
     ++control_cycles_;
     metrics_.OnEstimate(vehicle::StateView(sim_.state()), stack_.estimate());
     if (options_.on_control_cycle) options_.on_control_cycle(stack_);
+    if (options_.observer) {
+      runtime::CycleTelemetry c = runtime::TelemetryOf(stack_, t, stack_.supervisor().mode(), command_.thrust_n);
+      c.command.cycle = control_cycles_;
+      c.command.sent_t_ns = command_sent_ns_;
+      c.command.compute_s = cycle_s;
+      options_.observer->OnCycle(c);
+    }
     cycle_to_record_ = t;  // recorded with the first physics step, once the command is final
   }
 
@@ -183,6 +191,7 @@ class Flight::Loop {
     simulator_s_ += clock.Restart();
     DeliverToStack(outputs, &stack_, recorder_.sensor_log());
     stack_s_ += clock.seconds();
+    if (options_.observer) options_.observer->OnSensors(sim_.time_ns(), outputs);
     recorder_.AfterStep();
     ++physics_steps_;
     // As RunScenario always has: a crash ends the flight before the mission's end is noted.
@@ -237,6 +246,7 @@ class Flight::Loop {
     DiagnoseFailure(metrics_.last_violation(), sc_.success, &s);
     AddTimes(&s);
     recorder_.WriteSummary(s);
+    if (options_.observer) options_.observer->Finish();
     return s;
   }
 

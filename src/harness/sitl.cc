@@ -1,9 +1,6 @@
 #include "rotorguard/harness/sitl.h"
 
 #include <fmt/format.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +17,7 @@
 #include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/failure_diagnosis.h"
 #include "rotorguard/harness/flight_recorder.h"
+#include "rotorguard/harness/node_process.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/io/json_archive.h"
 #include "rotorguard/runtime/realtime.h"
@@ -146,23 +144,6 @@ void EachSensorMessage(const sim::SensorOutputs& o, F&& f) {
   if (o.odometry) f(runtime::SensorMessage::Of(*o.odometry));
 }
 
-/// The stack's side of the loop as the simulator sees it: where sensor messages go and commands
-/// come from, the clock the stack follows, and the stack's account at the end.
-class StackLink {
- public:
-  virtual ~StackLink() = default;
-  /// The stack is ready for t = 0 once this returns (its threads started).
-  virtual void Start() = 0;
-  virtual runtime::Clock& clock() = 0;
-  /// With lockstep_clock: the simulator's time moves to t, once the messages delivered so far are
-  /// in the stack's hands.
-  virtual void AdvanceTime(TimeNs t) = 0;
-  virtual void Deliver(const sim::SensorOutputs& outputs) = 0;
-  virtual bool TryReceive(runtime::CycleTelemetry* cycle) = 0;
-  /// Stops the stack; its account and its loops' report (JSON).
-  virtual StackAccount Finish(nlohmann::json* loops) = 0;
-};
-
 /// The stack in this process, on the executor's threads; the commands come back through a queue.
 class InProcessLink final : public StackLink {
  public:
@@ -180,11 +161,12 @@ class InProcessLink final : public StackLink {
     if (o.lidar) executor_.OnLidar(std::make_shared<const LidarFrame>(*o.lidar));
   }
   bool TryReceive(runtime::CycleTelemetry* cycle) override { return sink_.TryReceive(cycle); }
-  StackAccount Finish(nlohmann::json* loops) override {
+  nlohmann::json Finish(nlohmann::json* loops) override {
     time_.Stop();
     executor_.Stop();
-    *loops = LoopsJson(executor_.Report());
-    return AccountOf(stack_);
+    const nlohmann::json j = NodeAccountJson(stack_, executor_.Report());
+    *loops = j.at("loops");
+    return j.at("account");
   }
 
  private:
@@ -217,13 +199,7 @@ class SharedMemoryLink final : public StackLink {
     for (int i = 0; i < runtime::SitlChannel::kFrameSlots; ++i) ch.free_slots.TryPush(i);
     std::vector<std::string> argv = sitl.node_command;
     argv.insert(argv.end(), {"--channel", channel_.name()});
-    node_ = Spawn(argv);
-  }
-  ~SharedMemoryLink() override {
-    if (node_ > 0) {  // not waited for: a failure on the way
-      kill(node_, SIGKILL);
-      waitpid(node_, nullptr, 0);
-    }
+    node_ = NodeProcess(argv, "sitl");
   }
   void Start() override {
     WaitFor(runtime::NodeState::kBuilt, 60.0, "build its stack");
@@ -255,7 +231,7 @@ class SharedMemoryLink final : public StackLink {
     channel_->to_node_bell.Ring();
   }
   bool TryReceive(runtime::CycleTelemetry* cycle) override { return channel_->cycles.TryPop(cycle); }
-  StackAccount Finish(nlohmann::json* loops) override {
+  nlohmann::json Finish(nlohmann::json* loops) override {
     time_.Stop();
     runtime::SitlMessage end;
     end.kind = runtime::SitlMessage::Kind::kEnd;
@@ -264,13 +240,9 @@ class SharedMemoryLink final : public StackLink {
     WaitFor(runtime::NodeState::kDone, 60.0, "finish");
     const nlohmann::json j = nlohmann::json::parse(
         std::string(channel_->account.data(), channel_->account_size.load(std::memory_order_acquire)));
-    int status = 0;
-    waitpid(node_, &status, 0);
-    node_ = 0;
+    node_.Wait();
     *loops = j.at("loops");
-    StackAccount account;
-    io::FromJson(j.at("account"), &account);
-    return account;
+    return j.at("account");
   }
 
  private:
@@ -279,16 +251,6 @@ class SharedMemoryLink final : public StackLink {
   static std::string ChannelName() {
     static std::atomic<int> counter{0};
     return fmt::format("/rotorguard-sitl-{}-{}", getpid(), counter.fetch_add(1));
-  }
-  static pid_t Spawn(const std::vector<std::string>& argv) {
-    std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    pid_t pid = 0;
-    if (const int e = posix_spawnp(&pid, args[0], nullptr, nullptr, args.data(), environ); e != 0) {
-      throw std::runtime_error(fmt::format("sitl: cannot start the node '{}': {}", argv[0], std::strerror(e)));
-    }
-    return pid;
   }
   /// Waits until the node reaches `state`; throws naming what it was doing when it failed, exited
   /// or took longer than `timeout_s`.
@@ -303,14 +265,7 @@ class SharedMemoryLink final : public StackLink {
             std::string(channel_->account.data(), channel_->account_size.load(std::memory_order_acquire))));
       }
       if (now >= static_cast<int>(state)) return;
-      int status = 0;
-      if (waitpid(node_, &status, WNOHANG) == node_) {
-        node_ = 0;
-        throw std::runtime_error(fmt::format("sitl: the node exited ({}) before it could {}",
-                                             WIFEXITED(status) ? fmt::format("status {}", WEXITSTATUS(status))
-                                                               : fmt::format("signal {}", WTERMSIG(status)),
-                                             doing));
-      }
+      node_.ThrowIfExited(doing);
       if (runtime::SteadyClock::Monotonic() > until) {
         throw std::runtime_error(fmt::format("sitl: the node did not {} within {:g} s", doing, timeout_s));
       }
@@ -349,7 +304,7 @@ class SharedMemoryLink final : public StackLink {
   runtime::SimulatedTime time_{-1};  // the simulator's, with lockstep_clock (the node keeps its own copy)
   runtime::SimulatedClock simulated_clock_{&time_};
   bool lockstep_;
-  pid_t node_ = 0;
+  NodeProcess node_;
   std::uint64_t frames_dropped_ = 0;
 };
 
@@ -364,6 +319,17 @@ void SitlOptions::Validate() const {
     ThrowValidation("SitlOptions", "executor.stalls", executor.stalls.size(),
                     fmt::format("at most {} stalls (what the node's channel carries)", runtime::SitlChannel::kMaxStalls));
   }
+}
+
+NodeStack MakeNodeStack(const Scenario& scenario) {
+  NodeStack n{Flown(scenario), nullptr};
+  const Scenario& sc = n.scenario;
+  n.stack = std::make_unique<stack::FlightStack>(sc.vehicle, sc.reference, sc.stack, ExternalController(sc));
+  return n;
+}
+
+nlohmann::json NodeAccountJson(const stack::FlightStack& stack, const runtime::OnboardReport& report) {
+  return {{"account", io::ToJson(AccountOf(stack))}, {"loops", LoopsJson(report)}};
 }
 
 nlohmann::json SitlResult::RuntimeJson() const {
@@ -411,14 +377,16 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     executor_options.lockstep_order = true;
   }
   std::unique_ptr<StackLink> stack;
-  if (sitl.node_command.empty()) {
+  if (sitl.make_link) {
+    stack = sitl.make_link(sitl, executor_options);
+  } else if (sitl.node_command.empty()) {
     stack = std::make_unique<InProcessLink>(sc, sitl, executor_options);
   } else {
     stack = std::make_unique<SharedMemoryLink>(sitl, executor_options);
   }
   SitlResult result;
   SitlLinkReport& link = result.link;
-  link.processes = sitl.node_command.empty() ? 1 : 2;
+  link.processes = sitl.node_command.empty() && !sitl.make_link ? 1 : 2;
   // A cycle's command to the ESCs, at `acts`; its estimate judged against the truth at its instant.
   const auto apply = [&](const runtime::CycleTelemetry& c, TimeNs acts) {
     ++link.commands;
@@ -431,6 +399,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     row.mode = c.mode;
     reference.Add(c.command.state_t_ns, c.reference);
     metrics.OnEstimate(vehicle::StateView(history.At(c.command.state_t_ns)), c.estimate);
+    if (options.observer) options.observer->OnCycle(c);
   };
   // The simulator's thread paces the world: it runs at the control thread's priority, and on its
   // CPU, when that one runs under SCHED_FIFO or pinned (it stands for the sensors' drivers).
@@ -442,6 +411,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   if (!sitl.lockstep_clock) clock.SleepUntil(0);
   stack->Deliver(sim.outputs());
   AppendSensorLog(sim.outputs(), recorder.sensor_log());
+  if (options.observer) options.observer->OnSensors(sim.time_ns(), sim.outputs());
   history.Add(sim.time_ns(), sim.state());
 
   const std::int64_t progress_stride = std::max<std::int64_t>(1, steps / 100);
@@ -471,6 +441,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
         link.behind.Add(t, behind);
       }
       clock.SleepUntil(t + dt);
+      stack->OnClock(t + dt);
       work_start = runtime::SteadyClock::Monotonic();
       while (stack->TryReceive(&c)) {
         if (c.command.sent_t_ns < t) {
@@ -490,6 +461,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     if (!done) {
       stack->Deliver(outputs);  // the flight's end has no cycle (as in `run`)
       AppendSensorLog(outputs, recorder.sensor_log());
+      if (options.observer) options.observer->OnSensors(sim.time_ns(), outputs);
     }
     if (work_start != 0) {
       const TimeNs work = runtime::SteadyClock::Monotonic() - work_start;
@@ -500,7 +472,8 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
       options.progress(static_cast<double>(k) / static_cast<double>(steps));
     }
   }
-  const StackAccount account = stack->Finish(&result.loops);
+  StackAccount account;
+  io::FromJson(stack->Finish(&result.loops), &account);
   for (runtime::CycleTelemetry c; stack->TryReceive(&c);) ++link.commands_after_end;
   if (options.progress) options.progress(1.0);
 
@@ -523,14 +496,16 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     io::WriteFileAtomically((std::filesystem::path(options.out_dir) / "runtime.json").string(),
                             result.RuntimeJson().dump(2) + "\n");
   }
+  if (options.observer) options.observer->Finish();
   return result;
 }
 
 namespace {
 
 /// The node's side: what it does once its channel is open, until its account is written.
-void FlyNode(const Scenario& sc, runtime::SitlChannel& ch) {
-  stack::FlightStack st(sc.vehicle, sc.reference, sc.stack, ExternalController(sc));
+void FlyNode(const Scenario& scenario, runtime::SitlChannel& ch) {
+  const NodeStack node = MakeNodeStack(scenario);
+  stack::FlightStack& st = *node.stack;
   const auto set_state = [&ch](runtime::NodeState state) {
     ch.node_state.store(static_cast<int>(state), std::memory_order_release);
     ch.node_bell.Ring();
@@ -605,8 +580,7 @@ void FlyNode(const Scenario& sc, runtime::SitlChannel& ch) {
     if (!any && !end) ch.to_node_bell.Wait(seen, 50'000'000);
   }
   executor.Stop();
-  const std::string text =
-      nlohmann::json{{"account", io::ToJson(AccountOf(st))}, {"loops", LoopsJson(executor.Report())}}.dump();
+  const std::string text = NodeAccountJson(st, executor.Report()).dump();
   if (text.size() > ch.account.size()) throw std::runtime_error("node: the stack's account is larger than the channel's");
   std::copy(text.begin(), text.end(), ch.account.begin());
   ch.account_size.store(text.size(), std::memory_order_release);
@@ -618,7 +592,7 @@ void FlyNode(const Scenario& sc, runtime::SitlChannel& ch) {
 void RunNode(const Scenario& scenario, const std::string& channel) {
   runtime::Shared<runtime::SitlChannel> ch = runtime::Shared<runtime::SitlChannel>::Open(channel, runtime::kSitlChannelMagic);
   try {
-    FlyNode(Flown(scenario), *ch);
+    FlyNode(scenario, *ch);
   } catch (const std::exception& e) {
     // The simulator's side reports it: it waits on the state.
     const std::string what = e.what();

@@ -266,13 +266,8 @@ void OnboardExecutor::RunCycle(TimeNs t) {
     }
   }
   const RotorCommand& command = stack_->EndCycle(t, mode, plan ? plan->followed : nullptr);
-  CycleTelemetry cycle;
+  CycleTelemetry cycle = TelemetryOf(*stack_, t, mode, command.thrust_n);
   cycle.command.cycle = ++cycles_;
-  cycle.command.state_t_ns = t;
-  cycle.command.thrust_n = command.thrust_n;
-  cycle.mode = mode;
-  cycle.estimate = stack_->estimate();
-  cycle.reference = stack_->reference_point();
   // The plan's commands for the instants after this one: what the guard holds if they are late.
   std::array<RotorVector, 2> held;
   for (int j = 0; policy_ && j < options_.hold_periods; ++j) {
@@ -294,6 +289,25 @@ void OnboardExecutor::RunCycle(TimeNs t) {
   const TimeNs latency = cycle.command.sent_t_ns - t;
   report_.control.Record(t, latency, SteadyClock::Monotonic() - start);
   if (latency > deadline_ns_) ++report_.control.misses;
+}
+
+CycleTelemetry TelemetryOf(const stack::FlightStack& stack, TimeNs t, stack::FlightMode mode, const RotorVector& thrust_n) {
+  CycleTelemetry cycle;
+  cycle.command.state_t_ns = t;
+  cycle.command.thrust_n = thrust_n;
+  cycle.mode = mode;
+  cycle.estimate = stack.estimate();
+  cycle.reference = stack.reference_point();
+  if (const fdd::FaultDetector* fdd = stack.fault_detector()) {
+    const std::vector<fdd::RotorStatus>& rotors = fdd->rotors();
+    cycle.fdd_rotors = static_cast<int>(std::min<std::size_t>(rotors.size(), kMaxRotors));
+    for (int i = 0; i < cycle.fdd_rotors; ++i) {
+      const fdd::RotorStatus& r = rotors[static_cast<std::size_t>(i)];
+      cycle.health[static_cast<std::size_t>(i)] = {r.health, static_cast<float>(r.eta), static_cast<float>(r.motor_index),
+                                                   static_cast<float>(r.propeller_index)};
+    }
+  }
+  return cycle;
 }
 
 void OnboardExecutor::LockSend() {

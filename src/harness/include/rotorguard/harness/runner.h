@@ -8,6 +8,7 @@
 #include "rotorguard/harness/flight_recorder.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/harness/stack_observer.h"
 
 namespace rotorguard::harness {
 
@@ -21,6 +22,9 @@ struct RunOptions : FlightRecorderOptions {
   /// held it for the scenario's success.hold_s (Monte Carlo trials need not fly out their whole
   /// duration).
   bool stop_when_mission_complete = false;
+  /// Sees every sensor message handed to the stack and every cycle's telemetry (a bag recorder);
+  /// null: none. Not owned; Finish is called once the flight's outputs are written.
+  StackObserver* observer = nullptr;
 };
 
 /// Runs the scenario to its duration or to a crash. Throws std::invalid_argument for a scenario

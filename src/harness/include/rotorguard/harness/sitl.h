@@ -5,6 +5,7 @@
 /// time grid at the instant it was sent (sub-step resolution), plus the ESCs' drawn latency. The
 /// stack's computation and hand-off delays are in the loop: measured, not drawn.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,8 +16,34 @@
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/runtime/onboard_executor.h"
+#include "rotorguard/sim/simulator.h"
 
 namespace rotorguard::harness {
+
+struct SitlOptions;
+
+/// The stack's side of the loop as the simulator sees it: where sensor messages go and commands
+/// come from, the clock the stack follows, and the stack's account at the end. RunSitl has two
+/// of its own (the stack in this process; `rotorguard node` over shared memory); a transport
+/// brings its own through SitlOptions::make_link (rosbridge: over ROS).
+class StackLink {
+ public:
+  virtual ~StackLink() = default;
+  /// The stack is ready for t = 0 once this returns (its threads started).
+  virtual void Start() = 0;
+  virtual runtime::Clock& clock() = 0;
+  /// With lockstep_clock: the simulator's time moves to t, once the messages delivered so far are
+  /// in the stack's hands.
+  virtual void AdvanceTime(TimeNs t) = 0;
+  /// Without lockstep_clock: the simulator's clock has reached t, the end of the step about to be
+  /// simulated, whose sensor messages follow (a transport publishes its clock).
+  virtual void OnClock(TimeNs /*t*/) {}
+  virtual void Deliver(const sim::SensorOutputs& outputs) = 0;
+  virtual bool TryReceive(runtime::CycleTelemetry* cycle) = 0;
+  /// Stops the stack; its account (JSON: the stack's summary, as `rotorguard node` sends it) and
+  /// its loops' report (JSON).
+  virtual nlohmann::json Finish(nlohmann::json* loops) = 0;
+};
 
 struct SitlOptions {
   /// Simulated seconds per wall-clock second, in (0, 10]: 1 is real time.
@@ -33,6 +60,9 @@ struct SitlOptions {
   /// (`rotorguard node SCENARIO ...`), given `--channel NAME` at its end: the two processes share
   /// a memory segment (runtime/sitl_channel.h). The node must fly the same scenario.
   std::vector<std::string> node_command;
+  /// Set: the link to the stack, made by a transport (it then starts the node itself, from
+  /// node_command when it needs one); RunSitl's own links are not used.
+  std::function<std::unique_ptr<StackLink>(const SitlOptions&, const runtime::OnboardExecutorOptions&)> make_link;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -78,5 +108,18 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
 /// executor until the flight ends and writes its account back. Throws std::runtime_error when the
 /// channel cannot be opened or holds another layout (and tells the simulator of any failure).
 void RunNode(const Scenario& scenario, const std::string& channel);
+
+/// A node's flight stack for `scenario`: the scenario as flown (an assembly's mission planned
+/// first, as the simulator's side plans it) and the stack built from its vehicle file and stack
+/// keys alone.
+struct NodeStack {
+  Scenario scenario;
+  std::unique_ptr<stack::FlightStack> stack;
+};
+NodeStack MakeNodeStack(const Scenario& scenario);
+
+/// What a node sends back at the end of a flight, over any transport: {"account": the stack's
+/// summary and FDD account, "loops": the executor's loops and scheduling (runtime.json's)}.
+nlohmann::json NodeAccountJson(const stack::FlightStack& stack, const runtime::OnboardReport& report);
 
 }  // namespace rotorguard::harness

@@ -53,14 +53,30 @@ struct StampedCommand {
   RotorVector thrust_n;
 };
 
-/// What the control thread reports of each cycle (what a recorder logs): the command, the mode,
-/// the estimate and the reference point it was computed with.
+/// The fault detection's view of one rotor at a cycle (fdd::RotorStatus without its strings and
+/// times: copied without allocating).
+struct RotorHealthSample {
+  fdd::RotorHealth health = fdd::RotorHealth::kOk;
+  float loss_of_effectiveness = 0.0f;  ///< eta, in [0, 1]
+  float motor_index = 1.0f;
+  float propeller_index = 0.0f;
+};
+
+/// What the control thread reports of each cycle (what a recorder logs, what a transport
+/// publishes): the command, the mode, the estimate and the reference point it was computed with,
+/// and the FDD's view of each rotor.
 struct CycleTelemetry {
   StampedCommand command;
   stack::FlightMode mode = stack::FlightMode::kNominal;
   StateEstimate estimate;
   ReferencePoint reference;
+  int fdd_rotors = 0;  ///< rotors in `health` (0: the stack runs no fault detection)
+  std::array<RotorHealthSample, kMaxRotors> health{};
 };
+
+/// The telemetry of the cycle `stack` has just run at `t` with `mode` and `thrust_n` (the
+/// command's stamps and timing are the caller's). Never allocates.
+CycleTelemetry TelemetryOf(const stack::FlightStack& stack, TimeNs t, stack::FlightMode mode, const RotorVector& thrust_n);
 
 /// One sensor message, tagged (copying it never allocates): what the executor's intake queues
 /// and a transport carry.

@@ -16,7 +16,7 @@
 namespace rotorguard::runtime {
 
 /// The layout's version: a change of anything below changes it.
-inline constexpr std::uint64_t kSitlChannelMagic = 0x72672d7369746c03ull;  // "rg-sitl", 3
+inline constexpr std::uint64_t kSitlChannelMagic = 0x72672d7369746c04ull;  // "rg-sitl", 4
 
 /// A LiDAR frame in shared memory (LidarFrame without its vectors).
 struct FrameSlot {

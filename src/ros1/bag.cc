@@ -1,0 +1,124 @@
+#include "rotorguard/ros1/bag.h"
+
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "convert.h"
+
+namespace rotorguard::ros1 {
+
+using internal::FromRos;
+using internal::RosType;
+using internal::ToRos;
+
+struct BagWriter::Impl {
+  rosbag::Bag bag;
+  std::string active;
+  bool open = false;
+};
+
+BagWriter::BagWriter(const std::string& path) : impl_(std::make_unique<Impl>()), path_(path) {
+  impl_->active = path + ".active";
+  try {
+    impl_->bag.open(impl_->active, rosbag::bagmode::Write);
+  } catch (const rosbag::BagException& e) {
+    throw std::runtime_error("bag: cannot create '" + impl_->active + "': " + e.what());
+  }
+  impl_->open = true;
+}
+
+BagWriter::~BagWriter() {
+  // Not closed by the program: it stopped on an error; the bag stays PATH.active.
+  if (impl_->open) {
+    try {
+      impl_->bag.close();
+    } catch (...) {
+    }
+  }
+}
+
+template <typename T>
+void BagWriter::Write(const std::string& topic, Stamp time, const T& message) {
+  impl_->bag.write(topic, internal::ToRosTime(time), ToRos(message));
+}
+
+void BagWriter::Close() {
+  if (!impl_->open) return;
+  impl_->bag.close();
+  impl_->open = false;
+  if (std::rename(impl_->active.c_str(), path_.c_str()) != 0) {
+    throw std::runtime_error("bag: cannot rename '" + impl_->active + "' to '" + path_ + "'");
+  }
+}
+
+#define ROTORGUARD_WRITTEN(T) template void BagWriter::Write<T>(const std::string&, Stamp, const T&);
+ROTORGUARD_WRITTEN(Imu)
+ROTORGUARD_WRITTEN(Esc)
+ROTORGUARD_WRITTEN(Battery)
+ROTORGUARD_WRITTEN(Odometry)
+ROTORGUARD_WRITTEN(Cloud)
+ROTORGUARD_WRITTEN(Command)
+ROTORGUARD_WRITTEN(Health)
+ROTORGUARD_WRITTEN(Cycle)
+ROTORGUARD_WRITTEN(Transforms)
+ROTORGUARD_WRITTEN(Text)
+ROTORGUARD_WRITTEN(ClockTick)
+#undef ROTORGUARD_WRITTEN
+
+namespace {
+
+/// Converts `view`'s message to T when it holds T's ROS type; false when it does not.
+template <typename T>
+bool TryRead(const rosbag::MessageInstance& mi, BagMessage* out, BagReadSummary* summary) {
+  using Message = typename RosType<T>::type;
+  if (mi.getDataType() != ros::message_traits::DataType<Message>::value()) return false;
+  const typename Message::ConstPtr r = mi.instantiate<Message>();
+  T m;
+  if (!r) return false;
+  if (const std::string e = FromRos(*r, &m); !e.empty()) {
+    ++summary->bad[mi.getTopic()];
+    return true;
+  }
+  out->message = std::move(m);
+  return true;
+}
+
+}  // namespace
+
+BagReadSummary ReadBag(const std::string& path, const std::function<void(const BagMessage&)>& visit) {
+  rosbag::Bag bag;
+  try {
+    bag.open(path, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    throw std::runtime_error("bag: cannot read '" + path + "': " + e.what());
+  }
+  BagReadSummary summary;
+  rosbag::View view(bag);
+  for (const rosbag::MessageInstance& mi : view) {
+    BagMessage m;
+    m.topic = mi.getTopic();
+    m.time = internal::FromRosTime(mi.getTime());
+    const std::uint64_t bad_before = summary.bad[m.topic];
+    // A cloud is read as a LiDAR frame (PointSet clouds have no time field: counted as bad).
+    const bool known = TryRead<Imu>(mi, &m, &summary) || TryRead<Esc>(mi, &m, &summary) ||
+                       TryRead<Battery>(mi, &m, &summary) || TryRead<Odometry>(mi, &m, &summary) ||
+                       TryRead<Cloud>(mi, &m, &summary) || TryRead<Command>(mi, &m, &summary) ||
+                       TryRead<Health>(mi, &m, &summary) || TryRead<Cycle>(mi, &m, &summary) ||
+                       TryRead<Text>(mi, &m, &summary) || TryRead<ClockTick>(mi, &m, &summary);
+    if (!known) {
+      ++summary.skipped_types[mi.getDataType()];
+      continue;
+    }
+    if (summary.bad[m.topic] != bad_before) continue;
+    if (summary.bad[m.topic] == 0) summary.bad.erase(m.topic);
+    ++summary.messages;
+    visit(m);
+  }
+  bag.close();
+  return summary;
+}
+
+}  // namespace rotorguard::ros1

@@ -1,0 +1,162 @@
+#include "rotorguard/ros1/bus.h"
+
+#include <ros/callback_queue.h>
+#include <ros/master.h>
+#include <ros/ros.h>
+
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "convert.h"
+
+namespace rotorguard::ros1 {
+
+using internal::FromRos;
+using internal::RosType;
+using internal::ToRos;
+
+template <typename T>
+struct Publisher<T>::Impl {
+  ros::Publisher publisher;
+};
+template <typename T>
+Publisher<T>::Publisher() = default;
+template <typename T>
+Publisher<T>::~Publisher() = default;
+template <typename T>
+Publisher<T>::Publisher(Publisher&&) noexcept = default;
+template <typename T>
+Publisher<T>& Publisher<T>::operator=(Publisher&&) noexcept = default;
+template <typename T>
+void Publisher<T>::Publish(const T& message) {
+  if (impl_) impl_->publisher.publish(ToRos(message));
+}
+template <typename T>
+std::uint32_t Publisher<T>::subscribers() const {
+  return impl_ ? impl_->publisher.getNumSubscribers() : 0;
+}
+
+struct Bus::Impl {
+  std::unique_ptr<ros::NodeHandle> node;
+  std::vector<ros::Subscriber> subscribers;
+  BadMessageHandler on_bad;
+};
+
+namespace {
+std::atomic<bool> g_initialised{false};
+}  // namespace
+
+Bus::Bus(const Options& options) : impl_(std::make_unique<Impl>()) {
+  if (g_initialised.exchange(true)) throw std::runtime_error("ros: one Bus per process (ROS 1 has one node per process)");
+  std::map<std::string, std::string> remappings(options.remappings.begin(), options.remappings.end());
+  if (!options.master_uri.empty()) remappings["__master"] = options.master_uri;
+  // No SIGINT handler of ROS's own: the program's (rotorguard's commands stop cleanly on their own).
+  ros::init(remappings, options.node_name, ros::init_options::NoSigintHandler | ros::init_options::AnonymousName);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.master_timeout_s);
+  while (!ros::master::check()) {
+    if (std::chrono::steady_clock::now() > until) {
+      throw std::runtime_error("ros: no ROS master at " + ros::master::getURI() + " (start one with `roscore -p PORT` and set ROS_MASTER_URI, or pass --ros-master)");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  impl_->node = std::make_unique<ros::NodeHandle>();
+}
+
+Bus::~Bus() {
+  impl_->subscribers.clear();
+  impl_->node.reset();
+  ros::shutdown();
+}
+
+template <typename T>
+Publisher<T> Bus::Advertise(const std::string& topic, const TopicOptions& options) {
+  Publisher<T> p;
+  p.impl_ = std::make_unique<typename Publisher<T>::Impl>();
+  p.impl_->publisher = impl_->node->advertise<typename RosType<T>::type>(topic, options.queue_size, options.latch);
+  return p;
+}
+
+template <typename T>
+void Bus::Subscribe(const std::string& topic, const TopicOptions& options, std::function<void(const T&)> on_message) {
+  using Message = typename RosType<T>::type;
+  ros::TransportHints hints;
+  if (options.tcp_nodelay) hints = hints.tcpNoDelay();
+  Impl* impl = impl_.get();
+  impl_->subscribers.push_back(impl_->node->subscribe<Message>(
+      topic, options.queue_size,
+      [impl, topic, on_message = std::move(on_message)](const typename Message::ConstPtr& r) {
+        T m;
+        if (const std::string e = FromRos(*r, &m); !e.empty()) {
+          if (impl->on_bad) impl->on_bad(topic, e);
+          return;
+        }
+        on_message(m);
+      },
+      ros::VoidConstPtr(), hints));
+}
+
+void Bus::OnBadMessage(BadMessageHandler handler) { impl_->on_bad = std::move(handler); }
+
+std::uint32_t Bus::Publishers(const std::string& topic) const {
+  std::uint32_t n = 0;
+  const std::string resolved = ros::names::resolve(topic);
+  for (const ros::Subscriber& s : impl_->subscribers) {
+    if (s.getTopic() == resolved) n += s.getNumPublishers();
+  }
+  return n;
+}
+
+bool Bus::Spin(double timeout_s) {
+  if (!ros::ok()) return false;
+  ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(timeout_s));
+  return ros::ok();
+}
+
+Stamp Bus::Now() const { return internal::FromRosTime(ros::Time::now()); }
+bool Bus::SimTime() const { return ros::Time::isSimTime(); }
+void Bus::SetParam(const std::string& key, bool value) { ros::param::set(key, value); }
+void Bus::SetParam(const std::string& key, const std::string& value) { ros::param::set(key, value); }
+std::optional<std::string> Bus::GetParam(const std::string& key) const {
+  std::string v;
+  if (!ros::param::get(key, v)) return std::nullopt;
+  return v;
+}
+std::string Bus::master_uri() const { return ros::master::getURI(); }
+
+// The topics' types: every wire struct that is published, and those that are read.
+#define ROTORGUARD_PUBLISHED(T)                  \
+  template class Publisher<T>;                   \
+  template Publisher<T> Bus::Advertise<T>(const std::string&, const TopicOptions&);
+#define ROTORGUARD_READ(T) \
+  template void Bus::Subscribe<T>(const std::string&, const TopicOptions&, std::function<void(const T&)>);
+ROTORGUARD_PUBLISHED(Imu)
+ROTORGUARD_PUBLISHED(Esc)
+ROTORGUARD_PUBLISHED(Battery)
+ROTORGUARD_PUBLISHED(Odometry)
+ROTORGUARD_PUBLISHED(Cloud)
+ROTORGUARD_PUBLISHED(PointSet)
+ROTORGUARD_PUBLISHED(Command)
+ROTORGUARD_PUBLISHED(Health)
+ROTORGUARD_PUBLISHED(Cycle)
+ROTORGUARD_PUBLISHED(Transforms)
+ROTORGUARD_PUBLISHED(Path)
+ROTORGUARD_PUBLISHED(Text)
+ROTORGUARD_PUBLISHED(ClockTick)
+ROTORGUARD_READ(Imu)
+ROTORGUARD_READ(Esc)
+ROTORGUARD_READ(Battery)
+ROTORGUARD_READ(Odometry)
+ROTORGUARD_READ(Cloud)
+ROTORGUARD_READ(Command)
+ROTORGUARD_READ(Health)
+ROTORGUARD_READ(Cycle)
+ROTORGUARD_READ(Text)
+ROTORGUARD_READ(ClockTick)
+#undef ROTORGUARD_PUBLISHED
+#undef ROTORGUARD_READ
+
+}  // namespace rotorguard::ros1

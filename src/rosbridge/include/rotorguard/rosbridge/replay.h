@@ -1,0 +1,63 @@
+#pragma once
+/// Replay: a bag's sensor messages through a scenario's flight stack (`rotorguard replay`,
+/// docs/ros.md). The messages are handed over in the bag's time order (within one instant: IMU,
+/// ESC telemetry, odometry, LiDAR frame, as the simulator hands them), the control cycles run on
+/// the stack's control grid, and the perception finishes every frame before the next cycle: the
+/// lockstep order, so a replay is repeatable and every frame is processed. When the bag holds the
+/// cycles of the flight it recorded (control_cycle), the replay's estimate and FDD diagnosis are
+/// compared with them.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "rotorguard/harness/scenario.h"
+#include "rotorguard/ros1/bag.h"
+#include "rotorguard/runtime/onboard_executor.h"
+
+namespace rotorguard::rosbridge {
+
+struct ReplayOptions {
+  /// Output folder: replay.json, cycles.csv ("" writes nothing).
+  std::string out_dir;
+  /// A LiDAR frame's sweep [s] (a cloud is stamped at its first instant); <= 0: the scenario's
+  /// sensors.lidar.frame_rate_hz.
+  double frame_period_s = 0.0;
+  std::function<void(double)> progress;
+};
+
+/// The FDD's diagnosis of a flight from its cycles: per rotor, its health at the last cycle and
+/// the instant it first left ok.
+struct Diagnosis {
+  std::vector<std::string> health;
+  std::vector<std::optional<double>> first_not_ok_s;
+  bool operator==(const Diagnosis&) const = default;
+  std::string ToString() const;
+};
+/// The diagnosis of `cycles` (in the order they ran) up to instant `until_s` included.
+Diagnosis DiagnosisOf(const std::vector<runtime::CycleTelemetry>& cycles, double until_s);
+
+struct ReplaySummary {
+  ros1::BagReadSummary bag;
+  std::map<std::string, std::uint64_t> inputs;  ///< messages handed to the stack, per topic
+  std::uint64_t frames_dropped_points = 0;     ///< returns stamped outside their frame's sweep
+  std::vector<runtime::CycleTelemetry> cycles;           ///< the replay's
+  std::vector<runtime::CycleTelemetry> recorded_cycles;  ///< the bag's (control_cycle)
+  std::uint64_t compared = 0;          ///< cycles at the same instant in both
+  double position_max_diff_m = 0.0;    ///< the largest |p_replay - p_recorded| over them
+  double attitude_max_diff_rad = 0.0;  ///< the largest rotation between the two estimates' attitudes
+  double velocity_max_diff_m_s = 0.0;
+  Diagnosis diagnosis, recorded_diagnosis;  ///< both up to the last instant compared
+  nlohmann::json account;                   ///< the stack's account (as a node sends it)
+  nlohmann::json ToJson() const;
+};
+
+/// Replays the bag at `bag_path` through the stack of `scenario`. Throws std::runtime_error
+/// naming the file when the bag cannot be read or holds no IMU samples.
+ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_path, const ReplayOptions& options = {});
+
+}  // namespace rotorguard::rosbridge

@@ -1,0 +1,220 @@
+#include "rotorguard/rosbridge/replay.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <stdexcept>
+#include <thread>
+#include <variant>
+
+#include "rotorguard/core/config_schema.h"
+#include "rotorguard/harness/flight_recorder.h"
+#include "rotorguard/harness/sitl.h"
+#include "rotorguard/io/files.h"
+#include "rotorguard/rosbridge/topics.h"
+#include "rotorguard/rosbridge/wire_convert.h"
+#include "rotorguard/runtime/clock.h"
+#include "rotorguard/runtime/spsc_queue.h"
+
+namespace rotorguard::rosbridge {
+
+namespace {
+
+/// The topic without its leading slash (a bag written by `rosbag record` has resolved names).
+std::string_view Bare(std::string_view topic) { return topic.starts_with('/') ? topic.substr(1) : topic; }
+
+/// An input of the stack, in the order the simulator hands a step's messages over.
+struct Input {
+  int rank = 0;  // 0 IMU, 1 ESC, 2 odometry, 3 frame
+  runtime::SensorMessage message;
+  std::shared_ptr<const LidarFrame> frame;
+};
+
+class CollectingSink final : public runtime::CommandSink {
+ public:
+  void Send(const runtime::CycleTelemetry& cycle) override { queue_.TryPush(cycle); }
+  bool TryReceive(runtime::CycleTelemetry* cycle) { return queue_.TryPop(cycle); }
+
+ private:
+  runtime::SpscQueue<runtime::CycleTelemetry, 1024> queue_;
+};
+
+double AngleBetween(const Quaternion& a, const Quaternion& b) { return a.angularDistance(b); }
+
+}  // namespace
+
+std::string Diagnosis::ToString() const {
+  std::string s;
+  for (std::size_t i = 0; i < health.size(); ++i) {
+    s += fmt::format("{}rotor {}: {}", i ? "; " : "", i, health[i]);
+    if (first_not_ok_s[i]) s += fmt::format(" (from {:.3f} s)", *first_not_ok_s[i]);
+  }
+  return s.empty() ? "no fault detection" : s;
+}
+
+Diagnosis DiagnosisOf(const std::vector<runtime::CycleTelemetry>& cycles, double until_s) {
+  Diagnosis d;
+  for (const runtime::CycleTelemetry& c : cycles) {
+    const double t = ToSeconds(c.command.state_t_ns);
+    if (t > until_s + 1e-9 || c.command.held != 0) continue;
+    const auto n = static_cast<std::size_t>(c.fdd_rotors);
+    d.health.resize(n, "ok");
+    d.first_not_ok_s.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      d.health[i] = ToName(c.health[i].health);
+      if (c.health[i].health != fdd::RotorHealth::kOk && !d.first_not_ok_s[i]) d.first_not_ok_s[i] = t;
+    }
+  }
+  return d;
+}
+
+nlohmann::json ReplaySummary::ToJson() const {
+  nlohmann::json bag_json = {{"messages", bag.messages}, {"skipped_types", bag.skipped_types}, {"bad", bag.bad}};
+  return {{"bag", bag_json},
+          {"inputs", inputs},
+          {"frames_dropped_points", frames_dropped_points},
+          {"cycles", cycles.size()},
+          {"recorded_cycles", recorded_cycles.size()},
+          {"compared", compared},
+          {"position_max_diff_m", position_max_diff_m},
+          {"attitude_max_diff_rad", attitude_max_diff_rad},
+          {"velocity_max_diff_m_s", velocity_max_diff_m_s},
+          {"diagnosis", diagnosis.ToString()},
+          {"recorded_diagnosis", recorded_diagnosis.ToString()},
+          {"diagnosis_equal", diagnosis == recorded_diagnosis},
+          {"account", account}};
+}
+
+ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_path, const ReplayOptions& options) {
+  if (!options.out_dir.empty()) harness::PrepareRunFolder(options.out_dir, {"replay.json", "cycles.csv"});
+  harness::NodeStack node = harness::MakeNodeStack(scenario);
+  stack::FlightStack& st = *node.stack;
+  const double period_s = options.frame_period_s > 0.0 ? options.frame_period_s : 1.0 / node.scenario.sim.lidar.frame_rate_hz;
+  const TimeNs frame_period = FromSeconds(period_s);
+
+  runtime::SimulatedTime time(-1);
+  runtime::SimulatedClock clock(&time);
+  CollectingSink sink;
+  runtime::OnboardExecutorOptions eo;
+  eo.trigger = runtime::CycleTrigger::kClock;
+  eo.lockstep_order = true;
+  runtime::OnboardExecutor executor(&st, &clock, &sink, eo);
+  ReplaySummary r;
+  const TimeNs control_period = st.control_period_ns();
+  TimeNs next_control = 0;
+  // Runs every control instant before `b` (a cycle sees the messages handed over up to its instant).
+  const auto run_until = [&](TimeNs b) {
+    while (next_control < b) {
+      time.Advance(next_control);
+      for (runtime::CycleTelemetry c;;) {
+        if (sink.TryReceive(&c)) {
+          r.cycles.push_back(c);
+          if (c.command.state_t_ns >= next_control) break;
+        } else {
+          std::this_thread::yield();
+        }
+      }
+      next_control += control_period;
+    }
+  };
+  std::vector<Input> group;
+  TimeNs group_t = 0;
+  std::optional<TimeBase> flight_base;
+  const auto flush = [&]() {
+    std::stable_sort(group.begin(), group.end(), [](const Input& a, const Input& b) { return a.rank < b.rank; });
+    run_until(group_t);
+    for (const Input& in : group) {
+      if (in.frame) {
+        executor.OnLidar(in.frame);
+      } else {
+        executor.OnSensor(in.message);
+      }
+    }
+    group.clear();
+  };
+  executor.Start();
+  TimeNs last_t = 0;
+  r.bag = ros1::ReadBag(bag_path, [&](const ros1::BagMessage& m) {
+    const std::string_view topic = Bare(m.topic);
+    if (const auto* c = std::get_if<ros1::Cycle>(&m.message)) {
+      if (topic == topics::kControlCycle.name) r.recorded_cycles.push_back(FromWire(*c, flight_base.value_or(TimeBase{})));
+      return;
+    }
+    if (const auto* start = std::get_if<ros1::ClockTick>(&m.message)) {
+      if (topic == topics::kMissionStart.name && !flight_base) flight_base = TimeBase{start->clock};
+      return;
+    }
+    // Without a mission_start (a bag of `rosbag record`), t = 0 is the first message's time.
+    if (!flight_base) flight_base = TimeBase{m.time};
+    const TimeBase& b = *flight_base;
+    Input in;
+    if (const auto* imu = std::get_if<ros1::Imu>(&m.message); imu && topic == topics::kImu.name) {
+      in = {0, runtime::SensorMessage::Of(FromWire(*imu, b)), nullptr};
+    } else if (const auto* esc = std::get_if<ros1::Esc>(&m.message); esc && topic == topics::kEscTelemetry.name) {
+      const std::optional<EscTelemetry> e = FromWire(*esc, b);
+      if (!e) return;
+      in = {1, runtime::SensorMessage::Of(*e), nullptr};
+    } else if (const auto* odo = std::get_if<ros1::Odometry>(&m.message); odo && topic == topics::kExternalOdometry.name) {
+      in = {2, runtime::SensorMessage::Of(FromWireOdometry(*odo, b)), nullptr};
+    } else if (const auto* cloud = std::get_if<ros1::Cloud>(&m.message); cloud && topic == topics::kPoints.name) {
+      auto frame = std::make_shared<LidarFrame>(FromWire(*cloud, b, frame_period));
+      r.frames_dropped_points += static_cast<std::uint64_t>(frame->dropped);
+      in = {3, {}, std::move(frame)};
+    } else {
+      return;
+    }
+    ++r.inputs[std::string(topic)];
+    const TimeNs t = b.ToTime(m.time);
+    if (t != group_t && !group.empty()) flush();
+    group_t = t;
+    last_t = t;
+    group.push_back(std::move(in));
+  });
+  if (r.inputs[topics::kImu.name] == 0) {
+    executor.Stop();
+    throw std::runtime_error(fmt::format("bag: '{}' holds no IMU samples on topic '{}'", bag_path, topics::kImu.name));
+  }
+  flush();
+  run_until(last_t + 1);
+  time.Stop();
+  executor.Stop();
+  for (runtime::CycleTelemetry c; sink.TryReceive(&c);) r.cycles.push_back(c);
+  r.account = harness::NodeAccountJson(st, executor.Report()).at("account");
+
+  // The replay against the recording, at the instants both ran a cycle of their own.
+  double until_s = -1.0;
+  std::map<TimeNs, const runtime::CycleTelemetry*> recorded;
+  for (const runtime::CycleTelemetry& c : r.recorded_cycles) {
+    if (c.command.held == 0) recorded[c.command.state_t_ns] = &c;
+  }
+  for (const runtime::CycleTelemetry& c : r.cycles) {
+    const auto it = recorded.find(c.command.state_t_ns);
+    if (it == recorded.end()) continue;
+    const StateEstimate& a = c.estimate;
+    const StateEstimate& e = it->second->estimate;
+    ++r.compared;
+    r.position_max_diff_m = std::max(r.position_max_diff_m, (a.p_W - e.p_W).norm());
+    r.velocity_max_diff_m_s = std::max(r.velocity_max_diff_m_s, (a.v_W - e.v_W).norm());
+    r.attitude_max_diff_rad = std::max(r.attitude_max_diff_rad, AngleBetween(a.q_WB, e.q_WB));
+    until_s = std::max(until_s, ToSeconds(c.command.state_t_ns));
+  }
+  r.diagnosis = DiagnosisOf(r.cycles, until_s);
+  r.recorded_diagnosis = DiagnosisOf(r.recorded_cycles, until_s);
+
+  if (!options.out_dir.empty()) {
+    std::string csv = "t_s,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,mode\n";
+    for (const runtime::CycleTelemetry& c : r.cycles) {
+      const StateEstimate& e = c.estimate;
+      csv += fmt::format("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n",
+                         ToSeconds(c.command.state_t_ns), e.p_W.x(), e.p_W.y(), e.p_W.z(), e.q_WB.w(), e.q_WB.x(),
+                         e.q_WB.y(), e.q_WB.z(), e.v_W.x(), e.v_W.y(), e.v_W.z(), ToName(c.mode));
+    }
+    const std::filesystem::path dir(options.out_dir);
+    io::WriteFileAtomically((dir / "cycles.csv").string(), csv);
+    io::WriteFileAtomically((dir / "replay.json").string(), r.ToJson().dump(2) + "\n");
+  }
+  return r;
+}
+
+}  // namespace rotorguard::rosbridge

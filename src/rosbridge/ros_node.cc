@@ -1,0 +1,254 @@
+#include "rotorguard/rosbridge/ros_node.h"
+
+#include <fmt/format.h>
+#include <signal.h>
+#include <time.h>
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+#include "rotorguard/core/config_schema.h"
+#include "rotorguard/core/error.h"
+#include "rotorguard/harness/sitl.h"
+#include "rotorguard/ros1/bus.h"
+#include "rotorguard/rosbridge/input_guard.h"
+#include "rotorguard/rosbridge/topics.h"
+#include "rotorguard/rosbridge/wire_convert.h"
+#include "rotorguard/runtime/doorbell.h"
+#include "rotorguard/runtime/onboard_executor.h"
+#include "rotorguard/runtime/spsc_queue.h"
+
+namespace rotorguard::rosbridge {
+
+namespace {
+
+std::atomic<bool> g_signalled{false};
+void OnSignal(int) { g_signalled.store(true); }
+
+/// The node's clock: ROS time (the /clock under use_sim_time) less the mission's start.
+class RosClock final : public runtime::Clock {
+ public:
+  RosClock(const ros1::Bus* bus, ros1::Stamp origin) : bus_(bus), origin_(origin), sim_(bus->SimTime()) {}
+  TimeNs Now() const override { return bus_->Now() - origin_; }
+  bool SleepUntil(TimeNs t) override {
+    for (;;) {
+      if (stopped_.load(std::memory_order_acquire)) return false;
+      const TimeNs now = Now();
+      if (now >= t) return true;
+      if (!sim_) {
+        // Wall-clock ROS time: one sleep to the instant (CLOCK_REALTIME is ROS's time).
+        const ros1::Stamp at = origin_ + t;
+        const timespec ts{static_cast<time_t>(at / 1'000'000'000), static_cast<long>(at % 1'000'000'000)};
+        clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &ts, nullptr);
+      } else {
+        // The /clock moves in steps: poll it (a fifth of a millisecond at most late).
+        const timespec ts{0, static_cast<long>(std::min<TimeNs>(t - now, 200'000))};
+        nanosleep(&ts, nullptr);
+      }
+    }
+  }
+  void Stop() { stopped_.store(true, std::memory_order_release); }
+
+ private:
+  const ros1::Bus* bus_;
+  ros1::Stamp origin_;
+  bool sim_;
+  std::atomic<bool> stopped_{false};
+};
+
+/// The control thread's cycles to the publishing thread: a queue push and a ring (no allocation).
+class QueueSink final : public runtime::CommandSink {
+ public:
+  void Send(const runtime::CycleTelemetry& cycle) override {
+    queue_.TryPush(cycle);
+    bell_.Ring();
+  }
+  runtime::SpscQueue<runtime::CycleTelemetry, 1024>& queue() { return queue_; }
+  runtime::Doorbell& bell() { return bell_; }
+
+ private:
+  runtime::SpscQueue<runtime::CycleTelemetry, 1024> queue_;
+  runtime::Doorbell bell_;
+};
+
+/// The node's outputs of each cycle: the cycle, the command, the estimate and its TF, the FDD's
+/// view, and the mode when it changed.
+class Outputs {
+ public:
+  explicit Outputs(ros1::Bus* bus)
+      : cycle_(bus->Advertise<ros1::Cycle>(topics::kControlCycle.name, topics::kControlCycle.options)),
+        command_(bus->Advertise<ros1::Command>(topics::kRotorCommand.name, topics::kRotorCommand.options)),
+        odometry_(bus->Advertise<ros1::Odometry>(topics::kOdometry.name, topics::kOdometry.options)),
+        health_(bus->Advertise<ros1::Health>(topics::kFddHealth.name, topics::kFddHealth.options)),
+        mode_(bus->Advertise<ros1::Text>(topics::kMode.name, topics::kMode.options)),
+        tf_(bus->Advertise<ros1::Transforms>(topics::kTf.name, topics::kTf.options)) {}
+  void Publish(const runtime::CycleTelemetry& c, const TimeBase& base) {
+    const ros1::Cycle w = ToWire(c, base);
+    cycle_.Publish(w);
+    command_.Publish(w.command);
+    odometry_.Publish(w.estimate);
+    tf_.Publish({{w.estimate.stamp, frames::kOdom, frames::kBase, w.estimate.pose}});
+    health_.Publish(w.health);
+    if (w.health.mode != mode_text_) {
+      mode_text_ = w.health.mode;
+      mode_.Publish({mode_text_});
+    }
+  }
+
+ private:
+  ros1::Publisher<ros1::Cycle> cycle_;
+  ros1::Publisher<ros1::Command> command_;
+  ros1::Publisher<ros1::Odometry> odometry_;
+  ros1::Publisher<ros1::Health> health_;
+  ros1::Publisher<ros1::Text> mode_;
+  ros1::Publisher<ros1::Transforms> tf_;
+  std::string mode_text_;
+};
+
+}  // namespace
+
+void RosNodeOptions::Validate() const {
+  if (max_frame_points == 0) ThrowValidation("RosNodeOptions", "max_frame_points", max_frame_points, "at least 1");
+  realtime.Validate();
+}
+
+nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOptions& options) {
+  options.Validate();
+  g_signalled.store(false);
+  struct sigaction action {};
+  action.sa_handler = OnSignal;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+
+  ros1::Bus bus({.node_name = "rotorguard_node", .master_uri = options.master_uri, .master_timeout_s = 10.0, .remappings = options.remappings});
+  ros1::Publisher<ros1::Text> status = bus.Advertise<ros1::Text>(topics::kStatus.name, topics::kStatus.options);
+  ros1::Publisher<ros1::Text> account_out = bus.Advertise<ros1::Text>(topics::kAccount.name, topics::kAccount.options);
+  harness::NodeStack node;
+  try {
+    node = harness::MakeNodeStack(scenario);
+  } catch (const std::exception& e) {
+    status.Publish({std::string("failed: ") + e.what()});
+    throw;
+  }
+  stack::FlightStack& st = *node.stack;
+  const harness::Scenario& sc = node.scenario;
+  const TimeNs frame_period = FromSeconds(1.0 / sc.sim.lidar.frame_rate_hz);
+
+  // The sensors' mounts as the stack knows them (its files), and map = odom (the odometry's frame
+  // is the map's: no loop closure moves it).
+  ros1::Publisher<ros1::Transforms> tf_static = bus.Advertise<ros1::Transforms>(topics::kTfStatic.name, topics::kTfStatic.options);
+  const ros1::Stamp now = bus.Now();
+  tf_static.Publish({{now, frames::kMap, frames::kOdom, ToWirePose(Vector3::Zero(), Quaternion::Identity())},
+                     {now, frames::kBase, frames::kImu, ToWirePose(st.options().estimator.imu_position_m, Quaternion::Identity())},
+                     {now, frames::kBase, frames::kLidar,
+                      ToWirePose(st.options().estimator.lio.lidar_position_m, Quaternion::Identity())}});
+
+  // The intake: every input checked, then handed to the executor (once the mission has started).
+  const auto steady = [] { return runtime::SteadyClock::Monotonic(); };
+  // Silence limits: ten of the input's periods, at least 50 ms.
+  const auto limit = [](double rate_hz) { return std::max(0.05, 10.0 / rate_hz); };
+  InputGuard guard({{topics::kImu.name, limit(sc.sim.imu.rate_hz)}, {topics::kEscTelemetry.name, limit(sc.sim.esc.rate_hz)}});
+  bus.OnBadMessage([&](std::string_view topic, std::string_view what) { guard.Bad(std::string(topic), steady(), std::string(what)); });
+  QueueSink sink;
+  std::unique_ptr<RosClock> clock;
+  std::unique_ptr<runtime::OnboardExecutor> executor;
+  std::optional<TimeBase> base;
+  std::uint64_t before_start = 0;
+  const auto accept = [&](const char* topic, ros1::Stamp stamp) {
+    if (!executor) {
+      ++before_start;
+      return false;
+    }
+    return guard.Check(topic, stamp, steady()) == InputGuard::Verdict::kAccept;
+  };
+  bus.Subscribe<ros1::Imu>(topics::kImu.name, topics::kImu.options, [&](const ros1::Imu& m) {
+    if (accept(topics::kImu.name, m.stamp)) executor->OnImu(FromWire(m, *base));
+  });
+  bus.Subscribe<ros1::Esc>(topics::kEscTelemetry.name, topics::kEscTelemetry.options, [&](const ros1::Esc& m) {
+    if (m.motor_speed_rad_s.size() != static_cast<std::size_t>(st.model().num_rotors())) {
+      guard.Bad(topics::kEscTelemetry.name, steady(),
+                fmt::format("{} motor speeds for a vehicle of {} rotors", m.motor_speed_rad_s.size(), st.model().num_rotors()));
+      return;
+    }
+    if (accept(topics::kEscTelemetry.name, m.stamp)) executor->OnEscTelemetry(*FromWire(m, *base));
+  });
+  bus.Subscribe<ros1::Odometry>(topics::kExternalOdometry.name, topics::kExternalOdometry.options, [&](const ros1::Odometry& m) {
+    if (accept(topics::kExternalOdometry.name, m.stamp)) executor->OnOdometry(FromWireOdometry(m, *base));
+  });
+  bus.Subscribe<ros1::Cloud>(topics::kPoints.name, topics::kPoints.options, [&](const ros1::Cloud& m) {
+    if (m.points.size() > options.max_frame_points) {
+      guard.Oversize(topics::kPoints.name, steady(),
+                     fmt::format("a frame of {} points, more than the budget of {}", m.points.size(), options.max_frame_points));
+      return;
+    }
+    if (accept(topics::kPoints.name, m.stamp)) executor->OnLidar(std::make_shared<const LidarFrame>(FromWire(m, *base, frame_period)));
+  });
+  double battery_v = 0.0;
+  bus.Subscribe<ros1::Battery>(topics::kBattery.name, topics::kBattery.options, [&](const ros1::Battery& m) {
+    if (accept(topics::kBattery.name, m.stamp)) battery_v = m.voltage;
+  });
+  std::optional<ros1::Stamp> start;
+  if (options.start_now) start = bus.Now();
+  bus.Subscribe<ros1::ClockTick>(topics::kMissionStart.name, topics::kMissionStart.options,
+                                 [&](const ros1::ClockTick& m) { start = m.clock; });
+  std::string shutdown;
+  bus.Subscribe<ros1::Text>(topics::kShutdown.name, topics::kShutdown.options, [&](const ros1::Text& m) { shutdown = m.data; });
+  // Advertised before the start: a subscriber connects before the first cycle is sent.
+  Outputs outputs(&bus);
+  status.Publish({"built"});
+
+  // Until the mission starts: wait (the intake counts what comes before).
+  while (!start && shutdown.empty() && !g_signalled.load() && bus.Spin(0.01)) {
+  }
+  std::thread publisher;
+  std::atomic<bool> stop_publishing{false};
+  if (start) {
+    base = TimeBase{*start};
+    clock = std::make_unique<RosClock>(&bus, *start);
+    runtime::OnboardExecutorOptions eo;
+    eo.realtime = options.realtime;
+    executor = std::make_unique<runtime::OnboardExecutor>(&st, clock.get(), &sink, eo);
+    // ROS's publish serialises and allocates: on a thread of its own, never the control thread's.
+    publisher = std::thread([&] {
+      for (;;) {
+        const std::uint32_t seen = sink.bell().Count();
+        runtime::CycleTelemetry c;
+        bool any = false;
+        while (sink.queue().TryPop(&c)) {
+          outputs.Publish(c, *base);
+          any = true;
+        }
+        if (!any && stop_publishing.load(std::memory_order_acquire)) return;
+        if (!any) sink.bell().Wait(seen, 10'000'000);
+      }
+    });
+    executor->Start();
+    status.Publish({"flying"});
+    while (shutdown.empty() && !g_signalled.load() && bus.Spin(0.005)) {
+      for (const std::string& topic : guard.Silent(steady())) {
+        fmt::print(stderr, "node: no message on '{}' for more than its limit\n", topic);
+      }
+    }
+    clock->Stop();
+    executor->Stop();
+    stop_publishing.store(true, std::memory_order_release);
+    sink.bell().Ring();
+    publisher.join();
+  }
+  nlohmann::json account = harness::NodeAccountJson(st, executor ? executor->Report() : runtime::OnboardReport{});
+  account["wire"] = guard.ToJson();
+  account["wire_before_start"] = before_start;
+  account["battery_v"] = battery_v;
+  account_out.Publish({account.dump()});
+  status.Publish({"done"});
+  // The account is latched: wait until the one who asked has it (it says exit) or for a while.
+  const TimeNs until = steady() + 10'000'000'000;
+  while (shutdown != "exit" && !g_signalled.load() && steady() < until && bus.Spin(0.05)) {
+  }
+  return account;
+}
+
+}  // namespace rotorguard::rosbridge
