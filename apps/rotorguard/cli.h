@@ -57,15 +57,17 @@ std::unique_ptr<Command> MakeReplayCommand();
 // ---- ROS (ros_support.cc; each throws UsageError naming the option in a build without ROS).
 /// Whether this rotorguard was built with ROS 1 (ROTORGUARD_ROS).
 bool BuiltWithRos();
+/// --bag PATH: UsageError when it cannot be written (its folder does not exist).
+void CheckBagPath(const std::string& path);
 /// --bag PATH: a recorder of the flight's sensor messages and cycles.
 std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string& path);
 /// sitl --ros: the stack's link over ROS through the master `master_uri` ("" : ROS_MASTER_URI),
 /// the node started from sitl->node_command (with --ros added).
 void UseRosLink(harness::SitlOptions* sitl, const std::string& master_uri);
 /// node --ros: flies the node over ROS until told to stop; `args` are the ROS remappings
-/// (from:=to) given after the options.
+/// (from:=to) given after the options; `bag` ("": none) records its intake and cycles.
 void RunNodeOverRos(const harness::Scenario& scenario, const std::string& master_uri, const std::vector<std::string>& args,
-                    bool start_now, const runtime::RealtimeOptions& realtime);
+                    bool start_now, const std::string& bag, const runtime::RealtimeOptions& realtime);
 
 /// The exit code of an error, by its type (UsageError, io::ConfigError: 2; io::InputFileError,
 /// io::CorruptFileError: 3; std::invalid_argument: 2; anything else: 1), and its message with the

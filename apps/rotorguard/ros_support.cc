@@ -18,11 +18,15 @@ namespace rotorguard::cli {
 #if ROTORGUARD_HAS_ROS
 bool BuiltWithRos() { return true; }
 
-std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string& path) {
+void CheckBagPath(const std::string& path) {
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
     throw UsageError(fmt::format("--bag '{}': the folder '{}' does not exist", path, parent.string()));
   }
+}
+
+std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string& path) {
+  CheckBagPath(path);
   return std::make_unique<rosbridge::BagRecorder>(path);
 }
 
@@ -31,10 +35,11 @@ void UseRosLink(harness::SitlOptions* sitl, const std::string& master_uri) {
 }
 
 void RunNodeOverRos(const harness::Scenario& scenario, const std::string& master_uri, const std::vector<std::string>& args,
-                    bool start_now, const runtime::RealtimeOptions& realtime) {
+                    bool start_now, const std::string& bag, const runtime::RealtimeOptions& realtime) {
   rosbridge::RosNodeOptions o;
   o.master_uri = master_uri;
   o.start_now = start_now;
+  o.bag_path = bag;
   o.realtime = realtime;
   for (const std::string& a : args) {
     const std::size_t at = a.find(":=");
@@ -117,9 +122,10 @@ namespace {
 }  // namespace
 
 bool BuiltWithRos() { return false; }
+void CheckBagPath(const std::string&) { NoRos("--bag"); }
 std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string&) { NoRos("--bag"); }
 void UseRosLink(harness::SitlOptions*, const std::string&) { NoRos("sitl --ros"); }
-void RunNodeOverRos(const harness::Scenario&, const std::string&, const std::vector<std::string>&, bool,
+void RunNodeOverRos(const harness::Scenario&, const std::string&, const std::vector<std::string>&, bool, const std::string&,
                     const runtime::RealtimeOptions&) {
   NoRos("node --ros");
 }

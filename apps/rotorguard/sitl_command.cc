@@ -75,12 +75,19 @@ class SitlCommand final : public Command {
       sitl.node_command = {SelfPath(), "node", scenario_.path, "--seed", std::to_string(scenario.seed)};
       for (const std::string& set : scenario_.sets) sitl.node_command.insert(sitl.node_command.end(), {"--set", set});
     }
-    if (ros_) UseRosLink(&sitl, ros_master_);
     harness::RunOptions options;
     options.out_dir = out_dir_.empty() ? (fs::path("out") / (scenario.name + "-sitl")).string() : out_dir_;
     CreateOutputFolder(options.out_dir);
     std::unique_ptr<harness::StackObserver> bag;
-    if (!bag_.empty()) options.observer = (bag = MakeBagRecorder(bag_)).get();
+    if (!bag_.empty() && ros_) {
+      // Over ROS the node records what it took in, in the order it did (the topics' arrivals
+      // interleave on its side, not the simulator's): what a replay needs.
+      CheckBagPath(bag_);
+      sitl.node_command.insert(sitl.node_command.end(), {"--bag", fs::absolute(bag_).string()});
+    } else if (!bag_.empty()) {
+      options.observer = (bag = MakeBagRecorder(bag_)).get();
+    }
+    if (ros_) UseRosLink(&sitl, ros_master_);
     options.progress = FlightProgress(!quiet_, scenario.duration_s);
     options.report = io::HasViewer();
     const harness::SitlResult result = harness::RunSitl(scenario, options, sitl);
@@ -167,6 +174,9 @@ class NodeCommand final : public Command {
     node->add_option("--channel", channel_, "The shared-memory channel `sitl` created (/rotorguard-sitl-...)");
     node->add_flag("--ros", ros_, "Talk over ROS 1 (the master of ROS_MASTER_URI or --ros-master)");
     node->add_option("--ros-master", ros_master_, "The ROS master's URI for --ros (default: ROS_MASTER_URI)");
+    node->add_option("--bag", bag_,
+                     "With --ros: record the sensor messages the stack took in, in their order, and its cycles to\n"
+                     "this rosbag (what `rotorguard replay` replays exactly)");
     node->add_flag("--start-now", start_now_,
                    "With --ros: the mission starts (t = 0) once the stack is built, not at a mission_start message");
     node->allow_extras();
@@ -177,9 +187,11 @@ class NodeCommand final : public Command {
     const std::vector<std::string> extras = app_->remaining();
     if (ros_ == !channel_.empty()) throw UsageError("node: give either --channel NAME (sitl's shared memory) or --ros");
     if (!ros_ && !extras.empty()) throw UsageError(fmt::format("node: unexpected argument '{}'", extras.front()));
-    if (!ros_ && (start_now_ || !ros_master_.empty())) throw UsageError("node: --start-now and --ros-master need --ros");
+    if (!ros_ && (start_now_ || !ros_master_.empty() || !bag_.empty())) {
+      throw UsageError("node: --start-now, --ros-master and --bag need --ros");
+    }
     if (ros_) {
-      RunNodeOverRos(scenario_.Load(), ros_master_, extras, start_now_, {.lock_memory = false, .fifo_priority = 0});
+      RunNodeOverRos(scenario_.Load(), ros_master_, extras, start_now_, bag_, {.lock_memory = false, .fifo_priority = 0});
     } else {
       harness::RunNode(scenario_.Load(), channel_);
     }
@@ -189,7 +201,7 @@ class NodeCommand final : public Command {
  private:
   CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
-  std::string channel_, ros_master_;
+  std::string channel_, ros_master_, bag_;
   bool ros_ = false, start_now_ = false;
 };
 

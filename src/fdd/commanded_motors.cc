@@ -26,7 +26,14 @@ CommandedMotors::CommandedMotors(int num_rotors, double time_constant_s, double 
 void CommandedMotors::OnCommand(TimeNs t, const RotorVector& thrust_n) {
   if (thrust_n.size() != acting_.size() || !thrust_n.allFinite()) return;
   const TimeNs acts = t + delay_ns_;
-  if (size_ > 0 && acts < queue_[static_cast<std::size_t>((head_ + size_ - 1) % kCommands)].acts_ns) return;
+  if (size_ > 0) {
+    Command& last = queue_[static_cast<std::size_t>((head_ + size_ - 1) % kCommands)];
+    if (acts < last.acts_ns) return;
+    if (acts == last.acts_ns) {  // a command for the same instant replaces it (an overridden cycle's)
+      last.thrust_n = thrust_n;
+      return;
+    }
+  }
   if (size_ == kCommands) {  // full: the oldest acts now
     acting_ = queue_[static_cast<std::size_t>(head_)].thrust_n;
     head_ = (head_ + 1) % kCommands;

@@ -138,6 +138,7 @@ class Flight::Loop {
         command_(stack_.command()) {
     recorder_.Begin(stack_, sim_.model().num_rotors());
     DeliverToStack(sim_.outputs(), &stack_, recorder_.sensor_log());
+    inputs_ += static_cast<std::uint64_t>(sim_.outputs().count());
     if (options_.observer) options_.observer->OnSensors(sim_.time_ns(), sim_.outputs());
     if (!done_) RunControlCycle();
   }
@@ -163,6 +164,7 @@ class Flight::Loop {
       c.command.cycle = control_cycles_;
       c.command.sent_t_ns = command_sent_ns_;
       c.command.compute_s = cycle_s;
+      c.command.inputs = inputs_;
       options_.observer->OnCycle(c);
     }
     cycle_to_record_ = t;  // recorded with the first physics step, once the command is final
@@ -190,6 +192,7 @@ class Flight::Loop {
     const sim::SensorOutputs& outputs = sim_.Step();
     simulator_s_ += clock.Restart();
     DeliverToStack(outputs, &stack_, recorder_.sensor_log());
+    inputs_ += static_cast<std::uint64_t>(outputs.count());
     stack_s_ += clock.seconds();
     if (options_.observer) options_.observer->OnSensors(sim_.time_ns(), outputs);
     recorder_.AfterStep();
@@ -312,6 +315,7 @@ class Flight::Loop {
   TimeNs next_control_ = 0;
   double stack_s_ = 0.0, simulator_s_ = 0.0;  // wall-clock time in each [s]
   std::uint64_t physics_steps_ = 0, control_cycles_ = 0;
+  std::uint64_t inputs_ = 0;  // sensor messages handed to the stack (a recorded cycle's inputs)
   const fdd::CompositeFdd* composite_ = dynamic_cast<const fdd::CompositeFdd*>(stack_.fault_detector());
   fdd::IndexExtremes healthy_extremes_;  // the composite detector's, before the first fault
   double second_failure_index_ = 0.0;    // its second-failure statistic, before the second fault

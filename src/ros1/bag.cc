@@ -88,7 +88,8 @@ bool TryRead(const rosbag::MessageInstance& mi, BagMessage* out, BagReadSummary*
 
 }  // namespace
 
-BagReadSummary ReadBag(const std::string& path, const std::function<void(const BagMessage&)>& visit) {
+BagReadSummary ReadBag(const std::string& path, const std::function<void(const BagMessage&)>& visit,
+                       const std::vector<std::string>& topics) {
   rosbag::Bag bag;
   try {
     bag.open(path, rosbag::bagmode::Read);
@@ -96,7 +97,12 @@ BagReadSummary ReadBag(const std::string& path, const std::function<void(const B
     throw std::runtime_error("bag: cannot read '" + path + "': " + e.what());
   }
   BagReadSummary summary;
-  rosbag::View view(bag);
+  rosbag::View view;
+  if (topics.empty()) {
+    view.addQuery(bag);
+  } else {
+    view.addQuery(bag, rosbag::TopicQuery(topics));
+  }
   for (const rosbag::MessageInstance& mi : view) {
     BagMessage m;
     m.topic = mi.getTopic();

@@ -293,6 +293,8 @@ std::string FromRos(const rotorguard_msgs::FddHealth& r, Health* m) {
 rotorguard_msgs::ControlCycle ToRos(const Cycle& m) {
   rotorguard_msgs::ControlCycle r;
   r.command = ToRos(m.command);
+  r.inputs = m.inputs;
+  r.lio_serial = m.lio_serial;
   r.estimate_valid = m.estimate_valid;
   r.estimate = ToRos(m.estimate);
   r.reference.position.x = m.reference.position[0];
@@ -308,6 +310,8 @@ rotorguard_msgs::ControlCycle ToRos(const Cycle& m) {
 }
 std::string FromRos(const rotorguard_msgs::ControlCycle& r, Cycle* m) {
   if (auto e = FromRos(r.command, &m->command); !e.empty()) return "command: " + e;
+  m->inputs = r.inputs;
+  m->lio_serial = r.lio_serial;
   m->estimate_valid = r.estimate_valid;
   if (auto e = FromRos(r.estimate, &m->estimate); !e.empty()) return "estimate: " + e;
   m->reference.position = {r.reference.position.x, r.reference.position.y, r.reference.position.z};

@@ -1,5 +1,7 @@
 #include "rotorguard/rosbridge/bag_recorder.h"
 
+#include <algorithm>
+
 #include "rotorguard/rosbridge/topics.h"
 
 namespace rotorguard::rosbridge {
@@ -10,15 +12,44 @@ BagRecorder::BagRecorder(const std::string& path, const TimeBase& base) : bag_(p
   bag_.Write(topics::kMissionStart.name, base_.origin - 1, ros1::ClockTick{base_.origin});
 }
 
+ros1::Stamp BagRecorder::InputTime(TimeNs t) {
+  last_input_ = std::max(base_.ToStamp(t), last_input_ + 1);
+  return last_input_;
+}
+
+void BagRecorder::OnInput(TimeNs t, const runtime::SensorMessage& m) {
+  const std::lock_guard lock(mutex_);
+  const ros1::Stamp at = InputTime(t);
+  switch (m.kind) {
+    case runtime::SensorMessage::Kind::kImu:
+      bag_.Write(topics::kImu.name, at, ToWire(m.imu, base_));
+      break;
+    case runtime::SensorMessage::Kind::kEsc:
+      bag_.Write(topics::kEscTelemetry.name, at, ToWire(m.esc, base_));
+      break;
+    case runtime::SensorMessage::Kind::kOdometry:
+      bag_.Write(topics::kExternalOdometry.name, at, ToWire(m.odometry, base_));
+      break;
+    case runtime::SensorMessage::Kind::kFrame:
+      break;  // a frame is OnFrame's
+  }
+}
+
+void BagRecorder::OnFrame(TimeNs t, const LidarFrame& frame) {
+  const std::lock_guard lock(mutex_);
+  bag_.Write(topics::kPoints.name, InputTime(t), ToWire(frame, base_));
+}
+
 void BagRecorder::OnSensors(TimeNs t, const sim::SensorOutputs& o) {
-  const ros1::Stamp at = base_.ToStamp(t);
-  if (o.imu) bag_.Write(topics::kImu.name, at, ToWire(*o.imu, base_));
-  if (o.esc) bag_.Write(topics::kEscTelemetry.name, at, ToWire(*o.esc, base_));
-  if (o.odometry) bag_.Write(topics::kExternalOdometry.name, at, ToWire(*o.odometry, base_));
-  if (o.lidar) bag_.Write(topics::kPoints.name, at, ToWire(*o.lidar, base_));
+  // The order the simulator hands a step's messages over (DeliverToStack's).
+  if (o.imu) OnInput(t, runtime::SensorMessage::Of(*o.imu));
+  if (o.esc) OnInput(t, runtime::SensorMessage::Of(*o.esc));
+  if (o.odometry) OnInput(t, runtime::SensorMessage::Of(*o.odometry));
+  if (o.lidar) OnFrame(t, *o.lidar);
 }
 
 void BagRecorder::OnCycle(const runtime::CycleTelemetry& c) {
+  const std::lock_guard lock(mutex_);
   // At its sending: when a recorder on the wire would have received it.
   const ros1::Stamp at = base_.ToStamp(std::max(c.command.sent_t_ns, c.command.state_t_ns));
   const ros1::Cycle w = ToWire(c, base_);
@@ -28,6 +59,9 @@ void BagRecorder::OnCycle(const runtime::CycleTelemetry& c) {
   bag_.Write(topics::kFddHealth.name, at, w.health);
 }
 
-void BagRecorder::Finish() { bag_.Close(); }
+void BagRecorder::Finish() {
+  const std::lock_guard lock(mutex_);
+  bag_.Close();
+}
 
 }  // namespace rotorguard::rosbridge

@@ -24,13 +24,6 @@ namespace {
 /// The topic without its leading slash (a bag written by `rosbag record` has resolved names).
 std::string_view Bare(std::string_view topic) { return topic.starts_with('/') ? topic.substr(1) : topic; }
 
-/// An input of the stack, in the order the simulator hands a step's messages over.
-struct Input {
-  int rank = 0;  // 0 IMU, 1 ESC, 2 odometry, 3 frame
-  runtime::SensorMessage message;
-  std::shared_ptr<const LidarFrame> frame;
-};
-
 class CollectingSink final : public runtime::CommandSink {
  public:
   void Send(const runtime::CycleTelemetry& cycle) override { queue_.TryPush(cycle); }
@@ -92,105 +85,130 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
   stack::FlightStack& st = *node.stack;
   const double period_s = options.frame_period_s > 0.0 ? options.frame_period_s : 1.0 / node.scenario.sim.lidar.frame_rate_hz;
   const TimeNs frame_period = FromSeconds(period_s);
+  ReplaySummary r;
+  // Both spellings of each topic: as rotorguard writes them, as `rosbag record` resolves them.
+  const auto both = [](std::initializer_list<const char*> names) {
+    std::vector<std::string> v;
+    for (const char* n : names) v.insert(v.end(), {n, std::string("/") + n});
+    return v;
+  };
+
+  // Pass 1: the flight's time base and the cycles it recorded.
+  std::optional<TimeBase> flight_base;
+  std::vector<ros1::Cycle> recorded;
+  ros1::ReadBag(
+      bag_path,
+      [&](const ros1::BagMessage& m) {
+        if (const auto* start = std::get_if<ros1::ClockTick>(&m.message); start && !flight_base) flight_base = TimeBase{start->clock};
+        if (const auto* c = std::get_if<ros1::Cycle>(&m.message)) recorded.push_back(*c);
+      },
+      both({topics::kMissionStart.name, topics::kControlCycle.name}));
+  // A cycle that knows its inputs (recorded by rotorguard) can be replayed on exactly them.
+  const bool scripted = std::any_of(recorded.begin(), recorded.end(), [](const ros1::Cycle& c) { return c.inputs > 0; });
 
   runtime::SimulatedTime time(-1);
   runtime::SimulatedClock clock(&time);
   CollectingSink sink;
   runtime::OnboardExecutorOptions eo;
-  eo.trigger = runtime::CycleTrigger::kClock;
+  eo.trigger = scripted ? runtime::CycleTrigger::kScript : runtime::CycleTrigger::kClock;
   eo.lockstep_order = true;
   runtime::OnboardExecutor executor(&st, &clock, &sink, eo);
-  ReplaySummary r;
   const TimeNs control_period = st.control_period_ns();
   TimeNs next_control = 0;
-  // Runs every control instant before `b` (a cycle sees the messages handed over up to its instant).
+  // The cycles so far, taken from the sink (as they come: its queue is bounded).
+  const auto drain = [&] {
+    for (runtime::CycleTelemetry c; sink.TryReceive(&c);) r.cycles.push_back(c);
+  };
+  const auto receive = [&](auto&& until) {
+    for (drain(); !until(); drain()) std::this_thread::yield();
+  };
+  // Without a script: every control instant before `b` (a cycle sees the messages handed over up
+  // to its instant), on the control grid.
   const auto run_until = [&](TimeNs b) {
     while (next_control < b) {
       time.Advance(next_control);
-      for (runtime::CycleTelemetry c;;) {
-        if (sink.TryReceive(&c)) {
-          r.cycles.push_back(c);
-          if (c.command.state_t_ns >= next_control) break;
-        } else {
-          std::this_thread::yield();
-        }
-      }
+      const TimeNs t = next_control;
+      receive([&] { return !r.cycles.empty() && r.cycles.back().command.state_t_ns >= t; });
       next_control += control_period;
     }
   };
-  std::vector<Input> group;
-  TimeNs group_t = 0;
-  std::optional<TimeBase> flight_base;
-  const auto flush = [&]() {
-    std::stable_sort(group.begin(), group.end(), [](const Input& a, const Input& b) { return a.rank < b.rank; });
-    run_until(group_t);
-    for (const Input& in : group) {
-      if (in.frame) {
-        executor.OnLidar(in.frame);
-      } else {
-        executor.OnSensor(in.message);
-      }
+  // With one: the recorded cycles whose inputs have all been handed over.
+  std::vector<runtime::ScriptedCycle> script;
+  std::size_t scripted_next = 0;
+  std::uint64_t fed = 0;
+  const auto push_script = [&] {
+    for (; scripted_next < script.size() && script[scripted_next].inputs <= fed; ++scripted_next) {
+      time.Advance(script[scripted_next].t_ns);
+      executor.ScriptCycle(script[scripted_next]);
+      drain();
     }
-    group.clear();
   };
   executor.Start();
   TimeNs last_t = 0;
-  r.bag = ros1::ReadBag(bag_path, [&](const ros1::BagMessage& m) {
-    const std::string_view topic = Bare(m.topic);
-    if (const auto* c = std::get_if<ros1::Cycle>(&m.message)) {
-      if (topic == topics::kControlCycle.name) r.recorded_cycles.push_back(FromWire(*c, flight_base.value_or(TimeBase{})));
-      return;
-    }
-    if (const auto* start = std::get_if<ros1::ClockTick>(&m.message)) {
-      if (topic == topics::kMissionStart.name && !flight_base) flight_base = TimeBase{start->clock};
-      return;
-    }
-    // Without a mission_start (a bag of `rosbag record`), t = 0 is the first message's time.
-    if (!flight_base) flight_base = TimeBase{m.time};
-    const TimeBase& b = *flight_base;
-    Input in;
-    if (const auto* imu = std::get_if<ros1::Imu>(&m.message); imu && topic == topics::kImu.name) {
-      in = {0, runtime::SensorMessage::Of(FromWire(*imu, b)), nullptr};
-    } else if (const auto* esc = std::get_if<ros1::Esc>(&m.message); esc && topic == topics::kEscTelemetry.name) {
-      const std::optional<EscTelemetry> e = FromWire(*esc, b);
-      if (!e) return;
-      in = {1, runtime::SensorMessage::Of(*e), nullptr};
-    } else if (const auto* odo = std::get_if<ros1::Odometry>(&m.message); odo && topic == topics::kExternalOdometry.name) {
-      in = {2, runtime::SensorMessage::Of(FromWireOdometry(*odo, b)), nullptr};
-    } else if (const auto* cloud = std::get_if<ros1::Cloud>(&m.message); cloud && topic == topics::kPoints.name) {
-      auto frame = std::make_shared<LidarFrame>(FromWire(*cloud, b, frame_period));
-      r.frames_dropped_points += static_cast<std::uint64_t>(frame->dropped);
-      in = {3, {}, std::move(frame)};
-    } else {
-      return;
-    }
-    ++r.inputs[std::string(topic)];
-    const TimeNs t = b.ToTime(m.time);
-    if (t != group_t && !group.empty()) flush();
-    group_t = t;
-    last_t = t;
-    group.push_back(std::move(in));
-  });
+  r.bag = ros1::ReadBag(
+      bag_path,
+      [&](const ros1::BagMessage& m) {
+        if (!flight_base) flight_base = TimeBase{m.time};  // without a mission_start: t = 0 at the first message
+        const TimeBase& b = *flight_base;
+        if (script.empty() && scripted) {
+          for (const ros1::Cycle& c : recorded) {
+            if (c.command.held != 0) continue;
+            const std::size_t n = std::min<std::size_t>(c.command.thrust_n.size(), kMaxRotors);
+            script.push_back({b.ToTime(c.command.stamp), c.inputs, c.lio_serial,
+                              Eigen::Map<const Eigen::VectorXd>(c.command.thrust_n.data(), static_cast<Eigen::Index>(n))});
+          }
+        }
+        const std::string_view topic = Bare(m.topic);
+        const TimeNs t = b.ToTime(m.time);
+        if (!scripted) run_until(t);
+        // Handed over in the bag's order; a full intake is waited for (a replay loses nothing).
+        const auto hand_over = [&](auto&& give) {
+          while (!give()) std::this_thread::yield();
+          ++fed;
+          ++r.inputs[std::string(topic)];
+          last_t = t;
+          if (scripted) push_script();
+          drain();
+        };
+        if (const auto* imu = std::get_if<ros1::Imu>(&m.message); imu && topic == topics::kImu.name) {
+          hand_over([&] { return executor.OnImu(FromWire(*imu, b)); });
+        } else if (const auto* esc = std::get_if<ros1::Esc>(&m.message); esc && topic == topics::kEscTelemetry.name) {
+          if (const std::optional<EscTelemetry> e = FromWire(*esc, b)) hand_over([&] { return executor.OnEscTelemetry(*e); });
+        } else if (const auto* odo = std::get_if<ros1::Odometry>(&m.message); odo && topic == topics::kExternalOdometry.name) {
+          hand_over([&] { return executor.OnOdometry(FromWireOdometry(*odo, b)); });
+        } else if (const auto* cloud = std::get_if<ros1::Cloud>(&m.message); cloud && topic == topics::kPoints.name) {
+          auto frame = std::make_shared<const LidarFrame>(FromWire(*cloud, b, frame_period));
+          r.frames_dropped_points += static_cast<std::uint64_t>(frame->dropped);
+          hand_over([&] { return executor.OnLidar(frame); });
+        }
+      },
+      both({topics::kMissionStart.name, topics::kImu.name, topics::kEscTelemetry.name, topics::kExternalOdometry.name,
+            topics::kPoints.name}));
   if (r.inputs[topics::kImu.name] == 0) {
     executor.Stop();
     throw std::runtime_error(fmt::format("bag: '{}' holds no IMU samples on topic '{}'", bag_path, topics::kImu.name));
   }
-  flush();
-  run_until(last_t + 1);
+  if (scripted) {
+    push_script();
+    receive([&] { return r.cycles.size() >= scripted_next; });
+  } else {
+    run_until(last_t + 1);
+  }
   time.Stop();
   executor.Stop();
-  for (runtime::CycleTelemetry c; sink.TryReceive(&c);) r.cycles.push_back(c);
+  drain();
+  for (const ros1::Cycle& c : recorded) r.recorded_cycles.push_back(FromWire(c, flight_base.value_or(TimeBase{})));
   r.account = harness::NodeAccountJson(st, executor.Report()).at("account");
 
   // The replay against the recording, at the instants both ran a cycle of their own.
   double until_s = -1.0;
-  std::map<TimeNs, const runtime::CycleTelemetry*> recorded;
+  std::map<TimeNs, const runtime::CycleTelemetry*> by_instant;
   for (const runtime::CycleTelemetry& c : r.recorded_cycles) {
-    if (c.command.held == 0) recorded[c.command.state_t_ns] = &c;
+    if (c.command.held == 0) by_instant[c.command.state_t_ns] = &c;
   }
   for (const runtime::CycleTelemetry& c : r.cycles) {
-    const auto it = recorded.find(c.command.state_t_ns);
-    if (it == recorded.end()) continue;
+    const auto it = by_instant.find(c.command.state_t_ns);
+    if (it == by_instant.end()) continue;
     const StateEstimate& a = c.estimate;
     const StateEstimate& e = it->second->estimate;
     ++r.compared;

@@ -14,6 +14,7 @@
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/sitl.h"
 #include "rotorguard/ros1/bus.h"
+#include "rotorguard/rosbridge/bag_recorder.h"
 #include "rotorguard/rosbridge/input_guard.h"
 #include "rotorguard/rosbridge/topics.h"
 #include "rotorguard/rosbridge/wire_convert.h"
@@ -157,6 +158,9 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   std::unique_ptr<runtime::OnboardExecutor> executor;
   std::optional<TimeBase> base;
   std::uint64_t before_start = 0;
+  std::unique_ptr<BagRecorder> bag;
+  // Arrival on the flight's time (the bag's time of a message taken in).
+  const auto arrival = [&] { return base->ToTime(bus.Now()); };
   const auto accept = [&](const char* topic, ros1::Stamp stamp) {
     if (!executor) {
       ++before_start;
@@ -165,7 +169,9 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     return guard.Check(topic, stamp, steady()) == InputGuard::Verdict::kAccept;
   };
   bus.Subscribe<ros1::Imu>(topics::kImu.name, topics::kImu.options, [&](const ros1::Imu& m) {
-    if (accept(topics::kImu.name, m.stamp)) executor->OnImu(FromWire(m, *base));
+    if (!accept(topics::kImu.name, m.stamp)) return;
+    const runtime::SensorMessage s = runtime::SensorMessage::Of(FromWire(m, *base));
+    if (executor->OnSensor(s) && bag) bag->OnInput(arrival(), s);
   });
   bus.Subscribe<ros1::Esc>(topics::kEscTelemetry.name, topics::kEscTelemetry.options, [&](const ros1::Esc& m) {
     if (m.motor_speed_rad_s.size() != static_cast<std::size_t>(st.model().num_rotors())) {
@@ -173,10 +179,14 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
                 fmt::format("{} motor speeds for a vehicle of {} rotors", m.motor_speed_rad_s.size(), st.model().num_rotors()));
       return;
     }
-    if (accept(topics::kEscTelemetry.name, m.stamp)) executor->OnEscTelemetry(*FromWire(m, *base));
+    if (!accept(topics::kEscTelemetry.name, m.stamp)) return;
+    const runtime::SensorMessage s = runtime::SensorMessage::Of(*FromWire(m, *base));
+    if (executor->OnSensor(s) && bag) bag->OnInput(arrival(), s);
   });
   bus.Subscribe<ros1::Odometry>(topics::kExternalOdometry.name, topics::kExternalOdometry.options, [&](const ros1::Odometry& m) {
-    if (accept(topics::kExternalOdometry.name, m.stamp)) executor->OnOdometry(FromWireOdometry(m, *base));
+    if (!accept(topics::kExternalOdometry.name, m.stamp)) return;
+    const runtime::SensorMessage s = runtime::SensorMessage::Of(FromWireOdometry(m, *base));
+    if (executor->OnSensor(s) && bag) bag->OnInput(arrival(), s);
   });
   bus.Subscribe<ros1::Cloud>(topics::kPoints.name, topics::kPoints.options, [&](const ros1::Cloud& m) {
     if (m.points.size() > options.max_frame_points) {
@@ -184,7 +194,9 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
                      fmt::format("a frame of {} points, more than the budget of {}", m.points.size(), options.max_frame_points));
       return;
     }
-    if (accept(topics::kPoints.name, m.stamp)) executor->OnLidar(std::make_shared<const LidarFrame>(FromWire(m, *base, frame_period)));
+    if (!accept(topics::kPoints.name, m.stamp)) return;
+    auto frame = std::make_shared<const LidarFrame>(FromWire(m, *base, frame_period));
+    if (executor->OnLidar(frame) && bag) bag->OnFrame(arrival(), *frame);
   });
   double battery_v = 0.0;
   bus.Subscribe<ros1::Battery>(topics::kBattery.name, topics::kBattery.options, [&](const ros1::Battery& m) {
@@ -207,6 +219,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   std::atomic<bool> stop_publishing{false};
   if (start) {
     base = TimeBase{*start};
+    if (!options.bag_path.empty()) bag = std::make_unique<BagRecorder>(options.bag_path, *base);
     clock = std::make_unique<RosClock>(&bus, *start);
     runtime::OnboardExecutorOptions eo;
     eo.realtime = options.realtime;
@@ -219,6 +232,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
         bool any = false;
         while (sink.queue().TryPop(&c)) {
           outputs.Publish(c, *base);
+          if (bag) bag->OnCycle(c);
           any = true;
         }
         if (!any && stop_publishing.load(std::memory_order_acquire)) return;
@@ -237,6 +251,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     stop_publishing.store(true, std::memory_order_release);
     sink.bell().Ring();
     publisher.join();
+    if (bag) bag->Finish();
   }
   nlohmann::json account = harness::NodeAccountJson(st, executor ? executor->Report() : runtime::OnboardReport{});
   account["wire"] = guard.ToJson();

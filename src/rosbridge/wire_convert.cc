@@ -128,6 +128,8 @@ ros1::Cycle ToWire(const runtime::CycleTelemetry& c, const TimeBase& base) {
   ros1::Cycle w;
   w.command = {base.ToStamp(c.command.state_t_ns), c.command.cycle, base.ToStamp(c.command.sent_t_ns), c.command.compute_s,
                c.command.held, {c.command.thrust_n.begin(), c.command.thrust_n.end()}};
+  w.inputs = c.command.inputs;
+  w.lio_serial = c.command.lio_serial;
   w.estimate_valid = c.estimate.valid;
   w.estimate = EstimateToWire(c.estimate, base);
   w.reference = {ToVec3(c.reference.p_W), ToVec3(c.reference.v_W), ToVec3(c.reference.a_W), ToVec3(c.reference.j_W),
@@ -143,6 +145,8 @@ runtime::CycleTelemetry FromWire(const ros1::Cycle& w, const TimeBase& base) {
   c.command.sent_t_ns = base.ToTime(w.command.sent);
   c.command.compute_s = w.command.compute_s;
   c.command.held = w.command.held;
+  c.command.inputs = w.inputs;
+  c.command.lio_serial = w.lio_serial;
   const std::size_t n = std::min<std::size_t>(w.command.thrust_n.size(), kMaxRotors);
   c.command.thrust_n = Eigen::Map<const Eigen::VectorXd>(w.command.thrust_n.data(), static_cast<Eigen::Index>(n));
   c.mode = FromName<stack::FlightMode>(w.health.mode).value_or(stack::FlightMode::kNominal);

@@ -70,6 +70,8 @@ OnboardExecutor::OnboardExecutor(stack::FlightStack* stack, Clock* clock, Comman
   deadline_ns_ = options_.deadline_s > 0.0 ? FromSeconds(options_.deadline_s) : stack_->control_period_ns();
   std::sort(options_.stalls.begin(), options_.stalls.end(),
             [](const OnboardExecutorOptions::Stall& a, const OnboardExecutorOptions::Stall& b) { return a.at_s < b.at_s; });
+  // A script replays a recorded flight: in the lockstep order, without deadlines.
+  if (options_.trigger == CycleTrigger::kScript) options_.lockstep_order = true;
   if (tasks_.planning && !options_.lockstep_order) tasks_.planning->set_plan_ahead_s(options_.plan_ahead_s);
   policy_ = options_.deadline_policy && !options_.lockstep_order;
   if (policy_) stack_->PrepareFallback();
@@ -79,9 +81,9 @@ OnboardExecutor::OnboardExecutor(stack::FlightStack* stack, Clock* clock, Comman
 
 OnboardExecutor::~OnboardExecutor() { Stop(); }
 
-void OnboardExecutor::Intake(SensorMessage m) {
+bool OnboardExecutor::Intake(SensorMessage m) {
   m.seq = messages_in_;
-  if (!intake_.TryPush(m)) return;
+  if (!intake_.TryPush(m)) return false;
   if (m.kind == SensorMessage::Kind::kImu && policy_) {
     const std::uint64_t n = imu_written_.load(std::memory_order_relaxed);
     ImuArrival& a = imu_arrivals_[n % kImuArrivals];
@@ -91,24 +93,34 @@ void OnboardExecutor::Intake(SensorMessage m) {
   }
   ++messages_in_;
   intake_bell_.Ring();
+  return true;
 }
 
-void OnboardExecutor::OnSensor(const SensorMessage& message) {
-  if (message.kind != SensorMessage::Kind::kFrame) Intake(message);
+bool OnboardExecutor::OnSensor(const SensorMessage& message) {
+  return message.kind != SensorMessage::Kind::kFrame && Intake(message);
 }
 
-void OnboardExecutor::OnLidar(std::shared_ptr<const LidarFrame> frame) {
-  if (!frame) return;
+bool OnboardExecutor::OnLidar(std::shared_ptr<const LidarFrame> frame) {
+  if (!frame) return false;
+  // The marker's place first: a frame refused leaves nothing behind (its number is not used).
+  if (intake_.size() >= intake_.capacity()) return false;
   const TimeNs end = frame->t_end_ns;
-  const std::uint64_t number = ++frames_numbered_;
-  if (!frames_.TryPush({std::move(frame), number})) return;
+  const std::uint64_t number = frames_numbered_ + 1;
+  if (!frames_.TryPush({std::move(frame), number})) return false;
+  frames_numbered_ = number;
   frames_in_.fetch_add(1, std::memory_order_acq_rel);
   SensorMessage m;
   m.kind = SensorMessage::Kind::kFrame;
   m.frame = number;
   m.frame_end_ns = end;
-  Intake(m);
+  Intake(m);  // room was checked: the intake's thread is the only producer
   perception_bell_.Ring();
+  return true;
+}
+
+void OnboardExecutor::ScriptCycle(const ScriptedCycle& cycle) {
+  while (!script_.TryPush(cycle) && !stop_.load(std::memory_order_acquire)) std::this_thread::yield();
+  intake_bell_.Ring();
 }
 
 void OnboardExecutor::Start() {
@@ -148,10 +160,10 @@ void OnboardExecutor::Stop() {
 
 OnboardReport OnboardExecutor::Report() const { return report_; }
 
-bool OnboardExecutor::TakeMessages() {
+bool OnboardExecutor::TakeMessages(std::uint64_t limit) {
   SensorMessage m;
   bool any = false;
-  while (intake_.TryPop(&m)) {
+  while (messages_taken_.load(std::memory_order_relaxed) < limit && intake_.TryPop(&m)) {
     any = true;
     switch (m.kind) {
       case SensorMessage::Kind::kImu:
@@ -189,16 +201,61 @@ void OnboardExecutor::WaitForPerception() {
   }
 }
 
+void OnboardExecutor::FuseLioUpdate() {
+  stack::LioUpdate u;
+  if (lio_updates_.Read(&u)) stack_->OnLioUpdate(u);
+}
+
+void OnboardExecutor::ScriptLoop() {
+  ScriptedCycle c;
+  stack::LioUpdate u;
+  bool have_pending = false;  // u holds an update later than the cycle waiting for it wanted
+  while (true) {
+    const std::uint32_t seen = intake_bell_.Count();
+    if (!script_.TryPop(&c)) {
+      if (stop_.load(std::memory_order_acquire)) break;
+      intake_bell_.Wait(seen, kPollNs);
+      continue;
+    }
+    // The messages the recorded cycle had taken in, no more...
+    while (messages_taken_.load(std::memory_order_relaxed) < c.inputs) {
+      const std::uint32_t waited = intake_bell_.Count();
+      if (!TakeMessages(c.inputs)) {
+        if (stop_.load(std::memory_order_acquire) && intake_.size() == 0) break;
+        intake_bell_.Wait(waited, kPollNs);
+      }
+    }
+    // ... and the odometry update it had fused, that one alone (the perception's updates come in
+    // order; the ones between two cycles were never fused, as the newest replaces them).
+    while (stack_->lio_serial() < c.lio_serial && !stop_.load(std::memory_order_acquire)) {
+      if (!have_pending && !(have_pending = lio_script_.TryPop(&u))) {
+        std::this_thread::yield();
+        continue;
+      }
+      if (u.posterior.serial > c.lio_serial) break;  // not among the perception's updates: not fused
+      if (u.posterior.serial == c.lio_serial) stack_->OnLioUpdate(u);
+      have_pending = false;
+    }
+    RunCycle(c.t_ns, &c.thrust_n);
+  }
+}
+
 void OnboardExecutor::ControlLoop() {
   const double cpu0 = ThreadCpuSeconds();
   const TimeNs period = stack_->control_period_ns();
+  if (options_.trigger == CycleTrigger::kScript) {
+    ScriptLoop();
+    report_.control.cpu_s = ThreadCpuSeconds() - cpu0;
+    control_done_.store(true, std::memory_order_release);
+    perception_bell_.Ring();
+    return;
+  }
   if (options_.trigger == CycleTrigger::kClock) {
     // Each control instant on the clock, with the messages in by then.
     for (TimeNs t = 0; clock_->SleepUntil(t) && !stop_.load(std::memory_order_acquire); t += period) {
       TakeMessages();
       if (options_.lockstep_order) WaitForPerception();
-      stack::LioUpdate u;
-      if (lio_updates_.Read(&u)) stack_->OnLioUpdate(u);
+      FuseLioUpdate();
       RunCycle(t);
       const TimeNs now = clock_->Now();
       if (now >= t + 2 * period) {
@@ -219,8 +276,7 @@ void OnboardExecutor::ControlLoop() {
     if (any && have_imu_) {
       // The odometry's newest update, then a cycle when an IMU sample reached the next instant.
       if (options_.lockstep_order) WaitForPerception();
-      stack::LioUpdate u;
-      if (lio_updates_.Read(&u)) stack_->OnLioUpdate(u);
+      FuseLioUpdate();
       if (!next_cycle_ns_) next_cycle_ns_ = newest_imu_ns_;
       if (newest_imu_ns_ >= *next_cycle_ns_) {
         RunCycle(newest_imu_ns_);
@@ -240,7 +296,7 @@ void OnboardExecutor::ControlLoop() {
   perception_bell_.Ring();
 }
 
-void OnboardExecutor::RunCycle(TimeNs t) {
+void OnboardExecutor::RunCycle(TimeNs t, const RotorVector* recorded) {
   // Fault injection: a computer that falls behind.
   for (; next_stall_ < options_.stalls.size() && t >= FromSeconds(options_.stalls[next_stall_].at_s); ++next_stall_) {
     clock_->SleepUntil(t + FromSeconds(options_.stalls[next_stall_].duration_s));
@@ -265,9 +321,12 @@ void OnboardExecutor::RunCycle(TimeNs t) {
       plan = planning_output_.Newest();
     }
   }
-  const RotorCommand& command = stack_->EndCycle(t, mode, plan ? plan->followed : nullptr);
+  const RotorCommand* sent = &stack_->EndCycle(t, mode, plan ? plan->followed : nullptr);
+  if (recorded && recorded->size() == sent->thrust_n.size() && recorded->allFinite()) sent = &stack_->OverrideCommand(*recorded);
+  const RotorCommand& command = *sent;
   CycleTelemetry cycle = TelemetryOf(*stack_, t, mode, command.thrust_n);
   cycle.command.cycle = ++cycles_;
+  cycle.command.inputs = messages_taken_.load(std::memory_order_relaxed);
   // The plan's commands for the instants after this one: what the guard holds if they are late.
   std::array<RotorVector, 2> held;
   for (int j = 0; policy_ && j < options_.hold_periods; ++j) {
@@ -295,6 +354,7 @@ CycleTelemetry TelemetryOf(const stack::FlightStack& stack, TimeNs t, stack::Fli
   CycleTelemetry cycle;
   cycle.command.state_t_ns = t;
   cycle.command.thrust_n = thrust_n;
+  cycle.command.lio_serial = stack.lio_serial();
   cycle.mode = mode;
   cycle.estimate = stack.estimate();
   cycle.reference = stack.reference_point();
@@ -398,6 +458,9 @@ void OnboardExecutor::PublishLioUpdate(std::uint64_t* published_serial) {
   if (!u || u->posterior.serial <= *published_serial) return;
   *published_serial = u->posterior.serial;
   lio_updates_.Publish(*u);
+  if (options_.trigger == CycleTrigger::kScript) {
+    while (!lio_script_.TryPush(*u) && !stop_.load(std::memory_order_acquire)) std::this_thread::yield();
+  }
 }
 
 void OnboardExecutor::PerceptionLoop() {

@@ -226,6 +226,8 @@ void FlightStack::TakeOdometryUpdate() {
   if (const std::optional<LioUpdate> u = perception_->update()) OnLioUpdate(*u);
 }
 
+std::uint64_t FlightStack::lio_serial() const { return lio_head_ ? lio_head_->serial() : 0; }
+
 void FlightStack::OnLioUpdate(const LioUpdate& update) {
   if (lio_head_ && update.posterior.serial > lio_head_->serial()) lio_head_->OnLioUpdate(update);
 }

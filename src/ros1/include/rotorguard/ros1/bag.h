@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "rotorguard/ros1/wire.h"
 
@@ -50,8 +51,10 @@ struct BagReadSummary {
   std::map<std::string, std::uint64_t> bad;
 };
 
-/// Reads every message of the bag at `path` in the order of its time and hands each one rotorguard
-/// reads to `visit`. Throws std::runtime_error naming the file when it is not a readable bag.
-BagReadSummary ReadBag(const std::string& path, const std::function<void(const BagMessage&)>& visit);
+/// Reads every message of the bag at `path` (of `topics` alone when given) in the order of its
+/// time and hands each one rotorguard reads to `visit`. Throws std::runtime_error naming the file
+/// when it is not a readable bag.
+BagReadSummary ReadBag(const std::string& path, const std::function<void(const BagMessage&)>& visit,
+                       const std::vector<std::string>& topics = {});
 
 }  // namespace rotorguard::ros1

@@ -106,6 +106,8 @@ struct Reference {
 /// rotorguard_msgs/ControlCycle.
 struct Cycle {
   Command command;
+  std::uint64_t inputs = 0;
+  std::uint64_t lio_serial = 0;
   bool estimate_valid = false;
   Odometry estimate;
   Reference reference;

@@ -1,9 +1,12 @@
 #pragma once
 /// BagRecorder: a flight's sensor messages and control cycles into a rosbag (`run --bag`,
-/// `sitl --bag`: docs/ros.md), on the node's topics (topics.h). The sensor messages are written
-/// at the instant they were handed to the stack (the bag's time; each keeps its own stamp), so
-/// that `rotorguard replay` hands them over in the same order.
+/// `sitl --bag`, `node --ros --bag`: docs/ros.md), on the node's topics (topics.h). The sensor
+/// messages are written in the order the stack took them in, at the instant they were handed over
+/// (the bag's time, made strictly increasing; each message keeps its own stamp), so that
+/// `rotorguard replay` hands them over in that order; each cycle carries how many it had taken in.
+/// Thread-safe: a node records its intake and its cycles from two threads.
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "rotorguard/harness/stack_observer.h"
@@ -19,11 +22,18 @@ class BagRecorder final : public harness::StackObserver {
   void OnSensors(TimeNs t, const sim::SensorOutputs& outputs) override;
   void OnCycle(const runtime::CycleTelemetry& cycle) override;
   void Finish() override;
+  /// One sensor message (IMU, ESC telemetry or odometry) or frame taken in at `t`.
+  void OnInput(TimeNs t, const runtime::SensorMessage& message);
+  void OnFrame(TimeNs t, const LidarFrame& frame);
   const std::string& path() const { return bag_.path(); }
 
  private:
+  /// The bag's time of a message handed over at `t`: after every earlier one.
+  ros1::Stamp InputTime(TimeNs t);
+  std::mutex mutex_;
   ros1::BagWriter bag_;
   TimeBase base_;
+  ros1::Stamp last_input_ = 0;
 };
 
 }  // namespace rotorguard::rosbridge

@@ -1,11 +1,15 @@
 #pragma once
 /// Replay: a bag's sensor messages through a scenario's flight stack (`rotorguard replay`,
-/// docs/ros.md). The messages are handed over in the bag's time order (within one instant: IMU,
-/// ESC telemetry, odometry, LiDAR frame, as the simulator hands them), the control cycles run on
-/// the stack's control grid, and the perception finishes every frame before the next cycle: the
-/// lockstep order, so a replay is repeatable and every frame is processed. When the bag holds the
-/// cycles of the flight it recorded (control_cycle), the replay's estimate and FDD diagnosis are
-/// compared with them.
+/// docs/ros.md), handed over in the bag's time order, every LiDAR frame processed.
+///
+/// A bag rotorguard recorded holds its cycles (control_cycle), each with the number of messages
+/// the stack had taken in before it and the odometry update it had fused: the replay runs each
+/// cycle at its instant on exactly those (CycleTrigger::kScript), so a real-time flight, whose
+/// interleaving of messages, cycles and odometry updates depended on its threads' timing, is
+/// replayed as it happened, and the replay's estimates and FDD diagnosis are compared with the
+/// recorded ones. Another bag (`rosbag record` of a vehicle's drivers) is replayed on the stack's
+/// control grid, each cycle after the messages up to its instant, the perception finishing every
+/// frame first (the lockstep order).
 #include <cstdint>
 #include <functional>
 #include <map>

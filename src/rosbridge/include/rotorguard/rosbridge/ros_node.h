@@ -24,6 +24,9 @@ struct RosNodeOptions {
   bool start_now = false;
   /// A LiDAR frame larger than this is refused (and counted): the perception's budget.
   std::size_t max_frame_points = 200'000;
+  /// Record the sensor messages the stack took in, in that order, and its cycles to this bag
+  /// ("": none): what `rotorguard replay` replays exactly.
+  std::string bag_path;
   /// The control thread's scheduling (RealtimeOptions: SCHED_FIFO, locked memory, its CPU).
   runtime::RealtimeOptions realtime{.lock_memory = false, .fifo_priority = 0};
   /// Throws ValidationError naming the field.

@@ -22,6 +22,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <shared_mutex>
@@ -47,6 +48,11 @@ struct StampedCommand {
   TimeNs state_t_ns = 0;    ///< the instant of the IMU sample that started the cycle (the state it used)
   TimeNs sent_t_ns = 0;     ///< when it was sent, on the executor's clock
   double compute_s = 0.0;   ///< the cycle's own work, on the steady clock [s]
+  /// Sensor messages (IMU samples, ESC telemetry, odometry, LiDAR frames) the stack had taken in
+  /// before the cycle, and the LiDAR-inertial odometry update it had fused last (its serial):
+  /// with them a replay runs the cycle on exactly the inputs it had (CycleTrigger::kScript).
+  std::uint64_t inputs = 0;
+  std::uint64_t lio_serial = 0;
   /// 0: the cycle's own command; j > 0: the deadline guard's, the cycle's plan held at the j-th
   /// instant after its own (the later cycles were late).
   int held = 0;
@@ -128,6 +134,20 @@ enum class CycleTrigger {
   /// Each control instant on the clock, with the messages in by then (the lockstep runner's
   /// order, when the clock is the simulator's time).
   kClock,
+  /// A recorded flight's cycles, as ScriptCycle hands them in: each runs at its instant once the
+  /// stack has taken in exactly the messages the recorded one had, with the odometry update it
+  /// had fused (a replay: `rotorguard replay`). The planning runs in the lockstep order.
+  kScript,
+};
+
+/// A recorded cycle, for CycleTrigger::kScript.
+struct ScriptedCycle {
+  TimeNs t_ns = 0;
+  std::uint64_t inputs = 0;      ///< StampedCommand::inputs
+  std::uint64_t lio_serial = 0;  ///< StampedCommand::lio_serial
+  /// The command the recorded cycle sent: the one the vehicle flew, which the fault detection
+  /// compares the ESC telemetry with (FlightStack::OverrideCommand); empty: the replay's own.
+  RotorVector thrust_n;
 };
 
 struct OnboardExecutorOptions {
@@ -209,13 +229,16 @@ class OnboardExecutor {
   OnboardExecutor& operator=(const OnboardExecutor&) = delete;
 
   /// The sensor intake, called from one thread (a driver's or a transport's), in the order the
-  /// messages arrive. Never blocks: a full queue drops the message and counts it.
-  void OnImu(const ImuSample& imu) { Intake(SensorMessage::Of(imu)); }
-  void OnEscTelemetry(const EscTelemetry& esc) { Intake(SensorMessage::Of(esc)); }
-  void OnOdometry(const OdometrySample& odometry) { Intake(SensorMessage::Of(odometry)); }
-  void OnLidar(std::shared_ptr<const LidarFrame> frame);
+  /// messages arrive. Never blocks: a full queue refuses the message (false) and counts it.
+  bool OnImu(const ImuSample& imu) { return Intake(SensorMessage::Of(imu)); }
+  bool OnEscTelemetry(const EscTelemetry& esc) { return Intake(SensorMessage::Of(esc)); }
+  bool OnOdometry(const OdometrySample& odometry) { return Intake(SensorMessage::Of(odometry)); }
+  bool OnLidar(std::shared_ptr<const LidarFrame> frame);
   /// An IMU sample, ESC telemetry or odometry.
-  void OnSensor(const SensorMessage& message);
+  bool OnSensor(const SensorMessage& message);
+  /// CycleTrigger::kScript: the next recorded cycle (from the intake's thread, in their order;
+  /// waits while the script's queue is full).
+  void ScriptCycle(const ScriptedCycle& cycle);
 
   void Start();
   /// Lets the threads finish what they hold, then joins them (idempotent).
@@ -228,8 +251,8 @@ class OnboardExecutor {
   std::uint64_t deadline_steps() const { return deadline_steps_.load(std::memory_order_acquire); }
 
  private:
-  /// Pushes `m` to the control thread (dropped and counted when its queue is full).
-  void Intake(SensorMessage m);
+  /// Pushes `m` to the control thread; false (and counted) when its queue is full.
+  bool Intake(SensorMessage m);
   /// What the planning reads of the cycle just run.
   struct PlanningInput {
     TimeNs t_ns = 0;
@@ -245,8 +268,13 @@ class OnboardExecutor {
   };
 
   void ControlLoop();
-  /// The control thread takes in every sensor message waiting; true when there was one.
-  bool TakeMessages();
+  /// The control thread takes in every sensor message waiting (at most `limit` in all: its count
+  /// stops there); true when there was one.
+  bool TakeMessages(std::uint64_t limit = std::numeric_limits<std::uint64_t>::max());
+  /// The newest odometry update, fused when there is one.
+  void FuseLioUpdate();
+  /// CycleTrigger::kScript's control loop.
+  void ScriptLoop();
   /// Blocks until the perception finished every frame handed in so far and every message passed
   /// on (lockstep_order).
   void WaitForPerception();
@@ -254,8 +282,9 @@ class OnboardExecutor {
   void PublishLioUpdate(std::uint64_t* published_serial);
   void PerceptionLoop();
   void PlanningLoop();
-  /// A control cycle at the IMU sample of time t.
-  void RunCycle(TimeNs t);
+  /// A control cycle at the IMU sample of time t; `recorded`, when given and not empty, is the
+  /// command it sent in the flight replayed (kScript).
+  void RunCycle(TimeNs t, const RotorVector* recorded = nullptr);
   /// The deadline guard's thread (docs/runtime.md, "Deadline policy").
   void GuardLoop();
   /// The send lock: the control thread's and the guard's commands never interleave (either
@@ -303,6 +332,9 @@ class OnboardExecutor {
   std::atomic<std::uint64_t> perception_processed_{0};         // ... and the perception took
   // perception -> control
   Latest<stack::LioUpdate> lio_updates_;
+  SpscQueue<stack::LioUpdate, 64> lio_script_;  // kScript: every update, in order
+  // intake -> control (kScript)
+  SpscQueue<ScriptedCycle, 256> script_;
   // control -> planning
   SpscQueue<stack::PlanningEvent, 64> planning_events_;
   Latest<PlanningInput> planning_input_;

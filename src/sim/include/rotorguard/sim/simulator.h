@@ -48,6 +48,8 @@ struct SensorOutputs {
   std::optional<EscTelemetry> esc;
   std::optional<OdometrySample> odometry;
   std::optional<LidarFrame> lidar;  ///< a frame completed in this step
+  /// The messages of the step (what a stack's intake counts).
+  int count() const { return imu.has_value() + esc.has_value() + odometry.has_value() + lidar.has_value(); }
 };
 
 class Simulator {

@@ -273,6 +273,9 @@ class FlightStack {
   /// The LiDAR-inertial odometry's update for the control side's estimate (estimator lio; an
   /// update older than the last one taken is ignored).
   void OnLioUpdate(const LioUpdate& update);
+  /// The serial of the newest LiDAR-inertial odometry update the control side has fused (0: none,
+  /// or the estimator does not follow the odometry): what a replay needs to fuse the same one.
+  std::uint64_t lio_serial() const;
   /// The events the last BeginCycle raised for the planning task (valid until the next one).
   std::span<const PlanningEvent> planning_events() const { return planning_events_; }
   /// What the planning task reads of the fault detection (the flatness navigator's; empty for the
