@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 #include <variant>
@@ -70,9 +71,11 @@ nlohmann::json ReplaySummary::ToJson() const {
           {"cycles", cycles.size()},
           {"recorded_cycles", recorded_cycles.size()},
           {"compared", compared},
+          {"recorded_held", recorded_held},
           {"position_max_diff_m", position_max_diff_m},
           {"attitude_max_diff_rad", attitude_max_diff_rad},
           {"velocity_max_diff_m_s", velocity_max_diff_m_s},
+          {"first_divergence_s", first_divergence_s ? nlohmann::json(*first_divergence_s) : nlohmann::json()},
           {"diagnosis", diagnosis.ToString()},
           {"recorded_diagnosis", recorded_diagnosis.ToString()},
           {"diagnosis_equal", diagnosis == recorded_diagnosis},
@@ -185,6 +188,7 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
       both({topics::kMissionStart.name, topics::kImu.name, topics::kEscTelemetry.name, topics::kExternalOdometry.name,
             topics::kPoints.name}));
   if (r.inputs[topics::kImu.name] == 0) {
+    time.Stop();
     executor.Stop();
     throw std::runtime_error(fmt::format("bag: '{}' holds no IMU samples on topic '{}'", bag_path, topics::kImu.name));
   }
@@ -204,7 +208,11 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
   double until_s = -1.0;
   std::map<TimeNs, const runtime::CycleTelemetry*> by_instant;
   for (const runtime::CycleTelemetry& c : r.recorded_cycles) {
-    if (c.command.held == 0) by_instant[c.command.state_t_ns] = &c;
+    if (c.command.held == 0) {
+      by_instant[c.command.state_t_ns] = &c;
+    } else {
+      ++r.recorded_held;
+    }
   }
   for (const runtime::CycleTelemetry& c : r.cycles) {
     const auto it = by_instant.find(c.command.state_t_ns);
@@ -213,10 +221,12 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
     const StateEstimate& e = it->second->estimate;
     ++r.compared;
     r.position_max_diff_m = std::max(r.position_max_diff_m, (a.p_W - e.p_W).norm());
+    if (!r.first_divergence_s && (a.p_W - e.p_W).norm() > 1e-6) r.first_divergence_s = ToSeconds(c.command.state_t_ns);
     r.velocity_max_diff_m_s = std::max(r.velocity_max_diff_m_s, (a.v_W - e.v_W).norm());
     r.attitude_max_diff_rad = std::max(r.attitude_max_diff_rad, AngleBetween(a.q_WB, e.q_WB));
     until_s = std::max(until_s, ToSeconds(c.command.state_t_ns));
   }
+  if (r.compared == 0) until_s = std::numeric_limits<double>::infinity();  // nothing recorded: the whole replay
   r.diagnosis = DiagnosisOf(r.cycles, until_s);
   r.recorded_diagnosis = DiagnosisOf(r.recorded_cycles, until_s);
 

@@ -106,7 +106,7 @@ bool OnboardExecutor::OnLidar(std::shared_ptr<const LidarFrame> frame) {
   if (intake_.size() >= intake_.capacity()) return false;
   const TimeNs end = frame->t_end_ns;
   const std::uint64_t number = frames_numbered_ + 1;
-  if (!frames_.TryPush({std::move(frame), number})) return false;
+  if (!frames_.TryPush({std::move(frame), number, messages_in_})) return false;
   frames_numbered_ = number;
   frames_in_.fetch_add(1, std::memory_order_acq_rel);
   SensorMessage m;
@@ -484,9 +484,12 @@ void OnboardExecutor::PerceptionLoop() {
       continue;
     }
     const bool ready = frame && ticket;
-    const std::uint64_t until = ready ? ticket->after_messages : std::numeric_limits<std::uint64_t>::max();
     bool any = false;
-    for (const SensorMessage* m = perception_messages_.Front(); m && m->seq < until; m = perception_messages_.Front()) {
+    for (const SensorMessage* m = perception_messages_.Front(); m; m = perception_messages_.Front()) {
+      // Never past a frame's place, its ticket come or not: a message after its marker was passed
+      // on after the marker was taken, so the frame, queued before its marker, is visible now.
+      if (!frame) frame = frames_.Front();
+      if (frame && m->seq >= frame->seq) break;
       if (m->kind == SensorMessage::Kind::kImu) {
         tasks_.perception->OnImu(m->imu);
       } else {

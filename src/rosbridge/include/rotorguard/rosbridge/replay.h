@@ -42,7 +42,8 @@ struct Diagnosis {
   bool operator==(const Diagnosis&) const = default;
   std::string ToString() const;
 };
-/// The diagnosis of `cycles` (in the order they ran) up to instant `until_s` included.
+/// The diagnosis of `cycles` (in the order they ran) up to instant `until_s` included (the deadline
+/// guard's held commands are not cycles: skipped).
 Diagnosis DiagnosisOf(const std::vector<runtime::CycleTelemetry>& cycles, double until_s);
 
 struct ReplaySummary {
@@ -52,9 +53,12 @@ struct ReplaySummary {
   std::vector<runtime::CycleTelemetry> cycles;           ///< the replay's
   std::vector<runtime::CycleTelemetry> recorded_cycles;  ///< the bag's (control_cycle)
   std::uint64_t compared = 0;          ///< cycles at the same instant in both
+  std::uint64_t recorded_held = 0;     ///< recorded commands the deadline guard held (no cycle of their own)
   double position_max_diff_m = 0.0;    ///< the largest |p_replay - p_recorded| over them
   double attitude_max_diff_rad = 0.0;  ///< the largest rotation between the two estimates' attitudes
   double velocity_max_diff_m_s = 0.0;
+  /// The first instant whose estimates differ by more than a micrometre (where to look).
+  std::optional<double> first_divergence_s;
   Diagnosis diagnosis, recorded_diagnosis;  ///< both up to the last instant compared
   nlohmann::json account;                   ///< the stack's account (as a node sends it)
   nlohmann::json ToJson() const;

@@ -310,6 +310,7 @@ class OnboardExecutor {
   struct FrameMessage {
     std::shared_ptr<const LidarFrame> frame;
     std::uint64_t number = 0;
+    std::uint64_t seq = 0;  // its marker's place among the messages: those before it have seq below this
   };
   /// What the control thread adds to a frame when it reaches the frame's place among the other
   /// messages: every message before it has been passed on, and the frame's placement when the
