@@ -147,7 +147,10 @@ class BenchCommand final : public Command {
           {"--control-cpu", &sitl_cpu_, "Pin the time-critical threads to this CPU, perception and planning to the others (default: none)"},
           {"--platform-seconds", &sitl_platform_, "Seconds per load of the machine's own wake-up timing, without the stack (default 60; 0: none)"},
           {"--ftc-trials", &sitl_ftc_trials_, "Flights per FTC cell (default 20; 0: none)"},
-          {"--ftc-seed", &sitl_ftc_seed_, "The FTC flights' first seed (default 5001)"}}},
+          {"--ftc-seed", &sitl_ftc_seed_, "The FTC flights' first seed (default 5001)"},
+          {"--transport", &sitl_transport_,
+           "The timing flights' link to the node: shared_memory (default) or ros (over the ROS master of\n"
+           "ROS_MASTER_URI, /clock and all: docs/ros.md)"}}},
         {&ftc_,
          "ftc",
          "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
@@ -544,6 +547,14 @@ class BenchCommand final : public Command {
     o.ftc_trials = static_cast<int>(ParseUnsigned("--ftc-trials", sitl_ftc_trials_, 0, 1000));
     o.ftc_seed = ParseUnsigned("--ftc-seed", sitl_ftc_seed_, 0, UINT64_MAX - 1000);
     o.self = SelfPath();
+    if (sitl_transport_ == "ros") {
+      harness::SitlOptions link;
+      UseRosLink(&link, "");
+      o.make_link = link.make_link;
+      o.transport = "ros";
+    } else if (sitl_transport_ != "shared_memory") {
+      throw UsageError(fmt::format("--transport '{}' is invalid; expected shared_memory or ros", sitl_transport_));
+    }
     UseReferenceVehicle(&o.ftc);
     o.ftc.truth = sim::TruthPreset::kRealistic;
     const nlohmann::json r =
@@ -562,7 +573,7 @@ class BenchCommand final : public Command {
   std::string qp_instance_, qp_repetitions_ = "3", qp_solver_ = "riccati";
   std::string nmpc_qp_solver_ = "riccati";
   std::string sitl_scenario_, sitl_repeats_ = "3", sitl_loads_ = "idle,one_core_busy", sitl_fifo_ = "0", sitl_cpu_, sitl_platform_,
-              sitl_ftc_trials_ = "20", sitl_ftc_seed_ = "5001";
+              sitl_ftc_trials_ = "20", sitl_ftc_seed_ = "5001", sitl_transport_ = "shared_memory";
   std::string truth_ = "realistic", estimator_;
   std::string ftc_trials_ = "20", ftc_methods_ = "rotorguard,fixedtime,ukf,indi,passive,none", ftc_cells_, ftc_replay_;
   std::string perception_duration_ = "10";

@@ -62,8 +62,8 @@ void CheckBagPath(const std::string& path);
 /// --bag PATH: a recorder of the flight's sensor messages and cycles.
 std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string& path);
 /// sitl --ros: the stack's link over ROS through the master `master_uri` ("" : ROS_MASTER_URI),
-/// the node started from sitl->node_command (with --ros added).
-void UseRosLink(harness::SitlOptions* sitl, const std::string& master_uri);
+/// the node started from sitl->node_command (with --ros added) unless `external_node`.
+void UseRosLink(harness::SitlOptions* sitl, const std::string& master_uri, bool external_node = false);
 /// node --ros: flies the node over ROS until told to stop; `args` are the ROS remappings
 /// (from:=to) given after the options; `bag` ("": none) records its intake and cycles.
 void RunNodeOverRos(const harness::Scenario& scenario, const std::string& master_uri, const std::vector<std::string>& args,

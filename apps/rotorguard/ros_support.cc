@@ -30,8 +30,8 @@ std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string& path)
   return std::make_unique<rosbridge::BagRecorder>(path);
 }
 
-void UseRosLink(harness::SitlOptions* sitl, const std::string& master_uri) {
-  sitl->make_link = rosbridge::RosLinkMaker({.master_uri = master_uri, .node_command = sitl->node_command, .node_timeout_s = 60.0});
+void UseRosLink(harness::SitlOptions* sitl, const std::string& master_uri, bool external_node) {
+  sitl->make_link = rosbridge::RosLinkMaker({.master_uri = master_uri, .external_node = external_node, .node_timeout_s = 60.0});
 }
 
 void RunNodeOverRos(const harness::Scenario& scenario, const std::string& master_uri, const std::vector<std::string>& args,
@@ -124,7 +124,7 @@ namespace {
 bool BuiltWithRos() { return false; }
 void CheckBagPath(const std::string&) { NoRos("--bag"); }
 std::unique_ptr<harness::StackObserver> MakeBagRecorder(const std::string&) { NoRos("--bag"); }
-void UseRosLink(harness::SitlOptions*, const std::string&) { NoRos("sitl --ros"); }
+void UseRosLink(harness::SitlOptions*, const std::string&, bool) { NoRos("--ros"); }
 void RunNodeOverRos(const harness::Scenario&, const std::string&, const std::vector<std::string>&, bool, const std::string&,
                     const runtime::RealtimeOptions&) {
   NoRos("node --ros");

@@ -51,12 +51,20 @@ class SitlCommand final : public Command {
                    "The stack's node talks to the simulator over ROS 1 topics (the master of ROS_MASTER_URI or\n"
                    "--ros-master), the simulator publishing /clock with /use_sim_time set (docs/ros.md)");
     sitl->add_option("--ros-master", ros_master_, "The ROS master's URI for --ros (default: ROS_MASTER_URI)");
+    sitl->add_flag("--external-node", external_node_,
+                   "With --ros: the node is started by someone else (ros/launch/sitl.launch) and waited for");
     sitl->add_flag("--quiet,-q", quiet_, "No progress bar and no summary table");
+    sitl->allow_extras();  // roslaunch's __name:= and __log:= (sitl.launch)
     app_ = sitl;
     return sitl;
   }
 
   int Execute() override {
+    for (const std::string& extra : app_->remaining()) {
+      if (!ros_ || !extra.starts_with("__") || extra.find(":=") == std::string::npos) {
+        throw UsageError(fmt::format("sitl: unexpected argument '{}'", extra));
+      }
+    }
     harness::SitlOptions sitl = sitl_;
     if (app_->count("--realtime-factor") > 0) sitl.realtime_factor = ParsePositive("--realtime-factor", factor_text_, 10.0);
     if (app_->count("--fifo-priority") > 0) {
@@ -70,6 +78,10 @@ class SitlCommand final : public Command {
     const harness::Scenario scenario = scenario_.Load();
     if (ros_ && in_process_) throw UsageError("--ros and --in-process: a ROS node is a process of its own");
     if (!ros_ && !ros_master_.empty()) throw UsageError("--ros-master: only with --ros");
+    if (external_node_ && !ros_) throw UsageError("--external-node: only with --ros");
+    if (external_node_ && !bag_.empty()) {
+      throw UsageError("--bag with --external-node: the node records (its --bag; the launch file's bag argument)");
+    }
     if (!in_process_) {
       // The node flies the same scenario: the same file, overrides and seed.
       sitl.node_command = {SelfPath(), "node", scenario_.path, "--seed", std::to_string(scenario.seed)};
@@ -87,7 +99,7 @@ class SitlCommand final : public Command {
     } else if (!bag_.empty()) {
       options.observer = (bag = MakeBagRecorder(bag_)).get();
     }
-    if (ros_) UseRosLink(&sitl, ros_master_);
+    if (ros_) UseRosLink(&sitl, ros_master_, external_node_);
     options.progress = FlightProgress(!quiet_, scenario.duration_s);
     options.report = io::HasViewer();
     const harness::SitlResult result = harness::RunSitl(scenario, options, sitl);
@@ -156,7 +168,7 @@ class SitlCommand final : public Command {
   ScenarioArguments scenario_;
   std::string out_dir_, factor_text_, fifo_text_, cpu_text_, bag_, ros_master_;
   std::vector<std::string> stall_texts_;
-  bool quiet_ = false, in_process_ = false, ros_ = false;
+  bool quiet_ = false, in_process_ = false, ros_ = false, external_node_ = false;
   harness::SitlOptions sitl_;
 };
 

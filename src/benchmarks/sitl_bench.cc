@@ -96,6 +96,7 @@ nlohmann::json TimingFlight(const SitlBenchOptions& o, const std::string& load, 
   harness::SitlOptions sitl;
   sitl.executor.realtime = Realtime(o);
   if (!o.self.empty()) sitl.node_command = {o.self, "node", o.scenario, "--seed", std::to_string(sc.seed)};
+  sitl.make_link = o.make_link;
   std::optional<BusyCore> busy;
   if (load == "one_core_busy") busy.emplace();
   const harness::SitlResult r = harness::RunSitl(sc, {}, sitl);
@@ -295,7 +296,8 @@ nlohmann::json RunSitlBenchmark(const SitlBenchOptions& o, const std::function<v
             {"ftc_trials", o.ftc_trials},
             {"ftc_seed", o.ftc_seed},
             {"ftc_world", o.ftc.truth == sim::TruthPreset::kRealistic ? "realistic" : "ideal"},
-            {"stack_process", o.self.empty() ? "in process" : "its own (rotorguard node)"}}},
+            {"stack_process", o.self.empty() ? "in process" : "its own (rotorguard node)"},
+            {"transport", o.transport}}},
           {"host", buildinfo::HostInfo()},
           {"platform", platform},
           {"timing", timing},

@@ -365,6 +365,30 @@ rosgraph_msgs::Clock ToRos(const ClockTick& m) {
   r.clock = ToRosTime(m.clock);
   return r;
 }
+visualization_msgs::MarkerArray ToRos(const Markers& m) {
+  visualization_msgs::MarkerArray r;
+  for (const Marker& k : m.markers) {
+    visualization_msgs::Marker v;
+    v.header = Header(m.stamp, m.frame_id);
+    v.ns = "rotorguard";
+    v.id = k.id;
+    v.type = k.shape == Marker::Shape::kSphere ? visualization_msgs::Marker::SPHERE : visualization_msgs::Marker::TEXT_VIEW_FACING;
+    v.action = visualization_msgs::Marker::ADD;
+    v.pose.position.x = k.position[0];
+    v.pose.position.y = k.position[1];
+    v.pose.position.z = k.position[2];
+    v.pose.orientation.w = 1.0;
+    v.scale.x = v.scale.y = v.scale.z = k.size;
+    v.color.r = k.rgba[0];
+    v.color.g = k.rgba[1];
+    v.color.b = k.rgba[2];
+    v.color.a = k.rgba[3];
+    v.text = k.text;
+    r.markers.push_back(v);
+  }
+  return r;
+}
+
 std::string FromRos(const rosgraph_msgs::Clock& r, ClockTick* m) {
   m->clock = FromRosTime(r.clock);
   return {};

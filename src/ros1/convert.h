@@ -10,6 +10,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/String.h>
 #include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <string>
 
@@ -37,6 +38,7 @@ template <> struct RosType<Transforms> { using type = tf2_msgs::TFMessage; };
 template <> struct RosType<Path> { using type = nav_msgs::Path; };
 template <> struct RosType<Text> { using type = std_msgs::String; };
 template <> struct RosType<ClockTick> { using type = rosgraph_msgs::Clock; };
+template <> struct RosType<Markers> { using type = visualization_msgs::MarkerArray; };
 
 ros::Time ToRosTime(Stamp t);
 Stamp FromRosTime(const ros::Time& t);
@@ -54,6 +56,7 @@ tf2_msgs::TFMessage ToRos(const Transforms& m);
 nav_msgs::Path ToRos(const Path& m);
 std_msgs::String ToRos(const Text& m);
 rosgraph_msgs::Clock ToRos(const ClockTick& m);
+visualization_msgs::MarkerArray ToRos(const Markers& m);
 
 std::string FromRos(const sensor_msgs::Imu& r, Imu* m);
 std::string FromRos(const rotorguard_msgs::EscTelemetry& r, Esc* m);

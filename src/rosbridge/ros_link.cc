@@ -64,8 +64,9 @@ class RosLink final : public harness::StackLink {
       while (!stop_.load(std::memory_order_acquire) && bus_.Spin(0.002)) {
       }
     });
-    if (!options_.node_command.empty()) {
-      std::vector<std::string> argv = options_.node_command;
+    if (!options_.external_node) {
+      if (sitl.node_command.empty()) throw std::invalid_argument("sitl --ros: no command to start the node with (SitlOptions::node_command)");
+      std::vector<std::string> argv = sitl.node_command;
       argv.insert(argv.end(), {"--ros", "--ros-master", bus_.master_uri()});
       node_ = harness::NodeProcess(argv, "sitl --ros");
     }
@@ -159,8 +160,7 @@ class RosLink final : public harness::StackLink {
 
 }  // namespace
 
-std::function<std::unique_ptr<harness::StackLink>(const harness::SitlOptions&, const runtime::OnboardExecutorOptions&)>
-RosLinkMaker(const RosLinkOptions& options) {
+harness::StackLinkMaker RosLinkMaker(const RosLinkOptions& options) {
   return [options](const harness::SitlOptions& sitl, const runtime::OnboardExecutorOptions&) {
     return std::make_unique<RosLink>(sitl, options);
   };

@@ -79,8 +79,10 @@ class QueueSink final : public runtime::CommandSink {
 /// view, and the mode when it changed.
 class Outputs {
  public:
-  explicit Outputs(ros1::Bus* bus)
-      : cycle_(bus->Advertise<ros1::Cycle>(topics::kControlCycle.name, topics::kControlCycle.options)),
+  Outputs(ros1::Bus* bus, const vehicle::VehicleParams& vehicle)
+      : vehicle_(vehicle),
+        markers_(bus->Advertise<ros1::Markers>(topics::kFddMarkers.name, topics::kFddMarkers.options)),
+        cycle_(bus->Advertise<ros1::Cycle>(topics::kControlCycle.name, topics::kControlCycle.options)),
         command_(bus->Advertise<ros1::Command>(topics::kRotorCommand.name, topics::kRotorCommand.options)),
         odometry_(bus->Advertise<ros1::Odometry>(topics::kOdometry.name, topics::kOdometry.options)),
         health_(bus->Advertise<ros1::Health>(topics::kFddHealth.name, topics::kFddHealth.options)),
@@ -97,9 +99,33 @@ class Outputs {
       mode_text_ = w.health.mode;
       mode_.Publish({mode_text_});
     }
+    if (w.health.mode != marked_mode_ || w.health.health != marked_health_) {
+      marked_mode_ = w.health.mode;
+      marked_health_ = w.health.health;
+      markers_.Publish(MarkersOf(w.health));
+    }
   }
 
  private:
+  /// Each rotor at its hub, green when ok, orange degraded, red out; the mode above the body.
+  ros1::Markers MarkersOf(const ros1::Health& h) const {
+    ros1::Markers m{h.stamp, frames::kBase, {}};
+    for (std::size_t i = 0; i < h.health.size() && i < vehicle_.rotors.size(); ++i) {
+      const Vector3& p = vehicle_.rotors[i].p_B;
+      const std::string& s = h.health[i];
+      const std::array<float, 4> rgba = s == "ok" ? std::array<float, 4>{0.1f, 0.9f, 0.1f, 0.9f}
+                                        : s == "degraded" ? std::array<float, 4>{1.0f, 0.6f, 0.0f, 0.9f}
+                                                          : std::array<float, 4>{1.0f, 0.1f, 0.1f, 0.9f};
+      m.markers.push_back({ros1::Marker::Shape::kSphere, static_cast<int>(i), {p.x(), p.y(), p.z()}, 0.08, rgba, {}});
+    }
+    m.markers.push_back({ros1::Marker::Shape::kText, 1000, {0.0, 0.0, 0.4}, 0.15, {1.f, 1.f, 1.f, 1.f}, h.mode});
+    return m;
+  }
+
+  vehicle::VehicleParams vehicle_;
+  ros1::Publisher<ros1::Markers> markers_;
+  std::string marked_mode_;
+  std::vector<std::string> marked_health_;
   ros1::Publisher<ros1::Cycle> cycle_;
   ros1::Publisher<ros1::Command> command_;
   ros1::Publisher<ros1::Odometry> odometry_;
@@ -108,6 +134,18 @@ class Outputs {
   ros1::Publisher<ros1::Transforms> tf_;
   std::string mode_text_;
 };
+
+/// The next 5 s of `reference` from `t`, a pose each 0.1 s (nav_msgs/Path in odom).
+ros1::Path PathOf(const ReferenceTrajectory& reference, TimeNs t, const TimeBase& base) {
+  ros1::Path p{base.ToStamp(t), frames::kOdom, {}, {}};
+  for (int k = 0; k <= 50; ++k) {
+    const TimeNs at = t + static_cast<TimeNs>(k) * 100'000'000;  // k * 1e8 overflows an int
+    const ReferencePoint r = reference.Evaluate(ToSeconds(at));
+    p.stamps.push_back(base.ToStamp(at));
+    p.poses.push_back(ToWirePose(r.p_W, Quaternion(Eigen::AngleAxisd(r.yaw, Vector3::UnitZ()))));
+  }
+  return p;
+}
 
 }  // namespace
 
@@ -209,7 +247,9 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   std::string shutdown;
   bus.Subscribe<ros1::Text>(topics::kShutdown.name, topics::kShutdown.options, [&](const ros1::Text& m) { shutdown = m.data; });
   // Advertised before the start: a subscriber connects before the first cycle is sent.
-  Outputs outputs(&bus);
+  Outputs outputs(&bus, st.model().params());
+  ros1::Publisher<ros1::Path> path = bus.Advertise<ros1::Path>(topics::kPath.name, topics::kPath.options);
+  ros1::Publisher<ros1::PointSet> map = bus.Advertise<ros1::PointSet>(topics::kMap.name, topics::kMap.options);
   status.Publish({"built"});
 
   // Until the mission starts: wait (the intake counts what comes before).
@@ -219,6 +259,8 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   std::atomic<bool> stop_publishing{false};
   if (start) {
     base = TimeBase{*start};
+    fmt::print(stderr, "node: the mission starts at ROS time {:.3f} s (now {:.3f} s{})\n", 1e-9 * static_cast<double>(*start),
+               1e-9 * static_cast<double>(bus.Now()), bus.SimTime() ? ", /clock" : "");
     if (!options.bag_path.empty()) bag = std::make_unique<BagRecorder>(options.bag_path, *base);
     clock = std::make_unique<RosClock>(&bus, *start);
     runtime::OnboardExecutorOptions eo;
@@ -241,14 +283,33 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     });
     executor->Start();
     status.Publish({"flying"});
+    // The slow outputs, twice a second, on a thread of their own (reading the map waits while a
+    // frame is inserted; the intake and the commands never wait for it): the path followed and
+    // the map.
+    runtime::Doorbell slow_bell;
+    std::thread slow([&] {
+      while (!stop_publishing.load(std::memory_order_acquire)) {
+        const std::uint32_t seen = slow_bell.Count();
+        const std::shared_ptr<const ReferenceTrajectory> followed = executor->FollowedReference();
+        path.Publish(PathOf(followed ? *followed : *sc.reference, clock->Now(), *base));
+        ros1::PointSet cloud{base->ToStamp(clock->Now()), frames::kOdom, {}};
+        for (const Vector3& p : executor->OccupiedVoxels()) {
+          cloud.points.push_back({static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())});
+        }
+        map.Publish(cloud);
+        slow_bell.Wait(seen, 500'000'000);
+      }
+    });
     while (shutdown.empty() && !g_signalled.load() && bus.Spin(0.005)) {
       for (const std::string& topic : guard.Silent(steady())) {
         fmt::print(stderr, "node: no message on '{}' for more than its limit\n", topic);
       }
     }
+    stop_publishing.store(true, std::memory_order_release);
+    slow_bell.Ring();
+    slow.join();
     clock->Stop();
     executor->Stop();
-    stop_publishing.store(true, std::memory_order_release);
     sink.bell().Ring();
     publisher.join();
     if (bag) bag->Finish();

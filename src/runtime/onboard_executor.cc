@@ -76,7 +76,10 @@ OnboardExecutor::OnboardExecutor(stack::FlightStack* stack, Clock* clock, Comman
   policy_ = options_.deadline_policy && !options_.lockstep_order;
   if (policy_) stack_->PrepareFallback();
   // The control cycle reads the planning's status and reference before its first output.
-  if (tasks_.planning) planning_output_.Publish({tasks_.planning->followed(), tasks_.planning->status()});
+  if (tasks_.planning) {
+    planning_output_.Publish({tasks_.planning->followed(), tasks_.planning->status()});
+    published_reference_.store(tasks_.planning->followed());
+  }
 }
 
 OnboardExecutor::~OnboardExecutor() { Stop(); }
@@ -159,6 +162,16 @@ void OnboardExecutor::Stop() {
 }
 
 OnboardReport OnboardExecutor::Report() const { return report_; }
+
+std::vector<Vector3> OnboardExecutor::OccupiedVoxels() {
+  const std::shared_lock lock(map_mutex_);
+  const perception::VoxelMap* map = tasks_.perception ? tasks_.perception->map() : nullptr;
+  return map ? map->OccupiedVoxels() : std::vector<Vector3>{};
+}
+
+std::shared_ptr<const ReferenceTrajectory> OnboardExecutor::FollowedReference() const {
+  return published_reference_.load(std::memory_order_acquire);
+}
 
 bool OnboardExecutor::TakeMessages(std::uint64_t limit) {
   SensorMessage m;
@@ -543,6 +556,7 @@ void OnboardExecutor::PlanningLoop() {
           tasks_.planning->Update(ToSeconds(in.t_ns), in.mode, tasks_.perception->map(), in.faults);
         }
         std::shared_ptr<const ReferenceTrajectory> followed = tasks_.planning->followed();
+        published_reference_.store(followed, std::memory_order_release);
         if (followed != kept[(next_kept + kept.size() - 1) % kept.size()]) {
           kept[next_kept] = followed;
           next_kept = (next_kept + 1) % kept.size();

@@ -75,5 +75,28 @@ TEST(SitlOverRos, APropellerLossIsFlownOverRosRecordedAndReplayed) {
   EXPECT_NE(r.at("diagnosis").get<std::string>().find("rotor 0: propeller_failed"), std::string::npos) << r.dump(2);
 }
 
+// The launch file: the simulator and the node as two ROS nodes under roslaunch, /use_sim_time
+// set, the node recording; its path, map and FDD markers on the wire for RViz.
+TEST(SitlOverRos, TheLaunchFileFliesTheSimulatorAndTheNodeAsTwoRosNodes) {
+  const testing::Roscore master;
+  const fs::path dir = fs::path(master.home()) / "launch";
+  fs::create_directories(dir);
+  const std::string package_path = fs::path(ROTORGUARD_CLI).parent_path().parent_path().string() + "/ros";
+  setenv("ROS_PACKAGE_PATH", (package_path + ":/usr/share").c_str(), 1);
+  std::future<Output> path = std::async(std::launch::async, [] { return RunShell("timeout 120 rostopic echo -n 1 /path"); });
+  std::future<Output> markers = std::async(std::launch::async, [] { return RunShell("timeout 120 rostopic echo -n 1 /fdd_markers"); });
+  const Output launch = RunShell("timeout 180 roslaunch rotorguard sitl.launch out:=" + (dir / "sitl").string() +
+                                 " bag:=" + (dir / "flight.bag").string());
+  ASSERT_EQ(launch.status, 0) << launch.text;
+  EXPECT_NE(launch.text.find("outcome           success"), std::string::npos) << launch.text;
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "sitl" / "summary.json"));
+  EXPECT_TRUE(summary.at("success").get<bool>());
+  EXPECT_TRUE(fs::exists(dir / "flight.bag")) << "the node's bag, complete";
+  const Output p = path.get(), m = markers.get();
+  EXPECT_NE(p.text.find("frame_id: \"odom\""), std::string::npos) << p.text;
+  EXPECT_NE(m.text.find("frame_id: \"base_link\""), std::string::npos) << m.text;
+  EXPECT_NE(m.text.find("text: \"nominal\""), std::string::npos) << m.text;
+}
+
 }  // namespace
 }  // namespace rotorguard

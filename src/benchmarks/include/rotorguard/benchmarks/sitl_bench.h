@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/harness/sitl.h"
 
 namespace rotorguard::benchmarks {
 
@@ -36,6 +37,10 @@ struct SitlBenchOptions {
   double platform_s = 60.0;
   /// The command that starts the stack's process: this program's path (`node` is appended).
   std::string self;
+  /// The timing flights' transport, when not the shared-memory channel (SitlOptions::make_link:
+  /// `bench sitl --transport ros`), and its name for the result.
+  harness::StackLinkMaker make_link;
+  std::string transport = "shared_memory";
   int ftc_trials = 20;  ///< flights per FTC cell, in [0, 1000]
   /// The FTC flights' vehicle, fault detection thresholds and world, as `bench ftc` sets them
   /// (its trials, seed, methods and cells are not used).

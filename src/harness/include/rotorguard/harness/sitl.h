@@ -45,6 +45,9 @@ class StackLink {
   virtual nlohmann::json Finish(nlohmann::json* loops) = 0;
 };
 
+/// What makes a transport's link (SitlOptions::make_link).
+using StackLinkMaker = std::function<std::unique_ptr<StackLink>(const SitlOptions&, const runtime::OnboardExecutorOptions&)>;
+
 struct SitlOptions {
   /// Simulated seconds per wall-clock second, in (0, 10]: 1 is real time.
   double realtime_factor = 1.0;
@@ -62,7 +65,7 @@ struct SitlOptions {
   std::vector<std::string> node_command;
   /// Set: the link to the stack, made by a transport (it then starts the node itself, from
   /// node_command when it needs one); RunSitl's own links are not used.
-  std::function<std::unique_ptr<StackLink>(const SitlOptions&, const runtime::OnboardExecutorOptions&)> make_link;
+  StackLinkMaker make_link;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };

@@ -132,6 +132,22 @@ struct Path {
   std::vector<Pose> poses;
 };
 
+/// visualization_msgs/MarkerArray of spheres and texts (what RViz draws of the FDD's state).
+struct Marker {
+  enum class Shape { kSphere, kText };
+  Shape shape = Shape::kSphere;
+  int id = 0;
+  Vec3 position{};
+  double size = 0.1;                          ///< [m] (a text's height)
+  std::array<float, 4> rgba{1.f, 1.f, 1.f, 1.f};
+  std::string text;
+};
+struct Markers {
+  Stamp stamp = 0;
+  std::string frame_id;
+  std::vector<Marker> markers;
+};
+
 /// std_msgs/String.
 struct Text {
   std::string data;

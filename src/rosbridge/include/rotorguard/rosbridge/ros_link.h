@@ -5,7 +5,6 @@
 /// (`rotorguard node ... --ros`) and takes its cycles from control_cycle.
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "rotorguard/harness/sitl.h"
 
@@ -14,16 +13,16 @@ namespace rotorguard::rosbridge {
 struct RosLinkOptions {
   /// The master (http://host:port); empty: ROS_MASTER_URI.
   std::string master_uri;
-  /// The node's command line (`rotorguard node SCENARIO ...`; `--ros --ros-master URI` is added);
-  /// empty: the node is started by someone else (a launch file) and is waited for.
-  std::vector<std::string> node_command;
+  /// The node is started by someone else (a launch file) and is waited for; else the link starts
+  /// it from SitlOptions::node_command (`rotorguard node SCENARIO ...`; `--ros --ros-master URI`
+  /// is added).
+  bool external_node = false;
   /// Seconds to wait for the node to build its stack and subscribe.
   double node_timeout_s = 60.0;
 };
 
 /// SitlOptions::make_link for the ROS transport. The link is made when RunSitl starts; it throws
 /// std::runtime_error naming the master or the node when either does not answer.
-std::function<std::unique_ptr<harness::StackLink>(const harness::SitlOptions&, const runtime::OnboardExecutorOptions&)>
-RosLinkMaker(const RosLinkOptions& options);
+harness::StackLinkMaker RosLinkMaker(const RosLinkOptions& options);
 
 }  // namespace rotorguard::rosbridge

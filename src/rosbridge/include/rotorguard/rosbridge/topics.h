@@ -33,6 +33,9 @@ inline constexpr Topic kControlCycle{"control_cycle", {.queue_size = 1000, .tcp_
 inline constexpr Topic kOdometry{"odometry", {.queue_size = 10}};       // nav_msgs/Odometry (and TF odom -> base_link)
 inline constexpr Topic kFddHealth{"fdd_health", {.queue_size = 10}};    // rotorguard_msgs/FddHealth
 inline constexpr Topic kMode{"mode", {.queue_size = 1, .latch = true}};  // std_msgs/String, on each change
+inline constexpr Topic kPath{"path", {.queue_size = 1, .latch = true}};  // nav_msgs/Path: the next 5 s followed, twice a second
+inline constexpr Topic kMap{"map", {.queue_size = 1, .latch = true}};    // sensor_msgs/PointCloud2: occupied voxels' centres, twice a second
+inline constexpr Topic kFddMarkers{"fdd_markers", {.queue_size = 1, .latch = true}};  // visualization_msgs/MarkerArray: each rotor by its health, and the mode
 inline constexpr Topic kStatus{"status", {.queue_size = 1, .latch = true}};    // std_msgs/String: built, flying, done, failed: ...
 inline constexpr Topic kAccount{"account", {.queue_size = 1, .latch = true}};  // std_msgs/String: the flight's account (JSON)
 inline constexpr Topic kTf{"/tf", {.queue_size = 100}};

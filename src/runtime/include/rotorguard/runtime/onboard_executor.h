@@ -247,6 +247,11 @@ class OnboardExecutor {
   OnboardReport Report() const;
   /// Sensor messages the control thread has taken in so far (any thread may ask).
   std::uint64_t messages_taken() const { return messages_taken_.load(std::memory_order_acquire); }
+  /// The map's occupied voxels' centres now (any thread but the control thread: it takes the
+  /// map's shared lock, waiting while the perception inserts a frame); empty without a map.
+  std::vector<Vector3> OccupiedVoxels();
+  /// The reference the planning published last (any thread); null without a planning task.
+  std::shared_ptr<const ReferenceTrajectory> FollowedReference() const;
   /// The deadline guard's steps so far (holds and hand-overs; any thread may ask).
   std::uint64_t deadline_steps() const { return deadline_steps_.load(std::memory_order_acquire); }
 
@@ -343,6 +348,7 @@ class OnboardExecutor {
   // planning -> control
   Latest<PlanningOutput> planning_output_;
   std::shared_mutex map_mutex_;  // the perception writes the map, the planning reads it
+  std::atomic<std::shared_ptr<const ReferenceTrajectory>> published_reference_;  // for FollowedReference
 
   // control <-> deadline guard, under send_lock_ (a spin lock: the holders copy and send only)
   std::atomic_flag send_lock_;
