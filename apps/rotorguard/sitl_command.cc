@@ -189,6 +189,9 @@ class NodeCommand final : public Command {
     node->add_option("--bag", bag_,
                      "With --ros: record the sensor messages the stack took in, in their order, and its cycles to\n"
                      "this rosbag (what `rotorguard replay` replays exactly)");
+    node->add_option("--fifo-priority", fifo_text_,
+                     "With --ros: the control thread under SCHED_FIFO at this priority, in [3, 99], memory locked (as sitl's)");
+    node->add_option("--control-cpu", cpu_text_, "With --ros: the time-critical threads on this CPU (as sitl's)");
     node->add_flag("--start-now", start_now_,
                    "With --ros: the mission starts (t = 0) once the stack is built, not at a mission_start message");
     node->allow_extras();
@@ -199,11 +202,17 @@ class NodeCommand final : public Command {
     const std::vector<std::string> extras = app_->remaining();
     if (ros_ == !channel_.empty()) throw UsageError("node: give either --channel NAME (sitl's shared memory) or --ros");
     if (!ros_ && !extras.empty()) throw UsageError(fmt::format("node: unexpected argument '{}'", extras.front()));
-    if (!ros_ && (start_now_ || !ros_master_.empty() || !bag_.empty())) {
-      throw UsageError("node: --start-now, --ros-master and --bag need --ros");
+    if (!ros_ && (start_now_ || !ros_master_.empty() || !bag_.empty() || !fifo_text_.empty() || !cpu_text_.empty())) {
+      throw UsageError("node: --start-now, --ros-master, --bag, --fifo-priority and --control-cpu need --ros");
     }
     if (ros_) {
-      RunNodeOverRos(scenario_.Load(), ros_master_, extras, start_now_, bag_, {.lock_memory = false, .fifo_priority = 0});
+      runtime::RealtimeOptions realtime{.lock_memory = false, .fifo_priority = 0};
+      if (!fifo_text_.empty()) {
+        realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
+        realtime.lock_memory = true;
+      }
+      if (!cpu_text_.empty()) realtime.control_cpu = static_cast<int>(ParseUnsigned("--control-cpu", cpu_text_, 0, CPU_SETSIZE - 1));
+      RunNodeOverRos(scenario_.Load(), ros_master_, extras, start_now_, bag_, realtime);
     } else {
       harness::RunNode(scenario_.Load(), channel_);
     }
@@ -213,7 +222,7 @@ class NodeCommand final : public Command {
  private:
   CLI::App* app_ = nullptr;
   ScenarioArguments scenario_;
-  std::string channel_, ros_master_, bag_;
+  std::string channel_, ros_master_, bag_, fifo_text_, cpu_text_;
   bool ros_ = false, start_now_ = false;
 };
 

@@ -51,11 +51,17 @@ std::atomic<bool> g_initialised{false};
 }  // namespace
 
 Bus::Bus(const Options& options) : impl_(std::make_unique<Impl>()) {
-  if (g_initialised.exchange(true)) throw std::runtime_error("ros: one Bus per process (ROS 1 has one node per process)");
-  std::map<std::string, std::string> remappings(options.remappings.begin(), options.remappings.end());
-  if (!options.master_uri.empty()) remappings["__master"] = options.master_uri;
-  // No SIGINT handler of ROS's own: the program's (rotorguard's commands stop cleanly on their own).
-  ros::init(remappings, options.node_name, ros::init_options::NoSigintHandler | ros::init_options::AnonymousName);
+  // ROS 1 has one node per process, started once: a later Bus (the next flight of a benchmark)
+  // shares it, on the same master, with publishers and subscriptions of its own.
+  if (!g_initialised.exchange(true)) {
+    std::map<std::string, std::string> remappings(options.remappings.begin(), options.remappings.end());
+    if (!options.master_uri.empty()) remappings["__master"] = options.master_uri;
+    // No SIGINT handler of ROS's own: the program's (rotorguard's commands stop cleanly on their own).
+    ros::init(remappings, options.node_name, ros::init_options::NoSigintHandler | ros::init_options::AnonymousName);
+  } else if (!options.master_uri.empty() && options.master_uri != ros::master::getURI()) {
+    throw std::runtime_error("ros: this process's node talks to " + ros::master::getURI() + ", not " + options.master_uri +
+                             " (one ROS node per process)");
+  }
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.master_timeout_s);
   while (!ros::master::check()) {
     if (std::chrono::steady_clock::now() > until) {
@@ -67,9 +73,10 @@ Bus::Bus(const Options& options) : impl_(std::make_unique<Impl>()) {
 }
 
 Bus::~Bus() {
+  // The subscriptions and the handle go; the process's node stays for a later Bus (ROS 1 cannot
+  // start a node twice) and ends with the process.
   impl_->subscribers.clear();
   impl_->node.reset();
-  ros::shutdown();
 }
 
 template <typename T>

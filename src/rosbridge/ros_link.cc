@@ -23,7 +23,7 @@ namespace {
 
 class RosLink final : public harness::StackLink {
  public:
-  RosLink(const harness::SitlOptions& sitl, const RosLinkOptions& options)
+  RosLink(const harness::SitlOptions& sitl, const runtime::OnboardExecutorOptions& executor, const RosLinkOptions& options)
       : options_(options),
         bus_({.node_name = "rotorguard_sim", .master_uri = options.master_uri, .master_timeout_s = 10.0, .remappings = {}}),
         rate_(sitl.realtime_factor),
@@ -68,6 +68,9 @@ class RosLink final : public harness::StackLink {
       if (sitl.node_command.empty()) throw std::invalid_argument("sitl --ros: no command to start the node with (SitlOptions::node_command)");
       std::vector<std::string> argv = sitl.node_command;
       argv.insert(argv.end(), {"--ros", "--ros-master", bus_.master_uri()});
+      // The executor's scheduling, as the shared-memory channel carries it.
+      if (executor.realtime.fifo_priority > 0) argv.insert(argv.end(), {"--fifo-priority", std::to_string(executor.realtime.fifo_priority)});
+      if (executor.realtime.control_cpu >= 0) argv.insert(argv.end(), {"--control-cpu", std::to_string(executor.realtime.control_cpu)});
       node_ = harness::NodeProcess(argv, "sitl --ros");
     }
   }
@@ -161,8 +164,8 @@ class RosLink final : public harness::StackLink {
 }  // namespace
 
 harness::StackLinkMaker RosLinkMaker(const RosLinkOptions& options) {
-  return [options](const harness::SitlOptions& sitl, const runtime::OnboardExecutorOptions&) {
-    return std::make_unique<RosLink>(sitl, options);
+  return [options](const harness::SitlOptions& sitl, const runtime::OnboardExecutorOptions& executor) {
+    return std::make_unique<RosLink>(sitl, executor, options);
   };
 }
 

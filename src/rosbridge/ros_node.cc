@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <time.h>
 
+#include <algorithm>
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -20,6 +21,7 @@
 #include "rotorguard/rosbridge/wire_convert.h"
 #include "rotorguard/runtime/doorbell.h"
 #include "rotorguard/runtime/onboard_executor.h"
+#include "rotorguard/runtime/realtime.h"
 #include "rotorguard/runtime/spsc_queue.h"
 
 namespace rotorguard::rosbridge {
@@ -45,8 +47,9 @@ class RosClock final : public runtime::Clock {
         const timespec ts{static_cast<time_t>(at / 1'000'000'000), static_cast<long>(at % 1'000'000'000)};
         clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &ts, nullptr);
       } else {
-        // The /clock moves in steps: poll it (a fifth of a millisecond at most late).
-        const timespec ts{0, static_cast<long>(std::min<TimeNs>(t - now, 200'000))};
+        // The /clock moves in steps, delivered by ROS's threads at the normal priority: poll it
+        // every 0.1-0.2 ms, sleeping each time (a real-time thread that did not would starve them).
+        const timespec ts{0, static_cast<long>(std::clamp<TimeNs>(t - now, 100'000, 200'000))};
         nanosleep(&ts, nullptr);
       }
     }
@@ -282,6 +285,9 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
       }
     });
     executor->Start();
+    // The intake is ROS's callbacks, fed by ROS's threads at the normal priority: this thread stays
+    // with them (the executor's start made it real-time, as a driver's intake would be).
+    runtime::UseNormalScheduling();
     status.Publish({"flying"});
     // The slow outputs, twice a second, on a thread of their own (reading the map waits while a
     // frame is inserted; the intake and the commands never wait for it): the path followed and

@@ -60,8 +60,8 @@ class Bus {
     /// ROS remappings ("imu" -> "/livox/imu"), as `imu:=/livox/imu` on a ROS command line.
     std::vector<std::pair<std::string, std::string>> remappings;
   };
-  /// Starts the node (ros::init once per process; a second Bus in one process is refused).
-  /// Throws std::runtime_error naming the master when it does not answer.
+  /// Starts the process's node (ros::init, once per process: a later Bus shares it, on the same
+  /// master). Throws std::runtime_error naming the master when it does not answer.
   explicit Bus(const Options& options);
   ~Bus();
   Bus(const Bus&) = delete;
