@@ -2,6 +2,9 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 ROTORGUARD_WARNINGS_AS_ERRORS ?= OFF
+# ROS 1 (docs/ros.md): install-deps installs it, so `make` builds with it and its tests run;
+# ROTORGUARD_ROS=OFF leaves it out.
+ROTORGUARD_ROS ?= ON
 DEMO_SCENARIO ?= configs/scenarios/forest.yaml
 DEMO_OUT ?= out/demo
 
@@ -15,7 +18,8 @@ deps:
 configure: deps
 	@mkdir -p $(BUILD_DIR)
 	@cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release \
-	  -DROTORGUARD_WARNINGS_AS_ERRORS=$(ROTORGUARD_WARNINGS_AS_ERRORS) > $(BUILD_DIR)/configure.log 2>&1 \
+	  -DROTORGUARD_WARNINGS_AS_ERRORS=$(ROTORGUARD_WARNINGS_AS_ERRORS) -DROTORGUARD_ROS=$(ROTORGUARD_ROS) \
+	  > $(BUILD_DIR)/configure.log 2>&1 \
 	  || (cat $(BUILD_DIR)/configure.log; exit 1)
 
 build: configure
