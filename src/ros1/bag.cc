@@ -70,20 +70,26 @@ ROTORGUARD_WRITTEN(ClockTick)
 
 namespace {
 
-/// Converts `view`'s message to T when it holds T's ROS type; false when it does not.
+enum class Outcome { kOtherType, kRead, kBad };
+
+/// Converts the message to T when it holds T's ROS type.
 template <typename T>
-bool TryRead(const rosbag::MessageInstance& mi, BagMessage* out, BagReadSummary* summary) {
+Outcome TryRead(const rosbag::MessageInstance& mi, BagMessage* out) {
   using Message = typename RosType<T>::type;
-  if (mi.getDataType() != ros::message_traits::DataType<Message>::value()) return false;
+  if (mi.getDataType() != ros::message_traits::DataType<Message>::value()) return Outcome::kOtherType;
   const typename Message::ConstPtr r = mi.instantiate<Message>();
   T m;
-  if (!r) return false;
-  if (const std::string e = FromRos(*r, &m); !e.empty()) {
-    ++summary->bad[mi.getTopic()];
-    return true;
-  }
+  if (!r || !FromRos(*r, &m).empty()) return Outcome::kBad;
   out->message = std::move(m);
-  return true;
+  return Outcome::kRead;
+}
+
+/// The first of the types Ts the message holds, converted.
+template <typename... Ts>
+Outcome ReadAny(const rosbag::MessageInstance& mi, BagMessage* out) {
+  Outcome o = Outcome::kOtherType;
+  ((o = TryRead<Ts>(mi, out), o != Outcome::kOtherType) || ...);
+  return o;
 }
 
 }  // namespace
@@ -107,21 +113,19 @@ BagReadSummary ReadBag(const std::string& path, const std::function<void(const B
     BagMessage m;
     m.topic = mi.getTopic();
     m.time = internal::FromRosTime(mi.getTime());
-    const std::uint64_t bad_before = summary.bad[m.topic];
     // A cloud is read as a LiDAR frame (PointSet clouds have no time field: counted as bad).
-    const bool known = TryRead<Imu>(mi, &m, &summary) || TryRead<Esc>(mi, &m, &summary) ||
-                       TryRead<Battery>(mi, &m, &summary) || TryRead<Odometry>(mi, &m, &summary) ||
-                       TryRead<Cloud>(mi, &m, &summary) || TryRead<Command>(mi, &m, &summary) ||
-                       TryRead<Health>(mi, &m, &summary) || TryRead<Cycle>(mi, &m, &summary) ||
-                       TryRead<Text>(mi, &m, &summary) || TryRead<ClockTick>(mi, &m, &summary);
-    if (!known) {
-      ++summary.skipped_types[mi.getDataType()];
-      continue;
+    switch (ReadAny<Imu, Esc, Battery, Odometry, Cloud, Command, Health, Cycle, Text, ClockTick>(mi, &m)) {
+      case Outcome::kOtherType:
+        ++summary.skipped_types[mi.getDataType()];
+        break;
+      case Outcome::kBad:
+        ++summary.bad[m.topic];
+        break;
+      case Outcome::kRead:
+        ++summary.messages;
+        visit(m);
+        break;
     }
-    if (summary.bad[m.topic] != bad_before) continue;
-    if (summary.bad[m.topic] == 0) summary.bad.erase(m.topic);
-    ++summary.messages;
-    visit(m);
   }
   bag.close();
   return summary;

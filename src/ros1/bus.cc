@@ -126,12 +126,6 @@ bool Bus::Spin(double timeout_s) {
 Stamp Bus::Now() const { return internal::FromRosTime(ros::Time::now()); }
 bool Bus::SimTime() const { return ros::Time::isSimTime(); }
 void Bus::SetParam(const std::string& key, bool value) { ros::param::set(key, value); }
-void Bus::SetParam(const std::string& key, const std::string& value) { ros::param::set(key, value); }
-std::optional<std::string> Bus::GetParam(const std::string& key) const {
-  std::string v;
-  if (!ros::param::get(key, v)) return std::nullopt;
-  return v;
-}
 std::string Bus::master_uri() const { return ros::master::getURI(); }
 
 // The topics' types: every wire struct that is published, and those that are read.

@@ -6,12 +6,13 @@
 
 namespace rotorguard::rosbridge {
 
-BagRecorder::BagRecorder(const std::string& path, const TimeBase& base) : bag_(path), base_(base) {
+BagRecorder::BagRecorder(const std::string& path, const TimeBase& base) : bag_(path), base_(base), last_input_(base.origin - 1) {
   // The flight's t = 0, first in the bag (a nanosecond before anything else): what the node
   // reads on mission_start, and what `replay` takes as the flight's time base.
   bag_.Write(topics::kMissionStart.name, base_.origin - 1, ros1::ClockTick{base_.origin});
 }
 
+// A node's first messages may arrive before its clock has: they still follow the marker.
 ros1::Stamp BagRecorder::InputTime(TimeNs t) {
   last_input_ = std::max(base_.ToStamp(t), last_input_ + 1);
   return last_input_;
@@ -55,7 +56,7 @@ void BagRecorder::OnCycle(const runtime::CycleTelemetry& c) {
   const ros1::Cycle w = ToWire(c, base_);
   bag_.Write(topics::kControlCycle.name, at, w);
   bag_.Write(topics::kRotorCommand.name, at, w.command);
-  bag_.Write(topics::kOdometry.name, at, w.estimate);
+  if (w.estimate_valid) bag_.Write(topics::kOdometry.name, at, w.estimate);  // as the node publishes it
   bag_.Write(topics::kFddHealth.name, at, w.health);
 }
 

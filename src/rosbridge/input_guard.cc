@@ -18,20 +18,19 @@ TopicHealth& InputGuard::Arrived(const std::string& topic, TimeNs arrival) {
 }
 
 InputGuard::Verdict InputGuard::Check(const std::string& topic, TimeNs stamp, TimeNs arrival) {
-  const bool first = !watch_[topic].any || topics_[topic].accepted == 0;
-  const TimeNs last = watch_[topic].last_stamp;
   TopicHealth& h = Arrived(topic, arrival);
-  if (!first && stamp == last) {
+  Watch& w = watch_[topic];
+  if (h.accepted > 0 && stamp == w.last_stamp) {
     ++h.duplicates;
     h.last_error = "a duplicate stamp";
     return Verdict::kDuplicate;
   }
-  if (!first && stamp < last) {
+  if (h.accepted > 0 && stamp < w.last_stamp) {
     ++h.out_of_order;
     h.last_error = "a stamp before the topic's last one";
     return Verdict::kOutOfOrder;
   }
-  watch_[topic].last_stamp = stamp;
+  w.last_stamp = stamp;
   ++h.accepted;
   return Verdict::kAccept;
 }

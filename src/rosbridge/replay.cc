@@ -34,7 +34,6 @@ class CollectingSink final : public runtime::CommandSink {
   runtime::SpscQueue<runtime::CycleTelemetry, 1024> queue_;
 };
 
-double AngleBetween(const Quaternion& a, const Quaternion& b) { return a.angularDistance(b); }
 
 }  // namespace
 
@@ -223,7 +222,7 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
     r.position_max_diff_m = std::max(r.position_max_diff_m, (a.p_W - e.p_W).norm());
     if (!r.first_divergence_s && (a.p_W - e.p_W).norm() > 1e-6) r.first_divergence_s = ToSeconds(c.command.state_t_ns);
     r.velocity_max_diff_m_s = std::max(r.velocity_max_diff_m_s, (a.v_W - e.v_W).norm());
-    r.attitude_max_diff_rad = std::max(r.attitude_max_diff_rad, AngleBetween(a.q_WB, e.q_WB));
+    r.attitude_max_diff_rad = std::max(r.attitude_max_diff_rad, a.q_WB.angularDistance(e.q_WB));
     until_s = std::max(until_s, ToSeconds(c.command.state_t_ns));
   }
   if (r.compared == 0) until_s = std::numeric_limits<double>::infinity();  // nothing recorded: the whole replay

@@ -56,10 +56,6 @@ class RosLink final : public harness::StackLink {
       const std::lock_guard lock(mutex_);
       account_ = m.data;
     });
-    bus_.OnBadMessage([this](std::string_view topic, std::string_view what) {
-      const std::lock_guard lock(mutex_);
-      bad_ = fmt::format("{}: {}", topic, what);
-    });
     spinner_ = std::thread([this] {
       while (!stop_.load(std::memory_order_acquire) && bus_.Spin(0.002)) {
       }
@@ -137,7 +133,9 @@ class RosLink final : public harness::StackLink {
     }
   }
   void WaitForStatus(const std::string& status, double timeout_s, const char* doing) {
-    WaitUntil([&] { return Locked(status_) == status || (status == "built" && Locked(status_) == "flying"); }, timeout_s, doing);
+    // The node's states in order: one past the one waited for will do.
+    const auto rank = [](const std::string& s) { return s == "built" ? 1 : s == "flying" ? 2 : s == "done" ? 3 : 0; };
+    WaitUntil([&] { return rank(Locked(status_)) >= rank(status); }, timeout_s, doing);
   }
 
   RosLinkOptions options_;
@@ -153,7 +151,7 @@ class RosLink final : public harness::StackLink {
   ros1::Publisher<ros1::Text> shutdown_;
   runtime::SpscQueue<runtime::CycleTelemetry, 4096> cycles_;
   std::mutex mutex_;
-  std::string status_, account_, bad_;
+  std::string status_, account_;
   std::optional<runtime::SteadyClock> steady_;
   std::atomic<const runtime::SteadyClock*> steady_clock_{nullptr};  // steady_ once set (the spinner reads it)
   std::atomic<bool> stop_{false};

@@ -95,18 +95,16 @@ class Outputs {
     const ros1::Cycle w = ToWire(c, base);
     cycle_.Publish(w);
     command_.Publish(w.command);
-    odometry_.Publish(w.estimate);
-    tf_.Publish({{w.estimate.stamp, frames::kOdom, frames::kBase, w.estimate.pose}});
+    if (w.estimate_valid) {  // none until the estimator has what it needs (the cycle says so)
+      odometry_.Publish(w.estimate);
+      tf_.Publish({{w.estimate.stamp, frames::kOdom, frames::kBase, w.estimate.pose}});
+    }
     health_.Publish(w.health);
-    if (w.health.mode != mode_text_) {
-      mode_text_ = w.health.mode;
-      mode_.Publish({mode_text_});
-    }
-    if (w.health.mode != marked_mode_ || w.health.health != marked_health_) {
-      marked_mode_ = w.health.mode;
-      marked_health_ = w.health.health;
-      markers_.Publish(MarkersOf(w.health));
-    }
+    // The mode and the markers on a change only (latched).
+    const bool mode_changed = w.health.mode != last_.mode;
+    if (mode_changed) mode_.Publish({w.health.mode});
+    if (mode_changed || w.health.health != last_.health) markers_.Publish(MarkersOf(w.health));
+    last_ = w.health;
   }
 
  private:
@@ -127,15 +125,13 @@ class Outputs {
 
   vehicle::VehicleParams vehicle_;
   ros1::Publisher<ros1::Markers> markers_;
-  std::string marked_mode_;
-  std::vector<std::string> marked_health_;
+  ros1::Health last_;  // the last cycle's health and mode
   ros1::Publisher<ros1::Cycle> cycle_;
   ros1::Publisher<ros1::Command> command_;
   ros1::Publisher<ros1::Odometry> odometry_;
   ros1::Publisher<ros1::Health> health_;
   ros1::Publisher<ros1::Text> mode_;
   ros1::Publisher<ros1::Transforms> tf_;
-  std::string mode_text_;
 };
 
 /// The next 5 s of `reference` from `t`, a pose each 0.1 s (nav_msgs/Path in odom).
@@ -209,10 +205,14 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     }
     return guard.Check(topic, stamp, steady()) == InputGuard::Verdict::kAccept;
   };
-  bus.Subscribe<ros1::Imu>(topics::kImu.name, topics::kImu.options, [&](const ros1::Imu& m) {
-    if (!accept(topics::kImu.name, m.stamp)) return;
-    const runtime::SensorMessage s = runtime::SensorMessage::Of(FromWire(m, *base));
+  // A checked input to the stack, and to the bag when the stack took it in.
+  const auto take = [&](const char* topic, ros1::Stamp stamp, auto&& message_of) {
+    if (!accept(topic, stamp)) return;
+    const runtime::SensorMessage s = message_of();
     if (executor->OnSensor(s) && bag) bag->OnInput(arrival(), s);
+  };
+  bus.Subscribe<ros1::Imu>(topics::kImu.name, topics::kImu.options, [&](const ros1::Imu& m) {
+    take(topics::kImu.name, m.stamp, [&] { return runtime::SensorMessage::Of(FromWire(m, *base)); });
   });
   bus.Subscribe<ros1::Esc>(topics::kEscTelemetry.name, topics::kEscTelemetry.options, [&](const ros1::Esc& m) {
     if (m.motor_speed_rad_s.size() != static_cast<std::size_t>(st.model().num_rotors())) {
@@ -220,14 +220,10 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
                 fmt::format("{} motor speeds for a vehicle of {} rotors", m.motor_speed_rad_s.size(), st.model().num_rotors()));
       return;
     }
-    if (!accept(topics::kEscTelemetry.name, m.stamp)) return;
-    const runtime::SensorMessage s = runtime::SensorMessage::Of(*FromWire(m, *base));
-    if (executor->OnSensor(s) && bag) bag->OnInput(arrival(), s);
+    take(topics::kEscTelemetry.name, m.stamp, [&] { return runtime::SensorMessage::Of(*FromWire(m, *base)); });
   });
   bus.Subscribe<ros1::Odometry>(topics::kExternalOdometry.name, topics::kExternalOdometry.options, [&](const ros1::Odometry& m) {
-    if (!accept(topics::kExternalOdometry.name, m.stamp)) return;
-    const runtime::SensorMessage s = runtime::SensorMessage::Of(FromWireOdometry(m, *base));
-    if (executor->OnSensor(s) && bag) bag->OnInput(arrival(), s);
+    take(topics::kExternalOdometry.name, m.stamp, [&] { return runtime::SensorMessage::Of(FromWireOdometry(m, *base)); });
   });
   bus.Subscribe<ros1::Cloud>(topics::kPoints.name, topics::kPoints.options, [&](const ros1::Cloud& m) {
     if (m.points.size() > options.max_frame_points) {

@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -85,8 +84,6 @@ class Bus {
   /// Whether the node follows /clock.
   bool SimTime() const;
   void SetParam(const std::string& key, bool value);
-  void SetParam(const std::string& key, const std::string& value);
-  std::optional<std::string> GetParam(const std::string& key) const;
   std::string master_uri() const;
 
  private:

@@ -33,7 +33,7 @@ class BagRecorder final : public harness::StackObserver {
   std::mutex mutex_;
   ros1::BagWriter bag_;
   TimeBase base_;
-  ros1::Stamp last_input_ = 0;
+  ros1::Stamp last_input_ = 0;  // from the mission_start marker on: every input after it
 };
 
 }  // namespace rotorguard::rosbridge

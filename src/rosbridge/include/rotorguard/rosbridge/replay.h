@@ -31,7 +31,6 @@ struct ReplayOptions {
   /// A LiDAR frame's sweep [s] (a cloud is stamped at its first instant); <= 0: the scenario's
   /// sensors.lidar.frame_rate_hz.
   double frame_period_s = 0.0;
-  std::function<void(double)> progress;
 };
 
 /// The FDD's diagnosis of a flight from its cycles: per rotor, its health at the last cycle and
