@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/report_html.h"
 #if ROTORGUARD_HAS_ROS
 #include "rotorguard/rosbridge/bag_recorder.h"
 #include "rotorguard/rosbridge/replay.h"
@@ -61,13 +62,15 @@ class ReplayCommand final : public Command {
     CLI::App* replay = app->add_subcommand(
         "replay",
         "Replay a bag's sensor messages (imu, esc_telemetry, points, external_odometry) through SCENARIO's flight\n"
-        "stack in their recorded order, every LiDAR frame processed; write DIR/replay.json and DIR/cycles.csv. When\n"
-        "the bag holds the cycles of the flight that recorded it (control_cycle), compare the estimates and the\n"
-        "FDD's diagnosis. Exit 0 when they agree (within 1 mm, the same diagnosis) or there is nothing to\n"
-        "compare, 1 when they differ, 3 when the bag cannot be read.");
+        "stack in their recorded order, every LiDAR frame processed; write what `run` writes, without the truth a\n"
+        "bag does not hold: DIR/summary.json, DIR/report.html, DIR/log.csv, DIR/scene.json, DIR/sensors.csv,\n"
+        "DIR/vehicle.yaml. When the bag holds the cycles of the flight that recorded it (control_cycle), compare\n"
+        "the estimates and the FDD's diagnosis (summary.json \"replay\"). Exit 0 when they agree (within 1 mm,\n"
+        "the same diagnosis) or there is nothing to compare, 1 when they differ, 3 when the bag cannot be read.");
     replay->add_option("bag", bag_, "The bag (`run --bag`, `sitl --bag`, or `rosbag record` of the node's topics)")->required();
     scenario_.Register(replay);
     replay->add_option("--out", out_dir_, "Output folder (default: out/<scenario name>-replay)");
+    replay->add_flag("--no-report", no_report_, "Do not write report.html");
     replay->add_flag("--quiet,-q", quiet_, "No summary");
     return replay;
   }
@@ -76,6 +79,10 @@ class ReplayCommand final : public Command {
     const harness::Scenario scenario = scenario_.Load();
     rosbridge::ReplayOptions o;
     o.out_dir = out_dir_.empty() ? (std::filesystem::path("out") / (scenario.name + "-replay")).string() : out_dir_;
+    o.report = !no_report_ && io::HasViewer();
+    if (!no_report_ && !o.report) {
+      fmt::print(stderr, "note: no report.html: this rotorguard was built without the report viewer (npm)\n");
+    }
     CreateOutputFolder(o.out_dir);
     rosbridge::ReplaySummary r;
     try {
@@ -97,7 +104,8 @@ class ReplayCommand final : public Command {
         if (!(r.diagnosis == r.recorded_diagnosis)) fmt::print("recorded          {}\n", r.recorded_diagnosis.ToString());
       }
       fmt::print("outcome           {}\n", agree ? "agrees with the recording" : "DIFFERS from the recording");
-      fmt::print("replay            {}\n", (std::filesystem::path(o.out_dir) / "replay.json").string());
+      fmt::print("summary           {}\n", (std::filesystem::path(o.out_dir) / "summary.json").string());
+      if (o.report) fmt::print("report            {}\n", (std::filesystem::path(o.out_dir) / "report.html").string());
     }
     return agree ? kOk : kRunFailed;
   }
@@ -105,7 +113,7 @@ class ReplayCommand final : public Command {
  private:
   ScenarioArguments scenario_;
   std::string bag_, out_dir_;
-  bool quiet_ = false;
+  bool quiet_ = false, no_report_ = false;
 };
 
 }  // namespace

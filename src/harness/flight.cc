@@ -96,18 +96,22 @@ StackAccount AccountOf(const stack::FlightStack& st) {
   return a;
 }
 
-void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::Simulator& sim,
-                     const StackAccount& st, RunSummary* s) {
+void SummarizeStack(const Scenario& sc, const StackAccount& st, RunSummary* s) {
   s->scenario = sc.name;
   s->seed = sc.seed;
+  s->stack = st.summary;
+  s->sensors = {sc.sim.imu.rate_hz, st.imu_position_m, st.command_delay_s, st.imu_notch};
+  if (sc.stack.fdd == stack::FddKind::kComposite) s->composite_fdd = sc.stack.composite_fdd;
+}
+
+void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::Simulator& sim,
+                     const StackAccount& st, RunSummary* s) {
+  SummarizeStack(sc, st, s);
   s->truth = draw;
   s->sim_time_s = sim.time_s();
   s->crashed = sim.crashed();
   s->crash_reason = sim.crash_reason();
   s->crash_speed_m_s = sim.crash_speed_m_s();
-  s->stack = st.summary;
-  s->sensors = {sc.sim.imu.rate_hz, st.imu_position_m, st.command_delay_s, st.imu_notch};
-  if (sc.stack.fdd == stack::FddKind::kComposite) s->composite_fdd = sc.stack.composite_fdd;
   if (st.fdd_rotors) {
     s->fdd = ScoreFdd(*st.fdd_rotors, sim.fault_events());
     AddReconfigurationLatency(s->stack.reconfigurations, sim.fault_events(), &*s->fdd);

@@ -63,6 +63,10 @@ struct StackAccount {
 };
 StackAccount AccountOf(const stack::FlightStack& st);
 
+/// The summary's account of the stack: the scenario, the stack's summary, its sensors as it knows
+/// them, its FDD's thresholds.
+void SummarizeStack(const Scenario& sc, const StackAccount& st, RunSummary* s);
+
 /// The summary's account of the flight's end from the simulator and the stack: the scenario, the
 /// drawn truth, the crash, the stack's summary, its sensors as it knows them, the FDD scored
 /// against the faults that happened, and the faults.

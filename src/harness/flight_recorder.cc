@@ -18,30 +18,70 @@ namespace {
 namespace fs = std::filesystem;
 using vehicle::StateView;
 
+/// Fills one row of a log column by column, checking at the end that it filled them all.
+class RowWriter {
+ public:
+  explicit RowWriter(io::NumericTable* table) : table_(table) {}
+  void operator()(double v) { table_->values[c_++].push_back(v); }
+  void v3(const Vector3& v) { (*this)(v.x()), (*this)(v.y()), (*this)(v.z()); }
+  void q4(const Quaternion& q) { (*this)(q.w()), (*this)(q.x()), (*this)(q.y()), (*this)(q.z()); }
+  ~RowWriter() { RG_INVARIANT(c_ == table_->columns.size(), "log row and LogColumns disagree"); }
+
+ private:
+  io::NumericTable* table_;
+  std::size_t c_ = 0;
+};
+
+void PutReference(const ReferencePoint& r, RowWriter& put) {
+  put.v3(r.p_W);
+  put.v3(r.v_W);
+  put(r.yaw);
+}
+
+void PutEstimate(const StateEstimate& e, RowWriter& put) {
+  put.v3(e.p_W);
+  put.q4(e.q_WB);
+  put.v3(e.v_W);
+  put.v3(e.w_B);
+}
+
+/// mi_i, pi_i, health_i of the first n rotors of `rotors` (fdd::RotorStatus or a cycle's
+/// runtime::RotorHealthSample).
+template <typename Rotors>
+void PutFdd(const Rotors& rotors, int n, RowWriter& put) {
+  const auto each = [&](auto&& value) {
+    for (int i = 0; i < n; ++i) put(value(rotors[static_cast<std::size_t>(i)]));
+  };
+  each([](const auto& r) { return static_cast<double>(r.motor_index); });
+  each([](const auto& r) { return static_cast<double>(r.propeller_index); });
+  each([](const auto& r) { return static_cast<double>(static_cast<int>(r.health)); });
+}
+
+/// The newest LiDAR frame's health, held until the next frame; before the first, a default
+/// summary (nothing used or matched, all zeros).
+void PutLio(const perception::LioFrameSummary& f, RowWriter& put) {
+  put(f.used ? 1.0 : 0.0);
+  put(f.degenerate ? 1.0 : 0.0);
+  put(f.points_matched);
+  put(f.residual_rms_m);
+  // Infinite when no point matched (record::kLioWeakestStdCapM); `!(x < cap)` also caps a NaN.
+  put(f.weakest_std_m < record::kLioWeakestStdCapM ? f.weakest_std_m : record::kLioWeakestStdCapM);
+}
+
 /// One row of log.csv (record/flight_log.h, LogColumns): the truth, the stack's reference,
 /// estimate and outputs, the rotors, and the FDD indices, NMPC solve time and LiDAR-inertial
 /// odometry's health when the stack has them.
 void AppendRow(const sim::Simulator& sim, const StackRow& row, io::NumericTable* table) {
   const StateView s(sim.state());
-  std::size_t c = 0;
-  const auto put = [&](double v) { table->values[c++].push_back(v); };
-  const auto v3 = [&](const Vector3& v) { put(v.x()), put(v.y()), put(v.z()); };
-  const auto q4 = [&](const Quaternion& q) { put(q.w()), put(q.x()), put(q.y()), put(q.z()); };
+  RowWriter put(table);
   put(sim.time_s());
-  v3(s.p_W());
-  q4(s.q_WB());
-  v3(s.v_W());
-  v3(s.w_B());
-  const ReferencePoint& r = row.reference;
-  v3(r.p_W);
-  v3(r.v_W);
-  put(r.yaw);
-  const StateEstimate& e = row.estimate;
-  v3(e.p_W);
-  q4(e.q_WB);
-  v3(e.v_W);
-  v3(e.w_B);
-  v3(sim.wind());
+  put.v3(s.p_W());
+  put.q4(s.q_WB());
+  put.v3(s.v_W());
+  put.v3(s.w_B());
+  PutReference(row.reference, put);
+  PutEstimate(row.estimate, put);
+  put.v3(sim.wind());
   put(sim.landed() ? 1.0 : 0.0);
   put(static_cast<int>(row.mode));
   const int n = sim.model().num_rotors();
@@ -49,36 +89,32 @@ void AppendRow(const sim::Simulator& sim, const StackRow& row, io::NumericTable*
   for (int i = 0; i < n; ++i) put(sim.rotor_thrusts()[i]);
   for (int i = 0; i < n; ++i) put(vehicle::RadPerSecondToRpm(sim.motor_speeds()[i]));
   for (int i = 0; i < n; ++i) put(static_cast<int>(sim.faults()[i].kind));  // docs/scenarios.md, "Outputs"
-  if (!row.stack) {
-    RG_INVARIANT(c == table->columns.size(), "log row and LogColumns disagree");
-    return;
-  }
+  if (!row.stack) return;
   const stack::FlightStack& st = *row.stack;
-  if (const fdd::FaultDetector* detector = st.fault_detector()) {
-    const std::vector<fdd::RotorStatus>& rotors = detector->rotors();
-    for (int i = 0; i < n; ++i) put(rotors[i].motor_index);
-    for (int i = 0; i < n; ++i) put(rotors[i].propeller_index);
-    for (int i = 0; i < n; ++i) put(static_cast<int>(rotors[i].health));
-  }
+  if (const fdd::FaultDetector* detector = st.fault_detector()) PutFdd(detector->rotors(), n, put);
   if (const control::NmpcController* nmpc = st.nmpc()) put(1e3 * nmpc->summary().solve_time_s);
   if (const stack::LioEstimator* lio = st.lio()) {
-    // The newest frame's health, held until the next frame; before the first, a default summary
-    // (nothing used or matched, all zeros).
     const std::vector<perception::LioFrameSummary>& frames = lio->frames();
-    const perception::LioFrameSummary f = frames.empty() ? perception::LioFrameSummary{} : frames.back();
-    put(f.used ? 1.0 : 0.0);
-    put(f.degenerate ? 1.0 : 0.0);
-    put(f.points_matched);
-    put(f.residual_rms_m);
-    // Infinite when no point matched (record::kLioWeakestStdCapM); `!(x < cap)` also caps a NaN.
-    put(f.weakest_std_m < record::kLioWeakestStdCapM ? f.weakest_std_m : record::kLioWeakestStdCapM);
+    PutLio(frames.empty() ? perception::LioFrameSummary{} : frames.back(), put);
   }
-  RG_INVARIANT(c == table->columns.size(), "log row and LogColumns disagree");
 }
 
 std::string InFolder(const std::string& dir, const char* name) { return (fs::path(dir) / name).string(); }
 
 }  // namespace
+
+void AppendCycleRow(const runtime::CycleTelemetry& c, const perception::LioFrameSummary* lio_frame,
+                    io::NumericTable* table) {
+  RowWriter put(table);
+  put(ToSeconds(c.command.state_t_ns));
+  PutReference(c.reference, put);
+  PutEstimate(c.estimate, put);
+  put(static_cast<int>(c.mode));
+  const auto n = static_cast<int>(c.command.thrust_n.size());
+  for (int i = 0; i < n; ++i) put(c.command.thrust_n[i]);
+  if (c.fdd_rotors > 0) PutFdd(c.health, c.fdd_rotors, put);
+  if (lio_frame) PutLio(*lio_frame, put);
+}
 
 void PrepareRunFolder(const std::string& dir, std::initializer_list<const char*> outputs) {
   std::error_code ec;
@@ -103,12 +139,15 @@ FlightRecorder::FlightRecorder(const FlightRecorderOptions& options, const Scena
 
 void FlightRecorder::Begin(const stack::FlightStack& st, int num_rotors) {
   flight_.table.columns =
-      record::LogColumns(num_rotors, st.fault_detector() != nullptr, st.nmpc() != nullptr, st.lio() != nullptr);
+      record::LogColumns({.rotors = num_rotors,
+                          .fdd = st.fault_detector() != nullptr,
+                          .nmpc = st.nmpc() != nullptr,
+                          .lio = st.lio() != nullptr});
   flight_.table.values.resize(flight_.table.columns.size());
 }
 
 void FlightRecorder::BeginWithoutStack(int num_rotors) {
-  flight_.table.columns = record::LogColumns(num_rotors, false, false, false);
+  flight_.table.columns = record::LogColumns({.rotors = num_rotors});
   flight_.table.values.resize(flight_.table.columns.size());
 }
 

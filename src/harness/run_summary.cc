@@ -174,4 +174,20 @@ nlohmann::json RunSummary::ToJson() const {
   return j;
 }
 
+nlohmann::json RunSummary::ToJsonWithoutTruth() const {
+  nlohmann::json j = ToJson();
+  for (const char* key : {"success", "crashed", "crash_reason", "crash_speed_m_s", "failure_reason", "truth",
+                          "tracking_rmse_m", "tracking_rmse_window_m", "tracking_window_s", "tracking_rmse_eq37_m",
+                          "max_position_error_m", "min_altitude_m", "altitude_change_m", "max_spin_rad_s",
+                          "max_tilt_rad", "estimate_position_rmse_m", "estimate_position_max_m",
+                          "estimate_attitude_max_rad", "tilt_recovery_s", "faults", "physics_steps"}) {
+    j[key] = nullptr;
+  }
+  if (fdd) {
+    j["fdd"] = DiagnosisJson(fdd->diagnosis);
+    j["fdd"]["detected"] = fdd->detected();
+  }
+  return j;
+}
+
 }  // namespace rotorguard::harness

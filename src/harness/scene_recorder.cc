@@ -89,12 +89,14 @@ void SceneRecorder::OnControlCycle(double t, const stack::FlightStack& st) {
                                  {"duration_s", duration}, {"sample_s", options_.plan_sample_s}, {"points_m", points}});
     }
   }
-  const perception::VoxelMap* map = st.map();
-  if (map == nullptr || t < next_map_s_) return;
+  if (const perception::VoxelMap* map = st.map(); map != nullptr && t >= next_map_s_) OnMap(t, *map);
+}
+
+void SceneRecorder::OnMap(double t, const perception::VoxelMap& map) {
   next_map_s_ = t + 1.0 / options_.map_rate_hz;
-  map_resolution_ = map->resolution();
+  map_resolution_ = map.resolution();
   std::vector<std::int64_t> keys;
-  for (const Vector3& c : map->OccupiedVoxels()) {
+  for (const Vector3& c : map.OccupiedVoxels()) {
     keys.push_back(PackVoxel((c / map_resolution_).array().floor().cast<int>()));
   }
   std::sort(keys.begin(), keys.end());

@@ -332,6 +332,19 @@ nlohmann::json NodeAccountJson(const stack::FlightStack& stack, const runtime::O
   return {{"account", io::ToJson(AccountOf(stack))}, {"loops", LoopsJson(report)}};
 }
 
+RunSummary SummaryWithoutTruth(const NodeStack& node, double sim_time_s) {
+  RunSummary s;
+  const StackAccount account = AccountOf(*node.stack);
+  SummarizeStack(node.scenario, account, &s);
+  s.sim_time_s = sim_time_s;
+  // The earliest diagnosis (ScoreFdd without fault events: only its diagnosis is a fact here).
+  if (account.fdd_rotors) {
+    s.fdd.emplace();
+    s.fdd->diagnosis = ScoreFdd(*account.fdd_rotors, {}).diagnosis;
+  }
+  return s;
+}
+
 nlohmann::json SitlResult::RuntimeJson() const {
   nlohmann::json j = loops;
   j["link"] = {{"commands", link.commands},

@@ -20,20 +20,24 @@ namespace fs = std::filesystem;
 
 }  // namespace
 
-std::vector<std::string> LogColumns(int n, bool with_fdd, bool with_nmpc, bool with_lio) {
-  std::vector<std::string> c = {"t",       "p_x",     "p_y",     "p_z",     "q_w",     "q_x",     "q_y",
-                                "q_z",     "v_x",     "v_y",     "v_z",     "w_x",     "w_y",     "w_z",
-                                "ref_p_x", "ref_p_y", "ref_p_z", "ref_v_x", "ref_v_y", "ref_v_z", "ref_yaw",
-                                "est_p_x", "est_p_y", "est_p_z", "est_q_w", "est_q_x", "est_q_y", "est_q_z",
-                                "est_v_x", "est_v_y", "est_v_z", "est_w_x", "est_w_y", "est_w_z", "wind_x",
-                                "wind_y",  "wind_z",  "landed",  "mode"};
-  std::vector<const char*> prefixes = {"cmd_", "thrust_", "rpm_", "fault_"};
-  if (with_fdd) prefixes.insert(prefixes.end(), {"mi_", "pi_", "health_"});
-  for (const char* prefix : prefixes) {
-    for (int i = 0; i < n; ++i) c.push_back(fmt::format("{}{}", prefix, i));
+std::vector<std::string> LogColumns(const LogLayout& layout) {
+  std::vector<std::string> c = {"t"};
+  if (layout.truth) {
+    c.insert(c.end(), {"p_x", "p_y", "p_z", "q_w", "q_x", "q_y", "q_z", "v_x", "v_y", "v_z", "w_x", "w_y", "w_z"});
   }
-  if (with_nmpc) c.emplace_back("nmpc_ms");
-  if (with_lio) {
+  c.insert(c.end(), {"ref_p_x", "ref_p_y", "ref_p_z", "ref_v_x", "ref_v_y", "ref_v_z", "ref_yaw", "est_p_x", "est_p_y",
+                     "est_p_z", "est_q_w", "est_q_x", "est_q_y", "est_q_z", "est_v_x", "est_v_y", "est_v_z", "est_w_x",
+                     "est_w_y", "est_w_z"});
+  if (layout.truth) c.insert(c.end(), {"wind_x", "wind_y", "wind_z", "landed"});
+  c.emplace_back("mode");
+  std::vector<const char*> prefixes = {"cmd_"};
+  if (layout.truth) prefixes.insert(prefixes.end(), {"thrust_", "rpm_", "fault_"});
+  if (layout.fdd) prefixes.insert(prefixes.end(), {"mi_", "pi_", "health_"});
+  for (const char* prefix : prefixes) {
+    for (int i = 0; i < layout.rotors; ++i) c.push_back(fmt::format("{}{}", prefix, i));
+  }
+  if (layout.nmpc) c.emplace_back("nmpc_ms");
+  if (layout.lio) {
     c.insert(c.end(), {"lio_used", "lio_degenerate", "lio_matched", "lio_residual_rms_m", "lio_weakest_std_m"});
   }
   return c;

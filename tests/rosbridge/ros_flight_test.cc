@@ -67,7 +67,8 @@ TEST(SitlOverRos, APropellerLossIsFlownOverRosRecordedAndReplayed) {
   const Output replay = RunShell(cli + " replay " + bag + " " + scenario + " --out " + (dir / "replay").string());
   EXPECT_EQ(replay.status, 0) << replay.text;
   EXPECT_NE(replay.text.find("agrees with the recording"), std::string::npos) << replay.text;
-  const nlohmann::json r = nlohmann::json::parse(std::ifstream(dir / "replay" / "replay.json"));
+  const nlohmann::json summary = nlohmann::json::parse(std::ifstream(dir / "replay" / "summary.json"));
+  const nlohmann::json& r = summary.at("replay");
   EXPECT_GT(r.at("compared").get<int>(), 700);  // 4 s at 200 Hz, every cycle
   EXPECT_EQ(r.at("compared").get<int>() + r.at("recorded_held").get<int>(), r.at("recorded_cycles").get<int>());
   EXPECT_LT(r.at("position_max_diff_m").get<double>(), 1e-3);

@@ -22,16 +22,26 @@ function header(app, data) {
   const s = data.summary;
   app.appendChild(el("h1", { text: `rotorguard · ${data.title}` }));
   const outcome = el("div", { class: "sub" });
-  outcome.appendChild(el("span", { class: `badge ${s.success ? "ok" : "bad"}`, text: s.success ? "success" : "failed" }));
-  outcome.appendChild(document.createTextNode(s.success ? `seed ${s.seed}` : `${s.failure_reason} · seed ${s.seed}`));
+  if (data.truthless) {
+    // A replayed bag: no truth to judge the flight by; the replay against its recording instead.
+    const agrees = s.replay && s.replay.compared > 0 ? s.replay.diagnosis_equal && s.replay.position_max_diff_m <= 1e-3 : null;
+    outcome.appendChild(el("span", { class: `badge ${agrees === false ? "bad" : "ok"}`, text: "replay" }));
+    outcome.appendChild(document.createTextNode(agrees === null ? "of a bag without recorded cycles · no truth"
+      : `${agrees ? "agrees with" : "differs from"} the recording · no truth: the vehicle drawn is the stack's estimate`));
+  } else {
+    outcome.appendChild(el("span", { class: `badge ${s.success ? "ok" : "bad"}`, text: s.success ? "success" : "failed" }));
+    outcome.appendChild(document.createTextNode(s.success ? `seed ${s.seed}` : `${s.failure_reason} · seed ${s.seed}`));
+  }
   app.appendChild(outcome);
   const cards = el("div", { class: "cards" });
   const card = (k, v) => cards.appendChild(el("div", { class: "card" }, [el("div", { class: "k", text: k }), el("div", { class: "v", text: v })]));
-  card("simulated", `${fmt(s.sim_time_s, 2)} s`);
-  card("tracking RMSE", `${fmt(s.tracking_rmse_m)} m`);
-  card("max error", `${fmt(s.max_position_error_m)} m`);
-  card("max spin", `${fmt(s.max_spin_rad_s, 2)} rad/s`);
-  card("min altitude", `${fmt(s.min_altitude_m, 2)} m`);
+  card(data.truthless ? "replayed" : "simulated", `${fmt(s.sim_time_s, 2)} s`);
+  if (!data.truthless) {
+    card("tracking RMSE", `${fmt(s.tracking_rmse_m)} m`);
+    card("max error", `${fmt(s.max_position_error_m)} m`);
+    card("max spin", `${fmt(s.max_spin_rad_s, 2)} rad/s`);
+    card("min altitude", `${fmt(s.min_altitude_m, 2)} m`);
+  }
   for (const f of s.faults || []) card(`fault rotor ${f.rotor}`, `${f.kind} @ ${fmt(f.onset_s, 2)} s`);
   if (s.fdd) {
     card("FDD", s.fdd.detected ? `rotor ${s.fdd.rotor} ${s.fdd.kind} @ ${fmt(s.fdd.detection_s, 3)} s` : "no detection");
@@ -42,11 +52,16 @@ function header(app, data) {
   if (s.map_voxels_occupied !== null && s.map_voxels_occupied !== undefined) card("map voxels", String(s.map_voxels_occupied));
   if (s.supervisor && s.supervisor.transitions.length > 0) card("flight mode at the end", s.supervisor.final_mode.replace("_", " "));
   if (s.odometry) {
-    card("estimate RMSE", `${fmt(s.estimate_position_rmse_m)} m`);
-    card("estimate max error", `${fmt(s.estimate_position_max_m)} m · ${fmt((s.estimate_attitude_max_rad * 180) / Math.PI, 2)}°`);
+    if (!data.truthless) {
+      card("estimate RMSE", `${fmt(s.estimate_position_rmse_m)} m`);
+      card("estimate max error", `${fmt(s.estimate_position_max_m)} m · ${fmt((s.estimate_attitude_max_rad * 180) / Math.PI, 2)}°`);
+    }
     card("LIO frames", `${s.odometry.frames_used} / ${s.odometry.frames} used · ${s.odometry.frames_degenerate} degenerate`);
   }
   card("real-time factor", `${fmt(s.realtime_factor, 0)}×`);
+  if (data.truthless && s.replay && s.replay.compared > 0) {
+    card("replay vs recording", `${fmt(s.replay.position_max_diff_m)} m over ${s.replay.compared} cycles`);
+  }
   app.appendChild(cards);
 }
 
@@ -93,7 +108,7 @@ function replaySection(app, data, clock) {
   app.appendChild(controls);
   const legend = el("div", { class: "legend note" });
   legend.innerHTML =
-    '<span><i style="background:#d62728"></i>flown</span><span><i style="background:#1f77b4"></i>reference</span>' +
+    '<span><i style="background:#d62728"></i>${data.truthless ? "estimate" : "flown"}</span><span><i style="background:#1f77b4"></i>reference</span>' +
     '<span><i style="background:#00a0e0"></i>plan</span><span><i style="background:#4060c0"></i>LiDAR map</span>' +
     '<span><i style="background:#2ca02c"></i>rotor healthy</span><span><i style="background:#d62728"></i>rotor failed (injected)</span>' +
     '<span><i style="background:#ff7f0e"></i>ring: FDD diagnosis</span> · drag to orbit, wheel to zoom';
@@ -114,6 +129,10 @@ function replaySection(app, data, clock) {
     rows += `<tr><td>roll / pitch</td><td class="num">${fmt((roll * 180) / Math.PI, 1)}° / ${fmt((pitch * 180) / Math.PI, 1)}°</td></tr>`;
     rows += `<tr><td>yaw rate</td><td class="num">${fmt(s.w_z[i], 2)} rad/s</td></tr>`;
     for (let r = 0; r < n; r += 1) {
+      if (data.truthless) {
+        rows += `<tr><td>rotor ${r}</td><td class="num">${fmt(s[`cmd_${r}`][i], 2)} N commanded</td></tr>`;
+        continue;
+      }
       const fault = s[`fault_${r}`][i] > 0 ? " ✗" : "";
       rows += `<tr><td>rotor ${r}${fault}</td><td class="num">${fmt(s[`thrust_${r}`][i], 2)} N · ${fmt(s[`rpm_${r}`][i], 0)} rpm</td></tr>`;
     }
@@ -126,9 +145,8 @@ function replaySection(app, data, clock) {
     }
     if (s.nmpc_ms) rows += `<tr><td>NMPC solve</td><td class="num">${fmt(s.nmpc_ms[i], 2)} ms</td></tr>`;
     if (s.lio_matched) {
-      const estErr = estimateError(s, i);
       const state = s.lio_used[i] ? (s.lio_degenerate[i] ? " · degenerate" : "") : " · not used";
-      rows += `<tr><td>estimate error</td><td class="num">${fmt(estErr)} m</td></tr>`;
+      if (!data.truthless) rows += `<tr><td>estimate error</td><td class="num">${fmt(estimateError(s, i))} m</td></tr>`;
       rows += `<tr><td>LIO frame</td><td class="num">${fmt(s.lio_matched[i], 0)} matched${state}</td></tr>`;
     }
     side.innerHTML = `<table>${rows}</table>`;
@@ -187,25 +205,24 @@ function plotsSection(app, data, clock) {
   const rotorPlots = el("div", { class: "plots" });
   app.appendChild(rotorPlots);
   for (let r = 0; r < n; r += 1) {
+    const series = [{ label: "commanded", values: s[`cmd_${r}`], color: "#1f77b4", dash: [5, 3] }];
+    if (!data.truthless) series.push({ label: "actual", values: s[`thrust_${r}`], color: "#d62728" });
     makePlot(rotorPlots, {
-      title: `Rotor ${r}: commanded vs actual thrust`, x: t, yLabel: "thrust [N]", markers, height: 180,
-      series: [
-        { label: "commanded", values: s[`cmd_${r}`], color: "#1f77b4", dash: [5, 3] },
-        { label: "actual", values: s[`thrust_${r}`], color: "#d62728" },
-      ],
+      title: `Rotor ${r}: ${data.truthless ? "commanded thrust" : "commanded vs actual thrust"}`, x: t, yLabel: "thrust [N]",
+      markers, height: 180, series,
     }, clock);
   }
   // Commanded speeds from the commanded thrusts (T = k_n w^2), dashed beside the actual ones.
   const kn = data.scene.vehicle.thrust_coefficient_n_s2;
   const rpmSeries = [];
   for (let r = 0; r < n; r += 1) {
-    rpmSeries.push({ label: `rotor ${r}`, values: s[`rpm_${r}`], color: color(r) });
+    if (!data.truthless) rpmSeries.push({ label: `rotor ${r}`, values: s[`rpm_${r}`], color: color(r) });
     if (kn > 0) {
       const commanded = s[`cmd_${r}`].map((c) => (Math.sqrt(Math.max(0, c) / kn) * 60) / (2 * Math.PI));
       rpmSeries.push({ label: `rotor ${r} commanded`, values: commanded, color: color(r), dash: [5, 3], width: 1 });
     }
   }
-  makePlot(rotorPlots, { title: "Rotor speeds: actual and commanded", x: t, yLabel: "rpm", markers, series: rpmSeries }, clock);
+  makePlot(rotorPlots, { title: data.truthless ? "Rotor speeds: commanded" : "Rotor speeds: actual and commanded", x: t, yLabel: "rpm", markers, series: rpmSeries }, clock);
 
   if (s.mi_0) {
     const fdd = summary.composite_fdd || {};
@@ -232,7 +249,7 @@ function plotsSection(app, data, clock) {
       title: `Position ${axis}`, x: t, yLabel: `${axis} [m]`, markers,
       series: [
         { label: "reference", values: s[`ref_p_${axis}`], color: "#1f77b4", dash: [5, 3] },
-        { label: "flown", values: s[`p_${axis}`], color: "#d62728" },
+        { label: data.truthless ? "estimate" : "flown", values: s[`p_${axis}`], color: "#d62728" },
       ],
     }, clock);
   }
@@ -291,11 +308,10 @@ function quaternionAngle(a, b) {
 
 /**
  * The LiDAR-inertial odometry (the log's lio_* columns, written only when it was the stack's
- * estimator): its estimate against the truth, and each frame's health as the filter judged it.
+ * estimator): its estimate against the truth (when there is one), and each frame's health as the
+ * filter judged it.
  */
 function localisationSection(app, data, clock, markers) {
-  const s = data.series;
-  const t = s.t;
   const o = data.summary.odometry || {};
   app.appendChild(el("h2", { text: "Localisation (LiDAR-inertial odometry)" }));
   if (data.summary.odometry) {
@@ -309,6 +325,14 @@ function localisationSection(app, data, clock, markers) {
   }
   const plots = el("div", { class: "plots" });
   app.appendChild(plots);
+  if (!data.truthless) estimateAgainstTruth(plots, data, clock, markers);
+  lioHealth(plots, data, clock, markers);
+}
+
+/** The estimate against the truth: position per axis, position and attitude errors. */
+function estimateAgainstTruth(plots, data, clock, markers) {
+  const s = data.series;
+  const t = s.t;
   for (const axis of ["x", "y", "z"]) {
     makePlot(plots, {
       title: `Estimate vs truth: ${axis}`, x: t, yLabel: `${axis} [m]`, markers,
@@ -336,6 +360,13 @@ function localisationSection(app, data, clock, markers) {
       color: "#9467bd",
     }],
   }, clock);
+}
+
+/** Each frame's health as the filter judged it. */
+function lioHealth(plots, data, clock, markers) {
+  const s = data.series;
+  const t = s.t;
+  const o = data.summary.odometry || {};
   // The frames the filter did not take (the first, which starts the map, and those with too few
   // matches) and those it took with a direction left unconstrained, as dots on their values.
   const only = (flag, values, want) => values.map((v, i) => (flag[i] === want ? v : null));
@@ -365,7 +396,20 @@ function localisationSection(app, data, clock, markers) {
   }, clock);
 }
 
-export function renderFlight(app, data) {
+/**
+ * A flight without a truth (a replayed bag: its log has the stack's estimate, not the simulator's
+ * state): the vehicle is drawn, and the tracking plotted, at the estimate, and said to be.
+ */
+function withoutTruth(data) {
+  const s = data.series;
+  if ("p_x" in s || !("est_p_x" in s)) return data;
+  const view = { ...s };
+  for (const c of ["p_x", "p_y", "p_z", "q_w", "q_x", "q_y", "q_z", "v_x", "v_y", "v_z", "w_x", "w_y", "w_z"]) view[c] = s[`est_${c}`];
+  return { ...data, series: view, truthless: true };
+}
+
+export function renderFlight(app, input) {
+  const data = withoutTruth(input);
   const t = data.series.t;
   const clock = makeClock(t[0], t[t.length - 1]);
   header(app, data);

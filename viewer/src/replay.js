@@ -260,7 +260,8 @@ export class Replay {
     const qj = new THREE.Quaternion(s.q_x[j], s.q_y[j], s.q_z[j], s.q_w[j]);
     this.vehicle.quaternion.copy(qi.slerp(qj, a));
     this.rotorDiscs.forEach((disc, r) => {
-      disc.material.color.setHex(s[`fault_${r}`][i] > 0 ? HEALTH_COLORS.fault : HEALTH_COLORS.ok);
+      const fault = s[`fault_${r}`] ? s[`fault_${r}`][i] : 0;  // no fault_i columns without a truth
+      disc.material.color.setHex(fault > 0 ? HEALTH_COLORS.fault : HEALTH_COLORS.ok);
     });
     this.rotorRings.forEach((ring, r) => {
       const h = s[`health_${r}`] ? s[`health_${r}`][i] : 0;

@@ -17,6 +17,7 @@
 #include "rotorguard/harness/scene_recorder.h"
 #include "rotorguard/io/files.h"
 #include "rotorguard/record/flight_log.h"
+#include "rotorguard/runtime/onboard_executor.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/stack/flight_stack.h"
 
@@ -43,6 +44,13 @@ struct FlightRecorderOptions {
 /// a summary left behind must not pass for this run's, nor its files mix with these. Throws
 /// std::runtime_error when the folder cannot be created.
 void PrepareRunFolder(const std::string& dir, std::initializer_list<const char*> outputs);
+
+/// Appends to `table` the log row of a cycle the stack reported (what `rotorguard replay` logs: a
+/// bag has no truth). The table's columns are record::LogColumns({.rotors = the command's size,
+/// .truth = false, .fdd = cycle.fdd_rotors > 0, .lio = lio_frame != nullptr}); `lio_frame` is the
+/// odometry's newest frame at the cycle.
+void AppendCycleRow(const runtime::CycleTelemetry& cycle, const perception::LioFrameSummary* lio_frame,
+                    io::NumericTable* table);
 
 /// The stack's side of a log row: the stack in this process (with its FDD indices, NMPC solve
 /// time and odometry health), or what a software-in-the-loop node reports of its newest cycle

@@ -130,6 +130,10 @@ struct RunSummary {
   bool infeasible_request = false;
 
   nlohmann::json ToJson() const;
+  /// summary.json of a flight without a truth (`rotorguard replay`): ToJson's keys, null where the
+  /// value needs the simulator (success, crash, truth, tracking, attitude and estimate errors,
+  /// faults, and the FDD's scoring: only its diagnosis is kept).
+  nlohmann::json ToJsonWithoutTruth() const;
 };
 
 }  // namespace rotorguard::harness

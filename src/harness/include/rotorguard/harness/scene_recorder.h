@@ -28,8 +28,11 @@ class SceneRecorder {
   /// that the replay draws the docked units.
   SceneRecorder(const vehicle::VehicleParams& vehicle, const sim::World& world,
                 const SceneRecorderOptions& options = {}, const modular::Assembly* assembly = nullptr);
-  /// After each control cycle at time t [s].
+  /// After each control cycle at time t [s]: the plans adopted since, and the map when a snapshot
+  /// is due.
   void OnControlCycle(double t, const stack::FlightStack& stack);
+  /// A snapshot of the map at time t [s] (the changes since the last one).
+  void OnMap(double t, const perception::VoxelMap& map);
   /// Samples the moving boxes when due (call at every physics step or so).
   void OnTime(double t);
   nlohmann::json ToJson() const;

@@ -125,4 +125,10 @@ NodeStack MakeNodeStack(const Scenario& scenario);
 /// summary and FDD account, "loops": the executor's loops and scheduling (runtime.json's)}.
 nlohmann::json NodeAccountJson(const stack::FlightStack& stack, const runtime::OnboardReport& report);
 
+/// The summary of a flight known from its sensors alone (`rotorguard replay`: a bag holds no
+/// truth) at instant sim_time_s [s]: the scenario, the stack's account, and its FDD's earliest
+/// diagnosis. Write it with RunSummary::ToJsonWithoutTruth: its fields that need the truth are
+/// not known.
+RunSummary SummaryWithoutTruth(const NodeStack& node, double sim_time_s);
+
 }  // namespace rotorguard::harness

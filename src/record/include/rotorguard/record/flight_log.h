@@ -22,13 +22,23 @@ struct FlightLog {
   io::NumericTable table;  ///< log.csv
 };
 
-/// The names of the log's columns for a vehicle of n rotors (`mode` is the supervisor's flight
-/// mode, stack::FlightMode's code), with the FDD columns (motor index
-/// mi_i, propeller index pi_i, diagnosed health code health_i) when the stack runs fault
-/// detection, nmpc_ms (the NMPC's last solve time) when it flies the NMPC, and the LiDAR-inertial
-/// odometry's newest frame (lio_used, lio_degenerate, lio_matched, lio_residual_rms_m,
-/// lio_weakest_std_m) when it is the stack's estimator.
-std::vector<std::string> LogColumns(int num_rotors, bool with_fdd, bool with_nmpc, bool with_lio);
+/// What a log holds besides its time, the stack's reference and estimate, its mode and its
+/// commands (t, ref_*, est_*, mode, cmd_i).
+struct LogLayout {
+  int rotors = 4;
+  /// The simulator's truth: its state (p_*, q_*, v_*, w_*), wind, landed, and each rotor's thrust,
+  /// speed and injected fault (thrust_i, rpm_i, fault_i). A replayed bag has none.
+  bool truth = true;
+  bool fdd = false;   ///< the FDD's motor index mi_i, propeller index pi_i and health code health_i
+  bool nmpc = false;  ///< nmpc_ms, the NMPC's last solve time
+  /// The LiDAR-inertial odometry's newest frame (lio_used, lio_degenerate, lio_matched,
+  /// lio_residual_rms_m, lio_weakest_std_m), when it is the stack's estimator.
+  bool lio = false;
+};
+
+/// The names of the log's columns (`mode` is the supervisor's flight mode, stack::FlightMode's
+/// code), in the order rows hold them.
+std::vector<std::string> LogColumns(const LogLayout& layout);
 
 /// lio_weakest_std_m is written at most this [m]: a frame whose points leave a direction
 /// unconstrained has an infinite (or astronomically large) std there, which is no number a log

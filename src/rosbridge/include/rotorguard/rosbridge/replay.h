@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/ros1/bag.h"
 #include "rotorguard/runtime/onboard_executor.h"
@@ -26,8 +27,11 @@
 namespace rotorguard::rosbridge {
 
 struct ReplayOptions {
-  /// Output folder: replay.json, cycles.csv ("" writes nothing).
+  /// Output folder ("" writes nothing): a run's files without its truth (docs/ros.md,
+  /// "Replay"): summary.json (its "replay" key the comparison), log.csv, scene.json,
+  /// sensors.csv, vehicle.yaml, and report.html when `report`.
   std::string out_dir;
+  bool report = false;
   /// A LiDAR frame's sweep [s] (a cloud is stamped at its first instant); <= 0: the scenario's
   /// sensors.lidar.frame_rate_hz.
   double frame_period_s = 0.0;
@@ -59,8 +63,12 @@ struct ReplaySummary {
   /// The first instant whose estimates differ by more than a micrometre (where to look).
   std::optional<double> first_divergence_s;
   Diagnosis diagnosis, recorded_diagnosis;  ///< both up to the last instant compared
-  nlohmann::json account;                   ///< the stack's account (as a node sends it)
+  harness::RunSummary summary;              ///< the stack's account and diagnosis (no truth)
+  /// summary.json: summary.ToJsonWithoutTruth() with the comparison under "replay" (ReplayJson)
+  /// and the bag under "source".
   nlohmann::json ToJson() const;
+  /// The comparison with the recording, and what was handed over.
+  nlohmann::json ReplayJson() const;
 };
 
 /// Replays the bag at `bag_path` through the stack of `scenario`. Throws std::runtime_error
