@@ -42,6 +42,7 @@ std::uint32_t Publisher<T>::subscribers() const {
 
 struct Bus::Impl {
   std::unique_ptr<ros::NodeHandle> node;
+  ros::CallbackQueue heavy;  // TopicOptions::Queue::kHeavy's
   std::vector<ros::Subscriber> subscribers;
   BadMessageHandler on_bad;
 };
@@ -93,17 +94,19 @@ void Bus::Subscribe(const std::string& topic, const TopicOptions& options, std::
   ros::TransportHints hints;
   if (options.tcp_nodelay) hints = hints.tcpNoDelay();
   Impl* impl = impl_.get();
-  impl_->subscribers.push_back(impl_->node->subscribe<Message>(
-      topic, options.queue_size,
-      [impl, topic, on_message = std::move(on_message)](const typename Message::ConstPtr& r) {
-        T m;
-        if (const std::string e = FromRos(*r, &m); !e.empty()) {
-          if (impl->on_bad) impl->on_bad(topic, e);
-          return;
-        }
-        on_message(m);
-      },
-      ros::VoidConstPtr(), hints));
+  ros::SubscribeOptions o;
+  o.template init<Message>(topic, options.queue_size,
+                           [impl, topic, on_message = std::move(on_message)](const typename Message::ConstPtr& r) {
+                             T m;
+                             if (const std::string e = FromRos(*r, &m); !e.empty()) {
+                               if (impl->on_bad) impl->on_bad(topic, e);
+                               return;
+                             }
+                             on_message(m);
+                           });
+  o.transport_hints = hints;
+  if (options.queue == TopicOptions::Queue::kHeavy) o.callback_queue = &impl_->heavy;
+  impl_->subscribers.push_back(impl_->node->subscribe(o));
 }
 
 void Bus::OnBadMessage(BadMessageHandler handler) { impl_->on_bad = std::move(handler); }
@@ -117,9 +120,10 @@ std::uint32_t Bus::Publishers(const std::string& topic) const {
   return n;
 }
 
-bool Bus::Spin(double timeout_s) {
+bool Bus::Spin(double timeout_s, TopicOptions::Queue queue) {
   if (!ros::ok()) return false;
-  ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(timeout_s));
+  ros::CallbackQueue* q = queue == TopicOptions::Queue::kHeavy ? &impl_->heavy : ros::getGlobalCallbackQueue();
+  q->callAvailable(ros::WallDuration(timeout_s));
   return ros::ok();
 }
 

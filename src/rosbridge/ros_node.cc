@@ -1,15 +1,19 @@
 #include "rotorguard/rosbridge/ros_node.h"
 
 #include <fmt/format.h>
+#include <pthread.h>
+#include <sched.h>
 #include <signal.h>
 #include <time.h>
 
 #include <algorithm>
+#include <limits>
 #include <atomic>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/error.h"
@@ -31,26 +35,65 @@ namespace {
 std::atomic<bool> g_signalled{false};
 void OnSignal(int) { g_signalled.store(true); }
 
-/// The node's clock: ROS time (the /clock under use_sim_time) less the mission's start.
+/// The node's clock: ROS time less the mission's start.
+///
+/// Under /clock (use_sim_time) it is not the newest /clock message itself: that moves in the
+/// publisher's steps (a millisecond for `sitl --ros`), arrives through ROS's threads at the normal
+/// priority, and roscpp's own ros::Time::now() takes a mutex those threads hold to set it. The
+/// node runs its own steady clock instead, placed on /clock by the lower envelope of
+/// (steady time - /clock) over every reading: the offset of a /clock that advances at real time,
+/// plus the least delivery delay seen (tens of microseconds on one machine). Its time has the
+/// steady clock's resolution, its sleeps are one timed wait, and a /clock message that comes late
+/// delays nothing. It never leads the newest /clock by more than kMaxLeadNs, two physics steps of
+/// `sitl --ros` (and of Gazebo at 1 kHz): the deadlines stay judged on simulated time, and a
+/// /clock that pauses (the simulator waiting for the node), falls behind real time (a loaded
+/// machine) or runs slow (a bag played at half speed) holds it back. A reading kRenewNs past the
+/// envelope (a pause, not a late message) starts the envelope again.
 class RosClock final : public runtime::Clock {
  public:
-  RosClock(const ros1::Bus* bus, ros1::Stamp origin) : bus_(bus), origin_(origin), sim_(bus->SimTime()) {}
-  TimeNs Now() const override { return bus_->Now() - origin_; }
+  static constexpr TimeNs kMaxLeadNs = 2'000'000;
+  static constexpr TimeNs kRenewNs = 5'000'000;
+  /// `newest_clock`: the newest /clock [ns of ROS time], kept by the node's subscription; null
+  /// without use_sim_time (ROS time is then the wall clock).
+  RosClock(const ros1::Bus* bus, ros1::Stamp origin, const std::atomic<TimeNs>* newest_clock)
+      : bus_(bus), origin_(origin), newest_clock_(newest_clock) {}
+  TimeNs Now() const override {
+    if (!newest_clock_) return bus_->Now() - origin_;
+    const TimeNs ros = newest_clock_->load(std::memory_order_acquire);
+    const TimeNs steady = runtime::SteadyClock::Monotonic();
+    const TimeNs sample = steady - ros;
+    TimeNs offset = offset_.load(std::memory_order_relaxed);
+    // A lower reading refines the envelope; one that leaves the clock more than kMaxLeadNs ahead
+    // of /clock means /clock paused (the simulator waiting for the node) or runs slow: start the
+    // envelope again from it.
+    const auto renewed = [&](TimeNs o) { return sample < o || sample - o > kRenewNs; };
+    while (renewed(offset) && !offset_.compare_exchange_weak(offset, sample, std::memory_order_relaxed)) {
+    }
+    if (renewed(offset)) offset = sample;
+    // Never backwards (a renewed envelope can put it behind what was read before).
+    const TimeNs now = std::min(steady - offset, ros + kMaxLeadNs) - origin_;
+    TimeNs last = last_.load(std::memory_order_relaxed);
+    while (now > last && !last_.compare_exchange_weak(last, now, std::memory_order_relaxed)) {
+    }
+    return std::max(now, last);
+  }
   bool SleepUntil(TimeNs t) override {
     for (;;) {
       if (stopped_.load(std::memory_order_acquire)) return false;
       const TimeNs now = Now();
       if (now >= t) return true;
-      if (!sim_) {
-        // Wall-clock ROS time: one sleep to the instant (CLOCK_REALTIME is ROS's time).
-        const ros1::Stamp at = origin_ + t;
+      // Under /clock at most 2 ms at a time (a /clock faster or slower than real time, or paused,
+      // is followed) and at least 50 us (a clock held at its cap is not polled in a spin); on the
+      // wall clock up to 10 ms, so that a stop is seen.
+      const TimeNs wait = newest_clock_ ? std::clamp<TimeNs>(t - now, 50'000, 2'000'000) : std::min<TimeNs>(t - now, 10'000'000);
+      if (!newest_clock_) {
+        const ros1::Stamp at = bus_->Now() + wait;  // ROS's wall time is CLOCK_REALTIME
         const timespec ts{static_cast<time_t>(at / 1'000'000'000), static_cast<long>(at % 1'000'000'000)};
         clock_nanosleep(CLOCK_REALTIME, TIMER_ABSTIME, &ts, nullptr);
       } else {
-        // The /clock moves in steps, delivered by ROS's threads at the normal priority: poll it
-        // every 0.1-0.2 ms, sleeping each time (a real-time thread that did not would starve them).
-        const timespec ts{0, static_cast<long>(std::clamp<TimeNs>(t - now, 100'000, 200'000))};
-        nanosleep(&ts, nullptr);
+        const TimeNs at = runtime::SteadyClock::Monotonic() + wait;
+        const timespec ts{static_cast<time_t>(at / 1'000'000'000), static_cast<long>(at % 1'000'000'000)};
+        clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
       }
     }
   }
@@ -59,7 +102,9 @@ class RosClock final : public runtime::Clock {
  private:
   const ros1::Bus* bus_;
   ros1::Stamp origin_;
-  bool sim_;
+  const std::atomic<TimeNs>* newest_clock_;
+  mutable std::atomic<TimeNs> offset_{std::numeric_limits<TimeNs>::max() / 2};
+  mutable std::atomic<TimeNs> last_{std::numeric_limits<TimeNs>::min()};
   std::atomic<bool> stopped_{false};
 };
 
@@ -189,17 +234,26 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   // Silence limits: ten of the input's periods, at least 50 ms.
   const auto limit = [](double rate_hz) { return std::max(0.05, 10.0 / rate_hz); };
   InputGuard guard({{topics::kImu.name, limit(sc.sim.imu.rate_hz)}, {topics::kEscTelemetry.name, limit(sc.sim.esc.rate_hz)}});
-  bus.OnBadMessage([&](std::string_view topic, std::string_view what) { guard.Bad(std::string(topic), steady(), std::string(what)); });
+  // Two threads take inputs in (the main queue's and the point clouds', topics.h): the guard, the
+  // executor's intake and the bag are theirs in turn. Held for a check and a hand-over only (a
+  // cloud is converted before); priority inheritance, as both run real-time.
+  runtime::PiMutex intake;
+  bus.OnBadMessage([&](std::string_view topic, std::string_view what) {
+    const std::lock_guard lock(intake);
+    guard.Bad(std::string(topic), steady(), std::string(what));
+  });
   QueueSink sink;
   std::unique_ptr<RosClock> clock;
   std::unique_ptr<runtime::OnboardExecutor> executor;
   std::optional<TimeBase> base;
   std::uint64_t before_start = 0;
+  // Set once `base` and `executor` are (the heavy queue's thread reads them after it).
+  std::atomic<bool> started{false};
   std::unique_ptr<BagRecorder> bag;
   // Arrival on the flight's time (the bag's time of a message taken in).
   const auto arrival = [&] { return base->ToTime(bus.Now()); };
   const auto accept = [&](const char* topic, ros1::Stamp stamp) {
-    if (!executor) {
+    if (!started.load(std::memory_order_acquire)) {
       ++before_start;
       return false;
     }
@@ -207,6 +261,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   };
   // A checked input to the stack, and to the bag when the stack took it in.
   const auto take = [&](const char* topic, ros1::Stamp stamp, auto&& message_of) {
+    const std::lock_guard lock(intake);
     if (!accept(topic, stamp)) return;
     const runtime::SensorMessage s = message_of();
     if (executor->OnSensor(s) && bag) bag->OnInput(arrival(), s);
@@ -216,6 +271,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   });
   bus.Subscribe<ros1::Esc>(topics::kEscTelemetry.name, topics::kEscTelemetry.options, [&](const ros1::Esc& m) {
     if (m.motor_speed_rad_s.size() != static_cast<std::size_t>(st.model().num_rotors())) {
+      const std::lock_guard lock(intake);
       guard.Bad(topics::kEscTelemetry.name, steady(),
                 fmt::format("{} motor speeds for a vehicle of {} rotors", m.motor_speed_rad_s.size(), st.model().num_rotors()));
       return;
@@ -225,20 +281,61 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   bus.Subscribe<ros1::Odometry>(topics::kExternalOdometry.name, topics::kExternalOdometry.options, [&](const ros1::Odometry& m) {
     take(topics::kExternalOdometry.name, m.stamp, [&] { return runtime::SensorMessage::Of(FromWireOdometry(m, *base)); });
   });
+  // On the heavy queue's thread (below).
   bus.Subscribe<ros1::Cloud>(topics::kPoints.name, topics::kPoints.options, [&](const ros1::Cloud& m) {
-    if (m.points.size() > options.max_frame_points) {
+    const bool oversize = m.points.size() > options.max_frame_points;
+    std::shared_ptr<const LidarFrame> frame;
+    if (!oversize && started.load(std::memory_order_acquire)) {
+      frame = std::make_shared<const LidarFrame>(FromWire(m, *base, frame_period));  // the long part, unlocked
+    }
+    const std::lock_guard lock(intake);
+    if (oversize) {
       guard.Oversize(topics::kPoints.name, steady(),
                      fmt::format("a frame of {} points, more than the budget of {}", m.points.size(), options.max_frame_points));
       return;
     }
     if (!accept(topics::kPoints.name, m.stamp)) return;
-    auto frame = std::make_shared<const LidarFrame>(FromWire(m, *base, frame_period));
+    // With --bag the frame is converted for the bag here, under the lock (ToWire of 20 000 points).
     if (executor->OnLidar(frame) && bag) bag->OnFrame(arrival(), *frame);
   });
+  // The point clouds' queue: a conversion of milliseconds, never ahead of an IMU sample. Once the
+  // mission starts it runs beside the perception (its priority, its CPUs).
+  std::atomic<bool> stop_heavy{false};
+  std::thread heavy([&] {
+    bool scheduled = false;
+    while (!stop_heavy.load(std::memory_order_acquire) && bus.Spin(0.01, ros1::TopicOptions::Queue::kHeavy)) {
+      if (scheduled || !started.load(std::memory_order_acquire)) continue;
+      scheduled = true;
+      if (executor->realtime_grant().fifo) {
+        sched_param p{};
+        p.sched_priority = std::max(1, options.realtime.fifo_priority - 1);
+        pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+      }
+      runtime::PinThread(options.realtime.control_cpu, runtime::ThreadRole::kCompute);
+    }
+  });
+  // Joined on every way out (an exception from here on included).
+  struct Joiner {
+    std::atomic<bool>* stop;
+    std::thread* thread;
+    ~Joiner() {
+      stop->store(true, std::memory_order_release);
+      if (thread->joinable()) thread->join();
+    }
+  } heavy_joiner{&stop_heavy, &heavy};
   double battery_v = 0.0;
   bus.Subscribe<ros1::Battery>(topics::kBattery.name, topics::kBattery.options, [&](const ros1::Battery& m) {
+    const std::lock_guard lock(intake);
     if (accept(topics::kBattery.name, m.stamp)) battery_v = m.voltage;
   });
+  // The newest /clock, for the node's clock (RosClock): read without roscpp's time mutex.
+  std::atomic<TimeNs> newest_clock{0};
+  const bool sim_time = bus.SimTime();
+  if (sim_time) {
+    bus.Subscribe<ros1::ClockTick>(topics::kClock.name, topics::kClock.options, [&](const ros1::ClockTick& m) {
+      if (m.clock > newest_clock.load(std::memory_order_relaxed)) newest_clock.store(m.clock, std::memory_order_release);
+    });
+  }
   std::optional<ros1::Stamp> start;
   if (options.start_now) start = bus.Now();
   bus.Subscribe<ros1::ClockTick>(topics::kMissionStart.name, topics::kMissionStart.options,
@@ -261,7 +358,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     fmt::print(stderr, "node: the mission starts at ROS time {:.3f} s (now {:.3f} s{})\n", 1e-9 * static_cast<double>(*start),
                1e-9 * static_cast<double>(bus.Now()), bus.SimTime() ? ", /clock" : "");
     if (!options.bag_path.empty()) bag = std::make_unique<BagRecorder>(options.bag_path, *base);
-    clock = std::make_unique<RosClock>(&bus, *start);
+    clock = std::make_unique<RosClock>(&bus, *start, sim_time ? &newest_clock : nullptr);
     runtime::OnboardExecutorOptions eo;
     eo.realtime = options.realtime;
     executor = std::make_unique<runtime::OnboardExecutor>(&st, clock.get(), &sink, eo);
@@ -281,15 +378,32 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
       }
     });
     executor->Start();
-    // The intake is ROS's callbacks, fed by ROS's threads at the normal priority: this thread stays
-    // with them (the executor's start made it real-time, as a driver's intake would be).
-    runtime::UseNormalScheduling();
+    started.store(true, std::memory_order_release);
+    // The executor's start made this thread, the intake (it runs ROS's callbacks), real-time at
+    // the control thread's priority, on its CPU when asked. ROS's own threads (network, callback
+    // queues) and the publishing thread carry the sensor messages in and the commands out: they
+    // follow, just below (the network thread reading a cloud never holds up a woken control
+    // thread), or a perception frame or the simulator would hold a sample up for milliseconds.
+    // None of them polls: at SCHED_FIFO nothing else on their CPU would run.
+    const runtime::RealtimeGrant& grant = executor->realtime_grant();
+    const int below = std::max(1, options.realtime.fifo_priority - 1);
+    const int raised = grant.fifo ? runtime::RaiseNormalThreads(below, options.realtime.control_cpu) : 0;
+    if (grant.fifo) fmt::print(stderr, "node: {} thread(s) of ROS and the publisher at SCHED_FIFO {}\n", raised, below);
     status.Publish({"flying"});
     // The slow outputs, twice a second, on a thread of their own (reading the map waits while a
     // frame is inserted; the intake and the commands never wait for it): the path followed and
     // the map.
     runtime::Doorbell slow_bell;
     std::thread slow([&] {
+      // The map's copy is long: beside the planning (its priority, its CPUs), never at the intake's.
+      // Not the normal scheduler: roscpp serialises every publication under one mutex without
+      // priority inheritance, and a command's publication would wait behind a starved map.
+      if (grant.fifo) {
+        sched_param p{};
+        p.sched_priority = std::max(1, options.realtime.fifo_priority - 2);
+        pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+      }
+      runtime::PinThread(options.realtime.control_cpu, runtime::ThreadRole::kCompute);
       while (!stop_publishing.load(std::memory_order_acquire)) {
         const std::uint32_t seen = slow_bell.Count();
         const std::shared_ptr<const ReferenceTrajectory> followed = executor->FollowedReference();
@@ -303,13 +417,20 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
       }
     });
     while (shutdown.empty() && !g_signalled.load() && bus.Spin(0.005)) {
-      for (const std::string& topic : guard.Silent(steady())) {
+      std::vector<std::string> silent;
+      {
+        const std::lock_guard lock(intake);
+        silent = guard.Silent(steady());
+      }
+      for (const std::string& topic : silent) {
         fmt::print(stderr, "node: no message on '{}' for more than its limit\n", topic);
       }
     }
     stop_publishing.store(true, std::memory_order_release);
     slow_bell.Ring();
     slow.join();
+    stop_heavy.store(true, std::memory_order_release);
+    heavy.join();
     clock->Stop();
     executor->Stop();
     sink.bell().Ring();

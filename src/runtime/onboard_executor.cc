@@ -346,7 +346,7 @@ void OnboardExecutor::RunCycle(TimeNs t, const RotorVector* recorded) {
     held[static_cast<std::size_t>(j)] = stack_->HeldCommand(t + (j + 1) * stack_->control_period_ns());
   }
   cycle.command.compute_s = ToSeconds(SteadyClock::Monotonic() - start);
-  LockSend();
+  send_lock_.lock();
   cycle.command.sent_t_ns = clock_->Now();
   sink_->Send(cycle);
   const bool first = !have_fresh_;
@@ -356,7 +356,7 @@ void OnboardExecutor::RunCycle(TimeNs t, const RotorVector* recorded) {
   // is handed over, not held forever).
   if (cycle.command.sent_t_ns - t <= deadline_ns_) missed_ = 0;
   have_fresh_ = true;
-  UnlockSend();
+  send_lock_.unlock();
   if (first) guard_bell_.Ring();
   const TimeNs latency = cycle.command.sent_t_ns - t;
   report_.control.Record(t, latency, SteadyClock::Monotonic() - start);
@@ -383,14 +383,6 @@ CycleTelemetry TelemetryOf(const stack::FlightStack& stack, TimeNs t, stack::Fli
   return cycle;
 }
 
-void OnboardExecutor::LockSend() {
-  for (int spins = 0; send_lock_.test_and_set(std::memory_order_acquire); ++spins) {
-    if (spins > 64) std::this_thread::yield();  // a holder that was preempted (no SCHED_FIFO)
-  }
-}
-
-void OnboardExecutor::UnlockSend() { send_lock_.clear(std::memory_order_release); }
-
 std::optional<TimeNs> OnboardExecutor::ArrivalOfSampleAtOrAfter(TimeNs t) const {
   // Newest first, back to the first sample at or after t; the intake overwrites the oldest entry
   // only after kImuArrivals newer samples, far more than an instant's deadline spans.
@@ -414,10 +406,10 @@ void OnboardExecutor::GuardLoop() {
   std::optional<TimeNs> watched;  // the next instant judged at its deadline (only ever later)
   while (!stop_.load(std::memory_order_acquire)) {
     const std::uint32_t seen = guard_bell_.Count();
-    LockSend();
+    send_lock_.lock();
     const bool have = have_fresh_;
     const TimeNs fresh = fresh_.command.state_t_ns;
-    UnlockSend();
+    send_lock_.unlock();
     if (!have) {
       guard_bell_.Wait(seen, kPollNs);
       continue;
@@ -437,9 +429,9 @@ void OnboardExecutor::GuardLoop() {
     if (*arrival > instant) {
       if (!clock_->SleepUntil(*arrival + deadline_ns_ + grace) || stop_.load(std::memory_order_acquire)) break;
     }
-    LockSend();
+    send_lock_.lock();
     if (fresh_.command.state_t_ns >= instant - slack) {
-      UnlockSend();  // the instant's own command came
+      send_lock_.unlock();  // the instant's own command came
       continue;
     }
     // A miss: the last plan's command for the instant, or, once too many came in a row, the
@@ -456,7 +448,7 @@ void OnboardExecutor::GuardLoop() {
       c.command.sent_t_ns = clock_->Now();
       sink_->Send(c);
     }
-    UnlockSend();
+    send_lock_.unlock();
     *watched += period;
     if (e.missed <= options_.hold_periods + 1) {  // the steps of one run of misses, not every one after
       deadline_events_.TryPush(e);

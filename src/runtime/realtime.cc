@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <cerrno>
 #include <cstring>
 
@@ -54,6 +56,40 @@ void UseNormalScheduling() {
   sched_param p{};
   pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
   RunOn([](int) { return true; });
+}
+
+PiMutex::PiMutex() {
+  pthread_mutexattr_t a;
+  pthread_mutexattr_init(&a);
+  const int err = pthread_mutexattr_setprotocol(&a, PTHREAD_PRIO_INHERIT);
+  RG_INVARIANT(err == 0, "PiMutex: priority inheritance is not supported");
+  const int init = pthread_mutex_init(&mutex_, &a);
+  pthread_mutexattr_destroy(&a);
+  RG_INVARIANT(init == 0, "PiMutex: pthread_mutex_init failed");
+}
+
+PiMutex::~PiMutex() { pthread_mutex_destroy(&mutex_); }
+void PiMutex::lock() { RG_INVARIANT(pthread_mutex_lock(&mutex_) == 0, "PiMutex: lock failed"); }
+void PiMutex::unlock() { RG_INVARIANT(pthread_mutex_unlock(&mutex_) == 0, "PiMutex: unlock failed"); }
+
+int RaiseNormalThreads(int priority, int control_cpu) {
+  int moved = 0;
+  std::error_code ec;
+  for (const std::filesystem::directory_entry& e : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+    const pid_t tid = static_cast<pid_t>(std::strtol(e.path().filename().c_str(), nullptr, 10));
+    if (tid <= 0 || sched_getscheduler(tid) != SCHED_OTHER) continue;
+    sched_param p{};
+    p.sched_priority = priority;
+    if (sched_setscheduler(tid, SCHED_FIFO, &p) != 0) continue;
+    ++moved;
+    if (control_cpu >= 0 && control_cpu < OnlineCpus()) {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      CPU_SET(control_cpu, &set);
+      sched_setaffinity(tid, sizeof(set), &set);
+    }
+  }
+  return moved;
 }
 
 bool PinThread(int control_cpu, ThreadRole role) {

@@ -3,9 +3,14 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <pthread.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <optional>
 #include <cmath>
 #include <thread>
 #include <utility>
@@ -162,6 +167,71 @@ TEST(Realtime, ValidatesThePriorityAndReportsWhatItGranted) {
   EXPECT_FALSE(g.memory_locked);
   EXPECT_FALSE(g.fifo);
   EXPECT_EQ(g.note, "memory not locked (not asked), normal scheduler (not asked)");
+}
+
+/// Under SCHED_FIFO on one CPU: a holder at priority 10 takes `lock` and has 20 ms of work left
+/// when a waiter at priority 20 asks for it. Returns whether both finish within 5 s; each run is a
+/// child process, so that a livelock (a lock that spins while its holder cannot run) is killed.
+/// Null when this process may not use SCHED_FIFO.
+template <typename Lock>
+std::optional<bool> FinishesUnderPriorityInversion(int cpu) {
+  const auto fifo = [cpu](int priority) {
+    sched_param p{};
+    p.sched_priority = priority;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    // The priority first: a thread that moved to the CPU first could not run there to raise it.
+    return pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0 &&
+           pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+  };
+  bool permitted = false;
+  std::thread([&] { permitted = fifo(1); }).join();
+  if (!permitted) return std::nullopt;
+  const pid_t child = fork();
+  if (child < 0) return false;
+  if (child == 0) {
+    Lock lock;
+    std::atomic<bool> held{false};
+    std::thread holder([&] {
+      if (!fifo(10)) _exit(2);
+      lock.lock();
+      held = true;
+      const auto cpu_time = [] {
+        timespec ts{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+        return ts.tv_sec + 1e-9 * ts.tv_nsec;
+      };
+      for (const double start = cpu_time(); cpu_time() - start < 0.02;) {
+      }
+      lock.unlock();
+    });
+    while (!held) std::this_thread::yield();
+    std::thread waiter([&] {
+      if (!fifo(20)) _exit(2);  // preempts the holder on their CPU
+      lock.lock();
+      lock.unlock();
+    });
+    waiter.join();
+    holder.join();
+    _exit(0);
+  }
+  for (int k = 0; k < 500; ++k) {
+    int status = 0;
+    if (waitpid(child, &status, WNOHANG) == child) return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    usleep(10'000);
+  }
+  kill(child, SIGKILL);
+  waitpid(child, nullptr, 0);
+  return false;
+}
+
+TEST(Realtime, APriorityInheritingMutexLetsAPreemptedHolderOfLowerPriorityFinish) {
+  // The waiter is started by this thread while the holder runs: it needs a CPU of its own.
+  if (AllowedCpus().size() < 2) GTEST_SKIP() << "needs two CPUs";
+  const std::optional<bool> finished = FinishesUnderPriorityInversion<PiMutex>(AllowedCpus().front());
+  if (!finished) GTEST_SKIP() << "SCHED_FIFO is not permitted here";
+  EXPECT_TRUE(*finished) << "the waiter at priority 20 never got the lock its holder at 10 had";
 }
 
 }  // namespace

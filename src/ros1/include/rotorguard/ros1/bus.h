@@ -1,7 +1,7 @@
 #pragma once
 /// Bus: one ROS 1 node's publishers and subscribers over the wire structs (wire.h), without ROS
-/// in the interface. Callbacks run on the thread that calls Spin (one thread: the messages reach
-/// it in the order they arrived), never on a hidden one.
+/// in the interface. Callbacks run on the thread that calls Spin for their topic's queue (one
+/// thread per queue: its messages reach it in the order they arrived), never on a hidden one.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -23,6 +23,11 @@ struct TopicOptions {
   bool tcp_nodelay = false;
   /// Publisher: the last message goes to every later subscriber (status, static TF, the account).
   bool latch = false;
+  /// Subscriber: the callbacks' queue. kHeavy is for large messages whose conversion takes
+  /// milliseconds (a point cloud): a thread of its own spins it, so that they never hold up the
+  /// small, urgent ones (IMU samples) queued behind them.
+  enum class Queue { kMain, kHeavy };
+  Queue queue = Queue::kMain;
 };
 
 /// Counts of what a subscription refused (a message that does not convert: a NaN, a cloud
@@ -76,9 +81,9 @@ class Bus {
   /// Publishers connected now to this node's subscription of `topic` (0 when it has none).
   std::uint32_t Publishers(const std::string& topic) const;
 
-  /// Calls the callbacks of the messages that arrived, waiting up to `timeout_s` for one; false
-  /// once the node is shutting down.
-  bool Spin(double timeout_s);
+  /// Calls the callbacks of the messages that arrived on `queue`, waiting up to `timeout_s` for
+  /// one; false once the node is shutting down.
+  bool Spin(double timeout_s, TopicOptions::Queue queue = TopicOptions::Queue::kMain);
   /// ROS time now (the /clock when /use_sim_time is set).
   Stamp Now() const;
   /// Whether the node follows /clock.

@@ -6,7 +6,9 @@
 /// Queue sizes: a high-rate input keeps what arrives while the intake is busy for a moment
 /// (200 IMU samples: 0.2 s at 1 kHz); a LiDAR frame keeps two (a frame arriving while the last
 /// one is handed over is not lost, an older one is worth nothing); the cycle topic keeps a
-/// second of cycles, so a recorder misses none; a state topic keeps one, latched.
+/// second of cycles, so a recorder misses none; a state topic keeps one, latched. A LiDAR frame
+/// (20 000 points) is converted on a callback queue of its own (kHeavy), never ahead of an IMU
+/// sample.
 #include <cstdint>
 
 #include "rotorguard/ros1/bus.h"
@@ -21,7 +23,7 @@ struct Topic {
 namespace topics {
 // Inputs: the vehicle's drivers (or `rotorguard sitl --ros`).
 inline constexpr Topic kImu{"imu", {.queue_size = 200, .tcp_nodelay = true}};                       // sensor_msgs/Imu
-inline constexpr Topic kPoints{"points", {.queue_size = 2, .tcp_nodelay = true}};                   // sensor_msgs/PointCloud2
+inline constexpr Topic kPoints{"points", {.queue_size = 2, .tcp_nodelay = true, .queue = ros1::TopicOptions::Queue::kHeavy}};                   // sensor_msgs/PointCloud2
 inline constexpr Topic kEscTelemetry{"esc_telemetry", {.queue_size = 100, .tcp_nodelay = true}};    // rotorguard_msgs/EscTelemetry
 inline constexpr Topic kBattery{"battery", {.queue_size = 5}};                                       // sensor_msgs/BatteryState
 inline constexpr Topic kExternalOdometry{"external_odometry", {.queue_size = 20, .tcp_nodelay = true}};  // nav_msgs/Odometry

@@ -245,6 +245,8 @@ class OnboardExecutor {
   void Stop();
   /// The loops' figures; complete once stopped.
   OnboardReport Report() const;
+  /// What Start was granted (set before its threads start: safe to read while they run).
+  const RealtimeGrant& realtime_grant() const { return report_.realtime; }
   /// Sensor messages the control thread has taken in so far (any thread may ask).
   std::uint64_t messages_taken() const { return messages_taken_.load(std::memory_order_acquire); }
   /// The map's occupied voxels' centres now (any thread but the control thread: it takes the
@@ -292,10 +294,6 @@ class OnboardExecutor {
   void RunCycle(TimeNs t, const RotorVector* recorded = nullptr);
   /// The deadline guard's thread (docs/runtime.md, "Deadline policy").
   void GuardLoop();
-  /// The send lock: the control thread's and the guard's commands never interleave (either
-  /// holds it for a copy and a send only).
-  void LockSend();
-  void UnlockSend();
 
   stack::FlightStack* stack_;
   stack::FlightStack::Tasks tasks_;
@@ -350,8 +348,10 @@ class OnboardExecutor {
   std::shared_mutex map_mutex_;  // the perception writes the map, the planning reads it
   std::atomic<std::shared_ptr<const ReferenceTrajectory>> published_reference_;  // for FollowedReference
 
-  // control <-> deadline guard, under send_lock_ (a spin lock: the holders copy and send only)
-  std::atomic_flag send_lock_;
+  // control <-> deadline guard, under send_lock_: their commands never interleave (either holds it
+  // for a copy and a send only). The guard runs above the control thread, on its CPU when pinned:
+  // priority inheritance lets a control thread it interrupted in there finish.
+  PiMutex send_lock_;
   bool have_fresh_ = false;                         // a cycle's command was sent
   CycleTelemetry fresh_;                            // the last cycle's own command
   std::array<RotorVector, 2> held_;                 // its plan's commands at the next instants

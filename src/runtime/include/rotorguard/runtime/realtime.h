@@ -4,6 +4,7 @@
 /// fault in a control cycle). Both need privileges (CAP_SYS_NICE, CAP_IPC_LOCK or an rtprio /
 /// memlock limit); without them the loop runs under the normal scheduler and says so: the
 /// fallback is reported, never silent.
+#include <pthread.h>
 #include <sched.h>
 
 #include <string>
@@ -58,6 +59,32 @@ class ThreadSchedulingScope {
 /// Sets the calling thread to the normal scheduler on every online CPU: for a thread that must not
 /// inherit its creator's real-time scheduling (a benchmark's background load).
 void UseNormalScheduling();
+
+/// Moves every thread of this process that runs under the normal scheduler to SCHED_FIFO at
+/// `priority` and, when control_cpu names a CPU of this machine, onto that CPU: for the threads a
+/// middleware started before the executor (ROS's network and callback threads), which carry the
+/// sensor messages to the control loop and its commands out. A thread started later inherits its
+/// creator's scheduling. Returns how many threads were moved (0 when refused: no privilege).
+/// Every normal thread: call it where none busy-waits (one would then hold its CPU).
+int RaiseNormalThreads(int priority, int control_cpu);
+
+/// A mutex with priority inheritance (PTHREAD_PRIO_INHERIT): a SCHED_FIFO thread waiting for it
+/// lends its priority to the holder, so that a holder of lower priority on the same CPU runs to
+/// its unlock. A spin lock livelocks there: the waiter spins (or yields, which under SCHED_FIFO
+/// yields only to threads of its own priority) and the holder never runs again. Uncontended, lock
+/// and unlock are an atomic operation each, no system call. For std::lock_guard.
+class PiMutex {
+ public:
+  PiMutex();
+  ~PiMutex();
+  PiMutex(const PiMutex&) = delete;
+  PiMutex& operator=(const PiMutex&) = delete;
+  void lock();
+  void unlock();
+
+ private:
+  pthread_mutex_t mutex_;
+};
 
 /// Which CPUs a thread of the runtime may run on under `control_cpu` (see RealtimeOptions).
 enum class ThreadRole { kTimeCritical, kCompute };
