@@ -36,9 +36,17 @@ void BagRecorder::OnInput(TimeNs t, const runtime::SensorMessage& m) {
   }
 }
 
-void BagRecorder::OnFrame(TimeNs t, const LidarFrame& frame) {
+void BagRecorder::OnFrame(TimeNs t, const LidarFrame& frame) { WriteFrame(ReserveInput(t), frame); }
+
+ros1::Stamp BagRecorder::ReserveInput(TimeNs t) {
   const std::lock_guard lock(mutex_);
-  bag_.Write(topics::kPoints.name, InputTime(t), ToWire(frame, base_));
+  return InputTime(t);
+}
+
+void BagRecorder::WriteFrame(ros1::Stamp at, const LidarFrame& frame) {
+  const ros1::Cloud cloud = ToWire(frame, base_);  // the long part, before the lock
+  const std::lock_guard lock(mutex_);
+  bag_.Write(topics::kPoints.name, at, cloud);
 }
 
 void BagRecorder::OnSensors(TimeNs t, const sim::SensorOutputs& o) {

@@ -288,15 +288,18 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     if (!oversize && started.load(std::memory_order_acquire)) {
       frame = std::make_shared<const LidarFrame>(FromWire(m, *base, frame_period));  // the long part, unlocked
     }
-    const std::lock_guard lock(intake);
-    if (oversize) {
-      guard.Oversize(topics::kPoints.name, steady(),
-                     fmt::format("a frame of {} points, more than the budget of {}", m.points.size(), options.max_frame_points));
-      return;
+    std::optional<ros1::Stamp> bag_at;  // the frame's place in the bag, taken in order
+    {
+      const std::lock_guard lock(intake);
+      if (oversize) {
+        guard.Oversize(topics::kPoints.name, steady(),
+                       fmt::format("a frame of {} points, more than the budget of {}", m.points.size(), options.max_frame_points));
+        return;
+      }
+      if (!accept(topics::kPoints.name, m.stamp)) return;
+      if (executor->OnLidar(frame) && bag) bag_at = bag->ReserveInput(arrival());
     }
-    if (!accept(topics::kPoints.name, m.stamp)) return;
-    // With --bag the frame is converted for the bag here, under the lock (ToWire of 20 000 points).
-    if (executor->OnLidar(frame) && bag) bag->OnFrame(arrival(), *frame);
+    if (bag_at) bag->WriteFrame(*bag_at, *frame);  // converted for the bag outside the intake's lock
   });
   // The point clouds' queue: a conversion of milliseconds, never ahead of an IMU sample. Once the
   // mission starts it runs beside the perception (its priority, its CPUs).

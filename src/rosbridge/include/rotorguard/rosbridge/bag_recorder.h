@@ -25,6 +25,11 @@ class BagRecorder final : public harness::StackObserver {
   /// One sensor message (IMU, ESC telemetry or odometry) or frame taken in at `t`.
   void OnInput(TimeNs t, const runtime::SensorMessage& message);
   void OnFrame(TimeNs t, const LidarFrame& frame);
+  /// OnFrame in two steps, for an intake that must not wait for a frame's conversion (20 000
+  /// points): its place among the inputs, taken in order (under the intake's lock), then the frame
+  /// written there from any thread (a bag is read back in time order).
+  ros1::Stamp ReserveInput(TimeNs t);
+  void WriteFrame(ros1::Stamp at, const LidarFrame& frame);
   const std::string& path() const { return bag_.path(); }
 
  private:
