@@ -1,8 +1,6 @@
 #include "rotorguard/rosbridge/ros_node.h"
 
 #include <fmt/format.h>
-#include <pthread.h>
-#include <sched.h>
 #include <signal.h>
 #include <time.h>
 
@@ -309,12 +307,8 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     while (!stop_heavy.load(std::memory_order_acquire) && bus.Spin(0.01, ros1::TopicOptions::Queue::kHeavy)) {
       if (scheduled || !started.load(std::memory_order_acquire)) continue;
       scheduled = true;
-      if (executor->realtime_grant().fifo) {
-        sched_param p{};
-        p.sched_priority = std::max(1, options.realtime.fifo_priority - 1);
-        pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
-      }
-      runtime::PinThread(options.realtime.control_cpu, runtime::ThreadRole::kCompute);
+      runtime::FollowRealtime(executor->realtime_grant().fifo ? options.realtime.fifo_priority - 1 : 0,
+                              options.realtime.control_cpu, runtime::ThreadRole::kCompute);
     }
   });
   // Joined on every way out (an exception from here on included).
@@ -401,12 +395,8 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
       // The map's copy is long: beside the planning (its priority, its CPUs), never at the intake's.
       // Not the normal scheduler: roscpp serialises every publication under one mutex without
       // priority inheritance, and a command's publication would wait behind a starved map.
-      if (grant.fifo) {
-        sched_param p{};
-        p.sched_priority = std::max(1, options.realtime.fifo_priority - 2);
-        pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
-      }
-      runtime::PinThread(options.realtime.control_cpu, runtime::ThreadRole::kCompute);
+      runtime::FollowRealtime(grant.fifo ? options.realtime.fifo_priority - 2 : 0, options.realtime.control_cpu,
+                              runtime::ThreadRole::kCompute);
       while (!stop_publishing.load(std::memory_order_acquire)) {
         const std::uint32_t seen = slow_bell.Count();
         const std::shared_ptr<const ReferenceTrajectory> followed = executor->FollowedReference();

@@ -26,15 +26,6 @@ double ThreadCpuSeconds() {
 /// How long a thread sleeps on its doorbell before it looks at the stop flag again.
 constexpr TimeNs kPollNs = 20'000'000;
 
-/// SCHED_FIFO at `priority` for the calling thread when permitted (RequestRealtime reported the
-/// process's grant; the other threads follow it quietly).
-void FollowFifo(int priority) {
-  if (priority <= 0) return;
-  sched_param p{};
-  p.sched_priority = priority;
-  pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
-}
-
 }  // namespace
 
 void OnboardExecutorOptions::Validate() const {
@@ -135,8 +126,7 @@ void OnboardExecutor::Start() {
   // above it) on the CPUs of its role, then its loop.
   const auto start = [this, priority](const char* name, int below, ThreadRole role, void (OnboardExecutor::*loop)()) {
     return std::thread([this, priority, name, below, role, loop] {
-      FollowFifo(priority > 0 ? std::clamp(priority - below, 1, sched_get_priority_max(SCHED_FIFO)) : 0);
-      PinThread(options_.realtime.control_cpu, role);
+      FollowRealtime(priority > 0 ? std::max(priority - below, 1) : 0, options_.realtime.control_cpu, role);
       if (options_.on_thread_start) options_.on_thread_start(name);
       (this->*loop)();
     });

@@ -98,6 +98,15 @@ bool PinThread(int control_cpu, ThreadRole role) {
   return RunOn([&](int cpu) { return (cpu == control_cpu) == (role == ThreadRole::kTimeCritical); });
 }
 
+void FollowRealtime(int priority, int control_cpu, ThreadRole role) {
+  if (priority > 0) {
+    sched_param p{};
+    p.sched_priority = std::clamp(priority, 1, sched_get_priority_max(SCHED_FIFO));
+    pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+  }
+  PinThread(control_cpu, role);
+}
+
 RealtimeGrant RequestRealtime(const RealtimeOptions& options) {
   options.Validate();
   RealtimeGrant g;

@@ -92,4 +92,9 @@ enum class ThreadRole { kTimeCritical, kCompute };
 /// this machine does not have, or the machine has one CPU (a compute thread keeps all).
 bool PinThread(int control_cpu, ThreadRole role);
 
+/// A thread of a real-time program, after RequestRealtime reported the process's grant: the
+/// calling thread at SCHED_FIFO `priority` when it is > 0 (clamped to [1, 99]; a refusal leaves
+/// its scheduler as it was), then pinned by its role (PinThread).
+void FollowRealtime(int priority, int control_cpu, ThreadRole role);
+
 }  // namespace rotorguard::runtime
