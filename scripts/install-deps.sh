@@ -28,6 +28,9 @@ packages=(
   # ROS 1 (docs/ros.md): roscpp, the message generators, roscore, rostopic and rosbag's tools
   # (ros-core-dev), rosbag's C++ library, and tf2's messages; the build turns ROS on when they are here.
   ros-core-dev librosbag-dev libtf2-msgs-dev
+  # the Python message classes `rostopic echo` needs for the node's outputs (odometry and path,
+  # RViz markers; the tests echo them): ros-core-dev brings the C++ ones only
+  python3-nav-msgs python3-visualization-msgs python3-sensor-msgs
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-14-dev)  # libFuzzer, with AddressSanitizer (docs/reliability.md)

@@ -103,12 +103,13 @@ nlohmann::json HistogramJson(const runtime::LatencyHistogram& h) {
           {"mean_ms", 1e3 * h.mean_s()}};
 }
 
-/// The slowest records, slowest first: the instant [s], its latency and compute [ms].
+/// The slowest records, slowest first: the instant [s], its latency, compute and inbound share [ms].
 nlohmann::json SlowestJson(const runtime::SlowestRecords& s) {
   nlohmann::json j = nlohmann::json::array();
   for (std::size_t i = 0; i < s.size(); ++i) {
     j.push_back({{"t_s", ToSeconds(s[i].t_ns)}, {"latency_ms", 1e-6 * static_cast<double>(s[i].latency_ns)},
-                 {"compute_ms", 1e-6 * static_cast<double>(s[i].compute_ns)}});
+                 {"compute_ms", 1e-6 * static_cast<double>(s[i].compute_ns)},
+                 {"inbound_ms", 1e-6 * static_cast<double>(s[i].inbound_ns)}});
   }
   return j;
 }

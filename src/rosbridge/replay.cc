@@ -173,10 +173,10 @@ ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_p
   runtime::OnboardExecutor executor(&st, &clock, &sink, eo);
   const TimeNs control_period = st.control_period_ns();
   TimeNs next_control = 0;
-  // The cycles so far, taken from the sink (as they come: its queue is bounded).
   // sensors.csv: every message handed over, and each cycle's command as it comes.
   const bool writes = !options.out_dir.empty();
   std::string sensor_log(writes ? record::kSensorLogHeader : "");
+  // The cycles so far, taken from the sink (as they come: its queue is bounded).
   const auto drain = [&] {
     for (runtime::CycleTelemetry c; sink.TryReceive(&c);) {
       r.cycles.push_back(c);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <mutex>
@@ -15,6 +16,7 @@
 #include "rotorguard/rosbridge/topics.h"
 #include "rotorguard/rosbridge/wire_convert.h"
 #include "rotorguard/runtime/clock.h"
+#include "rotorguard/runtime/realtime.h"
 #include "rotorguard/runtime/spsc_queue.h"
 
 namespace rotorguard::rosbridge {
@@ -25,6 +27,8 @@ class RosLink final : public harness::StackLink {
  public:
   RosLink(const harness::SitlOptions& sitl, const runtime::OnboardExecutorOptions& executor, const RosLinkOptions& options)
       : options_(options),
+        realtime_(executor.realtime),
+        threads_before_bus_(runtime::ThreadIds()),
         bus_({.node_name = "rotorguard_sim", .master_uri = options.master_uri, .master_timeout_s = 10.0, .remappings = {}}),
         rate_(sitl.realtime_factor),
         clock_pub_(bus_.Advertise<ros1::ClockTick>(topics::kClock.name, topics::kClock.options)),
@@ -83,6 +87,18 @@ class RosLink final : public harness::StackLink {
     // ... and the node's cycles connected to the simulator before the first one is sent.
     WaitUntil([this] { return bus_.Publishers(topics::kControlCycle.name) > 0; }, options_.node_timeout_s,
               "advertise its control cycles");
+    // The simulator stands for the drivers, its thread at the control thread's priority: ROS's
+    // threads here write every message it publishes (roscpp's network thread does the sending)
+    // and take the commands in, so they follow just below it, on its CPU. At the normal
+    // scheduler, between real-time threads on every CPU, they waited up to tens of milliseconds.
+    // Only ROS's threads: the process may run others (a benchmark's load) that must stay normal.
+    if (realtime_.fifo_priority > 0) {
+      std::vector<pid_t> added;
+      for (const pid_t tid : runtime::ThreadIds()) {
+        if (std::find(threads_before_bus_.begin(), threads_before_bus_.end(), tid) == threads_before_bus_.end()) added.push_back(tid);
+      }
+      runtime::RaiseThreads(added, std::max(1, realtime_.fifo_priority - 1), realtime_.control_cpu);
+    }
     steady_.emplace(runtime::SteadyClock::Monotonic() + kLeadNs, rate_);
     steady_clock_.store(&*steady_, std::memory_order_release);
     start_.Publish({base_.origin});
@@ -139,6 +155,8 @@ class RosLink final : public harness::StackLink {
   }
 
   RosLinkOptions options_;
+  runtime::RealtimeOptions realtime_;
+  std::vector<pid_t> threads_before_bus_;  // the process's threads before ROS started its own
   ros1::Bus bus_;
   double rate_;
   TimeBase base_;

@@ -5,8 +5,9 @@
 #include <time.h>
 
 #include <algorithm>
-#include <limits>
 #include <atomic>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -32,6 +33,32 @@ namespace {
 
 std::atomic<bool> g_signalled{false};
 void OnSignal(int) { g_signalled.store(true); }
+
+/// A thread of the node that is told to stop and joined when it goes (on every way out, an
+/// exception included), or earlier by Join(), in the order the shutdown needs.
+class StoppingThread {
+ public:
+  StoppingThread() = default;
+  /// `stop` tells `body` to return (a flag, a doorbell).
+  StoppingThread(std::function<void()> stop, std::function<void()> body) : stop_(std::move(stop)), thread_(std::move(body)) {}
+  StoppingThread(StoppingThread&&) noexcept = default;
+  StoppingThread& operator=(StoppingThread&& other) noexcept {
+    Join();
+    stop_ = std::move(other.stop_);
+    thread_ = std::move(other.thread_);
+    return *this;
+  }
+  ~StoppingThread() { Join(); }
+  void Join() {
+    if (!thread_.joinable()) return;
+    stop_();
+    thread_.join();
+  }
+
+ private:
+  std::function<void()> stop_;
+  std::thread thread_;
+};
 
 /// The node's clock: ROS time less the mission's start.
 ///
@@ -302,7 +329,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   // The point clouds' queue: a conversion of milliseconds, never ahead of an IMU sample. Once the
   // mission starts it runs beside the perception (its priority, its CPUs).
   std::atomic<bool> stop_heavy{false};
-  std::thread heavy([&] {
+  StoppingThread heavy([&] { stop_heavy.store(true, std::memory_order_release); }, [&] {
     bool scheduled = false;
     while (!stop_heavy.load(std::memory_order_acquire) && bus.Spin(0.01, ros1::TopicOptions::Queue::kHeavy)) {
       if (scheduled || !started.load(std::memory_order_acquire)) continue;
@@ -311,15 +338,6 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
                               options.realtime.control_cpu, runtime::ThreadRole::kCompute);
     }
   });
-  // Joined on every way out (an exception from here on included).
-  struct Joiner {
-    std::atomic<bool>* stop;
-    std::thread* thread;
-    ~Joiner() {
-      stop->store(true, std::memory_order_release);
-      if (thread->joinable()) thread->join();
-    }
-  } heavy_joiner{&stop_heavy, &heavy};
   double battery_v = 0.0;
   bus.Subscribe<ros1::Battery>(topics::kBattery.name, topics::kBattery.options, [&](const ros1::Battery& m) {
     const std::lock_guard lock(intake);
@@ -348,7 +366,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
   // Until the mission starts: wait (the intake counts what comes before).
   while (!start && shutdown.empty() && !g_signalled.load() && bus.Spin(0.01)) {
   }
-  std::thread publisher;
+  StoppingThread publisher;
   std::atomic<bool> stop_publishing{false};
   if (start) {
     base = TimeBase{*start};
@@ -360,7 +378,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     eo.realtime = options.realtime;
     executor = std::make_unique<runtime::OnboardExecutor>(&st, clock.get(), &sink, eo);
     // ROS's publish serialises and allocates: on a thread of its own, never the control thread's.
-    publisher = std::thread([&] {
+    publisher = StoppingThread([&] { stop_publishing.store(true, std::memory_order_release); sink.bell().Ring(); }, [&] {
       for (;;) {
         const std::uint32_t seen = sink.bell().Count();
         runtime::CycleTelemetry c;
@@ -391,7 +409,7 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
     // frame is inserted; the intake and the commands never wait for it): the path followed and
     // the map.
     runtime::Doorbell slow_bell;
-    std::thread slow([&] {
+    StoppingThread slow([&] { stop_publishing.store(true, std::memory_order_release); slow_bell.Ring(); }, [&] {
       // The map's copy is long: beside the planning (its priority, its CPUs), never at the intake's.
       // Not the normal scheduler: roscpp serialises every publication under one mutex without
       // priority inheritance, and a command's publication would wait behind a starved map.
@@ -419,15 +437,11 @@ nlohmann::json RunRosNode(const harness::Scenario& scenario, const RosNodeOption
         fmt::print(stderr, "node: no message on '{}' for more than its limit\n", topic);
       }
     }
-    stop_publishing.store(true, std::memory_order_release);
-    slow_bell.Ring();
-    slow.join();
-    stop_heavy.store(true, std::memory_order_release);
-    heavy.join();
+    slow.Join();
+    heavy.Join();
     clock->Stop();
     executor->Stop();
-    sink.bell().Ring();
-    publisher.join();
+    publisher.Join();  // after the executor: it sends the last cycles
     if (bag) bag->Finish();
   }
   nlohmann::json account = harness::NodeAccountJson(st, executor ? executor->Report() : runtime::OnboardReport{});

@@ -55,12 +55,12 @@ void LatencyHistogram::Merge(const LatencyHistogram& other) {
   sum_s_ += other.sum_s_;
 }
 
-void SlowestRecords::Add(TimeNs t_ns, TimeNs latency_ns, TimeNs compute_ns) noexcept {
+void SlowestRecords::Add(TimeNs t_ns, TimeNs latency_ns, TimeNs compute_ns, TimeNs inbound_ns) noexcept {
   if (size_ == kKept && latency_ns <= records_[kKept - 1].latency_ns) return;
   // Insertion into the sorted few: the new record's place, the slower ones before it.
   std::size_t i = size_ < kKept ? size_++ : kKept - 1;
   for (; i > 0 && records_[i - 1].latency_ns < latency_ns; --i) records_[i] = records_[i - 1];
-  records_[i] = {t_ns, latency_ns, compute_ns};
+  records_[i] = {t_ns, latency_ns, compute_ns, inbound_ns};
 }
 
 }  // namespace rotorguard::runtime

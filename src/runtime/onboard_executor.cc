@@ -349,7 +349,8 @@ void OnboardExecutor::RunCycle(TimeNs t, const RotorVector* recorded) {
   send_lock_.unlock();
   if (first) guard_bell_.Ring();
   const TimeNs latency = cycle.command.sent_t_ns - t;
-  report_.control.Record(t, latency, SteadyClock::Monotonic() - start);
+  const std::optional<TimeNs> arrival = ArrivalOfSampleAtOrAfter(t);  // none in a script's replay
+  report_.control.Record(t, latency, SteadyClock::Monotonic() - start, arrival ? std::max<TimeNs>(0, *arrival - t) : 0);
   if (latency > deadline_ns_) ++report_.control.misses;
 }
 

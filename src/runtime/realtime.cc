@@ -72,12 +72,20 @@ PiMutex::~PiMutex() { pthread_mutex_destroy(&mutex_); }
 void PiMutex::lock() { RG_INVARIANT(pthread_mutex_lock(&mutex_) == 0, "PiMutex: lock failed"); }
 void PiMutex::unlock() { RG_INVARIANT(pthread_mutex_unlock(&mutex_) == 0, "PiMutex: unlock failed"); }
 
-int RaiseNormalThreads(int priority, int control_cpu) {
-  int moved = 0;
+std::vector<pid_t> ThreadIds() {
+  std::vector<pid_t> tids;
   std::error_code ec;
   for (const std::filesystem::directory_entry& e : std::filesystem::directory_iterator("/proc/self/task", ec)) {
     const pid_t tid = static_cast<pid_t>(std::strtol(e.path().filename().c_str(), nullptr, 10));
-    if (tid <= 0 || sched_getscheduler(tid) != SCHED_OTHER) continue;
+    if (tid > 0) tids.push_back(tid);
+  }
+  return tids;
+}
+
+int RaiseThreads(const std::vector<pid_t>& tids, int priority, int control_cpu) {
+  int moved = 0;
+  for (const pid_t tid : tids) {
+    if (sched_getscheduler(tid) != SCHED_OTHER) continue;
     sched_param p{};
     p.sched_priority = priority;
     if (sched_setscheduler(tid, SCHED_FIFO, &p) != 0) continue;
@@ -91,6 +99,8 @@ int RaiseNormalThreads(int priority, int control_cpu) {
   }
   return moved;
 }
+
+int RaiseNormalThreads(int priority, int control_cpu) { return RaiseThreads(ThreadIds(), priority, control_cpu); }
 
 bool PinThread(int control_cpu, ThreadRole role) {
   const int online = OnlineCpus();

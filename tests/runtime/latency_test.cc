@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <optional>
 #include <cmath>
 #include <thread>
@@ -88,7 +89,7 @@ TEST(SlowestRecords, KeepsTheSlowestWithTheirInstantsSlowestFirst) {
   for (TimeNs t = 0; t < 1000; ++t) {
     const auto latency = static_cast<TimeNs>(rng.Uniform(0.0, 1e7));
     all.emplace_back(latency, t);
-    s.Add(t, latency, latency / 2);
+    s.Add(t, latency, latency / 2, latency / 3);
     EXPECT_EQ(s.size(), std::min<std::size_t>(all.size(), SlowestRecords::kKept));
   }
   // The oracle: all records sorted by latency, the first kKept.
@@ -97,6 +98,7 @@ TEST(SlowestRecords, KeepsTheSlowestWithTheirInstantsSlowestFirst) {
     EXPECT_EQ(s[i].latency_ns, all[i].first) << i;
     EXPECT_EQ(s[i].t_ns, all[i].second) << i;
     EXPECT_EQ(s[i].compute_ns, all[i].first / 2) << i;
+    EXPECT_EQ(s[i].inbound_ns, all[i].first / 3) << i;
   }
   EXPECT_EQ(s.max_ns(), all.front().first);
 }
@@ -167,6 +169,39 @@ TEST(Realtime, ValidatesThePriorityAndReportsWhatItGranted) {
   EXPECT_FALSE(g.memory_locked);
   EXPECT_FALSE(g.fifo);
   EXPECT_EQ(g.note, "memory not locked (not asked), normal scheduler (not asked)");
+}
+
+TEST(Realtime, RaisesTheListedNormalThreadsOnlyOntoTheControlCpu) {
+  // Two waiting threads; only the first is listed (as a middleware's threads are, beside a load
+  // that must stay normal).
+  std::atomic<pid_t> listed{0}, other{0};
+  std::atomic<bool> done{false};
+  const auto park = [&](std::atomic<pid_t>* tid) {
+    tid->store(gettid());
+    while (!done.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  };
+  std::thread a(park, &listed), b(park, &other);
+  while (listed.load() == 0 || other.load() == 0) std::this_thread::yield();
+  const std::vector<pid_t> ids = ThreadIds();
+  EXPECT_NE(std::find(ids.begin(), ids.end(), listed.load()), ids.end());
+  EXPECT_NE(std::find(ids.begin(), ids.end(), other.load()), ids.end());
+  EXPECT_NE(std::find(ids.begin(), ids.end(), gettid()), ids.end());
+  const int cpu = AllowedCpus().front();
+  const int moved = RaiseThreads({listed.load()}, 1, cpu);
+  const int listed_policy = sched_getscheduler(listed.load()), other_policy = sched_getscheduler(other.load());
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  sched_getaffinity(listed.load(), sizeof(set), &set);
+  done = true;
+  a.join();
+  b.join();
+  EXPECT_EQ(other_policy, SCHED_OTHER);
+  if (moved == 0) GTEST_SKIP() << "SCHED_FIFO is not permitted here";
+  EXPECT_EQ(moved, 1);
+  EXPECT_EQ(listed_policy, SCHED_FIFO);
+  EXPECT_EQ(CPU_COUNT(&set), 1);
+  EXPECT_TRUE(CPU_ISSET(cpu, &set));
+  EXPECT_EQ(RaiseThreads({}, 1, cpu), 0);
 }
 
 /// Under SCHED_FIFO on one CPU: a holder at priority 10 takes `lock` and has 20 ms of work left

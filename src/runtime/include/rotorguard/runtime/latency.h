@@ -50,8 +50,12 @@ class SlowestRecords {
     TimeNs t_ns = 0;        ///< the instant (a cycle's sample, a frame's end, a step's start)
     TimeNs latency_ns = 0;  ///< what was slow about it
     TimeNs compute_ns = 0;  ///< the work itself in it, where the loop measures it (else 0)
+    /// Of the latency, the part before the loop had its input, where the loop knows it (else 0):
+    /// the control loop's IMU sample from its instant to its arrival at the intake (the sensor's
+    /// and the transport's share; the rest less the compute is the wait for the loop's thread).
+    TimeNs inbound_ns = 0;
   };
-  void Add(TimeNs t_ns, TimeNs latency_ns, TimeNs compute_ns = 0) noexcept;
+  void Add(TimeNs t_ns, TimeNs latency_ns, TimeNs compute_ns = 0, TimeNs inbound_ns = 0) noexcept;
   /// The kept records, slowest first.
   std::size_t size() const { return size_; }
   const Record& operator[](std::size_t i) const { return records_[i]; }

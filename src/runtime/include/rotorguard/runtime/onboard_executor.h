@@ -202,12 +202,13 @@ struct LoopReport {
   SlowestRecords slowest;        ///< the slowest latencies with their instants and compute
   double cpu_s = 0.0;            ///< the thread's CPU time
   std::uint64_t dropped = 0;     ///< inputs refused by a full queue
-  /// One run at instant t: its latency and its compute, into the histograms and the slowest few.
-  void Record(TimeNs t, TimeNs latency_ns, TimeNs compute_ns) noexcept {
+  /// One run at instant t: its latency and its compute, into the histograms and the slowest few
+  /// (with the latency's inbound share, SlowestRecords::Record).
+  void Record(TimeNs t, TimeNs latency_ns, TimeNs compute_ns, TimeNs inbound_ns = 0) noexcept {
     ++runs;
     latency.Record(latency_ns);
     compute.Record(compute_ns);
-    slowest.Add(t, latency_ns, compute_ns);
+    slowest.Add(t, latency_ns, compute_ns, inbound_ns);
   }
 };
 

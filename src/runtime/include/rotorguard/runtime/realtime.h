@@ -8,6 +8,7 @@
 #include <sched.h>
 
 #include <string>
+#include <vector>
 
 namespace rotorguard::runtime {
 
@@ -67,6 +68,13 @@ void UseNormalScheduling();
 /// creator's scheduling. Returns how many threads were moved (0 when refused: no privilege).
 /// Every normal thread: call it where none busy-waits (one would then hold its CPU).
 int RaiseNormalThreads(int priority, int control_cpu);
+
+/// The ids of this process's threads (/proc/self/task), in no particular order.
+std::vector<pid_t> ThreadIds();
+/// RaiseNormalThreads for the threads of `tids` only (those still alive and under the normal
+/// scheduler): for a middleware's threads in a process that has others that must stay normal (a
+/// benchmark's background load), found as the threads its start added (ThreadIds before and after).
+int RaiseThreads(const std::vector<pid_t>& tids, int priority, int control_cpu);
 
 /// A mutex with priority inheritance (PTHREAD_PRIO_INHERIT): a SCHED_FIFO thread waiting for it
 /// lends its priority to the holder, so that a holder of lower priority on the same CPU runs to
