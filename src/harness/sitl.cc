@@ -117,6 +117,7 @@ nlohmann::json SlowestJson(const runtime::SlowestRecords& s) {
 nlohmann::json LoopJson(const runtime::LoopReport& r) {
   return {{"runs", r.runs},
           {"deadline_misses", r.misses},
+          {"deadline_misses_late_input", r.misses_late_input},
           {"miss_rate", r.runs ? static_cast<double>(r.misses) / static_cast<double>(r.runs) : 0.0},
           {"latency", HistogramJson(r.latency)},
           {"compute", HistogramJson(r.compute)},

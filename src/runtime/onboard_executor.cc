@@ -78,7 +78,7 @@ OnboardExecutor::~OnboardExecutor() { Stop(); }
 bool OnboardExecutor::Intake(SensorMessage m) {
   m.seq = messages_in_;
   if (!intake_.TryPush(m)) return false;
-  if (m.kind == SensorMessage::Kind::kImu && policy_) {
+  if (m.kind == SensorMessage::Kind::kImu) {  // for the guard, and the report's inbound share
     const std::uint64_t n = imu_written_.load(std::memory_order_relaxed);
     ImuArrival& a = imu_arrivals_[n % kImuArrivals];
     a.arrival.store(clock_->Now(), std::memory_order_relaxed);
@@ -350,8 +350,12 @@ void OnboardExecutor::RunCycle(TimeNs t, const RotorVector* recorded) {
   if (first) guard_bell_.Ring();
   const TimeNs latency = cycle.command.sent_t_ns - t;
   const std::optional<TimeNs> arrival = ArrivalOfSampleAtOrAfter(t);  // none in a script's replay
-  report_.control.Record(t, latency, SteadyClock::Monotonic() - start, arrival ? std::max<TimeNs>(0, *arrival - t) : 0);
-  if (latency > deadline_ns_) ++report_.control.misses;
+  const TimeNs inbound = arrival ? std::max<TimeNs>(0, *arrival - t) : 0;
+  report_.control.Record(t, latency, SteadyClock::Monotonic() - start, inbound);
+  if (latency > deadline_ns_) {
+    ++report_.control.misses;
+    if (latency - inbound <= deadline_ns_) ++report_.control.misses_late_input;
+  }
 }
 
 CycleTelemetry TelemetryOf(const stack::FlightStack& stack, TimeNs t, stack::FlightMode mode, const RotorVector& thrust_n) {

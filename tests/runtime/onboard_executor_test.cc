@@ -159,6 +159,11 @@ TEST_F(ExecutorTest, ACommandSentMoreThanAPeriodAfterItsImuSampleIsADeadlineMiss
   EXPECT_EQ(r.control.runs, 2u);
   EXPECT_EQ(r.control.misses, 1u);
   EXPECT_NEAR(r.control.latency.max_s(), 7e-3, 1e-9);
+  // The 7 ms were the sample's way in: sent at its arrival, the miss is its input's.
+  EXPECT_EQ(r.control.misses_late_input, 1u);
+  ASSERT_GE(r.control.slowest.size(), 1u);
+  EXPECT_EQ(r.control.slowest[0].t_ns, 0);
+  EXPECT_EQ(r.control.slowest[0].inbound_ns, 7 * kMs);
 }
 
 TEST_F(ExecutorTest, OnTheClockEachInstantRunsACycleWithTheMessagesInByThen) {
@@ -240,6 +245,9 @@ TEST_F(DeadlinePolicyTest, ALateCycleIsHeldOnItsPlanForTwoInstantsThenTheFallbac
   const OnboardReport r = executor_->Report();
   EXPECT_EQ(r.holds, 2u);
   EXPECT_EQ(r.fallbacks, 1u);
+  // The stalled cycle's sample came in time: its miss is the computer's.
+  EXPECT_EQ(r.control.misses, 1u);
+  EXPECT_EQ(r.control.misses_late_input, 0u);
   const stack::FlightStackSummary s = stack_.Summarize();
   ASSERT_EQ(s.deadline_events.size(), 3u);
   const std::vector<double> at = {0.005, 0.010, 0.015};

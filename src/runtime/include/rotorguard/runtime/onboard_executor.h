@@ -196,6 +196,10 @@ struct OnboardExecutorOptions {
 struct LoopReport {
   std::uint64_t runs = 0;        ///< cycles, frames or planning calls
   std::uint64_t misses = 0;      ///< control: deadline misses
+  /// control: of the misses, those whose sample came so late that the command, sent within the
+  /// deadline of the sample's arrival at the intake, still missed it (the delay was the sensor's
+  /// or the transport's, not the stack's)
+  std::uint64_t misses_late_input = 0;
   std::uint64_t skipped = 0;     ///< control: instants passed without a cycle (the thread was late)
   LatencyHistogram latency;      ///< control: IMU capture -> command sent; perception: frame end -> update published
   LatencyHistogram compute;      ///< the work itself, on the steady clock
@@ -359,7 +363,8 @@ class OnboardExecutor {
   int missed_ = 0;  // instants in a row whose deadline passed without their command (the guard counts, a timely command resets)
   // The intake's IMU samples, stamp and arrival on the clock, the newest kImuArrivals of them: an
   // instant's deadline runs from its sample's arrival when that came late (a sensor burst is not
-  // a late computer). Written by the intake thread only; imu_written_ counts the entries.
+  // a late computer), and a cycle's report splits its latency there. Written by the intake
+  // thread only; imu_written_ counts the entries.
   static constexpr std::size_t kImuArrivals = 128;
   struct ImuArrival {
     std::atomic<TimeNs> stamp{0}, arrival{0};
