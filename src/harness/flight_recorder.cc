@@ -116,11 +116,11 @@ void AppendCycleRow(const runtime::CycleTelemetry& c, const perception::LioFrame
   if (lio_frame) PutLio(*lio_frame, put);
 }
 
-void PrepareRunFolder(const std::string& dir, std::initializer_list<const char*> outputs) {
+void PrepareRunFolder(const std::string& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error(fmt::format("cannot create {}: {}", dir, ec.message()));
-  for (const char* name : outputs) fs::remove(InFolder(dir, name), ec);
+  for (const char* name : kRunFolderFiles) fs::remove(InFolder(dir, name), ec);
 }
 
 FlightRecorder::FlightRecorder(const FlightRecorderOptions& options, const Scenario& scenario)
@@ -129,8 +129,7 @@ FlightRecorder::FlightRecorder(const FlightRecorderOptions& options, const Scena
       log_period_ns_(PeriodFromRate(scenario.log_rate_hz)),
       scene_(scenario.vehicle, scenario.world, {}, scenario.assembly.get()) {
   if (!writes()) return;
-  PrepareRunFolder(options_.out_dir,
-                   {"summary.json", "report.html", "flight.mcap", "log.csv", "scene.json", "sensors.csv"});
+  PrepareRunFolder(options_.out_dir);
   if (options_.log_format != LogFormat::kMcap) {
     sensors_.emplace(InFolder(options_.out_dir, "sensors.csv"));
     sensor_buffer_ = record::kSensorLogHeader;

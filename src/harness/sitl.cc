@@ -373,7 +373,6 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   const Scenario sc = Flown(scenario);
   // The run's folder as `run` writes it (summary, log, scene, sensors, report), and runtime.json.
   FlightRecorder recorder(options, sc);
-  if (!options.out_dir.empty()) PrepareRunFolder(options.out_dir, {"runtime.json"});
   const sim::TruthDraw draw = sim::DrawTruth(sc.truth, sc.vehicle, sc.seed);
   const vehicle::MultirotorModel truth(sim::TruthVehicle(sc.vehicle, draw), sim::ThrustRatios(draw));
   sim::Simulator sim = MakeSimulator(sc, truth, draw);

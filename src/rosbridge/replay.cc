@@ -134,10 +134,7 @@ void WriteRunFolder(const harness::NodeStack& node, const ReplaySummary& r, cons
 }  // namespace
 
 ReplaySummary Replay(const harness::Scenario& scenario, const std::string& bag_path, const ReplayOptions& options) {
-  if (!options.out_dir.empty()) {
-    harness::PrepareRunFolder(options.out_dir,
-                              {"summary.json", "report.html", "log.csv", "scene.json", "sensors.csv", "vehicle.yaml"});
-  }
+  if (!options.out_dir.empty()) harness::PrepareRunFolder(options.out_dir);
   const Stopwatch wall;
   harness::NodeStack node = harness::MakeNodeStack(scenario);
   stack::FlightStack& st = *node.stack;

@@ -6,8 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
+#include "rotorguard/harness/flight_recorder.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/stack/flight_stack.h"
@@ -76,6 +80,22 @@ TEST(Flight, ACommandOfTheWrongSizeOrNotFiniteIsRefusedAndNothingIsFlown) {
   nan[2] = std::nan("");
   EXPECT_THROW(flight.StepControlPeriod(&nan), std::invalid_argument);
   EXPECT_EQ(flight.steps_taken(), 0);
+}
+
+using RunFolderTest = testing::TempFolderTest;
+
+TEST_F(RunFolderTest, PreparingARunFolderRemovesEveryRunFileAnEarlierRunLeftAndNothingElse) {
+  // Every file any command writes, hand-listed (so that the list cannot lose one unnoticed).
+  const std::vector<std::string> run_files = {"summary.json", "report.html", "flight.mcap",
+                                              "log.csv",      "scene.json",  "sensors.csv",
+                                              "vehicle.yaml", "truth_vehicle.yaml", "runtime.json"};
+  for (const std::string& f : run_files) Write(f, "from an earlier run");
+  Write("notes.txt", "the user's");
+  PrepareRunFolder(dir_.string());
+  for (const std::string& f : run_files) EXPECT_FALSE(std::filesystem::exists(dir_ / f)) << f;
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "notes.txt"));
+  PrepareRunFolder((dir_ / "new" / "deeper").string());  // created where missing
+  EXPECT_TRUE(std::filesystem::is_directory(dir_ / "new" / "deeper"));
 }
 
 }  // namespace

@@ -286,8 +286,10 @@ TEST_F(DeadlinePolicyTest, ACycleLateByLessThanItsDeadlineIsNeitherHeldNorHanded
 
 TEST_F(DeadlinePolicyTest, SamplesThatArriveLateTogetherGiveTheCycleItsDeadlineFromTheirArrival) {
   // The IMU's samples of 5-20 ms come in one burst at 20 ms (a sensor's or a transport's delay):
-  // one cycle runs on the newest, in time from the burst; the instants it passed over are no
-  // late computer's and nothing is held.
+  // the cycles run on the burst's samples, the last on the newest, in time from the burst; the
+  // instants they passed over are no late computer's and nothing is held. (The control thread
+  // may wake between two of the burst's samples: one cycle on the newest when it takes all
+  // four at once, up to four when a loaded machine lets it take them one by one.)
   Build({});  // the policy on (the default), no stall
   AdvanceWithImu(0);
   ASSERT_EQ(Cycles(1).size(), 1u);
@@ -298,14 +300,21 @@ TEST_F(DeadlinePolicyTest, SamplesThatArriveLateTogetherGiveTheCycleItsDeadlineF
     imu.specific_force_B = {0.0, 0.0, kGravity};
     executor_->OnImu(imu);
   }
-  ASSERT_EQ(Cycles(2).size(), 2u);
+  for (int i = 0; i < 20000 && (sink_.cycles().empty() || sink_.cycles().back().command.state_t_ns < 20 * kMs); ++i) {
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  }
   time_.Advance(40 * kMs);  // past every deadline counted from the burst
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
   time_.Stop();
   executor_->Stop();
   const std::vector<CycleTelemetry> cycles = sink_.cycles();
-  ASSERT_EQ(cycles.size(), 2u);
-  EXPECT_EQ(cycles[1].command.state_t_ns, 20 * kMs);
+  ASSERT_GE(cycles.size(), 2u);
+  ASSERT_LE(cycles.size(), 5u);
+  for (std::size_t i = 1; i < cycles.size(); ++i) {  // each on one of the burst's samples, in order
+    const TimeNs t = cycles[i].command.state_t_ns;
+    EXPECT_TRUE(t % (5 * kMs) == 0 && t >= 5 * kMs && t > cycles[i - 1].command.state_t_ns) << i << ": " << t;
+  }
+  EXPECT_EQ(cycles.back().command.state_t_ns, 20 * kMs);
   EXPECT_EQ(executor_->Report().holds + executor_->Report().fallbacks, 0u);
 }
 

@@ -4,7 +4,6 @@
 /// and every command it sent), vehicle.yaml (the vehicle the stack flew), summary.json and, when
 /// asked, report.html. summary.json comes last, so that a folder with one holds a whole run.
 #include <cstdint>
-#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <span>
@@ -40,10 +39,17 @@ struct FlightRecorderOptions {
   bool keep_log = false;
 };
 
-/// Creates a run's output folder `dir` and removes the files of `outputs` an earlier run left there:
-/// a summary left behind must not pass for this run's, nor its files mix with these. Throws
+/// Every file a run's folder may hold, whichever command wrote it (`run`, `sitl`, `replay`;
+/// docs/scenarios.md, "Outputs").
+inline constexpr const char* kRunFolderFiles[] = {"summary.json", "report.html", "flight.mcap",
+                                                  "log.csv",      "scene.json",  "sensors.csv",
+                                                  "vehicle.yaml", "truth_vehicle.yaml", "runtime.json"};
+
+/// Creates a run's output folder `dir` and removes every file of kRunFolderFiles an earlier run
+/// left there: a summary left behind must not pass for this run's, nor its files mix with these
+/// (a `replay` into a `run`'s folder leaves no flight.mcap of the flight behind). Throws
 /// std::runtime_error when the folder cannot be created.
-void PrepareRunFolder(const std::string& dir, std::initializer_list<const char*> outputs);
+void PrepareRunFolder(const std::string& dir);
 
 /// Appends to `table` the log row of a cycle the stack reported (what `rotorguard replay` logs: a
 /// bag has no truth). The table's columns are record::LogColumns({.rotors = the command's size,
