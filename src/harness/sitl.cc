@@ -347,21 +347,25 @@ RunSummary SummaryWithoutTruth(const NodeStack& node, double sim_time_s) {
   return s;
 }
 
+nlohmann::json SitlLinkReport::ToJson() const {
+  return {{"commands", commands},
+          {"commands_after_end", commands_after_end},
+          {"commands_before_their_sample", commands_before_their_sample},
+          {"commands_late", commands_late},
+          {"late_max_ms", 1e3 * late_max_s},
+          {"steps_behind", steps_behind},
+          {"behind_max_ms", 1e-6 * static_cast<double>(behind.max_ns())},
+          {"behind_slowest", SlowestJson(behind)},
+          {"step_work", HistogramJson(step_work)},
+          {"step_work_slowest", SlowestJson(step_work_slowest)},
+          {"command_delay", HistogramJson(command_delay)},
+          {"processes", processes},
+          {"simulator_scheduling", simulator_realtime}};
+}
+
 nlohmann::json SitlResult::RuntimeJson() const {
   nlohmann::json j = loops;
-  j["link"] = {{"commands", link.commands},
-               {"commands_after_end", link.commands_after_end},
-               {"commands_before_their_sample", link.commands_before_their_sample},
-               {"commands_late", link.commands_late},
-               {"late_max_ms", 1e3 * link.late_max_s},
-               {"steps_behind", link.steps_behind},
-               {"behind_max_ms", 1e-6 * static_cast<double>(link.behind.max_ns())},
-               {"behind_slowest", SlowestJson(link.behind)},
-               {"step_work", HistogramJson(link.step_work)},
-               {"step_work_slowest", SlowestJson(link.step_work_slowest)},
-               {"command_delay", HistogramJson(link.command_delay)},
-               {"processes", link.processes},
-               {"simulator_scheduling", link.simulator_realtime}};
+  j["link"] = link.ToJson();
   return j;
 }
 

@@ -93,11 +93,7 @@ class RosLink final : public harness::StackLink {
     // scheduler, between real-time threads on every CPU, they waited up to tens of milliseconds.
     // Only ROS's threads: the process may run others (a benchmark's load) that must stay normal.
     if (realtime_.fifo_priority > 0) {
-      std::vector<pid_t> added;
-      for (const pid_t tid : runtime::ThreadIds()) {
-        if (std::find(threads_before_bus_.begin(), threads_before_bus_.end(), tid) == threads_before_bus_.end()) added.push_back(tid);
-      }
-      runtime::RaiseThreads(added, std::max(1, realtime_.fifo_priority - 1), realtime_.control_cpu);
+      runtime::RaiseNormalThreads(std::max(1, realtime_.fifo_priority - 1), realtime_.control_cpu, threads_before_bus_);
     }
     steady_.emplace(runtime::SteadyClock::Monotonic() + kLeadNs, rate_);
     steady_clock_.store(&*steady_, std::memory_order_release);

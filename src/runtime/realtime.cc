@@ -82,10 +82,10 @@ std::vector<pid_t> ThreadIds() {
   return tids;
 }
 
-int RaiseThreads(const std::vector<pid_t>& tids, int priority, int control_cpu) {
+int RaiseNormalThreads(int priority, int control_cpu, const std::vector<pid_t>& except) {
   int moved = 0;
-  for (const pid_t tid : tids) {
-    if (sched_getscheduler(tid) != SCHED_OTHER) continue;
+  for (const pid_t tid : ThreadIds()) {
+    if (std::find(except.begin(), except.end(), tid) != except.end() || sched_getscheduler(tid) != SCHED_OTHER) continue;
     sched_param p{};
     p.sched_priority = priority;
     if (sched_setscheduler(tid, SCHED_FIFO, &p) != 0) continue;
@@ -99,8 +99,6 @@ int RaiseThreads(const std::vector<pid_t>& tids, int priority, int control_cpu) 
   }
   return moved;
 }
-
-int RaiseNormalThreads(int priority, int control_cpu) { return RaiseThreads(ThreadIds(), priority, control_cpu); }
 
 bool PinThread(int control_cpu, ThreadRole role) {
   const int online = OnlineCpus();

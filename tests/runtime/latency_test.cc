@@ -171,37 +171,41 @@ TEST(Realtime, ValidatesThePriorityAndReportsWhatItGranted) {
   EXPECT_EQ(g.note, "memory not locked (not asked), normal scheduler (not asked)");
 }
 
-TEST(Realtime, RaisesTheListedNormalThreadsOnlyOntoTheControlCpu) {
-  // Two waiting threads; only the first is listed (as a middleware's threads are, beside a load
-  // that must stay normal).
-  std::atomic<pid_t> listed{0}, other{0};
+TEST(Realtime, RaisesTheNormalThreadsStartedSinceASnapshotOnlyOntoTheControlCpu) {
+  // A thread that was there before (a benchmark's load) and one started after the snapshot (a
+  // middleware's): only the second is raised.
+  std::atomic<pid_t> started{0}, other{0};
   std::atomic<bool> done{false};
   const auto park = [&](std::atomic<pid_t>* tid) {
     tid->store(gettid());
     while (!done.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   };
-  std::thread a(park, &listed), b(park, &other);
-  while (listed.load() == 0 || other.load() == 0) std::this_thread::yield();
+  std::thread b(park, &other);
+  while (other.load() == 0) std::this_thread::yield();
+  const std::vector<pid_t> before = ThreadIds();
+  EXPECT_NE(std::find(before.begin(), before.end(), other.load()), before.end());
+  EXPECT_NE(std::find(before.begin(), before.end(), gettid()), before.end());
+  std::thread a(park, &started);
+  while (started.load() == 0) std::this_thread::yield();
   const std::vector<pid_t> ids = ThreadIds();
-  EXPECT_NE(std::find(ids.begin(), ids.end(), listed.load()), ids.end());
-  EXPECT_NE(std::find(ids.begin(), ids.end(), other.load()), ids.end());
-  EXPECT_NE(std::find(ids.begin(), ids.end(), gettid()), ids.end());
+  EXPECT_NE(std::find(ids.begin(), ids.end(), started.load()), ids.end());
   const int cpu = AllowedCpus().front();
-  const int moved = RaiseThreads({listed.load()}, 1, cpu);
-  const int listed_policy = sched_getscheduler(listed.load()), other_policy = sched_getscheduler(other.load());
+  const int moved = RaiseNormalThreads(1, cpu, before);
+  const int started_policy = sched_getscheduler(started.load()), other_policy = sched_getscheduler(other.load());
   cpu_set_t set;
   CPU_ZERO(&set);
-  sched_getaffinity(listed.load(), sizeof(set), &set);
+  sched_getaffinity(started.load(), sizeof(set), &set);
+  const int moved_again = RaiseNormalThreads(1, cpu, ThreadIds());  // every thread excepted
   done = true;
   a.join();
   b.join();
   EXPECT_EQ(other_policy, SCHED_OTHER);
+  EXPECT_EQ(moved_again, 0);
   if (moved == 0) GTEST_SKIP() << "SCHED_FIFO is not permitted here";
   EXPECT_EQ(moved, 1);
-  EXPECT_EQ(listed_policy, SCHED_FIFO);
+  EXPECT_EQ(started_policy, SCHED_FIFO);
   EXPECT_EQ(CPU_COUNT(&set), 1);
   EXPECT_TRUE(CPU_ISSET(cpu, &set));
-  EXPECT_EQ(RaiseThreads({}, 1, cpu), 0);
 }
 
 /// Under SCHED_FIFO on one CPU: a holder at priority 10 takes `lock` and has 20 ms of work left

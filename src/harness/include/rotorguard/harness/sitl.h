@@ -88,6 +88,8 @@ struct SitlLinkReport {
   runtime::LatencyHistogram command_delay;  ///< a command's IMU sample -> it acts on the ESCs (before their latency)
   int processes = 1;                 ///< the simulator's and the stack's: 1 or 2
   std::string simulator_realtime = "normal scheduler (not asked)";  ///< the simulator thread's scheduling
+  /// As runtime.json's "link" holds it (docs/runtime.md).
+  nlohmann::json ToJson() const;
 };
 
 struct SitlResult {

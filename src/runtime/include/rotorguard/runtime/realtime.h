@@ -61,20 +61,18 @@ class ThreadSchedulingScope {
 /// inherit its creator's real-time scheduling (a benchmark's background load).
 void UseNormalScheduling();
 
-/// Moves every thread of this process that runs under the normal scheduler to SCHED_FIFO at
-/// `priority` and, when control_cpu names a CPU of this machine, onto that CPU: for the threads a
-/// middleware started before the executor (ROS's network and callback threads), which carry the
-/// sensor messages to the control loop and its commands out. A thread started later inherits its
+/// Moves every thread of this process that runs under the normal scheduler, but those of
+/// `except`, to SCHED_FIFO at `priority` and, when control_cpu names a CPU of this machine, onto
+/// that CPU: for the threads a middleware started before the executor (ROS's network and callback
+/// threads), which carry the sensor messages to the control loop and its commands out. `except`
+/// keeps others normal: a process that also runs a benchmark's background load passes the
+/// threads it had before the middleware started (ThreadIds). A thread started later inherits its
 /// creator's scheduling. Returns how many threads were moved (0 when refused: no privilege).
-/// Every normal thread: call it where none busy-waits (one would then hold its CPU).
-int RaiseNormalThreads(int priority, int control_cpu);
+/// Every thread moved must not busy-wait (it would then hold its CPU).
+int RaiseNormalThreads(int priority, int control_cpu, const std::vector<pid_t>& except = {});
 
 /// The ids of this process's threads (/proc/self/task), in no particular order.
 std::vector<pid_t> ThreadIds();
-/// RaiseNormalThreads for the threads of `tids` only (those still alive and under the normal
-/// scheduler): for a middleware's threads in a process that has others that must stay normal (a
-/// benchmark's background load), found as the threads its start added (ThreadIds before and after).
-int RaiseThreads(const std::vector<pid_t>& tids, int priority, int control_cpu);
 
 /// A mutex with priority inheritance (PTHREAD_PRIO_INHERIT): a SCHED_FIFO thread waiting for it
 /// lends its priority to the holder, so that a holder of lower priority on the same CPU runs to
