@@ -221,6 +221,16 @@ void RayCasterOptions::Validate() const {
 
 RayCaster::RayCaster(World world, const RayCasterOptions& options) : world_(std::move(world)) {
   options.Validate();
+  // Rays are cast in the ground's frame (the ground at z = 0, where the kernels put it): the world
+  // lifted by the ground's depth, each ray's origin with it.
+  lift_m_ = -world_.ground_z_m;
+  if (!std::isfinite(lift_m_)) ThrowInvalidArgument("RayCaster", "world.ground_z_m", world_.ground_z_m, "a finite height");
+  for (Cylinder& cy : world_.cylinders) cy.height_m += lift_m_;
+  for (Box& b : world_.boxes) b.center_m.z() += lift_m_;
+  for (MovingBox& m : world_.moving_boxes) {
+    for (Vector3& w : m.waypoints_m) w.z() += lift_m_;
+  }
+  world_.ground_z_m = 0.0;
   cell_ = options.cell_size_m;
 #if defined(__AVX2__) && defined(__FMA__)
   vector_kernel_ = options.cylinder_kernel == RayCasterOptions::CylinderKernel::kAuto;
@@ -414,7 +424,8 @@ void RayCaster::CastCylinders(const Vector3& o, const Vector3& d, double max_m, 
   }
 }
 
-std::optional<RayHit> RayCaster::Cast(const Vector3& o, const Vector3& d, double max_m, double t) {
+std::optional<RayHit> RayCaster::Cast(const Vector3& origin, const Vector3& d, double max_m, double t) {
+  const Vector3 o(origin.x(), origin.y(), origin.z() + lift_m_);
   std::optional<RayHit> best = IntersectGround(o, d, max_m);
   for (const MovingBox& m : world_.moving_boxes) Nearer(IntersectBox(m.At(t), o, d, max_m), &best);
   if (!o.allFinite() || !d.allFinite()) return best;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -65,15 +66,30 @@ void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
   if (!std::isfinite(crash_tilt_rad) || crash_tilt_rad <= 0.0 || crash_tilt_rad > std::numbers::pi) {
     ThrowValidation("SimulatorOptions", "sim.crash_tilt_rad", crash_tilt_rad, "an angle in (0, pi]");
   }
+  prefixed("sim.ground.", [&] { ground.Validate(); });
+  if (ground_z_m && !(std::abs(*ground_z_m) <= kMaxCoordinateM)) {
+    ThrowValidation("SimulatorOptions", "ground_z_m", *ground_z_m, fmt::format("a height within ±{:g} m", kMaxCoordinateM));
+  }
 }
+
+namespace {
+
+World OnGround(World world, double ground_z_m) {
+  world.ground_z_m = ground_z_m;
+  return world;
+}
+
+}  // namespace
 
 Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::vector<FaultSpec> faults,
                      const SimulatorOptions& options, std::uint64_t seed, const vehicle::StateVector& initial)
     : model_(model),
-      world_(std::move(world)),
+      world_(OnGround(std::move(world), options.ground_z_m.value_or(-model.params().RestingHeight()))),
       options_(Validated(options, model.params())),
       injector_(std::move(faults), model.num_rotors()),
       integrator_(model),
+      contact_(model.params().LandingGear(), model.params().mass_kg, options_.ground,
+               GroundPlane{.normal_W = Vector3::UnitZ(), .offset_m = world_.ground_z_m}),
       imu_(options_.imu, DeriveSeed(seed, kImuStream)),
       esc_(options_.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
       odometry_(options_.odometry, world_, DeriveSeed(seed, kOdometryStream)),
@@ -91,8 +107,22 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
         initial.size(), model.state_size()));
   }
   x_.segment<4>(StateIndex::kQuaternion).normalize();
-  landed_ = x_[StateIndex::kPosition + 2] <= 0.0;
-  if (landed_) x_[StateIndex::kPosition + 2] = 0.0;
+  // Feet at or below the ground: the vehicle stands on them, at rest, its lowest feet sunk as
+  // far as its weight presses them (all of them, on a level start).
+  {
+    const std::vector<Vector3> feet = model.params().LandingGear();
+    const Matrix3 R = StateView(x_).q_WB().toRotationMatrix();
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Vector3& f : feet) lowest = std::min(lowest, x_[StateIndex::kPosition + 2] + R.row(2).dot(f));
+    if (lowest <= world_.ground_z_m) {
+      const double sink = model.params().weight_n() / (static_cast<double>(feet.size()) * contact_.point_stiffness_n_m());
+      x_[StateIndex::kPosition + 2] += world_.ground_z_m - lowest - sink;
+      x_.segment<3>(StateIndex::kVelocity).setZero();
+      x_.segment<3>(StateIndex::kBodyRate).setZero();
+    }
+  }
+  contact_.Update(x_);
+  landed_ = contact_.points_in_contact() > 0;
   // Before the first command acts, the ESCs hold what the motors do (a flight that starts in the
   // air has been commanded its hover before).
   command_ = x_.tail(model.num_rotors()).cwiseMax(0.0).cwiseMin(model.max_thrust());
@@ -116,7 +146,10 @@ void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
   TruthSample truth;
   truth.t_ns = t_ns_;
   truth.x = &x_;
-  if (!landed_) truth.acc = model_.ComputeAccelerations(x_, faults_, disturbance);
+  // The ground's push on the feet is felt as any other force.
+  vehicle::Disturbance with_ground = disturbance;
+  contact_.AddTo(x_, &with_ground);
+  truth.acc = model_.ComputeAccelerations(x_, faults_, with_ground);
   truth.motor_speed_rad_s = speed_;
   truth.faults = &faults_;
   if (imu_due) outputs_.imu = imu_.Sample(truth);
@@ -137,38 +170,23 @@ void Simulator::UpdateOutputs() {
   model_.MotorSpeeds(x_, faults_, &speed_);
 }
 
-void Simulator::ResolveGroundContact(const vehicle::StateVector& before) {
+void Simulator::ResolveGroundContact() {
+  const bool was_touching = landed_;
+  contact_.Update(x_);
+  landed_ = contact_.points_in_contact() > 0;
+  if (!landed_) return;
   const StateView s(x_);
-  if (landed_) {
-    // Resting on the ground: lift off only when the net vertical force points up.
-    const double up_force = thrust_.sum() * s.q_WB().toRotationMatrix()(2, 2);
-    if (up_force > model_.params().weight_n() && s.p_W().z() >= 0.0) {
-      landed_ = false;
-      return;
-    }
-    // Stay pinned: keep the attitude and motor states, cancel the rigid-body motion.
-    x_.head<StateIndex::kMotor>() = before.head<StateIndex::kMotor>();
-    x_.segment<3>(StateIndex::kVelocity).setZero();
-    x_.segment<3>(StateIndex::kBodyRate).setZero();
-    return;
-  }
-  if (s.p_W().z() > 0.0) return;
   const double speed = s.v_W().norm();
   const double tilt = TiltOf(s.q_WB());
-  if (speed > options_.crash_speed_m_s || tilt > options_.crash_tilt_rad) crash_speed_m_s_ = speed;
-  if (speed > options_.crash_speed_m_s) {
+  if (!was_touching && speed > options_.crash_speed_m_s) {
     crash_reason_ = fmt::format("ground impact at {:.2f} m/s", speed);
   } else if (tilt > options_.crash_tilt_rad) {
+    // Tipped over its feet: the propellers strike the ground.
     crash_reason_ = fmt::format("ground contact tilted {:.0f} deg", tilt * 180.0 / std::numbers::pi);
+  } else if (s.p_W().z() <= world_.ground_z_m) {
+    crash_reason_ = "the body on the ground";
   }
-  // Touchdown (or the crash site): stop on the ground, level on its landing gear (yaw kept), so
-  // that repeated hops cannot accumulate a tilt the flat ground would not allow.
-  landed_ = true;
-  x_[StateIndex::kPosition + 2] = 0.0;
-  const Quaternion level = QuaternionFromYaw(YawOf(s.q_WB()));
-  x_.segment<4>(StateIndex::kQuaternion) << level.w(), level.x(), level.y(), level.z();
-  x_.segment<3>(StateIndex::kVelocity).setZero();
-  x_.segment<3>(StateIndex::kBodyRate).setZero();
+  if (crash_reason_) crash_speed_m_s_ = speed;
 }
 
 void Simulator::Send(const RotorCommand& command, TimeNs sent_ns) {
@@ -227,11 +245,11 @@ const SensorOutputs& Simulator::Step() {
   ActivateCommands(t);
   while (queue_size_ > 0 && queue_[static_cast<std::size_t>(queue_head_)].acts_ns < end) {
     const TimeNs next = queue_[static_cast<std::size_t>(queue_head_)].acts_ns;
-    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_);
+    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_, &contact_);
     t = next;
     ActivateCommands(t);
   }
-  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_);
+  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_, &contact_);
   t_ns_ = end;
   ActivateCommands(t_ns_);  // applied_command(): the one acting at the new time
   UpdateOutputs();
@@ -240,8 +258,7 @@ const SensorOutputs& Simulator::Step() {
     x_ = x_before_;
     return outputs_;
   }
-  ResolveGroundContact(x_before_);
-  UpdateOutputs();
+  ResolveGroundContact();
   if (!crash_reason_ && !landed_) {
     const StateView s(x_);
     const vehicle::VehicleParams& v = model_.params();

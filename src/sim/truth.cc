@@ -198,6 +198,9 @@ vehicle::VehicleParams TruthVehicle(const vehicle::VehicleParams& file, const Tr
     if (i < d.yaw_coefficient_ratio.size()) v.rotors[i].yaw_coefficient_m *= d.yaw_coefficient_ratio[i];
   }
   for (vehicle::CollisionSphere& c : v.collision_spheres) c.centre_B = MovedBodyPoint(c.centre_B - d.cog_offset_m);
+  // The feet, as the hubs (the file's, or its default under the file's hubs).
+  v.landing_gear_B.clear();
+  for (const Vector3& f : file.LandingGear()) v.landing_gear_B.push_back(MovedBodyPoint(f - d.cog_offset_m));
   // The spheres, moved, stay within the bound about the true CoG only if it grows by the offset. A
   // body of one sphere keeps it centred on the CoG (off by the offset, at most 12 mm).
   if (!v.collision_spheres.empty()) {
@@ -230,6 +233,8 @@ SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const v
   // The front end reports the file's body frame, whose origin lies at -c from the true CoG; the
   // LiDAR is mounted on that body, so it moves by -c too, and is turned and its clock off.
   o.odometry.body_origin_m = -draw.cog_offset_m;
+  // The world's frame is the file's: its body origin rests at z = 0, the ground its gear below.
+  o.ground_z_m = -file.RestingHeight();
   o.lidar.position_m = MovedBodyPoint(scenario.lidar.position_m - draw.cog_offset_m);
   const double angle = draw.lidar_rotation_rad.norm();
   if (angle > 0.0) o.lidar.rotation = Quaternion(Eigen::AngleAxisd(angle, draw.lidar_rotation_rad / angle));

@@ -24,9 +24,9 @@ double Box::Distance(const Vector3& p) const {
   return outside.norm();
 }
 
-double Cylinder::Distance(const Vector3& p) const {
+double Cylinder::Distance(const Vector3& p, double ground_z_m) const {
   const double radial = std::max(0.0, (p.head<2>() - center_m).norm() - radius_m);
-  const double vertical = p.z() < 0.0 ? -p.z() : std::max(0.0, p.z() - height_m);
+  const double vertical = p.z() < ground_z_m ? ground_z_m - p.z() : std::max(0.0, p.z() - height_m);
   return std::hypot(radial, vertical);
 }
 
@@ -63,7 +63,7 @@ std::optional<std::string> World::SphereCollision(const Vector3& p, double radiu
     if (boxes[i].Distance(p) < radius) return fmt::format("box {}", i);
   }
   for (std::size_t i = 0; i < cylinders.size(); ++i) {
-    if (cylinders[i].Distance(p) < radius) return fmt::format("cylinder {}", i);
+    if (cylinders[i].Distance(p, ground_z_m) < radius) return fmt::format("cylinder {}", i);
   }
   for (std::size_t i = 0; i < moving_boxes.size(); ++i) {
     if (moving_boxes[i].At(t).Distance(p) < radius) return fmt::format("moving box {}", i);
@@ -72,13 +72,13 @@ std::optional<std::string> World::SphereCollision(const Vector3& p, double radiu
 }
 
 double World::DistanceToSurface(const Vector3& p, double t) const {
-  return std::min(std::abs(p.z()), DistanceToObstacles(p, t));
+  return std::min(std::abs(p.z() - ground_z_m), DistanceToObstacles(p, t));
 }
 
 double World::DistanceToObstacles(const Vector3& p, double t) const {
   double d = std::numeric_limits<double>::infinity();
   for (const Box& b : boxes) d = std::min(d, b.Distance(p));
-  for (const Cylinder& c : cylinders) d = std::min(d, c.Distance(p));
+  for (const Cylinder& c : cylinders) d = std::min(d, c.Distance(p, ground_z_m));
   for (const MovingBox& m : moving_boxes) d = std::min(d, m.At(t).Distance(p));
   return d;
 }

@@ -139,15 +139,27 @@ Rk4Integrator::Rk4Integrator(const MultirotorModel& model) : model_(model) {
   tmp_.resize(n);
 }
 
+void Rk4Integrator::Derivative(const StateVector& x, const RotorVector& u, const RotorFaults& faults,
+                               const Disturbance& disturbance, const StateWrench* state_wrench,
+                               StateVector* x_dot) const {
+  if (state_wrench == nullptr) {
+    model_.Derivative(x, u, faults, disturbance, x_dot);
+    return;
+  }
+  Disturbance d = disturbance;
+  state_wrench->AddTo(x, &d);
+  model_.Derivative(x, u, faults, d, x_dot);
+}
+
 void Rk4Integrator::Step(const RotorVector& u, const RotorFaults& faults, const Disturbance& d,
-                         double dt, StateVector* x) {
-  model_.Derivative(*x, u, faults, d, &k1_);
+                         double dt, StateVector* x, const StateWrench* state_wrench) {
+  Derivative(*x, u, faults, d, state_wrench, &k1_);
   tmp_ = *x + 0.5 * dt * k1_;
-  model_.Derivative(tmp_, u, faults, d, &k2_);
+  Derivative(tmp_, u, faults, d, state_wrench, &k2_);
   tmp_ = *x + 0.5 * dt * k2_;
-  model_.Derivative(tmp_, u, faults, d, &k3_);
+  Derivative(tmp_, u, faults, d, state_wrench, &k3_);
   tmp_ = *x + dt * k3_;
-  model_.Derivative(tmp_, u, faults, d, &k4_);
+  Derivative(tmp_, u, faults, d, state_wrench, &k4_);
   *x += (dt / 6.0) * (k1_ + 2.0 * k2_ + 2.0 * k3_ + k4_);
   x->segment<4>(StateIndex::kQuaternion).normalize();
 }

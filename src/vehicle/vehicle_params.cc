@@ -29,6 +29,19 @@ double VehicleParams::total_max_thrust_n() const {
   return sum;
 }
 
+std::vector<Vector3> VehicleParams::LandingGear() const {
+  if (!landing_gear_B.empty()) return landing_gear_B;
+  std::vector<Vector3> feet;
+  for (const Rotor& r : rotors) feet.emplace_back(r.p_B.x(), r.p_B.y(), -kDefaultGearDepth * collision_radius_m);
+  return feet;
+}
+
+double VehicleParams::RestingHeight() const {
+  double lowest = 0.0;
+  for (const Vector3& f : LandingGear()) lowest = std::min(lowest, f.z());
+  return -lowest;
+}
+
 void VehicleParams::Validate() const {
   // Each key in its range (the rotors' and collision spheres' too, named "rotors.2.max_thrust_n",
   // the thrust coefficient in the files' unit), then the rules of the whole.
@@ -58,6 +71,12 @@ void VehicleParams::Validate() const {
     if (c.centre_B.norm() + c.radius_m > collision_radius_m * (1.0 + 1e-9)) {
       ThrowValidation(kOwner, fmt::format("collision_spheres.{}", i), c.centre_B.norm() + c.radius_m,
                       fmt::format("within the bounding collision_radius_m = {} m", collision_radius_m));
+    }
+  }
+  for (std::size_t i = 0; i < landing_gear_B.size(); ++i) {
+    if (!(landing_gear_B[i].z() < 0.0)) {
+      ThrowValidation(kOwner, fmt::format("landing_gear_m.{}", i), landing_gear_B[i].z(),
+                      "a foot below the centre of gravity (body z < 0)");
     }
   }
   if (rotors.empty() || num_rotors() > kMaxRotors) {

@@ -66,6 +66,33 @@ TEST(Raycast, GroundBoxAndCylinderAgainstClosedForms) {
   EXPECT_FALSE(IntersectCylinder(tree, Vector3(0, 0, 1), Vector3::UnitX(), 10.0)) << "from inside";
 }
 
+TEST(Raycast, AWorldWhoseGroundLiesBelowZeroIsCastAgainstThatGround) {
+  // The vehicle's frame: z = 0 where its centre of gravity rests, the ground 5 cm below; a trunk
+  // stands on that ground, a box where its file puts it.
+  World w;
+  w.ground_z_m = -0.05;
+  w.cylinders.push_back(Cylinder{Eigen::Vector2d(3, 0), 0.5, 3.0});
+  w.boxes.push_back(Box{Vector3(0, 3, 1.0), Vector3(1, 1, 1), 0.0});
+  RayCaster caster(w);
+  const auto down = caster.Cast(Vector3(0, 0, 1), -Vector3::UnitZ(), 10.0, 0.0);
+  ASSERT_TRUE(down);
+  EXPECT_NEAR(down->distance_m, 1.05, 1e-12);
+  // The trunk's foot, below z = 0: hit 2.5 m away.
+  const auto foot = caster.Cast(Vector3(0, 0, -0.03), Vector3::UnitX(), 10.0, 0.0);
+  ASSERT_TRUE(foot);
+  EXPECT_NEAR(foot->distance_m, 2.5, 1e-12);
+  // Its top at z = 3, as written: a ray over it at 3.01 goes on to nothing.
+  EXPECT_FALSE(caster.Cast(Vector3(0, 0, 3.01), Vector3::UnitX(), 10.0, 0.0));
+  // The box, from z = 0.5 to 1.5 as written.
+  const auto box = caster.Cast(Vector3(0, 0, 1.4), Vector3::UnitY(), 10.0, 0.0);
+  ASSERT_TRUE(box);
+  EXPECT_NEAR(box->distance_m, 2.5, 1e-12);
+  EXPECT_FALSE(caster.Cast(Vector3(0, 0, 1.6), Vector3::UnitY(), 10.0, 0.0));
+  // The distance functions agree: the ground 0.05 below z = 0, the trunk's foot 2.5 m away.
+  EXPECT_NEAR(w.DistanceToSurface(Vector3(0, 0, 0), 0.0), 0.05, 1e-12);
+  EXPECT_NEAR(w.DistanceToObstacles(Vector3(0, 0, -0.03), 0.0), 2.5, 1e-12);  // the box: hypot(2.5, 0.53)
+}
+
 // Against an independent truth: marching along the ray with the obstacles' distance functions
 // (world.h), then bisecting the first step that enters one. Random boxes, cylinders and rays.
 TEST(Raycast, HitsAgreeWithDistanceFunctionMarching) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
 #include "rotorguard/sim/simulator.h"
 #include "rotorguard/vehicle/vehicle_params.h"
 #include "vehicle_fixture.h"
@@ -87,7 +88,12 @@ TEST(Simulator, RestsOnTheGroundReadingGravityUntilThrustExceedsWeight) {
   idle.thrust_n = RotorVector::Constant(4, 1.0);
   rig.Run(1.0, idle);
   EXPECT_TRUE(rig.sim.landed());
-  EXPECT_EQ(StateView(rig.sim.state()).p_W().z(), 0.0);
+  EXPECT_EQ(rig.sim.contact().points_in_contact(), 4);
+  // On its feet: the centre of gravity at z = 0, sunk by the feet's springs under the weight
+  // left over by the idle thrust (Hooke), and still.
+  const double pressing = rig.model.params().weight_n() - 4.0;
+  EXPECT_NEAR(StateView(rig.sim.state()).p_W().z(), -pressing / (4.0 * rig.sim.contact().point_stiffness_n_m()), 1e-6);
+  EXPECT_LT(StateView(rig.sim.state()).v_W().norm(), 1e-6);
   EXPECT_NEAR(rig.imu.specific_force_B.z(), kGravity, 0.3);  // noise and bias
   RotorCommand climb;
   climb.thrust_n = RotorVector::Constant(4, 4.0);
@@ -95,6 +101,33 @@ TEST(Simulator, RestsOnTheGroundReadingGravityUntilThrustExceedsWeight) {
   EXPECT_FALSE(rig.sim.landed());
   EXPECT_GT(StateView(rig.sim.state()).p_W().z(), 0.5);
   EXPECT_FALSE(rig.sim.crashed());
+}
+
+TEST(Simulator, AVehicleThatLosesARotorAtLiftOffTipsOverTheFeetUnderIt) {
+  // Spun up to lift off, propeller 0 (front right) gone: the ground no longer holds the vehicle
+  // level. The thrust of the other three turns it about the feet under the lost rotor, which stay
+  // on the ground while the opposite ones rise, until it tips over (a crash: the propellers strike).
+  sim::FaultSpec loss;
+  loss.rotor = 0;
+  loss.kind = vehicle::FaultKind::kPropellerLoss;
+  loss.onset = {FaultOnset::Kind::kAtTime, 0.0};
+  Rig rig({loss}, 0.0);
+  RotorCommand lift;
+  lift.thrust_n = RotorVector::Constant(4, 0.3 * rig.model.params().weight_n());
+  bool pivoted = false;
+  for (int k = 0; k < 2000 && !rig.sim.crashed(); ++k) {
+    rig.sim.Step(lift);
+    const vehicle::StateView s(rig.sim.state());
+    // Pivoting: tilted, with the feet of the lost rotor's side still touching and not all four.
+    const Vector3 hub_W = s.q_WB() * rig.model.params().rotors[0].p_B + s.p_W();
+    if (TiltOf(s.q_WB()) > 0.1 && rig.sim.contact().points_in_contact() > 0 &&
+        rig.sim.contact().points_in_contact() < 4 && hub_W.z() < s.p_W().z()) {
+      pivoted = true;
+    }
+  }
+  EXPECT_TRUE(pivoted);
+  ASSERT_TRUE(rig.sim.crashed());
+  EXPECT_NE(rig.sim.crash_reason()->find("tilted"), std::string::npos);
 }
 
 TEST(Simulator, FallingOntoTheGroundIsACrash) {

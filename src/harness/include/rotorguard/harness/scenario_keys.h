@@ -61,11 +61,12 @@ struct SimKeys {
     // The log is held in memory until the end: beyond a sensor's rate it would only grow.
     a->Visit("log_rate_hz", &s->log_rate_hz,
              {.meaning = "rows per second in log.csv, at most the physics rate", .min = kMinRateHz, .max = kMaxRateHz});
+    a->Visit("ground", &s->sim.ground, {.meaning = "the ground under the landing gear's feet"});
     a->Visit("crash_speed_m_s", &s->sim.crash_speed_m_s,
              {.meaning = "touching the ground faster is a crash [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
     a->Visit(
         "crash_tilt_rad", &s->sim.crash_tilt_rad,
-        {.meaning = "touching the ground more tilted is a crash [rad]", .max = std::numbers::pi, .positive = true});
+        {.meaning = "touching the ground more tilted is a crash (tipped over) [rad]", .max = std::numbers::pi, .positive = true});
     a->Visit("computation_delay", &s->computation_delay,
              {.meaning = "a control cycle's computation delay: drawn (the truth's range, docs/truth.md) or measured "
                          "(the stack's wall-clock time for the cycle on this computer; not reproducible)"});

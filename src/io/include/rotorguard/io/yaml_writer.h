@@ -32,6 +32,11 @@ class YamlWriter {
         text += "  - " + line.text() + "\n";
       }
       Add(key, text, /*whole_lines=*/true);
+    } else if constexpr (std::is_same_v<T, std::vector<Eigen::Vector3d>>) {  // a list of points
+      if (value->empty() && !info.required) return;
+      std::string text = fmt::format("{}:\n", key);
+      for (const Eigen::Vector3d& p : *value) text += "  - " + Text(p) + "\n";
+      Add(key, text, /*whole_lines=*/true);
     } else if constexpr (std::is_same_v<T, Eigen::Matrix3d>) {
       std::string text = fmt::format("{}:\n", key);
       for (int r = 0; r < 3; ++r) text += "  - " + Text(Eigen::Vector3d(value->row(r).transpose())) + "\n";

@@ -65,6 +65,7 @@ class RayCaster {
   explicit RayCaster(World world, const RayCasterOptions& options = {});
   /// The nearest hit of the ray (o, unit d) within max_m at time t [s] (moving boxes), if any.
   std::optional<RayHit> Cast(const Vector3& o, const Vector3& d, double max_m, double t);
+  /// The world as the caster holds it: lifted so that its ground lies at z = 0.
   const World& world() const { return world_; }
   /// How often the azimuth index was built (at each ray from beyond the margin of the last build).
   int index_rebuilds() const { return rebuilds_; }
@@ -84,6 +85,7 @@ class RayCaster {
   int AzimuthBin(double x, double y) const;
 
   World world_;
+  double lift_m_ = 0.0;  // the world's ground depth: rays are cast in the ground's frame
   // Boxes: the grid.
   double cell_ = 1.0;
   Eigen::Vector2d min_ = Eigen::Vector2d::Zero();  // grid origin (lower corner)

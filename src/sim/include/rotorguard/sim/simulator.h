@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rotorguard/core/messages.h"
+#include "rotorguard/sim/contact.h"
 #include "rotorguard/sim/fault_injector.h"
 #include "rotorguard/sim/lidar.h"
 #include "rotorguard/sim/sensors.h"
@@ -33,9 +34,14 @@ struct SimulatorOptions {
   /// A constant torque on the airframe, body frame [N*m]: a payload or cable the stack is not told
   /// of. Not a scenario key: the scenario's truth draws it (truth.h).
   Vector3 external_torque_n_m = Vector3::Zero();
+  /// The ground under the landing gear's feet (contact.h).
+  GroundContactOptions ground;
+  /// The ground plane's height [m]; none: where the model's feet reach when its centre of gravity
+  /// rests at z = 0. (A drawn truth passes the file's: its body origin rests at z = 0.)
+  std::optional<double> ground_z_m;
   /// Touching the ground faster than this (any direction) is a crash [m/s], in (0, kMaxSpeedMS].
   double crash_speed_m_s = 1.0;
-  /// Touching the ground tilted more than this is a crash [rad], in (0, pi].
+  /// Touching the ground tilted more than this is a crash [rad], in (0, pi]: tipped over.
   double crash_tilt_rad = 0.6;
   /// Throws ValidationError whose field is the scenario key path ("sim.physics_rate_hz",
   /// "sensors.esc.rate_hz", "wind.gust_std_m_s"); needs the vehicle for the time-constant rule.
@@ -54,7 +60,8 @@ struct SensorOutputs {
 
 class Simulator {
  public:
-  /// `initial` is the full truth state; a vehicle at altitude <= 0 starts landed.
+  /// `initial` is the full truth state; a vehicle whose feet reach the ground starts standing on
+  /// them (lifted onto the ground, at rest).
   Simulator(const vehicle::MultirotorModel& model, World world, std::vector<FaultSpec> faults,
             const SimulatorOptions& options, std::uint64_t seed, const vehicle::StateVector& initial);
 
@@ -91,14 +98,16 @@ class Simulator {
   std::uint64_t commands_overrun() const { return commands_overrun_; }
   const Vector3& wind() const { return wind_.velocity(); }
   const World& world() const { return world_; }
+  /// A foot touches the ground.
   bool landed() const { return landed_; }
+  const GroundContact& contact() const { return contact_; }
   bool crashed() const { return crash_reason_.has_value(); }
   const std::optional<std::string>& crash_reason() const { return crash_reason_; }
   /// The speed [m/s] at the crash's ground contact; none without a crash.
   std::optional<double> crash_speed_m_s() const { return crash_speed_m_s_; }
 
  private:
-  void ResolveGroundContact(const vehicle::StateVector& before);
+  void ResolveGroundContact();
   void UpdateOutputs();
   void SampleSensors(const vehicle::Disturbance& disturbance);
   void DeliverTelemetry();
@@ -122,6 +131,7 @@ class Simulator {
   SimulatorOptions options_;
   FaultInjector injector_;
   vehicle::Rk4Integrator integrator_;
+  GroundContact contact_;
   ImuModel imu_;
   EscModel esc_;
   OdometryModel odometry_;

@@ -1,5 +1,5 @@
 #pragma once
-/// The world the simulated vehicle flies in: the ground plane z = 0, static boxes and vertical
+/// The world the simulated vehicle flies in: the ground plane z = ground_z_m, static boxes and vertical
 /// cylinders (trees), and boxes moving along waypoints. Only the simulator (and benchmarks scoring
 /// a map against the truth) may see it; the flight stack perceives obstacles through sensors.
 #include <optional>
@@ -35,7 +35,8 @@ struct Box {
   double Distance(const Vector3& p) const;
 };
 
-/// Vertical cylinder standing on the ground (a tree trunk): axis at (x, y), from z = 0 to height.
+/// Vertical cylinder standing on the ground (a tree trunk): axis at (x, y), from the ground up to
+/// z = height.
 struct Cylinder {
   Eigen::Vector2d center_m = Eigen::Vector2d::Zero();
   double radius_m = 0.1;
@@ -49,7 +50,8 @@ struct Cylinder {
     a->Visit("height_m", &height_m,
              {.meaning = "standing on the ground [m]", .max = kMaxCoordinateM, .positive = true, .required = true});
   }
-  double Distance(const Vector3& p) const;
+  /// Euclidean distance from `p` to the trunk standing on ground at ground_z_m (0 inside).
+  double Distance(const Vector3& p, double ground_z_m = 0.0) const;
 };
 
 /// A box moving at constant speed along a polyline of centre positions, looping back to the first
@@ -84,6 +86,11 @@ class World {
   std::vector<Box> boxes;
   std::vector<Cylinder> cylinders;
   std::vector<MovingBox> moving_boxes;
+  /// The ground plane's height [m]. The world's frame is the vehicle's: z = 0 where its centre of
+  /// gravity rests on flat ground, the ground its landing gear's height below (the simulator sets
+  /// it from the gear). Not a key: obstacles are written as standing at z = 0 and trunks reach
+  /// down to the ground; a few centimetres under a box's base stay open.
+  double ground_z_m = 0.0;
 
   /// The keys of a scenario's `world`.
   template <typename Archive>

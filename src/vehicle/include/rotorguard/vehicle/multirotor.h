@@ -44,6 +44,16 @@ struct Disturbance {
   Vector3 torque_B = Vector3::Zero();  ///< additional torque [N*m]
 };
 
+/// A force and torque that depend on the state (the ground's contact on the landing gear): an
+/// integrator evaluates it at every stage of a step, as it does the dynamics' own terms, so that a
+/// stiff contact stays stable and accurate.
+class StateWrench {
+ public:
+  virtual ~StateWrench() = default;
+  /// Adds its force (world frame, at the centre of gravity) and torque (body frame) at x to `d`.
+  virtual void AddTo(const StateVector& x, Disturbance* d) const = 0;
+};
+
 /// Accelerations at a state, as an accelerometer and the FDD observers see them.
 struct Accelerations {
   Vector3 a_W = Vector3::Zero();      ///< acceleration of the centre of gravity
@@ -97,11 +107,14 @@ class MultirotorModel {
 class Rk4Integrator {
  public:
   explicit Rk4Integrator(const MultirotorModel& model);
-  /// Advances x by dt [s] in place.
+  /// Advances x by dt [s] in place; `state_wrench`, when given, adds to `disturbance` at every stage.
   void Step(const RotorVector& u, const RotorFaults& faults, const Disturbance& disturbance,
-            double dt, StateVector* x);
+            double dt, StateVector* x, const StateWrench* state_wrench = nullptr);
 
  private:
+  void Derivative(const StateVector& x, const RotorVector& u, const RotorFaults& faults,
+                  const Disturbance& disturbance, const StateWrench* state_wrench, StateVector* x_dot) const;
+
   const MultirotorModel& model_;
   StateVector k1_, k2_, k3_, k4_, tmp_;
 };

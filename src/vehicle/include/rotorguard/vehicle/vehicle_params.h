@@ -73,6 +73,16 @@ struct VehicleParams {
   /// by PWM inputs (PwmQuadModel); 0 when the vehicle has no PWM model.
   double pwm_gain_n = 0.0;
   std::vector<Rotor> rotors;
+  /// The landing gear's feet relative to the centre of gravity, body frame [m]: the points the
+  /// vehicle stands on (sim/contact.h). Empty: the default, LandingGear().
+  std::vector<Vector3> landing_gear_B;
+
+  /// The feet: landing_gear_B, or one below each rotor hub, kDefaultGearDepth collision radii
+  /// below the centre of gravity (a frame whose legs hang under its motor mounts).
+  std::vector<Vector3> LandingGear() const;
+  /// The centre of gravity's height above flat ground when the vehicle stands level on its feet.
+  double RestingHeight() const;
+  static constexpr double kDefaultGearDepth = 0.25;
 
   int num_rotors() const { return static_cast<int>(rotors.size()); }
   double weight_n() const { return mass_kg * kGravity; }
@@ -138,6 +148,11 @@ void VehicleParams::Serialize(Archive* a) {
                        "gravity (an assembly writes one per unit)",
             .min = 1});
   a->Visit("rotors", &rotors, {.meaning = "the rotors, 1 to 64", .min = 1, .required = true});
+  a->Visit("landing_gear_m", &landing_gear_B,
+           {.meaning = "the feet it stands on, relative to the centre of gravity, body frame [m], each below it",
+            .min = -kMaxBodyOffsetM,
+            .max = kMaxBodyOffsetM,
+            .default_text = "one foot below each rotor hub, a quarter of collision_radius_m below the centre of gravity"});
 }
 
 }  // namespace rotorguard::vehicle
