@@ -107,14 +107,15 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
         initial.size(), model.state_size()));
   }
   x_.segment<4>(StateIndex::kQuaternion).normalize();
-  // Feet at or below the ground: the vehicle stands on them, at rest, its lowest feet sunk as
-  // far as its weight presses them (all of them, on a level start).
+  // A start at z <= 0 (the file's body origin at rest), or feet at or below the ground: the
+  // vehicle stands on them, at rest, its lowest feet sunk as far as its weight presses them (all
+  // of them, on a level start). A drawn centre of gravity above the file's stands higher.
   {
     const std::vector<Vector3> feet = model.params().LandingGear();
     const Matrix3 R = StateView(x_).q_WB().toRotationMatrix();
     double lowest = std::numeric_limits<double>::infinity();
     for (const Vector3& f : feet) lowest = std::min(lowest, x_[StateIndex::kPosition + 2] + R.row(2).dot(f));
-    if (lowest <= world_.ground_z_m) {
+    if (x_[StateIndex::kPosition + 2] <= 0.0 || lowest <= world_.ground_z_m) {
       const double sink = model.params().weight_n() / (static_cast<double>(feet.size()) * contact_.point_stiffness_n_m());
       x_[StateIndex::kPosition + 2] += world_.ground_z_m - lowest - sink;
       x_.segment<3>(StateIndex::kVelocity).setZero();

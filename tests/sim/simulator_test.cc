@@ -103,6 +103,26 @@ TEST(Simulator, RestsOnTheGroundReadingGravityUntilThrustExceedsWeight) {
   EXPECT_FALSE(rig.sim.crashed());
 }
 
+TEST(Simulator, AStartOnTheGroundStandsOnTheFeetWhereverTheDrawnCentreOfGravityPutsThem) {
+  // The file's feet 5 cm below its body origin put the ground at z = -0.05; a truth whose centre
+  // of gravity sits 1 cm lower has its feet 4 cm below it. Started at z = 0, it stands on the
+  // ground (1 cm lower, sunk by its weight), not 1 cm above it waiting to drop.
+  vehicle::VehicleParams truth = ReferenceQuad();
+  truth.landing_gear_B = {{0.05, 0.05, -0.04}, {0.05, -0.05, -0.04}, {-0.05, 0.05, -0.04}, {-0.05, -0.05, -0.04}};
+  const vehicle::MultirotorModel model(truth);
+  SimulatorOptions options;
+  options.ground_z_m = -0.05;
+  Simulator sim(model, World{}, {}, options, 1, model.MakeState(Vector3::Zero(), 0.0, RotorVector::Zero(4)));
+  const double sink = truth.weight_n() / (4.0 * sim.contact().point_stiffness_n_m());
+  EXPECT_TRUE(sim.landed());
+  EXPECT_NEAR(StateView(sim.state()).p_W().z(), -0.01 - sink, 1e-12);
+  RotorCommand off;
+  off.thrust_n = RotorVector::Zero(4);
+  for (int k = 0; k < 200; ++k) sim.Step(off);
+  EXPECT_NEAR(StateView(sim.state()).p_W().z(), -0.01 - sink, 1e-6);
+  EXPECT_LT(StateView(sim.state()).v_W().norm(), 1e-6);
+}
+
 TEST(Simulator, AVehicleThatLosesARotorAtLiftOffTipsOverTheFeetUnderIt) {
   // Spun up to lift off, propeller 0 (front right) gone: the ground no longer holds the vehicle
   // level. The thrust of the other three turns it about the feet under the lost rotor, which stay

@@ -60,8 +60,8 @@ struct SensorOutputs {
 
 class Simulator {
  public:
-  /// `initial` is the full truth state; a vehicle whose feet reach the ground starts standing on
-  /// them (lifted onto the ground, at rest).
+  /// `initial` is the full truth state; a vehicle at z <= 0, or whose feet reach the ground,
+  /// starts standing on them, at rest.
   Simulator(const vehicle::MultirotorModel& model, World world, std::vector<FaultSpec> faults,
             const SimulatorOptions& options, std::uint64_t seed, const vehicle::StateVector& initial);
 
