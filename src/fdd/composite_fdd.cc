@@ -240,8 +240,19 @@ void CompositeFdd::RunObserver(double t, double dt) {
                        wrench_filter_.value()[0] < (1.0 - kContactFraction) * vehicle_.weight_n();
   const bool flying = have_estimate_ && !contact &&
                       (estimate_.p_W.z() > 0.05 || wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
-  if (flying && !airborne_since_s_) airborne_since_s_ = t;
-  if (!flying) airborne_since_s_.reset();
+  if (flying && !airborne_since_s_) {
+    airborne_since_s_ = t;
+    // A take-off is a lift-off from rest (or the flight's start in the air): a touchdown's bounce
+    // leaves the ground for a moment and rocks the vehicle on its feet as a lost rotor would
+    // turn it, so it does not open the take-off detector's window (the observer judges it).
+    takeoff_armed_ = !grounded_since_s_ || t - *grounded_since_s_ >= options_.takeoff_rest_s;
+  }
+  if (flying) {
+    grounded_since_s_.reset();
+  } else {
+    airborne_since_s_.reset();
+    if (have_estimate_ && !grounded_since_s_) grounded_since_s_ = t;
+  }
   takeoff_index_ = 0.0;
   if (!airborne_since_s_) {
     std::fill(above_since_s_.begin(), above_since_s_.end(), -1.0);
@@ -286,7 +297,7 @@ void CompositeFdd::RunObserver(double t, double dt) {
 
   // Take-off detector (eq. 18): a strong roll/pitch angular acceleration shortly after lift-off,
   // pointing like the loss of one rotor's thrust: alpha ~ -I^-1 (r_i x T e3).
-  const bool takeoff = isolated == 0 && t - *airborne_since_s_ <= options_.takeoff_window_s &&
+  const bool takeoff = isolated == 0 && takeoff_armed_ && t - *airborne_since_s_ <= options_.takeoff_window_s &&
                        estimate_.p_W.z() <= options_.takeoff_max_altitude_m;
   if (takeoff) {
     takeoff_index_ = alpha.head<2>().norm() / one_rotor_alpha_;

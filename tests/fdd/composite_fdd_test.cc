@@ -378,6 +378,33 @@ TEST(CompositeFdd, TakeoffDetectorIgnoresATurnThatCostsNoThrust) {
   }
 }
 
+TEST(CompositeFdd, ATouchdownsBounceDoesNotOpenTheTakeoffWindowALiftOffFromRestDoes) {
+  // On the ground the rotors lift half the weight and the accelerometer reads the rest (the ground
+  // carries it); in the air they lift it all. A rotor lost 50 ms after leaving the ground is the
+  // take-off detector's case when the vehicle rested there 0.5 s, not after a 50 ms bounce (a
+  // touchdown rocks the vehicle on its feet as a lost rotor turns it).
+  for (const double rest_s : {0.05, 0.5}) {
+    CompositeFddOptions o;
+    o.propeller_persistence_s = 1.0;  // keep the observer's own isolation out of the way
+    Bench b(1.0, o);
+    ASSERT_FALSE(b.Run(4.0, 0.02));  // low hover: the window of the flight's start has closed
+    b.drive_ = b.actual_ = 0.5 * b.hover_;
+    b.force_bias_ = 0.5 * kGravity;
+    ASSERT_FALSE(b.Run(rest_s, 0.0));
+    b.drive_ = b.actual_ = b.hover_;
+    b.force_bias_ = 0.0;
+    ASSERT_FALSE(b.Run(0.05, 0.02));
+    b.actual_[0] = 0.0;
+    const auto detected = b.Run(0.2, 0.02);
+    if (rest_s >= o.takeoff_rest_s) {
+      ASSERT_TRUE(detected);
+      EXPECT_EQ(b.fdd_.rotors()[0].detector, "takeoff");
+    } else {
+      EXPECT_FALSE(detected) << b.fdd_.rotors()[0].detector;
+    }
+  }
+}
+
 TEST(CompositeFdd, ARampLossCrossesIntoPropellerFailure) {
   Bench b(1.0);
   ASSERT_FALSE(b.Run(1.0));
