@@ -242,10 +242,12 @@ void CompositeFdd::RunObserver(double t, double dt) {
                       (estimate_.p_W.z() > 0.05 || wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
   if (flying && !airborne_since_s_) {
     airborne_since_s_ = t;
-    // A take-off is a lift-off from rest (or the flight's start in the air): a touchdown's bounce
-    // leaves the ground for a moment and rocks the vehicle on its feet as a lost rotor would
-    // turn it, so it does not open the take-off detector's window (the observer judges it).
-    takeoff_armed_ = !grounded_since_s_ || t - *grounded_since_s_ >= options_.takeoff_rest_s;
+    // A take-off is the flight's first lift-off (or its start in the air), or a lift-off from
+    // rest: a touchdown's bounce leaves the ground for a moment and rocks the vehicle on its feet
+    // as a lost rotor would turn it, so it does not open the take-off detector's window (the
+    // observer judges it).
+    takeoff_armed_ = !been_airborne_ || (grounded_since_s_ && t - *grounded_since_s_ >= options_.takeoff_rest_s);
+    been_airborne_ = true;
   }
   if (flying) {
     grounded_since_s_.reset();

@@ -405,6 +405,22 @@ TEST(CompositeFdd, ATouchdownsBounceDoesNotOpenTheTakeoffWindowALiftOffFromRestD
   }
 }
 
+TEST(CompositeFdd, TheFlightsFirstLiftOffOpensTheTakeoffWindowHoweverShortTheRest) {
+  // A take-off whose motors spin up at once leaves the ground 0.1 s after the start.
+  CompositeFddOptions o;
+  o.propeller_persistence_s = 1.0;
+  Bench b(1.0, o);
+  b.drive_ = b.actual_ = 0.5 * b.hover_;
+  b.force_bias_ = 0.5 * kGravity;
+  ASSERT_FALSE(b.Run(0.1, 0.0));
+  b.drive_ = b.actual_ = b.hover_;
+  b.force_bias_ = 0.0;
+  ASSERT_FALSE(b.Run(0.05, 0.02));
+  b.actual_[2] = 0.0;
+  ASSERT_TRUE(b.Run(0.2, 0.02));
+  EXPECT_EQ(b.fdd_.rotors()[2].detector, "takeoff");
+}
+
 TEST(CompositeFdd, ARampLossCrossesIntoPropellerFailure) {
   Bench b(1.0);
   ASSERT_FALSE(b.Run(1.0));

@@ -75,8 +75,8 @@ struct CompositeFddOptions {
   /// within takeoff_window_s of lift-off, > 0.
   double takeoff_max_altitude_m = 0.6;
   double takeoff_window_s = 3.0;
-  /// ... after a lift-off from at least this long on the ground [s], in [0, 100]: a touchdown's
-  /// bounce is not a take-off.
+  /// ... after the flight's first lift-off, or one from at least this long on the ground [s], in
+  /// [0, 100]: a touchdown's bounce is not a take-off.
   double takeoff_rest_s = 0.3;
   /// The take-off index: the filtered roll/pitch angular acceleration magnitude over the one that
   /// losing one rotor's share of the hover thrust causes (the smallest over the rotors,
@@ -152,7 +152,7 @@ struct CompositeFddOptions {
     a->Visit("takeoff_window_s", &takeoff_window_s,
              {.meaning = "... and within this long of lift-off [s] ...", .min = 1e-3, .max = 1000.0});
     a->Visit("takeoff_rest_s", &takeoff_rest_s,
-             {.meaning = "... after at least this long on the ground (a touchdown's bounce is no take-off) [s]",
+             {.meaning = "... of the first lift-off, or one after this long on the ground (a touchdown's bounce is no take-off) [s]",
               .min = 0.0,
               .max = 100.0});
     // 1e6: out of reach, the detector off (Disarmed).
@@ -374,6 +374,7 @@ class CompositeFdd final : public FaultDetectorBase {
   std::optional<double> airborne_since_s_;
   std::optional<double> grounded_since_s_;  // on the ground (by the estimate and the contact test) since
   bool takeoff_armed_ = false;               // the current airborne phase began with a take-off
+  bool been_airborne_ = false;               // an airborne phase came before
   std::vector<double> above_since_s_, degraded_since_s_, degraded_sum_;
   std::vector<int> degraded_count_;
   Eigen::VectorXd thrust_loss_;
