@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -35,6 +36,7 @@ GroundContact::GroundContact(std::vector<Vector3> points_B, double mass_kg, cons
   const double m_foot = mass_kg / static_cast<double>(feet_.size());
   k_ = m_foot * omega * omega;
   c_ = 2.0 * options_.damping_ratio * m_foot * omega;
+  sink_m_ = kGravity / (omega * omega);
 }
 
 GroundContact::FootState GroundContact::StateOf(const Foot& f, const vehicle::StateView& s, const Matrix3& R) const {
@@ -46,17 +48,9 @@ GroundContact::FootState GroundContact::StateOf(const Foot& f, const vehicle::St
   return fs;
 }
 
-void GroundContact::Forces(const Foot& f, const FootState& fs, double* normal_n, Vector3* tangential_W) const {
-  const Vector3& n = plane_.normal_W;
-  const double v_n = n.dot(fs.v_W);
+double GroundContact::NormalForce(const FootState& fs) const {
   // The ground pushes, never pulls: a foot leaving faster than its spring relaxes lets go.
-  *normal_n = std::max(0.0, k_ * fs.depth - c_ * v_n);
-  const Vector3 v_t = fs.v_W - v_n * n;
-  *tangential_W = -c_ * v_t;
-  if (f.anchored) {
-    const Vector3 e = fs.p_W - f.anchor_W;
-    *tangential_W -= k_ * (e - n.dot(e) * n);
-  }
+  return std::max(0.0, k_ * fs.depth - c_ * plane_.normal_W.dot(fs.v_W));
 }
 
 void GroundContact::AddTo(const vehicle::StateVector& x, vehicle::Disturbance* d) const {
@@ -65,14 +59,19 @@ void GroundContact::AddTo(const vehicle::StateVector& x, vehicle::Disturbance* d
   for (const Foot& f : feet_) {
     const FootState fs = StateOf(f, s, R);
     if (fs.depth <= 0.0) continue;
-    double normal = 0.0;
-    Vector3 tangential;
-    Forces(f, fs, &normal, &tangential);
-    // Coulomb: the tangential force never exceeds mu N (the foot slides at that force).
+    const Vector3& n = plane_.normal_W;
+    const double normal = NormalForce(fs);
+    // The tangential spring to the anchor and its damper ...
+    Vector3 tangential = -c_ * (fs.v_W - n.dot(fs.v_W) * n);
+    if (f.anchored) {
+      const Vector3 e = fs.p_W - f.anchor_W;
+      tangential -= k_ * (e - n.dot(e) * n);
+    }
+    // ... within Coulomb's mu N (the foot slides at that force).
     const double limit = options_.friction_coefficient * normal;
     const double t = tangential.norm();
-    if (t > limit) tangential *= t > 0.0 ? limit / t : 0.0;
-    const Vector3 force_W = normal * plane_.normal_W + tangential;
+    if (t > limit) tangential *= limit / t;
+    const Vector3 force_W = normal * n + tangential;
     d->force_W += force_W;
     d->torque_B += f.c_B.cross(R.transpose() * force_W);
   }
@@ -95,12 +94,9 @@ void GroundContact::Update(const vehicle::StateVector& x) {
       continue;
     }
     // Sliding: the spring's stretch beyond mu N / k is where the foot went, not the ground.
-    double normal = 0.0;
-    Vector3 tangential;
-    Forces(f, fs, &normal, &tangential);
     const Vector3 e = on_plane - f.anchor_W;
     const double stretch = e.norm();
-    const double max_stretch = options_.friction_coefficient * normal / k_;
+    const double max_stretch = options_.friction_coefficient * NormalForce(fs) / k_;
     if (stretch > max_stretch) f.anchor_W = on_plane - e * (max_stretch / stretch);
   }
 }
@@ -109,10 +105,12 @@ int GroundContact::points_in_contact() const {
   return static_cast<int>(std::count_if(feet_.begin(), feet_.end(), [](const Foot& f) { return f.anchored; }));
 }
 
-double GroundContact::resting_height_m() const {
-  double lowest = feet_.front().c_B.z();
-  for (const Foot& f : feet_) lowest = std::min(lowest, f.c_B.z());
-  return -lowest;
+double GroundContact::Depth(const vehicle::StateVector& x) const {
+  const vehicle::StateView s(x);
+  const Matrix3 R = s.q_WB().toRotationMatrix();
+  double deepest = -std::numeric_limits<double>::infinity();
+  for (const Foot& f : feet_) deepest = std::max(deepest, StateOf(f, s, R).depth);
+  return deepest;
 }
 
 }  // namespace rotorguard::sim

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -110,17 +109,10 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
   // A start at z <= 0 (the file's body origin at rest), or feet at or below the ground: the
   // vehicle stands on them, at rest, its lowest feet sunk as far as its weight presses them (all
   // of them, on a level start). A drawn centre of gravity above the file's stands higher.
-  {
-    const std::vector<Vector3> feet = model.params().LandingGear();
-    const Matrix3 R = StateView(x_).q_WB().toRotationMatrix();
-    double lowest = std::numeric_limits<double>::infinity();
-    for (const Vector3& f : feet) lowest = std::min(lowest, x_[StateIndex::kPosition + 2] + R.row(2).dot(f));
-    if (x_[StateIndex::kPosition + 2] <= 0.0 || lowest <= world_.ground_z_m) {
-      const double sink = model.params().weight_n() / (static_cast<double>(feet.size()) * contact_.point_stiffness_n_m());
-      x_[StateIndex::kPosition + 2] += world_.ground_z_m - lowest - sink;
-      x_.segment<3>(StateIndex::kVelocity).setZero();
-      x_.segment<3>(StateIndex::kBodyRate).setZero();
-    }
+  if (const double depth = contact_.Depth(x_); x_[StateIndex::kPosition + 2] <= 0.0 || depth >= 0.0) {
+    x_[StateIndex::kPosition + 2] += depth - contact_.standing_sink_m();
+    x_.segment<3>(StateIndex::kVelocity).setZero();
+    x_.segment<3>(StateIndex::kBodyRate).setZero();
   }
   contact_.Update(x_);
   landed_ = contact_.points_in_contact() > 0;

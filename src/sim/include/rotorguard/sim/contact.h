@@ -57,12 +57,13 @@ class GroundContact final : public vehicle::StateWrench {
 
   /// Points touching the ground at the last Update.
   int points_in_contact() const;
-  /// The centre of gravity's height above the plane when the vehicle rests level on its gear
-  /// (ignoring the springs' sink).
-  double resting_height_m() const;
+  /// How far the deepest foot lies below the plane at x [m] (negative: all above it).
+  double Depth(const vehicle::StateVector& x) const;
+  /// How far the weight presses the feet into the ground when the vehicle stands level on all of
+  /// them, m g / (n k) = g / (2 pi f)^2 [m].
+  double standing_sink_m() const { return sink_m_; }
   /// The stiffness of one point [N/m].
   double point_stiffness_n_m() const { return k_; }
-  const GroundPlane& plane() const { return plane_; }
 
  private:
   struct Foot {
@@ -75,13 +76,13 @@ class GroundContact final : public vehicle::StateWrench {
     double depth = 0.0;  // below the plane, > 0 in contact
   };
   FootState StateOf(const Foot& f, const vehicle::StateView& s, const Matrix3& R) const;
-  /// The normal force's magnitude and the tangential force before Coulomb's limit.
-  void Forces(const Foot& f, const FootState& fs, double* normal_n, Vector3* tangential_W) const;
+  /// The normal force's magnitude on a foot in contact.
+  double NormalForce(const FootState& fs) const;
 
   std::vector<Foot> feet_;
   GroundContactOptions options_;
   GroundPlane plane_;
-  double k_ = 0.0, c_ = 0.0;
+  double k_ = 0.0, c_ = 0.0, sink_m_ = 0.0;
 };
 
 }  // namespace rotorguard::sim
