@@ -17,6 +17,23 @@ using vehicle::StateView;
 
 // Independent random streams of one run.
 enum Stream : std::uint64_t { kImuStream = 1, kEscStream = 2, kOdometryStream = 3, kWindStream = 4, kLidarStream = 5 };
+
+// What the ground does at a state, for the integrator's every stage: it pushes on the feet that
+// touch it and on the rotors' wakes. Built where it is used (it points into the simulator).
+class GroundWrench final : public vehicle::StateWrench {
+ public:
+  GroundWrench(const GroundContact& contact, const GroundEffect& effect, const vehicle::RotorFaults& faults)
+      : contact_(contact), effect_(effect), faults_(faults) {}
+  void AddTo(const vehicle::StateVector& x, vehicle::Disturbance* d) const override {
+    contact_.AddTo(x, d);
+    effect_.AddTo(x, faults_, d);
+  }
+
+ private:
+  const GroundContact& contact_;
+  const GroundEffect& effect_;
+  const vehicle::RotorFaults& faults_;
+};
 }  // namespace
 
 const SimulatorOptions& Simulator::Validated(const SimulatorOptions& options,
@@ -66,6 +83,7 @@ void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
     ThrowValidation("SimulatorOptions", "sim.crash_tilt_rad", crash_tilt_rad, "an angle in (0, pi]");
   }
   prefixed("sim.ground.", [&] { ground.Validate(); });
+  prefixed("sim.ground_effect.", [&] { ground_effect.Validate(); });
   if (ground_z_m && !(std::abs(*ground_z_m) <= kMaxCoordinateM)) {
     ThrowValidation("SimulatorOptions", "ground_z_m", *ground_z_m, fmt::format("a height within ±{:g} m", kMaxCoordinateM));
   }
@@ -89,6 +107,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
       integrator_(model),
       contact_(model.params().LandingGear(), model.params().mass_kg, options_.ground,
                GroundPlane{.normal_W = Vector3::UnitZ(), .offset_m = world_.ground_z_m}),
+      ground_effect_(model, options_.ground_effect, world_.ground_z_m),
       imu_(options_.imu, DeriveSeed(seed, kImuStream)),
       esc_(options_.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
       odometry_(options_.odometry, world_, DeriveSeed(seed, kOdometryStream)),
@@ -139,9 +158,9 @@ void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
   TruthSample truth;
   truth.t_ns = t_ns_;
   truth.x = &x_;
-  // The ground's push on the feet is felt as any other force.
+  // The ground's push on the feet and the wakes is felt as any other force.
   vehicle::Disturbance with_ground = disturbance;
-  contact_.AddTo(x_, &with_ground);
+  GroundWrench(contact_, ground_effect_, faults_).AddTo(x_, &with_ground);
   truth.acc = model_.ComputeAccelerations(x_, faults_, with_ground);
   truth.motor_speed_rad_s = speed_;
   truth.faults = &faults_;
@@ -235,14 +254,15 @@ const SensorOutputs& Simulator::Step() {
   // own instant, not from the next step's).
   const TimeNs end = t_ns_ + dt_ns_;
   TimeNs t = t_ns_;
+  const GroundWrench ground(contact_, ground_effect_, faults_);
   ActivateCommands(t);
   while (queue_size_ > 0 && queue_[static_cast<std::size_t>(queue_head_)].acts_ns < end) {
     const TimeNs next = queue_[static_cast<std::size_t>(queue_head_)].acts_ns;
-    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_, &contact_);
+    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_, &ground);
     t = next;
     ActivateCommands(t);
   }
-  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_, &contact_);
+  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_, &ground);
   t_ns_ = end;
   ActivateCommands(t_ns_);  // applied_command(): the one acting at the new time
   UpdateOutputs();

@@ -45,6 +45,7 @@ TruthRanges RangesOf(TruthPreset preset) {
   r.lidar_clock_offset_s = 0.002;
   r.imu_axial_vibration_m_s2 = 0.8;
   r.gyro_vibration_gain = 3.0;
+  r.ground_effect_fraction = 0.5;
   return r;
 }
 
@@ -162,6 +163,7 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   if (r.lidar_clock_offset_s > 0.0) d.lidar_clock_offset_s = rng.Uniform(-r.lidar_clock_offset_s, r.lidar_clock_offset_s);
   if (r.imu_axial_vibration_m_s2 > 0.0) d.imu_axial_vibration_m_s2 = rng.Uniform(0.5, 1.0) * r.imu_axial_vibration_m_s2;
   if (r.gyro_vibration_gain > 0.0) d.gyro_vibration_gain = rng.Uniform(std::min(1.0, r.gyro_vibration_gain), r.gyro_vibration_gain);
+  d.ground_effect_ratio = Ratio(r.ground_effect_fraction, &rng);
   return d;
 }
 
@@ -243,6 +245,7 @@ SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const v
   o.imu.gyro_noise_density = scenario.imu.gyro_noise_density * draw.imu_gyro_noise_ratio;
   o.imu.axial_vibration_m_s2 = draw.imu_axial_vibration_m_s2;
   o.imu.gyro_vibration_gain = draw.gyro_vibration_gain;
+  o.ground_effect.strength = std::min(scenario.ground_effect.strength * draw.ground_effect_ratio, kMaxGroundEffectStrength);
   if (draw.gyro_vibration_gain > 0.0) {
     const vehicle::VehicleParams v = TruthVehicle(file, draw);
     for (const vehicle::Rotor& r : v.rotors) o.imu.rotor_positions_m.push_back(r.p_B);

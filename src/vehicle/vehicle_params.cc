@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "rotorguard/core/error.h"
@@ -40,6 +41,16 @@ double VehicleParams::RestingHeight() const {
   double lowest = 0.0;
   for (const Vector3& f : LandingGear()) lowest = std::min(lowest, f.z());
   return -lowest;
+}
+
+double VehicleParams::PropellerRadius() const {
+  if (propeller_radius_m > 0.0) return propeller_radius_m;
+  double closest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < rotors.size(); ++i) {
+    for (std::size_t j = i + 1; j < rotors.size(); ++j) closest = std::min(closest, (rotors[i].p_B - rotors[j].p_B).norm());
+  }
+  // Coincident hubs (a coaxial pair) say nothing of the radius.
+  return std::isfinite(closest) && closest > 0.0 ? 0.5 * closest : 0.5 * collision_radius_m;
 }
 
 void VehicleParams::Validate() const {

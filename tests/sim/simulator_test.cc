@@ -90,8 +90,9 @@ TEST(Simulator, RestsOnTheGroundReadingGravityUntilThrustExceedsWeight) {
   EXPECT_TRUE(rig.sim.landed());
   EXPECT_EQ(rig.sim.contact().points_in_contact(), 4);
   // On its feet: the centre of gravity at z = 0, sunk by the feet's springs under the weight
-  // left over by the idle thrust (Hooke), and still.
-  const double pressing = rig.model.params().weight_n() - 4.0;
+  // left over by the idle thrust, raised by the ground effect at the hubs' height (Hooke), and still.
+  const double hub_height = StateView(rig.sim.state()).p_W().z() + rig.model.params().RestingHeight();
+  const double pressing = rig.model.params().weight_n() - 4.0 * rig.sim.ground_effect().Ratio(hub_height);
   EXPECT_NEAR(StateView(rig.sim.state()).p_W().z(), -pressing / (4.0 * rig.sim.contact().point_stiffness_n_m()), 1e-6);
   EXPECT_LT(StateView(rig.sim.state()).v_W().norm(), 1e-6);
   EXPECT_NEAR(rig.imu.specific_force_B.z(), kGravity, 0.3);  // noise and bias

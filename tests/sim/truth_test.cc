@@ -40,6 +40,7 @@ TEST(Truth, TheIdealWorldIsTheFileExactly) {
   EXPECT_EQ(d.thrust_coefficient_ratio, std::vector<double>(4, 1.0));
   EXPECT_EQ(d.motor_stop_time_constant_s, file.motor_stop_time_constant_s);
   EXPECT_EQ(d.external_torque_n_m, Vector3::Zero());
+  EXPECT_EQ(d.ground_effect_ratio, 1.0);  // the world's physics, not the file's: nominal, not absent
   const vehicle::VehicleParams v = TruthVehicle(file, d);
   // Bit for bit: the ideal world must reproduce the figures measured before the truth existed.
   EXPECT_EQ(v.mass_kg, file.mass_kg);
@@ -102,9 +103,11 @@ TEST(Truth, ADrawIsAPureFunctionOfItsSeed) {
 TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   const vehicle::VehicleParams file = ReferenceQuad();
   const TruthRanges r = RangesOf(TruthPreset::kRealistic);
-  std::vector<double> mass, kn, stop, torque, cog, latency, computation, esc_latency, noise, lidar_turn, lidar_clock;
+  std::vector<double> mass, kn, stop, torque, cog, latency, computation, esc_latency, noise, lidar_turn, lidar_clock,
+      ground_effect;
   for (std::uint64_t seed = 0; seed < 4000; ++seed) {
     const TruthDraw d = DrawTruth(Realistic(), file, seed);
+    ground_effect.push_back(d.ground_effect_ratio);
     computation.push_back(d.computation_delay_s);
     esc_latency.push_back(d.esc_command_latency_s);
     noise.push_back(d.imu_gyro_noise_ratio);
@@ -136,6 +139,9 @@ TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   fills(kn, 1.0, r.thrust_coefficient_fraction);
   fills(torque, 0.0, r.external_torque_n_m);
   fills(cog, 0.0, r.cog_offset_m);
+  // The ground effect from half to one and a half times Cheeseman and Bennett's.
+  EXPECT_GE(r.ground_effect_fraction, 0.5);
+  fills(ground_effect, 1.0, r.ground_effect_fraction);
   const auto fills_interval = [&fills](const std::vector<double>& x, double lo, double hi) {
     fills(x, 0.5 * (lo + hi), 0.5 * (hi - lo));
   };

@@ -62,6 +62,8 @@ struct SimKeys {
     a->Visit("log_rate_hz", &s->log_rate_hz,
              {.meaning = "rows per second in log.csv, at most the physics rate", .min = kMinRateHz, .max = kMaxRateHz});
     a->Visit("ground", &s->sim.ground, {.meaning = "the ground under the landing gear's feet"});
+    a->Visit("ground_effect", &s->sim.ground_effect,
+             {.meaning = "the rotors' extra thrust near the ground (the truth draws its strength about this one)"});
     a->Visit("crash_speed_m_s", &s->sim.crash_speed_m_s,
              {.meaning = "touching the ground faster is a crash [m/s]", .min = kMinSpeedMS, .max = kMaxSpeedMS});
     a->Visit(

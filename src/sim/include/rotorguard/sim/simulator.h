@@ -11,6 +11,7 @@
 #include "rotorguard/core/messages.h"
 #include "rotorguard/sim/contact.h"
 #include "rotorguard/sim/fault_injector.h"
+#include "rotorguard/sim/ground_effect.h"
 #include "rotorguard/sim/lidar.h"
 #include "rotorguard/sim/sensors.h"
 #include "rotorguard/sim/wind.h"
@@ -36,6 +37,8 @@ struct SimulatorOptions {
   Vector3 external_torque_n_m = Vector3::Zero();
   /// The ground under the landing gear's feet (contact.h).
   GroundContactOptions ground;
+  /// The ground's push on the rotors' wakes (ground_effect.h).
+  GroundEffectOptions ground_effect;
   /// The ground plane's height [m]; none: where the model's feet reach when its centre of gravity
   /// rests at z = 0. (A drawn truth passes the file's: its body origin rests at z = 0.)
   std::optional<double> ground_z_m;
@@ -89,7 +92,7 @@ class Simulator {
   const vehicle::StateVector& state() const { return x_; }
   const vehicle::RotorFaults& faults() const { return faults_; }
   const std::vector<FaultEvent>& fault_events() const { return injector_.events(); }
-  /// Thrust each rotor applies now [N], and each motor's speed [rad/s].
+  /// Thrust each rotor applies now out of ground effect [N], and each motor's speed [rad/s].
   const RotorVector& rotor_thrusts() const { return thrust_; }
   const RotorVector& motor_speeds() const { return speed_; }
   /// Commands after saturation to [0, T_bar], as the motors see them (the one acting now).
@@ -101,6 +104,7 @@ class Simulator {
   /// A foot touches the ground.
   bool landed() const { return landed_; }
   const GroundContact& contact() const { return contact_; }
+  const GroundEffect& ground_effect() const { return ground_effect_; }
   bool crashed() const { return crash_reason_.has_value(); }
   const std::optional<std::string>& crash_reason() const { return crash_reason_; }
   /// The speed [m/s] at the crash's ground contact; none without a crash.
@@ -132,6 +136,7 @@ class Simulator {
   FaultInjector injector_;
   vehicle::Rk4Integrator integrator_;
   GroundContact contact_;
+  GroundEffect ground_effect_;
   ImuModel imu_;
   EscModel esc_;
   OdometryModel odometry_;

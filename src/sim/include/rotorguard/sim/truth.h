@@ -72,6 +72,9 @@ struct TruthRanges {
   /// ImuOptions) times a frame's flex, drawn in [1, a] (0: no rocking).
   double imu_axial_vibration_m_s2 = 0.0;
   double gyro_vibration_gain = 0.0;
+  /// The ground effect's strength (GroundEffectOptions::strength) drawn in (1 ± a) times the
+  /// scenario's.
+  double ground_effect_fraction = 0.0;
 };
 
 /// The ranges of a preset.
@@ -87,7 +90,7 @@ struct TruthOptions {
       odometry_yaw_drift_rad_per_sqrt_s, odometry_few_features_gain, odometry_outage_rate_hz,
       computation_delay_min_s, computation_delay_max_s, computation_delay_jitter_fraction, esc_command_latency_min_s,
       esc_command_latency_max_s, imu_noise_fraction, lidar_rotation_rad, lidar_clock_offset_s,
-      imu_axial_vibration_m_s2, gyro_vibration_gain;
+      imu_axial_vibration_m_s2, gyro_vibration_gain, ground_effect_fraction;
 
   /// The preset's ranges with the overrides applied.
   TruthRanges Ranges() const;
@@ -259,6 +262,10 @@ inline constexpr TruthOverrideKey kTruthOverrideKeys[] = {
                  "drawn in [1, a] (0: none)",
       .min = 0,
       .max = 100}},
+    {"ground_effect_fraction",
+     &TruthOptions::ground_effect_fraction,
+     &TruthRanges::ground_effect_fraction,
+     {.meaning = "the ground effect's strength drawn in (1 ± a) times sim.ground_effect.strength", .min = 0, .max = 1}},
 };
 
 template <typename Archive>
@@ -300,6 +307,7 @@ struct TruthDraw {
   double lidar_clock_offset_s = 0.0;               ///< LidarOptions::clock_offset_s
   double imu_axial_vibration_m_s2 = 0.0;           ///< ImuOptions::axial_vibration_m_s2
   double gyro_vibration_gain = 0.0;                ///< ImuOptions::gyro_vibration_gain
+  double ground_effect_ratio = 1.0;                ///< true / the scenario's ground effect strength
 
   /// summary.json's "truth" object.
   template <typename Archive>
@@ -347,6 +355,8 @@ struct TruthDraw {
              {.meaning = "a healthy rotor's axial vibration at hover speed, blade-pass frequency [m/s²]"});
     a->Visit("gyro_vibration_gain", &gyro_vibration_gain,
              {.meaning = "the airframe's rocking over the vibration forces' rigid-body moment"});
+    a->Visit("ground_effect_ratio", &ground_effect_ratio,
+             {.meaning = "true ground effect strength / sim.ground_effect.strength"});
   }
 };
 

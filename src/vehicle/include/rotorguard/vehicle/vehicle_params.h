@@ -76,6 +76,9 @@ struct VehicleParams {
   /// The landing gear's feet relative to the centre of gravity, body frame [m]: the points the
   /// vehicle stands on (sim/contact.h). Empty: the default, LandingGear().
   std::vector<Vector3> landing_gear_B;
+  /// The propellers' radius [m] (the ground effect's scale, sim/ground_effect.h); 0: the default,
+  /// PropellerRadius().
+  double propeller_radius_m = 0.0;
 
   /// The feet: landing_gear_B, or one below each rotor hub, kDefaultGearDepth collision radii
   /// below the centre of gravity (a frame whose legs hang under its motor mounts).
@@ -83,6 +86,9 @@ struct VehicleParams {
   /// The centre of gravity's height above flat ground when the vehicle stands level on its feet.
   double RestingHeight() const;
   static constexpr double kDefaultGearDepth = 0.25;
+  /// propeller_radius_m, or the largest propellers that do not overlap: half the smallest
+  /// distance between two hubs (a single rotor: half the collision radius).
+  double PropellerRadius() const;
 
   int num_rotors() const { return static_cast<int>(rotors.size()); }
   double weight_n() const { return mass_kg * kGravity; }
@@ -153,6 +159,11 @@ void VehicleParams::Serialize(Archive* a) {
             .min = -kMaxBodyOffsetM,
             .max = kMaxBodyOffsetM,
             .default_text = "one foot below each rotor hub, a quarter of collision_radius_m below the centre of gravity"});
+  a->Visit("propeller_radius_m", &propeller_radius_m,
+           {.meaning = "the propellers' radius [m]: the scale of the ground effect (simulated vehicles)",
+            .min = 0,
+            .max = kMaxBodyOffsetM,
+            .default_text = "half the smallest distance between two hubs (propellers that do not overlap)"});
 }
 
 }  // namespace rotorguard::vehicle
