@@ -11,10 +11,10 @@ namespace rotorguard::sim {
 void GroundEffectOptions::Validate() const { CheckDeclaredRanges("GroundEffectOptions", *this); }
 
 GroundEffect::GroundEffect(const vehicle::MultirotorModel& model, const GroundEffectOptions& options,
-                           double ground_z_m)
+                           const GroundPlane& ground)
     : model_(model),
       options_(options),
-      ground_z_m_(ground_z_m),
+      ground_(ground),
       radius_m_(model.params().PropellerRadius()),
       max_image_term_(1.0 - 1.0 / options.max_ratio) {
   options_.Validate();
@@ -23,8 +23,8 @@ GroundEffect::GroundEffect(const vehicle::MultirotorModel& model, const GroundEf
 double GroundEffect::Ratio(double height_m) const {
   if (options_.strength <= 0.0) return 1.0;
   if (!(height_m > 0.0)) return options_.max_ratio;
-  const double image = options_.strength * std::pow(radius_m_ / (4.0 * height_m), 2);
-  return 1.0 / (1.0 - std::min(image, max_image_term_));
+  const double r = radius_m_ / (4.0 * height_m);
+  return 1.0 / (1.0 - std::min(options_.strength * r * r, max_image_term_));
 }
 
 void GroundEffect::AddTo(const vehicle::StateVector& x, const vehicle::RotorFaults& faults,
@@ -33,17 +33,19 @@ void GroundEffect::AddTo(const vehicle::StateVector& x, const vehicle::RotorFaul
   const vehicle::StateView s(x);
   const Matrix3 R = s.q_WB().toRotationMatrix();
   // A rotor whose axis points away from the ground blows no wake onto it.
-  if (R(2, 2) <= 0.0) return;
+  const Vector3& n = ground_.normal_W;
+  if (n.dot(R.col(2)) <= 0.0) return;
   RotorVector thrust;
   model_.RotorThrusts(x, faults, &thrust);
   const std::vector<vehicle::Rotor>& rotors = model_.params().rotors;
   double added_total = 0.0;
   Vector3 torque_B = Vector3::Zero();
   for (int i = 0; i < model_.num_rotors(); ++i) {
-    const double height = s.p_W().z() + R.row(2).dot(rotors[static_cast<std::size_t>(i)].p_B) - ground_z_m_;
+    const Vector3& hub_B = rotors[static_cast<std::size_t>(i)].p_B;
+    const double height = n.dot(s.p_W() + R * hub_B) - ground_.offset_m;
     const double added = (Ratio(height) - 1.0) * thrust[i];
     added_total += added;
-    torque_B += rotors[static_cast<std::size_t>(i)].p_B.cross(Vector3(0.0, 0.0, added));
+    torque_B += hub_B.cross(Vector3(0.0, 0.0, added));
   }
   d->force_W += added_total * R.col(2);
   d->torque_B += torque_B;

@@ -107,7 +107,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
       integrator_(model),
       contact_(model.params().LandingGear(), model.params().mass_kg, options_.ground,
                GroundPlane{.normal_W = Vector3::UnitZ(), .offset_m = world_.ground_z_m}),
-      ground_effect_(model, options_.ground_effect, world_.ground_z_m),
+      ground_effect_(model, options_.ground_effect, contact_.plane()),
       imu_(options_.imu, DeriveSeed(seed, kImuStream)),
       esc_(options_.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
       odometry_(options_.odometry, world_, DeriveSeed(seed, kOdometryStream)),

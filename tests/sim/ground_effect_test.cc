@@ -31,12 +31,12 @@ vehicle::StateVector LevelAt(const vehicle::MultirotorModel& model, double z, co
 
 TEST(GroundEffect, TheRatioIsCheesemanAndBennettsBoundedNearTheGround) {
   const vehicle::MultirotorModel model(FiveInchQuad());
-  const GroundEffect nominal(model, {.strength = 1.0, .max_ratio = 1.5}, 0.0);
+  const GroundEffect nominal(model, {.strength = 1.0, .max_ratio = 1.5}, GroundPlane{});
   // 1 / (1 - (R/4z)^2): 16/15 at z = R, 64/63 at z = 2R.
   EXPECT_NEAR(nominal.Ratio(kRadius), 16.0 / 15.0, 1e-12);
   EXPECT_NEAR(nominal.Ratio(2.0 * kRadius), 64.0 / 63.0, 1e-12);
   EXPECT_LT(nominal.Ratio(1.0) - 1.0, 3e-4);
-  const GroundEffect doubled(model, {.strength = 2.0, .max_ratio = 1.5}, 0.0);
+  const GroundEffect doubled(model, {.strength = 2.0, .max_ratio = 1.5}, GroundPlane{});
   EXPECT_NEAR(doubled.Ratio(kRadius), 8.0 / 7.0, 1e-12);
   // The bound is reached continuously and held down to the ground (and below it).
   const double z_bound = kRadius / 4.0 / std::sqrt(1.0 - 1.0 / 1.5);
@@ -51,7 +51,7 @@ TEST(GroundEffect, TheRatioIsCheesemanAndBennettsBoundedNearTheGround) {
     ASSERT_GE(r, 1.0);
     previous = r;
   }
-  const GroundEffect none(model, {.strength = 0.0, .max_ratio = 1.5}, 0.0);
+  const GroundEffect none(model, {.strength = 0.0, .max_ratio = 1.5}, GroundPlane{});
   EXPECT_EQ(none.Ratio(0.01), 1.0);
 }
 
@@ -66,7 +66,7 @@ TEST(GroundEffect, TheDefaultRadiusIsTheLargestPropellersThatDoNotOverlap) {
 TEST(GroundEffect, ALevelVehicleGetsEachRotorsExtraThrustAlongItsAxis) {
   const vehicle::MultirotorModel model(FiveInchQuad());
   const double ground = -0.4, z = -0.33;  // hubs 7 cm above the ground
-  const GroundEffect effect(model, {.strength = 1.0}, ground);
+  const GroundEffect effect(model, {.strength = 1.0}, GroundPlane{.offset_m = ground});
   const RotorVector thrust = (RotorVector(4) << 2.0, 3.0, 2.5, 3.5).finished();
   vehicle::Disturbance d;
   effect.AddTo(LevelAt(model, z, thrust), vehicle::RotorFaults(4), &d);
@@ -82,7 +82,7 @@ TEST(GroundEffect, ALevelVehicleGetsEachRotorsExtraThrustAlongItsAxis) {
 
 TEST(GroundEffect, ATiltedVehicleNearTheGroundIsRightedItsLowerRotorsPushMore) {
   const vehicle::MultirotorModel model(FiveInchQuad());
-  const GroundEffect effect(model, {.strength = 1.0}, 0.0);
+  const GroundEffect effect(model, {.strength = 1.0}, GroundPlane{});
   vehicle::StateVector x = model.MakeState(Vector3(0, 0, 0.06), 0.0, model.HoverThrusts());
   for (const double roll : {0.2, -0.2}) {
     const Quaternion q(Eigen::AngleAxisd(roll, Vector3::UnitX()));
@@ -111,7 +111,7 @@ TEST(GroundEffect, ATiltedVehicleNearTheGroundIsRightedItsLowerRotorsPushMore) {
 
 TEST(GroundEffect, ARotorWithoutItsPropellerGetsNone) {
   const vehicle::MultirotorModel model(FiveInchQuad());
-  const GroundEffect effect(model, {.strength = 1.0}, 0.0);
+  const GroundEffect effect(model, {.strength = 1.0}, GroundPlane{});
   const vehicle::StateVector x = LevelAt(model, 0.07, RotorVector::Constant(4, 3.0));
   vehicle::RotorFaults faults(4);
   vehicle::Disturbance healthy, lost;
@@ -124,7 +124,7 @@ TEST(GroundEffect, ARotorWithoutItsPropellerGetsNone) {
 TEST(GroundEffect, OptionsOutOfRangeAreRejectedByKey) {
   const vehicle::MultirotorModel model(FiveInchQuad());
   try {
-    GroundEffect(model, {.strength = 1.0, .max_ratio = 0.9}, 0.0);
+    GroundEffect(model, {.strength = 1.0, .max_ratio = 0.9}, GroundPlane{});
     FAIL() << "a ratio below 1 was accepted";
   } catch (const ValidationError& e) {
     EXPECT_EQ(e.field(), "max_ratio");

@@ -64,6 +64,7 @@ class GroundContact final : public vehicle::StateWrench {
   double standing_sink_m() const { return sink_m_; }
   /// The stiffness of one point [N/m].
   double point_stiffness_n_m() const { return k_; }
+  const GroundPlane& plane() const { return plane_; }
 
  private:
   struct Foot {

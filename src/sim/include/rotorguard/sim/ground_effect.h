@@ -17,6 +17,7 @@
 /// (a rotor in ground effect needs slightly less torque for its thrust; neglected).
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/types.h"
+#include "rotorguard/sim/contact.h"
 #include "rotorguard/vehicle/faults.h"
 #include "rotorguard/vehicle/multirotor.h"
 
@@ -46,9 +47,9 @@ struct GroundEffectOptions {
 class GroundEffect {
  public:
   /// `model`: its rotors (positions about the centre of gravity, thrusts) and its vehicle's
-  /// propeller radius; `ground_z_m`: the ground plane's height (level ground). The model must
-  /// outlive this object.
-  GroundEffect(const vehicle::MultirotorModel& model, const GroundEffectOptions& options, double ground_z_m);
+  /// propeller radius; `ground`: the plane the contact stands on (heights along its normal). The
+  /// model must outlive this object.
+  GroundEffect(const vehicle::MultirotorModel& model, const GroundEffectOptions& options, const GroundPlane& ground);
 
   /// T / T_inf for a hub at `height_m` above the ground (1 for a rotor at or above no ground).
   double Ratio(double height_m) const;
@@ -60,7 +61,8 @@ class GroundEffect {
  private:
   const vehicle::MultirotorModel& model_;
   GroundEffectOptions options_;
-  double ground_z_m_ = 0.0, radius_m_ = 0.0;
+  GroundPlane ground_;
+  double radius_m_ = 0.0;
   double max_image_term_ = 0.0;  // s (R/4z)^2 at which the ratio reaches max_ratio
 };
 
