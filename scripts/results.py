@@ -29,7 +29,8 @@ Z95 = 1.959963984540054
 # the second failures and the fault-free cells (the false-alarm rate).
 FTC_CELLS = ('hover/propeller_loss,hover/motor_stop,tracking/propeller_loss,tracking/motor_stop,'
              'takeoff/propeller_loss,takeoff/motor_stop,hover/motor_stop_then_twin,'
-             'hover/motor_stop_then_adjacent,hover/none,tracking/none,takeoff/none')
+             'hover/motor_stop_then_adjacent,hover/motor_stop_then_adjacent_parachute,hover/none,tracking/none,'
+             'takeoff/none')
 
 # name, kind, arguments after `rotorguard`, what it measures
 JOBS = [
@@ -253,11 +254,18 @@ def mean_ci(values, digits=3):
 
 
 def median(values):
+    return percentile(values, 0.5)
+
+
+def percentile(values, p):
+    """Linear interpolation between the order statistics, as the benchmarks' own (core/statistics.h)."""
     v = sorted(values)
     if not v:
         return float('nan')
-    mid = len(v) // 2
-    return v[mid] if len(v) % 2 else 0.5 * (v[mid - 1] + v[mid])
+    position = p * (len(v) - 1)
+    lo = int(math.floor(position))
+    hi = min(lo + 1, len(v) - 1)
+    return v[lo] + (position - lo) * (v[hi] - v[lo])
 
 
 def cpu_model():
@@ -385,9 +393,10 @@ def ftc_fault_free(recs, methods):
 
 def ftc_second(recs, methods):
     cells = ftc_cells(recs)
-    lines = ['| second failure | method | trials | SucR | second isolated | false second isolations | '
+    lines = ['| second failure | method | trials | SucR | second isolated | second latency median / p95 (s) | '
+             'false second isolations | impact speed median / p95 (m/s) | '
              + ' | '.join('onset %g-%g s after the first isolation' % b for b in BINS) + ' |',
-             '|---|---|---|---|---|---|' + '---|' * len(BINS)]
+             '|---|---|---|---|---|---|---|---|' + '---|' * len(BINS)]
     out = {}
     for (phase, fault, method), rs in cells.items():
         if method not in methods or not fault.startswith('motor_stop_then'):
@@ -403,10 +412,15 @@ def ftc_second(recs, methods):
                    and lo <= r['metrics']['second_after_isolation_s'] < hi]
             k = sum(1 for r in inb if r['metrics'].get('second_correct'))
             bins.append((k, len(inb)))
-        lines.append('| %s | %s | %d | %s | %s | %d | %s |' % (
-            fault.replace('motor_stop_then_', ''), method, n, pct(success, n), pct(second, n), false2,
+        latency = [r['metrics']['second_latency_s'] for r in ok
+                   if r['metrics'].get('second_correct') and r['metrics'].get('second_latency_s') is not None]
+        impact = [r['metrics']['crash_speed_m_s'] for r in ok if r['metrics'].get('crash_speed_m_s') is not None]
+        two = lambda v, f: '%s / %s' % (f % percentile(v, 0.5), f % percentile(v, 0.95)) if v else '/'
+        lines.append('| %s | %s | %d | %s | %s | %s | %d | %s | %s |' % (
+            fault.replace('motor_stop_then_', '').replace('_', ', with a '), method, n, pct(success, n),
+            pct(second, n), two(latency, '%.3f'), false2, two(impact, '%.2f'),
             ' | '.join('%s of %d' % (pct(k, m), m) if m else '/' for k, m in bins)))
-        out[(fault, method)] = dict(n=n, second=second, false2=false2, bins=bins)
+        out[(fault, method)] = dict(n=n, second=second, false2=false2, bins=bins, impact=impact)
     return '\n'.join(lines), out
 
 
@@ -493,7 +507,10 @@ def render(out_dir, present):
         body += ['Second failures, a propeller lost 0.1-6 s after the first failure (a motor stop in hover), on the',
                  'rotor beside it (adjacent: the vehicle cannot hover on the two left and is terminated) or on its',
                  'diagonal twin (which the controller turns nearly off, so that its loss is neither needed nor',
-                 'visible above the spinning vehicle\'s force-balance noise; the vehicle flies on):', '', st, '']
+                 'visible above the spinning vehicle\'s force-balance noise; the vehicle flies on); "adjacent, with a',
+                 'parachute": the adjacent cell\'s trials with a recovery parachute fitted, released on flight',
+                 'termination (docs/scenarios.md, `sim.parachute`). Impact speeds are those of the trials that crashed:',
+                 '', st, '']
         adj = sec.get(('motor_stop_then_adjacent', 'rotorguard'))
         late_k = late_n = 0
         if adj:

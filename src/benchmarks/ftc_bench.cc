@@ -50,6 +50,8 @@ struct Cell {
   // first one's isolation: kSecondOnsetBinEdges): on the first rotor's diagonal twin ("twin") or on
   // a rotor beside it ("adjacent"); nullptr: none.
   const char* second = nullptr;
+  // The vehicle carries a recovery parachute, released on flight termination (sim/parachute.h).
+  bool parachute = false;
 };
 
 constexpr Cell kCells[] = {
@@ -69,6 +71,7 @@ constexpr Cell kCells[] = {
     {"+", "hover", "propeller_loss_intermittent", "propeller_loss", 0.0, true},
     {"+", "hover", "motor_stop_then_twin", "motor_stop", 0.0, false, "twin"},
     {"+", "hover", "motor_stop_then_adjacent", "motor_stop", 0.0, false, "adjacent"},
+    {"+", "hover", "motor_stop_then_adjacent_parachute", "motor_stop", 0.0, false, "adjacent", true},
     {"-", "hover", "none"},
     {"-", "tracking", "none"},
     {"-", "takeoff", "none"},
@@ -181,6 +184,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     s.duration_s = std::max(s.duration_s, f.onset.value + 3.0);
     s.tracking_start_s = s.duration_s - 3.0;
   }
+  s.sim.parachute.fitted = cell.parachute;
   if (o.fdd) s.stack.composite_fdd = *o.fdd;
   if (o.estimator == stack::EstimatorKind::kLio) {
     s.world = FtcHall();
@@ -260,11 +264,13 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
       {"eta_error_max", NullIfNan(eta_errors.empty() ? nan : *std::max_element(eta_errors.begin(), eta_errors.end()))},
       {"second_isolated", NullIfNan(with_second ? second_correct / n : nan)},
       {"second_latency_s_median", NullIfNan(second_latencies.empty() ? nan : Percentile(second_latencies, 0.5))},
+      {"second_latency_s_p95", NullIfNan(second_latencies.empty() ? nan : Percentile(second_latencies, 0.95))},
       {"second_by_onset_after_isolation", bins},
       // A rotor isolated without a fault of its own after a correct first isolation.
       {"false_second_isolations", with_fdd > 0 && faulty ? nlohmann::json(healthy_isolated) : nlohmann::json(nullptr)},
       {"crashes", crash_speeds.size()},
       {"crash_speed_m_s_median", NullIfNan(crash_speeds.empty() ? nan : Percentile(crash_speeds, 0.5))},
+      {"crash_speed_m_s_p95", NullIfNan(crash_speeds.empty() ? nan : Percentile(crash_speeds, 0.95))},
       {"crash_speed_m_s_max",
        NullIfNan(crash_speeds.empty() ? nan : *std::max_element(crash_speeds.begin(), crash_speeds.end()))},
       {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
@@ -550,8 +556,10 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                         {"|η̂ − η| max", "eta_error_max", "{:.3f}", 1.0, "none", true},
                         {"second failure isolated (%)", "second_isolated", "{:.1f}", 100.0, "none", true},
                         {"second failure latency median (s)", "second_latency_s_median", "{:.3f}", 1.0, "none", true},
+                        {"second failure latency p95 (s)", "second_latency_s_p95", "{:.3f}", 1.0, "none", true},
                         {"false second isolations (trials)", "false_second_isolations", "{:.0f}", 1.0, "none", true},
                         {"impact speed median (m/s)", "crash_speed_m_s_median", "{:.2f}", 1.0, "none", true},
+                        {"impact speed p95 (m/s)", "crash_speed_m_s_p95", "{:.2f}", 1.0, "none", true},
                         {"impact speed max (m/s)", "crash_speed_m_s_max", "{:.2f}", 1.0, "none", true}};
     for (const Row& row : rows) {
       if (fault == "none" && (std::string(row.key) == "fdd_latency_s_mean" || std::string(row.key) == "fdd_latency_s_max" ||

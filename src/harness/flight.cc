@@ -112,6 +112,7 @@ void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::
   s->crashed = sim.crashed();
   s->crash_reason = sim.crash_reason();
   s->crash_speed_m_s = sim.crash_speed_m_s();
+  if (const std::optional<TimeNs> released = sim.parachute().released_ns()) s->parachute_release_s = ToSeconds(*released);
   if (st.fdd_rotors) {
     s->fdd = ScoreFdd(*st.fdd_rotors, sim.fault_events());
     AddReconfigurationLatency(s->stack.reconfigurations, sim.fault_events(), &*s->fdd);

@@ -137,6 +137,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["crashed"] = crashed;
   j["crash_reason"] = OrNull(crash_reason);
   j["crash_speed_m_s"] = OrNull(crash_speed_m_s);
+  j["parachute_release_s"] = OrNull(parachute_release_s);
   j["failure_reason"] = OrNull(failure_reason);
   j["truth"] = io::ToJson(truth);
   j["sim_time_s"] = sim_time_s;
@@ -176,7 +177,7 @@ nlohmann::json RunSummary::ToJson() const {
 
 nlohmann::json RunSummary::ToJsonWithoutTruth() const {
   nlohmann::json j = ToJson();
-  for (const char* key : {"success", "crashed", "crash_reason", "crash_speed_m_s", "failure_reason", "truth",
+  for (const char* key : {"success", "crashed", "crash_reason", "crash_speed_m_s", "parachute_release_s", "failure_reason", "truth",
                           "tracking_rmse_m", "tracking_rmse_window_m", "tracking_window_s", "tracking_rmse_eq37_m",
                           "max_position_error_m", "min_altitude_m", "altitude_change_m", "max_spin_rad_s",
                           "max_tilt_rad", "estimate_position_rmse_m", "estimate_position_max_m",

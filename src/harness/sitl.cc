@@ -410,8 +410,9 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
     ++link.commands;
     if (c.command.sent_t_ns < c.command.state_t_ns) ++link.commands_before_their_sample;
     link.command_delay.Record(acts - c.command.state_t_ns);
-    sim.Send(RotorCommand{c.command.state_t_ns, c.command.thrust_n}, acts);
-    recorder.OnCommand(RotorCommand{c.command.state_t_ns, c.command.thrust_n});
+    const RotorCommand command{c.command.state_t_ns, c.command.thrust_n, c.command.release_parachute};
+    sim.Send(command, acts);
+    recorder.OnCommand(command);
     row.reference = c.reference;
     row.estimate = c.estimate;
     row.mode = c.mode;

@@ -258,6 +258,7 @@ rotorguard_msgs::RotorCommand ToRos(const Command& m) {
   r.compute_s = m.compute_s;
   r.held = m.held;
   r.thrust_n = m.thrust_n;
+  r.release_parachute = m.release_parachute;
   return r;
 }
 std::string FromRos(const rotorguard_msgs::RotorCommand& r, Command* m) {
@@ -267,6 +268,7 @@ std::string FromRos(const rotorguard_msgs::RotorCommand& r, Command* m) {
   m->compute_s = r.compute_s;
   m->held = r.held;
   m->thrust_n = r.thrust_n;
+  m->release_parachute = r.release_parachute;
   return NonFinite("thrust_n", m->thrust_n);
 }
 

@@ -127,7 +127,7 @@ ros1::Health HealthToWire(const runtime::CycleTelemetry& c, const TimeBase& base
 ros1::Cycle ToWire(const runtime::CycleTelemetry& c, const TimeBase& base) {
   ros1::Cycle w;
   w.command = {base.ToStamp(c.command.state_t_ns), c.command.cycle, base.ToStamp(c.command.sent_t_ns), c.command.compute_s,
-               c.command.held, {c.command.thrust_n.begin(), c.command.thrust_n.end()}};
+               c.command.held, {c.command.thrust_n.begin(), c.command.thrust_n.end()}, c.command.release_parachute};
   w.inputs = c.command.inputs;
   w.lio_serial = c.command.lio_serial;
   w.estimate_valid = c.estimate.valid;
@@ -145,6 +145,7 @@ runtime::CycleTelemetry FromWire(const ros1::Cycle& w, const TimeBase& base) {
   c.command.sent_t_ns = base.ToTime(w.command.sent);
   c.command.compute_s = w.command.compute_s;
   c.command.held = w.command.held;
+  c.command.release_parachute = w.command.release_parachute;
   c.command.inputs = w.inputs;
   c.command.lio_serial = w.lio_serial;
   const std::size_t n = std::min<std::size_t>(w.command.thrust_n.size(), kMaxRotors);

@@ -362,6 +362,7 @@ CycleTelemetry TelemetryOf(const stack::FlightStack& stack, TimeNs t, stack::Fli
   CycleTelemetry cycle;
   cycle.command.state_t_ns = t;
   cycle.command.thrust_n = thrust_n;
+  cycle.command.release_parachute = stack.command().release_parachute;
   cycle.command.lio_serial = stack.lio_serial();
   cycle.mode = mode;
   cycle.estimate = stack.estimate();

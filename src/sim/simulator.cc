@@ -18,21 +18,25 @@ using vehicle::StateView;
 // Independent random streams of one run.
 enum Stream : std::uint64_t { kImuStream = 1, kEscStream = 2, kOdometryStream = 3, kWindStream = 4, kLidarStream = 5 };
 
-// What the ground does at a state, for the integrator's every stage: it pushes on the feet that
-// touch it and on the rotors' wakes. Built where it is used (it points into the simulator).
-class GroundWrench final : public vehicle::StateWrench {
+// What the world does at a state besides the air on the rotors, for the integrator's every
+// stage: the ground pushes on the feet that touch it and on the rotors' wakes, an open parachute
+// drags. Built where it is used (it points into the simulator).
+class ExternalWrench final : public vehicle::StateWrench {
  public:
-  GroundWrench(const GroundContact& contact, const GroundEffect& effect, const vehicle::RotorFaults& faults)
-      : contact_(contact), effect_(effect), faults_(faults) {}
+  ExternalWrench(const GroundContact& contact, const GroundEffect& effect, const vehicle::RotorFaults& faults,
+                 const Parachute& parachute)
+      : contact_(contact), effect_(effect), faults_(faults), parachute_(parachute) {}
   void AddTo(const vehicle::StateVector& x, vehicle::Disturbance* d) const override {
     contact_.AddTo(x, d);
     effect_.AddTo(x, faults_, d);
+    parachute_.AddTo(x, d);
   }
 
  private:
   const GroundContact& contact_;
   const GroundEffect& effect_;
   const vehicle::RotorFaults& faults_;
+  const Parachute& parachute_;
 };
 }  // namespace
 
@@ -84,6 +88,7 @@ void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
   }
   prefixed("sim.ground.", [&] { ground.Validate(); });
   prefixed("sim.ground_effect.", [&] { ground_effect.Validate(); });
+  prefixed("sim.parachute.", [&] { parachute.Validate(); });
   if (ground_z_m && !(std::abs(*ground_z_m) <= kMaxCoordinateM)) {
     ThrowValidation("SimulatorOptions", "ground_z_m", *ground_z_m, fmt::format("a height within ±{:g} m", kMaxCoordinateM));
   }
@@ -108,6 +113,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
       contact_(model.params().LandingGear(), model.params().mass_kg, options_.ground,
                GroundPlane{.normal_W = Vector3::UnitZ(), .offset_m = world_.ground_z_m}),
       ground_effect_(model, options_.ground_effect, contact_.plane()),
+      parachute_(options_.parachute),
       imu_(options_.imu, DeriveSeed(seed, kImuStream)),
       esc_(options_.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
       odometry_(options_.odometry, world_, DeriveSeed(seed, kOdometryStream)),
@@ -158,10 +164,10 @@ void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
   TruthSample truth;
   truth.t_ns = t_ns_;
   truth.x = &x_;
-  // The ground's push on the feet and the wakes is felt as any other force.
-  vehicle::Disturbance with_ground = disturbance;
-  GroundWrench(contact_, ground_effect_, faults_).AddTo(x_, &with_ground);
-  truth.acc = model_.ComputeAccelerations(x_, faults_, with_ground);
+  // The ground's push on the feet and the wakes, and a parachute's drag, are felt as any other force.
+  vehicle::Disturbance external = disturbance;
+  ExternalWrench(contact_, ground_effect_, faults_, parachute_).AddTo(x_, &external);
+  truth.acc = model_.ComputeAccelerations(x_, faults_, external);
   truth.motor_speed_rad_s = speed_;
   truth.faults = &faults_;
   if (imu_due) outputs_.imu = imu_.Sample(truth);
@@ -212,13 +218,14 @@ void Simulator::Send(const RotorCommand& command, TimeNs sent_ns) {
     acts = std::max(acts, queue_[static_cast<std::size_t>((queue_head_ + queue_size_ - 1) % kCommandQueue)].acts_ns);
   }
   if (queue_size_ == kCommandQueue) {  // full: the oldest acts now
-    command_ = queue_[static_cast<std::size_t>(queue_head_)].thrust_n;
+    Act(queue_[static_cast<std::size_t>(queue_head_)], t_ns_);
     queue_head_ = (queue_head_ + 1) % kCommandQueue;
     --queue_size_;
     ++commands_overrun_;
   }
   SentCommand& slot = queue_[static_cast<std::size_t>((queue_head_ + queue_size_) % kCommandQueue)];
   slot.acts_ns = acts;
+  slot.release_parachute = command.release_parachute;
   // A non-finite command reaches the motors as zero thrust (a real ESC would reject the frame).
   slot.thrust_n.resize(model_.num_rotors());
   for (int i = 0; i < model_.num_rotors(); ++i) {
@@ -228,9 +235,15 @@ void Simulator::Send(const RotorCommand& command, TimeNs sent_ns) {
   ++queue_size_;
 }
 
+void Simulator::Act(const SentCommand& c, TimeNs t) {
+  command_ = c.thrust_n;
+  if (c.release_parachute) parachute_.Release(t);
+}
+
 void Simulator::ActivateCommands(TimeNs t) {
   while (queue_size_ > 0 && queue_[static_cast<std::size_t>(queue_head_)].acts_ns <= t) {
-    command_ = queue_[static_cast<std::size_t>(queue_head_)].thrust_n;
+    const SentCommand& c = queue_[static_cast<std::size_t>(queue_head_)];
+    Act(c, c.acts_ns);
     queue_head_ = (queue_head_ + 1) % kCommandQueue;
     --queue_size_;
   }
@@ -254,15 +267,16 @@ const SensorOutputs& Simulator::Step() {
   // own instant, not from the next step's).
   const TimeNs end = t_ns_ + dt_ns_;
   TimeNs t = t_ns_;
-  const GroundWrench ground(contact_, ground_effect_, faults_);
   ActivateCommands(t);
+  parachute_.Update(t);
+  const ExternalWrench external(contact_, ground_effect_, faults_, parachute_);
   while (queue_size_ > 0 && queue_[static_cast<std::size_t>(queue_head_)].acts_ns < end) {
     const TimeNs next = queue_[static_cast<std::size_t>(queue_head_)].acts_ns;
-    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_, &ground);
+    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_, &external);
     t = next;
     ActivateCommands(t);
   }
-  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_, &ground);
+  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_, &external);
   t_ns_ = end;
   ActivateCommands(t_ns_);  // applied_command(): the one acting at the new time
   UpdateOutputs();

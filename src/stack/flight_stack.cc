@@ -376,6 +376,9 @@ const RotorCommand& FlightStack::EndCycle(TimeNs t, FlightMode mode, std::shared
   if (plan) plan_ = std::move(plan);
   const ReferenceTrajectory& followed = descent_ ? *descent_ : plan_ ? *plan_ : *reference_;
   reference_point_ = followed.Evaluate(ts);
+  // The vehicle cannot hover: the parachute's release goes out with the stopped motors' command,
+  // and with every command after it (an output that stays set, as a flight controller's does).
+  command_.release_parachute = command_.release_parachute || mode == FlightMode::kFlightTermination;
   if (!estimate_.valid || mode == FlightMode::kLanded || mode == FlightMode::kFlightTermination) {
     // Nothing to act on yet, on the ground after a landing, or a vehicle that cannot hover: motors
     // off, and the fault detection told so (it stays armed: a motor that keeps turning after the

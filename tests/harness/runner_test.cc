@@ -320,9 +320,38 @@ TEST(FddClosedLoop, ASecondFailureFliesOnOnTheTwinAndStopsTheMotorsBesideIt) {
         ASSERT_TRUE(r.crash_speed_m_s) << what;
         // Falling from 2 m: at most sqrt(2 g h) = 6.26 m/s, drag only slowing it.
         EXPECT_LT(*r.crash_speed_m_s, std::sqrt(2.0 * kGravity * 2.0)) << what;
+        // The parachute's release goes out with the termination's command: after the second
+        // isolation, within a control period and the drawn computation and ESC delays.
+        ASSERT_TRUE(r.parachute_release_s) << what;
+        const double isolated_s = 5.0 + *r.fdd->second->latency_s;
+        EXPECT_GE(*r.parachute_release_s, isolated_s) << what;
+        EXPECT_LT(*r.parachute_release_s, isolated_s + 0.012) << what;
+      }
+      if (second == 1) {
+        EXPECT_FALSE(r.parachute_release_s) << what << ": a vehicle that flies on releases nothing";
       }
     }
   }
+}
+
+TEST(FddClosedLoop, AParachuteReleasedOnTerminationSlowsTheFallOfTwoAdjacentRotorsLost) {
+  // The second test's adjacent double failure, with and without a parachute: the canopy only
+  // drags, so the vehicle reaches the ground later and slower (from 2 m it has about 0.6 s).
+  std::optional<double> without, with;
+  for (const bool fitted : {false, true}) {
+    Scenario s = LoadScenario(Config("fdd_hover_motor_stop.yaml"), {{"duration_s", "8"}});
+    s.seed = 1;
+    s.sim.parachute.fitted = fitted;
+    sim::FaultSpec f;
+    f.rotor = 2;
+    f.kind = vehicle::FaultKind::kPropellerLoss;
+    f.onset = {sim::FaultOnset::Kind::kAtTime, 5.0};
+    s.faults.push_back(f);
+    const RunSummary r = RunScenario(s);
+    ASSERT_TRUE(r.crashed && r.crash_speed_m_s && r.parachute_release_s) << fitted;
+    (fitted ? with : without) = r.crash_speed_m_s;
+  }
+  EXPECT_LT(*with, *without - 0.3) << "without " << *without << " m/s";
 }
 
 TEST(FddClosedLoop, NoFalseAlarmOnTheAggressiveNominalLemniscate) {

@@ -35,7 +35,7 @@ TEST(Bag, WhatIsWrittenIsReadBackInTimeOrder) {
   Esc esc{1'000'000'200, {1000.5, 1001.5, 999.0, 1002.25}};
   Cloud cloud{1'000'000'300, "lidar_link", {{1.0f, 2.0f, 3.0f, 7.0f, 0.05f, 3}, {-1.5f, 0.25f, 0.0f, 9.0f, 0.099f, 11}}, true};
   Cycle cycle;
-  cycle.command = {1'000'000'400, 7, 1'000'000'450, 0.0003, 0, {1.0, 2.0, 3.0, 4.0}};
+  cycle.command = {1'000'000'400, 7, 1'000'000'450, 0.0003, 0, {1.0, 2.0, 3.0, 4.0}, true};
   cycle.inputs = 42;
   cycle.lio_serial = 5;
   cycle.estimate_valid = true;
@@ -75,6 +75,7 @@ TEST(Bag, WhatIsWrittenIsReadBackInTimeOrder) {
   EXPECT_EQ(y.command.cycle, 7u);
   EXPECT_EQ(y.command.sent, cycle.command.sent);
   EXPECT_EQ(y.command.thrust_n, cycle.command.thrust_n);
+  EXPECT_TRUE(y.command.release_parachute);
   EXPECT_EQ(y.inputs, 42u);
   EXPECT_EQ(y.lio_serial, 5u);
   EXPECT_EQ(y.estimate.pose.orientation_xyzw, cycle.estimate.pose.orientation_xyzw);

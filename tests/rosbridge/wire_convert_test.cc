@@ -85,7 +85,7 @@ TEST(WireConvert, AFrameRoundTripsWithinFloatTimeAndDropsPointsOutsideItsSweep) 
 TEST(WireConvert, ACycleRoundTrips) {
   runtime::CycleTelemetry c;
   c.command = {.cycle = 12, .state_t_ns = 1'500'000'000, .sent_t_ns = 1'500'400'000, .compute_s = 0.0004, .inputs = 321,
-               .lio_serial = 9, .held = 0, .thrust_n = RotorVector::Constant(4, 2.5)};
+               .lio_serial = 9, .held = 0, .thrust_n = RotorVector::Constant(4, 2.5), .release_parachute = true};
   c.mode = stack::FlightMode::kFailureRecovery;
   c.estimate.t_ns = 1'500'000'000;
   c.estimate.valid = true;
@@ -101,6 +101,7 @@ TEST(WireConvert, ACycleRoundTrips) {
   EXPECT_EQ(back.command.inputs, 321u);
   EXPECT_EQ(back.command.lio_serial, 9u);
   EXPECT_EQ(back.command.thrust_n, c.command.thrust_n);
+  EXPECT_TRUE(back.command.release_parachute);
   EXPECT_EQ(back.mode, stack::FlightMode::kFailureRecovery);
   EXPECT_TRUE(back.estimate.valid);
   EXPECT_EQ(back.estimate.p_W, c.estimate.p_W);

@@ -41,10 +41,13 @@ struct LidarFrame {
   int dropped = 0;
 };
 
-/// The stack's output: commanded thrust per rotor [N] (paper 000: u_i, eq. 6).
+/// The stack's output: commanded thrust per rotor [N] (paper 000: u_i, eq. 6), and the recovery
+/// parachute's release, an output beside the motors' as on a flight controller: set from flight
+/// termination on (the motors stopped in the air), and never cleared (docs/supervisor.md).
 struct RotorCommand {
   TimeNs t_ns = 0;
   RotorVector thrust_n;
+  bool release_parachute = false;
 };
 
 }  // namespace rotorguard

@@ -69,6 +69,8 @@ struct RunSummary {
   bool crashed = false;
   std::optional<std::string> crash_reason;    ///< "ground impact at 5.56 m/s"; none without a crash
   std::optional<double> crash_speed_m_s;      ///< the speed at the crash's ground contact [m/s]
+  /// When the stack's parachute release reached the vehicle [s] (fitted or not); none: never sent.
+  std::optional<double> parachute_release_s;
   std::optional<std::string> failure_reason;  ///< why the run failed; none on success
   /// The simulated vehicle's departure from the vehicle file (summary.json "truth").
   sim::TruthDraw truth;

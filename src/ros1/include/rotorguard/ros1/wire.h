@@ -87,6 +87,7 @@ struct Command {
   double compute_s = 0.0;
   int held = 0;
   std::vector<double> thrust_n;
+  bool release_parachute = false;
 };
 
 /// rotorguard_msgs/FddHealth.

@@ -57,6 +57,7 @@ struct StampedCommand {
   /// instant after its own (the later cycles were late).
   int held = 0;
   RotorVector thrust_n;
+  bool release_parachute = false;  ///< RotorCommand::release_parachute
 };
 
 /// The fault detection's view of one rotor at a cycle (fdd::RotorStatus without its strings and

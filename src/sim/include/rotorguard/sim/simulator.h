@@ -12,6 +12,7 @@
 #include "rotorguard/sim/contact.h"
 #include "rotorguard/sim/fault_injector.h"
 #include "rotorguard/sim/ground_effect.h"
+#include "rotorguard/sim/parachute.h"
 #include "rotorguard/sim/lidar.h"
 #include "rotorguard/sim/sensors.h"
 #include "rotorguard/sim/wind.h"
@@ -39,6 +40,8 @@ struct SimulatorOptions {
   GroundContactOptions ground;
   /// The ground's push on the rotors' wakes (ground_effect.h).
   GroundEffectOptions ground_effect;
+  /// A recovery parachute the stack's release signal deploys (parachute.h); none by default.
+  ParachuteOptions parachute;
   /// The ground plane's height [m]; none: where the model's feet reach when its centre of gravity
   /// rests at z = 0. (A drawn truth passes the file's: its body origin rests at z = 0.)
   std::optional<double> ground_z_m;
@@ -105,6 +108,8 @@ class Simulator {
   bool landed() const { return landed_; }
   const GroundContact& contact() const { return contact_; }
   const GroundEffect& ground_effect() const { return ground_effect_; }
+  /// The parachute (RotorCommand::release_parachute; fitted or not, it records the release).
+  const Parachute& parachute() const { return parachute_; }
   bool crashed() const { return crash_reason_.has_value(); }
   const std::optional<std::string>& crash_reason() const { return crash_reason_; }
   /// The speed [m/s] at the crash's ground contact; none without a crash.
@@ -124,7 +129,10 @@ class Simulator {
   struct SentCommand {
     TimeNs acts_ns = 0;
     RotorVector thrust_n;
+    bool release_parachute = false;
   };
+  /// A sent command acts from t: the motors take its thrusts; its release reaches the parachute.
+  void Act(const SentCommand& c, TimeNs t);
   std::array<SentCommand, kCommandQueue> queue_;
   int queue_head_ = 0, queue_size_ = 0;
   TimeNs command_latency_ns_ = 0;
@@ -137,6 +145,7 @@ class Simulator {
   vehicle::Rk4Integrator integrator_;
   GroundContact contact_;
   GroundEffect ground_effect_;
+  Parachute parachute_;
   ImuModel imu_;
   EscModel esc_;
   OdometryModel odometry_;
