@@ -52,6 +52,9 @@ struct Cell {
   const char* second = nullptr;
   // The vehicle carries a recovery parachute, released on flight termination (sim/parachute.h).
   bool parachute = false;
+  // Flies the trials (seeds) of the cell of this name ("phase/fault"): a paired comparison;
+  // nullptr: its own.
+  const char* same_trials_as = nullptr;
 };
 
 constexpr Cell kCells[] = {
@@ -71,10 +74,12 @@ constexpr Cell kCells[] = {
     {"+", "hover", "propeller_loss_intermittent", "propeller_loss", 0.0, true},
     {"+", "hover", "motor_stop_then_twin", "motor_stop", 0.0, false, "twin"},
     {"+", "hover", "motor_stop_then_adjacent", "motor_stop", 0.0, false, "adjacent"},
-    {"+", "hover", "motor_stop_then_adjacent_parachute", "motor_stop", 0.0, false, "adjacent", true},
     {"-", "hover", "none"},
     {"-", "tracking", "none"},
     {"-", "takeoff", "none"},
+    // Last, so that the cells above keep their seeds.
+    {"+", "hover", "motor_stop_then_adjacent_parachute", "motor_stop", 0.0, false, "adjacent", true,
+     "hover/motor_stop_then_adjacent"},
 };
 constexpr int kNumCells = sizeof(kCells) / sizeof(kCells[0]);
 
@@ -365,7 +370,8 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
   };
   c.parameters = [o, decompose](int index) {
     const auto [cell, method, trial] = decompose(index);
-    const std::uint64_t seed = TrialSeed(o.seed, "bench ftc", static_cast<std::uint64_t>(cell) * 1'000'003ull + trial);
+    const int seeded = kCells[cell].same_trials_as ? CellIndexNamed(kCells[cell].same_trials_as, "ftc", "cell") : cell;
+    const std::uint64_t seed = TrialSeed(o.seed, "bench ftc", static_cast<std::uint64_t>(seeded) * 1'000'003ull + trial);
     return std::map<std::string, std::string>{{"test", kCells[cell].test},   {"phase", kCells[cell].phase},
                                               {"fault", kCells[cell].fault}, {"method", o.methods[method]},
                                               {"trial", std::to_string(trial)}, {"seed", std::to_string(seed)}};

@@ -8,6 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
+#include <set>
+#include <string>
 
 #include "rotorguard/benchmarks/flatness_bench.h"
 #include "rotorguard/benchmarks/ftc_bench.h"
@@ -55,6 +58,12 @@ class BenchCampaigns : public testing::TempFolderTest {};
 TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSameCampaign) {
   const campaign::Campaign c = FtcCampaign(SmallFtc());
   ASSERT_EQ(c.trials, 20 * 2);  // 20 cells (docs/benchmarks.md), two methods
+  // The adjacent double failure with a parachute flies the trials of the one without (a paired
+  // comparison); every other cell its own.
+  std::map<std::string, std::set<std::string>> seeds;
+  for (int i = 0; i < c.trials; ++i) seeds[c.parameters(i).at("fault")].insert(c.parameters(i).at("seed"));
+  EXPECT_EQ(seeds.at("motor_stop_then_adjacent_parachute"), seeds.at("motor_stop_then_adjacent"));
+  EXPECT_NE(seeds.at("motor_stop_then_twin"), seeds.at("motor_stop_then_adjacent"));
   // Whole, on two threads, in a temporary folder.
   campaign::CampaignRunOptions whole;
   whole.jobs = 2;
