@@ -30,7 +30,8 @@ Z95 = 1.959963984540054
 FTC_CELLS = ('hover/propeller_loss,hover/motor_stop,tracking/propeller_loss,tracking/motor_stop,'
              'takeoff/propeller_loss,takeoff/motor_stop,hover/motor_stop_then_twin,'
              'hover/motor_stop_then_adjacent,hover/motor_stop_then_adjacent_parachute,hover/none,tracking/none,'
-             'takeoff/none')
+             'takeoff/none,hover/propeller_loss_battery_full,hover/propeller_loss_battery_30,'
+             'tracking/propeller_loss_battery_full,tracking/propeller_loss_battery_30')
 
 # name, kind, arguments after `rotorguard`, what it measures
 JOBS = [
@@ -359,7 +360,7 @@ def ftc_table(recs, methods):
              '|---|---|---|---|---|---|---|---|---|---|']
     summary = {}
     for (phase, fault, method), rs in cells.items():
-        if method not in methods or fault == 'none' or fault.startswith('motor_stop_then'):
+        if method not in methods or fault == 'none' or fault.startswith('motor_stop_then') or 'battery' in fault:
             continue
         n = len(rs)
         ok = [r for r in rs if r['status'] == 'ok']
@@ -389,6 +390,29 @@ def ftc_fault_free(recs, methods):
         lines.append('| %s | %s | %d | %d | %s |' % (phase, method, n, alarms, pct(alarms, n)))
         out[(phase, method)] = (alarms, n)
     return '\n'.join(lines), out
+
+
+def ftc_battery(recs, methods):
+    """The propeller losses flown on a battery, full and at 30 %, beside the same trials without one."""
+    cells = ftc_cells(recs)
+    lines = ['| phase | battery | method | trials | SucR | largest thrust at onset, median (min), × T̄ | FDD latency mean (s) |',
+             '|---|---|---|---|---|---|---|']
+    for phase in ('hover', 'tracking'):
+        for fault, label in (('propeller_loss', 'none (the file\'s T̄ throughout)'),
+                             ('propeller_loss_battery_full', 'full'), ('propeller_loss_battery_30', '30 %')):
+            for method in methods:
+                rs = cells.get((phase, fault, method))
+                if not rs:
+                    continue
+                n = len(rs)
+                ok = [r for r in rs if r['status'] == 'ok']
+                success = sum(1 for r in ok if r['metrics'].get('success'))
+                limit = [r['metrics']['thrust_limit_at_fault'] for r in ok if r['metrics'].get('thrust_limit_at_fault') is not None]
+                lat = [r['metrics']['latency_s'] for r in ok if r['metrics'].get('correct') and r['metrics'].get('latency_s') is not None]
+                lines.append('| %s | %s | %s | %d | %s | %s | %s |' % (
+                    phase, label, method, n, pct(success, n),
+                    '%.3f (%.3f)' % (median(limit), min(limit)) if limit else '/', mean_ci(lat)))
+    return '\n'.join(lines)
 
 
 def ftc_second(recs, methods):
@@ -519,6 +543,9 @@ def render(out_dir, present):
             body += ['Adjacent, the second failure 0.3 s or more after the first isolation: isolated in %d of %d trials (%s).'
                      % (late_k, late_n, pct(late_k, late_n)), '']
         body += ['False second isolations over the single-failure cells above: %d of %d flights (%s).' % (k2, n2, pct(k2, n2)), '']
+        body += ['Propeller losses on a battery (docs/scenarios.md, `sim.battery`: a 4S pack whose voltage sags with its',
+                 'load and charge, every rotor\'s largest thrust scaling with (V / V_ref)²), full and at 30 % charge, on the',
+                 'trials of the cells without one:', '', ftc_battery(recs, ('rotorguard',)), '']
         # README: the headline figures, realistic.
         def rng(keys, f):
             vals = [f(single[k]) for k in keys if k in single]

@@ -55,6 +55,8 @@ struct Cell {
   // Flies the trials (seeds) of the cell of this name ("phase/fault"): a paired comparison;
   // nullptr: its own.
   const char* same_trials_as = nullptr;
+  // > 0: the vehicle flies on a battery (sim/battery.h) charged this much at the start; 0: none.
+  double battery_charge = 0.0;
 };
 
 constexpr Cell kCells[] = {
@@ -80,6 +82,13 @@ constexpr Cell kCells[] = {
     // Last, so that the cells above keep their seeds.
     {"+", "hover", "motor_stop_then_adjacent_parachute", "motor_stop", 0.0, false, "adjacent", true,
      "hover/motor_stop_then_adjacent"},
+    // The single failures on a battery, full and at 30 %, on the trials of the cells without one.
+    {"+", "hover", "propeller_loss_battery_full", "propeller_loss", 0.0, false, nullptr, false, "hover/propeller_loss", 1.0},
+    {"+", "hover", "propeller_loss_battery_30", "propeller_loss", 0.0, false, nullptr, false, "hover/propeller_loss", 0.3},
+    {"+", "tracking", "propeller_loss_battery_full", "propeller_loss", 0.0, false, nullptr, false,
+     "tracking/propeller_loss", 1.0},
+    {"+", "tracking", "propeller_loss_battery_30", "propeller_loss", 0.0, false, nullptr, false, "tracking/propeller_loss",
+     0.3},
 };
 constexpr int kNumCells = sizeof(kCells) / sizeof(kCells[0]);
 
@@ -190,6 +199,10 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     s.tracking_start_s = s.duration_s - 3.0;
   }
   s.sim.parachute.fitted = cell.parachute;
+  if (cell.battery_charge > 0.0) {
+    s.sim.battery.fitted = true;
+    s.sim.battery.initial_charge = cell.battery_charge;
+  }
   if (o.fdd) s.stack.composite_fdd = *o.fdd;
   if (o.estimator == stack::EstimatorKind::kLio) {
     s.world = FtcHall();
@@ -209,7 +222,7 @@ nlohmann::json NullIfNan(double v) { return std::isfinite(v) ? nlohmann::json(v)
 }  // namespace
 
 nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty, bool with_second) {
-  std::vector<double> latencies, final_rmse, eta_errors, second_latencies, crash_speeds;
+  std::vector<double> latencies, final_rmse, eta_errors, second_latencies, crash_speeds, thrust_limits;
   int second_correct = 0, healthy_isolated = 0;
   // Per bin of the second onset after the first isolation: trials, and second failures isolated.
   constexpr int kBins = static_cast<int>(std::size(kSecondOnsetBinEdges)) - 1;
@@ -225,6 +238,7 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
     if (!r.errored && std::isfinite(r.final_rmse_m)) final_rmse.push_back(r.final_rmse_m);
     if (!r.errored && std::isfinite(r.eta_error)) eta_errors.push_back(r.eta_error);
     if (!r.errored && std::isfinite(r.crash_speed_m_s)) crash_speeds.push_back(r.crash_speed_m_s);
+    if (!r.errored && std::isfinite(r.thrust_limit_at_fault)) thrust_limits.push_back(r.thrust_limit_at_fault);
     if (r.second_correct) {
       ++second_correct;
       second_latencies.push_back(r.second_latency_s);
@@ -278,6 +292,9 @@ nlohmann::json AggregateFtcCell(const std::vector<FtcTrial>& trials, bool faulty
       {"crash_speed_m_s_p95", NullIfNan(crash_speeds.empty() ? nan : Percentile(crash_speeds, 0.95))},
       {"crash_speed_m_s_max",
        NullIfNan(crash_speeds.empty() ? nan : *std::max_element(crash_speeds.begin(), crash_speeds.end()))},
+      {"thrust_limit_at_fault_median", NullIfNan(thrust_limits.empty() ? nan : Percentile(thrust_limits, 0.5))},
+      {"thrust_limit_at_fault_min",
+       NullIfNan(thrust_limits.empty() ? nan : *std::min_element(thrust_limits.begin(), thrust_limits.end()))},
       {"fdd_latencies_s", latencies},  // every correct detection's latency: the distribution
       {"failures", failures.listed()},
       {"failures_not_listed", failures.not_listed()}};
@@ -395,7 +412,8 @@ campaign::Campaign FtcCampaign(const FtcBenchOptions& o) {
         {"success", s.success},
         {"altitude_change_m", s.altitude_change_m ? nlohmann::json(*s.altitude_change_m) : nlohmann::json(nullptr)},
         {"final_rmse_m", takeoff ? nlohmann::json(nullptr) : nlohmann::json(s.tracking_rmse_m)},
-        {"crash_speed_m_s", s.crash_speed_m_s ? nlohmann::json(*s.crash_speed_m_s) : nlohmann::json(nullptr)}};
+        {"crash_speed_m_s", s.crash_speed_m_s ? nlohmann::json(*s.crash_speed_m_s) : nlohmann::json(nullptr)},
+        {"thrust_limit_at_fault", s.thrust_limit_at_fault ? nlohmann::json(*s.thrust_limit_at_fault) : nlohmann::json(nullptr)}};
     if (s.fdd) {
       const bool partial = s.fdd->correct && s.fdd->diagnosis->kind == "degraded";
       out.metrics["eta_error"] =
@@ -465,6 +483,7 @@ nlohmann::json FtcResult(const nlohmann::json& options, const std::vector<nlohma
         trial.crash_speed_m_s = number("crash_speed_m_s");
         trial.second_latency_s = number("second_latency_s");
         trial.second_after_isolation_s = number("second_after_isolation_s");
+        trial.thrust_limit_at_fault = number("thrust_limit_at_fault");
         if (x.contains("healthy_rotors_isolated")) trial.healthy_rotors_isolated = x.at("healthy_rotors_isolated").get<int>();
         if (x.contains("second_correct")) trial.second_correct = x.at("second_correct").get<bool>();
         if (x.contains("correct")) {
@@ -566,7 +585,9 @@ std::string FtcMarkdown(const nlohmann::json& result) {
                         {"false second isolations (trials)", "false_second_isolations", "{:.0f}", 1.0, "none", true},
                         {"impact speed median (m/s)", "crash_speed_m_s_median", "{:.2f}", 1.0, "none", true},
                         {"impact speed p95 (m/s)", "crash_speed_m_s_p95", "{:.2f}", 1.0, "none", true},
-                        {"impact speed max (m/s)", "crash_speed_m_s_max", "{:.2f}", 1.0, "none", true}};
+                        {"impact speed max (m/s)", "crash_speed_m_s_max", "{:.2f}", 1.0, "none", true},
+                        {"largest thrust at onset, median (× T̄)", "thrust_limit_at_fault_median", "{:.3f}", 1.0, "none", true},
+                        {"largest thrust at onset, min (× T̄)", "thrust_limit_at_fault_min", "{:.3f}", 1.0, "none", true}};
     for (const Row& row : rows) {
       if (fault == "none" && (std::string(row.key) == "fdd_latency_s_mean" || std::string(row.key) == "fdd_latency_s_max" ||
                               std::string(row.key) == "mdr")) {

@@ -113,6 +113,10 @@ void SummarizeFlight(const Scenario& sc, const sim::TruthDraw& draw, const sim::
   s->crash_reason = sim.crash_reason();
   s->crash_speed_m_s = sim.crash_speed_m_s();
   if (const std::optional<TimeNs> released = sim.parachute().released_ns()) s->parachute_release_s = ToSeconds(*released);
+  if (sim.battery().options().fitted) {
+    s->battery_final_charge = sim.battery().charge();
+    s->thrust_limit_at_fault = sim.thrust_limit_at_first_fault();
+  }
   if (st.fdd_rotors) {
     s->fdd = ScoreFdd(*st.fdd_rotors, sim.fault_events());
     AddReconfigurationLatency(s->stack.reconfigurations, sim.fault_events(), &*s->fdd);

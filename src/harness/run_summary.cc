@@ -98,6 +98,7 @@ void AddStackJson(const RunSummary& r, nlohmann::json* j) {
   }
   if (s.ukf) (*j)["ukf"] = {{"w_hat", s.ukf->w_hat}, {"settled_s", OrNull(s.ukf->settled_s)}};
   (*j)["lidar_points_dropped"] = s.lidar_points_dropped;
+  (*j)["battery_min_voltage_v"] = OrNull(s.battery_min_voltage_v);
   if (s.odometry) {
     const stack::LioSummary& o = *s.odometry;
     (*j)["odometry"] = {{"frames", o.frames},
@@ -138,6 +139,8 @@ nlohmann::json RunSummary::ToJson() const {
   j["crash_reason"] = OrNull(crash_reason);
   j["crash_speed_m_s"] = OrNull(crash_speed_m_s);
   j["parachute_release_s"] = OrNull(parachute_release_s);
+  j["battery_final_charge"] = OrNull(battery_final_charge);
+  j["thrust_limit_at_fault"] = OrNull(thrust_limit_at_fault);
   j["failure_reason"] = OrNull(failure_reason);
   j["truth"] = io::ToJson(truth);
   j["sim_time_s"] = sim_time_s;
@@ -177,7 +180,8 @@ nlohmann::json RunSummary::ToJson() const {
 
 nlohmann::json RunSummary::ToJsonWithoutTruth() const {
   nlohmann::json j = ToJson();
-  for (const char* key : {"success", "crashed", "crash_reason", "crash_speed_m_s", "parachute_release_s", "failure_reason", "truth",
+  for (const char* key : {"success", "crashed", "crash_reason", "crash_speed_m_s", "parachute_release_s", "battery_final_charge",
+                          "thrust_limit_at_fault", "failure_reason", "truth",
                           "tracking_rmse_m", "tracking_rmse_window_m", "tracking_window_s", "tracking_rmse_eq37_m",
                           "max_position_error_m", "min_altitude_m", "altitude_change_m", "max_spin_rad_s",
                           "max_tilt_rad", "estimate_position_rmse_m", "estimate_position_max_m",

@@ -20,6 +20,7 @@ void DeliverToStack(const sim::SensorOutputs& o, stack::FlightStack* st, std::st
   if (o.esc) st->OnEscTelemetry(*o.esc);
   if (o.odometry) st->OnOdometry(*o.odometry);
   if (o.lidar) st->OnLidar(*o.lidar);
+  if (o.battery) st->OnBattery(*o.battery);
   AppendSensorLog(o, sensor_log);
 }
 

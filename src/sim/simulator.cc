@@ -38,6 +38,10 @@ class ExternalWrench final : public vehicle::StateWrench {
   const vehicle::RotorFaults& faults_;
   const Parachute& parachute_;
 };
+// The power module's message, when its time has come (a fitted battery only).
+void SampleBattery(const Battery& battery, TimeNs t_ns, RateTimer* timer, SensorOutputs* outputs) {
+  if (battery.options().fitted && timer->Due(t_ns)) outputs->battery = battery.Status(t_ns);
+}
 }  // namespace
 
 const SimulatorOptions& Simulator::Validated(const SimulatorOptions& options,
@@ -89,6 +93,7 @@ void SimulatorOptions::Validate(const vehicle::VehicleParams& vehicle) const {
   prefixed("sim.ground.", [&] { ground.Validate(); });
   prefixed("sim.ground_effect.", [&] { ground_effect.Validate(); });
   prefixed("sim.parachute.", [&] { parachute.Validate(); });
+  prefixed("sim.battery.", [&] { battery.Validate(); });
   if (ground_z_m && !(std::abs(*ground_z_m) <= kMaxCoordinateM)) {
     ThrowValidation("SimulatorOptions", "ground_z_m", *ground_z_m, fmt::format("a height within ±{:g} m", kMaxCoordinateM));
   }
@@ -114,6 +119,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
                GroundPlane{.normal_W = Vector3::UnitZ(), .offset_m = world_.ground_z_m}),
       ground_effect_(model, options_.ground_effect, contact_.plane()),
       parachute_(options_.parachute),
+      battery_(options_.battery, model.params()),
       imu_(options_.imu, DeriveSeed(seed, kImuStream)),
       esc_(options_.esc, model.num_rotors(), DeriveSeed(seed, kEscStream)),
       odometry_(options_.odometry, world_, DeriveSeed(seed, kOdometryStream)),
@@ -121,6 +127,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
       imu_timer_(options_.imu.rate_hz),
       esc_timer_(options_.esc.rate_hz),
       odometry_timer_(options_.odometry.rate_hz),
+      battery_timer_(options_.battery.rate_hz),
       dt_ns_(PeriodFromRate(options_.physics_rate_hz)),
       x_(initial),
       faults_(model.num_rotors()) {
@@ -150,6 +157,7 @@ Simulator::Simulator(const vehicle::MultirotorModel& model, World world, std::ve
   still_air.wind_W = wind_.velocity();
   still_air.torque_B = options_.external_torque_n_m;
   SampleSensors(still_air);
+  SampleBattery(battery_, t_ns_, &battery_timer_, &outputs_);
 }
 
 void Simulator::SampleSensors(const vehicle::Disturbance& disturbance) {
@@ -259,6 +267,9 @@ const SensorOutputs& Simulator::Step() {
   if (crashed()) return outputs_;
   const double dt = ToSeconds(dt_ns_);
   injector_.Update(t_ns_, x_[StateIndex::kPosition + 2], !landed_, &faults_);
+  if (!thrust_limit_at_first_fault_ && !injector_.events().empty()) {
+    thrust_limit_at_first_fault_ = battery_.thrust_limit_ratio();
+  }
   vehicle::Disturbance disturbance;
   disturbance.wind_W = wind_.Step(dt);
   disturbance.torque_B = options_.external_torque_n_m;
@@ -270,13 +281,19 @@ const SensorOutputs& Simulator::Step() {
   ActivateCommands(t);
   parachute_.Update(t);
   const ExternalWrench external(contact_, ground_effect_, faults_, parachute_);
+  // The battery's sag over the step lowers every rotor's largest thrust (its voltage at the step's
+  // start: the load changes over the motors' time constant, tens of steps).
+  const double limit = battery_.thrust_limit_ratio();
+  const auto acting = [&] {
+    return limit < 1.0 ? RotorVector(command_.cwiseMin(limit * model_.max_thrust())) : command_;
+  };
   while (queue_size_ > 0 && queue_[static_cast<std::size_t>(queue_head_)].acts_ns < end) {
     const TimeNs next = queue_[static_cast<std::size_t>(queue_head_)].acts_ns;
-    integrator_.Step(command_, faults_, disturbance, ToSeconds(next - t), &x_, &external);
+    integrator_.Step(acting(), faults_, disturbance, ToSeconds(next - t), &x_, &external);
     t = next;
     ActivateCommands(t);
   }
-  integrator_.Step(command_, faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_, &external);
+  integrator_.Step(acting(), faults_, disturbance, t == t_ns_ ? dt : ToSeconds(end - t), &x_, &external);
   t_ns_ = end;
   ActivateCommands(t_ns_);  // applied_command(): the one acting at the new time
   UpdateOutputs();
@@ -285,6 +302,8 @@ const SensorOutputs& Simulator::Step() {
     x_ = x_before_;
     return outputs_;
   }
+  battery_.Step(thrust_, speed_, dt);
+  SampleBattery(battery_, t_ns_, &battery_timer_, &outputs_);
   ResolveGroundContact();
   if (!crash_reason_ && !landed_) {
     const StateView s(x_);

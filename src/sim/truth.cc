@@ -46,6 +46,7 @@ TruthRanges RangesOf(TruthPreset preset) {
   r.imu_axial_vibration_m_s2 = 0.8;
   r.gyro_vibration_gain = 3.0;
   r.ground_effect_fraction = 0.5;
+  r.battery_fraction = 0.3;
   return r;
 }
 
@@ -164,6 +165,10 @@ TruthDraw DrawTruth(const TruthOptions& options, const vehicle::VehicleParams& v
   if (r.imu_axial_vibration_m_s2 > 0.0) d.imu_axial_vibration_m_s2 = rng.Uniform(0.5, 1.0) * r.imu_axial_vibration_m_s2;
   if (r.gyro_vibration_gain > 0.0) d.gyro_vibration_gain = rng.Uniform(std::min(1.0, r.gyro_vibration_gain), r.gyro_vibration_gain);
   d.ground_effect_ratio = Ratio(r.ground_effect_fraction, &rng);
+  if (r.battery_fraction > 0.0) {
+    d.battery_capacity_ratio = rng.Uniform(1.0 - r.battery_fraction, 1.0);
+    d.battery_resistance_ratio = rng.Uniform(1.0, 1.0 + 2.0 * r.battery_fraction);
+  }
   return d;
 }
 
@@ -246,6 +251,8 @@ SimulatorOptions TruthSimulatorOptions(const SimulatorOptions& scenario, const v
   o.imu.axial_vibration_m_s2 = draw.imu_axial_vibration_m_s2;
   o.imu.gyro_vibration_gain = draw.gyro_vibration_gain;
   o.ground_effect.strength = std::min(scenario.ground_effect.strength * draw.ground_effect_ratio, kMaxGroundEffectStrength);
+  o.battery.capacity_mah = scenario.battery.capacity_mah * draw.battery_capacity_ratio;
+  o.battery.internal_resistance_ohm = scenario.battery.internal_resistance_ohm * draw.battery_resistance_ratio;
   if (draw.gyro_vibration_gain > 0.0) {
     const vehicle::VehicleParams v = TruthVehicle(file, draw);
     for (const vehicle::Rotor& r : v.rotors) o.imu.rotor_positions_m.push_back(r.p_B);

@@ -213,6 +213,12 @@ void FlightStack::OnEscTelemetry(const EscTelemetry& esc) {
 
 void FlightStack::OnOdometry(const OdometrySample& odometry) { estimator_->OnOdometry(odometry); }
 
+void FlightStack::OnBattery(const BatteryStatus& battery) {
+  if (!std::isfinite(battery.voltage_v)) return;  // a power module's glitch: the last good one stays
+  battery_ = battery;
+  battery_min_voltage_v_ = std::min(battery_min_voltage_v_.value_or(battery.voltage_v), battery.voltage_v);
+}
+
 void FlightStack::OnLidar(const LidarFrame& frame) {
   RG_INVARIANT(!tasks_detached_, "FlightStack::OnLidar: the perception task runs elsewhere (DetachTasks)");
   perception_->OnFrame(frame, FrameEstimate(frame));
@@ -459,6 +465,7 @@ FlightStackSummary FlightStack::Summarize() const {
   s.transitions = supervisor_.transitions();
   if (const perception::VoxelMap* m = map()) s.map_voxels_occupied = m->occupied_count();
   s.lidar_points_dropped = lidar_points_dropped();
+  s.battery_min_voltage_v = battery_min_voltage_v_;
   if (const LioEstimator* odometry = lio()) s.odometry = odometry->Summarize();
   s.reconfigurations = reconfigurations_;
   s.deadline_events = supervisor_.deadline_events();

@@ -57,13 +57,22 @@ class BenchCampaigns : public testing::TempFolderTest {};
 
 TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSameCampaign) {
   const campaign::Campaign c = FtcCampaign(SmallFtc());
-  ASSERT_EQ(c.trials, 20 * 2);  // 20 cells (docs/benchmarks.md), two methods
+  ASSERT_EQ(c.trials, 24 * 2);  // 24 cells (docs/benchmarks.md), two methods
   // The adjacent double failure with a parachute flies the trials of the one without (a paired
   // comparison); every other cell its own.
   std::map<std::string, std::set<std::string>> seeds;
-  for (int i = 0; i < c.trials; ++i) seeds[c.parameters(i).at("fault")].insert(c.parameters(i).at("seed"));
-  EXPECT_EQ(seeds.at("motor_stop_then_adjacent_parachute"), seeds.at("motor_stop_then_adjacent"));
-  EXPECT_NE(seeds.at("motor_stop_then_twin"), seeds.at("motor_stop_then_adjacent"));
+  for (int i = 0; i < c.trials; ++i) {
+    const std::map<std::string, std::string> p = c.parameters(i);
+    seeds[p.at("phase") + "/" + p.at("fault")].insert(p.at("seed"));
+  }
+  EXPECT_EQ(seeds.at("hover/motor_stop_then_adjacent_parachute"), seeds.at("hover/motor_stop_then_adjacent"));
+  EXPECT_NE(seeds.at("hover/motor_stop_then_twin"), seeds.at("hover/motor_stop_then_adjacent"));
+  // The propeller losses on a battery fly the trials of those without one.
+  for (const std::string phase : {"hover", "tracking"}) {
+    for (const std::string battery : {"_battery_full", "_battery_30"}) {
+      EXPECT_EQ(seeds.at(phase + "/propeller_loss" + battery), seeds.at(phase + "/propeller_loss")) << phase << battery;
+    }
+  }
   // Whole, on two threads, in a temporary folder.
   campaign::CampaignRunOptions whole;
   whole.jobs = 2;
@@ -153,7 +162,7 @@ TEST_F(BenchCampaigns, FtcResultCountsAnErroredTrialAsAFailure) {
   EXPECT_EQ(r["cells"][0]["failures"][0]["reason"], "error: boom");
   EXPECT_EQ(r["cells"][1]["sucr"], 1.0);
   records.pop_back();
-  RG_EXPECT_THROW_WITH(FtcResult(c.bench["options"], records), std::invalid_argument, "19 trial records");
+  RG_EXPECT_THROW_WITH(FtcResult(c.bench["options"], records), std::invalid_argument, "23 trial records");
 }
 
 /// The nav benchmark's campaign of `trials` rooms, each flown by both variants.

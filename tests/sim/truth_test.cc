@@ -41,6 +41,8 @@ TEST(Truth, TheIdealWorldIsTheFileExactly) {
   EXPECT_EQ(d.motor_stop_time_constant_s, file.motor_stop_time_constant_s);
   EXPECT_EQ(d.external_torque_n_m, Vector3::Zero());
   EXPECT_EQ(d.ground_effect_ratio, 1.0);  // the world's physics, not the file's: nominal, not absent
+  EXPECT_EQ(d.battery_capacity_ratio, 1.0);
+  EXPECT_EQ(d.battery_resistance_ratio, 1.0);
   const vehicle::VehicleParams v = TruthVehicle(file, d);
   // Bit for bit: the ideal world must reproduce the figures measured before the truth existed.
   EXPECT_EQ(v.mass_kg, file.mass_kg);
@@ -104,10 +106,12 @@ TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   const vehicle::VehicleParams file = ReferenceQuad();
   const TruthRanges r = RangesOf(TruthPreset::kRealistic);
   std::vector<double> mass, kn, stop, torque, cog, latency, computation, esc_latency, noise, lidar_turn, lidar_clock,
-      ground_effect;
+      ground_effect, capacity, resistance;
   for (std::uint64_t seed = 0; seed < 4000; ++seed) {
     const TruthDraw d = DrawTruth(Realistic(), file, seed);
     ground_effect.push_back(d.ground_effect_ratio);
+    capacity.push_back(d.battery_capacity_ratio);
+    resistance.push_back(d.battery_resistance_ratio);
     computation.push_back(d.computation_delay_s);
     esc_latency.push_back(d.esc_command_latency_s);
     noise.push_back(d.imu_gyro_noise_ratio);
@@ -142,6 +146,10 @@ TEST(Truth, RealisticDrawsStayInTheirRangesAndFillThem) {
   // The ground effect from half to one and a half times Cheeseman and Bennett's.
   EXPECT_GE(r.ground_effect_fraction, 0.5);
   fills(ground_effect, 1.0, r.ground_effect_fraction);
+  // Packs that have aged: capacity down to 70 %, resistance up to 1.6 times the label's.
+  EXPECT_GE(r.battery_fraction, 0.3);
+  fills(capacity, 1.0 - 0.5 * r.battery_fraction, 0.5 * r.battery_fraction);
+  fills(resistance, 1.0 + r.battery_fraction, r.battery_fraction);
   const auto fills_interval = [&fills](const std::vector<double>& x, double lo, double hi) {
     fills(x, 0.5 * (lo + hi), 0.5 * (hi - lo));
   };

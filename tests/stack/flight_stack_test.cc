@@ -24,6 +24,7 @@ std::shared_ptr<const ReferenceTrajectory> HoverAt(double z) {
 static_assert(std::is_same_v<decltype(&FlightStack::OnImu), void (FlightStack::*)(const ImuSample&)>);
 static_assert(std::is_same_v<decltype(&FlightStack::OnEscTelemetry), void (FlightStack::*)(const EscTelemetry&)>);
 static_assert(std::is_same_v<decltype(&FlightStack::OnOdometry), void (FlightStack::*)(const OdometrySample&)>);
+static_assert(std::is_same_v<decltype(&FlightStack::OnBattery), void (FlightStack::*)(const BatteryStatus&)>);
 static_assert(std::is_same_v<decltype(&FlightStack::Update), const RotorCommand& (FlightStack::*)(TimeNs)>);
 
 TEST(FlightStack, IdlesUntilItHasSensorData) {
@@ -44,6 +45,20 @@ TEST(FlightStack, HoldsHoverThrustAtTheReference) {
   st.OnOdometry(odom);
   const RotorCommand& c = st.Update(0);
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(c.thrust_n[i], 1.15 * kGravity / 4.0, 1e-9);
+}
+
+TEST(FlightStack, KeepsThePowerModulesNewestMessageAndReportsItsLowestVoltage) {
+  FlightStack st(ReferenceQuad(), HoverAt(1.0), {});
+  EXPECT_FALSE(st.battery());
+  EXPECT_FALSE(st.Summarize().battery_min_voltage_v);
+  st.OnBattery({100, 16.2, 12.0});
+  st.OnBattery({200, 15.1, 30.0});
+  st.OnBattery({300, std::nan(""), 10.0});  // a glitch: dropped, the last good one stays
+  st.OnBattery({400, 15.6, 14.0});
+  ASSERT_TRUE(st.battery());
+  EXPECT_EQ(st.battery()->t_ns, 400);
+  EXPECT_EQ(st.battery()->voltage_v, 15.6);
+  EXPECT_EQ(st.Summarize().battery_min_voltage_v, 15.1);
 }
 
 TEST(FlightStack, CorruptSensorDataNeverReachesTheMotorsAsNan) {

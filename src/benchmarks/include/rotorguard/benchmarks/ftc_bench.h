@@ -90,6 +90,8 @@ struct FtcTrial {
   /// Rotors isolated without a fault of their own (after a correct first isolation: a false second
   /// isolation).
   int healthy_rotors_isolated = 0;
+  /// With a battery: the factor on every rotor's largest thrust at the fault's onset (NaN without).
+  double thrust_limit_at_fault = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The bins of a second failure's onset after the first isolation that bench ftc reports [s]:

@@ -41,6 +41,14 @@ struct LidarFrame {
   int dropped = 0;
 };
 
+/// The flight battery's terminal voltage and current, as a flight controller's power module
+/// measures them.
+struct BatteryStatus {
+  TimeNs t_ns = 0;
+  double voltage_v = 0.0;
+  double current_a = 0.0;
+};
+
 /// The stack's output: commanded thrust per rotor [N] (paper 000: u_i, eq. 6), and the recovery
 /// parachute's release, an output beside the motors' as on a flight controller: set from flight
 /// termination on (the motors stopped in the air), and never cleared (docs/supervisor.md).

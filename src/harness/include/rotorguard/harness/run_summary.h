@@ -71,6 +71,10 @@ struct RunSummary {
   std::optional<double> crash_speed_m_s;      ///< the speed at the crash's ground contact [m/s]
   /// When the stack's parachute release reached the vehicle [s] (fitted or not); none: never sent.
   std::optional<double> parachute_release_s;
+  /// With a fitted battery: the charge left at the end, in [0, 1], and the factor on every
+  /// rotor's largest thrust when the first fault began (the thrust margin it met).
+  std::optional<double> battery_final_charge;
+  std::optional<double> thrust_limit_at_fault;
   std::optional<std::string> failure_reason;  ///< why the run failed; none on success
   /// The simulated vehicle's departure from the vehicle file (summary.json "truth").
   sim::TruthDraw truth;

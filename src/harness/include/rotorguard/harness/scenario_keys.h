@@ -64,6 +64,9 @@ struct SimKeys {
     a->Visit("ground", &s->sim.ground, {.meaning = "the ground under the landing gear's feet"});
     a->Visit("ground_effect", &s->sim.ground_effect,
              {.meaning = "the rotors' extra thrust near the ground (the truth draws its strength about this one)"});
+    a->Visit("battery", &s->sim.battery,
+             {.meaning = "the flight battery, whose voltage sags with load and charge (the truth draws its capacity and "
+                         "resistance about these)"});
     a->Visit("parachute", &s->sim.parachute,
              {.meaning = "a recovery parachute, deployed by the stack's release signal on flight termination"});
     a->Visit("crash_speed_m_s", &s->sim.crash_speed_m_s,

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rotorguard/core/messages.h"
+#include "rotorguard/sim/battery.h"
 #include "rotorguard/sim/contact.h"
 #include "rotorguard/sim/fault_injector.h"
 #include "rotorguard/sim/ground_effect.h"
@@ -42,6 +43,8 @@ struct SimulatorOptions {
   GroundEffectOptions ground_effect;
   /// A recovery parachute the stack's release signal deploys (parachute.h); none by default.
   ParachuteOptions parachute;
+  /// The flight battery, whose sag lowers the rotors' largest thrust (battery.h); none by default.
+  BatteryOptions battery;
   /// The ground plane's height [m]; none: where the model's feet reach when its centre of gravity
   /// rests at z = 0. (A drawn truth passes the file's: its body origin rests at z = 0.)
   std::optional<double> ground_z_m;
@@ -60,6 +63,9 @@ struct SensorOutputs {
   std::optional<EscTelemetry> esc;
   std::optional<OdometrySample> odometry;
   std::optional<LidarFrame> lidar;  ///< a frame completed in this step
+  /// The battery's voltage and current, with a fitted battery (handed to the stack in lockstep
+  /// only; not among count()'s: the onboard runtime does not take it).
+  std::optional<BatteryStatus> battery;
   /// The messages of the step (what a stack's intake counts).
   int count() const { return imu.has_value() + esc.has_value() + odometry.has_value() + lidar.has_value(); }
 };
@@ -110,6 +116,11 @@ class Simulator {
   const GroundEffect& ground_effect() const { return ground_effect_; }
   /// The parachute (RotorCommand::release_parachute; fitted or not, it records the release).
   const Parachute& parachute() const { return parachute_; }
+  /// The flight battery (fitted or not).
+  const Battery& battery() const { return battery_; }
+  /// The battery's thrust_limit_ratio() at the first fault's onset (the margin the failure meets);
+  /// none before a fault.
+  std::optional<double> thrust_limit_at_first_fault() const { return thrust_limit_at_first_fault_; }
   bool crashed() const { return crash_reason_.has_value(); }
   const std::optional<std::string>& crash_reason() const { return crash_reason_; }
   /// The speed [m/s] at the crash's ground contact; none without a crash.
@@ -146,12 +157,14 @@ class Simulator {
   GroundContact contact_;
   GroundEffect ground_effect_;
   Parachute parachute_;
+  Battery battery_;
+  std::optional<double> thrust_limit_at_first_fault_;
   ImuModel imu_;
   EscModel esc_;
   OdometryModel odometry_;
   WindModel wind_;
   std::optional<LidarSimulator> lidar_;
-  RateTimer imu_timer_, esc_timer_, odometry_timer_;
+  RateTimer imu_timer_, esc_timer_, odometry_timer_, battery_timer_;
   TimeNs t_ns_ = 0;
   TimeNs dt_ns_;
   vehicle::StateVector x_, x_before_;

@@ -75,6 +75,9 @@ struct TruthRanges {
   /// The ground effect's strength (GroundEffectOptions::strength) drawn in (1 ± a) times the
   /// scenario's.
   double ground_effect_fraction = 0.0;
+  /// The battery's capacity drawn in [1 - a, 1] times the scenario's (packs age), its internal
+  /// resistance in [1, 1 + 2a] times (and cold or worn cells).
+  double battery_fraction = 0.0;
 };
 
 /// The ranges of a preset.
@@ -90,7 +93,7 @@ struct TruthOptions {
       odometry_yaw_drift_rad_per_sqrt_s, odometry_few_features_gain, odometry_outage_rate_hz,
       computation_delay_min_s, computation_delay_max_s, computation_delay_jitter_fraction, esc_command_latency_min_s,
       esc_command_latency_max_s, imu_noise_fraction, lidar_rotation_rad, lidar_clock_offset_s,
-      imu_axial_vibration_m_s2, gyro_vibration_gain, ground_effect_fraction;
+      imu_axial_vibration_m_s2, gyro_vibration_gain, ground_effect_fraction, battery_fraction;
 
   /// The preset's ranges with the overrides applied.
   TruthRanges Ranges() const;
@@ -266,6 +269,13 @@ inline constexpr TruthOverrideKey kTruthOverrideKeys[] = {
      &TruthOptions::ground_effect_fraction,
      &TruthRanges::ground_effect_fraction,
      {.meaning = "the ground effect's strength drawn in (1 ± a) times sim.ground_effect.strength", .min = 0, .max = 1}},
+    {"battery_fraction",
+     &TruthOptions::battery_fraction,
+     &TruthRanges::battery_fraction,
+     {.meaning = "the battery's capacity drawn in [1 − a, 1] and its internal resistance in [1, 1 + 2a] times "
+                 "sim.battery's",
+      .min = 0,
+      .max = 0.9}},
 };
 
 template <typename Archive>
@@ -308,6 +318,8 @@ struct TruthDraw {
   double imu_axial_vibration_m_s2 = 0.0;           ///< ImuOptions::axial_vibration_m_s2
   double gyro_vibration_gain = 0.0;                ///< ImuOptions::gyro_vibration_gain
   double ground_effect_ratio = 1.0;                ///< true / the scenario's ground effect strength
+  double battery_capacity_ratio = 1.0;             ///< true / sim.battery's capacity
+  double battery_resistance_ratio = 1.0;           ///< true / sim.battery's internal resistance
 
   /// summary.json's "truth" object.
   template <typename Archive>
@@ -357,6 +369,9 @@ struct TruthDraw {
              {.meaning = "the airframe's rocking over the vibration forces' rigid-body moment"});
     a->Visit("ground_effect_ratio", &ground_effect_ratio,
              {.meaning = "true ground effect strength / sim.ground_effect.strength"});
+    a->Visit("battery_capacity_ratio", &battery_capacity_ratio, {.meaning = "true battery capacity / sim.battery's"});
+    a->Visit("battery_resistance_ratio", &battery_resistance_ratio,
+             {.meaning = "true battery internal resistance / sim.battery's"});
   }
 };
 

@@ -213,6 +213,8 @@ struct FlightStackSummary {
   long lidar_points_dropped = 0;                 ///< as lidar_points_dropped()
   std::vector<RotorReconfiguration> reconfigurations;  ///< in the order they happened
   std::vector<DeadlineEvent> deadline_events;          ///< an onboard executor's deadline policy's steps
+  /// The lowest voltage the power module reported (OnBattery); none without its messages.
+  std::optional<double> battery_min_voltage_v;
   /// Every field (the software-in-the-loop node sends it to the simulator's side: docs/runtime.md).
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -226,6 +228,7 @@ struct FlightStackSummary {
     a->Visit("lidar_points_dropped", &lidar_points_dropped);
     a->Visit("reconfigurations", &reconfigurations);
     a->Visit("deadline_events", &deadline_events);
+    a->Visit("battery_min_voltage_v", &battery_min_voltage_v);
   }
 };
 
@@ -242,6 +245,9 @@ class FlightStack {
   void OnImu(const ImuSample& imu);
   void OnEscTelemetry(const EscTelemetry& esc);
   void OnOdometry(const OdometrySample& odometry);
+  /// The power module's voltage and current: kept (battery()) and reported (Summarize); the
+  /// controllers keep the vehicle file's thrust limits.
+  void OnBattery(const BatteryStatus& battery);
   /// A LiDAR frame: deskewed and inserted into the map (the map is created with the first frame).
   void OnLidar(const LidarFrame& frame);
   /// One control cycle at time t: estimate, reference, controller. Call every control_period_ns().
@@ -321,6 +327,8 @@ class FlightStack {
   const vehicle::MultirotorModel& model() const { return model_; }
   /// What the stack was configured with (the vehicle's sensors as it believes them).
   const FlightStackOptions& options() const { return options_; }
+  /// The newest power module message; none before one.
+  const std::optional<BatteryStatus>& battery() const { return battery_; }
   const control::Controller& controller() const { return *controller_; }
   /// The NMPC, when it is the controller (for its solve statistics); else null.
   const control::NmpcController* nmpc() const { return nmpc_; }
@@ -395,6 +403,8 @@ class FlightStack {
   TimeNs control_period_ns_;
   std::optional<TimeNs> last_update_ns_;
   StateEstimate estimate_;
+  std::optional<BatteryStatus> battery_;
+  std::optional<double> battery_min_voltage_v_;
   ReferencePoint reference_point_;
   RotorCommand command_;
   RpmNotchBank<6> imu_filter_;  // the IMU's vibration notches, for the FDD and the controller's rates
