@@ -31,7 +31,8 @@ FTC_CELLS = ('hover/propeller_loss,hover/motor_stop,tracking/propeller_loss,trac
              'takeoff/propeller_loss,takeoff/motor_stop,hover/motor_stop_then_twin,'
              'hover/motor_stop_then_adjacent,hover/motor_stop_then_adjacent_parachute,hover/none,tracking/none,'
              'takeoff/none,hover/propeller_loss_battery_full,hover/propeller_loss_battery_30,'
-             'tracking/propeller_loss_battery_full,tracking/propeller_loss_battery_30')
+             'tracking/propeller_loss_battery_full,tracking/propeller_loss_battery_30,'
+             'takeoff/propeller_loss_ground_effect,takeoff/motor_stop_ground_effect')
 
 # name, kind, arguments after `rotorguard`, what it measures
 JOBS = [
@@ -44,9 +45,15 @@ JOBS = [
       '--cells', FTC_CELLS],
      'the baselines on the same cells'),
 ] + [
+    ('mars_' + w, 'bench', ['bench', 'mars', '--trials', '100', '--seed', '1', '--truth', w],
+     'paper 002\'s benchmark (Tables I and II, the allocation\'s time, the self-reconfiguration), %s' % w)
+    for w in ('realistic', 'ideal')
+] + [
     ('far_' + s, 'campaign', ['campaign', 'run', 'configs/campaigns/fdd_far_%s.yaml' % s], d)
     for s, d in (('takeoff', '1000 take-offs to 1.5 m and a hover, 10 s'),
                  ('landing', '1000 hovers at 1.5 m and landings, 10 s'),
+                 ('takeoff_ground_effect', 'the take-offs with the rotors\' ground effect'),
+                 ('landing_ground_effect', 'the landings with the rotors\' ground effect'),
                  ('emergency_landing', '1000 hovers whose odometry is lost for 1 s, landed by the supervisor, 12 s'),
                  ('lemniscate', '1000 flights of 60 s of the 2 m/s lemniscate, gusts 0-0.5 m/s'),
                  ('lemniscate_3ms', '1000 flights of 60 s of the lemniscate at 3 m/s, gusts 0-0.5 m/s'),
@@ -360,7 +367,8 @@ def ftc_table(recs, methods):
              '|---|---|---|---|---|---|---|---|---|---|']
     summary = {}
     for (phase, fault, method), rs in cells.items():
-        if method not in methods or fault == 'none' or fault.startswith('motor_stop_then') or 'battery' in fault:
+        if (method not in methods or fault == 'none' or fault.startswith('motor_stop_then') or 'battery' in fault
+                or fault.endswith('_ground_effect')):
             continue
         n = len(rs)
         ok = [r for r in rs if r['status'] == 'ok']
@@ -412,6 +420,29 @@ def ftc_battery(recs, methods):
                 lines.append('| %s | %s | %s | %d | %s | %s | %s |' % (
                     phase, label, method, n, pct(success, n),
                     '%.3f (%.3f)' % (median(limit), min(limit)) if limit else '/', mean_ci(lat)))
+    return '\n'.join(lines)
+
+
+def ftc_ground_effect(recs, methods):
+    """The take-off failures with the rotors' ground effect beside the same trials without it."""
+    cells = ftc_cells(recs)
+    lines = ['| fault | ground effect | method | trials | SucR | altitude change ≥ −0.05 m (of successes) | '
+             'lowest altitude change (m) | FDD latency mean (s) |', '|---|---|---|---|---|---|---|---|']
+    for fault in ('propeller_loss', 'motor_stop'):
+        for cell, label in ((fault, 'none'), (fault + '_ground_effect', 'strength 1 (drawn 0.5-1.5)')):
+            for method in methods:
+                rs = cells.get(('takeoff', cell, method))
+                if not rs:
+                    continue
+                n = len(rs)
+                ok = [r for r in rs if r['status'] == 'ok']
+                wins = [r for r in ok if r['metrics'].get('success')]
+                change = [r['metrics']['altitude_change_m'] for r in wins if r['metrics'].get('altitude_change_m') is not None]
+                held = sum(1 for c in change if c >= -0.05)
+                lat = [r['metrics']['latency_s'] for r in ok if r['metrics'].get('correct') and r['metrics'].get('latency_s') is not None]
+                lines.append('| %s | %s | %s | %d | %s | %s | %s | %s |' % (
+                    fault, label, method, n, pct(len(wins), n), pct(held, len(change)) if change else '/',
+                    '%.3f' % min(change) if change else '/', mean_ci(lat)))
     return '\n'.join(lines)
 
 
@@ -546,6 +577,8 @@ def render(out_dir, present):
         body += ['Propeller losses on a battery (docs/scenarios.md, `sim.battery`: a 4S pack whose voltage sags with its',
                  'load and charge, every rotor\'s largest thrust scaling with (V / V_ref)²), full and at 30 % charge, on the',
                  'trials of the cells without one:', '', ftc_battery(recs, ('rotorguard',)), '']
+        body += ['Take-off failures with the rotors\' ground effect (docs/scenarios.md, `sim.ground_effect`), on the trials of',
+                 'the cells without it:', '', ftc_ground_effect(recs, ('rotorguard',)), '']
         # README: the headline figures, realistic.
         def rng(keys, f):
             vals = [f(single[k]) for k in keys if k in single]
@@ -610,6 +643,19 @@ def render(out_dir, present):
             body += ['', 'Vehicles the evaluation sets below share with the calibration\'s %d: %s.'
                      % (len(cal_seeds), ', '.join(shared))]
         body.append('')
+    for world in ('realistic', 'ideal'):
+        name = 'mars_' + world
+        if name not in present:
+            continue
+        args = dict((j[0], j[2]) for j in JOBS)[name]
+        with open(os.path.join(out_dir, name, 'bench.md')) as f:
+            table = f.read().strip()
+        # The bench's own headings one level below this page's.
+        table = re.sub(r'^(#+) ', lambda m: '#' + m.group(1) + ' ', table, flags=re.M)
+        m = manifest(os.path.join(out_dir, name))
+        body += ['## Modular assemblies (paper 002), %s world' % world, '',
+                 '`%s` (rotorguard, %s; host %s, finished %s)' % (command_text(args), m.get('version', ''),
+                                                                m.get('host', ''), m.get('finished', '')), '', table, '']
     far = [j for j in JOBS if j[1] == 'campaign' and j[0] in present]
     if far:
         body += ['## False alarms on evaluation sets', '',

@@ -13,6 +13,7 @@
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/campaign/failure_list.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
@@ -23,13 +24,6 @@ namespace rotorguard::benchmarks {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 nlohmann::json OrNull(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(); }
 
@@ -184,11 +178,11 @@ nlohmann::json FlatnessResult(const nlohmann::json& options, const std::vector<n
   }
   const auto identified = std::count_if(w.begin(), w.end(), [&](double e) { return std::abs(e - truth) <= 0.05; });
   const auto median = [](const std::vector<double>& v) {
-    return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(Median(v));
+    return v.empty() ? nlohmann::json(nullptr) : nlohmann::json(Percentile(v, 0.5));
   };
   const auto range = [](const std::vector<double>& v) {
     if (v.empty()) return nlohmann::json(nullptr);
-    return nlohmann::json({{"median", Median(v)}, {"min", *std::min_element(v.begin(), v.end())},
+    return nlohmann::json({{"median", Percentile(v, 0.5)}, {"min", *std::min_element(v.begin(), v.end())},
                            {"max", *std::max_element(v.begin(), v.end())}});
   };
   return {{"benchmark", "flatness"},

@@ -57,6 +57,8 @@ struct Cell {
   const char* same_trials_as = nullptr;
   // > 0: the vehicle flies on a battery (sim/battery.h) charged this much at the start; 0: none.
   double battery_charge = 0.0;
+  // The rotors' ground effect (sim/ground_effect.h) at strength 1, drawn about it in realistic.
+  bool ground_effect = false;
 };
 
 constexpr Cell kCells[] = {
@@ -89,6 +91,11 @@ constexpr Cell kCells[] = {
      "tracking/propeller_loss", 1.0},
     {"+", "tracking", "propeller_loss_battery_30", "propeller_loss", 0.0, false, nullptr, false, "tracking/propeller_loss",
      0.3},
+    // The take-off failures with the ground effect, on the trials of the cells without it.
+    {"+", "takeoff", "propeller_loss_ground_effect", "propeller_loss", 0.0, false, nullptr, false,
+     "takeoff/propeller_loss", 0.0, true},
+    {"+", "takeoff", "motor_stop_ground_effect", "motor_stop", 0.0, false, nullptr, false, "takeoff/motor_stop", 0.0,
+     true},
 };
 constexpr int kNumCells = sizeof(kCells) / sizeof(kCells[0]);
 
@@ -199,6 +206,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     s.tracking_start_s = s.duration_s - 3.0;
   }
   s.sim.parachute.fitted = cell.parachute;
+  if (cell.ground_effect) s.sim.ground_effect.strength = 1.0;
   if (cell.battery_charge > 0.0) {
     s.sim.battery.fitted = true;
     s.sim.battery.initial_charge = cell.battery_charge;

@@ -5,6 +5,7 @@
 
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/statistics.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
@@ -12,12 +13,6 @@
 namespace rotorguard::benchmarks {
 
 namespace {
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 }  // namespace
 
 nlohmann::json RunSimBenchmark(harness::Scenario scenario, const SimBenchOptions& options) {
@@ -45,8 +40,8 @@ nlohmann::json RunSimBenchmark(harness::Scenario scenario, const SimBenchOptions
           {"crashed", last.crashed},
           {"tracking_rmse_m", last.tracking_rmse_m},
           {"repetitions", options.repetitions},
-          {"realtime_factor", Median(rtf)},
-          {"steps_per_s", Median(steps_per_s)},
+          {"realtime_factor", Percentile(rtf, 0.5)},
+          {"steps_per_s", Percentile(steps_per_s, 0.5)},
           {"runs", runs},
           {"host", buildinfo::HostInfo()}};
 }

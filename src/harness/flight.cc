@@ -71,17 +71,21 @@ std::unique_ptr<control::Controller> ExternalController(const Scenario& sc) {
   return std::make_unique<modular::AssemblyController>(*sc.assembly, AssemblyControllerOptionsOf(sc));
 }
 
-ComputationDelayModel::ComputationDelayModel(const Scenario& sc, const sim::TruthDraw& draw)
-    : kind_(sc.computation_delay),
+}  // namespace internal
+
+ComputationDelayModel::ComputationDelayModel(ComputationDelay kind, const sim::TruthDraw& draw, std::uint64_t seed)
+    : kind_(kind),
       delay_s_(draw.computation_delay_s),
       jitter_(draw.computation_delay_jitter_fraction),
-      rng_(DeriveSeed(sc.seed, "computation_delay")) {}
+      rng_(DeriveSeed(seed, "computation_delay")) {}
 
 TimeNs ComputationDelayModel::Next(double cycle_s) {
   if (kind_ == ComputationDelay::kMeasured) return FromSeconds(cycle_s);
   const double scale = jitter_ > 0.0 ? 1.0 + rng_.Uniform(-jitter_, jitter_) : 1.0;
   return FromSeconds(delay_s_ * scale);
 }
+
+namespace internal {
 
 StackAccount AccountOf(const stack::FlightStack& st) {
   StackAccount a;
@@ -320,7 +324,7 @@ class Flight::Loop {
   FlightMetrics metrics_;
   RotorCommand command_;
   TimeNs command_sent_ns_ = 0;  // when the last cycle's command leaves the computer
-  ComputationDelayModel delay_{sc_, draw_};
+  ComputationDelayModel delay_{sc_.computation_delay, draw_, sc_.seed};
   TimeNs next_control_ = 0;
   double stack_s_ = 0.0, simulator_s_ = 0.0;  // wall-clock time in each [s]
   std::uint64_t physics_steps_ = 0, control_cycles_ = 0;

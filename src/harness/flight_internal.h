@@ -6,6 +6,7 @@
 
 #include "rotorguard/control/controller.h"
 #include "rotorguard/core/rng.h"
+#include "rotorguard/harness/computation_delay.h"
 #include "rotorguard/harness/flight_metrics.h"
 #include "rotorguard/harness/run_summary.h"
 #include "rotorguard/harness/scenario.h"
@@ -26,21 +27,6 @@ FlightMetricsOptions MetricsOptionsOf(const Scenario& sc, TimeNs dt_ns, std::int
 sim::Simulator MakeSimulator(const Scenario& sc, const vehicle::MultirotorModel& truth, const sim::TruthDraw& draw);
 /// The controller the stack cannot build itself (it lives in a module above it), when asked for.
 std::unique_ptr<control::Controller> ExternalController(const Scenario& sc);
-/// A cycle's computation delay: the flight's drawn delay within its jitter, or the stack's
-/// measured wall-clock time for the cycle (sim.computation_delay: measured). The ideal world draws
-/// none: its commands act at their cycle's instant.
-class ComputationDelayModel {
- public:
-  ComputationDelayModel(const Scenario& sc, const sim::TruthDraw& draw);
-  /// The delay of a cycle that took `cycle_s` of wall-clock time [ns].
-  TimeNs Next(double cycle_s);
-
- private:
-  ComputationDelay kind_;
-  double delay_s_, jitter_;
-  Rng rng_;
-};
-
 /// What a flight's summary reads of the stack at its end: from the stack in this process, or sent
 /// by a software-in-the-loop node from its own.
 struct StackAccount {

@@ -385,7 +385,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   FlightMetrics metrics(MetricsOptionsOf(sc, dt, steps, draw));
   ReferenceTrace reference(sc.reference.get());
   TruthHistory history;
-  ComputationDelayModel delay(sc, draw);
+  ComputationDelayModel delay(sc.computation_delay, draw, sc.seed);
   recorder.BeginWithoutStack(sim.model().num_rotors());
   StackRow row;  // the stack's newest cycle as the log shows it
 

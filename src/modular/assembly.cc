@@ -40,6 +40,47 @@ void AssemblySpec::Validate() const {
   }
 }
 
+vehicle::VehicleParams ComposeVehicle(const std::vector<RigidPart>& parts, const std::string& name, Vector3* cog_B) {
+  if (parts.empty()) ThrowInvalidArgument("ComposeVehicle", "parts", 0, "at least one part");
+  vehicle::VehicleParams v = *parts.front().params;
+  v.name = name;
+  // Weights relative to the first part's mass: identical parts weigh exactly 1 each.
+  const double m0 = parts.front().params->mass_kg;
+  double weight = 0.0;
+  for (const RigidPart& p : parts) weight += p.params->mass_kg / m0;
+  v.mass_kg = m0 * weight;
+  Vector3 com = Vector3::Zero();
+  for (const RigidPart& p : parts) com += p.params->mass_kg / m0 * p.cog_B / weight;
+  v.inertia_kg_m2.setZero();
+  v.rotor_drag_kg_s.setZero();
+  v.yaw_damping_n_m_s = 0.0;
+  v.rotors.clear();
+  v.collision_spheres.clear();
+  double radius = 0.0;
+  const double n = static_cast<double>(parts.size());
+  for (const RigidPart& p : parts) {
+    const vehicle::VehicleParams& u = *p.params;
+    const Vector3 r = p.cog_B - com;
+    // Parallel-axis theorem: I = sum_k I_k + m_k (|r_k|^2 E - r_k r_k').
+    v.inertia_kg_m2 += u.inertia_kg_m2 + u.mass_kg * (r.squaredNorm() * Matrix3::Identity() - r * r.transpose());
+    v.rotor_drag_kg_s += u.rotor_drag_kg_s;
+    v.yaw_damping_n_m_s += u.yaw_damping_n_m_s;
+    // The mean, as the first part's plus the mean deviation: exact for identical parts.
+    v.motor_time_constant_s += (u.motor_time_constant_s - parts.front().params->motor_time_constant_s) / n;
+    v.motor_stop_time_constant_s +=
+        (u.motor_stop_time_constant_s - parts.front().params->motor_stop_time_constant_s) / n;
+    for (vehicle::Rotor rotor : u.rotors) {
+      rotor.p_B += r;
+      v.rotors.push_back(rotor);
+    }
+    radius = std::max(radius, r.norm() + u.collision_radius_m);
+    v.collision_spheres.push_back({r, u.collision_radius_m});  // the footprint: a sphere per part
+  }
+  v.collision_radius_m = radius;
+  if (cog_B) *cog_B = com;
+  return v;
+}
+
 Assembly BuildAssembly(const AssemblySpec& spec) {
   spec.Validate();
   const vehicle::VehicleParams& u = spec.unit;
@@ -52,35 +93,12 @@ Assembly BuildAssembly(const AssemblySpec& spec) {
   a.unit_radius_m = u.collision_radius_m;
   a.unit = u;
   a.spacing_m = spec.spacing_m;
-  Vector3 com = Vector3::Zero();
-  std::vector<Vector3> grid(n);
-  for (int k = 0; k < n; ++k) {
-    grid[k] = Vector3(spec.slots[k].x(), spec.slots[k].y(), 0.0) * spec.spacing_m;
-    com += grid[k] / n;  // identical units: the centre of mass is the mean of their centres
-  }
-  vehicle::VehicleParams& v = a.vehicle;
-  v = u;
-  v.name = spec.name.empty() ? u.name + "_assembly" : spec.name;
-  v.mass_kg = n * u.mass_kg;
-  v.inertia_kg_m2.setZero();
-  v.rotor_drag_kg_s = n * u.rotor_drag_kg_s;
-  v.yaw_damping_n_m_s = n * u.yaw_damping_n_m_s;
-  v.rotors.clear();
-  double radius = 0.0;
-  for (int k = 0; k < n; ++k) {
-    const Vector3 r = grid[k] - com;
-    a.unit_position_B.push_back(r);
-    // Parallel-axis theorem: I = sum_k I_unit + m (|r|^2 E - r r').
-    v.inertia_kg_m2 += u.inertia_kg_m2 + u.mass_kg * (r.squaredNorm() * Matrix3::Identity() - r * r.transpose());
-    for (vehicle::Rotor rotor : u.rotors) {
-      rotor.p_B += r;
-      v.rotors.push_back(rotor);
-    }
-    radius = std::max(radius, r.norm() + u.collision_radius_m);
-    v.collision_spheres.push_back({r, u.collision_radius_m});  // the footprint: a sphere per unit
-  }
-  v.collision_radius_m = radius;
-  v.Validate();
+  std::vector<RigidPart> parts;
+  for (int k = 0; k < n; ++k) parts.push_back({&u, Vector3(spec.slots[k].x(), spec.slots[k].y(), 0.0) * spec.spacing_m});
+  Vector3 com;
+  a.vehicle = ComposeVehicle(parts, spec.name.empty() ? u.name + "_assembly" : spec.name, &com);
+  for (const RigidPart& p : parts) a.unit_position_B.push_back(p.cog_B - com);
+  a.vehicle.Validate();
   return a;
 }
 

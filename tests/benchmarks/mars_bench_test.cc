@@ -128,6 +128,7 @@ TEST(MarsTableTwo, CellsAreOverEachMethodsPlansAndTheComparisonOverTheTrialsBoth
 TEST(Reconfiguration, AUnitSeparatesFliesOverAndDocksWhileTheAssemblyStaysLevel) {
   ReconfigurationOptions o;
   o.base = harness::LoadScenario(Config("scenarios/mars_reconfigure_3x1.yaml"));
+  o.base.truth.preset = sim::TruthPreset::kIdeal;  // the paper's floor: the vehicles as their files
   const ReconfigurationResult prepared = RunReconfiguration(o);
   ASSERT_TRUE(prepared.success) << prepared.failure;
   EXPECT_GT(prepared.docking_s, prepared.separation_s + 3.0);  // up, across and down at 0.3 m/s
@@ -141,6 +142,23 @@ TEST(Reconfiguration, AUnitSeparatesFliesOverAndDocksWhileTheAssemblyStaysLevel)
   EXPECT_LT(prepared.separation_max_accel_m_s2, naive.separation_max_accel_m_s2);
   o.target_slot = Eigen::Vector2i(1, 0);  // occupied
   RG_EXPECT_THROW_WITH(RunReconfiguration(o), std::invalid_argument, "target_slot");
+}
+
+TEST(Reconfiguration, InTheDrawnWorldTheUnitDocksByItsCameraNotByItsOdometry) {
+  // Each unit drawn about its file, each body's odometry drifting on its own: the two bodies'
+  // estimates part by centimetres over the transfer, more than the latch's 3 cm.
+  ReconfigurationOptions o;
+  o.base = harness::LoadScenario(Config("scenarios/mars_reconfigure_3x1.yaml"));
+  ASSERT_EQ(o.base.truth.preset, sim::TruthPreset::kRealistic);
+  const ReconfigurationResult guided = RunReconfiguration(o);
+  // Docked (the docked assembly's hold is judged after, on its own drifting odometry).
+  EXPECT_GT(guided.docking_s, guided.separation_s + 3.0) << guided.failure;
+  o.dock_camera_range_m = 1.01 * o.dock_tolerance_m;  // sees the slot only once docked: blind
+  const ReconfigurationResult blind = RunReconfiguration(o);
+  EXPECT_FALSE(blind.success);
+  EXPECT_NE(blind.failure.find("did not reach its slot"), std::string::npos) << blind.failure;
+  o.dock_camera_noise_m = o.dock_tolerance_m;
+  RG_EXPECT_THROW_WITH(RunReconfiguration(o), std::invalid_argument, "dock_camera_noise_m");
 }
 
 }  // namespace

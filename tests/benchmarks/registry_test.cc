@@ -57,7 +57,7 @@ class BenchCampaigns : public testing::TempFolderTest {};
 
 TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSameCampaign) {
   const campaign::Campaign c = FtcCampaign(SmallFtc());
-  ASSERT_EQ(c.trials, 24 * 2);  // 24 cells (docs/benchmarks.md), two methods
+  ASSERT_EQ(c.trials, 26 * 2);  // 26 cells (docs/benchmarks.md), two methods
   // The adjacent double failure with a parachute flies the trials of the one without (a paired
   // comparison); every other cell its own.
   std::map<std::string, std::set<std::string>> seeds;
@@ -72,6 +72,18 @@ TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSa
     for (const std::string battery : {"_battery_full", "_battery_30"}) {
       EXPECT_EQ(seeds.at(phase + "/propeller_loss" + battery), seeds.at(phase + "/propeller_loss")) << phase << battery;
     }
+  }
+  // The take-off failures with the ground effect fly those without; only the ground effect differs.
+  FtcBenchOptions small = SmallFtc();
+  for (const std::string fault : {"propeller_loss", "motor_stop"}) {
+    EXPECT_EQ(seeds.at("takeoff/" + fault + "_ground_effect"), seeds.at("takeoff/" + fault)) << fault;
+    const harness::Scenario with = MakeFtcTrial("takeoff/" + fault + "_ground_effect", "rotorguard", small, 7);
+    const harness::Scenario without = MakeFtcTrial("takeoff/" + fault, "rotorguard", small, 7);
+    EXPECT_EQ(with.sim.ground_effect.strength, 1.0);
+    EXPECT_EQ(without.sim.ground_effect.strength, 0.0);
+    ASSERT_EQ(with.faults.size(), 1u);
+    EXPECT_EQ(with.faults[0].rotor, without.faults[0].rotor);
+    EXPECT_EQ(with.faults[0].onset.value, without.faults[0].onset.value);
   }
   // Whole, on two threads, in a temporary folder.
   campaign::CampaignRunOptions whole;
@@ -162,7 +174,7 @@ TEST_F(BenchCampaigns, FtcResultCountsAnErroredTrialAsAFailure) {
   EXPECT_EQ(r["cells"][0]["failures"][0]["reason"], "error: boom");
   EXPECT_EQ(r["cells"][1]["sucr"], 1.0);
   records.pop_back();
-  RG_EXPECT_THROW_WITH(FtcResult(c.bench["options"], records), std::invalid_argument, "23 trial records");
+  RG_EXPECT_THROW_WITH(FtcResult(c.bench["options"], records), std::invalid_argument, "25 trial records");
 }
 
 /// The nav benchmark's campaign of `trials` rooms, each flown by both variants.

@@ -58,6 +58,48 @@ TEST(Assembly, RotorsAreTheUnitsRotorsMovedToTheirSlots) {
   EXPECT_DOUBLE_EQ(a.vehicle.collision_radius_m, 0.25 + 0.15);
 }
 
+TEST(ComposeVehicle, UnequalPartsByTheParallelAxisTheorem) {
+  // Two parts 1 m apart along x, of 1 kg and 3 kg: the common centre of gravity lies 0.75 m from
+  // the light one, and the pair adds m1 m2 d^2 / (m1 + m2) = 0.75 kg m^2 about y and z.
+  vehicle::VehicleParams light = testing::MarsSpec("3x1").unit, heavy = light;
+  heavy.mass_kg = 3.0;
+  light.mass_kg = 1.0;
+  heavy.motor_time_constant_s = 3.0 * light.motor_time_constant_s;
+  heavy.rotor_drag_kg_s *= 2.0;
+  Vector3 cog;
+  const vehicle::VehicleParams v =
+      ComposeVehicle({{&light, Vector3::Zero()}, {&heavy, Vector3(1.0, 0.0, 0.0)}}, "pair", &cog);
+  EXPECT_EQ(v.name, "pair");
+  EXPECT_DOUBLE_EQ(v.mass_kg, 4.0);
+  EXPECT_TRUE(testing::MatricesNear(cog, Vector3(0.75, 0.0, 0.0), 1e-15));
+  const Matrix3 pair = Vector3(0.0, 0.75, 0.75).asDiagonal();
+  EXPECT_TRUE(testing::MatricesNear(v.inertia_kg_m2, light.inertia_kg_m2 + heavy.inertia_kg_m2 + pair, 1e-12));
+  EXPECT_TRUE(testing::MatricesNear(v.rotor_drag_kg_s, 3.0 * light.rotor_drag_kg_s, 1e-15));
+  EXPECT_DOUBLE_EQ(v.motor_time_constant_s, 2.0 * light.motor_time_constant_s);
+  ASSERT_EQ(v.num_rotors(), 2 * light.num_rotors());
+  const int n = light.num_rotors();
+  for (int i = 0; i < n; ++i) {
+    EXPECT_TRUE(testing::MatricesNear(v.rotors[i].p_B, light.rotors[i].p_B - Vector3(0.75, 0, 0), 1e-15));
+    EXPECT_TRUE(testing::MatricesNear(v.rotors[n + i].p_B, heavy.rotors[i].p_B + Vector3(0.25, 0, 0), 1e-15));
+  }
+  ASSERT_EQ(v.collision_spheres.size(), 2u);
+  EXPECT_DOUBLE_EQ(v.collision_radius_m, 0.75 + light.collision_radius_m);
+  EXPECT_THROW(ComposeVehicle({}, "none"), std::invalid_argument);
+}
+
+TEST(ComposeVehicle, OfIdenticalUnitsIsTheAssembly) {
+  const Assembly a = BuildAssembly(testing::MarsSpec("3x2"));
+  std::vector<RigidPart> parts;
+  for (const Vector3& r : a.unit_position_B) parts.push_back({&a.unit, r + Vector3(0.1, -0.2, 0.05)});
+  Vector3 cog;
+  const vehicle::VehicleParams v = ComposeVehicle(parts, a.vehicle.name, &cog);
+  EXPECT_TRUE(testing::MatricesNear(cog, Vector3(0.1, -0.2, 0.05), 1e-15));
+  EXPECT_TRUE(testing::MatricesNear(v.inertia_kg_m2, a.vehicle.inertia_kg_m2, 1e-14));
+  for (int i = 0; i < v.num_rotors(); ++i) {
+    EXPECT_TRUE(testing::MatricesNear(v.rotors[i].p_B, a.vehicle.rotors[i].p_B, 1e-15));
+  }
+}
+
 TEST(Assembly, InvalidSpecsNameTheField) {
   AssemblySpec s = testing::MarsSpec("3x2");
   s.slots[4] = s.slots[1];

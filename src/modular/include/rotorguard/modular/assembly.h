@@ -48,7 +48,24 @@ struct Assembly {
   int FirstRotor(int unit_index) const { return unit_index * rotors_per_unit; }
 };
 
-/// Builds the assembly of `spec` (validated). Units keep their own drag and yaw damping (summed);
+/// One rigid part of a composed vehicle: a vehicle (rotors, inertia, spheres about its own centre
+/// of gravity) and where that centre lies in the composed body's frame. Parts keep the body's
+/// orientation (a grid of docked units).
+struct RigidPart {
+  const vehicle::VehicleParams* params = nullptr;
+  Vector3 cog_B = Vector3::Zero();
+};
+
+/// The vehicle of rigidly joined `parts` about their common centre of gravity, which `*cog_B`
+/// (when given) receives in the parts' frame: masses, drag and yaw damping summed, inertia by the
+/// parallel-axis theorem, every rotor and a sphere per part (its collision radius about its centre)
+/// moved to that centre. What one number holds for the whole vehicle (the motors' time constants)
+/// is the parts' mean; the rest (k_n, the feet, the propellers' radius) is the first part's.
+/// Throws std::invalid_argument without a part.
+vehicle::VehicleParams ComposeVehicle(const std::vector<RigidPart>& parts, const std::string& name,
+                                      Vector3* cog_B = nullptr);
+
+/// Builds the assembly of `spec` (validated): ComposeVehicle of its identical units. Units keep their own drag and yaw damping (summed);
 /// the collision radius covers every unit's sphere.
 Assembly BuildAssembly(const AssemblySpec& spec);
 
