@@ -86,13 +86,17 @@ struct Body {
   TimeNs next_control = 0;
 
   /// A control cycle when one is due (its command reaches the ESCs after the cycle's computation
-  /// delay, as in a flight of the runner), then one physics step.
+  /// delay, as in a flight of the runner), then one physics step. Until its estimate is valid (the
+  /// odometry's first message, up to its latency after the split or the merge) a new body's stack
+  /// commands nothing and the ESCs hold what its rotors were last commanded (the simulator starts
+  /// from the motors' state): the hand-over of a vehicle in flight, not a start on the ground,
+  /// whose idle command would drop it.
   void Step() {
     const TimeNs t = sim->time_ns();
     if (t >= next_control) {
       const Stopwatch clock;
       const RotorCommand command = stack->Update(t);
-      sim->Send(command, t + delay->Next(clock.seconds()));
+      if (stack->estimate().valid) sim->Send(command, t + delay->Next(clock.seconds()));
       next_control += stack->control_period_ns();
     }
     harness::DeliverToStack(sim->Step(), stack.get());
