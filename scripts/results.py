@@ -353,6 +353,12 @@ PAPER_SUCR = {('hover', 'propeller_loss'): '100', ('hover', 'motor_stop'): '100'
 BINS = [(0.0, 0.3), (0.3, 1.0), (1.0, 2.0), (2.0, 4.0), (4.0, 6.5)]
 
 
+def metric_values(rs, key, only=None):
+    """A metric's recorded values over the trials that finished (and where metric `only` holds)."""
+    return [r['metrics'][key] for r in rs if r['status'] == 'ok' and r['metrics'].get(key) is not None
+            and (only is None or r['metrics'].get(only))]
+
+
 def ftc_cells(recs):
     cells = {}
     for r in recs:
@@ -376,7 +382,7 @@ def ftc_table(recs, methods):
         correct = sum(1 for r in ok if r['metrics'].get('correct'))
         false_alarm = sum(1 for r in ok if r['metrics'].get('false_alarm'))
         has_fdd = any('correct' in r['metrics'] for r in ok)
-        lat = [r['metrics']['latency_s'] for r in ok if r['metrics'].get('correct') and r['metrics'].get('latency_s') is not None]
+        lat = metric_values(rs, 'latency_s', 'correct')
         missed = n - correct
         lines.append('| %s | %s | %s | %d | %s | %s | %s | %s | %s | %s, %s |' % (
             phase, fault, method, n, pct(success, n), pct(missed, n) if has_fdd else '/',
@@ -415,8 +421,8 @@ def ftc_battery(recs, methods):
                 n = len(rs)
                 ok = [r for r in rs if r['status'] == 'ok']
                 success = sum(1 for r in ok if r['metrics'].get('success'))
-                limit = [r['metrics']['thrust_limit_at_fault'] for r in ok if r['metrics'].get('thrust_limit_at_fault') is not None]
-                lat = [r['metrics']['latency_s'] for r in ok if r['metrics'].get('correct') and r['metrics'].get('latency_s') is not None]
+                limit = metric_values(rs, 'thrust_limit_at_fault')
+                lat = metric_values(rs, 'latency_s', 'correct')
                 lines.append('| %s | %s | %s | %d | %s | %s | %s |' % (
                     phase, label, method, n, pct(success, n),
                     '%.3f (%.3f)' % (median(limit), min(limit)) if limit else '/', mean_ci(lat)))
@@ -437,9 +443,9 @@ def ftc_ground_effect(recs, methods):
                 n = len(rs)
                 ok = [r for r in rs if r['status'] == 'ok']
                 wins = [r for r in ok if r['metrics'].get('success')]
-                change = [r['metrics']['altitude_change_m'] for r in wins if r['metrics'].get('altitude_change_m') is not None]
+                change = metric_values(rs, 'altitude_change_m', 'success')
                 held = sum(1 for c in change if c >= -0.05)
-                lat = [r['metrics']['latency_s'] for r in ok if r['metrics'].get('correct') and r['metrics'].get('latency_s') is not None]
+                lat = metric_values(rs, 'latency_s', 'correct')
                 lines.append('| %s | %s | %s | %d | %s | %s | %s | %s |' % (
                     fault, label, method, n, pct(len(wins), n), pct(held, len(change)) if change else '/',
                     '%.3f' % min(change) if change else '/', mean_ci(lat)))

@@ -186,7 +186,6 @@ class GuidedReference final : public ReferenceTrajectory {
   }
   [[nodiscard]] double duration() const override { return path_->duration(); }
   void set_offset(const Vector3& offset) { offset_ = offset; }
-  const Vector3& offset() const { return offset_; }
 
  private:
   std::shared_ptr<const ReferenceTrajectory> path_;
@@ -358,9 +357,11 @@ ReconfigurationResult RunReconfiguration(const ReconfigurationOptions& o) {
   const TimeNs camera_period = FromSeconds(1.0 / o.dock_camera_rate_hz);
   TimeNs next_frame = 0;
   Vector3 shift = Vector3::Zero(), unit_error = Vector3::Zero();
-  // The integral is four times slower than the lag: well inside the unit's position loop.
-  const double integral_gain = 1.0 - std::exp(-1.0 / (4.0 * o.dock_camera_rate_hz * o.dock_guidance_time_constant_s));
-  const double lag = 1.0 - std::exp(-1.0 / (o.dock_camera_rate_hz * o.dock_guidance_time_constant_s));
+  // A first-order lag's gain per camera frame, for a time constant of `frames` frames. The
+  // integral is four times slower than the lag: well inside the unit's position loop.
+  const auto per_frame = [](double frames) { return 1.0 - std::exp(-1.0 / frames); };
+  const double integral_gain = per_frame(4.0 * o.dock_camera_rate_hz * o.dock_guidance_time_constant_s);
+  const double lag = per_frame(o.dock_camera_rate_hz * o.dock_guidance_time_constant_s);
   while (true) {
     const double t_local = b->sim->time_s(), t = o.separate_s + t_local;
     record(t, 1, *b);
