@@ -164,7 +164,8 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
     s.success.max_altitude_loss_m = 0.05;
     // On the climb, 2-50 cm above the ground (the take-off detector's domain, paper 000 Sec. V-B3).
     // Not earlier: with the landing gear still on the ground, the ground carries the lost thrust
-    // and torque and no inertial detector can see the loss (docs/benchmarks.md).
+    // and torque and no inertial detector can see the loss (CHANGELOG.md, "Faults before the
+    // vehicle has left the ground").
     onset = {sim::FaultOnset::Kind::kAtAltitude, 0.02 + 0.48 * draw};
   }
   // Where the vehicle settled: the last 3 s, at least 2 s after the latest isolation of a partial

@@ -57,7 +57,7 @@ class BenchCampaigns : public testing::TempFolderTest {};
 
 TEST_F(BenchCampaigns, FtcInShardsMergesToTheResultOfOneRunAndItsSpecFileIsTheSameCampaign) {
   const campaign::Campaign c = FtcCampaign(SmallFtc());
-  ASSERT_EQ(c.trials, 26 * 2);  // 26 cells (docs/benchmarks.md), two methods
+  ASSERT_EQ(c.trials, 26 * 2);  // 26 cells (ftc_bench.cc, kCells), two methods
   // The adjacent double failure with a parachute flies the trials of the one without (a paired
   // comparison); every other cell its own.
   std::map<std::string, std::set<std::string>> seeds;

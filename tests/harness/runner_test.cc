@@ -292,7 +292,8 @@ TEST(FddClosedLoop, IsolatesAndSurvivesEachFaultKindInHover) {
 TEST(FddClosedLoop, ASecondFailureFliesOnOnTheTwinAndStopsTheMotorsBesideIt) {
   // Rotor 0's motor stops at 2 s in hover, in the realistic world; at 5 s a propeller is lost on
   // its idle diagonal twin (1) or on a rotor beside it (2). (Seeds whose drawn vehicle recovers
-  // from the first failure; seed 2 draws one whose spin diverges, docs/benchmarks.md.)
+  // from the first failure; seed 2 draws one whose spin diverges, CHANGELOG.md,
+  // "Measurements of earlier releases".)
   for (std::uint64_t seed : {1u, 3u, 4u}) {
     for (int second : {1, 2}) {
       Scenario s = LoadScenario(Config("fdd_hover_motor_stop.yaml"), {{"duration_s", "8"}});
