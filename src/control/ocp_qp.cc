@@ -98,7 +98,7 @@ void CondensingQpSolver::CondenseMatrices(const OcpQp& qp) {
 
   // Sensitivities S_kj = A_{k-1} ... A_{j+1} B_j, a stage's row [S_k0 ... S_k,k-2] = A_{k-1}
   // [S_{k-1,0} ... S_{k-1,k-2}] as one product (faster than k-1 products of 17 x 17 by 17 x 4:
-  // docs/control.md, "Condensing a stage at a time").
+  // CHANGELOG.md, "Condensing a stage at a time").
   for (int k = 1; k <= N; ++k) {
     if (k > 1) Srow(k).leftCols((k - 1) * nu).noalias() = stage.A(k - 1) * Srow(k - 1);
     Srow(k).rightCols(nu) = stage.B(k - 1);
