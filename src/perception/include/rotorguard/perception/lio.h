@@ -85,7 +85,7 @@ struct LioOptions {
   /// the map built on with the error for good (0.13 m of height 14 m away). After eight frames
   /// on the IMU alone the tilt is off by 1.9 mrad at the median over 39 forest flights, 4.6 at
   /// most (registered from the second frame: 2.5 and 15.7), and the map holds the ground
-  /// (docs/navigation.md, "Localisation over many flights").
+  /// (docs/navigation.md, "Starting the map").
   int seed_frames = 8;
   /// A frame's points nearer than this to the sensor are dropped (the airframe, the propellers) [m], >= 0.
   double min_range_m = 0.3;
