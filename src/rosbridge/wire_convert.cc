@@ -74,7 +74,7 @@ ros1::Cloud ToWire(const LidarFrame& m, const TimeBase& base) {
     p.y = m.points_S[i].y();
     p.z = m.points_S[i].z();
     p.intensity = 100.0f;  // the simulated sensor measures no reflectivity
-    p.time_s = static_cast<float>(1e-9 * static_cast<double>(m.offset_ns[i]));
+    p.time_s = LidarOffsetToSeconds32(m.offset_ns[i]);
   }
   return c;
 }
@@ -86,7 +86,7 @@ LidarFrame FromWire(const ros1::Cloud& m, const TimeBase& base, TimeNs frame_per
   f.offset_ns.reserve(m.points.size());
   for (const ros1::CloudPoint& p : m.points) {
     // A point stamped outside the sweep is not one of its returns (a driver's wrap-around).
-    const double offset = std::round(1e9 * static_cast<double>(p.time_s));
+    const double offset = LidarOffsetFromSeconds32(p.time_s);
     if (!(offset >= 0.0 && offset < static_cast<double>(frame_period_ns))) {
       ++f.dropped;
       continue;

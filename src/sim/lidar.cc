@@ -98,7 +98,8 @@ std::optional<LidarFrame> LidarSimulator::Step(TimeNs t0, const BodyPose& pose0,
     }
     const double range = hit->distance_m + options_.range_noise_m * rng_.Normal();
     frame_.points_S.push_back((range * dir_S).cast<float>());
-    frame_.offset_ns.push_back(static_cast<std::uint32_t>(t - frame_.t_start_ns));
+    // Stamped at the resolution the driver publishes (float32 seconds after the frame's start).
+    frame_.offset_ns.push_back(LidarOffsetAsOnTheWire(static_cast<std::uint32_t>(t - frame_.t_start_ns)));
   }
   if (done && clock_offset_ns_ != 0) {
     // Stamped by the sensor's clock; delivered once its stamped end has come, never earlier.

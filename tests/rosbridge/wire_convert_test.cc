@@ -82,6 +82,21 @@ TEST(WireConvert, AFrameRoundTripsWithinFloatTimeAndDropsPointsOutsideItsSweep) 
   }
 }
 
+// The simulated sensor stamps its returns as the wire reads them back, so a recorded frame
+// replays on exactly the times the live stack saw: every nanosecond offset of a 10 Hz frame
+// (and of a 1 Hz one, in steps), taken to the wire's resolution, crosses the wire unchanged,
+// and lies within half the float32 spacing (3.7 ns at 0.1 s) of where it was.
+TEST(WireConvert, AnOffsetAtTheWiresResolutionCrossesItUnchanged) {
+  const auto check = [](std::uint32_t o) {
+    const std::uint32_t q = LidarOffsetAsOnTheWire(o);
+    ASSERT_EQ(LidarOffsetFromSeconds32(LidarOffsetToSeconds32(q)), static_cast<double>(q)) << o;
+    const double spacing = 1e9 * std::nextafter(LidarOffsetToSeconds32(o), 1.0f) - 1e9 * LidarOffsetToSeconds32(o);
+    ASSERT_LE(std::abs(static_cast<double>(q) - static_cast<double>(o)), 0.5 * spacing + 0.5) << o;
+  };
+  for (std::uint32_t o = 0; o < 100'000'000u; ++o) check(o);
+  for (std::uint32_t o = 100'000'000u; o < 1'000'000'000u; o += 997u) check(o);
+}
+
 TEST(WireConvert, ACycleRoundTrips) {
   runtime::CycleTelemetry c;
   c.command = {.cycle = 12, .state_t_ns = 1'500'000'000, .sent_t_ns = 1'500'400'000, .compute_s = 0.0004, .inputs = 321,

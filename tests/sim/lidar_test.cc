@@ -108,6 +108,7 @@ TEST(LidarSimulator, PointsLieOnSurfacesFromTheirOwnPoseAndSmearFromTheFrameEnd)
     double own_max = 0.0, end_mean = 0.0;
     const BodyPose end = pose_at(ToSeconds(f.t_end_ns));
     for (std::size_t i = 0; i < f.points_S.size(); ++i) {
+      ASSERT_EQ(f.offset_ns[i], LidarOffsetAsOnTheWire(f.offset_ns[i])) << "stamped as the driver publishes";
       const BodyPose at = pose_at(ToSeconds(f.t_start_ns + f.offset_ns[i]));
       const Vector3 p_S = f.points_S[i].cast<double>();
       own_max = std::max(own_max, room.DistanceToSurface(at.p_W + at.q_WB * (o.position_m + p_S), 0.0));

@@ -1,6 +1,7 @@
 #pragma once
 /// The messages that cross the boundary between the simulator (or a real vehicle) and the flight
 /// stack. The stack's only inputs are these sensor messages; its only output is RotorCommand.
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -40,6 +41,18 @@ struct LidarFrame {
   /// Pulses with no usable return: nothing within range, closer than the minimum range, or lost.
   int dropped = 0;
 };
+
+/// A return's time after its frame's start as the Velodyne point layout that FAST-LIO2 reads
+/// carries it: float32 seconds (resolution 7.5 ns near 0.1 s).
+inline float LidarOffsetToSeconds32(std::uint32_t offset_ns) { return static_cast<float>(1e-9 * static_cast<double>(offset_ns)); }
+/// The nanosecond offset a float32 time stands for, to the nearest nanosecond.
+inline double LidarOffsetFromSeconds32(float time_s) { return std::round(1e9 * static_cast<double>(time_s)); }
+/// `offset_ns` as it reads back from the wire: a frame stamped with these offsets crosses
+/// ToSeconds32/FromSeconds32 unchanged (the round trip is idempotent below 4.29 s), so a
+/// recorded flight replays on the very times the live stack saw.
+inline std::uint32_t LidarOffsetAsOnTheWire(std::uint32_t offset_ns) {
+  return static_cast<std::uint32_t>(LidarOffsetFromSeconds32(LidarOffsetToSeconds32(offset_ns)));
+}
 
 /// The flight battery's terminal voltage and current, as a flight controller's power module
 /// measures them.
