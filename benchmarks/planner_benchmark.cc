@@ -1,7 +1,7 @@
-// The trajectory optimiser of the planner (MINCO s = 3 + Ceres L-BFGS) on 10-piece problems.
+// The trajectory optimiser of the planner (MINCO s = 3 + the planner's L-BFGS) on 10-piece problems.
 // BM_OptimizeFreeSpace: 20 m rest to rest, waypoints and durations optimised under v/a/j limits.
 // BM_OptimizeAmongPillars: the same through a row of pillars across the straight line (the
-// nearest pillar's surface within 1 m of each sample of the initial guess as its plane). Target (issue): <= 5 ms for about 10 pieces.
+// nearest pillar's surface within 1 m of each sample of the initial guess as its plane). Target: <= 5 ms for about 10 pieces.
 // Run: build/bin/planner_benchmark
 #include <benchmark/benchmark.h>
 

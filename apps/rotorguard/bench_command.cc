@@ -122,7 +122,7 @@ class BenchCommand final : public Command {
           {"--repetitions", &sim_repetitions_, "Repetitions; the median is reported (default 5)"}}},
         {&qp_,
          "qp",
-         "The NMPC's QP solver (condensing + dual active set) on a reference OCP QP instance:\n"
+         "The NMPC's QP solver (dual active set: --solver riccati or condensing) on a reference OCP QP instance:\n"
          "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
          "iterations_mean and max_u0_error against the instance's optimal u_0.",
          {{"--instance", &qp_instance_, "Instance file (JSON), e.g. a copy of qp_hover_n20.json", true},

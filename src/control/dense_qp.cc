@@ -219,7 +219,7 @@ bool DenseQpSolver::Factorize(const Eigen::MatrixXd& H) {
   // L^-T of the ordered Hessian, upper triangular: column j solves L' x = e_j and needs only the
   // leading (j+1) x (j+1) block, so the columns are solved in panels against growing leading
   // blocks. That is a third of the work of solving against the whole identity (measured:
-  // docs/control.md). J_ is free to serve as scratch: a new factorisation ends the hot starts.
+  // CHANGELOG.md). J_ is free to serve as scratch: a new factorisation ends the hot starts.
   Eigen::MatrixXd& ordered = permuted() ? J_ : J0_;
   constexpr int kPanel = 8;
   ordered.setZero();

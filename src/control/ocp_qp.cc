@@ -109,7 +109,7 @@ void CondensingQpSolver::CondenseMatrices(const OcpQp& qp) {
     tmp.noalias() = W(m + 1) * stage.A(m);
     W(m) = stage.Q(m);
     // Eigen's product evaluator, not lazyProduct: with AVX2 it runs A' (W A) in 12 µs per
-    // condensing where lazyProduct's dot products took 21 (docs/control.md).
+    // condensing where lazyProduct's dot products took 21 (CHANGELOG.md).
     W(m).noalias() += stage.A(m).transpose() * tmp;
   }
   // Hessian blocks H_ij = S_{j+1,i}' W_{j+1} B_j (i <= j) plus R_j: input j's column of blocks is
@@ -193,7 +193,8 @@ const OcpQpSummary& CondensingQpSolver::Prepare(const OcpQp& qp, bool whole) {
   const Stopwatch clock;
   summary_ = OcpQpSummary{};
   RequireSameDims(qp, dims_, "CondensingQpSolver");
-  // The NMPC's sizes get their own instantiation (measured: docs/control.md).
+  // The NMPC's sizes get their own instantiation: fixed-size products (measured: CHANGELOG.md,
+  // "The NMPC's implementation").
   const bool nmpc_sizes = internal::IsNmpcSize(dims_);
   if (nmpc_sizes) {
     CondenseVectors<17, 4>(qp);

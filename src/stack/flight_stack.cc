@@ -421,7 +421,7 @@ void FlightStack::PrepareFallback() {
   // The same NMPC, fault-aware as the flown one, at a fraction of its cost: half the horizon and
   // a mixed-level iteration (Jacobians and the condensed factorisation reused between
   // re-linearisations). The INDI controller would cost less still, but taking over from the NMPC
-  // in the spin of a failed rotor it tumbles (tilt about 1 rad throughout, docs/runtime.md).
+  // in the spin of a failed rotor it tumbles (tilt about 1 rad, docs/runtime.md).
   control::NmpcOptions reduced = nmpc_->options();
   reduced.horizon_steps = std::max(1, reduced.horizon_steps / 2);
   reduced.relinearise_every = std::max(reduced.relinearise_every, 4);

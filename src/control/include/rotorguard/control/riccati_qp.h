@@ -15,7 +15,8 @@
 /// Its cost is a factorisation of O(N nx^3) and one response per constraint the iterations touch,
 /// where condensing (CondensingQpSolver) pays O(N^2 nx^2 nu) and a Cholesky factorisation and
 /// inversion of the N nu-square Hessian before its first iteration: the Riccati form wins where
-/// few bounds are active (docs/control.md, "Two QP solvers", gives the measurements).
+/// few bounds are active (docs/control.md, "Two QP solvers"; the measurements that chose it are in
+/// CHANGELOG.md).
 #include <Eigen/Core>
 #include <vector>
 

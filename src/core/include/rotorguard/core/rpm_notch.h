@@ -4,7 +4,7 @@
 /// own frequency and the propeller's blades at multiples of it; on a 333 Hz IMU without an
 /// anti-aliasing filter these land anywhere in its band. The flight controllers of the field
 /// filter the same way (Betaflight's RPM filter, PX4's ESC-RPM dynamic notch, ArduPilot's
-/// harmonic notch on ESC telemetry); docs/navigation.md, "Vibration".
+/// harmonic notch on ESC telemetry); docs/control.md, "Delay".
 ///
 /// Every notch delays what it passes (at 20 Hz of width, 0.6 ms about a 74 Hz centre, more nearer
 /// the band's foot): a signal compared with the notched IMU passes an identical bank fed the same

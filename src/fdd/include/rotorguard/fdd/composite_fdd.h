@@ -2,7 +2,8 @@
 /// Composite fault detection and diagnosis of paper 000, Sec. V-B: the motor index (eq. 13) from
 /// ESC telemetry, the thrust/torque-loss observer (eqs. 14-17) on filtered IMU data and measured
 /// rotor speeds, and the take-off detector (eq. 18). It sees only sensor messages, the stack's
-/// estimate and its own commands; docs/fdd.md gives the filter design and the measured latencies.
+/// estimate and its own commands; docs/fdd.md gives the filter design, docs/results.md the
+/// measured latencies.
 /// After an isolation the motor index and the observer keep watching the remaining rotors for a
 /// second complete failure; partial losses and the take-off detector assume a single failure, as
 /// the paper does.

@@ -48,7 +48,9 @@ struct LbfgsOptions {
   int max_iterations = 200;               ///< >= 1
   double relative_cost_tolerance = 1e-4;  ///< stop once f falls by less than this fraction (see LbfgsMethod)
   LbfgsMethod method = LbfgsMethod::kCeres;
-  int memory = 128;  ///< kLewisOverton: correction pairs kept, >= 1 (docs/planning.md: chosen by measurement)
+  /// kLewisOverton: correction pairs kept, >= 1 (chosen by measurement: CHANGELOG.md, "Choosing the
+  /// L-BFGS").
+  int memory = 128;
   int past = 3;     ///< kLewisOverton: iterations the decrease test spans, >= 1
   /// Throws ValidationError naming the field (the tolerance in (0, 0.1]).
   void Validate() const;

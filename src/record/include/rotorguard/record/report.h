@@ -17,7 +17,7 @@ struct FlightReportOptions {
   int max_rows = 6000;        ///< >= 2
 };
 
-/// What the viewer draws for a flight (kind "flight"; docs/report.md, "Data"): the summary, the
+/// What the viewer draws for a flight (kind "flight"; docs/report.md, "Files"): the summary, the
 /// scene and the log's columns thinned and rounded.
 nlohmann::json FlightReportData(const FlightLog& log, const FlightReportOptions& options = {});
 

@@ -155,7 +155,7 @@ void FlightStackOptions::Serialize(Archive* a) {
            {.meaning = "where the stack's pose comes from (docs/navigation.md)", .shorthand = "kind"});
   a->Visit("supervisor", &supervisor, {.meaning = "flight modes and emergency landing (docs/navigation.md)"});
   a->Visit("imu_notch", &imu_notch,
-           {.meaning = "notches on the IMU at the rotors' frequencies from their telemetry (docs/navigation.md)"});
+           {.meaning = "notches on the IMU at the rotors' frequencies from their telemetry (docs/control.md)"});
   a->Visit("planner", &navigation,
            {.meaning = "the navigate mission's planner (docs/planning.md)", .shorthand = "method"}, [this] {
              navigation.replanner.WidenPlaneSearch();
