@@ -149,7 +149,7 @@ void ScenarioArguments::Register(CLI::App* command) {
   command->add_option("scenario", path, "Scenario file (YAML), e.g. configs/scenarios/hover.yaml")->required();
   command->add_option("--set", sets,
                       "Override a value: key.path=value (e.g. duration_s=5, faults.0.rotor=2, vehicle.mass_kg=1.2); "
-                      "the key must exist in the file. Repeatable.");
+                      "any key `rotorguard keys` lists, written in the file or not. Repeatable.");
   command->add_option("--seed", seed_text, "Random seed, an integer in [0, 2^64-1] (overrides the file's seed)");
 }
 

@@ -12,9 +12,9 @@ class ValidateCommand final : public Command {
  public:
   CLI::App* Register(CLI::App* app) override {
     CLI::App* validate = app->add_subcommand("validate",
-                                             "Check a scenario or vehicle file without flying it.\n"
+                                             "Check a scenario, vehicle, assembly, campaign or FDD-threshold file without flying it.\n"
                                              "Exit 0 when valid, 2 when invalid, 3 when unreadable.");
-    validate->add_option("file", path_, "Scenario or vehicle file (YAML)")->required();
+    validate->add_option("file", path_, "Scenario, vehicle, assembly, campaign or FDD-threshold file (YAML)")->required();
     return validate;
   }
 

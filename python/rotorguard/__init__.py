@@ -84,7 +84,7 @@ def _seed(seed):
 
 def load_scenario(scenario, set=None, seed=None):
     """Loads and validates a scenario file (YAML), with `set` overrides ({"duration_s": 5,
-    "faults.0.rotor": 2, "vehicle.mass_kg": 1.2}: a key must exist in the file) and `seed`
+    "faults.0.rotor": 2, "vehicle.mass_kg": 1.2}: any key `rotorguard keys` lists) and `seed`
     (overrides the file's). Raises ConfigError (with file, line and key) or InputFileError."""
     if isinstance(scenario, _core.Scenario):
         if set:

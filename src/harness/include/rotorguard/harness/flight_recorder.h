@@ -2,7 +2,8 @@
 /// The files of a run folder (docs/scenarios.md, "Outputs"), written as the flight goes and at its
 /// end: log.csv and scene.json and/or flight.mcap, sensors.csv (every message the stack received
 /// and every command it sent), vehicle.yaml (the vehicle the stack flew), summary.json and, when
-/// asked, report.html. summary.json comes last, so that a folder with one holds a whole run.
+/// asked, report.html. summary.json comes after the data files, so that a folder with one holds a
+/// whole run's data; report.html, built from them, after it.
 #include <cstdint>
 #include <memory>
 #include <optional>
