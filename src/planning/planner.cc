@@ -44,6 +44,30 @@ double CheckInterval(double step_m, double speed_m_s) {
   return std::max(step_m / speed, 1e-3);
 }
 
+LayerExit::LayerExit(const perception::VoxelMap& map, const Vector3& start)
+    : map_(map),
+      radius_m_(map.options().inflation_radius_m + map.resolution()),
+      // Parallel to a plane of centres spaced r apart at distance d, the nearest centre's
+      // distance varies by sqrt(d² + r²/4) - d: at most 0.1 r from d = 1.2 r on, where a layer's
+      // start lies once its vehicle keeps its radius.
+      tolerance_m_(0.1 * map.resolution()),
+      leaving_(map.IsInflated(start)) {
+  if (leaving_) start_clearance_m_ = Clearance(start);
+}
+
+double LayerExit::Clearance(const Vector3& p) const {
+  const std::optional<perception::NearestObstacle> o = map_.Nearest(p, radius_m_);
+  return o ? o->distance_m : radius_m_;
+}
+
+bool LayerExit::Clear(const Vector3& p) {
+  if (leaving_) {
+    if (map_.IsInflated(p)) return Clearance(p) >= start_clearance_m_ - tolerance_m_;
+    leaving_ = false;
+  }
+  return !map_.IsInflated(p);
+}
+
 const char* ToString(PlanSummary::Status status) {
   switch (status) {
     case PlanSummary::Status::kSuccess: return "success";
@@ -216,30 +240,31 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
                                                                                              : Status::kOptimizerFailed,
                   summary.optimizer.message);
     }
-    // Check the result against the map, every check_step_m of path at most.
+    // Check the result against the map, every check_step_m of path at most. A start inside an
+    // inflation layer may leave it (as the front end allows) but not come closer to the obstacle
+    // on the way (LayerExit); the summary's clearance and the planes start where it is out.
     const double dt = CheckInterval(options_.check_step_m, limits.v_max);
-    // Positions every dt along each piece (its end included). A start inside an inflation layer
-    // may leave it (as the front end allows): the positions before the first free one are not
-    // held against the result.
-    const bool start_inflated = map.IsInflated(start.col(0));
-    const auto for_each_position = [&](auto&& f) {
-      bool leaving = start_inflated;
+    const auto each_position = [&](auto&& f) {
       for (int i = 0; i < pieces; ++i) {
         const int steps = std::max(1, static_cast<int>(std::ceil(traj.durations()(i) / dt)));
         for (int k = 0; k <= steps; ++k) {
-          const Vector3 p = traj.PieceDerivative(i, traj.durations()(i) * k / steps, 0);
-          if (leaving && map.IsInflated(p)) continue;
-          leaving = false;
-          if (!f(p)) return;
+          if (!f(traj.PieceDerivative(i, traj.durations()(i) * k / steps, 0))) return;
         }
       }
     };
     bool collides = false;
-    for_each_position([&](const Vector3& p) { return !(collides = map.IsInflated(p)); });
+    LayerExit exit(map, start.col(0));
+    each_position([&](const Vector3& p) { return !(collides = !exit.Clear(p)); });
     if (!collides) {
-      // The clearance the summary reports, at the same spacing (once: a nearest-voxel search
-      // costs as much as hundreds of inflation lookups).
-      summary.min_clearance_m = MinClearance(map, options_.plane_search_m, for_each_position);
+      // The clearance the summary reports, at the same spacing, from where the path is out of the
+      // layer (once: a nearest-voxel search costs as much as hundreds of inflation lookups).
+      summary.min_clearance_m = MinClearance(map, options_.plane_search_m, [&](auto&& f) {
+        LayerExit out_of(map, start.col(0));
+        each_position([&](const Vector3& p) {
+          out_of.Clear(p);
+          return out_of.leaving() || f(p);
+        });
+      });
       break;
     }
     if (round == options_.clearance_rounds) {
@@ -252,13 +277,12 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     // obstacle's own normal points anywhere from inside it, the guide's side is where the path
     // went round. Then again from the result.
     ++summary.clearance_rounds;
-    bool leaving = start_inflated;
+    // The same where the result, still leaving the start's layer, comes closer to its obstacle.
+    LayerExit sampled(map, start.col(0));
     for (int i = 0; i < pieces; ++i) {
       for (int j = 0; j <= samples; ++j) {
         const Vector3 p = traj.PieceDerivative(i, traj.durations()(i) * j / samples, 0);
-        const bool inflated = map.IsInflated(p);
-        leaving = leaving && inflated;
-        if (!inflated || leaving) continue;
+        if (sampled.Clear(p)) continue;
         const std::optional<perception::NearestObstacle> o = map.Nearest(p, options_.plane_search_m);
         if (!o) continue;
         const Vector3 away = guide(i, j) - o->point_W;

@@ -129,8 +129,11 @@ bool Replanner::UnsafeAhead(double t, const perception::VoxelMap& map) const {
   if (trajectory_.empty()) return false;
   const double end = std::min(trajectory_.duration(), t + options_.check_horizon_s);
   const double dt = CheckInterval(options_.check_step_m, limits_.v_max);
+  // From where the reference is now: out of an inflation layer it started in, as the planner
+  // checked it (LayerExit), then clear of every layer.
+  LayerExit exit(map, Reference(t).p_W);
   for (double s = t; s <= end; s += dt) {
-    if (map.IsInflated(Reference(s).p_W)) return true;
+    if (!exit.Clear(Reference(s).p_W)) return true;
   }
   return false;
 }
@@ -199,8 +202,9 @@ void Replanner::Brake(double t, const perception::VoxelMap& map) {
   };
   const auto collides = [&](const MinimumJerkTrajectory& brake, double duration) {
     const double step = CheckInterval(options_.check_step_m, v.norm());
+    LayerExit exit(map, head.col(0));
     for (double s = 0.0; s <= duration + 1e-9; s += std::min(step, 0.05)) {
-      if (map.IsInflated(brake.Evaluate(brake.start_time() + s).p_W)) return true;
+      if (!exit.Clear(brake.Evaluate(brake.start_time() + s).p_W)) return true;
     }
     return false;
   };

@@ -388,5 +388,60 @@ TEST(Replanner, AWallTooCloseForTheLimitsIsBrakedForHarderRatherThanReached) {
   EXPECT_LT(r.Reference(12.0).v_W.norm(), 1e-9);
 }
 
+// LayerExit against the distances to a hand-made wall: voxel centres at x = 1.05 (and 1.15), the
+// inflation radius 0.2 m, a start 0.17 m from the nearest centre (inside the layer). Away from the
+// wall and along it the path is clear (along it the nearest centre stays 0.17 m or more away);
+// 0.02 m closer is not (beyond the 0.01 m tolerance); once out of the layer, back into it is not.
+TEST(LayerExit, LeavesTheLayerItStartedInButNeverCloserToItsObstacle) {
+  perception::VoxelMap map = EmptyMap();
+  AddWall(&map, 1.0, false);
+  const Vector3 start(0.88, 0.05, 1.55);
+  ASSERT_TRUE(map.IsInflated(start));
+  {
+    LayerExit away(map, start);
+    for (double x = 0.88; x > 0.5; x -= 0.01) EXPECT_TRUE(away.Clear(Vector3(x, 0.05, 1.55))) << x;
+    EXPECT_FALSE(away.leaving());
+    EXPECT_FALSE(away.Clear(Vector3(0.88, 0.05, 1.55))) << "back into the layer once out of it";
+  }
+  {
+    LayerExit along(map, start);
+    for (double y = 0.05; y < 2.0; y += 0.01) EXPECT_TRUE(along.Clear(Vector3(0.88, y, 1.55))) << y;
+    EXPECT_TRUE(along.leaving());
+  }
+  {
+    LayerExit closer(map, start);
+    EXPECT_TRUE(closer.Clear(Vector3(0.885, 0.05, 1.55))) << "within the tolerance";
+    EXPECT_FALSE(closer.Clear(Vector3(0.90, 0.05, 1.55)));
+  }
+  {
+    LayerExit outside(map, Vector3(0.5, 0.05, 1.55));  // a free start: the layer is an obstacle
+    EXPECT_FALSE(outside.leaving());
+    EXPECT_FALSE(outside.Clear(Vector3(0.88, 0.05, 1.55)));
+  }
+}
+
+// A vehicle held inside a wall's inflation layer (it stopped there, or the wall was mapped beside
+// it) with a goal along the free side: the plan leaves the layer, and the replanner keeps it (its
+// look-ahead applies the planner's rule) instead of condemning every plan at the next tick as an
+// obstacle ahead; the reference stays within the limits and never comes closer to the wall.
+TEST(Replanner, AVehicleHeldInsideAnInflationLayerLeavesItOnOnePlan) {
+  perception::VoxelMap map = EmptyMap();
+  AddWall(&map, 1.0, false);
+  const Vector3 start(0.88, 0.05, 1.55);
+  ASSERT_TRUE(map.IsInflated(start));
+  Replanner r(ReplannerOptions{}, start);
+  r.SetGoal(Vector3(0.4, 3.0, 1.55));
+  Fly(&r, map, 0.0, 10.0, [](double) {});
+  EXPECT_EQ(Count(r, "obstacle ahead"), 0);
+  EXPECT_TRUE(r.arrived());
+  double a_max = 0.0, x_max = 0.0;
+  for (double t = 0.0; t <= 10.0; t += 0.005) {
+    a_max = std::max(a_max, r.Reference(t).a_W.norm());
+    x_max = std::max(x_max, r.Reference(t).p_W.x());
+  }
+  EXPECT_LE(a_max, r.limits().a_max * 1.001);
+  EXPECT_LE(x_max, start.x() + 0.01) << "never closer to the wall than it started";
+}
+
 }  // namespace
 }  // namespace rotorguard::planning

@@ -27,6 +27,29 @@ namespace rotorguard::planning {
 /// speed a scenario accepts). A speed below 1 mm/s counts as 1 mm/s.
 double CheckInterval(double step_m, double speed_m_s);
 
+/// The map check of a path that may start inside the inflation layer (a vehicle that stopped
+/// there, or an obstacle mapped beside it). The path may leave the layer, as the front end's search
+/// may, but while in it never come closer to an occupied voxel than where it started; once out,
+/// the layer is an obstacle. The planner's check, the replanner's look-ahead and its brake share
+/// it, so that a plan the planner accepts is one the replanner keeps, and no plan goes deeper
+/// towards the obstacle it started beside.
+class LayerExit {
+ public:
+  LayerExit(const perception::VoxelMap& map, const Vector3& start);
+  /// Whether `p`, the next position along the path, is clear.
+  bool Clear(const Vector3& p);
+  /// Whether the path is still inside the layer it started in.
+  bool leaving() const { return leaving_; }
+
+ private:
+  double Clearance(const Vector3& p) const;
+  const perception::VoxelMap& map_;
+  double radius_m_;   ///< Nearest's search: the inflation radius and a voxel, so an inflated point finds its obstacle
+  double tolerance_m_;  ///< moving along a row of voxel centres changes the distance to the nearest by up to this
+  bool leaving_;
+  double start_clearance_m_ = 0.0;
+};
+
 struct PlannerOptions {
   AStarOptions search;
   TrajectoryOptimizerOptions optimizer;
