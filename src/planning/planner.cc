@@ -254,16 +254,18 @@ PlanSummary::Status Planner::Refine(const PvaState& start, const Vector3& goal, 
     };
     bool collides = false;
     LayerExit exit(map, start.col(0));
-    each_position([&](const Vector3& p) { return !(collides = !exit.Clear(p)); });
+    int in_layer = 0;  // the positions before the path is out of its start's layer
+    each_position([&](const Vector3& p) {
+      collides = !exit.Clear(p);
+      in_layer += exit.leaving();
+      return !collides;
+    });
     if (!collides) {
       // The clearance the summary reports, at the same spacing, from where the path is out of the
       // layer (once: a nearest-voxel search costs as much as hundreds of inflation lookups).
       summary.min_clearance_m = MinClearance(map, options_.plane_search_m, [&](auto&& f) {
-        LayerExit out_of(map, start.col(0));
-        each_position([&](const Vector3& p) {
-          out_of.Clear(p);
-          return out_of.leaving() || f(p);
-        });
+        int k = 0;
+        each_position([&](const Vector3& p) { return k++ < in_layer || f(p); });
       });
       break;
     }

@@ -1,6 +1,6 @@
 #pragma once
 /// Monte Carlo campaigns on one machine: independent trials spread over threads. Each trial's
-/// seed is derived from the campaign's seed and the trial's index (DeriveSeed), never from the
+/// seed is derived from the campaign's seed and the trial's index (TrialSeed), never from the
 /// thread that runs it, so the results do not depend on the number of jobs.
 #include <functional>
 

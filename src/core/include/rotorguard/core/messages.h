@@ -47,9 +47,10 @@ struct LidarFrame {
 inline float LidarOffsetToSeconds32(std::uint32_t offset_ns) { return static_cast<float>(1e-9 * static_cast<double>(offset_ns)); }
 /// The nanosecond offset a float32 time stands for, to the nearest nanosecond.
 inline double LidarOffsetFromSeconds32(float time_s) { return std::round(1e9 * static_cast<double>(time_s)); }
-/// `offset_ns` as it reads back from the wire: a frame stamped with these offsets crosses
-/// ToSeconds32/FromSeconds32 unchanged (the round trip is idempotent below 4.29 s), so a
-/// recorded flight replays on the very times the live stack saw.
+/// `offset_ns` as it reads back from the wire: an offset taken to this crosses
+/// LidarOffsetToSeconds32 and LidarOffsetFromSeconds32 unchanged (the round trip is idempotent
+/// below 4 s; a frame lasts 0.1 s), so a recorded flight replays on the very times the live stack
+/// saw.
 inline std::uint32_t LidarOffsetAsOnTheWire(std::uint32_t offset_ns) {
   return static_cast<std::uint32_t>(LidarOffsetFromSeconds32(LidarOffsetToSeconds32(offset_ns)));
 }

@@ -12,7 +12,8 @@ namespace rotorguard::record {
 
 struct FlightReportOptions {
   /// The log is thinned to at most this many rows per second and `max_rows` rows in all, so that
-  /// a long flight's page stays small (a 60 s flight: under 2 MB with the bundle).
+  /// a long flight's page stays small (a 60 s flight: 1.7-2.4 MB with the bundle,
+  /// docs/report.md).
   double max_rate_hz = 50.0;  ///< > 0
   int max_rows = 6000;        ///< >= 2
 };
