@@ -206,7 +206,7 @@ PYBIND11_MODULE(_core, m) {
                              [](const harness::Scenario& s) { return std::string(ToName(s.stack.controller)); })
       .def_property_readonly("nominal_gains",
                              [](const harness::Scenario& s) {
-                               // stack.nominal: the nominal cascade's gains (docs/control.md).
+                               // stack.nominal: the nominal cascade's gains (docs/scenarios.md, "stack.nominal").
                                const control::NominalControllerOptions& n = s.stack.nominal;
                                return py::dict(py::arg("kp_position") = ArrayOf(n.position.kp_position),
                                                py::arg("kd_velocity") = ArrayOf(n.position.kd_velocity),

@@ -90,7 +90,7 @@ nlohmann::json Aggregate(const std::vector<const NavTrial*>& trials, const std::
           {"failures_not_listed", failures.not_listed()}};
 }
 
-/// The two variants on the same worlds, pair by pair (docs/metrics.md, "Paired comparison"): how
+/// The two variants on the same worlds, pair by pair (docs/metrics.md, "Comparing two methods"): how
 /// many worlds each alone succeeded in, and the exact McNemar test of that split.
 nlohmann::json Paired(const std::vector<const NavTrial*>& aware, const std::vector<const NavTrial*>& unaware) {
   int both = 0, only_aware = 0, only_unaware = 0, neither = 0;

@@ -1,6 +1,6 @@
 #pragma once
-/// Fault detection scored against the faults that were injected (docs/metrics.md, "FDD latency,
-/// MDR and FAR"): the run summary's `fdd` and the offline calibration's score.
+/// Fault detection scored against the faults that were injected (docs/metrics.md, "Fault
+/// detection"): the run summary's `fdd` and the offline calibration's score.
 #include <optional>
 #include <string>
 #include <vector>
