@@ -157,7 +157,9 @@ TEST_F(CampaignEngine, AHungTrialTimesOutAndACrashedOneIsAnErrorWhileTheShardGoe
     if (i == 4) std::abort();
     return made_up(i, p);
   };
-  c.simulated_s = [](int, const std::map<std::string, std::string>&) { return 0.005; };  // 50 x: 0.25 s budget
+  // The hung trial gets 50 x 0.005 s = 0.25 s; the others 50 s, so that a loaded machine's slow fork
+  // never turns a trial that ends into a timeout.
+  c.simulated_s = [](int i, const std::map<std::string, std::string>&) { return i == 3 ? 0.005 : 1.0; };
   c.reproduce = [](int i, const std::map<std::string, std::string>&) { return fmt::format("replay {}", i); };
   const CampaignRunSummary r = Run(c, "watched", 2, {}, false, /*trial_timeout_factor=*/50.0);
   EXPECT_EQ(r.ran, 12);
