@@ -67,6 +67,7 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
       static_cast<std::size_t>(std::ceil(2.0 * std::max(options_.propeller_persistence_s, options_.second_failure_persistence_s) *
                                          options_.imu_rate_hz) + 4.0);
   recent_propeller_index_.assign(n_, SampleRing(persistence_samples));
+  median_scratch_.reserve(persistence_samples);
   above_since_s_.assign(n_, -1.0);
   degraded_since_s_.assign(n_, -1.0);
   degraded_sum_.assign(n_, 0.0);
@@ -123,6 +124,17 @@ std::optional<double> CompositeFdd::SampleRing::HeldOver(double t, double v, dou
   while (size_ >= 2 && t - time(1) >= span) PopFront();
   if (t - time(0) < span) return std::nullopt;
   return Min();
+}
+
+std::optional<double> CompositeFdd::SampleRing::MedianOver(double t, double v, double span, std::vector<double>* scratch) {
+  Push(t, v);
+  while (size_ >= 2 && t - time(1) >= span) PopFront();
+  if (t - time(0) < span) return std::nullopt;
+  scratch->clear();
+  for (std::size_t k = 0; k < size_; ++k) scratch->push_back(value(k));
+  const auto middle = scratch->begin() + static_cast<std::ptrdiff_t>((size_ - 1) / 2);
+  std::nth_element(scratch->begin(), middle, scratch->end());
+  return *middle;
 }
 
 void IndexExtremes::Merge(const IndexExtremes& other) {
@@ -358,16 +370,21 @@ void CompositeFdd::RunObserver(double t, double dt) {
     bool largest_loss = true;
     for (int j = 0; j < n_; ++j) largest_loss = largest_loss && (j == i || working_[j] == 0.0 || thrust_loss_[j] <= thrust_loss_[i]);
     if (isolated > 0) {
-      // The second-failure rule's statistic: P_i through its gates, held for the persistence.
-      if (const auto held = recent_propeller_index_[i].HeldOver(t, costs_thrust && largest_loss ? p : 0.0,
-                                                                 options_.second_failure_persistence_s)) {
-        extremes_.second_failure_index = std::max(extremes_.second_failure_index, *held);
+      // A second failure: the lower median of the gated P_i over the persistence exceeds gamma_P.
+      SampleRing& recent = recent_propeller_index_[i];
+      const auto median = recent.MedianOver(t, costs_thrust && largest_loss ? p : 0.0,
+                                            options_.second_failure_persistence_s, &median_scratch_);
+      if (median) {
+        extremes_.second_failure_index = std::max(extremes_.second_failure_index, *median);
+        if (*median > options_.propeller_index_threshold) {
+          std::size_t first = 0;  // the onset: the window's first sample over gamma_P
+          while (recent.value(first) <= options_.propeller_index_threshold) ++first;
+          Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer", recent.time(first));
+        }
       }
-    }
-    if (p > options_.propeller_index_threshold && costs_thrust && largest_loss) {
+    } else if (p > options_.propeller_index_threshold && costs_thrust && largest_loss) {
       if (above_since_s_[i] < 0.0) above_since_s_[i] = t;
-      const double persistence = isolated == 0 ? options_.propeller_persistence_s : options_.second_failure_persistence_s;
-      if (t - above_since_s_[i] >= persistence) {
+      if (t - above_since_s_[i] >= options_.propeller_persistence_s) {
         Isolate(i, RotorHealth::kPropellerFailed, t, "thrust_loss_observer", above_since_s_[i]);
       }
     } else {

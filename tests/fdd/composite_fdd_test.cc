@@ -190,6 +190,34 @@ TEST(CompositeFdd, ASecondLossAFewTenthsAfterTheIsolationIsIsolatedAtOnce) {
   EXPECT_EQ(b.fdd_.rotors()[3].health, RotorHealth::kOk);
 }
 
+// A lost propeller on a vehicle spinning on three rotors reads P_i between 0.74 and 0.98: it dips
+// below gamma_P and comes back. The second-failure rule asks that most of the last 50 ms be above
+// gamma_P, not all of it: a loss that lets the rotor's thrust back for 10 ms in every 45 (its P_i
+// under 0.8 in each period) is isolated, where a rule restarting at every dip never would be.
+TEST(CompositeFdd, ASecondLossWhoseIndexDipsBelowTheThresholdIsIsolatedByMostOfItsWindow) {
+  Bench b(1.0);
+  ASSERT_FALSE(b.Run(2.0));
+  AfterAFailureOfRotor0(&b);
+  ASSERT_EQ(b.fdd_.TakeNewIsolations(), std::vector<int>{0});
+  const double onset = b.now();
+  double lowest = 1.0;
+  for (int period = 0; period < 10 && b.fdd_.rotors()[2].health == RotorHealth::kOk; ++period) {
+    b.actual_[2] = 0.0;
+    b.Run(0.035);
+    b.actual_[2] = b.drive_[2];
+    for (int ms = 0; ms < 10; ++ms) {
+      b.Run(1e-3);
+      lowest = std::min(lowest, b.fdd_.rotors()[2].propeller_index);
+    }
+  }
+  EXPECT_LT(lowest, 0.8) << "the index must dip below gamma_P for the case to mean anything";
+  const RotorStatus& status = b.fdd_.rotors()[2];
+  ASSERT_EQ(status.health, RotorHealth::kPropellerFailed);
+  EXPECT_LT(*status.detected_s - onset, 0.15);
+  EXPECT_EQ(b.fdd_.rotors()[3].health, RotorHealth::kOk);
+  EXPECT_EQ(b.fdd_.rotors()[1].health, RotorHealth::kOk);
+}
+
 // In the air a spinning vehicle's force balance swings (its thrust model errors at strongly unequal
 // rotor speeds): the accelerometer reading a third of the weight more than the rotors give, while
 // they carry the weight, is not the ground. Taken for it, the observer would disarm and relearn,
@@ -294,6 +322,31 @@ TEST(CompositeFdd, EachRulesStatisticIsExactlyItsAlarmBoundary) {
     EXPECT_LE(e.persistent_propeller_index, e.max_propeller_index);
     EXPECT_LE(e.gated_takeoff_index, e.max_takeoff_index);
   }
+}
+
+// The second-failure rule's statistic likewise: rotor 0's motor stops (the motor rule isolates
+// it), then rotor 2 loses 60 % of its thrust; gamma_P just under the statistic isolates rotor 2,
+// just over it isolates nothing more. gamma_P is also the first failure's threshold, which the
+// healthy hover before the stop stays far from.
+TEST(CompositeFdd, TheSecondFailuresStatisticIsExactlyItsAlarmBoundary) {
+  const auto fly = [](double threshold) {
+    CompositeFddOptions o;
+    o.propeller_index_threshold = threshold;
+    auto b = std::make_unique<Bench>(1.0, o);
+    b->Run(2.0);
+    AfterAFailureOfRotor0(b.get());
+    b->actual_[2] *= 0.4;
+    b->Run(0.5);
+    return b;
+  };
+  const auto unarmed = fly(1.0);
+  ASSERT_EQ(unarmed->fdd_.first_isolated_rotor(), 0);
+  const double extreme = unarmed->fdd_.healthy_extremes().second_failure_index;
+  ASSERT_GT(extreme, 0.3);
+  ASSERT_LT(extreme, 1.0);
+  EXPECT_EQ(fly(extreme * (1.0 - 1e-9))->fdd_.rotors()[2].health, RotorHealth::kPropellerFailed);
+  const auto silent = fly(extreme * (1.0 + 1e-9));
+  for (int i = 1; i < 4; ++i) EXPECT_EQ(silent->fdd_.rotors()[i].health, RotorHealth::kOk) << "rotor " << i;
 }
 
 TEST(CompositeFdd, ThresholdsAreInUnitsOfTheVehiclesHoverThrustAndOneRotorsTurn) {

@@ -68,9 +68,12 @@ struct CompositeFddOptions {
   /// it the loss is within what the spinning vehicle's force balance swings by (docs/fdd.md), and
   /// the rotor matters little (the one the controller turns nearly off beside a failure).
   double second_failure_min_thrust_fraction = 0.5;
-  /// ... above gamma_P for this long [s] (the first failure's rule holds propeller_persistence_s):
-  /// a vehicle spinning on three rotors drives them through steps the telemetry lags, and the
-  /// mismatch reads as a short loss. In [0, 10].
+  /// ... above gamma_P for most of this long [s]: the lower median of its gated P_i over the last
+  /// second_failure_persistence_s exceeds gamma_P. A vehicle spinning on three rotors drives them
+  /// through steps the telemetry lags, and the mismatch reads as a short loss, which a window
+  /// rejects; but a lost propeller's P_i on that vehicle hovers at 0.74-0.98, and a rule that
+  /// restarts at every dip below gamma_P (the first failure's) waited past the median onset's
+  /// 0.1 s in half the trials. In [0, 10].
   double second_failure_persistence_s = 0.05;
   /// Take-off detector (eq. 18): active while the vehicle is airborne below this altitude [m] and
   /// within takeoff_window_s of lift-off, > 0.
@@ -236,9 +239,10 @@ struct IndexExtremes {
   /// Highest take-off index while its direction and missing-thrust conditions held: a take-off
   /// threshold below it would have fired.
   double gated_takeoff_index = 0.0;
-  /// After an isolation: highest P_i of a remaining rotor held for second_failure_persistence_s while the
-  /// second-failure gates held (force balance, thrust, largest loss): gamma_P below it would have
-  /// isolated a second rotor. 0 in a flight with no isolation.
+  /// After an isolation: highest lower median, over second_failure_persistence_s, of a remaining
+  /// rotor's P_i through the second-failure gates (force balance, thrust, largest loss; 0 where
+  /// they fail): gamma_P below it would have isolated a second rotor. 0 in a flight with no
+  /// isolation.
   double second_failure_index = 0.0;
   void Merge(const IndexExtremes& other);
   template <typename Archive>
@@ -334,12 +338,17 @@ class CompositeFdd final : public FaultDetectorBase {
     void PopFront();
     std::size_t size() const { return size_; }
     double time(std::size_t k) const { return t_[(head_ + k) % t_.size()]; }
+    double value(std::size_t k) const { return v_[(head_ + k) % v_.size()]; }
     double Min() const;
     double Max() const;
     /// Pushes (t, v), keeps the samples spanning the last `span` seconds, and returns the smallest
     /// value held over the whole span (the value a persistence rule compares), or nullopt while
     /// the samples span less.
     std::optional<double> HeldOver(double t, double v, double span);
+    /// Pushes (t, v) as HeldOver does and returns the lower median of the samples spanning the
+    /// last `span` seconds (it exceeds a threshold when a strict majority of them do), or nullopt
+    /// while the samples span less. `scratch` holds a copy (reserved by the caller: no allocation).
+    std::optional<double> MedianOver(double t, double v, double span, std::vector<double>* scratch);
 
    private:
     std::vector<double> t_, v_;
@@ -362,6 +371,7 @@ class CompositeFdd final : public FaultDetectorBase {
   // For the rules' statistics (IndexExtremes): each rotor's last motor_index_samples M_i, and its
   // P_i over the last propeller_persistence_s.
   std::vector<SampleRing> recent_motor_index_, recent_propeller_index_;
+  std::vector<double> median_scratch_;  // SampleRing::MedianOver's copy, reserved once
   RotorVector measured_thrust_;
   RotorVector working_;  // 1 for a rotor not isolated, else 0
   int isolated_seen_ = 0;
