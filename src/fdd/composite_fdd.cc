@@ -119,17 +119,19 @@ double CompositeFdd::SampleRing::Max() const {
   return m;
 }
 
-std::optional<double> CompositeFdd::SampleRing::HeldOver(double t, double v, double span) {
+bool CompositeFdd::SampleRing::PushSpanning(double t, double v, double span) {
   Push(t, v);
   while (size_ >= 2 && t - time(1) >= span) PopFront();
-  if (t - time(0) < span) return std::nullopt;
+  return t - time(0) >= span;
+}
+
+std::optional<double> CompositeFdd::SampleRing::HeldOver(double t, double v, double span) {
+  if (!PushSpanning(t, v, span)) return std::nullopt;
   return Min();
 }
 
 std::optional<double> CompositeFdd::SampleRing::MedianOver(double t, double v, double span, std::vector<double>* scratch) {
-  Push(t, v);
-  while (size_ >= 2 && t - time(1) >= span) PopFront();
-  if (t - time(0) < span) return std::nullopt;
+  if (!PushSpanning(t, v, span)) return std::nullopt;
   scratch->clear();
   for (std::size_t k = 0; k < size_; ++k) scratch->push_back(value(k));
   const auto middle = scratch->begin() + static_cast<std::ptrdiff_t>((size_ - 1) / 2);

@@ -315,8 +315,8 @@ TEST(FddClosedLoop, ASecondFailureFliesOnOnTheTwinAndStopsTheMotorsBesideIt) {
       } else {
         EXPECT_TRUE(r.fdd->second->correct) << what;
         // Isolated well before the fall from 2 m ends (0.64 s). The latency's distribution is bench
-        // ftc's (hover/motor_stop_then_adjacent, 300 trials: median 0.055 s, p95 0.081 s, largest
-        // 0.196 s; docs/fdd.md): three seeds can only say that it is not far out.
+        // ftc's (hover/motor_stop_then_adjacent; docs/fdd.md, "The parachute"), whose tail passes
+        // 0.1 s: three seeds can only say that it is not far out.
         EXPECT_LT(r.fdd->second->latency_s.value_or(1e9), 0.3) << what;
         EXPECT_EQ(r.stack.final_mode, stack::FlightMode::kFlightTermination) << what;
         EXPECT_TRUE(r.crashed) << what;

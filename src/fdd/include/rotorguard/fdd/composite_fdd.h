@@ -71,9 +71,9 @@ struct CompositeFddOptions {
   /// ... above gamma_P for most of this long [s]: the lower median of its gated P_i over the last
   /// second_failure_persistence_s exceeds gamma_P. A vehicle spinning on three rotors drives them
   /// through steps the telemetry lags, and the mismatch reads as a short loss, which a window
-  /// rejects; but a lost propeller's P_i on that vehicle hovers at 0.74-0.98, and a rule that
-  /// restarts at every dip below gamma_P (the first failure's) waited past the median onset's
-  /// 0.1 s in half the trials. In [0, 10].
+  /// rejects; but a lost propeller's P_i on that spinning vehicle swings about gamma_P, and a rule
+  /// that restarts at every dip below it (the first failure's) waits long after the loss
+  /// (docs/fdd.md, "Second failures"). In [0, 10].
   double second_failure_persistence_s = 0.05;
   /// Take-off detector (eq. 18): active while the vehicle is airborne below this altitude [m] and
   /// within takeoff_window_s of lift-off, > 0.
@@ -351,6 +351,9 @@ class CompositeFdd final : public FaultDetectorBase {
     std::optional<double> MedianOver(double t, double v, double span, std::vector<double>* scratch);
 
    private:
+    /// Pushes (t, v) and drops the samples older than needed to span `span` seconds; true when
+    /// the samples left span it.
+    bool PushSpanning(double t, double v, double span);
     std::vector<double> t_, v_;
     std::size_t head_ = 0, size_ = 0;  // the oldest sample, and how many
   };
