@@ -65,7 +65,7 @@ bench: build
 # The published benchmarks -> docs/results.md and README's results block (scripts/results.py;
 # finished jobs in out/results are kept, an interrupted one resumes).
 results: build
-	python3 scripts/results.py --build $(BUILD_DIR)
+	python3 scripts/results.py --build $(BUILD_DIR) --pack
 
 clean:
 	rm -rf $(BUILD_DIR)

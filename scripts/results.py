@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """make results: runs the published benchmarks and writes docs/results.md from their records.
 
-    scripts/results.py [--build build] [--out out/results] [--only NAME ...] [--render-only]
+    scripts/results.py [--build build] [--source DIR] [--out out/results] [--only NAME ...]
+                       [--render-only] [--pack | --pack-only] [--records results/records.tar.xz]
 
 Each job is one `rotorguard bench ...` or `rotorguard campaign run ...` command whose trial records
 (results.jsonl) land in OUT/NAME, a set of `rotorguard run` flights (their summaries), or the
@@ -12,6 +13,15 @@ from the trial records: rates with their 95 % Wilson intervals, means with their
 intervals. The page names each table's command, world and the machine (CPU model) it ran on; the
 README's block between `<!-- BEGIN results -->` and `<!-- END results -->` is written from the same
 figures, and a test (tests/docs) fails when README quotes a number the page does not hold.
+
+The whole run takes several hours on a 2-core machine, so its records travel with the repository:
+ `--pack` (after the jobs) or `--pack-only` (at once; stop a running `make results` first)
+writes OUT into RECORDS, a reproducible tar.xz (the flights' logs left out, an unfinished calibration
+left out whole), and a later run whose OUT holds no job yet starts from RECORDS. A job resumes only
+with a build of the revision that began it (`campaign run --resume` refuses another): build that
+revision in a checkout of its own (`git worktree add ../rg REV`, then `make -C ../rg configure &&
+cmake --build ../rg/build --target rotorguard_cli`) and pass `--build ../rg/build --source ../rg`,
+so that the jobs fly that revision's configs; the page is written here.
 """
 import argparse
 import datetime
@@ -23,6 +33,9 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The checkout whose configs the jobs fly and whose build runs them (--source; by default this one).
+SOURCE = ROOT
+RECORDS = os.path.join(ROOT, 'results', 'records.tar.xz')
 Z95 = 1.959963984540054
 
 # The FTC benchmark's cells flown at 1000 trials: the single complete failures (Tables III and IV),
@@ -97,7 +110,7 @@ INTENDED_FAILURES = {'hover_motor_stop_nominal': 'crash', 'fdd_hover_second_fail
 def shipped_scenarios():
     """(name, path relative to ROOT, stated world) of configs/scenarios/*.yaml."""
     out = []
-    folder = os.path.join(ROOT, 'configs', 'scenarios')
+    folder = os.path.join(SOURCE, 'configs', 'scenarios')
     for f in sorted(os.listdir(folder)):
         if not f.endswith('.yaml'):
             continue
@@ -110,10 +123,11 @@ def shipped_scenarios():
     return out
 
 
-RUN_JOBS['shipped'] = [('%s_%s_seed%d' % (name, w, k), path, k, ['truth=%s' % w])
-                       for name, path, stated in shipped_scenarios()
-                       for w in ('realistic', 'ideal')
-                       for k in SHIPPED_SEEDS]
+def shipped_flights():
+    return [('%s_%s_seed%d' % (name, w, k), path, k, ['truth=%s' % w])
+            for name, path, stated in shipped_scenarios()
+            for w in ('realistic', 'ideal')
+            for k in SHIPPED_SEEDS]
 JOBS += [('shipped', 'runs', ['run', 'configs/scenarios/NAME.yaml', '--seed', 'K', '--set', 'truth=WORLD'],
           'every shipped scenario at seeds 1001-1050')]
 
@@ -148,7 +162,7 @@ def run_calibration(binary, folder):
     cmd = [binary, 'fdd-calibrate'] + runs
     for c in CALIBRATION_CAMPAIGNS:
         cmd += ['--healthy', os.path.join(folder, c)]
-    subprocess.run(cmd + ['--out', os.path.join(folder, 'calibration')], cwd=ROOT, check=True,
+    subprocess.run(cmd + ['--out', os.path.join(folder, 'calibration')], cwd=SOURCE, check=True,
                    stdout=subprocess.DEVNULL)
 
 
@@ -158,7 +172,7 @@ def fly(binary, out, scenario, seed, sets):
         cmd = [binary, 'run', scenario, '--seed', str(seed), '-q', '--no-report', '--out', out]
         for kv in sets:
             cmd += ['--set', kv]
-        subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.run(cmd, cwd=SOURCE, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     path = os.path.join(out, 'summary.json')
     if not os.path.exists(path):
         return None
@@ -313,15 +327,19 @@ def run_job(binary, name, kind, args, folder):
     if os.path.isdir(folder) and os.path.exists(os.path.join(folder, 'results.jsonl')):
         cmd.append('--resume')
     print('results: %s: %s' % (name, ' '.join(cmd)), flush=True)
-    subprocess.run(cmd, cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+    done = subprocess.run(cmd, cwd=SOURCE, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if done.returncode != 0:
+        sys.stderr.write(done.stderr)
+        sys.exit('results: %s failed (exit %d); a resume refused for another build needs the build of the revision '
+                 'that began it (see --help), or delete %s to start it again' % (name, done.returncode, folder))
     if kind == 'campaign':
-        subprocess.run([binary, 'campaign', 'merge', folder], cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([binary, 'campaign', 'merge', folder], cwd=SOURCE, check=True, stdout=subprocess.DEVNULL)
 
 
 def load_thresholds():
     """The shipped composite-FDD thresholds (a flat YAML map of numbers)."""
     out = {}
-    with open(os.path.join(ROOT, 'configs/vehicles/zhou2025_quad_fdd.yaml')) as f:
+    with open(os.path.join(SOURCE, 'configs/vehicles/zhou2025_quad_fdd.yaml')) as f:
         for line in f:
             line = line.split('#', 1)[0].strip()
             if ':' in line:
@@ -782,15 +800,77 @@ def write_readme_block(lines):
         f.write(text)
 
 
+def pack(out_dir, path):
+    """Writes out_dir's job folders into path, a tar.xz that is the same for the same records: names
+    sorted, times and owners cleared; the flights' logs (kept only for fdd-calibrate) and lock files
+    left out, and an unfinished calibration left out whole (its runs must be flown again for their logs)."""
+    import io
+    import tarfile
+    names = set(j[0] for j in JOBS)
+    members = []
+    for dirpath, dirnames, filenames in os.walk(out_dir):
+        dirnames.sort()
+        rel = os.path.relpath(dirpath, out_dir)
+        top = rel.split(os.sep)[0]
+        if rel == '.' or top not in names:
+            continue
+        if top == 'calibration' and not finished('calibration', os.path.join(out_dir, 'calibration')):
+            continue
+        for f in sorted(filenames):
+            if f.endswith('.lock') or (os.sep + 'runs' + os.sep in os.sep + rel + os.sep and f != 'summary.json'):
+                continue
+            members.append(os.path.join(rel, f))
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    partial = path + '.partial'
+    with tarfile.open(partial, 'w:xz', preset=9) as tar:
+        for rel in sorted(members):
+            with open(os.path.join(out_dir, rel), 'rb') as f:
+                data = f.read()
+            info = tarfile.TarInfo(rel.replace(os.sep, '/'))
+            info.size, info.mtime, info.mode = len(data), 0, 0o644
+            tar.addfile(info, io.BytesIO(data))
+    os.replace(partial, path)
+    print('results: %d files of %s packed into %s (%.1f MB)' % (len(members), out_dir, path,
+                                                              os.path.getsize(path) / 1e6), flush=True)
+
+
+def unpack(path, out_dir):
+    """Starts out_dir from the packed records when it holds no job yet."""
+    import tarfile
+    if not os.path.exists(path) or any(os.path.isdir(os.path.join(out_dir, j[0])) for j in JOBS):
+        return
+    with tarfile.open(path, 'r:xz') as tar:
+        for m in tar.getmembers():
+            if not m.isfile() or m.name.startswith('/') or '..' in m.name.split('/'):
+                sys.exit('results: %s: member %r is not a record file' % (path, m.name))
+        tar.extractall(out_dir)
+    print('results: %s started from %s' % (out_dir, path), flush=True)
+
+
 def main():
+    global SOURCE
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('--build', default=os.path.join(ROOT, 'build'))
+    ap.add_argument('--source', default=ROOT, help='the checkout the build was built from, whose configs the jobs fly')
     ap.add_argument('--out', default=os.path.join(ROOT, 'out', 'results'))
     ap.add_argument('--only', nargs='*', default=None, help='run only these jobs (the page shows every finished one)')
     ap.add_argument('--render-only', action='store_true', help='run nothing; render the finished jobs')
+    ap.add_argument('--records', default=RECORDS, help='the packed records a run starts from and --pack writes')
+    ap.add_argument('--pack', action='store_true', help='after the jobs, pack OUT into RECORDS')
+    ap.add_argument('--pack-only', action='store_true', help='run and render nothing; pack OUT into RECORDS')
     a = ap.parse_args()
+    SOURCE = os.path.abspath(a.source)
+    if not os.path.isdir(os.path.join(SOURCE, 'configs')):
+        sys.exit('results: --source %s: not a rotorguard checkout (no configs/)' % a.source)
+    RUN_JOBS['shipped'] = shipped_flights()
     binary = os.path.join(a.build, 'bin', 'rotorguard')
+    if a.pack_only:
+        pack(a.out, a.records)
+        return
+    if not a.render_only and not os.access(binary, os.X_OK):
+        sys.exit('results: %s: no rotorguard binary (build it first: make build)' % binary)
     os.makedirs(a.out, exist_ok=True)
+    unpack(a.records, a.out)
     for name, kind, args, _ in JOBS:
         folder = os.path.join(a.out, name)
         if a.render_only or (a.only is not None and name not in a.only) or finished(kind, folder):
@@ -808,6 +888,8 @@ def main():
     render(a.out, present)
     print('results: docs/results.md and README.md written from %s' % ', '.join(sorted(present)) if present
           else 'results: nothing finished yet')
+    if a.pack:
+        pack(a.out, a.records)
 
 
 if __name__ == '__main__':

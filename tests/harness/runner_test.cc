@@ -315,7 +315,7 @@ TEST(FddClosedLoop, ASecondFailureFliesOnOnTheTwinAndStopsTheMotorsBesideIt) {
       } else {
         EXPECT_TRUE(r.fdd->second->correct) << what;
         // Isolated well before the fall from 2 m ends (0.64 s). The latency's distribution is bench
-        // ftc's (hover/motor_stop_then_adjacent; docs/fdd.md, "The parachute"), whose tail passes
+        // ftc's (hover/motor_stop_then_adjacent; docs/results.md, its second failures), whose tail passes
         // 0.1 s: three seeds can only say that it is not far out.
         EXPECT_LT(r.fdd->second->latency_s.value_or(1e9), 0.3) << what;
         EXPECT_EQ(r.stack.final_mode, stack::FlightMode::kFlightTermination) << what;
