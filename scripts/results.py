@@ -3,6 +3,7 @@
 
     scripts/results.py [--build build] [--source DIR] [--out out/results] [--only NAME ...]
                        [--render-only] [--pack | --pack-only] [--records results/records.tar.xz]
+    scripts/results.py --self-test
 
 Each job is one `rotorguard bench ...` or `rotorguard campaign run ...` command whose trial records
 (results.jsonl) land in OUT/NAME, a set of `rotorguard run` flights (their summaries), or the
@@ -847,8 +848,57 @@ def unpack(path, out_dir):
     print('results: %s started from %s' % (out_dir, path), flush=True)
 
 
+def self_test():
+    """pack and unpack on made-up records: the same records pack to the same bytes, unpack to the
+    same files, the flights' logs, lock files and an unfinished calibration left out."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, 'out')
+        files = {'ftc_rotorguard/results.jsonl': '{"trial":0}\n', 'ftc_rotorguard/manifest.json': '{}',
+                 'ftc_rotorguard/manifest.json.lock': '', 'shipped/hover_realistic_seed1001/summary.json': '{}',
+                 'calibration/fdd_calibration_takeoff/results.jsonl': '{"trial":0}\n',
+                 'calibration/runs/hover_motor_0/summary.json': '{}',
+                 'calibration/runs/hover_motor_0/sensors.csv': 't\n', 'unrelated/file.txt': 'x'}
+        for rel, text in files.items():
+            os.makedirs(os.path.dirname(os.path.join(out, rel)), exist_ok=True)
+            with open(os.path.join(out, rel), 'w') as f:
+                f.write(text)
+        first, second = os.path.join(tmp, 'a.tar.xz'), os.path.join(tmp, 'b.tar.xz')
+        pack(out, first)
+        os.utime(os.path.join(out, 'ftc_rotorguard/results.jsonl'), (1, 1))  # times do not count
+        pack(out, second)
+        with open(first, 'rb') as f, open(second, 'rb') as g:
+            assert f.read() == g.read(), 'the same records packed to different bytes'
+        back = os.path.join(tmp, 'back')
+        unpack(first, back)
+        got = sorted(os.path.relpath(os.path.join(d, f), back) for d, _, fs in os.walk(back) for f in fs)
+        assert got == ['ftc_rotorguard/manifest.json', 'ftc_rotorguard/results.jsonl',
+                       'shipped/hover_realistic_seed1001/summary.json'], got
+        with open(os.path.join(back, 'ftc_rotorguard/results.jsonl')) as f:
+            assert f.read() == '{"trial":0}\n'
+        # A finished calibration keeps its campaigns and the runs' summaries, never their logs.
+        os.makedirs(os.path.join(out, 'calibration/calibration'))
+        with open(os.path.join(out, 'calibration/calibration/calibration.json'), 'w') as f:
+            f.write('{}')
+        pack(out, first)
+        again = os.path.join(tmp, 'again')
+        unpack(first, again)
+        assert os.path.exists(os.path.join(again, 'calibration/runs/hover_motor_0/summary.json'))
+        assert not os.path.exists(os.path.join(again, 'calibration/runs/hover_motor_0/sensors.csv'))
+        # A folder that already holds a job is not overwritten.
+        with open(os.path.join(again, 'ftc_rotorguard/results.jsonl'), 'w') as f:
+            f.write('newer')
+        unpack(second, again)
+        with open(os.path.join(again, 'ftc_rotorguard/results.jsonl')) as f:
+            assert f.read() == 'newer'
+    print('results: self-test passed')
+
+
 def main():
     global SOURCE
+    if sys.argv[1:] == ['--self-test']:
+        self_test()
+        return
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('--build', default=os.path.join(ROOT, 'build'))
     ap.add_argument('--source', default=ROOT, help='the checkout the build was built from, whose configs the jobs fly')
