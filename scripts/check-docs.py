@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks that docs/ stays a reference a newcomer can follow.
 
-    scripts/check-docs.py paths PAGE...     every repository path and CHANGELOG section PAGE names exists
+    scripts/check-docs.py paths PAGE|DIR... every repository path and CHANGELOG section a page names exists
     scripts/check-docs.py words DOCS_DIR    the pages total at most --limit words (default 35000)
     scripts/check-docs.py --self-test       both checks fail on made-up pages
 
@@ -43,29 +43,34 @@ def named_paths(text, root):
 POINTER = re.compile(r'CHANGELOG\.md,\s+"([^"]+)"')
 
 
-def missing_sections(text, changelog):
-    """(line, title) of each CHANGELOG pointer in text that begins no heading of changelog."""
-    def norm(s):
-        return ' '.join(s.split())
-    heads = [norm(line.lstrip('#')) for line in changelog.splitlines() if line.startswith('#')]
-    out = []
-    for m in POINTER.finditer(text):
-        title = norm(m.group(1))
-        if not any(h.startswith(title) for h in heads):
-            out.append((text.count('\n', 0, m.start()) + 1, title))
-    return out
+def changelog_headings(root):
+    """CHANGELOG.md's headings, whitespace folded (none without the file)."""
+    path = os.path.join(root, 'CHANGELOG.md')
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        return [' '.join(line.lstrip('#').split()) for line in f if line.startswith('#')]
 
 
-def missing_paths(page, root):
+def missing_paths(page, root, headings):
+    """What `page` names that does not exist: repository paths, and CHANGELOG pointers whose title
+    begins none of `headings`."""
     with open(page) as f:
         text = f.read()
     out = ['%s:%d: `%s` does not exist' % (page, line_no, p)
            for line_no, p in named_paths(text, root) if not os.path.exists(os.path.join(root, p))]
-    changelog = os.path.join(root, 'CHANGELOG.md')
-    if os.path.exists(changelog):
-        with open(changelog) as f:
-            out += ['%s:%d: CHANGELOG.md has no section "%s"' % (page, line_no, title)
-                    for line_no, title in missing_sections(text, f.read())]
+    for m in POINTER.finditer(text):
+        title = ' '.join(m.group(1).split())
+        if not any(h.startswith(title) for h in headings):
+            out.append('%s:%d: CHANGELOG.md has no section "%s"' % (page, text.count('\n', 0, m.start()) + 1, title))
+    return out
+
+
+def pages_of(args):
+    """The pages named: files as given, folders as their *.md."""
+    out = []
+    for a in args:
+        out += sorted(glob.glob(os.path.join(a, '*.md'))) if os.path.isdir(a) else [a]
     return out
 
 
@@ -89,7 +94,7 @@ def self_test():
                     'History: CHANGELOG.md, "The first\nrelease"; CHANGELOG.md, "A lost section".\n')
         with open(os.path.join(root, 'CHANGELOG.md'), 'w') as f:
             f.write('# Changelog\n\n### The first release (formerly a page)\n')
-        found = missing_paths(page, root)
+        found = missing_paths(page, root, changelog_headings(root))
         assert len(found) == 2 and 'src/core/b.cc' in found[0] and 'A lost section' in found[1], found
         docs = os.path.join(root, 'docs')
         os.makedirs(docs)
@@ -121,11 +126,12 @@ def main(argv):
         return 2
     if args[0] == 'paths':
         problems = []
-        for page in args[1:]:
+        headings = changelog_headings(ROOT)
+        for page in pages_of(args[1:]):
             if not os.path.isfile(page):
                 print('check-docs: %s: no such page' % page, file=sys.stderr)
                 return 2
-            problems += missing_paths(page, ROOT)
+            problems += missing_paths(page, ROOT, headings)
         for p in problems:
             print(p)
         return 1 if problems else 0

@@ -328,11 +328,12 @@ def run_job(binary, name, kind, args, folder):
     if os.path.isdir(folder) and os.path.exists(os.path.join(folder, 'results.jsonl')):
         cmd.append('--resume')
     print('results: %s: %s' % (name, ' '.join(cmd)), flush=True)
-    done = subprocess.run(cmd, cwd=SOURCE, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    # stderr passes through: the command's own error (a resume refused for another build, say) and,
+    # on a terminal, its progress.
+    done = subprocess.run(cmd, cwd=SOURCE, stdout=subprocess.DEVNULL)
     if done.returncode != 0:
-        sys.stderr.write(done.stderr)
-        sys.exit('results: %s failed (exit %d); a resume refused for another build needs the build of the revision '
-                 'that began it (see --help), or delete %s to start it again' % (name, done.returncode, folder))
+        sys.exit('results: %s failed (exit %d); resume it with the build of the revision that began it '
+                 '(see --help), or delete %s to start it again' % (name, done.returncode, folder))
     if kind == 'campaign':
         subprocess.run([binary, 'campaign', 'merge', folder], cwd=SOURCE, check=True, stdout=subprocess.DEVNULL)
 
@@ -818,7 +819,7 @@ def pack(out_dir, path):
         if top == 'calibration' and not finished('calibration', os.path.join(out_dir, 'calibration')):
             continue
         for f in sorted(filenames):
-            if f.endswith('.lock') or (os.sep + 'runs' + os.sep in os.sep + rel + os.sep and f != 'summary.json'):
+            if f.endswith('.lock') or (rel.split(os.sep)[:2] == ['calibration', 'runs'] and f != 'summary.json'):
                 continue
             members.append(os.path.join(rel, f))
     os.makedirs(os.path.dirname(path), exist_ok=True)
