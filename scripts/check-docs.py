@@ -11,7 +11,7 @@ when no such file or folder exists; tokens with placeholders (<name>, *, ...) an
 or out/, which a clean clone has not made yet) are skipped. It also fails on a pointer
 `CHANGELOG.md, "Title"` whose title begins no heading of CHANGELOG.md. `words`
 counts whitespace-separated words of DOCS_DIR/*.md without the generated parts: docs/results.md and
-the key tables between `<!-- BEGIN rotorguard keys` and `<!-- END rotorguard keys ... -->`.
+the tables the code writes, between `<!-- BEGIN rotorguard keys` (or `bench --list`) and its `<!-- END ... -->`.
 Exit 0 when the check holds, 1 naming what does not, 2 on a usage or input error.
 """
 import glob
@@ -22,7 +22,7 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TICKED = re.compile(r'`([^`\s]+)`')
-GENERATED_KEYS = re.compile(r'<!-- BEGIN rotorguard keys.*?<!-- END rotorguard keys[^>]*-->', re.S)
+GENERATED_KEYS = re.compile(r'<!-- BEGIN rotorguard (keys|bench --list).*?<!-- END rotorguard (keys|bench --list)[^>]*-->', re.S)
 PLACEHOLDER = re.compile(r'[<>*]|\.\.\.')
 
 

@@ -1,6 +1,8 @@
 // rotorguard bench NAME: the papers' benchmarks and the project's own, as tables or JSON.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -36,41 +38,38 @@ class BenchCommand final : public Command {
  public:
   CLI::App* Register(CLI::App* app) override {
     CLI::App* bench = app->add_subcommand("bench", "Benchmarks; results as a table or JSON.");
-    bench->require_subcommand(1);
+    bench->require_subcommand(0, 1);
+    bench->add_flag("--list", list_, "Print every benchmark as a Markdown table (the one of docs/benchmarks.md)");
     for (const Benchmark& b : Benchmarks()) {
-      *b.app = bench->add_subcommand(b.name, b.description);
+      CLI::App* sub = *b.app = bench->add_subcommand(b.name, b.description);
       for (const Flag& f : b.flags) {
-        CLI::Option* option = (*b.app)->add_option(f.name, *f.value, f.help);
+        CLI::Option* option = sub->add_option(f.name, *f.value, f.help);
         if (f.required) option->required();
       }
+      // Flags that follow from what the benchmark is (its Capability bits), alike for all.
+      if (b.capabilities & kCampaign) {
+        // Its trials run on the campaign engine (benchmarks/registry.h): they can be kept, resumed,
+        // sharded and merged like a campaign's.
+        sub->add_option("--out", out_,
+                        b.out_help != nullptr ? b.out_help
+                                              : "Keep the trials' records (results.jsonl, manifest.json) and the result\n"
+                                                "(bench.json, bench.md) in this folder (default: a temporary folder)");
+        sub->add_option("--shard", shard_,
+                        "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
+                        "with `campaign merge` when all are done");
+        sub->add_flag("--resume", resume_, "Continue the trials recorded in --out");
+        sub->add_option("--trial-timeout", trial_timeout_, kTrialTimeoutHelp);
+      }
+      if (b.capabilities & kTruth) {
+        sub->add_option("--truth", truth_,
+                        "The simulated vehicles: realistic (each trial draws its own about the file;\n"
+                        "docs/truth.md) or ideal (the vehicle file exactly) (default realistic)");
+      }
+      // Every benchmark can write its page: tables and distributions (record/report.h).
+      sub->add_option("--html", html_, "Also write the result as an HTML page to this file");
+      sub->add_flag("--json", json_,
+                    b.capabilities & kPlainTable ? "Print JSON instead of a table" : "Print JSON instead of Markdown");
     }
-    // The benchmarks that run on the campaign engine (benchmarks/registry.h): their trials can be
-    // kept, resumed, sharded and merged like a campaign's.
-    for (CLI::App* b : {ftc_, nav_, mars_, flatness_}) {
-      b->add_option("--out", out_,
-                    b == nav_ ? "The trials' records and the result (bench.json, bench.md); with --replay: the\n"
-                                "run folder (default out/nav_KIND_SEED)"
-                              : "Keep the trials' records (results.jsonl, manifest.json) and the result\n"
-                                "(bench.json, bench.md) in this folder (default: a temporary folder)");
-      b->add_option("--shard", shard_,
-                    "Run shard i of N only (i/N, 0 <= i < N) into --out; merge the folders\n"
-                    "with `campaign merge` when all are done");
-      b->add_flag("--resume", resume_, "Continue the trials recorded in --out");
-      b->add_option("--trial-timeout", trial_timeout_, kTrialTimeoutHelp);
-    }
-    for (CLI::App* b : {sim_, nmpc_, ftc_, nav_, mars_, flatness_}) {
-      b->add_option("--truth", truth_,
-                    "The simulated vehicles: realistic (each trial draws its own about the file;\n"
-                    "docs/truth.md) or ideal (the vehicle file exactly) (default realistic)");
-    }
-    // Every benchmark can also write its page: tables and distributions (record/report.h).
-    for (CLI::App* b : {sim_, qp_, nmpc_, sitl_, ftc_, perception_, planner_, nav_, flatness_, mars_, campaign_}) {
-      b->add_option("--html", html_, "Also write the result as an HTML page to this file");
-      b->add_flag("--json", json_,
-                  b == sim_ || b == qp_ || b == nmpc_ || b == campaign_ ? "Print JSON instead of a table"
-                                                                        : "Print JSON instead of Markdown");
-    }
-    lio_->add_flag("--json", json_, "Print JSON instead of Markdown");
     planner_->add_flag("--free-space", planner_free_space_,
                        "The trajectory optimiser alone on random free-space problems (docs/planning.md):\n"
                        "free_space records of solve_us_median, eval_us_median, cost_mean, duration_s_mean");
@@ -78,18 +77,12 @@ class BenchCommand final : public Command {
   }
 
   int Execute() override {
-    if (*sim_) return Sim();
-    if (*qp_) return Qp();
-    if (*nmpc_) return Nmpc();
-    if (*sitl_) return Sitl();
-    if (*ftc_) return Ftc();
-    if (*perception_) return Perception();
-    if (*lio_) return Lio();
-    if (*planner_) return Planner();
-    if (*nav_) return Nav();
-    if (*flatness_) return Flatness();
-    if (*mars_) return Mars();
-    return Campaign();
+    for (const Benchmark& b : Benchmarks()) {
+      if (**b.app) return (this->*b.run)();
+    }
+    if (!list_) throw UsageError("bench: name a benchmark (rotorguard bench --list, or --help)");
+    fmt::print("{}", ListTable());
+    return kOk;
   }
 
  private:
@@ -100,11 +93,23 @@ class BenchCommand final : public Command {
     const char* help;
     bool required = false;
   };
+  /// What a benchmark is, beyond its own flags: each bit adds the flags it implies.
+  enum Capability : unsigned {
+    kCampaign = 1u << 0,    ///< runs its trials on the campaign engine: --out, --shard, --resume, --trial-timeout
+    kTruth = 1u << 1,       ///< flies drawn vehicles: --truth
+    kPlainTable = 1u << 2,  ///< prints a plain table, not Markdown, without --json
+  };
+  /// One benchmark: everything `rotorguard bench` needs to offer and run it. Adding a benchmark is
+  /// adding an entry to Benchmarks(), its CLI::App* and option members, and its run function.
   struct Benchmark {
     CLI::App** app;
     const char* name;
     const char* description;
+    const char* paper;  ///< the paper's figure it reproduces ("" for the project's own)
     std::vector<Flag> flags;
+    unsigned capabilities = 0;
+    int (BenchCommand::*run)() const = nullptr;
+    const char* out_help = nullptr;  ///< --out's help where the default does not fit
   };
 
   /// Every benchmark with its description and options, in the order of `rotorguard bench --help`.
@@ -117,22 +122,31 @@ class BenchCommand final : public Command {
          "sim",
          "Closed-loop simulation speed: the 2 m/s lemniscate with all sensors and the nominal "
          "controller. Reports the median realtime_factor and steps_per_s (target >= 200x real time).",
+         "",
          {{"--scenario", &sim_scenario_, "Scenario to fly (default: configs/scenarios/lemniscate_2ms.yaml)"},
           {"--duration", &sim_duration_, "Simulated seconds per repetition (default 60)"},
-          {"--repetitions", &sim_repetitions_, "Repetitions; the median is reported (default 5)"}}},
+          {"--repetitions", &sim_repetitions_, "Repetitions; the median is reported (default 5)"}},
+         kTruth | kPlainTable,
+         &BenchCommand::Sim},
         {&qp_,
          "qp",
          "The NMPC's QP solver (dual active set: --solver riccati or condensing) on a reference OCP QP instance:\n"
          "every case solved cold; reports stress_us_median/p99, track_us_median/p99,\n"
          "iterations_mean and max_u0_error against the instance's optimal u_0.",
+         "",
          {{"--instance", &qp_instance_, "Instance file (JSON), e.g. a copy of qp_hover_n20.json", true},
           {"--repetitions", &qp_repetitions_, "Solves per case; the median time counts (default 3)"},
-          {"--solver", &qp_solver_, "riccati (default) or condensing"}}},
+          {"--solver", &qp_solver_, "riccati (default) or condensing"}},
+         kPlainTable,
+         &BenchCommand::Qp},
         {&nmpc_,
          "nmpc",
          "The NMPC in closed loop: the nominal 2 m/s lemniscate and a 1 m/s lemniscate with propeller 0\n"
          "lost (known). Reports solve_ms_mean/p99/max, qp_iterations_mean, fallbacks and tracking RMSEs.",
-         {{"--qp-solver", &nmpc_qp_solver_, "The NMPC's QP solver: riccati (default, the stack's) or condensing"}}},
+         "paper 000 (1.88 ms per solve on its Jetson)",
+         {{"--qp-solver", &nmpc_qp_solver_, "The NMPC's QP solver: riccati (default, the stack's) or condensing"}},
+         kTruth | kPlainTable,
+         &BenchCommand::Nmpc},
         {&sitl_,
          "sitl",
          "The onboard runtime in software in the loop (docs/runtime.md): the machine's own wake-up timing\n"
@@ -140,6 +154,7 @@ class BenchCommand final : public Command {
          "process (deadline misses, IMU-to-command latency), and paper 000's hover and tracking failure cells,\n"
          "--ftc-trials flights each, against lockstep with the measured delay (equal outcomes, FDD latency).\n"
          "At real time: about 30 min with the defaults (3 + 12 + 15).",
+         "",
          {{"--scenario", &sitl_scenario_, "The timing flights' scenario (default configs/scenarios/forest.yaml)"},
           {"--repeats", &sitl_repeats_, "Timing flights per load (default 3; 0: none)"},
           {"--loads", &sitl_loads_, "Comma-separated: idle, one_core_busy (default both)"},
@@ -150,12 +165,15 @@ class BenchCommand final : public Command {
           {"--ftc-seed", &sitl_ftc_seed_, "The FTC flights' first seed (default 5001)"},
           {"--transport", &sitl_transport_,
            "The timing flights' link to the node: shared_memory (default) or ros (over the ROS master of\n"
-           "ROS_MASTER_URI, /clock and all: docs/ros.md)"}}},
+           "ROS_MASTER_URI, /clock and all: docs/ros.md)"}},
+         0,
+         &BenchCommand::Sitl},
         {&ftc_,
          "ftc",
          "Paper 000's FTC benchmark (Tables III and IV): propeller and motor failures while hovering, while\n"
          "tracking the 2 m/s lemniscate and during take-off, plus fault-free trials for the false-alarm rate.\n"
          "Each trial draws onset, rotor, noise seed and a light gust. Prints Markdown tables (or JSON).",
+         "paper 000, Tables III and IV",
          {{"--trials", &ftc_trials_, "Trials per cell (default 20, the paper's count)"},
           trial_seed,
           {"--methods", &ftc_methods_,
@@ -168,36 +186,47 @@ class BenchCommand final : public Command {
            "Where the stack takes its pose from: odometry (external, in open space: the paper's\n"
            "benchmark; the default) or lio (its own LiDAR-inertial odometry, in a hall)"},
           {"--replay", &ftc_replay_,
-           "Fly one trial instead, CELL:METHOD:SEED (a seed from the failures listed), into --out"}}},
+           "Fly one trial instead, CELL:METHOD:SEED (a seed from the failures listed), into --out"}},
+         kCampaign | kTruth,
+         &BenchCommand::Ftc},
         {&perception_,
          "perception",
          "The simulated MID-360 on a vehicle spinning at 11 rad/s and flying 1 m/s through a 500-tree\n"
          "forest and around a room, deskewing on and off: points_per_s_simulated, map_update_ms_mean\n"
          "per frame, map precision and recall against the world within one voxel; the same frames\n"
          "inserted into OctoMap and scored alike (octomap, time_ratio_octomap_over_rotorguard).",
+         "paper 000, Sec. IV-B",
          {{"--duration", &perception_duration_, "Simulated seconds per run (default 10)"},
-          {"--seed", &seed_, "Sensor noise and forest layout (default 1)"}}},
+          {"--seed", &seed_, "Sensor noise and forest layout (default 1)"}},
+         0,
+         &BenchCommand::Perception},
         {&lio_,
          "lio",
          "The stack's LiDAR-inertial odometry on prescribed motions with the simulated IMU (vibrating) and\n"
          "LiDAR: a 500-tree forest and a room with a ceiling, hovering and flying 1 m/s, spinning at each\n"
          "rate of --spins: ate_rmse_m, attitude error, drift_percent per 10 m, frame_ms_mean and\n"
          "frame_ms_p99 on one core, the fraction of frames flagged degenerate.",
+         "",
          {{"--duration", &lio_duration_, "Simulated seconds per condition (default 20)"},
           {"--spins", &lio_spins_, "Comma-separated yaw rates [rad/s] (default 0,5,11,20)"},
-          {"--seed", &seed_, "Sensor noise and forest layout (default 1)"}}},
+          {"--seed", &seed_, "Sensor noise and forest layout (default 1)"}},
+         0,
+         &BenchCommand::Lio},
         {&planner_,
          "planner",
          "The trajectory planner (A*, MINCO, L-BFGS) on random forests (30 x 20 m) and rooms (10 x 8 m),\n"
          "random start/goal pairs, nominal and post-failure limits, on the map of the true world:\n"
          "plan_ms_mean, plan_ms_p99, success_rate, mean_traj_duration_s, max_limit_violation.",
+         "paper 000, Sec. V-C",
          {{"--pairs", &planner_pairs_, "Start/goal pairs per world kind (default 100)"},
           {"--worlds", &planner_worlds_, "Distinct worlds per kind (default 10, at most --pairs)"},
           {"--seed", &seed_, "Worlds and pairs, or the free-space problems (default 1)"},
           {"--problems", &planner_problems_, "With --free-space: problems per size (default 200)"},
           {"--pieces", &planner_pieces_, "With --free-space: comma-separated sizes in pieces (default 5,10)"},
           {"--lbfgs", &planner_lbfgs_,
-           "The optimiser's L-BFGS: lewis_overton (the library's own, the default) or ceres (docs/planning.md)"}}},
+           "The optimiser's L-BFGS: lewis_overton (the library's own, the default) or ceres (docs/planning.md)"}},
+         0,
+         &BenchCommand::Planner},
         {&nav_,
          "nav",
          "The whole stack navigating random forests (30 x 20 m) and rooms (10 x 8 m) with a propeller lost\n"
@@ -205,6 +234,7 @@ class BenchCommand final : public Command {
          "success_rate, collision_rate, tracking_rmse_m, max_spin_rad_s, mission_time_s, planner_ms_mean,\n"
          "stack_ms_per_cycle_mean, realtime_factor (the stack's, on one core) and trial_realtime_factor\n"
          "(the simulator included).",
+         "paper 000, Secs. VI-C and VI-D",
          {{"--trials", &nav_trials_, "Random worlds per kind, each flown by both variants (default 100)"},
           trial_seed,
           jobs,
@@ -213,13 +243,20 @@ class BenchCommand final : public Command {
            "Where the stack takes its pose from: lio (its own LiDAR-inertial odometry, the default)\n"
            "or odometry (external)"},
           {"--replay", &nav_replay_,
-           "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out"}}},
+           "Fly one trial instead, KIND:SEED[:unaware] (a seed from the failures listed), into --out"}},
+         kCampaign | kTruth,
+         &BenchCommand::Nav,
+         "The trials' records and the result (bench.json, bench.md); with --replay: the\n"
+         "run folder (default out/nav_KIND_SEED)"},
         {&flatness_,
          "flatness",
          "Paper 004: closed-form settling times of Fig. 1 (ts_envelope_s, ts_actuator_s) and the Fig. 2\n"
          "flight (configs/scenarios/flatness_fig2.yaml) over many seeds: ukf_w_estimate, ukf_settle_s,\n"
          "replan_ts_s against a fault-free re-plan, max_pitch_deg against theta_max.",
-         {{"--seeds", &flatness_seeds_, "Flights of the Fig. 2 scenario (default 20)"}, first_seed, jobs}},
+         "paper 004, Figs. 1 and 2",
+         {{"--seeds", &flatness_seeds_, "Flights of the Fig. 2 scenario (default 20)"}, first_seed, jobs},
+         kCampaign | kTruth,
+         &BenchCommand::Flatness},
         {&mars_,
          "mars",
          "Paper 002: the 3x2 assembly on Table I's spiral (configs/scenarios/mars_spiral_3x2.yaml) with the\n"
@@ -228,15 +265,39 @@ class BenchCommand final : public Command {
          "for nine units (configs/assemblies/3x3.yaml); the self-reconfiguration (mars_reconfigure_3x1.yaml);\n"
          "table2: the 4x1 and 3x2 assemblies planned through a door by ours and the baseline\n"
          "(mars_plan_4x1.yaml, mars_plan_3x2.yaml) and flown, the error over each plan's duration.",
-         {{"--trials", &mars_trials_, "Flights per case and method (default 10, the paper's)"}, first_seed, jobs}},
+         "paper 002, Tables I and II",
+         {{"--trials", &mars_trials_, "Flights per case and method (default 10, the paper's)"}, first_seed, jobs},
+         kCampaign | kTruth,
+         &BenchCommand::Mars},
         {&campaign_,
          "campaign",
          "The campaign engine (docs/campaigns.md): a spec run with one worker and with two\n"
          "(trials_per_s_1worker, trials_per_s_2workers, scaling_efficiency), killed and resumed, and\n"
          "in 4 shards; each merged summary compared byte for byte with the uninterrupted one.",
+         "",
          {{"--spec", &campaign_spec_, "Campaign spec (default configs/campaigns/bench_campaign.yaml)"},
-          {"--work", &campaign_work_, "A new folder for the runs (default: a temporary one, removed after)"}}},
+          {"--work", &campaign_work_, "A new folder for the runs (default: a temporary one, removed after)"}},
+         kPlainTable,
+         &BenchCommand::Campaign},
     };
+  }
+
+  /// The registry as docs/benchmarks.md shows it (a test keeps the page equal to it).
+  std::string ListTable() {
+    std::string out =
+        "| name | what it measures | the paper's figure it reproduces | options beside its own, `--json` and `--html` |\n"
+        "|---|---|---|---|\n";
+    for (const Benchmark& b : Benchmarks()) {
+      std::string description = b.description;
+      std::replace(description.begin(), description.end(), '\n', ' ');
+      std::vector<std::string> options;
+      if (b.capabilities & kTruth) options.emplace_back("`--truth`");
+      if (b.capabilities & kCampaign) {
+        for (const char* o : {"`--out`", "`--shard`", "`--resume`", "`--trial-timeout` (a campaign's)"}) options.emplace_back(o);
+      }
+      out += fmt::format("| `{}` | {} | {} | {} |\n", b.name, description, b.paper, fmt::join(options, ", "));
+    }
+    return out;
   }
 
   /// Writes the result's page when --html asked for one.
@@ -396,7 +457,7 @@ class BenchCommand final : public Command {
     o.seed = Seed();
     o.progress = CountProgress("conditions");
     const nlohmann::json r = benchmarks::RunLioBenchmark(o);
-    fmt::print("{}", json_ ? r.dump(2) + "\n" : benchmarks::LioMarkdown(r));
+    PrintMarkdownResult("lio", r, benchmarks::LioMarkdown(r));
     return kOk;
   }
 
@@ -567,7 +628,7 @@ class BenchCommand final : public Command {
            *planner_ = nullptr, *nav_ = nullptr, *flatness_ = nullptr, *mars_ = nullptr, *campaign_ = nullptr;
   // Options several benchmarks share (one of them runs per invocation).
   std::string seed_ = "1", jobs_, out_, shard_ = "0/1", html_;
-  bool resume_ = false, json_ = false;
+  bool resume_ = false, json_ = false, list_ = false;
   std::string trial_timeout_;
   std::string sim_scenario_, sim_duration_ = "60", sim_repetitions_ = "5";
   std::string qp_instance_, qp_repetitions_ = "3", qp_solver_ = "riccati";

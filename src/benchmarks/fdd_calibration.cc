@@ -88,7 +88,7 @@ fdd::CompositeFddOptions WithLogImu(fdd::CompositeFddOptions options, const Cali
 std::vector<sim::FaultEvent> FaultEvents(const CalibrationLog& log) {
   std::vector<sim::FaultEvent> events;
   for (const harness::FaultRecord& f : log.faults) {
-    events.push_back({f.rotor, vehicle::ParseFaultKind(f.kind).value_or(vehicle::FaultKind::kNone), f.onset_s});
+    events.push_back({f.rotor, FromName<vehicle::FaultKind>(f.kind).value_or(vehicle::FaultKind::kNone), f.onset_s});
   }
   return events;
 }

@@ -174,7 +174,7 @@ harness::Scenario MakeTrial(const Cell& cell, const std::string& method, const F
   if (std::string(cell.kind) != "none") {
     sim::FaultSpec f;
     f.rotor = rotor;
-    f.kind = *vehicle::ParseFaultKind(cell.kind);
+    f.kind = *FromName<vehicle::FaultKind>(cell.kind);
     f.eta = cell.eta;
     f.onset = onset;
     if (cell.intermittent) f.intermittent = sim::IntermittentPattern{0.5, 0.5};

@@ -236,6 +236,36 @@ void MarsBenchOptions::Validate() const {
   }
 }
 
+namespace {
+
+/// Where a trial index falls: bench mars's trials are, in order, the allocation's timing (one
+/// trial), Table I (case, method, trial), the self-reconfiguration (trial, switch) and Table II
+/// (row, planner, trial), the trial varying fastest in each. One decoder for the trial's parameters
+/// and its run.
+struct MarsTrial {
+  enum class Part { kAlloc, kTableOne, kReconfig, kTableTwo } part = Part::kAlloc;
+  int row = 0;     ///< Table I's case or Table II's row
+  int method = 0;  ///< kMethods (Table I), kPlanners (Table II), kSwitches (reconfiguration)
+  int trial = 0;   ///< the repetition; every row and method flies the same seeds
+};
+
+MarsTrial DecodeMarsTrial(int index, int trials, int table_one_trials, int reconfig_trials) {
+  MarsTrial d;
+  if (index == 0) return d;
+  int k = index - 1;
+  if (k < table_one_trials) {
+    const int methods = static_cast<int>(kMethods.size());
+    return {MarsTrial::Part::kTableOne, k / (trials * methods), (k / trials) % methods, k % trials};
+  }
+  k -= table_one_trials;
+  if (k < reconfig_trials) return {MarsTrial::Part::kReconfig, 0, k % 2, k / 2};
+  k -= reconfig_trials;
+  const int slot = k / trials;  // row * 2 + planner
+  return {MarsTrial::Part::kTableTwo, slot / 2, slot % 2, k % trials};
+}
+
+}  // namespace
+
 campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
   options_in.Validate();
   MarsBenchOptions o = options_in;  // every scenario flies the options' world
@@ -274,23 +304,25 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
   c.hash = campaign::Fingerprint(inputs);
   const int trials = o.trials;
   c.parameters = [o, cases, n1, n2, trials](int index) -> std::map<std::string, std::string> {
-    if (index == 0) return {{"part", "alloc"}, {"seed", std::to_string(o.seed)}};
-    int k = index - 1;
+    const MarsTrial d = DecodeMarsTrial(index, trials, n1, n2);
     // Every row and method flies the same seeds: the rows differ by their faults only.
-    const auto seed = [&](int trial) { return std::to_string(TrialSeed(o.seed, "bench mars", static_cast<std::uint64_t>(trial))); };
-    if (k < n1) {
-      const int trial = k % trials, method = (k / trials) % static_cast<int>(kMethods.size());
-      const int row = k / (trials * static_cast<int>(kMethods.size()));
-      return {{"part", "table1"}, {"case", cases[static_cast<std::size_t>(row)].name},
-              {"method", std::string(ToName(kMethods[static_cast<std::size_t>(method)]))},
-              {"trial", std::to_string(trial)}, {"seed", seed(trial)}};
+    const std::string seed = std::to_string(TrialSeed(o.seed, "bench mars", static_cast<std::uint64_t>(d.trial)));
+    const auto at = [](int i) { return static_cast<std::size_t>(i); };
+    switch (d.part) {
+      case MarsTrial::Part::kAlloc:
+        return {{"part", "alloc"}, {"seed", std::to_string(o.seed)}};
+      case MarsTrial::Part::kTableOne:
+        return {{"part", "table1"}, {"case", cases[at(d.row)].name}, {"method", std::string(ToName(kMethods[at(d.method)]))},
+                {"trial", std::to_string(d.trial)}, {"seed", seed}};
+      case MarsTrial::Part::kReconfig:
+        return {{"part", "reconfig"}, {"variant", kSwitches[at(d.method)]}, {"trial", std::to_string(d.trial)}, {"seed", seed}};
+      case MarsTrial::Part::kTableTwo: {
+        const PlanRow row = TableTwoRows(o)[at(d.row)];
+        return {{"part", "table2"}, {"shape", row.scene->assembly->name}, {"fault", row.fault},
+                {"method", ToName(kPlanners[at(d.method)])}, {"trial", std::to_string(d.trial)}, {"seed", seed}};
+      }
     }
-    k -= n1;
-    if (k < n2) return {{"part", "reconfig"}, {"variant", kSwitches[k % 2]}, {"trial", std::to_string(k / 2)}, {"seed", seed(k / 2)}};
-    k -= n2;
-    const PlanRow row = TableTwoRows(o)[static_cast<std::size_t>(k / (2 * trials))];
-    return {{"part", "table2"}, {"shape", row.scene->assembly->name}, {"fault", row.fault},
-            {"method", ToName(kPlanners[(k / trials) % 2])}, {"trial", std::to_string(k % trials)}, {"seed", seed(k % trials)}};
+    return {};
   };
   // The flights' simulated time, for the watchdog: Table II's comes from its plan, made inside
   // the trial, and those trials run without a budget.
@@ -310,9 +342,9 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
       return out;
     }
     harness::RunSummary r;
+    const MarsTrial d = DecodeMarsTrial(index, trials, n1, n2);
     if (part == "table1") {
-      const int k = index - 1;
-      const FaultCase& fault = cases[static_cast<std::size_t>(k / (trials * static_cast<int>(kMethods.size())))];
+      const FaultCase& fault = cases[static_cast<std::size_t>(d.row)];
       // Whether the rotors that still deliver can hold the assembly's weight at all (the
       // allocator's exact QP): a case that cannot hover is reported, not held against the target.
       modular::AssemblyAllocator check(*o.spiral.assembly, {});
@@ -322,7 +354,7 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
       RotorVector hover;
       out.metrics["hover_attainable"] =
           check.Allocate(Eigen::Vector4d(o.spiral.vehicle.weight_n(), 0, 0, 0), &hover).attainable;
-      r = harness::RunScenario(WithFaults(o.spiral, fault, kMethods[static_cast<std::size_t>((k / trials) % 3)], seed), harness::RunOptions{});
+      r = harness::RunScenario(WithFaults(o.spiral, fault, kMethods[static_cast<std::size_t>(d.method)], seed), harness::RunOptions{});
     } else if (part == "reconfig") {
       ReconfigurationOptions ro;
       ro.base = o.reconfigure;
@@ -340,10 +372,8 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
       out.message = x.failure;
       return out;
     } else {
-      const int k = index - 1 - n1 - n2;
-      const int slot = k / trials;  // row * 2 + planner
-      const PlannedTrial t =
-          PlanTrial(TableTwoRows(o)[static_cast<std::size_t>(slot / 2)], kPlanners[slot % 2], k % trials, seed);
+      const PlannedTrial t = PlanTrial(TableTwoRows(o)[static_cast<std::size_t>(d.row)],
+                                       kPlanners[static_cast<std::size_t>(d.method)], d.trial, seed);
       const harness::AssemblyPlanResult& plan = t.plan;
       out.metrics["planned"] = plan.ok;
       if (!plan.ok) {

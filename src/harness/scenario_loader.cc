@@ -41,7 +41,7 @@ sim::FaultSpec ParseFault(const ConfigNode& f) {
   // The range is checked against the vehicle's rotor count by FaultSpec::Validate.
   spec.rotor = static_cast<int>(f.Required("rotor").AsIntIn(-1'000'000, 1'000'000));
   const ConfigNode kind = f.Required("kind");
-  spec.kind = *vehicle::ParseFaultKind(kind.AsEnum({"motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck"}));
+  spec.kind = *FromName<vehicle::FaultKind>(kind.AsEnum(NameList<vehicle::FaultKind>()));
   if (spec.kind == vehicle::FaultKind::kLossOfEffectiveness) {
     spec.eta = f.Required("eta").AsDouble();
   } else if (f.Has("eta")) {

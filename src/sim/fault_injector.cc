@@ -1,6 +1,7 @@
 #include "rotorguard/sim/fault_injector.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <limits>
@@ -18,7 +19,7 @@ void FaultSpec::Validate(int index, int num_rotors, double duration_s) const {
                                 num_rotors - 1, num_rotors));
   }
   if (kind == vehicle::FaultKind::kNone) {
-    ThrowValidation("FaultSpec", prefix + "kind", "none", "one of " + vehicle::FaultKindNames());
+    ThrowValidation("FaultSpec", prefix + "kind", "none", fmt::format("one of {}", fmt::join(NameList<vehicle::FaultKind>(), ", ")));
   }
   if (kind == vehicle::FaultKind::kLossOfEffectiveness && (!std::isfinite(eta) || eta < 0.0 || eta >= 1.0)) {
     ThrowValidation("FaultSpec", prefix + "eta", eta, "a value in [0, 1)");

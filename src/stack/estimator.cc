@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/math.h"
@@ -185,10 +186,13 @@ LioSummary LioEstimator::Summarize() const {
 }
 
 std::unique_ptr<Estimator> MakeControlEstimator(double thrust_coefficient_n_s2, const EstimatorOptions& options) {
-  if (options.kind == EstimatorKind::kLio) {
-    return std::make_unique<LioHeadEstimator>(thrust_coefficient_n_s2, options.lio.imu_position_m);
+  switch (options.kind) {  // no default: a new kind fails to compile until it is built here
+    case EstimatorKind::kLio:
+      return std::make_unique<LioHeadEstimator>(thrust_coefficient_n_s2, options.lio.imu_position_m);
+    case EstimatorKind::kOdometry:
+      return std::make_unique<OdometryImuEstimator>(thrust_coefficient_n_s2, options);
   }
-  return std::make_unique<OdometryImuEstimator>(thrust_coefficient_n_s2, options);
+  throw std::logic_error("MakeControlEstimator: an EstimatorKind without a case");
 }
 
 }  // namespace rotorguard::stack

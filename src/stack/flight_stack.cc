@@ -122,25 +122,38 @@ FlightStack::FlightStack(const vehicle::VehicleParams& vehicle, std::shared_ptr<
                       fmt::format("the name of the controller handed in ({})", controller->name()));
     }
     controller_ = std::move(controller);
-  } else if (options_.controller == ControllerKind::kAssembly) {
-    ThrowValidation("FlightStackOptions", "controller", ToName(options_.controller),
-                    "a controller built by the caller (the assembly controller lives in the modular module)");
-  } else if (options_.controller == ControllerKind::kNmpc) {
-    control::NmpcOptions nmpc_options = options_.nmpc;
-    nmpc_options.expected_delay_s = options_.command_delay_s;
-    auto nmpc = std::make_unique<control::NmpcController>(model_.params(), nmpc_options);
-    nmpc_ = nmpc.get();
-    controller_ = std::move(nmpc);
-  } else if (options_.controller == ControllerKind::kIndi) {
-    controller_ = std::make_unique<control::IndiController>(model_, IndiOptionsInStack(options_));
-  } else if (options_.controller == ControllerKind::kLqr) {
-    control::LqrControllerOptions lqr = options_.lqr;
-    lqr.sample_hz = options_.control_rate_hz;
-    controller_ = std::make_unique<control::LqrController>(vehicle::PwmQuadModel::FromVehicle(model_.params()), lqr);
-  } else if (options_.controller == ControllerKind::kPassive) {
-    controller_ = std::make_unique<control::PassiveController>(model_, options_.passive);
   } else {
-    controller_ = std::make_unique<control::NominalController>(model_, options_.nominal);
+    // One case per kind, no default: a kind added to ControllerKind without its construction here
+    // fails to compile (-Wswitch).
+    switch (options_.controller) {
+      case ControllerKind::kAssembly:
+        ThrowValidation("FlightStackOptions", "controller", ToName(options_.controller),
+                        "a controller built by the caller (the assembly controller lives in the modular module)");
+      case ControllerKind::kNmpc: {
+        control::NmpcOptions nmpc_options = options_.nmpc;
+        nmpc_options.expected_delay_s = options_.command_delay_s;
+        auto nmpc = std::make_unique<control::NmpcController>(model_.params(), nmpc_options);
+        nmpc_ = nmpc.get();
+        controller_ = std::move(nmpc);
+        break;
+      }
+      case ControllerKind::kIndi:
+        controller_ = std::make_unique<control::IndiController>(model_, IndiOptionsInStack(options_));
+        break;
+      case ControllerKind::kLqr: {
+        control::LqrControllerOptions lqr = options_.lqr;
+        lqr.sample_hz = options_.control_rate_hz;
+        controller_ =
+            std::make_unique<control::LqrController>(vehicle::PwmQuadModel::FromVehicle(model_.params()), lqr);
+        break;
+      }
+      case ControllerKind::kPassive:
+        controller_ = std::make_unique<control::PassiveController>(model_, options_.passive);
+        break;
+      case ControllerKind::kNominal:
+        controller_ = std::make_unique<control::NominalController>(model_, options_.nominal);
+        break;
+    }
   }
   for (std::size_t i = 0; i < options_.known_faults.size(); ++i) {
     const int rotor = options_.known_faults[i].rotor;

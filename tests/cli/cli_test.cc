@@ -392,6 +392,31 @@ TEST_F(CliTest, KeysPrintsEveryScenarioKeyWithItsDefault) {
   EXPECT_NE(r.out.find("`mission` with `type: lemniscate`"), std::string::npos);
 }
 
+// docs/benchmarks.md's table is the registry's (`bench --list`), unedited; every benchmark it
+// lists takes --html, --json and --help.
+TEST_F(CliTest, TheBenchmarksPageListsTheRegistry) {
+  const Result list = Cli("bench --list");
+  ASSERT_EQ(list.exit_code, 0) << list.out;
+  const std::string page = ReadText(rotorguard::testing::SourcePath("docs/benchmarks.md"));
+  const std::string begin = "<!-- BEGIN rotorguard bench --list: generated, do not edit by hand -->\n";
+  const std::size_t a = page.find(begin), b = page.find("<!-- END rotorguard bench --list -->");
+  ASSERT_TRUE(a != std::string::npos && b != std::string::npos) << "docs/benchmarks.md lacks the markers";
+  EXPECT_EQ(page.substr(a + begin.size(), b - a - begin.size()), list.out)
+      << "docs/benchmarks.md's table is out of date: replace the lines between the markers with the output of "
+         "`rotorguard bench --list`";
+  int rows = 0;
+  for (std::size_t at = list.out.find("\n| `"); at != std::string::npos; at = list.out.find("\n| `", at + 1)) {
+    const std::size_t name_end = list.out.find('`', at + 4);
+    const std::string name = list.out.substr(at + 4, name_end - at - 4);
+    const Result help = Cli("bench " + name + " --help");
+    EXPECT_EQ(help.exit_code, 0) << name;
+    for (const char* flag : {"--html", "--json"}) EXPECT_NE(help.out.find(flag), std::string::npos) << name << " " << flag;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 12);  // sim, qp, nmpc, sitl, ftc, perception, lio, planner, nav, flatness, mars, campaign
+  EXPECT_EQ(Cli("bench").exit_code, 2);  // a benchmark or --list
+}
+
 TEST_F(CliTest, UsageErrorsExitTwo) {
   EXPECT_EQ(Cli("").exit_code, 2);
   EXPECT_EQ(Cli("fly").exit_code, 2);

@@ -37,6 +37,7 @@
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/record/flight_log.h"
 #include "rotorguard/record/report.h"
+#include "rotorguard/vehicle/faults.h"
 
 namespace {
 
@@ -184,7 +185,7 @@ YAML::Node Value(const Key& k, const YAML::Node& current, double duration_s, Gen
 
 // The faults: re-timed into the flight, some dropped, some added of any kind.
 void MutateFaults(YAML::Node root, double duration_s, Generator* g) {
-  static const char* const kKinds[] = {"motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck"};
+  const auto& kinds = rotorguard::vehicle::kFaultKindNames;  // every kind a file can name
   YAML::Node faults = root["faults"];
   YAML::Node out(YAML::NodeType::Sequence);
   if (faults.IsSequence() && !g->Chance(0.2)) {
@@ -198,7 +199,7 @@ void MutateFaults(YAML::Node root, double duration_s, Generator* g) {
   for (int i = 0; i < added; ++i) {
     YAML::Node f(YAML::NodeType::Map);
     f["rotor"] = static_cast<int>(g->Below(4));
-    const std::string kind = kKinds[g->Below(4)];
+    const std::string kind = kinds[g->Below(std::size(kinds))].name;
     f["kind"] = kind;
     if (kind == "loss_of_effectiveness") f["eta"] = g->Uniform(0.0, 1.0);
     f["onset"]["at_time_s"] = g->Uniform(0.0, duration_s);

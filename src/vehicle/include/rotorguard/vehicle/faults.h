@@ -1,9 +1,10 @@
 #pragma once
 /// Rotor fault kinds and how each changes a rotor (docs/scenarios.md, "Faults").
-#include <optional>
-#include <string>
+#include <span>
 #include <string_view>
 #include <vector>
+
+#include "rotorguard/core/config_schema.h"
 
 namespace rotorguard::vehicle {
 
@@ -21,11 +22,19 @@ enum class FaultKind {
   kStuck,
 };
 
+/// The kinds a scenario's `faults[].kind` names, in the order shown to users: parsing (FromName),
+/// printing (ToName), the loader's list of accepted names and the fuzzer's draw all read this table.
+/// A healthy rotor (kNone) is not a fault a file can inject, so it has no name here.
+inline constexpr EnumName<FaultKind> kFaultKindNames[] = {
+    {FaultKind::kMotorStop, "motor_stop"},
+    {FaultKind::kPropellerLoss, "propeller_loss"},
+    {FaultKind::kLossOfEffectiveness, "loss_of_effectiveness"},
+    {FaultKind::kStuck, "stuck"},
+};
+constexpr std::span<const EnumName<FaultKind>> NamesOf(const FaultKind*) { return kFaultKindNames; }
+
+/// The kind's name, "none" for a healthy rotor (a rotor's state, as the Python API reports it).
 std::string_view ToString(FaultKind kind);
-/// Parses "motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck" (and "none").
-std::optional<FaultKind> ParseFaultKind(std::string_view name);
-/// The names accepted by ParseFaultKind, for error messages.
-std::string FaultKindNames();
 
 /// The fault a rotor currently suffers (kNone when healthy).
 struct RotorFaultState {
