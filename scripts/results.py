@@ -654,7 +654,8 @@ def render(out_dir, present):
             fmt = lambda v, d=3: '/' if v is None else '%.*f' % (d, v)
             body.append('| %s | %g | %s | %s | %s | %s | %s | %s |' % (
                 sw['threshold'], shipped,
-                fmt(row['margin'], 2) + 'x' if row and abs(row['value'] - shipped) < 1e-9 else '/',
+                ('unbounded (the rule never moved)' if row['margin'] is None else fmt(row['margin'], 2) + 'x')
+                if row and abs(row['value'] - shipped) < 1e-9 else '/',
                 '%d / %d' % (row['detected'], row['missed']) if row else '/',
                 fmt(row['latency_s_mean']) if row else '/',
                 '%g' % sug['value'] if sug else 'none', fmt(sug['margin'], 2) + 'x' if sug else '/',
@@ -705,7 +706,8 @@ def render(out_dir, present):
             if a:
                 where.append('%d in %s' % (a, name.replace('far_', '').replace('_', ' ')))
         body += ['', 'Each set: `rotorguard campaign run configs/campaigns/<set>.yaml --out DIR`, then `campaign merge DIR`.',
-                 'All sets together: %d false alarms in %d flights (%s).' % (total[0], total[1], pct(total[0], total[1])), '']
+                 'All sets together: %d false alarm%s in %d flights (%s).' % (total[0], '' if total[0] == 1 else 's', total[1],
+                                                                             pct(total[0], total[1])), '']
         readme += ['- False alarms on %d healthy evaluation flights (%s, 1000 each): %d (%s)%s.'
                    % (total[1], ', '.join(j[0].replace('far_', '').replace('_', ' ') for j in far), total[0],
                       pct(total[0], total[1]), ': ' + ', '.join(where) if where else '')]
