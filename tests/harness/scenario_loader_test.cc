@@ -4,12 +4,14 @@
 // tables are the ones the loader reads.
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <vector>
 
 #include "rotorguard/harness/assembly_mission.h"
 #include "rotorguard/harness/scenario.h"
@@ -19,6 +21,7 @@
 #include "rotorguard/io/json_archive.h"
 #include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/planning/references.h"
+#include "rotorguard/vehicle/faults.h"
 #include "test_util.h"
 
 namespace rotorguard::harness {
@@ -42,6 +45,29 @@ class ScenarioLoader : public testing::TempFolderTest {
     return "(no error)";
   }
 };
+
+// Every name of the fault kinds' table loads as its kind, and a name outside it is refused with the
+// table's names: the loader reads the one table (vehicle::kFaultKindNames), not a list of its own.
+TEST_F(ScenarioLoader, FaultKindsComeFromTheirNameTable) {
+  std::vector<std::string> names;
+  for (const EnumName<vehicle::FaultKind>& n : vehicle::kFaultKindNames) {
+    names.emplace_back(n.name);
+    const std::string eta = n.value == vehicle::FaultKind::kLossOfEffectiveness ? ", eta: 0.3" : "";
+    const Scenario s = LoadScenario(File(fmt::format(
+        "mission: {{type: hover}}\nfaults: [{{rotor: 1, kind: {}{}, onset: {{at_time_s: 2.0}}}}]\n", n.name, eta)));
+    ASSERT_EQ(s.faults.size(), 1u) << n.name;
+    EXPECT_EQ(s.faults[0].kind, n.value) << n.name;
+    EXPECT_EQ(vehicle::ToString(n.value), n.name);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"motor_stop", "propeller_loss", "loss_of_effectiveness", "stuck"}));
+  EXPECT_EQ(vehicle::ToString(vehicle::FaultKind::kNone), "none");  // a healthy rotor, never a file's kind
+  for (const char* refused : {"none", "propeller"}) {
+    const std::string error = Error(fmt::format(
+        "mission: {{type: hover}}\nfaults: [{{rotor: 1, kind: {}, onset: {{at_time_s: 2.0}}}}]\n", refused));
+    EXPECT_NE(error.find("faults.0.kind"), std::string::npos) << error;
+    EXPECT_NE(error.find(fmt::format("{}", fmt::join(names, ", "))), std::string::npos) << error;
+  }
+}
 
 TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
   const Scenario s = LoadScenario(File("mission: {type: hover}\n"));
