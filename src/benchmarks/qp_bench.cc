@@ -113,7 +113,7 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
 
   // Every case, and every repetition of one, is solved cold, as the reference solver's figures
   // are: a start from the previous solve's active set would make the repetitions free.
-  control::DenseQpOptions cold;
+  control::ActiveSetOptions cold;
   cold.warm_start = false;
   const std::unique_ptr<control::OcpQpSolver> solver = control::MakeOcpQpSolver(options.solver, dims, cold);
   // Each case where u_0 differs from the reference by more than this is cross-examined.

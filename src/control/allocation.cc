@@ -37,7 +37,7 @@ std::optional<RotorVector> HoverThrustSplit(const vehicle::VehicleParams& vehicl
   qp.C = vehicle::ComputeEffectivenessMatrix(vehicle.rotors).topRows<3>();
   qp.lc << vehicle.weight_n(), 0.0, 0.0;
   qp.uc = qp.lc;
-  DenseQpOptions options;
+  ActiveSetOptions options;
   options.feasibility_tolerance = 1e-9 * vehicle.weight_n();
   DenseQpSolver solver(n, 3, options);
   if (!solver.Solve(qp).IsSolutionUsable()) return std::nullopt;

@@ -33,38 +33,11 @@ inline void Givens(double a, double b, double* c, double* s) {
 }
 }  // namespace
 
-std::string_view ToString(QpStatus status) {
-  switch (status) {
-    case QpStatus::kNotSolved: return "not solved (Solve() was not called)";
-    case QpStatus::kSolved: return "solved";
-    case QpStatus::kMaxIterations: return "max iterations reached";
-    case QpStatus::kInfeasible: return "infeasible";
-    case QpStatus::kNumericalFailure: return "numerical failure";
-  }
-  return "unknown";
-}
-
-std::string_view ToString(QpStart start) {
-  switch (start) {
-    case QpStart::kCold: return "cold";
-    case QpStart::kWarm: return "warm";
-    case QpStart::kHot: return "hot";
-  }
-  return "unknown";
-}
-
 std::string DenseQpSummary::BriefReport() const {
   return fmt::format("QP {}: {} start from {} active, {} iterations, {} active, objective {:.6g}, max violation "
                      "{:.2e}, {:.1f} us",
                      ToString(status), ToString(start), start_active_constraints, iterations, active_constraints,
                      objective, max_violation, solve_time_s * 1e6);
-}
-
-void DenseQpOptions::Validate() const {
-  if (!(feasibility_tolerance > 0.0) || !std::isfinite(feasibility_tolerance)) {
-    ThrowValidation("DenseQpOptions", "feasibility_tolerance", feasibility_tolerance, "a finite value > 0");
-  }
-  if (max_iterations < 1) ThrowValidation("DenseQpOptions", "max_iterations", max_iterations, "a count >= 1");
 }
 
 DenseQp::DenseQp(int n, int m)
@@ -76,7 +49,7 @@ DenseQp::DenseQp(int n, int m)
       lc(Eigen::VectorXd::Constant(m, -kInf)),
       uc(Eigen::VectorXd::Constant(m, kInf)) {}
 
-DenseQpSolver::DenseQpSolver(int n, int m, const DenseQpOptions& options)
+DenseQpSolver::DenseQpSolver(int n, int m, const ActiveSetOptions& options)
     : n_(n),
       m_(m),
       options_(options),
@@ -91,16 +64,13 @@ DenseQpSolver::DenseQpSolver(int n, int m, const DenseQpOptions& options)
       d_(n),
       step_(n),
       r_(n),
-      u_(n),
       cz_(m),
       y_bound_(n),
       y_constraint_(m),
-      is_active_(2 * static_cast<std::size_t>(n + m), 0),
+      set_(n + m, n),  // at most n independent normals
       previous_rows_(n, n) {
   if (n < 1 || m < 0) ThrowInvalidArgument("DenseQpSolver", "n, m", fmt::format("{}, {}", n, m), "n >= 1, m >= 0");
   options_.Validate();
-  active_.reserve(static_cast<std::size_t>(n));
-  previous_.reserve(static_cast<std::size_t>(n));
   placed_.reserve(static_cast<std::size_t>(n));
 }
 
@@ -110,9 +80,9 @@ double DenseQpSolver::SignedBound(const DenseQp& qp, const Side& c) const {
   return c.sign * (c.sign > 0 ? qp.lc[row] : qp.uc[row]);
 }
 
-double DenseQpSolver::Slack(const DenseQp& qp, const Side& c) const {
-  const double sz = c.index < n_ ? c.sign * z_[c.index] : c.sign * qp.C.row(c.index - n_).dot(z_);
-  return sz - SignedBound(qp, c);
+double DenseQpSolver::Slack(const Side& c) const {
+  const double sz = c.index < n_ ? c.sign * z_[c.index] : c.sign * qp_->C.row(c.index - n_).dot(z_);
+  return sz - SignedBound(*qp_, c);
 }
 
 void DenseQpSolver::ComputeD(const DenseQp& qp, const Side& c) {
@@ -124,9 +94,23 @@ void DenseQpSolver::ComputeD(const DenseQp& qp, const Side& c) {
   }
 }
 
-double DenseQpSolver::NormalDotStep(const DenseQp& qp, const Side& c) const {
-  if (c.index < n_) return c.sign * step_[c.index];
-  return c.sign * qp.C.row(c.index - n_).dot(step_);
+void DenseQpSolver::ScanViolations(internal::ViolationSearch& search) {
+  search.Scan(z_, qp_->lb, qp_->ub, 0);
+  if (m_ > 0) {
+    cz_.noalias() = qp_->C * z_;
+    search.Scan(cz_, qp_->lc, qp_->uc, n_);
+  }
+}
+
+internal::Direction DenseQpSolver::MakeDirection(const Side& p, Eigen::Ref<Eigen::VectorXd> r) {
+  // The primal step in the null space of the active normals, J2 J2' n_p, and the dual one,
+  // R^-1 J1' n_p.
+  const int q = set_.size();
+  ComputeD(*qp_, p);
+  step_.noalias() = J_.rightCols(n_ - q) * d_.tail(n_ - q);
+  r = R_.topLeftCorner(q, q).triangularView<Eigen::Upper>().solve(d_.head(q));
+  const double ns = p.index < n_ ? p.sign * step_[p.index] : p.sign * qp_->C.row(p.index - n_).dot(step_);
+  return {.independent = step_.norm() > 1e-14 * (1.0 + d_.norm()), .normal_dot_step = ns};
 }
 
 void DenseQpSolver::RotateColumns(int j, double cs, double sn) {
@@ -141,9 +125,10 @@ void DenseQpSolver::RotateColumns(int j, double cs, double sn) {
   }
 }
 
-void DenseQpSolver::AddToActiveSet(const Side& c) {
+bool DenseQpSolver::AddToFactor(const Side&) {
   // Rotate d so that only d[0..q] is non-zero; apply the same rotations to the columns of J.
-  for (int j = n_ - 1; j > q_; --j) {
+  const int q = set_.size();
+  for (int j = n_ - 1; j > q; --j) {
     if (d_[j] == 0.0) continue;  // Givens would give sn = 0: nothing to rotate
     double cs, sn;
     Givens(d_[j - 1], d_[j], &cs, &sn);
@@ -152,26 +137,21 @@ void DenseQpSolver::AddToActiveSet(const Side& c) {
     d_[j] = 0.0;
     RotateColumns(j - 1, cs, sn);
   }
-  R_.col(q_).head(q_ + 1) = d_.head(q_ + 1);
-  active_.push_back(c);
-  is_active_[2 * c.index + (c.sign < 0)] = 1;
-  ++q_;
+  R_.col(q).head(q + 1) = d_.head(q + 1);
+  return true;
 }
 
-void DenseQpSolver::DropFromActiveSet(int position) {
-  const Side c = active_[position];
-  is_active_[2 * c.index + (c.sign < 0)] = 0;
-  active_.erase(active_.begin() + position);
-  for (int j = position; j < q_ - 1; ++j) u_[j] = u_[j + 1];
+void DenseQpSolver::DropFromFactor(int position) {
   // Remove column `position` of R; the upper-Hessenberg rest is made triangular by rotations on
   // rows (col, col + 1), mirrored on the columns of J.
-  for (int col = position; col < q_ - 1; ++col) R_.col(col).head(q_) = R_.col(col + 1).head(q_);
-  R_.col(q_ - 1).setZero();
-  for (int col = position; col < q_ - 1; ++col) {
+  const int q = set_.size();
+  for (int col = position; col < q - 1; ++col) R_.col(col).head(q) = R_.col(col + 1).head(q);
+  R_.col(q - 1).setZero();
+  for (int col = position; col < q - 1; ++col) {
     double cs, sn;
     Givens(R_(col, col), R_(col + 1, col), &cs, &sn);
     if (sn == 0.0) continue;
-    for (int k = col; k < q_ - 1; ++k) {
+    for (int k = col; k < q - 1; ++k) {
       const double a = R_(col, k), b = R_(col + 1, k);
       R_(col, k) = cs * a + sn * b;
       R_(col + 1, k) = -sn * a + cs * b;
@@ -179,7 +159,6 @@ void DenseQpSolver::DropFromActiveSet(int position) {
     R_(col + 1, col) = 0.0;
     RotateColumns(col, cs, sn);
   }
-  --q_;
 }
 
 void DenseQpSolver::OrderVariables() {
@@ -187,7 +166,7 @@ void DenseQpSolver::OrderVariables() {
   // trailing columns factorise them as they stand (StartActiveSet); the other variables keep
   // their order.
   placed_.clear();
-  for (const Side& c : previous_) {
+  for (const Side& c : set_.previous()) {
     if (c.index < n_) placed_.push_back(c);
   }
   std::fill(placed_mark_.begin(), placed_mark_.end(), 0);
@@ -245,9 +224,7 @@ const DenseQpSummary& DenseQpSolver::Solve(const DenseQp& qp) {
 
 void DenseQpSolver::ResetActiveSet() {
   hot_startable_ = false;
-  q_ = 0;
-  active_.clear();
-  std::fill(is_active_.begin(), is_active_.end(), 0);
+  set_.Clear();
 }
 
 void DenseQpSolver::ClearActiveSet() {
@@ -267,8 +244,8 @@ QpStart DenseQpSolver::StartActiveSet(const DenseQp& qp) {
   // (With warm_start off nothing is ever kept: KeepForWarmStart is where the option acts.)
   constexpr int kMaxHotStartsInARow = 50;
   bool hot = hot_startable_ && hot_starts_in_a_row_ < kMaxHotStartsInARow;
-  for (int j = 0; hot && j < q_; ++j) {
-    const Side& c = active_[j];
+  for (int j = 0; hot && j < set_.size(); ++j) {
+    const Side& c = set_[j];
     hot = c.index < n_ || qp.C.row(c.index - n_) == previous_rows_.row(j);
   }
   hot_startable_ = false;  // until this solve succeeds
@@ -278,24 +255,22 @@ QpStart DenseQpSolver::StartActiveSet(const DenseQp& qp) {
   } else {
     hot_starts_in_a_row_ = 0;
     ClearActiveSet();
-    start = !placed_.empty() || !previous_.empty() ? QpStart::kWarm : QpStart::kCold;
+    start = !placed_.empty() || !set_.previous().empty() ? QpStart::kWarm : QpStart::kCold;
   }
   if (start == QpStart::kWarm) {
     PlaceOrderedBounds();
-    for (const Side& c : previous_) {
-      if (is_active_[2 * c.index + (c.sign < 0)] || !std::isfinite(SignedBound(qp, c))) continue;
+    for (const Side& c : set_.previous()) {
+      if (set_.IsActive(c) || !std::isfinite(SignedBound(qp, c))) continue;
       ComputeD(qp, c);
       // A normal (nearly) in the span of those already added would make R singular: left to the
       // iterations, which add it only if it is violated and independent.
       constexpr double kIndependence = 1e-8;
-      if (d_.tail(n_ - q_).norm() <= kIndependence * d_.norm()) continue;
-      AddToActiveSet(c);
+      if (d_.tail(n_ - set_.size()).norm() <= kIndependence * d_.norm()) continue;
+      set_.Add(*this, c);
     }
   }
   // A side whose bound is now infinite binds no more.
-  for (int j = q_ - 1; j >= 0; --j) {
-    if (!std::isfinite(SignedBound(qp, active_[j]))) DropFromActiveSet(j);
-  }
+  set_.DropWhere(*this, [&](const Side& c) { return !std::isfinite(SignedBound(qp, c)); });
   return start;
 }
 
@@ -312,40 +287,28 @@ void DenseQpSolver::PlaceOrderedBounds() {
   for (int c = 0; c < k; ++c) {
     const Side& side = placed_[static_cast<std::size_t>(c)];
     for (int a = 0; a <= c; ++a) R_(a, c) = side.sign * J0_(side.index, n_ - 1 - a);
-    active_.push_back(side);
-    is_active_[2 * side.index + (side.sign < 0)] = 1;
+    set_.Push(side);
   }
-  q_ = k;
 }
 
-void DenseQpSolver::MinimiseOnActiveSet(const DenseQp& qp) {
-  // With J' N = [R; 0] for the active normals N and J J' = H^-1, the minimum on N' z = b is
-  // z = J1 R^-T b - J2 J2' g, and its multipliers (H z + g = N u) u = R^-1 (R^-T b + J1' g).
-  while (true) {
-    for (int j = 0; j < q_; ++j) r_[j] = SignedBound(qp, active_[j]);
-    auto R = R_.topLeftCorner(q_, q_).triangularView<Eigen::Upper>();
-    R.transpose().solveInPlace(r_.head(q_));  // R^-T b
-    d_.noalias() = J_.transpose() * qp.g;       // [J1' g; J2' g]
-    u_.head(q_) = r_.head(q_) + d_.head(q_);
-    R.solveInPlace(u_.head(q_));
-    d_.head(q_) = r_.head(q_);
-    d_.tail(n_ - q_) *= -1.0;
-    z_.noalias() = J_ * d_;
-    // Drop the most negative multiplier and minimise again; at most q rounds.
-    int most_negative = -1;
-    for (int j = 0; j < q_; ++j) {
-      if (u_[j] < 0.0 && (most_negative < 0 || u_[j] < u_[most_negative])) most_negative = j;
-    }
-    if (most_negative < 0) return;
-    DropFromActiveSet(most_negative);
-  }
+void DenseQpSolver::MinimiseOnFactor(Eigen::Ref<Eigen::VectorXd> u) {
+  const int q = set_.size();
+  for (int j = 0; j < q; ++j) r_[j] = SignedBound(*qp_, set_[j]);
+  auto R = R_.topLeftCorner(q, q).triangularView<Eigen::Upper>();
+  R.transpose().solveInPlace(r_.head(q));  // R^-T b
+  d_.noalias() = J_.transpose() * qp_->g;   // [J1' g; J2' g]
+  u = r_.head(q) + d_.head(q);
+  R.solveInPlace(u);
+  d_.head(q) = r_.head(q);
+  d_.tail(n_ - q) *= -1.0;
+  z_.noalias() = J_ * d_;
 }
 
 void DenseQpSolver::KeepForWarmStart(const DenseQp& qp) {
   if (!options_.warm_start) return;
-  previous_.assign(active_.begin(), active_.end());
-  for (int j = 0; j < q_; ++j) {
-    if (active_[j].index >= n_) previous_rows_.row(j) = qp.C.row(active_[j].index - n_);
+  set_.Remember();
+  for (int j = 0; j < set_.size(); ++j) {
+    if (set_[j].index >= n_) previous_rows_.row(j) = qp.C.row(set_[j].index - n_);
   }
   hot_startable_ = true;
 }
@@ -353,17 +316,19 @@ void DenseQpSolver::KeepForWarmStart(const DenseQp& qp) {
 const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
   const Stopwatch clock;
   summary_ = DenseQpSummary{};
+  qp_ = &qp;
   const auto finish = [&](QpStatus status) -> const DenseQpSummary& {
     summary_.status = status;
-    summary_.active_constraints = q_;
+    summary_.iterations = set_.iterations();
+    summary_.active_constraints = set_.size();
     y_bound_.setZero();
     y_constraint_.setZero();
-    for (int j = 0; j < q_; ++j) {
-      const Side& c = active_[j];
+    for (int j = 0; j < set_.size(); ++j) {
+      const Side& c = set_[j];
       if (c.index < n_) {
-        y_bound_[c.index] += c.sign * u_[j];
+        y_bound_[c.index] += c.sign * set_.multipliers()[j];
       } else {
-        y_constraint_[c.index - n_] += c.sign * u_[j];
+        y_constraint_[c.index - n_] += c.sign * set_.multipliers()[j];
       }
     }
     if (status != QpStatus::kNumericalFailure && z_.allFinite()) {  // the data may hold NaN
@@ -381,8 +346,9 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
     } else {
       // The next solve starts without this one's set: from the bounds the factorisation placed
       // last (still a valid start), or cold.
-      previous_.clear();
+      set_.Forget();
     }
+    qp_ = nullptr;
     summary_.solve_time_s = clock.seconds();
     return summary_;
   };
@@ -394,6 +360,7 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
     if (status == QpStatus::kNumericalFailure) z_.setZero();
     return finish(status);
   };
+  set_.ResetIterations();
   // Bounds may be infinite but never NaN (a NaN bound would be silently ignored by comparisons).
   const bool nan_bound = qp.lb.array().isNaN().any() || qp.ub.array().isNaN().any() ||
                          qp.lc.array().isNaN().any() || qp.uc.array().isNaN().any();
@@ -408,80 +375,11 @@ const DenseQpSummary& DenseQpSolver::SolveFactorized(const DenseQp& qp) {
   // The start: the minimum on the kept or rebuilt active set, or the unconstrained minimum
   // z = -J J' g (H = L L', J = L^-T) when the set is empty.
   summary_.start = StartActiveSet(qp);
-  MinimiseOnActiveSet(qp);
-  summary_.start_active_constraints = q_;
+  set_.MinimiseOnActiveSet(*this);
+  summary_.start_active_constraints = set_.size();
   // A start on a nearly dependent set with huge finite bounds could overflow.
   if (!z_.allFinite()) return reject(QpStatus::kNumericalFailure);
-
-  const double tol = options_.feasibility_tolerance;
-  while (true) {
-    // The most violated constraint side that is not active.
-    Side p{-1, 0.0};
-    double worst = -tol;
-    for (int i = 0; i < n_; ++i) {
-      if (z_[i] - qp.lb[i] < worst && !is_active_[2 * i]) {
-        worst = z_[i] - qp.lb[i];
-        p = {i, 1.0};
-      }
-      if (qp.ub[i] - z_[i] < worst && !is_active_[2 * i + 1]) {
-        worst = qp.ub[i] - z_[i];
-        p = {i, -1.0};
-      }
-    }
-    if (m_ > 0) {
-      cz_.noalias() = qp.C * z_;
-      for (int i = 0; i < m_; ++i) {
-        if (cz_[i] - qp.lc[i] < worst && !is_active_[2 * (n_ + i)]) {
-          worst = cz_[i] - qp.lc[i];
-          p = {n_ + i, 1.0};
-        }
-        if (qp.uc[i] - cz_[i] < worst && !is_active_[2 * (n_ + i) + 1]) {
-          worst = qp.uc[i] - cz_[i];
-          p = {n_ + i, -1.0};
-        }
-      }
-    }
-    if (p.index < 0) return finish(QpStatus::kSolved);
-
-    double slack = worst;
-    double u_p = 0.0;
-    while (true) {
-      if (summary_.iterations >= options_.max_iterations) return finish(QpStatus::kMaxIterations);
-      ComputeD(qp, p);
-      // Primal step direction in the null space of the active constraints, and the dual one.
-      step_.noalias() = J_.rightCols(n_ - q_) * d_.tail(n_ - q_);
-      r_.head(q_) = R_.topLeftCorner(q_, q_).triangularView<Eigen::Upper>().solve(d_.head(q_));
-      double t1 = kInf;
-      int drop = -1;
-      for (int j = 0; j < q_; ++j) {
-        if (r_[j] > 0.0 && u_[j] / r_[j] < t1) {
-          t1 = u_[j] / r_[j];
-          drop = j;
-        }
-      }
-      const double ns = NormalDotStep(qp, p);
-      const bool primal_step = step_.norm() > 1e-14 * (1.0 + d_.norm()) && ns > 0.0;
-      const double t2 = primal_step ? -slack / ns : kInf;
-      const double t = std::min(t1, t2);
-      if (!std::isfinite(t)) return finish(QpStatus::kInfeasible);
-      ++summary_.iterations;
-      u_.head(q_) -= t * r_.head(q_);
-      u_p += t;
-      if (!primal_step) {
-        DropFromActiveSet(drop);  // dual step only: make room for p
-        continue;
-      }
-      z_ += t * step_;
-      if (t2 <= t1) {
-        AddToActiveSet(p);
-        u_[q_ - 1] = u_p;
-        break;
-      }
-      DropFromActiveSet(drop);
-      slack = Slack(qp, p);
-    }
-    if (!z_.allFinite()) return finish(QpStatus::kNumericalFailure);
-  }
+  return finish(set_.Iterate(*this, options_));
 }
 
 }  // namespace rotorguard::control

@@ -53,7 +53,7 @@ std::string OcpQpSummary::BriefReport() const {
       feedback_time_s * 1e6);
 }
 
-CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options)
+CondensingQpSolver::CondensingQpSolver(const OcpQpDims& dims, const ActiveSetOptions& options)
     : dims_(dims),
       options_(options),
       dense_(dims.horizon * dims.nu, dims.horizon * static_cast<int>(dims.state_bound_index.size())),
@@ -178,7 +178,7 @@ void OcpQpSolver::RequireSameDims(const OcpQp& qp, const OcpQpDims& dims, const 
   }
 }
 
-std::unique_ptr<OcpQpSolver> MakeOcpQpSolver(OcpQpMethod method, const OcpQpDims& dims, const DenseQpOptions& options) {
+std::unique_ptr<OcpQpSolver> MakeOcpQpSolver(OcpQpMethod method, const OcpQpDims& dims, const ActiveSetOptions& options) {
   if (method == OcpQpMethod::kRiccati) return std::make_unique<RiccatiQpSolver>(dims, options);
   return std::make_unique<CondensingQpSolver>(dims, options);
 }

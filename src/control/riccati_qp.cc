@@ -20,7 +20,7 @@ using internal::StageMaps;
 constexpr double kDependence = 1e-12;
 }  // namespace
 
-RiccatiQpSolver::RiccatiQpSolver(const OcpQpDims& dims, const DenseQpOptions& options)
+RiccatiQpSolver::RiccatiQpSolver(const OcpQpDims& dims, const ActiveSetOptions& options)
     : dims_(dims), options_(options) {
   dims_.Validate();
   options_.Validate();
@@ -50,16 +50,13 @@ RiccatiQpSolver::RiccatiQpSolver(const OcpQpDims& dims, const DenseQpOptions& op
   step_.resize(nc_);
   responses_.resize(nc_, nc_);
   have_response_.assign(static_cast<std::size_t>(nc_), 0);
-  // At most N nu sides are independent (the inputs' count), and dependent ones are never added.
+  // At most N nu sides are independent (the inputs' count), and dependent ones are never added;
+  // rounding may pass one more through the test (AddToFactor).
   const int max_active = std::min(nc_, N * nu);
+  set_ = internal::DualActiveSet(nc_, max_active + 1);
   L_ = Eigen::MatrixXd::Zero(max_active + 1, max_active + 1);
-  multipliers_.resize(max_active + 1);
   b_.resize(max_active + 1);
-  r_.resize(max_active + 1);
   update_.resize(max_active + 1);
-  active_.reserve(static_cast<std::size_t>(max_active + 1));
-  previous_.reserve(static_cast<std::size_t>(max_active + 1));
-  is_active_.assign(2 * static_cast<std::size_t>(nc_), 0);
 }
 
 template <int NX, int NU>
@@ -246,41 +243,35 @@ Eigen::Ref<const Eigen::VectorXd> RiccatiQpSolver::Response(int index) {
   return responses_.col(index);
 }
 
-double RiccatiQpSolver::SchurComplementRow(const Side& c) {
+void RiccatiQpSolver::SchurComplementRow(const Side& c) {
   // M's new row would be [N_A' H^-1 n_c; n_c' H^-1 n_c]: l = L^-1 N_A' H^-1 n_c (into b_) and the
   // new diagonal's square d² = n_c' H^-1 n_c - |l|², the part of n_c outside the active normals' span.
   const Eigen::Ref<const Eigen::VectorXd> v = Response(c.index);
-  for (int j = 0; j < q_; ++j) b_[j] = active_[j].sign * c.sign * v[active_[j].index];
-  auto l = b_.head(q_);
-  L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().solveInPlace(l);
-  return v[c.index] - l.squaredNorm();
+  const int q = set_.size();
+  for (int j = 0; j < q; ++j) b_[j] = set_[j].sign * c.sign * v[set_[j].index];
+  auto l = b_.head(q);
+  L_.topLeftCorner(q, q).triangularView<Eigen::Lower>().solveInPlace(l);
+  d2_ = v[c.index] - l.squaredNorm();
 }
 
-bool RiccatiQpSolver::IsIndependent(const Side& c, double d2) const {
-  return d2 > kDependence * responses_(c.index, c.index);
-}
+bool RiccatiQpSolver::IsIndependent(const Side& c) const { return d2_ > kDependence * responses_(c.index, c.index); }
 
-bool RiccatiQpSolver::AppendToActiveSet(const Side& c, double d2) {
+bool RiccatiQpSolver::AddToFactor(const Side& c) {
   // At most N nu normals are independent; rounding may pass one more through the test, never more
   // than the factor's rows.
-  if (q_ >= static_cast<int>(L_.rows()) || !IsIndependent(c, d2)) return false;
-  L_.row(q_).head(q_) = b_.head(q_).transpose();
-  L_(q_, q_) = std::sqrt(d2);
-  active_.push_back(c);
-  is_active_[2 * c.index + (c.sign < 0)] = 1;
-  ++q_;
+  const int q = set_.size();
+  if (q >= static_cast<int>(L_.rows()) || !IsIndependent(c)) return false;
+  L_.row(q).head(q) = b_.head(q).transpose();
+  L_(q, q) = std::sqrt(d2_);
   return true;
 }
 
-void RiccatiQpSolver::DropFromActiveSet(int position) {
-  const Side c = active_[position];
-  is_active_[2 * c.index + (c.sign < 0)] = 0;
-  active_.erase(active_.begin() + position);
-  for (int j = position; j < q_ - 1; ++j) multipliers_[j] = multipliers_[j + 1];
+void RiccatiQpSolver::DropFromFactor(int position) {
   // Without row and column `position`, M's factor keeps its rows above; below, the trailing block
   // T (rows and columns after `position`) must factorise T T' + x x' with x the dropped column's
   // part below the diagonal: a rank-one update by rotations, then everything moves up and left.
-  const int m = q_ - 1 - position, first = position + 1;
+  const int q = set_.size();
+  const int m = q - 1 - position, first = position + 1;
   auto x = update_.head(m);
   x = L_.col(position).segment(first, m);
   for (int k = 0; k < m; ++k) {
@@ -293,96 +284,45 @@ void RiccatiQpSolver::DropFromActiveSet(int position) {
       x[i] = cs * x[i] - sn * lik;
     }
   }
-  for (int i = first; i < q_; ++i) {
+  for (int i = first; i < q; ++i) {
     L_.row(i - 1).head(position) = L_.row(i).head(position);
     L_.row(i - 1).segment(position, i - position) = L_.row(i).segment(first, i - position);
   }
-  L_.row(q_ - 1).head(q_).setZero();
-  --q_;
+  L_.row(q - 1).head(q).setZero();
 }
 
-void RiccatiQpSolver::MinimiseOnActiveSet() {
-  // On the active sides as equalities the minimum is w = w0 + V λ with V = H^-1 N and λ the
-  // multipliers, M λ = b_A - N_A' w0 (Goldfarb and Idnani's start from an S-pair): drop the most
-  // negative multiplier until none is left.
-  while (true) {
-    auto lambda = multipliers_.head(q_);
-    for (int j = 0; j < q_; ++j) lambda[j] = SignedBound(active_[j]) - active_[j].sign * w0_[active_[j].index];
-    const auto L = L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>();
-    L.solveInPlace(lambda);
-    L.transpose().solveInPlace(lambda);
-    w_ = w0_;
-    for (int j = 0; j < q_; ++j) w_ += (lambda[j] * active_[j].sign) * Response(active_[j].index);
-    int most_negative = -1;
-    for (int j = 0; j < q_; ++j) {
-      if (lambda[j] < 0.0 && (most_negative < 0 || lambda[j] < lambda[most_negative])) most_negative = j;
-    }
-    if (most_negative < 0) return;
-    DropFromActiveSet(most_negative);
-  }
+void RiccatiQpSolver::MinimiseOnFactor(Eigen::Ref<Eigen::VectorXd> lambda) {
+  const int q = set_.size();
+  for (int j = 0; j < q; ++j) lambda[j] = SignedBound(set_[j]) - set_[j].sign * w0_[set_[j].index];
+  const auto L = L_.topLeftCorner(q, q).triangularView<Eigen::Lower>();
+  L.solveInPlace(lambda);
+  L.transpose().solveInPlace(lambda);
+  w_ = w0_;
+  for (int j = 0; j < q; ++j) w_ += (lambda[j] * set_[j].sign) * Response(set_[j].index);
+}
+
+internal::Direction RiccatiQpSolver::MakeDirection(const Side& p, Eigen::Ref<Eigen::VectorXd> r) {
+  // The dual direction r = M^-1 N_A' H^-1 n_p = L^-T l and the primal one H^-1 n_p - V r; b_ keeps
+  // l for p's row of the factor should p be added.
+  const int q = set_.size();
+  SchurComplementRow(p);
+  r = b_.head(q);
+  L_.topLeftCorner(q, q).triangularView<Eigen::Lower>().transpose().solveInPlace(r);
+  step_ = p.sign * responses_.col(p.index);
+  for (int j = 0; j < q; ++j) step_ -= (r[j] * set_[j].sign) * Response(set_[j].index);
+  return {.independent = IsIndependent(p), .normal_dot_step = p.sign * step_[p.index]};
 }
 
 QpStatus RiccatiQpSolver::Iterate() {
-  const double tol = options_.feasibility_tolerance;
-  while (true) {
-    // The most violated side that is not active.
-    Side p{-1, 0.0};
-    double worst = -tol;
-    for (int i = 0; i < nc_; ++i) {
-      if (w_[i] - lower_[i] < worst && !is_active_[2 * i]) {
-        worst = w_[i] - lower_[i];
-        p = {i, 1.0};
-      }
-      if (upper_[i] - w_[i] < worst && !is_active_[2 * i + 1]) {
-        worst = upper_[i] - w_[i];
-        p = {i, -1.0};
-      }
-    }
-    if (p.index < 0) return QpStatus::kSolved;
-
-    double slack = worst;
-    double u_p = 0.0;
-    while (true) {
-      if (iterations_ >= options_.max_iterations) return QpStatus::kMaxIterations;
-      // The dual direction r = M^-1 N_A' H^-1 n_p = L^-T l and the primal one H^-1 n_p - V r; b_
-      // keeps l for p's row of the factor should p be added below.
-      const double d2 = SchurComplementRow(p);
-      r_.head(q_) = b_.head(q_);
-      L_.topLeftCorner(q_, q_).triangularView<Eigen::Lower>().transpose().solveInPlace(r_.head(q_));
-      step_ = p.sign * responses_.col(p.index);
-      for (int j = 0; j < q_; ++j) step_ -= (r_[j] * active_[j].sign) * Response(active_[j].index);
-      double t1 = kInf;
-      int drop = -1;
-      for (int j = 0; j < q_; ++j) {
-        if (r_[j] > 0.0 && multipliers_[j] / r_[j] < t1) {
-          t1 = multipliers_[j] / r_[j];
-          drop = j;
-        }
-      }
-      const double ns = p.sign * step_[p.index];
-      const bool primal_step = IsIndependent(p, d2) && ns > 0.0;
-      const double t2 = primal_step ? -slack / ns : kInf;
-      const double t = std::min(t1, t2);
-      if (!std::isfinite(t)) return QpStatus::kInfeasible;
-      ++iterations_;
-      multipliers_.head(q_) -= t * r_.head(q_);
-      u_p += t;
-      if (!primal_step) {
-        DropFromActiveSet(drop);  // dual step only: make room for p
-        continue;
-      }
-      w_ += t * step_;
-      if (t2 <= t1) {
-        // Independent by the test above: only a full factor refuses it.
-        if (!AppendToActiveSet(p, d2)) return QpStatus::kNumericalFailure;
-        multipliers_[q_ - 1] = u_p;
-        break;
-      }
-      DropFromActiveSet(drop);
-      slack = p.sign * w_[p.index] - SignedBound(p);
-    }
-    if (!w_.allFinite()) return QpStatus::kNumericalFailure;
+  set_.MinimiseOnActiveSet(*this);
+  QpStatus status = set_.Iterate(*this, options_);
+  if (status == QpStatus::kSolved) {
+    // The iterate accumulated its steps' rounding: the minimum on the final active set, computed
+    // afresh, and the iterations again should that have moved a side past its bound.
+    set_.MinimiseOnActiveSet(*this);
+    status = set_.Iterate(*this, options_);
   }
+  return status;
 }
 
 template <int NX, int NU>
@@ -397,9 +337,9 @@ void RiccatiQpSolver::ExpandTrajectory(const Eigen::VectorXd& x0) {
   const std::vector<int>& idx = dims_.state_bound_index;
   for (int k = 0; k < N; ++k) y_u_[k].setZero();
   for (int k = 0; k <= N; ++k) y_x_[k].setZero();
-  for (int j = 0; j < q_; ++j) {
-    const Side& c = active_[j];
-    const double y = c.sign * multipliers_[j];
+  for (int j = 0; j < set_.size(); ++j) {
+    const Side& c = set_[j];
+    const double y = c.sign * set_.multipliers()[j];
     if (c.index < N * nu) {
       y_u_[c.index / nu][c.index % nu] += y;
     } else {
@@ -446,11 +386,7 @@ void RiccatiQpSolver::ExpandTrajectory(const Eigen::VectorXd& x0) {
   }
 }
 
-void RiccatiQpSolver::ClearActiveSet() {
-  q_ = 0;
-  active_.clear();
-  std::fill(is_active_.begin(), is_active_.end(), 0);
-}
+void RiccatiQpSolver::ClearActiveSet() { set_.Clear(); }
 
 const OcpQpSummary& RiccatiQpSolver::Fail(QpStatus status) {
   for (auto& u : u_) u.setZero();
@@ -458,7 +394,7 @@ const OcpQpSummary& RiccatiQpSolver::Fail(QpStatus status) {
   for (auto& y : y_u_) y.setZero();
   for (auto& y : y_x_) y.setZero();
   ClearActiveSet();
-  previous_.clear();
+  set_.Forget();
   summary_.status = status;
   return summary_;
 }
@@ -513,12 +449,14 @@ const OcpQpSummary& RiccatiQpSolver::Prepare(const OcpQp& qp, bool whole) {
   // kept, the active set and its Schur complement are kept too.
   if (whole) {
     ClearActiveSet();
-    start_ = previous_.empty() ? QpStart::kCold : QpStart::kWarm;
-    for (const Side& c : previous_) {
-      if (std::isfinite(SignedBound(c)) && !IsFixed(c.index)) AppendToActiveSet(c, SchurComplementRow(c));
+    start_ = set_.previous().empty() ? QpStart::kCold : QpStart::kWarm;
+    for (const Side& c : set_.previous()) {
+      if (!std::isfinite(SignedBound(c)) || IsFixed(c.index)) continue;
+      SchurComplementRow(c);
+      set_.Add(*this, c);  // refused when dependent on those added
     }
   } else {
-    start_ = q_ > 0 ? QpStart::kHot : QpStart::kCold;
+    start_ = set_.size() > 0 ? QpStart::kHot : QpStart::kCold;
   }
   prepared_ = true;
   summary_.prepare_time_s = clock.seconds();
@@ -548,33 +486,24 @@ const OcpQpSummary& RiccatiQpSolver::Feedback(const Eigen::VectorXd& x0) {
   }
   if (!w0_.allFinite()) return finish(QpStatus::kNumericalFailure);
   summary_.start = start_;
-  iterations_ = 0;
+  set_.ResetIterations();
   // A side whose bound is now infinite binds no more; one whose input is now fixed holds by
   // construction.
-  for (int j = q_ - 1; j >= 0; --j) {
-    if (!std::isfinite(SignedBound(active_[j])) || IsFixed(active_[j].index)) DropFromActiveSet(j);
-  }
-  MinimiseOnActiveSet();
-  QpStatus status = Iterate();
-  if (status == QpStatus::kSolved) {
-    // The iterate accumulated its steps' rounding: the minimum on the final active set, computed
-    // afresh, and the iterations again should that have moved a side past its bound.
-    MinimiseOnActiveSet();
-    status = Iterate();
-  }
+  set_.DropWhere(*this, [&](const Side& c) { return !std::isfinite(SignedBound(c)) || IsFixed(c.index); });
+  const QpStatus status = Iterate();
   if (status == QpStatus::kNumericalFailure || !w_.allFinite()) return finish(QpStatus::kNumericalFailure);
   if (nmpc_sizes_) {
     ExpandTrajectory<17, 4>(x0);
   } else {
     ExpandTrajectory<Eigen::Dynamic, Eigen::Dynamic>(x0);
   }
-  summary_.iterations = iterations_;
-  summary_.active_constraints = q_ + static_cast<int>(std::count(fixed_.begin(), fixed_.end(), 1));
+  summary_.iterations = set_.iterations();
+  summary_.active_constraints = set_.size() + static_cast<int>(std::count(fixed_.begin(), fixed_.end(), 1));
   if (status == QpStatus::kSolved && options_.warm_start) {
-    previous_.assign(active_.begin(), active_.end());
+    set_.Remember();
     start_ = QpStart::kHot;  // a feedback again on this preparation starts from this set
   } else {
-    previous_.clear();
+    set_.Forget();
     ClearActiveSet();
     start_ = QpStart::kCold;
   }

@@ -166,8 +166,8 @@ DenseQp Perturbed(const DenseQp& qp, double scale, Rng& rng) {
 }
 
 /// Options of a solver that starts every solve from the unconstrained minimum: the comparison.
-DenseQpOptions ColdStarts() {
-  DenseQpOptions options;
+ActiveSetOptions ColdStarts() {
+  ActiveSetOptions options;
   options.warm_start = false;
   return options;
 }

@@ -495,7 +495,7 @@ TEST(RiccatiQp, AWarmStartReachesTheColdSolutionInFewerIterations) {
   // the previous active set, the solution is the cold one.
   Rng rng(47);
   const OcpQp base = OcpPulledAgainstItsStateBounds(10, 6, 3, {0, 3}, rng);
-  DenseQpOptions cold_options;
+  ActiveSetOptions cold_options;
   cold_options.warm_start = false;
   RiccatiQpSolver warm(base.dims), cold(base.dims, cold_options);
   int warm_iterations = 0, cold_iterations = 0;

@@ -11,51 +11,24 @@
 /// NMPC QP (80 variables) where few constraints are active, as qpOASES does for ACADO (paper 000).
 ///
 /// A sequence of similar QPs (the NMPC's calls at 200 Hz) starts each solve from the previous
-/// solve's active set (DenseQpOptions::warm_start): the method may start from any active set whose
+/// solve's active set (ActiveSetOptions::warm_start): the method may start from any active set whose
 /// equality-constrained minimum has non-negative multipliers (Goldfarb and Idnani's S-pair), so the
 /// previous set is taken, its minimum for the new g and bounds computed from the factorisation, and
-/// constraints whose multipliers turn negative dropped before the usual iterations.
+/// constraints whose multipliers turn negative dropped before the usual iterations. With its
+/// factorisation kept when no Factorize came in between and the active constraints' rows of C are
+/// unchanged, a start is hot (no Givens sweep for the constraints that stay); else the set is
+/// rebuilt from J0 (warm: the bounds active when Factorize ran were ordered last and need no
+/// rotation, the set's other constraints are added). The iterations themselves are the shared
+/// core's (active_set.h); this class is its factorisation.
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "rotorguard/control/active_set.h"
+
 namespace rotorguard::control {
-
-struct DenseQpOptions {
-  /// Largest violation of a constraint accepted at the solution (absolute, in the constraint's
-  /// units); > 0.
-  double feasibility_tolerance = 1e-9;
-  /// Cap on active-set changes (adds plus drops); >= 1.
-  int max_iterations = 1000;
-  /// Start from the previous solve's active set (after a solve that succeeded): with its
-  /// factorisation J, R kept when no Factorize came in between and the active constraints' rows
-  /// of C are unchanged (a hot start: no Givens sweep for the constraints that stay), else rebuilt
-  /// from J0 (a warm start: the bounds active when Factorize ran were ordered last and need no
-  /// rotation, the set's other constraints are added). The solution is a cold start's up to
-  /// feasibility_tolerance (the iterations stop at the first point within it); only the work to
-  /// reach it differs (docs/control.md).
-  bool warm_start = true;
-  void Validate() const;
-};
-
-enum class QpStatus {
-  kNotSolved,          ///< Solve() was not called
-  kSolved,             ///< optimal within tolerance
-  kMaxIterations,      ///< stopped at max_iterations; the iterate is not optimal
-  kInfeasible,         ///< the constraints admit no point
-  kNumericalFailure,   ///< H not positive definite, or non-finite data
-};
-std::string_view ToString(QpStatus status);
-
-/// How a solve started (DenseQpOptions::warm_start).
-enum class QpStart {
-  kCold,  ///< from the unconstrained minimum
-  kWarm,  ///< from the previous active set rebuilt on J0 (after a Factorize, a changed row of C)
-  kHot,   ///< from the previous active set and its kept factorisation
-};
-std::string_view ToString(QpStart start);
 
 struct DenseQpSummary {
   QpStatus status = QpStatus::kNotSolved;
@@ -88,7 +61,7 @@ struct DenseQp {
 class DenseQpSolver {
  public:
   /// Allocates all workspace for problems of n variables and m general constraints.
-  DenseQpSolver(int n, int m, const DenseQpOptions& options = {});
+  DenseQpSolver(int n, int m, const ActiveSetOptions& options = {});
   /// Solves `qp`; the solution is in z() and the multipliers in bound_multipliers() and
   /// constraint_multipliers() (positive at a lower bound, negative at an upper bound; the KKT
   /// stationarity reads H z + g = y_b + C' y_c). Equals Factorize(qp.H) then SolveFactorized(qp).
@@ -105,15 +78,10 @@ class DenseQpSolver {
   const DenseQpSummary& summary() const { return summary_; }
 
  private:
-  // A one-sided constraint s' z >= b: index < n is a bound on z_index; >= n a row of C. sign is
-  // +1 for a lower side, -1 for an upper side.
-  struct Side {
-    int index;
-    double sign;
-  };
+  friend class internal::DualActiveSet;  // calls the factorisation's operations below
+  using Side = internal::Side;  // index < n: a bound on z_index; >= n: row index - n of C
   /// The side's bound in the form s' z >= b: b = sign * (lower or upper bound).
   double SignedBound(const DenseQp& qp, const Side& c) const;
-  double Slack(const DenseQp& qp, const Side& c) const;
   /// order_ and placed_ for the next factorisation: the bounds of the last solve's active set
   /// (a warm start's guess) last.
   void OrderVariables();
@@ -127,20 +95,28 @@ class DenseQpSolver {
   /// The start of the iterations: the kept active set (hot), the previous one added to the new
   /// factorisation (warm) or none (cold); returns which.
   QpStart StartActiveSet(const DenseQp& qp);
-  /// z and u, the minimum on the active constraints held as equalities and its multipliers;
-  /// constraints with a negative multiplier are dropped until none is left.
-  void MinimiseOnActiveSet(const DenseQp& qp);
   /// Keeps what a later hot start needs: the active set of a successful solve and its rows of C.
   void KeepForWarmStart(const DenseQp& qp);
   void ComputeD(const DenseQp& qp, const Side& c);  // d_ = J' n_c
-  double NormalDotStep(const DenseQp& qp, const Side& c) const;
-  void AddToActiveSet(const Side& c);
-  void DropFromActiveSet(int position);
   /// Columns j and j + 1 of J_ times the rotation [cs -sn; sn cs], over their non-zero rows.
   void RotateColumns(int j, double cs, double sn);
 
+  // The factorisation's operations for internal::DualActiveSet (active_set.h), on qp_.
+  void ScanViolations(internal::ViolationSearch& search);
+  internal::Direction MakeDirection(const Side& p, Eigen::Ref<Eigen::VectorXd> r);
+  void TakeStep(double t) { z_ += t * step_; }
+  double Slack(const Side& c) const;
+  bool IterateIsFinite() const { return z_.allFinite(); }
+  /// Rotates d_ = J' n_c (ComputeD) so that R gains a column; never refuses.
+  bool AddToFactor(const Side& c);
+  /// Removes R's column `position`; the Hessenberg rest made triangular by rotations, mirrored on J.
+  void DropFromFactor(int position);
+  /// With J' N = [R; 0] for the active normals N and J J' = H^-1, the minimum on N' z = b is
+  /// z = J1 R^-T b - J2 J2' g, and its multipliers (H z + g = N u) u = R^-1 (R^-T b + J1' g).
+  void MinimiseOnFactor(Eigen::Ref<Eigen::VectorXd> u);
+
   int n_, m_;
-  DenseQpOptions options_;
+  ActiveSetOptions options_;
   Eigen::MatrixXd chol_;   // L with P H P' = L L'
   // J0 = P' L^-T: H^-1 = J0 J0' with the rows in the variables' order. P orders the variables as
   // order_ (position -> variable), with the bounds in placed_ last (OrderVariables).
@@ -157,15 +133,14 @@ class DenseQpSolver {
   // two columns gives both the larger height. The rotations skip the zero rows.
   std::vector<int> height_;
   Eigen::MatrixXd R_;      // upper triangular, q x q in the top-left corner
-  Eigen::VectorXd z_, d_, step_, r_, u_, cz_;
+  Eigen::VectorXd z_, d_, step_, r_, cz_;
   Eigen::VectorXd y_bound_, y_constraint_;
-  std::vector<Side> active_;
-  std::vector<char> is_active_;  // per side: 2 * index + (sign < 0)
-  int q_ = 0;
-  // The last successful solve's active set (a warm start's guess), and whether J_, R_ still hold
-  // its factorisation for the factorised Hessian (a hot start's condition), with its rows of C
-  // (a hot start needs them unchanged) and the hot starts since the set was last built from J0.
-  std::vector<Side> previous_;
+  // The active set, its multipliers and the last successful solve's set (a warm start's guess).
+  internal::DualActiveSet set_;
+  const DenseQp* qp_ = nullptr;  // the problem of the running solve
+  // Whether J_, R_ still hold the factorisation of set_.previous() for the factorised Hessian (a
+  // hot start's condition), with its rows of C (a hot start needs them unchanged) and the hot
+  // starts since the set was last built from J0.
   bool hot_startable_ = false;
   Eigen::MatrixXd previous_rows_;
   int hot_starts_in_a_row_ = 0;

@@ -51,7 +51,7 @@ struct NmpcOptions {
   int relinearise_every = 1;
   /// What the model misses, estimated in flight and predicted with (offset-free NMPC).
   DisturbanceObserverOptions disturbance;
-  DenseQpOptions qp;
+  ActiveSetOptions qp;
   /// The QP solver of each iteration: riccati (the stage form factorised by a Riccati recursion,
   /// the default: faster on average) or condensing (the states eliminated, a dense active-set
   /// solve); the same QP, the same solution (docs/control.md, "Two QP solvers").

@@ -58,7 +58,7 @@ struct OcpQp {
 
 struct OcpQpSummary {
   QpStatus status = QpStatus::kNotSolved;
-  QpStart start = QpStart::kCold;  ///< how the dense solver started (DenseQpOptions::warm_start)
+  QpStart start = QpStart::kCold;  ///< how the dense solver started (ActiveSetOptions::warm_start)
   int iterations = 0;           ///< active-set changes of the dense solver
   int active_constraints = 0;
   double objective = 0.0;
@@ -102,11 +102,11 @@ class OcpQpSolver {
 
 /// The solver `method` names, for `dims`.
 std::unique_ptr<OcpQpSolver> MakeOcpQpSolver(OcpQpMethod method, const OcpQpDims& dims,
-                                             const DenseQpOptions& options = {});
+                                             const ActiveSetOptions& options = {});
 
 class CondensingQpSolver final : public OcpQpSolver {
  public:
-  explicit CondensingQpSolver(const OcpQpDims& dims, const DenseQpOptions& options = {});
+  explicit CondensingQpSolver(const OcpQpDims& dims, const ActiveSetOptions& options = {});
   /// Preparation phase of a real-time iteration: condenses `qp` around its x0 and factorises the
   /// Hessian. Inputs whose bounds coincide (a failed rotor's, u_bar_i = 0) are fixed: they are
   /// eliminated, and the dense QP is solved over the free inputs only (fewer variables, and no
@@ -149,7 +149,7 @@ class CondensingQpSolver final : public OcpQpSolver {
   void ReducedVectors();
 
   OcpQpDims dims_;
-  DenseQpOptions options_;
+  ActiveSetOptions options_;
   // s_rows_[k] = [S_k0 ... S_k,k-1] side by side (nx x k nu), S_kj = dx_k/du_j: one product per
   // stage builds a row of them, and one per input the Hessian's column of blocks.
   std::vector<Eigen::MatrixXd> s_rows_, w_matrix_, y_;

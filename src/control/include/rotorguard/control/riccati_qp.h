@@ -20,7 +20,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "rotorguard/control/dense_qp.h"
+#include "rotorguard/control/active_set.h"
 #include "rotorguard/control/ocp_qp.h"
 
 namespace rotorguard::control {
@@ -29,7 +29,7 @@ class RiccatiQpSolver final : public OcpQpSolver {
  public:
   /// Workspace for problems of `dims`; options.feasibility_tolerance and max_iterations act as for
   /// DenseQpSolver, and warm_start starts each solve from the previous solve's active set.
-  explicit RiccatiQpSolver(const OcpQpDims& dims, const DenseQpOptions& options = {});
+  explicit RiccatiQpSolver(const OcpQpDims& dims, const ActiveSetOptions& options = {});
   /// The factorisation, the cost-to-go's linear terms and, for a warm start, the previous active
   /// set's responses and Schur complement: everything but the forward pass from x0.
   const OcpQpSummary& Prepare(const OcpQp& qp) override;
@@ -47,12 +47,9 @@ class RiccatiQpSolver final : public OcpQpSolver {
   const std::vector<Eigen::VectorXd>& state_multipliers() const { return y_x_; }
 
  private:
-  /// One side of a bound on bounded component `index`: s z[index] >= s * (lower or upper bound),
-  /// with sign s = +1 for the lower side and -1 for the upper side.
-  struct Side {
-    int index;
-    double sign;
-  };
+  friend class internal::DualActiveSet;  // calls the factorisation's operations below
+  /// One side of a bound on bounded component `index`: s z[index] >= s * (lower or upper bound).
+  using Side = internal::Side;
   /// Backward Riccati recursion for the matrices: P_k, the stage's P_{k+1} B_k, the Cholesky
   /// factor of R_k + B_k' P_{k+1} B_k and the feedback gains K_k. False when a stage's reduced
   /// input Hessian is not positive definite or the data are not finite.
@@ -83,19 +80,29 @@ class RiccatiQpSolver final : public OcpQpSolver {
   /// Whether `index` is an input fixed by equal bounds (out of the recursion, never active).
   bool IsFixed(int index) const { return index < dims_.horizon * dims_.nu && fixed_[static_cast<std::size_t>(index)]; }
   double SignedBound(const Side& c) const { return c.sign * (c.sign > 0 ? lower_[c.index] : upper_[c.index]); }
-  /// c's row of the Schur complement's Cholesky factor, l = L^-1 N_A' H^-1 n_c, left in b_; returns
-  /// the square of the new diagonal, d² = n_c' H^-1 n_c - |l|².
-  double SchurComplementRow(const Side& c);
-  /// Whether c's normal, with that d², is independent of the active ones (kDependence).
-  bool IsIndependent(const Side& c, double d2) const;
+  /// c's row of the Schur complement's Cholesky factor, l = L^-1 N_A' H^-1 n_c, left in b_, and the
+  /// square of the new diagonal, d² = n_c' H^-1 n_c - |l|², left in d2_.
+  void SchurComplementRow(const Side& c);
+  /// Whether c's normal, with the d² of SchurComplementRow(c), is independent of the active ones
+  /// (kDependence).
+  bool IsIndependent(const Side& c) const;
+
+  // The factorisation's operations for internal::DualActiveSet (active_set.h).
+  void ScanViolations(internal::ViolationSearch& search) const { search.Scan(w_, lower_, upper_, 0); }
+  internal::Direction MakeDirection(const Side& p, Eigen::Ref<Eigen::VectorXd> r);
+  void TakeStep(double t) { w_ += t * step_; }
+  double Slack(const Side& c) const { return c.sign * w_[c.index] - SignedBound(c); }
+  bool IterateIsFinite() const { return w_.allFinite(); }
   /// Appends c with the row SchurComplementRow(c) left in b_. False (nothing added) when c is
   /// dependent on the active sides or the factor is full.
-  bool AppendToActiveSet(const Side& c, double d2);
-  void DropFromActiveSet(int position);
-  /// w_ and multipliers_ the minimum with the active sides held as equalities; sides with a
-  /// negative multiplier are dropped until none is left.
-  void MinimiseOnActiveSet();
-  /// The Goldfarb-Idnani iterations from the current active set; the status they end with.
+  bool AddToFactor(const Side& c);
+  /// M's factor without row and column `position`: a rank-one update of the trailing block.
+  void DropFromFactor(int position);
+  /// On the active sides as equalities the minimum is w = w0 + V λ with V = H^-1 N and λ the
+  /// multipliers, M λ = b_A - N_A' w0.
+  void MinimiseOnFactor(Eigen::Ref<Eigen::VectorXd> lambda);
+  /// The iterations from the start's S-pair, then again from the minimum on the final set computed
+  /// afresh; the status they end with.
   QpStatus Iterate();
   /// u_, x_, the multipliers and the summary's objective and violation from w_ and x0.
   template <int NX, int NU>
@@ -104,7 +111,7 @@ class RiccatiQpSolver final : public OcpQpSolver {
   const OcpQpSummary& Fail(QpStatus status);
 
   OcpQpDims dims_;
-  DenseQpOptions options_;
+  ActiveSetOptions options_;
   int nbx_ = 0, nc_ = 0;  // bounded states per stage; bounded components N nu + N nbx
   bool nmpc_sizes_ = false;
   const OcpQp* qp_ = nullptr;  // the prepared problem
@@ -127,14 +134,12 @@ class RiccatiQpSolver final : public OcpQpSolver {
   Eigen::VectorXd lower_, upper_, w0_, w_, step_;
   Eigen::MatrixXd responses_;
   std::vector<char> have_response_;
-  // The active set: its sides, their multipliers, the lower Cholesky factor L of M = N' H^-1 N,
-  // and per side (2 * index + (sign < 0)) whether it is active.
-  std::vector<Side> active_, previous_;
+  // The active set with its multipliers and the last solve's set, and the lower Cholesky factor L
+  // of M = N' H^-1 N; b_ and d2_ the last SchurComplementRow.
+  internal::DualActiveSet set_;
   Eigen::MatrixXd L_;
-  Eigen::VectorXd multipliers_, b_, r_, update_;
-  std::vector<char> is_active_;
-  int q_ = 0;
-  int iterations_ = 0;
+  Eigen::VectorXd b_, update_;
+  double d2_ = 0.0;
 };
 
 }  // namespace rotorguard::control

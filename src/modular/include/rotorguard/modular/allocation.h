@@ -52,7 +52,7 @@ struct AllocatorOptions {
   double regularisation = 1e-6;
   /// Rotors whose eta is at most this deliver nothing and are left out (dead units, lost props).
   double dead_eta = 1e-3;
-  control::DenseQpOptions qp;
+  control::ActiveSetOptions qp;
   /// Throws ValidationError naming the field.
   void Validate() const;
   /// The keys of this struct in config files (core/config_schema.h).
