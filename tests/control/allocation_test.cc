@@ -1,56 +1,22 @@
-// The control-rate path allocates nothing once warmed up (STYLE.md, "Model / Data"): malloc is
-// interposed in this test executable (glibc's own allocator does the work) and counted while the
-// NMPC, its QP solvers and the fault detector run; and in the planner's inner loop, the trajectory
-// optimiser's cost and gradient (hundreds of evaluations a solve).
+// The control-rate path allocates nothing once warmed up: malloc is interposed in this test
+// executable (allocation_counter.h) and counted while the NMPC, its QP solvers and the fault
+// detector run; and in the planner's inner loop, the trajectory optimiser's cost and gradient
+// (hundreds of evaluations a solve). Each QP solver alone: qp_contract_test.cc.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstddef>
+#include <cmath>
 
+#include "allocation_counter.h"
 #include "rotorguard/control/nmpc.h"
 #include "rotorguard/fdd/composite_fdd.h"
 #include "rotorguard/planning/references.h"
 #include "rotorguard/planning/trajectory_optimizer.h"
 #include "vehicle_fixture.h"
 
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void* __libc_calloc(std::size_t count, std::size_t size);
-void* __libc_realloc(void* pointer, std::size_t size);
-}
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-extern "C" {
-void* malloc(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t count, std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(count, size);
-}
-void* realloc(void* pointer, std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(pointer, size);
-}
-}
-
 namespace rotorguard::control {
 namespace {
 
-/// Counts the allocations made by `f`.
-template <typename F>
-long CountAllocations(F&& f) {
-  g_allocations = 0;
-  g_counting = true;
-  f();
-  g_counting = false;
-  return g_allocations;
-}
+using rotorguard::testing::CountAllocations;
 
 TEST(Allocation, TheCounterSeesAllocations) {
   // The counter itself must work, or the zero counts below would prove nothing.

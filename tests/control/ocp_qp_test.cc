@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rotorguard/control/riccati_qp.h"
+#include "ocp_qp_oracle.h"
 #include "rotorguard/core/rng.h"
 #include "test_util.h"
 
@@ -19,105 +20,6 @@ namespace rotorguard::control {
 namespace {
 
 using rotorguard::testing::MatricesNear;
-
-Eigen::MatrixXd RandomMatrix(int r, int c, Rng& rng, double scale = 1.0) {
-  Eigen::MatrixXd m(r, c);
-  for (int i = 0; i < r; ++i)
-    for (int j = 0; j < c; ++j) m(i, j) = scale * rng.Normal();
-  return m;
-}
-
-/// A random time-varying OCP QP with state bounds on `bounded` and input bounds that bind.
-OcpQp RandomOcp(int N, int nx, int nu, std::vector<int> bounded, Rng& rng) {
-  OcpQpDims dims{N, nx, nu, bounded};
-  OcpQp qp(dims);
-  qp.x0 = RandomMatrix(nx, 1, rng, 2.0);
-  for (int k = 0; k < N; ++k) {
-    qp.A[k] = Eigen::MatrixXd::Identity(nx, nx) + RandomMatrix(nx, nx, rng, 0.15);
-    qp.B[k] = RandomMatrix(nx, nu, rng, 0.5);
-    qp.c[k] = RandomMatrix(nx, 1, rng, 0.1);
-    const Eigen::MatrixXd M = RandomMatrix(nu, nu, rng);
-    qp.R[k] = M * M.transpose() + 0.2 * Eigen::MatrixXd::Identity(nu, nu);
-    qp.r[k] = RandomMatrix(nu, 1, rng, 0.3);
-    qp.u_lower[k].setConstant(-0.6);
-    qp.u_upper[k].setConstant(0.6);
-  }
-  for (int k = 0; k <= N; ++k) {
-    const Eigen::MatrixXd M = RandomMatrix(nx, nx, rng);
-    qp.Q[k] = M * M.transpose() + 0.1 * Eigen::MatrixXd::Identity(nx, nx);
-    qp.q[k] = RandomMatrix(nx, 1, rng, 0.3);
-    qp.x_lower[k].setConstant(-1.5);
-    qp.x_upper[k].setConstant(1.5);
-  }
-  return qp;
-}
-
-/// RandomOcp with mild dynamics from a small start and a cost that pulls states 0 and 3 to +-4,
-/// beyond the bounds' +-1.5, so that state bounds bind.
-OcpQp OcpPulledAgainstItsStateBounds(int N, int nx, int nu, std::vector<int> bounded, Rng& rng) {
-  OcpQp qp = RandomOcp(N, nx, nu, std::move(bounded), rng);
-  qp.x0 *= 0.1;
-  Eigen::VectorXd target = Eigen::VectorXd::Zero(nx);
-  target[0] = 4.0;
-  target[3] = -4.0;
-  for (int k = 0; k < N; ++k) {
-    qp.A[k] = Eigen::MatrixXd::Identity(nx, nx) + 0.02 * (qp.A[k] - Eigen::MatrixXd::Identity(nx, nx));
-    qp.B[k] *= 4.0;
-    qp.c[k].setZero();
-  }
-  for (int k = 0; k <= N; ++k) qp.q[k] = -qp.Q[k] * target;
-  return qp;
-}
-
-/// States of a trajectory at their +-1.5 bound (stages 1..N, the bounded indices).
-int StateBoundsAtTheirLimit(const std::vector<Eigen::VectorXd>& x, const std::vector<int>& bounded) {
-  int binding = 0;
-  for (std::size_t k = 1; k < x.size(); ++k) {
-    for (int b : bounded) binding += std::abs(std::abs(x[k][b]) - 1.5) < 1e-7;
-  }
-  return binding;
-}
-
-/// Condensing done the naive way: the prediction matrix built from explicit products, the Hessian
-/// as Gamma' Qbig Gamma + Rbig. An oracle independent of the solver's recursions.
-void NaiveCondense(const OcpQp& qp, Eigen::MatrixXd* H, Eigen::VectorXd* g, Eigen::MatrixXd* C, Eigen::VectorXd* lc,
-                   Eigen::VectorXd* uc) {
-  const int N = qp.dims.horizon, nx = qp.dims.nx, nu = qp.dims.nu;
-  const int nbx = static_cast<int>(qp.dims.state_bound_index.size());
-  Eigen::MatrixXd gamma = Eigen::MatrixXd::Zero(N * nx, N * nu);  // rows: x_1 .. x_N
-  Eigen::VectorXd free = Eigen::VectorXd::Zero(N * nx);
-  Eigen::VectorXd x = qp.x0;
-  for (int k = 0; k < N; ++k) {
-    x = qp.A[k] * x + qp.c[k];
-    free.segment(k * nx, nx) = x;
-    for (int j = 0; j <= k; ++j) {
-      Eigen::MatrixXd phi = Eigen::MatrixXd::Identity(nx, nx);
-      for (int m = j + 1; m <= k; ++m) phi = qp.A[m] * phi;
-      gamma.block(k * nx, j * nu, nx, nu) = phi * qp.B[j];
-    }
-  }
-  Eigen::MatrixXd qbig = Eigen::MatrixXd::Zero(N * nx, N * nx), rbig = Eigen::MatrixXd::Zero(N * nu, N * nu);
-  Eigen::VectorXd qvec(N * nx), rvec(N * nu);
-  for (int k = 0; k < N; ++k) {
-    qbig.block(k * nx, k * nx, nx, nx) = qp.Q[k + 1];
-    qvec.segment(k * nx, nx) = qp.q[k + 1];
-    rbig.block(k * nu, k * nu, nu, nu) = qp.R[k];
-    rvec.segment(k * nu, nu) = qp.r[k];
-  }
-  *H = gamma.transpose() * qbig * gamma + rbig;
-  *g = gamma.transpose() * (qbig * free + qvec) + rvec;
-  C->resize(N * nbx, N * nu);
-  lc->resize(N * nbx);
-  uc->resize(N * nbx);
-  for (int k = 0; k < N; ++k) {
-    for (int b = 0; b < nbx; ++b) {
-      const int i = qp.dims.state_bound_index[b];
-      C->row(k * nbx + b) = gamma.row(k * nx + i);
-      (*lc)[k * nbx + b] = qp.x_lower[k + 1][b] - free[k * nx + i];
-      (*uc)[k * nbx + b] = qp.x_upper[k + 1][b] - free[k * nx + i];
-    }
-  }
-}
 
 /// The solver's condensed problem equals the naive construction, to rounding.
 void ExpectCondensedEqualsNaive(const OcpQp& qp) {
@@ -398,73 +300,20 @@ TEST(CondensingQp, RejectsMismatchedDimensionsAndBadDims) {
 
 // ---- RiccatiQpSolver: the stage form, against oracles independent of its recursions.
 
-/// Checks the KKT conditions of `qp`, condensed the naive way, at the solver's inputs and
-/// multipliers: feasibility, stationarity H u + g = y_u + C' y_x, and multipliers that are zero off
-/// their bounds and of the right sign on them. For a strictly convex QP they define the optimum.
-/// Returns the number of bounds active at the point.
+/// ExpectKktOfTheNaiveCondensing at the Riccati solver's inputs and multipliers, and its states the
+/// inputs' trajectory, exactly. Returns the number of bounds active at the point.
 int ExpectKktOfTheNaiveCondensing(const OcpQp& qp, const RiccatiQpSolver& solver) {
   const int N = qp.dims.horizon, nu = qp.dims.nu, nbx = static_cast<int>(qp.dims.state_bound_index.size());
-  Eigen::MatrixXd H, C;
-  Eigen::VectorXd g, lc, uc;
-  NaiveCondense(qp, &H, &g, &C, &lc, &uc);
   Eigen::VectorXd u(N * nu), yu(N * nu), yx(N * nbx);
   for (int k = 0; k < N; ++k) {
     u.segment(k * nu, nu) = solver.u()[k];
     yu.segment(k * nu, nu) = solver.input_multipliers()[k];
     yx.segment(k * nbx, nbx) = solver.state_multipliers()[k + 1];
   }
-  const Eigen::VectorXd residual = H * u + g - yu - C.transpose() * yx;
-  EXPECT_LE(residual.cwiseAbs().maxCoeff(), 1e-8 * (1.0 + g.cwiseAbs().maxCoeff())) << "stationarity";
-  const Eigen::VectorXd cu = C * u;
-  int active = 0;
-  // A side is "at" its bound within kAt; a multiplier above kZero must sit on its side's bound.
-  constexpr double kAt = 1e-8, kZero = 1e-9;
-  const auto check = [&](double value, double lower, double upper, double y, const std::string& what) {
-    EXPECT_GE(value, lower - kAt) << what;
-    EXPECT_LE(value, upper + kAt) << what;
-    if (y > kZero) {
-      EXPECT_NEAR(value, lower, kAt) << what << ": a positive multiplier off the lower bound";
-    }
-    if (y < -kZero) {
-      EXPECT_NEAR(value, upper, kAt) << what << ": a negative multiplier off the upper bound";
-    }
-    active += std::abs(value - lower) < kAt || std::abs(value - upper) < kAt;
-  };
-  for (int k = 0; k < N; ++k) {
-    for (int i = 0; i < nu; ++i) {
-      check(u[k * nu + i], qp.u_lower[k][i], qp.u_upper[k][i], yu[k * nu + i], fmt::format("u_{}[{}]", k, i));
-    }
-  }
-  for (int r = 0; r < N * nbx; ++r) check(cu[r], lc[r], uc[r], yx[r], fmt::format("state bound row {}", r));
-  // The returned states are the inputs' trajectory, exactly.
   for (int k = 0; k < N; ++k) {
     EXPECT_TRUE(MatricesNear(solver.x()[k + 1], qp.A[k] * solver.x()[k] + qp.B[k] * solver.u()[k] + qp.c[k], 1e-12));
   }
-  return active;
-}
-
-TEST(RiccatiQp, SolutionsSatisfyTheKktConditionsOfTheNaivelyCondensedQp) {
-  Rng rng(41);
-  int binding = 0, problems = 0;
-  for (int trial = 0; trial < 30; ++trial) {
-    // Input bounds bind in the first kind (random dynamics with state bounds are mostly
-    // infeasible), input and state bounds in the second; the third is the NMPC's size (the
-    // compile-time-sized code path).
-    const OcpQp qp = trial % 3 == 0   ? RandomOcp(8, 5, 2, {}, rng)
-                     : trial % 3 == 1 ? OcpPulledAgainstItsStateBounds(10, 6, 3, {0, 3}, rng)
-                                      : OcpPulledAgainstItsStateBounds(12, 17, 4, {0, 3, 10}, rng);
-    RiccatiQpSolver solver(qp.dims);
-    const OcpQpSummary& s = solver.Solve(qp);
-    ASSERT_TRUE(s.IsSolutionUsable()) << "trial " << trial << ": " << s.BriefReport();
-    SCOPED_TRACE(fmt::format("trial {}", trial));
-    const int active = ExpectKktOfTheNaiveCondensing(qp, solver);
-    EXPECT_EQ(active, s.active_constraints);
-    EXPECT_LE(s.max_violation, 1e-8);
-    binding += active;
-    ++problems;
-  }
-  EXPECT_EQ(problems, 30);
-  EXPECT_GT(binding, 100) << "the problems must exercise the bounds";
+  return ExpectKktOfTheNaiveCondensing(qp, u, yu, yx);
 }
 
 TEST(RiccatiQp, UnconstrainedSolutionEqualsTheCondensingSolvers) {
@@ -488,32 +337,6 @@ TEST(RiccatiQp, UnconstrainedSolutionEqualsTheCondensingSolvers) {
       EXPECT_TRUE(MatricesNear(riccati.u()[k], condensing.u()[k], 1e-8 * (1.0 + condensing.u()[k].norm())));
     }
   }
-}
-
-TEST(RiccatiQp, AWarmStartReachesTheColdSolutionInFewerIterations) {
-  // A sequence of QPs with the initial state moving a little, as the NMPC's calls: started from
-  // the previous active set, the solution is the cold one.
-  Rng rng(47);
-  const OcpQp base = OcpPulledAgainstItsStateBounds(10, 6, 3, {0, 3}, rng);
-  ActiveSetOptions cold_options;
-  cold_options.warm_start = false;
-  RiccatiQpSolver warm(base.dims), cold(base.dims, cold_options);
-  int warm_iterations = 0, cold_iterations = 0;
-  for (int step = 0; step < 10; ++step) {
-    OcpQp qp = base;
-    qp.x0 = base.x0 + 0.02 * step * Eigen::VectorXd::Ones(6);
-    const OcpQpSummary& w = warm.Solve(qp);
-    const OcpQpSummary& c = cold.Solve(qp);
-    ASSERT_TRUE(w.IsSolutionUsable() && c.IsSolutionUsable());
-    EXPECT_EQ(w.start, step == 0 ? QpStart::kCold : QpStart::kWarm);
-    EXPECT_EQ(c.start, QpStart::kCold);
-    for (int k = 0; k < 10; ++k) EXPECT_TRUE(MatricesNear(warm.u()[k], cold.u()[k], 1e-9)) << "step " << step;
-    if (step > 0) {
-      warm_iterations += w.iterations;
-      cold_iterations += c.iterations;
-    }
-  }
-  EXPECT_LT(warm_iterations, cold_iterations / 2);
 }
 
 TEST(RiccatiQp, BoundsWhoseNormalsAreDependentAreHandled) {
@@ -582,43 +405,13 @@ TEST(RiccatiQp, InputsFixedByEqualBoundsAreHeldExactlyAndTheKktConditionsHold) {
   EXPECT_EQ(compared, 5);
 }
 
-TEST(RiccatiQp, ReportsInfeasibleBoundsAndRejectsBadData) {
+TEST(RiccatiQp, RejectsMismatchedDimensions) {
+  // The solvers' shared contract (KKT against Ipopt, warm starts, infeasibility, bad data):
+  // qp_contract_test.cc.
   Rng rng(59);
-  const OcpQp base = OcpPulledAgainstItsStateBounds(5, 4, 2, {0}, rng);
-  RiccatiQpSolver solver(base.dims);
-  {  // crossed bounds
-    OcpQp qp = base;
-    qp.u_lower[2][1] = 1.0;
-    qp.u_upper[2][1] = 0.5;
-    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kInfeasible);
-  }
-  {  // a state bound no admissible input reaches: x_1 depends on u_0 alone, |u_0| <= 0.6
-    OcpQp qp = base;
-    const double reachable = (qp.A[0] * qp.x0 + qp.c[0])[0] + qp.B[0].row(0).cwiseAbs().sum() * 0.6;
-    qp.x_lower[1][0] = reachable + 1.0;
-    qp.x_upper[1][0] = reachable + 2.0;
-    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kInfeasible);
-  }
-  for (int bad = 0; bad < 3; ++bad) {
-    OcpQp qp = base;
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    if (bad == 0) qp.A[3](1, 2) = nan;
-    if (bad == 1) qp.u_lower[0][0] = nan;
-    if (bad == 2) qp.x0[1] = nan;
-    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure) << "bad " << bad;
-    for (const auto& u : solver.u()) EXPECT_TRUE(u.allFinite());
-    for (const auto& x : solver.x()) EXPECT_TRUE(x.allFinite());
-  }
-  {  // R not positive definite
-    OcpQp qp = base;
-    qp.R[4] = -Eigen::MatrixXd::Identity(2, 2);
-    qp.Q[5].setZero();
-    EXPECT_EQ(solver.Solve(qp).status, QpStatus::kNumericalFailure);
-  }
-  // Solvable again after the failures.
-  EXPECT_TRUE(solver.Solve(base).IsSolutionUsable());
+  const OcpQp qp = OcpPulledAgainstItsStateBounds(5, 4, 2, {0}, rng);
   RiccatiQpSolver other(OcpQpDims{6, 4, 2, {0}});
-  EXPECT_THROW(other.Solve(base), std::invalid_argument);
+  EXPECT_THROW(other.Solve(qp), std::invalid_argument);
 }
 
 }  // namespace
