@@ -13,7 +13,7 @@
 #include <benchmark/benchmark.h>
 
 #include "rotorguard/benchmarks/perception_bench.h"
-#include "rotorguard/benchmarks/planner_bench.h"
+#include "rotorguard/campaign_kinds/planner_bench.h"
 #include "rotorguard/perception/deskew.h"
 #include "rotorguard/perception/voxel_map.h"
 #include "rotorguard/sim/lidar.h"

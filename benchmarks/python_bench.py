@@ -66,7 +66,7 @@ def python_controller(repeats, duration):
 
     def stepped(with_controller):
         flight = rotorguard.Flight(hover, set=overrides, log=False)
-        controller = example.NominalController(flight.stack.model, flight.scenario.nominal_gains)
+        controller = example.NominalController(flight.stack.model, flight.scenario.options["stack"]["nominal"])
         while not flight.done:
             if with_controller:
                 flight.step_control(controller(flight.time_s, flight.stack.estimate, flight.stack.reference))

@@ -10,17 +10,17 @@
 
 #include "cli.h"
 #include "rotorguard/benchmarks/campaign_bench.h"
-#include "rotorguard/benchmarks/flatness_bench.h"
+#include "rotorguard/campaign_kinds/flatness_bench.h"
 #include "rotorguard/benchmarks/free_space_bench.h"
-#include "rotorguard/benchmarks/ftc_bench.h"
-#include "rotorguard/benchmarks/mars_bench.h"
-#include "rotorguard/benchmarks/nav_bench.h"
+#include "rotorguard/campaign_kinds/ftc_bench.h"
+#include "rotorguard/campaign_kinds/mars_bench.h"
+#include "rotorguard/campaign_kinds/nav_bench.h"
 #include "rotorguard/benchmarks/nmpc_bench.h"
 #include "rotorguard/benchmarks/sitl_bench.h"
 #include "rotorguard/benchmarks/perception_bench.h"
-#include "rotorguard/benchmarks/planner_bench.h"
+#include "rotorguard/campaign_kinds/planner_bench.h"
 #include "rotorguard/benchmarks/qp_bench.h"
-#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/campaign_kinds/registry.h"
 #include "rotorguard/benchmarks/sim_bench.h"
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/harness/runner.h"
@@ -48,7 +48,7 @@ class BenchCommand final : public Command {
       }
       // Flags that follow from what the benchmark is (its Capability bits), alike for all.
       if (b.capabilities & kCampaign) {
-        // Its trials run on the campaign engine (benchmarks/registry.h): they can be kept, resumed,
+        // Its trials run on the campaign engine (campaign_kinds/registry.h): they can be kept, resumed,
         // sharded and merged like a campaign's.
         sub->add_option("--out", out_,
                         b.out_help != nullptr ? b.out_help

@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "cli.h"
-#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/campaign_kinds/registry.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/registry.h"
 #include "rotorguard/campaign/slurm.h"

@@ -86,7 +86,8 @@ class NominalController:
         self.hover = model["hover_thrusts_n"]
         B = model["effectiveness"]
         self.allocation = B.T @ np.linalg.inv(B @ B.T)  # the pseudo-inverse, as vehicle::PseudoInverse
-        self.k = gains
+        # stack.nominal's keys (scenario.options["stack"]["nominal"]), vectors as arrays.
+        self.k = {key: np.asarray(value) if isinstance(value, list) else value for key, value in gains.items()}
         self.integral = np.zeros(3)
         self.last_t = None
 
@@ -150,7 +151,7 @@ class NominalController:
 def fly_with_python_controller(scenario, **kwargs):
     """Flies `scenario` with NominalController in place of the stack's; returns its RunResult."""
     flight = rotorguard.Flight(scenario, **kwargs)
-    controller = NominalController(flight.stack.model, flight.scenario.nominal_gains)
+    controller = NominalController(flight.stack.model, flight.scenario.options["stack"]["nominal"])
     while not flight.done:
         thrust = controller(flight.time_s, flight.stack.estimate, flight.stack.reference)
         # The stack's rule around its controller: motors off until the estimate is valid, once

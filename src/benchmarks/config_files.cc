@@ -4,8 +4,8 @@
 
 #include <algorithm>
 
-#include "rotorguard/benchmarks/registry.h"
-#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign_kinds/registry.h"
+#include "rotorguard/campaign_kinds/scenario_sweep.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/registry.h"
 #include "rotorguard/harness/assembly_mission.h"

@@ -9,7 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign_kinds/scenario_sweep.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/harness/flight_metrics.h"

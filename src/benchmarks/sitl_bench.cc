@@ -8,7 +8,7 @@
 #include <optional>
 #include <thread>
 
-#include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/campaign_kinds/ftc_bench.h"
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/campaign/statistics.h"
 #include "rotorguard/core/error.h"

@@ -13,6 +13,7 @@
 #include "rotorguard/harness/scenario_keys.h"
 #include "rotorguard/io/config_archive.h"
 #include "rotorguard/io/config_node.h"
+#include "rotorguard/io/json_archive.h"
 #include "rotorguard/vehicle/pwm_model.h"
 
 namespace rotorguard::harness {
@@ -325,6 +326,50 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
   CheckAcrossSections(root, s);
   CheckPlannedMission(s);  // an assembly_plan's, once planned (PlanMission)
   return s;
+}
+
+namespace {
+/// The sections ScenarioOptions writes and SetScenarioOptions reads: how a scenario is flown, not
+/// what is flown (its vehicle, world, start, mission and faults).
+constexpr const char* kOptionSections[] = {"sim", "sensors", "wind", "stack", "metrics"};
+}  // namespace
+
+nlohmann::json ScenarioOptions(const Scenario& scenario) {
+  Scenario s = scenario;  // the declarations visit through non-const pointers
+  const auto write = [](auto keys) {
+    io::JsonWriter writer;
+    keys.Serialize(&writer);
+    return writer.json();
+  };
+  nlohmann::json options;
+  options["sim"] = write(SimKeys{&s});
+  options["sensors"] = write(SensorsKeys{&s.sim});
+  options["wind"] = write(s.sim.wind);
+  options["stack"] = write(StackKeys{&s});
+  options["metrics"] = write(MetricsKeys{&s});
+  return options;
+}
+
+void SetScenarioOptions(Scenario* scenario, const std::string& text, const std::string& name) {
+  const ConfigDocument doc = ConfigDocument::LoadString(text, name);
+  const ConfigNode root = doc.root();
+  for (const std::string& key : root.Keys()) {
+    if (std::find_if(std::begin(kOptionSections), std::end(kOptionSections),
+                     [&](const char* section) { return key == section; }) == std::end(kOptionSections)) {
+      root.FailAt(key, fmt::format("'{}' is what the scenario flies, set when it is loaded; expected sim, sensors, "
+                                   "wind, stack or metrics",
+                                   key));
+    }
+  }
+  // The loader's own readers and rules, on a copy: the scenario is unchanged when one throws.
+  Scenario s = *scenario;
+  ReadSimulation(root, &s);
+  ReadStack(root, &s);
+  if (auto metrics = ReadSection(root, "metrics", MetricsKeys{&s})) s.source.metrics = std::move(metrics);
+  root.RejectUnknownKeys();
+  CheckAcrossSections(root, s);
+  CheckPlannedMission(s);
+  *scenario = std::move(s);
 }
 
 void CheckPlannedMission(const Scenario& s) {

@@ -12,7 +12,7 @@
 #include <fstream>
 #include <map>
 
-#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign_kinds/scenario_sweep.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/core/error.h"

@@ -1,5 +1,5 @@
 // The FTC benchmark's cell metrics (docs/metrics.md) on hand-made trials.
-#include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/campaign_kinds/ftc_bench.h"
 
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "rotorguard/benchmarks/mars_bench.h"
-#include "rotorguard/benchmarks/reconfiguration.h"
+#include "rotorguard/campaign_kinds/mars_bench.h"
+#include "rotorguard/campaign_kinds/reconfiguration.h"
 #include "rotorguard/harness/scenario.h"
 #include "test_util.h"
 

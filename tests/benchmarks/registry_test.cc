@@ -1,8 +1,8 @@
-// The benchmarks on the campaign engine (benchmarks/registry.h): a benchmark run whole, in
+// The benchmarks on the campaign engine (campaign_kinds/registry.h): a benchmark run whole, in
 // shards merged by `MergeCampaign`, or from its spec file gives one result; the results are built
 // from the records as hand-made records say they must be; bad specs name the key.
 
-#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/campaign_kinds/registry.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -12,9 +12,9 @@
 #include <set>
 #include <string>
 
-#include "rotorguard/benchmarks/flatness_bench.h"
-#include "rotorguard/benchmarks/ftc_bench.h"
-#include "rotorguard/benchmarks/nav_bench.h"
+#include "rotorguard/campaign_kinds/flatness_bench.h"
+#include "rotorguard/campaign_kinds/ftc_bench.h"
+#include "rotorguard/campaign_kinds/nav_bench.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/registry.h"

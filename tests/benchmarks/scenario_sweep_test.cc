@@ -1,4 +1,4 @@
-// Scenario sweeps run by the campaign engine (benchmarks/scenario_sweep.h, campaign/campaign.h):
+// Scenario sweeps run by the campaign engine (campaign_kinds/scenario_sweep.h, campaign/campaign.h):
 // trial parameters and seeds, crash-safe results, resume, shards and the merge's checks, on real
 // flights. The oracle for "results do not depend on how they were run" is a byte
 // comparison of merged summaries.
@@ -16,8 +16,8 @@
 #include <gtest/gtest.h>
 
 #include "rotorguard/benchmarks/campaign_bench.h"
-#include "rotorguard/benchmarks/registry.h"
-#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign_kinds/registry.h"
+#include "rotorguard/campaign_kinds/scenario_sweep.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/campaign/slurm.h"

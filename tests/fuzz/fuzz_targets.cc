@@ -11,7 +11,7 @@
 
 #include "rotorguard/benchmarks/config_files.h"
 #include "rotorguard/benchmarks/fdd_calibration.h"
-#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/campaign_kinds/registry.h"
 #include "rotorguard/campaign/merge.h"
 #include "rotorguard/io/config_node.h"
 #include "rotorguard/record/flight_log.h"

@@ -69,6 +69,49 @@ TEST_F(ScenarioLoader, FaultKindsComeFromTheirNameTable) {
   }
 }
 
+// A scenario's options (sim, sensors, wind, stack, metrics) as the keys their structs declare:
+// written back unchanged they change nothing; a key set through them gives the scenario the loader
+// gives with the same key overridden (one set of keys, one loader); a bad value or a section that
+// defines what is flown is refused naming the key, and leaves the scenario as it was.
+TEST_F(ScenarioLoader, OptionsWrittenBackChangeNothingAndASetKeyEqualsTheLoadersOverride) {
+  const std::string file = File("mission: {type: hover, position_m: [0, 0, 1.5]}\nstack: {controller: nmpc}\n");
+  Scenario s = LoadScenario(file);
+  const nlohmann::json before = ScenarioOptions(s);
+  ASSERT_TRUE(before.contains("stack") && before["stack"].contains("nmpc"));
+  SetScenarioOptions(&s, before.dump(1), "<options>");
+  EXPECT_EQ(ScenarioOptions(s), before);
+
+  SetScenarioOptions(&s, "stack: {nmpc: {q_position: [50, 60, 700]}}\nsim: {physics_rate_hz: 2000}\n", "<options>");
+  const Scenario overridden =
+      LoadScenario(file, {{"stack.nmpc.q_position", "[50, 60, 700]"}, {"sim.physics_rate_hz", "2000"}});
+  EXPECT_EQ(ScenarioOptions(s), ScenarioOptions(overridden));
+  EXPECT_EQ(s.stack.nmpc.q_position, Vector3(50, 60, 700));
+  EXPECT_EQ(s.sim.physics_rate_hz, 2000.0);
+  // An optional number is written null when unset, and null unsets it.
+  SetScenarioOptions(&s, "stack: {planner: {post_failure_clearance_m: 0.5}}", "<options>");
+  EXPECT_EQ(s.stack.navigation.replanner.post_failure_clearance_m, 0.5);
+  SetScenarioOptions(&s, "stack: {planner: {post_failure_clearance_m: null}}", "<options>");
+  EXPECT_FALSE(s.stack.navigation.replanner.post_failure_clearance_m.has_value());
+
+  const nlohmann::json set = ScenarioOptions(s);
+  const auto refused = [&](const std::string& text) {
+    try {
+      SetScenarioOptions(&s, text, "<options>");
+    } catch (const io::ConfigError& e) {
+      EXPECT_EQ(ScenarioOptions(s), set) << "unchanged after: " << e.what();
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string range = refused("stack:\n  nmpc:\n    horizon_steps: 0\n");
+  EXPECT_NE(range.find("<options>:3"), std::string::npos) << range;
+  EXPECT_NE(range.find("stack.nmpc.horizon_steps"), std::string::npos) << range;
+  const std::string flown = refused("faults: []\n");
+  EXPECT_NE(flown.find("set when it is loaded"), std::string::npos) << flown;
+  const std::string unknown = refused("stack: {no_such_key: 1}\n");
+  EXPECT_NE(unknown.find("no_such_key"), std::string::npos) << unknown;
+}
+
 TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
   const Scenario s = LoadScenario(File("mission: {type: hover}\n"));
   EXPECT_EQ(s.name, "s");  // the file's name

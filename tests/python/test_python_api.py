@@ -109,6 +109,22 @@ def test_overrides_take_python_values():
         rotorguard.load_scenario(HOVER, seed=-1)
 
 
+def test_options_are_the_declared_keys_and_writable_through_the_loader():
+    scenario = rotorguard.load_scenario(HOVER)
+    options = scenario.options
+    assert set(options) == {"sim", "sensors", "wind", "stack", "metrics"}
+    scenario.set_options(options)  # written back unchanged: nothing changes
+    assert scenario.options == options
+    scenario.set_options({"stack": {"nmpc": {"q_position": np.array([50.0, 60.0, 700.0])}}})
+    assert scenario.options["stack"]["nmpc"]["q_position"] == [50.0, 60.0, 700.0]
+    assert scenario.options == rotorguard.load_scenario(HOVER, set={"stack.nmpc.q_position": [50, 60, 700]}).options
+    with pytest.raises(rotorguard.ConfigError) as error:
+        scenario.set_options({"stack": {"nmpc": {"horizon_steps": 0}}})
+    assert error.value.file == "<options>"
+    assert error.value.key == "stack.nmpc.horizon_steps"
+    assert scenario.options["stack"]["nmpc"]["horizon_steps"] == options["stack"]["nmpc"]["horizon_steps"]
+
+
 def test_a_missing_file_is_an_input_file_error(tmp_path):
     with pytest.raises(rotorguard.InputFileError) as error:
         rotorguard.run(tmp_path / "none.yaml")

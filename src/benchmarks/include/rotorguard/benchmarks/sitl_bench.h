@@ -20,7 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/campaign_kinds/ftc_bench.h"
 #include "rotorguard/harness/sitl.h"
 
 namespace rotorguard::benchmarks {

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "rotorguard/core/config_schema.h"
 #include "rotorguard/core/trajectory.h"
 #include "rotorguard/harness/mission.h"
@@ -102,6 +104,16 @@ void FitStackToHardware(Scenario* scenario);
 /// Loads and validates a scenario file. Throws io::ConfigError (bad content, with file, line and
 /// key path) or io::InputFileError (a file that cannot be read).
 Scenario LoadScenario(const std::string& path, const std::vector<Override>& overrides = {});
+
+/// The sections of a scenario that set how it is flown, not what is flown: `sim`, `sensors`,
+/// `wind`, `stack` and `metrics`, each key under its declared name in the file's units (the shape
+/// of a scenario file's sections).
+nlohmann::json ScenarioOptions(const Scenario& scenario);
+
+/// Sets keys of those sections from `text` (YAML, or JSON of ScenarioOptions' shape; keys left out
+/// keep their values) through the loader's readers and rules. Throws io::ConfigError naming `name`,
+/// line and key; the scenario is unchanged when it throws.
+void SetScenarioOptions(Scenario* scenario, const std::string& text, const std::string& name);
 
 /// The rules that need the mission's reference, reported at the file's keys (Scenario::source):
 /// the tracking window holds at least one physics step; the reference stays above the ground.

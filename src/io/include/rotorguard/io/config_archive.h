@@ -83,7 +83,7 @@ class ConfigReader {
   const ConfigNode& node() const { return node_; }
 
   /// One key: a number, an integer, a boolean, a word, a vector, an enum's name, an optional
-  /// number, a list of points, a block (a struct that declares its keys, validated once read) or a
+  /// number (null: unset), a list of points, a block (a struct that declares its keys, validated once read) or a
   /// list of blocks.
   template <typename T>
   void Visit(const char* key, T* value, const KeyInfo& info = {}) {
@@ -193,7 +193,12 @@ class ConfigReader {
   }
 
   static void Read(const ConfigNode& n, double* v, const KeyInfo& info) { *v = Number(n, info); }
+  /// null unsets it (what io::JsonWriter writes for an unset one, so that options read back as written).
   static void Read(const ConfigNode& n, std::optional<double>* v, const KeyInfo& info) {
+    if (n.IsNull()) {
+      v->reset();
+      return;
+    }
     double x = 0.0;
     Read(n, &x, info);
     *v = x;

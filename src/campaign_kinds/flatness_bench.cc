@@ -1,4 +1,4 @@
-#include "rotorguard/benchmarks/flatness_bench.h"
+#include "rotorguard/campaign_kinds/flatness_bench.h"
 
 #include <fmt/format.h>
 

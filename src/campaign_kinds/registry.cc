@@ -1,15 +1,15 @@
-#include "rotorguard/benchmarks/registry.h"
+#include "rotorguard/campaign_kinds/registry.h"
 
 #include <fmt/format.h>
 
 #include <filesystem>
 #include <stdexcept>
 
-#include "rotorguard/benchmarks/flatness_bench.h"
-#include "rotorguard/benchmarks/ftc_bench.h"
-#include "rotorguard/benchmarks/mars_bench.h"
-#include "rotorguard/benchmarks/nav_bench.h"
-#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign_kinds/flatness_bench.h"
+#include "rotorguard/campaign_kinds/ftc_bench.h"
+#include "rotorguard/campaign_kinds/mars_bench.h"
+#include "rotorguard/campaign_kinds/nav_bench.h"
+#include "rotorguard/campaign_kinds/scenario_sweep.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/registry.h"
 #include "rotorguard/harness/scenario.h"

@@ -1,4 +1,4 @@
-#include "rotorguard/benchmarks/nav_bench.h"
+#include "rotorguard/campaign_kinds/nav_bench.h"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "rotorguard/benchmarks/planner_bench.h"
+#include "rotorguard/campaign_kinds/planner_bench.h"
 #include "rotorguard/buildinfo/build_info.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/campaign/failure_list.h"

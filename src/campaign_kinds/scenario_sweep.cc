@@ -1,4 +1,4 @@
-#include "rotorguard/benchmarks/scenario_sweep.h"
+#include "rotorguard/campaign_kinds/scenario_sweep.h"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "rotorguard/benchmarks/ftc_bench.h"
+#include "rotorguard/campaign_kinds/ftc_bench.h"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "rotorguard/benchmarks/planner_bench.h"
+#include "rotorguard/campaign_kinds/planner_bench.h"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "rotorguard/benchmarks/mars_bench.h"
+#include "rotorguard/campaign_kinds/mars_bench.h"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 #include <mutex>
 #include <numbers>
 
-#include "rotorguard/benchmarks/reconfiguration.h"
+#include "rotorguard/campaign_kinds/reconfiguration.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"

@@ -1,4 +1,4 @@
-#include "rotorguard/benchmarks/reconfiguration.h"
+#include "rotorguard/campaign_kinds/reconfiguration.h"
 
 #include <algorithm>
 #include <cmath>

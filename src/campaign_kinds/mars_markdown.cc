@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "rotorguard/benchmarks/mars_bench.h"
+#include "rotorguard/campaign_kinds/mars_bench.h"
 
 namespace rotorguard::benchmarks {
 
