@@ -229,9 +229,6 @@ void ReadFaults(const ConfigNode& root, Scenario* s) {
 /// rules against the vehicle and the simulation.
 void ReadStack(const ConfigNode& root, Scenario* s) {
   FitStackToHardware(s);
-  // An assembly reallocates over its rotors: it flies on while four remain (stack.supervisor keys
-  // may lower it).
-  if (s->assembly) s->stack.supervisor.max_failed_rotors = s->assembly->FailedRotorAllowance();
   if (const auto node = ReadSection(root, "stack", StackKeys{s})) ValidateAt(*node, [&] { s->stack.Validate(); });
   FitStackToHardware(s);
   for (std::size_t i = 0; i < s->stack.known_faults.size(); ++i) {
@@ -317,6 +314,10 @@ Scenario LoadScenario(const std::string& path, const std::vector<Override>& over
     header.Serialize(&reader);
   }
   ReadVehicle(root, path, overrides, &s);
+  // An assembly reallocates over its rotors: it flies on while four remain (stack.supervisor keys
+  // may lower it). A default of the loaded vehicle, set once: ReadStack also serves
+  // SetScenarioOptions, which must keep what the file or an earlier set gave.
+  if (s.assembly) s.stack.supervisor.max_failed_rotors = s.assembly->FailedRotorAllowance();
   ReadSimulation(root, &s);
   ReadMission(root, &s);
   ReadFaults(root, &s);

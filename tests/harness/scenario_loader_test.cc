@@ -112,6 +112,20 @@ TEST_F(ScenarioLoader, OptionsWrittenBackChangeNothingAndASetKeyEqualsTheLoaders
   EXPECT_NE(unknown.find("no_such_key"), std::string::npos) << unknown;
 }
 
+// Setting one section re-runs the loader's readers of the others (the stack is fitted to the
+// sensors again): a value the file gave, or a default of the loaded vehicle overridden there, stays.
+TEST_F(ScenarioLoader, SettingOneSectionKeepsTheOthersAsLoaded) {
+  const std::string file = testing::SourcePath("configs/scenarios/mars_reconfigure_3x1.yaml");
+  Scenario s = LoadScenario(file, {{"stack.supervisor.max_failed_rotors", "2"}});
+  ASSERT_TRUE(s.assembly);
+  ASSERT_NE(s.assembly->FailedRotorAllowance(), 2) << "the override must differ from the assembly's default";
+  nlohmann::json expected = ScenarioOptions(s);
+  SetScenarioOptions(&s, "sim: {log_rate_hz: 50}\n", "<options>");
+  EXPECT_EQ(s.stack.supervisor.max_failed_rotors, 2);
+  expected["sim"]["log_rate_hz"] = 50.0;
+  EXPECT_EQ(ScenarioOptions(s), expected);
+}
+
 TEST_F(ScenarioLoader, AbsentKeysKeepEveryDefault) {
   const Scenario s = LoadScenario(File("mission: {type: hover}\n"));
   EXPECT_EQ(s.name, "s");  // the file's name
