@@ -1,8 +1,7 @@
 // The control thread never allocates (docs/runtime.md): every heap allocation of this process
-// goes through the malloc family defined here, which counts the ones made on the executor's
-// control thread while a flight is past its start. Counted at the malloc level, not operator
-// new's: Eigen's dynamic matrices call malloc directly. Flights in software in the loop, in this
-// process, past their first second (the first cycles size the buffers: the NMPC's first plan, the
+// goes through the allocation counter's malloc family (allocation_counter.h), whose hook here
+// counts the ones made on the executor's control thread while a flight is past its start.
+// Flights in software in the loop, in this process, past their first second (the first cycles size the buffers: the NMPC's first plan, the
 // histograms' first samples), without a fault in the flight (an isolation is an event that
 // allocates: a mode transition's reason, a reconfiguration's new matrices).
 #include <execinfo.h>
@@ -20,15 +19,8 @@
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/harness/sitl.h"
+#include "allocation_counter.h"
 #include "test_util.h"
-
-extern "C" {
-void* __libc_malloc(std::size_t size);
-void* __libc_calloc(std::size_t n, std::size_t size);
-void* __libc_realloc(void* p, std::size_t size);
-void* __libc_memalign(std::size_t alignment, std::size_t size);
-void __libc_free(void* p);
-}
 
 namespace {
 
@@ -51,35 +43,6 @@ void Count() {
 
 }  // namespace
 
-extern "C" {
-void* malloc(std::size_t size) {
-  Count();
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t n, std::size_t size) {
-  Count();
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, std::size_t size) {
-  Count();
-  return __libc_realloc(p, size);
-}
-void* memalign(std::size_t alignment, std::size_t size) {
-  Count();
-  return __libc_memalign(alignment, size);
-}
-void* aligned_alloc(std::size_t alignment, std::size_t size) {
-  Count();
-  return __libc_memalign(alignment, size);
-}
-int posix_memalign(void** p, std::size_t alignment, std::size_t size) {
-  Count();
-  *p = __libc_memalign(alignment, size);
-  return *p ? 0 : ENOMEM;
-}
-void free(void* p) { __libc_free(p); }
-}
-
 namespace rotorguard::harness {
 namespace {
 
@@ -101,8 +64,10 @@ TEST_P(ControlThread, NeverAllocatesOnceTheFlightIsUnderWay) {
   RunOptions run;
   run.progress = [&](double fraction) { g_armed.store(fraction * sc.duration_s >= 1.0 && fraction < 1.0); };
   g_allocations.store(0);
+  rotorguard::testing::SetAllocationHook(&Count);
   const SitlResult r = RunSitl(sc, run, o);
   g_armed.store(false);
+  rotorguard::testing::SetAllocationHook(nullptr);
   const long n = g_allocations.load();
   EXPECT_GT(r.loops.at("control").at("runs").get<long>(), 100) << "a flight that ran no cycles checks nothing";
   EXPECT_EQ(n, 0) << "allocations on the control thread; the first ones' call stacks follow";

@@ -135,7 +135,6 @@ class DualActiveSet {
 
   int size() const { return static_cast<int>(active_.size()); }
   const Side& operator[](int j) const { return active_[static_cast<std::size_t>(j)]; }
-  const std::vector<Side>& sides() const { return active_; }
   bool IsActive(const Side& c) const { return is_active_[c.slot()] != 0; }
   /// The multipliers of the active sides (size()), >= 0 at a solution.
   Eigen::Ref<const Eigen::VectorXd> multipliers() const { return multipliers_.head(size()); }
