@@ -35,6 +35,7 @@ struct Kind {
 struct Group {
   std::vector<double> plan_ms;
   double search_ms = 0.0, optimize_ms = 0.0, iterations = 0.0, rounds = 0.0, pieces = 0.0;
+  double expansions = 0.0, segment_checks = 0.0;  // the front end's work
   int attempted = 0, no_path = 0, succeeded = 0;
   /// Successful plans that needed the planner's fallbacks (PlanSummary::fine_search, rest_to_rest).
   int fine_search = 0, rest_to_rest = 0;
@@ -75,6 +76,8 @@ nlohmann::json GroupJson(const Group& g) {
           {"plan_ms_samples", ms},  // the distribution, for the HTML page's histogram
           {"mean_traj_duration_s", g.succeeded > 0 ? g.duration_sum / g.succeeded : 0.0},
           {"search_ms_mean", g.attempted > 0 ? g.search_ms / g.attempted : 0.0},
+          {"search_expansions_mean", g.attempted > 0 ? g.expansions / g.attempted : 0.0},
+          {"search_segment_checks_mean", g.attempted > 0 ? g.segment_checks / g.attempted : 0.0},
           {"optimize_ms_mean", g.attempted > 0 ? g.optimize_ms / g.attempted : 0.0},
           {"lbfgs_iterations_mean", g.attempted > 0 ? g.iterations / g.attempted : 0.0},
           {"clearance_rounds_mean", g.attempted > 0 ? g.rounds / g.attempted : 0.0},
@@ -167,6 +170,8 @@ nlohmann::json RunPlannerBenchmark(const PlannerBenchOptions& options) {
             ++x->attempted;
             x->plan_ms.push_back(s.total_ms);
             x->search_ms += s.search_ms;
+            x->expansions += s.path.expansions;
+            x->segment_checks += s.path.segment_checks;
             x->optimize_ms += s.optimize_ms;
             x->iterations += s.optimizer.iterations;
             x->rounds += s.clearance_rounds;

@@ -90,14 +90,12 @@ VoxelMap::VoxelMap(const VoxelMapOptions& options) : options_(options) {
   const int s = kSortedOffsetRadius;
   for (int x = -s; x <= s; ++x) {
     for (int y = -s; y <= s; ++y) {
-      for (int z = -s; z <= s; ++z) {
-        const double d = std::sqrt(static_cast<double>(x * x + y * y + z * z));
-        if (d <= s) sorted_offsets_.push_back({Index(x, y, z), d});
-      }
+      const double d = std::sqrt(static_cast<double>(x * x + y * y));
+      if (d <= s) sorted_columns_.push_back({x, y, d});
     }
   }
-  std::sort(sorted_offsets_.begin(), sorted_offsets_.end(),
-            [](const SortedOffset& a, const SortedOffset& b) { return a.distance < b.distance; });
+  std::sort(sorted_columns_.begin(), sorted_columns_.end(),
+            [](const SortedColumn& a, const SortedColumn& b) { return a.distance < b.distance; });
 }
 
 VoxelMap::Index VoxelMap::ToIndex(const Vector3& p) const {
@@ -206,22 +204,29 @@ VoxelMap::Index VoxelMap::IndexOf(std::size_t address) const {
                          PositiveMod(w.z() - origin_.z(), size_.z()));
 }
 
+template <typename Visit>
+bool VoxelMap::ForEachOccupiedRun(int x, int y, int z0, int z1, Visit&& visit) const {
+  const int z_min = origin_.z(), z_mask = size_.z() - 1;
+  const Index bottom(x, y, z_min);  // the column's (x, y) at the window's floor
+  if (!InWindow(bottom)) return true;
+  const std::size_t base = Address(bottom) & ~static_cast<std::size_t>(z_mask);  // its (x, y) fields
+  z1 = std::min(z1, z_min + size_.z() - 1);
+  for (int z = std::max(z0, z_min); z <= z1;) {
+    const std::size_t address = base | static_cast<std::size_t>(z & z_mask);
+    const int run = std::min({z1 - z + 1, 64 - static_cast<int>(address & 63), size_.z() - (z & z_mask)});
+    const std::uint64_t mask = run == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << run) - 1;
+    const std::uint64_t bits = (occupied_[address >> 6] >> (address & 63)) & mask;
+    if (bits != 0 && !visit(z, bits)) return false;
+    z += run;
+  }
+  return true;
+}
+
 bool VoxelMap::AnyOccupiedWithinRadius(const Index& i) const {
-  const int z_min = origin_.z(), z_max = origin_.z() + size_.z() - 1, z_mask = size_.z() - 1;
   for (const StencilColumn& c : stencil_columns_) {
-    const Index bottom(i.x() + c.dx, i.y() + c.dy, z_min);  // the column's (x, y) at the window's floor
-    if (!InWindow(bottom)) continue;
-    const std::size_t base = Address(bottom) & ~static_cast<std::size_t>(z_mask);  // its (x, y) fields
-    // The column's bits in runs of consecutive addresses, each up to the end of a word or to where
-    // z wraps around the ring: in the default window (64 voxels tall) one or two runs of the
-    // column's one word.
-    const int z1 = std::min(i.z() + c.z_hi, z_max);
-    for (int z = std::max(i.z() + c.z_lo, z_min); z <= z1;) {
-      const std::size_t address = base | static_cast<std::size_t>(z & z_mask);
-      const int run = std::min({z1 - z + 1, 64 - static_cast<int>(address & 63), size_.z() - (z & z_mask)});
-      const std::uint64_t mask = run == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << run) - 1;
-      if ((occupied_[address >> 6] >> (address & 63)) & mask) return true;
-      z += run;
+    if (!ForEachOccupiedRun(i.x() + c.dx, i.y() + c.dy, i.z() + c.z_lo, i.z() + c.z_hi,
+                            [](int, std::uint64_t) { return false; })) {
+      return true;
     }
   }
   return false;
@@ -584,31 +589,56 @@ bool VoxelMap::IsInflated(const Vector3& p) const { return InWindow(p) && Inflat
 std::optional<NearestObstacle> VoxelMap::Nearest(const Vector3& p, double radius_m) const {
   if (!p.allFinite() || !(radius_m >= 0.0)) return std::nullopt;
   const Index c = ToIndex(p);
-  // The query lies within half a diagonal of its voxel's centre, so a voxel whose centre is d from
-  // that centre is at least d - half_diagonal from the query: the offsets, visited by increasing
-  // d, can stop once that bound exceeds the radius or the best distance found.
-  const double half_diagonal = 0.5 * std::numbers::sqrt3 * res_;
   std::optional<NearestObstacle> best;
-  const auto consider = [&](const Index& i) {
-    if (!InWindow(i) || !OccupiedBit(Address(i))) return;
-    const Vector3 q = Center(i);
-    const double d = (p - q).norm();
-    if (d > radius_m || (best && d >= best->distance_m)) return;
+  Index best_index;
+  // Voxel i at distance d: nearer than the best, or as near and of lower index.
+  const auto consider = [&](const Index& i, const Vector3& q, double d) {
+    if (d > radius_m) return;
+    if (best && (d > best->distance_m ||
+                 (d == best->distance_m && !std::lexicographical_compare(i.data(), i.data() + 3, best_index.data(),
+                                                                          best_index.data() + 3)))) {
+      return;
+    }
     const Vector3 n = d > 1e-12 ? Vector3((p - q) / d) : Vector3::UnitZ();
     best = NearestObstacle{q, d, n};
+    best_index = i;
   };
   if (radius_m <= FastNearestRadiusM(res_)) {
-    for (const SortedOffset& o : sorted_offsets_) {
-      const double lower = o.distance * res_ - half_diagonal;
-      if (lower > radius_m || (best && lower > best->distance_m)) break;
-      consider(c + o.offset);
+    // The query lies within half a voxel's diagonal in the plane of its voxel's centre there, so
+    // a column whose centre is d from that centre holds no voxel nearer than d - that: the columns,
+    // visited by increasing d, can stop once the bound exceeds the radius or the best distance.
+    const double planar_half_diagonal = 0.5 * std::numbers::sqrt2 * res_;
+    for (const SortedColumn& col : sorted_columns_) {
+      const double bound = best ? best->distance_m : radius_m;
+      const double planar = col.distance * res_ - planar_half_diagonal;
+      if (planar > bound) break;
+      // Heights whose centres lie within the bound of p's (a voxel more each way: the candidates
+      // are measured exactly).
+      const double in_plane = std::max(planar, 0.0);
+      const double dz = std::sqrt(std::max(bound * bound - in_plane * in_plane, 0.0));
+      const int x = c.x() + col.dx, y = c.y() + col.dy;
+      const int z0 = static_cast<int>(std::floor((p.z() - dz) / res_)) - 1;
+      const int z1 = static_cast<int>(std::floor((p.z() + dz) / res_)) + 1;
+      ForEachOccupiedRun(x, y, z0, z1, [&](int z, std::uint64_t bits) {
+        for (; bits != 0; bits &= bits - 1) {
+          const Index i(x, y, z + std::countr_zero(bits));
+          const Vector3 q = Center(i);
+          consider(i, q, (p - q).norm());
+        }
+        return true;
+      });
     }
     return best;
   }
   const int r = static_cast<int>(std::ceil(radius_m / res_)) + 1;
   for (int x = -r; x <= r; ++x) {
     for (int y = -r; y <= r; ++y) {
-      for (int z = -r; z <= r; ++z) consider(c + Index(x, y, z));
+      for (int z = -r; z <= r; ++z) {
+        const Index i = c + Index(x, y, z);
+        if (!InWindow(i) || !OccupiedBit(Address(i))) continue;
+        const Vector3 q = Center(i);
+        consider(i, q, (p - q).norm());
+      }
     }
   }
   return best;

@@ -1,10 +1,10 @@
 #include "rotorguard/planning/astar.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <queue>
 
 #include "rotorguard/core/error.h"
 
@@ -34,8 +34,8 @@ const char* ToString(PathStatus status) {
   return "unknown";
 }
 
-PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const Vector3& goal,
-                    const AStarOptions& options) {
+PathResult PathSearch::Find(const perception::VoxelMap& map, const Vector3& start, const Vector3& goal,
+                            const AStarOptions& options) {
   options.Validate();
   PathResult result;
   const double res = options.resolution_m;
@@ -72,27 +72,103 @@ PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const
     result.status = PathStatus::kGoalBlocked;
     return result;
   }
-  const auto index = [&](const Eigen::Vector3i& c) { return (c.x() * n.y() + c.y()) * n.z() + c.z(); };
-  const auto cell = [&](int i) { return Eigen::Vector3i(i / (n.y() * n.z()), (i / n.z()) % n.y(), i % n.z()); };
-  const auto center = [&](int i) { return Vector3(lo + (cell(i).cast<double>() + Vector3::Constant(0.5)) * res); };
-  const std::size_t cells = static_cast<std::size_t>(n.prod());
-  std::vector<float> g(cells, std::numeric_limits<float>::infinity());
-  std::vector<std::int32_t> parent(cells, -1);
-  std::vector<std::uint8_t> closed(cells, 0);
-  using Entry = std::pair<float, std::int32_t>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+  // Cells in row-major order, z fastest.
+  const int nyz = n.y() * n.z();
+  const auto index = [&](const Eigen::Vector3i& c) { return c.x() * nyz + c.y() * n.z() + c.z(); };
+  const auto cell = [&](int i) { return Eigen::Vector3i(i / nyz, (i / n.z()) % n.y(), i % n.z()); };
+  const auto centre_of = [&](const Eigen::Vector3i& c) { return Vector3(lo + (c.cast<double>() + Vector3::Constant(0.5)) * res); };
+  const std::size_t count = static_cast<std::size_t>(n.prod());
+  if (cells_.size() < count) cells_.resize(count);
+  if (++generation_ >= (1u << (32 - kFlagBits))) {  // the tags would wrap: every cell untouched again
+    std::fill(cells_.begin(), cells_.end(), Cell{});
+    generation_ = 1;
+  }
+  const auto record = [&](int i) -> Cell& {
+    Cell& c = cells_[static_cast<std::size_t>(i)];
+    if ((c.tag >> kFlagBits) != generation_) c = Cell{generation_ << kFlagBits, std::numeric_limits<float>::infinity(), -1};
+    return c;
+  };
   const int s = index(start_cell), t = index(goal_cell);
   const bool start_inflated = map.IsInflated(start);
-  const auto h = [&](int i) { return static_cast<float>(options.heuristic_weight * (center(i) - goal).norm()); };
-  g[static_cast<std::size_t>(s)] = 0.0f;
-  open.push({h(s), s});
+  // A move's ends: the start and goal points themselves in their cells, else the cells' centres.
+  const auto point = [&](int i) { return i == s ? start : (i == t ? goal : centre_of(cell(i))); };
+  // Out of an inflated start only the target needs to be free.
+  const auto blocked = [&](int i, int j) {
+    ++result.segment_checks;
+    return i == s && start_inflated ? map.IsInflated(point(j)) : map.SegmentCollides(point(i), point(j));
+  };
+  const auto h = [&](const Vector3& p) { return static_cast<float>(options.heuristic_weight * (p - goal).norm()); };
+  // The 26 moves: offsets and, between centres, lengths.
+  struct Move {
+    Eigen::Vector3i offset;
+    int delta;
+    float length;
+  };
+  std::array<Move, 26> moves;
+  int m = 0;
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dz = -1; dz <= 1; ++dz) {
+        if ((dx | dy | dz) == 0) continue;
+        const Eigen::Vector3i o(dx, dy, dz);
+        moves[static_cast<std::size_t>(m++)] = {o, dx * nyz + dy * n.z() + dz, static_cast<float>(res * o.cast<double>().norm())};
+      }
+    }
+  }
+  const auto in_grid = [&](const Eigen::Vector3i& c) { return (c.array() >= 0).all() && (c.array() < n.array()).all(); };
+  // Length of the move i -> j (neighbours): the table's unless an end is the start or the goal point.
+  const auto length = [&](int i, int j, const Move& move) {
+    return i == s || j == t ? static_cast<float>((point(j) - point(i)).norm()) : move.length;
+  };
+  // The open list: lowest f first, and of equal f the deeper move (larger g), which in open space
+  // runs straight at the goal instead of widening the front.
+  const auto later = [](const Entry& a, const Entry& b) { return a.f > b.f || (a.f == b.f && a.g < b.g); };
+  open_.clear();
+  const auto propose = [&](int j, int parent, float g, const Vector3& p) {
+    open_.push_back({g + h(p), g, j, parent});
+    std::push_heap(open_.begin(), open_.end(), later);
+  };
+  record(s).g = 0.0f;
+  propose(s, -1, 0.0f, start);
   bool found = false;
-  while (!open.empty()) {
-    const int i = open.top().second;
-    open.pop();
-    if (closed[static_cast<std::size_t>(i)]) continue;
-    closed[static_cast<std::size_t>(i)] = 1;
-    if (i == t) {
+  while (!open_.empty()) {
+    std::pop_heap(open_.begin(), open_.end(), later);
+    const Entry e = open_.back();
+    open_.pop_back();
+    Cell& cj = record(e.cell);
+    // Stale: expanded already, or a cheaper move into it was proposed since (or ruled out).
+    if ((cj.tag & kExpanded) || e.parent != cj.parent || e.g != cj.g) continue;
+    if (e.parent >= 0 && !(cj.tag & kMoveChecked) && blocked(e.parent, e.cell)) {
+      // The move is blocked: the cell's cheapest free move from the cells already expanded (those
+      // an eager search would have checked) is proposed again, checked; or none, until another
+      // neighbour expands.
+      const Eigen::Vector3i c = cell(e.cell);
+      std::array<std::pair<float, int>, 26> candidates;
+      int k = 0;
+      for (const Move& move : moves) {
+        if (!in_grid(c - move.offset)) continue;
+        const int i = e.cell - move.delta;
+        const Cell& ci = cells_[static_cast<std::size_t>(i)];
+        if (i == e.parent || !(ci.tag & kExpanded) || (ci.tag >> kFlagBits) != generation_) continue;
+        candidates[static_cast<std::size_t>(k++)] = {ci.g + length(i, e.cell, move), i};
+      }
+      std::sort(candidates.begin(), candidates.begin() + k);
+      cj.g = std::numeric_limits<float>::infinity();
+      cj.parent = -1;
+      for (int q = 0; q < k; ++q) {
+        const auto [g, i] = candidates[static_cast<std::size_t>(q)];
+        if (blocked(i, e.cell)) continue;
+        cj.g = g;
+        cj.parent = i;
+        cj.tag |= kMoveChecked;
+        propose(e.cell, i, g, point(e.cell));
+        break;
+      }
+      continue;
+    }
+    const int j = e.cell;
+    cj.tag |= kExpanded;
+    if (j == t) {
       found = true;
       break;
     }
@@ -100,41 +176,36 @@ PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const
       result.status = PathStatus::kExpansionLimit;
       return result;
     }
-    const Eigen::Vector3i c = cell(i);
-    const Vector3 from = i == s ? start : center(i);
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dz = -1; dz <= 1; ++dz) {
-          const Eigen::Vector3i nc = c + Eigen::Vector3i(dx, dy, dz);
-          if ((dx | dy | dz) == 0 || (nc.array() < 0).any() || (nc.array() >= n.array()).any()) continue;
-          const int j = index(nc);
-          if (closed[static_cast<std::size_t>(j)]) continue;
-          const Vector3 to = j == t ? goal : center(j);
-          // Out of an inflated start only the target needs to be free.
-          const bool blocked = i == s && start_inflated ? map.IsInflated(to) : map.SegmentCollides(from, to);
-          if (blocked) continue;
-          const float cost = g[static_cast<std::size_t>(i)] + static_cast<float>((to - from).norm());
-          if (cost >= g[static_cast<std::size_t>(j)]) continue;
-          g[static_cast<std::size_t>(j)] = cost;
-          parent[static_cast<std::size_t>(j)] = i;
-          open.push({cost + h(j), j});
-        }
+    const Eigen::Vector3i c = cell(j);
+    for (const Move& move : moves) {
+      const Eigen::Vector3i nc = c + move.offset;
+      if (!in_grid(nc)) continue;
+      const int k = j + move.delta;
+      Cell& ck = record(k);
+      if (ck.tag & kExpanded) continue;
+      const Vector3 centre = centre_of(nc);
+      if (k != t) {  // a move ending in an inflated centre collides wherever it comes from
+        if (!(ck.tag & kCentreKnown)) ck.tag |= kCentreKnown | (map.IsInflated(centre) ? kCentreInflated : 0u);
+        if (ck.tag & kCentreInflated) continue;
       }
+      const float g = cj.g + length(j, k, move);
+      if (g >= ck.g) continue;
+      ck.g = g;
+      ck.parent = j;
+      ck.tag &= ~kMoveChecked;
+      propose(k, j, g, k == t ? goal : centre);
     }
   }
   if (!found) {
     result.status = PathStatus::kNoPath;
     return result;
   }
-  // Cell centres from the goal back to the start, the ends replaced by the goal and start points
-  // themselves (both kept when they share a cell).
-  std::vector<Vector3> raw;
-  for (int i = t; i != -1; i = parent[static_cast<std::size_t>(i)]) raw.push_back(i == t ? goal : center(i));
-  if (raw.size() == 1) {
-    raw.push_back(start);
-  } else {
-    raw.back() = start;
+  // Points from the goal back to the start (both kept when they share a cell).
+  std::vector<Vector3> raw = {goal};
+  for (int i = cells_[static_cast<std::size_t>(t)].parent; i != -1; i = cells_[static_cast<std::size_t>(i)].parent) {
+    raw.push_back(point(i));
   }
+  if (t == s) raw.push_back(start);
   std::reverse(raw.begin(), raw.end());
   // Line-of-sight pruning: from each kept point, on to the farthest of the following points it sees
   // without a break (out of an inflated start, the next point).
@@ -150,6 +221,12 @@ PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const
   }
   result.status = PathStatus::kFound;
   return result;
+}
+
+PathResult FindPath(const perception::VoxelMap& map, const Vector3& start, const Vector3& goal,
+                    const AStarOptions& options) {
+  PathSearch search;
+  return search.Find(map, start, goal, options);
 }
 
 }  // namespace rotorguard::planning

@@ -11,12 +11,21 @@ namespace rotorguard::planning {
 namespace {
 
 /// PlanSummary::min_clearance_m: the smallest distance to an occupied voxel centre over the
-/// positions that for_each_position(f) hands to f (f returns true to go on), capped at `cap`.
+/// positions that for_each_position(f) hands to f (f returns true to go on), capped at `cap`. That
+/// capped distance moves by at most as much as the position does, so a position nearer to the last
+/// one measured than that one's clearance exceeds the smallest so far cannot lower it and is not
+/// measured (in a forest, most of a result's 5-cm checks).
 template <typename ForEachPosition>
 double MinClearance(const perception::VoxelMap& map, double cap, ForEachPosition&& for_each_position) {
   double clearance = cap;
+  Vector3 measured_at = Vector3::Zero();
+  double measured = -1.0;  // none yet
   for_each_position([&](const Vector3& p) {
-    if (const auto o = map.Nearest(p, cap)) clearance = std::min(clearance, o->distance_m);
+    if (measured - (p - measured_at).norm() >= clearance) return true;
+    const std::optional<perception::NearestObstacle> o = map.Nearest(p, cap);
+    measured_at = p;
+    measured = o ? o->distance_m : cap;
+    clearance = std::min(clearance, measured);
     return true;
   });
   return clearance;
@@ -98,7 +107,7 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     summary.total_ms = clock.milliseconds();
     return summary;
   };
-  summary.path = FindPath(map, start.col(0), goal, options_.search);
+  summary.path = search_.Find(map, start.col(0), goal, options_.search);
   if (summary.path.status == PathStatus::kNoPath && options_.fine_search_fallback &&
       options_.search.resolution_m > map.resolution()) {
     // The coarse cells may see no way out of a pocket that the map's voxels leave open (a vehicle
@@ -106,7 +115,7 @@ PlanSummary Planner::Plan(const PvaState& start, const Vector3& goal, const Dyna
     // map's own voxels, eight times as many cells, only when the coarse one has failed.
     AStarOptions fine = options_.search;
     fine.resolution_m = map.resolution();
-    summary.path = FindPath(map, start.col(0), goal, fine);
+    summary.path = search_.Find(map, start.col(0), goal, fine);
     summary.fine_search = true;
   }
   summary.search_ms = clock.milliseconds();

@@ -458,30 +458,57 @@ TEST_P(VoxelMapWalk, ManyFramesWithAMovingWindowMatchAPlainReferenceModel) {
 }
 
 // Nearest against a brute-force search over the list of occupied voxels, for radii that take the
-// sorted-offset path (up to 1.1 m at 0.1 m) and the cube scan beyond it.
+// sorted-column path (up to 1.1 m at 0.1 m) and the cube scan beyond it: the same distance and the
+// same voxel, of equally near ones the lowest index (x, then y, then z). A quarter of the queries
+// lie on voxel corners or centres.
 TEST(VoxelMap, NearestEqualsABruteForceSearch) {
-  VoxelMap map(Small());
-  Rng rng(9);
-  for (int k = 0; k < 200; ++k) map.MarkOccupied(Vector3(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(0.2, 1.8)));
-  const std::vector<Vector3> occupied = map.OccupiedVoxels();
-  ASSERT_GT(occupied.size(), 150u);
-  int found = 0;
-  for (int k = 0; k < 2000; ++k) {
-    const Vector3 p(rng.Uniform(-3.5, 3.5), rng.Uniform(-3.5, 3.5), rng.Uniform(0.0, 2.0));
-    const double radius = k % 4 == 3 ? 1.6 : rng.Uniform(0.0, 1.0);
-    double truth = std::numeric_limits<double>::infinity();
-    for (const Vector3& c : occupied) truth = std::min(truth, (c - p).norm());
-    const auto n = map.Nearest(p, radius);
-    if (truth > radius) {
-      EXPECT_FALSE(n) << "nothing within " << radius << " of " << p.transpose();
-      continue;
+  // At 0.1 m, and at 0.25 m, where centres and corners are exact in binary, so that the voxels
+  // about a corner or a centre are exactly as near.
+  for (const double res : {0.1, 0.25}) {
+    VoxelMapOptions o = Small();
+    o.resolution_m = res;
+    VoxelMap map(o);
+    Rng rng(9);
+    for (int k = 0; k < 200; ++k) map.MarkOccupied(Vector3(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(0.2, 1.8)));
+    const std::vector<Vector3> occupied = map.OccupiedVoxels();
+    ASSERT_GT(occupied.size(), 150u);
+    const auto index_of = [&](const Vector3& centre) { return Eigen::Vector3i((centre / res).array().floor().cast<int>()); };
+    const auto lower = [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+      return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+    };
+    int found = 0, tied = 0;
+    for (int k = 0; k < 2000; ++k) {
+      Vector3 p(rng.Uniform(-3.5, 3.5), rng.Uniform(-3.5, 3.5), rng.Uniform(0.0, 2.0));
+      if (k % 8 == 1) p = (p / res).array().round() * res;          // a corner
+      if (k % 8 == 5) p = ((p / res).array().floor() + 0.5) * res;  // a centre
+      const double radius = k % 4 == 3 ? 1.6 : rng.Uniform(0.0, 1.0);
+      double truth = std::numeric_limits<double>::infinity();
+      Eigen::Vector3i truth_index;
+      int as_near = 0;
+      for (const Vector3& c : occupied) {
+        const double d = (c - p).norm();
+        if (d > truth) continue;
+        as_near = d < truth ? 1 : as_near + 1;
+        if (d < truth || lower(index_of(c), truth_index)) truth_index = index_of(c);
+        truth = d;
+      }
+      const auto n = map.Nearest(p, radius);
+      if (truth > radius) {
+        EXPECT_FALSE(n) << "nothing within " << radius << " of " << p.transpose();
+        continue;
+      }
+      ASSERT_TRUE(n) << p.transpose();
+      EXPECT_EQ(n->distance_m, truth);
+      EXPECT_EQ(index_of(n->point_W), truth_index) << "at " << p.transpose() << ", " << as_near << " as near";
+      EXPECT_NEAR((n->point_W - p).norm(), truth, 1e-12);
+      ++found;
+      tied += as_near > 1;
     }
-    ASSERT_TRUE(n) << p.transpose();
-    EXPECT_NEAR(n->distance_m, truth, 1e-12);
-    EXPECT_NEAR((n->point_W - p).norm(), truth, 1e-12);
-    ++found;
+    EXPECT_GT(found, 500) << res;
+    if (res == 0.25) {
+      EXPECT_GT(tied, 20) << "the queries on corners and centres meet ties";
+    }
   }
-  EXPECT_GT(found, 500);
 }
 
 // The AVX2 walk kernel against the portable one, which the tests above hold to exact oracles:

@@ -114,6 +114,9 @@ class Planner {
 
   PlannerOptions options_;
   TrajectoryOptimizer optimizer_;
+  /// The front end's memory between plans (PathSearch), so one Plan at a time per planner, as for
+  /// the map it plans on.
+  mutable PathSearch search_;
 };
 
 }  // namespace rotorguard::planning
