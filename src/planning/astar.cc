@@ -78,6 +78,16 @@ PathResult PathSearch::Find(const perception::VoxelMap& map, const Vector3& star
   const auto cell = [&](int i) { return Eigen::Vector3i(i / nyz, (i / n.z()) % n.y(), i % n.z()); };
   const auto centre_of = [&](const Eigen::Vector3i& c) { return Vector3(lo + (c.cast<double>() + Vector3::Constant(0.5)) * res); };
   const std::size_t count = static_cast<std::size_t>(n.prod());
+  // The map's voxel of each cell centre, per axis (VoxelOf is per axis): the centre test of every
+  // proposed move without a division.
+  std::vector<int> voxel_x(static_cast<std::size_t>(n.x())), voxel_y(static_cast<std::size_t>(n.y())),
+      voxel_z(static_cast<std::size_t>(n.z()));
+  for (int k = 0; k < n.maxCoeff(); ++k) {
+    const Eigen::Vector3i v = map.VoxelOf(centre_of(Eigen::Vector3i::Constant(k)));
+    if (k < n.x()) voxel_x[static_cast<std::size_t>(k)] = v.x();
+    if (k < n.y()) voxel_y[static_cast<std::size_t>(k)] = v.y();
+    if (k < n.z()) voxel_z[static_cast<std::size_t>(k)] = v.z();
+  }
   if (cells_.size() < count) cells_.resize(count);
   if (++generation_ >= (1u << (32 - kFlagBits))) {  // the tags would wrap: every cell untouched again
     std::fill(cells_.begin(), cells_.end(), Cell{});
@@ -183,16 +193,21 @@ PathResult PathSearch::Find(const perception::VoxelMap& map, const Vector3& star
       const int k = j + move.delta;
       Cell& ck = record(k);
       if (ck.tag & kExpanded) continue;
-      const Vector3 centre = centre_of(nc);
-      if (k != t) {  // a move ending in an inflated centre collides wherever it comes from
-        if (!(ck.tag & kCentreKnown)) ck.tag |= kCentreKnown | (map.IsInflated(centre) ? kCentreInflated : 0u);
-        if (ck.tag & kCentreInflated) continue;
-      }
       const float g = cj.g + length(j, k, move);
       if (g >= ck.g) continue;
+      if (k != t) {  // a move ending in an inflated centre collides wherever it comes from
+        if (!(ck.tag & kCentreKnown)) {
+          const bool inflated = map.IsInflatedVoxel(Eigen::Vector3i(voxel_x[static_cast<std::size_t>(nc.x())],
+                                                                    voxel_y[static_cast<std::size_t>(nc.y())],
+                                                                    voxel_z[static_cast<std::size_t>(nc.z())]));
+          ck.tag |= kCentreKnown | (inflated ? kCentreInflated : 0u);
+        }
+        if (ck.tag & kCentreInflated) continue;
+      }
       ck.g = g;
       ck.parent = j;
       ck.tag &= ~kMoveChecked;
+      const Vector3 centre = centre_of(nc);
       propose(k, j, g, k == t ? goal : centre);
     }
   }

@@ -149,6 +149,11 @@ class VoxelMap {
   /// Within the inflation radius of an occupied voxel. Outside the window: false. Not safe to
   /// call from two threads at once on one map, nor with SegmentCollides: both fill a memo.
   bool IsInflated(const Vector3& p_W) const;
+  /// The voxel holding p (its index: floor of p over the resolution, per axis), and IsInflated of a
+  /// voxel by index: IsInflated(p) is IsInflatedVoxel(VoxelOf(p)) for a finite p. A search asking
+  /// for many points on a grid computes their voxels once per axis.
+  Eigen::Vector3i VoxelOf(const Vector3& p_W) const { return ToIndex(p_W); }
+  bool IsInflatedVoxel(const Eigen::Vector3i& voxel) const { return InWindow(voxel) && Inflated(Address(voxel)); }
   /// The nearest occupied voxel within `radius_m` of p, if any; of equally near ones, the one of
   /// lowest index (x, then y, then z). Up to FastNearestRadiusM it reads the columns along z of
   /// the disc around p by increasing distance, a column's height range a word of occupied bits at
