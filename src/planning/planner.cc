@@ -14,7 +14,7 @@ namespace {
 /// positions that for_each_position(f) hands to f (f returns true to go on), capped at `cap`. That
 /// capped distance moves by at most as much as the position does, so a position nearer to the last
 /// one measured than that one's clearance exceeds the smallest so far cannot lower it and is not
-/// measured (in a forest, most of a result's 5-cm checks).
+/// measured: the minimum is the same as with every position measured.
 template <typename ForEachPosition>
 double MinClearance(const perception::VoxelMap& map, double cap, ForEachPosition&& for_each_position) {
   double clearance = cap;
