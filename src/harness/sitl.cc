@@ -233,6 +233,7 @@ class SharedMemoryLink final : public StackLink {
     channel_->to_node_bell.Ring();
   }
   bool TryReceive(runtime::CycleTelemetry* cycle) override { return channel_->cycles.TryPop(cycle); }
+  std::uint64_t frames_dropped() const override { return frames_dropped_; }
   nlohmann::json Finish(nlohmann::json* loops) override {
     time_.Stop();
     runtime::SitlMessage end;
@@ -359,6 +360,7 @@ nlohmann::json SitlLinkReport::ToJson() const {
           {"step_work", HistogramJson(step_work)},
           {"step_work_slowest", SlowestJson(step_work_slowest)},
           {"command_delay", HistogramJson(command_delay)},
+          {"frames_dropped", frames_dropped},
           {"processes", processes},
           {"simulator_scheduling", simulator_realtime}};
 }
@@ -493,6 +495,7 @@ SitlResult RunSitl(const Scenario& scenario, const RunOptions& options, const Si
   }
   StackAccount account;
   io::FromJson(stack->Finish(&result.loops), &account);
+  link.frames_dropped = stack->frames_dropped();
   for (runtime::CycleTelemetry c; stack->TryReceive(&c);) ++link.commands_after_end;
   if (options.progress) options.progress(1.0);
 

@@ -16,6 +16,7 @@
 #include "rotorguard/rosbridge/topics.h"
 #include "rotorguard/rosbridge/wire_convert.h"
 #include "rotorguard/runtime/clock.h"
+#include "rotorguard/runtime/doorbell.h"
 #include "rotorguard/runtime/realtime.h"
 #include "rotorguard/runtime/spsc_queue.h"
 
@@ -64,6 +65,26 @@ class RosLink final : public harness::StackLink {
       while (!stop_.load(std::memory_order_acquire) && bus_.Spin(0.002)) {
       }
     });
+    // A LiDAR frame's conversion and publication (two copies of ~0.5 MB and roscpp's serialisation)
+    // on a thread of its own, as a LiDAR driver has: not on the simulator's thread, where it held
+    // the next step's IMU sample up. Off the control CPU, one below the simulator's priority: roscpp
+    // serialises every publication under one mutex, which the IMU's publication then waits for at
+    // most one serialisation, never a preempted thread's turn.
+    frame_publisher_ = std::thread([this] {
+      runtime::FollowRealtime(realtime_.fifo_priority > 0 ? std::max(1, realtime_.fifo_priority - 1) : 0,
+                              realtime_.control_cpu, runtime::ThreadRole::kCompute);
+      LidarFrame frame;
+      for (;;) {
+        const std::uint32_t seen = frames_bell_.Count();
+        bool any = false;
+        while (frames_.TryPop(&frame)) {
+          points_.Publish(ToWire(frame, base_));
+          any = true;
+        }
+        if (!any && stop_.load(std::memory_order_acquire)) return;
+        if (!any) frames_bell_.Wait(seen, 10'000'000);
+      }
+    });
     if (!options_.external_node) {
       if (sitl.node_command.empty()) throw std::invalid_argument("sitl --ros: no command to start the node with (SitlOptions::node_command)");
       std::vector<std::string> argv = sitl.node_command;
@@ -76,6 +97,8 @@ class RosLink final : public harness::StackLink {
   }
   ~RosLink() override {
     stop_.store(true, std::memory_order_release);
+    frames_bell_.Ring();
+    if (frame_publisher_.joinable()) frame_publisher_.join();
     if (spinner_.joinable()) spinner_.join();
   }
 
@@ -107,9 +130,12 @@ class RosLink final : public harness::StackLink {
     if (o.imu) imu_.Publish(ToWire(*o.imu, base_));
     if (o.esc) esc_.Publish(ToWire(*o.esc, base_));
     if (o.odometry) odometry_.Publish(ToWire(*o.odometry, base_));
-    if (o.lidar) points_.Publish(ToWire(*o.lidar, base_));
+    // A copy into a slot whose buffers are reused (no allocation once the first frames went); a
+    // frame the publisher is four behind on is dropped and counted (frames_dropped()).
+    if (o.lidar && frames_.TryPush(*o.lidar)) frames_bell_.Ring();
   }
   bool TryReceive(runtime::CycleTelemetry* cycle) override { return cycles_.TryPop(cycle); }
+  std::uint64_t frames_dropped() const override { return frames_.dropped(); }
   nlohmann::json Finish(nlohmann::json* loops) override {
     shutdown_.Publish({"end"});
     WaitUntil([this] { return !Locked(account_).empty(); }, 60.0, "send its account");
@@ -164,12 +190,15 @@ class RosLink final : public harness::StackLink {
   ros1::Publisher<ros1::ClockTick> start_;
   ros1::Publisher<ros1::Text> shutdown_;
   runtime::SpscQueue<runtime::CycleTelemetry, 4096> cycles_;
+  runtime::SpscQueue<LidarFrame, 4> frames_;  // the simulator's thread to frame_publisher_
+  runtime::Doorbell frames_bell_;
   std::mutex mutex_;
   std::string status_, account_;
   std::optional<runtime::SteadyClock> steady_;
   std::atomic<const runtime::SteadyClock*> steady_clock_{nullptr};  // steady_ once set (the spinner reads it)
   std::atomic<bool> stop_{false};
   std::thread spinner_;
+  std::thread frame_publisher_;
   harness::NodeProcess node_;  // last: killed (if still running) before the bus goes
 };
 

@@ -40,6 +40,8 @@ class StackLink {
   virtual void OnClock(TimeNs /*t*/) {}
   virtual void Deliver(const sim::SensorOutputs& outputs) = 0;
   virtual bool TryReceive(runtime::CycleTelemetry* cycle) = 0;
+  /// LiDAR frames the link could not hand on (its slots all still held), so far.
+  virtual std::uint64_t frames_dropped() const { return 0; }
   /// Stops the stack; its account (JSON: the stack's summary, as `rotorguard node` sends it) and
   /// its loops' report (JSON).
   virtual nlohmann::json Finish(nlohmann::json* loops) = 0;
@@ -86,6 +88,7 @@ struct SitlLinkReport {
   runtime::LatencyHistogram step_work;
   runtime::SlowestRecords step_work_slowest;
   runtime::LatencyHistogram command_delay;  ///< a command's IMU sample -> it acts on the ESCs (before their latency)
+  std::uint64_t frames_dropped = 0;  ///< LiDAR frames the link could not hand on (StackLink::frames_dropped)
   int processes = 1;                 ///< the simulator's and the stack's: 1 or 2
   std::string simulator_realtime = "normal scheduler (not asked)";  ///< the simulator thread's scheduling
   /// As runtime.json's "link" holds it (docs/runtime.md).
