@@ -153,6 +153,9 @@ void AssemblyTrajectoryOptions::Validate() const {
   require(check_samples_per_piece >= samples_per_piece, "check_samples_per_piece", check_samples_per_piece,
           "at least samples_per_piece");
   require(max_slowdowns >= 0, "max_slowdowns", max_slowdowns, ">= 0");
+  require(collision_rounds >= 0, "collision_rounds", collision_rounds, ">= 0");
+  require(collision_weight_growth >= 1.0 && std::isfinite(collision_weight_growth), "collision_weight_growth",
+          collision_weight_growth, "a finite value >= 1");
   require(slowdown_factor > 1.0 && slowdown_factor <= 2.0, "slowdown_factor", slowdown_factor, "in (1, 2]");
   require(attitude_bins >= 4 && attitude_bins <= 3600, "attitude_bins", attitude_bins, "in [4, 3600]");
 }
@@ -298,7 +301,8 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
         add_yaw(0, -w * 2.0 * vh.squaredNorm() * e);
       }
       // G_o: each unit's centre p + R_z(ψ) r_k against its plane.
-      if (!problem.planes.empty() && o.weight_obstacle > 0.0) {
+      const double weight_obstacle = o.weight_obstacle * problem.obstacle_weight_scale;
+      if (!problem.planes.empty() && weight_obstacle > 0.0) {
         const std::vector<FootprintPlane>& list = problem.planes[static_cast<std::size_t>(i)];
         while (cursor < list.size() && list[cursor].sample < j) ++cursor;
         for (std::size_t k = cursor; k < list.size() && list[k].sample == j; ++k) {
@@ -309,8 +313,8 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
           double slope;
           const double pen = CubicPenalty(required - (c - plane.point).dot(plane.normal), &slope);
           if (slope == 0.0) continue;
-          cost += o.weight_obstacle * pen;
-          const Eigen::RowVector3d gc = -o.weight_obstacle * slope * plane.normal.transpose();
+          cost += weight_obstacle * pen;
+          const Eigen::RowVector3d gc = -weight_obstacle * slope * plane.normal.transpose();
           add_position(0, gc);
           add_yaw(0, gc.dot(Vector3::UnitZ().cross(offset).transpose()));  // d(R_z(ψ) r)/dψ = e_z × R_z(ψ) r
         }
@@ -351,6 +355,82 @@ FootprintPlaneSet AssemblyTrajectoryOptimizer::BuildPlanes(const perception::Vox
     }
   }
   return planes;
+}
+
+std::optional<std::pair<AssemblyTrajectorySummary::Status, std::string>> AssemblyTrajectoryOptimizer::StretchToLimits(
+    const Problem& problem, Eigen::VectorXd* x, AssemblyTrajectory* traj, AssemblyTrajectorySummary* summary) const {
+  // Honest feasibility: check densely and stretch time while a limit is exceeded (between rest
+  // states, durations times k scale v, a, j by 1/k, 1/k², 1/k³ and the yaw's rate and
+  // acceleration by 1/k, 1/k²).
+  using Status = AssemblyTrajectorySummary::Status;
+  const AssemblyLimits& limits = problem.limits;
+  const int dense = options_.check_samples_per_piece;
+  for (int slowdowns = 0;; ++slowdowns) {
+    const planning::MinimumJerkTrajectory& pos = traj->position();
+    const int m = pos.pieces();
+    std::vector<double> ratio = {pos.MaxNorm(1, dense) / limits.kinematic.v_max,
+                                 std::sqrt(pos.MaxNorm(2, dense) / limits.kinematic.a_max),
+                                 std::cbrt(pos.MaxNorm(3, dense) / limits.kinematic.j_max)};
+    if (limits.yaw_rate_max > 0.0) ratio.push_back(traj->yaw().MaxNorm(1, dense) / limits.yaw_rate_max);
+    if (limits.yaw_acceleration_max > 0.0) {
+      ratio.push_back(std::sqrt(traj->yaw().MaxNorm(2, dense) / limits.yaw_acceleration_max));
+    }
+    if (limits.thrust_acceleration_max > 0.0) {
+      // |a + g e_z| <= |a| + g: stretching until |a| <= limit - g is enough (a scales by 1 / k²).
+      double thrust = 0.0;
+      for (int i = 0; i < m; ++i) {
+        for (int j = 0; j <= dense; ++j) {
+          Vector3 f = pos.PieceDerivative(i, pos.durations()(i) * j / dense, 2);
+          f.z() += kGravity;
+          thrust = std::max(thrust, f.norm());
+        }
+      }
+      if (thrust > limits.thrust_acceleration_max) {
+        ratio.push_back(std::sqrt(pos.MaxNorm(2, dense) / (limits.thrust_acceleration_max - kGravity)));
+      }
+    }
+    const double worst = *std::max_element(ratio.begin(), ratio.end());
+    summary->limit_margin = 1.0 - worst;  // of the stretch factor's scale: >= 0 when all hold
+    if (worst <= 1.0) return std::nullopt;
+    if (slowdowns == options_.max_slowdowns) {
+      return std::pair{Status::kInfeasible,
+                       "a limit still exceeded after stretching time " + std::to_string(slowdowns) + " times"};
+    }
+    ++summary->slowdowns;
+    const double k = std::min(worst * options_.slowdown_factor, 2.0);
+    for (int i = 0; i < m; ++i) (*x)(4 * (m - 1) + i) = TrajectoryOptimizer::TauOf(k * pos.durations()(i));
+    if (!Build(problem, *x, traj)) {
+      return std::pair{Status::kSolverFailure, std::string("the stretched trajectory cannot be built")};
+    }
+  }
+}
+
+void AssemblyTrajectoryOptimizer::DenseCheck(const perception::VoxelMap& map, const AssemblyTrajectory& traj,
+                                             AssemblyTrajectorySummary* summary) const {
+  // The dense check of the footprint and of eq. (12b).
+  const int dense = options_.check_samples_per_piece;
+  const planning::MinimumJerkTrajectory& pos = traj.position();
+  summary->duration_s = pos.total_duration();
+  summary->min_clearance_m = options_.obstacle_range_m;
+  double deviation = 0.0;
+  int moving = 0;
+  for (int i = 0; i < pos.pieces(); ++i) {
+    for (int j = 0; j <= dense; ++j) {
+      const double ts = pos.durations()(i) * j / dense;
+      const AssemblyPose pose{pos.PieceDerivative(i, ts, 0), traj.yaw().PieceDerivative(i, ts, 0).x()};
+      const Vector3 v = pos.PieceDerivative(i, ts, 1);
+      if (v.head<2>().norm() > 0.1) {
+        deviation += std::abs(AttitudeError(pose.yaw_rad, std::atan2(v.y(), v.x())));
+        ++moving;
+      }
+      for (const Vector3& r : assembly_.unit_position_B) {
+        if (const auto hit = map.Nearest(pose.p_W + QuaternionFromYaw(pose.yaw_rad) * r, options_.obstacle_range_m)) {
+          summary->min_clearance_m = std::min(summary->min_clearance_m, hit->distance_m - assembly_.unit_radius_m);
+        }
+      }
+    }
+  }
+  summary->attitude_deviation_rad = moving > 0 ? deviation / moving : 0.0;
 }
 
 AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception::VoxelMap& map,
@@ -407,90 +487,46 @@ AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception
   AssemblyTrajectory traj;
   if (!Build(problem, x, &traj)) return finish(Status::kInvalidInput, "the initial guess has no trajectory");
   std::string message;
-  for (int round = 0; round < options_.plane_rounds; ++round) {
-    problem.planes = BuildPlanes(map, traj);
+  const auto solve = [&] {
     const planning::LbfgsSummary lbfgs = planning::MinimizeLbfgs(
         [&](const Eigen::VectorXd& v, Eigen::VectorXd* g) { return Objective(problem, v, g); },
         {options_.max_iterations, options_.relative_cost_tolerance}, &x);
     summary.iterations += lbfgs.iterations;
     summary.evaluations += lbfgs.evaluations;
     message = lbfgs.message;
-    if (!x.allFinite() || lbfgs.failed || !Build(problem, x, &traj)) {
-      return finish(Status::kSolverFailure, "L-BFGS: " + lbfgs.message);
-    }
+    return x.allFinite() && !lbfgs.failed && Build(problem, x, &traj);
+  };
+  for (int round = 0; round < options_.plane_rounds; ++round) {
+    problem.planes = BuildPlanes(map, traj);
+    if (!solve()) return finish(Status::kSolverFailure, "L-BFGS: " + message);
   }
 
-  // Honest feasibility: check densely and stretch time while a limit is exceeded (between rest
-  // states, durations times k scale v, a, j by 1/k, 1/k², 1/k³ and the yaw's rate and
-  // acceleration by 1/k, 1/k²).
-  const int dense = options_.check_samples_per_piece;
-  for (;;) {
-    const planning::MinimumJerkTrajectory& pos = traj.position();
-    std::vector<double> ratio = {pos.MaxNorm(1, dense) / limits.kinematic.v_max,
-                                 std::sqrt(pos.MaxNorm(2, dense) / limits.kinematic.a_max),
-                                 std::cbrt(pos.MaxNorm(3, dense) / limits.kinematic.j_max)};
-    if (limits.yaw_rate_max > 0.0) ratio.push_back(traj.yaw().MaxNorm(1, dense) / limits.yaw_rate_max);
-    if (limits.yaw_acceleration_max > 0.0) {
-      ratio.push_back(std::sqrt(traj.yaw().MaxNorm(2, dense) / limits.yaw_acceleration_max));
-    }
-    if (limits.thrust_acceleration_max > 0.0) {
-      // |a + g e_z| <= |a| + g: stretching until |a| <= limit - g is enough (a scales by 1 / k²).
-      double thrust = 0.0;
-      for (int i = 0; i < m; ++i) {
-        for (int j = 0; j <= dense; ++j) {
-          Vector3 f = pos.PieceDerivative(i, pos.durations()(i) * j / dense, 2);
-          f.z() += kGravity;
-          thrust = std::max(thrust, f.norm());
-        }
-      }
-      if (thrust > limits.thrust_acceleration_max) {
-        ratio.push_back(std::sqrt(pos.MaxNorm(2, dense) / (limits.thrust_acceleration_max - kGravity)));
-      }
-    }
-    const double worst = *std::max_element(ratio.begin(), ratio.end());
-    summary.limit_margin = 1.0 - worst;  // of the stretch factor's scale: >= 0 when all hold
-    if (worst <= 1.0) break;
-    if (summary.slowdowns == options_.max_slowdowns) {
-      return finish(Status::kInfeasible, "a limit still exceeded after stretching time " +
-                                             std::to_string(summary.slowdowns) + " times");
-    }
-    ++summary.slowdowns;
-    const double k = std::min(worst * options_.slowdown_factor, 2.0);
-    for (int i = 0; i < m; ++i) x(4 * (m - 1) + i) = TrajectoryOptimizer::TauOf(k * pos.durations()(i));
-    if (!Build(problem, x, &traj)) return finish(Status::kSolverFailure, "the stretched trajectory cannot be built");
-  }
-
-  // The dense check of the footprint and of eq. (12b).
-  const planning::MinimumJerkTrajectory& pos = traj.position();
-  summary.duration_s = pos.total_duration();
-  summary.min_clearance_m = options_.obstacle_range_m;
-  double deviation = 0.0;
-  int moving = 0;
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j <= dense; ++j) {
-      const double ts = pos.durations()(i) * j / dense;
-      const AssemblyPose pose{pos.PieceDerivative(i, ts, 0), traj.yaw().PieceDerivative(i, ts, 0).x()};
-      const Vector3 v = pos.PieceDerivative(i, ts, 1);
-      if (v.head<2>().norm() > 0.1) {
-        deviation += std::abs(AttitudeError(pose.yaw_rad, std::atan2(v.y(), v.x())));
-        ++moving;
-      }
-      for (const Vector3& r : assembly_.unit_position_B) {
-        if (const auto hit = map.Nearest(pose.p_W + QuaternionFromYaw(pose.yaw_rad) * r, options_.obstacle_range_m)) {
-          summary.min_clearance_m = std::min(summary.min_clearance_m, hit->distance_m - assembly_.unit_radius_m);
-        }
-      }
-    }
-  }
-  summary.attitude_deviation_rad = moving > 0 ? deviation / moving : 0.0;
-  *out = traj;
   const double reach = 0.5 * std::sqrt(3.0) * map.resolution();
-  if (summary.min_clearance_m < reach) {
-    return finish(Status::kCollides,
-                  fmt::format("a unit's sphere may reach an occupied voxel: it comes within {:.3f} m of a voxel's "
-                              "centre beyond its radius, less than the voxel's half-diagonal {:.3f} m",
-                              summary.min_clearance_m, reach));
+  for (;;) {
+    if (const auto failed = StretchToLimits(problem, &x, &traj, &summary)) return finish(failed->first, failed->second);
+    DenseCheck(map, traj, &summary);
+    if (summary.min_clearance_m >= reach) break;
+    if (summary.collision_rounds == options_.collision_rounds) {
+      *out = traj;
+      return finish(Status::kCollides,
+                    fmt::format("a unit's sphere may reach an occupied voxel: it comes within {:.3f} m of a voxel's "
+                                "centre beyond its radius, less than the voxel's half-diagonal {:.3f} m",
+                                summary.min_clearance_m, reach));
+    }
+    // The planes of each sample's nearest obstacles are local: where the solution crossed into
+    // another obstacle's reach, solve again with its planes added and the clearance weighted more.
+    ++summary.collision_rounds;
+    const FootprintPlaneSet added = BuildPlanes(map, traj);
+    for (std::size_t i = 0; i < added.size(); ++i) {
+      std::vector<FootprintPlane>& list = problem.planes[i];
+      list.insert(list.end(), added[i].begin(), added[i].end());
+      std::stable_sort(list.begin(), list.end(),
+                       [](const FootprintPlane& a, const FootprintPlane& b) { return a.sample < b.sample; });
+    }
+    problem.obstacle_weight_scale *= options_.collision_weight_growth;
+    if (!solve()) return finish(Status::kSolverFailure, "L-BFGS: " + message);
   }
+  *out = traj;
   return finish(Status::kSuccess, message);
 }
 

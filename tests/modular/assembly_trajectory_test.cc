@@ -168,6 +168,23 @@ TEST(AssemblyTrajectoryOptimizer, TheAttitudeTermTurnsABroadsideRowLengthwiseWit
       << s_ours.attitude_deviation_rad << " rad against " << s_base.attitude_deviation_rad;
 }
 
+/// By brute force: the smallest distance from a unit's centre to a wall voxel's cube (0.1 m, about
+/// its centre) minus the unit's radius, every 10 ms of `traj`.
+double BruteForceClearance(const Assembly& a, const AssemblyTrajectory& traj, const std::vector<Vector3>& wall) {
+  double nearest = 1e9;
+  for (double time = 0.0; time <= traj.duration(); time += 0.01) {
+    const AssemblyPose pose = traj.PoseAt(time);
+    const double c = std::cos(pose.yaw_rad), sn = std::sin(pose.yaw_rad);
+    for (const Vector3& u : a.unit_position_B) {
+      const Vector3 p = pose.p_W + Vector3(c * u.x() - sn * u.y(), sn * u.x() + c * u.y(), 0.0);
+      for (const Vector3& w : wall) {
+        nearest = std::min(nearest, ((p - w).cwiseAbs().array() - 0.05).cwiseMax(0.0).matrix().norm());
+      }
+    }
+  }
+  return nearest - a.unit_radius_m;
+}
+
 TEST(AssemblyTrajectoryOptimizer, TheFootprintPassesAGapNarrowerThanTheRowIsLong) {
   const Assembly a = testing::MarsAssembly("4x1");  // 1.05 m long, 0.3 m wide
   std::vector<Vector3> wall;
@@ -183,21 +200,53 @@ TEST(AssemblyTrajectoryOptimizer, TheFootprintPassesAGapNarrowerThanTheRowIsLong
     const AssemblyTrajectorySummary s = AssemblyTrajectoryOptimizer(a, eta, o).Optimize(map, path, Limits(), &traj);
     ASSERT_TRUE(s.ok()) << ToString(s.status) << ": " << s.message;
     EXPECT_GE(s.min_clearance_m, 0.0);
-    // The truth by brute force: no unit's sphere reaches a wall voxel's cube (0.1 m, about its
-    // centre), every 10 ms.
-    double nearest = 1e9;
-    for (double time = 0.0; time <= traj.duration(); time += 0.01) {
-      const AssemblyPose pose = traj.PoseAt(time);
-      const double c = std::cos(pose.yaw_rad), sn = std::sin(pose.yaw_rad);
-      for (const Vector3& u : a.unit_position_B) {
-        const Vector3 p = pose.p_W + Vector3(c * u.x() - sn * u.y(), sn * u.x() + c * u.y(), 0.0);
-        for (const Vector3& w : wall) {
-          nearest = std::min(nearest, ((p - w).cwiseAbs().array() - 0.05).cwiseMax(0.0).matrix().norm());
+    // The truth by brute force: no unit's sphere reaches a wall voxel's cube.
+    EXPECT_GE(BruteForceClearance(a, traj, wall), 0.0) << "weight " << weight;
+  }
+}
+
+TEST(AssemblyTrajectoryOptimizer, CollisionRoundsPlanWhatOneSolveLeavesColliding) {
+  // Starts and goals moved about a gap barely wider than the row: one solve's planes (each
+  // sample's nearest obstacle) leave some footprints reaching a wall voxel; the collision rounds
+  // plan every one of them clear, on an independent check.
+  const Assembly a = testing::MarsAssembly("4x1");
+  std::vector<Vector3> wall;
+  const perception::VoxelMap map = WallWithGap(0.8, &wall);
+  const RotorVector eta = RotorVector::Ones(16);
+  AssemblyTrajectoryOptions one_solve;
+  one_solve.collision_rounds = 0;
+  int collided_once = 0, planned = 0, trials = 0;
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const Vector3 start(-1.5, -0.3 + 0.2 * i, 1.5), goal(1.5, 0.3 - 0.2 * j, 1.5);
+      const AssemblyPath path = FindAssemblyPath(map, a, eta, {start, 0.5 * kPi}, goal, Band());
+      if (path.status != AssemblyPathStatus::kFound) continue;
+      ++trials;
+      for (const double weight : {50.0, 0.0}) {  // ours and the baseline
+        AssemblyTrajectoryOptions o;
+        o.weight_attitude = weight;
+        one_solve.weight_attitude = weight;
+        AssemblyTrajectory traj, once;
+        const AssemblyTrajectorySummary s = AssemblyTrajectoryOptimizer(a, eta, o).Optimize(map, path, Limits(), &traj);
+        const AssemblyTrajectorySummary s1 =
+            AssemblyTrajectoryOptimizer(a, eta, one_solve).Optimize(map, path, Limits(), &once);
+        if (s1.status == AssemblyTrajectorySummary::Status::kCollides) {
+          ++collided_once;
+          EXPECT_LT(BruteForceClearance(a, once, wall), 0.5 * std::sqrt(3.0) * 0.1);  // what it reported
         }
+        if (!s.ok()) {
+          ADD_FAILURE() << "start " << start.transpose() << ", goal " << goal.transpose() << ", weight " << weight
+                        << ": " << ToString(s.status) << ": " << s.message;
+          continue;
+        }
+        ++planned;
+        EXPECT_GE(BruteForceClearance(a, traj, wall), 0.0) << "start " << start.transpose() << ", weight " << weight;
       }
     }
-    EXPECT_GE(nearest, a.unit_radius_m) << "weight " << weight;
   }
+  EXPECT_GE(trials, 8);
+  EXPECT_EQ(planned, 2 * trials);
+  EXPECT_GE(collided_once, 1) << "no case needed the collision rounds";
 }
 
 TEST(AssemblyTrajectoryOptimizer, BadInputIsReportedNotFlown) {

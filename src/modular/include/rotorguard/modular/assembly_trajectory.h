@@ -16,7 +16,9 @@
 /// attitude of eqs. (7)-(8) for the direction of flight at each sample.
 ///
 /// The baseline of Table II (SVSDF) is the same optimiser with kinematic limits only and λ_Φ = 0.
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -99,6 +101,11 @@ struct AssemblyTrajectoryOptions {
   double obstacle_range_m = 1.0;
   int samples_per_piece = 32;    ///< penalty samples per piece, in [2, 1000]
   int plane_rounds = 3;          ///< solves, each with the planes of the last one's trajectory, >= 1
+  /// When the dense check finds a unit's sphere reaching an occupied voxel: at most this many
+  /// further solves from that trajectory, each keeping the planes so far, adding those of the
+  /// trajectory that collided and weighting G_o `collision_weight_growth` times more, >= 0.
+  int collision_rounds = 3;
+  double collision_weight_growth = 4.0;  ///< >= 1
   int max_iterations = 300;      ///< L-BFGS iterations per solve, >= 1
   double relative_cost_tolerance = 1e-5;  ///< in (0, 0.1]
   /// The initial guess keeps one A* pose per this distance (and every yaw turn) [m], > 0.
@@ -119,6 +126,7 @@ struct AssemblyTrajectorySummary {
   Status status = Status::kInvalidInput;
   std::string message;
   int iterations = 0, evaluations = 0, slowdowns = 0;
+  int collision_rounds = 0;  ///< further solves after a dense check found a collision
   double solve_ms = 0.0;
   double duration_s = 0.0;
   /// Eq. (12b) on the dense check: the mean over samples in flight (|v_xy| > 0.1 m/s) of
@@ -163,6 +171,7 @@ class AssemblyTrajectoryOptimizer {
     AssemblyPose start, goal;
     AssemblyLimits limits;
     FootprintPlaneSet planes;  ///< empty (free space) or one list per piece
+    double obstacle_weight_scale = 1.0;  ///< G_o's weight is weight_obstacle times this
   };
   /// Eq. (11) at x and its gradient (may be null); NaN when no trajectory can be built. Public for
   /// the gradient tests.
@@ -177,6 +186,14 @@ class AssemblyTrajectoryOptimizer {
   double AttitudeError(double yaw, double heading) const;
 
  private:
+  /// Stretches time while a limit is exceeded on the dense check (summary's slowdowns and
+  /// limit_margin): nothing when every limit holds, else the failure.
+  std::optional<std::pair<AssemblyTrajectorySummary::Status, std::string>> StretchToLimits(
+      const Problem& problem, Eigen::VectorXd* x, AssemblyTrajectory* traj, AssemblyTrajectorySummary* summary) const;
+  /// The footprint's clearance and eq. (12b) on the dense check, with the duration, into `summary`.
+  void DenseCheck(const perception::VoxelMap& map, const AssemblyTrajectory& traj,
+                  AssemblyTrajectorySummary* summary) const;
+
   Assembly assembly_;
   AssemblyTrajectoryOptions options_;
   std::vector<double> optimal_relative_yaws_;
