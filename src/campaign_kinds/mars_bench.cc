@@ -18,6 +18,7 @@
 #include "rotorguard/harness/runner.h"
 #include "rotorguard/harness/scenario.h"
 #include "rotorguard/modular/allocation.h"
+#include "rotorguard/sim/truth.h"
 
 namespace rotorguard::benchmarks {
 
@@ -222,6 +223,22 @@ void WriteCell(const Cell& c, const std::string& name, nlohmann::json* row) {
 
 }  // namespace
 
+double TruthThrustAcceleration(const harness::Scenario& s) {
+  modular::Assembly truth = *s.assembly;
+  const sim::TruthDraw draw = sim::DrawTruth(s.truth, s.vehicle, s.seed);
+  truth.vehicle = sim::TruthVehicle(s.vehicle, draw);
+  const RotorVector ratio = sim::ThrustRatios(draw);
+  RotorVector eta = RotorVector::Ones(truth.vehicle.num_rotors());
+  for (int i = 0; i < truth.vehicle.num_rotors(); ++i) {
+    truth.vehicle.rotors[static_cast<std::size_t>(i)].max_thrust_n *= ratio[i];
+  }
+  for (const sim::FaultSpec& f : s.faults) {
+    if (f.kind == vehicle::FaultKind::kMotorStop) eta[f.rotor] = 0.0;  // Table II's dead units
+  }
+  const modular::AssemblyCapacity c = modular::CapacityOf(truth, eta);
+  return c.hover_attainable ? c.max_thrust_n / truth.vehicle.mass_kg : 0.0;
+}
+
 void MarsBenchOptions::Validate() const {
   if (trials < 1 || trials > 10000) ThrowInvalidArgument("MarsBenchOptions", "trials", trials, "a count in [1, 10000]");
   if (jobs < 1 || jobs > 256) ThrowInvalidArgument("MarsBenchOptions", "jobs", jobs, "a count in [1, 256]");
@@ -391,6 +408,7 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
       out.metrics["capacity_accel_m_s2"] = plan.capacity.max_acceleration_m_s2;
       out.metrics["capacity_thrust_accel_m_s2"] = plan.capacity.max_thrust_n / t.scene.vehicle.mass_kg;
       out.metrics["capacity_yaw_accel_rad_s2"] = plan.capacity.max_yaw_acceleration_rad_s2;
+      out.metrics["truth_capacity_thrust_accel_m_s2"] = TruthThrustAcceleration(t.scene);
       const harness::Scenario& s = t.scene;
       r = harness::RunScenario(s, harness::RunOptions{});
     }

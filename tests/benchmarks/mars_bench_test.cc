@@ -2,13 +2,18 @@
 // short runs: the cases that can hover are held near the fault-free error, the planner's rows fly
 // as the paper's do.
 
+#include <cmath>
+#include <cstdint>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "rotorguard/campaign_kinds/mars_bench.h"
 #include "rotorguard/campaign_kinds/reconfiguration.h"
+#include "rotorguard/core/types.h"
 #include "rotorguard/harness/scenario.h"
+#include "rotorguard/modular/assembly_trajectory.h"
+#include "rotorguard/sim/truth.h"
 #include "test_util.h"
 
 namespace rotorguard::benchmarks {
@@ -77,6 +82,45 @@ TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError
 // Table II on hand-made records: 5 rows x 2 planners (baseline, ours) x 3 trials. In row 0 the
 // baseline plans trials 0 and 1 (errors 0.2, 0.4 m; trial 1 crashed) and not trial 2, ours all three
 // (0.1, 0.1, 0.7 m): the cells are over each method's own plans, the comparison over trials 0 and 1.
+TEST(MarsTableTwo, TheTruthsThrustPerKilogramIsTheFilesOverTheDrawnMass) {
+  // Only the mass drawn (up to 7 %): the rotors and the centre of gravity are the file's, so the
+  // drawn vehicle's thrust with zero torque is the planner's (CapacityOf on the file), per drawn
+  // kilogram; with the end unit dead (6 % above hover on the file) a heavier draw cannot hover: 0.
+  harness::Scenario scene = harness::LoadScenario(Config("scenarios/mars_plan_4x1.yaml"));
+  scene.truth = sim::TruthOptions{};
+  scene.truth.preset = sim::TruthPreset::kIdeal;
+  scene.truth.mass_fraction = 0.07;
+  const double mass = scene.vehicle.mass_kg;
+  const int rotors = scene.vehicle.num_rotors();
+  const double healthy = modular::CapacityOf(*scene.assembly, RotorVector::Ones(rotors)).max_thrust_n;
+  RotorVector eta = RotorVector::Ones(rotors);
+  eta.tail(4).setZero();
+  const double dead_end = modular::CapacityOf(*scene.assembly, eta).max_thrust_n;
+  const double tolerance = 1e-4 * scene.vehicle.total_max_thrust_n() / (0.93 * mass);  // CapacityOf's bisection
+  int cannot_hover = 0;
+  for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+    scene.seed = seed;
+    scene.faults.clear();
+    const double ratio = sim::DrawTruth(scene.truth, scene.vehicle, seed).mass_ratio;
+    EXPECT_NEAR(TruthThrustAcceleration(scene), healthy / (mass * ratio), tolerance) << "seed " << seed;
+    for (int r = rotors - 4; r < rotors; ++r) {
+      sim::FaultSpec f;
+      f.rotor = r;
+      scene.faults.push_back(f);  // a motor stop
+    }
+    const double weight = kGravity * mass * ratio;
+    if (std::abs(dead_end - weight) < 1e-4 * scene.vehicle.total_max_thrust_n()) continue;  // within the bisection
+    if (dead_end < weight) {
+      ++cannot_hover;
+      EXPECT_EQ(TruthThrustAcceleration(scene), 0.0) << "seed " << seed;
+    } else {
+      EXPECT_NEAR(TruthThrustAcceleration(scene), dead_end / (mass * ratio), tolerance) << "seed " << seed;
+    }
+  }
+  EXPECT_GT(cannot_hover, 0);
+  EXPECT_LT(cannot_hover, 60);
+}
+
 TEST(MarsTableTwo, CellsAreOverEachMethodsPlansAndTheComparisonOverTheTrialsBothPlanned) {
   const auto flight = [](double rmse, bool success) {
     return nlohmann::json{{"status", "ok"},

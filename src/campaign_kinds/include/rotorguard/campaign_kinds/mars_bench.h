@@ -57,6 +57,12 @@ nlohmann::json MarsResult(const nlohmann::json& options, const std::vector<nlohm
 /// table2_ours_better_in_every_row}. Throws std::invalid_argument for a wrong record count.
 nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, int trials);
 
+/// The largest collective thrust per kilogram, with zero torque, of the vehicle `scene` draws (its
+/// mass, centre of gravity and each rotor's thrust coefficient; the battery full) without the rotors
+/// its faults stop; 0 when that cannot hold its weight. What a flight could give, for the evaluation
+/// only (Table II's truth_capacity_thrust_accel_m_s2): the planner and controller know the file.
+double TruthThrustAcceleration(const harness::Scenario& scene);
+
 /// Runs MarsCampaign on `jobs` threads in a temporary folder:
 /// {table1: [{case, faults, hover_attainable, none_error_m, partial_error_m, full_error_m,
 /// ..._success_rate, full_over_fault_free}], table1_full_within_1_5x_fault_free (over the cases
