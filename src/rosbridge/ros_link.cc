@@ -61,6 +61,16 @@ class RosLink final : public harness::StackLink {
       const std::lock_guard lock(mutex_);
       account_ = m.data;
     });
+    // The node first: a constructor that throws must not leave this link's threads running.
+    if (!options_.external_node) {
+      if (sitl.node_command.empty()) throw std::invalid_argument("sitl --ros: no command to start the node with (SitlOptions::node_command)");
+      std::vector<std::string> argv = sitl.node_command;
+      argv.insert(argv.end(), {"--ros", "--ros-master", bus_.master_uri()});
+      // The executor's scheduling, as the shared-memory channel carries it.
+      if (executor.realtime.fifo_priority > 0) argv.insert(argv.end(), {"--fifo-priority", std::to_string(executor.realtime.fifo_priority)});
+      if (executor.realtime.control_cpu >= 0) argv.insert(argv.end(), {"--control-cpu", std::to_string(executor.realtime.control_cpu)});
+      node_ = harness::NodeProcess(argv, "sitl --ros");
+    }
     spinner_ = std::thread([this] {
       while (!stop_.load(std::memory_order_acquire) && bus_.Spin(0.002)) {
       }
@@ -85,15 +95,6 @@ class RosLink final : public harness::StackLink {
         if (!any) frames_bell_.Wait(seen, 10'000'000);
       }
     });
-    if (!options_.external_node) {
-      if (sitl.node_command.empty()) throw std::invalid_argument("sitl --ros: no command to start the node with (SitlOptions::node_command)");
-      std::vector<std::string> argv = sitl.node_command;
-      argv.insert(argv.end(), {"--ros", "--ros-master", bus_.master_uri()});
-      // The executor's scheduling, as the shared-memory channel carries it.
-      if (executor.realtime.fifo_priority > 0) argv.insert(argv.end(), {"--fifo-priority", std::to_string(executor.realtime.fifo_priority)});
-      if (executor.realtime.control_cpu >= 0) argv.insert(argv.end(), {"--control-cpu", std::to_string(executor.realtime.control_cpu)});
-      node_ = harness::NodeProcess(argv, "sitl --ros");
-    }
   }
   ~RosLink() override {
     stop_.store(true, std::memory_order_release);
