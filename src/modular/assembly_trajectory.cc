@@ -519,9 +519,10 @@ AssemblyTrajectorySummary AssemblyTrajectoryOptimizer::Optimize(const perception
     const FootprintPlaneSet added = BuildPlanes(map, traj);
     for (std::size_t i = 0; i < added.size(); ++i) {
       std::vector<FootprintPlane>& list = problem.planes[i];
-      list.insert(list.end(), added[i].begin(), added[i].end());
-      std::stable_sort(list.begin(), list.end(),
-                       [](const FootprintPlane& a, const FootprintPlane& b) { return a.sample < b.sample; });
+      const auto kept = static_cast<std::ptrdiff_t>(list.size());
+      list.insert(list.end(), added[i].begin(), added[i].end());  // both sorted by sample
+      std::inplace_merge(list.begin(), list.begin() + kept, list.end(),
+                         [](const FootprintPlane& a, const FootprintPlane& b) { return a.sample < b.sample; });
     }
     problem.obstacle_weight_scale *= options_.collision_weight_growth;
     if (!solve()) return finish(Status::kSolverFailure, "L-BFGS: " + message);
