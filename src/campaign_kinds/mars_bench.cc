@@ -10,6 +10,7 @@
 #include "rotorguard/campaign_kinds/reconfiguration.h"
 #include "rotorguard/campaign/campaign.h"
 #include "rotorguard/core/error.h"
+#include "rotorguard/core/math.h"
 #include "rotorguard/core/rng.h"
 #include "rotorguard/core/statistics.h"
 #include "rotorguard/harness/assembly_mission.h"
@@ -105,15 +106,25 @@ std::vector<std::pair<int, double>> DeadUnit(int k) {
 /// the largest acceleration, thrust per kilogram |a + g e_z| and yaw acceleration.
 struct PlanDemands {
   double accel = 0.0, thrust_accel = 0.0, yaw_accel = 0.0;
+  /// The tilt's angular acceleration about the body's x and y axes: near hover the horizontal
+  /// snap in the yaw's frame over g (y's snap needs roll, x's pitch).
+  double roll_accel = 0.0, pitch_accel = 0.0;
 };
 PlanDemands DemandsOf(const modular::AssemblyTrajectory& t) {
   PlanDemands d;
-  for (double time = 0.0; time <= t.duration(); time += 1e-3) {
-    Vector3 a = t.Evaluate(time).a_W;
-    d.accel = std::max(d.accel, a.norm());
-    a.z() += kGravity;
-    d.thrust_accel = std::max(d.thrust_accel, a.norm());
-    d.yaw_accel = std::max(d.yaw_accel, std::abs(t.yaw().Evaluate(time).a_W.x()));
+  const planning::MinimumJerkTrajectory& p = t.position();
+  for (int i = 0; i < p.pieces(); ++i) {
+    for (double time = 0.0; time <= p.durations()(i); time += 1e-3) {
+      Vector3 a = p.PieceDerivative(i, time, 2);
+      d.accel = std::max(d.accel, a.norm());
+      a.z() += kGravity;
+      d.thrust_accel = std::max(d.thrust_accel, a.norm());
+      d.yaw_accel = std::max(d.yaw_accel, std::abs(t.yaw().PieceDerivative(i, time, 2).x()));
+      const Vector3 snap = QuaternionFromYaw(t.yaw().PieceDerivative(i, time, 0).x()).inverse() *
+                           p.PieceDerivative(i, time, 4);
+      d.roll_accel = std::max(d.roll_accel, std::abs(snap.y()) / kGravity);
+      d.pitch_accel = std::max(d.pitch_accel, std::abs(snap.x()) / kGravity);
+    }
   }
   return d;
 }
@@ -405,9 +416,13 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
       out.metrics["max_accel_m_s2"] = demands.accel;
       out.metrics["max_thrust_accel_m_s2"] = demands.thrust_accel;
       out.metrics["max_yaw_accel_rad_s2"] = demands.yaw_accel;
+      out.metrics["max_roll_accel_rad_s2"] = demands.roll_accel;
+      out.metrics["max_pitch_accel_rad_s2"] = demands.pitch_accel;
       out.metrics["capacity_accel_m_s2"] = plan.capacity.max_acceleration_m_s2;
       out.metrics["capacity_thrust_accel_m_s2"] = plan.capacity.max_thrust_n / t.scene.vehicle.mass_kg;
       out.metrics["capacity_yaw_accel_rad_s2"] = plan.capacity.max_yaw_acceleration_rad_s2;
+      out.metrics["capacity_roll_accel_rad_s2"] = plan.capacity.max_roll_acceleration_rad_s2;
+      out.metrics["capacity_pitch_accel_rad_s2"] = plan.capacity.max_pitch_acceleration_rad_s2;
       out.metrics["truth_capacity_thrust_accel_m_s2"] = TruthThrustAcceleration(t.scene);
       const harness::Scenario& s = t.scene;
       r = harness::RunScenario(s, harness::RunOptions{});
@@ -543,7 +558,8 @@ nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, i
       WriteCell(c, name, &r);
       r[name + "_first_failure"] = c.first_failure;
       // The plans' figures: their means, and the most any of them asks of the assembly.
-      double duration = 0.0, deviation = 0.0, plan_ms = 0.0, accel = 0.0, thrust_accel = 0.0, yaw_accel = 0.0;
+      double duration = 0.0, deviation = 0.0, plan_ms = 0.0, accel = 0.0, thrust_accel = 0.0, yaw_accel = 0.0,
+             roll_accel = 0.0, pitch_accel = 0.0;
       for (const nlohmann::json* f : flown) {
         const nlohmann::json& x = f->at("metrics");
         duration += x.at("duration_s").get<double>() / static_cast<double>(flown.size());
@@ -552,10 +568,13 @@ nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, i
         accel = std::max(accel, x.at("max_accel_m_s2").get<double>());
         thrust_accel = std::max(thrust_accel, x.at("max_thrust_accel_m_s2").get<double>());
         yaw_accel = std::max(yaw_accel, x.at("max_yaw_accel_rad_s2").get<double>());
+        roll_accel = std::max(roll_accel, x.at("max_roll_accel_rad_s2").get<double>());
+        pitch_accel = std::max(pitch_accel, x.at("max_pitch_accel_rad_s2").get<double>());
         // The assembly's capacity depends on the row alone.
-        r["capacity_accel_m_s2"] = x.at("capacity_accel_m_s2");
-        r["capacity_thrust_accel_m_s2"] = x.at("capacity_thrust_accel_m_s2");
-        r["capacity_yaw_accel_rad_s2"] = x.at("capacity_yaw_accel_rad_s2");
+        for (const char* key : {"capacity_accel_m_s2", "capacity_thrust_accel_m_s2", "capacity_yaw_accel_rad_s2",
+                                "capacity_roll_accel_rad_s2", "capacity_pitch_accel_rad_s2"}) {
+          r[key] = x.at(key);
+        }
       }
       r[name + "_duration_s"] = duration;
       r[name + "_attitude_deviation_deg"] = deviation;
@@ -563,6 +582,8 @@ nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, i
       r[name + "_max_accel_m_s2"] = accel;
       r[name + "_max_thrust_accel_m_s2"] = thrust_accel;
       r[name + "_max_yaw_accel_rad_s2"] = yaw_accel;
+      r[name + "_max_roll_accel_rad_s2"] = roll_accel;
+      r[name + "_max_pitch_accel_rad_s2"] = pitch_accel;
     }
     // The comparison: the same trials, both planned. A row without one has none: null, left out of
     // the averages.

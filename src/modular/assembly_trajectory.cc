@@ -45,6 +45,26 @@ double Bisect(double lo, double hi, double tolerance, const Ok& ok) {
   return lo;
 }
 
+/// The tilt's angular acceleration that the horizontal snap `snap` asks for at yaw `yaw`, squared
+/// and relative to the limits' ellipse (AssemblyLimits: <= 1 within), with its gradients.
+struct TiltDemand {
+  double squared = 0.0;
+  Eigen::Vector2d d_snap = Eigen::Vector2d::Zero();
+  double d_yaw = 0.0;
+};
+TiltDemand TiltDemandOf(const AssemblyLimits& limits, const Eigen::Vector2d& snap, double yaw) {
+  // Near hover the body's x acceleration needs pitch (about y) and its y acceleration roll.
+  const double sx_max = kGravity * limits.pitch_acceleration_max, sy_max = kGravity * limits.roll_acceleration_max;
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const Eigen::Vector2d b(c * snap.x() + s * snap.y(), -s * snap.x() + c * snap.y());  // R_z(-ψ) snap
+  const Eigen::Vector2d d_b(2.0 * b.x() / (sx_max * sx_max), 2.0 * b.y() / (sy_max * sy_max));
+  TiltDemand t;
+  t.squared = b.x() * b.x() / (sx_max * sx_max) + b.y() * b.y() / (sy_max * sy_max);
+  t.d_snap = Eigen::Vector2d(c * d_b.x() - s * d_b.y(), s * d_b.x() + c * d_b.y());  // R_z(ψ) d_b
+  t.d_yaw = d_b.x() * b.y() - d_b.y() * b.x();  // d b / dψ = (b_y, -b_x)
+  return t;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -80,16 +100,29 @@ AssemblyCapacity CapacityOf(const Assembly& assembly, const RotorVector& eta) {
   const double total = v.total_max_thrust_n();
   c.max_thrust_n = Bisect(weight, total, 1e-4 * total,
                           [&](double f) { return attainable(Eigen::Vector4d(f, 0.0, 0.0, 0.0)); });
-  double yaw_reach = 0.0;  // an upper bound: every rotor's reaction torque at full thrust
-  for (const vehicle::Rotor& r : v.rotors) yaw_reach += r.yaw_coefficient_m * r.max_thrust_n;
-  const auto yaw_torque = [&](double sign) {
-    return Bisect(0.0, yaw_reach, 1e-4 * yaw_reach,
-                  [&](double tz) { return attainable(Eigen::Vector4d(weight, 0.0, 0.0, sign * tz)); });
+  // Upper bounds of each torque: every rotor at full thrust with its lever arm (its reaction
+  // torque for yaw).
+  Vector3 reach = Vector3::Zero();
+  for (const vehicle::Rotor& r : v.rotors) {
+    reach += r.max_thrust_n * Vector3(std::abs(r.p_B.y()), std::abs(r.p_B.x()), r.yaw_coefficient_m);
+  }
+  // The largest torque about `axis` (1 roll, 2 pitch, 3 yaw) of either sign at the hover thrust.
+  const auto torque = [&](int axis) {
+    const auto one_sign = [&](double sign) {
+      return Bisect(0.0, reach(axis - 1), 1e-4 * reach(axis - 1), [&](double tau) {
+        Eigen::Vector4d w(weight, 0.0, 0.0, 0.0);
+        w(axis) = sign * tau;
+        return attainable(w);
+      });
+    };
+    return std::min(one_sign(1.0), one_sign(-1.0));
   };
-  c.max_yaw_torque_n_m = std::min(yaw_torque(1.0), yaw_torque(-1.0));
+  c.max_yaw_torque_n_m = torque(3);
   const double f = c.max_thrust_n / v.mass_kg;
   c.max_acceleration_m_s2 = std::sqrt(std::max(f * f - kGravity * kGravity, 0.0));
   c.max_yaw_acceleration_rad_s2 = c.max_yaw_torque_n_m / v.inertia_kg_m2(2, 2);
+  c.max_roll_acceleration_rad_s2 = torque(1) / v.inertia_kg_m2(0, 0);
+  c.max_pitch_acceleration_rad_s2 = torque(2) / v.inertia_kg_m2(1, 1);
   return c;
 }
 
@@ -104,10 +137,19 @@ void AssemblyLimits::Validate() const {
   if (!(std::isfinite(thrust_acceleration_max) && (thrust_acceleration_max == 0.0 || thrust_acceleration_max > kGravity))) {
     ThrowValidation("AssemblyLimits", "thrust_acceleration_max", thrust_acceleration_max, "0 (none) or above g");
   }
+  for (const auto& [v, field] : {std::pair{roll_acceleration_max, "roll_acceleration_max"},
+                                 std::pair{pitch_acceleration_max, "pitch_acceleration_max"}}) {
+    if (!(std::isfinite(v) && v >= 0.0)) ThrowValidation("AssemblyLimits", field, v, "a finite limit >= 0 (0: none)");
+  }
+  if ((roll_acceleration_max > 0.0) != (pitch_acceleration_max > 0.0)) {
+    ThrowValidation("AssemblyLimits", "pitch_acceleration_max", pitch_acceleration_max,
+                    "off (0) exactly when roll_acceleration_max is");
+  }
 }
 
 bool HasMargin(const AssemblyCapacity& c) {
-  return c.hover_attainable && c.max_acceleration_m_s2 > 0.0 && c.max_yaw_acceleration_rad_s2 > 0.0;
+  return c.hover_attainable && c.max_acceleration_m_s2 > 0.0 && c.max_yaw_acceleration_rad_s2 > 0.0 &&
+         c.max_roll_acceleration_rad_s2 > 0.0 && c.max_pitch_acceleration_rad_s2 > 0.0;
 }
 
 AssemblyLimits DynamicsAwareLimits(const planning::DynamicLimits& kinematic, const AssemblyCapacity& capacity,
@@ -125,6 +167,8 @@ AssemblyLimits DynamicsAwareLimits(const planning::DynamicLimits& kinematic, con
   l.thrust_acceleration_max = kGravity + safety_factor * (capacity.max_thrust_n / mass_kg - kGravity);
   l.yaw_rate_max = yaw_rate_max;
   l.yaw_acceleration_max = safety_factor * capacity.max_yaw_acceleration_rad_s2;
+  l.roll_acceleration_max = safety_factor * capacity.max_roll_acceleration_rad_s2;
+  l.pitch_acceleration_max = safety_factor * capacity.max_pitch_acceleration_rad_s2;
   return l;
 }
 
@@ -252,7 +296,8 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
       // Accumulates d cost / d (position derivative `d`) and d cost / d (yaw derivative `d`).
       const auto add_position = [&](int d, const Eigen::RowVector3d& g) {
         dcp.middleRows<kC>(kC * i) += basis.row(d).transpose() * g;
-        dt(i) += g.dot(der.row(d + 1)) * s;  // the sample moves with T_i
+        // The sample moves with T_i; the quintic's fifth derivative is 5! times its last coefficient.
+        dt(i) += g.dot(d < 4 ? Eigen::RowVector3d(der.row(d + 1)) : Eigen::RowVector3d(120.0 * cp.row(5))) * s;
       };
       const auto add_yaw = [&](int d, double g) {
         dcy.middleRows<kC>(kC * i).col(0) += basis.row(d).transpose() * g;
@@ -276,6 +321,20 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
         if (slope != 0.0) {
           cost += o.weight_dynamics * pen;
           add_position(2, o.weight_dynamics * slope * 2.0 * f);
+        }
+      }
+      // The tilt's angular acceleration, the snap over g (the assembly's dynamics; 0: off), in
+      // snap² units as the kinematic terms.
+      if (lim.roll_acceleration_max > 0.0) {
+        const TiltDemand tilt = TiltDemandOf(lim, der.row(4).head<2>().transpose(), psi(0));
+        const double scale = std::pow(kGravity * std::min(lim.roll_acceleration_max, lim.pitch_acceleration_max), 2);
+        double slope;
+        const double pen = CubicPenalty(scale * (tilt.squared - 1.0), &slope);
+        if (slope != 0.0) {
+          const double w = o.weight_dynamics * slope * scale;
+          cost += o.weight_dynamics * pen;
+          add_position(4, Eigen::RowVector3d(w * tilt.d_snap.x(), w * tilt.d_snap.y(), 0.0));
+          add_yaw(0, w * tilt.d_yaw);
         }
       }
       // The yaw's rate and acceleration (the assembly's dynamics; 0: off).
@@ -388,6 +447,18 @@ std::optional<std::pair<AssemblyTrajectorySummary::Status, std::string>> Assembl
       if (thrust > limits.thrust_acceleration_max) {
         ratio.push_back(std::sqrt(pos.MaxNorm(2, dense) / (limits.thrust_acceleration_max - kGravity)));
       }
+    }
+    if (limits.roll_acceleration_max > 0.0) {  // the snap scales by 1 / k⁴
+      double tilt = 0.0;
+      for (int i = 0; i < m; ++i) {
+        for (int j = 0; j <= dense; ++j) {
+          const double ts = pos.durations()(i) * j / dense;
+          tilt = std::max(tilt, TiltDemandOf(limits, pos.PieceDerivative(i, ts, 4).head<2>(),
+                                             traj->yaw().PieceDerivative(i, ts, 0).x())
+                                    .squared);
+        }
+      }
+      ratio.push_back(std::pow(tilt, 1.0 / 8.0));
     }
     const double worst = *std::max_element(ratio.begin(), ratio.end());
     summary->limit_margin = 1.0 - worst;  // of the stretch factor's scale: >= 0 when all hold

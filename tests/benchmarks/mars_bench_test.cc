@@ -43,6 +43,8 @@ TEST(MarsBenchmark, FullReallocationHoldsEveryHoverableCaseNearTheFaultFreeError
     // the allocator's capacity, not the planner's own limits).
     EXPECT_LT(row["ours_max_thrust_accel_m_s2"].get<double>(), row["capacity_thrust_accel_m_s2"].get<double>());
     EXPECT_LT(row["ours_max_yaw_accel_rad_s2"].get<double>(), row["capacity_yaw_accel_rad_s2"].get<double>());
+    EXPECT_LT(row["ours_max_roll_accel_rad_s2"].get<double>(), row["capacity_roll_accel_rad_s2"].get<double>());
+    EXPECT_LT(row["ours_max_pitch_accel_rad_s2"].get<double>(), row["capacity_pitch_accel_rad_s2"].get<double>());
   }
   // The baseline plans the same trajectory whatever the fault: with the end unit No. 4 dead it asks
   // for more yaw acceleration than the row can give (ours, above, does not). Whether the row then
@@ -140,9 +142,13 @@ TEST(MarsTableTwo, CellsAreOverEachMethodsPlansAndTheComparisonOverTheTrialsBoth
                             {"max_accel_m_s2", 1.0},
                             {"max_thrust_accel_m_s2", 11.0},
                             {"max_yaw_accel_rad_s2", 2.0},
+                            {"max_roll_accel_rad_s2", 3.0},
+                            {"max_pitch_accel_rad_s2", 1.0},
                             {"capacity_accel_m_s2", 5.0},
                             {"capacity_thrust_accel_m_s2", 20.0},
-                            {"capacity_yaw_accel_rad_s2", 4.0}}}};
+                            {"capacity_yaw_accel_rad_s2", 4.0},
+                            {"capacity_roll_accel_rad_s2", 30.0},
+                            {"capacity_pitch_accel_rad_s2", 10.0}}}};
   };
   const nlohmann::json no_plan = {{"status", "ok"},
                                   {"message", "A*: no_path"},

@@ -35,6 +35,11 @@ TEST(AssemblyCapacity, OneUnitMatchesTheClosedForms) {
   EXPECT_NEAR(c.max_yaw_torque_n_m, 0.016 * w, 1e-3 * 0.016 * w);
   EXPECT_NEAR(c.max_yaw_acceleration_rad_s2, 0.016 * w / 4.0e-3, 1e-3 * 0.016 * w / 4.0e-3);
   EXPECT_NEAR(c.max_acceleration_m_s2, std::sqrt(std::pow(10.4 / 0.5, 2) - kGravity * kGravity), 0.05);
+  // The largest roll torque at W: the two rotors at y = +0.075 m carry W / 2 each (one of either
+  // spin, so no yaw; one either side of x, so no pitch), those at y = -0.075 m nothing: 0.075 W.
+  // Pitch likewise about x. Over the frame's 2.2e-3 kg m².
+  EXPECT_NEAR(c.max_roll_acceleration_rad_s2, 0.075 * w / 2.2e-3, 1e-3 * 0.075 * w / 2.2e-3);
+  EXPECT_NEAR(c.max_pitch_acceleration_rad_s2, 0.075 * w / 2.2e-3, 1e-3 * 0.075 * w / 2.2e-3);
 }
 
 TEST(AssemblyCapacity, ADeadEndUnitLeavesTheThrustOfTheLinearProgramSolvedByHand) {
@@ -48,6 +53,14 @@ TEST(AssemblyCapacity, ADeadEndUnitLeavesTheThrustOfTheLinearProgramSolvedByHand
   ASSERT_TRUE(c.hover_attainable);
   EXPECT_NEAR(c.max_thrust_n, 20.8, 0.01);
   EXPECT_NEAR(c.max_acceleration_m_s2, std::sqrt(10.4 * 10.4 - kGravity * kGravity), 0.01);
+  // The pitch torque at the hover thrust W = 19.62 N, as a linear program over the rotor pairs at
+  // x = -0.45, -0.3, -0.2, -0.05, 0.05, 0.2 m (each pair 0..5.2 N; one of either spin, at
+  // y = ±0.075 m, so no roll or yaw): towards +x the pairs at 0.2, 0.05, -0.05 m full and 4.02 N at
+  // -0.2 m give 0.236 N m; towards -x 5.14 N m. The smaller over I_yy = 0.5 (2 0.375² + 2 0.125²)
+  // + 4 2.2e-3 = 0.16505 kg m².
+  const double hover = 2.0 * kGravity, rest = hover - 3 * 5.2;
+  const double pitch_torque = 5.2 * 0.2 + 5.2 * 0.05 - 5.2 * 0.05 - rest * 0.2;
+  EXPECT_NEAR(c.max_pitch_acceleration_rad_s2, pitch_torque / 0.16505, 0.01 * pitch_torque / 0.16505);
   // Two dead units at one end cannot hover: no capacity, and ours has no limits to give.
   eta.segment(8, 4).setZero();
   const AssemblyCapacity none = CapacityOf(a, eta);
@@ -74,6 +87,8 @@ AssemblyTrajectoryOptimizer::Problem ActiveProblem() {
   p.limits.yaw_rate_max = 0.3;
   p.limits.yaw_acceleration_max = 0.2;
   p.limits.thrust_acceleration_max = 9.815;  // above g by less than the climb's acceleration
+  p.limits.roll_acceleration_max = 0.02;     // unequal, so the yaw's gradient of the ellipse counts
+  p.limits.pitch_acceleration_max = 0.01;
   p.planes.resize(3);
   p.planes[1].push_back({3, 0, {Vector3(1.5, 0.7, 1.5), Vector3(0.0, -1.0, 0.0)}});
   p.planes[1].push_back({3, 2, {Vector3(1.5, 0.7, 1.5), Vector3(0.0, -1.0, 0.0)}});
@@ -106,6 +121,8 @@ TEST(AssemblyTrajectoryOptimizer, GradientMatchesFiniteDifferences) {
   EXPECT_LT(without([](auto*, auto* q) { q->limits.yaw_rate_max = 0.0; }), f - 1.0);
   EXPECT_LT(without([](auto*, auto* q) { q->limits.yaw_acceleration_max = 0.0; }), f - 1.0);
   EXPECT_LT(without([](auto*, auto* q) { q->limits.thrust_acceleration_max = 0.0; }), f - 1e-6);
+  EXPECT_LT(without([](auto*, auto* q) { q->limits.roll_acceleration_max = q->limits.pitch_acceleration_max = 0.0; }),
+            f - 1e-6);
   ASSERT_EQ(g.size(), x.size());
   for (int k = 0; k < x.size(); ++k) {
     const double h = 1e-6;
@@ -166,6 +183,46 @@ TEST(AssemblyTrajectoryOptimizer, TheAttitudeTermTurnsABroadsideRowLengthwiseWit
   EXPECT_GT(s_base.attitude_deviation_rad, 0.5 * kPi - 0.05);
   EXPECT_LT(s_ours.attitude_deviation_rad, 0.5 * s_base.attitude_deviation_rad)
       << s_ours.attitude_deviation_rad << " rad against " << s_base.attitude_deviation_rad;
+}
+
+TEST(AssemblyTrajectoryOptimizer, TheTiltLimitKeepsTheSnapWithinWhatTheRotorsCanTiltTheRow) {
+  // A row flown lengthwise brakes with pitch, broadside with roll: with pitch 5x slower to
+  // accelerate than roll, the snap (g times the tilt's angular acceleration near hover) along the
+  // body's x stays within g α_pitch, and the broadside flight is the quicker.
+  const Assembly a = testing::MarsAssembly("4x1");
+  const perception::VoxelMap map = WallWithGap(100.0);  // open space
+  AssemblyTrajectoryOptions o;
+  o.weight_attitude = 0.0;  // no preference of heading: only the tilt's limits tell the yaws apart
+  AssemblyLimits tilt = Limits();
+  tilt.roll_acceleration_max = 0.5;
+  tilt.pitch_acceleration_max = 0.1;
+  const AssemblyTrajectoryOptimizer opt(a, RotorVector::Ones(16), o);
+  // The largest demand on the ellipse, from the snap by central differences of the jerk (not the
+  // optimiser's own fourth derivative) in the frame of the yaw.
+  const auto demand = [](const AssemblyTrajectory& t) {
+    double worst = 0.0;
+    const double h = 1e-4;
+    for (double time = h; time <= t.duration() - h; time += 0.005) {
+      const Vector3 snap = (t.Evaluate(time + h).j_W - t.Evaluate(time - h).j_W) / (2.0 * h);
+      const double yaw = t.Evaluate(time).yaw, c = std::cos(yaw), sn = std::sin(yaw);
+      const double bx = c * snap.x() + sn * snap.y(), by = -sn * snap.x() + c * snap.y();
+      worst = std::max(worst, std::pow(bx / (kGravity * 0.1), 2) + std::pow(by / (kGravity * 0.5), 2));
+    }
+    return worst;
+  };
+  AssemblyTrajectory lengthwise, broadside, free;
+  const AssemblyTrajectorySummary s_length = opt.Optimize(map, StraightPath(0.0), tilt, &lengthwise);
+  const AssemblyTrajectorySummary s_broad = opt.Optimize(map, StraightPath(0.5 * kPi), tilt, &broadside);
+  const AssemblyTrajectorySummary s_free = opt.Optimize(map, StraightPath(0.0), Limits(), &free);
+  ASSERT_TRUE(s_length.ok()) << s_length.message;
+  ASSERT_TRUE(s_broad.ok()) << s_broad.message;
+  ASSERT_TRUE(s_free.ok()) << s_free.message;
+  EXPECT_GE(s_length.limit_margin, 0.0);
+  EXPECT_LE(demand(lengthwise), 1.0 + 1e-3);
+  EXPECT_LE(demand(broadside), 1.0 + 1e-3);
+  EXPECT_GT(demand(free), 2.0);  // the limit binds: without it the plan asks for more
+  EXPECT_LT(s_broad.duration_s, s_length.duration_s);
+  EXPECT_LT(s_free.duration_s, s_length.duration_s);
 }
 
 /// By brute force: the smallest distance from a unit's centre to a wall voxel's cube (0.1 m, about

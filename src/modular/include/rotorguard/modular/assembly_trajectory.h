@@ -63,6 +63,10 @@ struct AssemblyCapacity {
   /// planner bounds the thrust itself, AssemblyLimits::thrust_acceleration_max).
   double max_acceleration_m_s2 = 0.0;
   double max_yaw_acceleration_rad_s2 = 0.0;  ///< max_yaw_torque / I_zz
+  /// The largest |roll| and |pitch| torque of either sign at the hover thrust over I_xx and I_yy
+  /// [rad/s²]: how fast the remaining rotors can tilt the assembly (its snap, AssemblyLimits).
+  double max_roll_acceleration_rad_s2 = 0.0;
+  double max_pitch_acceleration_rad_s2 = 0.0;
 };
 
 /// Bisects the allocator's attainability (to 1e-4 of the range) for the rotors' effectiveness `eta`.
@@ -75,15 +79,22 @@ struct AssemblyLimits {
   double yaw_acceleration_max = 0.0;  ///< [rad/s²], >= 0
   /// The thrust the assembly may ask for, per kilogram: |a + g e_z| <= this [m/s²]; 0 (off) or > g.
   double thrust_acceleration_max = 0.0;
+  /// The tilt's angular acceleration the plan may ask for about the body's x and y axes
+  /// [rad/s²], both 0 (off) or both > 0. Near hover the thrust's direction is a + g e_z, so the
+  /// tilt's angular acceleration is the horizontal snap over g: the snap in the body's frame
+  /// (rotated by the yaw) is kept in the ellipse (s_x / (g α_y))² + (s_y / (g α_x))² <= 1.
+  double roll_acceleration_max = 0.0;
+  double pitch_acceleration_max = 0.0;
   void Validate() const;
 };
 
-/// Whether the assembly has thrust and yaw torque to spare at hover (what DynamicsAwareLimits needs).
+/// Whether the assembly has thrust, roll, pitch and yaw torque to spare at hover (what
+/// DynamicsAwareLimits needs).
 bool HasMargin(const AssemblyCapacity& capacity);
 
 /// Ours: the kinematic limits with the assembly's dynamics, each at `safety_factor` (in (0, 1]) of
-/// its margin: the thrust per kilogram g + γ (F_max / m - g), the yaw acceleration γ τ_z / I_zz, and
-/// `yaw_rate_max`. Throws std::invalid_argument when !HasMargin(capacity).
+/// its margin: the thrust per kilogram g + γ (F_max / m - g), the yaw acceleration γ τ_z / I_zz, the
+/// roll and pitch accelerations γ τ_x / I_xx and γ τ_y / I_yy, and `yaw_rate_max`. Throws std::invalid_argument when !HasMargin(capacity).
 AssemblyLimits DynamicsAwareLimits(const planning::DynamicLimits& kinematic, const AssemblyCapacity& capacity,
                                    double mass_kg, double yaw_rate_max, double safety_factor);
 
@@ -137,7 +148,8 @@ struct AssemblyTrajectorySummary {
   /// the sphere may reach the occupied cube: kCollides.
   double min_clearance_m = 0.0;
   /// 1 - the time-stretch factor the dense check would still call for (v / v_max, sqrt(a / a_max),
-  /// cbrt(j / j_max) and the yaw's and thrust's likewise, the largest): >= 0 when every limit holds.
+  /// cbrt(j / j_max) and the yaw's, thrust's and tilt's likewise, the largest): >= 0 when every
+  /// limit holds.
   double limit_margin = 0.0;
   bool ok() const { return status == Status::kSuccess; }
 };
