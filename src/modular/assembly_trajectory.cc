@@ -284,6 +284,8 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
                                 lim.yaw_acceleration_max * lim.yaw_acceleration_max};
   const double required = assembly_.unit_radius_m + o.clearance_m;
   const int k_samples = o.samples_per_piece;
+  // The tilt's ellipse penalised in snap² units, as the kinematic terms (its smaller axis squared).
+  const double tilt_scale = std::pow(kGravity * std::min(lim.roll_acceleration_max, lim.pitch_acceleration_max), 2);
   for (int i = 0; i < m; ++i) {
     const auto cp = pos.coefficients().middleRows<kC>(kC * i);
     const auto cy = yaw.coefficients().middleRows<kC>(kC * i).col(0);
@@ -323,15 +325,13 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
           add_position(2, o.weight_dynamics * slope * 2.0 * f);
         }
       }
-      // The tilt's angular acceleration, the snap over g (the assembly's dynamics; 0: off), in
-      // snap² units as the kinematic terms.
+      // The tilt's angular acceleration, the snap over g (the assembly's dynamics; 0: off).
       if (lim.roll_acceleration_max > 0.0) {
         const TiltDemand tilt = TiltDemandOf(lim, der.row(4).head<2>().transpose(), psi(0));
-        const double scale = std::pow(kGravity * std::min(lim.roll_acceleration_max, lim.pitch_acceleration_max), 2);
         double slope;
-        const double pen = CubicPenalty(scale * (tilt.squared - 1.0), &slope);
+        const double pen = CubicPenalty(tilt_scale * (tilt.squared - 1.0), &slope);
         if (slope != 0.0) {
-          const double w = o.weight_dynamics * slope * scale;
+          const double w = o.weight_dynamics * slope * tilt_scale;
           cost += o.weight_dynamics * pen;
           add_position(4, Eigen::RowVector3d(w * tilt.d_snap.x(), w * tilt.d_snap.y(), 0.0));
           add_yaw(0, w * tilt.d_yaw);
@@ -434,32 +434,26 @@ std::optional<std::pair<AssemblyTrajectorySummary::Status, std::string>> Assembl
     if (limits.yaw_acceleration_max > 0.0) {
       ratio.push_back(std::sqrt(traj->yaw().MaxNorm(2, dense) / limits.yaw_acceleration_max));
     }
-    if (limits.thrust_acceleration_max > 0.0) {
-      // |a + g e_z| <= |a| + g: stretching until |a| <= limit - g is enough (a scales by 1 / k²).
-      double thrust = 0.0;
-      for (int i = 0; i < m; ++i) {
-        for (int j = 0; j <= dense; ++j) {
-          Vector3 f = pos.PieceDerivative(i, pos.durations()(i) * j / dense, 2);
-          f.z() += kGravity;
-          thrust = std::max(thrust, f.norm());
-        }
-      }
-      if (thrust > limits.thrust_acceleration_max) {
-        ratio.push_back(std::sqrt(pos.MaxNorm(2, dense) / (limits.thrust_acceleration_max - kGravity)));
-      }
-    }
-    if (limits.roll_acceleration_max > 0.0) {  // the snap scales by 1 / k⁴
-      double tilt = 0.0;
+    // The thrust per kilogram and the tilt's demand on one pass over the dense samples.
+    double thrust = 0.0, tilt = 0.0;
+    if (limits.thrust_acceleration_max > 0.0 || limits.roll_acceleration_max > 0.0) {
       for (int i = 0; i < m; ++i) {
         for (int j = 0; j <= dense; ++j) {
           const double ts = pos.durations()(i) * j / dense;
-          tilt = std::max(tilt, TiltDemandOf(limits, pos.PieceDerivative(i, ts, 4).head<2>(),
-                                             traj->yaw().PieceDerivative(i, ts, 0).x())
-                                    .squared);
+          thrust = std::max(thrust, (pos.PieceDerivative(i, ts, 2) + kGravity * Vector3::UnitZ()).norm());
+          if (limits.roll_acceleration_max > 0.0) {
+            tilt = std::max(tilt, TiltDemandOf(limits, pos.PieceDerivative(i, ts, 4).head<2>(),
+                                               traj->yaw().PieceDerivative(i, ts, 0).x())
+                                      .squared);
+          }
         }
       }
-      ratio.push_back(std::pow(tilt, 1.0 / 8.0));
     }
+    if (limits.thrust_acceleration_max > 0.0 && thrust > limits.thrust_acceleration_max) {
+      // |a + g e_z| <= |a| + g: stretching until |a| <= limit - g is enough (a scales by 1 / k²).
+      ratio.push_back(std::sqrt(pos.MaxNorm(2, dense) / (limits.thrust_acceleration_max - kGravity)));
+    }
+    if (limits.roll_acceleration_max > 0.0) ratio.push_back(std::pow(tilt, 1.0 / 8.0));  // snap scales by 1 / k⁴
     const double worst = *std::max_element(ratio.begin(), ratio.end());
     summary->limit_margin = 1.0 - worst;  // of the stretch factor's scale: >= 0 when all hold
     if (worst <= 1.0) return std::nullopt;
