@@ -33,8 +33,9 @@ class SitlCommand final : public Command {
                    "scenario's computation delay: the threaded stack flies `run`'s flight (a check, not a timing)");
     sitl->add_option("--fifo-priority", fifo_text_,
                      "Run the stack's control thread under SCHED_FIFO at this priority, in [3, 99] (perception and\n"
-                     "planning one and two below), with its memory locked; needs CAP_SYS_NICE and CAP_IPC_LOCK (or\n"
-                     "rtprio and memlock limits), else the normal scheduler, as runtime.json reports (default: 0, none)");
+                     "planning one and two below), with its memory locked and the CPUs' wake-up latency held at 0;\n"
+                     "needs CAP_SYS_NICE and CAP_IPC_LOCK (or rtprio and memlock limits) and write access to\n"
+                     "/dev/cpu_dma_latency, else without, as runtime.json reports (default: 0, none)");
     sitl->add_option("--control-cpu", cpu_text_,
                      "Pin the time-critical threads (control, its deadline guard, the sensor intake, the simulator)\n"
                      "to this CPU and the perception and planning threads to the others (default: no pinning)");
@@ -70,6 +71,7 @@ class SitlCommand final : public Command {
     if (app_->count("--fifo-priority") > 0) {
       sitl.executor.realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
       sitl.executor.realtime.lock_memory = true;
+      sitl.executor.realtime.hold_wakeup_latency = true;
     }
     if (app_->count("--control-cpu") > 0) {
       sitl.executor.realtime.control_cpu = static_cast<int>(ParseUnsigned("--control-cpu", cpu_text_, 0, CPU_SETSIZE - 1));
@@ -190,7 +192,8 @@ class NodeCommand final : public Command {
                      "With --ros: record the sensor messages the stack took in, in their order, and its cycles to\n"
                      "this rosbag (what `rotorguard replay` replays exactly)");
     node->add_option("--fifo-priority", fifo_text_,
-                     "With --ros: the control thread under SCHED_FIFO at this priority, in [3, 99], memory locked (as sitl's)");
+                     "With --ros: the control thread under SCHED_FIFO at this priority, in [3, 99], memory locked and the\n"
+                     "CPUs' wake-up latency held (as sitl's)");
     node->add_option("--control-cpu", cpu_text_, "With --ros: the time-critical threads on this CPU (as sitl's)");
     node->add_flag("--start-now", start_now_,
                    "With --ros: the mission starts (t = 0) once the stack is built, not at a mission_start message");
@@ -210,6 +213,7 @@ class NodeCommand final : public Command {
       if (!fifo_text_.empty()) {
         realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
         realtime.lock_memory = true;
+        realtime.hold_wakeup_latency = true;
       }
       if (!cpu_text_.empty()) realtime.control_cpu = static_cast<int>(ParseUnsigned("--control-cpu", cpu_text_, 0, CPU_SETSIZE - 1));
       RunNodeOverRos(scenario_.Load(), ros_master_, extras, start_now_, bag_, realtime);

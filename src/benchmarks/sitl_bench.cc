@@ -54,7 +54,10 @@ class BusyCore {
 
 /// The realtime options the benchmark's flights ask for.
 runtime::RealtimeOptions Realtime(const SitlBenchOptions& o) {
-  return {.lock_memory = o.fifo_priority > 0, .fifo_priority = o.fifo_priority, .control_cpu = o.control_cpu};
+  return {.lock_memory = o.fifo_priority > 0,
+          .fifo_priority = o.fifo_priority,
+          .control_cpu = o.control_cpu,
+          .hold_wakeup_latency = o.fifo_priority > 0};
 }
 
 /// The machine's own timing, without the stack: a thread with the control thread's scheduling that

@@ -133,7 +133,11 @@ nlohmann::json LoopsJson(const runtime::OnboardReport& r) {
           {"perception", LoopJson(r.perception)},
           {"planning", LoopJson(r.planning)},
           {"deadline_policy", {{"holds", r.holds}, {"fallbacks", r.fallbacks}}},
-          {"realtime", {{"memory_locked", r.realtime.memory_locked}, {"fifo", r.realtime.fifo}, {"note", r.realtime.note}}}};
+          {"realtime",
+           {{"memory_locked", r.realtime.memory_locked},
+            {"fifo", r.realtime.fifo},
+            {"wakeup_latency_held", r.realtime.wakeup_latency_held},
+            {"note", r.realtime.note}}}};
 }
 
 /// A simulator step's IMU sample, ESC telemetry and odometry, each as a message to `f`, in the

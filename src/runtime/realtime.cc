@@ -3,11 +3,14 @@
 #include <fmt/format.h>
 #include <pthread.h>
 #include <sched.h>
+#include <fcntl.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
+#include <mutex>
 #include <filesystem>
 #include <cerrno>
 #include <cstring>
@@ -48,6 +51,27 @@ bool RunOn(Keep keep) {
     if (keep(cpu)) CPU_SET(cpu, &set);
   }
   return pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+}
+
+/// PM QoS's CPU latency request (the kernel's Documentation/power/pm_qos_interface.rst): the
+/// request lasts while the file is open, so the process keeps it open to its end, once for all
+/// callers. Not inherited by a program it starts (close on exec): that one asks for its own.
+/// Empty when held, else why not.
+std::string HoldWakeupLatency() {
+  static std::mutex mutex;
+  static int held_fd = -1;
+  const std::lock_guard lock(mutex);
+  if (held_fd >= 0) return {};
+  const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return fmt::format("/dev/cpu_dma_latency: {}", std::strerror(errno));
+  const std::int32_t zero_us = 0;
+  if (write(fd, &zero_us, sizeof zero_us) != static_cast<ssize_t>(sizeof zero_us)) {
+    const std::string why = fmt::format("/dev/cpu_dma_latency: {}", std::strerror(errno));
+    close(fd);
+    return why;
+  }
+  held_fd = fd;
+  return {};
 }
 
 }  // namespace
@@ -145,6 +169,12 @@ RealtimeGrant RequestRealtime(const RealtimeOptions& options) {
     cpu = g.pinned ? fmt::format(", pinned to CPU {}", options.control_cpu)
                    : fmt::format(", not pinned (CPU {} is not among this machine's {} online CPUs)", options.control_cpu,
                                  OnlineCpus());
+  }
+  if (options.hold_wakeup_latency) {
+    const std::string why = HoldWakeupLatency();
+    g.wakeup_latency_held = why.empty();
+    cpu += g.wakeup_latency_held ? ", CPU wake-up latency held at 0"
+                                 : fmt::format(", CPU wake-up latency not held ({}; needs write access to it)", why);
   }
   g.note = memory + ", " + priority + cpu;
   return g;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <optional>
 #include <cmath>
 #include <thread>
@@ -169,6 +171,57 @@ TEST(Realtime, ValidatesThePriorityAndReportsWhatItGranted) {
   EXPECT_FALSE(g.memory_locked);
   EXPECT_FALSE(g.fifo);
   EXPECT_EQ(g.note, "memory not locked (not asked), normal scheduler (not asked)");
+}
+
+/// The kernel's CPU latency target [us], read back from the PM QoS file (an int32: the least of
+/// every open request, or the default); nullopt where it cannot be read.
+std::optional<std::int32_t> CpuLatencyTarget() {
+  const int fd = open("/dev/cpu_dma_latency", O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  std::int32_t us = 0;
+  const bool ok = read(fd, &us, sizeof us) == static_cast<ssize_t>(sizeof us);
+  close(fd);
+  return ok ? std::optional<std::int32_t>(us) : std::nullopt;
+}
+
+TEST(Realtime, HoldsTheCpusWakeUpLatencyAtZeroUntilTheProcessEndsOrSaysWhyNot) {
+  const RealtimeOptions hold{.lock_memory = false, .fifo_priority = 0, .hold_wakeup_latency = true};
+  if (access("/dev/cpu_dma_latency", W_OK) != 0) {
+    const RealtimeGrant g = RequestRealtime(hold);
+    EXPECT_FALSE(g.wakeup_latency_held);
+    EXPECT_NE(g.note.find(", CPU wake-up latency not held (/dev/cpu_dma_latency: "), std::string::npos) << g.note;
+    return;
+  }
+  // In a child, as the request is the process's to its end: it reports what it was granted and
+  // what the kernel then reads back; the parent checks the request went with it.
+  const std::optional<std::int32_t> before = CpuLatencyTarget();
+  int out[2];
+  ASSERT_EQ(pipe(out), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const RealtimeGrant first = RequestRealtime(hold);
+    const RealtimeGrant again = RequestRealtime(hold);  // one request for the process, however asked
+    const std::int32_t report[3] = {first.wakeup_latency_held && again.wakeup_latency_held,
+                                    first.note.ends_with(", CPU wake-up latency held at 0"), CpuLatencyTarget().value_or(-1)};
+    _exit(write(out[1], report, sizeof report) == static_cast<ssize_t>(sizeof report) ? 0 : 1);
+  }
+  close(out[1]);
+  std::int32_t report[3] = {0, 0, -1};
+  const bool reported = read(out[0], report, sizeof report) == static_cast<ssize_t>(sizeof report);
+  close(out[0]);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(reported && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  EXPECT_EQ(report[0], 1) << "held";
+  EXPECT_EQ(report[1], 1) << "the note says so";
+  if (before) {
+    EXPECT_EQ(report[2], 0) << "the kernel's target while the child ran";
+    // Another process may hold its own request (a real-time program running beside the tests).
+    if (*before != 0) {
+      EXPECT_EQ(CpuLatencyTarget(), before) << "the request ended with the process";
+    }
+  }
 }
 
 TEST(Realtime, RaisesTheNormalThreadsStartedSinceASnapshotOnlyOntoTheControlCpu) {

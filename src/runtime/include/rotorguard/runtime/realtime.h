@@ -22,6 +22,13 @@ struct RealtimeOptions {
   /// the perception and planning threads then run on the other CPUs, so that their long
   /// computations never fill the control loop's CPU. -1 leaves affinities alone.
   int control_cpu = -1;
+  /// Hold every CPU's wake-up latency at 0 while the process runs (Linux PM QoS: a 0 written to
+  /// /dev/cpu_dma_latency and the file kept open, as cyclictest does): an idle CPU then polls
+  /// instead of halting. A halted CPU wakes slowly, and a virtual machine's halted CPU waits for
+  /// its host to run it again: on a 2-core VM a sleeping SCHED_FIFO thread woke up to 23 ms late
+  /// without it, under 5 ms with it (docs/runtime.md, "Clocks and scheduling"). Costs power: an
+  /// idle CPU no longer sleeps. Needs write access to the file (root, or a udev rule).
+  bool hold_wakeup_latency = false;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };
@@ -31,6 +38,7 @@ struct RealtimeGrant {
   bool memory_locked = false;
   bool fifo = false;
   bool pinned = false;  ///< the calling thread runs on control_cpu alone
+  bool wakeup_latency_held = false;  ///< the process holds the CPUs' wake-up latency at 0
   /// One line: what was asked, what was granted, and why not.
   std::string note;
 };
