@@ -14,6 +14,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// The real-time configuration of `--fifo-priority` and `--control-cpu` (null: not given), shared
+/// by `sitl` and `node`.
+runtime::RealtimeOptions RealtimeFromFlags(const std::string* fifo_text, const std::string* cpu_text) {
+  const int priority = fifo_text ? static_cast<int>(ParseUnsigned("--fifo-priority", *fifo_text, 3, 99)) : 0;
+  const int cpu = cpu_text ? static_cast<int>(ParseUnsigned("--control-cpu", *cpu_text, 0, CPU_SETSIZE - 1)) : -1;
+  return runtime::RealtimeConfiguration(priority, cpu);
+}
+
 class SitlCommand final : public Command {
  public:
   CLI::App* Register(CLI::App* app) override {
@@ -68,13 +76,9 @@ class SitlCommand final : public Command {
     }
     harness::SitlOptions sitl = sitl_;
     if (app_->count("--realtime-factor") > 0) sitl.realtime_factor = ParsePositive("--realtime-factor", factor_text_, 10.0);
-    if (app_->count("--fifo-priority") > 0) {
-      sitl.executor.realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
-      sitl.executor.realtime.lock_memory = true;
-      sitl.executor.realtime.hold_wakeup_latency = true;
-    }
-    if (app_->count("--control-cpu") > 0) {
-      sitl.executor.realtime.control_cpu = static_cast<int>(ParseUnsigned("--control-cpu", cpu_text_, 0, CPU_SETSIZE - 1));
+    if (app_->count("--fifo-priority") > 0 || app_->count("--control-cpu") > 0) {
+      sitl.executor.realtime = RealtimeFromFlags(app_->count("--fifo-priority") > 0 ? &fifo_text_ : nullptr,
+                                                 app_->count("--control-cpu") > 0 ? &cpu_text_ : nullptr);
     }
     for (const std::string& text : stall_texts_) sitl.executor.stalls.push_back(ParseStall(text));
     const harness::Scenario scenario = scenario_.Load();
@@ -209,13 +213,8 @@ class NodeCommand final : public Command {
       throw UsageError("node: --start-now, --ros-master, --bag, --fifo-priority and --control-cpu need --ros");
     }
     if (ros_) {
-      runtime::RealtimeOptions realtime{.lock_memory = false, .fifo_priority = 0};
-      if (!fifo_text_.empty()) {
-        realtime.fifo_priority = static_cast<int>(ParseUnsigned("--fifo-priority", fifo_text_, 3, 99));
-        realtime.lock_memory = true;
-        realtime.hold_wakeup_latency = true;
-      }
-      if (!cpu_text_.empty()) realtime.control_cpu = static_cast<int>(ParseUnsigned("--control-cpu", cpu_text_, 0, CPU_SETSIZE - 1));
+      const runtime::RealtimeOptions realtime =
+          RealtimeFromFlags(fifo_text_.empty() ? nullptr : &fifo_text_, cpu_text_.empty() ? nullptr : &cpu_text_);
       RunNodeOverRos(scenario_.Load(), ros_master_, extras, start_now_, bag_, realtime);
     } else {
       harness::RunNode(scenario_.Load(), channel_);

@@ -54,10 +54,7 @@ class BusyCore {
 
 /// The realtime options the benchmark's flights ask for.
 runtime::RealtimeOptions Realtime(const SitlBenchOptions& o) {
-  return {.lock_memory = o.fifo_priority > 0,
-          .fifo_priority = o.fifo_priority,
-          .control_cpu = o.control_cpu,
-          .hold_wakeup_latency = o.fifo_priority > 0};
+  return runtime::RealtimeConfiguration(o.fifo_priority, o.control_cpu);
 }
 
 /// The machine's own timing, without the stack: a thread with the control thread's scheduling that

@@ -28,6 +28,13 @@ void RealtimeOptions::Validate() const {
   }
 }
 
+RealtimeOptions RealtimeConfiguration(int fifo_priority, int control_cpu) {
+  return {.lock_memory = fifo_priority > 0,
+          .fifo_priority = fifo_priority,
+          .control_cpu = control_cpu,
+          .hold_wakeup_latency = fifo_priority > 0};
+}
+
 ThreadSchedulingScope::ThreadSchedulingScope() {
   have_policy_ = pthread_getschedparam(pthread_self(), &policy_, &param_) == 0;
   have_cpus_ = pthread_getaffinity_np(pthread_self(), sizeof(cpus_), &cpus_) == 0;
@@ -57,16 +64,17 @@ bool RunOn(Keep keep) {
 /// request lasts while the file is open, so the process keeps it open to its end, once for all
 /// callers. Not inherited by a program it starts (close on exec): that one asks for its own.
 /// Empty when held, else why not.
+constexpr const char* kCpuLatencyFile = "/dev/cpu_dma_latency";
 std::string HoldWakeupLatency() {
   static std::mutex mutex;
   static int held_fd = -1;
   const std::lock_guard lock(mutex);
   if (held_fd >= 0) return {};
-  const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
-  if (fd < 0) return fmt::format("/dev/cpu_dma_latency: {}", std::strerror(errno));
+  const int fd = open(kCpuLatencyFile, O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return fmt::format("{}: {}", kCpuLatencyFile, std::strerror(errno));
   const std::int32_t zero_us = 0;
   if (write(fd, &zero_us, sizeof zero_us) != static_cast<ssize_t>(sizeof zero_us)) {
-    const std::string why = fmt::format("/dev/cpu_dma_latency: {}", std::strerror(errno));
+    const std::string why = fmt::format("{}: {}", kCpuLatencyFile, std::strerror(errno));
     close(fd);
     return why;
   }

@@ -184,6 +184,17 @@ std::optional<std::int32_t> CpuLatencyTarget() {
   return ok ? std::optional<std::int32_t>(us) : std::nullopt;
 }
 
+TEST(Realtime, APriorityAlsoLocksTheMemoryAndHoldsTheWakeUpLatencyAPinningAloneNeither) {
+  const RealtimeOptions fifo = RealtimeConfiguration(80, 0);
+  EXPECT_TRUE(fifo.lock_memory && fifo.hold_wakeup_latency);
+  EXPECT_EQ(fifo.fifo_priority, 80);
+  EXPECT_EQ(fifo.control_cpu, 0);
+  const RealtimeOptions pinned = RealtimeConfiguration(0, 1);
+  EXPECT_FALSE(pinned.lock_memory || pinned.hold_wakeup_latency);
+  EXPECT_EQ(pinned.fifo_priority, 0);
+  EXPECT_EQ(pinned.control_cpu, 1);
+}
+
 TEST(Realtime, HoldsTheCpusWakeUpLatencyAtZeroUntilTheProcessEndsOrSaysWhyNot) {
   const RealtimeOptions hold{.lock_memory = false, .fifo_priority = 0, .hold_wakeup_latency = true};
   if (access("/dev/cpu_dma_latency", W_OK) != 0) {

@@ -33,6 +33,11 @@ struct RealtimeOptions {
   void Validate() const;
 };
 
+/// The runtime's real-time configuration for a SCHED_FIFO priority (the commands'
+/// --fifo-priority; 0: none) and a control CPU (-1: none): a priority also locks the memory and
+/// holds the wake-up latency, as a vehicle's control loop needs all three.
+RealtimeOptions RealtimeConfiguration(int fifo_priority, int control_cpu);
+
 /// What was granted.
 struct RealtimeGrant {
   bool memory_locked = false;
