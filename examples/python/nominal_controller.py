@@ -3,7 +3,8 @@
 The cascade of src/control/nominal_controller.cc and position_loop.cc, line for line: position
 PID with acceleration feed-forward -> thrust vector (eq. 1 solved for T z_B, rotor drag
 compensated, tilt limited) -> attitude from the thrust direction and the reference yaw, body-rate
-feed-forward from the reference jerk (Mellinger & Kumar 2011) -> rate loop -> wrench -> thrusts by
+feed-forward from the reference jerk (Mellinger & Kumar 2011) and angular-acceleration feed-forward
+from its snap (Faessler et al. 2018) -> rate loop -> wrench -> thrusts by
 the effectiveness matrix's pseudo-inverse, clipped to [0, T_bar].
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/nominal_controller.py
@@ -132,8 +133,11 @@ class NominalController:
         R_des = np.array((x_des, y_des, z_des)).T
         thrust = max(0.0, f_des @ R[:, 2])
         c = max(norm(f_des) / self.m, 0.1 * self.g)
-        h = (ref["jerk"] - (z_des @ ref["jerk"]) * z_des) / c
-        w_ff_des = np.array([-(h @ y_des), h @ x_des, ref["yaw_rate"] * z_des[2]])
+        c_dot = z_des @ ref["jerk"]
+        w_ff_des = np.array([-(y_des @ ref["jerk"]) / c, (x_des @ ref["jerk"]) / c, ref["yaw_rate"] * z_des[2]])
+        s = ref["snap"]
+        alpha_ff_des = np.array([(-(y_des @ s) - 2.0 * c_dot * w_ff_des[0] + c * w_ff_des[1] * w_ff_des[2]) / c,
+                                 ((x_des @ s) - 2.0 * c_dot * w_ff_des[1] - c * w_ff_des[0] * w_ff_des[2]) / c, 0.0])
         q = est["attitude"] / norm(est["attitude"])
         q_e = quaternion_product(q * np.array([1.0, -1.0, -1.0, -1.0]), quaternion(R_des))
         if q_e[0] < 0.0:
@@ -143,7 +147,7 @@ class NominalController:
         if rate_norm > k["max_rate_rad_s"]:
             w_des *= k["max_rate_rad_s"] / rate_norm
         w = est["angular_velocity"]
-        alpha_des = k["k_rate"] * (w_des - w)
+        alpha_des = k["k_rate"] * (w_des - w) + R.T @ R_des @ alpha_ff_des
         tau = self.I @ alpha_des + cross(w, self.I @ w) + np.array([0.0, 0.0, self.yaw_damping * w[2]])
         return np.concatenate(([thrust], tau))
 

@@ -192,7 +192,8 @@ void BindFlight(py::module_& m) {
                                return py::dict(
                                    py::arg("position") = ArrayOf(r.p_W), py::arg("velocity") = ArrayOf(r.v_W),
                                    py::arg("acceleration") = ArrayOf(r.a_W), py::arg("jerk") = ArrayOf(r.j_W),
-                                   py::arg("yaw") = r.yaw, py::arg("yaw_rate") = r.yaw_rate);
+                                   py::arg("snap") = ArrayOf(r.s_W), py::arg("yaw") = r.yaw,
+                                   py::arg("yaw_rate") = r.yaw_rate);
                              })
       .def_property_readonly("command", [](const StackView& v) { return ArrayOf(v.stack().command().thrust_n); })
       .def_property_readonly("mode",

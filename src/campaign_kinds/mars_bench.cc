@@ -404,6 +404,8 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
                                        kPlanners[static_cast<std::size_t>(d.method)], d.trial, seed);
       const harness::AssemblyPlanResult& plan = t.plan;
       out.metrics["planned"] = plan.ok;
+      // Whether the drawn assembly can hover at all (a bound on the row's success, plan or not).
+      out.metrics["truth_capacity_thrust_accel_m_s2"] = TruthThrustAcceleration(t.scene);
       if (!plan.ok) {
         out.message = plan.message;
         return out;
@@ -423,7 +425,6 @@ campaign::Campaign MarsCampaign(const MarsBenchOptions& options_in) {
       out.metrics["capacity_yaw_accel_rad_s2"] = plan.capacity.max_yaw_acceleration_rad_s2;
       out.metrics["capacity_roll_accel_rad_s2"] = plan.capacity.max_roll_acceleration_rad_s2;
       out.metrics["capacity_pitch_accel_rad_s2"] = plan.capacity.max_pitch_acceleration_rad_s2;
-      out.metrics["truth_capacity_thrust_accel_m_s2"] = TruthThrustAcceleration(t.scene);
       const harness::Scenario& s = t.scene;
       r = harness::RunScenario(s, harness::RunOptions{});
     }
@@ -537,6 +538,21 @@ nlohmann::json MarsTableTwo(const std::vector<const nlohmann::json*>& records, i
     for (int t = 0; t < trials; ++t) {
       if (!planned(at(0, t)) || !planned(at(1, t))) continue;
       for (int m = 0; m < 2; ++m) paired[m].push_back(&at(m, t));
+    }
+    // The trials whose drawn assembly can hover at all (both methods fly the same draw): no method
+    // can succeed in the others, so the row's success is bounded by their share.
+    int hover_capable = 0, hover_capable_success[2] = {0, 0};
+    for (int t = 0; t < trials; ++t) {
+      const double capacity = std::max(MetricOr(at(0, t), "truth_capacity_thrust_accel_m_s2", 0.0),
+                                       MetricOr(at(1, t), "truth_capacity_thrust_accel_m_s2", 0.0));
+      if (!(capacity > kGravity)) continue;
+      ++hover_capable;
+      for (int m = 0; m < 2; ++m) hover_capable_success[m] += Succeeded(at(m, t));
+    }
+    r["hover_capable_trials"] = hover_capable;
+    for (int m = 0; m < 2; ++m) {
+      r[std::string(ToName(kPlanners[m])) + "_success_rate_hover_capable"] =
+          hover_capable > 0 ? nlohmann::json(static_cast<double>(hover_capable_success[m]) / hover_capable) : nlohmann::json();
     }
     for (int m = 0; m < 2; ++m) {
       const std::string name = ToName(kPlanners[m]);

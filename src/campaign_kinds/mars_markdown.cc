@@ -58,14 +58,26 @@ std::string MarsMarkdown(const nlohmann::json& r) {
          "the trajectory's mean duration; the improvement over the trials both planned)\n\n| shape | fault | "
          "baseline (SVSDF) | ours | improvement (trials) |\n|---|---|---|---|---|\n";
     for (const auto& row : r["table2"]) {
+      // Where some drawn assemblies cannot hover at all, the success among those that can beside.
+      const int hover_capable = row.value("hover_capable_trials", r["trials"].get<int>());
+      const bool bounded = hover_capable < r["trials"].get<int>();
       const auto cell = [&](const std::string& m) {
         if (!row[m + "_planned"].get<bool>()) return "no plan: " + row[m + "_plan_failure"].get<std::string>();
-        return fmt::format("{:.3f} m ({:.0f} %, planned {:.0f} %, {:.1f} s{})", row[m + "_error_m"].get<double>(),
-                           100.0 * row[m + "_success_rate"].get<double>(), 100.0 * row[m + "_plan_rate"].get<double>(),
-                           row[m + "_duration_s"].get<double>(), ToCrash(row, m));
+        const nlohmann::json& capable = row[m + "_success_rate_hover_capable"];
+        return fmt::format("{:.3f} m ({:.0f} %{}, planned {:.0f} %, {:.1f} s{})", row[m + "_error_m"].get<double>(),
+                           100.0 * row[m + "_success_rate"].get<double>(),
+                           bounded && !capable.is_null() ? fmt::format(", {:.0f} % where it can hover",
+                                                                       100.0 * capable.get<double>())
+                                                         : std::string(),
+                           100.0 * row[m + "_plan_rate"].get<double>(), row[m + "_duration_s"].get<double>(),
+                           ToCrash(row, m));
       };
-      s += fmt::format("| {} | {} | {} | {} | {} ({}) |\n", row["shape"].get<std::string>(),
-                       row["fault"].get<std::string>(), cell("baseline"), cell("ours"),
+      s += fmt::format("| {} | {}{} | {} | {} | {} ({}) |\n", row["shape"].get<std::string>(),
+                       row["fault"].get<std::string>(),
+                       bounded ? fmt::format(" (the drawn assembly cannot hover in {} of {} trials)",
+                                             r["trials"].get<int>() - hover_capable, r["trials"].get<int>())
+                               : std::string(),
+                       cell("baseline"), cell("ours"),
                        row["improvement"].is_null() ? std::string("-")
                                                     : fmt::format("{:.1f} %", 100.0 * row["improvement"].get<double>()),
                        row["paired_trials"].get<int>());

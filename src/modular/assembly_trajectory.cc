@@ -45,24 +45,38 @@ double Bisect(double lo, double hi, double tolerance, const Ok& ok) {
   return lo;
 }
 
-/// The tilt's angular acceleration that the horizontal snap `snap` asks for at yaw `yaw`, squared
-/// and relative to the limits' ellipse (AssemblyLimits: <= 1 within), with its gradients.
+/// A horizontal derivative `v` of the position (world frame) at yaw `yaw` in the body's frame,
+/// against the ellipse with semi-axes `x_max` and `y_max` along the body's x and y: squared, <= 1
+/// within, with its gradients. Near hover the body's x acceleration needs pitch (about y) and its
+/// y acceleration roll, so the snap over g is the tilt's angular acceleration and the jerk over g
+/// its rate.
 struct TiltDemand {
   double squared = 0.0;
-  Eigen::Vector2d d_snap = Eigen::Vector2d::Zero();
+  Eigen::Vector2d d_horizontal = Eigen::Vector2d::Zero();
   double d_yaw = 0.0;
 };
-TiltDemand TiltDemandOf(const AssemblyLimits& limits, const Eigen::Vector2d& snap, double yaw) {
-  // Near hover the body's x acceleration needs pitch (about y) and its y acceleration roll.
-  const double sx_max = kGravity * limits.pitch_acceleration_max, sy_max = kGravity * limits.roll_acceleration_max;
+TiltDemand TiltDemandOf(double x_max, double y_max, const Eigen::Vector2d& v, double yaw) {
   const double c = std::cos(yaw), s = std::sin(yaw);
-  const Eigen::Vector2d b(c * snap.x() + s * snap.y(), -s * snap.x() + c * snap.y());  // R_z(-ψ) snap
-  const Eigen::Vector2d d_b(2.0 * b.x() / (sx_max * sx_max), 2.0 * b.y() / (sy_max * sy_max));
+  const Eigen::Vector2d b(c * v.x() + s * v.y(), -s * v.x() + c * v.y());  // R_z(-ψ) v
+  const Eigen::Vector2d d_b(2.0 * b.x() / (x_max * x_max), 2.0 * b.y() / (y_max * y_max));
   TiltDemand t;
-  t.squared = b.x() * b.x() / (sx_max * sx_max) + b.y() * b.y() / (sy_max * sy_max);
-  t.d_snap = Eigen::Vector2d(c * d_b.x() - s * d_b.y(), s * d_b.x() + c * d_b.y());  // R_z(ψ) d_b
+  t.squared = b.x() * b.x() / (x_max * x_max) + b.y() * b.y() / (y_max * y_max);
+  t.d_horizontal = Eigen::Vector2d(c * d_b.x() - s * d_b.y(), s * d_b.x() + c * d_b.y());  // R_z(ψ) d_b
   t.d_yaw = d_b.x() * b.y() - d_b.y() * b.x();  // d b / dψ = (b_y, -b_x)
   return t;
+}
+
+/// The tilt limits' ellipses (AssemblyLimits, both on): the snap's, (g α_pitch, g α_roll); and the
+/// jerk's at the plan's two ends. There the held reference steps the tilt rate ω = j / g to zero;
+/// stopped at the angular acceleration α the tilt overshoots by ω² / (2 α), kept within `overshoot`
+/// [rad]: |j| <= g sqrt(2 α overshoot) per axis.
+struct TiltEllipses {
+  double snap_x = 0.0, snap_y = 0.0, end_jerk_x = 0.0, end_jerk_y = 0.0;
+};
+TiltEllipses TiltEllipsesOf(const AssemblyLimits& limits, double overshoot_rad) {
+  return {kGravity * limits.pitch_acceleration_max, kGravity * limits.roll_acceleration_max,
+          kGravity * std::sqrt(2.0 * limits.pitch_acceleration_max * overshoot_rad),
+          kGravity * std::sqrt(2.0 * limits.roll_acceleration_max * overshoot_rad)};
 }
 
 }  // namespace
@@ -202,6 +216,8 @@ void AssemblyTrajectoryOptions::Validate() const {
           collision_weight_growth, "a finite value >= 1");
   require(slowdown_factor > 1.0 && slowdown_factor <= 2.0, "slowdown_factor", slowdown_factor, "in (1, 2]");
   require(attitude_bins >= 4 && attitude_bins <= 3600, "attitude_bins", attitude_bins, "in [4, 3600]");
+  require(std::isfinite(end_tilt_overshoot_rad) && end_tilt_overshoot_rad > 0.0, "end_tilt_overshoot_rad",
+          end_tilt_overshoot_rad, "an angle > 0 rad");
 }
 
 const char* ToString(AssemblyTrajectorySummary::Status status) {
@@ -284,8 +300,11 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
                                 lim.yaw_acceleration_max * lim.yaw_acceleration_max};
   const double required = assembly_.unit_radius_m + o.clearance_m;
   const int k_samples = o.samples_per_piece;
-  // The tilt's ellipse penalised in snap² units, as the kinematic terms (its smaller axis squared).
-  const double tilt_scale = std::pow(kGravity * std::min(lim.roll_acceleration_max, lim.pitch_acceleration_max), 2);
+  // The tilt's ellipses penalised in snap² and jerk² units, as the kinematic terms (each one's
+  // smaller axis squared).
+  const TiltEllipses ellipse = TiltEllipsesOf(lim, o.end_tilt_overshoot_rad);
+  const double tilt_scale = std::pow(std::min(ellipse.snap_x, ellipse.snap_y), 2);
+  const double end_scale = std::pow(std::min(ellipse.end_jerk_x, ellipse.end_jerk_y), 2);
   for (int i = 0; i < m; ++i) {
     const auto cp = pos.coefficients().middleRows<kC>(kC * i);
     const auto cy = yaw.coefficients().middleRows<kC>(kC * i).col(0);
@@ -325,16 +344,26 @@ double AssemblyTrajectoryOptimizer::Objective(const Problem& problem, const Eige
           add_position(2, o.weight_dynamics * slope * 2.0 * f);
         }
       }
-      // The tilt's angular acceleration, the snap over g (the assembly's dynamics; 0: off).
-      if (lim.roll_acceleration_max > 0.0) {
-        const TiltDemand tilt = TiltDemandOf(lim, der.row(4).head<2>().transpose(), psi(0));
+      // A horizontal derivative `order` kept within the tilt's ellipse with semi-axes x_max, y_max
+      // (TiltEllipsesOf), penalised in its units squared (`scale`: the smaller axis squared).
+      const auto tilt_term = [&](int order, double x_max, double y_max, double scale) {
+        const TiltDemand d = TiltDemandOf(x_max, y_max, der.row(order).head<2>().transpose(), psi(0));
         double slope;
-        const double pen = CubicPenalty(tilt_scale * (tilt.squared - 1.0), &slope);
-        if (slope != 0.0) {
-          const double w = o.weight_dynamics * slope * tilt_scale;
-          cost += o.weight_dynamics * pen;
-          add_position(4, Eigen::RowVector3d(w * tilt.d_snap.x(), w * tilt.d_snap.y(), 0.0));
-          add_yaw(0, w * tilt.d_yaw);
+        const double pen = CubicPenalty(scale * (d.squared - 1.0), &slope);
+        if (slope == 0.0) return;
+        const double w = o.weight_dynamics * slope * scale;
+        cost += o.weight_dynamics * pen;
+        add_position(order, Eigen::RowVector3d(w * d.d_horizontal.x(), w * d.d_horizontal.y(), 0.0));
+        add_yaw(0, w * d.d_yaw);
+      };
+      if (lim.roll_acceleration_max > 0.0) {  // the assembly's dynamics; 0: off
+        // The tilt's angular acceleration, the snap over g.
+        tilt_term(4, ellipse.snap_x, ellipse.snap_y, tilt_scale);
+        // Its rate, the jerk over g, where the plan starts and ends at rest: the held reference steps
+        // it to or from zero there, so a row with little angular acceleration to spare (a long one
+        // about its pitch) would overshoot, saturate its rotors and diverge.
+        if ((i == 0 && j == 0) || (i == m - 1 && j == k_samples)) {
+          tilt_term(3, ellipse.end_jerk_x, ellipse.end_jerk_y, end_scale);
         }
       }
       // The yaw's rate and acceleration (the assembly's dynamics; 0: off).
@@ -435,6 +464,7 @@ std::optional<std::pair<AssemblyTrajectorySummary::Status, std::string>> Assembl
       ratio.push_back(std::sqrt(traj->yaw().MaxNorm(2, dense) / limits.yaw_acceleration_max));
     }
     // The thrust per kilogram and the tilt's demand on one pass over the dense samples.
+    const TiltEllipses ellipse = TiltEllipsesOf(limits, options_.end_tilt_overshoot_rad);
     double thrust = 0.0, tilt = 0.0;
     if (limits.thrust_acceleration_max > 0.0 || limits.roll_acceleration_max > 0.0) {
       for (int i = 0; i < m; ++i) {
@@ -442,7 +472,7 @@ std::optional<std::pair<AssemblyTrajectorySummary::Status, std::string>> Assembl
           const double ts = pos.durations()(i) * j / dense;
           thrust = std::max(thrust, (pos.PieceDerivative(i, ts, 2) + kGravity * Vector3::UnitZ()).norm());
           if (limits.roll_acceleration_max > 0.0) {
-            tilt = std::max(tilt, TiltDemandOf(limits, pos.PieceDerivative(i, ts, 4).head<2>(),
+            tilt = std::max(tilt, TiltDemandOf(ellipse.snap_x, ellipse.snap_y, pos.PieceDerivative(i, ts, 4).head<2>(),
                                                traj->yaw().PieceDerivative(i, ts, 0).x())
                                       .squared);
           }
@@ -453,7 +483,16 @@ std::optional<std::pair<AssemblyTrajectorySummary::Status, std::string>> Assembl
       // |a + g e_z| <= |a| + g: stretching until |a| <= limit - g is enough (a scales by 1 / k²).
       ratio.push_back(std::sqrt(pos.MaxNorm(2, dense) / (limits.thrust_acceleration_max - kGravity)));
     }
-    if (limits.roll_acceleration_max > 0.0) ratio.push_back(std::pow(tilt, 1.0 / 8.0));  // snap scales by 1 / k⁴
+    if (limits.roll_acceleration_max > 0.0) {
+      ratio.push_back(std::pow(tilt, 1.0 / 8.0));  // snap scales by 1 / k⁴
+      for (const auto& [piece, time] : {std::pair{0, 0.0}, std::pair{m - 1, pos.durations()(m - 1)}}) {
+        const double end = TiltDemandOf(ellipse.end_jerk_x, ellipse.end_jerk_y,
+                                        pos.PieceDerivative(piece, time, 3).head<2>(),
+                                        traj->yaw().PieceDerivative(piece, time, 0).x())
+                               .squared;
+        ratio.push_back(std::pow(end, 1.0 / 6.0));  // jerk scales by 1 / k³
+      }
+    }
     const double worst = *std::max_element(ratio.begin(), ratio.end());
     summary->limit_margin = 1.0 - worst;  // of the stretch factor's scale: >= 0 when all hold
     if (worst <= 1.0) return std::nullopt;

@@ -162,12 +162,9 @@ ReferencePoint CriticallyDampedReference::Evaluate(double t) const {
   r.v_W = d[1];
   r.a_W = d[2];
   r.j_W = d[3];
+  r.s_W = d[4];
   return r;
 }
 
-Vector3 CriticallyDampedReference::Snap(double t) const {
-  if (t <= t0_ || t >= duration()) return Vector3::Zero();
-  return Derivatives(t - t0_)[4];
-}
 
 }  // namespace rotorguard::planning

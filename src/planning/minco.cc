@@ -215,6 +215,7 @@ ReferencePoint MinimumJerkTrajectory::Evaluate(double t) const {
   r.v_W = PieceDerivative(i, local, 1);
   r.a_W = PieceDerivative(i, local, 2);
   r.j_W = PieceDerivative(i, local, 3);
+  r.s_W = PieceDerivative(i, local, 4);
   return r;
 }
 

@@ -164,6 +164,7 @@ ReferencePoint TakeoffReference::Evaluate(double t) const {
   r.v_W.z() = h / T * 30.0 * s2 * one_minus_s * one_minus_s;
   r.a_W.z() = h / (T * T) * 60.0 * s * one_minus_s * (1.0 - 2.0 * s);
   r.j_W.z() = h / (T * T * T) * (60.0 - 360.0 * s + 360.0 * s2);
+  r.s_W.z() = h / (T * T * T * T) * (-360.0 + 720.0 * s);
   return r;
 }
 

@@ -125,8 +125,9 @@ TEST(MarsTableTwo, TheTruthsThrustPerKilogramIsTheFilesOverTheDrawnMass) {
 // Table II on hand-made records: 5 rows x 2 planners (baseline, ours) x 3 trials. In row 0 the
 // baseline plans trials 0 and 1 (errors 0.2, 0.4 m; trial 1 crashed) and not trial 2, ours all three
 // (0.1, 0.1, 0.7 m): the cells are over each method's own plans, the comparison over trials 0 and 1.
+// Trial 2's drawn assembly cannot hover (its thrust per kilogram below g; ours crashes there).
 TEST(MarsTableTwo, CellsAreOverEachMethodsPlansAndTheComparisonOverTheTrialsBothPlanned) {
-  const auto flight = [](double rmse, bool success) {
+  const auto flight = [](double rmse, bool success, double truth_capacity = 11.0) {
     return nlohmann::json{{"status", "ok"},
                           {"message", success ? "" : "crash: collision with box 0"},
                           {"params", {{"shape", "mars_4x1"}, {"fault", "normal"}}},
@@ -148,16 +149,17 @@ TEST(MarsTableTwo, CellsAreOverEachMethodsPlansAndTheComparisonOverTheTrialsBoth
                             {"capacity_thrust_accel_m_s2", 20.0},
                             {"capacity_yaw_accel_rad_s2", 4.0},
                             {"capacity_roll_accel_rad_s2", 30.0},
-                            {"capacity_pitch_accel_rad_s2", 10.0}}}};
+                            {"capacity_pitch_accel_rad_s2", 10.0},
+                            {"truth_capacity_thrust_accel_m_s2", truth_capacity}}}};
   };
   const nlohmann::json no_plan = {{"status", "ok"},
                                   {"message", "A*: no_path"},
                                   {"params", {{"shape", "mars_4x1"}, {"fault", "normal"}}},
-                                  {"metrics", {{"planned", false}}}};
+                                  {"metrics", {{"planned", false}, {"truth_capacity_thrust_accel_m_s2", 9.0}}}};
   std::vector<nlohmann::json> records;
   for (int row = 0; row < 5; ++row) {
     for (const nlohmann::json& r : {flight(0.2, true), flight(0.4, false), no_plan}) records.push_back(r);  // baseline
-    for (const nlohmann::json& r : {flight(0.1, true), flight(0.1, true), flight(0.7, true)}) records.push_back(r);
+    for (const nlohmann::json& r : {flight(0.1, true), flight(0.1, true), flight(0.7, false, 9.0)}) records.push_back(r);
   }
   std::vector<const nlohmann::json*> pointers;
   for (const nlohmann::json& r : records) pointers.push_back(&r);
@@ -169,6 +171,10 @@ TEST(MarsTableTwo, CellsAreOverEachMethodsPlansAndTheComparisonOverTheTrialsBoth
   EXPECT_EQ(row["baseline_plan_failure"], "A*: no_path");
   EXPECT_NEAR(row["ours_error_m"].get<double>(), 0.3, 1e-12);  // (0.1 + 0.1 + 0.7) / 3
   EXPECT_EQ(row["paired_trials"], 2);
+  EXPECT_EQ(row["hover_capable_trials"], 2);  // trials 0 and 1
+  EXPECT_NEAR(row["baseline_success_rate_hover_capable"].get<double>(), 0.5, 1e-12);
+  EXPECT_NEAR(row["ours_success_rate_hover_capable"].get<double>(), 1.0, 1e-12);
+  EXPECT_NEAR(row["ours_success_rate"].get<double>(), 2.0 / 3.0, 1e-12);
   EXPECT_NEAR(row["improvement"].get<double>(), 1.0 - 0.1 / 0.3, 1e-12);  // trials 0 and 1 only
   EXPECT_NEAR(t["table2_improvement_average"].get<double>(), 1.0 - 0.1 / 0.3, 1e-12);
   EXPECT_TRUE(t["table2_ours_better_in_every_row"].get<bool>());

@@ -225,6 +225,36 @@ TEST(AssemblyTrajectoryOptimizer, TheTiltLimitKeepsTheSnapWithinWhatTheRotorsCan
   EXPECT_LT(s_free.duration_s, s_length.duration_s);
 }
 
+TEST(AssemblyTrajectoryOptimizer, WithTheTiltLimitThePlansEndsAskForATiltRateTheRotorsCanStop) {
+  // Near hover the tilt rate is the horizontal jerk over g. The plan starts and ends at rest and the
+  // reference held before and after it has no jerk: the rate at either end is started or stopped at
+  // once, and stopped at the limit's angular acceleration α it overshoots by ω² / (2 α). With the
+  // tilt limits on that stays within end_tilt_overshoot_rad; without them it is what a minimum-jerk
+  // plan leaves there (a rest-to-rest quintic's 60 h / T³ of jerk).
+  const Assembly a = testing::MarsAssembly("4x1");
+  const perception::VoxelMap map = WallWithGap(100.0);  // open space
+  AssemblyTrajectoryOptions o;
+  o.weight_attitude = 0.0;
+  AssemblyLimits tilt = Limits();
+  tilt.roll_acceleration_max = 0.5;
+  tilt.pitch_acceleration_max = 0.1;
+  const AssemblyTrajectoryOptimizer opt(a, RotorVector::Ones(16), o);
+  // Flown lengthwise (yaw 0), the body's x is the world's: pitch, at 0.1 rad/s² at most.
+  const auto overshoot = [](const AssemblyTrajectory& t, double time) {
+    const double rate = t.Evaluate(time).j_W.head<2>().norm() / kGravity;
+    return rate * rate / (2.0 * 0.1);
+  };
+  AssemblyTrajectory limited, free;
+  const AssemblyTrajectorySummary s_limited = opt.Optimize(map, StraightPath(0.0), tilt, &limited);
+  ASSERT_TRUE(s_limited.ok()) << s_limited.message;
+  ASSERT_TRUE(opt.Optimize(map, StraightPath(0.0), Limits(), &free).ok());
+  EXPECT_GE(s_limited.limit_margin, 0.0);
+  for (const double end : {1e-9, 1.0 - 1e-9}) {
+    EXPECT_LE(overshoot(limited, end * limited.duration()), o.end_tilt_overshoot_rad * (1.0 + 1e-3)) << end;
+    EXPECT_GT(overshoot(free, end * free.duration()), 2.0 * o.end_tilt_overshoot_rad) << end;
+  }
+}
+
 /// By brute force: the smallest distance from a unit's centre to a wall voxel's cube (0.1 m, about
 /// its centre) minus the unit's radius, every 10 ms of `traj`.
 double BruteForceClearance(const Assembly& a, const AssemblyTrajectory& traj, const std::vector<Vector3>& wall) {

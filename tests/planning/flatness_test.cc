@@ -71,7 +71,7 @@ TEST(Flatness, ReferenceOfEq7AndItsDerivativesByFiniteDifferences) {
     EXPECT_LT(((b.p_W - a.p_W) / (2 * h) - c.v_W).norm(), 1e-8) << t;
     EXPECT_LT(((b.v_W - a.v_W) / (2 * h) - c.a_W).norm(), 1e-8) << t;
     EXPECT_LT(((b.a_W - a.a_W) / (2 * h) - c.j_W).norm(), 1e-7) << t;
-    EXPECT_LT(((b.j_W - a.j_W) / (2 * h) - moving.Snap(t)).norm(), 1e-6) << t;
+    EXPECT_LT(((b.j_W - a.j_W) / (2 * h) - c.s_W).norm(), 1e-6) << t;
   }
   // It starts from the given state and ends at rest on the goal.
   const ReferencePoint start = moving.Evaluate(1.0 + 1e-12);
@@ -113,7 +113,7 @@ TEST(Flatness, ChosenSettlingTimeMeetsTheBindingLimitWithEqualityAndKeepsTheOthe
     for (int i = 0; i < 4; ++i) {
       const double limit = (1.0 - w[i]) * limits.rho_u * limits.u_max;
       // The reference's t = 0 is a step (the acceleration jumps); evaluate just after it.
-      max_u_margin[i] = MaxOver([&](double t) { return NominalPwm(m, ref.Snap(std::max(t, 1e-13)))[i]; }, st.t_s) - limit;
+      max_u_margin[i] = MaxOver([&](double t) { return NominalPwm(m, ref.Evaluate(std::max(t, 1e-13)).s_W)[i]; }, st.t_s) - limit;
     }
     // Every limit holds ...
     EXPECT_LE(max_theta, theta_limit * (1.0 + 1e-9));

@@ -1,6 +1,6 @@
 #pragma once
 /// Nominal cascaded geometric controller: position -> thrust vector -> attitude -> body rates ->
-/// torques, then pseudo-inverse allocation. Flatness feedforward of acceleration and jerk.
+/// torques, then pseudo-inverse allocation. Flatness feedforward of acceleration, jerk and snap.
 /// Not fault tolerant: the "no FTC" row of the benchmarks.
 #include "rotorguard/control/allocation.h"
 #include "rotorguard/control/controller.h"

@@ -12,6 +12,9 @@ struct ReferencePoint {
   Vector3 j_W = Vector3::Zero();  ///< jerk
   double yaw = 0.0;               ///< [rad]
   double yaw_rate = 0.0;          ///< [rad/s]
+  /// Snap (the fourth derivative): the tilt's angular acceleration follows from it. Zero where a
+  /// reference does not define it (piecewise-constant accelerations, fixed points).
+  Vector3 s_W = Vector3::Zero();
 };
 
 /// A reference defined for all t >= 0 (it holds its final point after `duration()`).

@@ -82,7 +82,9 @@ struct AssemblyLimits {
   /// The tilt's angular acceleration the plan may ask for about the body's x and y axes
   /// [rad/s²], both 0 (off) or both > 0. Near hover the thrust's direction is a + g e_z, so the
   /// tilt's angular acceleration is the horizontal snap over g: the snap in the body's frame
-  /// (rotated by the yaw) is kept in the ellipse (s_x / (g α_y))² + (s_y / (g α_x))² <= 1.
+  /// (rotated by the yaw) is kept in the ellipse (s_x / (g α_y))² + (s_y / (g α_x))² <= 1. With
+  /// these on, the plan's first and last jerk are bounded too (AssemblyTrajectoryOptions::
+  /// end_tilt_overshoot_rad).
   double roll_acceleration_max = 0.0;
   double pitch_acceleration_max = 0.0;
   void Validate() const;
@@ -128,6 +130,10 @@ struct AssemblyTrajectoryOptions {
   double slowdown_factor = 1.02;
   /// Optimal relative yaws of eq. (7) are searched among this many yaw steps per turn, >= 4.
   int attitude_bins = 72;
+  /// With the tilt limits on (AssemblyLimits): the tilt rate at the plan's start and end (its
+  /// jerk over g), which the held reference steps to or from zero there, is kept so small that
+  /// stopping it at the limit's angular acceleration overshoots the tilt by at most this [rad], > 0.
+  double end_tilt_overshoot_rad = 0.05;
   /// Throws ValidationError naming the field.
   void Validate() const;
 };

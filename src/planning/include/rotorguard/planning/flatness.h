@@ -84,8 +84,6 @@ class CriticallyDampedReference final : public ReferenceTrajectory {
   CriticallyDampedReference(double t0, const Vector3& p0, const Vector3& v0, const Vector3& goal, double t_s,
                             double yaw = 0.0);
   [[nodiscard]] ReferencePoint Evaluate(double t) const override;
-  /// The fourth derivative (snap) at t, for the flat feed-forward (eq. 5).
-  [[nodiscard]] Vector3 Snap(double t) const;
   [[nodiscard]] double duration() const override { return t0_ + 40.0 / omega_; }
   double t0() const { return t0_; }
   double t_s() const { return t_s_; }
