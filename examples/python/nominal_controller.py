@@ -147,7 +147,9 @@ class NominalController:
         if rate_norm > k["max_rate_rad_s"]:
             w_des *= k["max_rate_rad_s"] / rate_norm
         w = est["angular_velocity"]
-        alpha_des = k["k_rate"] * (w_des - w) + R.T @ R_des @ alpha_ff_des
+        alpha_des = k["k_rate"] * (w_des - w)
+        if k["snap_feedforward"]:
+            alpha_des = alpha_des + R.T @ R_des @ alpha_ff_des
         tau = self.I @ alpha_des + cross(w, self.I @ w) + np.array([0.0, 0.0, self.yaw_damping * w[2]])
         return np.concatenate(([thrust], tau))
 

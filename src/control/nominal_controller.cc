@@ -50,12 +50,10 @@ bool CascadedWrenchLaw::Compute(const StateEstimate& est, const ReferencePoint& 
   //       + c (w_x w_z x_B + w_y w_z y_B - (w_x^2 + w_y^2) z_B),
   // so the tilt's angular acceleration from the snap: without it the rate loop meets a demand for
   // it only through its error (a heavy assembly braking hard lags, saturates and overshoots).
+  // Added with options_.snap_feedforward.
   const double c = std::max(f_des.norm() / m, 0.1 * kGravity);
-  const double c_dot = z_des.dot(ref.j_W);
-  const Vector3 w_ff_des(-y_des.dot(ref.j_W) / c, x_des.dot(ref.j_W) / c, ref.yaw_rate * z_des.z());
-  const Vector3 alpha_ff_des((-y_des.dot(ref.s_W) - 2.0 * c_dot * w_ff_des.x() + c * w_ff_des.y() * w_ff_des.z()) / c,
-                             (x_des.dot(ref.s_W) - 2.0 * c_dot * w_ff_des.y() - c * w_ff_des.x() * w_ff_des.z()) / c,
-                             0.0);
+  const Vector3 h = (ref.j_W - z_des.dot(ref.j_W) * z_des) / c;
+  const Vector3 w_ff_des(-h.dot(y_des), h.dot(x_des), ref.yaw_rate * z_des.z());
 
   // Attitude error in the body frame: q_e = q^-1 (x) q_des, shortest way round.
   Quaternion q_e = est.q_WB.normalized().conjugate() * Quaternion(R_des);
@@ -67,8 +65,15 @@ bool CascadedWrenchLaw::Compute(const StateEstimate& est, const ReferencePoint& 
   // Rate loop: torque from the desired angular acceleration plus gyroscopic and yaw-damping terms.
   const Matrix3& I = vp.inertia_kg_m2;
   const Vector3& w = est.w_B;
-  const Vector3 alpha_des = options_.k_rate.cwiseProduct(w_des - w) + R.transpose() * R_des * alpha_ff_des;
-  const Vector3 tau = I * alpha_des + w.cross(I * w) + Vector3(0.0, 0.0, vp.yaw_damping_n_m_s * w.z());
+  const Vector3 alpha_des = options_.k_rate.cwiseProduct(w_des - w);
+  Vector3 tau = I * alpha_des + w.cross(I * w) + Vector3(0.0, 0.0, vp.yaw_damping_n_m_s * w.z());
+  if (options_.snap_feedforward) {
+    const double c_dot = z_des.dot(ref.j_W);
+    const Vector3 alpha_ff_des(
+        (-y_des.dot(ref.s_W) - 2.0 * c_dot * w_ff_des.x() + c * w_ff_des.y() * w_ff_des.z()) / c,
+        (x_des.dot(ref.s_W) - 2.0 * c_dot * w_ff_des.y() - c * w_ff_des.x() * w_ff_des.z()) / c, 0.0);
+    tau += I * (R.transpose() * R_des * alpha_ff_des);
+  }
   *wrench << thrust, tau;
   return wrench->allFinite();
 }

@@ -305,6 +305,7 @@ rotorguard_msgs::ControlCycle ToRos(const Cycle& m) {
   r.reference.velocity = ToVector3(m.reference.velocity);
   r.reference.acceleration = ToVector3(m.reference.acceleration);
   r.reference.jerk = ToVector3(m.reference.jerk);
+  r.reference.snap = ToVector3(m.reference.snap);
   r.reference.yaw = m.reference.yaw;
   r.reference.yaw_rate = m.reference.yaw_rate;
   r.health = ToRos(m.health);
@@ -320,6 +321,7 @@ std::string FromRos(const rotorguard_msgs::ControlCycle& r, Cycle* m) {
   m->reference.velocity = FromVector3(r.reference.velocity);
   m->reference.acceleration = FromVector3(r.reference.acceleration);
   m->reference.jerk = FromVector3(r.reference.jerk);
+  m->reference.snap = FromVector3(r.reference.snap);
   m->reference.yaw = r.reference.yaw;
   m->reference.yaw_rate = r.reference.yaw_rate;
   return FromRos(r.health, &m->health);

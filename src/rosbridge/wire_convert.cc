@@ -133,7 +133,7 @@ ros1::Cycle ToWire(const runtime::CycleTelemetry& c, const TimeBase& base) {
   w.estimate_valid = c.estimate.valid;
   w.estimate = EstimateToWire(c.estimate, base);
   w.reference = {ToVec3(c.reference.p_W), ToVec3(c.reference.v_W), ToVec3(c.reference.a_W), ToVec3(c.reference.j_W),
-                 c.reference.yaw, c.reference.yaw_rate};
+                 c.reference.yaw, c.reference.yaw_rate, ToVec3(c.reference.s_W)};
   w.health = HealthToWire(c, base);
   return w;
 }
@@ -153,7 +153,7 @@ runtime::CycleTelemetry FromWire(const ros1::Cycle& w, const TimeBase& base) {
   c.mode = FromName<stack::FlightMode>(w.health.mode).value_or(stack::FlightMode::kNominal);
   c.estimate = EstimateFromWire(w.estimate, base, w.estimate_valid);
   c.reference = {FromVec3(w.reference.position), FromVec3(w.reference.velocity), FromVec3(w.reference.acceleration),
-                 FromVec3(w.reference.jerk), w.reference.yaw, w.reference.yaw_rate};
+                 FromVec3(w.reference.jerk), w.reference.yaw, w.reference.yaw_rate, FromVec3(w.reference.snap)};
   c.fdd_rotors = static_cast<int>(std::min<std::size_t>(w.health.health.size(), kMaxRotors));
   for (int i = 0; i < c.fdd_rotors; ++i) {
     const auto k = static_cast<std::size_t>(i);

@@ -49,7 +49,9 @@ double TorqueOnTheFlatState(const planning::MinimumJerkTrajectory& traj, int axi
 
   vehicle::VehicleParams vp = ReferenceQuad();
   vp.rotor_drag_kg_s.setZero();  // the flat map above is that of a vehicle without rotor drag
-  CascadedWrenchLaw law(vp, NominalControllerOptions{});
+  NominalControllerOptions options;
+  options.snap_feedforward = true;
+  CascadedWrenchLaw law(vp, options);
   ReferencePoint ref = traj.Evaluate(t);
   if (!with_snap) ref.s_W.setZero();
   StateEstimate est;
@@ -85,7 +87,8 @@ TEST(CascadedWrenchLaw, OnTheFlatStateTheTorqueIsTheInertiaTimesTheTiltsAngularA
 }
 
 // Without the snap (a reference that does not define it) the law keeps only the jerk's part of the
-// feedforward (the thrust's change turning the rate, -2 c' w / c), and the check above fails.
+// feedforward (the thrust's change turning the rate, -2 c' w / c), and the check above fails; the
+// default (snap_feedforward off) leaves the torque to the rate loop alone.
 TEST(CascadedWrenchLaw, WithoutTheSnapTheTorqueMissesTheFlatStatesAngularAcceleration) {
   const vehicle::VehicleParams vp = ReferenceQuad();
   const planning::MinimumJerkTrajectory traj = PlanarFlight(0);
@@ -96,6 +99,22 @@ TEST(CascadedWrenchLaw, WithoutTheSnapTheTorqueMissesTheFlatStatesAngularAcceler
     worst_miss = std::max(worst_miss, std::abs(vp.inertia_kg_m2(1, 1) * acceleration - torque));
   }
   EXPECT_GT(worst_miss, 1.0 * vp.inertia_kg_m2(1, 1));
+  vehicle::VehicleParams vq = ReferenceQuad();
+  vq.rotor_drag_kg_s.setZero();
+  CascadedWrenchLaw off(vq, NominalControllerOptions{});
+  const double t = 0.5 * traj.duration();
+  const ReferencePoint ref = traj.Evaluate(t);
+  StateEstimate est;
+  est.valid = true;
+  est.p_W = ref.p_W;
+  est.v_W = ref.v_W;
+  est.q_WB = Quaternion(Eigen::AngleAxisd(Tilt(traj, 0, t), Vector3::UnitY()));
+  est.w_B = Vector3::Zero();
+  Eigen::Vector4d wrench;
+  ASSERT_TRUE(off.Compute(est, ref, 0.0, &wrench));
+  // Off, the pitch torque is the rate loop's alone: I k_rate (w_ff - 0) about y.
+  const double h = 1e-4, rate = (Tilt(traj, 0, t + h) - Tilt(traj, 0, t - h)) / (2.0 * h);
+  EXPECT_NEAR(wrench(2), vq.inertia_kg_m2(1, 1) * NominalControllerOptions{}.k_rate.y() * rate, 1e-6);
 }
 
 }  // namespace

@@ -40,7 +40,7 @@ TEST(Bag, WhatIsWrittenIsReadBackInTimeOrder) {
   cycle.lio_serial = 5;
   cycle.estimate_valid = true;
   cycle.estimate = {1'000'000'400, "odom", "base_link", {{1, 2, 3}, {0, 0, std::sqrt(0.5), std::sqrt(0.5)}}, {1, 0, 0}, {0, 0, 0.5}};
-  cycle.reference = {{1, 2, 3}, {0.1, 0.2, 0.3}, {0, 0, 0}, {0, 0, 1}, 0.5, 0.1};
+  cycle.reference = {{1, 2, 3}, {0.1, 0.2, 0.3}, {0, 0, 0}, {0, 0, 1}, 0.5, 0.1, {0.4, -0.2, 3}};
   cycle.health = {1'000'000'400, "failure_recovery", {"propeller_failed", "ok", "ok", "ok"}, {1, 0, 0, 0}, {0.2, 1, 1, 1}, {3, 0, 0, 0}};
   {
     BagWriter bag(path);
@@ -81,6 +81,7 @@ TEST(Bag, WhatIsWrittenIsReadBackInTimeOrder) {
   EXPECT_EQ(y.estimate.pose.orientation_xyzw, cycle.estimate.pose.orientation_xyzw);
   EXPECT_EQ(y.estimate.child_frame_id, "base_link");
   EXPECT_EQ(y.reference.jerk, cycle.reference.jerk);
+  EXPECT_EQ(y.reference.snap, cycle.reference.snap);
   EXPECT_EQ(y.health.health, cycle.health.health);
   EXPECT_EQ(y.health.mode, "failure_recovery");
   fs::remove(path);

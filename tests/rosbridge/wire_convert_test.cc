@@ -107,6 +107,7 @@ TEST(WireConvert, ACycleRoundTrips) {
   c.estimate.p_W = {1, 2, 3};
   c.reference.p_W = {4, 5, 6};
   c.reference.yaw_rate = 0.3;
+  c.reference.s_W = {0.7, -0.1, 2.5};
   c.fdd_rotors = 4;
   c.health[0] = {fdd::RotorHealth::kPropellerFailed, 1.0f, 0.25f, 3.0f};
   const runtime::CycleTelemetry back = FromWire(ToWire(c, TimeBase{}), TimeBase{});
@@ -122,6 +123,7 @@ TEST(WireConvert, ACycleRoundTrips) {
   EXPECT_EQ(back.estimate.p_W, c.estimate.p_W);
   EXPECT_EQ(back.reference.p_W, c.reference.p_W);
   EXPECT_EQ(back.reference.yaw_rate, 0.3);
+  EXPECT_EQ(back.reference.s_W, c.reference.s_W);
   ASSERT_EQ(back.fdd_rotors, 4);
   EXPECT_EQ(back.health[0].health, fdd::RotorHealth::kPropellerFailed);
   EXPECT_EQ(back.health[0].motor_index, 0.25f);

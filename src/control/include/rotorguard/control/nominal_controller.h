@@ -1,6 +1,7 @@
 #pragma once
 /// Nominal cascaded geometric controller: position -> thrust vector -> attitude -> body rates ->
-/// torques, then pseudo-inverse allocation. Flatness feedforward of acceleration, jerk and snap.
+/// torques, then pseudo-inverse allocation. Flatness feedforward of acceleration and jerk (and snap,
+/// NominalControllerOptions::snap_feedforward).
 /// Not fault tolerant: the "no FTC" row of the benchmarks.
 #include "rotorguard/control/allocation.h"
 #include "rotorguard/control/controller.h"
@@ -15,6 +16,11 @@ struct NominalControllerOptions {
   Vector3 k_attitude = Vector3(9.0, 9.0, 4.0);    ///< attitude error -> rate [1/s], > 0
   Vector3 k_rate = Vector3(22.0, 22.0, 10.0);     ///< rate error -> angular acceleration [1/s], > 0
   double max_rate_rad_s = 8.0;        ///< commanded body-rate limit [rad/s], > 0
+  /// The tilt's angular acceleration from the reference's snap as feed-forward. For a vehicle whose
+  /// attitude is slow against its plans (an assembly: a 4x1 row's pitch inertia is 20 times a
+  /// unit's). Off by default: a quadrotor's rate loop follows without it, and the replanner's brake
+  /// to rest asks for snap beyond its rotors, whose feed-forward saturates them.
+  bool snap_feedforward = false;
   /// Throws ValidationError naming the field.
   void Validate() const;
   /// The keys of this struct in config files (core/config_schema.h).
@@ -27,6 +33,8 @@ struct NominalControllerOptions {
              {.meaning = "rate error to angular acceleration [1/s]", .max = 1000.0, .positive = true});
     a->Visit("max_rate_rad_s", &max_rate_rad_s,
              {.meaning = "commanded body-rate limit [rad/s]", .max = kMaxBodyRateRadS, .positive = true});
+    a->Visit("snap_feedforward", &snap_feedforward,
+             {.meaning = "feed the tilt's angular acceleration forward from the reference's snap"});
   }
 };
 

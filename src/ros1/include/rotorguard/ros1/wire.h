@@ -102,6 +102,7 @@ struct Health {
 struct Reference {
   Vec3 position{}, velocity{}, acceleration{}, jerk{};
   double yaw = 0.0, yaw_rate = 0.0;
+  Vec3 snap{};
 };
 
 /// rotorguard_msgs/ControlCycle.
