@@ -133,11 +133,8 @@ class NominalController:
         R_des = np.array((x_des, y_des, z_des)).T
         thrust = max(0.0, f_des @ R[:, 2])
         c = max(norm(f_des) / self.m, 0.1 * self.g)
-        c_dot = z_des @ ref["jerk"]
-        w_ff_des = np.array([-(y_des @ ref["jerk"]) / c, (x_des @ ref["jerk"]) / c, ref["yaw_rate"] * z_des[2]])
-        s = ref["snap"]
-        alpha_ff_des = np.array([(-(y_des @ s) - 2.0 * c_dot * w_ff_des[0] + c * w_ff_des[1] * w_ff_des[2]) / c,
-                                 ((x_des @ s) - 2.0 * c_dot * w_ff_des[1] - c * w_ff_des[0] * w_ff_des[2]) / c, 0.0])
+        h = (ref["jerk"] - (z_des @ ref["jerk"]) * z_des) / c
+        w_ff_des = np.array([-(h @ y_des), h @ x_des, ref["yaw_rate"] * z_des[2]])
         q = est["attitude"] / norm(est["attitude"])
         q_e = quaternion_product(q * np.array([1.0, -1.0, -1.0, -1.0]), quaternion(R_des))
         if q_e[0] < 0.0:
@@ -148,9 +145,14 @@ class NominalController:
             w_des *= k["max_rate_rad_s"] / rate_norm
         w = est["angular_velocity"]
         alpha_des = k["k_rate"] * (w_des - w)
-        if k["snap_feedforward"]:
-            alpha_des = alpha_des + R.T @ R_des @ alpha_ff_des
         tau = self.I @ alpha_des + cross(w, self.I @ w) + np.array([0.0, 0.0, self.yaw_damping * w[2]])
+        if k["snap_feedforward"]:  # the tilt's angular acceleration from the snap (off by default)
+            c_dot = z_des @ ref["jerk"]
+            s = ref["snap"]
+            alpha_ff_des = np.array([(-(y_des @ s) - 2.0 * c_dot * w_ff_des[0] + c * w_ff_des[1] * w_ff_des[2]) / c,
+                                     ((x_des @ s) - 2.0 * c_dot * w_ff_des[1] - c * w_ff_des[0] * w_ff_des[2]) / c,
+                                     0.0])
+            tau = tau + self.I @ (R.T @ R_des @ alpha_ff_des)
         return np.concatenate(([thrust], tau))
 
 
