@@ -683,6 +683,22 @@ def render(out_dir, present):
         body += ['## Modular assemblies (paper 002), %s world' % world, '',
                  '`%s` (rotorguard, %s; host %s, finished %s)' % (command_text(args), m.get('version', ''),
                                                                 m.get('host', ''), m.get('finished', '')), '', table, '']
+        if world == 'realistic':  # README: Table II's success of ours, row by row
+            with open(os.path.join(out_dir, name, 'bench.json')) as f:
+                bench = json.load(f)
+            cells = []
+            for r in bench.get('table2') or []:
+                if 'ours_success_rate' not in r:
+                    continue
+                cell = '%s %s %.0f %%' % (r['shape'].replace('mars_', ''), r['fault'], 100.0 * r['ours_success_rate'])
+                capable = r.get('ours_success_rate_hover_capable')
+                if r.get('hover_capable_trials', bench['trials']) < bench['trials'] and capable is not None:
+                    cell += ' (%.0f %% where it can hover: %d of %d drawn assemblies cannot)' % (
+                        100.0 * capable, bench['trials'] - r['hover_capable_trials'], bench['trials'])
+                cells.append(cell)
+            if cells:
+                readme += ['- Modular assemblies (paper 002, Table II), %d trials per row, realistic world: ours succeeds '
+                           'in %s.' % (bench['trials'], '; '.join(cells))]
     far = [j for j in JOBS if j[1] == 'campaign' and j[0] in present]
     if far:
         body += ['## False alarms on evaluation sets', '',
