@@ -1,5 +1,4 @@
 #include <cmath>
-#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -38,11 +37,13 @@ double Tilt(const planning::MinimumJerkTrajectory& traj, int axis, double t) {
 }
 
 // The torque the law asks for on the flat state at t (the estimate on the reference, at its
-// attitude and rate) about the tilt's axis, with the reference's snap or without it.
+// attitude, turning at its rate or, `turning` false, not at all) about the tilt's axis, with the
+// reference's snap or without it, the feed-forward on or off.
 double TorqueOnTheFlatState(const planning::MinimumJerkTrajectory& traj, int axis, double t, bool with_snap,
-                            double* tilt_rate, double* tilt_acceleration) {
+                            double* tilt_rate, double* tilt_acceleration, bool snap_feedforward = true,
+                            bool turning = true) {
   constexpr double h = 1e-4;
-  const std::function<double(double)> tilt = [&](double s) { return Tilt(traj, axis, s); };
+  const auto tilt = [&](double s) { return Tilt(traj, axis, s); };
   *tilt_rate = (tilt(t + h) - tilt(t - h)) / (2.0 * h);
   *tilt_acceleration = (tilt(t + h) - 2.0 * tilt(t) + tilt(t - h)) / (h * h);
   const Vector3 body_axis = axis == 0 ? Vector3::UnitY() : Vector3::UnitX();
@@ -50,7 +51,7 @@ double TorqueOnTheFlatState(const planning::MinimumJerkTrajectory& traj, int axi
   vehicle::VehicleParams vp = ReferenceQuad();
   vp.rotor_drag_kg_s.setZero();  // the flat map above is that of a vehicle without rotor drag
   NominalControllerOptions options;
-  options.snap_feedforward = true;
+  options.snap_feedforward = snap_feedforward;
   CascadedWrenchLaw law(vp, options);
   ReferencePoint ref = traj.Evaluate(t);
   if (!with_snap) ref.s_W.setZero();
@@ -59,7 +60,7 @@ double TorqueOnTheFlatState(const planning::MinimumJerkTrajectory& traj, int axi
   est.p_W = ref.p_W;
   est.v_W = ref.v_W;
   est.q_WB = Quaternion(Eigen::AngleAxisd(tilt(t), body_axis));
-  est.w_B = *tilt_rate * body_axis;
+  est.w_B = turning ? Vector3(*tilt_rate * body_axis) : Vector3::Zero();
   Eigen::Vector4d wrench;
   EXPECT_TRUE(law.Compute(est, ref, 0.0, &wrench));
   return wrench(axis == 0 ? 2 : 1);
@@ -99,22 +100,11 @@ TEST(CascadedWrenchLaw, WithoutTheSnapTheTorqueMissesTheFlatStatesAngularAcceler
     worst_miss = std::max(worst_miss, std::abs(vp.inertia_kg_m2(1, 1) * acceleration - torque));
   }
   EXPECT_GT(worst_miss, 1.0 * vp.inertia_kg_m2(1, 1));
-  vehicle::VehicleParams vq = ReferenceQuad();
-  vq.rotor_drag_kg_s.setZero();
-  CascadedWrenchLaw off(vq, NominalControllerOptions{});
-  const double t = 0.5 * traj.duration();
-  const ReferencePoint ref = traj.Evaluate(t);
-  StateEstimate est;
-  est.valid = true;
-  est.p_W = ref.p_W;
-  est.v_W = ref.v_W;
-  est.q_WB = Quaternion(Eigen::AngleAxisd(Tilt(traj, 0, t), Vector3::UnitY()));
-  est.w_B = Vector3::Zero();
-  Eigen::Vector4d wrench;
-  ASSERT_TRUE(off.Compute(est, ref, 0.0, &wrench));
-  // Off, the pitch torque is the rate loop's alone: I k_rate (w_ff - 0) about y.
-  const double h = 1e-4, rate = (Tilt(traj, 0, t + h) - Tilt(traj, 0, t - h)) / (2.0 * h);
-  EXPECT_NEAR(wrench(2), vq.inertia_kg_m2(1, 1) * NominalControllerOptions{}.k_rate.y() * rate, 1e-6);
+  // Off, at the flat attitude but not turning, the pitch torque is the rate loop's alone:
+  // I k_rate (w_ff - 0) about y.
+  double rate = 0.0, acceleration = 0.0;
+  const double torque = TorqueOnTheFlatState(traj, 0, 0.5 * traj.duration(), true, &rate, &acceleration, false, false);
+  EXPECT_NEAR(torque, vp.inertia_kg_m2(1, 1) * NominalControllerOptions{}.k_rate.y() * rate, 1e-6);
 }
 
 }  // namespace
