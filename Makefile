@@ -8,7 +8,7 @@ ROTORGUARD_ROS ?= ON
 DEMO_SCENARIO ?= configs/scenarios/forest.yaml
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build demo test bench results sanitize fuzz clean
+.PHONY: all deps configure build demo test bench results peers sanitize fuzz clean
 
 all: build
 
@@ -30,6 +30,15 @@ demo: build
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# The peers of docs/performance.md (HPIPM, GCOPTER's L-BFGS), cloned and built outside the sources
+# (PEERS_DIR), and the drivers of benchmarks/peers/ that run them beside rotorguard's solvers.
+PEERS_DIR ?= out/peers
+peers: configure
+	./scripts/peers.sh $(PEERS_DIR)
+	@cmake -S . -B $(BUILD_DIR) -DROTORGUARD_PEERS_DIR=$(abspath $(PEERS_DIR)) > $(BUILD_DIR)/configure.log 2>&1 \
+	  || (cat $(BUILD_DIR)/configure.log; exit 1)
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target peer_qp peer_lbfgs rotorguard_cli
 
 # The unit tests under AddressSanitizer and UndefinedBehaviorSanitizer, in their own build folder
 # (docs/reliability.md): its build alone takes longer than all of `make test`, so it runs before a

@@ -10,7 +10,8 @@ and starts with one of the repository's top-level folders or files) and fails, n
 when no such file or folder exists; tokens with placeholders (<name>, *, ...) and outputs (under build/
 or out/, which a clean clone has not made yet) are skipped. It also fails on a pointer
 `CHANGELOG.md, "Title"` whose title begins no heading of CHANGELOG.md. `words`
-counts whitespace-separated words of DOCS_DIR/*.md without the generated parts: docs/results.md and
+counts whitespace-separated words of DOCS_DIR/*.md without the generated parts: docs/results.md,
+docs/performance.md and
 the tables the code writes, between `<!-- BEGIN rotorguard keys` (or `bench --list`) and its `<!-- END ... -->`.
 Exit 0 when the check holds, 1 naming what does not, 2 on a usage or input error.
 """
@@ -23,6 +24,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TICKED = re.compile(r'`([^`\s]+)`')
 GENERATED_KEYS = re.compile(r'<!-- BEGIN rotorguard (keys|bench --list).*?<!-- END rotorguard (keys|bench --list)[^>]*-->', re.S)
+GENERATED_PAGES = ('results.md', 'performance.md')  # written by scripts/results.py from its records
 PLACEHOLDER = re.compile(r'[<>*]|\.\.\.')
 
 
@@ -77,7 +79,7 @@ def pages_of(args):
 def reference_words(docs_dir):
     total = 0
     for page in sorted(glob.glob(os.path.join(docs_dir, '*.md'))):
-        if os.path.basename(page) == 'results.md':
+        if os.path.basename(page) in GENERATED_PAGES:
             continue
         with open(page) as f:
             total += len(GENERATED_KEYS.sub('', f.read()).split())
@@ -101,8 +103,9 @@ def self_test():
         with open(os.path.join(docs, 'one.md'), 'w') as f:
             f.write('four words on this\n<!-- BEGIN rotorguard keys: x -->\nmany many many\n'
                     '<!-- END rotorguard keys -->\n')
-        with open(os.path.join(docs, 'results.md'), 'w') as f:
-            f.write('generated words are not counted\n')
+        for generated in GENERATED_PAGES:
+            with open(os.path.join(docs, generated), 'w') as f:
+                f.write('generated words are not counted\n')
         assert reference_words(docs) == 4, reference_words(docs)
     print('check-docs: self-test passed')
     return 0

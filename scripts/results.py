@@ -150,6 +150,73 @@ JOBS += [('calibration', 'calibration', ['fdd-calibrate', 'runs/*', '--healthy']
           'the thresholds calibrated on the calibration sets')]
 
 
+# Side by side with the peers (docs/performance.md): the drivers of benchmarks/peers/ run rotorguard's
+# solver and the peer's in one process, alternated. They exist in a build configured with the peers
+# (`make peers`: scripts/peers.sh, then ROTORGUARD_PEERS_DIR); the QP instance is not in the repository
+# (--qp-instance). Each driver runs PEER_REPEATS times, the two drivers alternated; every run is kept.
+PEER_REPEATS = 3
+PEER_DRIVERS = [('peer_qp', ['QP_INSTANCE', '--repetitions', '3']),
+                ('peer_lbfgs', ['--problems', '200', '--seed', '1', '--repetitions', '3'])]
+JOBS += [('performance', 'peers', [], 'rotorguard beside HPIPM (the NMPC\'s QP) and GCOPTER\'s L-BFGS (the '
+          'planner\'s optimiser), %d runs each' % PEER_REPEATS)]
+
+
+def cmake_cache(build):
+    """The build's CMake cache as a dict (empty when there is none)."""
+    out = {}
+    try:
+        with open(os.path.join(build, 'CMakeCache.txt')) as f:
+            for line in f:
+                m = re.match(r'([A-Za-z0-9_]+):[A-Z]+=(.*)', line.rstrip('\n'))
+                if m:
+                    out[m.group(1)] = m.group(2)
+    except OSError:
+        pass
+    return out
+
+
+def run_peers(build, folder, qp_instance):
+    """The peer drivers' runs into folder (peer_qp.K.json, peer_lbfgs.K.json) and its manifest.json; a
+    clear word, and nothing run, when the build has no drivers or no instance was given."""
+    cache = cmake_cache(build)
+    peers_dir = cache.get('ROTORGUARD_PEERS_DIR', '')
+    drivers = [os.path.join(build, 'bin', d) for d, _ in PEER_DRIVERS]
+    if not peers_dir or not all(os.access(d, os.X_OK) for d in drivers):
+        print('results: performance: skipped: %s has no peer drivers (make peers; docs/performance.md)' % build,
+              flush=True)
+        return
+    if not qp_instance:
+        print('results: performance: skipped: no --qp-instance FILE (the NMPC\'s reference QP)', flush=True)
+        return
+    with open(os.path.join(peers_dir, 'peers.json')) as f:
+        peers = json.load(f)
+    os.makedirs(folder, exist_ok=True)
+    commands = {}
+    for k in range(1, PEER_REPEATS + 1):
+        for name, args in PEER_DRIVERS:
+            path = os.path.join(folder, '%s.%d.json' % (name, k))
+            args = [os.path.abspath(qp_instance) if a == 'QP_INSTANCE' else a for a in args]
+            commands[name] = ' '.join(['build/bin/' + name] + [os.path.basename(a) if a.endswith('.json') else a
+                                                               for a in args])
+            if os.path.exists(path):
+                continue
+            print('results: performance: %s, run %d of %d' % (name, k, PEER_REPEATS), flush=True)
+            done = subprocess.run([os.path.join(build, 'bin', name)] + args, capture_output=True, text=True)
+            if done.returncode != 0:
+                sys.exit('results: performance: %s failed (exit %d): %s' % (name, done.returncode, done.stderr.strip()))
+            with open(path + '.partial', 'w') as f:
+                f.write(done.stdout)
+            os.replace(path + '.partial', path)
+    flags = ' '.join(x for x in (cache.get('CMAKE_CXX_FLAGS_RELEASE', ''),
+                                 '-march=x86-64-v3' if cache.get('ROTORGUARD_X86_64_V3') == 'ON'
+                                 and cache.get('ROTORGUARD_HAS_X86_64_V3') == '1' else '') if x)
+    with open(os.path.join(folder, 'manifest.json'), 'w') as f:
+        json.dump({'version': program_version(os.path.join(build, 'bin', 'rotorguard')), 'cpu': cpu_model(),
+                   'cores': os.cpu_count(), 'compiler': cache.get('CMAKE_CXX_COMPILER', ''),
+                   'rotorguard_flags': flags, 'peers': peers, 'commands': commands,
+                   'finished': datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}, f, indent=1)
+
+
 def run_calibration(binary, folder):
     """The calibration campaigns and faulty runs (their logs kept: fdd-calibrate replays them)."""
     for c in CALIBRATION_CAMPAIGNS:
@@ -320,6 +387,8 @@ def finished(kind, folder):
         return os.path.exists(os.path.join(folder, 'bench.json'))
     if kind == 'calibration':
         return os.path.exists(os.path.join(folder, 'calibration', 'calibration.json'))
+    if kind == 'peers':
+        return os.path.exists(os.path.join(folder, 'manifest.json'))
     return os.path.exists(os.path.join(folder, 'summary.json'))
 
 
@@ -807,6 +876,130 @@ def render(out_dir, present):
     write_readme_block(readme)
 
 
+def span(values, fmt='%.0f'):
+    """'a' when every run gave the same figure, else 'min-max'."""
+    lo, hi = fmt % min(values), fmt % max(values)
+    return lo if lo == hi else '%s-%s' % (lo, hi)
+
+
+def performance_page(out_dir):
+    """docs/performance.md's text from the performance job's records (None when it has none)."""
+    folder = os.path.join(out_dir, 'performance')
+    if not finished('peers', folder):
+        return None
+    with open(os.path.join(folder, 'manifest.json')) as f:
+        m = json.load(f)
+    runs = {}
+    for name, _ in PEER_DRIVERS:
+        runs[name] = []
+        for k in range(1, PEER_REPEATS + 1):
+            with open(os.path.join(folder, '%s.%d.json' % (name, k))) as f:
+                runs[name].append(json.load(f))
+    peers = m['peers']
+    out = ['# Performance beside the peers', '',
+           '<!-- Generated by `make results` (scripts/results.py, job `performance`); do not edit by hand. -->', '',
+           'rotorguard\'s solvers measured beside the fastest open peers on the same problems, in one process, on one',
+           'core, the sides taking turns problem by problem so that neither always runs first. Machine: %s, %d cores'
+           % (m['cpu'], m['cores']),
+           '(a VM: its figures move by 10-20 %% from run to run, so each driver ran %d times, alternated with the other,'
+           % PEER_REPEATS,
+           'and every run is given: ranges are over the runs, ratios are taken within each run). Finished %s with'
+           % m['finished'],
+           'rotorguard %s, built with %s (`%s`, Release).' % (m['version'], os.path.basename(m['compiler']) or 'the compiler',
+                                                               m['rotorguard_flags']), '',
+           '## How to run it', '',
+           'The peers are never part of this repository. `make peers` runs `scripts/peers.sh out/peers`, which clones',
+           'each at the commit below into `out/peers/src`, builds BLASFEO and HPIPM there (static, Release), and',
+           'configures this build with `ROTORGUARD_PEERS_DIR=out/peers`, which adds the two drivers of',
+           '`benchmarks/peers/` (rotorguard\'s code, calling the peers\' public APIs). Then:', '',
+           '```',
+           'make peers',
+           'python3 scripts/results.py --only performance --qp-instance qp_hover_n20_v2.json',
+           '```', '',
+           '| peer | commit | built with |', '|---|---|---|',
+           '| BLASFEO | `%s` | `TARGET=%s`, `LA=HIGH_PERFORMANCE` |' % (peers['giaf/blasfeo'][:12], peers['blasfeo_target']),
+           '| HPIPM | `%s` | `TARGET=%s` |' % (peers['giaf/hpipm'][:12], peers['hpipm_target']),
+           '| GCOPTER (`gcopter/include/gcopter/lbfgs.hpp`, header only) | `%s` | with rotorguard\'s flags |'
+           % peers['ZJU-FAST-Lab/GCOPTER'][:12], '']
+    qp = runs['peer_qp']
+    names = [sd['name'] for sd in qp[0]['sides']]
+    side = lambda r, n: next(sd for sd in r['sides'] if sd['name'] == n)
+    cases = side(qp[0], 'rotorguard')
+    out += ['## The NMPC\'s QP beside HPIPM', '',
+            '`%s`, the reference OCP QP of the NMPC\'s size (N = 20, 17 states, 4 inputs, input bounds and three'
+            % m['commands']['peer_qp'],
+            'rate bounds at every stage; %d cases with about 20 active bounds, "stress", %d with about one, "track"),'
+            % (cases['cases_stress'], cases['cases_track']),
+            'each solved cold, a case\'s time the fastest of 3 solves. HPIPM is given the problem as its users give it,',
+            'x0 eliminated, and its settings are frozen in the driver (`benchmarks/peers/peer_qp.cc`). An answer is',
+            'wrong when its u0 is more than 1e-4 from the instance\'s certified optimum.', '',
+            '| solver | settings | stress median / p99 [us] | track median / p99 [us] | wrong u0 | largest u0 error | '
+            'iterations |', '|---|---|---|---|---|---|---|']
+    for n in names:
+        rows = [side(r, n) for r in qp]
+        out.append('| %s | %s | %s / %s | %s / %s | %s of %d | %s | %s |' % (
+            '**rotorguard**' if n == 'rotorguard' else n.replace('_', ' '), rows[0]['settings'],
+            span([x['stress_us_median'] for x in rows]), span([x['stress_us_p99'] for x in rows]),
+            span([x['track_us_median'] for x in rows]), span([x['track_us_p99'] for x in rows]),
+            span([x['cases_u0_error_above_1e-4'] for x in rows]), rows[0]['cases_stress'] + rows[0]['cases_track'],
+            span([x['max_u0_error'] for x in rows], '%.1e'), span([x['iterations_mean'] for x in rows], '%.1f')))
+    fast = [n for n in names if n.startswith('hpipm_fast')]
+    out += ['', 'rotorguard\'s time over HPIPM\'s, per run (below 1: rotorguard faster); "best fast" is, per figure, the',
+            'faster of HPIPM\'s two fast modes in that run:', '',
+            '| figure | over the best fast mode | over the accurate mode |', '|---|---|---|']
+    for key, label in (('stress_us_median', 'stress median'), ('stress_us_p99', 'stress p99'),
+                       ('track_us_median', 'track median'), ('track_us_p99', 'track p99')):
+        best = [side(r, 'rotorguard')[key] / min(side(r, n)[key] for n in fast) for r in qp]
+        acc = [side(r, 'rotorguard')[key] / side(r, 'hpipm_accurate')[key] for r in qp]
+        out.append('| %s | %s | %s |' % (label, span(best, '%.2f'), span(acc, '%.2f')))
+    lb = runs['peer_lbfgs']
+    out += ['', '## The planner\'s L-BFGS beside GCOPTER\'s', '',
+            '`%s`: the planner\'s objective, eq. (22) in free space (`TrajectoryOptimizer::Objective`),'
+            % m['commands']['peer_lbfgs'],
+            'minimised from the same start by the planner\'s own L-BFGS (as the planner runs it) and by GCOPTER\'s',
+            '`lbfgs::lbfgs_optimize` with the parameters GCOPTER\'s planner sets (256 pairs, past 3, g_epsilon 0,',
+            'min_step 1e-32, no iteration limit; its relative cost tolerance `delta` set to rotorguard\'s 1e-4). Each',
+            'problem, rest to rest, is drawn by the driver (`benchmarks/peers/peer_lbfgs.cc`: a goal 2M-4M m away for M',
+            'pieces, the initial waypoints on the line moved by 0.3 m, limits 2 m/s, 3 m/s^2, 6 m/s^3). Time: the',
+            'optimisation alone, the fastest of 3 per problem, the median over the problems. The cost difference is',
+            'per problem, rotorguard minus GCOPTER (below 0: rotorguard ends lower), with its standard error.', '',
+            '| pieces | problems | rotorguard median [us] | GCOPTER median [us] | ratio | mean cost, rotorguard / '
+            'GCOPTER | difference | rotorguard lower in | evaluations, rotorguard / GCOPTER |',
+            '|---|---|---|---|---|---|---|---|---|']
+    for i, size in enumerate(lb[0]['sizes']):
+        rows = [r['sizes'][i] for r in lb]
+        out.append('| %d | %d | %s | %s | %s | %s / %s | %s | %s | %s / %s |' % (
+            size['pieces'], size['problems'], span([x['rotorguard_us_median'] for x in rows]),
+            span([x['gcopter_us_median'] for x in rows]),
+            span([x['rotorguard_us_median'] / x['gcopter_us_median'] for x in rows], '%.2f'),
+            span([x['rotorguard_cost_mean'] for x in rows], '%.2f'), span([x['gcopter_cost_mean'] for x in rows], '%.2f'),
+            '%+.2f ± %.2f' % (size['cost_difference_mean'], size['cost_difference_stderr']),
+            span([x['problems_rotorguard_lower'] for x in rows]),
+            span([x['rotorguard_evaluations_mean'] for x in rows], '%.0f'),
+            span([x['gcopter_evaluations_mean'] for x in rows], '%.0f')))
+    same = all(r['sizes'][i]['cost_difference_mean'] == lb[0]['sizes'][i]['cost_difference_mean']
+               for r in lb for i in range(len(lb[0]['sizes'])))
+    out += ['', 'The costs are the same in every run (both optimisers are deterministic); only the times move.' if same
+            else 'The costs differ between the runs: the difference given is the first run\'s.', '']
+    return '\n'.join(out)
+
+
+def check_performance(records_path):
+    """Exit 1 when docs/performance.md differs from the page the packed records render."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        unpack(records_path, tmp)
+        page = performance_page(tmp)
+    if page is None:
+        sys.exit('results: %s holds no performance job' % records_path)
+    with open(os.path.join(ROOT, 'docs', 'performance.md')) as f:
+        if f.read() != page:
+            print('results: docs/performance.md is not the page %s renders (run scripts/results.py --render-only)'
+                  % records_path)
+            sys.exit(1)
+    print('results: docs/performance.md is the page the packed records render')
+
+
 def write_readme_block(lines):
     path = os.path.join(ROOT, 'README.md')
     with open(path) as f:
@@ -927,6 +1120,10 @@ def main():
     ap.add_argument('--records', default=RECORDS, help='the packed records a run starts from and --pack writes')
     ap.add_argument('--pack', action='store_true', help='after the jobs, pack OUT into RECORDS')
     ap.add_argument('--pack-only', action='store_true', help='run and render nothing; pack OUT into RECORDS')
+    ap.add_argument('--qp-instance', default=None, help='the NMPC\'s reference QP instance the performance job '
+                    'solves (qp_hover_n20_v2.json; not in the repository)')
+    ap.add_argument('--check-performance', action='store_true', help='run nothing; exit 1 when docs/performance.md '
+                    'is not the page the packed records render')
     a = ap.parse_args()
     SOURCE = os.path.abspath(a.source)
     if not os.path.isdir(os.path.join(SOURCE, 'configs')):
@@ -935,6 +1132,9 @@ def main():
     binary = os.path.join(a.build, 'bin', 'rotorguard')
     if a.pack_only:
         pack(a.out, a.records)
+        return
+    if a.check_performance:
+        check_performance(a.records)
         return
     if not a.render_only and not os.access(binary, os.X_OK):
         sys.exit('results: %s: no rotorguard binary (build it first: make build)' % binary)
@@ -948,6 +1148,8 @@ def main():
             print('results: calibration: %s, %d faulty runs, fdd-calibrate' % (', '.join(CALIBRATION_CAMPAIGNS),
                                                                             len(CALIBRATION_RUNS)), flush=True)
             run_calibration(binary, folder)
+        elif kind == 'peers':
+            run_peers(a.build, folder, a.qp_instance)
         elif kind == 'runs':
             print('results: %s: %d flights of rotorguard run' % (name, len(RUN_JOBS[name])), flush=True)
             run_flights(binary, name, folder)
@@ -955,6 +1157,10 @@ def main():
             run_job(binary, name, kind, args, folder)
     present = {name for name, kind, _, _ in JOBS if finished(kind, os.path.join(a.out, name))}
     render(a.out, present)
+    page = performance_page(a.out)
+    if page is not None:
+        with open(os.path.join(ROOT, 'docs', 'performance.md'), 'w') as f:
+            f.write(page)
     print('results: docs/results.md and README.md written from %s' % ', '.join(sorted(present)) if present
           else 'results: nothing finished yet')
     if a.pack:

@@ -40,10 +40,6 @@ Eigen::MatrixXd Matrix(const json& j, const std::string& what, int rows, int col
   return m;
 }
 
-struct Case {
-  Eigen::VectorXd x0, u0;
-};
-
 struct GroupResult {
   std::vector<double> times_us;
   std::vector<double> prepare_us, feedback_us;  ///< per case, each phase's fastest repetition
@@ -57,8 +53,7 @@ struct GroupResult {
 };
 }  // namespace
 
-json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
-  if (options.repetitions < 1) ThrowInvalidArgument("RunQpBenchmark", "repetitions", options.repetitions, ">= 1");
+QpInstance LoadQpInstance(const std::string& path) {
   std::string text;
   try {
     text = io::ReadFile(path);
@@ -67,7 +62,7 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
   }
   control::OcpQpDims dims;
   std::unique_ptr<control::OcpQp> qp;
-  std::vector<Case> stress, track;
+  std::vector<QpInstanceCase> stress, track;
   try {
     const json doc = json::parse(text);
     dims.horizon = doc.at("N").get<int>();
@@ -110,6 +105,16 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
   } catch (const std::exception& e) {
     throw io::InputFileError(path, fmt::format("not a valid QP instance: {}", e.what()));
   }
+  return QpInstance{std::move(*qp), std::move(stress), std::move(track)};
+}
+
+json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
+  if (options.repetitions < 1) ThrowInvalidArgument("RunQpBenchmark", "repetitions", options.repetitions, ">= 1");
+  QpInstance instance = LoadQpInstance(path);
+  control::OcpQp* qp = &instance.qp;
+  const control::OcpQpDims& dims = qp->dims;
+  const std::vector<QpInstanceCase>& stress = instance.stress;
+  const std::vector<QpInstanceCase>& track = instance.track;
 
   // Every case, and every repetition of one, is solved cold, as the reference solver's figures
   // are: a start from the previous solve's active set would make the repetitions free.
@@ -118,10 +123,10 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
   const std::unique_ptr<control::OcpQpSolver> solver = control::MakeOcpQpSolver(options.solver, dims, cold);
   // Each case where u_0 differs from the reference by more than this is cross-examined.
   constexpr double kExamineError = 1e-4;
-  const auto run = [&](const std::vector<Case>& cases) {
+  const auto run = [&](const std::vector<QpInstanceCase>& cases) {
     GroupResult g;
     std::vector<double> reps(static_cast<std::size_t>(options.repetitions));
-    for (const Case& c : cases) {
+    for (const QpInstanceCase& c : cases) {
       qp->x0 = c.x0;
       double prepare_min = kInf, feedback_min = kInf;
       for (int r = 0; r < options.repetitions; ++r) {

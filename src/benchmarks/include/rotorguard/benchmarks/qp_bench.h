@@ -4,6 +4,7 @@
 /// interior-point solver). Every case is solved cold; times and the error in u_0 are reported.
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "rotorguard/control/ocp_qp.h"
 
@@ -13,6 +14,23 @@ struct QpBenchOptions {
   int repetitions = 3;  ///< each case is solved this many times; its median time counts, >= 1
   control::OcpQpMethod solver = control::OcpQpMethod::kRiccati;
 };
+
+/// One case of an instance: the initial state and the instance's optimal first input.
+struct QpInstanceCase {
+  Eigen::VectorXd x0, u0;
+};
+
+/// A reference instance as this library's OCP QP (the instance's cost, sum x'Qx + u'Ru, is written
+/// with the factor 1/2 of OcpQp: Q and R doubled), and its two groups of cases.
+struct QpInstance {
+  control::OcpQp qp;
+  std::vector<QpInstanceCase> stress;  ///< about 20 active bounds each
+  std::vector<QpInstanceCase> track;   ///< about one
+};
+
+/// Reads the instance at `path`. Throws io::InputFileError when the file cannot be read or is not a
+/// valid instance (it names the missing or malformed field).
+QpInstance LoadQpInstance(const std::string& path);
 
 /// Runs the benchmark on the instance at `path`. Throws io::InputFileError when the file cannot be
 /// read or is not a valid instance (it names the missing or malformed field).

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Builds the peers rotorguard is measured against side by side (docs/performance.md), outside the
+# repository's sources: their code is never part of rotorguard, only driven by the programs of
+# benchmarks/peers/ in one process beside rotorguard's own solver.
+#
+#   scripts/peers.sh [DIR]        (default: out/peers; `make peers` runs it)
+#
+# Clones each peer at the commit the published figures used into DIR/src, builds BLASFEO and HPIPM
+# (static, the flags below) into DIR/install, and leaves GCOPTER's header-only L-BFGS where it is.
+# PEERS_GIT_BASE replaces https://github.com (a mirror, or a folder of clones named owner+name).
+# Then: cmake -S . -B build -DROTORGUARD_PEERS_DIR=DIR && cmake --build build --target peer_qp peer_lbfgs
+set -euo pipefail
+
+dir=$(realpath -m "${1:-out/peers}")
+base=${PEERS_GIT_BASE:-https://github.com}
+jobs=$(nproc 2>/dev/null || echo 2)
+
+# owner/name, the commit the figures of docs/performance.md were measured with, and the one folder
+# checked out where the rest is not needed (GCOPTER: its headers, not its demos' media).
+peers=(
+  "giaf/blasfeo 0ab5db3259c009ea62318a5e35622fe6de7ae554"
+  "giaf/hpipm 87ef7a6ab773427a8c416030a2b9d075a744c223"
+  "ZJU-FAST-Lab/GCOPTER e0444f6d47b84f972ced91746b05feb36ce1fd4f gcopter/include"
+)
+
+# BLASFEO's kernels for AVX2 and FMA (x86-64-v3, the flags rotorguard itself is built with) where the
+# CPU has them; HPIPM's AVX target then. Elsewhere both build their generic C.
+if grep -q ' avx2 ' /proc/cpuinfo 2>/dev/null && grep -q ' fma ' /proc/cpuinfo 2>/dev/null; then
+  blasfeo_target=X64_INTEL_HASWELL
+  hpipm_target=AVX
+else
+  blasfeo_target=GENERIC
+  hpipm_target=GENERIC
+fi
+
+mkdir -p "$dir/src" "$dir/install"
+for p in "${peers[@]}"; do
+  read -r repo commit only <<< "$p"
+  name=${repo#*/}
+  src="$dir/src/$name"
+  if [ -d "$base" ]; then url="$base/${repo/\//+}"; [ -d "$url/repo" ] && url="$url/repo"; else url="$base/$repo"; fi
+  if [ ! -d "$src/.git" ]; then
+    echo "peers: cloning $repo into $src"
+    git clone -q --no-checkout "$url" "$src"
+    [ -z "$only" ] || git -C "$src" sparse-checkout set --no-cone "/$only/"
+  fi
+  git -C "$src" -c advice.detachedHead=false checkout -q "$commit" \
+    || { echo "peers: $repo has no commit $commit (fetch it: git -C $src fetch)" >&2; exit 1; }
+done
+
+build() {  # name, then cmake options
+  local name=$1
+  shift
+  echo "peers: building $name ($*)"
+  cmake -S "$dir/src/$name" -B "$dir/build/$name" -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_INSTALL_PREFIX="$dir/install" -DCMAKE_POSITION_INDEPENDENT_CODE=ON "$@" \
+    > "$dir/build/$name.configure.log" 2>&1 || { cat "$dir/build/$name.configure.log"; exit 1; }
+  cmake --build "$dir/build/$name" -j "$jobs" > "$dir/build/$name.build.log" 2>&1 \
+    || { tail -40 "$dir/build/$name.build.log"; exit 1; }
+  cmake --install "$dir/build/$name" > /dev/null
+}
+mkdir -p "$dir/build"
+build blasfeo -DTARGET=$blasfeo_target -DLA=HIGH_PERFORMANCE -DBLASFEO_EXAMPLES=OFF -DBUILD_SHARED_LIBS=OFF
+build hpipm -DTARGET=$hpipm_target -DBLASFEO_PATH="$dir/install" -DHPIPM_TESTING=OFF -DBUILD_SHARED_LIBS=OFF
+
+# What the drivers report beside their figures.
+{
+  echo "{"
+  echo "  \"blasfeo_target\": \"$blasfeo_target\", \"hpipm_target\": \"$hpipm_target\","
+  first=1
+  for p in "${peers[@]}"; do
+    [ $first = 1 ] || echo ","
+    first=0
+    read -r repo commit only <<< "$p"
+    printf '  "%s": "%s"' "$repo" "$commit"
+  done
+  echo
+  echo "}"
+} > "$dir/peers.json"
+echo "peers: built into $dir (BLASFEO $blasfeo_target, HPIPM $hpipm_target); now"
+echo "  cmake -S . -B build -DROTORGUARD_PEERS_DIR=$dir && cmake --build build --target peer_qp peer_lbfgs"
