@@ -905,8 +905,9 @@ def performance_page(out_dir):
            % PEER_REPEATS,
            'and every run is given: ranges are over the runs, ratios are taken within each run). Finished %s with'
            % m['finished'],
-           'rotorguard %s, built with %s (`%s`, Release).' % (m['version'], os.path.basename(m['compiler']) or 'the compiler',
-                                                               m['rotorguard_flags']), '',
+           'rotorguard %s, built by `%s` %s (`%s`, Release).' % (
+               m['version'], os.path.basename(m['compiler']) or 'c++', runs['peer_qp'][0]['host']['compiler'],
+               m['rotorguard_flags']), '',
            '## How to run it', '',
            'The peers are never part of this repository. `make peers` runs `scripts/peers.sh out/peers`, which clones',
            'each at the commit below into `out/peers/src`, builds BLASFEO and HPIPM there (static, Release), and',
@@ -954,33 +955,35 @@ def performance_page(out_dir):
         out.append('| %s | %s | %s |' % (label, span(best, '%.2f'), span(acc, '%.2f')))
     lb = runs['peer_lbfgs']
     out += ['', '## The planner\'s L-BFGS beside GCOPTER\'s', '',
-            '`%s`: the planner\'s objective, eq. (22) in free space (`TrajectoryOptimizer::Objective`),'
+            '`%s`: the planner\'s objective (`TrajectoryOptimizer::Objective`) on the free-space problems MINCO'
             % m['commands']['peer_lbfgs'],
-            'minimised from the same start by the planner\'s own L-BFGS (as the planner runs it) and by GCOPTER\'s',
+            'optimisers are compared on (docs/planning.md, "The optimiser in free space": 200 problems of 5 and of 10',
+            'pieces, seed 1), minimised from the same start by the planner\'s own L-BFGS and by GCOPTER\'s',
             '`lbfgs::lbfgs_optimize` with the parameters GCOPTER\'s planner sets (256 pairs, past 3, g_epsilon 0,',
-            'min_step 1e-32, no iteration limit; its relative cost tolerance `delta` set to rotorguard\'s 1e-4). Each',
-            'problem, rest to rest, is drawn by the driver (`benchmarks/peers/peer_lbfgs.cc`: a goal 2M-4M m away for M',
-            'pieces, the initial waypoints on the line moved by 0.3 m, limits 2 m/s, 3 m/s^2, 6 m/s^3). Time: the',
-            'optimisation alone, the fastest of 3 per problem, the median over the problems. The cost difference is',
-            'per problem, rotorguard minus GCOPTER (below 0: rotorguard ends lower), with its standard error.', '',
-            '| pieces | problems | rotorguard median [us] | GCOPTER median [us] | ratio | mean cost, rotorguard / '
-            'GCOPTER | difference | rotorguard lower in | evaluations, rotorguard / GCOPTER |',
+            'min_step 1e-32; its relative cost tolerance `delta` set to rotorguard\'s 1e-4). Two budgets: the',
+            'planner\'s 200 iterations for both, and none (as GCOPTER\'s planner runs), where each stops by its own',
+            'decrease test. Time: the optimisation alone, the fastest of 3 per problem, the median over the',
+            'problems. The difference is per problem, rotorguard\'s final cost minus GCOPTER\'s (below 0:',
+            'rotorguard ends lower), with its standard error.', '',
+            '| pieces | budget | rotorguard [us] | GCOPTER [us] | ratio | mean cost, rotorguard / GCOPTER | '
+            'difference | rotorguard lower in | evaluations, rotorguard / GCOPTER |',
             '|---|---|---|---|---|---|---|---|---|']
     for i, size in enumerate(lb[0]['sizes']):
         rows = [r['sizes'][i] for r in lb]
-        out.append('| %d | %d | %s | %s | %s | %s / %s | %s | %s | %s / %s |' % (
-            size['pieces'], size['problems'], span([x['rotorguard_us_median'] for x in rows]),
-            span([x['gcopter_us_median'] for x in rows]),
-            span([x['rotorguard_us_median'] / x['gcopter_us_median'] for x in rows], '%.2f'),
-            span([x['rotorguard_cost_mean'] for x in rows], '%.2f'), span([x['gcopter_cost_mean'] for x in rows], '%.2f'),
-            '%+.2f ± %.2f' % (size['cost_difference_mean'], size['cost_difference_stderr']),
-            span([x['problems_rotorguard_lower'] for x in rows]),
-            span([x['rotorguard_evaluations_mean'] for x in rows], '%.0f'),
-            span([x['gcopter_evaluations_mean'] for x in rows], '%.0f')))
-    same = all(r['sizes'][i]['cost_difference_mean'] == lb[0]['sizes'][i]['cost_difference_mean']
-               for r in lb for i in range(len(lb[0]['sizes'])))
+        for budget, label in (('200', '200 iterations'), ('unlimited', 'none')):
+            own, peer = 'rotorguard_' + budget, 'gcopter_' + budget
+            out.append('| %d | %s | %s | %s | %s | %s / %s | %+.2f ± %.2f | %d of %d | %.0f / %.0f |' % (
+                size['pieces'], label, span([x[own + '_us_median'] for x in rows]),
+                span([x[peer + '_us_median'] for x in rows]),
+                span([x[own + '_us_median'] / x[peer + '_us_median'] for x in rows], '%.2f'),
+                '%.2f' % size[own + '_cost_mean'], '%.2f' % size[peer + '_cost_mean'],
+                size['cost_difference_%s_mean' % budget], size['cost_difference_%s_stderr' % budget],
+                size['problems_rotorguard_lower_' + budget], size['problems'],
+                size[own + '_evaluations_mean'], size[peer + '_evaluations_mean']))
+    same = all(r['sizes'][i][k] == lb[0]['sizes'][i][k] for r in lb for i in range(len(lb[0]['sizes']))
+               for k in lb[0]['sizes'][i] if k.endswith('_cost_mean'))
     out += ['', 'The costs are the same in every run (both optimisers are deterministic); only the times move.' if same
-            else 'The costs differ between the runs: the difference given is the first run\'s.', '']
+            else 'The costs differ between the runs: those given are the first run\'s.', '']
     return '\n'.join(out)
 
 

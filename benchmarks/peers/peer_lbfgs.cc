@@ -4,10 +4,9 @@
 //
 //   peer_lbfgs [--problems 200] [--seed 1] [--repetitions 3]
 //
-// Problem i of M pieces (M = 5 and 10): rest to rest from (0, 0, 1.5) to a point 2M-4M m away on a
-// random heading at a height in [1, 3] m; the initial waypoints on the straight line, each moved by
-// N(0, 0.3 m) per axis; each initial duration 1.5 times its piece's length at v_max; limits v 2 m/s,
-// a 3 m/s^2, j 6 m/s^3. Both start from the same variables x = [q, tau].
+// The problems are the free-space definition MINCO optimisers are compared on (free_space_bench.h,
+// `rotorguard bench planner --free-space`: DrawFreeSpaceProblem, its limits and cost), 5 and 10
+// pieces; both L-BFGS start from the same variables x = [q, tau].
 //   rotorguard: the planner's own L-BFGS as the planner runs it (TrajectoryOptimizerOptions::lbfgs);
 //   gcopter:    lbfgs::lbfgs_optimize with the parameters GCOPTER's planner sets (gcopter.hpp: 256
 //               pairs, past 3, delta 1e-4 (its relative cost tolerance as rotorguard's), g_epsilon 0,
@@ -29,7 +28,7 @@
 #include <vector>
 
 #include "rotorguard/buildinfo/build_info.h"
-#include "rotorguard/core/rng.h"
+#include "rotorguard/benchmarks/free_space_bench.h"
 #include "rotorguard/core/statistics.h"
 #include "rotorguard/planning/trajectory_optimizer.h"
 
@@ -44,24 +43,13 @@ struct Problem {
   Eigen::VectorXd x0;
 };
 
-Problem MakeProblem(int pieces, std::uint64_t seed, const DynamicLimits& limits) {
-  Rng rng(seed);
-  const Vector3 a(0.0, 0.0, 1.5);
-  const double heading = rng.Uniform(-M_PI, M_PI), distance = rng.Uniform(2.0 * pieces, 4.0 * pieces);
-  const Vector3 b(distance * std::cos(heading), distance * std::sin(heading), rng.Uniform(1.0, 3.0));
-  Eigen::Matrix3Xd q(3, pieces - 1);
-  for (int i = 1; i < pieces; ++i) {
-    q.col(i - 1) = a + (b - a) * i / pieces + Vector3(rng.Normal(0, 0.3), rng.Normal(0, 0.3), rng.Normal(0, 0.3));
-  }
-  Eigen::VectorXd t(pieces);
-  for (int i = 0; i < pieces; ++i) {
-    const Vector3 from = i == 0 ? a : Vector3(q.col(i - 1)), to = i == pieces - 1 ? b : Vector3(q.col(i));
-    t[i] = 1.5 * (to - from).norm() / limits.v_max;
-  }
-  Problem p{PvaState::Zero(), PvaState::Zero(), TrajectoryOptimizer::Variables(q, t)};
-  p.head.col(0) = a;
-  p.tail.col(0) = b;
-  return p;
+Problem MakeProblem(int pieces, std::uint64_t seed, int index) {
+  const benchmarks::FreeSpaceProblem p = benchmarks::DrawFreeSpaceProblem(pieces, seed, index);
+  Problem out{PvaState::Zero(), PvaState::Zero(),
+              TrajectoryOptimizer::Variables(p.points.middleCols(1, pieces - 1), p.durations)};
+  out.head.col(0) = p.points.col(0);
+  out.tail.col(0) = p.points.col(pieces);
+  return out;
 }
 
 struct Context {
@@ -110,86 +98,105 @@ int main(int argc, char** argv) {
       return Usage(("unknown argument '" + a + "'").c_str());
     }
   }
-  const TrajectoryOptimizer optimizer{TrajectoryOptimizerOptions{}};
-  const DynamicLimits limits{.v_max = 2.0, .a_max = 3.0, .j_max = 6.0};
-  lbfgs::lbfgs_parameter_t gcopter;  // as gcopter.hpp sets them
+  const TrajectoryOptimizer optimizer{benchmarks::FreeSpaceOptimizerOptions(LbfgsMethod::kLewisOverton)};
+  const DynamicLimits limits = benchmarks::FreeSpaceLimits();
+  // GCOPTER's parameters as gcopter.hpp sets them; its relative cost tolerance rotorguard's.
+  lbfgs::lbfgs_parameter_t gcopter;
   gcopter.mem_size = 256;
   gcopter.past = 3;
   gcopter.min_step = 1.0e-32;
   gcopter.g_epsilon = 0.0;
   gcopter.delta = optimizer.options().lbfgs.relative_cost_tolerance;
+  // Two budgets: the planner's 200 iterations for both, and none (GCOPTER's planner sets none;
+  // rotorguard's then gets kUnlimited), where each runs until its own decrease test stops it.
+  constexpr int kUnlimited = 100000;
+  struct Side {
+    const char* name;
+    bool own;
+    int max_iterations;  // 0: none (GCOPTER's convention)
+  };
+  const Side sides[] = {{"rotorguard_200", true, optimizer.options().lbfgs.max_iterations},
+                        {"gcopter_200", false, optimizer.options().lbfgs.max_iterations},
+                        {"rotorguard_unlimited", true, kUnlimited},
+                        {"gcopter_unlimited", false, 0}};
+  constexpr int kSides = 4;
+  const auto mean = [](const std::vector<double>& v) {
+    double sum = 0;
+    for (double e : v) sum += e;
+    return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+  };
 
   nlohmann::json sizes = nlohmann::json::array();
   for (const int pieces : {5, 10}) {
-    std::vector<double> time_own, time_gc, cost_own, cost_gc, diff, iter_own, iter_gc, eval_own, eval_gc;
-    int gc_errors = 0, own_failures = 0;
+    std::vector<double> time[kSides], cost[kSides], iterations[kSides], evaluations[kSides];
+    int failures[kSides] = {};
     for (long i = 0; i < problems; ++i) {
-      const Problem p = MakeProblem(pieces, TrialSeed(seed, "peer_lbfgs", static_cast<std::uint64_t>(pieces * 100000 + i)),
-                                    limits);
-      double best_own = std::numeric_limits<double>::infinity(), best_gc = best_own, f_own = 0, f_gc = 0;
+      const Problem p = MakeProblem(pieces, seed, static_cast<int>(i));
+      double best[kSides], final_cost[kSides];
+      std::fill(best, best + kSides, std::numeric_limits<double>::infinity());
       for (long r = 0; r < repetitions; ++r) {
-        for (int turn = 0; turn < 2; ++turn) {
-          const bool own = (turn + i + r) % 2 == 0;  // each side first in half of the solves
+        for (int turn = 0; turn < kSides; ++turn) {
+          const int k = static_cast<int>((turn + i + r) % kSides);  // each side first in a quarter of the solves
+          const Side& side = sides[k];
           Eigen::VectorXd x = p.x0;
           Context c{&optimizer, &p, &limits};
+          bool failed = false;
+          int iters = 0;
           const auto t0 = Clock::now();
-          if (own) {
+          if (side.own) {
+            LbfgsOptions o = optimizer.options().lbfgs;
+            o.max_iterations = side.max_iterations;
             const GradientObjective f = [&](const Eigen::VectorXd& v, Eigen::VectorXd* g) {
               ++c.evaluations;
               return optimizer.Objective(p.head, p.tail, limits, {}, v, g);
             };
-            const LbfgsSummary s = MinimizeLbfgs(f, optimizer.options().lbfgs, &x);
-            const double ms = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
-            best_own = std::min(best_own, ms);
-            f_own = optimizer.Objective(p.head, p.tail, limits, {}, x, nullptr);
-            if (r == 0) {
-              own_failures += s.failed;
-              iter_own.push_back(s.iterations);
-              eval_own.push_back(c.evaluations);
-            }
+            const LbfgsSummary summary = MinimizeLbfgs(f, o, &x);
+            failed = summary.failed;
+            iters = summary.iterations;
           } else {
+            lbfgs::lbfgs_parameter_t o = gcopter;
+            o.max_iterations = side.max_iterations;
             double f = 0.0;
-            const int ret = lbfgs::lbfgs_optimize(x, f, &GcopterCost, nullptr, nullptr, &c, gcopter);
-            const double ms = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
-            best_gc = std::min(best_gc, ms);
-            f_gc = optimizer.Objective(p.head, p.tail, limits, {}, x, nullptr);
-            if (r == 0) {
-              gc_errors += ret < 0;
-              eval_gc.push_back(c.evaluations);
-            }
+            failed = lbfgs::lbfgs_optimize(x, f, &GcopterCost, nullptr, nullptr, &c, o) < 0;
+            iters = -1;  // lbfgs.hpp does not return its count
+          }
+          best[k] = std::min(best[k], std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+          final_cost[k] = optimizer.Objective(p.head, p.tail, limits, {}, x, nullptr);
+          if (r == 0) {
+            failures[k] += failed;
+            if (iters >= 0) iterations[k].push_back(iters);
+            evaluations[k].push_back(c.evaluations);
           }
         }
       }
-      time_own.push_back(best_own);
-      time_gc.push_back(best_gc);
-      cost_own.push_back(f_own);
-      cost_gc.push_back(f_gc);
-      diff.push_back(f_own - f_gc);
+      for (int k = 0; k < kSides; ++k) {
+        time[k].push_back(best[k]);
+        cost[k].push_back(final_cost[k]);
+      }
     }
-    const auto mean = [](const std::vector<double>& v) {
-      double s = 0;
-      for (double e : v) s += e;
-      return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-    };
-    double var = 0;
-    const double d_mean = mean(diff);
-    for (double d : diff) var += (d - d_mean) * (d - d_mean);
-    const double n = static_cast<double>(diff.size());
-    const int lower = static_cast<int>(std::count_if(diff.begin(), diff.end(), [](double d) { return d < 0; }));
-    sizes.push_back({{"pieces", pieces},
-                     {"problems", problems},
-                     {"rotorguard_us_median", Percentile(time_own, 0.5)},
-                     {"gcopter_us_median", Percentile(time_gc, 0.5)},
-                     {"rotorguard_cost_mean", mean(cost_own)},
-                     {"gcopter_cost_mean", mean(cost_gc)},
-                     {"cost_difference_mean", d_mean},
-                     {"cost_difference_stderr", n > 1 ? std::sqrt(var / (n - 1) / n) : 0.0},
-                     {"problems_rotorguard_lower", lower},
-                     {"rotorguard_iterations_mean", mean(iter_own)},
-                     {"rotorguard_evaluations_mean", mean(eval_own)},
-                     {"gcopter_evaluations_mean", mean(eval_gc)},
-                     {"rotorguard_failures", own_failures},
-                     {"gcopter_errors", gc_errors}});
+    nlohmann::json size = {{"pieces", pieces}, {"problems", problems}};
+    for (int k = 0; k < kSides; ++k) {
+      const std::string n = sides[k].name;
+      size[n + "_us_median"] = Percentile(time[k], 0.5);
+      size[n + "_cost_mean"] = mean(cost[k]);
+      size[n + "_evaluations_mean"] = mean(evaluations[k]);
+      if (!iterations[k].empty()) size[n + "_iterations_mean"] = mean(iterations[k]);
+      size[n + "_failures"] = failures[k];
+    }
+    // Per problem, rotorguard's final cost minus GCOPTER's at the same budget.
+    for (const std::string budget : {"200", "unlimited"}) {
+      const int own = budget == "200" ? 0 : 2, peer = own + 1;
+      std::vector<double> diff;
+      for (std::size_t j = 0; j < cost[own].size(); ++j) diff.push_back(cost[own][j] - cost[peer][j]);
+      const double d = mean(diff), n = static_cast<double>(diff.size());
+      double var = 0.0;
+      for (double e : diff) var += (e - d) * (e - d);
+      size["cost_difference_" + budget + "_mean"] = d;
+      size["cost_difference_" + budget + "_stderr"] = n > 1 ? std::sqrt(var / (n - 1) / n) : 0.0;
+      size["problems_rotorguard_lower_" + budget] =
+          std::count_if(diff.begin(), diff.end(), [](double e) { return e < 0.0; });
+    }
+    sizes.push_back(size);
   }
   const nlohmann::json out = {{"benchmark", "peer_lbfgs"},
                               {"seed", seed},

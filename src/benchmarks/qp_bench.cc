@@ -45,6 +45,7 @@ struct GroupResult {
   std::vector<double> prepare_us, feedback_us;  ///< per case, each phase's fastest repetition
   std::vector<double> u0_errors;
   double iterations_sum = 0.0;
+  std::vector<double> iterations, active;  ///< per case
   int failures = 0;
   /// Cases whose reference u_0 is provably not optimal for the stated problem: fixing u_0 to it
   /// makes the best achievable objective higher than ours (and ours is feasible).
@@ -141,6 +142,8 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
       const control::OcpQpSummary& s = solver->summary();
       if (!s.IsSolutionUsable()) ++g.failures;
       g.iterations_sum += s.iterations;
+      g.iterations.push_back(s.iterations);
+      g.active.push_back(s.active_constraints);
       const double error = (solver->u()[0] - c.u0).cwiseAbs().maxCoeff();
       g.u0_errors.push_back(error);
       if (error > kExamineError && s.IsSolutionUsable()) {
@@ -161,6 +164,17 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
     return g;
   };
   const GroupResult st = run(stress), tr = run(track);
+  // What the slowest 1 % of the stress cases do, beside the median case: a case's time is about a
+  // preparation plus a constant per active-set change, so the tail is the cases with most changes.
+  const auto slowest = [](const GroupResult& g, const std::vector<double>& per_case) {
+    std::vector<std::size_t> order(g.times_us.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return g.times_us[a] > g.times_us[b]; });
+    const std::size_t n = std::max<std::size_t>(1, order.size() / 100);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < n && i < order.size(); ++i) sum += per_case[order[i]];
+    return order.empty() ? 0.0 : sum / static_cast<double>(std::min(n, order.size()));
+  };
   const double cases = static_cast<double>(stress.size() + track.size());
   std::vector<double> all_errors = st.u0_errors;
   all_errors.insert(all_errors.end(), tr.u0_errors.begin(), tr.u0_errors.end());
@@ -181,6 +195,10 @@ json RunQpBenchmark(const std::string& path, const QpBenchOptions& options) {
           {"track_prepare_us_median", Percentile(tr.prepare_us, 0.5)},
           {"track_feedback_us_median", Percentile(tr.feedback_us, 0.5)},
           {"iterations_mean", cases > 0 ? (st.iterations_sum + tr.iterations_sum) / cases : 0.0},
+          {"stress_iterations_median", Percentile(st.iterations, 0.5)},
+          {"stress_active_median", Percentile(st.active, 0.5)},
+          {"stress_slowest_1pct_iterations_mean", slowest(st, st.iterations)},
+          {"stress_slowest_1pct_active_mean", slowest(st, st.active)},
           {"max_u0_error", std::max(Percentile(st.u0_errors, 1.0), Percentile(tr.u0_errors, 1.0))},
           {"u0_error_median", Percentile(all_errors, 0.5)},
           {"u0_error_p99", Percentile(all_errors, 0.99)},
