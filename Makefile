@@ -31,14 +31,15 @@ demo: build
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
-# The peers of docs/performance.md (HPIPM, GCOPTER's L-BFGS), cloned and built outside the sources
+# The peers of docs/performance.md (HPIPM, GCOPTER's L-BFGS, KISS-ICP), cloned and built outside the sources
 # (PEERS_DIR), and the drivers of benchmarks/peers/ that run them beside rotorguard's solvers.
 PEERS_DIR ?= out/peers
 peers: configure
+	@./scripts/install-deps.sh --peers
 	./scripts/peers.sh $(PEERS_DIR)
 	@cmake -S . -B $(BUILD_DIR) -DROTORGUARD_PEERS_DIR=$(abspath $(PEERS_DIR)) > $(BUILD_DIR)/configure.log 2>&1 \
 	  || (cat $(BUILD_DIR)/configure.log; exit 1)
-	@cmake --build $(BUILD_DIR) -j $(JOBS) --target peer_qp peer_lbfgs rotorguard_cli
+	@cmake --build $(BUILD_DIR) -j $(JOBS) --target peer_qp peer_lbfgs peer_lio rotorguard_cli
 
 # The unit tests under AddressSanitizer and UndefinedBehaviorSanitizer, in their own build folder
 # (docs/reliability.md): its build alone takes longer than all of `make test`, so it runs before a

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian package rotorguard builds, tests and runs with; with --fuzz also clang and
-# its libFuzzer runtime, which only `make fuzz` uses.
+# its libFuzzer runtime, which only `make fuzz` uses; with --peers also git and TBB, which the peers
+# `make peers` builds outside the sources need (docs/performance.md).
 # Idempotent: does nothing (and needs no network or root) when all are present.
 # Works as root or through sudo.
 set -euo pipefail
@@ -34,8 +35,10 @@ packages=(
 )
 if [ "${1:-}" = "--fuzz" ]; then
   packages+=(clang libclang-rt-14-dev)  # libFuzzer, with AddressSanitizer (docs/reliability.md)
+elif [ "${1:-}" = "--peers" ]; then
+  packages+=(git libtbb-dev)  # cloning the peers; KISS-ICP's parallel loops
 elif [ $# -gt 0 ]; then
-  echo "install-deps: unknown argument '$1'; expected none or --fuzz" >&2
+  echo "install-deps: unknown argument '$1'; expected none, --fuzz or --peers" >&2
   exit 2
 fi
 # Node.js and npm build the report viewer (viewer/); a machine that has them already keeps its own.

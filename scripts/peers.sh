@@ -6,9 +6,11 @@
 #   scripts/peers.sh [DIR]        (default: out/peers; `make peers` runs it)
 #
 # Clones each peer at the commit the published figures used into DIR/src, builds BLASFEO and HPIPM
-# (static, the flags below) into DIR/install, and leaves GCOPTER's header-only L-BFGS where it is.
+# (static, the flags below), Sophus and robin-map into DIR/install and KISS-ICP in DIR/build, and
+# leaves GCOPTER's header-only L-BFGS where it is.
 # PEERS_GIT_BASE replaces https://github.com (a mirror, or a folder of clones named owner+name).
-# Then: cmake -S . -B build -DROTORGUARD_PEERS_DIR=DIR && cmake --build build --target peer_qp peer_lbfgs
+# Needs git and Debian's TBB (scripts/install-deps.sh --peers).
+# Then: cmake -S . -B build -DROTORGUARD_PEERS_DIR=DIR && cmake --build build --target peer_qp peer_lbfgs peer_lio
 set -euo pipefail
 
 dir=$(realpath -m "${1:-out/peers}")
@@ -21,6 +23,9 @@ peers=(
   "giaf/blasfeo 0ab5db3259c009ea62318a5e35622fe6de7ae554"
   "giaf/hpipm 87ef7a6ab773427a8c416030a2b9d075a744c223"
   "ZJU-FAST-Lab/GCOPTER e0444f6d47b84f972ced91746b05feb36ce1fd4f gcopter/include"
+  "PRBonn/kiss-icp 4bd9a1054931bd037ef5e690122832faab621113 cpp"
+  "strasdat/Sophus d0b7315a0d90fc6143defa54596a3a95d9fa10ec"
+  "Tessil/robin-map 4ec1bf19c6a96125ea22062f38c2cf5b958e448e"
 )
 
 # BLASFEO's kernels for AVX2 and FMA (x86-64-v3, the flags rotorguard itself is built with) where the
@@ -62,6 +67,17 @@ build() {  # name, then cmake options
 mkdir -p "$dir/build"
 build blasfeo -DTARGET=$blasfeo_target -DLA=HIGH_PERFORMANCE -DBLASFEO_EXAMPLES=OFF -DBUILD_SHARED_LIBS=OFF
 build hpipm -DTARGET=$hpipm_target -DBLASFEO_PATH="$dir/install" -DHPIPM_TESTING=OFF -DBUILD_SHARED_LIBS=OFF
+# KISS-ICP (its C++ core and pipeline) on Sophus 1.24.6 and robin-map 1.4.0, the versions its own build
+# fetches, and Debian's TBB (libtbb-dev: scripts/install-deps.sh --peers).
+build Sophus -DBUILD_SOPHUS_TESTS=OFF -DBUILD_SOPHUS_EXAMPLES=OFF -DSOPHUS_USE_BASIC_LOGGING=ON
+build robin-map
+echo "peers: building kiss-icp"
+cmake -S "$dir/src/kiss-icp/cpp/kiss_icp" -B "$dir/build/kiss-icp" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$dir/install" -DUSE_CCACHE=OFF -DUSE_SYSTEM_SOPHUS=ON -DUSE_SYSTEM_TSL-ROBIN-MAP=ON \
+  -DUSE_SYSTEM_TBB=ON -DUSE_SYSTEM_EIGEN3=ON > "$dir/build/kiss-icp.configure.log" 2>&1 \
+  || { cat "$dir/build/kiss-icp.configure.log"; exit 1; }
+cmake --build "$dir/build/kiss-icp" -j "$jobs" > "$dir/build/kiss-icp.build.log" 2>&1 \
+  || { tail -40 "$dir/build/kiss-icp.build.log"; exit 1; }
 
 # What the drivers report beside their figures.
 {
@@ -78,4 +94,4 @@ build hpipm -DTARGET=$hpipm_target -DBLASFEO_PATH="$dir/install" -DHPIPM_TESTING
   echo "}"
 } > "$dir/peers.json"
 echo "peers: built into $dir (BLASFEO $blasfeo_target, HPIPM $hpipm_target); now"
-echo "  cmake -S . -B build -DROTORGUARD_PEERS_DIR=$dir && cmake --build build --target peer_qp peer_lbfgs"
+echo "  cmake -S . -B build -DROTORGUARD_PEERS_DIR=$dir && cmake --build build --target peer_qp peer_lbfgs peer_lio"

@@ -153,12 +153,14 @@ JOBS += [('calibration', 'calibration', ['fdd-calibrate', 'runs/*', '--healthy']
 # Side by side with the peers (docs/performance.md): the drivers of benchmarks/peers/ run rotorguard's
 # solver and the peer's in one process, alternated. They exist in a build configured with the peers
 # (`make peers`: scripts/peers.sh, then ROTORGUARD_PEERS_DIR); the QP instance is not in the repository
-# (--qp-instance). Each driver runs PEER_REPEATS times, the two drivers alternated; every run is kept.
-PEER_REPEATS = 3
-PEER_DRIVERS = [('peer_qp', ['QP_INSTANCE', '--repetitions', '3']),
-                ('peer_lbfgs', ['--problems', '200', '--seed', '1', '--repetitions', '3'])]
-JOBS += [('performance', 'peers', [], 'rotorguard beside HPIPM (the NMPC\'s QP) and GCOPTER\'s L-BFGS (the '
-          'planner\'s optimiser), %d runs each' % PEER_REPEATS)]
+# (--qp-instance). A driver runs as many times as it names, the drivers taking turns; every run is
+# kept. The odometry's runs are long (7 min: 16 conditions of 200 frames), so once.
+PEER_DRIVERS = [('peer_qp', ['QP_INSTANCE', '--repetitions', '3'], 3),
+                ('peer_lbfgs', ['--problems', '200', '--seed', '1', '--repetitions', '3'], 3),
+                ('peer_lio', ['--seed', '1', '--duration', '20'], 1)]
+PEER_REPEATS = max(r for _, _, r in PEER_DRIVERS)
+JOBS += [('performance', 'peers', [], 'rotorguard beside HPIPM (the NMPC\'s QP), GCOPTER\'s L-BFGS (the '
+          'planner\'s optimiser) and KISS-ICP (the odometry)')]
 
 
 def cmake_cache(build):
@@ -180,7 +182,7 @@ def run_peers(build, folder, qp_instance):
     clear word, and nothing run, when the build has no drivers or no instance was given."""
     cache = cmake_cache(build)
     peers_dir = cache.get('ROTORGUARD_PEERS_DIR', '')
-    drivers = [os.path.join(build, 'bin', d) for d, _ in PEER_DRIVERS]
+    drivers = [os.path.join(build, 'bin', d) for d, _, _ in PEER_DRIVERS]
     if not peers_dir or not all(os.access(d, os.X_OK) for d in drivers):
         print('results: performance: skipped: %s has no peer drivers (make peers; docs/performance.md)' % build,
               flush=True)
@@ -193,14 +195,16 @@ def run_peers(build, folder, qp_instance):
     os.makedirs(folder, exist_ok=True)
     commands = {}
     for k in range(1, PEER_REPEATS + 1):
-        for name, args in PEER_DRIVERS:
+        for name, args, repeats in PEER_DRIVERS:
+            if k > repeats:
+                continue
             path = os.path.join(folder, '%s.%d.json' % (name, k))
             args = [os.path.abspath(qp_instance) if a == 'QP_INSTANCE' else a for a in args]
             commands[name] = ' '.join(['build/bin/' + name] + [os.path.basename(a) if a.endswith('.json') else a
                                                                for a in args])
             if os.path.exists(path):
                 continue
-            print('results: performance: %s, run %d of %d' % (name, k, PEER_REPEATS), flush=True)
+            print('results: performance: %s, run %d of %d' % (name, k, repeats), flush=True)
             done = subprocess.run([os.path.join(build, 'bin', name)] + args, capture_output=True, text=True)
             if done.returncode != 0:
                 sys.exit('results: performance: %s failed (exit %d): %s' % (name, done.returncode, done.stderr.strip()))
@@ -890,9 +894,9 @@ def performance_page(out_dir):
     with open(os.path.join(folder, 'manifest.json')) as f:
         m = json.load(f)
     runs = {}
-    for name, _ in PEER_DRIVERS:
+    for name, _, repeats in PEER_DRIVERS:
         runs[name] = []
-        for k in range(1, PEER_REPEATS + 1):
+        for k in range(1, repeats + 1):
             with open(os.path.join(folder, '%s.%d.json' % (name, k))) as f:
                 runs[name].append(json.load(f))
     peers = m['peers']
@@ -901,8 +905,7 @@ def performance_page(out_dir):
            'rotorguard\'s solvers measured beside the fastest open peers on the same problems, in one process, on one',
            'core, the sides taking turns problem by problem so that neither always runs first. Machine: %s, %d cores'
            % (m['cpu'], m['cores']),
-           '(a VM: its figures move by 10-20 %% from run to run, so each driver ran %d times, alternated with the other,'
-           % PEER_REPEATS,
+           '(a VM: its figures move by 10-20 % from run to run, so the QP and L-BFGS drivers ran 3 times, taking turns,',
            'and every run is given: ranges are over the runs, ratios are taken within each run). Finished %s with'
            % m['finished'],
            'rotorguard %s, built by `%s` %s (`%s`, Release).' % (
@@ -921,7 +924,11 @@ def performance_page(out_dir):
            '| BLASFEO | `%s` | `TARGET=%s`, `LA=HIGH_PERFORMANCE` |' % (peers['giaf/blasfeo'][:12], peers['blasfeo_target']),
            '| HPIPM | `%s` | `TARGET=%s` |' % (peers['giaf/hpipm'][:12], peers['hpipm_target']),
            '| GCOPTER (`gcopter/include/gcopter/lbfgs.hpp`, header only) | `%s` | with rotorguard\'s flags |'
-           % peers['ZJU-FAST-Lab/GCOPTER'][:12], '']
+           % peers['ZJU-FAST-Lab/GCOPTER'][:12],
+           '| KISS-ICP (`cpp/kiss_icp`: core and pipeline) | `%s` | its own CMake (Release), Debian\'s TBB |'
+           % peers['PRBonn/kiss-icp'][:12],
+           '| Sophus, robin-map (KISS-ICP\'s) | `%s`, `%s` | the versions KISS-ICP\'s build fetches (1.24.6, 1.4.0) |'
+           % (peers['strasdat/Sophus'][:12], peers['Tessil/robin-map'][:12]), '']
     qp = runs['peer_qp']
     names = [sd['name'] for sd in qp[0]['sides']]
     side = lambda r, n: next(sd for sd in r['sides'] if sd['name'] == n)
@@ -984,6 +991,38 @@ def performance_page(out_dir):
                for k in lb[0]['sizes'][i] if k.endswith('_cost_mean'))
     out += ['', 'The costs are the same in every run (both optimisers are deterministic); only the times move.' if same
             else 'The costs differ between the runs: those given are the first run\'s.', '']
+    lio = runs['peer_lio'][0]
+    kc = lio['kiss_icp']
+    out += ['## The odometry beside KISS-ICP', '',
+            '`%s`: the frames of `rotorguard bench lio` (the simulated MID-360 and the vibrating IMU; a 500-tree'
+            % m['commands']['peer_lio'],
+            'forest and a room with a ceiling; hovering and flying 1 m/s; spinning at 0-20 rad/s; %.0f s a condition),'
+            % lio['duration_s'],
+            'each given to rotorguard\'s LiDAR-inertial odometry (with the IMU) and then to a KISS-ICP of its own',
+            '(LiDAR only: the points in the sensor frame with their times, which it deskews by its constant-velocity',
+            'model). KISS-ICP is configured as its defaults with this LiDAR\'s range: max_range %.0f m, voxel_size %.1f m'
+            % (kc['max_range'], kc['voxel_size']),
+            '(max_range / 100, its rule), min_range %.0f, deskew on, %d thread. Both start at the true pose. Error: the'
+            % (kc['min_range'], kc['max_num_threads']),
+            'position after each frame against the truth (rotorguard\'s body, KISS-ICP\'s sensor), RMSE / largest over',
+            'the frames; diverged: an error past 1 m. Time: each frame\'s `Lio::OnFrame` and `KissICP::RegisterFrame`, medians.', '',
+            '| scene | motion | spin [rad/s] | rotorguard error [m] | KISS-ICP error [m] | error ratio | rotorguard [ms] '
+            '| KISS-ICP [ms] | time ratio |', '|---|---|---|---|---|---|---|---|---|']
+    for r in lio['runs']:
+        out.append('| %s | %s | %.0f | %.3f / %.3f%s | %.3f / %.3f%s | %.1f | %.2f | %.1f | %.1f |' % (
+            r['scene'], r['motion'], r['spin_rad_s'], r['rotorguard_error_rmse_m'], r['rotorguard_error_max_m'],
+            ' (diverged)' if r['rotorguard_diverged'] else '', r['kiss_icp_error_rmse_m'], r['kiss_icp_error_max_m'],
+            ' (diverged)' if r['kiss_icp_diverged'] else '', r['kiss_icp_error_rmse_m'] / r['rotorguard_error_rmse_m'],
+            r['rotorguard_frame_ms_median'], r['kiss_icp_frame_ms_median'],
+            r['kiss_icp_frame_ms_median'] / r['rotorguard_frame_ms_median']))
+    ratios = [r['kiss_icp_error_rmse_m'] / r['rotorguard_error_rmse_m'] for r in lio['runs']]
+    times = [r['kiss_icp_frame_ms_median'] / r['rotorguard_frame_ms_median'] for r in lio['runs']]
+    out += ['', 'KISS-ICP\'s error over rotorguard\'s: %.1f-%.1f (median %.1f); its time a frame over rotorguard\'s: '
+            '%.1f-%.1f (median %.1f). KISS-ICP diverges in %d of %d conditions, rotorguard in %d. One run (seed 1); a'
+            % (min(ratios), max(ratios), median(ratios), min(times), max(times), median(times),
+               sum(r['kiss_icp_diverged'] for r in lio['runs']), len(lio['runs']),
+               sum(r['rotorguard_diverged'] for r in lio['runs'])),
+            'time is the median of a condition\'s frames.', '']
     return '\n'.join(out)
 
 

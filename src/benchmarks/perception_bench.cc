@@ -291,6 +291,18 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
     const Stopwatch clock;
     const perception::LioFrameSummary f = lio.OnFrame(*frame);
     frame_ms.push_back(1e3 * clock.seconds());
+    if (options.on_frame) {
+      // The sensor's pose: the body's with the mount's offset (axes aligned, LidarOptions).
+      const auto sensor = [&](TimeNs at) {
+        const sim::BodyPose b = path.Pose(at);
+        return sim::BodyPose{b.p_W + b.q_WB * lidar_options.position_m, b.q_WB};
+      };
+      TimeNs last = frame->t_start_ns;
+      for (std::uint32_t o : frame->offset_ns) last = std::max(last, frame->t_start_ns + static_cast<TimeNs>(o));
+      const StateEstimate e = lio.Estimate();
+      options.on_frame({scene.name, motion, path.spin_rad_s, *frame, sensor(last), sensor(0),
+                        e.p_W - path.Pose(e.t_ns).p_W, frame_ms.back()});
+    }
     ++frames;
     used += f.used;
     degenerate += f.used && f.degenerate;

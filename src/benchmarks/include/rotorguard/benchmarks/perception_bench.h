@@ -18,7 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "rotorguard/core/messages.h"
 #include "rotorguard/perception/voxel_map.h"
+#include "rotorguard/sim/lidar.h"
 #include "rotorguard/sim/world.h"
 
 namespace rotorguard::benchmarks {
@@ -55,12 +57,26 @@ std::string PerceptionMarkdown(const nlohmann::json& result);
 /// ate_max_m, attitude_rmse_deg and attitude_max_deg, drift_percent (flying: the error of the displacement over each 10
 /// m travelled, per cent of 10 m; null hovering), frame_ms_mean and frame_ms_p99 (Lio::OnFrame on one core),
 /// degenerate_fraction, frames_used and diverged (an error above 1 m).
+/// One LiDAR frame of `bench lio` as the odometry took it: what a peer odometry needs to run on the
+/// same frames and be scored by the same truth (benchmarks/peers/peer_lio.cc).
+struct LioFrameEvent {
+  const std::string& scene;   ///< "forest" or "room"
+  const std::string& motion;  ///< "hover" or "flying"
+  double spin_rad_s;
+  const LidarFrame& frame;           ///< the frame, points in the sensor frame at their own time
+  sim::BodyPose sensor_truth;        ///< the LiDAR's true pose at the frame's last point
+  sim::BodyPose sensor_start_truth;  ///< and at the condition's start (a peer's origin)
+  Vector3 lio_position_error_m;      ///< rotorguard's estimate less the truth after this frame
+  double lio_frame_ms;               ///< rotorguard's Lio::OnFrame on this frame
+};
+
 struct LioBenchOptions {
   double duration_s = 20.0;                            ///< simulated seconds per condition, in (0, 600]
   double speed_m_s = 1.0;                              ///< the flying conditions' speed, in (0, 5]
   std::vector<double> spins = {0.0, 5.0, 11.0, 20.0};  ///< yaw rates [rad/s], each in [0, 30]
   std::uint64_t seed = 1;                              ///< sensor noise and forest layout
   std::function<void(int, int)> progress;              ///< after each condition, (done, total)
+  std::function<void(const LioFrameEvent&)> on_frame;  ///< after each frame the odometry took (optional)
   void Validate() const;
 };
 nlohmann::json RunLioBenchmark(const LioBenchOptions& options);
