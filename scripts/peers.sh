@@ -30,12 +30,16 @@ peers=(
 
 # BLASFEO's kernels for AVX2 and FMA (x86-64-v3, the flags rotorguard itself is built with) where the
 # CPU has them; HPIPM's AVX target then. Elsewhere both build their generic C.
+# KISS-ICP gets rotorguard's ISA flag too: the same Eigen code (Sophus' poses) on both sides of its
+# interface must agree on vector width and alignment.
 if grep -q ' avx2 ' /proc/cpuinfo 2>/dev/null && grep -q ' fma ' /proc/cpuinfo 2>/dev/null; then
   blasfeo_target=X64_INTEL_HASWELL
   hpipm_target=AVX
+  isa_flags=-march=x86-64-v3
 else
   blasfeo_target=GENERIC
   hpipm_target=GENERIC
+  isa_flags=
 fi
 
 mkdir -p "$dir/src" "$dir/install"
@@ -47,8 +51,8 @@ for p in "${peers[@]}"; do
   if [ ! -d "$src/.git" ]; then
     echo "peers: cloning $repo into $src"
     git clone -q --no-checkout "$url" "$src"
-    [ -z "$only" ] || git -C "$src" sparse-checkout set --no-cone "/$only/"
   fi
+  [ -z "$only" ] || git -C "$src" sparse-checkout set --no-cone "/$only/"
   git -C "$src" -c advice.detachedHead=false checkout -q "$commit" \
     || { echo "peers: $repo has no commit $commit (fetch it: git -C $src fetch)" >&2; exit 1; }
 done
@@ -69,10 +73,11 @@ build blasfeo -DTARGET=$blasfeo_target -DLA=HIGH_PERFORMANCE -DBLASFEO_EXAMPLES=
 build hpipm -DTARGET=$hpipm_target -DBLASFEO_PATH="$dir/install" -DHPIPM_TESTING=OFF -DBUILD_SHARED_LIBS=OFF
 # KISS-ICP (its C++ core and pipeline) on Sophus 1.24.6 and robin-map 1.4.0, the versions its own build
 # fetches, and Debian's TBB (libtbb-dev: scripts/install-deps.sh --peers).
-build Sophus -DBUILD_SOPHUS_TESTS=OFF -DBUILD_SOPHUS_EXAMPLES=OFF -DSOPHUS_USE_BASIC_LOGGING=ON
+build Sophus -DBUILD_SOPHUS_TESTS=OFF -DBUILD_SOPHUS_EXAMPLES=OFF
 build robin-map
 echo "peers: building kiss-icp"
 cmake -S "$dir/src/kiss-icp/cpp/kiss_icp" -B "$dir/build/kiss-icp" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_CXX_FLAGS="$isa_flags" \
   -DCMAKE_PREFIX_PATH="$dir/install" -DUSE_CCACHE=OFF -DUSE_SYSTEM_SOPHUS=ON -DUSE_SYSTEM_TSL-ROBIN-MAP=ON \
   -DUSE_SYSTEM_TBB=ON -DUSE_SYSTEM_EIGEN3=ON > "$dir/build/kiss-icp.configure.log" 2>&1 \
   || { cat "$dir/build/kiss-icp.configure.log"; exit 1; }
@@ -82,7 +87,7 @@ cmake --build "$dir/build/kiss-icp" -j "$jobs" > "$dir/build/kiss-icp.build.log"
 # What the drivers report beside their figures.
 {
   echo "{"
-  echo "  \"blasfeo_target\": \"$blasfeo_target\", \"hpipm_target\": \"$hpipm_target\","
+  echo "  \"blasfeo_target\": \"$blasfeo_target\", \"hpipm_target\": \"$hpipm_target\", \"kiss_icp_flags\": \"$isa_flags\","
   first=1
   for p in "${peers[@]}"; do
     [ $first = 1 ] || echo ","

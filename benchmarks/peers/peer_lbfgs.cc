@@ -11,8 +11,9 @@
 //   gcopter:    lbfgs::lbfgs_optimize with the parameters GCOPTER's planner sets (gcopter.hpp: 256
 //               pairs, past 3, delta 1e-4 (its relative cost tolerance as rotorguard's), g_epsilon 0,
 //               min_step 1e-32; no iteration limit).
-// A non-finite cost (a trajectory that cannot be built) reaches GCOPTER's line search as +inf with a
-// zero gradient, which it rejects as too high. Reported per size: each side's median time of the
+// A non-finite cost (a trajectory that cannot be built) reaches GCOPTER as +inf with a zero gradient:
+// lbfgs.hpp then returns LBFGSERR_INVALID_FUNCVAL with the last good point, counted in gcopter_*_errors
+// (stopping at the iteration limit is counted apart, as *_at_limit). Reported per size: each side's median time of the
 // optimisation alone (the fastest of its repetitions per problem), its mean final cost, and the
 // per-problem cost difference (rotorguard - gcopter) with its standard error. Prints one JSON object.
 #include <gcopter/lbfgs.hpp>
@@ -129,7 +130,7 @@ int main(int argc, char** argv) {
   nlohmann::json sizes = nlohmann::json::array();
   for (const int pieces : {5, 10}) {
     std::vector<double> time[kSides], cost[kSides], iterations[kSides], evaluations[kSides];
-    int failures[kSides] = {};
+    int failures[kSides] = {}, limits_hit[kSides] = {};
     for (long i = 0; i < problems; ++i) {
       const Problem p = MakeProblem(pieces, seed, static_cast<int>(i));
       double best[kSides], final_cost[kSides];
@@ -140,7 +141,7 @@ int main(int argc, char** argv) {
           const Side& side = sides[k];
           Eigen::VectorXd x = p.x0;
           Context c{&optimizer, &p, &limits};
-          bool failed = false;
+          bool failed = false, at_limit = false;
           int iters = 0;
           const auto t0 = Clock::now();
           if (side.own) {
@@ -153,17 +154,21 @@ int main(int argc, char** argv) {
             const LbfgsSummary summary = MinimizeLbfgs(f, o, &x);
             failed = summary.failed;
             iters = summary.iterations;
+            at_limit = !failed && iters >= o.max_iterations;
           } else {
             lbfgs::lbfgs_parameter_t o = gcopter;
             o.max_iterations = side.max_iterations;
             double f = 0.0;
-            failed = lbfgs::lbfgs_optimize(x, f, &GcopterCost, nullptr, nullptr, &c, o) < 0;
+            const int code = lbfgs::lbfgs_optimize(x, f, &GcopterCost, nullptr, nullptr, &c, o);
+            at_limit = code == lbfgs::LBFGSERR_MAXIMUMITERATION;
+            failed = code < 0 && !at_limit;
             iters = -1;  // lbfgs.hpp does not return its count
           }
           best[k] = std::min(best[k], std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
           final_cost[k] = optimizer.Objective(p.head, p.tail, limits, {}, x, nullptr);
           if (r == 0) {
             failures[k] += failed;
+            limits_hit[k] += at_limit;
             if (iters >= 0) iterations[k].push_back(iters);
             evaluations[k].push_back(c.evaluations);
           }
@@ -181,7 +186,8 @@ int main(int argc, char** argv) {
       size[n + "_cost_mean"] = mean(cost[k]);
       size[n + "_evaluations_mean"] = mean(evaluations[k]);
       if (!iterations[k].empty()) size[n + "_iterations_mean"] = mean(iterations[k]);
-      size[n + "_failures"] = failures[k];
+      size[n + "_errors"] = failures[k];
+      size[n + "_at_limit"] = limits_hit[k];
     }
     // Per problem, rotorguard's final cost minus GCOPTER's at the same budget.
     for (const std::string budget : {"200", "unlimited"}) {

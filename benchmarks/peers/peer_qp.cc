@@ -6,12 +6,16 @@
 // Every solve is cold: rotorguard's active set from empty, HPIPM's interior point without a warm
 // start. HPIPM sees the problem as its users give it: x0 eliminated (stage 0 has no state, its
 // dynamics' constant A x0), the same Q, R, bounds. Its settings are frozen here, as published:
-//   fast_pc4:  partial condensing to 4 stages of 5 (d_part_cond_qp), SPEED_ABS defaults;
+//   fast_pc4:  partial condensing to 4 stages of 5 (d_part_cond_qp), SPEED_ABS defaults (mu0 10,
+//              at most 15 iterations, the residual test 1e-8);
 //   fast:      no condensing, SPEED_ABS defaults;
-//   accurate:  no condensing, ROBUST, every tolerance 1e-10, at most 100 iterations.
-// A case's time is the fastest of its repetitions (the condensing and the expansion of the solution
-// are inside HPIPM's; rotorguard's Prepare and Feedback inside its own). u0's error is against the
-// instance's certified optimum. Prints one JSON object.
+//   balance:   no condensing, BALANCE, every tolerance 1e-10, at most 100 iterations;
+//   robust:    no condensing, ROBUST, every tolerance 1e-10, at most 100 iterations.
+// A case's time is the fastest of its repetitions. Each side's timed solve takes the problem's data
+// as an NMPC step would hand them over: rotorguard's Prepare and Feedback from its OcpQp, HPIPM's
+// d_ocp_qp_set_* of every stage, the condensing and the expansion of its solution. u0's error is
+// against the instance's certified optimum; HPIPM's status other than converged is counted apart
+// (not_converged). Prints one JSON object.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -73,30 +77,14 @@ class HpipmSolver {
     d_ocp_qp_create(&dim_, &qp_, arena_.Get(d_ocp_qp_memsize(&dim_)));
     d_ocp_qp_sol_create(&dim_, &sol_, arena_.Get(d_ocp_qp_sol_memsize(&dim_)));
 
-    // Column-major copies (Eigen's default storage, as HPIPM reads them).
-    std::vector<int> idxbx(qp.dims.state_bound_index), idxbu(nu_);
-    for (int i = 0; i < nu_; ++i) idxbu[i] = i;
+    qp_data_ = &qp;
+    idxbx_ = qp.dims.state_bound_index;
+    idxbu_.resize(nu_);
+    for (int i = 0; i < nu_; ++i) idxbu_[i] = i;
     b0_ = Eigen::VectorXd::Zero(nx_);
-    const Eigen::VectorXd zero_x = Eigen::VectorXd::Zero(nx_), zero_u = Eigen::VectorXd::Zero(nu_);
-    for (int k = 0; k <= n_; ++k) {
-      if (k < n_) {
-        if (k > 0) d_ocp_qp_set_A(k, const_cast<double*>(qp.A[k].data()), &qp_);
-        d_ocp_qp_set_B(k, const_cast<double*>(qp.B[k].data()), &qp_);
-        d_ocp_qp_set_b(k, k == 0 ? b0_.data() : const_cast<double*>(zero_x.data()), &qp_);
-        d_ocp_qp_set_R(k, const_cast<double*>(qp.R[k].data()), &qp_);
-        d_ocp_qp_set_r(k, const_cast<double*>(zero_u.data()), &qp_);
-        d_ocp_qp_set_idxbu(k, idxbu.data(), &qp_);
-        d_ocp_qp_set_lbu(k, const_cast<double*>(qp.u_lower[k].data()), &qp_);
-        d_ocp_qp_set_ubu(k, const_cast<double*>(qp.u_upper[k].data()), &qp_);
-      }
-      if (k > 0) {
-        d_ocp_qp_set_Q(k, const_cast<double*>(qp.Q[k].data()), &qp_);
-        d_ocp_qp_set_q(k, const_cast<double*>(zero_x.data()), &qp_);
-        d_ocp_qp_set_idxbx(k, idxbx.data(), &qp_);
-        d_ocp_qp_set_lbx(k, const_cast<double*>(qp.x_lower[k].data()), &qp_);
-        d_ocp_qp_set_ubx(k, const_cast<double*>(qp.x_upper[k].data()), &qp_);
-      }
-    }
+    zero_x_ = Eigen::VectorXd::Zero(nx_);
+    zero_u_ = Eigen::VectorXd::Zero(nu_);
+    Load();
 
     const bool condense = condensed_ < n_;
     struct d_ocp_qp_dim* ipm_dim = &dim_;
@@ -129,10 +117,11 @@ class HpipmSolver {
     u0_.resize(nu_);
   }
 
-  /// Solves from x0; returns HPIPM's status (0: converged) and leaves u0.
+  /// Solves from x0, the problem's data set again first; returns HPIPM's status (0: converged) and
+  /// leaves u0.
   int Solve(const Eigen::VectorXd& x0) {
     b0_ = a0_ * x0;
-    d_ocp_qp_set_b(0, b0_.data(), &qp_);
+    Load();
     int status = 0;
     if (condensed_ < n_) {
       d_part_cond_qp_cond(&qp_, &qp2_, &cond_arg_, &cond_ws_);
@@ -147,12 +136,39 @@ class HpipmSolver {
     return status;
   }
   const Eigen::VectorXd& u0() const { return u0_; }
+
+  /// Every stage's data into HPIPM's problem (column-major, Eigen's default storage, as HPIPM reads
+  /// them; stage 0 has no state: its dynamics' constant is b0_ = A x0).
+  void Load() {
+    const rotorguard::control::OcpQp& qp = *qp_data_;
+    for (int k = 0; k <= n_; ++k) {
+      if (k < n_) {
+        if (k > 0) d_ocp_qp_set_A(k, const_cast<double*>(qp.A[k].data()), &qp_);
+        d_ocp_qp_set_B(k, const_cast<double*>(qp.B[k].data()), &qp_);
+        d_ocp_qp_set_b(k, k == 0 ? b0_.data() : zero_x_.data(), &qp_);
+        d_ocp_qp_set_R(k, const_cast<double*>(qp.R[k].data()), &qp_);
+        d_ocp_qp_set_r(k, zero_u_.data(), &qp_);
+        d_ocp_qp_set_idxbu(k, idxbu_.data(), &qp_);
+        d_ocp_qp_set_lbu(k, const_cast<double*>(qp.u_lower[k].data()), &qp_);
+        d_ocp_qp_set_ubu(k, const_cast<double*>(qp.u_upper[k].data()), &qp_);
+      }
+      if (k > 0) {
+        d_ocp_qp_set_Q(k, const_cast<double*>(qp.Q[k].data()), &qp_);
+        d_ocp_qp_set_q(k, zero_x_.data(), &qp_);
+        d_ocp_qp_set_idxbx(k, idxbx_.data(), &qp_);
+        d_ocp_qp_set_lbx(k, const_cast<double*>(qp.x_lower[k].data()), &qp_);
+        d_ocp_qp_set_ubx(k, const_cast<double*>(qp.x_upper[k].data()), &qp_);
+      }
+    }
+  }
   int iterations() const { return iterations_; }
 
  private:
   int n_, nx_, nu_, condensed_;
   Eigen::MatrixXd a0_;
-  Eigen::VectorXd b0_, u0_;
+  const rotorguard::control::OcpQp* qp_data_ = nullptr;
+  std::vector<int> idxbx_, idxbu_;
+  Eigen::VectorXd b0_, u0_, zero_x_, zero_u_;
   Arena arena_;
   std::vector<int> block_size_;
   struct d_ocp_qp_dim dim_ {}, dim2_{};
@@ -209,14 +225,17 @@ int main(int argc, char** argv) {
   rotorguard::control::ActiveSetOptions cold;
   cold.warm_start = false;
   auto riccati = rotorguard::control::MakeOcpQpSolver(rotorguard::control::OcpQpMethod::kRiccati, qp.dims, cold);
-  HpipmSolver fast_pc4(qp, SPEED_ABS, 4, 0.0), fast(qp, SPEED_ABS, n, 0.0), accurate(qp, ROBUST, n, 1e-10);
+  HpipmSolver fast_pc4(qp, SPEED_ABS, 4, 0.0), fast(qp, SPEED_ABS, n, 0.0), balance(qp, BALANCE, n, 1e-10),
+      robust(qp, ROBUST, n, 1e-10);
 
   std::vector<Side> sides = {
-      {"rotorguard", "Riccati recursion + dual active set (the default), cold", {}, {}, {}},
-      {"hpipm_fast_pc4", "SPEED_ABS, partial condensing to 4 stages, cold", {}, {}, {}},
-      {"hpipm_fast", "SPEED_ABS, no condensing, cold", {}, {}, {}},
-      {"hpipm_accurate", "ROBUST, tolerances 1e-10, 100 iterations, no condensing, cold", {}, {}, {}}};
-  HpipmSolver* hpipm[] = {nullptr, &fast_pc4, &fast, &accurate};
+      {"rotorguard", "Riccati recursion + dual active set (the default)", {}, {}, {}},
+      {"hpipm_fast_pc4", "SPEED_ABS defaults (at most 15 iterations), partial condensing to 4 stages", {}, {}, {}},
+      {"hpipm_fast", "SPEED_ABS defaults, no condensing", {}, {}, {}},
+      {"hpipm_balance", "BALANCE, tolerances 1e-10, at most 100 iterations, no condensing", {}, {}, {}},
+      {"hpipm_robust", "ROBUST, tolerances 1e-10, at most 100 iterations, no condensing", {}, {}, {}}};
+  HpipmSolver* hpipm[] = {nullptr, &fast_pc4, &fast, &balance, &robust};
+  constexpr int kSides = 5;
   std::vector<double> reps(static_cast<std::size_t>(repetitions));
   int index = 0;
   for (const auto& [group, cases] : {std::pair{0, &instance.stress}, std::pair{1, &instance.track}}) {
@@ -224,8 +243,8 @@ int main(int argc, char** argv) {
     for (int c = 0; c < count; ++c, ++index) {
       const QpInstanceCase& ic = (*cases)[c];
       qp.x0 = ic.x0;
-      for (int turn = 0; turn < 4; ++turn) {
-        const int s = (turn + index) % 4;  // each solver first in a quarter of the cases
+      for (int turn = 0; turn < kSides; ++turn) {
+        const int s = (turn + index) % kSides;  // each solver first in a fifth of the cases
         Side& side = sides[s];
         int status = 0;
         for (int r = 0; r < repetitions; ++r) {

@@ -300,8 +300,8 @@ nlohmann::json RunLioScene(const Scene& scene, const std::string& motion, const 
       TimeNs last = frame->t_start_ns;
       for (std::uint32_t o : frame->offset_ns) last = std::max(last, frame->t_start_ns + static_cast<TimeNs>(o));
       const StateEstimate e = lio.Estimate();
-      options.on_frame({scene.name, motion, path.spin_rad_s, *frame, sensor(last), sensor(0),
-                        e.p_W - path.Pose(e.t_ns).p_W, frame_ms.back()});
+      options.on_frame(
+          {scene.name, motion, path.spin_rad_s, *frame, sensor(last), e.p_W - path.Pose(e.t_ns).p_W, frame_ms.back()});
     }
     ++frames;
     used += f.used;

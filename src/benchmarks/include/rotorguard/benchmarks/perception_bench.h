@@ -49,14 +49,6 @@ nlohmann::json RunPerceptionBenchmark(const PerceptionBenchOptions& options);
 /// The result as a Markdown table.
 std::string PerceptionMarkdown(const nlohmann::json& result);
 
-/// `rotorguard bench lio`: the stack's LiDAR-inertial odometry (perception::Lio) on the same
-/// prescribed motions and simulated sensors, the IMU shaken by the airframe's vibration (0.6 m/s²
-/// at the rotors' frequency): in the forest and in the room (with a ceiling), hovering and flying
-/// 1 m/s, spinning at each rate of `spins` (speed and spin reached from rest over 2 s). Per condition: ate_rmse_m (the
-/// estimate's position against the truth at every IMU sample, no alignment: the odometry starts at the true pose),
-/// ate_max_m, attitude_rmse_deg and attitude_max_deg, drift_percent (flying: the error of the displacement over each 10
-/// m travelled, per cent of 10 m; null hovering), frame_ms_mean and frame_ms_p99 (Lio::OnFrame on one core),
-/// degenerate_fraction, frames_used and diverged (an error above 1 m).
 /// One LiDAR frame of `bench lio` as the odometry took it: what a peer odometry needs to run on the
 /// same frames and be scored by the same truth (benchmarks/peers/peer_lio.cc).
 struct LioFrameEvent {
@@ -65,11 +57,18 @@ struct LioFrameEvent {
   double spin_rad_s;
   const LidarFrame& frame;           ///< the frame, points in the sensor frame at their own time
   sim::BodyPose sensor_truth;        ///< the LiDAR's true pose at the frame's last point
-  sim::BodyPose sensor_start_truth;  ///< and at the condition's start (a peer's origin)
   Vector3 lio_position_error_m;      ///< rotorguard's estimate less the truth after this frame
   double lio_frame_ms;               ///< rotorguard's Lio::OnFrame on this frame
 };
 
+/// `rotorguard bench lio`: the stack's LiDAR-inertial odometry (perception::Lio) on the same
+/// prescribed motions and simulated sensors, the IMU shaken by the airframe's vibration (0.6 m/s²
+/// at the rotors' frequency): in the forest and in the room (with a ceiling), hovering and flying
+/// 1 m/s, spinning at each rate of `spins` (speed and spin reached from rest over 2 s). Per condition: ate_rmse_m (the
+/// estimate's position against the truth at every IMU sample, no alignment: the odometry starts at the true pose),
+/// ate_max_m, attitude_rmse_deg and attitude_max_deg, drift_percent (flying: the error of the displacement over each 10
+/// m travelled, per cent of 10 m; null hovering), frame_ms_mean and frame_ms_p99 (Lio::OnFrame on one core),
+/// degenerate_fraction, frames_used and diverged (an error above 1 m).
 struct LioBenchOptions {
   double duration_s = 20.0;                            ///< simulated seconds per condition, in (0, 600]
   double speed_m_s = 1.0;                              ///< the flying conditions' speed, in (0, 5]
