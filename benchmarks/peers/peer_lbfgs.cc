@@ -71,9 +71,10 @@ double GcopterCost(void* instance, const Eigen::VectorXd& x, Eigen::VectorXd& g)
   return f;
 }
 
+constexpr const char* kUsage = "peer_lbfgs [--problems N >= 1] [--seed S] [--repetitions R >= 1]";
+
 int Usage(const char* why) {
-  std::fprintf(stderr, "peer_lbfgs: %s\nusage: peer_lbfgs [--problems N >= 1] [--seed S] [--repetitions R >= 1]\n",
-               why);
+  std::fprintf(stderr, "peer_lbfgs: %s\nusage: %s\n", why, kUsage);
   return 2;
 }
 
@@ -83,6 +84,10 @@ int main(int argc, char** argv) {
   long problems = 200, repetitions = 3;
   unsigned long long seed = 1;
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::printf("usage: %s\n", kUsage);
+      return 0;
+    }
     const std::string a = argv[i];
     if ((a == "--problems" || a == "--seed" || a == "--repetitions") && i + 1 < argc) {
       char* end = nullptr;

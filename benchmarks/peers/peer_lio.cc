@@ -48,8 +48,10 @@ double Rmse(const std::vector<double>& e) {
   return e.empty() ? 0.0 : std::sqrt(s / static_cast<double>(e.size()));
 }
 
+constexpr const char* kUsage = "peer_lio [--seed S] [--duration SECONDS in (0, 600]]";
+
 int Usage(const std::string& why) {
-  std::fprintf(stderr, "peer_lio: %s\nusage: peer_lio [--seed S] [--duration SECONDS in (0, 600]]\n", why.c_str());
+  std::fprintf(stderr, "peer_lio: %s\nusage: %s\n", why.c_str(), kUsage);
   return 2;
 }
 
@@ -58,6 +60,10 @@ int Usage(const std::string& why) {
 int main(int argc, char** argv) {
   benchmarks::LioBenchOptions options;
   for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::printf("usage: %s\n", kUsage);
+      return 0;
+    }
     const std::string a = argv[i];
     if ((a == "--seed" || a == "--duration") && i + 1 < argc) {
       char* end = nullptr;

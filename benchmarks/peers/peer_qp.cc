@@ -190,8 +190,10 @@ struct Side {
   double iterations = 0.0;
 };
 
+constexpr const char* kUsage = "peer_qp INSTANCE.json [--repetitions R >= 1] [--cases N >= 1]";
+
 int Usage(const char* why) {
-  std::fprintf(stderr, "peer_qp: %s\nusage: peer_qp INSTANCE.json [--repetitions R >= 1] [--cases N >= 1]\n", why);
+  std::fprintf(stderr, "peer_qp: %s\nusage: %s\n", why, kUsage);
   return 2;
 }
 
@@ -199,6 +201,12 @@ int Usage(const char* why) {
 
 int main(int argc, char** argv) {
   if (argc < 2) return Usage("no instance given");
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::printf("usage: %s\n", kUsage);
+      return 0;
+    }
+  }
   std::string path = argv[1];
   int repetitions = 3, max_cases = 1 << 30;
   for (int i = 2; i < argc; ++i) {
