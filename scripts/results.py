@@ -912,7 +912,7 @@ def performance_page(out_dir):
            'rotorguard\'s solvers measured beside open peers of the field on the same problems, in one process, on one',
            'core, the sides taking turns problem by problem so that neither always runs first. Machine: %s, %d cores'
            % (m['cpu'], m['cores']),
-           '(a VM: its figures move by 10-20 % from run to run, so the QP and L-BFGS drivers ran 3 times, taking turns,',
+           '(a VM: its times move by up to a third from run to run, so the QP and L-BFGS drivers ran 3 times, taking turns,',
            'and every run is given: ranges are over the runs, ratios are taken within each run). Finished %s with'
            % m['finished'],
            'rotorguard %s (%s), built by `%s` %s (`%s`, Release).' % (
@@ -934,8 +934,8 @@ def performance_page(out_dir):
            '| HPIPM | `%s` | `TARGET=%s` |' % (peers['giaf/hpipm'][:12], peers['hpipm_target']),
            '| GCOPTER (`gcopter/include/gcopter/lbfgs.hpp`, header only) | `%s` | with rotorguard\'s flags |'
            % peers['ZJU-FAST-Lab/GCOPTER'][:12],
-           '| KISS-ICP (`cpp/kiss_icp`: core and pipeline) | `%s` | its own CMake (Release), Debian\'s TBB |'
-           % peers['PRBonn/kiss-icp'][:12],
+           '| KISS-ICP (`cpp/kiss_icp`: core and pipeline) | `%s` | its own CMake (Release), `%s`, Debian\'s TBB |'
+           % (peers['PRBonn/kiss-icp'][:12], peers.get('kiss_icp_flags') or 'no ISA flag'),
            '| Sophus, robin-map (KISS-ICP\'s) | `%s`, `%s` | the versions KISS-ICP\'s build fetches (1.24.6, 1.4.0) |'
            % (peers['strasdat/Sophus'][:12], peers['Tessil/robin-map'][:12]), '']
     qp = runs['peer_qp']
