@@ -202,13 +202,16 @@ def run_peers(build, folder, qp_instance):
             if k > repeats:
                 continue
             path = os.path.join(folder, '%s.%d.json' % (name, k))
-            args = [os.path.abspath(qp_instance) if a == 'QP_INSTANCE' else a for a in args]
-            commands[name] = ' '.join(['build/bin/' + name] + [os.path.basename(a) if a.endswith('.json') else a
-                                                               for a in args])
+            # The instance is named by its file name, run from its folder: the records hold no path of
+            # this machine.
+            cwd = os.path.dirname(os.path.abspath(qp_instance)) if 'QP_INSTANCE' in args else None
+            args = [os.path.basename(qp_instance) if a == 'QP_INSTANCE' else a for a in args]
+            commands[name] = ' '.join(['build/bin/' + name] + args)
             if os.path.exists(path):
                 continue
             print('results: performance: %s, run %d of %d' % (name, k, repeats), flush=True)
-            done = subprocess.run([os.path.join(build, 'bin', name)] + args, capture_output=True, text=True)
+            done = subprocess.run([os.path.abspath(os.path.join(build, 'bin', name))] + args, capture_output=True,
+                                  text=True, cwd=cwd)
             if done.returncode != 0:
                 sys.exit('results: performance: %s failed (exit %d): %s' % (name, done.returncode, done.stderr.strip()))
             with open(path + '.partial', 'w') as f:
