@@ -126,11 +126,6 @@ int main(int argc, char** argv) {
                         {"rotorguard_unlimited", true, kUnlimited},
                         {"gcopter_unlimited", false, 0}};
   constexpr int kSides = 4;
-  const auto mean = [](const std::vector<double>& v) {
-    double sum = 0;
-    for (double e : v) sum += e;
-    return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
-  };
 
   nlohmann::json sizes = nlohmann::json::array();
   for (const int pieces : {5, 10}) {
@@ -188,9 +183,9 @@ int main(int argc, char** argv) {
     for (int k = 0; k < kSides; ++k) {
       const std::string n = sides[k].name;
       size[n + "_us_median"] = Percentile(time[k], 0.5);
-      size[n + "_cost_mean"] = mean(cost[k]);
-      size[n + "_evaluations_mean"] = mean(evaluations[k]);
-      if (!iterations[k].empty()) size[n + "_iterations_mean"] = mean(iterations[k]);
+      size[n + "_cost_mean"] = Mean(cost[k]);
+      size[n + "_evaluations_mean"] = Mean(evaluations[k]);
+      if (!iterations[k].empty()) size[n + "_iterations_mean"] = Mean(iterations[k]);
       size[n + "_errors"] = failures[k];
       size[n + "_at_limit"] = limits_hit[k];
     }
@@ -199,7 +194,7 @@ int main(int argc, char** argv) {
       const int own = budget == "200" ? 0 : 2, peer = own + 1;
       std::vector<double> diff;
       for (std::size_t j = 0; j < cost[own].size(); ++j) diff.push_back(cost[own][j] - cost[peer][j]);
-      const double d = mean(diff), n = static_cast<double>(diff.size());
+      const double d = Mean(diff), n = static_cast<double>(diff.size());
       double var = 0.0;
       for (double e : diff) var += (e - d) * (e - d);
       size["cost_difference_" + budget + "_mean"] = d;
