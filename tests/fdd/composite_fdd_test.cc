@@ -458,6 +458,26 @@ TEST(CompositeFdd, ATouchdownsBounceDoesNotOpenTheTakeoffWindowALiftOffFromRestD
   }
 }
 
+TEST(CompositeFdd, BackInTheGroundBandTheObserverHoldsAndTheMotorIndexWatches) {
+  // A touchdown rocks the vehicle on its legs as a lost rotor would turn it, while the rotors still
+  // lift the weight: the observer holds within 5 cm of the ground once the flight has been higher.
+  // The same turn at 10 cm is a lost propeller; a motor that stops in the band is still isolated.
+  Bench b(1.0);
+  ASSERT_FALSE(b.Run(1.0, 1.0));
+  ASSERT_FALSE(b.Run(0.05, 0.03));
+  b.actual_[0] = 0.0;
+  EXPECT_FALSE(b.Run(0.2, 0.03)) << b.fdd_.rotors()[0].detector;
+  ASSERT_TRUE(b.Run(0.3, 0.10));  // within takeoff_rest_s of touching down: no take-off window
+  EXPECT_EQ(b.fdd_.rotors()[0].detector, "thrust_loss_observer");
+
+  Bench m(1.0);
+  ASSERT_FALSE(m.Run(1.0, 1.0));
+  ASSERT_FALSE(m.Run(0.2, 0.03));
+  m.drive_[1] = m.actual_[1] = 0.0;
+  ASSERT_TRUE(m.Run(0.1, 0.03));
+  EXPECT_EQ(m.fdd_.rotors()[1].detector, "motor_index");
+}
+
 TEST(CompositeFdd, TheFlightsFirstLiftOffOpensTheTakeoffWindowHoweverShortTheRest) {
   // A take-off whose motors spin up at once leaves the ground 0.1 s after the start.
   CompositeFddOptions o;
