@@ -68,6 +68,7 @@ JOBS = [
                  ('landing', '1000 hovers at 1.5 m and landings, 10 s'),
                  ('takeoff_ground_effect', 'the take-offs with the rotors\' ground effect'),
                  ('landing_ground_effect', 'the landings with the rotors\' ground effect'),
+                 ('landing_ground_effect_strong', 'the landings with twice that ground effect'),
                  ('emergency_landing', '1000 hovers whose odometry is lost for 1 s, landed by the supervisor, 12 s'),
                  ('lemniscate', '1000 flights of 60 s of the 2 m/s lemniscate, gusts 0-0.5 m/s'),
                  ('lemniscate_3ms', '1000 flights of 60 s of the lemniscate at 3 m/s, gusts 0-0.5 m/s'),
@@ -655,8 +656,9 @@ def render(out_dir, present):
                                                                 m.get('host', ''), m.get('finished', '')), '']
         if base:
             bargs = dict((j[0], j[2]) for j in JOBS)['ftc_baselines']
-            body += ['`%s` (FixedA = `fixedtime`, our re-implementation of the fixed-time observer with the same NMPC; '
-                     'INDI driven by the same FDD)' % command_text(bargs), '']
+            body += ['`%s` (rotorguard, %s; FixedA = `fixedtime`, our re-implementation of the fixed-time observer with the '
+                     'same NMPC; INDI driven by the same FDD)' % (command_text(bargs),
+                                                                 manifest(os.path.join(out_dir, 'ftc_baselines')).get('version', '')), '']
         body += ['Single complete failures. SucR: the vehicle hovers or tracks on after the failure; MDR: the faulty',
                  'rotor not isolated correctly; FAR: a diagnosis before the onset or of another rotor; latency: onset',
                  'to isolation, over the correct isolations. The paper reports 20 trials per cell.', '', table, '']
@@ -800,7 +802,11 @@ def render(out_dir, present):
             total[1] += n
             if a:
                 where.append('%d in %s' % (a, name.replace('far_', '').replace('_', ' ')))
-        body += ['', 'Each set: `rotorguard campaign run configs/campaigns/<set>.yaml --out DIR`, then `campaign merge DIR`.',
+        builds = {}
+        for name, _, _, _ in far:
+            builds.setdefault(manifest(os.path.join(out_dir, name)).get('version', 'unknown'), []).append(name.replace('far_', ''))
+        body += ['', 'Each set: `rotorguard campaign run configs/campaigns/<set>.yaml --out DIR`, then `campaign merge DIR`; '
+                 'flown by rotorguard %s.' % '; '.join('%s (%s)' % (v, ', '.join(sets)) for v, sets in sorted(builds.items())),
                  'All sets together: %d false alarm%s in %d flights (%s).' % (total[0], '' if total[0] == 1 else 's', total[1],
                                                                              pct(total[0], total[1])), '']
         readme += ['- False alarms on %d healthy evaluation flights (%s, 1000 each): %d (%s)%s.'
