@@ -252,16 +252,17 @@ void CompositeFdd::RunObserver(double t, double dt) {
   const double support = vehicle_.mass_kg * force_filter_.value().z() - wrench_filter_.value()[0];
   const bool contact = support > kContactFraction * vehicle_.weight_n() &&
                        wrench_filter_.value()[0] < (1.0 - kContactFraction) * vehicle_.weight_n();
-  // A touchdown: once the flight has been above the ground band, coming back into it is a landing.
-  // The feet may touch anywhere in the band (the estimate's error is centimetres and never goes
-  // below the ground), and a vehicle rocking on its legs turns as a lost rotor would while the rotors,
-  // helped by the ground effect, still lift most of the weight: the contact rule cannot see it. The
-  // motor index keeps watching; a rotor lost higher up has had the whole fall to be seen. The
-  // flight's first lift-off rises through the band with the observer judging.
+  // A touchdown: once the flight has risen above the take-off detector's altitude, coming back into
+  // the ground band is a landing. The feet may touch anywhere in the band (the estimate's error is
+  // centimetres and never goes below the ground), and a vehicle rocking on its legs turns as a lost
+  // rotor would while the rotors, helped by the ground effect, still lift most of the weight: the
+  // contact rule cannot see it. The motor index keeps watching; a rotor lost higher up has had the
+  // whole fall to be seen. A take-off (whose estimate may cross the band's edge more than once)
+  // climbs through the band with the observer and the take-off detector judging.
   constexpr double kGroundBandM = 0.05;
   const bool in_band = estimate_.p_W.z() <= kGroundBandM;
-  if (have_estimate_ && !in_band) been_above_band_ = true;
-  const bool touching_down = been_above_band_ && in_band;
+  if (have_estimate_ && estimate_.p_W.z() > options_.takeoff_max_altitude_m) been_above_takeoff_ = true;
+  const bool touching_down = been_above_takeoff_ && in_band;
   const bool flying = have_estimate_ && !contact && !touching_down &&
                       (!in_band || wrench_filter_.value()[0] > kLiftFraction * vehicle_.weight_n());
   if (flying && !airborne_since_s_) {

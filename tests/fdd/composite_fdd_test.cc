@@ -460,7 +460,8 @@ TEST(CompositeFdd, ATouchdownsBounceDoesNotOpenTheTakeoffWindowALiftOffFromRestD
 
 TEST(CompositeFdd, BackInTheGroundBandTheObserverHoldsAndTheMotorIndexWatches) {
   // A touchdown rocks the vehicle on its legs as a lost rotor would turn it, while the rotors still
-  // lift the weight: the observer holds within 5 cm of the ground once the flight has been higher.
+  // lift the weight: the observer holds within 5 cm of the ground once the flight has been above
+  // the take-off detector's altitude.
   // The same turn at 10 cm is a lost propeller; a motor that stops in the band is still isolated.
   Bench b(1.0);
   ASSERT_FALSE(b.Run(1.0, 1.0));
@@ -476,6 +477,15 @@ TEST(CompositeFdd, BackInTheGroundBandTheObserverHoldsAndTheMotorIndexWatches) {
   m.drive_[1] = m.actual_[1] = 0.0;
   ASSERT_TRUE(m.Run(0.1, 0.03));
   EXPECT_EQ(m.fdd_.rotors()[1].detector, "motor_index");
+
+  // A take-off whose estimate crosses the band's edge and back (it lags the climb) is no touchdown:
+  // below the take-off detector's altitude the band does not hold the observer.
+  Bench c(1.0);
+  ASSERT_FALSE(c.Run(0.2, 0.08));
+  ASSERT_FALSE(c.Run(0.05, 0.03));
+  c.actual_[2] = 0.0;
+  ASSERT_TRUE(c.Run(0.3, 0.03));
+  EXPECT_EQ(c.fdd_.rotors()[2].health, RotorHealth::kPropellerFailed);
 }
 
 TEST(CompositeFdd, TheFlightsFirstLiftOffOpensTheTakeoffWindowHoweverShortTheRest) {

@@ -389,7 +389,7 @@ class CompositeFdd final : public FaultDetectorBase {
   std::optional<double> grounded_since_s_;  // on the ground (by the estimate and the contact test) since
   bool takeoff_armed_ = false;               // the current airborne phase began with a take-off
   bool been_airborne_ = false;               // an airborne phase came before
-  bool been_above_band_ = false;             // the estimate has been above the ground band
+  bool been_above_takeoff_ = false;          // the estimate has been above takeoff_max_altitude_m
   std::vector<double> above_since_s_, degraded_since_s_, degraded_sum_;
   std::vector<int> degraded_count_;
   Eigen::VectorXd thrust_loss_;
