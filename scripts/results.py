@@ -340,7 +340,9 @@ def pct(k, n):
     if n == 0:
         return '/'
     lo, hi = wilson(k, n)
-    d = 2 if 0 < k < 0.01 * n else 1  # a rate below 1 % keeps its second decimal: 2 of 5000 is not 0.0 %
+    # A rate or bound below 1 % keeps its second decimal: 2 of 5000 is not 0.0 %, nor is 0 of 9000's
+    # upper bound.
+    d = 2 if (0 < k < 0.01 * n) or (k == 0 and hi < 0.001) else 1
     return '%.*f %% [%.*f, %.*f]' % (d, 100.0 * k / n, d, 100.0 * lo, d, 100.0 * hi)
 
 
