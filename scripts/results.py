@@ -606,6 +606,7 @@ MARGINS = [  # (statistic, threshold key, lower is alarming, name)
     ('fdd.healthy_extremes.debounced_motor_index', 'motor_index_threshold', True, 'motor index'),
     ('fdd.healthy_extremes.persistent_propeller_index', 'propeller_index_threshold', False, 'propeller index'),
     ('fdd.healthy_extremes.gated_takeoff_index', 'takeoff_index_threshold', False, 'take-off index'),
+    ('fdd.healthy_extremes.debounced_motor_shortfall', 'motor_shortfall_threshold', False, 'motor shortfall'),
 ]
 
 
@@ -791,9 +792,11 @@ def render(out_dir, present):
                  'margin is the most alarming healthy value of a rule\'s statistic against its threshold (docs/metrics.md):',
                  'the lowest debounced motor index over gamma_M = %g, gamma_P = %g over the highest persistent propeller'
                  % (thresholds['motor_index_threshold'], thresholds['propeller_index_threshold']),
-                 'index, the take-off threshold %g over the highest gated take-off index.' % thresholds['takeoff_index_threshold'], '',
-                 '| set | flights | n | false alarms | FAR | errors | lowest debounced M_i (margin) | highest persistent P_i (margin) | highest gated take-off index (margin) |',
-                 '|---|---|---|---|---|---|---|---|---|']
+                 'index, the take-off threshold %g over the highest gated take-off index, gamma_S = %g over the highest'
+                 % (thresholds['takeoff_index_threshold'], thresholds['motor_shortfall_threshold']),
+                 'debounced motor shortfall (`/`: a set flown before that rule).', '',
+                 '| set | flights | n | false alarms | FAR | errors | lowest debounced M_i (margin) | highest persistent P_i (margin) | highest gated take-off index (margin) | highest debounced S_i (margin) |',
+                 '|---|---|---|---|---|---|---|---|---|---|']
         total = [0, 0]
         where = []
         for name, _, args, desc in far:

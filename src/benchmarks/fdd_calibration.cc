@@ -345,6 +345,13 @@ nlohmann::json CalibrateCompositeFdd(const std::vector<CalibrationLog>& logs,
        &fdd::IndexExtremes::max_takeoff_index,
        {0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.47, 0.6, 0.8, 1.0, 1.2, 1.5},
        false},
+      // The shortfall rule's statistic is its own index, debounced (no gates to pass).
+      {"motor_shortfall_threshold",
+       &fdd::CompositeFddOptions::motor_shortfall_threshold,
+       &fdd::IndexExtremes::debounced_motor_shortfall,
+       &fdd::IndexExtremes::debounced_motor_shortfall,
+       {0.02, 0.03, 0.04, 0.05, 0.07, 0.1, 0.15, 0.2, 0.3, 0.5},
+       false},
   };
   const auto finite_or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   nlohmann::json sweep_docs = nlohmann::json::array();
@@ -488,10 +495,12 @@ std::string CalibrationMarkdown(const nlohmann::json& c) {
   const auto& x = c["fault_free_extremes"];
   fmt::format_to(it,
                  "\n\nFault-free extremes (/: not moved), each rule's statistic (the index itself):\n"
-                 "debounced M_i {} ({}), persistent P_i {} ({}), gated take-off index {} ({})\n",
+                 "debounced M_i {} ({}), persistent P_i {} ({}), gated take-off index {} ({}), debounced motor "
+                 "shortfall {}\n",
                  num(x["debounced_motor_index"], "{:.3f}"), num(x["min_motor_index"], "{:.3f}"),
                  num(x["persistent_propeller_index"], "{:.3f}"), num(x["max_propeller_index"], "{:.3f}"),
-                 num(x["gated_takeoff_index"], "{:.3f}"), num(x["max_takeoff_index"], "{:.3f}"));
+                 num(x["gated_takeoff_index"], "{:.3f}"), num(x["max_takeoff_index"], "{:.3f}"),
+                 num(x["debounced_motor_shortfall"], "{:.3f}"));
   for (const auto& sw : c["sweeps"]) {
     fmt::format_to(it, "\n### {} (configured {:g})\n\n", sw["threshold"].get<std::string>(), sw["configured"].get<double>());
     fmt::format_to(it, "| value | detected | missed | false alarms | latency mean (s) | latency max (s) | margin |\n");
@@ -517,6 +526,7 @@ std::string CalibratedFddYaml(const nlohmann::json& calibration, fdd::CompositeF
     if (name == "motor_index_threshold") base.motor_index_threshold = value;
     if (name == "propeller_index_threshold") base.propeller_index_threshold = value;
     if (name == "takeoff_index_threshold") base.takeoff_index_threshold = value;
+    if (name == "motor_shortfall_threshold") base.motor_shortfall_threshold = value;
     applied += fmt::format("#   {}\n", sw["note"].get<std::string>());
   }
   base.Validate();

@@ -47,7 +47,8 @@ const std::vector<std::string> kRecordable = {"success",
                                               "fdd.healthy_extremes.debounced_motor_index",
                                               "fdd.healthy_extremes.persistent_propeller_index",
                                               "fdd.healthy_extremes.gated_takeoff_index",
-                                              "fdd.healthy_extremes.second_failure_index"};
+                                              "fdd.healthy_extremes.second_failure_index",
+                                              "fdd.healthy_extremes.debounced_motor_shortfall"};
 const std::vector<std::string> kDefaultMetrics = {
     "success",        "crashed",      "tracking_rmse_m", "max_position_error_m",
     "min_altitude_m", "max_tilt_rad", "tilt_recovery_s"};

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "rotorguard/core/error.h"
@@ -74,6 +75,67 @@ const RotorVector& CommandedMotors::AdvanceTo(TimeNs t) {
     Activate(t_ns_);
   }
   return thrust_;
+}
+
+RotorHistory::RotorHistory(int num_rotors, int capacity) {
+  if (num_rotors < 1 || num_rotors > kMaxRotors) {
+    ThrowInvalidArgument("RotorHistory", "num_rotors", num_rotors, fmt::format("a count in [1, {}]", kMaxRotors));
+  }
+  if (capacity < 2) ThrowInvalidArgument("RotorHistory", "capacity", capacity, "a capacity >= 2");
+  t_.assign(static_cast<std::size_t>(capacity), 0);
+  values_.assign(static_cast<std::size_t>(capacity), RotorVector::Zero(num_rotors));
+}
+
+TimeNs RotorHistory::newest_time() const { return t_[(head_ + size_ + t_.size() - 1) % t_.size()]; }
+
+void RotorHistory::Push(TimeNs t, const RotorVector& values) {
+  if (values.size() != values_.front().size() || !values.allFinite()) return;
+  const std::size_t n = t_.size();
+  if (size_ > 0) {
+    const std::size_t last = (head_ + size_ - 1) % n;
+    if (t < t_[last]) return;
+    if (t == t_[last]) {
+      values_[last] = values;
+      return;
+    }
+  }
+  if (size_ == n) {
+    head_ = (head_ + 1) % n;
+    --size_;
+  }
+  const std::size_t k = (head_ + size_) % n;
+  t_[k] = t;
+  values_[k] = values;
+  ++size_;
+}
+
+std::optional<std::size_t> RotorHistory::LatestAtOrBefore(TimeNs t) const {
+  for (std::size_t k = size_; k-- > 0;) {
+    const std::size_t j = (head_ + k) % t_.size();
+    if (t_[j] <= t) return j;
+  }
+  return std::nullopt;
+}
+
+bool RotorHistory::LowestOver(TimeNs from, TimeNs to, RotorVector* lowest) const {
+  const std::size_t n = t_.size();
+  if (size_ == 0 || t_[head_] > from) return false;
+  // From the newest back: the entries after `to` are not in force in the interval; the first one
+  // at or before `from` is the one in force there, and the last needed.
+  bool any = false;
+  for (std::size_t k = size_; k-- > 0;) {
+    const std::size_t j = (head_ + k) % n;
+    if (t_[j] > to) continue;
+    *lowest = any ? lowest->cwiseMin(values_[j]) : values_[j];
+    any = true;
+    if (t_[j] <= from) break;
+  }
+  return any;
+}
+
+double HealthyThrustFloor(double start_n, double lowest_command_n, double window_s, double min_time_constant_s) {
+  const double settled = lowest_command_n + (start_n - lowest_command_n) * std::exp(-window_s / min_time_constant_s);
+  return std::min(start_n, settled);
 }
 
 }  // namespace rotorguard::fdd

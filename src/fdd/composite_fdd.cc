@@ -13,6 +13,12 @@
 namespace rotorguard::fdd {
 
 namespace {
+// The shortfall rule's rings: commands (a 64-cycle span covers the window and the delay span at
+// control rates up to 2 kHz), and telemetry thrusts kept at least an eighth of the window apart,
+// so that 16 span more than the window at any telemetry rate.
+constexpr int kShortfallCommands = 64;
+constexpr int kShortfallSamples = 16;
+
 void RequireIn(const char* field, double v, double lo, double hi, const char* rule) {
   if (!std::isfinite(v) || v < lo || v > hi) ThrowValidation("CompositeFddOptions", field, v, rule);
 }
@@ -43,6 +49,7 @@ CompositeFddOptions CompositeFddOptions::Disarmed() const {
   o.motor_index_threshold = 1e-6;
   o.propeller_index_threshold = 1.0;
   o.takeoff_index_threshold = 1e6;
+  o.motor_shortfall_threshold = 1.0;
   return o;
 }
 
@@ -53,7 +60,9 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
       n_(vehicle.num_rotors()),
       motors_(vehicle.num_rotors(), vehicle.motor_time_constant_s,
               options.command_delay_s + options.motor_index_delay_margin_s),
-      wrench_notch_(vehicle.num_rotors(), options.imu_notch) {
+      wrench_notch_(vehicle.num_rotors(), options.imu_notch),
+      commands_(vehicle.num_rotors(), kShortfallCommands),
+      measured_history_(vehicle.num_rotors(), kShortfallSamples) {
   effectiveness_ = vehicle::ComputeEffectivenessMatrix(vehicle_.rotors);
   pinv_ = vehicle::PseudoInverse(effectiveness_);
   expected_thrust_ = RotorVector::Zero(n_);
@@ -61,6 +70,10 @@ CompositeFdd::CompositeFdd(const vehicle::VehicleParams& vehicle, const Composit
   working_ = RotorVector::Ones(n_);
   low_index_count_.assign(n_, 0);
   low_index_since_s_.assign(n_, 0.0);
+  mean_measured_ = mean_modelled_ = lowest_command_ = RotorVector::Zero(n_);
+  shortfall_count_.assign(n_, 0);
+  shortfall_since_s_.assign(n_, 0.0);
+  recent_shortfall_.assign(n_, SampleRing(static_cast<std::size_t>(options_.motor_index_samples)));
   recent_motor_index_.assign(n_, SampleRing(static_cast<std::size_t>(options_.motor_index_samples)));
   // Twice the samples the persistence spans at the nominal IMU rate, for a faster or jittery IMU.
   const auto persistence_samples =
@@ -147,6 +160,7 @@ void IndexExtremes::Merge(const IndexExtremes& other) {
   persistent_propeller_index = std::max(persistent_propeller_index, other.persistent_propeller_index);
   gated_takeoff_index = std::max(gated_takeoff_index, other.gated_takeoff_index);
   second_failure_index = std::max(second_failure_index, other.second_failure_index);
+  debounced_motor_shortfall = std::max(debounced_motor_shortfall, other.debounced_motor_shortfall);
 }
 
 FaultDetectorBase::FaultDetectorBase(int num_rotors) : rotors_(static_cast<std::size_t>(num_rotors)) {}
@@ -181,7 +195,10 @@ void FaultDetectorBase::SetEstimate(const StateEstimate& estimate) {
   have_estimate_ = true;
 }
 
-void CompositeFdd::SetCommand(const RotorCommand& command) { motors_.OnCommand(command.t_ns, command.thrust_n); }
+void CompositeFdd::SetCommand(const RotorCommand& command) {
+  motors_.OnCommand(command.t_ns, command.thrust_n);
+  commands_.Push(command.t_ns, command.thrust_n);
+}
 
 void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
   if (esc.motor_speed_rad_s.size() != n_ || !esc.motor_speed_rad_s.allFinite()) return;
@@ -219,7 +236,63 @@ void CompositeFdd::OnEscTelemetry(const EscTelemetry& esc) {
       Isolate(i, RotorHealth::kMotorFailed, t, "motor_index", low_index_since_s_[i]);
     }
   }
+  CheckShortfall(esc.t_ns);
   have_esc_ = true;
+}
+
+void CompositeFdd::CheckShortfall(TimeNs t_ns) {
+  const double t = ToSeconds(t_ns);
+  const TimeNs window_ns = FromSeconds(options_.motor_shortfall_window_s);
+  // Each rotor's measured-to-modelled ratio: the file's thrust coefficient and the ESC's gain are
+  // not the vehicle's, and the commands the floor starts from are in the file's newtons.
+  const double dt = last_esc_ns_ ? ToSeconds(t_ns - *last_esc_ns_) : 0.0;
+  last_esc_ns_ = t_ns;
+  const double blend = std::min(1.0, std::max(0.0, dt) / options_.motor_scale_time_constant_s);
+  for (int i = 0; i < n_; ++i) {
+    if (IsIsolated(rotors_[i].health)) continue;
+    mean_measured_[i] += blend * (measured_thrust_[i] - mean_measured_[i]);
+    mean_modelled_[i] += blend * (expected_thrust_[i] - mean_modelled_[i]);
+  }
+  // The telemetry a window ago: the latest sample kept at or before t - W, and its actual age.
+  const std::optional<std::size_t> start = measured_history_.LatestAtOrBefore(t_ns - window_ns);
+  const TimeNs delay_ns = FromSeconds(options_.command_delay_s + options_.motor_delay_span_s);
+  const bool judged = start && commands_.LowestOver(measured_history_.time(*start) - delay_ns, t_ns, &lowest_command_);
+  const double min_thrust = options_.min_thrust_fraction * hover_thrust_per_rotor_n_;
+  for (int i = 0; i < n_ && judged; ++i) {
+    if (IsIsolated(rotors_[i].health)) continue;
+    const double ratio = mean_modelled_[i] > min_thrust ? mean_measured_[i] / mean_modelled_[i] : 1.0;
+    const double command =
+        std::clamp(lowest_command_[i], 0.0, vehicle_.rotors[i].max_thrust_n) * ratio * (1.0 - options_.motor_scale_margin);
+    const double floor = HealthyThrustFloor(measured_history_.values(*start)[i], command,
+                                            ToSeconds(t_ns - measured_history_.time(*start)),
+                                            (1.0 - options_.motor_lag_fraction) * vehicle_.motor_time_constant_s);
+    if (floor < min_thrust) {
+      shortfall_count_[i] = 0;
+      recent_shortfall_[i].Clear();
+      continue;
+    }
+    const double shortfall = 1.0 - measured_thrust_[i] / floor;
+    if (!first_isolated_) {
+      SampleRing& recent = recent_shortfall_[i];
+      recent.Push(t, shortfall);
+      if (static_cast<int>(recent.size()) == options_.motor_index_samples) {
+        extremes_.debounced_motor_shortfall = std::max(extremes_.debounced_motor_shortfall, recent.Min());
+      }
+    }
+    shortfall_count_[i] = shortfall > options_.motor_shortfall_threshold ? shortfall_count_[i] + 1 : 0;
+    if (shortfall_count_[i] == 1) shortfall_since_s_[i] = t;
+    if (shortfall_count_[i] >= options_.motor_index_samples) {
+      Isolate(i, RotorHealth::kMotorFailed, t, "motor_shortfall", shortfall_since_s_[i]);
+    }
+  }
+  if (!judged) {  // the history does not reach back a window and the delay span yet
+    std::fill(shortfall_count_.begin(), shortfall_count_.end(), 0);
+    for (SampleRing& recent : recent_shortfall_) recent.Clear();
+  }
+  // Keep this sample when an eighth of the window has passed since the last one kept.
+  if (measured_history_.empty() || t_ns - measured_history_.newest_time() >= window_ns / 8) {
+    measured_history_.Push(t_ns, measured_thrust_);
+  }
 }
 
 void CompositeFdd::OnImu(const ImuSample& imu) {

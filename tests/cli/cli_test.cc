@@ -467,7 +467,7 @@ TEST_F(CliTest, FddCalibrateReplaysRunFoldersAndRejectsBadOnes) {
   EXPECT_NE(r.out.find("2 logs (1 faulty, 1 fault-free)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("### motor_index_threshold"), std::string::npos);
   const nlohmann::json j = nlohmann::json::parse(ReadText(fs::path(Out()) / "cal" / "calibration.json"));
-  EXPECT_EQ(j["sweeps"].size(), 3u);
+  EXPECT_EQ(j["sweeps"].size(), 4u);
   EXPECT_EQ(j["logs"][1]["with_configured_thresholds"]["correct"], true);
   // --write: the thresholds with the suggestions applied, a file a vehicle file names with `fdd:`.
   const Result w = Cli("fdd-calibrate " + Out() + "/free " + Out() + "/faulty --write " + Out() + "/thresholds.yaml");

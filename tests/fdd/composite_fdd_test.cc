@@ -9,6 +9,9 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "rotorguard/core/error.h"
 #include "rotorguard/core/rng.h"
@@ -21,13 +24,31 @@ namespace {
 
 using rotorguard::testing::ReferenceQuad;
 
+/// The bench below drives its motors' telemetry straight from the drive thrusts, faster than any
+/// motor: the motor shortfall rule, which bounds how fast a healthy motor can slow, is off on it
+/// (FlyLaggingMotors below flies it).
+CompositeFddOptions WithoutShortfall() {
+  CompositeFddOptions o;
+  o.motor_shortfall_threshold = 1.0;
+  return o;
+}
+
+template <typename Options>
+Options BenchDefaults() {
+  return Options{};
+}
+template <>
+CompositeFddOptions BenchDefaults() {
+  return WithoutShortfall();
+}
+
 /// A vehicle hovering at 1 m whose rotors drive `drive` thrusts while `actual` thrusts act (they
 /// differ by the fault); integrates the rotation the torque imbalance causes and feeds the FDD
 /// IMU (333 Hz, polled at 1 kHz), telemetry (1 kHz) and estimates (200 Hz).
 template <typename Detector, typename Options>
 class BenchOf {
  public:
-  explicit BenchOf(double noise = 0.0, Options options = {})
+  explicit BenchOf(double noise = 0.0, Options options = BenchDefaults<Options>())
       : vehicle_(ReferenceQuad()), fdd_(vehicle_, options), rng_(3), noise_(noise) {
     hover_ = RotorVector::Constant(4, vehicle_.weight_n() / 4.0);
     drive_ = actual_ = hover_;
@@ -241,7 +262,7 @@ TEST(CompositeFdd, AForceBalanceSwingInTheAirIsNotTakenForTheGround) {
 
 TEST(CompositeFdd, ASecondLossWithinTheRelearningIsNotJudgedUntilItEnds) {
   for (double relearn : {2.0, 0.0}) {
-    CompositeFddOptions o;
+    CompositeFddOptions o = WithoutShortfall();
     o.post_isolation_relearn_s = relearn;
     Bench b(1.0, o);
     ASSERT_FALSE(b.Run(1.0));
@@ -289,6 +310,8 @@ TEST(CompositeFdd, EachRulesStatisticIsExactlyItsAlarmBoundary) {
   const Case cases[] = {
       {"motor_index", &CompositeFddOptions::motor_index_threshold, &IndexExtremes::debounced_motor_index, true, 30.0,
        1.0, 1.0},
+      {"motor_shortfall", &CompositeFddOptions::motor_shortfall_threshold, &IndexExtremes::debounced_motor_shortfall,
+       false, 30.0, 1.0, 1.0},
       {"thrust_loss_observer", &CompositeFddOptions::propeller_index_threshold,
        &IndexExtremes::persistent_propeller_index, false, 1.0, 1.0, 0.5},
       {"takeoff", &CompositeFddOptions::takeoff_index_threshold, &IndexExtremes::gated_takeoff_index, false, 1.0, 0.3,
@@ -330,7 +353,7 @@ TEST(CompositeFdd, EachRulesStatisticIsExactlyItsAlarmBoundary) {
 // healthy hover before the stop stays far from.
 TEST(CompositeFdd, TheSecondFailuresStatisticIsExactlyItsAlarmBoundary) {
   const auto fly = [](double threshold) {
-    CompositeFddOptions o;
+    CompositeFddOptions o = WithoutShortfall();
     o.propeller_index_threshold = threshold;
     auto b = std::make_unique<Bench>(1.0, o);
     b->Run(2.0);
@@ -389,7 +412,7 @@ TEST(CompositeFdd, MeasuresLossesFromTheResidualOfTheVehicleAsItFlies) {
   // wrong): to the file's model rotor 0 loses a fifth of its thrust, from the start. The baseline
   // learns that residual; a later true partial loss of rotor 2 is measured from it.
   for (const double time_constant : {0.5, 0.0}) {
-    CompositeFddOptions o;
+    CompositeFddOptions o = WithoutShortfall();
     o.baseline_time_constant_s = time_constant;
     Bench b(1.0, o);
     b.drive_[0] = 1.25 * b.hover_[0];
@@ -415,7 +438,7 @@ TEST(CompositeFdd, TakeoffDetectorIgnoresATurnThatCostsNoThrust) {
   // their telemetry says (as a centre of gravity off the file's does): the vehicle turns as if
   // rotor 1 were lost, at 18 rad/s², but no thrust is missing.
   for (const double fraction : {0.5, 0.0}) {
-    CompositeFddOptions o;
+    CompositeFddOptions o = WithoutShortfall();
     o.takeoff_missing_thrust_fraction = fraction;
     Bench b(1.0, o);
     ASSERT_FALSE(b.Run(0.2, 0.02));
@@ -437,7 +460,7 @@ TEST(CompositeFdd, ATouchdownsBounceDoesNotOpenTheTakeoffWindowALiftOffFromRestD
   // take-off detector's case when the vehicle rested there 0.5 s, not after a 50 ms bounce (a
   // touchdown rocks the vehicle on its feet as a lost rotor turns it).
   for (const double rest_s : {0.05, 0.5}) {
-    CompositeFddOptions o;
+    CompositeFddOptions o = WithoutShortfall();
     o.propeller_persistence_s = 1.0;  // keep the observer's own isolation out of the way
     Bench b(1.0, o);
     ASSERT_FALSE(b.Run(4.0, 0.02));  // low hover: the window of the flight's start has closed
@@ -490,7 +513,7 @@ TEST(CompositeFdd, BackInTheGroundBandTheObserverHoldsAndTheMotorIndexWatches) {
 
 TEST(CompositeFdd, TheFlightsFirstLiftOffOpensTheTakeoffWindowHoweverShortTheRest) {
   // A take-off whose motors spin up at once leaves the ground 0.1 s after the start.
-  CompositeFddOptions o;
+  CompositeFddOptions o = WithoutShortfall();
   o.propeller_persistence_s = 1.0;
   Bench b(1.0, o);
   b.drive_ = b.actual_ = 0.5 * b.hover_;
@@ -517,7 +540,7 @@ TEST(CompositeFdd, ARampLossCrossesIntoPropellerFailure) {
 
 TEST(CompositeFdd, TakeoffDetectorIsolatesEveryRotorJustAfterLiftOff) {
   for (int rotor = 0; rotor < 4; ++rotor) {
-    CompositeFddOptions o;
+    CompositeFddOptions o = WithoutShortfall();
     o.propeller_persistence_s = 1.0;  // keep the observer's own isolation out of the way
     Bench b(1.0, o);
     ASSERT_FALSE(b.Run(0.2, 0.02));  // lifting off: thrust at weight, 2 cm up
@@ -553,6 +576,108 @@ TEST(FixedTimeFdd, IsolatesEveryRotorFromTheObserverWithoutTelemetry) {
 TEST(FixedTimeFdd, FiltersAtTheCompositeFddsCutOff) {
   // A fair comparison: the baseline's filters pass what ours pass.
   EXPECT_EQ(FixedTimeFddOptions{}.estimate_cutoff_hz, CompositeFddOptions{}.filter_cutoff_hz);
+}
+
+/// Motors that follow their commands through eq. (6) with their own time constant (sigma_ratio
+/// times the file's) and delay, integrated exactly in 0.1 ms steps; telemetry at 1 kHz with speed
+/// noise, commands at 200 Hz whose level per rotor steps every 20 ms between 0.3 and 1.5 of the
+/// hover thrust per rotor (a vehicle manoeuvring hard). Only telemetry and commands: the motor
+/// rules alone judge. `stop_rotor`, held at hover, coasts down from stop_at_s with its own time
+/// constant (a motor stop, as the simulator draws it).
+struct LaggingMotors {
+  double sigma_ratio = 1.0;
+  double delay_s = 0.0;
+  int stop_rotor = -1;
+  double stop_at_s = 0.0, stop_time_constant_s = 0.05;
+};
+
+struct LaggingFlight {
+  std::optional<double> detected_s;
+  std::string detector;
+  IndexExtremes extremes;
+};
+
+LaggingFlight FlyLaggingMotors(const LaggingMotors& m, const CompositeFddOptions& options, std::uint64_t seed) {
+  const vehicle::VehicleParams vehicle = ReferenceQuad();
+  CompositeFdd fdd(vehicle, options);
+  Rng rng(seed);
+  const double hover = vehicle.weight_n() / 4.0, sigma = m.sigma_ratio * vehicle.motor_time_constant_s;
+  RotorVector level = RotorVector::Constant(4, hover), thrust = level;
+  std::vector<std::pair<double, RotorVector>> commands;  // (instant, thrusts), all of the flight
+  std::size_t acting = 0;
+  LaggingFlight out;
+  constexpr double kStep = 1e-4;
+  for (int k = 0; k <= 20000; ++k) {  // 2 s
+    const double t = k * kStep;
+    if (k % 200 == 0) {
+      for (int i = 0; i < 4; ++i) level[i] = i == m.stop_rotor ? hover : hover * rng.Uniform(0.3, 1.5);
+    }
+    if (k % 50 == 0) {
+      commands.emplace_back(t, level);
+      fdd.SetCommand(RotorCommand{FromSeconds(t), level});
+    }
+    if (k % 10 == 0) {
+      EscTelemetry esc;
+      esc.t_ns = FromSeconds(t);
+      esc.motor_speed_rad_s = (thrust / vehicle.thrust_coefficient_n_s2).cwiseSqrt();
+      for (int i = 0; i < 4; ++i) esc.motor_speed_rad_s[i] += 2.0 * rng.Normal();
+      fdd.OnEscTelemetry(esc);
+      if (const auto rotor = fdd.first_isolated_rotor(); rotor && !out.detected_s) {
+        out.detected_s = *fdd.rotors()[*rotor].detected_s;
+        out.detector = fdd.rotors()[*rotor].detector;
+      }
+    }
+    // The command in force over the next step: the latest whose instant plus the delay has come.
+    while (acting + 1 < commands.size() && commands[acting + 1].first + m.delay_s <= t + 1e-12) ++acting;
+    for (int i = 0; i < 4; ++i) {
+      if (i == m.stop_rotor && t >= m.stop_at_s) {
+        thrust[i] *= std::exp(-kStep / m.stop_time_constant_s);
+      } else {
+        thrust[i] = commands[acting].second[i] + (thrust[i] - commands[acting].second[i]) * std::exp(-kStep / sigma);
+      }
+    }
+  }
+  out.extremes = fdd.healthy_extremes();
+  return out;
+}
+
+TEST(CompositeFdd, HealthyMotorsFasterAndLaterThanTheFileStayAboveTheShortfallFloor) {
+  const CompositeFddOptions o;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    // 20 % faster than the file and 6 ms late (within the 30 % and the delay span the floor allows),
+    // and 20 % slower with no delay.
+    for (const auto& [ratio, delay] : {std::pair{0.8, 0.006}, std::pair{1.2, 0.0}}) {
+      const LaggingFlight f = FlyLaggingMotors({.sigma_ratio = ratio, .delay_s = delay}, o, seed);
+      EXPECT_FALSE(f.detected_s) << "seed " << seed << ", sigma x" << ratio << ": " << f.detector;
+      EXPECT_LT(f.extremes.debounced_motor_shortfall, 0.02) << "seed " << seed << ", sigma x" << ratio;
+      EXPECT_GT(f.extremes.debounced_motor_shortfall, -1.0);
+    }
+  }
+  // Motors twice as fast as the file fall faster than the floor allows: the floor is what bounds.
+  const LaggingFlight fast = FlyLaggingMotors({.sigma_ratio = 0.5}, o, 1);
+  EXPECT_GT(fast.extremes.debounced_motor_shortfall, o.motor_shortfall_threshold);
+}
+
+TEST(CompositeFdd, AStoppingMotorIsIsolatedByItsShortfallBeforeItsIndexFalls) {
+  const CompositeFddOptions o;
+  CompositeFddOptions index_only = o;
+  index_only.motor_shortfall_threshold = 1.0;
+  // The simulator's motor stops coast down with a time constant of 5 to 50 ms.
+  for (const auto& [coast, bound] : {std::pair{0.05, 0.010}, std::pair{0.005, 0.003}}) {
+    for (int rotor = 0; rotor < 4; ++rotor) {
+      const LaggingMotors m{.sigma_ratio = 0.8, .delay_s = 0.006, .stop_rotor = rotor, .stop_at_s = 1.0,
+                            .stop_time_constant_s = coast};
+      const LaggingFlight f = FlyLaggingMotors(m, o, 7);
+      ASSERT_TRUE(f.detected_s) << "coast " << coast << ", rotor " << rotor;
+      EXPECT_EQ(f.detector, "motor_shortfall");
+      EXPECT_GE(*f.detected_s, 1.0);
+      EXPECT_LE(*f.detected_s - 1.0, bound) << "coast " << coast << ", rotor " << rotor;
+      const LaggingFlight by_index = FlyLaggingMotors(m, index_only, 7);
+      ASSERT_TRUE(by_index.detected_s);
+      EXPECT_EQ(by_index.detector, "motor_index");
+      EXPECT_GT(*by_index.detected_s - 1.0, 3.0 * (*f.detected_s - 1.0)) << "coast " << coast;
+    }
+  }
 }
 
 TEST(CompositeFdd, OptionsValidationNamesTheField) {

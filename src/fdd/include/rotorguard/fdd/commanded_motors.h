@@ -4,7 +4,13 @@
 /// latency the stack expects), and a motor follows the command acting on it through the first-order
 /// lag of paper 000's eq. (6), integrated exactly piece by piece between the instants commands
 /// start acting. Nothing is allocated after construction.
+///
+/// RotorHistory and HealthyThrustFloor bound the other way: how low a healthy motor can be now,
+/// whatever its delay and however much faster than the file it is (the motor shortfall rule,
+/// docs/fdd.md).
 #include <array>
+#include <optional>
+#include <vector>
 
 #include "rotorguard/core/types.h"
 
@@ -44,5 +50,40 @@ class CommandedMotors {
   TimeNs t_ns_ = 0;
   bool started_ = false;
 };
+
+/// Timed per-rotor values of the last span (the commands sent, or the thrusts measured), in a ring
+/// fixed at construction: when full, a new entry drops the oldest, and a query reaching before what
+/// is kept has no answer. The motor shortfall rule asks for the lowest command that can have acted
+/// over an interval, whatever the delay, and for the thrust measured a window ago.
+class RotorHistory {
+ public:
+  /// Holds up to `capacity` >= 2 entries. Throws std::invalid_argument.
+  RotorHistory(int num_rotors, int capacity);
+  /// Values for time t; one older than the latest is ignored, one for the same instant replaces it.
+  void Push(TimeNs t, const RotorVector& values);
+  TimeNs newest_time() const;  ///< the latest entry's time; empty(): undefined
+  bool empty() const { return size_ == 0; }
+  /// Per rotor, the lowest value in force at some instant of [from, to]: the entries within it and
+  /// the one in force at `from` (the latest before it). False, `lowest` untouched, when the history
+  /// does not reach back to `from` (no entry at or before it is kept).
+  bool LowestOver(TimeNs from, TimeNs to, RotorVector* lowest) const;
+  /// The latest entry at or before t (its index for time() and values()), if one is kept.
+  std::optional<std::size_t> LatestAtOrBefore(TimeNs t) const;
+  TimeNs time(std::size_t index) const { return t_[index]; }
+  const RotorVector& values(std::size_t index) const { return values_[index]; }
+
+ private:
+  std::vector<TimeNs> t_;
+  std::vector<RotorVector> values_;
+  std::size_t head_ = 0, size_ = 0;  // the oldest entry, and how many
+};
+
+/// The lowest thrust [N] a healthy motor can give `window_s` after it gave `start_n`, while every
+/// command acting on it was at least `lowest_command_n`, for any time constant >= `min_time_constant_s`
+/// > 0. Eq. (6) is linear with a positive gain, so its solutions are ordered by their inputs and start:
+/// the motor is above the one driven by the lowest command throughout, c + (T0 - c) e^(-W/sigma),
+/// which falls fastest with the shortest sigma; a motor below that command rises, and stays above
+/// where it started.
+double HealthyThrustFloor(double start_n, double lowest_command_n, double window_s, double min_time_constant_s);
 
 }  // namespace rotorguard::fdd

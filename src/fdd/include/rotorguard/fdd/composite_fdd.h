@@ -35,6 +35,24 @@ struct CompositeFddOptions {
   /// cycle, and a reference that leads the motors reads a healthy motor spinning up as stopped.
   /// Judged against the latest plausible response, a stopped motor is found this much later.
   double motor_index_delay_margin_s = 0.005;
+  /// Motor shortfall: a stopping motor slows faster than any command lets a healthy one
+  /// (docs/fdd.md, "The motor shortfall"). S_i = 1 - T_measured / floor, the floor the lowest thrust
+  /// a healthy motor can have now (HealthyThrustFloor) from its telemetry motor_shortfall_window_s
+  /// ago; S_i above this for motor_index_samples samples isolates a motor failure (gamma_S), in
+  /// (0, 1]: 1 turns the rule off (S_i never exceeds 1).
+  double motor_shortfall_threshold = 0.05;
+  /// The window over which the floor is taken [s], in (0, 0.1].
+  double motor_shortfall_window_s = 0.005;
+  /// A healthy motor may be this fraction faster than the vehicle file's time constant, in [0, 0.9].
+  double motor_lag_fraction = 0.3;
+  /// A command may act with any delay from 0 to command_delay_s plus this [s], in [0, 0.1].
+  double motor_delay_span_s = 0.015;
+  /// Each rotor's measured-to-modelled thrust ratio (its telemetry against CommandedMotors), which
+  /// scales the commands the floor starts from, is the ratio of their averages over this time
+  /// constant [s], in (0, 100] ...
+  double motor_scale_time_constant_s = 0.5;
+  /// ... less this fraction, in [0, 0.5].
+  double motor_scale_margin = 0.03;
   /// The indices are evaluated only while the rotor's thrust (expected, for M_i; measured, for
   /// P_i) exceeds this fraction of its share of the hover thrust, W / n (w_expected -> 0 makes
   /// the ratios meaningless), in (0, 1].
@@ -130,6 +148,23 @@ struct CompositeFddOptions {
                          "uncertainty",
               .min = 0.0,
               .max = 0.1});
+    a->Visit("motor_shortfall_threshold", &motor_shortfall_threshold,
+             {.meaning = "γ_S: a motor shortfall S_i above it for motor_index_samples isolates a motor failure "
+                         "(1: off)",
+              .max = 1.0,
+              .positive = true});
+    a->Visit("motor_shortfall_window_s", &motor_shortfall_window_s,
+             {.meaning = "the window of the healthy thrust floor [s]", .max = 0.1, .positive = true});
+    a->Visit("motor_lag_fraction", &motor_lag_fraction,
+             {.meaning = "a healthy motor may be this fraction faster than the file's time constant", .min = 0.0, .max = 0.9});
+    a->Visit("motor_delay_span_s", &motor_delay_span_s,
+             {.meaning = "a command may act with any delay up to stack.command_delay_s plus this [s]", .min = 0.0, .max = 0.1});
+    a->Visit("motor_scale_time_constant_s", &motor_scale_time_constant_s,
+             {.meaning = "each rotor's measured-to-modelled thrust ratio is averaged over this [s] ...",
+              .max = 100.0,
+              .positive = true});
+    a->Visit("motor_scale_margin", &motor_scale_margin,
+             {.meaning = "... and lowered by this fraction", .min = 0.0, .max = 0.5});
     a->Visit("min_thrust_fraction", &min_thrust_fraction,
              {.meaning = "the indices are evaluated only above this fraction of a rotor's hover thrust W/n",
               .max = 1.0,
@@ -224,7 +259,7 @@ struct RotorStatus {
 };
 
 /// The most alarming values a composite FDD's indices took. The first three are the indices
-/// themselves; the last three are what each rule compares with its threshold (the index through
+/// themselves; the others are what each rule compares with its threshold (the index through
 /// the rule's debounce, persistence or gates), so a threshold beyond them raises no alarm on that
 /// flight: the statistics a margin is stated on (fdd-calibrate, docs/fdd.md).
 struct IndexExtremes {
@@ -244,13 +279,16 @@ struct IndexExtremes {
   /// they fail): gamma_P below it would have isolated a second rotor. 0 in a flight with no
   /// isolation.
   double second_failure_index = 0.0;
+  /// Highest motor shortfall S_i held over motor_index_samples consecutive telemetry samples:
+  /// gamma_S below it would have isolated a motor.
+  double debounced_motor_shortfall = 0.0;
   void Merge(const IndexExtremes& other);
   template <typename Archive>
   void Serialize(Archive* a);
 };
 
 /// Each statistic's name in run summaries (fdd.healthy_extremes.NAME) and its member.
-inline constexpr std::array<std::pair<std::string_view, double IndexExtremes::*>, 7> kIndexExtremesFields{{
+inline constexpr std::array<std::pair<std::string_view, double IndexExtremes::*>, 8> kIndexExtremesFields{{
     {"min_motor_index", &IndexExtremes::min_motor_index},
     {"max_propeller_index", &IndexExtremes::max_propeller_index},
     {"max_takeoff_index", &IndexExtremes::max_takeoff_index},
@@ -258,6 +296,7 @@ inline constexpr std::array<std::pair<std::string_view, double IndexExtremes::*>
     {"persistent_propeller_index", &IndexExtremes::persistent_propeller_index},
     {"gated_takeoff_index", &IndexExtremes::gated_takeoff_index},
     {"second_failure_index", &IndexExtremes::second_failure_index},
+    {"debounced_motor_shortfall", &IndexExtremes::debounced_motor_shortfall},
 }};
 
 template <typename Archive>
@@ -359,6 +398,8 @@ class CompositeFdd final : public FaultDetectorBase {
   };
 
   void RunObserver(double t, double dt);
+  /// The motor shortfall rule on the telemetry at t (measured_thrust_ and expected_thrust_ set).
+  void CheckShortfall(TimeNs t);
 
   vehicle::VehicleParams vehicle_;
   CompositeFddOptions options_;
@@ -371,6 +412,14 @@ class CompositeFdd final : public FaultDetectorBase {
   RpmNotchBank<4> wrench_notch_;  // the telemetry's wrench, notched as the stack notches the IMU
   std::vector<int> low_index_count_;
   std::vector<double> low_index_since_s_;
+  // Motor shortfall: the commands and the telemetry's thrusts of the last window and delay span,
+  // each rotor's averages of measured and modelled thrust, and its debounce.
+  RotorHistory commands_, measured_history_;
+  RotorVector mean_measured_, mean_modelled_, lowest_command_;
+  std::optional<TimeNs> last_esc_ns_;
+  std::vector<int> shortfall_count_;
+  std::vector<double> shortfall_since_s_;
+  std::vector<SampleRing> recent_shortfall_;
   // For the rules' statistics (IndexExtremes): each rotor's last motor_index_samples M_i, and its
   // P_i over the last propeller_persistence_s.
   std::vector<SampleRing> recent_motor_index_, recent_propeller_index_;
